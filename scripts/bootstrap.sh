@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages plenoptic needs to build, test and run its demo.
+# Idempotent and quiet when everything is already present; run as root (or with sudo).
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config ccache git
+  libembree-dev libtbb-dev libglm-dev libtinyobjloader-dev libtinygltf-dev
+  libopenexr-dev libstb-dev libzstd-dev libsquish-dev libsdl2-dev libimgui-dev
+  libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  xvfb xauth
+)
+# Optional: ffmpeg turns rendered walk-throughs into MP4. Installed when it is available.
+optional_packages=(ffmpeg)
+
+missing=()
+for p in "${packages[@]}" "${optional_packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "bootstrap: need root (or sudo) to install: ${missing[*]}" >&2; exit 1; }
+  SUDO=sudo
+fi
+echo "bootstrap: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+# Required packages must install; the optional ones may fail without stopping the build.
+$SUDO apt-get install -y -qq --no-install-recommends "${packages[@]}" >/dev/null
+$SUDO apt-get install -y -qq --no-install-recommends "${optional_packages[@]}" >/dev/null 2>&1 \
+  || echo "bootstrap: optional packages not installed: ${optional_packages[*]}" >&2

@@ -1,0 +1,60 @@
+#include "core/parallel.h"
+
+#include <pmmintrin.h>
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_scheduler_observer.h>
+#include <xmmintrin.h>
+
+#include <fstream>
+#include <optional>
+#include <string>
+
+namespace pl {
+
+void enableFlushDenormals() {
+  _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+  _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
+
+namespace {
+class DenormalObserver : public tbb::task_scheduler_observer {
+ public:
+  DenormalObserver() { observe(true); }
+  ~DenormalObserver() override { observe(false); }
+  void on_scheduler_entry(bool) override { enableFlushDenormals(); }
+};
+}  // namespace
+
+struct ThreadPool::Impl {
+  std::optional<tbb::global_control> control;
+  DenormalObserver observer;
+};
+
+ThreadPool::ThreadPool(int threads) : impl_(std::make_unique<Impl>()) {
+  const int hardware = tbb::info::default_concurrency();
+  threads_ = threads > 0 ? threads : hardware;
+  impl_->control.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads_));
+  enableFlushDenormals();
+}
+
+ThreadPool::~ThreadPool() = default;
+
+void parallelForRange(uint64_t count, uint64_t grain, const std::function<void(uint64_t, uint64_t)>& body) {
+  if (count == 0) return;
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, count, grain ? grain : 1),
+                    [&](const tbb::blocked_range<uint64_t>& r) { body(r.begin(), r.end()); });
+}
+
+uint64_t peakRssBytes() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) * 1024ull;  // reported in kB
+  }
+  return 0;
+}
+
+}  // namespace pl

@@ -1,0 +1,93 @@
+#pragma once
+// The light field: the scene's exitant radiance discretised over its surfaces, as in the
+// light-field seed (slides 9–17). This header is the data model shared by the bake (which
+// fills it), the .plf file (which stores it) and the renderers (which look it up).
+//
+// Position: every chart (a planar polygon: edge-connected coplanar triangles with one
+// material) has an orthonormal frame (origin, axisU, axisV, normal) and a uniform grid of
+// resU × resV tixels of side tixelSize (scene units) covering its bounding rectangle in the
+// plane: tixel (i, j) has centre origin + (i + ½)·tixelSize·axisU + (j + ½)·tixelSize·axisV.
+// Every tixel holds valid values, including those whose centre lies outside the polygon, so
+// bilinear interpolation at polygon edges never reads garbage.
+//
+// Direction: a tixel's hemisphere (around the chart normal) is a paraboloid map (seed slides
+// 16–17): a local unit direction d (z along the normal) maps to
+//     (s, t) = (d.x, d.y) / (1 + d.z)  ∈ unit disk ⊂ [−1, 1]²
+// and back by d = (2s, 2t, 1 − s² − t²) / (1 + s² + t²). The dirRes × dirRes texels cover
+// [−1, 1]²; texels outside the disk hold the value of the nearest horizon direction.
+//
+// What is stored per chart kind:
+//   Diffuse   1 value per tixel: irradiance E (W·m⁻²). Outgoing radiance is
+//             Le + albedo(uv)·E/π, with the albedo texture applied at full resolution.
+//   Glossy    dirRes² values per tixel: exitant radiance Lo (W·sr⁻¹·m⁻², emission included).
+//   Specular  nothing: an ideal mirror's radiance is that of whatever the mirrored
+//             direction sees (a reordering), followed at render time.
+#include "core/math.h"
+#include "scene/scene.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pl {
+
+enum class ChartKind : uint8_t { Diffuse = 0, Glossy = 1, Specular = 2 };
+
+struct Chart {
+  uint32_t material = 0;
+  ChartKind kind = ChartKind::Diffuse;
+  Vec3 origin{0.0f};            ///< corner of tixel (0, 0)
+  Vec3 axisU{1, 0, 0}, axisV{0, 1, 0}, normal{0, 0, 1};
+  float tixelSize = 1.0f;       ///< scene units
+  uint32_t resU = 1, resV = 1;  ///< tixel grid
+  uint32_t dirRes = 1;          ///< paraboloid map resolution (1 for diffuse, 0 for specular)
+  uint64_t firstTixel = 0;      ///< index of tixel (0, 0) among all tixels of the light field
+  uint64_t firstValue = 0;      ///< index of tixel (0, 0), direction texel (0, 0) in values
+
+  uint64_t tixelCount() const { return uint64_t(resU) * resV; }
+  uint64_t valuesPerTixel() const { return uint64_t(dirRes) * dirRes; }
+  /// Values are tixel-major: all direction texels of one tixel are contiguous, direction
+  /// texel (s, t) at s + t·dirRes, tixels row by row (i + j·resU).
+  uint64_t valueIndex(uint32_t i, uint32_t j, uint32_t s = 0, uint32_t t = 0) const {
+    return firstValue + (uint64_t(j) * resU + i) * valuesPerTixel() + uint64_t(t) * dirRes + s;
+  }
+};
+
+/// Quality preset parameters (see presets in bake.cpp and the README).
+struct BakeSettings {
+  std::string preset = "default";
+  float tixelsPerUnit = 0.0f;      ///< world-space density; 0 = derive from the scene size
+  uint32_t maxTixelsPerChartSide = 64;
+  uint32_t gatherDirections = 256; ///< gather rays per tixel (visibility field)
+  uint32_t glossyDirRes = 8;       ///< cap on the paraboloid map size of glossy charts
+  float tolerance = 1e-3f;         ///< relative change of total outgoing power to stop at
+  uint32_t maxIterations = 200;
+  uint32_t mirrorDepth = 8;        ///< ideal-specular chain length followed
+  uint64_t seed = 0;
+};
+
+struct BakeStats {
+  double seconds = 0, visibilitySeconds = 0, propagationSeconds = 0;
+  uint32_t iterations = 0;
+  double residual = 0;
+  uint64_t tixels = 0;
+  uint64_t values = 0;
+  uint64_t visibilityRays = 0;
+  uint64_t peakRssBytes = 0;
+  bool reusedVisibility = false;
+};
+
+struct LightField {
+  Scene scene;                                     ///< geometry, materials, textures, cameras, environment
+  std::vector<Chart> charts;
+  std::vector<std::vector<uint32_t>> triangleChart;  ///< [mesh][triangle] → chart index
+  std::vector<Rgb> values;                         ///< see the header comment for units
+  BakeSettings settings;
+  BakeStats stats;
+};
+
+/// Paraboloid map of the upper hemisphere (local frame, z = normal), see above.
+Vec2 directionToParaboloid(const Vec3& localDirection);
+Vec3 paraboloidToDirection(Vec2 st);
+
+}  // namespace pl

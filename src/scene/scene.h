@@ -1,0 +1,144 @@
+#pragma once
+// The scene: triangle meshes, materials, emitters, cameras and the environment, in the
+// scene file's own world units. Loaded once, then read-only; every renderer (path tracer,
+// light-field bake, light-field renderer) uses the same Scene.
+#include "bsdf/bsdf.h"
+#include "core/math.h"
+#include "image/image.h"
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace pl {
+
+/// An sRGB-decoded (linear) RGB texture, sampled bilinearly with wrap-around (repeat).
+/// uv = (0,0) is the *bottom-left* of the image (OBJ/OpenGL convention); glTF loaders flip v.
+struct Texture {
+  std::string path;
+  Image image;
+  Rgb average{0.0f};  ///< mean over all texels (used where one albedo per region is needed)
+
+  Rgb sample(Vec2 uv) const;
+};
+
+struct Material {
+  std::string name;
+  Bsdf bsdf = LambertBsdf{};
+  /// Index into Scene::textures multiplying the diffuse albedo, or -1.
+  int albedoTexture = -1;
+  /// Emitted radiance Le (W·sr⁻¹·m⁻²), leaving the front side (along the geometric normal
+  /// given by the triangle's winding, counter-clockwise = front) unless twoSided.
+  Rgb emission{0.0f};
+  bool twoSidedEmission = false;
+
+  bool isEmissive() const { return !isBlack(emission); }
+};
+
+/// Triangles sharing vertex arrays. Vertex attributes are per vertex; materials per triangle.
+struct Mesh {
+  std::string name;
+  /// Vertex positions. Scene::finalize() reserves one element of padding past the end so
+  /// that Embree may share this buffer (it reads 16 bytes at the last vertex).
+  std::vector<Vec3> positions;
+  std::vector<Vec3> normals;  ///< empty, or one per vertex (unit length)
+  std::vector<Vec2> uvs;      ///< empty, or one per vertex
+  std::vector<UVec3> triangles;
+  std::vector<uint32_t> materials;  ///< one per triangle, index into Scene::materials
+};
+
+/// Isotropic point light: intensity I in W·sr⁻¹ (irradiance at distance d is I cos θ / d²).
+struct PointLight {
+  Vec3 position{0.0f};
+  Rgb intensity{1.0f};
+};
+
+/// Spot light: intensity I (W·sr⁻¹) on its axis, full inside innerAngle, falling smoothly
+/// (smoothstep in cos) to zero at outerAngle; angles in radians from the axis.
+struct SpotLight {
+  Vec3 position{0.0f};
+  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< unit, the way the light shines
+  Rgb intensity{1.0f};
+  float innerAngle = 0.3f;
+  float outerAngle = 0.5f;
+};
+
+/// Directional light at infinity: irradiance E in W·m⁻² on a surface facing it.
+struct DirectionalLight {
+  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< unit, the way the light travels
+  Rgb irradiance{1.0f};
+};
+
+using Light = std::variant<PointLight, SpotLight, DirectionalLight>;
+
+/// A camera as a scene file describes it. The camera module turns it into rays.
+struct CameraDesc {
+  std::string name;
+  Vec3 eye{0.0f, 0.0f, 1.0f};
+  Vec3 target{0.0f};
+  Vec3 up{0.0f, 1.0f, 0.0f};
+  float fovYDegrees = 40.0f;  ///< vertical field of view
+  /// Thin lens (optional): f-number N (0 = pinhole) and focus distance in scene units.
+  float fNumber = 0.0f;
+  float focusDistance = 0.0f;
+  /// Focal length in millimetres of a 35 mm-equivalent lens (used with fNumber to get the
+  /// aperture diameter f/N in scene units; see camera.h). 0 = derive from the fov.
+  float focalLengthMm = 0.0f;
+  std::optional<float> aspectRatio;  ///< width / height if the file says so
+};
+
+/// Light arriving from infinity in directions no geometry covers. Radiance Le = constant.
+struct Environment {
+  Rgb constant{0.0f};
+};
+
+struct Scene {
+  std::string sourcePath;  ///< the file it came from ("cornell" for the built-in box)
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<Light> lights;
+  std::vector<CameraDesc> cameras;
+  Environment environment;
+
+  /// Checks every index and number (throws pl::Error naming sourcePath and the problem:
+  /// NaN vertices, out-of-range indices, no triangles), drops degenerate triangles, and pads
+  /// the vertex buffers for sharing with Embree. Loaders call it last.
+  void finalize();
+
+  size_t triangleCount() const;
+  /// Axis-aligned bounds of all vertices.
+  void bounds(Vec3& lo, Vec3& hi) const;
+  /// The camera called `name`; throws pl::Error listing the available ones if missing.
+  const CameraDesc& camera(const std::string& name) const;
+  /// A camera that frames the whole scene (looking down −z at its bounding box).
+  CameraDesc automaticCamera() const;
+};
+
+/// Loads `cornell`, .obj, .gltf/.glb or .json (see README for the JSON schema).
+/// Throws pl::Error with the file name and the problem for any malformed input.
+Scene loadScene(const std::string& pathOrName);
+
+/// The measured Cornell box (see cornell.cpp for the data source).
+Scene makeCornellBox();
+
+/// Everything a renderer needs about a ray's hit on a triangle.
+struct SurfaceHit {
+  Vec3 position{0.0f};
+  Vec3 geometricNormal{0.0f, 0.0f, 1.0f};  ///< unit, from the triangle winding
+  Vec3 shadingNormal{0.0f, 0.0f, 1.0f};    ///< unit, interpolated (or geometric), same side
+  Vec2 uv{0.0f};
+  uint32_t mesh = 0, triangle = 0, material = 0;
+};
+
+/// Surface data at barycentrics (b1, b2) of triangle `triangle` of mesh `mesh`
+/// (point = (1−b1−b2)·p0 + b1·p1 + b2·p2, as Embree reports u, v).
+SurfaceHit surfaceAt(const Scene& scene, uint32_t mesh, uint32_t triangle, Vec2 barycentrics);
+
+/// The material's BSDF with its albedo texture applied at uv.
+Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit);
+
+}  // namespace pl
