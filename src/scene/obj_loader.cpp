@@ -1,0 +1,339 @@
+// Wavefront OBJ + MTL through tinyobjloader (the only file that includes it).
+//
+// tinyobjloader is lenient: it reads a non-numeric coordinate as 0 and keeps going. So before
+// handing a file to it we scan the OBJ and its MTL files line by line (CRLF tolerated) and
+// reject what it would silently misread, with "file:line: problem" messages.
+//
+// MTL → BSDF mapping (Ka, Ni, Pe, d/Tr/Tf are ignored; refraction is not modelled):
+//  * mirror when the material is mirror-like: illum 3 or 5 (with non-black Ks), or
+//    Ks ≥ 0.9 with Ns ≥ 1000 (a lobe narrower than ~2°), or Kd ≈ 0 (≤ 0.02) with Ks ≥ 0.5
+//    and Ns ≥ 1000. Reflectance = Ks; illum 5 ("Fresnel on") → Schlick Fresnel with F0 = Ks.
+//  * normalized Blinn-Phong when Ks is non-black: diffuse = Kd, specular = Ks, exponent = Ns.
+//    Where Kd + Ks > 1 in a channel both are scaled by 1/(Kd + Ks) there, so that the model
+//    conserves energy (bsdf.h), with a warning.
+//  * Lambert with albedo Kd otherwise.
+//  * Ke → emitted radiance (front side). map_Kd → albedo texture multiplying Kd (a Kd of
+//    exactly 0 next to a map_Kd is read as 1, the usual exporter habit), path relative to the
+//    MTL file, PNG/JPG decoded from sRGB by readImage().
+//  * A missing .mtl file: warning, and its materials become a grey Lambert (albedo 0.8).
+#include "core/error.h"
+#include "scene/loaders.h"
+
+#include <spdlog/spdlog.h>
+#include <tiny_obj_loader.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <unordered_map>
+
+namespace pl::detail {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr float kDefaultGrey = 0.8f;
+
+std::vector<std::string> splitWhitespace(const std::string& line) {
+  std::vector<std::string> tokens;
+  std::istringstream stream(line);
+  std::string token;
+  while (stream >> token) tokens.push_back(token);
+  return tokens;
+}
+
+bool parseFloat(const std::string& text, float& value) {
+  const char* end = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  return ec == std::errc() && ptr == end;
+}
+
+bool parseInt(const std::string& text, long& value) {
+  const char* end = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  return ec == std::errc() && ptr == end;
+}
+
+/// Reads a text file into lines, stripping a trailing '\r' (CRLF files) and comments.
+std::vector<std::string> readLines(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail("{}: cannot open file", path);
+  std::vector<std::string> lines;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+/// Checks numeric statements and face indices of an OBJ; returns the mtllib file names.
+std::vector<std::string> validateObj(const std::string& path) {
+  const std::vector<std::string> lines = readLines(path);
+  long positions = 0, texcoords = 0, normals = 0;
+  std::vector<std::string> libraries;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const size_t lineNumber = i + 1;
+    const std::vector<std::string> tokens = splitWhitespace(lines[i]);
+    if (tokens.empty()) continue;
+    const std::string& keyword = tokens[0];
+    if (keyword == "v" || keyword == "vn" || keyword == "vt") {
+      const size_t needed = keyword == "vt" ? 2 : 3;
+      if (tokens.size() < needed + 1)
+        fail("{}:{}: '{}' needs {} numbers, found {}", path, lineNumber, keyword, needed, tokens.size() - 1);
+      for (size_t k = 1; k < tokens.size(); ++k) {
+        float value;
+        if (!parseFloat(tokens[k], value))
+          fail("{}:{}: '{}' is not a number in '{}' statement", path, lineNumber, tokens[k], keyword);
+      }
+      (keyword == "v" ? positions : keyword == "vn" ? normals : texcoords)++;
+    } else if (keyword == "f") {
+      if (tokens.size() < 4) fail("{}:{}: a face needs at least 3 vertices, found {}", path, lineNumber, tokens.size() - 1);
+      for (size_t k = 1; k < tokens.size(); ++k) {
+        // v, v/vt, v//vn or v/vt/vn; negative indices count back from the last element.
+        const std::string& token = tokens[k];
+        const long counts[3] = {positions, texcoords, normals};
+        const char* names[3] = {"vertex", "texture coordinate", "normal"};
+        size_t start = 0;
+        for (int part = 0; part < 3 && start <= token.size(); ++part) {
+          const size_t slash = token.find('/', start);
+          const std::string field = token.substr(start, slash == std::string::npos ? std::string::npos : slash - start);
+          if (!field.empty() || part == 0) {
+            long index;
+            if (!parseInt(field, index) || index == 0)
+              fail("{}:{}: bad face index '{}' in '{}'", path, lineNumber, field, token);
+            const long resolved = index > 0 ? index : counts[part] + index + 1;
+            if (resolved < 1 || resolved > counts[part])
+              fail("{}:{}: face {} index {} out of range ({} defined so far)", path, lineNumber, names[part], index,
+                   counts[part]);
+          }
+          if (slash == std::string::npos) break;
+          start = slash + 1;
+        }
+      }
+    } else if (keyword == "mtllib") {
+      if (tokens.size() < 2) fail("{}:{}: 'mtllib' without a file name", path, lineNumber);
+      for (size_t k = 1; k < tokens.size(); ++k) libraries.push_back(tokens[k]);
+    }
+  }
+  return libraries;
+}
+
+/// Checks the numeric statements of an MTL file.
+void validateMtl(const std::string& path) {
+  const std::vector<std::string> lines = readLines(path);
+  bool inMaterial = false;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const size_t lineNumber = i + 1;
+    const std::vector<std::string> tokens = splitWhitespace(lines[i]);
+    if (tokens.empty()) continue;
+    const std::string& keyword = tokens[0];
+    if (keyword == "newmtl") {
+      if (tokens.size() < 2) fail("{}:{}: 'newmtl' without a material name", path, lineNumber);
+      inMaterial = true;
+      continue;
+    }
+    static const char* colours[] = {"Ka", "Kd", "Ks", "Ke", "Tf"};
+    static const char* scalars[] = {"Ns", "Ni", "d", "Tr", "illum", "Pr", "Pm"};
+    size_t minCount = 0, maxCount = 0;
+    if (std::find(std::begin(colours), std::end(colours), keyword) != std::end(colours)) minCount = 1, maxCount = 3;
+    if (std::find(std::begin(scalars), std::end(scalars), keyword) != std::end(scalars)) minCount = maxCount = 1;
+    if (minCount == 0) continue;
+    if (!inMaterial) fail("{}:{}: '{}' before any 'newmtl'", path, lineNumber, keyword);
+    if (tokens.size() - 1 < minCount)
+      fail("{}:{}: '{}' needs {} number(s)", path, lineNumber, keyword, maxCount);
+    // Colours may carry a trailing comment-free extra token in some exporters ("Tf 1 1 1 "):
+    // only the first maxCount tokens must be numbers, and at least one must be.
+    for (size_t k = 1; k < tokens.size() && k <= maxCount; ++k) {
+      float value;
+      if (!parseFloat(tokens[k], value) || !std::isfinite(value))
+        fail("{}:{}: '{}' is not a finite number in '{}' statement", path, lineNumber, tokens[k], keyword);
+      if (value < 0.0f && keyword != "illum")
+        fail("{}:{}: negative value {} in '{}' statement", path, lineNumber, value, keyword);
+    }
+  }
+}
+
+Rgb rgbOf(const tinyobj::real_t* values) { return Rgb(float(values[0]), float(values[1]), float(values[2])); }
+
+Material convertMaterial(const tinyobj::material_t& mtl, const std::string& mtlPath, Scene& scene,
+                         std::map<std::string, int>& textureIndex, const std::vector<fs::path>& mtlDirs) {
+  Material material;
+  material.name = mtl.name;
+  Rgb kd = rgbOf(mtl.diffuse);
+  Rgb ks = rgbOf(mtl.specular);
+  const float ns = float(mtl.shininess);
+  material.emission = rgbOf(mtl.emission);
+
+  const bool hasSpecular = maxComponent(ks) > 0.0f;
+  const bool mirrorLike = (hasSpecular && (mtl.illum == 3 || mtl.illum == 5)) ||
+                          (maxComponent(ks) >= 0.9f && ns >= 1000.0f) ||
+                          (maxComponent(kd) <= 0.02f && maxComponent(ks) >= 0.5f && ns >= 1000.0f);
+  if (mtl.illum >= 6 || mtl.dissolve < 1.0f)
+    spdlog::warn("{}: material '{}': transparency/refraction (illum {}, d {}) is not modelled; treated as opaque",
+                 mtlPath, mtl.name, mtl.illum, mtl.dissolve);
+
+  if (!mtl.diffuse_texname.empty()) {
+    if (mirrorLike) spdlog::warn("{}: material '{}': map_Kd ignored on a mirror", mtlPath, mtl.name);
+    else {
+      // Resolve against the MTL file's directory (the first library directory holding it).
+      fs::path resolved = mtlDirs.empty() ? fs::path(mtl.diffuse_texname) : mtlDirs.front() / mtl.diffuse_texname;
+      for (const fs::path& dir : mtlDirs)
+        if (fs::exists(dir / mtl.diffuse_texname)) {
+          resolved = dir / mtl.diffuse_texname;
+          break;
+        }
+      const std::string key = resolved.lexically_normal().string();
+      if (!fs::exists(resolved))
+        fail("{}: material '{}': texture file '{}' not found", mtlPath, mtl.name, key);
+      auto [it, inserted] = textureIndex.try_emplace(key, int(scene.textures.size()));
+      if (inserted) {
+        Texture texture;
+        texture.path = key;
+        texture.image = readImage(key);
+        scene.textures.push_back(std::move(texture));
+      }
+      material.albedoTexture = it->second;
+      if (isBlack(kd)) kd = Rgb(1.0f);
+    }
+  }
+
+  if (mirrorLike) {
+    material.bsdf = MirrorBsdf{glm::min(ks, Rgb(1.0f)), mtl.illum == 5};
+  } else if (hasSpecular) {
+    const Rgb sum = kd + ks;
+    if (maxComponent(sum) > 1.0f) {
+      spdlog::warn("{}: material '{}': Kd + Ks = ({}, {}, {}) exceeds 1; scaled down to conserve energy", mtlPath,
+                   mtl.name, sum.r, sum.g, sum.b);
+      for (int c = 0; c < 3; ++c)
+        if (sum[c] > 1.0f) kd[c] /= sum[c], ks[c] /= sum[c];
+    }
+    material.bsdf = BlinnPhongBsdf{kd, ks, std::max(ns, 0.0f)};
+  } else {
+    material.bsdf = LambertBsdf{glm::min(kd, Rgb(1.0f))};
+  }
+  return material;
+}
+
+struct VertexKey {
+  int position, texcoord, normal;
+  bool operator==(const VertexKey&) const = default;
+};
+struct VertexKeyHash {
+  size_t operator()(const VertexKey& k) const {
+    return std::hash<int64_t>()((int64_t(k.position) * 73856093) ^ (int64_t(k.texcoord) * 19349663) ^
+                                (int64_t(k.normal) * 83492791));
+  }
+};
+
+}  // namespace
+
+Scene loadObj(const std::string& path) {
+  const fs::path objPath(path);
+  const fs::path objDir = objPath.parent_path();
+  const std::vector<std::string> libraries = validateObj(path);
+
+  std::vector<fs::path> mtlDirs;
+  std::string mtlNames;
+  for (const std::string& library : libraries) {
+    const fs::path mtlPath = objDir / library;
+    if (!fs::exists(mtlPath)) {
+      spdlog::warn("{}: material library '{}' not found; its materials become grey Lambert", path,
+                   mtlPath.string());
+      continue;
+    }
+    validateMtl(mtlPath.string());
+    mtlDirs.push_back(mtlPath.parent_path());
+    mtlNames += (mtlNames.empty() ? "" : ", ") + mtlPath.string();
+  }
+
+  tinyobj::ObjReaderConfig config;
+  config.triangulate = true;
+  config.vertex_color = false;
+  config.mtl_search_path = objDir.string();
+  tinyobj::ObjReader reader;
+  if (!reader.ParseFromFile(path, config)) fail("{}: {}", path, reader.Error());
+  const std::string& attribWarning = reader.Warning();
+  // Missing libraries were reported above; other tinyobjloader warnings are passed on.
+  if (!attribWarning.empty() && attribWarning.find("not found") == std::string::npos)
+    spdlog::warn("{}: {}", path, attribWarning);
+
+  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  Scene scene;
+  scene.sourcePath = path;
+  std::map<std::string, int> textureIndex;
+  const std::string mtlLabel = mtlNames.empty() ? path : mtlNames;
+  for (const tinyobj::material_t& mtl : reader.GetMaterials())
+    scene.materials.push_back(convertMaterial(mtl, mtlLabel, scene, textureIndex, mtlDirs));
+  int defaultMaterial = -1;  // added on first use by a face without a (known) material
+
+  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    Mesh mesh;
+    mesh.name = shape.name;
+    const tinyobj::mesh_t& objMesh = shape.mesh;
+    bool anyNormal = false, anyTexcoord = false;
+    for (const tinyobj::index_t& index : objMesh.indices) {
+      anyNormal |= index.normal_index >= 0;
+      anyTexcoord |= index.texcoord_index >= 0;
+    }
+    std::unordered_map<VertexKey, uint32_t, VertexKeyHash> vertexOf;
+    size_t offset = 0;
+    for (size_t face = 0; face < objMesh.num_face_vertices.size(); ++face) {
+      const unsigned count = objMesh.num_face_vertices[face];
+      if (count != 3) fail("{}: face {} of '{}' has {} vertices after triangulation", path, face, shape.name, count);
+      UVec3 triangle;
+      for (unsigned k = 0; k < 3; ++k) {
+        const tinyobj::index_t& index = objMesh.indices[offset + k];
+        const VertexKey key{index.vertex_index, index.texcoord_index, index.normal_index};
+        auto [it, inserted] = vertexOf.try_emplace(key, uint32_t(mesh.positions.size()));
+        if (inserted) {
+          const auto p = size_t(index.vertex_index);
+          if (index.vertex_index < 0 || 3 * p + 2 >= attrib.vertices.size())
+            fail("{}: shape '{}': vertex index {} out of range", path, shape.name, index.vertex_index);
+          mesh.positions.emplace_back(attrib.vertices[3 * p], attrib.vertices[3 * p + 1], attrib.vertices[3 * p + 2]);
+          if (anyNormal) {
+            // Faces without normals get zero ones: surfaceAt() then uses the geometric normal.
+            Vec3 n(0.0f);
+            if (index.normal_index >= 0) {
+              const auto q = size_t(index.normal_index);
+              n = Vec3(attrib.normals[3 * q], attrib.normals[3 * q + 1], attrib.normals[3 * q + 2]);
+            }
+            mesh.normals.push_back(n);
+          }
+          if (anyTexcoord) {
+            Vec2 uv(0.0f);
+            if (index.texcoord_index >= 0) {
+              const auto q = size_t(index.texcoord_index);
+              uv = Vec2(attrib.texcoords[2 * q], attrib.texcoords[2 * q + 1]);
+            }
+            mesh.uvs.push_back(uv);
+          }
+        }
+        triangle[int(k)] = it->second;
+      }
+      offset += 3;
+      int material = face < objMesh.material_ids.size() ? objMesh.material_ids[face] : -1;
+      if (material < 0 || size_t(material) >= scene.materials.size()) {
+        if (defaultMaterial < 0) {
+          defaultMaterial = int(scene.materials.size());
+          scene.materials.push_back({.name = "default", .bsdf = LambertBsdf{Rgb(kDefaultGrey)}});
+        }
+        material = defaultMaterial;
+      }
+      mesh.triangles.push_back(triangle);
+      mesh.materials.push_back(uint32_t(material));
+    }
+    if (!mesh.triangles.empty()) scene.meshes.push_back(std::move(mesh));
+  }
+  if (scene.materials.empty()) scene.materials.push_back({.name = "default", .bsdf = LambertBsdf{Rgb(kDefaultGrey)}});
+  scene.finalize();
+  return scene;
+}
+
+}  // namespace pl::detail

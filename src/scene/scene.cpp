@@ -1,0 +1,279 @@
+// Scene validation, queries and per-hit surface data. No third-party library here.
+#include "scene/scene.h"
+
+#include "core/error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <string>
+
+namespace pl {
+
+namespace {
+
+bool isFinite2(const Vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+
+/// A triangle is degenerate when its edge vectors are parallel to float precision:
+/// |e1 × e2| = |e1|·|e2|·sin(angle) ≤ kDegenerateSine·|e1|·|e2|. With float's unit roundoff of
+/// 6e-8, a sine below 1e-7 cannot be told from zero, so such a triangle has no usable normal.
+constexpr float kDegenerateSine = 1e-7f;
+
+bool isDegenerate(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  const Vec3 e1 = p1 - p0, e2 = p2 - p0;
+  const float crossLength = glm::length(glm::cross(e1, e2));
+  return !(crossLength > kDegenerateSine * glm::length(e1) * glm::length(e2));
+}
+
+std::string vecString(const Vec3& v) { return fmt::format("({}, {}, {})", v.x, v.y, v.z); }
+
+/// The diffuse albedo a texture multiplies (models without one return black).
+Rgb diffuseAlbedoOf(const Bsdf& bsdf) {
+  return std::visit(
+      [](const auto& model) -> Rgb {
+        using T = std::decay_t<decltype(model)>;
+        if constexpr (std::is_same_v<T, LambertBsdf>) return model.albedo;
+        else if constexpr (std::is_same_v<T, BlinnPhongBsdf>) return model.diffuse;
+        else if constexpr (std::is_same_v<T, GgxBsdf>) return model.diffuse;
+        else return Rgb(0.0f);
+      },
+      bsdf);
+}
+
+void validateLights(const Scene& scene) {
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    std::visit(
+        [&](const auto& light) {
+          using T = std::decay_t<decltype(light)>;
+          if constexpr (std::is_same_v<T, PointLight>) {
+            if (!isFinite(light.position) || !isFinite(light.intensity))
+              fail("{}: point light {} has a non-finite position or intensity", scene.sourcePath, i);
+          } else if constexpr (std::is_same_v<T, SpotLight>) {
+            if (!isFinite(light.position) || !isFinite(light.intensity) || !isFinite(light.direction) ||
+                glm::length(light.direction) == 0.0f)
+              fail("{}: spot light {} has a non-finite position/intensity or no direction", scene.sourcePath, i);
+            if (!(light.innerAngle >= 0.0f && light.innerAngle <= light.outerAngle && light.outerAngle <= kPi))
+              fail("{}: spot light {} needs 0 <= inner angle ({}) <= outer angle ({}) <= pi", scene.sourcePath,
+                   i, light.innerAngle, light.outerAngle);
+          } else {
+            if (!isFinite(light.direction) || !isFinite(light.irradiance) || glm::length(light.direction) == 0.0f)
+              fail("{}: directional light {} has a non-finite irradiance or no direction", scene.sourcePath, i);
+          }
+        },
+        scene.lights[i]);
+  }
+}
+
+}  // namespace
+
+Rgb Texture::sample(Vec2 uv) const {
+  if (image.empty()) return Rgb(1.0f);
+  // Texel (x, y) has its centre at u = (x + 0.5)/W and v = 1 − (y + 0.5)/H (row 0 is the top
+  // of the image, v = 0 its bottom). Continuous texel coordinates of uv:
+  const float x = uv.x * float(image.width) - 0.5f;
+  const float y = (1.0f - uv.y) * float(image.height) - 0.5f;
+  if (!std::isfinite(x) || !std::isfinite(y)) return average;
+  const float x0f = std::floor(x), y0f = std::floor(y);
+  const float fx = x - x0f, fy = y - y0f;
+  // Wrap-around (repeat) with a non-negative modulo; fmod keeps huge coordinates in range.
+  auto wrap = [](float i, int n) {
+    float m = std::fmod(i, float(n));
+    if (m < 0.0f) m += float(n);
+    int k = int(m);
+    return k >= n ? 0 : k;
+  };
+  const int x0 = wrap(x0f, image.width), x1 = wrap(x0f + 1.0f, image.width);
+  const int y0 = wrap(y0f, image.height), y1 = wrap(y0f + 1.0f, image.height);
+  const Rgb top = (1.0f - fx) * image.at(x0, y0) + fx * image.at(x1, y0);
+  const Rgb bottom = (1.0f - fx) * image.at(x0, y1) + fx * image.at(x1, y1);
+  return (1.0f - fy) * top + fy * bottom;
+}
+
+void Scene::finalize() {
+  const std::string& src = sourcePath;
+  if (materials.empty()) fail("{}: the scene has no materials", src);
+
+  for (size_t m = 0; m < materials.size(); ++m) {
+    const Material& material = materials[m];
+    if (!isFinite(material.emission) || material.emission.r < 0.0f || material.emission.g < 0.0f ||
+        material.emission.b < 0.0f)
+      fail("{}: material '{}' has an invalid emission {}", src, material.name, vecString(material.emission));
+    if (material.albedoTexture < -1 || material.albedoTexture >= int(textures.size()))
+      fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name,
+           material.albedoTexture, textures.size());
+  }
+  for (Texture& texture : textures) {
+    if (texture.image.empty() || texture.image.width <= 0 || texture.image.height <= 0)
+      fail("{}: texture '{}' is empty", src, texture.path);
+    Rgb sum(0.0f);
+    for (const Rgb& texel : texture.image.pixels) {
+      if (!isFinite(texel)) fail("{}: texture '{}' contains a non-finite texel", src, texture.path);
+      sum += texel;
+    }
+    texture.average = sum / float(texture.image.pixels.size());
+  }
+
+  size_t totalBefore = 0, dropped = 0;
+  for (Mesh& mesh : meshes) {
+    const size_t vertexCount = mesh.positions.size();
+    if (!mesh.normals.empty() && mesh.normals.size() != vertexCount)
+      fail("{}: mesh '{}' has {} normals for {} vertices", src, mesh.name, mesh.normals.size(), vertexCount);
+    if (!mesh.uvs.empty() && mesh.uvs.size() != vertexCount)
+      fail("{}: mesh '{}' has {} texture coordinates for {} vertices", src, mesh.name, mesh.uvs.size(),
+           vertexCount);
+    if (mesh.materials.size() != mesh.triangles.size())
+      fail("{}: mesh '{}' has {} material indices for {} triangles", src, mesh.name, mesh.materials.size(),
+           mesh.triangles.size());
+    for (size_t v = 0; v < vertexCount; ++v)
+      if (!isFinite(mesh.positions[v]))
+        fail("{}: mesh '{}': vertex {} is not finite {}", src, mesh.name, v, vecString(mesh.positions[v]));
+    for (size_t v = 0; v < mesh.normals.size(); ++v) {
+      Vec3& n = mesh.normals[v];
+      if (!isFinite(n)) fail("{}: mesh '{}': normal {} is not finite {}", src, mesh.name, v, vecString(n));
+      // Zero normals stay zero: surfaceAt() falls back to the geometric normal there.
+      const float length = glm::length(n);
+      if (length > 0.0f) n /= length;
+    }
+    for (size_t v = 0; v < mesh.uvs.size(); ++v)
+      if (!isFinite2(mesh.uvs[v]))
+        fail("{}: mesh '{}': texture coordinate {} is not finite", src, mesh.name, v);
+
+    totalBefore += mesh.triangles.size();
+    size_t kept = 0;
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const UVec3 tri = mesh.triangles[t];
+      for (int k = 0; k < 3; ++k)
+        if (tri[k] >= vertexCount)
+          fail("{}: mesh '{}': triangle {} refers to vertex {} but the mesh has {} vertices", src, mesh.name, t,
+               tri[k], vertexCount);
+      if (mesh.materials[t] >= materials.size())
+        fail("{}: mesh '{}': triangle {} uses material {} but the scene has {}", src, mesh.name, t,
+             mesh.materials[t], materials.size());
+      if (isDegenerate(mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z])) continue;
+      mesh.triangles[kept] = tri;
+      mesh.materials[kept] = mesh.materials[t];
+      ++kept;
+    }
+    dropped += mesh.triangles.size() - kept;
+    mesh.triangles.resize(kept);
+    mesh.materials.resize(kept);
+  }
+  std::erase_if(meshes, [](const Mesh& mesh) { return mesh.triangles.empty(); });
+  if (meshes.empty()) {
+    if (totalBefore == 0) fail("{}: the scene has no triangles", src);
+    fail("{}: all {} triangles are degenerate (zero area)", src, totalBefore);
+  }
+  (void)dropped;
+
+  // Embree reads vertex buffers with 16-byte loads, so the last Vec3 needs 4 readable bytes
+  // past it: one element of spare capacity (a copy of the Scene does not keep it, so the
+  // renderers build their Accel from the Scene object that was finalized or moved).
+  for (Mesh& mesh : meshes) mesh.positions.reserve(mesh.positions.size() + 1);
+
+  validateLights(*this);
+  for (Light& light : lights) {
+    if (auto* spot = std::get_if<SpotLight>(&light)) spot->direction = glm::normalize(spot->direction);
+    if (auto* sun = std::get_if<DirectionalLight>(&light)) sun->direction = glm::normalize(sun->direction);
+  }
+  for (const CameraDesc& camera : cameras) {
+    if (!isFinite(camera.eye) || !isFinite(camera.target) || !isFinite(camera.up))
+      fail("{}: camera '{}' has non-finite eye, target or up", src, camera.name);
+    if (camera.eye == camera.target) fail("{}: camera '{}' has eye == target", src, camera.name);
+    if (glm::length(glm::cross(camera.target - camera.eye, camera.up)) == 0.0f)
+      fail("{}: camera '{}' has an up vector parallel to its view direction", src, camera.name);
+    if (!(camera.fovYDegrees > 0.0f && camera.fovYDegrees < 180.0f))
+      fail("{}: camera '{}' has a vertical field of view of {} degrees (needs 0 < fov < 180)", src,
+           camera.name, camera.fovYDegrees);
+    if (!(camera.fNumber >= 0.0f) || !(camera.focusDistance >= 0.0f))
+      fail("{}: camera '{}' has a negative f-number or focus distance", src, camera.name);
+    if (camera.aspectRatio && !(*camera.aspectRatio > 0.0f && std::isfinite(*camera.aspectRatio)))
+      fail("{}: camera '{}' has an invalid aspect ratio", src, camera.name);
+  }
+  if (!isFinite(environment.constant) || environment.constant.r < 0.0f || environment.constant.g < 0.0f ||
+      environment.constant.b < 0.0f)
+    fail("{}: the environment colour {} is invalid", src, vecString(environment.constant));
+}
+
+size_t Scene::triangleCount() const {
+  size_t count = 0;
+  for (const Mesh& mesh : meshes) count += mesh.triangles.size();
+  return count;
+}
+
+void Scene::bounds(Vec3& lo, Vec3& hi) const {
+  lo = Vec3(kInfinity);
+  hi = Vec3(-kInfinity);
+  for (const Mesh& mesh : meshes)
+    for (const Vec3& p : mesh.positions) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+}
+
+const CameraDesc& Scene::camera(const std::string& name) const {
+  for (const CameraDesc& camera : cameras)
+    if (camera.name == name) return camera;
+  std::string available;
+  for (const CameraDesc& camera : cameras) available += (available.empty() ? "" : ", ") + ("'" + camera.name + "'");
+  fail("{}: no camera named '{}' (available: {})", sourcePath, name, available.empty() ? "none" : available);
+}
+
+CameraDesc Scene::automaticCamera() const {
+  Vec3 lo, hi;
+  bounds(lo, hi);
+  CameraDesc camera;
+  camera.name = "automatic";
+  camera.fovYDegrees = 40.0f;
+  if (!isFinite(lo) || !isFinite(hi)) return camera;  // no vertices: the default camera
+  const Vec3 centre = 0.5f * (lo + hi);
+  // The bounding sphere (radius = half the box diagonal) fits the vertical field of view when
+  // seen from distance d = r / sin(fov/2): the tangent cone from the eye then has half-angle
+  // fov/2. (Any aspect ratio >= 1 then fits horizontally too.)
+  const float radius = std::max(0.5f * glm::length(hi - lo), 1e-6f);
+  const float halfFov = 0.5f * glm::radians(camera.fovYDegrees);
+  const float distance = radius / std::sin(halfFov);
+  camera.target = centre;
+  camera.eye = centre + Vec3(0.0f, 0.0f, distance);  // looks along −z
+  camera.up = Vec3(0.0f, 1.0f, 0.0f);
+  camera.focusDistance = distance;
+  return camera;
+}
+
+SurfaceHit surfaceAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, Vec2 barycentrics) {
+  const Mesh& mesh = scene.meshes[meshIndex];
+  const UVec3 tri = mesh.triangles[triangle];
+  const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.0f - b1 - b2;
+  const Vec3 &p0 = mesh.positions[tri.x], &p1 = mesh.positions[tri.y], &p2 = mesh.positions[tri.z];
+
+  SurfaceHit hit;
+  hit.mesh = meshIndex;
+  hit.triangle = triangle;
+  hit.material = mesh.materials[triangle];
+  hit.position = b0 * p0 + b1 * p1 + b2 * p2;
+  // Counter-clockwise winding (p0, p1, p2) seen from the front ⇒ (p1−p0)×(p2−p0) points out
+  // of the front side.
+  hit.geometricNormal = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+  hit.shadingNormal = hit.geometricNormal;
+  if (!mesh.normals.empty()) {
+    const Vec3 n = b0 * mesh.normals[tri.x] + b1 * mesh.normals[tri.y] + b2 * mesh.normals[tri.z];
+    const float length = glm::length(n);
+    // Opposing vertex normals can cancel; then the geometric normal is the only sensible one.
+    if (length > 1e-6f && std::isfinite(length)) {
+      Vec3 shading = n / length;
+      if (glm::dot(shading, hit.geometricNormal) < 0.0f) shading = -shading;
+      hit.shadingNormal = shading;
+    }
+  }
+  // Without texture coordinates uv are the barycentrics, so a texture still maps somewhere.
+  hit.uv = mesh.uvs.empty() ? Vec2(b1, b2) : b0 * mesh.uvs[tri.x] + b1 * mesh.uvs[tri.y] + b2 * mesh.uvs[tri.z];
+  return hit;
+}
+
+Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit) {
+  const Material& material = scene.materials[hit.material];
+  if (material.albedoTexture < 0) return material.bsdf;
+  const Rgb texel = scene.textures[size_t(material.albedoTexture)].sample(hit.uv);
+  return withDiffuseAlbedo(material.bsdf, diffuseAlbedoOf(material.bsdf) * texel);
+}
+
+}  // namespace pl
