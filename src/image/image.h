@@ -10,8 +10,11 @@
 //   .hdr  Radiance RGBE                        read + write (linear)
 //   .pfm  Portable float map                   read + write (linear)
 //   .png  8-bit sRGB                           read (decoded to linear) + write (tone-mapped)
+//   .jpg/.jpeg/.tga/.bmp  8-bit sRGB           read only (decoded to linear)
 // Writes are atomic: a temporary file beside the target is renamed over it on success, so a
 // failed write never leaves a half-written file.
+//
+// Tone mapping (Image → Image8) is in image/tonemap.h, error metrics in image/compare.h.
 #include "core/math.h"
 
 #include <cstdint>
@@ -39,19 +42,35 @@ struct Image8 {
   std::vector<uint8_t> rgb;  ///< width * height * 3
 };
 
-/// sRGB transfer function (IEC 61966-2-1) and its inverse, per channel.
+/// Limits on the size of an image file we accept (reading) or produce (writing): a header
+/// claiming more is treated as corrupt rather than allocating gigabytes.
+inline constexpr int kMaxImageDimension = 65536;          ///< pixels per side
+inline constexpr uint64_t kMaxImagePixels = 1ull << 28;  ///< 268 M pixels = 3.2 GB of floats
+
+/// sRGB transfer function (IEC 61966-2-1) and its inverse, per channel. linearToSrgb clamps
+/// its input to [0, 1] (NaN gives 0); srgbToLinear expects [0, 1].
 float srgbToLinear(float encoded);
 float linearToSrgb(float linear);
 
-/// Reads an HDR image (.exr, .hdr, .pfm) or an 8-bit one (.png, .jpg: sRGB-decoded to linear).
-/// Throws pl::Error naming the file and the problem.
+/// Reads an HDR image (.exr, .hdr, .pfm) or an 8-bit one (.png, .jpg, .tga, .bmp: sRGB-decoded
+/// to linear). Throws pl::Error naming the file and the problem (missing, truncated,
+/// corrupt, unsupported variant, absurd size, unknown extension).
 Image readImage(const std::string& path);
 
-/// Writes linear pixels to .exr/.hdr/.pfm as they are. Throws pl::Error on failure.
-void writeHdrImage(const std::string& path, const Image& image);
-/// Writes an already tone-mapped 8-bit image as PNG.
+/// How writeHdrImage stores pixels where the format offers a choice.
+struct HdrWriteOptions {
+  bool exrHalf = false;  ///< EXR: 16-bit half floats instead of 32-bit floats
+};
+
+/// Writes linear pixels to .exr/.hdr/.pfm as they are (atomic). Throws pl::Error on failure,
+/// including an unknown extension, an empty image, and non-finite pixels for .hdr (RGBE
+/// cannot store them; EXR and PFM keep NaN/Inf). RGBE clamps negative values to 0.
+void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOptions& options = {});
+/// Writes an already tone-mapped 8-bit image as PNG (atomic).
 void writePng(const std::string& path, const Image8& image);
-/// True for the extensions writeHdrImage accepts.
+/// True for the extensions writeHdrImage accepts (.exr, .hdr, .pfm; case-insensitive).
 bool isHdrExtension(const std::string& path);
+/// The file's extension, lower-case, with the dot (".exr"); empty when there is none.
+std::string lowerExtension(const std::string& path);
 
 }  // namespace pl

@@ -1,0 +1,111 @@
+// OpenEXR reading and writing: the only file that includes OpenEXR.
+//
+// Reading accepts scan-line or tiled single-part files with R, G, B channels (half, float or
+// uint; A and any other channels are ignored) or a single luminance channel Y (replicated to
+// grey), and any data window: the image covers the data window, so a file whose data window
+// starts at (−10, 5) gives an image of the data window's size. Writing stores R, G, B as
+// 32-bit float (exact) or 16-bit half, ZIP-compressed, data window = display window.
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfTestFile.h>
+#include <Imath/half.h>
+
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "image/image_io.h"
+
+namespace pl::detail {
+
+Image readExr(const std::string& path) {
+  bool tiled = false, deep = false, multiPart = false;
+  if (!Imf::isOpenExrFile(path.c_str(), tiled, deep, multiPart))
+    fail("{}: not an OpenEXR file (bad magic number or unreadable header)", path);
+  if (deep) fail("{}: deep OpenEXR images are not supported", path);
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    const long long width = (long long)window.max.x - window.min.x + 1;
+    const long long height = (long long)window.max.y - window.min.y + 1;
+    checkImageSize(path, width, height);
+
+    const Imf::ChannelList& channels = file.header().channels();
+    const bool hasRgb = channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
+    const bool hasY = channels.findChannel("Y") != nullptr;
+    if (!hasRgb && !hasY) {
+      std::string names;
+      for (auto it = channels.begin(); it != channels.end(); ++it) names += std::string(names.empty() ? "" : ", ") + it.name();
+      fail("{}: no R, G, B (or Y) channels; the file has: {}", path, names.empty() ? "none" : names);
+    }
+    for (const char* name : {"R", "G", "B", "Y"}) {
+      const Imf::Channel* c = channels.findChannel(name);
+      if (c && (c->xSampling != 1 || c->ySampling != 1))
+        fail("{}: channel {} is subsampled ({}x{}); only full-resolution channels are supported", path, name,
+             c->xSampling, c->ySampling);
+    }
+
+    Image image(static_cast<int>(width), static_cast<int>(height));
+    const size_t xStride = sizeof(Rgb), yStride = sizeof(Rgb) * size_t(width);
+    Imf::FrameBuffer frame;
+    float* base = &image.pixels[0].r;
+    if (hasRgb) {
+      frame.insert("R", Imf::Slice::Make(Imf::FLOAT, base + 0, window, xStride, yStride));
+      frame.insert("G", Imf::Slice::Make(Imf::FLOAT, base + 1, window, xStride, yStride));
+      frame.insert("B", Imf::Slice::Make(Imf::FLOAT, base + 2, window, xStride, yStride));
+    } else {
+      frame.insert("Y", Imf::Slice::Make(Imf::FLOAT, base + 0, window, xStride, yStride));
+    }
+    file.setFrameBuffer(frame);
+    if (!file.isComplete()) fail("{}: truncated OpenEXR file (pixel data incomplete)", path);
+    file.readPixels(window.min.y, window.max.y);
+    if (!hasRgb)
+      for (Rgb& p : image.pixels) p = Rgb(p.r);
+    return image;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail("{}: corrupt or unreadable OpenEXR file: {}", path, e.what());
+  }
+}
+
+void writeExr(const std::string& path, const Image& image, bool half) {
+  try {
+    Imf::Header header(image.width, image.height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    const Imf::PixelType type = half ? Imf::HALF : Imf::FLOAT;
+    for (const char* name : {"R", "G", "B"}) header.channels().insert(name, Imf::Channel(type));
+
+    Imf::FrameBuffer frame;
+    std::vector<Imath::half> halves;
+    if (half) {
+      // Values beyond the half range (±65504) become ±infinity, as OpenEXR's own conversion does.
+      halves.resize(image.pixels.size() * 3);
+      for (size_t i = 0; i < image.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c) halves[3 * i + size_t(c)] = Imath::half(image.pixels[i][c]);
+      const size_t xStride = 3 * sizeof(Imath::half), yStride = xStride * size_t(image.width);
+      char* base = reinterpret_cast<char*>(halves.data());
+      frame.insert("R", Imf::Slice(Imf::HALF, base + 0 * sizeof(Imath::half), xStride, yStride));
+      frame.insert("G", Imf::Slice(Imf::HALF, base + 1 * sizeof(Imath::half), xStride, yStride));
+      frame.insert("B", Imf::Slice(Imf::HALF, base + 2 * sizeof(Imath::half), xStride, yStride));
+    } else {
+      const size_t xStride = sizeof(Rgb), yStride = xStride * size_t(image.width);
+      // OpenEXR's Slice takes a non-const pointer even for writing; it only reads through it.
+      char* base = const_cast<char*>(reinterpret_cast<const char*>(image.pixels.data()));
+      frame.insert("R", Imf::Slice(Imf::FLOAT, base + 0 * sizeof(float), xStride, yStride));
+      frame.insert("G", Imf::Slice(Imf::FLOAT, base + 1 * sizeof(float), xStride, yStride));
+      frame.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xStride, yStride));
+    }
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(frame);
+    file.writePixels(image.height);
+  } catch (const std::exception& e) {
+    fail("OpenEXR: {}", e.what());
+  }
+}
+
+}  // namespace pl::detail

@@ -1,0 +1,147 @@
+// Image basics: the sRGB transfer function, dispatch on the file extension, atomic writes.
+#include "image/image.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <cmath>
+#include <filesystem>
+#include <system_error>
+
+#include "core/error.h"
+#include "image/image_io.h"
+
+namespace pl {
+
+// IEC 61966-2-1: a linear segment of slope 12.92 below 0.0031308 (0.04045 encoded), a
+// 2.4-power curve with offset 0.055 above; the two pieces meet continuously.
+float srgbToLinear(float encoded) {
+  if (encoded <= 0.04045f) return encoded / 12.92f;
+  return std::pow((encoded + 0.055f) / 1.055f, 2.4f);
+}
+
+float linearToSrgb(float linear) {
+  if (!(linear > 0.0f)) return 0.0f;  // also maps NaN to 0 (the caller decides about NaN)
+  if (linear >= 1.0f) return 1.0f;
+  if (linear <= 0.0031308f) return 12.92f * linear;
+  return 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+}
+
+std::string lowerExtension(const std::string& path) {
+  const std::filesystem::path p(path);
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+bool isHdrExtension(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  return ext == ".exr" || ext == ".hdr" || ext == ".pfm";
+}
+
+namespace detail {
+std::vector<unsigned char> readFileBytes(const std::string& path) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) fail("{}: cannot open: {}", path, std::strerror(errno));
+  std::vector<unsigned char> bytes;
+  unsigned char buffer[1 << 16];
+  size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, file)) > 0) bytes.insert(bytes.end(), buffer, buffer + n);
+  const bool failed = std::ferror(file) != 0;
+  std::fclose(file);
+  if (failed) fail("{}: read error", path);
+  return bytes;
+}
+
+void writeFileBytes(const std::string& path, const void* data, size_t size) {
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (!file) fail("cannot create file: {}", std::strerror(errno));
+  const bool written = std::fwrite(data, 1, size, file) == size && std::fflush(file) == 0;
+  const int writeErrno = errno;
+  const bool closed = std::fclose(file) == 0;
+  if (!written || !closed) fail("write failed: {}", std::strerror(written ? errno : writeErrno));
+}
+
+void checkImageSize(const std::string& path, long long width, long long height) {
+  if (width < 1 || height < 1 || width > kMaxImageDimension || height > kMaxImageDimension ||
+      uint64_t(width) * uint64_t(height) > kMaxImagePixels) {
+    fail("{}: image size {}x{} is out of range (1..{} per side, at most {} pixels)", path, width, height,
+         kMaxImageDimension, kMaxImagePixels);
+  }
+}
+}  // namespace detail
+
+Image readImage(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) fail("{}: no such file", path);
+  if (std::filesystem::is_directory(path, ec)) fail("{}: is a directory, not an image file", path);
+  const std::string ext = lowerExtension(path);
+  if (ext == ".exr") return detail::readExr(path);
+  if (ext == ".hdr") return detail::readRadianceHdr(path);
+  if (ext == ".pfm") return detail::readPfm(path);
+  if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tga" || ext == ".bmp") return detail::readLdr(path);
+  fail("{}: unknown image extension '{}' (readable: .exr .hdr .pfm .png .jpg .jpeg .tga .bmp)", path, ext);
+}
+
+namespace {
+
+/// A unique name in the target's directory, so that the final rename is atomic (same file
+/// system). Pid + counter keep concurrent writers (threads, processes) apart.
+std::string temporaryPathFor(const std::string& target) {
+  static std::atomic<uint64_t> counter{0};
+  const std::filesystem::path p(target);
+  const std::string name = fmt::format(".{}.tmp-{}-{}", p.filename().string(), long(::getpid()), counter++);
+  return (p.parent_path() / name).string();
+}
+
+/// Runs write(tempPath), then renames the temporary over `target`. On any failure the
+/// temporary is removed and pl::Error names the target and the problem.
+template <typename WriteFn>
+void writeAtomically(const std::string& target, WriteFn&& write) {
+  const std::filesystem::path parent = std::filesystem::path(target).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+    fail("{}: cannot write: directory '{}' does not exist", target, parent.string());
+  if (std::filesystem::is_directory(target, ec)) fail("{}: cannot write: is a directory", target);
+  const std::string temp = temporaryPathFor(target);
+  try {
+    write(temp);
+    std::filesystem::rename(temp, target);
+  } catch (const std::exception& e) {
+    std::filesystem::remove(temp, ec);
+    fail("{}: cannot write: {}", target, e.what());
+  }
+}
+
+}  // namespace
+
+void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOptions& options) {
+  const std::string ext = lowerExtension(path);
+  if (ext != ".exr" && ext != ".hdr" && ext != ".pfm")
+    fail("{}: cannot write HDR image with extension '{}' (use .exr, .hdr or .pfm)", path, ext);
+  if (image.pixels.size() != size_t(image.width) * size_t(image.height))
+    fail("{}: cannot write: pixel buffer holds {} pixels, expected {}x{}", path, image.pixels.size(), image.width,
+         image.height);
+  detail::checkImageSize(path, image.width, image.height);
+  writeAtomically(path, [&](const std::string& temp) {
+    if (ext == ".exr") detail::writeExr(temp, image, options.exrHalf);
+    else if (ext == ".hdr") detail::writeRadianceHdr(temp, image);
+    else detail::writePfm(temp, image);
+  });
+}
+
+void writePng(const std::string& path, const Image8& image) {
+  if (lowerExtension(path) != ".png") fail("{}: writePng needs a .png file name", path);
+  if (image.rgb.size() != size_t(image.width) * size_t(image.height) * 3)
+    fail("{}: cannot write: 8-bit buffer holds {} bytes, expected {}x{}x3", path, image.rgb.size(), image.width,
+         image.height);
+  detail::checkImageSize(path, image.width, image.height);
+  writeAtomically(path, [&](const std::string& temp) { detail::writePngFile(temp, image); });
+}
+
+}  // namespace pl

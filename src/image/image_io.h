@@ -1,0 +1,38 @@
+#pragma once
+// Private to the image module: one reader/writer pair per file format, each in the one .cpp
+// that includes its third-party library. image.cpp dispatches on the extension and makes
+// writes atomic. Readers throw pl::Error naming `path`; writers write to `path` (a temporary
+// file) and throw pl::Error describing the problem *without* the path, which image.cpp
+// prefixes with the user's target name.
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+
+namespace pl::detail {
+
+// exr_io.cpp (OpenEXR)
+Image readExr(const std::string& path);
+void writeExr(const std::string& path, const Image& image, bool half);
+
+// stb_io.cpp (stb_image / stb_image_write) and the Radiance RGBE format
+Image readLdr(const std::string& path);  ///< PNG/JPEG/TGA/BMP, sRGB-decoded to linear
+void writePngFile(const std::string& path, const Image8& image);
+Image readRadianceHdr(const std::string& path);
+void writeRadianceHdr(const std::string& path, const Image& image);
+
+// pfm_io.cpp
+Image readPfm(const std::string& path);
+void writePfm(const std::string& path, const Image& image);
+
+/// The whole file as bytes; pl::Error "<path>: no such file" / "cannot read: <reason>".
+std::vector<unsigned char> readFileBytes(const std::string& path);
+/// Writes bytes to path and checks every step (open, write, flush, close); pl::Error with
+/// the system's reason (disk full, permission) and no path.
+void writeFileBytes(const std::string& path, const void* data, size_t size);
+
+/// Throws pl::Error "<path>: image size W×H ..." unless 1 ≤ W,H ≤ kMaxImageDimension and
+/// W·H ≤ kMaxImagePixels.
+void checkImageSize(const std::string& path, long long width, long long height);
+
+}  // namespace pl::detail
