@@ -43,8 +43,8 @@ Scene loadScene(const std::string& pathOrName) {
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return char(std::tolower(c)); });
   if (extension == ".obj") return detail::loadObj(pathOrName);
-  if (extension == ".gltf" || extension == ".glb" || extension == ".json")
-    fail("{}: the {} loader is being written (not in this build yet)", pathOrName, extension);
+  if (extension == ".gltf" || extension == ".glb") return detail::loadGltf(pathOrName);
+  if (extension == ".json") return detail::loadJsonScene(pathOrName);
   fail("{}: unsupported scene format '{}' (supported: 'cornell', .obj, .gltf, .glb, .json)", pathOrName,
        extension.empty() ? std::string("no extension") : extension);
 }

@@ -1,0 +1,419 @@
+// glTF 2.0 (.gltf and .glb) through tinygltf (the only file that includes it).
+//
+// What is read:
+//  * The default scene's node hierarchy (every root node if the file has no scenes); a node's
+//    local transform is its `matrix` or T·R·S. Positions go through the world matrix M,
+//    normals through the inverse transpose of its upper 3×3, and a mirroring transform
+//    (det < 0) swaps the winding so the front side stays the front side.
+//  * Triangle primitives (mode 4) with POSITION, optional NORMAL and TEXCOORD_0 (float, or
+//    normalised unsigned byte/short), indexed or not. Other modes: warning, skipped.
+//  * Metallic-roughness materials → GgxBsdf:
+//        diffuse = baseColor · (1 − metallic)
+//        f0      = mix(0.04, baseColor, metallic)        (0.04: dielectric F0 of the spec)
+//        alpha   = max(roughness², 1e-3)                 (GGX α; the floor keeps the
+//                                                         microfacet distribution finite)
+//    baseColor = baseColorFactor.rgb (alpha ignored); baseColorTexture → albedo texture
+//    multiplying `diffuse` (so it tints dielectrics; a metal's f0 keeps the factor only), its
+//    sRGB 8/16-bit texels decoded to linear; v is flipped to our bottom-left convention
+//    (uv_ours = (u, 1 − v)) since glTF's (0,0) is the image's top-left. A primitive without a
+//    material gets the spec's default material (baseColor 1, metallic 1, roughness 1).
+//  * emissiveFactor × KHR_materials_emissive_strength.emissiveStrength → emitted radiance in
+//    W·sr⁻¹·m⁻²; doubleSided materials emit from both sides.
+//  * Perspective cameras: yfov (radians) and aspectRatio; the camera looks down its node's
+//    −z with +y up. Named after the node, else the camera, else "camera<N>".
+//  * KHR_lights_punctual point, spot and directional lights (shining down the node's −z).
+//    glTF gives photometric intensities (point/spot: candela = lm/sr; directional: lux =
+//    lm/m²). We convert them to radiometric units with the photometric efficacy of
+//    683 lm/W (the definition of the candela at 555 nm), as Blender's glTF exporter does in
+//    reverse: I [W/sr] = color · intensity[cd] / 683 and E [W/m²] = color · intensity[lx] / 683.
+//    `range` is ignored (physically lights have no cut-off).
+#include "core/error.h"
+#include "scene/loaders.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <spdlog/spdlog.h>
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+
+namespace pl::detail {
+
+namespace {
+
+/// Photometric efficacy used to turn lumens into watts (see the header comment).
+constexpr double kLumensPerWatt = 683.0;
+/// Smallest GGX α we emit (roughness ≈ 0.03); α → 0 makes the distribution a Dirac delta.
+constexpr float kMinGgxAlpha = 1e-3f;
+
+struct GltfContext {
+  const std::string& path;
+  const tinygltf::Model& model;
+  Scene& scene;
+  std::vector<int> textureOfImage;  ///< scene texture index per glTF image (-1 until used)
+  int defaultMaterial = -1;
+  int unnamedCameras = 0;
+};
+
+/// Reads accessor `index` as `components` floats per element (float or normalised integers).
+std::vector<float> readFloats(const GltfContext& ctx, int index, int components, const char* what) {
+  const tinygltf::Model& model = ctx.model;
+  if (index < 0 || size_t(index) >= model.accessors.size())
+    fail("{}: {} accessor {} does not exist", ctx.path, what, index);
+  const tinygltf::Accessor& accessor = model.accessors[size_t(index)];
+  if (accessor.sparse.isSparse) fail("{}: sparse accessors ({}) are not supported", ctx.path, what);
+  if (tinygltf::GetNumComponentsInType(uint32_t(accessor.type)) != components)
+    fail("{}: {} accessor {} has {} components per element, expected {}", ctx.path, what, index,
+         tinygltf::GetNumComponentsInType(uint32_t(accessor.type)), components);
+  if (accessor.bufferView < 0 || size_t(accessor.bufferView) >= model.bufferViews.size())
+    fail("{}: {} accessor {} has no buffer view", ctx.path, what, index);
+  const tinygltf::BufferView& view = model.bufferViews[size_t(accessor.bufferView)];
+  if (view.buffer < 0 || size_t(view.buffer) >= model.buffers.size())
+    fail("{}: buffer view {} refers to a missing buffer", ctx.path, accessor.bufferView);
+  const tinygltf::Buffer& buffer = model.buffers[size_t(view.buffer)];
+  const int componentSize = tinygltf::GetComponentSizeInBytes(uint32_t(accessor.componentType));
+  const int stride = accessor.ByteStride(view);
+  if (componentSize <= 0 || stride <= 0) fail("{}: {} accessor {} has an invalid layout", ctx.path, what, index);
+  const size_t start = view.byteOffset + accessor.byteOffset;
+  const size_t elementBytes = size_t(componentSize) * size_t(components);
+  if (accessor.count > 0 &&
+      (start + size_t(stride) * (accessor.count - 1) + elementBytes > buffer.data.size() ||
+       accessor.byteOffset + size_t(stride) * (accessor.count - 1) + elementBytes > view.byteLength))
+    fail("{}: {} accessor {} reads past the end of its buffer", ctx.path, what, index);
+
+  std::vector<float> values(accessor.count * size_t(components));
+  for (size_t i = 0; i < accessor.count; ++i) {
+    const unsigned char* element = buffer.data.data() + start + size_t(stride) * i;
+    for (int c = 0; c < components; ++c) {
+      const unsigned char* p = element + size_t(c) * size_t(componentSize);
+      float value;
+      switch (accessor.componentType) {
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: std::memcpy(&value, p, 4); break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: value = float(*p) / 255.0f; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+          uint16_t v;
+          std::memcpy(&v, p, 2);
+          value = float(v) / 65535.0f;
+          break;
+        }
+        default: fail("{}: {} accessor {} has an unsupported component type {}", ctx.path, what, index,
+                      accessor.componentType);
+      }
+      values[i * size_t(components) + size_t(c)] = value;
+    }
+  }
+  return values;
+}
+
+std::vector<uint32_t> readIndices(const GltfContext& ctx, int index) {
+  const tinygltf::Model& model = ctx.model;
+  if (index < 0 || size_t(index) >= model.accessors.size()) fail("{}: index accessor {} does not exist", ctx.path, index);
+  const tinygltf::Accessor& accessor = model.accessors[size_t(index)];
+  if (accessor.type != TINYGLTF_TYPE_SCALAR) fail("{}: index accessor {} is not scalar", ctx.path, index);
+  if (accessor.bufferView < 0 || size_t(accessor.bufferView) >= model.bufferViews.size())
+    fail("{}: index accessor {} has no buffer view", ctx.path, index);
+  const tinygltf::BufferView& view = model.bufferViews[size_t(accessor.bufferView)];
+  if (view.buffer < 0 || size_t(view.buffer) >= model.buffers.size())
+    fail("{}: buffer view {} refers to a missing buffer", ctx.path, accessor.bufferView);
+  const tinygltf::Buffer& buffer = model.buffers[size_t(view.buffer)];
+  const int size = tinygltf::GetComponentSizeInBytes(uint32_t(accessor.componentType));
+  const int stride = accessor.ByteStride(view);
+  if (size <= 0 || stride <= 0) fail("{}: index accessor {} has an invalid layout", ctx.path, index);
+  const size_t start = view.byteOffset + accessor.byteOffset;
+  if (accessor.count > 0 && start + size_t(stride) * (accessor.count - 1) + size_t(size) > buffer.data.size())
+    fail("{}: index accessor {} reads past the end of its buffer", ctx.path, index);
+  std::vector<uint32_t> indices(accessor.count);
+  for (size_t i = 0; i < accessor.count; ++i) {
+    const unsigned char* p = buffer.data.data() + start + size_t(stride) * i;
+    switch (accessor.componentType) {
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: indices[i] = *p; break;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v;
+        std::memcpy(&v, p, 2);
+        indices[i] = v;
+        break;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&indices[i], p, 4); break;
+      default: fail("{}: index accessor {} has an unsupported component type {}", ctx.path, index, accessor.componentType);
+    }
+  }
+  return indices;
+}
+
+Mat4 localTransform(const tinygltf::Node& node) {
+  if (node.matrix.size() == 16) {
+    Mat4 m;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) m[c][r] = float(node.matrix[size_t(c * 4 + r)]);  // column-major, like glm
+    return m;
+  }
+  Mat4 m(1.0f);
+  if (node.translation.size() == 3)
+    m = glm::translate(m, Vec3(float(node.translation[0]), float(node.translation[1]), float(node.translation[2])));
+  if (node.rotation.size() == 4) {
+    const glm::quat q(float(node.rotation[3]), float(node.rotation[0]), float(node.rotation[1]),
+                      float(node.rotation[2]));  // glTF stores (x, y, z, w)
+    m = m * glm::mat4_cast(glm::normalize(q));
+  }
+  if (node.scale.size() == 3) m = glm::scale(m, Vec3(float(node.scale[0]), float(node.scale[1]), float(node.scale[2])));
+  return m;
+}
+
+int textureFor(GltfContext& ctx, int textureIndex) {
+  const tinygltf::Model& model = ctx.model;
+  if (textureIndex < 0 || size_t(textureIndex) >= model.textures.size())
+    fail("{}: texture {} does not exist", ctx.path, textureIndex);
+  const int source = model.textures[size_t(textureIndex)].source;
+  if (source < 0 || size_t(source) >= model.images.size())
+    fail("{}: texture {} has no image source", ctx.path, textureIndex);
+  if (ctx.textureOfImage[size_t(source)] >= 0) return ctx.textureOfImage[size_t(source)];
+  const tinygltf::Image& gltfImage = model.images[size_t(source)];
+  const std::string label = gltfImage.uri.empty() ? fmt::format("image {}", source) : gltfImage.uri;
+  if (gltfImage.image.empty() || gltfImage.width <= 0 || gltfImage.height <= 0 || gltfImage.component < 1 ||
+      (gltfImage.bits != 8 && gltfImage.bits != 16))
+    fail("{}: texture image '{}' could not be decoded", ctx.path, label);
+  const size_t bytesPerChannel = size_t(gltfImage.bits / 8);
+  const size_t expected = size_t(gltfImage.width) * size_t(gltfImage.height) * size_t(gltfImage.component) * bytesPerChannel;
+  if (gltfImage.image.size() < expected) fail("{}: texture image '{}' is truncated", ctx.path, label);
+
+  Texture texture;
+  texture.path = label;
+  texture.image = Image(gltfImage.width, gltfImage.height);
+  const float maxValue = gltfImage.bits == 8 ? 255.0f : 65535.0f;
+  for (size_t i = 0; i < size_t(gltfImage.width) * size_t(gltfImage.height); ++i) {
+    Rgb texel;
+    for (int c = 0; c < 3; ++c) {
+      // Grey images repeat their single channel (grey + alpha: component 2).
+      const size_t channel = size_t(gltfImage.component >= 3 ? c : 0);
+      const size_t offset = (i * size_t(gltfImage.component) + channel) * bytesPerChannel;
+      float encoded;
+      if (bytesPerChannel == 1) encoded = float(gltfImage.image[offset]) / maxValue;
+      else {
+        uint16_t v;
+        std::memcpy(&v, &gltfImage.image[offset], 2);
+        encoded = float(v) / maxValue;
+      }
+      texel[c] = srgbToLinear(encoded);  // baseColorTexture is sRGB-encoded (glTF spec 3.9.2)
+    }
+    texture.image.pixels[i] = texel;
+  }
+  const int ours = int(ctx.scene.textures.size());
+  ctx.scene.textures.push_back(std::move(texture));
+  ctx.textureOfImage[size_t(source)] = ours;
+  return ours;
+}
+
+Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int index) {
+  const auto& pbr = gltf.pbrMetallicRoughness;
+  Rgb baseColor(1.0f);
+  if (pbr.baseColorFactor.size() >= 3)
+    baseColor = Rgb(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2]));
+  const float metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
+  const float roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
+
+  Material material;
+  material.name = gltf.name.empty() ? fmt::format("material{}", index) : gltf.name;
+  GgxBsdf ggx;
+  ggx.diffuse = baseColor * (1.0f - metallic);
+  ggx.f0 = glm::mix(Rgb(0.04f), baseColor, metallic);
+  ggx.alpha = std::max(roughness * roughness, kMinGgxAlpha);
+  material.bsdf = ggx;
+  if (pbr.baseColorTexture.index >= 0) {
+    if (pbr.baseColorTexture.texCoord != 0)
+      spdlog::warn("{}: material '{}': baseColorTexture uses TEXCOORD_{}, only TEXCOORD_0 is read", ctx.path,
+                   material.name, pbr.baseColorTexture.texCoord);
+    material.albedoTexture = textureFor(ctx, pbr.baseColorTexture.index);
+  }
+  if (gltf.emissiveFactor.size() >= 3) {
+    float strength = 1.0f;
+    if (auto it = gltf.extensions.find("KHR_materials_emissive_strength"); it != gltf.extensions.end()) {
+      if (it->second.Has("emissiveStrength")) strength = float(it->second.Get("emissiveStrength").GetNumberAsDouble());
+    }
+    material.emission = strength * Rgb(float(gltf.emissiveFactor[0]), float(gltf.emissiveFactor[1]),
+                                       float(gltf.emissiveFactor[2]));
+  }
+  if (gltf.emissiveTexture.index >= 0)
+    spdlog::warn("{}: material '{}': emissiveTexture is not supported; emissiveFactor used alone", ctx.path,
+                 material.name);
+  material.twoSidedEmission = gltf.doubleSided;
+  return material;
+}
+
+void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const Mat4& world, const std::string& name) {
+  const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
+  if (mode != TINYGLTF_MODE_TRIANGLES) {
+    spdlog::warn("{}: mesh '{}': primitive mode {} is not triangles (4); skipped", ctx.path, name, mode);
+    return;
+  }
+  auto attribute = [&](const char* key) {
+    auto it = primitive.attributes.find(key);
+    return it == primitive.attributes.end() ? -1 : it->second;
+  };
+  const int positionAccessor = attribute("POSITION");
+  if (positionAccessor < 0) fail("{}: mesh '{}' has a primitive without POSITION", ctx.path, name);
+
+  Mesh mesh;
+  mesh.name = name;
+  const std::vector<float> positions = readFloats(ctx, positionAccessor, 3, "POSITION");
+  const size_t vertexCount = positions.size() / 3;
+  const Mat3 linear(world);
+  const Mat3 normalMatrix = glm::transpose(glm::inverse(linear));
+  for (size_t v = 0; v < vertexCount; ++v)
+    mesh.positions.push_back(Vec3(world * Vec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0f)));
+  if (const int normalAccessor = attribute("NORMAL"); normalAccessor >= 0) {
+    const std::vector<float> normals = readFloats(ctx, normalAccessor, 3, "NORMAL");
+    if (normals.size() != positions.size()) fail("{}: mesh '{}': NORMAL and POSITION counts differ", ctx.path, name);
+    for (size_t v = 0; v < vertexCount; ++v)
+      mesh.normals.push_back(normalMatrix * Vec3(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]));
+  }
+  if (const int uvAccessor = attribute("TEXCOORD_0"); uvAccessor >= 0) {
+    const std::vector<float> uvs = readFloats(ctx, uvAccessor, 2, "TEXCOORD_0");
+    if (uvs.size() / 2 != vertexCount) fail("{}: mesh '{}': TEXCOORD_0 and POSITION counts differ", ctx.path, name);
+    for (size_t v = 0; v < vertexCount; ++v) mesh.uvs.push_back(Vec2(uvs[2 * v], 1.0f - uvs[2 * v + 1]));
+  }
+
+  std::vector<uint32_t> indices;
+  if (primitive.indices >= 0) indices = readIndices(ctx, primitive.indices);
+  else {
+    indices.resize(vertexCount);
+    for (size_t i = 0; i < vertexCount; ++i) indices[i] = uint32_t(i);
+  }
+  if (indices.size() % 3 != 0)
+    fail("{}: mesh '{}': {} indices is not a multiple of 3 for triangles", ctx.path, name, indices.size());
+
+  uint32_t material;
+  if (primitive.material >= 0) {
+    if (size_t(primitive.material) >= ctx.model.materials.size())
+      fail("{}: mesh '{}' uses material {} but the file has {}", ctx.path, name, primitive.material,
+           ctx.model.materials.size());
+    material = uint32_t(primitive.material);
+  } else {
+    if (ctx.defaultMaterial < 0) {
+      ctx.defaultMaterial = int(ctx.scene.materials.size());
+      // The glTF default material: baseColor 1, metallic 1, roughness 1 (spec 3.9.6).
+      ctx.scene.materials.push_back({.name = "default", .bsdf = GgxBsdf{Rgb(0.0f), Rgb(1.0f), 1.0f}});
+    }
+    material = uint32_t(ctx.defaultMaterial);
+  }
+  // A mirroring transform reverses the apparent winding; swap to keep the front side.
+  const bool mirrored = glm::determinant(linear) < 0.0f;
+  for (size_t i = 0; i < indices.size(); i += 3) {
+    mesh.triangles.push_back(mirrored ? UVec3(indices[i], indices[i + 2], indices[i + 1])
+                                      : UVec3(indices[i], indices[i + 1], indices[i + 2]));
+    mesh.materials.push_back(material);
+  }
+  // finalize() checks the indices against the vertex count and names the file.
+  ctx.scene.meshes.push_back(std::move(mesh));
+}
+
+void addLight(GltfContext& ctx, int lightIndex, const Mat4& world, const std::string& nodeName) {
+  if (lightIndex < 0 || size_t(lightIndex) >= ctx.model.lights.size())
+    fail("{}: node '{}' refers to light {} but the file has {}", ctx.path, nodeName, lightIndex, ctx.model.lights.size());
+  const tinygltf::Light& light = ctx.model.lights[size_t(lightIndex)];
+  Rgb color(1.0f);
+  if (light.color.size() >= 3) color = Rgb(float(light.color[0]), float(light.color[1]), float(light.color[2]));
+  const Rgb radiometric = color * float(light.intensity / kLumensPerWatt);
+  const Vec3 position(world * Vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  const Vec3 direction = glm::normalize(Mat3(world) * Vec3(0.0f, 0.0f, -1.0f));
+  if (light.type == "point") {
+    ctx.scene.lights.push_back(PointLight{position, radiometric});
+  } else if (light.type == "spot") {
+    SpotLight spot;
+    spot.position = position;
+    spot.direction = direction;
+    spot.intensity = radiometric;
+    spot.innerAngle = float(light.spot.innerConeAngle);
+    spot.outerAngle = float(light.spot.outerConeAngle);
+    ctx.scene.lights.push_back(spot);
+  } else if (light.type == "directional") {
+    ctx.scene.lights.push_back(DirectionalLight{direction, radiometric});
+  } else {
+    fail("{}: light {} has unknown type '{}' (point, spot, directional)", ctx.path, lightIndex, light.type);
+  }
+}
+
+void addCamera(GltfContext& ctx, int cameraIndex, const Mat4& world, const std::string& nodeName) {
+  if (cameraIndex < 0 || size_t(cameraIndex) >= ctx.model.cameras.size())
+    fail("{}: node '{}' refers to camera {} but the file has {}", ctx.path, nodeName, cameraIndex,
+         ctx.model.cameras.size());
+  const tinygltf::Camera& gltf = ctx.model.cameras[size_t(cameraIndex)];
+  if (gltf.type != "perspective") {
+    spdlog::warn("{}: camera '{}' is {}; only perspective cameras are supported, skipped", ctx.path, gltf.name,
+                 gltf.type);
+    return;
+  }
+  CameraDesc camera;
+  camera.name = !nodeName.empty() ? nodeName : !gltf.name.empty() ? gltf.name : fmt::format("camera{}", ctx.unnamedCameras++);
+  camera.eye = Vec3(world * Vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  const Vec3 forward = glm::normalize(Mat3(world) * Vec3(0.0f, 0.0f, -1.0f));
+  camera.target = camera.eye + forward;
+  camera.up = glm::normalize(Mat3(world) * Vec3(0.0f, 1.0f, 0.0f));
+  camera.fovYDegrees = glm::degrees(float(gltf.perspective.yfov));
+  if (gltf.perspective.aspectRatio > 0.0) camera.aspectRatio = float(gltf.perspective.aspectRatio);
+  ctx.scene.cameras.push_back(camera);
+}
+
+void visitNode(GltfContext& ctx, int nodeIndex, const Mat4& parent, int depth) {
+  const tinygltf::Model& model = ctx.model;
+  if (nodeIndex < 0 || size_t(nodeIndex) >= model.nodes.size()) fail("{}: node {} does not exist", ctx.path, nodeIndex);
+  // glTF requires the hierarchy to be a forest; a cycle would recurse forever.
+  if (depth > int(model.nodes.size())) fail("{}: the node hierarchy has a cycle (at node {})", ctx.path, nodeIndex);
+  const tinygltf::Node& node = model.nodes[size_t(nodeIndex)];
+  const Mat4 world = parent * localTransform(node);
+  if (node.mesh >= 0) {
+    if (size_t(node.mesh) >= model.meshes.size()) fail("{}: node '{}' refers to missing mesh {}", ctx.path, node.name, node.mesh);
+    const tinygltf::Mesh& mesh = model.meshes[size_t(node.mesh)];
+    const std::string name = !mesh.name.empty() ? mesh.name : node.name;
+    for (const tinygltf::Primitive& primitive : mesh.primitives) addPrimitive(ctx, primitive, world, name);
+  }
+  if (node.camera >= 0) addCamera(ctx, node.camera, world, node.name);
+  if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end() && it->second.Has("light"))
+    addLight(ctx, it->second.Get("light").GetNumberAsInt(), world, node.name);
+  for (int child : node.children) visitNode(ctx, child, world, depth + 1);
+}
+
+}  // namespace
+
+Scene loadGltf(const std::string& path) {
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string error, warning;
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  const bool ok = extension == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
+                                      : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+  if (!warning.empty()) spdlog::warn("{}: {}", path, warning);
+  if (!ok) {
+    while (!error.empty() && (error.back() == '\n' || error.back() == '\r')) error.pop_back();
+    fail("{}: not a valid glTF file: {}", path, error.empty() ? "unknown error" : error);
+  }
+
+  Scene scene;
+  scene.sourcePath = path;
+  GltfContext ctx{path, model, scene, std::vector<int>(model.images.size(), -1)};
+  for (size_t m = 0; m < model.materials.size(); ++m)
+    scene.materials.push_back(convertMaterial(ctx, model.materials[m], int(m)));
+
+  std::vector<int> roots;
+  if (!model.scenes.empty()) {
+    const int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (size_t(sceneIndex) >= model.scenes.size()) fail("{}: default scene {} does not exist", path, sceneIndex);
+    roots = model.scenes[size_t(sceneIndex)].nodes;
+  } else {
+    std::vector<bool> isChild(model.nodes.size(), false);
+    for (const tinygltf::Node& node : model.nodes)
+      for (int child : node.children)
+        if (child >= 0 && size_t(child) < isChild.size()) isChild[size_t(child)] = true;
+    for (size_t n = 0; n < model.nodes.size(); ++n)
+      if (!isChild[n]) roots.push_back(int(n));
+  }
+  for (int root : roots) visitNode(ctx, root, Mat4(1.0f), 0);
+  if (scene.materials.empty()) scene.materials.push_back({.name = "unused", .bsdf = LambertBsdf{}});
+  scene.finalize();
+  return scene;
+}
+
+}  // namespace pl::detail

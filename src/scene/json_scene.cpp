@@ -1,0 +1,355 @@
+// The JSON scene description, through nlohmann-json (the only file that includes it).
+//
+// Schema (every key optional unless marked required; colours are linear RGB triples,
+// positions/directions are [x, y, z] in scene units, relative paths are relative to the
+// JSON file's directory):
+//
+// {
+//   "include_cornell": false,               // true: start from the built-in Cornell box (mm)
+//   "meshes": [ {
+//       "file": "box.obj",                  // required: .obj, .gltf or .glb
+//       "transform": [16 numbers]           // row-major 4×4 matrix (first four = first row),
+//                 | {"translate": [x,y,z],  //   or T·R·S: translate,
+//                    "rotate": {"axis": [x,y,z], "degrees": a},   // rotate (right-handed),
+//                    "scale": s | [sx,sy,sz]},                    // scale
+//       "material": "name"                  // every triangle of the file uses this material
+//   } ],                                    //   from "materials" below
+//   "materials": {
+//     "name": {"type": "lambert",     "albedo": [r,g,b], "texture": "albedo.png"}
+//           | {"type": "mirror",      "reflectance": [r,g,b], "fresnel": false}
+//           | {"type": "blinn-phong", "diffuse": [r,g,b], "specular": [r,g,b], "exponent": n,
+//              "texture": "albedo.png"}
+//           | {"type": "ggx",         "diffuse": [r,g,b], "f0": [r,g,b],
+//              "alpha": a | "roughness": r (alpha = r²), "texture": "albedo.png"}
+//       (+ for every type: "emission": [r,g,b] radiance in W·sr⁻¹·m⁻², "two_sided": false)
+//     A material whose name equals a material of a loaded file replaces it there.
+//   },
+//   "lights": [ {"type": "point", "position": [..], "intensity": [r,g,b] | I}      // W·sr⁻¹
+//             | {"type": "spot", "position": [..], "direction": [..], "intensity": ..,
+//                "inner_angle": deg, "outer_angle": deg}                           // W·sr⁻¹
+//             | {"type": "directional", "direction": [..], "irradiance": [r,g,b] | E} ],  // W·m⁻²
+//   "cameras": [ {"name": "main", "eye": [..], "target": [..], "up": [0,1,0],
+//                 "fov": 40 (vertical, degrees), "fstop": 0 (0 = pinhole),
+//                 "focus_distance": d, "focal_length": mm, "aspect": w/h} ],
+//   "environment": {"color": [r,g,b]}        // constant radiance from infinity
+// }
+//
+// Lights and cameras of the loaded mesh files are kept (and moved by their transform).
+#include "core/error.h"
+#include "scene/loaders.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+namespace pl::detail {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct JsonContext {
+  std::string path;
+  fs::path dir;
+};
+
+const json* find(const json& object, const char* key) {
+  auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+float number(const JsonContext& ctx, const json& value, const std::string& where) {
+  if (!value.is_number()) fail("{}: {}: expected a number, got {}", ctx.path, where, value.dump());
+  const double v = value.get<double>();
+  if (!std::isfinite(v)) fail("{}: {}: not a finite number", ctx.path, where);
+  return float(v);
+}
+
+Vec3 vec3(const JsonContext& ctx, const json& value, const std::string& where) {
+  if (!value.is_array() || value.size() != 3) fail("{}: {}: expected [x, y, z], got {}", ctx.path, where, value.dump());
+  return Vec3(number(ctx, value[0], where), number(ctx, value[1], where), number(ctx, value[2], where));
+}
+
+/// A colour: [r, g, b], or one number for grey.
+Rgb colour(const JsonContext& ctx, const json& value, const std::string& where) {
+  if (value.is_number()) return Rgb(number(ctx, value, where));
+  return vec3(ctx, value, where);
+}
+
+float numberOr(const JsonContext& ctx, const json& object, const char* key, float fallback, const std::string& where) {
+  const json* value = find(object, key);
+  return value ? number(ctx, *value, where + "." + key) : fallback;
+}
+Rgb colourOr(const JsonContext& ctx, const json& object, const char* key, Rgb fallback, const std::string& where) {
+  const json* value = find(object, key);
+  return value ? colour(ctx, *value, where + "." + key) : fallback;
+}
+Vec3 vec3Or(const JsonContext& ctx, const json& object, const char* key, Vec3 fallback, const std::string& where) {
+  const json* value = find(object, key);
+  return value ? vec3(ctx, *value, where + "." + key) : fallback;
+}
+std::string stringOf(const JsonContext& ctx, const json& value, const std::string& where) {
+  if (!value.is_string()) fail("{}: {}: expected a string, got {}", ctx.path, where, value.dump());
+  return value.get<std::string>();
+}
+bool boolOr(const JsonContext& ctx, const json& object, const char* key, bool fallback, const std::string& where) {
+  const json* value = find(object, key);
+  if (!value) return fallback;
+  if (!value->is_boolean()) fail("{}: {}.{}: expected true or false", ctx.path, where, key);
+  return value->get<bool>();
+}
+
+void checkKeys(const JsonContext& ctx, const json& object, const std::set<std::string>& known, const std::string& where) {
+  for (auto it = object.begin(); it != object.end(); ++it)
+    if (!known.count(it.key())) fail("{}: {}: unknown key '{}'", ctx.path, where, it.key());
+}
+
+Mat4 parseTransform(const JsonContext& ctx, const json& value, const std::string& where) {
+  if (value.is_array()) {
+    if (value.size() != 16) fail("{}: {}: a matrix needs 16 numbers, got {}", ctx.path, where, value.size());
+    Mat4 m;
+    for (int row = 0; row < 4; ++row)
+      for (int col = 0; col < 4; ++col) m[col][row] = number(ctx, value[size_t(row * 4 + col)], where);  // row-major in
+    return m;
+  }
+  if (!value.is_object()) fail("{}: {}: expected a 16-number matrix or {{translate, rotate, scale}}", ctx.path, where);
+  checkKeys(ctx, value, {"translate", "rotate", "scale"}, where);
+  Mat4 m(1.0f);
+  if (const json* t = find(value, "translate")) m = glm::translate(m, vec3(ctx, *t, where + ".translate"));
+  if (const json* r = find(value, "rotate")) {
+    if (!r->is_object()) fail("{}: {}.rotate: expected {{\"axis\": [x,y,z], \"degrees\": a}}", ctx.path, where);
+    checkKeys(ctx, *r, {"axis", "degrees"}, where + ".rotate");
+    const Vec3 axis = vec3Or(ctx, *r, "axis", Vec3(0.0f, 1.0f, 0.0f), where + ".rotate");
+    if (glm::length(axis) == 0.0f) fail("{}: {}.rotate.axis is zero", ctx.path, where);
+    m = glm::rotate(m, glm::radians(numberOr(ctx, *r, "degrees", 0.0f, where + ".rotate")), glm::normalize(axis));
+  }
+  if (const json* s = find(value, "scale")) m = glm::scale(m, colour(ctx, *s, where + ".scale"));
+  return m;
+}
+
+int loadTexture(const JsonContext& ctx, Scene& scene, const json& value, const std::string& where) {
+  const fs::path file = ctx.dir / stringOf(ctx, value, where);
+  if (!fs::exists(file)) fail("{}: {}: texture file '{}' not found", ctx.path, where, file.string());
+  Texture texture;
+  texture.path = file.string();
+  texture.image = readImage(texture.path);
+  scene.textures.push_back(std::move(texture));
+  return int(scene.textures.size()) - 1;
+}
+
+Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& name, const json& value) {
+  const std::string where = "materials." + name;
+  if (!value.is_object()) fail("{}: {}: expected an object", ctx.path, where);
+  const json* typeValue = find(value, "type");
+  if (!typeValue) fail("{}: {}: missing \"type\" (lambert, mirror, blinn-phong, ggx)", ctx.path, where);
+  const std::string type = stringOf(ctx, *typeValue, where + ".type");
+  Material material;
+  material.name = name;
+  material.emission = colourOr(ctx, value, "emission", Rgb(0.0f), where);
+  material.twoSidedEmission = boolOr(ctx, value, "two_sided", false, where);
+  std::set<std::string> known = {"type", "emission", "two_sided"};
+  if (type == "lambert") {
+    material.bsdf = LambertBsdf{colourOr(ctx, value, "albedo", Rgb(0.8f), where)};
+    known.insert({"albedo", "texture"});
+  } else if (type == "mirror") {
+    material.bsdf = MirrorBsdf{colourOr(ctx, value, "reflectance", Rgb(1.0f), where), boolOr(ctx, value, "fresnel", false, where)};
+    known.insert({"reflectance", "fresnel"});
+  } else if (type == "blinn-phong") {
+    material.bsdf = BlinnPhongBsdf{colourOr(ctx, value, "diffuse", Rgb(0.5f), where),
+                                   colourOr(ctx, value, "specular", Rgb(0.04f), where),
+                                   numberOr(ctx, value, "exponent", 64.0f, where)};
+    known.insert({"diffuse", "specular", "exponent", "texture"});
+  } else if (type == "ggx") {
+    GgxBsdf ggx;
+    ggx.diffuse = colourOr(ctx, value, "diffuse", Rgb(0.0f), where);
+    ggx.f0 = colourOr(ctx, value, "f0", Rgb(0.04f), where);
+    if (find(value, "alpha") && find(value, "roughness"))
+      fail("{}: {}: give either \"alpha\" or \"roughness\", not both", ctx.path, where);
+    if (const json* roughness = find(value, "roughness")) {
+      const float r = number(ctx, *roughness, where + ".roughness");
+      ggx.alpha = r * r;
+    } else {
+      ggx.alpha = numberOr(ctx, value, "alpha", ggx.alpha, where);
+    }
+    if (!(ggx.alpha > 0.0f && ggx.alpha <= 1.0f)) fail("{}: {}: GGX alpha {} must be in (0, 1]", ctx.path, where, ggx.alpha);
+    material.bsdf = ggx;
+    known.insert({"diffuse", "f0", "alpha", "roughness", "texture"});
+  } else {
+    fail("{}: {}: unknown material type '{}' (lambert, mirror, blinn-phong, ggx)", ctx.path, where, type);
+  }
+  checkKeys(ctx, value, known, where);
+  if (const json* texture = find(value, "texture")) material.albedoTexture = loadTexture(ctx, scene, *texture, where + ".texture");
+  if (auto* bp = std::get_if<BlinnPhongBsdf>(&material.bsdf)) {
+    if (maxComponent(bp->diffuse + bp->specular) > 1.0f)
+      fail("{}: {}: diffuse + specular exceeds 1 in a channel (the model would create energy)", ctx.path, where);
+  }
+  return material;
+}
+
+/// Moves everything of `part` by matrix m (positions, normals, lights, cameras).
+void transformScene(Scene& part, const Mat4& m) {
+  const Mat3 linear(m);
+  const Mat3 normalMatrix = glm::transpose(glm::inverse(linear));
+  const bool mirrored = glm::determinant(linear) < 0.0f;
+  auto point = [&](const Vec3& p) { return Vec3(m * Vec4(p, 1.0f)); };
+  for (Mesh& mesh : part.meshes) {
+    for (Vec3& p : mesh.positions) p = point(p);
+    for (Vec3& n : mesh.normals) n = normalMatrix * n;
+    if (mirrored)
+      for (UVec3& t : mesh.triangles) std::swap(t.y, t.z);
+  }
+  for (Light& light : part.lights) {
+    if (auto* p = std::get_if<PointLight>(&light)) p->position = point(p->position);
+    if (auto* s = std::get_if<SpotLight>(&light)) s->position = point(s->position), s->direction = linear * s->direction;
+    if (auto* d = std::get_if<DirectionalLight>(&light)) d->direction = linear * d->direction;
+  }
+  for (CameraDesc& camera : part.cameras) {
+    camera.eye = point(camera.eye);
+    camera.target = point(camera.target);
+    camera.up = linear * camera.up;
+  }
+}
+
+Scene parseScene(const JsonContext& ctx, const json& root) {
+  if (!root.is_object()) fail("{}: the top level must be a JSON object", ctx.path);
+  checkKeys(ctx, root, {"include_cornell", "meshes", "materials", "lights", "cameras", "environment"}, "top level");
+  Scene scene;
+  scene.sourcePath = ctx.path;
+  if (boolOr(ctx, root, "include_cornell", false, "top level")) appendScene(scene, makeCornellBox());
+
+  std::map<std::string, uint32_t> namedMaterials;  // JSON materials by name → scene index
+  if (const json* materials = find(root, "materials")) {
+    if (!materials->is_object()) fail("{}: \"materials\" must be an object of name → material", ctx.path);
+    for (auto it = materials->begin(); it != materials->end(); ++it) {
+      namedMaterials[it.key()] = uint32_t(scene.materials.size());
+      Material material = parseMaterial(ctx, scene, it.key(), it.value());
+      scene.materials.push_back(std::move(material));
+    }
+  }
+
+  if (const json* meshes = find(root, "meshes")) {
+    if (!meshes->is_array()) fail("{}: \"meshes\" must be an array", ctx.path);
+    for (size_t i = 0; i < meshes->size(); ++i) {
+      const json& entry = (*meshes)[i];
+      const std::string where = fmt::format("meshes[{}]", i);
+      if (!entry.is_object()) fail("{}: {}: expected an object", ctx.path, where);
+      checkKeys(ctx, entry, {"file", "transform", "material"}, where);
+      const json* file = find(entry, "file");
+      if (!file) fail("{}: {}: missing \"file\"", ctx.path, where);
+      const fs::path meshPath = ctx.dir / stringOf(ctx, *file, where + ".file");
+      std::string extension = meshPath.extension().string();
+      std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+      if (extension != ".obj" && extension != ".gltf" && extension != ".glb")
+        fail("{}: {}.file: '{}' must be .obj, .gltf or .glb", ctx.path, where, meshPath.string());
+      Scene part;
+      try {
+        part = loadScene(meshPath.string());
+      } catch (const Error& e) {
+        fail("{}: {}: {}", ctx.path, where, e.what());
+      }
+      if (const json* transform = find(entry, "transform")) transformScene(part, parseTransform(ctx, *transform, where + ".transform"));
+      std::optional<uint32_t> forced;
+      if (const json* name = find(entry, "material")) {
+        const std::string materialName = stringOf(ctx, *name, where + ".material");
+        auto it = namedMaterials.find(materialName);
+        if (it == namedMaterials.end()) fail("{}: {}.material: no material named '{}' in \"materials\"", ctx.path, where, materialName);
+        forced = it->second;
+      }
+      const size_t materialOffset = scene.materials.size(), meshOffset = scene.meshes.size();
+      appendScene(scene, std::move(part));
+      // Same-named JSON materials replace the file's own (textures are shared, indices global).
+      for (size_t m = materialOffset; m < scene.materials.size(); ++m)
+        if (auto it = namedMaterials.find(scene.materials[m].name); it != namedMaterials.end())
+          scene.materials[m] = scene.materials[it->second];
+      if (forced)
+        for (size_t m = meshOffset; m < scene.meshes.size(); ++m)
+          std::fill(scene.meshes[m].materials.begin(), scene.meshes[m].materials.end(), *forced);
+    }
+  }
+
+  if (const json* lights = find(root, "lights")) {
+    if (!lights->is_array()) fail("{}: \"lights\" must be an array", ctx.path);
+    for (size_t i = 0; i < lights->size(); ++i) {
+      const json& entry = (*lights)[i];
+      const std::string where = fmt::format("lights[{}]", i);
+      if (!entry.is_object() || !find(entry, "type")) fail("{}: {}: expected an object with a \"type\"", ctx.path, where);
+      const std::string type = stringOf(ctx, entry["type"], where + ".type");
+      if (type == "point") {
+        checkKeys(ctx, entry, {"type", "position", "intensity"}, where);
+        scene.lights.push_back(PointLight{vec3Or(ctx, entry, "position", Vec3(0.0f), where),
+                                          colourOr(ctx, entry, "intensity", Rgb(1.0f), where)});
+      } else if (type == "spot") {
+        checkKeys(ctx, entry, {"type", "position", "direction", "intensity", "inner_angle", "outer_angle"}, where);
+        SpotLight spot;
+        spot.position = vec3Or(ctx, entry, "position", spot.position, where);
+        spot.direction = vec3Or(ctx, entry, "direction", spot.direction, where);
+        spot.intensity = colourOr(ctx, entry, "intensity", spot.intensity, where);
+        spot.innerAngle = glm::radians(numberOr(ctx, entry, "inner_angle", glm::degrees(spot.innerAngle), where));
+        spot.outerAngle = glm::radians(numberOr(ctx, entry, "outer_angle", glm::degrees(spot.outerAngle), where));
+        scene.lights.push_back(spot);
+      } else if (type == "directional") {
+        checkKeys(ctx, entry, {"type", "direction", "irradiance"}, where);
+        scene.lights.push_back(DirectionalLight{vec3Or(ctx, entry, "direction", Vec3(0.0f, -1.0f, 0.0f), where),
+                                                colourOr(ctx, entry, "irradiance", Rgb(1.0f), where)});
+      } else {
+        fail("{}: {}.type: unknown light type '{}' (point, spot, directional)", ctx.path, where, type);
+      }
+    }
+  }
+
+  if (const json* cameras = find(root, "cameras")) {
+    if (!cameras->is_array()) fail("{}: \"cameras\" must be an array", ctx.path);
+    for (size_t i = 0; i < cameras->size(); ++i) {
+      const json& entry = (*cameras)[i];
+      const std::string where = fmt::format("cameras[{}]", i);
+      if (!entry.is_object()) fail("{}: {}: expected an object", ctx.path, where);
+      checkKeys(ctx, entry, {"name", "eye", "target", "up", "fov", "fstop", "focus_distance", "focal_length", "aspect"}, where);
+      CameraDesc camera;
+      camera.name = find(entry, "name") ? stringOf(ctx, entry["name"], where + ".name") : fmt::format("camera{}", i);
+      camera.eye = vec3Or(ctx, entry, "eye", camera.eye, where);
+      camera.target = vec3Or(ctx, entry, "target", camera.target, where);
+      camera.up = vec3Or(ctx, entry, "up", camera.up, where);
+      camera.fovYDegrees = numberOr(ctx, entry, "fov", camera.fovYDegrees, where);
+      camera.fNumber = numberOr(ctx, entry, "fstop", 0.0f, where);
+      camera.focusDistance = numberOr(ctx, entry, "focus_distance", glm::length(camera.target - camera.eye), where);
+      camera.focalLengthMm = numberOr(ctx, entry, "focal_length", 0.0f, where);
+      if (find(entry, "aspect")) camera.aspectRatio = number(ctx, entry["aspect"], where + ".aspect");
+      scene.cameras.push_back(camera);
+    }
+  }
+
+  if (const json* environment = find(root, "environment")) {
+    if (!environment->is_object()) fail("{}: \"environment\" must be an object", ctx.path);
+    checkKeys(ctx, *environment, {"color"}, "environment");
+    scene.environment.constant = colourOr(ctx, *environment, "color", Rgb(0.0f), "environment");
+  }
+  scene.finalize();
+  return scene;
+}
+
+}  // namespace
+
+Scene loadJsonScene(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail("{}: cannot open file", path);
+  json root;
+  try {
+    root = json::parse(in);
+  } catch (const json::parse_error& e) {
+    fail("{}: malformed JSON at byte {}: {}", path, e.byte, e.what());
+  }
+  const JsonContext ctx{path, fs::path(path).parent_path()};
+  try {
+    return parseScene(ctx, root);
+  } catch (const json::exception& e) {
+    fail("{}: {}", path, e.what());
+  }
+}
+
+}  // namespace pl::detail
