@@ -1,0 +1,589 @@
+// The reference path tracer (see trace.h for the conventions).
+//
+// Estimator. For a path x0 (camera) → x1 → x2 → ..., with throughput β_k = Π f·cos/pdf of
+// the BSDF samples taken so far, the radiance is the sum over vertices x_k of
+//   β_k · Le(x_k)                         emission found by the BSDF-sampled ray, weighted by
+//                                         w_bsdf = p_bsdf² / (p_bsdf² + p_light²)
+// + β_k · f · cos θi · Le / p_light        next-event estimation at x_k, weighted by
+//                                         w_light = p_light² / (p_bsdf² + p_light²)
+// (Veach's power heuristic, β = 2). Both pdfs are solid-angle densities at x_k of the same
+// direction: p_light includes the probability of selecting that light. Delta lights (point,
+// spot, directional) can only be reached by NEE (weight 1); delta BSDF bounces (mirrors) can
+// only be followed by BSDF sampling, so emission seen right after one counts fully, as does
+// emission seen by the camera ray.
+//
+// Light selection: one discrete distribution over every emitter, proportional to an estimate
+// of its emitted power (luminance):
+//   emissive triangle  π · A · Y(Le)            (×2 when two-sided): exitant flux of a
+//                                                Lambertian emitter of radiance Le and area A
+//   point light        4π · Y(I)
+//   spot light         2π · (1 − (cos θinner + cos θouter)/2) · Y(I)   (pbrt's estimate)
+//   directional light  π R² · Y(E)             flux through the scene's bounding disk
+//   environment        4π · π R² · Y(Le)        (pbrt-v4's UniformInfiniteLight::Phi)
+// where R is the radius of the scene's bounding sphere. Any positive weights give an
+// unbiased estimator; these make the variance small when emitters differ a lot.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <optional>
+#include <variant>
+#include <vector>
+
+#include "accel/accel.h"
+#include "bsdf/bsdf.h"
+#include "camera/camera.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "scene/scene.h"
+#include "trace/trace.h"
+
+namespace pl {
+
+const char* strategyName(TraceStrategy strategy) {
+  switch (strategy) {
+    case TraceStrategy::Mis: return "mis";
+    case TraceStrategy::NeeOnly: return "nee";
+    case TraceStrategy::BsdfOnly: return "bsdf";
+  }
+  return "?";
+}
+
+TraceStrategy parseStrategy(const std::string& name) {
+  if (name == "mis") return TraceStrategy::Mis;
+  if (name == "nee") return TraceStrategy::NeeOnly;
+  if (name == "bsdf") return TraceStrategy::BsdfOnly;
+  fail("unknown strategy '{}' (expected mis, nee or bsdf)", name);
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------------------
+// The environment: light arriving from infinity where no geometry is hit. Every query of
+// it goes through this one struct so that an importance-sampled environment map only has
+// to change radiance(), sample() and pdf() here.
+struct EnvironmentLight {
+  Rgb constant{0.0f};
+
+  bool isBlack() const { return pl::isBlack(constant); }
+  /// Radiance arriving from direction `towardsLight` (pointing away from the scene).
+  Rgb radiance(const Vec3& /*towardsLight*/) const { return constant; }
+  /// Uniform on the sphere: the right density for a constant environment.
+  Vec3 sample(Vec2 u, float& pdfSolidAngle) const {
+    pdfSolidAngle = kUniformSpherePdf;
+    return sampleUniformSphere(u);
+  }
+  float pdf(const Vec3& /*towardsLight*/) const { return kUniformSpherePdf; }
+  /// Power estimate for light selection (see the file comment).
+  float power(float sceneRadius) const { return 4.0f * kPi * kPi * sceneRadius * sceneRadius * luminance(constant); }
+};
+
+struct EmissiveTriangle {
+  Vec3 p0, edge1, edge2;  ///< point = p0 + b1·edge1 + b2·edge2
+  Vec3 normal;            ///< unit geometric normal (winding), the emitting side
+  float area = 0.0f;
+  Rgb radiance{0.0f};
+  bool twoSided = false;
+};
+
+enum class PunctualKind : uint8_t { Point, Spot, Directional };
+struct PunctualLight {
+  PunctualKind kind = PunctualKind::Point;
+  Vec3 position{0.0f};
+  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< spot axis / directional travel direction (unit)
+  Rgb intensity{0.0f};                ///< W·sr⁻¹ (point, spot) or irradiance W·m⁻² (directional)
+  float cosInner = 1.0f, cosOuter = 1.0f;
+};
+
+enum class LightKind : uint8_t { Triangle, Punctual, Environment };
+struct LightEntry {
+  LightKind kind;
+  uint32_t index;  ///< into triangles_ or punctual_
+};
+
+/// Per-render counters, accumulated per tile and added atomically at the end of each tile.
+struct Counters {
+  uint64_t rays = 0;
+};
+
+/// Running sums of one pixel's samples in double precision.
+struct PixelAccumulator {
+  DVec3 sum{0.0}, sumSquares{0.0};
+  uint64_t samples = 0, nanSamples = 0;
+  uint64_t firstNanSample = 0;
+
+  void add(const Rgb& value, uint64_t sampleIndex) {
+    if (!isFinite(value)) {
+      if (nanSamples++ == 0) firstNanSample = sampleIndex;
+      return;
+    }
+    const DVec3 v(value);
+    sum += v;
+    sumSquares += v * v;
+    ++samples;
+  }
+  RadianceEstimate estimate() const {
+    RadianceEstimate e;
+    e.samples = samples;
+    e.nanSamples = nanSamples;
+    if (samples == 0) return e;
+    const double n = static_cast<double>(samples);
+    const DVec3 mean = sum / n;
+    e.mean = Rgb(mean);
+    if (samples > 1) {
+      // Unbiased sample variance s² = (Σx² − n·mean²)/(n − 1); variance of the mean = s²/n.
+      const DVec3 s2 = glm::max(DVec3(0.0), (sumSquares - n * mean * mean) / (n - 1.0));
+      e.varianceOfMean = Rgb(s2 / n);
+    }
+    return e;
+  }
+};
+
+/// Light-selection weights only need to be positive and finite: clamp absurdly bright
+/// emitters (whose estimated power overflows float) to the largest float instead of letting
+/// an infinity turn the whole distribution into NaNs.
+float selectionWeight(float power) { return std::min(power, std::numeric_limits<float>::max()); }
+
+float smoothStep(float edge0, float edge1, float x) {
+  if (edge1 <= edge0) return x >= edge1 ? 1.0f : 0.0f;
+  const float t = std::clamp((x - edge0) / (edge1 - edge0), 0.0f, 1.0f);
+  return t * t * (3.0f - 2.0f * t);
+}
+
+}  // namespace
+
+// -----------------------------------------------------------------------------------------
+struct PathTracer::Impl {
+  const Scene& scene;
+  const Accel& accel;
+  EnvironmentLight environment;
+  std::vector<EmissiveTriangle> triangles;
+  std::vector<PunctualLight> punctual;
+  std::vector<LightEntry> entries;
+  Distribution1D allLights;          ///< over entries
+  Distribution1D punctualLights;     ///< over punctual (used by the Bsdf strategy)
+  std::vector<uint32_t> meshTriangleBase;  ///< first global triangle index of each mesh
+  std::vector<int32_t> entryOfTriangle;    ///< light entry of each global triangle, or −1
+  int32_t environmentEntry = -1;
+
+  Impl(const Scene& s, const Accel& a);
+
+  float selectionProbability(int32_t entry) const {
+    return entry >= 0 ? allLights.probability(static_cast<size_t>(entry)) : 0.0f;
+  }
+
+  bool occluded(const Vec3& origin, const Vec3& direction, float tMax, Counters& counters) const {
+    ++counters.rays;
+    Ray shadow;
+    shadow.origin = origin;
+    shadow.direction = direction;
+    shadow.tMin = 0.0f;
+    shadow.tMax = tMax;
+    return accel.occluded(shadow);
+  }
+
+  Rgb directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame, const Vec3& woLocal,
+                  const Bsdf& bsdf, const TraceSettings& settings, Pcg32& rng, Counters& counters) const;
+  Rgb radiance(Ray ray, Pcg32& rng, const TraceSettings& settings, Counters& counters) const;
+  void tracePixel(const Camera& camera, const TraceSettings& settings, int x, int y, PixelAccumulator& acc,
+                  Counters& counters) const;
+};
+
+PathTracer::Impl::Impl(const Scene& s, const Accel& a) : scene(s), accel(a) {
+  environment.constant = scene.environment.constant;
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  const float sceneRadius = std::max(0.5f * glm::length(hi - lo), 1e-6f);
+
+  std::vector<float> weights;
+  uint32_t base = 0;
+  for (const Mesh& mesh : scene.meshes) {
+    meshTriangleBase.push_back(base);
+    base += static_cast<uint32_t>(mesh.triangles.size());
+  }
+  entryOfTriangle.assign(base, -1);
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const Material& material = scene.materials[mesh.materials[t]];
+      if (!material.isEmissive()) continue;
+      const UVec3 tri = mesh.triangles[t];
+      EmissiveTriangle e;
+      e.p0 = mesh.positions[tri.x];
+      e.edge1 = mesh.positions[tri.y] - e.p0;
+      e.edge2 = mesh.positions[tri.z] - e.p0;
+      const Vec3 cross = glm::cross(e.edge1, e.edge2);
+      const float length = glm::length(cross);
+      if (!(length > 0.0f)) continue;  // degenerate: cannot emit (and finalize() drops these)
+      e.normal = cross / length;
+      e.area = 0.5f * length;
+      e.radiance = material.emission;
+      e.twoSided = material.twoSidedEmission;
+      const float power = kPi * e.area * luminance(e.radiance) * (e.twoSided ? 2.0f : 1.0f);
+      if (!(power > 0.0f)) continue;
+      entryOfTriangle[meshTriangleBase[m] + t] = static_cast<int32_t>(entries.size());
+      entries.push_back({LightKind::Triangle, static_cast<uint32_t>(triangles.size())});
+      triangles.push_back(e);
+      weights.push_back(selectionWeight(power));
+    }
+  }
+
+  std::vector<float> punctualWeights;
+  for (const Light& light : scene.lights) {
+    PunctualLight p;
+    float power = 0.0f;
+    if (const auto* point = std::get_if<PointLight>(&light)) {
+      p.kind = PunctualKind::Point;
+      p.position = point->position;
+      p.intensity = point->intensity;
+      power = 4.0f * kPi * luminance(p.intensity);
+    } else if (const auto* spot = std::get_if<SpotLight>(&light)) {
+      p.kind = PunctualKind::Spot;
+      p.position = spot->position;
+      p.direction = glm::normalize(spot->direction);
+      p.intensity = spot->intensity;
+      p.cosInner = std::cos(spot->innerAngle);
+      p.cosOuter = std::cos(spot->outerAngle);
+      power = 2.0f * kPi * (1.0f - 0.5f * (p.cosInner + p.cosOuter)) * luminance(p.intensity);
+    } else if (const auto* directional = std::get_if<DirectionalLight>(&light)) {
+      p.kind = PunctualKind::Directional;
+      p.direction = glm::normalize(directional->direction);
+      p.intensity = directional->irradiance;
+      power = kPi * sceneRadius * sceneRadius * luminance(p.intensity);
+    }
+    if (!(power > 0.0f)) continue;
+    entries.push_back({LightKind::Punctual, static_cast<uint32_t>(punctual.size())});
+    punctual.push_back(p);
+    weights.push_back(selectionWeight(power));
+    punctualWeights.push_back(selectionWeight(power));
+  }
+
+  if (!environment.isBlack()) {
+    const float power = environment.power(sceneRadius);
+    if (power > 0.0f) {
+      environmentEntry = static_cast<int32_t>(entries.size());
+      entries.push_back({LightKind::Environment, 0});
+      weights.push_back(selectionWeight(power));
+    }
+  }
+  if (!weights.empty()) allLights = Distribution1D(weights);
+  if (!punctualWeights.empty()) punctualLights = Distribution1D(punctualWeights);
+}
+
+// Next-event estimation at a non-delta vertex: one light sample, MIS-weighted against the
+// BSDF's density when the light could also be hit by BSDF sampling.
+Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame,
+                                  const Vec3& woLocal, const Bsdf& bsdf, const TraceSettings& settings, Pcg32& rng,
+                                  Counters& counters) const {
+  // Always draw the same three numbers so that the stream layout does not depend on which
+  // light is picked (not needed for correctness, but keeps replays easy to reason about).
+  const float uSelect = rng.uniform();
+  const Vec2 u(rng.uniform(), rng.uniform());
+
+  const bool punctualOnly = settings.strategy == TraceStrategy::BsdfOnly;
+  const Distribution1D& distribution = punctualOnly ? punctualLights : allLights;
+  if (distribution.size() == 0) return Rgb(0.0f);
+  const size_t chosen = distribution.sample(uSelect);
+  const float selectProbability = distribution.probability(chosen);
+  if (!(selectProbability > 0.0f)) return Rgb(0.0f);
+  const LightEntry entry = punctualOnly ? LightEntry{LightKind::Punctual, static_cast<uint32_t>(chosen)}
+                                        : entries[chosen];
+
+  Vec3 wi;                  // towards the light, world space
+  Rgb incident(0.0f);       // radiance (area/environment) or irradiance-like term (punctual)
+  float lightPdf = 0.0f;    // solid angle density including selection (area/environment)
+  bool isDeltaLight = false;
+  Vec3 shadowTarget(0.0f);  // finite lights: the point the shadow ray must reach
+  bool infinite = false;
+
+  switch (entry.kind) {
+    case LightKind::Triangle: {
+      const EmissiveTriangle& e = triangles[entry.index];
+      const Vec2 b = sampleUniformTriangle(u);
+      const Vec3 point = e.p0 + b.x * e.edge1 + b.y * e.edge2;
+      const Vec3 toLight = point - position;
+      const float distanceSquared = glm::dot(toLight, toLight);
+      if (!(distanceSquared > 0.0f)) return Rgb(0.0f);
+      wi = toLight / std::sqrt(distanceSquared);
+      float cosLight = -glm::dot(e.normal, wi);
+      if (e.twoSided) cosLight = std::abs(cosLight);
+      if (!(cosLight > 0.0f)) return Rgb(0.0f);  // the back of a one-sided emitter
+      // Area density 1/A converted to solid angle at `position`: dA = r² dω / cos θlight.
+      lightPdf = selectProbability * distanceSquared / (cosLight * e.area);
+      incident = e.radiance;
+      // Offset the target off the emitter towards the shading point so the shadow ray does
+      // not hit the emitter itself (nor a coplanar ceiling right behind it).
+      shadowTarget = offsetRayOrigin(point, e.normal, -wi);
+      break;
+    }
+    case LightKind::Environment: {
+      float pdfSolidAngle = 0.0f;
+      wi = environment.sample(u, pdfSolidAngle);
+      lightPdf = selectProbability * pdfSolidAngle;
+      incident = environment.radiance(wi);
+      infinite = true;
+      break;
+    }
+    case LightKind::Punctual: {
+      const PunctualLight& p = punctual[entry.index];
+      isDeltaLight = true;
+      lightPdf = selectProbability;  // a discrete choice; the direction is fixed
+      if (p.kind == PunctualKind::Directional) {
+        wi = -p.direction;
+        incident = p.intensity;  // irradiance normal to the beam
+        infinite = true;
+      } else {
+        const Vec3 toLight = p.position - position;
+        const float distanceSquared = glm::dot(toLight, toLight);
+        if (!(distanceSquared > 0.0f)) return Rgb(0.0f);
+        wi = toLight / std::sqrt(distanceSquared);
+        // Irradiance normal to the ray from intensity I at distance d: I / d².
+        float falloff = 1.0f;
+        if (p.kind == PunctualKind::Spot) falloff = smoothStep(p.cosOuter, p.cosInner, glm::dot(p.direction, -wi));
+        if (!(falloff > 0.0f)) return Rgb(0.0f);
+        incident = p.intensity * (falloff / distanceSquared);
+        shadowTarget = p.position;
+      }
+      break;
+    }
+  }
+
+  // BSDFs here reflect only: a direction below the geometric surface cannot receive light
+  // (this also stops light leaking through when shading normals bend over the horizon).
+  if (glm::dot(wi, geometricNormal) <= 0.0f) return Rgb(0.0f);
+  const Vec3 wiLocal = frame.toLocal(wi);
+  const Rgb f = eval(bsdf, woLocal, wiLocal);
+  const float cosIn = wiLocal.z;
+  if (isBlack(f) || !(cosIn > 0.0f)) return Rgb(0.0f);
+
+  const Vec3 origin = offsetRayOrigin(position, geometricNormal, wi);
+  if (infinite) {
+    if (occluded(origin, wi, kInfinity, counters)) return Rgb(0.0f);
+  } else {
+    const Vec3 toTarget = shadowTarget - origin;
+    const float distance = glm::length(toTarget);
+    if (!(distance > 0.0f)) return Rgb(0.0f);
+    if (occluded(origin, toTarget / distance, distance, counters)) return Rgb(0.0f);
+  }
+
+  const Rgb unweighted = f * cosIn * incident / lightPdf;
+  if (isDeltaLight || settings.strategy != TraceStrategy::Mis) return unweighted;
+  return unweighted * powerHeuristic(lightPdf, pdf(bsdf, woLocal, wiLocal));
+}
+
+Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& settings, Counters& counters) const {
+  Rgb result(0.0f);
+  Rgb throughput(1.0f);
+  // Whether emission found by the current ray counts with full weight: true for the camera
+  // ray, after a delta bounce, and always with the Bsdf strategy.
+  bool countEmissionFully = true;
+  float previousBsdfPdf = 0.0f;  // solid-angle density with which the current ray was sampled
+  const bool useMis = settings.strategy == TraceStrategy::Mis;
+  const bool bsdfOnly = settings.strategy == TraceStrategy::BsdfOnly;
+
+  for (int depth = 0;; ++depth) {
+    RayHit hit;
+    ++counters.rays;
+    if (!accel.intersect(ray, hit)) {
+      if (environmentEntry >= 0) {
+        const Rgb le = environment.radiance(ray.direction);
+        if (countEmissionFully) {
+          result += throughput * le;
+        } else if (useMis) {
+          const float lightPdf = selectionProbability(environmentEntry) * environment.pdf(ray.direction);
+          result += throughput * le * powerHeuristic(previousBsdfPdf, lightPdf);
+        }
+      }
+      break;
+    }
+
+    const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+    const Material& material = scene.materials[surface.material];
+    const Vec3 wo = -ray.direction;
+    const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
+
+    if (material.isEmissive() && (cosWoGeometric > 0.0f || material.twoSidedEmission)) {
+      if (countEmissionFully) {
+        result += throughput * material.emission;
+      } else if (useMis) {
+        const int32_t entry = entryOfTriangle[meshTriangleBase[hit.mesh] + hit.triangle];
+        if (entry >= 0) {
+          const EmissiveTriangle& e = triangles[entries[static_cast<size_t>(entry)].index];
+          // The density NEE would have had for this point, in solid angle at the previous
+          // vertex: P(select) · (1/A) · t² / |cos θlight|.
+          const float cosLight = std::abs(cosWoGeometric);
+          const float lightPdf = cosLight > 0.0f
+                                     ? selectionProbability(entry) * hit.t * hit.t / (cosLight * e.area)
+                                     : 0.0f;
+          result += throughput * material.emission * powerHeuristic(previousBsdfPdf, lightPdf);
+        }
+      }
+    }
+    if (depth >= settings.maxDepth) break;
+
+    // Two-sided shading: both normals face the side the ray came from.
+    Vec3 geometricNormal = surface.geometricNormal;
+    Vec3 shadingNormal = surface.shadingNormal;
+    if (cosWoGeometric < 0.0f) {
+      geometricNormal = -geometricNormal;
+      shadingNormal = -shadingNormal;
+    }
+    const Bsdf bsdf = bsdfAt(scene, surface);
+    const Frame frame = Frame::fromNormal(shadingNormal);
+    const Vec3 woLocal = frame.toLocal(wo);
+
+    if (!isDelta(bsdf)) {
+      result += throughput *
+                directLight(surface.position, geometricNormal, frame, woLocal, bsdf, settings, rng, counters);
+    }
+
+    const Vec2 u(rng.uniform(), rng.uniform());
+    const std::optional<BsdfSample> s = sample(bsdf, woLocal, u);
+    if (!s) break;
+    const Vec3 wi = frame.toWorld(s->wi);
+    if (glm::dot(wi, geometricNormal) <= 0.0f) break;  // reflection only (see directLight)
+    throughput *= s->weight;
+    if (isBlack(throughput)) break;
+    countEmissionFully = s->delta || bsdfOnly;
+    previousBsdfPdf = s->pdf;
+    ray.origin = offsetRayOrigin(surface.position, geometricNormal, wi);
+    ray.direction = wi;
+    ray.tMin = 0.0f;
+    ray.tMax = kInfinity;
+
+    // Russian roulette (unbiased): continue with probability q, divide the throughput by q.
+    if (depth + 1 >= settings.rouletteDepth) {
+      const float q = maxComponent(throughput);
+      if (q < 1.0f) {
+        if (rng.uniform() >= q) break;
+        throughput /= q;
+      }
+    }
+  }
+  return result;
+}
+
+void PathTracer::Impl::tracePixel(const Camera& camera, const TraceSettings& settings, int x, int y,
+                                  PixelAccumulator& acc, Counters& counters) const {
+  const uint64_t pixelIndex = static_cast<uint64_t>(y) * static_cast<uint64_t>(camera.width()) + static_cast<uint64_t>(x);
+  for (int i = 0; i < settings.spp; ++i) {
+    Pcg32 rng = Pcg32::forKey(pixelIndex, static_cast<uint64_t>(i), settings.seed);
+    const Vec2 film(static_cast<float>(x) + rng.uniform(), static_cast<float>(y) + rng.uniform());
+    const Vec2 lens(rng.uniform(), rng.uniform());
+    const Camera::Sample cameraSample = camera.generateRay(film, lens);
+    Rgb value(0.0f);
+    if (cameraSample.weight > 0.0f) value = cameraSample.weight * radiance(cameraSample.ray, rng, settings, counters);
+    acc.add(value, static_cast<uint64_t>(i));
+  }
+}
+
+// -----------------------------------------------------------------------------------------
+PathTracer::PathTracer(const Scene& scene, const Accel& accel) : impl_(std::make_unique<Impl>(scene, accel)) {}
+PathTracer::~PathTracer() = default;
+
+size_t PathTracer::emissiveTriangleCount() const { return impl_->triangles.size(); }
+size_t PathTracer::lightCount() const { return impl_->entries.size(); }
+
+namespace {
+void checkSettings(const TraceSettings& settings) {
+  if (settings.spp < 1) fail("samples per pixel must be at least 1 (got {})", settings.spp);
+  if (settings.maxDepth < 0) fail("maximum depth must be at least 0 (got {})", settings.maxDepth);
+  if (settings.tileSize < 1) fail("tile size must be at least 1 (got {})", settings.tileSize);
+}
+}  // namespace
+
+TraceResult PathTracer::render(const Camera& camera, const TraceSettings& settings) const {
+  checkSettings(settings);
+  const int width = camera.width(), height = camera.height();
+  if (width < 1 || height < 1) fail("image size {}x{} is empty", width, height);
+
+  TraceResult result;
+  result.radiance = Image(width, height);
+  result.variance = Image(width, height);
+
+  const int tile = settings.tileSize;
+  const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+  const uint64_t tileCount = static_cast<uint64_t>(tilesX) * static_cast<uint64_t>(tilesY);
+
+  std::atomic<uint64_t> totalRays{0}, totalNans{0};
+  std::mutex nanMutex;
+  uint64_t firstNanPixel = ~0ull, firstNanSample = 0;
+
+  std::optional<Progress> progress;
+  if (settings.showProgress) progress.emplace("tracing", tileCount);
+  const auto start = std::chrono::steady_clock::now();
+
+  parallelForRange(tileCount, 1, [&](uint64_t begin, uint64_t end) {
+    for (uint64_t t = begin; t < end; ++t) {
+      const int x0 = static_cast<int>(t % static_cast<uint64_t>(tilesX)) * tile;
+      const int y0 = static_cast<int>(t / static_cast<uint64_t>(tilesX)) * tile;
+      const int x1 = std::min(x0 + tile, width), y1 = std::min(y0 + tile, height);
+      Counters counters;
+      uint64_t nans = 0;
+      for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+          PixelAccumulator acc;
+          impl_->tracePixel(camera, settings, x, y, acc, counters);
+          const RadianceEstimate e = acc.estimate();
+          result.radiance.at(x, y) = e.mean;
+          result.variance.at(x, y) = e.varianceOfMean;
+          if (acc.nanSamples > 0) {
+            nans += acc.nanSamples;
+            // Keep the first offending pixel in scan order, so the report does not depend
+            // on the thread schedule.
+            const uint64_t pixel = static_cast<uint64_t>(y) * static_cast<uint64_t>(width) + static_cast<uint64_t>(x);
+            std::lock_guard lock(nanMutex);
+            if (pixel < firstNanPixel) {
+              firstNanPixel = pixel;
+              firstNanSample = acc.firstNanSample;
+            }
+          }
+        }
+      }
+      totalRays += counters.rays;
+      totalNans += nans;
+      if (progress) progress->advance();
+    }
+  });
+  if (progress) progress->finish();
+
+  TraceStats& stats = result.stats;
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats.paths = static_cast<uint64_t>(width) * static_cast<uint64_t>(height) * static_cast<uint64_t>(settings.spp);
+  stats.rays = totalRays.load();
+  stats.nanSamples = totalNans.load();
+  if (stats.nanSamples > 0) {
+    stats.firstNanX = static_cast<int>(firstNanPixel % static_cast<uint64_t>(width));
+    stats.firstNanY = static_cast<int>(firstNanPixel / static_cast<uint64_t>(width));
+    stats.firstNanSample = firstNanSample;
+  }
+  return result;
+}
+
+RadianceEstimate PathTracer::renderPixel(const Camera& camera, const TraceSettings& settings, int x, int y) const {
+  checkSettings(settings);
+  if (x < 0 || y < 0 || x >= camera.width() || y >= camera.height())
+    fail("pixel ({}, {}) is outside the {}x{} image", x, y, camera.width(), camera.height());
+  PixelAccumulator acc;
+  Counters counters;
+  impl_->tracePixel(camera, settings, x, y, acc, counters);
+  return acc.estimate();
+}
+
+RadianceEstimate PathTracer::estimateRadiance(const Ray& ray, const TraceSettings& settings, uint64_t key) const {
+  checkSettings(settings);
+  PixelAccumulator acc;
+  Counters counters;
+  for (int i = 0; i < settings.spp; ++i) {
+    Pcg32 rng = Pcg32::forKey(key, static_cast<uint64_t>(i), settings.seed);
+    acc.add(impl_->radiance(ray, rng, settings, counters), static_cast<uint64_t>(i));
+  }
+  return acc.estimate();
+}
+
+}  // namespace pl

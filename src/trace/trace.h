@@ -1,0 +1,153 @@
+#pragma once
+// The reference path tracer: unidirectional path tracing with next-event estimation (NEE)
+// on emissive triangles, punctual lights and the environment, combined with BSDF sampling by
+// multiple importance sampling (power heuristic), and Russian roulette. It is the ground
+// truth every other renderer in plenoptic (the light-field bake in particular) is checked
+// against, so it favours being obviously right over being clever.
+//
+// Conventions:
+//  * A pixel value is the mean over the pixel's area (box filter) of camera weight × radiance
+//    (W·sr⁻¹·m⁻², linear Rec.709), where the camera weight is cos⁴θ with vignetting on, else 1.
+//    No exposure is applied here (the caller's ViewOptions do that when writing files).
+//  * Every sample's random stream is Pcg32::forKey(pixel index, sample index, seed), so an
+//    image depends on the seed only, never on the number of threads or the tile schedule.
+//  * Samples whose radiance is not finite (NaN or ±inf) are NOT added to the pixel (that
+//    would poison it) and NOT silently replaced by black either: they are counted in
+//    TraceStats::nanSamples and the first offending (pixel, sample) is reported so that it
+//    can be replayed with renderPixel() / `plenoptic trace --pixel X,Y`.
+//  * Emission is one-sided (along the triangle's geometric normal) unless the material says
+//    twoSidedEmission. BSDFs are two-sided: the shading frame is flipped to the side the ray
+//    arrives from.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "core/math.h"
+#include "image/image.h"
+
+namespace pl {
+
+struct Scene;
+class Accel;
+class Camera;
+
+/// How direct light is found. Mis is the production setting; NeeOnly and BsdfOnly exist to test the
+/// estimators against each other (they must agree within their noise).
+enum class TraceStrategy {
+  Mis,   ///< NEE + BSDF sampling, weighted by the power heuristic
+  NeeOnly,   ///< light sampling only; emission found by BSDF sampling counts only after a
+             ///< delta bounce (or on the camera ray)
+  BsdfOnly,  ///< BSDF sampling only for emissive surfaces and the environment. Punctual lights
+             ///< cannot be hit by a ray, so they are still sampled by NEE in this mode.
+};
+
+/// "mis", "nee", "bsdf".
+const char* strategyName(TraceStrategy strategy);
+/// Parses a strategy name; throws pl::Error listing the valid names otherwise.
+TraceStrategy parseStrategy(const std::string& name);
+
+struct TraceSettings {
+  int spp = 64;  ///< samples (paths) per pixel
+  /// Maximum number of scattering events along a path: 0 = emission seen directly only,
+  /// 1 = direct lighting, ... Russian roulette ends most paths long before; keep this large
+  /// enough that the cut-off bias is negligible (it is a^(maxDepth+1) of the total for a
+  /// closed scene of albedo a).
+  int maxDepth = 32;
+  /// Russian roulette starts after this many scattering events. It is unbiased: a path
+  /// continues with probability q = min(1, max RGB component of its throughput) and its
+  /// throughput is divided by q.
+  int rouletteDepth = 3;
+  uint64_t seed = 0;
+  TraceStrategy strategy = TraceStrategy::Mis;
+  int tileSize = 16;           ///< square tiles, rendered in parallel
+  bool showProgress = true;    ///< progress bar with ETA on stderr (still subject to --quiet)
+};
+
+struct TraceStats {
+  double seconds = 0.0;         ///< wall time of render()
+  uint64_t paths = 0;           ///< camera samples traced (= width·height·spp)
+  uint64_t rays = 0;            ///< closest-hit + shadow rays
+  uint64_t nanSamples = 0;      ///< samples dropped because their radiance was not finite
+  int firstNanX = -1, firstNanY = -1;  ///< a pixel with a dropped sample (-1 when none)
+  uint64_t firstNanSample = 0;
+  int threads = 0;              ///< worker threads available to the render
+  double pathsPerSecond() const { return seconds > 0.0 ? double(paths) / seconds : 0.0; }
+  double raysPerSecond() const { return seconds > 0.0 ? double(rays) / seconds : 0.0; }
+};
+
+struct TraceResult {
+  Image radiance;  ///< per-pixel mean of camera weight × radiance
+  /// Per-pixel, per-channel variance OF THE MEAN (sample variance / number of samples):
+  /// the squared standard error of `radiance`. Used for statistical image comparison.
+  Image variance;
+  TraceStats stats;
+};
+
+/// A Monte Carlo estimate with its own error estimate.
+struct RadianceEstimate {
+  Rgb mean{0.0f};
+  Rgb varianceOfMean{0.0f};  ///< sample variance / samples (squared standard error)
+  uint64_t samples = 0;      ///< finite samples that went into the mean
+  uint64_t nanSamples = 0;   ///< non-finite samples that were dropped (and counted)
+};
+
+class PathTracer {
+ public:
+  /// Builds the light-selection distribution. The scene and accel must outlive the tracer.
+  PathTracer(const Scene& scene, const Accel& accel);
+  ~PathTracer();
+  PathTracer(const PathTracer&) = delete;
+  PathTracer& operator=(const PathTracer&) = delete;
+
+  /// Renders the camera's full image, tiles in parallel on the current thread pool.
+  TraceResult render(const Camera& camera, const TraceSettings& settings) const;
+
+  /// Replays one pixel exactly as render() computes it (same random streams, same result).
+  RadianceEstimate renderPixel(const Camera& camera, const TraceSettings& settings, int x, int y) const;
+
+  /// settings.spp independent estimates of the radiance arriving at ray.origin from
+  /// direction −ray.direction (i.e. the radiance the ray "sees"), streams keyed by
+  /// (key, sample index, settings.seed). For tests and for checking other renderers at
+  /// chosen points.
+  RadianceEstimate estimateRadiance(const Ray& ray, const TraceSettings& settings, uint64_t key) const;
+
+  size_t emissiveTriangleCount() const;
+  /// Number of light-selection entries (emissive triangles + punctual lights + environment).
+  size_t lightCount() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Statistical comparison of two noisy estimates of the same image (each with its
+/// per-pixel variance of the mean). For every pixel and channel
+///     z = (a − b) / sqrt(varA + varB + floor²)
+/// where floor = 1e-6·max(|a|,|b|) absorbs float rounding of zero-variance pixels (e.g. the
+/// light seen directly). Under the hypothesis "same expectation", z is approximately
+/// standard normal, so the test rejects when
+///   * any |z| exceeds the two-sided Šidák-corrected threshold for `alpha` over all N
+///     pixel-channels (catches local errors), or
+///   * the whole-image z of the summed radiance, (Σa − Σb)/sqrt(ΣvarA + ΣvarB), exceeds the
+///     two-sided threshold for `alpha` (catches small global biases, e.g. a 5 % scale,
+///     that no single pixel can reveal).
+/// The two parts each use alpha/2 (Bonferroni), so the overall false-rejection rate is ≤ alpha
+/// as far as the normal approximation holds.
+struct ImageZTest {
+  size_t tests = 0;             ///< N = pixels × 3
+  double pixelThreshold = 0.0;  ///< Šidák-corrected |z| limit
+  double maxAbsZ = 0.0;
+  int worstX = -1, worstY = -1, worstChannel = -1;
+  double globalZ = 0.0;           ///< whole-image z
+  double globalThreshold = 0.0;
+  double meanSquaredZ = 0.0;      ///< ≈ 1 under the hypothesis (diagnostic)
+  bool pass = false;
+  std::string summary() const;
+};
+ImageZTest compareImagesZ(const Image& a, const Image& varianceA, const Image& b, const Image& varianceB,
+                          double alpha = 0.01);
+
+/// Two-sided standard-normal critical value: the z with P(|Z| > z) = p.
+double twoSidedNormalQuantile(double p);
+
+}  // namespace pl

@@ -1,0 +1,461 @@
+// Tests of the path tracer against closed-form answers and against itself.
+//
+// Every render here is deterministic (fixed seeds, streams keyed by pixel and sample), so a
+// statistical test either always passes or always fails for a given build: none of them is
+// flaky. The tolerances below are still derived from the estimators' own noise, so that a
+// pass means "consistent with the closed form", not "happened to match once".
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "accel/accel.h"
+#include "camera/camera.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "image/image.h"
+#include "scene/scene.h"
+#include "trace/trace.h"
+
+namespace pl {
+namespace {
+
+class TraceTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { Progress::setEnabled(false); }
+};
+
+// ---- scene building helpers ---------------------------------------------------------------
+
+uint32_t addMaterial(Scene& scene, const Rgb& albedo, const Rgb& emission = Rgb(0.0f), bool twoSided = false) {
+  Material m;
+  m.name = "m" + std::to_string(scene.materials.size());
+  m.bsdf = LambertBsdf{albedo};
+  m.emission = emission;
+  m.twoSidedEmission = twoSided;
+  scene.materials.push_back(m);
+  return static_cast<uint32_t>(scene.materials.size() - 1);
+}
+
+/// Adds the quad p0 p1 p2 p3 (in order around its edge) as two triangles whose geometric
+/// normal (winding) is `front`.
+void addQuad(Mesh& mesh, Vec3 p0, Vec3 p1, Vec3 p2, Vec3 p3, const Vec3& front, uint32_t material) {
+  if (glm::dot(glm::cross(p1 - p0, p2 - p0), front) < 0.0f) std::swap(p1, p3);
+  const auto base = static_cast<uint32_t>(mesh.positions.size());
+  mesh.positions.insert(mesh.positions.end(), {p0, p1, p2, p3});
+  mesh.triangles.push_back(UVec3(base, base + 1, base + 2));
+  mesh.triangles.push_back(UVec3(base, base + 2, base + 3));
+  mesh.materials.insert(mesh.materials.end(), {material, material});
+}
+
+/// Horizontal square at height y, half-size h, facing +y (or −y).
+void addHorizontalSquare(Mesh& mesh, float y, float h, bool facingUp, uint32_t material) {
+  addQuad(mesh, {-h, y, -h}, {h, y, -h}, {h, y, h}, {-h, y, h}, {0.0f, facingUp ? 1.0f : -1.0f, 0.0f}, material);
+}
+
+/// The cube [−1, 1]³ with all six faces facing inwards.
+void addInwardCube(Mesh& mesh, uint32_t material) {
+  for (int axis = 0; axis < 3; ++axis) {
+    for (float side : {-1.0f, 1.0f}) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      Vec3 corners[4];
+      const float cu[4] = {-1, 1, 1, -1}, cv[4] = {-1, -1, 1, 1};
+      for (int k = 0; k < 4; ++k) {
+        corners[k][axis] = side;
+        corners[k][u] = cu[k];
+        corners[k][v] = cv[k];
+      }
+      Vec3 inward(0.0f);
+      inward[axis] = -side;
+      addQuad(mesh, corners[0], corners[1], corners[2], corners[3], inward, material);
+    }
+  }
+}
+
+CameraDesc lookAt(Vec3 eye, Vec3 target, Vec3 up, float fovDegrees) {
+  CameraDesc c;
+  c.name = "test";
+  c.eye = eye;
+  c.target = target;
+  c.up = up;
+  c.fovYDegrees = fovDegrees;
+  return c;
+}
+
+Scene finished(Scene scene) {
+  scene.sourcePath = "test scene";
+  scene.finalize();
+  return scene;
+}
+
+/// Checks every pixel of a render against a known constant image with a per-pixel z-test
+/// (Šidák-corrected at α = 0.01 over all pixel-channels), and the image mean against
+/// `relativeTolerance`. Also requires the standard error of that mean to be at most a third
+/// of the tolerance, so that passing is meaningful (a 3σ margin) rather than lucky.
+void expectConstantImage(const TraceResult& r, const Rgb& expected, double relativeTolerance, const char* what) {
+  const Image exact(r.radiance.width, r.radiance.height, expected);
+  const Image zero(r.radiance.width, r.radiance.height, Rgb(0.0f));
+  const ImageZTest z = compareImagesZ(r.radiance, r.variance, exact, zero, 0.01);
+  EXPECT_TRUE(z.pass) << what << ": " << z.summary();
+  EXPECT_EQ(r.stats.nanSamples, 0u) << what;
+  for (int c = 0; c < 3; ++c) {
+    double sum = 0.0, variance = 0.0;
+    for (size_t i = 0; i < r.radiance.pixels.size(); ++i) {
+      sum += r.radiance.pixels[i][c];
+      variance += r.variance.pixels[i][c];
+    }
+    const double n = static_cast<double>(r.radiance.pixels.size());
+    const double mean = sum / n, standardError = std::sqrt(variance) / n;
+    EXPECT_NEAR(mean / expected[c], 1.0, relativeTolerance) << what << " channel " << c;
+    EXPECT_LE(standardError / expected[c], relativeTolerance / 3.0) << what << " channel " << c
+                                                                    << ": too noisy for the tolerance";
+  }
+}
+
+// ---- white furnace ------------------------------------------------------------------------
+
+// A closed box whose walls all have albedo a and emit Le (inwards): the radiance everywhere
+// is the Neumann series Le (1 + a + a² + ...) = Le / (1 − a). Deep paths matter (the k-th
+// bounce carries a^k), so maxDepth is set so high that the truncation a^(maxDepth+1) is
+// below 1e-9; Russian roulette ends the paths (mean length 1/(1 − a) bounces) without bias.
+// Tolerance 1 % (the requirement), with the sample count chosen so that the standard
+// error of the image mean is ≤ 1/3 % (checked), for every estimator.
+void runFurnace(float albedo, TraceStrategy strategy, int spp) {
+  Scene s;
+  const Rgb le(0.25f, 0.5f, 1.0f);
+  const uint32_t m = addMaterial(s, Rgb(albedo), le * (1.0f - albedo));  // ⇒ L = le exactly
+  Mesh mesh;
+  mesh.name = "box";
+  addInwardCube(mesh, m);
+  s.meshes.push_back(mesh);
+  const Scene scene = finished(std::move(s));
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  // Camera at the centre looking at a wall (and, through its 90° field, at the edges).
+  const Camera camera(lookAt({0.1f, 0.2f, -0.3f}, {0.5f, -0.2f, 1.0f}, {0, 1, 0}, 90.0f), 8, 8);
+  TraceSettings settings;
+  settings.spp = spp;
+  settings.maxDepth = 1000;  // a^(maxDepth+1) < 1e-45 for a = 0.9: no truncation bias
+  settings.strategy = strategy;
+  settings.seed = 7;
+  const TraceResult r = tracer.render(camera, settings);
+  expectConstantImage(r, le, 0.01, strategyName(strategy));
+}
+
+TEST_F(TraceTest, WhiteFurnaceAlbedoHalf) {
+  // Per-sample relative standard deviation is ≈ 0.7 here, so 64 pixels × 1024 samples give
+  // a mean with standard error ≈ 0.3 %.
+  for (TraceStrategy strategy : {TraceStrategy::Mis, TraceStrategy::NeeOnly, TraceStrategy::BsdfOnly})
+    runFurnace(0.5f, strategy, 1024);
+}
+
+TEST_F(TraceTest, WhiteFurnaceAlbedoPointNine) {
+  // The number of bounces is geometric with mean 10, so the per-sample relative standard
+  // deviation is ≈ 1; 64 × 4096 samples give ≈ 0.2 % standard error of the mean.
+  for (TraceStrategy strategy : {TraceStrategy::Mis, TraceStrategy::NeeOnly, TraceStrategy::BsdfOnly})
+    runFurnace(0.9f, strategy, 4096);
+}
+
+// ---- Lambertian patch under the constant environment -----------------------------------------
+
+// A lone patch facing up under an environment of radiance Le sees Le over its whole upper
+// hemisphere, so its irradiance is π·Le and its outgoing radiance ρ/π · π·Le = ρ·Le, in every
+// direction. The camera looks down at the patch (every pixel on it).
+TEST_F(TraceTest, LambertianPatchUnderConstantEnvironment) {
+  Scene s;
+  const Rgb albedo(0.8f, 0.5f, 0.25f);
+  const Rgb le(0.5f, 1.0f, 2.0f);
+  Mesh mesh;
+  mesh.name = "patch";
+  addHorizontalSquare(mesh, 0.0f, 1.0f, true, addMaterial(s, albedo));
+  s.meshes.push_back(mesh);
+  s.environment.constant = le;
+  const Scene scene = finished(std::move(s));
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  // From √10 units away a 15° field of view spans about ±0.45 of the unit-half-size patch:
+  // every pixel sees it.
+  const Camera camera(lookAt({0.0f, 3.0f, -1.0f}, {0, 0, 0}, {0, 1, 0}, 15.0f), 8, 8);
+  for (TraceStrategy strategy : {TraceStrategy::Mis, TraceStrategy::NeeOnly, TraceStrategy::BsdfOnly}) {
+    TraceSettings settings;
+    settings.spp = 1024;
+    settings.strategy = strategy;
+    const TraceResult r = tracer.render(camera, settings);
+    // 1 %: uniform-sphere NEE (half its samples below the patch) has a per-sample relative
+    // deviation ≈ 1.3, giving a 0.2 % standard error over 64 × 1024 samples.
+    expectConstantImage(r, albedo * le, 0.01, strategyName(strategy));
+  }
+  // Cosine-weighted BSDF sampling of a Lambertian surface under a constant environment is a
+  // zero-variance estimator (weight ρ, incident Le for every sample).
+  TraceSettings settings;
+  settings.spp = 4;
+  settings.strategy = TraceStrategy::BsdfOnly;
+  const TraceResult r = tracer.render(camera, settings);
+  for (const Rgb& v : r.variance.pixels) EXPECT_EQ(v, Rgb(0.0f));
+  for (const Rgb& p : r.radiance.pixels)
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[c], albedo[c] * le[c], 1e-5f * le[c]);  // float rounding
+}
+
+// ---- punctual lights above a Lambertian plane ---------------------------------------------
+
+Scene planeWith(const Light& light, const Rgb& albedo, bool blocker = false) {
+  Scene s;
+  Mesh mesh;
+  mesh.name = "plane";
+  addHorizontalSquare(mesh, 0.0f, 100.0f, true, addMaterial(s, albedo));
+  // A black blocker: it casts a shadow but reflects nothing, so the plane stays lit by the
+  // punctual light alone (no noisy indirect light).
+  if (blocker) addHorizontalSquare(mesh, 1.0f, 0.5f, true, addMaterial(s, Rgb(0.0f)));
+  s.meshes.push_back(mesh);
+  s.lights.push_back(light);
+  return finished(std::move(s));
+}
+
+/// Radiance leaving the plane at (x, 0, 0) towards a viewer above it, estimated with one
+/// deterministic sample per strategy (direct light from one punctual light has no noise).
+Rgb planeRadianceAt(const PathTracer& tracer, float x, TraceStrategy strategy) {
+  const Vec3 target(x, 0.0f, 0.0f);
+  Ray ray;
+  ray.origin = target + Vec3(0.3f, 5.0f, -0.2f);
+  ray.direction = glm::normalize(target - ray.origin);
+  TraceSettings settings;
+  settings.spp = 4;
+  settings.strategy = strategy;
+  const RadianceEstimate e = tracer.estimateRadiance(ray, settings, 1);
+  EXPECT_EQ(e.samples, 4u);
+  EXPECT_EQ(e.varianceOfMean, Rgb(0.0f));  // deterministic: nothing else lights the plane
+  return e.mean;
+}
+
+// A point light of intensity I at height d above a Lambertian plane of albedo ρ: at horizontal
+// offset x the distance is D = √(x² + d²), cos θ = d / D, the irradiance I cos θ / D², and the
+// outgoing radiance ρ/π times that: ρ·I·cos θ / (π D²).
+TEST_F(TraceTest, PointLightAboveLambertianPlane) {
+  const Rgb albedo(0.6f, 0.4f, 0.2f);
+  const Rgb intensity(10.0f, 20.0f, 30.0f);
+  const float d = 2.0f;
+  const Scene scene = planeWith(PointLight{{0.0f, d, 0.0f}, intensity}, albedo);
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  for (TraceStrategy strategy : {TraceStrategy::Mis, TraceStrategy::NeeOnly, TraceStrategy::BsdfOnly}) {
+    for (float x : {0.0f, 1.0f, 2.0f, 4.0f, 8.0f}) {  // θ = 0°, 26.6°, 45°, 63.4°, 76°
+      const float distance = std::sqrt(x * x + d * d);
+      const float cosTheta = d / distance;
+      const Rgb expected = albedo * intensity * cosTheta / (kPi * distance * distance);
+      const Rgb got = planeRadianceAt(tracer, x, strategy);
+      // Single-precision arithmetic along the path: 1e-5 relative.
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(got[c], expected[c], 1e-5f * expected[c]) << strategyName(strategy) << " x=" << x;
+    }
+  }
+}
+
+// A spot light is a point light inside its inner cone and dark outside its outer cone.
+TEST_F(TraceTest, SpotLightConesAboveLambertianPlane) {
+  const Rgb albedo(0.5f);
+  const Rgb intensity(4.0f);
+  SpotLight spot;
+  spot.position = {0.0f, 1.0f, 0.0f};
+  spot.direction = {0.0f, -1.0f, 0.0f};
+  spot.intensity = intensity;
+  spot.innerAngle = 0.5f;  // tan(0.5) ≈ 0.546: x = 0.4 is inside
+  spot.outerAngle = 0.7f;  // tan(0.7) ≈ 0.842: x = 1 is outside
+  const Scene scene = planeWith(spot, albedo);
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  for (float x : {0.0f, 0.4f}) {
+    const float distance = std::sqrt(x * x + 1.0f);
+    const Rgb expected = albedo * intensity * (1.0f / distance) / (kPi * distance * distance);
+    EXPECT_NEAR(planeRadianceAt(tracer, x, TraceStrategy::Mis).r, expected.r, 1e-5f * expected.r);
+  }
+  EXPECT_EQ(planeRadianceAt(tracer, 1.0f, TraceStrategy::Mis), Rgb(0.0f));
+}
+
+// A directional light of irradiance E (on a surface facing it) arriving at angle θ gives
+// radiance ρ·E·cos θ/π everywhere on the plane, and a shadow where a blocker is in the way.
+TEST_F(TraceTest, DirectionalLightAndShadow) {
+  const Rgb albedo(0.7f);
+  const Rgb irradiance(3.0f);
+  const float theta = 0.6f;
+  const Vec3 travel(std::sin(theta), -std::cos(theta), 0.0f);
+  const Scene scene = planeWith(DirectionalLight{travel, irradiance}, albedo, /*blocker=*/true);
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  const Rgb expected = albedo * irradiance * std::cos(theta) / kPi;
+  // Looking back towards the light from (x, 0, 0) the ray reaches height 1 at x − tan θ, so
+  // x = tan θ ≈ 0.68 lies in the middle of the shadow of the blocker (|x| ≤ 0.5 at height 1)
+  // and x = 5 far outside it.
+  EXPECT_NEAR(planeRadianceAt(tracer, 5.0f, TraceStrategy::Mis).g, expected.g, 1e-5f * expected.g);
+  EXPECT_EQ(planeRadianceAt(tracer, std::tan(theta), TraceStrategy::Mis), Rgb(0.0f));
+}
+
+// ---- one-sided emission ------------------------------------------------------------------------
+
+TEST_F(TraceTest, EmissionIsOneSidedUnlessTwoSided) {
+  for (bool twoSided : {false, true}) {
+    Scene s;
+    Mesh mesh;
+    mesh.name = "emitter";
+    const Rgb le(2.0f, 3.0f, 4.0f);
+    addHorizontalSquare(mesh, 0.0f, 1.0f, /*facingUp=*/true, addMaterial(s, Rgb(0.0f), le, twoSided));
+    s.meshes.push_back(mesh);
+    const Scene scene = finished(std::move(s));
+    const Accel accel(scene);
+    const PathTracer tracer(scene, accel);
+    TraceSettings settings;
+    settings.spp = 2;
+    Ray fromAbove{{0.1f, 1.0f, 0.2f}, {0.0f, -1.0f, 0.0f}}, fromBelow{{0.1f, -1.0f, 0.2f}, {0.0f, 1.0f, 0.0f}};
+    EXPECT_EQ(tracer.estimateRadiance(fromAbove, settings, 0).mean, le);
+    EXPECT_EQ(tracer.estimateRadiance(fromBelow, settings, 0).mean, twoSided ? le : Rgb(0.0f));
+  }
+}
+
+// ---- non-finite samples are counted, never silently dropped ---------------------------------------
+
+// An emitter of area A = 100 and radiance Le = 5e35 (finite, and so is its power π·A·Le ≈
+// 1.6e38, so the scene is valid) 0.1 units above a diffuse floor: next-event estimation right
+// below it computes (ρ/π)·Le·A·cos²/r² ≈ 0.25 · 5e35 · 100 / 0.01 ≈ 1.3e39, which overflows
+// float to +inf. Those samples must be excluded from the pixels AND reported.
+TEST_F(TraceTest, NonFiniteSamplesAreCountedAndReported) {
+  Scene s;
+  Mesh mesh;
+  mesh.name = "overflow";
+  addHorizontalSquare(mesh, 0.0f, 100.0f, true, addMaterial(s, Rgb(0.8f)));
+  addHorizontalSquare(mesh, 0.1f, 5.0f, false, addMaterial(s, Rgb(0.0f), Rgb(5e35f)));
+  s.meshes.push_back(mesh);
+  const Scene scene = finished(std::move(s));
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  // Looking into the gap between floor and emitter from the side.
+  const Camera camera(lookAt({0.0f, 0.05f, -8.0f}, {0.0f, 0.0f, 0.0f}, {0, 1, 0}, 30.0f), 4, 4);
+  TraceSettings settings;
+  settings.spp = 4;
+  settings.strategy = TraceStrategy::NeeOnly;
+  const TraceResult r = tracer.render(camera, settings);
+  EXPECT_GT(r.stats.nanSamples, 0u);
+  ASSERT_GE(r.stats.firstNanX, 0);
+  ASSERT_GE(r.stats.firstNanY, 0);
+  for (const Rgb& p : r.radiance.pixels) EXPECT_TRUE(isFinite(p));
+  // The replay finds the same dropped samples at the reported pixel.
+  const RadianceEstimate e = tracer.renderPixel(camera, settings, r.stats.firstNanX, r.stats.firstNanY);
+  EXPECT_GT(e.nanSamples, 0u);
+}
+
+// ---- the Cornell box --------------------------------------------------------------------------
+
+struct Cornell {
+  Scene scene = makeCornellBox();
+  Accel accel{scene};
+  PathTracer tracer{scene, accel};
+  Camera camera(int size) const { return Camera(scene.cameras.front(), size, size); }
+};
+
+TraceResult renderCornell(const Cornell& box, int size, int spp, TraceStrategy strategy, uint64_t seed) {
+  TraceSettings settings;
+  settings.spp = spp;
+  settings.strategy = strategy;
+  settings.seed = seed;
+  return box.tracer.render(box.camera(size), settings);
+}
+
+// Three different estimators of the same integral must agree within their noise. The
+// images are compared pixel by pixel (Šidák-corrected z-test) and as wholes (see
+// compareImagesZ), at α = 0.01. BSDF sampling alone finds the small light rarely (≈ 1 % of
+// the hemisphere), so it gets four times the samples.
+TEST_F(TraceTest, CornellStrategiesAgree) {
+  const Cornell box;
+  const TraceResult mis = renderCornell(box, 16, 256, TraceStrategy::Mis, 1);
+  const TraceResult nee = renderCornell(box, 16, 256, TraceStrategy::NeeOnly, 2);
+  const TraceResult bsdf = renderCornell(box, 16, 1024, TraceStrategy::BsdfOnly, 3);
+  const ImageZTest misNee = compareImagesZ(mis.radiance, mis.variance, nee.radiance, nee.variance);
+  const ImageZTest misBsdf = compareImagesZ(mis.radiance, mis.variance, bsdf.radiance, bsdf.variance);
+  const ImageZTest neeBsdf = compareImagesZ(nee.radiance, nee.variance, bsdf.radiance, bsdf.variance);
+  EXPECT_TRUE(misNee.pass) << "mis vs nee " << misNee.summary();
+  EXPECT_TRUE(misBsdf.pass) << "mis vs bsdf " << misBsdf.summary();
+  EXPECT_TRUE(neeBsdf.pass) << "nee vs bsdf " << neeBsdf.summary();
+  // MIS should never be much noisier than either strategy alone (it is the point of MIS);
+  // a broken weight typically shows up as a large variance increase.
+  double varMis = 0.0, varNee = 0.0;
+  for (size_t i = 0; i < mis.variance.pixels.size(); ++i) {
+    varMis += luminance(mis.variance.pixels[i]);
+    varNee += luminance(nee.variance.pixels[i]);
+  }
+  EXPECT_LT(varMis, 1.5 * varNee);
+}
+
+// The reference image was rendered once by the program itself with many samples (see
+// tests/data/trace/README.md for the command); a fresh low-sample render must be consistent
+// with it, and the same render scaled by 1.05 must be rejected (so the test can fail).
+TEST_F(TraceTest, CornellMatchesStoredReference) {
+  const std::string dir = std::string(PLENOPTIC_TEST_DATA_DIR) + "/trace/";
+  const Image reference = readImage(dir + "cornell_ref_32.pfm");
+  const Image referenceVariance = readImage(dir + "cornell_ref_32_variance.pfm");
+  const Cornell box;
+  const TraceResult r = renderCornell(box, 32, 128, TraceStrategy::Mis, 99);
+  const ImageZTest z = compareImagesZ(r.radiance, r.variance, reference, referenceVariance);
+  EXPECT_TRUE(z.pass) << z.summary();
+
+  Image scaled = r.radiance, scaledVariance = r.variance;
+  for (Rgb& p : scaled.pixels) p *= 1.05f;
+  for (Rgb& v : scaledVariance.pixels) v *= 1.05f * 1.05f;
+  const ImageZTest rejected = compareImagesZ(scaled, scaledVariance, reference, referenceVariance);
+  EXPECT_FALSE(rejected.pass) << rejected.summary();
+}
+
+// Streams are keyed by (pixel, sample, seed): the thread count and schedule cannot change a
+// single bit of the image, and renderPixel() replays exactly what render() computed.
+TEST_F(TraceTest, SameSeedSameImageForAnyThreadCount) {
+  const Cornell box;
+  TraceResult one, two, otherSeed;
+  {
+    ThreadPool pool(1);
+    one = renderCornell(box, 24, 8, TraceStrategy::Mis, 5);
+  }
+  {
+    ThreadPool pool(2);
+    two = renderCornell(box, 24, 8, TraceStrategy::Mis, 5);
+    otherSeed = renderCornell(box, 24, 8, TraceStrategy::Mis, 6);
+  }
+  EXPECT_EQ(one.radiance.pixels, two.radiance.pixels);
+  EXPECT_EQ(one.variance.pixels, two.variance.pixels);
+  EXPECT_NE(one.radiance.pixels, otherSeed.radiance.pixels);
+
+  TraceSettings settings;
+  settings.spp = 8;
+  settings.seed = 5;
+  for (auto [x, y] : {std::pair{0, 0}, std::pair{11, 17}, std::pair{23, 23}}) {
+    const RadianceEstimate e = box.tracer.renderPixel(box.camera(24), settings, x, y);
+    EXPECT_EQ(e.mean, one.radiance.at(x, y)) << x << "," << y;
+    EXPECT_EQ(e.varianceOfMean, one.variance.at(x, y)) << x << "," << y;
+  }
+}
+
+// ---- the statistics themselves --------------------------------------------------------------
+
+TEST(ImageZTest, NormalQuantiles) {
+  EXPECT_NEAR(twoSidedNormalQuantile(0.05), 1.959964, 1e-5);
+  EXPECT_NEAR(twoSidedNormalQuantile(0.01), 2.575829, 1e-5);
+  EXPECT_NEAR(twoSidedNormalQuantile(1e-6), 4.891638, 1e-5);
+}
+
+TEST(ImageZTest, DetectsLocalAndGlobalDifferences) {
+  const Image variance(10, 10, Rgb(0.01f));  // standard error 0.1 per pixel and image
+  const Image a(10, 10, Rgb(1.0f));
+  // Each pixel 0.2 σ off: no single pixel is significant, the whole image is (z = 0.2·√300/√2).
+  const Image slightlyBrighter(10, 10, Rgb(1.02f));
+  const ImageZTest global = compareImagesZ(slightlyBrighter, variance, a, variance);
+  EXPECT_FALSE(global.pass) << global.summary();
+  EXPECT_LT(global.maxAbsZ, global.pixelThreshold);
+  // One pixel 10 σ off.
+  Image outlier = a;
+  outlier.at(3, 4).g += 1.0f * std::sqrt(0.02f) * 10.0f;
+  const ImageZTest local = compareImagesZ(outlier, variance, a, variance);
+  EXPECT_FALSE(local.pass) << local.summary();
+  EXPECT_EQ(local.worstX, 3);
+  EXPECT_EQ(local.worstY, 4);
+  EXPECT_EQ(local.worstChannel, 1);
+  EXPECT_TRUE(compareImagesZ(a, variance, a, variance).pass);
+}
+
+}  // namespace
+}  // namespace pl
