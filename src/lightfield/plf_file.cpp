@@ -1,0 +1,988 @@
+// The .plf light-field file: layout in plf_file.h.
+#include "lightfield/plf_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cstring>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <span>
+#include <type_traits>
+
+#include "core/error.h"
+
+namespace pl {
+
+// The file is little-endian and arrays are copied to and from memory as they are, so the
+// host must be little-endian too (every platform plenoptic targets is).
+static_assert(std::endian::native == std::endian::little, ".plf I/O assumes a little-endian host");
+static_assert(sizeof(Vec2) == 8 && sizeof(Vec3) == 12 && sizeof(UVec3) == 12, "packed GLM vectors expected");
+static_assert(std::is_trivially_copyable_v<Vec3> && std::is_trivially_copyable_v<UVec3>);
+
+// ---------------------------------------------------------------------------------------
+// XXH64 (xxHash specification, https://github.com/Cyan4973/xxHash/blob/dev/doc/xxhash_spec.md):
+// four 64-bit accumulator lanes consume 32-byte stripes; the tail and the length are mixed
+// in at the end and the result is avalanched. ~10 GB/s here, so verifying a file costs far
+// less than reading it.
+namespace {
+
+constexpr uint64_t kPrime1 = 0x9E3779B185EBCA87ull;
+constexpr uint64_t kPrime2 = 0xC2B2AE3D27D4EB4Full;
+constexpr uint64_t kPrime3 = 0x165667B19E3779F9ull;
+constexpr uint64_t kPrime4 = 0x85EBCA77C2B2AE63ull;
+constexpr uint64_t kPrime5 = 0x27D4EB2F165667C5ull;
+
+uint64_t load64(const unsigned char* p) {
+  uint64_t v;
+  std::memcpy(&v, p, 8);
+  return v;
+}
+uint32_t load32(const unsigned char* p) {
+  uint32_t v;
+  std::memcpy(&v, p, 4);
+  return v;
+}
+uint64_t xxhRound(uint64_t acc, uint64_t input) {
+  acc += input * kPrime2;
+  acc = std::rotl(acc, 31);
+  return acc * kPrime1;
+}
+uint64_t xxhMerge(uint64_t acc, uint64_t lane) {
+  acc ^= xxhRound(0, lane);
+  return acc * kPrime1 + kPrime4;
+}
+
+}  // namespace
+
+Xxh64Stream::Xxh64Stream(uint64_t seed) : seed_(seed) {
+  lanes_[0] = seed + kPrime1 + kPrime2;
+  lanes_[1] = seed + kPrime2;
+  lanes_[2] = seed;
+  lanes_[3] = seed - kPrime1;
+}
+
+void Xxh64Stream::update(const void* data, size_t size) {
+  auto* p = static_cast<const unsigned char*>(data);
+  totalLength_ += size;
+  auto consumeStripe = [this](const unsigned char* stripe) {
+    for (int lane = 0; lane < 4; ++lane) lanes_[lane] = xxhRound(lanes_[lane], load64(stripe + 8 * lane));
+  };
+  if (buffered_ > 0) {
+    const size_t take = std::min(size, sizeof(buffer_) - buffered_);
+    std::memcpy(buffer_ + buffered_, p, take);
+    buffered_ += take;
+    p += take;
+    size -= take;
+    if (buffered_ < sizeof(buffer_)) return;
+    consumeStripe(buffer_);
+    buffered_ = 0;
+  }
+  for (; size >= 32; p += 32, size -= 32) consumeStripe(p);
+  std::memcpy(buffer_, p, size);
+  buffered_ = size;
+}
+
+uint64_t Xxh64Stream::digest() const {
+  uint64_t h;
+  if (totalLength_ >= 32) {
+    h = std::rotl(lanes_[0], 1) + std::rotl(lanes_[1], 7) + std::rotl(lanes_[2], 12) + std::rotl(lanes_[3], 18);
+    for (uint64_t lane : lanes_) h = xxhMerge(h, lane);
+  } else {
+    h = seed_ + kPrime5;
+  }
+  h += totalLength_;
+  const unsigned char* p = buffer_;
+  size_t size = buffered_;
+  for (; size >= 8; p += 8, size -= 8) h = std::rotl(h ^ xxhRound(0, load64(p)), 27) * kPrime1 + kPrime4;
+  if (size >= 4) {
+    h = std::rotl(h ^ uint64_t(load32(p)) * kPrime1, 23) * kPrime2 + kPrime3;
+    p += 4;
+    size -= 4;
+  }
+  for (; size > 0; ++p, --size) h = std::rotl(h ^ uint64_t(*p) * kPrime5, 11) * kPrime1;
+  h ^= h >> 33;
+  h *= kPrime2;
+  h ^= h >> 29;
+  h *= kPrime3;
+  h ^= h >> 32;
+  return h;
+}
+
+uint64_t xxh64(const void* data, size_t size, uint64_t seed) {
+  Xxh64Stream stream(seed);
+  stream.update(data, size);
+  return stream.digest();
+}
+
+// ---------------------------------------------------------------------------------------
+namespace {
+
+constexpr size_t kSectionAlignment = 64;
+/// No file of this version has more sections than this; a larger count is corruption.
+constexpr uint32_t kMaxSections = 64;
+/// Longest string (names, paths) a reader accepts.
+constexpr uint32_t kMaxStringBytes = 1u << 20;
+
+enum SectionIndex { kScene = 0, kCharts, kTriangleCharts, kValues, kMeta, kSectionKinds };
+constexpr const char* kSectionIds[kSectionKinds] = {"SCNE", "CHRT", "TRCH", "VALS", "META"};
+constexpr const char* kSectionNames[kSectionKinds] = {"scene", "charts", "triangle charts", "values",
+                                                      "metadata"};
+
+uint64_t alignUp(uint64_t x) { return (x + kSectionAlignment - 1) / kSectionAlignment * kSectionAlignment; }
+
+/// Appends little-endian fields to a byte buffer.
+class ByteWriter {
+ public:
+  template <typename T>
+  void put(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto* p = reinterpret_cast<const unsigned char*>(&value);
+    bytes_.insert(bytes_.end(), p, p + sizeof(T));
+  }
+  void putString(const std::string& s) {
+    put(uint32_t(s.size()));
+    bytes_.insert(bytes_.end(), s.begin(), s.end());
+  }
+  template <typename T>
+  void putArray(const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    put(uint64_t(v.size()));
+    const auto* p = reinterpret_cast<const unsigned char*>(v.data());
+    bytes_.insert(bytes_.end(), p, p + v.size() * sizeof(T));
+  }
+  std::vector<unsigned char>& bytes() { return bytes_; }
+
+ private:
+  std::vector<unsigned char> bytes_;
+};
+
+/// Reads fields back, checking every size against the bytes that remain, so a corrupt count
+/// is reported instead of allocating or reading past the end.
+class ByteReader {
+ public:
+  ByteReader(std::span<const unsigned char> bytes, const std::string& path, const char* section)
+      : bytes_(bytes), path_(path), section_(section) {}
+
+  template <typename T>
+  T get() {
+    static_assert(std::is_trivially_copyable_v<T>);
+    need(sizeof(T), "a field");
+    T value;
+    std::memcpy(&value, bytes_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return value;
+  }
+  std::string getString() {
+    const uint32_t length = get<uint32_t>();
+    if (length > kMaxStringBytes) corrupt(fmt::format("a string of {} bytes", length));
+    need(length, "a string");
+    std::string s(reinterpret_cast<const char*>(bytes_.data() + pos_), length);
+    pos_ += length;
+    return s;
+  }
+  /// A u64 element count whose elements (elementBytes each) must fit in what remains.
+  uint64_t getCount(uint64_t elementBytes, const char* what) {
+    const uint64_t count = get<uint64_t>();
+    if (elementBytes > 0 && count > remaining() / elementBytes)
+      corrupt(fmt::format("{} {} of {} bytes each, but only {} bytes remain", count, what, elementBytes,
+                          remaining()));
+    return count;
+  }
+  template <typename T>
+  std::vector<T> getArray(const char* what) {
+    const uint64_t count = getCount(sizeof(T), what);
+    std::vector<T> v(count);
+    std::memcpy(v.data(), bytes_.data() + pos_, count * sizeof(T));
+    pos_ += count * sizeof(T);
+    return v;
+  }
+  uint64_t remaining() const { return bytes_.size() - pos_; }
+  void expectEnd() {
+    if (pos_ != bytes_.size()) corrupt(fmt::format("{} unexpected bytes after the last field", remaining()));
+  }
+  [[noreturn]] void corrupt(const std::string& problem) const {
+    fail("{}: corrupt {} section at byte {}: {}", path_, section_, pos_, problem);
+  }
+
+ private:
+  void need(uint64_t bytes, const char* what) {
+    if (bytes > remaining())
+      corrupt(fmt::format("{} of {} bytes, but only {} bytes remain", what, bytes, remaining()));
+  }
+
+  std::span<const unsigned char> bytes_;
+  const std::string& path_;
+  const char* section_;
+  uint64_t pos_ = 0;
+};
+
+// --- Scene -------------------------------------------------------------------------------
+
+void putBsdf(ByteWriter& w, const Bsdf& bsdf) {
+  w.put(uint32_t(bsdf.index()));
+  std::visit(
+      [&](const auto& b) {
+        using T = std::decay_t<decltype(b)>;
+        if constexpr (std::is_same_v<T, LambertBsdf>) {
+          w.put(b.albedo);
+        } else if constexpr (std::is_same_v<T, MirrorBsdf>) {
+          w.put(b.reflectance);
+          w.put(uint8_t(b.fresnel));
+        } else if constexpr (std::is_same_v<T, BlinnPhongBsdf>) {
+          w.put(b.diffuse);
+          w.put(b.specular);
+          w.put(b.exponent);
+        } else {
+          static_assert(std::is_same_v<T, GgxBsdf>, "a new BSDF model needs its .plf encoding");
+          w.put(b.diffuse);
+          w.put(b.f0);
+          w.put(b.alpha);
+        }
+      },
+      bsdf);
+}
+
+Bsdf getBsdf(ByteReader& r) {
+  const uint32_t model = r.get<uint32_t>();
+  switch (model) {
+    case 0: return LambertBsdf{r.get<Rgb>()};
+    case 1: {
+      MirrorBsdf b;
+      b.reflectance = r.get<Rgb>();
+      b.fresnel = r.get<uint8_t>() != 0;
+      return b;
+    }
+    case 2: {
+      BlinnPhongBsdf b;
+      b.diffuse = r.get<Rgb>();
+      b.specular = r.get<Rgb>();
+      b.exponent = r.get<float>();
+      return b;
+    }
+    case 3: {
+      GgxBsdf b;
+      b.diffuse = r.get<Rgb>();
+      b.f0 = r.get<Rgb>();
+      b.alpha = r.get<float>();
+      return b;
+    }
+    default: r.corrupt(fmt::format("unknown BSDF model {}", model));
+  }
+}
+static_assert(std::variant_size_v<Bsdf> == 4, "getBsdf must decode every BSDF model");
+
+void putLight(ByteWriter& w, const Light& light) {
+  w.put(uint32_t(light.index()));
+  std::visit(
+      [&](const auto& l) {
+        using T = std::decay_t<decltype(l)>;
+        if constexpr (std::is_same_v<T, PointLight>) {
+          w.put(l.position);
+          w.put(l.intensity);
+        } else if constexpr (std::is_same_v<T, SpotLight>) {
+          w.put(l.position);
+          w.put(l.direction);
+          w.put(l.intensity);
+          w.put(l.innerAngle);
+          w.put(l.outerAngle);
+        } else {
+          static_assert(std::is_same_v<T, DirectionalLight>, "a new light type needs its .plf encoding");
+          w.put(l.direction);
+          w.put(l.irradiance);
+        }
+      },
+      light);
+}
+
+Light getLight(ByteReader& r) {
+  const uint32_t type = r.get<uint32_t>();
+  switch (type) {
+    case 0: {
+      PointLight l;
+      l.position = r.get<Vec3>();
+      l.intensity = r.get<Rgb>();
+      return l;
+    }
+    case 1: {
+      SpotLight l;
+      l.position = r.get<Vec3>();
+      l.direction = r.get<Vec3>();
+      l.intensity = r.get<Rgb>();
+      l.innerAngle = r.get<float>();
+      l.outerAngle = r.get<float>();
+      return l;
+    }
+    case 2: {
+      DirectionalLight l;
+      l.direction = r.get<Vec3>();
+      l.irradiance = r.get<Rgb>();
+      return l;
+    }
+    default: r.corrupt(fmt::format("unknown light type {}", type));
+  }
+}
+static_assert(std::variant_size_v<Light> == 3, "getLight must decode every light type");
+
+std::vector<unsigned char> encodeScene(const Scene& scene) {
+  ByteWriter w;
+  w.putString(scene.sourcePath);
+  w.put(uint64_t(scene.meshes.size()));
+  for (const Mesh& m : scene.meshes) {
+    w.putString(m.name);
+    w.putArray(m.positions);
+    w.putArray(m.normals);
+    w.putArray(m.uvs);
+    w.putArray(m.triangles);
+    w.putArray(m.materials);
+  }
+  w.put(uint64_t(scene.materials.size()));
+  for (const Material& m : scene.materials) {
+    w.putString(m.name);
+    putBsdf(w, m.bsdf);
+    w.put(int32_t(m.albedoTexture));
+    w.put(m.emission);
+    w.put(uint8_t(m.twoSidedEmission));
+  }
+  w.put(uint64_t(scene.textures.size()));
+  for (const Texture& t : scene.textures) {
+    w.putString(t.path);
+    w.put(int32_t(t.image.width));
+    w.put(int32_t(t.image.height));
+    w.putArray(t.image.pixels);
+    w.put(t.average);
+  }
+  w.put(uint64_t(scene.lights.size()));
+  for (const Light& l : scene.lights) putLight(w, l);
+  w.put(uint64_t(scene.cameras.size()));
+  for (const CameraDesc& c : scene.cameras) {
+    w.putString(c.name);
+    w.put(c.eye);
+    w.put(c.target);
+    w.put(c.up);
+    w.put(c.fovYDegrees);
+    w.put(c.fNumber);
+    w.put(c.focusDistance);
+    w.put(c.focalLengthMm);
+    w.put(uint8_t(c.aspectRatio.has_value()));
+    w.put(c.aspectRatio.value_or(0.0f));
+  }
+  w.put(scene.environment.constant);
+  return std::move(w.bytes());
+}
+
+// Smallest encoded size of one element, used to bound counts before allocating.
+constexpr uint64_t kMinMeshBytes = 4 + 5 * 8;
+constexpr uint64_t kMinMaterialBytes = 4 + 4 + 12 + 4 + 12 + 1;
+constexpr uint64_t kMinTextureBytes = 4 + 4 + 4 + 8 + 12;
+constexpr uint64_t kMinLightBytes = 4 + 24;
+constexpr uint64_t kMinCameraBytes = 4 + 36 + 16 + 1 + 4;
+
+/// Decodes SCNE and checks every index and size; the scene is ready for an Accel.
+Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path) {
+  ByteReader r(bytes, path, kSectionNames[kScene]);
+  Scene scene;
+  scene.sourcePath = r.getString();
+  scene.meshes.resize(r.getCount(kMinMeshBytes, "meshes"));
+  for (Mesh& m : scene.meshes) {
+    m.name = r.getString();
+    m.positions = r.getArray<Vec3>("positions");
+    m.normals = r.getArray<Vec3>("normals");
+    m.uvs = r.getArray<Vec2>("uvs");
+    m.triangles = r.getArray<UVec3>("triangles");
+    m.materials = r.getArray<uint32_t>("triangle materials");
+  }
+  scene.materials.resize(r.getCount(kMinMaterialBytes, "materials"));
+  for (Material& m : scene.materials) {
+    m.name = r.getString();
+    m.bsdf = getBsdf(r);
+    m.albedoTexture = r.get<int32_t>();
+    m.emission = r.get<Rgb>();
+    m.twoSidedEmission = r.get<uint8_t>() != 0;
+  }
+  scene.textures.resize(r.getCount(kMinTextureBytes, "textures"));
+  for (Texture& t : scene.textures) {
+    t.path = r.getString();
+    t.image.width = r.get<int32_t>();
+    t.image.height = r.get<int32_t>();
+    t.image.pixels = r.getArray<Rgb>("texels");
+    t.average = r.get<Rgb>();
+    if (t.image.width <= 0 || t.image.height <= 0 ||
+        uint64_t(t.image.width) * uint64_t(t.image.height) != t.image.pixels.size())
+      r.corrupt(fmt::format("texture '{}' is {}×{} but holds {} texels", t.path, t.image.width, t.image.height,
+                            t.image.pixels.size()));
+  }
+  scene.lights.resize(r.getCount(kMinLightBytes, "lights"));
+  for (Light& l : scene.lights) l = getLight(r);
+  scene.cameras.resize(r.getCount(kMinCameraBytes, "cameras"));
+  for (CameraDesc& c : scene.cameras) {
+    c.name = r.getString();
+    c.eye = r.get<Vec3>();
+    c.target = r.get<Vec3>();
+    c.up = r.get<Vec3>();
+    c.fovYDegrees = r.get<float>();
+    c.fNumber = r.get<float>();
+    c.focusDistance = r.get<float>();
+    c.focalLengthMm = r.get<float>();
+    const bool hasAspect = r.get<uint8_t>() != 0;
+    const float aspect = r.get<float>();
+    if (hasAspect) c.aspectRatio = aspect;
+  }
+  scene.environment.constant = r.get<Rgb>();
+  r.expectEnd();
+
+  // Cross-references. The writer only ever stores a finalized scene, so any violation means
+  // the file was produced by something else or damaged in a way the checksum missed.
+  for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+    Mesh& m = scene.meshes[mi];
+    const size_t vertices = m.positions.size();
+    if ((!m.normals.empty() && m.normals.size() != vertices) || (!m.uvs.empty() && m.uvs.size() != vertices))
+      r.corrupt(fmt::format("mesh {} has {} positions but {} normals and {} uvs", mi, vertices, m.normals.size(),
+                            m.uvs.size()));
+    if (m.materials.size() != m.triangles.size())
+      r.corrupt(fmt::format("mesh {} has {} triangles but {} triangle materials", mi, m.triangles.size(),
+                            m.materials.size()));
+    for (const Vec3& p : m.positions)
+      if (!isFinite(p)) r.corrupt(fmt::format("mesh {} has a non-finite vertex", mi));
+    for (size_t t = 0; t < m.triangles.size(); ++t) {
+      const UVec3& tri = m.triangles[t];
+      if (tri.x >= vertices || tri.y >= vertices || tri.z >= vertices)
+        r.corrupt(fmt::format("mesh {} triangle {} indexes a vertex beyond its {} vertices", mi, t, vertices));
+      if (m.materials[t] >= scene.materials.size())
+        r.corrupt(fmt::format("mesh {} triangle {} has material {} of {}", mi, t, m.materials[t],
+                              scene.materials.size()));
+    }
+    // Embree reads 16 bytes at the last vertex: keep one element of padding (see scene.h).
+    m.positions.reserve(vertices + 1);
+  }
+  for (const Material& m : scene.materials)
+    if (m.albedoTexture < -1 || m.albedoTexture >= int64_t(scene.textures.size()))
+      r.corrupt(fmt::format("material '{}' uses texture {} of {}", m.name, m.albedoTexture, scene.textures.size()));
+  return scene;
+}
+
+// --- Charts ------------------------------------------------------------------------------
+
+constexpr uint64_t kChartRecordBytes = 4 + 1 + 4 * 12 + 4 + 3 * 4 + 2 * 8;
+
+std::vector<unsigned char> encodeCharts(const std::vector<Chart>& charts) {
+  ByteWriter w;
+  w.put(uint64_t(charts.size()));
+  for (const Chart& c : charts) {
+    w.put(c.material);
+    w.put(uint8_t(c.kind));
+    w.put(c.origin);
+    w.put(c.axisU);
+    w.put(c.axisV);
+    w.put(c.normal);
+    w.put(c.tixelSize);
+    w.put(c.resU);
+    w.put(c.resV);
+    w.put(c.dirRes);
+    w.put(c.firstTixel);
+    w.put(c.firstValue);
+  }
+  return std::move(w.bytes());
+}
+
+/// Decodes CHRT; checks each chart's own fields and its material index.
+std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std::string& path, size_t materials) {
+  ByteReader r(bytes, path, kSectionNames[kCharts]);
+  std::vector<Chart> charts(r.getCount(kChartRecordBytes, "charts"));
+  for (size_t i = 0; i < charts.size(); ++i) {
+    Chart& c = charts[i];
+    c.material = r.get<uint32_t>();
+    const uint8_t kind = r.get<uint8_t>();
+    if (kind > uint8_t(ChartKind::Specular)) r.corrupt(fmt::format("chart {} has unknown kind {}", i, kind));
+    c.kind = ChartKind(kind);
+    c.origin = r.get<Vec3>();
+    c.axisU = r.get<Vec3>();
+    c.axisV = r.get<Vec3>();
+    c.normal = r.get<Vec3>();
+    c.tixelSize = r.get<float>();
+    c.resU = r.get<uint32_t>();
+    c.resV = r.get<uint32_t>();
+    c.dirRes = r.get<uint32_t>();
+    c.firstTixel = r.get<uint64_t>();
+    c.firstValue = r.get<uint64_t>();
+    if (c.material >= materials) r.corrupt(fmt::format("chart {} has material {} of {}", i, c.material, materials));
+    if (!isFinite(c.origin) || !isFinite(c.axisU) || !isFinite(c.axisV) || !isFinite(c.normal) ||
+        !(c.tixelSize > 0.0f) || !std::isfinite(c.tixelSize))
+      r.corrupt(fmt::format("chart {} has a non-finite frame or tixel size", i));
+    if (c.resU == 0 || c.resV == 0) r.corrupt(fmt::format("chart {} has an empty {}×{} grid", i, c.resU, c.resV));
+    const bool dirResFits = c.kind == ChartKind::Diffuse    ? c.dirRes == 1
+                            : c.kind == ChartKind::Specular ? c.dirRes == 0
+                                                            : c.dirRes >= 1;
+    if (!dirResFits) r.corrupt(fmt::format("chart {} of kind {} has direction resolution {}", i, kind, c.dirRes));
+  }
+  r.expectEnd();
+  return charts;
+}
+
+/// Checks that every chart's tixels and values lie inside the light field's arrays.
+void checkChartRanges(const std::vector<Chart>& charts, uint64_t valueCount, const std::string& path) {
+  for (size_t i = 0; i < charts.size(); ++i) {
+    const Chart& c = charts[i];
+    const uint64_t tixels = c.tixelCount();  // < 2^64: both factors are < 2^32
+    const uint64_t perTixel = c.valuesPerTixel();
+    if (perTixel == 0) continue;
+    if (tixels > valueCount / perTixel || c.firstValue > valueCount - tixels * perTixel)
+      fail("{}: corrupt charts section: chart {} needs values [{}, {} + {}·{}) but the file holds {} values", path, i,
+           c.firstValue, c.firstValue, tixels, perTixel, valueCount);
+  }
+}
+
+std::vector<unsigned char> encodeTriangleCharts(const std::vector<std::vector<uint32_t>>& triangleChart) {
+  ByteWriter w;
+  w.put(uint64_t(triangleChart.size()));
+  for (const auto& mesh : triangleChart) w.putArray(mesh);
+  return std::move(w.bytes());
+}
+
+std::vector<std::vector<uint32_t>> decodeTriangleCharts(std::span<const unsigned char> bytes, const std::string& path,
+                                                        const Scene& scene, size_t charts) {
+  ByteReader r(bytes, path, kSectionNames[kTriangleCharts]);
+  std::vector<std::vector<uint32_t>> triangleChart(r.getCount(8, "meshes"));
+  if (triangleChart.size() != scene.meshes.size())
+    r.corrupt(fmt::format("{} meshes, but the scene has {}", triangleChart.size(), scene.meshes.size()));
+  for (size_t m = 0; m < triangleChart.size(); ++m) {
+    triangleChart[m] = r.getArray<uint32_t>("triangle charts");
+    if (triangleChart[m].size() != scene.meshes[m].triangles.size())
+      r.corrupt(fmt::format("mesh {} maps {} triangles, but it has {}", m, triangleChart[m].size(),
+                            scene.meshes[m].triangles.size()));
+    for (size_t t = 0; t < triangleChart[m].size(); ++t)
+      if (triangleChart[m][t] >= charts)
+        r.corrupt(fmt::format("mesh {} triangle {} maps to chart {} of {}", m, t, triangleChart[m][t], charts));
+  }
+  r.expectEnd();
+  return triangleChart;
+}
+
+// --- Metadata ----------------------------------------------------------------------------
+
+nlohmann::json settingsToJson(const BakeSettings& s) {
+  return {{"preset", s.preset},
+          {"tixels_per_unit", s.tixelsPerUnit},
+          {"max_tixels_per_chart_side", s.maxTixelsPerChartSide},
+          {"tixels_across_scene", s.tixelsAcrossScene},
+          {"gather_directions", s.gatherDirections},
+          {"glossy_dir_res", s.glossyDirRes},
+          {"tolerance", s.tolerance},
+          {"max_iterations", s.maxIterations},
+          {"mirror_depth", s.mirrorDepth},
+          {"seed", s.seed}};
+}
+
+nlohmann::json statsToJson(const BakeStats& s) {
+  return {{"seconds", s.seconds},
+          {"visibility_seconds", s.visibilitySeconds},
+          {"propagation_seconds", s.propagationSeconds},
+          {"iterations", s.iterations},
+          {"residual", s.residual},
+          {"tixels", s.tixels},
+          {"values", s.values},
+          {"visibility_rays", s.visibilityRays},
+          {"peak_rss_bytes", s.peakRssBytes},
+          {"reused_visibility", s.reusedVisibility}};
+}
+
+std::vector<unsigned char> encodeMeta(const LightField& lf) {
+  const nlohmann::json meta = {{"writer", "plenoptic 0.1.0"},
+                               {"settings", settingsToJson(lf.settings)},
+                               {"stats", statsToJson(lf.stats)}};
+  const std::string text = meta.dump(2);
+  return {text.begin(), text.end()};
+}
+
+/// Keys a newer writer may add are ignored; keys it dropped keep their defaults.
+template <typename T>
+void readKey(const nlohmann::json& object, const char* key, T& field) {
+  if (auto it = object.find(key); it != object.end()) field = it->get<T>();
+}
+
+void decodeMeta(std::span<const unsigned char> bytes, const std::string& path, BakeSettings& settings,
+                BakeStats& stats) {
+  try {
+    const auto meta = nlohmann::json::parse(bytes.begin(), bytes.end());
+    const auto& s = meta.at("settings");
+    readKey(s, "preset", settings.preset);
+    readKey(s, "tixels_per_unit", settings.tixelsPerUnit);
+    readKey(s, "max_tixels_per_chart_side", settings.maxTixelsPerChartSide);
+    readKey(s, "tixels_across_scene", settings.tixelsAcrossScene);
+    readKey(s, "gather_directions", settings.gatherDirections);
+    readKey(s, "glossy_dir_res", settings.glossyDirRes);
+    readKey(s, "tolerance", settings.tolerance);
+    readKey(s, "max_iterations", settings.maxIterations);
+    readKey(s, "mirror_depth", settings.mirrorDepth);
+    readKey(s, "seed", settings.seed);
+    const auto& t = meta.at("stats");
+    readKey(t, "seconds", stats.seconds);
+    readKey(t, "visibility_seconds", stats.visibilitySeconds);
+    readKey(t, "propagation_seconds", stats.propagationSeconds);
+    readKey(t, "iterations", stats.iterations);
+    readKey(t, "residual", stats.residual);
+    readKey(t, "tixels", stats.tixels);
+    readKey(t, "values", stats.values);
+    readKey(t, "visibility_rays", stats.visibilityRays);
+    readKey(t, "peak_rss_bytes", stats.peakRssBytes);
+    readKey(t, "reused_visibility", stats.reusedVisibility);
+  } catch (const nlohmann::json::exception& e) {
+    fail("{}: corrupt metadata section: {}", path, e.what());
+  }
+}
+
+// --- Files -------------------------------------------------------------------------------
+
+std::string errnoText() { return std::strerror(errno); }
+
+/// An open file descriptor, closed on scope exit.
+struct FileHandle {
+  int fd = -1;
+  ~FileHandle() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+void writeAll(int fd, const void* data, size_t size, const std::string& tempPath) {
+  auto* p = static_cast<const unsigned char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, p, std::min<size_t>(size, size_t(1) << 30));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail("{}: write failed: {}", tempPath, errnoText());
+    }
+    p += n;
+    size -= size_t(n);
+  }
+}
+
+/// Reads exactly `size` bytes at `offset` (the caller has checked they exist).
+void readAt(int fd, uint64_t offset, void* data, uint64_t size, const std::string& path) {
+  auto* p = static_cast<unsigned char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::pread(fd, p, std::min<uint64_t>(size, uint64_t(1) << 30), off_t(offset));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail("{}: read failed: {}", path, errnoText());
+    }
+    if (n == 0) fail("{}: unexpected end of file at byte {} (the file shrank while being read?)", path, offset);
+    p += n;
+    offset += uint64_t(n);
+    size -= uint64_t(n);
+  }
+}
+
+struct SectionEntry {
+  char id[4];
+  uint32_t encoding;
+  uint64_t offset, storedSize, decodedSize, checksum, reserved;
+};
+static_assert(sizeof(SectionEntry) == kPlfSectionEntrySize);
+
+struct Header {
+  char magic[8];
+  uint32_t version;
+  uint32_t sectionCount;
+  uint64_t fileSize;
+  uint64_t headerHash;
+};
+static_assert(sizeof(Header) == kPlfHeaderSize);
+
+uint64_t headerHash(const Header& header, const std::vector<SectionEntry>& table) {
+  Xxh64Stream stream;
+  stream.update(&header, offsetof(Header, headerHash));
+  stream.update(table.data(), table.size() * sizeof(SectionEntry));
+  return stream.digest();
+}
+
+/// An opened, structurally validated .plf file: header and section table checked, every
+/// section known, raw, inside the file, in order and without overlap. Section contents are
+/// read (and checksummed) on demand.
+class PlfReader {
+ public:
+  explicit PlfReader(const std::string& path) : path_(path) {
+    file_.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (file_.fd < 0) fail("{}: cannot open light field: {}", path, errnoText());
+    struct stat st {};
+    if (::fstat(file_.fd, &st) != 0) fail("{}: cannot stat: {}", path, errnoText());
+    if (!S_ISREG(st.st_mode)) fail("{}: not a regular file", path);
+    actualSize_ = uint64_t(st.st_size);
+
+    if (actualSize_ == 0) fail("{}: empty file, not a plenoptic light field", path);
+    Header header{};
+    readAt(file_.fd, 0, &header, std::min<uint64_t>(actualSize_, sizeof(Header)), path);
+    const size_t magicBytes = std::min<size_t>(actualSize_, kPlfMagic.size());
+    if (std::memcmp(header.magic, kPlfMagic.data(), magicBytes) != 0)
+      fail("{}: not a plenoptic light field (wrong magic number)", path);
+    if (actualSize_ < kPlfMagic.size())
+      fail("{}: truncated: the file ends at byte {} inside the {}-byte header", path, actualSize_, kPlfHeaderSize);
+    if (actualSize_ < offsetof(Header, sectionCount))
+      fail("{}: truncated: the file ends at byte {} inside the {}-byte header", path, actualSize_, kPlfHeaderSize);
+    if (header.version != kPlfVersion)
+      fail("{}: unsupported .plf format version {} (this build of plenoptic reads version {}); "
+           "re-bake the scene with this build",
+           path, header.version, kPlfVersion);
+    if (actualSize_ < sizeof(Header))
+      fail("{}: truncated: the file ends at byte {} inside the {}-byte header", path, actualSize_, kPlfHeaderSize);
+    version_ = header.version;
+    if (header.sectionCount > kMaxSections)
+      fail("{}: corrupt header: {} sections (at most {} exist)", path, header.sectionCount, kMaxSections);
+    const uint64_t tableEnd = sizeof(Header) + uint64_t(header.sectionCount) * sizeof(SectionEntry);
+    if (tableEnd > actualSize_)
+      fail("{}: truncated: the section table needs bytes [{}, {}) but the file has {} bytes", path, sizeof(Header),
+           tableEnd, actualSize_);
+    table_.resize(header.sectionCount);
+    readAt(file_.fd, sizeof(Header), table_.data(), table_.size() * sizeof(SectionEntry), path);
+    if (headerHash(header, table_) != header.headerHash)
+      fail("{}: corrupt header or section table (checksum mismatch)", path);
+    fileSize_ = header.fileSize;
+
+    // From here on the header is trusted: a size mismatch is a truncation or an append.
+    int found[kSectionKinds];
+    std::fill(std::begin(found), std::end(found), -1);
+    uint64_t previousEnd = tableEnd;
+    for (size_t i = 0; i < table_.size(); ++i) {
+      const SectionEntry& e = table_[i];
+      const std::string id(e.id, 4);
+      const auto kind = std::find(std::begin(kSectionIds), std::end(kSectionIds), id) - std::begin(kSectionIds);
+      if (kind == kSectionKinds) fail("{}: unknown section '{}' in a version {} file", path, id, version_);
+      if (found[kind] >= 0) fail("{}: section {} appears twice", path, id);
+      found[kind] = int(i);
+      if (e.encoding != uint32_t(PlfEncoding::Raw))
+        fail("{}: section {} uses encoding {}, which this build does not know", path, id, e.encoding);
+      if (e.decodedSize != e.storedSize)
+        fail("{}: section {} is raw but its decoded size {} differs from its stored size {}", path, id,
+             e.decodedSize, e.storedSize);
+      if (e.offset < previousEnd || e.storedSize > fileSize_ || e.offset > fileSize_ - e.storedSize)
+        fail("{}: corrupt section table: section {} at [{}, +{}) overlaps another or lies outside the {}-byte file",
+             path, id, e.offset, e.storedSize, fileSize_);
+      previousEnd = e.offset + e.storedSize;
+    }
+    for (int kind = 0; kind < kSectionKinds; ++kind)
+      if (found[kind] < 0) fail("{}: the {} section ({}) is missing", path, kSectionNames[kind], kSectionIds[kind]);
+    std::copy(std::begin(found), std::end(found), std::begin(entryOf_));
+
+    if (actualSize_ < fileSize_) {
+      for (const SectionEntry& e : table_)
+        if (e.offset + e.storedSize > actualSize_)
+          fail("{}: truncated: section {} needs bytes [{}, {}) ({} bytes) but the file ends at byte {} "
+               "({} of {} bytes present)",
+               path, std::string(e.id, 4), e.offset, e.offset + e.storedSize, e.storedSize, actualSize_,
+               actualSize_ > e.offset ? actualSize_ - e.offset : 0, e.storedSize);
+      fail("{}: truncated: {} bytes expected, {} present", path, fileSize_, actualSize_);
+    }
+    if (actualSize_ > fileSize_)
+      fail("{}: {} unexpected bytes after the end of the light field ({} bytes expected)", path,
+           actualSize_ - fileSize_, fileSize_);
+    checkPadding(tableEnd);
+  }
+
+  const SectionEntry& entry(int kind) const { return table_[size_t(entryOf_[kind])]; }
+  uint32_t version() const { return version_; }
+  uint64_t fileSize() const { return fileSize_; }
+  const std::vector<SectionEntry>& table() const { return table_; }
+
+  /// The section's bytes, checksum verified.
+  std::vector<unsigned char> read(int kind) const {
+    const SectionEntry& e = entry(kind);
+    std::vector<unsigned char> bytes(e.storedSize);
+    readInto(kind, bytes.data());
+    return bytes;
+  }
+  /// Reads the section into memory the caller sized to storedSize, checksum verified.
+  void readInto(int kind, void* destination) const {
+    const SectionEntry& e = entry(kind);
+    readAt(file_.fd, e.offset, destination, e.storedSize, path_);
+    checkHash(kind, xxh64(destination, e.storedSize));
+  }
+  /// Verifies a section's checksum reading it in bounded chunks.
+  void verify(int kind) const {
+    const SectionEntry& e = entry(kind);
+    std::vector<unsigned char> chunk(std::min<uint64_t>(e.storedSize, 1u << 20));
+    Xxh64Stream stream;
+    for (uint64_t done = 0; done < e.storedSize;) {
+      const uint64_t n = std::min<uint64_t>(chunk.size(), e.storedSize - done);
+      readAt(file_.fd, e.offset + done, chunk.data(), n, path_);
+      stream.update(chunk.data(), n);
+      done += n;
+    }
+    checkHash(kind, stream.digest());
+  }
+
+ private:
+  void checkHash(int kind, uint64_t hash) const {
+    if (hash != entry(kind).checksum)
+      fail("{}: checksum mismatch in the {} section ({}): the file is corrupt", path_, kSectionNames[kind],
+           kSectionIds[kind]);
+  }
+  /// The bytes between sections carry no data and no checksum; they must be zero, so that
+  /// every byte of a .plf file is covered by some check.
+  void checkPadding(uint64_t tableEnd) const {
+    uint64_t previousEnd = tableEnd;
+    unsigned char gap[kSectionAlignment];
+    auto checkGap = [&](uint64_t begin, uint64_t end) {
+      for (uint64_t at = begin; at < end; at += sizeof(gap)) {
+        const uint64_t n = std::min<uint64_t>(sizeof(gap), end - at);
+        readAt(file_.fd, at, gap, n, path_);
+        if (std::any_of(gap, gap + n, [](unsigned char b) { return b != 0; }))
+          fail("{}: corrupt file: non-zero padding bytes in [{}, {})", path_, begin, end);
+      }
+    };
+    for (const SectionEntry& e : table_) {
+      checkGap(previousEnd, e.offset);
+      previousEnd = e.offset + e.storedSize;
+    }
+    checkGap(previousEnd, fileSize_);
+  }
+
+  std::string path_;
+  FileHandle file_;
+  uint64_t actualSize_ = 0, fileSize_ = 0;
+  uint32_t version_ = 0;
+  std::vector<SectionEntry> table_;
+  int entryOf_[kSectionKinds] = {};
+};
+
+std::vector<PlfSectionInfo> sectionInfos(const PlfReader& reader) {
+  std::vector<PlfSectionInfo> infos;
+  for (const SectionEntry& e : reader.table())
+    infos.push_back({std::string(e.id, 4), e.encoding, e.offset, e.storedSize, e.decodedSize, e.checksum});
+  return infos;
+}
+
+}  // namespace
+
+void writeLightField(const std::string& path, const LightField& lf) {
+  // Encode the small sections; the values are written straight from the LightField.
+  static_assert(sizeof(Rgb) == 12, "VALS stores float32 RGB triplets");
+  const std::vector<unsigned char> scene = encodeScene(lf.scene);
+  const std::vector<unsigned char> charts = encodeCharts(lf.charts);
+  const std::vector<unsigned char> triangleCharts = encodeTriangleCharts(lf.triangleChart);
+  const std::vector<unsigned char> meta = encodeMeta(lf);
+  const std::span<const unsigned char> sections[kSectionKinds] = {
+      scene, charts, triangleCharts,
+      {reinterpret_cast<const unsigned char*>(lf.values.data()), lf.values.size() * sizeof(Rgb)}, meta};
+
+  Header header{};
+  std::memcpy(header.magic, kPlfMagic.data(), kPlfMagic.size());
+  header.version = kPlfVersion;
+  header.sectionCount = kSectionKinds;
+  std::vector<SectionEntry> table(kSectionKinds);
+  uint64_t offset = alignUp(sizeof(Header) + table.size() * sizeof(SectionEntry));
+  for (int kind = 0; kind < kSectionKinds; ++kind) {
+    SectionEntry& e = table[size_t(kind)];
+    std::memcpy(e.id, kSectionIds[kind], 4);
+    e.encoding = uint32_t(PlfEncoding::Raw);
+    e.offset = offset;
+    e.storedSize = e.decodedSize = sections[kind].size();
+    e.checksum = xxh64(sections[kind].data(), sections[kind].size());
+    e.reserved = 0;
+    offset = alignUp(offset + e.storedSize);
+  }
+  // The last section is not padded: the file ends where its data ends.
+  header.fileSize = table.back().offset + table.back().storedSize;
+  header.headerHash = headerHash(header, table);
+
+  // Atomic write: temporary file in the same directory (same file system), fsync, rename.
+  std::string tempPath = path + ".tmp-XXXXXX";
+  FileHandle file;
+  file.fd = ::mkstemp(tempPath.data());
+  if (file.fd < 0) fail("{}: cannot create a temporary file beside it: {}", path, errnoText());
+  struct TempGuard {
+    const std::string& path;
+    bool keep = false;
+    ~TempGuard() {
+      if (!keep) ::unlink(path.c_str());
+    }
+  } guard{tempPath};
+
+  const mode_t umaskValue = ::umask(0);
+  ::umask(umaskValue);
+  if (::fchmod(file.fd, 0666 & ~umaskValue) != 0) fail("{}: cannot set permissions: {}", tempPath, errnoText());
+  writeAll(file.fd, &header, sizeof(header), tempPath);
+  writeAll(file.fd, table.data(), table.size() * sizeof(SectionEntry), tempPath);
+  uint64_t written = sizeof(header) + table.size() * sizeof(SectionEntry);
+  const unsigned char zeros[kSectionAlignment] = {};
+  for (int kind = 0; kind < kSectionKinds; ++kind) {
+    writeAll(file.fd, zeros, table[size_t(kind)].offset - written, tempPath);
+    writeAll(file.fd, sections[kind].data(), sections[kind].size(), tempPath);
+    written = table[size_t(kind)].offset + sections[kind].size();
+  }
+  if (::fsync(file.fd) != 0) fail("{}: fsync failed: {}", tempPath, errnoText());
+  if (::close(file.fd) != 0) {
+    file.fd = -1;
+    fail("{}: close failed: {}", tempPath, errnoText());
+  }
+  file.fd = -1;
+  if (::rename(tempPath.c_str(), path.c_str()) != 0)
+    fail("{}: cannot rename {} over it: {}", path, tempPath, errnoText());
+  guard.keep = true;
+  // Make the rename itself durable.
+  const auto slash = path.find_last_of('/');
+  const std::string directory = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  FileHandle dir;
+  dir.fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir.fd >= 0) ::fsync(dir.fd);
+}
+
+LightField readLightField(const std::string& path) {
+  const PlfReader reader(path);
+  LightField lf;
+  lf.scene = decodeScene(reader.read(kScene), path);
+  lf.charts = decodeCharts(reader.read(kCharts), path, lf.scene.materials.size());
+  lf.triangleChart = decodeTriangleCharts(reader.read(kTriangleCharts), path, lf.scene, lf.charts.size());
+  const uint64_t valueBytes = reader.entry(kValues).storedSize;
+  if (valueBytes % sizeof(Rgb) != 0)
+    fail("{}: corrupt values section: {} bytes is not a whole number of RGB float triplets", path, valueBytes);
+  lf.values.resize(valueBytes / sizeof(Rgb));  // bounded by the file's size, checked above
+  reader.readInto(kValues, lf.values.data());
+  checkChartRanges(lf.charts, lf.values.size(), path);
+  decodeMeta(reader.read(kMeta), path, lf.settings, lf.stats);
+  return lf;
+}
+
+PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
+  const PlfReader reader(path);
+  PlfInfo info;
+  info.path = path;
+  info.version = reader.version();
+  info.fileBytes = reader.fileSize();
+  info.sections = sectionInfos(reader);
+
+  const Scene scene = decodeScene(reader.read(kScene), path);
+  info.sceneSource = scene.sourcePath;
+  info.meshes = scene.meshes.size();
+  for (const Mesh& m : scene.meshes) {
+    info.triangles += m.triangles.size();
+    info.vertices += m.positions.size();
+  }
+  info.materials = scene.materials.size();
+  for (const Material& m : scene.materials) info.materialModels.push_back(modelName(m.bsdf));
+  info.textures = scene.textures.size();
+  info.lights = scene.lights.size();
+  for (const CameraDesc& c : scene.cameras) info.cameraNames.push_back(c.name);
+  info.environment = scene.environment.constant;
+
+  const std::vector<Chart> charts = decodeCharts(reader.read(kCharts), path, scene.materials.size());
+  info.charts = charts.size();
+  for (const Chart& c : charts) {
+    info.diffuseCharts += c.kind == ChartKind::Diffuse;
+    info.glossyCharts += c.kind == ChartKind::Glossy;
+    info.specularCharts += c.kind == ChartKind::Specular;
+    info.tixels += c.tixelCount();
+  }
+  info.values = reader.entry(kValues).storedSize / sizeof(Rgb);
+  decodeMeta(reader.read(kMeta), path, info.settings, info.stats);
+  if (verifyChecksums) {
+    reader.verify(kTriangleCharts);
+    reader.verify(kValues);
+    info.checksumsVerified = true;
+  }
+  return info;
+}
+
+}  // namespace pl

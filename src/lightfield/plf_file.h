@@ -1,0 +1,117 @@
+#pragma once
+// The light-field file (.plf): a LightField — its embedded Scene, charts, triangle → chart
+// map, HDR values, bake settings and statistics — in one self-contained binary file.
+//
+// Layout (all integers and floats little-endian; offsets and sizes in bytes):
+//
+//   offset 0   header (kHeaderSize = 32 bytes)
+//              magic        8 bytes  "PLF\0\r\n\x1a\n"  (the PNG trick: a text-mode transfer
+//                                     or a truncation to 7 bits corrupts it visibly)
+//              version      u32      kPlfVersion
+//              sectionCount u32
+//              fileSize     u64      total bytes; a shorter file is truncated
+//              headerHash   u64      XXH64 (seed 0) of header bytes [0, 24) followed by the
+//                                     section table: covers every field except itself
+//   offset 32  section table: sectionCount entries of 48 bytes
+//              id           4 bytes  four-character code, see PlfSection
+//              encoding     u32      0 = raw (see PlfEncoding; room for compressed modes)
+//              offset       u64      from the start of the file, 64-byte aligned
+//              storedSize   u64      bytes in the file
+//              decodedSize  u64      bytes after decoding (= storedSize when raw)
+//              checksum     u64      XXH64 of the stored bytes (seed 0)
+//              reserved     u64      0
+//   sections, each at its offset, in table order, zero padding between them (checked).
+//
+// Sections (each present exactly once):
+//   SCNE  the Scene: meshes, materials (every BSDF variant's parameters), textures with
+//         their pixels, lights, cameras, environment. Everything a renderer needs.
+//   CHRT  the charts: u64 count, then fixed 85-byte records (see writeCharts in plf_file.cpp).
+//   TRCH  triangle → chart: u64 mesh count, then per mesh u64 triangle count + u32 indices.
+//   VALS  the values: float32 RGB triplets (12 bytes each), in LightField::values order.
+//   META  UTF-8 JSON: {"settings": BakeSettings, "stats": BakeStats}.
+//
+// The version is checked right after the magic, before anything else is interpreted, so a
+// future layout can change everything after it. Reading never trusts the file: the magic,
+// version, header hash, every section's bounds and
+// checksum, and every count inside a section (against the bytes that remain) are checked
+// before anything is allocated, and all indices are range-checked. Any problem throws
+// pl::Error naming the file and the section.
+#include "lightfield/lightfield.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pl {
+
+inline constexpr uint32_t kPlfVersion = 1;
+inline constexpr size_t kPlfHeaderSize = 32;
+inline constexpr size_t kPlfSectionEntrySize = 48;
+inline constexpr std::array<char, 8> kPlfMagic = {'P', 'L', 'F', '\0', '\r', '\n', '\x1a', '\n'};
+
+/// How a section's bytes are stored. Only Raw exists in version 1; the compression work
+/// adds modes here (a reader refuses modes it does not know, naming the section).
+enum class PlfEncoding : uint32_t { Raw = 0 };
+
+/// One entry of the section table, as stored.
+struct PlfSectionInfo {
+  std::string id;  ///< "SCNE", "CHRT", "TRCH", "VALS", "META"
+  uint32_t encoding = 0;
+  uint64_t offset = 0, storedSize = 0, decodedSize = 0, checksum = 0;
+};
+
+/// What `plenoptic info` shows, read without decoding the big sections (VALS, TRCH are only
+/// checksummed, in chunks).
+struct PlfInfo {
+  std::string path;
+  uint32_t version = 0;
+  uint64_t fileBytes = 0;
+  std::vector<PlfSectionInfo> sections;
+  bool checksumsVerified = false;  ///< every section's checksum was recomputed and matched
+  // Scene summary (decoded from SCNE).
+  std::string sceneSource;
+  uint64_t meshes = 0, triangles = 0, vertices = 0, materials = 0, textures = 0, lights = 0;
+  std::vector<std::string> cameraNames;
+  std::vector<std::string> materialModels;  ///< modelName() of every material, in order
+  Rgb environment{0.0f};
+  // Charts (decoded from CHRT).
+  uint64_t charts = 0, diffuseCharts = 0, glossyCharts = 0, specularCharts = 0;
+  uint64_t tixels = 0, values = 0;
+  // Bake settings and statistics (from META).
+  BakeSettings settings;
+  BakeStats stats;
+};
+
+/// Writes the light field atomically: a temporary file beside `path` is written, fsynced
+/// and renamed over it; on any failure the temporary file is removed and pl::Error thrown.
+void writeLightField(const std::string& path, const LightField& lightField);
+
+/// Reads and fully validates a .plf file (see the header comment). The embedded scene is
+/// finalized (vertex buffers padded for Embree) and ready for an Accel.
+LightField readLightField(const std::string& path);
+
+/// Reads the header, the section table, the scene, charts and metadata; the checksums of
+/// the other sections are recomputed in bounded chunks when verifyChecksums is set.
+PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums = true);
+
+/// XXH64 (Yann Collet's xxHash, 64-bit variant) of `size` bytes: the checksum of .plf files.
+uint64_t xxh64(const void* data, size_t size, uint64_t seed = 0);
+
+/// Incremental XXH64 for data that arrives in pieces; equals xxh64() of the concatenation.
+class Xxh64Stream {
+ public:
+  explicit Xxh64Stream(uint64_t seed = 0);
+  void update(const void* data, size_t size);
+  uint64_t digest() const;
+
+ private:
+  uint64_t lanes_[4];
+  uint64_t seed_;
+  uint64_t totalLength_ = 0;
+  unsigned char buffer_[32];
+  size_t buffered_ = 0;
+};
+
+}  // namespace pl

@@ -1,0 +1,598 @@
+// Tests of the .plf file: XXH64 against reference vectors, a round trip of every field, and
+// one test per way a file can be bad (each must be refused with a message naming the file
+// and the problem, never a crash).
+#include "lightfield/plf_file.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+
+#include "core/error.h"
+
+namespace pl {
+namespace {
+
+namespace fs = std::filesystem;
+
+// --- XXH64 ---------------------------------------------------------------------------------
+
+TEST(Xxh64, MatchesReferenceVectors) {
+  // Reference values from the xxhashjs implementation of XXH64 (seeds 0 and 42). The inputs
+  // cover the short path (< 32 bytes: 0, 1, 3, 39 bytes → tail of 8-, 4- and 1-byte steps)
+  // and the four-lane stripe loop (62 bytes).
+  struct Vector {
+    const char* text;
+    uint64_t seed0, seed42;
+  };
+  const Vector vectors[] = {
+      {"", 0xef46db3751d8e999ull, 0x98b1582b0977e704ull},
+      {"a", 0xd24ec4f1a98c6e5bull, 0x88e4fe59adf7b0ccull},
+      {"abc", 0x44bc2cf5ad770999ull, 0x13c1d910702770e6ull},
+      {"Nobody inspects the spammish repetition", 0xfbcea83c8a378bf1ull, 0x44582824ca1018b5ull},
+      {"0123456789abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ", 0x7639d419de614eedull,
+       0xe023c8f961330a31ull},
+  };
+  for (const Vector& v : vectors) {
+    EXPECT_EQ(xxh64(v.text, std::strlen(v.text), 0), v.seed0) << v.text;
+    EXPECT_EQ(xxh64(v.text, std::strlen(v.text), 42), v.seed42) << v.text;
+  }
+}
+
+TEST(Xxh64, StreamingInAnyPiecesEqualsOneShot) {
+  std::vector<unsigned char> data(1000);
+  for (size_t i = 0; i < data.size(); ++i) data[i] = static_cast<unsigned char>(i * 131 + 7);
+  const uint64_t expected = xxh64(data.data(), data.size(), 5);
+  for (size_t piece : {1, 3, 7, 31, 32, 33, 64, 999}) {
+    Xxh64Stream stream(5);
+    for (size_t at = 0; at < data.size(); at += piece) stream.update(data.data() + at, std::min(piece, data.size() - at));
+    EXPECT_EQ(stream.digest(), expected) << "pieces of " << piece;
+  }
+}
+
+// --- A light field exercising every field ------------------------------------------------
+
+LightField makeTestLightField() {
+  LightField lf;
+  Scene& s = lf.scene;
+  s.sourcePath = "tests/handmade.json";
+  Mesh quad;
+  quad.name = "floor";
+  quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+  quad.normals = {{0, 1, 0}, {0, 1, 0}, {0, 1, 0}, {0, 1, 0}};
+  quad.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  quad.triangles = {{0, 2, 1}, {0, 3, 2}};
+  quad.materials = {0, 0};
+  Mesh mixed;
+  mixed.name = "mixed";
+  mixed.positions = {{0, 1, 0}, {1, 1, 0}, {0, 2, 0}, {2, 2, 2}, {3, 2, 2}};
+  mixed.triangles = {{0, 1, 2}, {2, 3, 4}, {0, 3, 4}};
+  mixed.materials = {1, 2, 3};
+  s.meshes = {quad, mixed};
+
+  Material lambert{"white", LambertBsdf{Rgb(0.7f, 0.6f, 0.5f)}, 0, Rgb(0.0f), false};
+  Material mirror{"mirror", MirrorBsdf{Rgb(0.9f, 0.8f, 0.95f), true}, -1, Rgb(0.0f), false};
+  Material phong{"phong", BlinnPhongBsdf{Rgb(0.3f, 0.2f, 0.1f), Rgb(0.2f, 0.25f, 0.3f), 123.5f}, -1,
+                 Rgb(1.0f, 2.0f, 3.0f), true};
+  Material ggx{"ggx", GgxBsdf{Rgb(0.1f), Rgb(0.04f, 0.05f, 0.06f), 0.33f}, -1, Rgb(17.0f, 12.0f, 4.0f), false};
+  s.materials = {lambert, mirror, phong, ggx};
+
+  Texture texture;
+  texture.path = "textures/checker.png";
+  texture.image = Image(3, 2);
+  for (size_t i = 0; i < texture.image.pixels.size(); ++i) texture.image.pixels[i] = Rgb(float(i), 0.5f, -1.0f);
+  texture.average = Rgb(2.5f, 0.5f, -1.0f);
+  s.textures = {texture};
+
+  s.lights = {PointLight{{1, 2, 3}, {4, 5, 6}}, SpotLight{{0, 5, 0}, {0, -1, 0}, {7, 8, 9}, 0.2f, 0.4f},
+              DirectionalLight{{0.6f, -0.8f, 0.0f}, {1.5f, 2.5f, 3.5f}}};
+  CameraDesc front;
+  front.name = "front";
+  front.eye = {0.5f, 0.5f, 3.0f};
+  front.target = {0.5f, 0.5f, 0.0f};
+  front.fovYDegrees = 35.0f;
+  CameraDesc lens = front;
+  lens.name = "lens";
+  lens.fNumber = 2.8f;
+  lens.focusDistance = 3.0f;
+  lens.focalLengthMm = 50.0f;
+  lens.aspectRatio = 1.5f;
+  s.cameras = {front, lens};
+  s.environment.constant = Rgb(0.1f, 0.2f, 0.3f);
+
+  Chart diffuse;
+  diffuse.material = 0;
+  diffuse.kind = ChartKind::Diffuse;
+  diffuse.origin = {0, 0, 1};
+  diffuse.axisU = {1, 0, 0};
+  diffuse.axisV = {0, 0, -1};
+  diffuse.normal = {0, 1, 0};
+  diffuse.tixelSize = 0.25f;
+  diffuse.resU = 4;
+  diffuse.resV = 4;
+  diffuse.dirRes = 1;
+  Chart mirrorChart = diffuse;
+  mirrorChart.material = 1;
+  mirrorChart.kind = ChartKind::Specular;
+  mirrorChart.dirRes = 0;
+  mirrorChart.firstTixel = 16;
+  mirrorChart.firstValue = 16;
+  Chart glossy = diffuse;
+  glossy.material = 2;
+  glossy.kind = ChartKind::Glossy;
+  glossy.resU = 2;
+  glossy.resV = 3;
+  glossy.dirRes = 4;
+  glossy.firstTixel = 32;
+  glossy.firstValue = 16;
+  lf.charts = {diffuse, mirrorChart, glossy};
+  lf.triangleChart = {{0, 0}, {1, 2, 2}};
+  lf.values.resize(16 + 2 * 3 * 16);
+  for (size_t i = 0; i < lf.values.size(); ++i) lf.values[i] = Rgb(float(i), float(i) * 0.5f, 1.0f / float(i + 1));
+
+  lf.settings.preset = "draft";
+  lf.settings.tixelsPerUnit = 12.5f;
+  lf.settings.maxTixelsPerChartSide = 33;
+  lf.settings.tixelsAcrossScene = 21.5f;
+  lf.settings.gatherDirections = 77;
+  lf.settings.glossyDirRes = 6;
+  lf.settings.tolerance = 2.5e-4f;
+  lf.settings.maxIterations = 91;
+  lf.settings.mirrorDepth = 3;
+  lf.settings.seed = 0x123456789abcdefull;
+  lf.stats.seconds = 1.25;
+  lf.stats.visibilitySeconds = 0.5;
+  lf.stats.propagationSeconds = 0.625;
+  lf.stats.iterations = 17;
+  lf.stats.residual = 3.5e-5;
+  lf.stats.tixels = 38;
+  lf.stats.values = lf.values.size();
+  lf.stats.visibilityRays = 123456789012ull;
+  lf.stats.peakRssBytes = 987654321;
+  lf.stats.reusedVisibility = true;
+  return lf;
+}
+
+/// A fresh directory per test, removed afterwards.
+class PlfFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           fmt::format("plf_test_{}_{}", ::getpid(), ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string file(const std::string& name) const { return (dir_ / name).string(); }
+
+  static std::vector<unsigned char> readBytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+  static void writeBytes(const std::string& path, const std::vector<unsigned char>& bytes) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  }
+
+  /// Expects reading `path` to throw pl::Error whose message contains every fragment.
+  static void expectRefused(const std::string& path, const std::vector<std::string>& fragments) {
+    for (int mode = 0; mode < 2; ++mode) {  // both the full reader and the info reader
+      try {
+        if (mode == 0)
+          readLightField(path);
+        else
+          readLightFieldInfo(path);
+        ADD_FAILURE() << "reading " << path << " succeeded, expected: " << fragments.front();
+      } catch (const Error& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(path), std::string::npos) << message;
+        for (const std::string& fragment : fragments)
+          EXPECT_NE(message.find(fragment), std::string::npos) << "'" << fragment << "' not in: " << message;
+      }
+    }
+  }
+
+  // Layout facts from plf_file.h, for locating and re-signing sections in a valid file.
+  struct Section {
+    std::string id;
+    uint64_t offset, size;
+  };
+  static std::vector<Section> sections(const std::vector<unsigned char>& bytes) {
+    uint32_t count;
+    std::memcpy(&count, bytes.data() + 12, 4);
+    std::vector<Section> result;
+    for (uint32_t i = 0; i < count; ++i) {
+      const unsigned char* e = bytes.data() + kPlfHeaderSize + i * kPlfSectionEntrySize;
+      Section s{std::string(reinterpret_cast<const char*>(e), 4), 0, 0};
+      std::memcpy(&s.offset, e + 8, 8);
+      std::memcpy(&s.size, e + 16, 8);
+      result.push_back(s);
+    }
+    return result;
+  }
+  /// Recomputes the checksums of every section and of the header after a deliberate edit,
+  /// so the reader's structural checks (not its checksums) must catch the edit.
+  static void resign(std::vector<unsigned char>& bytes) {
+    const auto table = sections(bytes);
+    for (size_t i = 0; i < table.size(); ++i) {
+      if (table[i].size > bytes.size() || table[i].offset > bytes.size() - table[i].size) continue;  // edited size
+      const uint64_t hash = xxh64(bytes.data() + table[i].offset, table[i].size);
+      std::memcpy(bytes.data() + kPlfHeaderSize + i * kPlfSectionEntrySize + 32, &hash, 8);
+    }
+    Xxh64Stream stream;
+    stream.update(bytes.data(), 24);
+    stream.update(bytes.data() + kPlfHeaderSize, table.size() * kPlfSectionEntrySize);
+    const uint64_t hash = stream.digest();
+    std::memcpy(bytes.data() + 24, &hash, 8);
+  }
+
+  fs::path dir_;
+};
+
+void expectSameRgb(const Rgb& a, const Rgb& b) {
+  EXPECT_EQ(a.r, b.r);
+  EXPECT_EQ(a.g, b.g);
+  EXPECT_EQ(a.b, b.b);
+}
+
+TEST_F(PlfFileTest, RoundTripPreservesEveryField) {
+  const LightField original = makeTestLightField();
+  const std::string path = file("round.plf");
+  writeLightField(path, original);
+  const LightField copy = readLightField(path);
+
+  const Scene &a = original.scene, &b = copy.scene;
+  EXPECT_EQ(b.sourcePath, a.sourcePath);
+  ASSERT_EQ(b.meshes.size(), a.meshes.size());
+  for (size_t m = 0; m < a.meshes.size(); ++m) {
+    EXPECT_EQ(b.meshes[m].name, a.meshes[m].name);
+    EXPECT_EQ(b.meshes[m].positions, a.meshes[m].positions);
+    EXPECT_GT(b.meshes[m].positions.capacity(), b.meshes[m].positions.size()) << "Embree padding";
+    EXPECT_EQ(b.meshes[m].normals, a.meshes[m].normals);
+    EXPECT_EQ(b.meshes[m].uvs, a.meshes[m].uvs);
+    EXPECT_EQ(b.meshes[m].triangles, a.meshes[m].triangles);
+    EXPECT_EQ(b.meshes[m].materials, a.meshes[m].materials);
+  }
+  ASSERT_EQ(b.materials.size(), a.materials.size());
+  for (size_t i = 0; i < a.materials.size(); ++i) {
+    const Material &ma = a.materials[i], &mb = b.materials[i];
+    EXPECT_EQ(mb.name, ma.name);
+    ASSERT_EQ(mb.bsdf.index(), ma.bsdf.index());
+    EXPECT_EQ(mb.albedoTexture, ma.albedoTexture);
+    expectSameRgb(mb.emission, ma.emission);
+    EXPECT_EQ(mb.twoSidedEmission, ma.twoSidedEmission);
+  }
+  EXPECT_EQ(std::get<LambertBsdf>(b.materials[0].bsdf).albedo, std::get<LambertBsdf>(a.materials[0].bsdf).albedo);
+  const auto &mirrorA = std::get<MirrorBsdf>(a.materials[1].bsdf), &mirrorB = std::get<MirrorBsdf>(b.materials[1].bsdf);
+  EXPECT_EQ(mirrorB.reflectance, mirrorA.reflectance);
+  EXPECT_EQ(mirrorB.fresnel, mirrorA.fresnel);
+  const auto &phongA = std::get<BlinnPhongBsdf>(a.materials[2].bsdf),
+             &phongB = std::get<BlinnPhongBsdf>(b.materials[2].bsdf);
+  EXPECT_EQ(phongB.diffuse, phongA.diffuse);
+  EXPECT_EQ(phongB.specular, phongA.specular);
+  EXPECT_EQ(phongB.exponent, phongA.exponent);
+  const auto &ggxA = std::get<GgxBsdf>(a.materials[3].bsdf), &ggxB = std::get<GgxBsdf>(b.materials[3].bsdf);
+  EXPECT_EQ(ggxB.diffuse, ggxA.diffuse);
+  EXPECT_EQ(ggxB.f0, ggxA.f0);
+  EXPECT_EQ(ggxB.alpha, ggxA.alpha);
+
+  ASSERT_EQ(b.textures.size(), 1u);
+  EXPECT_EQ(b.textures[0].path, a.textures[0].path);
+  EXPECT_EQ(b.textures[0].image.width, 3);
+  EXPECT_EQ(b.textures[0].image.height, 2);
+  EXPECT_EQ(b.textures[0].image.pixels, a.textures[0].image.pixels);
+  EXPECT_EQ(b.textures[0].average, a.textures[0].average);
+
+  ASSERT_EQ(b.lights.size(), 3u);
+  const auto &pa = std::get<PointLight>(a.lights[0]), &pb = std::get<PointLight>(b.lights[0]);
+  EXPECT_EQ(pb.position, pa.position);
+  EXPECT_EQ(pb.intensity, pa.intensity);
+  const auto &sa = std::get<SpotLight>(a.lights[1]), &sb = std::get<SpotLight>(b.lights[1]);
+  EXPECT_EQ(sb.position, sa.position);
+  EXPECT_EQ(sb.direction, sa.direction);
+  EXPECT_EQ(sb.intensity, sa.intensity);
+  EXPECT_EQ(sb.innerAngle, sa.innerAngle);
+  EXPECT_EQ(sb.outerAngle, sa.outerAngle);
+  const auto &da = std::get<DirectionalLight>(a.lights[2]), &db = std::get<DirectionalLight>(b.lights[2]);
+  EXPECT_EQ(db.direction, da.direction);
+  EXPECT_EQ(db.irradiance, da.irradiance);
+
+  ASSERT_EQ(b.cameras.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    const CameraDesc &ca = a.cameras[i], &cb = b.cameras[i];
+    EXPECT_EQ(cb.name, ca.name);
+    EXPECT_EQ(cb.eye, ca.eye);
+    EXPECT_EQ(cb.target, ca.target);
+    EXPECT_EQ(cb.up, ca.up);
+    EXPECT_EQ(cb.fovYDegrees, ca.fovYDegrees);
+    EXPECT_EQ(cb.fNumber, ca.fNumber);
+    EXPECT_EQ(cb.focusDistance, ca.focusDistance);
+    EXPECT_EQ(cb.focalLengthMm, ca.focalLengthMm);
+    EXPECT_EQ(cb.aspectRatio, ca.aspectRatio);
+  }
+  EXPECT_EQ(b.environment.constant, a.environment.constant);
+
+  ASSERT_EQ(copy.charts.size(), original.charts.size());
+  for (size_t i = 0; i < original.charts.size(); ++i) {
+    const Chart &ca = original.charts[i], &cb = copy.charts[i];
+    EXPECT_EQ(cb.material, ca.material);
+    EXPECT_EQ(cb.kind, ca.kind);
+    EXPECT_EQ(cb.origin, ca.origin);
+    EXPECT_EQ(cb.axisU, ca.axisU);
+    EXPECT_EQ(cb.axisV, ca.axisV);
+    EXPECT_EQ(cb.normal, ca.normal);
+    EXPECT_EQ(cb.tixelSize, ca.tixelSize);
+    EXPECT_EQ(cb.resU, ca.resU);
+    EXPECT_EQ(cb.resV, ca.resV);
+    EXPECT_EQ(cb.dirRes, ca.dirRes);
+    EXPECT_EQ(cb.firstTixel, ca.firstTixel);
+    EXPECT_EQ(cb.firstValue, ca.firstValue);
+  }
+  EXPECT_EQ(copy.triangleChart, original.triangleChart);
+  EXPECT_EQ(copy.values, original.values);  // bit-exact: float32 stored as is
+
+  const BakeSettings &sa2 = original.settings, &sb2 = copy.settings;
+  EXPECT_EQ(sb2.preset, sa2.preset);
+  EXPECT_EQ(sb2.tixelsPerUnit, sa2.tixelsPerUnit);
+  EXPECT_EQ(sb2.maxTixelsPerChartSide, sa2.maxTixelsPerChartSide);
+  EXPECT_EQ(sb2.tixelsAcrossScene, sa2.tixelsAcrossScene);
+  EXPECT_EQ(sb2.gatherDirections, sa2.gatherDirections);
+  EXPECT_EQ(sb2.glossyDirRes, sa2.glossyDirRes);
+  EXPECT_EQ(sb2.tolerance, sa2.tolerance);
+  EXPECT_EQ(sb2.maxIterations, sa2.maxIterations);
+  EXPECT_EQ(sb2.mirrorDepth, sa2.mirrorDepth);
+  EXPECT_EQ(sb2.seed, sa2.seed);
+  const BakeStats &ta = original.stats, &tb = copy.stats;
+  EXPECT_EQ(tb.seconds, ta.seconds);
+  EXPECT_EQ(tb.visibilitySeconds, ta.visibilitySeconds);
+  EXPECT_EQ(tb.propagationSeconds, ta.propagationSeconds);
+  EXPECT_EQ(tb.iterations, ta.iterations);
+  EXPECT_EQ(tb.residual, ta.residual);
+  EXPECT_EQ(tb.tixels, ta.tixels);
+  EXPECT_EQ(tb.values, ta.values);
+  EXPECT_EQ(tb.visibilityRays, ta.visibilityRays);
+  EXPECT_EQ(tb.peakRssBytes, ta.peakRssBytes);
+  EXPECT_EQ(tb.reusedVisibility, ta.reusedVisibility);
+}
+
+TEST_F(PlfFileTest, InfoSummarisesWithoutLoadingValues) {
+  const LightField lf = makeTestLightField();
+  const std::string path = file("info.plf");
+  writeLightField(path, lf);
+  const PlfInfo info = readLightFieldInfo(path);
+  EXPECT_EQ(info.version, kPlfVersion);
+  EXPECT_EQ(info.fileBytes, fs::file_size(path));
+  EXPECT_TRUE(info.checksumsVerified);
+  EXPECT_EQ(info.sceneSource, "tests/handmade.json");
+  EXPECT_EQ(info.meshes, 2u);
+  EXPECT_EQ(info.triangles, 5u);
+  EXPECT_EQ(info.vertices, 9u);
+  EXPECT_EQ(info.materials, 4u);
+  EXPECT_EQ(info.materialModels, (std::vector<std::string>{"lambert", "mirror", "blinn-phong", "ggx"}));
+  EXPECT_EQ(info.textures, 1u);
+  EXPECT_EQ(info.lights, 3u);
+  EXPECT_EQ(info.cameraNames, (std::vector<std::string>{"front", "lens"}));
+  EXPECT_EQ(info.charts, 3u);
+  EXPECT_EQ(info.diffuseCharts, 1u);
+  EXPECT_EQ(info.glossyCharts, 1u);
+  EXPECT_EQ(info.specularCharts, 1u);
+  EXPECT_EQ(info.tixels, 16u + 16u + 6u);
+  EXPECT_EQ(info.values, lf.values.size());
+  EXPECT_EQ(info.settings.preset, "draft");
+  EXPECT_EQ(info.stats.iterations, 17u);
+  ASSERT_EQ(info.sections.size(), 5u);
+  uint64_t previousEnd = kPlfHeaderSize + 5 * kPlfSectionEntrySize;
+  for (const PlfSectionInfo& s : info.sections) {
+    EXPECT_EQ(s.offset % 64, 0u) << s.id;
+    EXPECT_GE(s.offset, previousEnd) << s.id;
+    previousEnd = s.offset + s.storedSize;
+  }
+  EXPECT_EQ(info.sections[3].id, "VALS");
+  EXPECT_EQ(info.sections[3].storedSize, lf.values.size() * 12);
+  EXPECT_EQ(previousEnd, info.fileBytes);
+}
+
+TEST_F(PlfFileTest, OverwritesAtomicallyAndLeavesNoTemporaryFiles) {
+  const std::string path = file("out.plf");
+  writeBytes(path, {'o', 'l', 'd'});
+  writeLightField(path, makeTestLightField());
+  EXPECT_NO_THROW(readLightField(path));
+  size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) ++entries;
+  EXPECT_EQ(entries, 1u);
+}
+
+TEST_F(PlfFileTest, FailedWriteRemovesItsTemporaryFile) {
+  // A directory where the file should go: the final rename fails after everything was
+  // written, the error names the target, and the temporary file is gone.
+  const std::string path = file("taken.plf");
+  fs::create_directories(path);
+  try {
+    writeLightField(path, makeTestLightField());
+    ADD_FAILURE() << "writing over a directory succeeded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) ++entries;
+  EXPECT_EQ(entries, 1u) << "only the directory itself may remain";
+  EXPECT_THROW(writeLightField(file("no/such/dir/x.plf"), makeTestLightField()), Error);
+}
+
+TEST_F(PlfFileTest, RefusesMissingFile) { expectRefused(file("absent.plf"), {"cannot open", "No such file"}); }
+
+TEST_F(PlfFileTest, RefusesEmptyFile) {
+  writeBytes(file("empty.plf"), {});
+  expectRefused(file("empty.plf"), {"empty file"});
+}
+
+TEST_F(PlfFileTest, RefusesWrongMagic) {
+  writeBytes(file("text.plf"), {'h', 'e', 'l', 'l', 'o', ' ', 'w', 'o', 'r', 'l', 'd', '\n'});
+  expectRefused(file("text.plf"), {"not a plenoptic light field"});
+  const std::string path = file("flipped.plf");
+  writeLightField(path, makeTestLightField());
+  auto bytes = readBytes(path);
+  bytes[1] ^= 0x20;  // "PlF"
+  writeBytes(path, bytes);
+  expectRefused(path, {"not a plenoptic light field"});
+}
+
+TEST_F(PlfFileTest, RefusesOtherVersionNamingBoth) {
+  const std::string path = file("v7.plf");
+  writeLightField(path, makeTestLightField());
+  auto bytes = readBytes(path);
+  const uint32_t version = 7;
+  std::memcpy(bytes.data() + 8, &version, 4);
+  writeBytes(path, bytes);
+  expectRefused(path, {"unsupported .plf format version 7", "reads version 1"});
+}
+
+TEST_F(PlfFileTest, RefusesTruncationNamingTheSection) {
+  const std::string path = file("whole.plf");
+  writeLightField(path, makeTestLightField());
+  const auto whole = readBytes(path);
+  const auto table = sections(whole);
+  struct Cut {
+    uint64_t at;
+    std::vector<std::string> fragments;
+  };
+  std::vector<Cut> cuts = {{3, {"truncated", "header"}},
+                           {10, {"truncated", "header"}},
+                           {31, {"truncated", "header"}},
+                           {kPlfHeaderSize + 50, {"truncated", "section table"}}};
+  for (const Section& s : table) {
+    // Cut in the middle of each section and one byte before its end.
+    const std::string expected = fmt::format("needs bytes [{}, {})", s.offset, s.offset + s.size);
+    cuts.push_back({s.offset + s.size / 2, {"truncated", "section " + s.id, expected,
+                                            fmt::format("of {} bytes present", s.size)}});
+    cuts.push_back({s.offset + s.size - 1, {"truncated", "section " + s.id, expected}});
+  }
+  for (const Cut& cut : cuts) {
+    SCOPED_TRACE(fmt::format("cut at {}", cut.at));
+    const std::string cutPath = file(fmt::format("cut{}.plf", cut.at));
+    writeBytes(cutPath, std::vector<unsigned char>(whole.begin(), whole.begin() + std::ptrdiff_t(cut.at)));
+    expectRefused(cutPath, cut.fragments);
+  }
+  // Extra bytes appended are refused too: the header states the size.
+  auto longer = whole;
+  longer.push_back(0);
+  writeBytes(file("longer.plf"), longer);
+  expectRefused(file("longer.plf"), {"unexpected bytes after the end"});
+}
+
+TEST_F(PlfFileTest, RefusesAFlippedByteInEverySection) {
+  const std::string path = file("good.plf");
+  writeLightField(path, makeTestLightField());
+  const auto good = readBytes(path);
+  for (const Section& s : sections(good)) {
+    for (uint64_t at : {s.offset, s.offset + s.size / 2, s.offset + s.size - 1}) {
+      SCOPED_TRACE(fmt::format("{} byte {}", s.id, at));
+      auto bad = good;
+      bad[at] ^= 0x01;
+      const std::string badPath = file("bad.plf");
+      writeBytes(badPath, bad);
+      expectRefused(badPath, {"checksum mismatch", "(" + s.id + ")"});
+    }
+  }
+  // The header and the table are covered by the header hash …
+  for (uint64_t at : {uint64_t(16), uint64_t(kPlfHeaderSize + 20), uint64_t(kPlfHeaderSize + 3 * kPlfSectionEntrySize + 33)}) {
+    auto bad = good;
+    bad[at] ^= 0x40;
+    writeBytes(file("badheader.plf"), bad);
+    expectRefused(file("badheader.plf"), {"corrupt header"});
+  }
+  // … and the padding between sections must be zero.
+  const auto table = sections(good);
+  ASSERT_GT(table[1].offset, table[0].offset + table[0].size) << "test needs padding after SCNE";
+  auto bad = good;
+  bad[table[0].offset + table[0].size] = 0xff;
+  writeBytes(file("badpadding.plf"), bad);
+  expectRefused(file("badpadding.plf"), {"padding"});
+}
+
+TEST_F(PlfFileTest, RefusesAbsurdCountsWithoutAllocating) {
+  const std::string path = file("good.plf");
+  writeLightField(path, makeTestLightField());
+  const auto good = readBytes(path);
+  const auto table = sections(good);
+
+  // SCNE starts with the source path (u32 length + bytes), then the u64 mesh count. A count
+  // of 2^60 meshes with valid checksums must be refused by the bounds check, not by
+  // std::bad_alloc or a crash.
+  {
+    auto bad = good;
+    const uint64_t meshCountAt = table[0].offset + 4 + std::strlen("tests/handmade.json");
+    const uint64_t absurd = uint64_t(1) << 60;
+    std::memcpy(bad.data() + meshCountAt, &absurd, 8);
+    resign(bad);
+    writeBytes(file("meshes.plf"), bad);
+    expectRefused(file("meshes.plf"), {"corrupt scene section", "meshes", "bytes remain"});
+  }
+  // The same for the number of charts (first field of CHRT).
+  {
+    auto bad = good;
+    const uint64_t absurd = ~uint64_t(0);
+    std::memcpy(bad.data() + table[1].offset, &absurd, 8);
+    resign(bad);
+    writeBytes(file("charts.plf"), bad);
+    expectRefused(file("charts.plf"), {"corrupt charts section", "charts", "bytes remain"});
+  }
+  // A section table entry claiming more bytes than the file holds.
+  {
+    auto bad = good;
+    const uint64_t absurd = uint64_t(1) << 50;
+    std::memcpy(bad.data() + kPlfHeaderSize + 3 * kPlfSectionEntrySize + 16, &absurd, 8);
+    std::memcpy(bad.data() + kPlfHeaderSize + 3 * kPlfSectionEntrySize + 24, &absurd, 8);
+    resign(bad);
+    writeBytes(file("values.plf"), bad);
+    expectRefused(file("values.plf"), {"section VALS", "outside"});
+  }
+  // A section count far beyond any real file.
+  {
+    auto bad = good;
+    const uint32_t absurd = 1u << 30;
+    std::memcpy(bad.data() + 12, &absurd, 4);
+    writeBytes(file("count.plf"), bad);
+    expectRefused(file("count.plf"), {"corrupt header", "sections"});
+  }
+}
+
+TEST_F(PlfFileTest, RefusesOutOfRangeIndicesEvenWithValidChecksums) {
+  const std::string path = file("good.plf");
+  writeLightField(path, makeTestLightField());
+  const auto good = readBytes(path);
+  const auto table = sections(good);
+  // TRCH: u64 mesh count, u64 triangle count of mesh 0, then its u32 chart indices.
+  auto bad = good;
+  const uint32_t chart = 3;  // only charts 0–2 exist
+  std::memcpy(bad.data() + table[2].offset + 16, &chart, 4);
+  resign(bad);
+  writeBytes(file("trch.plf"), bad);
+  try {
+    readLightField(file("trch.plf"));
+    ADD_FAILURE() << "out-of-range chart index accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("maps to chart 3 of 3"), std::string::npos) << e.what();
+  }
+  // CHRT: the glossy chart's firstValue moved past the end of the values.
+  bad = good;
+  const uint64_t chartRecord = 4 + 1 + 48 + 4 + 12 + 16;
+  const uint64_t firstValueAt = table[1].offset + 8 + 2 * chartRecord + chartRecord - 8;
+  const uint64_t firstValue = 1000;
+  std::memcpy(bad.data() + firstValueAt, &firstValue, 8);
+  resign(bad);
+  writeBytes(file("chrt.plf"), bad);
+  try {
+    readLightField(file("chrt.plf"));
+    ADD_FAILURE() << "out-of-range chart values accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("chart 2 needs values"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pl
