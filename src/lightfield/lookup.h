@@ -1,0 +1,84 @@
+#pragma once
+// Looking the light field up: the 16-neighbour interpolation of seed slide 36 — bilinear over
+// the 2×2 nearest tixels (position) × bilinear over the 2×2 nearest paraboloid texels
+// (direction). Used by the renderers and, through the same functions, by the bake itself.
+//
+// Interpolation conventions (match lightfield.h):
+//   tixel (i, j) has its centre at continuous grid coordinate (i, j), where a world point p has
+//   grid coordinates ((p − origin)·axisU / tixelSize − ½, (p − origin)·axisV / tixelSize − ½);
+//   paraboloid texel (a, b) has its centre at continuous coordinate (a, b), see paraboloid.h.
+//   Outside the outermost centres the edge values are held (clamp-to-edge), never extrapolated.
+#include "core/math.h"
+#include "lightfield/lightfield.h"
+#include "scene/scene.h"
+
+#include <cstdint>
+
+namespace pl {
+
+/// One axis of a clamp-to-edge bilinear interpolation: value = (1−f)·v[i0] + f·v[i1].
+struct LinearTap {
+  uint32_t i0 = 0, i1 = 0;
+  float f = 0.0f;
+};
+
+/// The tap for continuous coordinate x over `count` samples centred at 0 … count−1.
+inline LinearTap linearTap(float x, uint32_t count) {
+  LinearTap tap;
+  if (!(x > 0.0f)) return tap;  // also catches NaN: hold the first sample
+  const float last = float(count - 1);
+  if (x >= last) {
+    tap.i0 = tap.i1 = count - 1;
+    return tap;
+  }
+  tap.i0 = uint32_t(x);
+  tap.i1 = tap.i0 + 1;
+  tap.f = x - float(tap.i0);
+  return tap;
+}
+
+/// Continuous tixel grid coordinates of world point p on chart c (p need not lie on it).
+inline Vec2 tixelGridCoordinates(const Chart& c, const Vec3& p) {
+  const Vec3 d = p - c.origin;
+  const float inv = 1.0f / c.tixelSize;
+  return {glm::dot(d, c.axisU) * inv - 0.5f, glm::dot(d, c.axisV) * inv - 0.5f};
+}
+
+/// A world direction in the chart's local frame (z along the chart normal).
+inline Vec3 chartLocalDirection(const Chart& c, const Vec3& w) {
+  return {glm::dot(w, c.axisU), glm::dot(w, c.axisV), glm::dot(w, c.normal)};
+}
+inline Vec3 chartWorldDirection(const Chart& c, const Vec3& local) {
+  return local.x * c.axisU + local.y * c.axisV + local.z * c.normal;
+}
+
+/// Bilinear interpolation of the stored values of chart c at tixel grid coordinates `grid`
+/// and paraboloid coordinates st (ignored for diffuse charts, which store one value).
+/// Returns 0 for specular charts (they store nothing).
+Rgb interpolateChartValues(const LightField& lf, const Chart& c, Vec2 grid, Vec2 st);
+
+/// Diffuse albedo of `material` at surface uv: the Lambertian albedo times its albedo texture
+/// (if any) sampled at full resolution, exactly as the path tracer's bsdfAt does.
+Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv);
+
+/// Emitted radiance of `material` towards local direction cosθ (chart frame, z = front side):
+/// one-sided along the geometric normal unless the material is two-sided.
+inline Rgb emittedRadiance(const Material& m, float cosTheta) {
+  return (cosTheta > 0.0f || m.twoSidedEmission) ? m.emission : Rgb(0.0f);
+}
+
+/// Exitant radiance (W·sr⁻¹·m⁻²) of chart `chart` at worldPosition towards the viewer:
+///   diffuse chart:  Le + albedo(uv)·E/π with E bilinearly interpolated over the 2×2 nearest
+///                   tixels and the albedo texture applied at full resolution at `uv`;
+///   glossy chart:   the 16-neighbour interpolation of the stored exitant radiance;
+///   specular chart: 0 — the caller follows the mirrored ray (reordering) and looks up what it
+///                   sees.
+/// A viewer behind the chart (one-sided parameterisation) sees the front-side reflected
+/// radiance; emission there follows emittedRadiance.
+Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosition,
+                    const Vec3& worldDirectionTowardsViewer, Vec2 uv);
+
+/// The same for a ray hit (chart from lf.triangleChart, uv from the hit).
+Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer);
+
+}  // namespace pl

@@ -1,0 +1,129 @@
+// Tests of the 16-neighbour light-field lookup.
+#include "lightfield/lookup.h"
+
+#include <gtest/gtest.h>
+
+#include "core/rng.h"
+#include "lightfield/paraboloid.h"
+
+namespace pl {
+namespace {
+
+// A light field with one chart of the given kind, frame rotated off the axes so that the
+// frame arithmetic is exercised, and values from `field(i, j, a, b)`.
+template <typename Field>
+LightField makeLightField(ChartKind kind, uint32_t dirRes, Field field) {
+  LightField lf;
+  Material m;
+  m.name = "test";
+  m.bsdf = LambertBsdf{Rgb(0.5f, 0.25f, 1.0f)};
+  m.emission = Rgb(0.1f, 0.2f, 0.3f);
+  lf.scene.materials.push_back(m);
+  Chart c;
+  c.kind = kind;
+  c.material = 0;
+  c.origin = Vec3(1.0f, -2.0f, 0.5f);
+  const Frame f = Frame::fromNormal(glm::normalize(Vec3(0.3f, 0.4f, 0.8f)));
+  c.axisU = f.s;
+  c.axisV = f.t;
+  c.normal = f.n;
+  c.tixelSize = 0.25f;
+  c.resU = 5;
+  c.resV = 4;
+  c.dirRes = kind == ChartKind::Specular ? 0 : dirRes;
+  lf.charts.push_back(c);
+  lf.values.resize(c.tixelCount() * c.valuesPerTixel());
+  for (uint32_t j = 0; j < c.resV; ++j)
+    for (uint32_t i = 0; i < c.resU; ++i)
+      for (uint32_t b = 0; b < c.dirRes; ++b)
+        for (uint32_t a = 0; a < c.dirRes; ++a) lf.values[c.valueIndex(i, j, a, b)] = field(i, j, a, b);
+  return lf;
+}
+
+Rgb linearField(float i, float j, float a, float b) {
+  return Rgb(1.0f + 0.5f * i + 0.25f * j + 0.125f * a - 0.0625f * b, 2.0f - 0.1f * i + 0.3f * j + 0.2f * a + 0.05f * b,
+             3.0f + i * 0.01f - j * 0.02f - a * 0.03f + b * 0.04f);
+}
+
+TEST(Lookup, GlossyInterpolationReproducesALinearFieldExactly) {
+  const uint32_t R = 6;
+  const LightField lf = makeLightField(ChartKind::Glossy, R, [](uint32_t i, uint32_t j, uint32_t a, uint32_t b) {
+    return linearField(float(i), float(j), float(a), float(b));
+  });
+  const Chart& c = lf.charts[0];
+  Pcg32 rng(1, 2);
+  for (int n = 0; n < 2000; ++n) {
+    // A point whose grid coordinates are strictly inside the tixel centres' range, and a
+    // direction whose texel coordinates are inside the texel centres' range (and the disk).
+    const float gu = rng.uniform() * (c.resU - 1), gv = rng.uniform() * (c.resV - 1);
+    const Vec3 p = c.origin + (gu + 0.5f) * c.tixelSize * c.axisU + (gv + 0.5f) * c.tixelSize * c.axisV +
+                   0.01f * c.normal;  // lookups ignore the offset along the normal
+    Vec2 st(2.0f * rng.uniform() - 1.0f, 2.0f * rng.uniform() - 1.0f);
+    st *= 0.7f;  // inside the disk and inside the texel-centre range of a 6-texel map
+    const Vec3 w = chartWorldDirection(c, paraboloidToDirection(st));
+    const Rgb got = exitantRadiance(lf, 0, p, w, Vec2(0.0f));
+    const Rgb expected = linearField(gu, gv, paraboloidTexelCoordinate(st.x, R), paraboloidTexelCoordinate(st.y, R));
+    // Bilinear interpolation is exact for linear data; float round-off in the frame and map
+    // arithmetic (a few ulps of coordinates of size ~5) bounds the error by ~1e-4.
+    EXPECT_NEAR(got.r, expected.r, 2e-4f);
+    EXPECT_NEAR(got.g, expected.g, 2e-4f);
+    EXPECT_NEAR(got.b, expected.b, 2e-4f);
+  }
+}
+
+TEST(Lookup, HoldsEdgeValuesOutsideTheGrid) {
+  const LightField lf = makeLightField(ChartKind::Glossy, 4, [](uint32_t i, uint32_t j, uint32_t a, uint32_t b) {
+    return linearField(float(i), float(j), float(a), float(b));
+  });
+  const Chart& c = lf.charts[0];
+  // Far outside the rectangle, beyond the last tixel centre in both u and v; looking along
+  // the normal, which maps to (s, t) = (0, 0), between texels 1 and 2 of a 4-texel map.
+  const Vec3 p = c.origin + 10.0f * c.axisU + 10.0f * c.axisV;
+  const Rgb got = exitantRadiance(lf, 0, p, c.normal, Vec2(0.0f));
+  const Rgb expected = linearField(float(c.resU - 1), float(c.resV - 1), 1.5f, 1.5f);
+  EXPECT_NEAR(got.r, expected.r, 1e-4f);
+  EXPECT_NEAR(got.g, expected.g, 1e-4f);
+  EXPECT_NEAR(got.b, expected.b, 1e-4f);
+}
+
+TEST(Lookup, DiffuseIsEmissionPlusAlbedoTimesInterpolatedIrradianceOverPi) {
+  const LightField lf = makeLightField(ChartKind::Diffuse, 1, [](uint32_t i, uint32_t j, uint32_t, uint32_t) {
+    return linearField(float(i), float(j), 0.0f, 0.0f);
+  });
+  const Chart& c = lf.charts[0];
+  const Material& m = lf.scene.materials[0];
+  const Rgb albedo = std::get<LambertBsdf>(m.bsdf).albedo;
+  const float gu = 2.3f, gv = 1.6f;
+  const Vec3 p = c.origin + (gu + 0.5f) * c.tixelSize * c.axisU + (gv + 0.5f) * c.tixelSize * c.axisV;
+  const Rgb front = exitantRadiance(lf, 0, p, glm::normalize(c.normal + 0.5f * c.axisU), Vec2(0.3f, 0.3f));
+  const Rgb expected = m.emission + albedo * linearField(gu, gv, 0.0f, 0.0f) * kInvPi;
+  EXPECT_NEAR(front.r, expected.r, 1e-5f);
+  EXPECT_NEAR(front.g, expected.g, 1e-5f);
+  EXPECT_NEAR(front.b, expected.b, 1e-5f);
+  // From behind, a one-sided emitter does not emit; the reflected part is the same.
+  const Rgb back = exitantRadiance(lf, 0, p, -c.normal, Vec2(0.3f, 0.3f));
+  EXPECT_NEAR(back.r, expected.r - m.emission.r, 1e-5f);
+  EXPECT_NEAR(back.b, expected.b - m.emission.b, 1e-5f);
+}
+
+TEST(Lookup, SpecularChartsStoreNothingAndReturnZero) {
+  LightField lf = makeLightField(ChartKind::Specular, 0, [](uint32_t, uint32_t, uint32_t, uint32_t) { return Rgb(1.0f); });
+  EXPECT_TRUE(lf.values.empty());
+  EXPECT_EQ(exitantRadiance(lf, 0, lf.charts[0].origin, lf.charts[0].normal, Vec2(0.0f)), Rgb(0.0f));
+}
+
+TEST(Lookup, LinearTapClampsAndInterpolates) {
+  EXPECT_EQ(linearTap(-0.5f, 4).i0, 0u);
+  EXPECT_EQ(linearTap(-0.5f, 4).f, 0.0f);
+  EXPECT_EQ(linearTap(3.5f, 4).i0, 3u);
+  EXPECT_EQ(linearTap(3.5f, 4).i1, 3u);
+  const LinearTap t = linearTap(1.25f, 4);
+  EXPECT_EQ(t.i0, 1u);
+  EXPECT_EQ(t.i1, 2u);
+  EXPECT_FLOAT_EQ(t.f, 0.25f);
+  EXPECT_EQ(linearTap(0.7f, 1).i1, 0u);  // a single sample: always that sample
+  EXPECT_EQ(linearTap(std::nanf(""), 3).i0, 0u);
+}
+
+}  // namespace
+}  // namespace pl
