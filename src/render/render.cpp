@@ -1,0 +1,126 @@
+// The straightforward light-field renderer (see render.h).
+#include "render/render.h"
+
+#include <algorithm>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "accel/accel.h"
+#include "bsdf/bsdf.h"
+#include "camera/camera.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "core/rng.h"
+#include "lightfield/lookup.h"
+#include "scene/scene.h"
+
+namespace pl {
+
+Rgb backgroundRadiance(const Environment& environment, const Vec3& /*direction*/) { return environment.constant; }
+
+namespace {
+
+/// Radiance along `ray` whose closest hit is `hit` (hit.hit() false: it left the scene).
+/// Mirrors are followed as a chain of reflections with the reflectance multiplied in
+/// (`throughput`); the first non-specular chart ends it with the light-field lookup.
+Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hit, uint32_t mirrorDepth) {
+  const Scene& scene = lf.scene;
+  Rgb throughput(1.0f), result(0.0f);
+  for (uint32_t reflections = 0;; ++reflections) {
+    if (!hit.hit()) return result + throughput * backgroundRadiance(scene.environment, ray.direction);
+    const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+    const Vec3 wo = -ray.direction;
+    const Chart& chart = lf.charts[lf.triangleChart[hit.mesh][hit.triangle]];
+    if (chart.kind != ChartKind::Specular) return result + throughput * exitantRadiance(lf, surface, wo);
+
+    // An ideal mirror: its own emission (if any) plus the reflectance times what the
+    // mirrored direction sees. BSDFs are two-sided: the frame faces the arriving ray, as in
+    // the path tracer.
+    const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
+    result += throughput * emittedRadiance(scene.materials[surface.material], cosWoGeometric);
+    if (reflections >= mirrorDepth) return result;
+    const bool back = cosWoGeometric < 0.0f;
+    const Vec3 geometricNormal = back ? -surface.geometricNormal : surface.geometricNormal;
+    const Frame frame = Frame::fromNormal(back ? -surface.shadingNormal : surface.shadingNormal);
+    // A delta lobe ignores the random numbers: (½, ½) is as good as any.
+    const std::optional<BsdfSample> s = sample(bsdfAt(scene, surface), frame.toLocal(wo), Vec2(0.5f));
+    if (!s || !s->delta) return result;
+    const Vec3 wi = frame.toWorld(s->wi);
+    if (glm::dot(wi, geometricNormal) <= 0.0f) return result;  // grazing: the reflection is below the surface
+    throughput *= s->weight;
+    ray = Ray{offsetRayOrigin(surface.position, geometricNormal, wi), wi, 0.0f, kInfinity};
+    hit = RayHit{};
+    accel.intersect(ray, hit);
+  }
+}
+
+uint32_t effectiveMirrorDepth(const LightField& lf, const RenderSettings& settings) {
+  return settings.mirrorDepth >= 0 ? uint32_t(settings.mirrorDepth) : lf.settings.mirrorDepth;
+}
+
+}  // namespace
+
+Rgb lightFieldRadiance(const LightField& lf, const Accel& accel, const Ray& ray, uint32_t mirrorDepth) {
+  RayHit hit;
+  accel.intersect(ray, hit);
+  return radianceFromHit(lf, accel, ray, hit, mirrorDepth);
+}
+
+Image renderLightField(const LightField& lf, const Accel& accel, const Camera& camera, const RenderSettings& settings) {
+  if (settings.samplesPerPixel < 0) fail("render: samples per pixel must be ≥ 0, got {}", settings.samplesPerPixel);
+  if (settings.tileSize < 1) fail("render: tile size must be ≥ 1, got {}", settings.tileSize);
+  const int spp = settings.samplesPerPixel > 0 ? settings.samplesPerPixel
+                  : camera.isThinLens()        ? RenderSettings::kThinLensSamples
+                                               : 1;
+  const uint32_t mirrorDepth = effectiveMirrorDepth(lf, settings);
+  const int width = camera.width(), height = camera.height();
+  const int tile = settings.tileSize;
+  const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+  Image image(width, height);
+
+  std::unique_ptr<Progress> progress;
+  if (settings.showProgress) progress = std::make_unique<Progress>("rendering", uint64_t(tilesX) * uint64_t(tilesY));
+  parallelForRange(uint64_t(tilesX) * uint64_t(tilesY), 1, [&](uint64_t begin, uint64_t end) {
+    std::vector<Ray> rays;
+    std::vector<float> weights;
+    std::vector<RayHit> hits;
+    for (uint64_t t = begin; t < end; ++t) {
+      const int x0 = int(t % uint64_t(tilesX)) * tile, y0 = int(t / uint64_t(tilesX)) * tile;
+      const int x1 = std::min(x0 + tile, width), y1 = std::min(y0 + tile, height);
+      // All camera rays of the tile first, then one coherent (packet) intersection.
+      rays.clear();
+      weights.clear();
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
+          for (int k = 0; k < spp; ++k) {
+            Vec2 film(float(x) + 0.5f, float(y) + 0.5f), lens(0.5f);
+            if (spp > 1) {
+              Pcg32 rng = Pcg32::forKey(pixel, uint64_t(k), settings.seed);
+              film = Vec2(float(x) + rng.uniform(), float(y) + rng.uniform());
+              lens = Vec2(rng.uniform(), rng.uniform());
+            }
+            const Camera::Sample cs = camera.generateRay(film, lens);
+            rays.push_back(cs.ray);
+            weights.push_back(cs.weight);
+          }
+        }
+      hits.assign(rays.size(), RayHit{});
+      accel.intersectCoherent(rays, hits);
+      size_t i = 0;
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          Rgb sum(0.0f);
+          for (int k = 0; k < spp; ++k, ++i)
+            if (weights[i] > 0.0f) sum += weights[i] * radianceFromHit(lf, accel, rays[i], hits[i], mirrorDepth);
+          image.at(x, y) = sum / float(spp);
+        }
+      if (progress) progress->advance();
+    }
+  });
+  return image;
+}
+
+}  // namespace pl

@@ -1,0 +1,215 @@
+// Tests of the straightforward light-field renderer on hand-made light fields whose
+// rendered radiance has a closed form.
+#include "render/render.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "accel/accel.h"
+#include "camera/camera.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "lightfield/lookup.h"
+
+namespace pl {
+namespace {
+
+/// A quad mesh (two triangles) with corners c0, c1, c2, c3 counter-clockwise seen from the
+/// front, one material.
+Mesh makeQuad(const std::string& name, Vec3 c0, Vec3 c1, Vec3 c2, Vec3 c3, uint32_t material) {
+  Mesh m;
+  m.name = name;
+  m.positions = {c0, c1, c2, c3};
+  m.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  m.materials = {material, material};
+  return m;
+}
+
+/// A diffuse chart over the square [lo, hi] of the plane through `origin` spanned by
+/// axisU, axisV, with res × res tixels whose stored irradiance is E0 + gradient·centre
+/// (a linear field: bilinear interpolation reproduces it exactly between tixel centres).
+Chart linearIrradianceChart(LightField& lf, uint32_t material, Vec3 origin, Vec3 axisU, Vec3 axisV, float side,
+                            uint32_t res, float e0, Vec3 gradient) {
+  Chart c;
+  c.material = material;
+  c.kind = ChartKind::Diffuse;
+  c.origin = origin;
+  c.axisU = axisU;
+  c.axisV = axisV;
+  c.normal = glm::cross(axisU, axisV);
+  c.tixelSize = side / float(res);
+  c.resU = c.resV = res;
+  c.dirRes = 1;
+  c.firstTixel = lf.stats.tixels;
+  c.firstValue = lf.values.size();
+  for (uint32_t j = 0; j < res; ++j)
+    for (uint32_t i = 0; i < res; ++i) {
+      const Vec3 centre = origin + (float(i) + 0.5f) * c.tixelSize * axisU + (float(j) + 0.5f) * c.tixelSize * axisV;
+      lf.values.push_back(Rgb(e0 + glm::dot(gradient, centre)));
+    }
+  lf.stats.tixels += c.tixelCount();
+  return c;
+}
+
+/// The irradiance the chart's clamp-to-edge bilinear interpolation gives at world point p:
+/// for a linear field, the field at p with each grid coordinate clamped to the tixel centres.
+float expectedIrradiance(const Chart& c, Vec3 p, float e0, Vec3 gradient) {
+  const float half = 0.5f * c.tixelSize, side = c.tixelSize * float(c.resU);
+  const float u = std::clamp(glm::dot(p - c.origin, c.axisU), half, side - half);
+  const float v = std::clamp(glm::dot(p - c.origin, c.axisV), half, side - half);
+  return e0 + glm::dot(gradient, c.origin + u * c.axisU + v * c.axisV);
+}
+
+class RenderTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { Progress::setEnabled(false); }
+  ThreadPool pool_{2};
+};
+
+TEST_F(RenderTest, DiffuseChartWithLinearIrradianceMatchesClosedForm) {
+  // A unit quad in z = 0 (front +z), albedo a, irradiance E(x, y) = 2 + 3x + 1.5y stored
+  // on 4×4 tixels, seen from above; everything else is the constant environment.
+  // Expected pixel value: a·E(hit)/π on the quad (Lambertian exitant radiance), the
+  // environment elsewhere.
+  LightField lf;
+  const Rgb albedo(0.5f, 0.25f, 0.75f);
+  lf.scene.sourcePath = "handmade";
+  lf.scene.materials = {Material{"wall", LambertBsdf{albedo}, -1, Rgb(0.0f), false}};
+  lf.scene.meshes = {makeQuad("quad", {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, 0)};
+  lf.scene.environment.constant = Rgb(0.1f, 0.2f, 0.3f);
+  lf.scene.finalize();
+  const float e0 = 2.0f;
+  const Vec3 gradient(3.0f, 1.5f, 0.0f);
+  lf.charts = {linearIrradianceChart(lf, 0, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 1.0f, 4, e0, gradient)};
+  lf.triangleChart = {{0, 0}};
+  const Accel accel(lf.scene);
+
+  CameraDesc desc;
+  desc.eye = {0.5f, 0.5f, 2.0f};
+  desc.target = {0.5f, 0.5f, 0.0f};
+  desc.up = {0, 1, 0};
+  desc.fovYDegrees = 40.0f;  // the quad fills the middle of the image, the environment the rest
+  const Camera camera(desc, 40, 30);
+  const Image image = renderLightField(lf, accel, camera, RenderSettings{});
+  ASSERT_EQ(image.width, 40);
+  ASSERT_EQ(image.height, 30);
+
+  int onQuad = 0, onEnvironment = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const Ray ray = camera.generateRay(Vec2(float(x) + 0.5f, float(y) + 0.5f), Vec2(0.5f)).ray;
+      const float t = -ray.origin.z / ray.direction.z;
+      const Vec3 p = ray.origin + t * ray.direction;
+      // Pixels whose ray passes within 1e-4 of the quad's border could go either way in
+      // float arithmetic; they say nothing about the lookup.
+      const float border = std::min({p.x, 1.0f - p.x, p.y, 1.0f - p.y});
+      if (std::abs(border) < 1e-4f) continue;
+      Rgb expected = lf.scene.environment.constant;
+      if (border > 0.0f) {
+        expected = albedo * expectedIrradiance(lf.charts[0], p, e0, gradient) * kInvPi;
+        ++onQuad;
+      } else {
+        ++onEnvironment;
+      }
+      // Relative 1e-5: float rounding of the hit point and of the bilinear weights (the
+      // values are O(1), errors of a few ulps), far below any interpolation mistake (which
+      // would be ≥ 1 % here: the field changes by 0.75 per tixel).
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(image.at(x, y)[ch], expected[ch], 1e-5f * expected[ch]) << "pixel " << x << "," << y;
+    }
+  EXPECT_GT(onQuad, 200);
+  EXPECT_GT(onEnvironment, 100);
+}
+
+TEST_F(RenderTest, MirrorReflectsTheDiffuseChartTimesReflectance) {
+  // A mirror quad [−1,1]² in z = 0 facing up, under a diffuse ceiling at z = 3 facing down
+  // whose irradiance grows linearly along x. The camera looks down at the mirror, so every
+  // pixel sees the ceiling by one reflection: expected = reflectance · a·E(q)/π where q is
+  // where the mirrored ray meets the ceiling.
+  LightField lf;
+  const Rgb reflectance(0.8f, 0.6f, 0.4f);
+  const Rgb albedo(0.5f);
+  lf.scene.sourcePath = "handmade-mirror";
+  lf.scene.materials = {Material{"mirror", MirrorBsdf{reflectance, false}, -1, Rgb(0.0f), false},
+                        Material{"ceiling", LambertBsdf{albedo}, -1, Rgb(0.0f), false}};
+  lf.scene.meshes = {makeQuad("mirror", {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, 0),
+                     makeQuad("ceiling", {-10, 10, 3}, {10, 10, 3}, {10, -10, 3}, {-10, -10, 3}, 1)};
+  lf.scene.environment.constant = Rgb(0.0f);
+  lf.scene.finalize();
+  Chart mirror;
+  mirror.material = 0;
+  mirror.kind = ChartKind::Specular;
+  mirror.dirRes = 0;
+  mirror.origin = {-1, -1, 0};
+  mirror.tixelSize = 2.0f;
+  const float e0 = 4.0f;
+  const Vec3 gradient(0.25f, 0.0f, 0.0f);
+  // Ceiling frame: normal −z, axisU = +x, axisV = normal × axisU = −y, origin at (−10, 10, 3).
+  const Chart ceiling = linearIrradianceChart(lf, 1, {-10, 10, 3}, {1, 0, 0}, {0, -1, 0}, 20.0f, 8, e0, gradient);
+  ASSERT_NEAR(ceiling.normal.z, -1.0f, 1e-6f);
+  lf.charts = {mirror, ceiling};
+  lf.triangleChart = {{0, 0}, {1, 1}};
+  lf.settings.mirrorDepth = 4;
+  const Accel accel(lf.scene);
+
+  CameraDesc desc;
+  desc.eye = {0.3f, -1.0f, 2.0f};
+  desc.target = {0.0f, 0.0f, 0.0f};
+  desc.fovYDegrees = 25.0f;
+  const Camera camera(desc, 24, 24);
+  const Image image = renderLightField(lf, accel, camera, RenderSettings{});
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const Ray ray = camera.generateRay(Vec2(float(x) + 0.5f, float(y) + 0.5f), Vec2(0.5f)).ray;
+      const Vec3 p = ray.origin + (-ray.origin.z / ray.direction.z) * ray.direction;
+      ASSERT_LT(std::max(std::abs(p.x), std::abs(p.y)), 1.0f) << "camera must see only the mirror";
+      const Vec3 reflected(ray.direction.x, ray.direction.y, -ray.direction.z);
+      const Vec3 q = p + ((3.0f - p.z) / reflected.z) * reflected;
+      const Rgb expected = reflectance * albedo * expectedIrradiance(ceiling, q, e0, gradient) * kInvPi;
+      // Relative 1e-4: the reflected ray starts from an offset origin (2e-5 relative, see
+      // offsetRayOrigin) and travels ~3 units, moving q by ~1e-4 along a field of slope
+      // 0.25/4 per unit: a relative change of < 1e-5; float rounding adds a few ulps.
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(image.at(x, y)[ch], expected[ch], 1e-4f * expected[ch]) << "pixel " << x << "," << y;
+    }
+
+  // With no reflections allowed the mirror (which does not emit) is black, as a chain longer
+  // than the bake's mirror depth contributes nothing.
+  RenderSettings noMirrors;
+  noMirrors.mirrorDepth = 0;
+  const Image black = renderLightField(lf, accel, camera, noMirrors);
+  for (const Rgb& pixel : black.pixels) EXPECT_EQ(pixel, Rgb(0.0f));
+}
+
+TEST_F(RenderTest, SeveralSamplesAverageTheLookupAndAreReproducible) {
+  // A chart of constant irradiance seen through a thin lens: every aperture and film sample
+  // sees the same radiance, so the image is uniform a·E/π; the random streams depend on
+  // (pixel, sample, seed) only, so two renders are identical.
+  LightField lf;
+  const Rgb albedo(0.6f);
+  lf.scene.materials = {Material{"wall", LambertBsdf{albedo}, -1, Rgb(0.0f), false}};
+  lf.scene.meshes = {makeQuad("quad", {-50, -50, 0}, {50, -50, 0}, {50, 50, 0}, {-50, 50, 0}, 0)};
+  lf.scene.finalize();
+  lf.charts = {linearIrradianceChart(lf, 0, {-50, -50, 0}, {1, 0, 0}, {0, 1, 0}, 100.0f, 2, 5.0f, Vec3(0.0f))};
+  lf.triangleChart = {{0, 0}};
+  const Accel accel(lf.scene);
+  CameraDesc desc;
+  desc.eye = {0, 0, 5};
+  desc.target = {0, 0, 0};
+  desc.fNumber = 2.0f;
+  desc.focusDistance = 3.0f;  // out of focus: the lens samples spread over the quad
+  desc.focalLengthMm = 50.0f;
+  const Camera camera(desc, 16, 12);
+  ASSERT_TRUE(camera.isThinLens());
+  const Image a = renderLightField(lf, accel, camera, RenderSettings{});
+  const Image b = renderLightField(lf, accel, camera, RenderSettings{});
+  EXPECT_EQ(a.pixels, b.pixels);
+  const float expected = 0.6f * 5.0f * kInvPi;
+  // Relative 1e-5: a mean of 16 equal float values.
+  for (const Rgb& pixel : a.pixels) EXPECT_NEAR(pixel.g, expected, 1e-5f * expected);
+}
+
+}  // namespace
+}  // namespace pl
