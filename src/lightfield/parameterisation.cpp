@@ -1,0 +1,456 @@
+// Charts, tixel grids and per-tixel gather points (see parameterisation.h).
+#include "lightfield/parameterisation.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <deque>
+#include <unordered_map>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "lightfield/lookup.h"
+
+namespace pl {
+
+ChartKind chartKindOf(const Bsdf& bsdf) {
+  if (isDelta(bsdf)) return ChartKind::Specular;
+  if (isDiffuse(bsdf)) return ChartKind::Diffuse;
+  return ChartKind::Glossy;
+}
+
+uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings) {
+  switch (chartKindOf(bsdf)) {
+    case ChartKind::Diffuse: return 1;
+    case ChartKind::Specular: return 0;
+    case ChartKind::Glossy: break;
+  }
+  // Angular half width θh of the microfacet/half-vector lobe at half maximum:
+  //   Blinn-Phong cosⁿθh = ½           → θh = acos(2^(−1/n));
+  //   GGX D ∝ 1/(α² + tan²θh)² (the cos⁴ factor ignored) = ½ D(0) → tan θh = α·√(√2 − 1).
+  // The reflected lobe is about twice as wide as the half-vector lobe, so its full width at
+  // half maximum is ≈ 4θh. Near the map centre s = tan(θ/2), so a texel 2/R wide in s spans
+  // ≈ 4/R radians; two texels across the lobe's FWHM needs R ≈ 8 / FWHM.
+  float thetaH = 0.5f;
+  if (const auto* bp = std::get_if<BlinnPhongBsdf>(&bsdf)) {
+    thetaH = std::acos(std::pow(0.5f, 1.0f / std::max(bp->exponent, 1e-3f)));
+  } else if (const auto* ggx = std::get_if<GgxBsdf>(&bsdf)) {
+    thetaH = std::atan(ggx->alpha * std::sqrt(std::sqrt(2.0f) - 1.0f));
+  }
+  const float fwhm = std::max(4.0f * thetaH, 1e-4f);
+  const float wanted = std::ceil(8.0f / fwhm);
+  const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
+  return uint32_t(std::clamp(wanted, 2.0f, float(cap)));
+}
+
+float baseTixelSize(const Scene& scene, const BakeSettings& settings) {
+  if (settings.tixelsPerUnit > 0.0f) return 1.0f / settings.tixelsPerUnit;
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  const float extent = maxComponent(hi - lo);
+  if (!(extent > 0.0f) || !std::isfinite(extent)) fail("{}: scene has no extent to parameterise", scene.sourcePath);
+  return extent / std::max(1.0f, settings.tixelsAcrossScene);
+}
+
+namespace {
+
+struct TriangleInfo {
+  uint32_t mesh = 0, triangle = 0, material = 0;
+  std::array<uint32_t, 3> welded{};
+  Vec3 normal{0.0f};  ///< unit winding normal (zero for a degenerate triangle)
+  double area = 0.0;
+};
+
+// A chart's triangles projected to its grid: coordinates in tixel units, so tixel (i, j)
+// covers [i, i+1] × [j, j+1].
+struct ChartRaster {
+  struct Tri2 {
+    Vec2 p[3];
+    uint32_t mesh, triangle;
+  };
+  std::vector<Tri2> tris;
+  std::vector<std::vector<uint32_t>> bins;  ///< per tixel: triangles overlapping its square (bbox test)
+};
+
+// Barycentrics (b0, b1, b2) of q in 2D triangle t; inside when all are ≥ −eps.
+std::array<float, 3> barycentric2(const ChartRaster::Tri2& t, Vec2 q) {
+  const Vec2 e1 = t.p[1] - t.p[0], e2 = t.p[2] - t.p[0], d = q - t.p[0];
+  const float det = e1.x * e2.y - e1.y * e2.x;
+  if (det == 0.0f) return {-1.0f, -1.0f, -1.0f};
+  const float b1 = (d.x * e2.y - d.y * e2.x) / det;
+  const float b2 = (e1.x * d.y - e1.y * d.x) / det;
+  return {1.0f - b1 - b2, b1, b2};
+}
+bool insideBary(const std::array<float, 3>& b) {
+  constexpr float kEps = 1e-6f;  // points on shared edges belong to both triangles
+  return b[0] >= -kEps && b[1] >= -kEps && b[2] >= -kEps;
+}
+
+Vec2 closestOnSegment(Vec2 a, Vec2 b, Vec2 q) {
+  const Vec2 ab = b - a;
+  const float len2 = glm::dot(ab, ab);
+  const float t = len2 > 0.0f ? std::clamp(glm::dot(q - a, ab) / len2, 0.0f, 1.0f) : 0.0f;
+  return a + t * ab;
+}
+
+ChartRaster rasteriseChart(const Scene& scene, const Chart& c, const std::vector<std::pair<uint32_t, uint32_t>>& tris) {
+  ChartRaster r;
+  r.bins.resize(c.tixelCount());
+  const float inv = 1.0f / c.tixelSize;
+  for (const auto& [m, t] : tris) {
+    const Mesh& mesh = scene.meshes[m];
+    ChartRaster::Tri2 t2;
+    t2.mesh = m;
+    t2.triangle = t;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 d = mesh.positions[mesh.triangles[t][k]] - c.origin;
+      t2.p[k] = Vec2(glm::dot(d, c.axisU) * inv, glm::dot(d, c.axisV) * inv);
+    }
+    const uint32_t index = uint32_t(r.tris.size());
+    r.tris.push_back(t2);
+    const Vec2 lo = glm::min(t2.p[0], glm::min(t2.p[1], t2.p[2]));
+    const Vec2 hi = glm::max(t2.p[0], glm::max(t2.p[1], t2.p[2]));
+    const int i0 = std::clamp(int(std::floor(lo.x)), 0, int(c.resU) - 1), i1 = std::clamp(int(std::floor(hi.x)), 0, int(c.resU) - 1);
+    const int j0 = std::clamp(int(std::floor(lo.y)), 0, int(c.resV) - 1), j1 = std::clamp(int(std::floor(hi.y)), 0, int(c.resV) - 1);
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) r.bins[size_t(j) * c.resU + i].push_back(index);
+  }
+  return r;
+}
+
+// For each tixel, the nearest tixel (4-neighbour BFS distance) whose bin is non-empty.
+std::vector<uint32_t> nearestNonEmptyBin(const Chart& c, const ChartRaster& r) {
+  const uint32_t n = uint32_t(c.tixelCount());
+  std::vector<uint32_t> nearest(n, UINT32_MAX);
+  std::deque<uint32_t> queue;
+  for (uint32_t k = 0; k < n; ++k)
+    if (!r.bins[k].empty()) {
+      nearest[k] = k;
+      queue.push_back(k);
+    }
+  while (!queue.empty()) {
+    const uint32_t k = queue.front();
+    queue.pop_front();
+    const uint32_t i = k % c.resU, j = k / c.resU;
+    const uint32_t nb[4] = {i > 0 ? k - 1 : UINT32_MAX, i + 1 < c.resU ? k + 1 : UINT32_MAX,
+                            j > 0 ? k - c.resU : UINT32_MAX, j + 1 < c.resV ? k + c.resU : UINT32_MAX};
+    for (uint32_t q : nb)
+      if (q != UINT32_MAX && nearest[q] == UINT32_MAX) {
+        nearest[q] = nearest[k];
+        queue.push_back(q);
+      }
+  }
+  return nearest;
+}
+
+// Point on the real (3D) triangle at 2D barycentrics b.
+Vec3 pointOnTriangle(const Scene& scene, const ChartRaster::Tri2& t, const std::array<float, 3>& b) {
+  const Mesh& mesh = scene.meshes[t.mesh];
+  const UVec3 tri = mesh.triangles[t.triangle];
+  return b[0] * mesh.positions[tri[0]] + b[1] * mesh.positions[tri[1]] + b[2] * mesh.positions[tri[2]];
+}
+
+// Sub-samples per tixel side for coverage and footprint-average albedo.
+constexpr int kFootprintSamples = 4;
+
+struct FootprintSample {
+  bool inside = false;
+  uint32_t tri = 0;
+  std::array<float, 3> bary{};
+};
+
+FootprintSample locate(const ChartRaster& r, uint32_t bin, Vec2 q) {
+  FootprintSample s;
+  for (uint32_t t : r.bins[bin]) {
+    const auto b = barycentric2(r.tris[t], q);
+    if (insideBary(b)) {
+      s.inside = true;
+      s.tri = t;
+      s.bary = b;
+      return s;
+    }
+  }
+  return s;
+}
+
+void fillChartTixels(const Scene& scene, const Chart& c, const std::vector<std::pair<uint32_t, uint32_t>>& tris,
+                     Parameterisation& p, bool gatherPoints) {
+  const ChartRaster r = rasteriseChart(scene, c, tris);
+  const std::vector<uint32_t> nearest = nearestNonEmptyBin(c, r);
+  const Material& material = scene.materials[c.material];
+  const bool textured = c.kind == ChartKind::Diffuse && material.albedoTexture >= 0;
+  const Rgb constantAlbedo = c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, Vec2(0.0f)) : Rgb(0.0f);
+  for (uint32_t j = 0; j < c.resV; ++j)
+    for (uint32_t i = 0; i < c.resU; ++i) {
+      const uint32_t local = j * c.resU + i;
+      const uint64_t g = c.firstTixel + local;
+      // Footprint: coverage and mean albedo over the sub-samples inside the polygon.
+      int inside = 0;
+      Rgb albedoSum(0.0f);
+      for (int b = 0; b < kFootprintSamples; ++b)
+        for (int a = 0; a < kFootprintSamples; ++a) {
+          const Vec2 q(float(i) + (a + 0.5f) / kFootprintSamples, float(j) + (b + 0.5f) / kFootprintSamples);
+          const FootprintSample s = locate(r, local, q);
+          if (!s.inside) continue;
+          ++inside;
+          if (textured) {
+            const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
+            albedoSum += diffuseAlbedoAt(scene, c.material, hit.uv);
+          }
+        }
+      if (gatherPoints) p.coverage[g] = float(inside) / float(kFootprintSamples * kFootprintSamples);
+
+      // Gather point: the centre if it lies on the polygon, else the closest polygon point.
+      const Vec2 centre(float(i) + 0.5f, float(j) + 0.5f);
+      FootprintSample s = locate(r, local, centre);
+      Vec3 point(0.0f);
+      if (!s.inside) {
+        const uint32_t bin = nearest[local];
+        float best = kInfinity;
+        Vec2 bestQ = centre;
+        uint32_t bestTri = 0;
+        for (uint32_t t : r.bins[bin]) {
+          const auto& tr = r.tris[t];
+          for (int e = 0; e < 3; ++e) {
+            const Vec2 q = closestOnSegment(tr.p[e], tr.p[(e + 1) % 3], centre);
+            const float d = glm::dot(q - centre, q - centre);
+            if (d < best) {
+              best = d;
+              bestQ = q;
+              bestTri = t;
+            }
+          }
+        }
+        // Pull the point slightly inside its triangle (towards the centroid, by at most 2 %
+        // of a tixel) so that rays from it do not start exactly on a shared edge or crack.
+        const auto& tr = r.tris[bestTri];
+        const Vec2 centroid = (tr.p[0] + tr.p[1] + tr.p[2]) / 3.0f;
+        const float dist = glm::length(centroid - bestQ);
+        if (dist > 0.0f) bestQ += (centroid - bestQ) * (std::min(0.02f, 0.5f * dist) / dist);
+        s.inside = true;
+        s.tri = bestTri;
+        s.bary = barycentric2(tr, bestQ);
+      }
+      if (!r.tris.empty()) point = pointOnTriangle(scene, r.tris[s.tri], s.bary);
+      if (gatherPoints) p.gatherPoint[g] = point;
+
+      if (c.kind == ChartKind::Diffuse) {
+        if (!textured) {
+          p.transportAlbedo[g] = constantAlbedo;
+        } else if (inside > 0) {
+          p.transportAlbedo[g] = albedoSum / float(inside);
+        } else {
+          const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
+          p.transportAlbedo[g] = diffuseAlbedoAt(scene, c.material, hit.uv);
+        }
+      } else {
+        p.transportAlbedo[g] = Rgb(0.0f);
+      }
+    }
+}
+
+}  // namespace
+
+Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& settings) {
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  const float diagonal = glm::length(hi - lo);
+  // Vertices closer than weldEps are one vertex for adjacency (split normals/uvs in OBJ files);
+  // 1e-5 of the diagonal keeps quantised coordinates within 21 bits per axis.
+  const float weldEps = 1e-5f * diagonal;
+  const float planeTol = kChartPlaneTolerance * diagonal;
+  const float cosTol = std::cos(kChartNormalToleranceDegrees * kPi / 180.0f);
+
+  // Triangles with welded vertex ids (positions quantised to weldEps).
+  std::vector<TriangleInfo> tris;
+  tris.reserve(scene.triangleCount());
+  std::unordered_map<uint64_t, uint32_t> weld;
+  auto weldId = [&](const Vec3& pos) {
+    const auto q = [&](float x, float origin) {
+      return uint64_t(std::llround(double(x - origin) / double(weldEps))) & 0x1fffff;
+    };
+    const uint64_t key = q(pos.x, lo.x) | (q(pos.y, lo.y) << 21) | (q(pos.z, lo.z) << 42);
+    return weld.try_emplace(key, uint32_t(weld.size())).first->second;
+  };
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      TriangleInfo info;
+      info.mesh = m;
+      info.triangle = t;
+      info.material = mesh.materials[t];
+      const Vec3 p0 = mesh.positions[mesh.triangles[t][0]], p1 = mesh.positions[mesh.triangles[t][1]],
+                 p2 = mesh.positions[mesh.triangles[t][2]];
+      const DVec3 cr = glm::cross(DVec3(p1 - p0), DVec3(p2 - p0));
+      const double len = glm::length(cr);
+      info.area = 0.5 * len;
+      info.normal = len > 0.0 ? Vec3(cr / len) : Vec3(0.0f);
+      info.welded = {weldId(p0), weldId(p1), weldId(p2)};
+      tris.push_back(info);
+    }
+  }
+
+  // Edge adjacency: sorted (edge key, triangle) pairs.
+  std::vector<std::pair<uint64_t, uint32_t>> edges;
+  edges.reserve(tris.size() * 3);
+  for (uint32_t g = 0; g < tris.size(); ++g)
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = tris[g].welded[e], b = tris[g].welded[(e + 1) % 3];
+      edges.emplace_back((uint64_t(std::min(a, b)) << 32) | std::max(a, b), g);
+    }
+  std::sort(edges.begin(), edges.end());
+  // neighbours(g) = triangles in the runs of g's three edge keys.
+  std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> runs;  // key → [begin, end)
+  runs.reserve(edges.size());
+  for (size_t k = 0; k < edges.size();) {
+    size_t e = k;
+    while (e < edges.size() && edges[e].first == edges[k].first) ++e;
+    runs[edges[k].first] = {uint32_t(k), uint32_t(e)};
+    k = e;
+  }
+
+  Parameterisation p;
+  p.triangleChart.resize(scene.meshes.size());
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m) p.triangleChart[m].assign(scene.meshes[m].triangles.size(), 0);
+  std::vector<uint32_t> chartOf(tris.size(), UINT32_MAX);
+  std::vector<uint32_t> stack;
+  for (uint32_t seed = 0; seed < tris.size(); ++seed) {
+    if (chartOf[seed] != UINT32_MAX) continue;
+    const uint32_t chart = uint32_t(p.chartTriangles.size());
+    p.chartTriangles.emplace_back();
+    const TriangleInfo& s = tris[seed];
+    const Vec3 n0 = s.normal;
+    const float d0 = glm::dot(n0, scene.meshes[s.mesh].positions[scene.meshes[s.mesh].triangles[s.triangle][0]]);
+    chartOf[seed] = chart;
+    stack.assign(1, seed);
+    while (!stack.empty()) {
+      const uint32_t g = stack.back();
+      stack.pop_back();
+      p.chartTriangles[chart].emplace_back(tris[g].mesh, tris[g].triangle);
+      if (s.area == 0.0) continue;  // a degenerate seed stays alone
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t a = tris[g].welded[e], b = tris[g].welded[(e + 1) % 3];
+        const auto [begin, end] = runs[(uint64_t(std::min(a, b)) << 32) | std::max(a, b)];
+        for (uint32_t k = begin; k < end; ++k) {
+          const uint32_t h = edges[k].second;
+          if (chartOf[h] != UINT32_MAX) continue;
+          const TriangleInfo& t = tris[h];
+          if (t.material != s.material || t.area == 0.0 || glm::dot(t.normal, n0) < cosTol) continue;
+          const Mesh& mesh = scene.meshes[t.mesh];
+          bool coplanar = true;
+          for (int v = 0; v < 3; ++v)
+            coplanar = coplanar && std::abs(glm::dot(n0, mesh.positions[mesh.triangles[t.triangle][v]]) - d0) <= planeTol;
+          if (!coplanar) continue;
+          chartOf[h] = chart;
+          stack.push_back(h);
+        }
+      }
+    }
+  }
+
+  // Frames and grids.
+  const float baseSize = baseTixelSize(scene, settings);
+  const uint32_t cap = std::max<uint32_t>(1, settings.maxTixelsPerChartSide);
+  const size_t chartCount = p.chartTriangles.size();
+  p.charts.resize(chartCount);
+  p.chartArea.assign(chartCount, 0.0);
+  parallelFor(chartCount, [&](uint64_t ci) {
+    const auto& list = p.chartTriangles[ci];
+    Chart& c = p.charts[ci];
+    DVec3 normalSum(0.0);
+    DVec3 centroid(0.0);
+    double area = 0.0;
+    for (const auto& [m, t] : list) {
+      const Mesh& mesh = scene.meshes[m];
+      const UVec3 tri = mesh.triangles[t];
+      const DVec3 p0 = mesh.positions[tri[0]], p1 = mesh.positions[tri[1]], p2 = mesh.positions[tri[2]];
+      const DVec3 cr = glm::cross(p1 - p0, p2 - p0);
+      normalSum += cr;
+      area += 0.5 * glm::length(cr);
+      centroid += (p0 + p1 + p2) / 3.0;
+    }
+    centroid /= double(list.size());
+    p.chartArea[ci] = area;
+    const uint32_t firstMaterial = scene.meshes[list[0].first].materials[list[0].second];
+    c.material = firstMaterial;
+    const Bsdf& bsdf = scene.materials[firstMaterial].bsdf;
+    c.kind = chartKindOf(bsdf);
+    c.dirRes = directionalResolution(bsdf, settings);
+    const double nLen = glm::length(normalSum);
+    const Vec3 n = nLen > 0.0 ? Vec3(normalSum / nLen) : Vec3(0.0f, 0.0f, 1.0f);
+    c.normal = n;
+
+    // axisU: among the (longest 256) triangle edges projected into the plane, the one giving
+    // the smallest bounding rectangle; ties keep the first.
+    std::vector<std::pair<float, Vec3>> candidates;
+    std::vector<Vec3> points;
+    for (const auto& [m, t] : list) {
+      const Mesh& mesh = scene.meshes[m];
+      const UVec3 tri = mesh.triangles[t];
+      for (int e = 0; e < 3; ++e) {
+        points.push_back(mesh.positions[tri[e]]);
+        Vec3 d = mesh.positions[tri[(e + 1) % 3]] - mesh.positions[tri[e]];
+        d -= glm::dot(d, n) * n;
+        const float len = glm::length(d);
+        if (len > 0.0f) candidates.emplace_back(len, d / len);
+      }
+    }
+    std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    if (candidates.size() > 256) candidates.resize(256);
+    if (candidates.empty()) candidates.emplace_back(1.0f, Frame::fromNormal(n).s);
+    const Vec3 ref(centroid);
+    float bestArea = kInfinity;
+    Vec3 bestU = candidates[0].second;
+    Vec2 bestLo(0.0f), bestHi(0.0f);
+    for (const auto& cand : candidates) {
+      const Vec3 u = cand.second, v = glm::cross(n, u);
+      Vec2 plo(kInfinity), phi(-kInfinity);
+      for (const Vec3& q : points) {
+        const Vec2 uv(glm::dot(q - ref, u), glm::dot(q - ref, v));
+        plo = glm::min(plo, uv);
+        phi = glm::max(phi, uv);
+      }
+      const float a = (phi.x - plo.x) * (phi.y - plo.y);
+      if (a < bestArea * (1.0f - 1e-5f)) {
+        bestArea = a;
+        bestU = u;
+        bestLo = plo;
+        bestHi = phi;
+      }
+    }
+    c.axisU = bestU;
+    c.axisV = glm::cross(n, bestU);
+    const float width = bestHi.x - bestLo.x, height = bestHi.y - bestLo.y;
+    float size = baseSize;
+    if (std::max(width, height) > size * float(cap)) size = std::max(width, height) / float(cap);
+    c.tixelSize = size;
+    // The small slack keeps an edge that is an exact multiple of the size from gaining a tixel.
+    c.resU = std::clamp(uint32_t(std::ceil(width / size - 1e-4f)), 1u, cap);
+    c.resV = std::clamp(uint32_t(std::ceil(height / size - 1e-4f)), 1u, cap);
+    const float padU = 0.5f * (float(c.resU) * size - width), padV = 0.5f * (float(c.resV) * size - height);
+    c.origin = ref + (bestLo.x - padU) * c.axisU + (bestLo.y - padV) * c.axisV;
+  });
+
+  for (uint32_t ci = 0; ci < chartCount; ++ci) {
+    Chart& c = p.charts[ci];
+    c.firstTixel = p.tixelCount;
+    c.firstValue = p.valueCount;
+    p.tixelCount += c.tixelCount();
+    p.valueCount += c.tixelCount() * c.valuesPerTixel();
+    for (const auto& [m, t] : p.chartTriangles[ci]) p.triangleChart[m][t] = ci;
+  }
+  p.tixelChart.resize(p.tixelCount);
+  p.gatherPoint.resize(p.tixelCount);
+  p.coverage.resize(p.tixelCount);
+  p.transportAlbedo.resize(p.tixelCount);
+  for (uint32_t ci = 0; ci < chartCount; ++ci)
+    std::fill_n(p.tixelChart.begin() + int64_t(p.charts[ci].firstTixel), p.charts[ci].tixelCount(), ci);
+  parallelFor(chartCount, [&](uint64_t ci) { fillChartTixels(scene, p.charts[ci], p.chartTriangles[ci], p, true); });
+  return p;
+}
+
+void computeTransportAlbedo(const Scene& scene, Parameterisation& p) {
+  parallelFor(p.charts.size(), [&](uint64_t ci) { fillChartTixels(scene, p.charts[ci], p.chartTriangles[ci], p, false); });
+}
+
+}  // namespace pl

@@ -1,0 +1,119 @@
+// Tests of chart construction and tixel grids.
+#include "lightfield/parameterisation.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "core/progress.h"
+#include "lightfield/lookup.h"
+
+namespace pl {
+namespace {
+
+double triangleArea(const Scene& s, uint32_t m, uint32_t t) {
+  const Mesh& mesh = s.meshes[m];
+  const UVec3 tri = mesh.triangles[t];
+  return 0.5 * glm::length(glm::cross(DVec3(mesh.positions[tri[1]] - mesh.positions[tri[0]]),
+                                      DVec3(mesh.positions[tri[2]] - mesh.positions[tri[0]])));
+}
+
+TEST(Parameterisation, CornellBoxCharts) {
+  Progress::setEnabled(false);
+  const Scene scene = makeCornellBox();
+  BakeSettings settings;
+  settings.tixelsAcrossScene = 32;
+  const Parameterisation p = buildParameterisation(scene, settings);
+  // 5 room quads + the light + 2 blocks × 5 faces: every quad is one planar chart (the
+  // measured walls are non-planar by at most 3.2 mm, within the 0.5 % plane tolerance).
+  EXPECT_EQ(p.charts.size(), 16u);
+
+  // Every triangle is in exactly one chart, and triangleChart agrees with chartTriangles.
+  std::set<std::pair<uint32_t, uint32_t>> seen;
+  double chartAreaSum = 0.0, sceneArea = 0.0;
+  for (uint32_t c = 0; c < p.charts.size(); ++c) {
+    for (const auto& mt : p.chartTriangles[c]) {
+      EXPECT_TRUE(seen.insert(mt).second) << "triangle in two charts";
+      EXPECT_EQ(p.triangleChart[mt.first][mt.second], c);
+      EXPECT_EQ(scene.meshes[mt.first].materials[mt.second], p.charts[c].material);
+    }
+    chartAreaSum += p.chartArea[c];
+  }
+  EXPECT_EQ(seen.size(), scene.triangleCount());
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m)
+    for (uint32_t t = 0; t < scene.meshes[m].triangles.size(); ++t) sceneArea += triangleArea(scene, m, t);
+  EXPECT_NEAR(chartAreaSum, sceneArea, 1e-9 * sceneArea);
+
+  for (uint32_t c = 0; c < p.charts.size(); ++c) {
+    const Chart& chart = p.charts[c];
+    // Orthonormal, right-handed frames; the normal is the triangles' winding normal.
+    EXPECT_NEAR(glm::dot(chart.axisU, chart.axisV), 0.0f, 1e-5f);
+    EXPECT_NEAR(glm::length(glm::cross(chart.axisU, chart.axisV) - chart.normal), 0.0f, 1e-5f);
+    const auto [m, t] = p.chartTriangles[c][0];
+    const Mesh& mesh = scene.meshes[m];
+    const Vec3 n = glm::normalize(glm::cross(mesh.positions[mesh.triangles[t][1]] - mesh.positions[mesh.triangles[t][0]],
+                                             mesh.positions[mesh.triangles[t][2]] - mesh.positions[mesh.triangles[t][0]]));
+    EXPECT_GT(glm::dot(n, chart.normal), 0.999f);
+    EXPECT_EQ(chart.kind, ChartKind::Diffuse);
+    EXPECT_EQ(chart.dirRes, 1u);
+    // The grid covers the chart: every vertex maps inside [−½, res − ½] in grid coordinates.
+    for (const auto& [mm, tt] : p.chartTriangles[c])
+      for (int k = 0; k < 3; ++k) {
+        const Vec2 g = tixelGridCoordinates(chart, scene.meshes[mm].positions[scene.meshes[mm].triangles[tt][k]]);
+        EXPECT_GE(g.x, -0.5f - 1e-3f);
+        EXPECT_LE(g.x, chart.resU - 0.5f + 1e-3f);
+        EXPECT_GE(g.y, -0.5f - 1e-3f);
+        EXPECT_LE(g.y, chart.resV - 0.5f + 1e-3f);
+      }
+    // Covered area (coverage × tixel area, 4×4 sub-samples) approximates the chart area;
+    // the sub-sampling error is at most about one tixel row along the perimeter.
+    double covered = 0.0;
+    for (uint64_t k = 0; k < chart.tixelCount(); ++k) covered += p.coverage[chart.firstTixel + k];
+    covered *= double(chart.tixelSize) * chart.tixelSize;
+    const double perimeterBound = 2.0 * (chart.resU + chart.resV) * double(chart.tixelSize) * chart.tixelSize;
+    EXPECT_NEAR(covered, p.chartArea[c], 0.25 * perimeterBound) << "chart " << c;
+    // Gather points lie on the chart's plane, within the chart's rectangle.
+    for (uint64_t k = 0; k < chart.tixelCount(); ++k) {
+      const Vec3 q = p.gatherPoint[chart.firstTixel + k];
+      EXPECT_EQ(p.tixelChart[chart.firstTixel + k], c);
+      EXPECT_NEAR(glm::dot(q - chart.origin, chart.normal), 0.0f, 5.0f);  // ≤ the 3.2 mm non-planarity
+      const Vec2 g = tixelGridCoordinates(chart, q);
+      EXPECT_GE(g.x, -0.51f);
+      EXPECT_LE(g.x, chart.resU - 0.49f);
+    }
+  }
+  // The room's walls are ~550 mm, the largest extent ~559 mm: 32 tixels across the scene
+  // gives 31–32 tixels per wall side.
+  EXPECT_GE(p.charts[0].resU, 31u);
+  EXPECT_LE(p.charts[0].resU, 33u);
+  EXPECT_EQ(p.tixelCount, p.valueCount);  // all diffuse: one value per tixel
+}
+
+TEST(Parameterisation, CapOnTixelsPerSide) {
+  const Scene scene = makeCornellBox();
+  BakeSettings settings;
+  settings.tixelsAcrossScene = 200;
+  settings.maxTixelsPerChartSide = 10;
+  const Parameterisation p = buildParameterisation(scene, settings);
+  for (const Chart& c : p.charts) {
+    EXPECT_LE(c.resU, 10u);
+    EXPECT_LE(c.resV, 10u);
+  }
+}
+
+TEST(Parameterisation, DirectionalResolutionByMaterial) {
+  BakeSettings settings;
+  settings.glossyDirRes = 16;
+  EXPECT_EQ(directionalResolution(LambertBsdf{}, settings), 1u);
+  EXPECT_EQ(directionalResolution(MirrorBsdf{}, settings), 0u);
+  const uint32_t wide = directionalResolution(BlinnPhongBsdf{Rgb(0.3f), Rgb(0.3f), 8.0f}, settings);
+  const uint32_t narrow = directionalResolution(BlinnPhongBsdf{Rgb(0.3f), Rgb(0.3f), 80.0f}, settings);
+  EXPECT_LT(wide, narrow);  // sharper lobes need finer maps
+  EXPECT_LE(narrow, 16u);
+  EXPECT_EQ(directionalResolution(BlinnPhongBsdf{Rgb(0.3f), Rgb(0.3f), 100000.0f}, settings), 16u);  // capped
+  EXPECT_LT(directionalResolution(GgxBsdf{Rgb(0.2f), Rgb(0.04f), 0.5f}, settings),
+            directionalResolution(GgxBsdf{Rgb(0.2f), Rgb(0.04f), 0.1f}, settings));
+}
+
+}  // namespace
+}  // namespace pl
