@@ -89,8 +89,8 @@ std::vector<std::string> validateObj(const std::string& path) {
         fail("{}:{}: '{}' needs {} numbers, found {}", path, lineNumber, keyword, needed, tokens.size() - 1);
       for (size_t k = 1; k < tokens.size(); ++k) {
         float value;
-        if (!parseFloat(tokens[k], value))
-          fail("{}:{}: '{}' is not a number in '{}' statement", path, lineNumber, tokens[k], keyword);
+        if (!parseFloat(tokens[k], value) || !std::isfinite(value))
+          fail("{}:{}: '{}' is not a finite number in '{}' statement", path, lineNumber, tokens[k], keyword);
       }
       (keyword == "v" ? positions : keyword == "vn" ? normals : texcoords)++;
     } else if (keyword == "f") {

@@ -1,0 +1,610 @@
+// Tests of the scene module: the built-in Cornell box, every loader on real files, texture
+// sampling, per-hit surface data, the automatic camera, and one test per kind of bad input.
+#include "core/error.h"
+#include "scene/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+
+namespace pl {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kMcGuireDir = std::string(PLENOPTIC_SHARED_DIR) + "/scenes/cornell-mcguire/";
+const std::string kDataDir = std::string(PLENOPTIC_TEST_DATA_DIR) + "/scene/";
+
+// Float tolerance for values that went through a few float operations (products, sums of
+// magnitude ≲ 10): a few ulps of float (6e-8 relative) at that scale.
+constexpr float kTight = 1e-5f;
+
+#define EXPECT_VEC3_NEAR(a, b, tol)                                                                    \
+  do {                                                                                                 \
+    const Vec3 va_ = (a), vb_ = (b);                                                                   \
+    EXPECT_NEAR(va_.x, vb_.x, tol);                                                                    \
+    EXPECT_NEAR(va_.y, vb_.y, tol);                                                                    \
+    EXPECT_NEAR(va_.z, vb_.z, tol);                                                                    \
+  } while (0)
+
+/// Runs `load`, expects a pl::Error whose message contains every string of `needles`.
+void expectError(const std::function<void()>& load, std::initializer_list<std::string> needles) {
+  try {
+    load();
+    ADD_FAILURE() << "no pl::Error thrown";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    for (const std::string& needle : needles)
+      EXPECT_NE(message.find(needle), std::string::npos) << "message '" << message << "' lacks '" << needle << "'";
+  }
+}
+
+/// A fresh directory for files written by one test.
+fs::path scratchDir(const std::string& name) {
+  const fs::path dir = fs::path(testing::TempDir()) / ("pl_scene_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string writeFile(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+  return path.string();
+}
+
+Vec3 triangleNormal(const Mesh& mesh, size_t t) {
+  const UVec3 tri = mesh.triangles[t];
+  return glm::normalize(glm::cross(mesh.positions[tri.y] - mesh.positions[tri.x], mesh.positions[tri.z] - mesh.positions[tri.x]));
+}
+Vec3 triangleCentroid(const Mesh& mesh, size_t t) {
+  const UVec3 tri = mesh.triangles[t];
+  return (mesh.positions[tri.x] + mesh.positions[tri.y] + mesh.positions[tri.z]) / 3.0f;
+}
+float triangleArea(const Mesh& mesh, size_t t) {
+  const UVec3 tri = mesh.triangles[t];
+  return 0.5f * glm::length(glm::cross(mesh.positions[tri.y] - mesh.positions[tri.x], mesh.positions[tri.z] - mesh.positions[tri.x]));
+}
+const Mesh& meshNamed(const Scene& scene, const std::string& name) {
+  for (const Mesh& mesh : scene.meshes)
+    if (mesh.name == name) return mesh;
+  throw std::runtime_error("no mesh " + name);
+}
+const Material& materialNamed(const Scene& scene, const std::string& name) {
+  for (const Material& material : scene.materials)
+    if (material.name == name) return material;
+  throw std::runtime_error("no material " + name);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Built-in Cornell box
+
+TEST(CornellBox, GeometryMatchesTheMeasuredData) {
+  const Scene scene = makeCornellBox();
+  // 5 walls + light = 6 quads, 2 blocks × (4 sides + top) = 10 quads ⇒ 16 quads = 32 triangles.
+  EXPECT_EQ(scene.triangleCount(), 32u);
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  // Published extremes: x up to 556.0 (ceiling/left wall), y 548.8, z 559.2.
+  EXPECT_VEC3_NEAR(lo, Vec3(0.0f), 0.0f);
+  EXPECT_VEC3_NEAR(hi, Vec3(556.0f, 548.8f, 559.2f), 0.0f);
+  for (const Material& material : scene.materials)
+    EXPECT_TRUE(std::holds_alternative<LambertBsdf>(material.bsdf)) << material.name;
+}
+
+TEST(CornellBox, LightIs130By105mmFacingDownJustBelowTheCeiling) {
+  const Scene scene = makeCornellBox();
+  double area = 0.0;
+  Rgb emission(0.0f);
+  for (const Mesh& mesh : scene.meshes)
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const Material& material = scene.materials[mesh.materials[t]];
+      if (!material.isEmissive()) continue;
+      area += triangleArea(mesh, t);
+      emission = material.emission;
+      EXPECT_VEC3_NEAR(triangleNormal(mesh, t), Vec3(0.0f, -1.0f, 0.0f), kTight);  // emits downward
+      const Vec3 c = triangleCentroid(mesh, t);
+      EXPECT_LT(c.y, 548.8f);
+      EXPECT_GT(c.y, 548.0f);
+    }
+  // 130 × 105 mm² = 13650 mm²; the corners are exact in float, the area to float rounding.
+  EXPECT_NEAR(area, 130.0 * 105.0, 1e-2);
+  EXPECT_VEC3_NEAR(emission, Rgb(18.387f, 13.9873f, 6.75357f), 0.0f);
+}
+
+TEST(CornellBox, WallsFaceInwardAndBlocksFaceOutward) {
+  const Scene scene = makeCornellBox();
+  const Mesh& room = meshNamed(scene, "room");
+  const Vec3 inside(278.0f, 274.0f, 280.0f);
+  ASSERT_EQ(room.triangles.size(), 10u);
+  for (size_t t = 0; t < room.triangles.size(); ++t)
+    EXPECT_GT(glm::dot(triangleNormal(room, t), inside - triangleCentroid(room, t)), 0.0f) << "room triangle " << t;
+  // Blocks: short block triangles 0..9, tall block 10..19; faces point away from each centre.
+  const Mesh& blocks = meshNamed(scene, "blocks");
+  ASSERT_EQ(blocks.triangles.size(), 20u);
+  const Vec3 shortCentre(186.0f, 82.5f, 169.0f), tallCentre(368.5f, 165.0f, 351.0f);
+  for (size_t t = 0; t < 20; ++t) {
+    const Vec3 centre = t < 10 ? shortCentre : tallCentre;
+    EXPECT_GT(glm::dot(triangleNormal(blocks, t), triangleCentroid(blocks, t) - centre), 0.0f) << "block triangle " << t;
+  }
+  // The red wall is at x ≈ 552–556 (camera's left), the green one at x = 0.
+  for (size_t t = 0; t < room.triangles.size(); ++t) {
+    const std::string& name = scene.materials[room.materials[t]].name;
+    if (name == "red") {
+      EXPECT_GT(triangleCentroid(room, t).x, 549.0f);
+    } else if (name == "green") {
+      EXPECT_EQ(triangleCentroid(room, t).x, 0.0f);
+    }
+  }
+}
+
+TEST(CornellBox, CameraAndLookup) {
+  const Scene scene = makeCornellBox();
+  for (const char* name : {"default", "cornell"}) {
+    const CameraDesc& camera = scene.camera(name);
+    EXPECT_VEC3_NEAR(camera.eye, Vec3(278.0f, 273.0f, -800.0f), 0.0f);
+    EXPECT_VEC3_NEAR(glm::normalize(camera.target - camera.eye), Vec3(0.0f, 0.0f, 1.0f), 0.0f);
+    EXPECT_VEC3_NEAR(camera.up, Vec3(0.0f, 1.0f, 0.0f), 0.0f);
+    // 2·atan(12.5 mm / 35 mm) in degrees.
+    EXPECT_NEAR(camera.fovYDegrees, 2.0 * std::atan(12.5 / 35.0) * 180.0 / kPiD, 1e-4);
+  }
+  expectError([&] { scene.camera("nope"); }, {"cornell", "nope", "'default'", "'cornell'"});
+  EXPECT_EQ(loadScene("cornell").triangleCount(), 32u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// McGuire's OBJ variants (CRLF line endings, as published)
+
+size_t countFacesTriangulated(const std::string& path) {
+  // Independent count of the file's triangles: an n-gon "f" line is n − 2 triangles.
+  std::ifstream in(path);
+  std::string line;
+  size_t triangles = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("f ", 0) != 0) continue;
+    std::istringstream tokens(line.substr(2));
+    std::string token;
+    size_t n = 0;
+    while (tokens >> token) ++n;
+    triangles += n - 2;
+  }
+  return triangles;
+}
+
+template <typename T>
+bool hasModel(const Scene& scene) {
+  for (const Material& material : scene.materials)
+    if (std::holds_alternative<T>(material.bsdf)) return true;
+  return false;
+}
+
+class McGuireVariant : public testing::TestWithParam<const char*> {};
+
+TEST_P(McGuireVariant, LoadsWithEveryTriangleAndALight) {
+  const std::string path = kMcGuireDir + "CornellBox-" + GetParam() + ".obj";
+  const Scene scene = loadScene(path);
+  // Every published triangle survives: none is degenerate in these files.
+  EXPECT_EQ(scene.triangleCount(), countFacesTriangulated(path));
+  EXPECT_GT(scene.triangleCount(), 0u);
+  bool emissive = false;
+  for (const Material& material : scene.materials) {
+    emissive |= material.isEmissive();
+    // CRLF must not leak into names.
+    EXPECT_EQ(material.name.find('\r'), std::string::npos);
+    // Every Blinn-Phong material conserves energy after the loader's rescaling.
+    if (const auto* bp = std::get_if<BlinnPhongBsdf>(&material.bsdf)) {
+      EXPECT_LE(maxComponent(bp->diffuse + bp->specular), 1.0f + 1e-6f) << material.name;
+    }
+  }
+  EXPECT_TRUE(emissive);
+  EXPECT_TRUE(materialNamed(scene, "light").isEmissive());
+  // The light hangs from the ceiling: emissive triangles lie within 1 % of the box height
+  // of its top, facing down.
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  for (const Mesh& mesh : scene.meshes)
+    for (size_t t = 0; t < mesh.triangles.size(); ++t)
+      if (scene.materials[mesh.materials[t]].isEmissive()) {
+        EXPECT_GT(triangleCentroid(mesh, t).y, hi.y - 0.01f * (hi.y - lo.y));
+        EXPECT_LT(triangleNormal(mesh, t).y, -0.99f);
+      }
+}
+
+INSTANTIATE_TEST_SUITE_P(Scene, McGuireVariant, testing::Values("Original", "Glossy", "Mirror", "Sphere", "Water"));
+
+TEST(McGuire, OriginalIsLambertWithPublishedLight) {
+  const Scene scene = loadScene(kMcGuireDir + "CornellBox-Original.obj");
+  EXPECT_EQ(scene.triangleCount(), 36u);  // 18 quads
+  for (const Material& material : scene.materials) EXPECT_TRUE(std::holds_alternative<LambertBsdf>(material.bsdf));
+  EXPECT_VEC3_NEAR(materialNamed(scene, "light").emission, Rgb(17.0f, 12.0f, 4.0f), 0.0f);
+  EXPECT_VEC3_NEAR(std::get<LambertBsdf>(materialNamed(scene, "leftWall").bsdf).albedo, Rgb(0.63f, 0.065f, 0.05f), 0.0f);
+}
+
+TEST(McGuire, GlossyHasEnergyConservingBlinnPhong) {
+  const Scene scene = loadScene(kMcGuireDir + "CornellBox-Glossy.obj");
+  EXPECT_TRUE(hasModel<BlinnPhongBsdf>(scene));
+  // floor: Kd 0.725 0.71 0.68 + Ks 0.3 exceeds 1 in red and green and is scaled there.
+  const auto& floor = std::get<BlinnPhongBsdf>(materialNamed(scene, "floor").bsdf);
+  EXPECT_NEAR(floor.diffuse.r, 0.725f / 1.025f, kTight);
+  EXPECT_NEAR(floor.specular.r, 0.3f / 1.025f, kTight);
+  EXPECT_NEAR(floor.diffuse.b, 0.68f, kTight);  // 0.98 ≤ 1: unchanged
+  EXPECT_NEAR(floor.specular.b, 0.3f, kTight);
+  EXPECT_EQ(floor.exponent, 80.0f);
+}
+
+TEST(McGuire, MirrorHasAFresnelMirror) {
+  const Scene scene = loadScene(kMcGuireDir + "CornellBox-Mirror.obj");
+  const auto* mirror = std::get_if<MirrorBsdf>(&materialNamed(scene, "tallBox").bsdf);
+  ASSERT_NE(mirror, nullptr);
+  EXPECT_TRUE(mirror->fresnel);  // illum 5
+  EXPECT_VEC3_NEAR(mirror->reflectance, Rgb(0.95f), 0.0f);
+}
+
+TEST(McGuire, SphereHasAPlainMirrorAndAGlossySphere) {
+  const Scene scene = loadScene(kMcGuireDir + "CornellBox-Sphere.obj");
+  const auto* mirror = std::get_if<MirrorBsdf>(&materialNamed(scene, "leftSphere").bsdf);
+  ASSERT_NE(mirror, nullptr);  // Ks 1 with Ns 1000, no illum
+  EXPECT_FALSE(mirror->fresnel);
+  EXPECT_TRUE(std::holds_alternative<BlinnPhongBsdf>(materialNamed(scene, "rightSphere").bsdf));
+}
+
+// ---------------------------------------------------------------------------------------------
+// OBJ with a texture
+
+TEST(ObjLoader, TextureIsResolvedRelativeToTheMtlAndSampledBottomLeft) {
+  const Scene scene = loadScene(kDataDir + "textured/quad.obj");
+  ASSERT_EQ(scene.textures.size(), 1u);
+  ASSERT_EQ(scene.triangleCount(), 2u);
+  // Where the quad's diagonal falls is tinyobjloader's choice, so find the triangle and
+  // barycentrics with uv = (0.25, 0.25) by solving uv = uv0 + b1·(uv1 − uv0) + b2·(uv2 − uv0).
+  const Mesh& mesh = scene.meshes[0];
+  const Vec2 wanted(0.25f, 0.25f);
+  SurfaceHit hit;
+  bool found = false;
+  for (uint32_t t = 0; t < mesh.triangles.size() && !found; ++t) {
+    const UVec3 tri = mesh.triangles[t];
+    const glm::mat2 edges(mesh.uvs[tri.y] - mesh.uvs[tri.x], mesh.uvs[tri.z] - mesh.uvs[tri.x]);
+    const Vec2 b = glm::inverse(edges) * (wanted - mesh.uvs[tri.x]);
+    if (b.x >= 0.0f && b.y >= 0.0f && b.x + b.y <= 1.0f) {
+      hit = surfaceAt(scene, 0, t, b);
+      found = true;
+    }
+  }
+  ASSERT_TRUE(found);
+  EXPECT_NEAR(hit.uv.x, 0.25f, kTight);
+  EXPECT_NEAR(hit.uv.y, 0.25f, kTight);
+  // (0.25, 0.25) is the centre of the bottom-left texel: blue, exactly (sRGB 255 → 1).
+  const Bsdf bsdf = bsdfAt(scene, hit);
+  EXPECT_VEC3_NEAR(std::get<LambertBsdf>(bsdf).albedo, Rgb(0.0f, 0.0f, 1.0f), kTight);
+}
+
+// ---------------------------------------------------------------------------------------------
+// glTF
+
+class GltfFile : public testing::TestWithParam<const char*> {};
+
+TEST_P(GltfFile, HierarchyCamerasLightsAndMaterial) {
+  const Scene scene = loadScene(kDataDir + GetParam());
+  // The line primitive is skipped; the quad is 2 triangles.
+  EXPECT_EQ(scene.triangleCount(), 2u);
+  // World transform of the quad: Parent (T(0,1,0)·R_y(90°)) · Quad (T(0,0,−2)·S(2,1,1)).
+  // A local point (x, y, 0) → (2x, y, −2) → R_y: (x,y,z) ↦ (z, y, −x) gives (−2, y, −2x)
+  // → (−2, y + 1, −2x). So the quad spans x = −2, y ∈ [0, 2], z ∈ [−2, 2].
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  EXPECT_VEC3_NEAR(lo, Vec3(-2.0f, 0.0f, -2.0f), kTight);
+  EXPECT_VEC3_NEAR(hi, Vec3(-2.0f, 2.0f, 2.0f), kTight);
+  // Geometric normal: local +z ↦ (1, 0, 0). Shading normal: local (1,0,1)/√2 through the
+  // inverse transpose of S(2,1,1) (= S(½,1,1)) ∝ (½, 0, 1), then R_y ↦ (1, 0, −½)/√1.25.
+  // (Transforming it by S itself would give (1, 0, −2)/√5 instead.)
+  const SurfaceHit hit = surfaceAt(scene, 0, 1, Vec2(0.25f, 0.5f));
+  EXPECT_VEC3_NEAR(hit.geometricNormal, Vec3(1.0f, 0.0f, 0.0f), kTight);
+  EXPECT_VEC3_NEAR(hit.shadingNormal, glm::normalize(Vec3(1.0f, 0.0f, -0.5f)), kTight);
+  // Triangle 1 = (v0, v2, v3) with our (v-flipped) uvs (0,0), (1,1), (0,1):
+  // uv = (b1, b1 + b2) = (0.25, 0.75), the centre of the image's top-left texel (red).
+  EXPECT_NEAR(hit.uv.x, 0.25f, kTight);
+  EXPECT_NEAR(hit.uv.y, 0.75f, kTight);
+
+  // Material: diffuse = 0.5·(1 − 0.25) = 0.375, f0 = 0.04 + 0.25·(0.5 − 0.04) = 0.155,
+  // alpha = 0.5² = 0.25, emission = (1, 0.5, 0)·4.
+  const Material& material = materialNamed(scene, "textured");
+  const auto& ggx = std::get<GgxBsdf>(material.bsdf);
+  EXPECT_VEC3_NEAR(ggx.diffuse, Rgb(0.375f), kTight);
+  EXPECT_VEC3_NEAR(ggx.f0, Rgb(0.155f), kTight);
+  EXPECT_NEAR(ggx.alpha, 0.25f, kTight);
+  EXPECT_VEC3_NEAR(material.emission, Rgb(4.0f, 2.0f, 0.0f), kTight);
+  const auto textured = std::get<GgxBsdf>(bsdfAt(scene, hit));
+  EXPECT_VEC3_NEAR(textured.diffuse, Rgb(0.375f, 0.0f, 0.0f), kTight);
+
+  // Camera under Parent at local (0,0,5): eye (5, 1, 0), looking down local −z ↦ (−1, 0, 0).
+  const CameraDesc& camera = scene.camera("Camera");
+  EXPECT_VEC3_NEAR(camera.eye, Vec3(5.0f, 1.0f, 0.0f), kTight);
+  EXPECT_VEC3_NEAR(glm::normalize(camera.target - camera.eye), Vec3(-1.0f, 0.0f, 0.0f), kTight);
+  EXPECT_VEC3_NEAR(camera.up, Vec3(0.0f, 1.0f, 0.0f), kTight);
+  EXPECT_NEAR(camera.fovYDegrees, 0.5f * 180.0f / kPi, 1e-4f);
+  ASSERT_TRUE(camera.aspectRatio.has_value());
+  EXPECT_NEAR(*camera.aspectRatio, 1.5f, kTight);
+
+  // Lights: 683 cd → 1 W/sr and 1366 lx → 2 W/m² (683 lm/W).
+  ASSERT_EQ(scene.lights.size(), 2u);
+  const auto& point = std::get<PointLight>(scene.lights[0]);
+  EXPECT_VEC3_NEAR(point.position, Vec3(0.0f, 3.0f, 0.0f), kTight);
+  EXPECT_VEC3_NEAR(point.intensity, Rgb(1.0f, 0.5f, 0.25f), kTight);
+  const auto& sun = std::get<DirectionalLight>(scene.lights[1]);
+  EXPECT_VEC3_NEAR(sun.direction, Vec3(0.0f, 0.0f, -1.0f), kTight);
+  EXPECT_VEC3_NEAR(sun.irradiance, Rgb(2.0f), kTight);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scene, GltfFile, testing::Values("quad.gltf", "quad.glb"));
+
+// ---------------------------------------------------------------------------------------------
+// JSON scene
+
+TEST(JsonScene, CombinesFilesWithTransformsOverridesLightsCamerasAndEnvironment) {
+  const Scene scene = loadScene(kDataDir + "scene.json");
+  EXPECT_EQ(scene.triangleCount(), 4u);  // OBJ quad + glTF quad
+  // OBJ quad (unit square in z = 0) under T(0,0,−1)·S(2): corners (0..2, 0..2, −1).
+  const Mesh& obj = scene.meshes[0];
+  Vec3 lo(kInfinity), hi(-kInfinity);
+  for (const Vec3& p : obj.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  EXPECT_VEC3_NEAR(lo, Vec3(0.0f, 0.0f, -1.0f), kTight);
+  EXPECT_VEC3_NEAR(hi, Vec3(2.0f, 2.0f, -1.0f), kTight);
+  // Its "checker" material is replaced by the JSON one (albedo 0.5, with texture).
+  const Material& checker = scene.materials[obj.materials[0]];
+  EXPECT_EQ(checker.name, "checker");
+  EXPECT_VEC3_NEAR(std::get<LambertBsdf>(checker.bsdf).albedo, Rgb(0.5f), 0.0f);
+  ASSERT_GE(checker.albedoTexture, 0);
+  // The glTF quad: forced to "gold" and moved by +10 in x (row-major matrix).
+  const Mesh& gltf = scene.meshes[1];
+  for (uint32_t material : gltf.materials) EXPECT_EQ(scene.materials[material].name, "gold");
+  for (const Vec3& p : gltf.positions) EXPECT_NEAR(p.x, 8.0f, kTight);
+  EXPECT_NEAR(std::get<GgxBsdf>(materialNamed(scene, "gold").bsdf).alpha, 0.09f, kTight);  // 0.3²
+  // Lights: the glTF point and sun (appended with their file) + the JSON spot (direction
+  // normalised, angles in radians).
+  ASSERT_EQ(scene.lights.size(), 3u);
+  EXPECT_VEC3_NEAR(std::get<PointLight>(scene.lights[0]).position, Vec3(10.0f, 3.0f, 0.0f), kTight);
+  EXPECT_TRUE(std::holds_alternative<DirectionalLight>(scene.lights[1]));
+  const auto& spot = std::get<SpotLight>(scene.lights[2]);
+  EXPECT_VEC3_NEAR(spot.direction, Vec3(0.0f, -1.0f, 0.0f), kTight);
+  EXPECT_NEAR(spot.outerAngle, 20.0f * kPi / 180.0f, kTight);
+  // Cameras: the glTF one moved along, and the JSON one with its thin lens.
+  EXPECT_VEC3_NEAR(scene.camera("Camera").eye, Vec3(15.0f, 1.0f, 0.0f), kTight);
+  const CameraDesc& main = scene.camera("main");
+  EXPECT_EQ(main.fovYDegrees, 45.0f);
+  EXPECT_EQ(main.fNumber, 2.8f);
+  EXPECT_EQ(main.focusDistance, 5.0f);
+  EXPECT_VEC3_NEAR(scene.environment.constant, Rgb(0.1f, 0.2f, 0.3f), 0.0f);
+}
+
+TEST(JsonScene, IncludeCornell) {
+  const fs::path dir = scratchDir("include_cornell");
+  const std::string path = writeFile(dir / "c.json", R"({"include_cornell": true, "environment": {"color": 0.5}})");
+  const Scene scene = loadScene(path);
+  EXPECT_EQ(scene.triangleCount(), 32u);
+  EXPECT_NO_THROW(scene.camera("cornell"));
+  EXPECT_VEC3_NEAR(scene.environment.constant, Rgb(0.5f), 0.0f);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Textures, surface data, automatic camera
+
+Texture twoByTwo() {
+  Texture texture;
+  texture.image = Image(2, 2);
+  texture.image.at(0, 0) = Rgb(1, 0, 0);  // top-left
+  texture.image.at(1, 0) = Rgb(0, 1, 0);  // top-right
+  texture.image.at(0, 1) = Rgb(0, 0, 1);  // bottom-left
+  texture.image.at(1, 1) = Rgb(1, 1, 1);  // bottom-right
+  return texture;
+}
+
+TEST(Texture, BilinearWithRepeatAndBottomLeftOrigin) {
+  const Texture t = twoByTwo();
+  // Texel centres sit at u, v ∈ {0.25, 0.75}; v = 0.25 is the bottom row.
+  EXPECT_VEC3_NEAR(t.sample(Vec2(0.25f, 0.25f)), Rgb(0, 0, 1), kTight);
+  EXPECT_VEC3_NEAR(t.sample(Vec2(0.75f, 0.25f)), Rgb(1, 1, 1), kTight);
+  EXPECT_VEC3_NEAR(t.sample(Vec2(0.25f, 0.75f)), Rgb(1, 0, 0), kTight);
+  EXPECT_VEC3_NEAR(t.sample(Vec2(0.75f, 0.75f)), Rgb(0, 1, 0), kTight);
+  // The image centre is equidistant from all four: their mean.
+  EXPECT_VEC3_NEAR(t.sample(Vec2(0.5f, 0.5f)), Rgb(0.5f, 0.5f, 0.5f), kTight);
+  // Halfway between the two top texels, weights ½ each.
+  EXPECT_VEC3_NEAR(t.sample(Vec2(0.5f, 0.75f)), Rgb(0.5f, 0.5f, 0.0f), kTight);
+  // A quarter of the way: weights ¾ (red) and ¼ (green).
+  EXPECT_VEC3_NEAR(t.sample(Vec2(0.375f, 0.75f)), Rgb(0.75f, 0.25f, 0.0f), kTight);
+  // Repeat: whole-number shifts change nothing, and u = 0 blends the left and right
+  // columns (which are neighbours across the wrap) half and half.
+  EXPECT_VEC3_NEAR(t.sample(Vec2(-1.75f, 2.25f)), Rgb(0, 0, 1), kTight);
+  EXPECT_VEC3_NEAR(t.sample(Vec2(0.0f, 0.75f)), Rgb(0.5f, 0.5f, 0.0f), kTight);
+}
+
+/// One triangle (0,0,0), (1,0,0), (0,1,0): counter-clockwise seen from +z.
+Scene oneTriangle() {
+  Scene scene;
+  scene.sourcePath = "triangle";
+  scene.materials.push_back({.name = "grey"});
+  Mesh mesh;
+  mesh.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  mesh.triangles = {UVec3(0, 1, 2)};
+  mesh.materials = {0};
+  scene.meshes.push_back(mesh);
+  return scene;
+}
+
+TEST(SurfaceAt, PositionNormalsAndUv) {
+  Scene scene = oneTriangle();
+  // Vertex normals tilted, deliberately pointing to the back side and not unit length:
+  // finalize() normalises them, surfaceAt() flips the interpolated one to the front.
+  scene.meshes[0].normals = {Vec3(0, 0, -2), Vec3(1, 0, -1), Vec3(0, 0, -3)};
+  scene.meshes[0].uvs = {Vec2(0, 0), Vec2(2, 0), Vec2(0, 4)};
+  scene.finalize();
+  const SurfaceHit hit = surfaceAt(scene, 0, 0, Vec2(0.5f, 0.25f));
+  EXPECT_VEC3_NEAR(hit.position, Vec3(0.5f, 0.25f, 0.0f), kTight);
+  EXPECT_VEC3_NEAR(hit.geometricNormal, Vec3(0, 0, 1), kTight);
+  // Interpolated: 0.25·(0,0,−1) + 0.5·(1,0,−1)/√2 + 0.25·(0,0,−1), normalised, flipped.
+  const Vec3 n = 0.25f * Vec3(0, 0, -1) + 0.5f * Vec3(1, 0, -1) / std::sqrt(2.0f) + 0.25f * Vec3(0, 0, -1);
+  EXPECT_VEC3_NEAR(hit.shadingNormal, -glm::normalize(n), kTight);
+  EXPECT_VEC3_NEAR(Vec3(hit.uv, 0.0f), Vec3(1.0f, 1.0f, 0.0f), kTight);  // 0.5·(2,0) + 0.25·(0,4)
+  EXPECT_EQ(hit.material, 0u);
+}
+
+TEST(SurfaceAt, OpposingNormalsFallBackToGeometric) {
+  Scene scene = oneTriangle();
+  scene.meshes[0].normals = {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 0, 0)};
+  scene.finalize();
+  // b0 = b1 = 0.5: the two vertex normals cancel exactly.
+  const SurfaceHit hit = surfaceAt(scene, 0, 0, Vec2(0.5f, 0.0f));
+  EXPECT_VEC3_NEAR(hit.shadingNormal, Vec3(0, 0, 1), 0.0f);
+}
+
+TEST(Finalize, DropsDegenerateTrianglesAndPadsVertices) {
+  Scene scene = oneTriangle();
+  Mesh& mesh = scene.meshes[0];
+  mesh.positions.push_back(Vec3(2, 0, 0));  // collinear with vertices 0 and 1
+  mesh.triangles.push_back(UVec3(0, 1, 3));
+  mesh.triangles.push_back(UVec3(0, 0, 2));  // repeated vertex
+  mesh.materials = {0, 0, 0};
+  scene.finalize();
+  EXPECT_EQ(scene.triangleCount(), 1u);
+  EXPECT_GE(scene.meshes[0].positions.capacity(), scene.meshes[0].positions.size() + 1);
+}
+
+TEST(AutomaticCamera, FramesTheBoundingBox) {
+  const Scene scene = makeCornellBox();
+  const CameraDesc camera = scene.automaticCamera();
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  const Vec3 view = glm::normalize(camera.target - camera.eye);
+  EXPECT_VEC3_NEAR(view, Vec3(0, 0, -1), kTight);  // looks along −z
+  EXPECT_VEC3_NEAR(camera.target, 0.5f * (lo + hi), 1e-3f);
+  // Every corner of the box lies inside the cone of half-angle fov/2 around the view axis
+  // (a fortiori inside the vertical field of view), and the bounding sphere touches it:
+  // |eye − centre|·sin(fov/2) = radius (to float rounding of values ~1e3: 1e-3 relative).
+  const float halfFov = glm::radians(camera.fovYDegrees) * 0.5f;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z);
+    const float angle = std::acos(glm::dot(glm::normalize(p - camera.eye), view));
+    EXPECT_LE(angle, halfFov) << "corner " << corner;
+  }
+  const float radius = 0.5f * glm::length(hi - lo);
+  EXPECT_NEAR(glm::length(camera.target - camera.eye) * std::sin(halfFov), radius, 1e-3f * radius);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input: one test per kind; each message names the file.
+
+TEST(BadInput, MissingFile) {
+  expectError([] { loadScene("/nonexistent/dir/box.obj"); }, {"/nonexistent/dir/box.obj", "no such file"});
+}
+
+TEST(BadInput, UnknownExtensionListsSupportedFormats) {
+  const fs::path dir = scratchDir("ext");
+  const std::string path = writeFile(dir / "scene.fbx", "x");
+  expectError([&] { loadScene(path); }, {"scene.fbx", ".obj", ".gltf", ".glb", ".json"});
+}
+
+TEST(BadInput, MalformedObjNonNumericCoordinate) {
+  const fs::path dir = scratchDir("obj_nan_text");
+  const std::string path = writeFile(dir / "bad.obj", "v 0 0 0\r\nv 1 zero 0\r\nv 0 1 0\r\nf 1 2 3\r\n");
+  expectError([&] { loadScene(path); }, {"bad.obj:2", "zero"});
+}
+
+TEST(BadInput, MalformedObjIndexOutOfRange) {
+  const fs::path dir = scratchDir("obj_index");
+  const std::string path = writeFile(dir / "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+  expectError([&] { loadScene(path); }, {"bad.obj:4", "out of range"});
+}
+
+TEST(BadInput, MalformedMtl) {
+  const fs::path dir = scratchDir("mtl");
+  writeFile(dir / "bad.mtl", "newmtl a\nKd 0.5 abc 0.5\n");
+  const std::string path = writeFile(dir / "m.obj", "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+  expectError([&] { loadScene(path); }, {"bad.mtl:2", "abc"});
+}
+
+TEST(BadInput, MissingTexture) {
+  const fs::path dir = scratchDir("tex");
+  writeFile(dir / "t.mtl", "newmtl a\nKd 1 1 1\nmap_Kd nothere.png\n");
+  const std::string path = writeFile(dir / "t.obj", "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+  expectError([&] { loadScene(path); }, {"nothere.png", "not found"});
+}
+
+TEST(BadInput, MissingMtlIsOnlyAWarning) {
+  const fs::path dir = scratchDir("nomtl");
+  const std::string path = writeFile(dir / "t.obj", "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+  const Scene scene = loadScene(path);
+  ASSERT_EQ(scene.triangleCount(), 1u);
+  const Material& material = scene.materials[scene.meshes[0].materials[0]];
+  EXPECT_VEC3_NEAR(std::get<LambertBsdf>(material.bsdf).albedo, Rgb(0.8f), 0.0f);
+}
+
+TEST(BadInput, MalformedGltf) {
+  const fs::path dir = scratchDir("gltf");
+  const std::string text = writeFile(dir / "bad.gltf", R"({"asset": {"version": "2.0"}, "nodes": [)");
+  expectError([&] { loadScene(text); }, {"bad.gltf"});
+  const std::string binary = writeFile(dir / "bad.glb", "glTF\x02\x00\x00\x00garbage");
+  expectError([&] { loadScene(binary); }, {"bad.glb"});
+}
+
+TEST(BadInput, GltfIndexOutOfRange) {
+  // A valid glTF whose only triangle refers to vertex 7 of 3.
+  const fs::path dir = scratchDir("gltf_index");
+  // 3 float3 positions (36 bytes) followed by 3 uint16 indices 0, 1, 7 (6 bytes, padded to 8).
+  const std::string blob =
+      "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAcAAAA=";  // base64 of the above
+  const std::string path = writeFile(dir / "index.gltf", R"({"asset": {"version": "2.0"},
+    "buffers": [{"byteLength": 44, "uri": "data:application/octet-stream;base64,)" + blob + R"("}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+                  {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+    "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]})");
+  expectError([&] { loadScene(path); }, {"index.gltf", "vertex 7"});
+}
+
+TEST(BadInput, MalformedJson) {
+  const fs::path dir = scratchDir("json");
+  const std::string path = writeFile(dir / "bad.json", R"({"meshes": [ {"file": "a.obj"} )");
+  expectError([&] { loadScene(path); }, {"bad.json", "malformed JSON"});
+}
+
+TEST(BadInput, NanVertex) {
+  const fs::path dir = scratchDir("nan");
+  const std::string path = writeFile(dir / "nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+  expectError([&] { loadScene(path); }, {"nan.obj:2", "'nan' is not a finite number"});
+  // The same check in Scene::finalize() for scenes built by code or other loaders.
+  Scene scene = oneTriangle();
+  scene.sourcePath = "built.scene";
+  scene.meshes[0].positions[1].y = std::numeric_limits<float>::quiet_NaN();
+  expectError([&] { scene.finalize(); }, {"built.scene", "vertex 1 is not finite"});
+  Scene infinite = oneTriangle();
+  infinite.meshes[0].positions[2].z = kInfinity;
+  expectError([&] { infinite.finalize(); }, {"triangle", "vertex 2 is not finite"});
+}
+
+TEST(BadInput, MeshWithNoTriangles) {
+  const fs::path dir = scratchDir("empty");
+  const std::string path = writeFile(dir / "empty.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+  expectError([&] { loadScene(path); }, {"empty.obj", "no triangles"});
+  // Only degenerate triangles is the same problem, said differently.
+  const std::string flat = writeFile(dir / "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+  expectError([&] { loadScene(flat); }, {"flat.obj", "degenerate"});
+}
+
+TEST(BadInput, UnknownMaterialModel) {
+  const fs::path dir = scratchDir("material");
+  const std::string path = writeFile(dir / "m.json", R"({"include_cornell": true,
+      "materials": {"shiny": {"type": "phong", "albedo": [1, 1, 1]}}})");
+  expectError([&] { loadScene(path); }, {"m.json", "materials.shiny", "phong"});
+}
+
+TEST(BadInput, JsonMeshFileProblemsNameBothFiles) {
+  const fs::path dir = scratchDir("json_mesh");
+  const std::string path = writeFile(dir / "s.json", R"({"meshes": [{"file": "missing.obj"}]})");
+  expectError([&] { loadScene(path); }, {"s.json", "meshes[0]", "missing.obj", "no such file"});
+}
+
+}  // namespace
+}  // namespace pl
