@@ -64,6 +64,7 @@ struct BakeSettings {
   float tolerance = 1e-3f;         ///< relative change of total outgoing power to stop at
   uint32_t maxIterations = 200;
   uint32_t mirrorDepth = 8;        ///< ideal-specular chain length followed
+  uint32_t areaLightSamples = 32;  ///< shadow rays per tixel towards emissive surfaces (MIS with the gather); 0 = gather only
   uint64_t seed = 0;
 };
 
