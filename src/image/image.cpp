@@ -32,7 +32,7 @@ float linearToSrgb(float linear) {
   return 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
 }
 
-std::string lowerExtension(const std::string& path) {
+std::string fileExtensionLower(const std::string& path) {
   const std::filesystem::path p(path);
   std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
@@ -40,7 +40,7 @@ std::string lowerExtension(const std::string& path) {
 }
 
 bool isHdrExtension(const std::string& path) {
-  const std::string ext = lowerExtension(path);
+  const std::string ext = fileExtensionLower(path);
   return ext == ".exr" || ext == ".hdr" || ext == ".pfm";
 }
 
@@ -80,7 +80,7 @@ Image readImage(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail("{}: no such file", path);
   if (std::filesystem::is_directory(path, ec)) fail("{}: is a directory, not an image file", path);
-  const std::string ext = lowerExtension(path);
+  const std::string ext = fileExtensionLower(path);
   if (ext == ".exr") return detail::readExr(path);
   if (ext == ".hdr") return detail::readRadianceHdr(path);
   if (ext == ".pfm") return detail::readPfm(path);
@@ -121,7 +121,7 @@ void writeAtomically(const std::string& target, WriteFn&& write) {
 }  // namespace
 
 void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOptions& options) {
-  const std::string ext = lowerExtension(path);
+  const std::string ext = fileExtensionLower(path);
   if (ext != ".exr" && ext != ".hdr" && ext != ".pfm")
     fail("{}: cannot write HDR image with extension '{}' (use .exr, .hdr or .pfm)", path, ext);
   if (image.pixels.size() != size_t(image.width) * size_t(image.height))
@@ -136,7 +136,7 @@ void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOp
 }
 
 void writePng(const std::string& path, const Image8& image) {
-  if (lowerExtension(path) != ".png") fail("{}: writePng needs a .png file name", path);
+  if (fileExtensionLower(path) != ".png") fail("{}: writePng needs a .png file name", path);
   if (image.rgb.size() != size_t(image.width) * size_t(image.height) * 3)
     fail("{}: cannot write: 8-bit buffer holds {} bytes, expected {}x{}x3", path, image.rgb.size(), image.width,
          image.height);

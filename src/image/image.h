@@ -71,6 +71,6 @@ void writePng(const std::string& path, const Image8& image);
 /// True for the extensions writeHdrImage accepts (.exr, .hdr, .pfm; case-insensitive).
 bool isHdrExtension(const std::string& path);
 /// The file's extension, lower-case, with the dot (".exr"); empty when there is none.
-std::string lowerExtension(const std::string& path);
+std::string fileExtensionLower(const std::string& path);
 
 }  // namespace pl

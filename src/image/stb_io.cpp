@@ -71,7 +71,7 @@ Image readLdr(const std::string& path) {
   const std::vector<unsigned char> bytes = readFileBytes(path);
   if (bytes.empty()) fail("{}: empty file", path);
   if (bytes.size() > size_t(INT32_MAX)) fail("{}: file too large for the 8-bit image reader", path);
-  const std::string ext = lowerExtension(path);
+  const std::string ext = fileExtensionLower(path);
   if (ext == ".png") checkPngStructure(path, bytes);
   const int size = int(bytes.size());
   int width = 0, height = 0, channels = 0;
