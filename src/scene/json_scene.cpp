@@ -31,7 +31,9 @@
 //   "cameras": [ {"name": "main", "eye": [..], "target": [..], "up": [0,1,0],
 //                 "fov": 40 (vertical, degrees), "fstop": 0 (0 = pinhole),
 //                 "focus_distance": d, "focal_length": mm, "aspect": w/h} ],
-//   "environment": {"color": [r,g,b]}        // constant radiance from infinity
+//   "environment": {"color": [r,g,b]},       // constant radiance from infinity
+//   "settings": {"width": 640, "height": 480, "spp": 64,       // suggestions; command-line
+//                "camera": "main"}                             //   flags take precedence
 // }
 //
 // Lights and cameras of the loaded mesh files are kept (and moved by their transform).
@@ -45,6 +47,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 
 namespace pl::detail {
@@ -218,7 +221,8 @@ void transformScene(Scene& part, const Mat4& m) {
 
 Scene parseScene(const JsonContext& ctx, const json& root) {
   if (!root.is_object()) fail("{}: the top level must be a JSON object", ctx.path);
-  checkKeys(ctx, root, {"include_cornell", "meshes", "materials", "lights", "cameras", "environment"}, "top level");
+  checkKeys(ctx, root, {"include_cornell", "meshes", "materials", "lights", "cameras", "environment", "settings"},
+            "top level");
   Scene scene;
   scene.sourcePath = ctx.path;
   if (boolOr(ctx, root, "include_cornell", false, "top level")) appendScene(scene, makeCornellBox());
@@ -328,6 +332,21 @@ Scene parseScene(const JsonContext& ctx, const json& root) {
     if (!environment->is_object()) fail("{}: \"environment\" must be an object", ctx.path);
     checkKeys(ctx, *environment, {"color"}, "environment");
     scene.environment.constant = colourOr(ctx, *environment, "color", Rgb(0.0f), "environment");
+  }
+  if (const json* settings = find(root, "settings")) {
+    if (!settings->is_object()) fail("{}: \"settings\" must be an object", ctx.path);
+    checkKeys(ctx, *settings, {"width", "height", "spp", "camera"}, "settings");
+    auto positiveInt = [&](const char* key) -> std::optional<int> {
+      const json* value = find(*settings, key);
+      if (!value) return std::nullopt;
+      if (!value->is_number_integer() || value->get<long long>() <= 0 || value->get<long long>() > (1 << 30))
+        fail("{}: settings.{}: expected a positive integer, got {}", ctx.path, key, value->dump());
+      return int(value->get<long long>());
+    };
+    scene.settings.width = positiveInt("width");
+    scene.settings.height = positiveInt("height");
+    scene.settings.spp = positiveInt("spp");
+    if (const json* camera = find(*settings, "camera")) scene.settings.camera = stringOf(ctx, *camera, "settings.camera");
   }
   scene.finalize();
   return scene;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <string>
 
 namespace pl {
@@ -163,7 +164,8 @@ void Scene::finalize() {
     if (totalBefore == 0) fail("{}: the scene has no triangles", src);
     fail("{}: all {} triangles are degenerate (zero area)", src, totalBefore);
   }
-  (void)dropped;
+  if (dropped > 0)
+    spdlog::warn("{}: dropped {} degenerate (zero-area) triangle(s) of {}", src, dropped, totalBefore);
 
   // Embree reads vertex buffers with 16-byte loads, so the last Vec3 needs 4 readable bytes
   // past it: one element of spare capacity (a copy of the Scene does not keep it, so the
@@ -189,6 +191,10 @@ void Scene::finalize() {
     if (camera.aspectRatio && !(*camera.aspectRatio > 0.0f && std::isfinite(*camera.aspectRatio)))
       fail("{}: camera '{}' has an invalid aspect ratio", src, camera.name);
   }
+  if ((settings.width && *settings.width <= 0) || (settings.height && *settings.height <= 0) ||
+      (settings.spp && *settings.spp <= 0))
+    fail("{}: settings: width, height and spp must be positive", src);
+  if (settings.camera) (void)camera(*settings.camera);  // throws, listing the cameras, if unknown
   if (!isFinite(environment.constant) || environment.constant.r < 0.0f || environment.constant.g < 0.0f ||
       environment.constant.b < 0.0f)
     fail("{}: the environment colour {} is invalid", src, vecString(environment.constant));

@@ -95,6 +95,14 @@ struct Environment {
   Rgb constant{0.0f};
 };
 
+/// Render settings a scene file may suggest (the JSON scene's "settings"). Command-line flags
+/// take precedence; unset values leave the command's defaults.
+struct SceneSettings {
+  std::optional<int> width, height;   ///< image size in pixels
+  std::optional<int> spp;             ///< samples per pixel for `trace`
+  std::optional<std::string> camera;  ///< name of the camera to use when --camera is absent
+};
+
 struct Scene {
   std::string sourcePath;  ///< the file it came from ("cornell" for the built-in box)
   std::vector<Mesh> meshes;
@@ -103,10 +111,14 @@ struct Scene {
   std::vector<Light> lights;
   std::vector<CameraDesc> cameras;
   Environment environment;
+  SceneSettings settings;
 
   /// Checks every index and number (throws pl::Error naming sourcePath and the problem:
-  /// NaN vertices, out-of-range indices, no triangles), drops degenerate triangles, and pads
-  /// the vertex buffers for sharing with Embree. Loaders call it last.
+  /// NaN vertices, out-of-range indices, no triangles), drops degenerate triangles (with a
+  /// warning), normalises normals and light directions, and pads the vertex buffers for
+  /// sharing with Embree. Loaders call it last. The padding is spare *capacity*: a moved
+  /// Scene keeps it, a copied one does not (build the Accel on the loaded object, or call
+  /// finalize() again on a copy).
   void finalize();
 
   size_t triangleCount() const;
@@ -114,7 +126,9 @@ struct Scene {
   void bounds(Vec3& lo, Vec3& hi) const;
   /// The camera called `name`; throws pl::Error listing the available ones if missing.
   const CameraDesc& camera(const std::string& name) const;
-  /// A camera that frames the whole scene (looking down −z at its bounding box).
+  /// A camera named "automatic" that frames the whole scene: it looks down −z at the centre of
+  /// the bounding box from distance r / sin(20°), r = half the box diagonal, so the bounding
+  /// sphere fits its 40° vertical field of view (and any image at least as wide as high).
   CameraDesc automaticCamera() const;
 };
 

@@ -377,6 +377,10 @@ TEST(JsonScene, CombinesFilesWithTransformsOverridesLightsCamerasAndEnvironment)
   EXPECT_EQ(main.fNumber, 2.8f);
   EXPECT_EQ(main.focusDistance, 5.0f);
   EXPECT_VEC3_NEAR(scene.environment.constant, Rgb(0.1f, 0.2f, 0.3f), 0.0f);
+  EXPECT_EQ(scene.settings.width, 320);
+  EXPECT_EQ(scene.settings.height, 240);
+  EXPECT_EQ(scene.settings.spp, 16);
+  EXPECT_EQ(scene.settings.camera, "main");
 }
 
 TEST(JsonScene, IncludeCornell) {
@@ -598,6 +602,16 @@ TEST(BadInput, UnknownMaterialModel) {
   const std::string path = writeFile(dir / "m.json", R"({"include_cornell": true,
       "materials": {"shiny": {"type": "phong", "albedo": [1, 1, 1]}}})");
   expectError([&] { loadScene(path); }, {"m.json", "materials.shiny", "phong"});
+}
+
+TEST(BadInput, JsonTyposAndDanglingNamesAreErrors) {
+  const fs::path dir = scratchDir("json_typos");
+  const std::string key = writeFile(dir / "k.json", R"({"include_cornell": true, "camras": []})");
+  expectError([&] { loadScene(key); }, {"k.json", "unknown key 'camras'"});
+  const std::string camera = writeFile(dir / "c.json", R"({"include_cornell": true, "settings": {"camera": "top"}})");
+  expectError([&] { loadScene(camera); }, {"c.json", "no camera named 'top'", "'cornell'"});
+  const std::string type = writeFile(dir / "t.json", R"({"include_cornell": true, "lights": [{"type": "point", "position": "up"}]})");
+  expectError([&] { loadScene(type); }, {"t.json", "lights[0].position"});
 }
 
 TEST(BadInput, JsonMeshFileProblemsNameBothFiles) {
