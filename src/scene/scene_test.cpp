@@ -281,6 +281,39 @@ TEST(ObjLoader, TextureIsResolvedRelativeToTheMtlAndSampledBottomLeft) {
   EXPECT_VEC3_NEAR(std::get<LambertBsdf>(bsdf).albedo, Rgb(0.0f, 0.0f, 1.0f), kTight);
 }
 
+TEST(ObjLoader, MtlMappingRules) {
+  const fs::path dir = scratchDir("mapping");
+  fs::copy_file(kDataDir + "checker.png", dir / "checker.png");
+  writeFile(dir / "m.mtl",
+            "newmtl chrome\r\nKd 0.5 0.5 0.5\r\nKs 0.8 0.8 0.8\r\nillum 3\r\n"  // illum 3: mirror
+            "newmtl dark\nKd 0.01 0.01 0.01\nKs 0.6 0.6 0.6\nNs 2000\n"        // Kd≈0, Ks high, Ns high
+            "newmtl satin\nKd 0.4 0.4 0.4\nKs 0.5 0.5 0.5\nNs 1000\n"          // Ks < 0.9: Blinn-Phong
+            "newmtl lamp\nKd 0.2 0.2 0.2\nKe 5 4 3\n"                           // Lambert + emission
+            "newmtl painted\nKd 0.5 0.25 1\nmap_Kd checker.png\n");              // texture × Kd
+  std::string obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n";
+  for (const char* name : {"chrome", "dark", "satin", "lamp", "painted"}) obj += std::string("usemtl ") + name + "\nf 1/1 2/2 3/3\n";
+  const Scene scene = loadScene(writeFile(dir / "m.obj", obj));
+  ASSERT_EQ(scene.triangleCount(), 5u);
+
+  const auto& chrome = std::get<MirrorBsdf>(materialNamed(scene, "chrome").bsdf);
+  EXPECT_FALSE(chrome.fresnel);
+  EXPECT_VEC3_NEAR(chrome.reflectance, Rgb(0.8f), 0.0f);
+  EXPECT_TRUE(std::holds_alternative<MirrorBsdf>(materialNamed(scene, "dark").bsdf));
+  const auto& satin = std::get<BlinnPhongBsdf>(materialNamed(scene, "satin").bsdf);
+  EXPECT_VEC3_NEAR(satin.diffuse, Rgb(0.4f), 0.0f);  // 0.4 + 0.5 ≤ 1: unscaled
+  EXPECT_VEC3_NEAR(satin.specular, Rgb(0.5f), 0.0f);
+  EXPECT_EQ(satin.exponent, 1000.0f);
+  const Material& lamp = materialNamed(scene, "lamp");
+  EXPECT_VEC3_NEAR(lamp.emission, Rgb(5.0f, 4.0f, 3.0f), 0.0f);
+  EXPECT_VEC3_NEAR(std::get<LambertBsdf>(lamp.bsdf).albedo, Rgb(0.2f), 0.0f);
+
+  // Texture × Kd: the triangle "painted" (index 4) at uv (0.25, 0.25) = b (0.25, 0.25) on
+  // uvs (0,0), (1,0), (0,1) is the bottom-left texel, blue: albedo (0, 0, 1)·Kd.
+  const SurfaceHit hit = surfaceAt(scene, 0, 4, Vec2(0.25f, 0.25f));
+  EXPECT_EQ(scene.materials[hit.material].name, "painted");
+  EXPECT_VEC3_NEAR(std::get<LambertBsdf>(bsdfAt(scene, hit)).albedo, Rgb(0.0f, 0.0f, 1.0f), kTight);
+}
+
 // ---------------------------------------------------------------------------------------------
 // glTF
 
@@ -329,13 +362,20 @@ TEST_P(GltfFile, HierarchyCamerasLightsAndMaterial) {
   EXPECT_NEAR(*camera.aspectRatio, 1.5f, kTight);
 
   // Lights: 683 cd → 1 W/sr and 1366 lx → 2 W/m² (683 lm/W).
-  ASSERT_EQ(scene.lights.size(), 2u);
+  ASSERT_EQ(scene.lights.size(), 3u);
   const auto& point = std::get<PointLight>(scene.lights[0]);
   EXPECT_VEC3_NEAR(point.position, Vec3(0.0f, 3.0f, 0.0f), kTight);
   EXPECT_VEC3_NEAR(point.intensity, Rgb(1.0f, 0.5f, 0.25f), kTight);
   const auto& sun = std::get<DirectionalLight>(scene.lights[1]);
   EXPECT_VEC3_NEAR(sun.direction, Vec3(0.0f, 0.0f, -1.0f), kTight);
   EXPECT_VEC3_NEAR(sun.irradiance, Rgb(2.0f), kTight);
+  // Spot: R_x(−90°) maps (x, y, z) ↦ (x, z, −y), so the node's −z axis becomes −y (down).
+  const auto& spot = std::get<SpotLight>(scene.lights[2]);
+  EXPECT_VEC3_NEAR(spot.position, Vec3(1.0f, 4.0f, 0.0f), kTight);
+  EXPECT_VEC3_NEAR(spot.direction, Vec3(0.0f, -1.0f, 0.0f), kTight);
+  EXPECT_VEC3_NEAR(spot.intensity, Rgb(2.0f), kTight);
+  EXPECT_NEAR(spot.innerAngle, 0.2f, kTight);
+  EXPECT_NEAR(spot.outerAngle, 0.4f, kTight);
 }
 
 INSTANTIATE_TEST_SUITE_P(Scene, GltfFile, testing::Values("quad.gltf", "quad.glb"));
@@ -364,10 +404,11 @@ TEST(JsonScene, CombinesFilesWithTransformsOverridesLightsCamerasAndEnvironment)
   EXPECT_NEAR(std::get<GgxBsdf>(materialNamed(scene, "gold").bsdf).alpha, 0.09f, kTight);  // 0.3²
   // Lights: the glTF point and sun (appended with their file) + the JSON spot (direction
   // normalised, angles in radians).
-  ASSERT_EQ(scene.lights.size(), 3u);
+  ASSERT_EQ(scene.lights.size(), 4u);
   EXPECT_VEC3_NEAR(std::get<PointLight>(scene.lights[0]).position, Vec3(10.0f, 3.0f, 0.0f), kTight);
   EXPECT_TRUE(std::holds_alternative<DirectionalLight>(scene.lights[1]));
-  const auto& spot = std::get<SpotLight>(scene.lights[2]);
+  EXPECT_VEC3_NEAR(std::get<SpotLight>(scene.lights[2]).position, Vec3(11.0f, 4.0f, 0.0f), kTight);
+  const auto& spot = std::get<SpotLight>(scene.lights[3]);
   EXPECT_VEC3_NEAR(spot.direction, Vec3(0.0f, -1.0f, 0.0f), kTight);
   EXPECT_NEAR(spot.outerAngle, 20.0f * kPi / 180.0f, kTight);
   // Cameras: the glTF one moved along, and the JSON one with its thin lens.

@@ -15,6 +15,8 @@ and binary (buffer and texture inside the .glb):
     node "Camera" (translation (0,0,5)), perspective yfov 0.5 rad, aspectRatio 1.5
   node "Lamp"  (translation (0,3,0)), KHR_lights_punctual point, color (1,0.5,0.25), 683 cd
   node "Sun"   (no transform), directional, color (1,1,1), 1366 lx
+  node "Spot"  (translation (1,4,0), rotation -90 deg about +x), spot, 1366 cd,
+               innerConeAngle 0.2, outerConeAngle 0.4
 material 0 "textured": baseColorFactor (0.5,0.5,0.5,1), metallic 0.25, roughness 0.5,
   baseColorTexture = checker.png, emissiveFactor (1,0.5,0), emissive strength 4.
 checker.png: 2x2 sRGB, top row red, green; bottom row blue, white.
@@ -94,9 +96,11 @@ def gltf_scene(binary):
         "extensions": {"KHR_lights_punctual": {"lights": [
             {"name": "lamp", "type": "point", "color": [1, 0.5, 0.25], "intensity": 683},
             {"name": "sun", "type": "directional", "color": [1, 1, 1], "intensity": 1366},
+            {"name": "spot", "type": "spot", "intensity": 1366,
+             "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.4}},
         ]}},
         "scene": 0,
-        "scenes": [{"nodes": [0, 3, 4]}],
+        "scenes": [{"nodes": [0, 3, 4, 5]}],
         "nodes": [
             {"name": "Parent", "translation": [0, 1, 0], "rotation": [0, half, 0, half], "children": [1, 2]},
             {"name": "Quad", "mesh": 0,
@@ -104,6 +108,8 @@ def gltf_scene(binary):
             {"name": "Camera", "camera": 0, "translation": [0, 0, 5]},
             {"name": "Lamp", "translation": [0, 3, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
             {"name": "Sun", "extensions": {"KHR_lights_punctual": {"light": 1}}},
+            {"name": "Spot", "translation": [1, 4, 0], "rotation": [-half, 0, 0, half],
+             "extensions": {"KHR_lights_punctual": {"light": 2}}},
         ],
         "cameras": [{"name": "cam", "type": "perspective",
                      "perspective": {"yfov": 0.5, "aspectRatio": 1.5, "znear": 0.01}}],
