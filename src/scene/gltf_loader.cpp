@@ -37,6 +37,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <filesystem>
 
@@ -172,6 +173,10 @@ int textureFor(GltfContext& ctx, int textureIndex) {
   if (ctx.textureOfImage[size_t(source)] >= 0) return ctx.textureOfImage[size_t(source)];
   const tinygltf::Image& gltfImage = model.images[size_t(source)];
   const std::string label = gltfImage.uri.empty() ? fmt::format("image {}", source) : gltfImage.uri;
+  if (gltfImage.image.empty() && !gltfImage.uri.empty() && gltfImage.uri.rfind("data:", 0) != 0) {
+    const std::filesystem::path file = std::filesystem::path(ctx.path).parent_path() / gltfImage.uri;
+    if (!std::filesystem::exists(file)) fail("{}: texture file '{}' not found", ctx.path, file.string());
+  }
   if (gltfImage.image.empty() || gltfImage.width <= 0 || gltfImage.height <= 0 || gltfImage.component < 1 ||
       (gltfImage.bits != 8 && gltfImage.bits != 16))
     fail("{}: texture image '{}' could not be decoded", ctx.path, label);
@@ -385,6 +390,7 @@ Scene loadGltf(const std::string& path) {
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   const bool ok = extension == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
                                       : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+  while (!warning.empty() && std::isspace(static_cast<unsigned char>(warning.back()))) warning.pop_back();
   if (!warning.empty()) spdlog::warn("{}: {}", path, warning);
   if (!ok) {
     while (!error.empty() && (error.back() == '\n' || error.back() == '\r')) error.pop_back();

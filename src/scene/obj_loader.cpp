@@ -23,6 +23,7 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -259,7 +260,8 @@ Scene loadObj(const std::string& path) {
   config.mtl_search_path = objDir.string();
   tinyobj::ObjReader reader;
   if (!reader.ParseFromFile(path, config)) fail("{}: {}", path, reader.Error());
-  const std::string& attribWarning = reader.Warning();
+  std::string attribWarning = reader.Warning();
+  while (!attribWarning.empty() && std::isspace(static_cast<unsigned char>(attribWarning.back()))) attribWarning.pop_back();
   // Missing libraries were reported above; other tinyobjloader warnings are passed on.
   if (!attribWarning.empty() && attribWarning.find("not found") == std::string::npos)
     spdlog::warn("{}: {}", path, attribWarning);

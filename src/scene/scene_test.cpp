@@ -576,6 +576,12 @@ TEST(BadInput, MissingTexture) {
   expectError([&] { loadScene(path); }, {"nothere.png", "not found"});
 }
 
+TEST(BadInput, MissingGltfTexture) {
+  const fs::path dir = scratchDir("gltf_tex");
+  fs::copy_file(kDataDir + "quad.gltf", dir / "quad.gltf");  // without its checker.png
+  expectError([&] { loadScene((dir / "quad.gltf").string()); }, {"quad.gltf", "checker.png", "not found"});
+}
+
 TEST(BadInput, MissingMtlIsOnlyAWarning) {
   const fs::path dir = scratchDir("nomtl");
   const std::string path = writeFile(dir / "t.obj", "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
