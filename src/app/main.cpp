@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   // (one line per subcommand; keep this list in pipeline order)
   pl::addCompareCommand(app, global);
   pl::addTonemapCommand(app, global);
+  pl::addEnvCommand(app, global);
 
   try {
     app.parse(argc, argv);
