@@ -52,6 +52,10 @@ inline Vec3 chartWorldDirection(const Chart& c, const Vec3& local) {
   return local.x * c.axisU + local.y * c.axisV + local.z * c.normal;
 }
 
+/// Bilinear × bilinear interpolation over a raw value array laid out like LightField::values
+/// (the bake uses it on its working arrays). Specular charts give 0.
+Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 st);
+
 /// Bilinear interpolation of the stored values of chart c at tixel grid coordinates `grid`
 /// and paraboloid coordinates st (ignored for diffuse charts, which store one value).
 /// Returns 0 for specular charts (they store nothing).
@@ -66,6 +70,22 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv);
 inline Rgb emittedRadiance(const Material& m, float cosTheta) {
   return (cosTheta > 0.0f || m.twoSidedEmission) ? m.emission : Rgb(0.0f);
 }
+
+/// The per-chart constants of exitantRadiance (its material's emission and, when no texture
+/// varies it, its diffuse albedo). The fast renderer (src/realtime) precomputes one per chart;
+/// the plain exitantRadiance below builds it on the fly, so both run the same formula.
+struct ChartShading {
+  Rgb emission{0.0f};             ///< Le of the chart's material (W·sr⁻¹·m⁻²)
+  bool twoSidedEmission = false;
+  bool texturedAlbedo = false;    ///< diffuse albedo varies with uv: diffuseAlbedoAt per point
+  Rgb albedo{0.0f};               ///< diffuse albedo when !texturedAlbedo (diffuse charts only)
+};
+ChartShading chartShading(const Scene& scene, const Chart& c);
+
+/// exitantRadiance (below) given the chart's precomputed shading and the value array laid out
+/// like LightField::values: the one implementation every caller goes through.
+Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
+                    const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv);
 
 /// Exitant radiance (W·sr⁻¹·m⁻²) of chart `chart` at worldPosition towards the viewer:
 ///   diffuse chart:  Le + albedo(uv)·E/π with E bilinearly interpolated over the 2×2 nearest

@@ -1,0 +1,99 @@
+// The bake driver and its presets (see bake.h).
+#include "lightfield/bake.h"
+
+#include <chrono>
+
+#include "accel/accel.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "lightfield/parameterisation.h"
+#include "lightfield/propagation.h"
+#include "lightfield/visibility.h"
+
+namespace pl {
+
+BakeSettings bakePreset(const std::string& name) {
+  BakeSettings s;
+  s.preset = name;
+  s.tixelsPerUnit = 0.0f;  // density from the scene size
+  if (name == "draft") {
+    s.tixelsAcrossScene = 24;
+    s.maxTixelsPerChartSide = 32;
+    s.gatherDirections = 144;
+    s.glossyDirRes = 8;
+    s.areaLightSamples = 16;
+    s.tolerance = 5e-3f;
+  } else if (name == "default") {
+    s.tixelsAcrossScene = 48;
+    s.maxTixelsPerChartSide = 64;
+    s.gatherDirections = 256;
+    s.glossyDirRes = 12;
+    s.areaLightSamples = 32;
+    s.tolerance = 1e-3f;
+  } else if (name == "high") {
+    s.tixelsAcrossScene = 96;
+    s.maxTixelsPerChartSide = 128;
+    s.gatherDirections = 576;
+    s.glossyDirRes = 16;
+    s.areaLightSamples = 64;
+    s.tolerance = 2e-4f;
+  } else {
+    fail("unknown bake preset '{}' (choose draft, default or high)", name);
+  }
+  s.maxIterations = 200;
+  s.mirrorDepth = 8;
+  return s;
+}
+
+std::vector<std::string> bakePresetNames() { return {"draft", "default", "high"}; }
+
+LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  auto note = [&](const std::string& text) {
+    if (options.log) options.log(text);
+  };
+  LightField lf;
+  lf.scene = std::move(scene);
+  lf.settings = settings;
+  const Accel accel(lf.scene);
+  const Parameterisation param = buildParameterisation(lf.scene, settings);
+  const uint64_t hash = visibilityHash(lf.scene, param, settings);
+
+  VisibilityField visibility;
+  bool reused = false;
+  if (options.reuseVisibility && !options.visibilityPath.empty()) {
+    std::string why;
+    reused = readVisibility(options.visibilityPath, hash, visibility, &why);
+    if (reused)
+      note(fmt::format("visibility: reusing {} ({} tixels × {} directions)", options.visibilityPath, visibility.tixelCount,
+                       visibility.directionsPerTixel()));
+    else
+      note(fmt::format("visibility: recomputing, because {}", why));
+  }
+  if (!reused) {
+    visibility = computeVisibility(lf.scene, accel, param, settings);
+    note(fmt::format("visibility: {} rays in {:.2f} s ({:.1f} Mrays/s), {:.1f} MB", visibility.rays, visibility.seconds,
+                     visibility.seconds > 0 ? visibility.rays / visibility.seconds * 1e-6 : 0.0, visibility.bytes() / 1e6));
+    if (!options.visibilityPath.empty()) writeVisibility(options.visibilityPath, visibility);
+  }
+
+  PropagationResult prop = propagate(lf.scene, accel, param, visibility, settings);
+  note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s", prop.iterations, prop.residual, prop.seconds));
+
+  lf.charts = param.charts;
+  lf.triangleChart = param.triangleChart;
+  lf.values = std::move(prop.values);
+  lf.stats.visibilitySeconds = reused ? 0.0 : visibility.seconds;
+  lf.stats.propagationSeconds = prop.seconds;
+  lf.stats.iterations = prop.iterations;
+  lf.stats.residual = prop.residual;
+  lf.stats.tixels = param.tixelCount;
+  lf.stats.values = param.valueCount;
+  lf.stats.visibilityRays = reused ? 0 : visibility.rays;
+  lf.stats.reusedVisibility = reused;
+  lf.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  lf.stats.peakRssBytes = peakRssBytes();
+  return lf;
+}
+
+}  // namespace pl

@@ -1,0 +1,37 @@
+#pragma once
+// The light-field bake: parameterisation → visibility field → propagation → LightField
+// (DESIGN.md "Light-field pipeline"). The .plf file is written by plf_file.h.
+//
+// Presets (densities are relative to the scene's largest extent, so a scene in millimetres and
+// one in metres get the same grids):
+//   preset   tixels across   max per side   gather dirs   glossy map ≤   area-light rays   tolerance
+//   draft          24              32        144 (12²)         8              16             5e-3
+//   default        48              64        256 (16²)        12              32             1e-3
+//   high           96             128        576 (24²)        16              64             2e-4
+// "tolerance" is the relative change of total outgoing power at which iteration stops; the
+// remaining error of the Neumann series is about tolerance·a/(1−a) for mean albedo a.
+#include "lightfield/lightfield.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace pl {
+
+/// The settings of a named preset; throws pl::Error listing the names for an unknown one.
+BakeSettings bakePreset(const std::string& name);
+std::vector<std::string> bakePresetNames();
+
+struct BakeOptions {
+  /// Where the visibility field is saved (and looked for with reuseVisibility); empty = not saved.
+  std::string visibilityPath;
+  /// Reuse visibilityPath when it exists and its hash matches this scene and settings.
+  bool reuseVisibility = false;
+  /// Receives one-line notes for the user (reuse decisions, rates). May be empty.
+  std::function<void(const std::string&)> log;
+};
+
+/// Bakes `scene` (moved into the result). Throws pl::Error on failures.
+LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options = {});
+
+}  // namespace pl

@@ -1,0 +1,436 @@
+// Propagation: first shot + Neumann-series iteration (see propagation.h).
+#include "lightfield/propagation.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "accel/accel.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "lightfield/lookup.h"
+#include "lightfield/paraboloid.h"
+
+namespace pl {
+
+namespace {
+
+// Sub-samples per side of an output texel (directions averaged over the texel's part inside the
+// disk) and of a gather cell (directions averaged over the cell) for the glossy operator.
+constexpr int kOutputSubsamples = 3;
+constexpr int kCellSubsamples = 4;
+
+/// Directions sub-sampling output texel (a, b) of an R-texel map, inside the disk only; the
+/// texel's representative direction when none of them is inside.
+std::vector<Vec3> outputTexelDirections(uint32_t a, uint32_t b, uint32_t res) {
+  std::vector<Vec3> dirs;
+  const float size = 2.0f / float(res);
+  for (int y = 0; y < kOutputSubsamples; ++y)
+    for (int x = 0; x < kOutputSubsamples; ++x) {
+      const Vec2 st(-1.0f + (float(a) + (x + 0.5f) / kOutputSubsamples) * size,
+                    -1.0f + (float(b) + (y + 0.5f) / kOutputSubsamples) * size);
+      if (st.x * st.x + st.y * st.y < kHorizonRadius * kHorizonRadius) dirs.push_back(paraboloidToDirection(st));
+    }
+  if (dirs.empty()) dirs.push_back(paraboloidTexelDirection(a, b, res));
+  return dirs;
+}
+
+/// Mean of f(wo, wi) over the output texel's sub-sample directions.
+Rgb texelAverageBsdf(const Bsdf& bsdf, const std::vector<Vec3>& outputs, const Vec3& wi) {
+  Rgb sum(0.0f);
+  for (const Vec3& wo : outputs) sum += eval(bsdf, wo, wi);
+  return sum / float(outputs.size());
+}
+
+struct GlossyMaterial {
+  uint32_t dirRes = 0;
+  std::vector<Rgb> op;                        ///< R² × N
+  std::vector<std::vector<Vec3>> outputs;     ///< per output texel, its sub-sample directions
+  std::vector<float> projectedSolidAngle;     ///< per output texel, ≈ Ω·cos θ (for the power sum)
+};
+
+// Incident radiance from point, spot and directional lights: returns false when the light
+// does not reach direction/position (outside a spot cone, behind, zero). `incident` is the
+// irradiance on a surface normal to wi, `distance` the shadow-ray length (∞ for directional).
+bool punctualIncident(const Light& light, const Vec3& x, Vec3& wi, float& distance, Rgb& incident) {
+  if (const auto* point = std::get_if<PointLight>(&light)) {
+    const Vec3 d = point->position - x;
+    const float d2 = glm::dot(d, d);
+    if (!(d2 > 0.0f)) return false;
+    distance = std::sqrt(d2);
+    wi = d / distance;
+    incident = point->intensity / d2;
+    return true;
+  }
+  if (const auto* spot = std::get_if<SpotLight>(&light)) {
+    const Vec3 d = spot->position - x;
+    const float d2 = glm::dot(d, d);
+    if (!(d2 > 0.0f)) return false;
+    distance = std::sqrt(d2);
+    wi = d / distance;
+    // Smoothstep in cos between the outer and inner cone angles, as the path tracer does.
+    const float cosOuter = std::cos(spot->outerAngle), cosInner = std::cos(spot->innerAngle);
+    const float c = glm::dot(glm::normalize(spot->direction), -wi);
+    float falloff;
+    if (cosInner <= cosOuter) {
+      falloff = c >= cosInner ? 1.0f : 0.0f;
+    } else {
+      const float t = std::clamp((c - cosOuter) / (cosInner - cosOuter), 0.0f, 1.0f);
+      falloff = t * t * (3.0f - 2.0f * t);
+    }
+    if (!(falloff > 0.0f)) return false;
+    incident = spot->intensity * (falloff / d2);
+    return true;
+  }
+  const auto& directional = std::get<DirectionalLight>(light);
+  wi = -glm::normalize(directional.direction);
+  distance = kInfinity;
+  incident = directional.irradiance;
+  return true;
+}
+
+struct EmissiveTriangle {
+  uint32_t mesh, triangle, material;
+};
+
+}  // namespace
+
+std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide) {
+  const uint32_t n = gridSide * gridSide, texels = dirRes * dirRes;
+  std::vector<Rgb> op(size_t(texels) * n);
+  // Incident sub-sample directions of every cell (same for every output texel).
+  std::vector<Vec3> cellDirs(size_t(n) * kCellSubsamples * kCellSubsamples);
+  for (uint32_t k = 0; k < n; ++k) {
+    const float a = float(k % gridSide), b = float(k / gridSide);
+    for (int y = 0; y < kCellSubsamples; ++y)
+      for (int x = 0; x < kCellSubsamples; ++x) {
+        const Vec2 u((a + (x + 0.5f) / kCellSubsamples) / gridSide, (b + (y + 0.5f) / kCellSubsamples) / gridSide);
+        cellDirs[(size_t(k) * kCellSubsamples + y) * kCellSubsamples + x] = sampleCosineHemisphere(u);
+      }
+  }
+  // ∫_cell f cos θ dω = (π/N)·E[f] over cosine-distributed directions in the cell.
+  const float cellWeight = kPi / float(n);
+  parallelFor(texels, [&](uint64_t c) {
+    const std::vector<Vec3> outputs = outputTexelDirections(uint32_t(c % dirRes), uint32_t(c / dirRes), dirRes);
+    const float norm = cellWeight / float(outputs.size() * kCellSubsamples * kCellSubsamples);
+    for (uint32_t k = 0; k < n; ++k) {
+      Rgb sum(0.0f);
+      for (const Vec3& wo : outputs)
+        for (int s = 0; s < kCellSubsamples * kCellSubsamples; ++s)
+          sum += eval(bsdf, wo, cellDirs[size_t(k) * kCellSubsamples * kCellSubsamples + s]);
+      op[c * n + k] = sum * norm;
+    }
+  });
+  return op;
+}
+
+PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                            const VisibilityField& vis, const BakeSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  if (vis.tixelCount != param.tixelCount)
+    fail("{}: visibility field has {} tixels, the parameterisation {}", scene.sourcePath, vis.tixelCount, param.tixelCount);
+  const uint32_t n = vis.directionsPerTixel();
+  const uint64_t tixels = param.tixelCount;
+  PropagationResult result;
+
+  // Glossy operators, one per material used by a glossy chart.
+  std::vector<GlossyMaterial> glossy(scene.materials.size());
+  for (const Chart& c : param.charts) {
+    if (c.kind != ChartKind::Glossy || !glossy[c.material].op.empty()) continue;
+    GlossyMaterial& g = glossy[c.material];
+    g.dirRes = c.dirRes;
+    g.op = glossyOperator(scene.materials[c.material].bsdf, c.dirRes, vis.gridSide);
+    const std::vector<float>& omega = paraboloidTexelSolidAngles(c.dirRes);
+    for (uint32_t t = 0; t < c.dirRes * c.dirRes; ++t) {
+      g.outputs.push_back(outputTexelDirections(t % c.dirRes, t / c.dirRes, c.dirRes));
+      g.projectedSolidAngle.push_back(omega[t] * std::max(0.0f, paraboloidTexelDirection(t % c.dirRes, t / c.dirRes, c.dirRes).z));
+    }
+  }
+  auto valueBase = [&](uint64_t g, const Chart& c) { return c.firstValue + (g - c.firstTixel) * c.valuesPerTixel(); };
+
+  // Emissive triangles for next-event estimation, chosen ∝ area · luminance(Le). The area pdf of
+  // a point on material m is then luminance(Le_m) / Σ(area·luminance): constant per material.
+  std::vector<EmissiveTriangle> emitters;
+  std::vector<float> emitterWeights;
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m)
+    for (uint32_t t = 0; t < scene.meshes[m].triangles.size(); ++t) {
+      const uint32_t mat = scene.meshes[m].materials[t];
+      if (!scene.materials[mat].isEmissive()) continue;
+      const Mesh& mesh = scene.meshes[m];
+      const UVec3 tri = mesh.triangles[t];
+      const float area = 0.5f * glm::length(glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]],
+                                                       mesh.positions[tri[2]] - mesh.positions[tri[0]]));
+      const float lum = luminance(scene.materials[mat].emission);
+      if (!(area > 0.0f) || !(lum > 0.0f)) continue;
+      emitters.push_back({m, t, mat});
+      emitterWeights.push_back(area * lum);
+    }
+  const Distribution1D emitterDistribution(emitterWeights);
+  std::vector<float> areaPdf(scene.materials.size(), 0.0f);
+  for (uint32_t m = 0; m < scene.materials.size(); ++m)
+    if (emitterDistribution.total() > 0.0) areaPdf[m] = float(luminance(scene.materials[m].emission) / emitterDistribution.total());
+  const uint32_t lightSamples = emitters.empty() ? 0 : settings.areaLightSamples;
+
+  // ---- First shot ------------------------------------------------------------------------
+  std::vector<Rgb> direct(param.valueCount, Rgb(0.0f));
+  std::atomic<uint64_t> shadowRays{0};
+  {
+    Progress progress("direct light", tixels);
+    const uint64_t tixelsPerBlock = 64;
+    const uint64_t blocks = (tixels + tixelsPerBlock - 1) / tixelsPerBlock;
+    struct Pending {
+      uint64_t tixel;
+      Vec3 wi;
+      Rgb irradiance;  ///< already multiplied by cos θ at the receiver (and MIS-weighted)
+    };
+    parallelFor(blocks, [&](uint64_t block) {
+      const uint64_t t0 = block * tixelsPerBlock, t1 = std::min(tixels, t0 + tixelsPerBlock);
+      std::vector<Ray> rays;
+      std::vector<Pending> pending;
+      for (uint64_t g = t0; g < t1; ++g) {
+        const Chart& c = param.charts[param.tixelChart[g]];
+        if (c.kind == ChartKind::Specular) continue;
+        const Vec3 x = param.gatherPoint[g];
+        for (const Light& light : scene.lights) {
+          Vec3 wi;
+          float distance;
+          Rgb incident;
+          if (!punctualIncident(light, x, wi, distance, incident)) continue;
+          const float cosTheta = glm::dot(c.normal, wi);
+          if (!(cosTheta > 0.0f) || isBlack(incident)) continue;
+          Ray ray;
+          ray.origin = offsetRayOrigin(x, c.normal, wi);
+          ray.direction = wi;
+          ray.tMax = std::isfinite(distance) ? distance * (1.0f - 1e-4f) : kInfinity;
+          rays.push_back(ray);
+          pending.push_back({g, wi, incident * cosTheta});
+        }
+        if (c.kind != ChartKind::Diffuse || lightSamples == 0) continue;
+        Pcg32 rng = Pcg32::forKey(g, 0x4e4545, settings.seed);
+        for (uint32_t s = 0; s < lightSamples; ++s) {
+          float remapped = 0.0f;
+          const size_t e = emitterDistribution.sample((float(s) + rng.uniform()) / float(lightSamples), &remapped);
+          const EmissiveTriangle& em = emitters[e];
+          const Mesh& mesh = scene.meshes[em.mesh];
+          const UVec3 tri = mesh.triangles[em.triangle];
+          const Vec2 b = sampleUniformTriangle(Vec2(remapped, rng.uniform()));
+          const Vec3 p0 = mesh.positions[tri[0]], p1 = mesh.positions[tri[1]], p2 = mesh.positions[tri[2]];
+          const Vec3 y = (1.0f - b.x - b.y) * p0 + b.x * p1 + b.y * p2;
+          const Vec3 ny = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+          const Vec3 d = y - x;
+          const float dist = glm::length(d);
+          if (!(dist > 0.0f)) continue;
+          const Vec3 wi = d / dist;
+          const float cosX = glm::dot(c.normal, wi);
+          float cosY = -glm::dot(ny, wi);
+          const Material& material = scene.materials[em.material];
+          if (!(cosX > 0.0f) || (cosY <= 0.0f && !material.twoSidedEmission)) continue;
+          cosY = std::abs(cosY);
+          if (!(cosY > 0.0f)) continue;
+          // Balance heuristic between this strategy (S samples, solid-angle pdf pl) and the N
+          // cosine-distributed gather rays (pdf cos θx / π).
+          const float pl = areaPdf[em.material] * dist * dist / cosY;
+          const float pg = cosX * kInvPi;
+          const float weight = float(lightSamples) * pl / (float(lightSamples) * pl + float(n) * pg);
+          Ray ray;
+          ray.origin = offsetRayOrigin(x, c.normal, wi);
+          ray.direction = wi;
+          ray.tMax = dist * (1.0f - 1e-4f);
+          rays.push_back(ray);
+          pending.push_back({g, wi, material.emission * (cosX / pl * weight / float(lightSamples))});
+        }
+      }
+      std::vector<uint8_t> occluded(rays.size());
+      accel.occludedMany(rays, occluded);
+      shadowRays += rays.size();
+      for (size_t r = 0; r < rays.size(); ++r) {
+        if (occluded[r]) continue;
+        const Pending& p = pending[r];
+        const Chart& c = param.charts[param.tixelChart[p.tixel]];
+        const uint64_t vb = valueBase(p.tixel, c);
+        if (c.kind == ChartKind::Diffuse) {
+          direct[vb] += p.irradiance;
+        } else {
+          const GlossyMaterial& gm = glossy[c.material];
+          const Bsdf& bsdf = scene.materials[c.material].bsdf;
+          const Vec3 wiLocal = chartLocalDirection(c, p.wi);
+          for (uint32_t t = 0; t < c.valuesPerTixel(); ++t)
+            direct[vb + t] += texelAverageBsdf(bsdf, gm.outputs[t], wiLocal) * p.irradiance;
+        }
+      }
+      progress.advance(t1 - t0);
+    });
+  }
+
+  // Emission and environment arriving through the gather rays (constant over the iteration).
+  const Rgb environment = scene.environment.constant;
+  parallelForRange(tixels, 16, [&](uint64_t t0, uint64_t t1) {
+    std::vector<Rgb> incoming(n);
+    for (uint64_t g = t0; g < t1; ++g) {
+      const Chart& c = param.charts[param.tixelChart[g]];
+      if (c.kind == ChartKind::Specular) continue;
+      uint64_t cursor = vis.extraOffset[g];
+      bool any = false;
+      for (uint32_t k = 0; k < n; ++k) {
+        const VisibilityEntry e = vis.entries[g * n + k];
+        const VisibilityExtra* extra = e.hasExtra() ? &vis.extras[cursor++] : nullptr;
+        Rgb L(0.0f);
+        if (e.escaped()) {
+          L = environment;
+        } else {
+          const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
+          const Material& material = scene.materials[seen.material];
+          if (material.isEmissive() && (!e.backSide() || material.twoSidedEmission)) {
+            float weight = 1.0f;
+            if (c.kind == ChartKind::Diffuse && lightSamples > 0 && !(extra && extra->viaMirror) && areaPdf[seen.material] > 0.0f) {
+              // The same balance heuristic as the shadow rays, evaluated for this gather ray
+              // against the seen chart's plane (exact for a direct hit on a planar emitter).
+              const Vec3 local = gatherDirectionLocal(g, k, vis.gridSide, settings.seed);
+              const Vec3 w = glm::normalize(chartWorldDirection(c, local));
+              const Vec3 o = offsetRayOrigin(param.gatherPoint[g], c.normal, w);
+              const float denom = glm::dot(w, seen.normal);
+              const float t = denom != 0.0f ? glm::dot(seen.origin - o, seen.normal) / denom : 0.0f;
+              const float cosY = std::abs(denom);
+              const float pl = t > 0.0f && cosY > 0.0f ? areaPdf[seen.material] * t * t / cosY : 0.0f;
+              const float pg = local.z * kInvPi;
+              weight = float(n) * pg / (float(n) * pg + float(lightSamples) * pl);
+            }
+            L = material.emission * weight;
+          }
+        }
+        if (extra) L *= extra->throughput;
+        incoming[k] = L;
+        any = any || !isBlack(L);
+      }
+      if (!any) continue;
+      const uint64_t vb = valueBase(g, c);
+      if (c.kind == ChartKind::Diffuse) {
+        Rgb sum(0.0f);
+        for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
+        direct[vb] += sum * (kPi / float(n));
+      } else {
+        const std::vector<Rgb>& op = glossy[c.material].op;
+        for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) {
+          Rgb sum(0.0f);
+          const Rgb* row = op.data() + size_t(t) * n;
+          for (uint32_t k = 0; k < n; ++k) sum += row[k] * incoming[k];
+          direct[vb + t] += sum;
+        }
+      }
+    }
+  });
+
+  // ---- Iteration ---------------------------------------------------------------------------
+  std::vector<Rgb> current = direct, next(param.valueCount);
+  std::vector<Rgb> transport(tixels, Rgb(0.0f));  // diffuse tixels: ρ̄·E/π
+  auto totalPower = [&](const std::vector<Rgb>& values) {
+    // Σ area · luminance of the radiant exitance (W): diffuse ρ̄E, glossy Σ Lo·cosθ·Ω.
+    std::vector<double> perChart(param.charts.size(), 0.0);
+    parallelFor(param.charts.size(), [&](uint64_t ci) {
+      const Chart& c = param.charts[ci];
+      if (c.kind == ChartKind::Specular) return;
+      double sum = 0.0;
+      const double tixelArea = double(c.tixelSize) * c.tixelSize;
+      for (uint64_t local = 0; local < c.tixelCount(); ++local) {
+        const uint64_t g = c.firstTixel + local;
+        const uint64_t vb = c.firstValue + local * c.valuesPerTixel();
+        double exitance = 0.0;
+        if (c.kind == ChartKind::Diffuse) {
+          exitance = luminance(param.transportAlbedo[g] * values[vb]);
+        } else {
+          const GlossyMaterial& gm = glossy[c.material];
+          for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) exitance += double(luminance(values[vb + t])) * gm.projectedSolidAngle[t];
+        }
+        sum += exitance * param.coverage[g] * tixelArea;
+      }
+      perChart[ci] = sum;
+    });
+    double total = 0.0;
+    for (double p : perChart) total += p;
+    return total;
+  };
+
+  double previousPower = totalPower(current);
+  Progress progress("propagation", settings.maxIterations);
+  for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
+    parallelForRange(tixels, 256, [&](uint64_t t0, uint64_t t1) {
+      for (uint64_t g = t0; g < t1; ++g) {
+        const Chart& c = param.charts[param.tixelChart[g]];
+        if (c.kind == ChartKind::Diffuse) transport[g] = param.transportAlbedo[g] * current[c.firstValue + (g - c.firstTixel)] * kInvPi;
+      }
+    });
+    parallelForRange(tixels, 16, [&](uint64_t t0, uint64_t t1) {
+      std::vector<Rgb> incoming(n);
+      for (uint64_t g = t0; g < t1; ++g) {
+        const Chart& c = param.charts[param.tixelChart[g]];
+        if (c.kind == ChartKind::Specular) continue;
+        uint64_t cursor = vis.extraOffset[g];
+        const VisibilityEntry* entries = vis.entries.data() + g * n;
+        for (uint32_t k = 0; k < n; ++k) {
+          const VisibilityEntry e = entries[k];
+          const VisibilityExtra* extra = e.hasExtra() ? &vis.extras[cursor++] : nullptr;
+          Rgb L(0.0f);
+          // Back-side hits see the inside of a closed solid (or the unlit back of a one-sided
+          // surface): no reflected light. Emission from behind is in the constant part.
+          if (!e.escaped() && !e.backSide()) {
+            const uint32_t base = e.tixel();
+            const Chart& seen = param.charts[param.tixelChart[base]];
+            const float fu = float(e.fu) * (1.0f / 65535.0f), fv = float(e.fv) * (1.0f / 65535.0f);
+            if (seen.kind == ChartKind::Diffuse) {
+              L = (1.0f - fu) * (1.0f - fv) * transport[base];
+              if (e.fu) L += fu * (1.0f - fv) * transport[base + 1];
+              if (e.fv) L += (1.0f - fu) * fv * transport[base + seen.resU];
+              if (e.fu && e.fv) L += fu * fv * transport[base + seen.resU + 1];
+            } else if (seen.kind == ChartKind::Glossy && extra) {
+              const uint64_t local = base - seen.firstTixel;
+              const Vec2 grid(float(local % seen.resU) + fu, float(local / seen.resU) + fv);
+              L = interpolateValues(current.data(), seen, grid, extra->st);
+            }
+            if (extra) L *= extra->throughput;
+          }
+          incoming[k] = L;
+        }
+        const uint64_t vb = valueBase(g, c);
+        if (c.kind == ChartKind::Diffuse) {
+          Rgb sum(0.0f);
+          for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
+          next[vb] = direct[vb] + sum * (kPi / float(n));
+        } else {
+          const std::vector<Rgb>& op = glossy[c.material].op;
+          for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) {
+            Rgb sum(0.0f);
+            const Rgb* row = op.data() + size_t(t) * n;
+            for (uint32_t k = 0; k < n; ++k) sum += row[k] * incoming[k];
+            next[vb + t] = direct[vb + t] + sum;
+          }
+        }
+      }
+    });
+    std::swap(current, next);
+    const double power = totalPower(current);
+    result.iterations = iteration;
+    result.residual = power > 0.0 ? std::abs(power - previousPower) / power : 0.0;
+    previousPower = power;
+    progress.advance(1);
+    if (result.residual < settings.tolerance) break;
+  }
+  progress.finish();
+
+  // Glossy values carry their emission (front side) from here on; diffuse ones stay irradiance.
+  for (const Chart& c : param.charts) {
+    if (c.kind != ChartKind::Glossy) continue;
+    const Rgb le = scene.materials[c.material].emission;
+    if (isBlack(le)) continue;
+    for (uint64_t v = 0; v < c.tixelCount() * c.valuesPerTixel(); ++v) current[c.firstValue + v] += le;
+  }
+  result.values = std::move(current);
+  result.shadowRays = shadowRays.load();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace pl

@@ -1,0 +1,50 @@
+#pragma once
+// Propagation (DESIGN.md "Light-field pipeline" step 3; seed slides 8, 18–27): solves
+// L = Le + M L over the parameterised surfaces by a Neumann series, with the transport operator
+// M split into gathering through the visibility field and a local BRDF operator per tixel.
+//
+// Quantities per tixel (the LightField value layout):
+//   diffuse  irradiance E (W·m⁻²); its transport radiance is ρ̄·E/π, ρ̄ the footprint albedo;
+//   glossy   exitant radiance per paraboloid texel, without emission during the iteration
+//            (emission is added when the values are written out).
+//
+// First shot (constant over the iteration, "direct"):
+//   * point, spot and directional lights: shadow rays from every tixel's gather point;
+//   * emissive surfaces: for diffuse tixels, areaLightSamples shadow rays towards emissive
+//     triangles (chosen ∝ area·luminance(Le)) combined by the balance heuristic with the gather
+//     rays that hit emitters; glossy tixels receive emission through their gather rays;
+//   * the environment (constant radiance) through gather rays that escape.
+// Iteration (Jacobi): R ← direct + M R, where M gathers the transport radiance of the seen
+// tixels (bilinear over 2×2 tixels, and for glossy targets bilinear over 2×2 directional
+// texels) and applies the local operator:
+//   diffuse  E = (π/N) Σ_k L_k                      (each gather cell has projected solid angle π/N)
+//   glossy   Lo(c) = Σ_k W[c][k] L_k,  W[c][k] = mean over output texel c of ∫_cell k f cos θ dω
+//            (precomputed per material by sub-sampling both the output texel and the cell)
+//   mirror   already folded into the visibility field (a reordering of what is seen).
+// It stops when the relative change of the total outgoing power Σ area·(exitant flux density)
+// drops below the tolerance, or at maxIterations.
+#include "lightfield/parameterisation.h"
+#include "lightfield/visibility.h"
+
+#include <vector>
+
+namespace pl {
+
+class Accel;
+
+struct PropagationResult {
+  std::vector<Rgb> values;  ///< in LightField::values layout, emission included for glossy charts
+  uint32_t iterations = 0;
+  double residual = 0.0;    ///< relative change of total outgoing power at the last iteration
+  double seconds = 0.0;
+  uint64_t shadowRays = 0;
+};
+
+PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                            const VisibilityField& visibility, const BakeSettings& settings);
+
+/// The glossy operator W of one material for an R-texel output map and an m × m gather grid:
+/// R² × m² RGB weights, row c (output texel a + b·R) times column k (gather cell).
+std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide);
+
+}  // namespace pl

@@ -1,0 +1,340 @@
+// The visibility field: tracing, hashing and its .plv file.
+//
+// .plv layout (little-endian; written by writeVisibility, validated by readVisibility):
+//   magic        8 bytes  "PLVIS\0\r\n"
+//   version      u32      kPlvVersion
+//   gridSide     u32      m (N = m² gather directions per tixel)
+//   hash         u64      visibilityHash of the bake that traced it
+//   tixelCount   u64
+//   entryCount   u64      = tixelCount · N
+//   extraCount   u64
+//   payloadHash  u64      FNV-1a 64 of every byte after the header
+//   payload      entries (8 bytes each), extraOffset (u64 × (tixelCount + 1)), extras (24 bytes each)
+#include "lightfield/visibility.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "accel/accel.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "lightfield/lookup.h"
+
+namespace pl {
+
+namespace {
+
+constexpr char kPlvMagic[8] = {'P', 'L', 'V', 'I', 'S', '\0', '\r', '\n'};
+constexpr uint32_t kPlvVersion = 1;
+constexpr size_t kPlvHeaderSize = 8 + 4 + 4 + 8 * 5;
+
+// FNV-1a, 64 bit: a change detector over bytes (not a cryptographic hash).
+struct Fnv1a {
+  uint64_t state = 0xcbf29ce484222325ULL;
+  void bytes(const void* data, size_t size) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < size; ++i) {
+      state ^= p[i];
+      state *= 0x100000001b3ULL;
+    }
+  }
+  template <typename T>
+  void value(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes(&v, sizeof(T));
+  }
+};
+
+}  // namespace
+
+uint32_t gatherGridSide(uint32_t gatherDirections) {
+  return std::max<uint32_t>(1, uint32_t(std::lround(std::sqrt(double(gatherDirections)))));
+}
+
+Vec3 gatherDirectionLocal(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed) {
+  Pcg32 rng = Pcg32::forKey(tixel, k, seed ^ 0x5649534942494c59ULL);
+  const float a = float(k % gridSide), b = float(k / gridSide);
+  const float inv = 1.0f / float(gridSide);
+  const Vec2 u((a + rng.uniform()) * inv, (b + rng.uniform()) * inv);
+  return sampleCosineHemisphere(u);
+}
+
+uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings) {
+  Fnv1a h;
+  h.value(kPlvVersion);
+  h.value(uint64_t(scene.meshes.size()));
+  for (const Mesh& mesh : scene.meshes) {
+    h.value(uint64_t(mesh.triangles.size()));
+    for (const UVec3& t : mesh.triangles) {
+      for (int k = 0; k < 3; ++k) h.value(mesh.positions[t[k]]);
+    }
+    h.bytes(mesh.materials.data(), mesh.materials.size() * sizeof(uint32_t));
+  }
+  for (const Material& m : scene.materials) {
+    h.value(uint8_t(chartKindOf(m.bsdf)));
+    if (const auto* mirror = std::get_if<MirrorBsdf>(&m.bsdf)) {
+      h.value(mirror->reflectance);
+      h.value(uint8_t(mirror->fresnel));
+    }
+  }
+  for (const Chart& c : param.charts) {
+    h.value(c.material);
+    h.value(uint8_t(c.kind));
+    h.value(c.origin);
+    h.value(c.axisU);
+    h.value(c.axisV);
+    h.value(c.normal);
+    h.value(c.tixelSize);
+    h.value(c.resU);
+    h.value(c.resV);
+    h.value(c.dirRes);
+  }
+  h.bytes(param.gatherPoint.data(), param.gatherPoint.size() * sizeof(Vec3));
+  h.value(gatherGridSide(settings.gatherDirections));
+  h.value(settings.mirrorDepth);
+  h.value(settings.seed);
+  return h.state;
+}
+
+VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                  const BakeSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  VisibilityField field;
+  field.gridSide = gatherGridSide(settings.gatherDirections);
+  field.tixelCount = param.tixelCount;
+  field.hash = visibilityHash(scene, param, settings);
+  if (param.tixelCount > VisibilityEntry::kIndexMask)
+    fail("{}: {} tixels exceed the visibility field's limit of {}", scene.sourcePath, param.tixelCount,
+         VisibilityEntry::kIndexMask - 1);
+  const uint32_t n = field.directionsPerTixel();
+  field.entries.resize(param.tixelCount * n);
+
+  // Blocks of tixels whose rays are traced as one Embree stream (~4096 rays).
+  const uint64_t tixelsPerBlock = std::max<uint64_t>(1, 4096 / n);
+  const uint64_t blockCount = (param.tixelCount + tixelsPerBlock - 1) / tixelsPerBlock;
+  std::vector<std::vector<std::pair<uint64_t, VisibilityExtra>>> blockExtras(blockCount);
+  std::atomic<uint64_t> rayCount{0};
+  Progress progress("visibility", param.tixelCount);
+
+  struct PathState {
+    uint64_t entry;
+    Rgb throughput;
+    bool viaMirror;
+  };
+  parallelFor(blockCount, [&](uint64_t block) {
+    const uint64_t t0 = block * tixelsPerBlock, t1 = std::min(param.tixelCount, t0 + tixelsPerBlock);
+    std::vector<Ray> rays, nextRays;
+    std::vector<RayHit> hits;
+    std::vector<PathState> states, nextStates;
+    auto& extras = blockExtras[block];
+    for (uint64_t g = t0; g < t1; ++g) {
+      const Chart& c = param.charts[param.tixelChart[g]];
+      if (c.kind == ChartKind::Specular) {
+        // Mirror tixels store nothing and gather nothing: their entries stay "escaped" and
+        // are never read. No rays are spent on them.
+        continue;
+      }
+      for (uint32_t k = 0; k < n; ++k) {
+        const Vec3 dir = glm::normalize(chartWorldDirection(c, gatherDirectionLocal(g, k, field.gridSide, settings.seed)));
+        Ray ray;
+        ray.origin = offsetRayOrigin(param.gatherPoint[g], c.normal, dir);
+        ray.direction = dir;
+        rays.push_back(ray);
+        states.push_back({g * n + k, Rgb(1.0f), false});
+      }
+    }
+    for (uint32_t depth = 0; !rays.empty(); ++depth) {
+      hits.resize(rays.size());
+      accel.intersectIncoherent(rays, hits);
+      rayCount += rays.size();
+      nextRays.clear();
+      nextStates.clear();
+      for (size_t r = 0; r < rays.size(); ++r) {
+        const Ray& ray = rays[r];
+        const PathState& state = states[r];
+        VisibilityEntry& entry = field.entries[state.entry];
+        const RayHit& hit = hits[r];
+        if (!hit.hit()) {
+          entry.target = VisibilityEntry::kEscape;
+          if (state.viaMirror) {
+            entry.target |= VisibilityEntry::kHasExtra;
+            extras.push_back({state.entry, VisibilityExtra{state.throughput, Vec2(0.0f), 1}});
+          }
+          continue;
+        }
+        const uint32_t chartIndex = param.triangleChart[hit.mesh][hit.triangle];
+        const Chart& c = param.charts[chartIndex];
+        const Vec3 pos = ray.origin + hit.t * ray.direction;
+        const bool back = glm::dot(ray.direction, c.normal) > 0.0f;
+        if (c.kind == ChartKind::Specular) {
+          const Vec3 n2 = back ? -c.normal : c.normal;
+          const Frame frame = Frame::fromNormal(n2);
+          const auto s = depth < settings.mirrorDepth ? sample(scene.materials[c.material].bsdf, frame.toLocal(-ray.direction), Vec2(0.5f))
+                                                      : std::nullopt;
+          if (!s) {
+            // Chain longer than mirrorDepth (or a sample below the surface): absorbed.
+            entry.target = VisibilityEntry::kEscape | VisibilityEntry::kHasExtra;
+            extras.push_back({state.entry, VisibilityExtra{Rgb(0.0f), Vec2(0.0f), 1}});
+            continue;
+          }
+          const Vec3 reflected = glm::normalize(reflect(-ray.direction, n2));
+          Ray next;
+          next.origin = offsetRayOrigin(pos, n2, reflected);
+          next.direction = reflected;
+          nextRays.push_back(next);
+          nextStates.push_back({state.entry, state.throughput * s->weight, true});
+          continue;
+        }
+        const Vec2 grid = tixelGridCoordinates(c, pos);
+        const LinearTap tu = linearTap(grid.x, c.resU), tv = linearTap(grid.y, c.resV);
+        const uint64_t base = c.firstTixel + uint64_t(tv.i0) * c.resU + tu.i0;
+        entry.target = uint32_t(base) | (back ? VisibilityEntry::kBackSide : 0u);
+        entry.fu = uint16_t(std::lround(tu.f * 65535.0f));
+        entry.fv = uint16_t(std::lround(tv.f * 65535.0f));
+        if (state.viaMirror || c.kind == ChartKind::Glossy) {
+          entry.target |= VisibilityEntry::kHasExtra;
+          const Vec2 st = directionToParaboloid(chartLocalDirection(c, -ray.direction));
+          extras.push_back({state.entry, VisibilityExtra{state.throughput, st, state.viaMirror ? 1u : 0u}});
+        }
+      }
+      std::swap(rays, nextRays);
+      std::swap(states, nextStates);
+    }
+    std::sort(extras.begin(), extras.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    progress.advance(t1 - t0);
+  });
+  progress.finish();
+
+  // Per-tixel offsets of the extra records, then the records in entry order.
+  field.extraOffset.assign(param.tixelCount + 1, 0);
+  for (const auto& list : blockExtras)
+    for (const auto& [entry, extra] : list) ++field.extraOffset[entry / n + 1];
+  for (uint64_t g = 0; g < param.tixelCount; ++g) field.extraOffset[g + 1] += field.extraOffset[g];
+  field.extras.reserve(field.extraOffset.back());
+  for (auto& list : blockExtras) {
+    for (const auto& item : list) field.extras.push_back(item.second);
+    std::vector<std::pair<uint64_t, VisibilityExtra>>().swap(list);
+  }
+  field.rays = rayCount.load();
+  field.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return field;
+}
+
+void writeVisibility(const std::string& path, const VisibilityField& field) {
+  Fnv1a payload;
+  payload.bytes(field.entries.data(), field.entries.size() * sizeof(VisibilityEntry));
+  payload.bytes(field.extraOffset.data(), field.extraOffset.size() * sizeof(uint64_t));
+  payload.bytes(field.extras.data(), field.extras.size() * sizeof(VisibilityExtra));
+
+  const std::string temp = path + ".tmp";
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out) fail("{}: cannot open for writing", temp);
+    auto put = [&](const void* data, size_t size) { out.write(static_cast<const char*>(data), std::streamsize(size)); };
+    const uint64_t entryCount = field.entries.size(), extraCount = field.extras.size();
+    put(kPlvMagic, 8);
+    put(&kPlvVersion, 4);
+    put(&field.gridSide, 4);
+    put(&field.hash, 8);
+    put(&field.tixelCount, 8);
+    put(&entryCount, 8);
+    put(&extraCount, 8);
+    put(&payload.state, 8);
+    put(field.entries.data(), field.entries.size() * sizeof(VisibilityEntry));
+    put(field.extraOffset.data(), field.extraOffset.size() * sizeof(uint64_t));
+    put(field.extras.data(), field.extras.size() * sizeof(VisibilityExtra));
+    out.flush();
+    if (!out) {
+      out.close();
+      std::remove(temp.c_str());
+      fail("{}: write failed (disk full?)", temp);
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temp, path, ec);
+  if (ec) {
+    std::remove(temp.c_str());
+    fail("{}: cannot move into place: {}", path, ec.message());
+  }
+}
+
+bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why) {
+  auto reason = [&](std::string text) {
+    if (why) *why = std::move(text);
+    return false;
+  };
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return reason(fmt::format("{} does not exist", path));
+  const uint64_t fileSize = std::filesystem::file_size(path, ec);
+  if (ec) fail("{}: cannot determine its size: {}", path, ec.message());
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail("{}: cannot open for reading", path);
+  if (fileSize < kPlvHeaderSize) fail("{}: truncated visibility field ({} bytes, header needs {})", path, fileSize, kPlvHeaderSize);
+  char magic[8];
+  uint32_t version = 0, gridSide = 0;
+  uint64_t hash = 0, tixelCount = 0, entryCount = 0, extraCount = 0, payloadHash = 0;
+  auto get = [&](void* data, size_t size) { in.read(static_cast<char*>(data), std::streamsize(size)); };
+  get(magic, 8);
+  if (std::memcmp(magic, kPlvMagic, 8) != 0) fail("{}: not a plenoptic visibility field (bad magic)", path);
+  get(&version, 4);
+  if (version != kPlvVersion) fail("{}: visibility field version {} (this program reads version {})", path, version, kPlvVersion);
+  get(&gridSide, 4);
+  get(&hash, 8);
+  get(&tixelCount, 8);
+  get(&entryCount, 8);
+  get(&extraCount, 8);
+  get(&payloadHash, 8);
+  if (!in) fail("{}: truncated header", path);
+  if (hash != expectedHash)
+    return reason(fmt::format("{} was traced for different geometry, parameterisation or settings (hash {:016x}, expected {:016x})",
+                              path, hash, expectedHash));
+  if (gridSide == 0 || gridSide > 4096 || tixelCount > VisibilityEntry::kIndexMask ||
+      entryCount != tixelCount * uint64_t(gridSide) * gridSide)
+    fail("{}: inconsistent counts in the header (grid {}, {} tixels, {} entries)", path, gridSide, tixelCount, entryCount);
+  const uint64_t expectedSize = kPlvHeaderSize + entryCount * sizeof(VisibilityEntry) + (tixelCount + 1) * sizeof(uint64_t);
+  if (extraCount > (fileSize - std::min(fileSize, expectedSize)) / sizeof(VisibilityExtra) ||
+      fileSize != expectedSize + extraCount * sizeof(VisibilityExtra))
+    fail("{}: truncated or oversized: {} bytes, the header describes {}", path, fileSize,
+         expectedSize + extraCount * sizeof(VisibilityExtra));
+  VisibilityField f;
+  f.gridSide = gridSide;
+  f.tixelCount = tixelCount;
+  f.hash = hash;
+  f.entries.resize(entryCount);
+  f.extraOffset.resize(tixelCount + 1);
+  f.extras.resize(extraCount);
+  get(f.entries.data(), entryCount * sizeof(VisibilityEntry));
+  get(f.extraOffset.data(), f.extraOffset.size() * sizeof(uint64_t));
+  get(f.extras.data(), extraCount * sizeof(VisibilityExtra));
+  if (!in) fail("{}: read failed", path);
+  Fnv1a payload;
+  payload.bytes(f.entries.data(), entryCount * sizeof(VisibilityEntry));
+  payload.bytes(f.extraOffset.data(), f.extraOffset.size() * sizeof(uint64_t));
+  payload.bytes(f.extras.data(), extraCount * sizeof(VisibilityExtra));
+  if (payload.state != payloadHash) fail("{}: corrupt visibility field (payload checksum mismatch)", path);
+  // Structural checks, so that propagation can index without bounds checks.
+  const uint32_t n = gridSide * gridSide;
+  if (f.extraOffset[0] != 0 || f.extraOffset.back() != extraCount) fail("{}: corrupt extra-record offsets", path);
+  for (uint64_t g = 0; g < tixelCount; ++g) {
+    uint64_t flagged = 0;
+    for (uint32_t k = 0; k < n; ++k) {
+      const VisibilityEntry& e = f.entries[g * n + k];
+      if (!e.escaped() && e.tixel() >= tixelCount) fail("{}: entry {} of tixel {} points outside the field", path, k, g);
+      flagged += e.hasExtra() ? 1 : 0;
+    }
+    if (f.extraOffset[g + 1] < f.extraOffset[g] || f.extraOffset[g + 1] - f.extraOffset[g] != flagged)
+      fail("{}: corrupt extra-record offsets at tixel {}", path, g);
+  }
+  field = std::move(f);
+  return true;
+}
+
+}  // namespace pl

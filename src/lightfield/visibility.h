@@ -1,0 +1,100 @@
+#pragma once
+// The visibility field (seed slide 21; DESIGN.md "Light-field pipeline" step 2): for every
+// tixel and each of its gather directions, what is seen — a point on a non-specular chart
+// (after following ideal-specular chains), or the environment. Computed once with Embree,
+// saved beside the light field (.plv) and reused while geometry and parameterisation are
+// unchanged, so that a change of emission or albedo only re-propagates.
+//
+// Gather directions. Each tixel has N = m² directions, one per cell of an m × m grid over the
+// unit square mapped to the hemisphere by the concentric cosine-weighted map
+// (sampleCosineHemisphere). Every cell has the same projected solid angle π/N, so a cell's
+// contribution to irradiance is (π/N)·L. Inside its cell each tixel's ray is jittered by a
+// hash of (tixel, cell, seed): stratified, and decorrelated between neighbouring tixels.
+//
+// Entries (8 bytes, tixel-major: entry k of tixel g at g·N + k):
+//   target  bits 0–29: global index of the tixel at the lower-left of the 2×2 bilinear
+//                      footprint of the seen point (kEscape: nothing was hit)
+//           bit 30:    the seen chart was hit from behind (its back side)
+//           bit 31:    the entry has an extra record (see below)
+//   fu, fv  bilinear fractions towards tixel (i+1, j) and (i, j+1), × 65535
+// Extra records (rare: glossy targets and paths through mirrors), in entry order per tixel,
+// starting at extraOffset[g]:
+//   throughput  product of the mirror reflectances along the chain (1 without mirrors)
+//   st          paraboloid coordinates, in the seen chart's frame, of the direction in which
+//               the seen point sends light back along the path (glossy targets)
+//   viaMirror   whether the path went through at least one mirror
+#include "core/math.h"
+#include "lightfield/parameterisation.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pl {
+
+class Accel;
+
+struct VisibilityEntry {
+  static constexpr uint32_t kIndexMask = 0x3fffffffu;
+  static constexpr uint32_t kEscape = kIndexMask;
+  static constexpr uint32_t kBackSide = 1u << 30;
+  static constexpr uint32_t kHasExtra = 1u << 31;
+  uint32_t target = kEscape;
+  uint16_t fu = 0, fv = 0;
+
+  uint32_t tixel() const { return target & kIndexMask; }
+  bool escaped() const { return tixel() == kEscape; }
+  bool backSide() const { return (target & kBackSide) != 0; }
+  bool hasExtra() const { return (target & kHasExtra) != 0; }
+};
+static_assert(sizeof(VisibilityEntry) == 8);
+
+struct VisibilityExtra {
+  Rgb throughput{1.0f};
+  Vec2 st{0.0f};
+  uint32_t viaMirror = 0;
+};
+static_assert(sizeof(VisibilityExtra) == 24);
+
+struct VisibilityField {
+  uint32_t gridSide = 0;          ///< m: N = m² gather directions per tixel
+  uint64_t tixelCount = 0;
+  uint64_t hash = 0;              ///< of geometry + parameterisation + settings (visibilityHash)
+  std::vector<VisibilityEntry> entries;   ///< tixelCount × N
+  std::vector<uint64_t> extraOffset;      ///< tixelCount + 1
+  std::vector<VisibilityExtra> extras;
+  uint64_t rays = 0;              ///< rays traced to build it (gather + mirror continuations)
+  double seconds = 0.0;
+
+  uint32_t directionsPerTixel() const { return gridSide * gridSide; }
+  uint64_t bytes() const {
+    return entries.size() * sizeof(VisibilityEntry) + extraOffset.size() * sizeof(uint64_t) +
+           extras.size() * sizeof(VisibilityExtra);
+  }
+};
+
+/// m for a requested number of gather directions: round(√N), at least 1.
+uint32_t gatherGridSide(uint32_t gatherDirections);
+
+/// Gather direction k of global tixel `tixel`, in the chart's local frame (z = normal).
+Vec3 gatherDirectionLocal(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed);
+
+/// Hash of everything the visibility field depends on: vertex positions, triangles and their
+/// materials' *transport class* (chart kind, and mirror parameters, which the field's
+/// throughputs contain — not diffuse albedo or emission), the parameterisation (charts,
+/// gather points) and the settings that shape it (gather directions, mirror depth, seed).
+uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings);
+
+/// Traces the visibility field (parallel, with a progress bar).
+VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                  const BakeSettings& settings);
+
+/// Writes the field atomically (temp + rename). Format: see visibility.cpp.
+void writeVisibility(const std::string& path, const VisibilityField& field);
+
+/// Reads a field. Returns false and sets *why when the file is absent or its hash differs
+/// from expectedHash (a stale field is not an error); throws pl::Error naming the file when
+/// it is present but corrupt or truncated.
+bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why);
+
+}  // namespace pl
