@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   // Subcommands in pipeline order. Each one's callback does the work, starting with a
   // pl::Runtime (thread pool, progress settings).
   // (one line per subcommand; keep this list in pipeline order)
+  pl::addBakeCommand(app, global);
   pl::addCompareCommand(app, global);
   pl::addTonemapCommand(app, global);
   pl::addEnvCommand(app, global);

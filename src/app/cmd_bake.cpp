@@ -1,0 +1,152 @@
+// `plenoptic bake SCENE -o OUT.plf`: the light-field bake (src/lightfield/bake.h).
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/commands.h"
+#include "core/error.h"
+#include "lightfield/bake.h"
+#include "lightfield/plf_file.h"
+#include "scene/scene.h"
+
+namespace pl {
+namespace {
+
+struct BakeCommandOptions {
+  std::string scene;            ///< `cornell`, .obj, .gltf/.glb, .json
+  std::string output;           ///< .plf
+  std::string preset = "default";
+  bool reuseVisibility = false;
+  std::string visibilityPath;   ///< default: OUT with extension .plv
+  std::string statsPath;
+  // Overrides of single preset values (0 / negative = keep the preset's).
+  float tixelsAcross = 0.0f;
+  uint32_t gatherDirections = 0;
+  uint32_t lightSamples = 0;
+  float tolerance = 0.0f;
+};
+
+void checkParentDirectory(const std::string& path, const char* option) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent))
+    fail("{} {}: directory '{}' does not exist", option, path, parent.string());
+}
+
+void writeTextAtomically(const std::string& path, const std::string& text) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) fail("{}: cannot open for writing", temporary);
+    out << text;
+    out.flush();
+    if (!out) {
+      std::remove(temporary.c_str());
+      fail("{}: write failed", temporary);
+    }
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::remove(temporary.c_str());
+    fail("{}: cannot rename the finished file into place: {}", path, error.message());
+  }
+}
+
+void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
+  Runtime runtime(global);
+  const auto start = std::chrono::steady_clock::now();
+  if (options.output.empty()) fail("bake: an output file is required (-o OUT.plf)");
+  checkParentDirectory(options.output, "-o");
+  if (!options.statsPath.empty()) checkParentDirectory(options.statsPath, "--stats");
+  const std::string visibilityPath =
+      options.visibilityPath.empty() ? std::filesystem::path(options.output).replace_extension(".plv").string()
+                                     : options.visibilityPath;
+  checkParentDirectory(visibilityPath, "--visibility");
+
+  BakeSettings settings = bakePreset(options.preset);
+  if (options.tixelsAcross > 0.0f) settings.tixelsAcrossScene = options.tixelsAcross;
+  if (options.gatherDirections > 0) settings.gatherDirections = options.gatherDirections;
+  if (options.lightSamples > 0) settings.areaLightSamples = options.lightSamples;
+  if (options.tolerance > 0.0f) settings.tolerance = options.tolerance;
+  settings.seed = global.seed;
+
+  Scene scene = loadScene(options.scene);
+  BakeOptions bakeOptions;
+  bakeOptions.visibilityPath = visibilityPath;
+  bakeOptions.reuseVisibility = options.reuseVisibility;
+  bakeOptions.log = [&](const std::string& line) {
+    if (!global.quiet) fmt::print(stderr, "{}\n", line);
+  };
+  LightField lf = bake(std::move(scene), settings, bakeOptions);
+  writeLightField(options.output, lf);
+  const uint64_t fileBytes = std::filesystem::file_size(options.output);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const BakeStats& s = lf.stats;
+
+  if (!options.statsPath.empty()) {
+    nlohmann::json json;
+    json["command"] = "bake";
+    json["scene"] = options.scene;
+    json["output"] = options.output;
+    json["preset"] = settings.preset;
+    json["threads"] = runtime.threads();
+    json["seconds"] = seconds;
+    json["bake_seconds"] = s.seconds;
+    json["visibility_seconds"] = s.visibilitySeconds;
+    json["propagation_seconds"] = s.propagationSeconds;
+    json["iterations"] = s.iterations;
+    json["residual"] = s.residual;
+    json["tixels"] = s.tixels;
+    json["values"] = s.values;
+    json["charts"] = lf.charts.size();
+    json["visibility_rays"] = s.visibilityRays;
+    json["visibility_rays_per_second"] = s.visibilitySeconds > 0 ? double(s.visibilityRays) / s.visibilitySeconds : 0.0;
+    json["reused_visibility"] = s.reusedVisibility;
+    json["visibility_file"] = visibilityPath;
+    json["peak_rss_bytes"] = s.peakRssBytes;
+    json["file_bytes"] = fileBytes;
+    writeTextAtomically(options.statsPath, json.dump(2) + "\n");
+  }
+  fmt::print("wrote {} ({} charts, {} tixels, {} values, {:.1f} MB; {} iterations, residual {:.2e}; {:.2f} s)\n",
+             options.output, lf.charts.size(), s.tixels, s.values, fileBytes / 1e6, s.iterations, s.residual, seconds);
+}
+
+}  // namespace
+
+void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
+  auto options = std::make_shared<BakeCommandOptions>();
+  CLI::App* command = app.add_subcommand(
+      "bake", "Precompute the scene's light field (charts, visibility field, propagation) into a .plf file");
+  command->add_option("scene", options->scene, "cornell, or a scene file (.obj, .gltf, .glb, .json)")->required();
+  command->add_option("-o,--output", options->output, "Output light field (.plf)")->required();
+  command->add_option("--preset", options->preset, "Quality preset")
+      ->check(CLI::IsMember({"draft", "default", "high"}))
+      ->capture_default_str();
+  command->add_flag("--reuse-visibility", options->reuseVisibility,
+                    "Reuse the saved visibility field if geometry, parameterisation and settings are unchanged "
+                    "(checked by hash); otherwise recompute it and say why");
+  command->add_option("--visibility", options->visibilityPath,
+                      "Where the visibility field is saved/looked for (default: OUT with extension .plv)");
+  command->add_option("--stats", options->statsPath, "Write timings and counts as JSON");
+  command->add_option("--tixels-across", options->tixelsAcross,
+                      "Override the preset: tixels along the scene's largest extent")
+      ->check(CLI::Range(1.0f, 4096.0f));
+  command->add_option("--directions", options->gatherDirections,
+                      "Override the preset: gather directions per tixel (rounded to a square)")
+      ->check(CLI::Range(1u, 65536u));
+  command->add_option("--light-samples", options->lightSamples,
+                      "Override the preset: shadow rays per tixel towards emissive surfaces")
+      ->check(CLI::Range(1u, 65536u));
+  command->add_option("--tolerance", options->tolerance,
+                      "Override the preset: relative change of total power at which iteration stops")
+      ->check(CLI::Range(1e-9f, 1.0f));
+  command->callback([options, &global] { runBake(*options, global); });
+}
+
+}  // namespace pl
