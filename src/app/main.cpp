@@ -24,6 +24,8 @@ int main(int argc, char** argv) {
   // pl::Runtime (thread pool, progress settings).
   // (one line per subcommand; keep this list in pipeline order)
   pl::addBakeCommand(app, global);
+  pl::addInfoCommand(app, global);
+  pl::addRenderCommand(app, global);
   pl::addCompareCommand(app, global);
   pl::addTonemapCommand(app, global);
   pl::addEnvCommand(app, global);

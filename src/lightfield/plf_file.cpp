@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <type_traits>
@@ -372,6 +373,13 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
     w.put(c.aspectRatio.value_or(0.0f));
   }
   w.put(scene.environment.constant);
+  // The scene file's suggested render settings: each a presence byte and a value.
+  for (const std::optional<int>& value : {scene.settings.width, scene.settings.height, scene.settings.spp}) {
+    w.put(uint8_t(value.has_value()));
+    w.put(int32_t(value.value_or(0)));
+  }
+  w.put(uint8_t(scene.settings.camera.has_value()));
+  w.putString(scene.settings.camera.value_or(""));
   return std::move(w.bytes());
 }
 
@@ -433,6 +441,14 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path)
     if (hasAspect) c.aspectRatio = aspect;
   }
   scene.environment.constant = r.get<Rgb>();
+  for (std::optional<int>* value : {&scene.settings.width, &scene.settings.height, &scene.settings.spp}) {
+    const bool present = r.get<uint8_t>() != 0;
+    const int32_t v = r.get<int32_t>();
+    if (present) *value = v;
+  }
+  const bool hasCamera = r.get<uint8_t>() != 0;
+  std::string camera = r.getString();
+  if (hasCamera) scene.settings.camera = std::move(camera);
   r.expectEnd();
 
   // Cross-references. The writer only ever stores a finalized scene, so any violation means
@@ -574,6 +590,7 @@ nlohmann::json settingsToJson(const BakeSettings& s) {
           {"tolerance", s.tolerance},
           {"max_iterations", s.maxIterations},
           {"mirror_depth", s.mirrorDepth},
+          {"area_light_samples", s.areaLightSamples},
           {"seed", s.seed}};
 }
 
@@ -618,6 +635,7 @@ void decodeMeta(std::span<const unsigned char> bytes, const std::string& path, B
     readKey(s, "tolerance", settings.tolerance);
     readKey(s, "max_iterations", settings.maxIterations);
     readKey(s, "mirror_depth", settings.mirrorDepth);
+    readKey(s, "area_light_samples", settings.areaLightSamples);
     readKey(s, "seed", settings.seed);
     const auto& t = meta.at("stats");
     readKey(t, "seconds", stats.seconds);

@@ -103,6 +103,9 @@ LightField makeTestLightField() {
   lens.aspectRatio = 1.5f;
   s.cameras = {front, lens};
   s.environment.constant = Rgb(0.1f, 0.2f, 0.3f);
+  s.settings.width = 320;
+  s.settings.spp = 1024;
+  s.settings.camera = "lens";
 
   Chart diffuse;
   diffuse.material = 0;
@@ -143,6 +146,7 @@ LightField makeTestLightField() {
   lf.settings.tolerance = 2.5e-4f;
   lf.settings.maxIterations = 91;
   lf.settings.mirrorDepth = 3;
+  lf.settings.areaLightSamples = 5;
   lf.settings.seed = 0x123456789abcdefull;
   lf.stats.seconds = 1.25;
   lf.stats.visibilitySeconds = 0.5;
@@ -315,6 +319,11 @@ TEST_F(PlfFileTest, RoundTripPreservesEveryField) {
     EXPECT_EQ(cb.aspectRatio, ca.aspectRatio);
   }
   EXPECT_EQ(b.environment.constant, a.environment.constant);
+  EXPECT_EQ(b.settings.width, a.settings.width);
+  EXPECT_EQ(b.settings.height, a.settings.height);
+  EXPECT_FALSE(b.settings.height.has_value());
+  EXPECT_EQ(b.settings.spp, a.settings.spp);
+  EXPECT_EQ(b.settings.camera, a.settings.camera);
 
   ASSERT_EQ(copy.charts.size(), original.charts.size());
   for (size_t i = 0; i < original.charts.size(); ++i) {
@@ -345,6 +354,7 @@ TEST_F(PlfFileTest, RoundTripPreservesEveryField) {
   EXPECT_EQ(sb2.tolerance, sa2.tolerance);
   EXPECT_EQ(sb2.maxIterations, sa2.maxIterations);
   EXPECT_EQ(sb2.mirrorDepth, sa2.mirrorDepth);
+  EXPECT_EQ(sb2.areaLightSamples, sa2.areaLightSamples);
   EXPECT_EQ(sb2.seed, sa2.seed);
   const BakeStats &ta = original.stats, &tb = copy.stats;
   EXPECT_EQ(tb.seconds, ta.seconds);
@@ -506,10 +516,13 @@ TEST_F(PlfFileTest, RefusesAFlippedByteInEverySection) {
     expectRefused(file("badheader.plf"), {"corrupt header"});
   }
   // … and the padding between sections must be zero.
+  // The table (5 entries) ends at byte 272 and the first section starts 64-byte aligned at
+  // 320, so there is always padding right after the table.
   const auto table = sections(good);
-  ASSERT_GT(table[1].offset, table[0].offset + table[0].size) << "test needs padding after SCNE";
+  const uint64_t tableEnd = kPlfHeaderSize + table.size() * kPlfSectionEntrySize;
+  ASSERT_GT(table[0].offset, tableEnd);
   auto bad = good;
-  bad[table[0].offset + table[0].size] = 0xff;
+  bad[tableEnd + 1] = 0xff;
   writeBytes(file("badpadding.plf"), bad);
   expectRefused(file("badpadding.plf"), {"padding"});
 }

@@ -1,0 +1,166 @@
+// `plenoptic info IN.plf [--json] [--no-verify]`: what a light-field file holds — format
+// version, the embedded scene, charts by kind, tixels, values, section sizes, and the bake's
+// settings and statistics — read without decoding the values (lightfield/plf_file.h).
+#include <fmt/format.h>
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/commands.h"
+#include "core/error.h"
+#include "lightfield/plf_file.h"
+
+namespace pl {
+namespace {
+
+struct InfoOptions {
+  std::string input;
+  bool json = false;      ///< --json: one JSON object on stdout
+  bool noVerify = false;  ///< --no-verify: skip recomputing the big sections' checksums
+};
+
+std::string humanBytes(uint64_t bytes) {
+  if (bytes < 1024) return fmt::format("{} B", bytes);
+  if (bytes < (uint64_t(1) << 20)) return fmt::format("{:.1f} KiB", double(bytes) / 1024.0);
+  if (bytes < (uint64_t(1) << 30)) return fmt::format("{:.1f} MiB", double(bytes) / double(1 << 20));
+  return fmt::format("{:.2f} GiB", double(bytes) / double(1 << 30));
+}
+
+const char* encodingName(uint32_t encoding) { return encoding == uint32_t(PlfEncoding::Raw) ? "raw" : "unknown"; }
+
+/// "lambert ×4, mirror ×1" in first-seen order.
+std::string modelCounts(const std::vector<std::string>& models) {
+  std::vector<std::pair<std::string, int>> counts;
+  for (const std::string& m : models) {
+    auto it = std::find_if(counts.begin(), counts.end(), [&](const auto& c) { return c.first == m; });
+    if (it == counts.end())
+      counts.emplace_back(m, 1);
+    else
+      ++it->second;
+  }
+  std::string text;
+  for (const auto& [model, count] : counts) text += fmt::format("{}{} ×{}", text.empty() ? "" : ", ", model, count);
+  return text;
+}
+
+nlohmann::json toJson(const PlfInfo& info) {
+  nlohmann::json sections = nlohmann::json::array();
+  for (const PlfSectionInfo& s : info.sections)
+    sections.push_back({{"id", s.id},
+                        {"encoding", encodingName(s.encoding)},
+                        {"offset", s.offset},
+                        {"stored_bytes", s.storedSize},
+                        {"decoded_bytes", s.decodedSize},
+                        {"checksum_xxh64", fmt::format("{:016x}", s.checksum)}});
+  const BakeSettings& bs = info.settings;
+  const BakeStats& st = info.stats;
+  return {{"file", info.path},
+          {"format_version", info.version},
+          {"file_bytes", info.fileBytes},
+          {"checksums_verified", info.checksumsVerified},
+          {"scene",
+           {{"source", info.sceneSource},
+            {"meshes", info.meshes},
+            {"triangles", info.triangles},
+            {"vertices", info.vertices},
+            {"materials", info.materials},
+            {"material_models", info.materialModels},
+            {"textures", info.textures},
+            {"lights", info.lights},
+            {"cameras", info.cameraNames},
+            {"environment", {info.environment.r, info.environment.g, info.environment.b}}}},
+          {"charts",
+           {{"total", info.charts},
+            {"diffuse", info.diffuseCharts},
+            {"glossy", info.glossyCharts},
+            {"specular", info.specularCharts}}},
+          {"tixels", info.tixels},
+          {"values", info.values},
+          {"sections", sections},
+          {"settings",
+           {{"preset", bs.preset},
+            {"tixels_per_unit", bs.tixelsPerUnit},
+            {"tixels_across_scene", bs.tixelsAcrossScene},
+            {"max_tixels_per_chart_side", bs.maxTixelsPerChartSide},
+            {"gather_directions", bs.gatherDirections},
+            {"glossy_dir_res", bs.glossyDirRes},
+            {"tolerance", bs.tolerance},
+            {"max_iterations", bs.maxIterations},
+            {"mirror_depth", bs.mirrorDepth},
+            {"area_light_samples", bs.areaLightSamples},
+            {"seed", bs.seed}}},
+          {"stats",
+           {{"seconds", st.seconds},
+            {"visibility_seconds", st.visibilitySeconds},
+            {"propagation_seconds", st.propagationSeconds},
+            {"iterations", st.iterations},
+            {"residual", st.residual},
+            {"tixels", st.tixels},
+            {"values", st.values},
+            {"visibility_rays", st.visibilityRays},
+            {"peak_rss_bytes", st.peakRssBytes},
+            {"reused_visibility", st.reusedVisibility}}}};
+}
+
+void printHuman(const PlfInfo& info) {
+  fmt::print("{}: plenoptic light field, format version {}, {} ({} bytes)\n", info.path, info.version,
+             humanBytes(info.fileBytes), info.fileBytes);
+  fmt::print("checksums    {}\n", info.checksumsVerified ? "all sections verified" : "header and small sections verified "
+                                                                                     "(values not checked: --no-verify)");
+  fmt::print("scene        {}\n", info.sceneSource.empty() ? "(unnamed)" : info.sceneSource);
+  fmt::print("  geometry   {} triangles, {} vertices in {} meshes\n", info.triangles, info.vertices, info.meshes);
+  fmt::print("  materials  {} ({})\n", info.materials, modelCounts(info.materialModels));
+  fmt::print("  textures   {}\n", info.textures);
+  fmt::print("  lights     {} point/spot/directional (plus emissive surfaces)\n", info.lights);
+  std::string cameras;
+  for (const std::string& c : info.cameraNames) cameras += (cameras.empty() ? "" : ", ") + (c.empty() ? "(unnamed)" : c);
+  fmt::print("  cameras    {}{}\n", info.cameraNames.size(), cameras.empty() ? "" : ": " + cameras);
+  fmt::print("  environment  {:.4g} {:.4g} {:.4g} W·sr⁻¹·m⁻²\n", info.environment.r, info.environment.g,
+             info.environment.b);
+  fmt::print("charts       {} ({} diffuse, {} glossy, {} specular)\n", info.charts, info.diffuseCharts,
+             info.glossyCharts, info.specularCharts);
+  fmt::print("tixels       {}\n", info.tixels);
+  fmt::print("values       {} RGB (float32, {})\n", info.values, humanBytes(info.values * 12));
+  fmt::print("sections     id    encoding        offset        bytes  xxh64\n");
+  for (const PlfSectionInfo& s : info.sections)
+    fmt::print("             {}  {:8} {:>13} {:>12}  {:016x}  ({})\n", s.id, encodingName(s.encoding), s.offset,
+               s.storedSize, s.checksum, humanBytes(s.storedSize));
+  const BakeSettings& bs = info.settings;
+  fmt::print("bake settings  preset {}, ", bs.preset);
+  if (bs.tixelsPerUnit > 0.0f)
+    fmt::print("{} tixels per scene unit", bs.tixelsPerUnit);
+  else
+    fmt::print("{} tixels across the scene", bs.tixelsAcrossScene);
+  fmt::print(" (≤ {} per chart side), {} gather directions, glossy maps ≤ {}², tolerance {}, ≤ {} iterations, "
+             "mirror depth {}, {} area-light samples, seed {}\n",
+             bs.maxTixelsPerChartSide, bs.gatherDirections, bs.glossyDirRes, bs.tolerance, bs.maxIterations,
+             bs.mirrorDepth, bs.areaLightSamples, bs.seed);
+  const BakeStats& st = info.stats;
+  fmt::print("bake stats     {:.3f} s (visibility {:.3f} s{}, propagation {:.3f} s), {} iterations, residual {:.3g}, "
+             "{} visibility rays, peak RSS {}\n",
+             st.seconds, st.visibilitySeconds, st.reusedVisibility ? ", reused" : "", st.propagationSeconds,
+             st.iterations, st.residual, st.visibilityRays, humanBytes(st.peakRssBytes));
+}
+
+}  // namespace
+
+void addInfoCommand(CLI::App& app, const GlobalOptions& global) {
+  auto options = std::make_shared<InfoOptions>();
+  CLI::App* command = app.add_subcommand("info", "Show what a light-field file (.plf) contains: format, scene, "
+                                                 "charts, sizes, bake settings and statistics");
+  command->add_option("input", options->input, "Light-field file (.plf)")->required();
+  command->add_flag("--json", options->json, "Print one JSON object instead of text");
+  command->add_flag("--no-verify", options->noVerify,
+                    "Do not recompute the checksums of the triangle-chart and value sections (faster on huge files)");
+  command->callback([options, &global] {
+    Runtime runtime(global);
+    const PlfInfo info = readLightFieldInfo(options->input, !options->noVerify);
+    if (options->json)
+      fmt::print("{}\n", toJson(info).dump(2));
+    else
+      printHuman(info);
+  });
+}
+
+}  // namespace pl

@@ -1,0 +1,176 @@
+// `plenoptic render IN.plf -o OUT.exr|png`: the straightforward light-field renderer
+// (src/render/render.h) through the shared camera, exposure and tone-mapping flags.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "accel/accel.h"
+#include "app/commands.h"
+#include "app/view_options.h"
+#include "camera/camera.h"
+#include "core/error.h"
+#include "lightfield/plf_file.h"
+#include "render/render.h"
+
+namespace pl {
+namespace {
+
+// Ranges of the options, declared once.
+constexpr int kMaxImageSide = 16384;
+constexpr int kMaxFrames = 100000;
+constexpr int kMaxSamples = 1 << 16;
+constexpr int kMaxMirrorDepth = 1000;
+
+struct RenderOptions {
+  std::string input;      ///< .plf light field
+  std::string output;     ///< .exr/.hdr/.pfm (radiance × exposure) or .png (tone-mapped)
+  std::string statsPath;  ///< --stats: JSON with frames, ms_per_frame_median, fps
+  int frames = 1;         ///< --frames N: render N times (timing); the last frame is written
+  int samples = 0;        ///< --samples N: camera samples per pixel (0 = automatic, see render.h)
+  int mirrorDepth = -1;   ///< --mirror-depth N (-1 = the bake's)
+  ViewOptions view;
+};
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+/// Fails before any work is done if `path` cannot be written as an image or a JSON file.
+void checkOutputPath(const std::string& path, const char* option, bool image) {
+  if (image) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (!isHdrExtension(path) && ext != ".png")
+      fail("{} {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", option, path, ext);
+  }
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent))
+    fail("{} {}: directory '{}' does not exist", option, path, parent.string());
+}
+
+/// Writes text to path atomically (temporary file beside it, then rename).
+void writeTextAtomically(const std::string& path, const std::string& text) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) fail("{}: cannot open for writing", temporary);
+    out << text;
+    out.flush();
+    if (!out) {
+      std::remove(temporary.c_str());
+      fail("{}: write failed", temporary);
+    }
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::remove(temporary.c_str());
+    fail("{}: cannot rename the finished file into place: {}", path, error.message());
+  }
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void runRender(const RenderOptions& options, const GlobalOptions& global) {
+  Runtime runtime(global);
+  const ViewOptions& view = options.view;
+  if (view.width < 1 || view.width > kMaxImageSide || view.height < 1 || view.height > kMaxImageSide)
+    fail("image size {}x{} is out of range (width and height must be 1..{})", view.width, view.height, kMaxImageSide);
+  if (options.output.empty()) fail("render: an output image is required (-o OUT.exr|png)");
+  checkOutputPath(options.output, "-o", true);
+  if (!options.statsPath.empty()) checkOutputPath(options.statsPath, "--stats", false);
+
+  const auto loadStart = Clock::now();
+  const LightField lightField = readLightField(options.input);
+  const double loadSeconds = secondsSince(loadStart);
+  const auto accelStart = Clock::now();
+  const Accel accel(lightField.scene);
+  const double accelSeconds = secondsSince(accelStart);
+  const CameraDesc cameraDesc = view.resolveCamera(lightField.scene);
+  const Camera camera(cameraDesc, view.width, view.height, view.vignetting);
+
+  RenderSettings settings;
+  settings.samplesPerPixel = options.samples;
+  settings.mirrorDepth = options.mirrorDepth;
+  settings.seed = global.seed;
+  settings.showProgress = options.frames == 1;
+  Image image;
+  std::vector<double> frameMs;
+  for (int frame = 0; frame < options.frames; ++frame) {
+    const auto start = Clock::now();
+    image = renderLightField(lightField, accel, camera, settings);
+    frameMs.push_back(1e3 * secondsSince(start));
+  }
+  view.writeImage(options.output, image);
+
+  const double medianMs = median(frameMs);
+  const double fps = medianMs > 0.0 ? 1e3 / medianMs : 0.0;
+  const int spp = options.samples > 0 ? options.samples : camera.isThinLens() ? RenderSettings::kThinLensSamples : 1;
+  if (!options.statsPath.empty()) {
+    nlohmann::json json;
+    json["command"] = "render";
+    json["input"] = options.input;
+    json["output"] = options.output;
+    json["camera"] = cameraDesc.name;
+    json["width"] = view.width;
+    json["height"] = view.height;
+    json["samples_per_pixel"] = spp;
+    json["mirror_depth"] = options.mirrorDepth >= 0 ? uint32_t(options.mirrorDepth) : lightField.settings.mirrorDepth;
+    json["threads"] = runtime.threads();
+    json["frames"] = options.frames;
+    json["ms_per_frame_median"] = medianMs;
+    json["ms_per_frame_min"] = *std::min_element(frameMs.begin(), frameMs.end());
+    json["ms_per_frame_max"] = *std::max_element(frameMs.begin(), frameMs.end());
+    json["fps"] = fps;
+    json["load_seconds"] = loadSeconds;
+    json["accel_build_seconds"] = accelSeconds;
+    json["file_bytes"] = std::filesystem::file_size(options.input);
+    writeTextAtomically(options.statsPath, json.dump(2) + "\n");
+  }
+  fmt::print("wrote {} ({}x{}, {} sample{}/pixel, {} frame{}: median {:.2f} ms/frame = {:.1f} fps; "
+             "load {:.3f} s, BVH {:.3f} s)\n",
+             options.output, view.width, view.height, spp, spp == 1 ? "" : "s", options.frames,
+             options.frames == 1 ? "" : "s", medianMs, fps, loadSeconds, accelSeconds);
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
+  auto options = std::make_shared<RenderOptions>();
+  CLI::App* command = app.add_subcommand(
+      "render", "Render a baked light field (.plf) by looking it up (16-neighbour interpolation, mirrors followed)");
+  command->add_option("input", options->input, "Light-field file (.plf) written by `plenoptic bake`")->required();
+  command->add_option("-o,--output", options->output,
+                      "Output image: .exr/.hdr/.pfm hold radiance (x exposure), .png is tone-mapped sRGB")
+      ->required();
+  command->add_option("--frames", options->frames, "Render N times for timing (the median goes to --stats)")
+      ->check(CLI::Range(1, kMaxFrames))
+      ->capture_default_str();
+  command->add_option("--samples", options->samples,
+                      "Camera samples per pixel (0 = 1 at the pixel centre for a pinhole, 16 for a thin lens)")
+      ->check(CLI::Range(0, kMaxSamples))
+      ->capture_default_str();
+  command->add_option("--mirror-depth", options->mirrorDepth,
+                      "Mirror reflections followed (-1 = the bake's own mirror depth)")
+      ->check(CLI::Range(-1, kMaxMirrorDepth))
+      ->capture_default_str();
+  command->add_option("--stats", options->statsPath,
+                      "Write JSON: frames, ms_per_frame_median, fps, load and BVH times");
+  options->view.addCameraOptions(*command);
+  options->view.addImageOptions(*command);
+  command->callback([options, &global] { runRender(*options, global); });
+}
+
+}  // namespace pl

@@ -1,0 +1,213 @@
+// Runs `plenoptic info` and `plenoptic render` end to end (PLENOPTIC_BINARY) on a hand-made
+// light field: what they print and write, and how they refuse bad input.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "accel/accel.h"
+#include "camera/camera.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "image/image.h"
+#include "lightfield/plf_file.h"
+#include "render/render.h"
+
+namespace pl {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A unit quad in z = 0 (front +z) with a diffuse chart of linear irradiance
+/// E = 2 + 3x + 1.5y on 4×4 tixels, a camera "top" looking down at it, and a constant
+/// environment around it.
+LightField makeQuadLightField() {
+  LightField lf;
+  lf.scene.sourcePath = "handmade-quad";
+  lf.scene.materials = {Material{"wall", LambertBsdf{Rgb(0.5f, 0.25f, 0.75f)}, -1, Rgb(0.0f), false}};
+  Mesh quad;
+  quad.name = "quad";
+  quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+  quad.materials = {0, 0};
+  lf.scene.meshes = {quad};
+  lf.scene.environment.constant = Rgb(0.1f, 0.2f, 0.3f);
+  CameraDesc top;
+  top.name = "top";
+  top.eye = {0.5f, 0.5f, 2.0f};
+  top.target = {0.5f, 0.5f, 0.0f};
+  top.fovYDegrees = 40.0f;
+  CameraDesc side = top;
+  side.name = "side";
+  side.eye = {0.5f, -2.0f, 1.0f};
+  lf.scene.cameras = {side, top};
+  lf.scene.finalize();
+  Chart c;
+  c.material = 0;
+  c.kind = ChartKind::Diffuse;
+  c.tixelSize = 0.25f;
+  c.resU = c.resV = 4;
+  for (uint32_t j = 0; j < 4; ++j)
+    for (uint32_t i = 0; i < 4; ++i)
+      lf.values.push_back(Rgb(2.0f + 3.0f * (float(i) + 0.5f) * 0.25f + 1.5f * (float(j) + 0.5f) * 0.25f));
+  lf.charts = {c};
+  lf.triangleChart = {{0, 0}};
+  lf.settings.preset = "handmade";
+  lf.stats.iterations = 3;
+  lf.stats.tixels = 16;
+  lf.stats.values = 16;
+  return lf;
+}
+
+class RenderCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("plenoptic_render_cli_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    writeLightField(path("quad.plf"), makeQuadLightField());
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  /// Runs plenoptic with `arguments`; returns the exit status, stdout and stderr.
+  int run(const std::string& arguments, std::string* output = nullptr, std::string* errors = nullptr) const {
+    const fs::path outFile = dir_ / "stdout.txt", errFile = dir_ / "stderr.txt";
+    const std::string command = std::string("\"") + PLENOPTIC_BINARY + "\" " + arguments + " --quiet > \"" +
+                                outFile.string() + "\" 2> \"" + errFile.string() + "\"";
+    const int status = std::system(command.c_str());
+    if (output) *output = slurp(outFile);
+    if (errors) *errors = slurp(errFile);
+    return status;
+  }
+  static std::string slurp(const fs::path& file) {
+    std::ifstream in(file);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  fs::path dir_;
+};
+
+TEST_F(RenderCliTest, InfoPrintsContentsAndSizes) {
+  std::string out, err;
+  ASSERT_EQ(run("info " + path("quad.plf"), &out, &err), 0) << err;
+  for (const char* fragment : {"format version 1", "all sections verified", "handmade-quad", "2 triangles",
+                               "lambert ×1", "cameras    2: side, top", "1 (1 diffuse, 0 glossy, 0 specular)",
+                               "tixels       16", "values       16 RGB", "VALS", "preset handmade", "3 iterations"})
+    EXPECT_NE(out.find(fragment), std::string::npos) << "'" << fragment << "' not in:\n" << out;
+}
+
+TEST_F(RenderCliTest, InfoJsonHasEveryFigure) {
+  std::string out, err;
+  ASSERT_EQ(run("info --json " + path("quad.plf"), &out, &err), 0) << err;
+  const auto json = nlohmann::json::parse(out);
+  EXPECT_EQ(json["format_version"], 1);
+  EXPECT_EQ(json["file_bytes"], fs::file_size(path("quad.plf")));
+  EXPECT_EQ(json["checksums_verified"], true);
+  EXPECT_EQ(json["scene"]["triangles"], 2);
+  EXPECT_EQ(json["scene"]["cameras"], nlohmann::json({"side", "top"}));
+  EXPECT_EQ(json["charts"]["diffuse"], 1);
+  EXPECT_EQ(json["tixels"], 16);
+  EXPECT_EQ(json["values"], 16);
+  ASSERT_EQ(json["sections"].size(), 5u);
+  EXPECT_EQ(json["sections"][3]["id"], "VALS");
+  EXPECT_EQ(json["sections"][3]["stored_bytes"], 16 * 12);
+  EXPECT_EQ(json["settings"]["preset"], "handmade");
+  EXPECT_EQ(json["stats"]["iterations"], 3);
+}
+
+TEST_F(RenderCliTest, RenderWritesTheLookedUpRadianceAndStats) {
+  const std::string out = path("top.exr"), stats = path("stats.json");
+  std::string err;
+  ASSERT_EQ(run("render " + path("quad.plf") + " -o " + out + " --camera top --width 40 --height 30 --frames 3 --stats " +
+                    stats,
+                nullptr, &err),
+            0)
+      << err;
+
+  // The same render through the library: the command must add nothing (no exposure flag,
+  // so the EXR holds radiance) and pick the named camera from the embedded scene.
+  Progress::setEnabled(false);
+  const ThreadPool pool(2);
+  const LightField lf = readLightField(path("quad.plf"));
+  const Accel accel(lf.scene);
+  const Image expected = renderLightField(lf, accel, Camera(lf.scene.camera("top"), 40, 30), RenderSettings{});
+  const Image image = readImage(out);
+  ASSERT_EQ(image.width, 40);
+  ASSERT_EQ(image.height, 30);
+  int quadPixels = 0;
+  for (size_t i = 0; i < image.pixels.size(); ++i) {
+    // Relative 1e-3: covers an EXR stored as half floats (11-bit mantissa, 4.9e-4).
+    for (int ch = 0; ch < 3; ++ch)
+      EXPECT_NEAR(image.pixels[i][ch], expected.pixels[i][ch], 1e-3f * expected.pixels[i][ch]) << "pixel " << i;
+    quadPixels += image.pixels[i] != lf.scene.environment.constant;
+  }
+  EXPECT_GT(quadPixels, 200) << "the quad must fill the middle of the top view";
+
+  const auto json = nlohmann::json::parse(slurp(stats));
+  EXPECT_EQ(json["frames"], 3);
+  EXPECT_EQ(json["camera"], "top");
+  EXPECT_EQ(json["samples_per_pixel"], 1);
+  const double median = json["ms_per_frame_median"];
+  EXPECT_GT(median, 0.0);
+  EXPECT_GE(median, double(json["ms_per_frame_min"]));
+  EXPECT_LE(median, double(json["ms_per_frame_max"]));
+  EXPECT_NEAR(double(json["fps"]), 1000.0 / median, 1e-9 * double(json["fps"]));
+}
+
+TEST_F(RenderCliTest, RenderWritesPng) {
+  std::string err;
+  ASSERT_EQ(run("render " + path("quad.plf") + " -o " + path("side.png") + " --width 24 --height 16", nullptr, &err), 0)
+      << err;
+  const Image png = readImage(path("side.png"));
+  EXPECT_EQ(png.width, 24);
+  EXPECT_EQ(png.height, 16);
+}
+
+TEST_F(RenderCliTest, RefusesBadInputWithoutWritingAnything) {
+  std::string err;
+  // A missing file.
+  EXPECT_NE(run("render " + path("absent.plf") + " -o " + path("a.exr"), nullptr, &err), 0);
+  EXPECT_NE(err.find(path("absent.plf")), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("a.exr")));
+  EXPECT_NE(run("info " + path("absent.plf"), nullptr, &err), 0);
+  EXPECT_NE(err.find("cannot open"), std::string::npos) << err;
+
+  // A corrupt file: one bit flipped in the last byte (inside the metadata section).
+  std::string bytes = slurp(path("quad.plf"));
+  bytes.back() ^= 0x04;
+  std::ofstream(path("corrupt.plf"), std::ios::binary) << bytes;
+  EXPECT_NE(run("render " + path("corrupt.plf") + " -o " + path("b.exr"), nullptr, &err), 0);
+  EXPECT_NE(err.find("checksum mismatch"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("b.exr")));
+  EXPECT_NE(run("info " + path("corrupt.plf"), nullptr, &err), 0);
+  EXPECT_NE(err.find("checksum mismatch"), std::string::npos) << err;
+
+  // Not a light field at all.
+  std::ofstream(path("scene.plf")) << "o cube\nv 0 0 0\n";
+  EXPECT_NE(run("info " + path("scene.plf"), nullptr, &err), 0);
+  EXPECT_NE(err.find("not a plenoptic light field"), std::string::npos) << err;
+
+  // An output type no writer knows, refused before any work.
+  EXPECT_NE(run("render " + path("quad.plf") + " -o " + path("c.txt"), nullptr, &err), 0);
+  EXPECT_NE(err.find("unknown image type"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("c.txt")));
+
+  // A camera the file does not have.
+  EXPECT_NE(run("render " + path("quad.plf") + " -o " + path("d.exr") + " --camera nosuch", nullptr, &err), 0);
+  EXPECT_NE(err.find("nosuch"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("d.exr")));
+}
+
+}  // namespace
+}  // namespace pl
