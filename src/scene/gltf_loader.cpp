@@ -78,6 +78,10 @@ std::vector<float> readFloats(const GltfContext& ctx, int index, int components,
   const int componentSize = tinygltf::GetComponentSizeInBytes(uint32_t(accessor.componentType));
   const int stride = accessor.ByteStride(view);
   if (componentSize <= 0 || stride <= 0) fail("{}: {} accessor {} has an invalid layout", ctx.path, what, index);
+  // Every element takes at least one byte; this also keeps the products below from overflowing.
+  if (accessor.count > buffer.data.size() || view.byteOffset > buffer.data.size() ||
+      accessor.byteOffset > buffer.data.size())
+    fail("{}: {} accessor {} reads past the end of its buffer", ctx.path, what, index);
   const size_t start = view.byteOffset + accessor.byteOffset;
   const size_t elementBytes = size_t(componentSize) * size_t(components);
   if (accessor.count > 0 &&
@@ -123,6 +127,9 @@ std::vector<uint32_t> readIndices(const GltfContext& ctx, int index) {
   const int size = tinygltf::GetComponentSizeInBytes(uint32_t(accessor.componentType));
   const int stride = accessor.ByteStride(view);
   if (size <= 0 || stride <= 0) fail("{}: index accessor {} has an invalid layout", ctx.path, index);
+  if (accessor.count > buffer.data.size() || view.byteOffset > buffer.data.size() ||
+      accessor.byteOffset > buffer.data.size())
+    fail("{}: index accessor {} reads past the end of its buffer", ctx.path, index);
   const size_t start = view.byteOffset + accessor.byteOffset;
   if (accessor.count > 0 && start + size_t(stride) * (accessor.count - 1) + size_t(size) > buffer.data.size())
     fail("{}: index accessor {} reads past the end of its buffer", ctx.path, index);

@@ -31,7 +31,10 @@
 //   "cameras": [ {"name": "main", "eye": [..], "target": [..], "up": [0,1,0],
 //                 "fov": 40 (vertical, degrees), "fstop": 0 (0 = pinhole),
 //                 "focus_distance": d, "focal_length": mm, "aspect": w/h} ],
-//   "environment": {"color": [r,g,b]},       // constant radiance from infinity
+//   "environment": {"color": [r,g,b],        // constant radiance from infinity, plus
+//                   "file": "sky.hdr",       //   an environment map (env/env.h: 2:1 lat-long,
+//                   "scale": 1,              //   cross, face directory or {face} pattern),
+//                   "rotation": 0},          //   radiance × scale, rotated about +y (degrees)
 //   "settings": {"width": 640, "height": 480, "spp": 64,       // suggestions; command-line
 //                "camera": "main"}                             //   flags take precedence
 // }
@@ -330,8 +333,21 @@ Scene parseScene(const JsonContext& ctx, const json& root) {
 
   if (const json* environment = find(root, "environment")) {
     if (!environment->is_object()) fail("{}: \"environment\" must be an object", ctx.path);
-    checkKeys(ctx, *environment, {"color"}, "environment");
+    checkKeys(ctx, *environment, {"color", "file", "scale", "rotation"}, "environment");
     scene.environment.constant = colourOr(ctx, *environment, "color", Rgb(0.0f), "environment");
+    if (const json* file = find(*environment, "file")) {
+      const float scale = numberOr(ctx, *environment, "scale", 1.0f, "environment");
+      const float rotation = numberOr(ctx, *environment, "rotation", 0.0f, "environment");
+      if (scale < 0.0f) fail("{}: environment.scale must be ≥ 0, got {}", ctx.path, scale);
+      const fs::path mapPath = ctx.dir / stringOf(ctx, *file, "environment.file");
+      try {
+        scene.environment.map = loadEnvironmentMap(mapPath.string(), scale, rotation);
+      } catch (const Error& e) {
+        fail("{}: environment.file: {}", ctx.path, e.what());
+      }
+    } else if (find(*environment, "scale") || find(*environment, "rotation")) {
+      fail("{}: environment: \"scale\" and \"rotation\" need a \"file\"", ctx.path);
+    }
   }
   if (const json* settings = find(root, "settings")) {
     if (!settings->is_object()) fail("{}: \"settings\" must be an object", ctx.path);

@@ -4,6 +4,7 @@
 // light-field bake, light-field renderer) uses the same Scene.
 #include "bsdf/bsdf.h"
 #include "core/math.h"
+#include "env/env.h"
 #include "image/image.h"
 
 #include <cstdint>
@@ -90,9 +91,17 @@ struct CameraDesc {
   std::optional<float> aspectRatio;  ///< width / height if the file says so
 };
 
-/// Light arriving from infinity in directions no geometry covers. Radiance Le = constant.
+/// Light arriving from infinity in directions no geometry covers:
+///   Le(dir) = constant + map->radiance(dir)   (dir: unit world direction towards the sky).
+/// `map` (optional, env/env.h) is an image-based environment that carries its own scale and
+/// rotation about +y, and importance-samples itself (EnvironmentMap::sample / pdf, densities
+/// per solid angle) so renderers can use it for next-event estimation with MIS.
 struct Environment {
   Rgb constant{0.0f};
+  std::shared_ptr<const EnvironmentMap> map;
+
+  Rgb radiance(const Vec3& dir) const { return map ? constant + map->radiance(dir) : constant; }
+  bool isBlack() const { return !map && pl::isBlack(constant); }
 };
 
 /// Render settings a scene file may suggest (the JSON scene's "settings"). Command-line flags

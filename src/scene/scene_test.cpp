@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <regex>
 #include <string>
 
 namespace pl {
@@ -659,6 +660,71 @@ TEST(BadInput, JsonTyposAndDanglingNamesAreErrors) {
   expectError([&] { loadScene(camera); }, {"c.json", "no camera named 'top'", "'cornell'"});
   const std::string type = writeFile(dir / "t.json", R"({"include_cornell": true, "lights": [{"type": "point", "position": "up"}]})");
   expectError([&] { loadScene(type); }, {"t.json", "lights[0].position"});
+}
+
+/// Loads prefixes of `source`, saved as `name` (every length up to 48 bytes, where the headers
+/// are, then 48 lengths spread over the rest): each must load or throw pl::Error naming the
+/// file — never crash or throw anything else.
+void loadEveryPrefix(const std::string& source, const std::string& name) {
+  std::ifstream in(source, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(bytes.empty());
+  const fs::path dir = scratchDir("prefix_" + name);
+  if (fs::exists(fs::path(source).parent_path() / "checker.png"))
+    fs::copy_file(fs::path(source).parent_path() / "checker.png", dir / "checker.png");
+  const std::string path = (dir / name).string();
+  size_t loaded = 0, rejected = 0;
+  const size_t step = std::max<size_t>(1, bytes.size() / 48);
+  for (size_t length = 0; length < bytes.size(); length += length < 48 ? 1 : step) {
+    writeFile(path, bytes.substr(0, length));
+    try {
+      loadScene(path);
+      ++loaded;
+    } catch (const Error& e) {
+      ++rejected;
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << name << " truncated to " << length << " bytes threw a non-pl::Error: " << e.what();
+    }
+  }
+  EXPECT_GT(rejected, 0u);
+}
+
+TEST(BadInput, TruncatedFilesAreRejectedCleanly) {
+  loadEveryPrefix(kDataDir + "quad.glb", "quad.glb");
+  loadEveryPrefix(kDataDir + "quad.gltf", "quad.gltf");
+  loadEveryPrefix(kDataDir + "scene.json", "scene.json");
+  loadEveryPrefix(kMcGuireDir + "CornellBox-Original.obj", "CornellBox-Original.obj");
+}
+
+TEST(BadInput, MutatedGltfNumbersAreRejectedCleanly) {
+  // Replaces each number of quad.gltf in turn by values that break indices, counts, offsets
+  // and enums (-1, 7, 2^32, 1e30); each variant must load or throw pl::Error naming the file.
+  std::ifstream in(kDataDir + "quad.gltf", std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const fs::path dir = scratchDir("mutated_gltf");
+  fs::copy_file(kDataDir + "checker.png", dir / "checker.png");
+  const std::string path = (dir / "mutated.gltf").string();
+  const std::regex number(R"(([:\[,]\s*)(-?[0-9]+(\.[0-9]+)?))");
+  size_t variants = 0, rejected = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), number); it != std::sregex_iterator(); ++it) {
+    const std::smatch& match = *it;
+    const size_t begin = size_t(match.position(2)), length = size_t(match.length(2));
+    for (const char* replacement : {"-1", "7", "4294967296", "1e30"}) {
+      writeFile(path, text.substr(0, begin) + replacement + text.substr(begin + length));
+      ++variants;
+      try {
+        loadScene(path);
+      } catch (const Error& e) {
+        ++rejected;
+        EXPECT_NE(std::string(e.what()).find("mutated.gltf"), std::string::npos) << e.what();
+      } catch (const std::exception& e) {
+        ADD_FAILURE() << "number at byte " << begin << " → " << replacement << ": non-pl::Error " << e.what();
+      }
+    }
+  }
+  EXPECT_GT(variants, 100u);
+  EXPECT_GT(rejected, variants / 4);
 }
 
 TEST(BadInput, JsonMeshFileProblemsNameBothFiles) {
