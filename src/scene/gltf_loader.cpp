@@ -222,7 +222,8 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
   const auto& pbr = gltf.pbrMetallicRoughness;
   Rgb baseColor(1.0f);
   if (pbr.baseColorFactor.size() >= 3)
-    baseColor = Rgb(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2]));
+    baseColor = glm::clamp(
+        Rgb(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2])), 0.0f, 1.0f);
   const float metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
   const float roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
 

@@ -191,10 +191,8 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
   }
   checkKeys(ctx, value, known, where);
   if (const json* texture = find(value, "texture")) material.albedoTexture = loadTexture(ctx, scene, *texture, where + ".texture");
-  if (auto* bp = std::get_if<BlinnPhongBsdf>(&material.bsdf)) {
-    if (maxComponent(bp->diffuse + bp->specular) > 1.0f)
-      fail("{}: {}: diffuse + specular exceeds 1 in a channel (the model would create energy)", ctx.path, where);
-  }
+  // Ranges (reflectances in [0, 1], Blinn-Phong diffuse + specular <= 1) are checked by
+  // Scene::finalize() for every loader.
   return material;
 }
 

@@ -217,6 +217,9 @@ Material convertMaterial(const tinyobj::material_t& mtl, const std::string& mtlP
     }
     material.bsdf = BlinnPhongBsdf{kd, ks, std::max(ns, 0.0f)};
   } else {
+    if (maxComponent(kd) > 1.0f)
+      spdlog::warn("{}: material '{}': Kd ({}, {}, {}) exceeds 1; clamped to conserve energy", mtlPath, mtl.name,
+                   kd.r, kd.g, kd.b);
     material.bsdf = LambertBsdf{glm::min(kd, Rgb(1.0f))};
   }
   return material;

@@ -41,6 +41,41 @@ Rgb diffuseAlbedoOf(const Bsdf& bsdf) {
       bsdf);
 }
 
+bool inUnitRange(const Rgb& c) { return isFinite(c) && glm::all(glm::greaterThanEqual(c, Rgb(0.0f))) && maxComponent(c) <= 1.0f; }
+
+/// Reflectances must lie in [0, 1] (more would create energy; bsdf.h's contract); Blinn-Phong
+/// needs diffuse + specular ≤ 1 per channel and GGX a roughness α in (0, 1].
+void validateBsdf(const Scene& scene, const Material& material) {
+  // Slack for decimal inputs such as 0.7 + 0.3 that round to a hair above 1 in float.
+  constexpr float kSumSlack = 1e-6f;
+  const std::string& src = scene.sourcePath;
+  std::visit(
+      [&](const auto& model) {
+        using T = std::decay_t<decltype(model)>;
+        if constexpr (std::is_same_v<T, LambertBsdf>) {
+          if (!inUnitRange(model.albedo))
+            fail("{}: material '{}': Lambert albedo {} outside [0, 1]", src, material.name, vecString(model.albedo));
+        } else if constexpr (std::is_same_v<T, MirrorBsdf>) {
+          if (!inUnitRange(model.reflectance))
+            fail("{}: material '{}': mirror reflectance {} outside [0, 1]", src, material.name, vecString(model.reflectance));
+        } else if constexpr (std::is_same_v<T, BlinnPhongBsdf>) {
+          if (!inUnitRange(model.diffuse) || !inUnitRange(model.specular) ||
+              maxComponent(model.diffuse + model.specular) > 1.0f + kSumSlack)
+            fail("{}: material '{}': Blinn-Phong needs diffuse, specular >= 0 and diffuse + specular <= 1 "
+                 "(diffuse {}, specular {})", src, material.name, vecString(model.diffuse), vecString(model.specular));
+          if (!(model.exponent >= 0.0f && std::isfinite(model.exponent)))
+            fail("{}: material '{}': Blinn-Phong exponent {} must be finite and >= 0", src, material.name, model.exponent);
+        } else {
+          if (!inUnitRange(model.diffuse) || !inUnitRange(model.f0))
+            fail("{}: material '{}': GGX diffuse {} and f0 {} must lie in [0, 1]", src, material.name,
+                 vecString(model.diffuse), vecString(model.f0));
+          if (!(model.alpha > 0.0f && model.alpha <= 1.0f))
+            fail("{}: material '{}': GGX alpha {} must lie in (0, 1]", src, material.name, model.alpha);
+        }
+      },
+      material.bsdf);
+}
+
 void validateLights(const Scene& scene) {
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     std::visit(
@@ -99,6 +134,7 @@ void Scene::finalize() {
     if (!isFinite(material.emission) || material.emission.r < 0.0f || material.emission.g < 0.0f ||
         material.emission.b < 0.0f)
       fail("{}: material '{}' has an invalid emission {}", src, material.name, vecString(material.emission));
+    validateBsdf(*this, material);
     if (material.albedoTexture < -1 || material.albedoTexture >= int(textures.size()))
       fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name,
            material.albedoTexture, textures.size());

@@ -727,6 +727,16 @@ TEST(BadInput, MutatedGltfNumbersAreRejectedCleanly) {
   EXPECT_GT(rejected, variants / 4);
 }
 
+TEST(BadInput, EnergyCreatingMaterials) {
+  const fs::path dir = scratchDir("energy");
+  const std::string bright = writeFile(dir / "b.json", R"({"include_cornell": true,
+      "materials": {"hot": {"type": "lambert", "albedo": [1.2, 0.5, 0.5]}}})");
+  expectError([&] { loadScene(bright); }, {"b.json", "'hot'", "outside [0, 1]"});
+  const std::string sum = writeFile(dir / "s.json", R"({"include_cornell": true,
+      "materials": {"shiny": {"type": "blinn-phong", "diffuse": 0.7, "specular": 0.4}}})");
+  expectError([&] { loadScene(sum); }, {"s.json", "'shiny'", "diffuse + specular <= 1"});
+}
+
 TEST(BadInput, JsonMeshFileProblemsNameBothFiles) {
   const fs::path dir = scratchDir("json_mesh");
   const std::string path = writeFile(dir / "s.json", R"({"meshes": [{"file": "missing.obj"}]})");
