@@ -216,7 +216,8 @@ void transformScene(Scene& part, const Mat4& m) {
   for (CameraDesc& camera : part.cameras) {
     camera.eye = point(camera.eye);
     camera.target = point(camera.target);
-    camera.up = linear * camera.up;
+    const Vec3 up = linear * camera.up;
+    if (glm::length(up) > 0.0f) camera.up = glm::normalize(up);
   }
 }
 
