@@ -1,0 +1,316 @@
+// End-to-end tests of the bake: white furnace, mirror furnace, visibility reuse and its hash.
+#include "lightfield/bake.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "accel/accel.h"
+#include "core/error.h"
+#include "core/progress.h"
+#include "core/rng.h"
+#include "lightfield/lookup.h"
+#include "lightfield/paraboloid.h"
+#include "lightfield/parameterisation.h"
+#include "lightfield/propagation.h"
+#include "lightfield/visibility.h"
+
+namespace pl {
+namespace {
+
+// A closed axis-aligned box [0, size]³ of 6 quads wound to face inwards; quad `special` (or
+// none when −1) gets material 1, all others material 0.
+Scene makeClosedBox(float size, const Material& walls, const Material& special = {}, int specialFace = -1) {
+  Scene scene;
+  scene.sourcePath = "furnace box";
+  scene.materials.push_back(walls);
+  scene.materials.push_back(special);
+  Mesh mesh;
+  const Vec3 centre(0.5f * size);
+  auto quad = [&](Vec3 a, Vec3 b, Vec3 c, Vec3 d, uint32_t material) {
+    if (glm::dot(glm::cross(b - a, c - a), centre - a) < 0.0f) std::swap(b, d);
+    const auto base = uint32_t(mesh.positions.size());
+    for (const Vec3& p : {a, b, c, d}) mesh.positions.push_back(p);
+    mesh.triangles.push_back(UVec3(base, base + 1, base + 2));
+    mesh.triangles.push_back(UVec3(base, base + 2, base + 3));
+    mesh.materials.push_back(material);
+    mesh.materials.push_back(material);
+  };
+  const float s = size;
+  const Vec3 p000(0, 0, 0), p100(s, 0, 0), p010(0, s, 0), p110(s, s, 0), p001(0, 0, s), p101(s, 0, s), p011(0, s, s),
+      p111(s, s, s);
+  const Vec3 faces[6][4] = {{p000, p100, p110, p010}, {p001, p101, p111, p011}, {p000, p001, p011, p010},
+                            {p100, p101, p111, p110}, {p000, p100, p101, p001}, {p010, p110, p111, p011}};
+  for (int f = 0; f < 6; ++f) quad(faces[f][0], faces[f][1], faces[f][2], faces[f][3], f == specialFace ? 1u : 0u);
+  scene.meshes.push_back(std::move(mesh));
+  scene.finalize();
+  return scene;
+}
+
+BakeSettings smallSettings() {
+  BakeSettings s = bakePreset("draft");
+  s.tixelsAcrossScene = 8;
+  s.gatherDirections = 64;
+  s.tolerance = 1e-6f;
+  s.maxIterations = 400;
+  return s;
+}
+
+class BakeTest : public ::testing::Test {
+ protected:
+  void SetUp() override { Progress::setEnabled(false); }
+};
+
+// White furnace: a closed enclosure whose walls all have albedo a and emit Le has radiance
+// Le/(1−a) everywhere (L = Le + a·L). Checked on every tixel (stored irradiance E satisfies
+// Le + a·E/π = Le/(1−a)) and through the renderer's lookup at random points.
+void checkFurnace(float a, uint32_t areaLightSamples, float perTixelTolerance) {
+  Material wall;
+  wall.bsdf = LambertBsdf{Rgb(a)};
+  wall.emission = Rgb(1.0f, 2.0f, 0.5f);
+  BakeSettings settings = smallSettings();
+  settings.areaLightSamples = areaLightSamples;
+  const LightField lf = bake(makeClosedBox(3.0f, wall), settings);
+  const Rgb expected = wall.emission / (1.0f - a);
+  // Iteration stops when the relative power change is below 1e-6: the remaining series error
+  // is ~1e-6·a/(1−a) ≤ 1e-5, far below the tolerances checked.
+  EXPECT_LT(lf.stats.residual, 1e-6);
+  double sumRel = 0.0, maxRel = 0.0;
+  for (const Chart& c : lf.charts) {
+    ASSERT_EQ(c.kind, ChartKind::Diffuse);
+    for (uint64_t t = 0; t < c.tixelCount(); ++t) {
+      const Rgb L = wall.emission + a * lf.values[c.firstValue + t] * kInvPi;
+      for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_NEAR(L[ch], expected[ch], perTixelTolerance * expected[ch]) << "chart tixel " << t;
+        sumRel += L[ch] / expected[ch];
+        maxRel = std::max(maxRel, double(std::abs(L[ch] / expected[ch] - 1.0f)));
+      }
+    }
+  }
+  // The mean over tixels is within 1 % (the furnace criterion) in every mode.
+  const double meanRel = sumRel / (3.0 * lf.stats.tixels);
+  EXPECT_NEAR(meanRel, 1.0, 0.01);
+  std::printf("furnace a=%.1f light samples %u: mean error %+.2e, max tixel error %.2e, %u iterations\n", a,
+              areaLightSamples, meanRel - 1.0, maxRel, lf.stats.iterations);
+  Pcg32 rng(3, 4);
+  for (int i = 0; i < 200; ++i) {
+    const uint32_t ci = uint32_t(rng.next() % lf.charts.size());
+    const Chart& c = lf.charts[ci];
+    // A random point inside the face (the grid covers the 3 × 3 face exactly).
+    const Vec3 p = c.origin + rng.uniform() * c.tixelSize * c.resU * c.axisU + rng.uniform() * c.tixelSize * c.resV * c.axisV;
+    const Vec3 w = glm::normalize(c.normal + 0.5f * c.axisU);
+    const Rgb L = exitantRadiance(lf, ci, p, w, Vec2(0.0f));
+    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(L[ch], expected[ch], perTixelTolerance * expected[ch]);
+  }
+}
+
+TEST_F(BakeTest, WhiteFurnaceGatherOnlyIsExactPerTixel) {
+  // Without area-light sampling every gather ray sees Le + a·E/π of a uniform field, so each
+  // tixel converges to the closed form up to the iteration tolerance and float round-off;
+  // 1e-3 is generous.
+  checkFurnace(0.5f, 0, 1e-3f);
+  checkFurnace(0.9f, 0, 1e-3f);
+}
+
+TEST_F(BakeTest, WhiteFurnaceWithAreaLightSampling) {
+  // With MIS area-light sampling the direct part is a Monte Carlo estimate per tixel (16
+  // shadow rays + 64 gather rays): unbiased, so the mean is within 1 %, but individual tixels
+  // scatter (worst of 384 tixels measured: 1.3 % at a = 0.5, 0.5 % at a = 0.9, where the
+  // direct part is a smaller fraction of the total); 5 % leaves room for other seeds.
+  checkFurnace(0.5f, 16, 0.05f);
+  checkFurnace(0.9f, 16, 0.05f);
+}
+
+TEST_F(BakeTest, MirrorFurnace) {
+  // One wall is an ideal mirror of reflectance 1: it shows the uniform furnace field, so the
+  // diffuse walls still converge to Le/(1−a). Exercises the mirror chains of the visibility
+  // field (every gather ray towards the mirror continues to a diffuse wall).
+  const float a = 0.5f;
+  Material wall;
+  wall.bsdf = LambertBsdf{Rgb(a)};
+  wall.emission = Rgb(1.0f);
+  Material mirror;
+  mirror.bsdf = MirrorBsdf{Rgb(1.0f), false};
+  BakeSettings settings = smallSettings();
+  settings.areaLightSamples = 0;
+  const LightField lf = bake(makeClosedBox(3.0f, wall, mirror, 2), settings);
+  int specular = 0;
+  for (const Chart& c : lf.charts) {
+    if (c.kind == ChartKind::Specular) {
+      ++specular;
+      EXPECT_EQ(c.dirRes, 0u);
+      continue;
+    }
+    for (uint64_t t = 0; t < c.tixelCount(); ++t) {
+      const Rgb L = wall.emission + a * lf.values[c.firstValue + t] * kInvPi;
+      EXPECT_NEAR(L.g, 2.0f, 2e-3f);  // Le/(1−a) = 2; tolerance as in the gather-only furnace
+    }
+  }
+  EXPECT_EQ(specular, 1);
+}
+
+TEST_F(BakeTest, GlossyOperatorRowsIntegrateTheBsdf) {
+  // Σ_k W[c][k] = mean over texel c of ∫ f cos θi dωi = the directional albedo. For Lambert it
+  // is exactly ρ; for Blinn-Phong the albedo at the texel's direction, compared with the BSDF
+  // module's own numerical albedo (the texel average and the 16 sub-samples per cell differ
+  // from it by < 2 % for a lobe this wide near normal incidence).
+  const uint32_t res = 6, m = 12;
+  const std::vector<Rgb> lambert = glossyOperator(LambertBsdf{Rgb(0.7f)}, res, m);
+  for (uint32_t c = 0; c < res * res; ++c) {
+    Rgb sum(0.0f);
+    for (uint32_t k = 0; k < m * m; ++k) sum += lambert[c * m * m + k];
+    EXPECT_NEAR(sum.r, 0.7f, 1e-4f);
+  }
+  // A finer map, so that the four texels around the normal span only θ < 19°, where the
+  // albedo varies by < 0.5 %: the texel average then matches the albedo at the texel centre.
+  const uint32_t fine = 12;
+  const BlinnPhongBsdf bp{Rgb(0.2f), Rgb(0.6f), 20.0f};
+  const std::vector<Rgb> op = glossyOperator(bp, fine, m);
+  for (uint32_t c : {65u, 66u, 77u, 78u}) {  // texels (5|6, 5|6) around the normal
+    Rgb sum(0.0f);
+    for (uint32_t k = 0; k < m * m; ++k) sum += op[c * m * m + k];
+    const Rgb expected = albedo(bp, paraboloidTexelDirection(c % fine, c / fine, fine));
+    EXPECT_NEAR(sum.g, expected.g, 0.02f * expected.g);
+  }
+}
+
+TEST_F(BakeTest, ReusedVisibilityAndChangedLightEqualsFullBake) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_bake_test_reuse";
+  std::filesystem::create_directories(dir);
+  const std::string plv = (dir / "cornell.plv").string();
+  std::filesystem::remove(plv);
+  BakeSettings settings = smallSettings();
+  settings.tixelsAcrossScene = 12;
+  settings.tolerance = 1e-4f;
+
+  BakeOptions save;
+  save.visibilityPath = plv;
+  const LightField first = bake(makeCornellBox(), settings, save);
+  EXPECT_FALSE(first.stats.reusedVisibility);
+  ASSERT_TRUE(std::filesystem::exists(plv));
+
+  Scene changed = makeCornellBox();
+  for (Material& m : changed.materials)
+    if (m.isEmissive()) m.emission *= Rgb(0.5f, 1.0f, 2.0f);
+  for (Material& m : changed.materials)
+    if (m.name == "red") m.bsdf = LambertBsdf{Rgb(0.3f, 0.6f, 0.1f)};  // albedo change: same field
+  BakeOptions reuse;
+  reuse.visibilityPath = plv;
+  reuse.reuseVisibility = true;
+  std::string note;
+  reuse.log = [&](const std::string& line) { note += line + "\n"; };
+  const LightField reused = bake(changed, settings, reuse);
+  EXPECT_TRUE(reused.stats.reusedVisibility) << note;
+  EXPECT_EQ(reused.stats.visibilityRays, 0u);
+
+  const LightField full = bake(changed, settings, BakeOptions{});
+  ASSERT_EQ(reused.values.size(), full.values.size());
+  double maxRel = 0.0, changedFromFirst = 0.0;
+  for (size_t i = 0; i < full.values.size(); ++i)
+    for (int ch = 0; ch < 3; ++ch) {
+      const double ref = std::max(1e-6f, std::abs(full.values[i][ch]));
+      maxRel = std::max(maxRel, std::abs(double(reused.values[i][ch]) - full.values[i][ch]) / ref);
+      changedFromFirst = std::max(changedFromFirst, std::abs(double(first.values[i][ch]) - full.values[i][ch]) / ref);
+    }
+  // Same deterministic visibility field, same propagation: identical up to float round-off.
+  EXPECT_LT(maxRel, 1e-5);
+  EXPECT_GT(changedFromFirst, 0.1);  // and the change did change the light field
+  std::filesystem::remove_all(dir);
+}
+
+TEST_F(BakeTest, VisibilityHashDetectsGeometryButNotAlbedoOrEmission) {
+  const Scene base = makeCornellBox();
+  const BakeSettings settings = smallSettings();
+  const uint64_t h0 = visibilityHash(base, buildParameterisation(base, settings), settings);
+
+  Scene albedoChanged = makeCornellBox();
+  albedoChanged.materials[0].bsdf = LambertBsdf{Rgb(0.1f)};
+  albedoChanged.materials[3].emission = Rgb(100.0f);
+  EXPECT_EQ(visibilityHash(albedoChanged, buildParameterisation(albedoChanged, settings), settings), h0);
+
+  Scene moved = makeCornellBox();
+  moved.meshes[2].positions[0].y += 1.0f;  // one corner of the short block, 1 mm higher
+  EXPECT_NE(visibilityHash(moved, buildParameterisation(moved, settings), settings), h0);
+
+  Scene mirrored = makeCornellBox();
+  mirrored.materials[1].bsdf = MirrorBsdf{};  // a wall becomes a mirror: different transport
+  EXPECT_NE(visibilityHash(mirrored, buildParameterisation(mirrored, settings), settings), h0);
+
+  BakeSettings moreDirections = settings;
+  moreDirections.gatherDirections = 100;
+  EXPECT_NE(visibilityHash(base, buildParameterisation(base, moreDirections), moreDirections), h0);
+}
+
+TEST_F(BakeTest, StaleOrCorruptVisibilityFiles) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_bake_test_files";
+  std::filesystem::create_directories(dir);
+  const std::string plv = (dir / "box.plv").string();
+  const Scene scene = makeCornellBox();
+  const BakeSettings settings = smallSettings();
+  const Parameterisation param = buildParameterisation(scene, settings);
+  const Accel accel(scene);
+  const VisibilityField field = computeVisibility(scene, accel, param, settings);
+  writeVisibility(plv, field);
+
+  VisibilityField read;
+  std::string why;
+  ASSERT_TRUE(readVisibility(plv, field.hash, read, &why)) << why;
+  EXPECT_EQ(read.entries.size(), field.entries.size());
+  EXPECT_EQ(read.extras.size(), field.extras.size());
+  EXPECT_EQ(std::memcmp(read.entries.data(), field.entries.data(), field.entries.size() * sizeof(VisibilityEntry)), 0);
+
+  // Stale: a different expected hash is not an error, but a reason.
+  EXPECT_FALSE(readVisibility(plv, field.hash ^ 1, read, &why));
+  EXPECT_NE(why.find("different geometry"), std::string::npos) << why;
+  EXPECT_FALSE(readVisibility((dir / "missing.plv").string(), field.hash, read, &why));
+
+  // Truncated and corrupt files are errors naming the file.
+  const auto size = std::filesystem::file_size(plv);
+  std::filesystem::copy_file(plv, dir / "truncated.plv", std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::resize_file(dir / "truncated.plv", size - 5);
+  try {
+    readVisibility((dir / "truncated.plv").string(), field.hash, read, &why);
+    ADD_FAILURE() << "truncated file accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("truncated.plv"), std::string::npos) << e.what();
+  }
+  {
+    std::fstream f(plv, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(std::streamoff(size / 2));
+    const char junk = 0x5a;
+    f.write(&junk, 1);
+  }
+  EXPECT_THROW(readVisibility(plv, field.hash, read, &why), Error);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_F(BakeTest, CornellBoxVisibilityFieldIsSane) {
+  const Scene scene = makeCornellBox();
+  BakeSettings settings = smallSettings();
+  const Parameterisation param = buildParameterisation(scene, settings);
+  const Accel accel(scene);
+  const VisibilityField field = computeVisibility(scene, accel, param, settings);
+  EXPECT_EQ(field.entries.size(), param.tixelCount * 64);
+  EXPECT_EQ(field.rays, param.tixelCount * 64);  // no mirrors: one ray per entry
+  EXPECT_TRUE(field.extras.empty());             // no glossy or mirror targets
+  // The box is open at the front only: a minority of gather rays escape, and no ray from the
+  // inside of the room may hit a surface from behind except from tixels under the blocks.
+  uint64_t escaped = 0;
+  for (const VisibilityEntry& e : field.entries) escaped += e.escaped() ? 1 : 0;
+  const double fraction = double(escaped) / double(field.entries.size());
+  EXPECT_GT(fraction, 0.05);
+  EXPECT_LT(fraction, 0.4);
+}
+
+TEST_F(BakeTest, PresetsAndUnknownPreset) {
+  for (const std::string& name : bakePresetNames()) EXPECT_EQ(bakePreset(name).preset, name);
+  EXPECT_LT(bakePreset("draft").tixelsAcrossScene, bakePreset("default").tixelsAcrossScene);
+  EXPECT_LT(bakePreset("default").tixelsAcrossScene, bakePreset("high").tixelsAcrossScene);
+  EXPECT_THROW(bakePreset("ultra"), Error);
+}
+
+}  // namespace
+}  // namespace pl
