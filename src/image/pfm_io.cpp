@@ -59,7 +59,10 @@ Image readPfm(const std::string& path) {
     fail("{}: corrupt PFM header (scale '{}' must be a non-zero number)", path, scaleToken);
   checkImageSize(path, width, height);
   if (at >= bytes.size() || !std::isspace(bytes[at])) fail("{}: truncated PFM header", path);
-  ++at;  // the single whitespace byte after the scale
+  // Exactly one whitespace byte ends the header; a "\r\n" (files written on Windows in text
+  // mode) is recognised by the pixel data being one byte longer than expected.
+  const size_t expectedBytes = size_t(width) * size_t(height) * size_t(magic == "PF" ? 3 : 1) * 4;
+  at += (bytes[at] == '\r' && at + 1 < bytes.size() && bytes[at + 1] == '\n' && bytes.size() - at - 2 == expectedBytes) ? 2 : 1;
 
   const size_t count = size_t(width) * size_t(height) * size_t(channels);
   const size_t expected = count * 4;
