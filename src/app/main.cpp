@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   // Subcommands in pipeline order. Each one's callback does the work, starting with a
   // pl::Runtime (thread pool, progress settings).
   // (one line per subcommand; keep this list in pipeline order)
+  pl::addDemoCommand(app, global);
+  pl::addTraceCommand(app, global);
   pl::addBakeCommand(app, global);
   pl::addInfoCommand(app, global);
   pl::addRenderCommand(app, global);

@@ -1,0 +1,209 @@
+// `plenoptic trace SCENE -o OUT.exr|png`: the reference path tracer (src/trace/trace.h).
+#include <fmt/format.h>
+
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "accel/accel.h"
+#include "app/commands.h"
+#include "app/view_options.h"
+#include "camera/camera.h"
+#include "core/error.h"
+#include "scene/scene.h"
+#include "trace/trace.h"
+
+namespace pl {
+namespace {
+
+// Ranges of the options, declared once (image size: ViewOptions::kMaxImageSide).
+constexpr int kMaxSpp = 1 << 24;
+constexpr int kMaxDepth = 100000;
+
+struct TraceOptions {
+  std::string scene;        ///< `cornell`, .obj, .gltf/.glb, .json
+  std::string output;       ///< .exr/.hdr/.pfm (radiance × exposure) or .png (tone-mapped)
+  int spp = 64;
+  int maxDepth = TraceSettings{}.maxDepth;
+  std::string strategy = "mis";
+  std::string statsPath;     ///< --stats: JSON with timings
+  std::string variancePath;  ///< --variance: per-pixel variance of the mean (HDR file)
+  std::vector<int> pixel;    ///< --pixel X,Y: replay one pixel, print it, write no image
+  ViewOptions view;
+  // Which flags were given: a scene file's "settings" fill in only the ones that were not.
+  bool sppGiven = false, widthGiven = false, heightGiven = false, cameraGiven = false;
+};
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+/// Fails before any work is done if `path` cannot be an output of the given kind.
+void checkOutputPath(const std::string& path, const char* option, bool hdrOnly) {
+  const std::string ext = lowerExtension(path);
+  const bool hdr = isHdrExtension(path);
+  if (hdrOnly && !hdr) fail("{} {}: expected an .exr, .hdr or .pfm file name", option, path);
+  if (!hdr && ext != ".png") fail("{} {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", option, path, ext);
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent))
+    fail("{} {}: directory '{}' does not exist", option, path, parent.string());
+}
+
+/// Writes text to path atomically (temporary file beside it, then rename).
+void writeTextAtomically(const std::string& path, const std::string& text) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) fail("{}: cannot open for writing", temporary);
+    out << text;
+    out.flush();
+    if (!out) {
+      std::remove(temporary.c_str());
+      fail("{}: write failed", temporary);
+    }
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::remove(temporary.c_str());
+    fail("{}: cannot rename the finished file into place: {}", path, error.message());
+  }
+}
+
+void runTrace(const TraceOptions& options, const GlobalOptions& global) {
+  Runtime runtime(global);
+  const bool replay = !options.pixel.empty();
+  if (!replay) {
+    if (options.output.empty()) fail("trace: an output image is required (-o OUT.exr|png)");
+    checkOutputPath(options.output, "-o", false);
+  }
+  if (!options.variancePath.empty()) checkOutputPath(options.variancePath, "--variance", true);
+  if (!options.statsPath.empty()) {
+    const std::filesystem::path parent = std::filesystem::path(options.statsPath).parent_path();
+    if (!parent.empty() && !std::filesystem::is_directory(parent))
+      fail("--stats {}: directory '{}' does not exist", options.statsPath, parent.string());
+  }
+
+  TraceSettings settings;
+  settings.spp = options.spp;
+  settings.maxDepth = options.maxDepth;
+  settings.seed = global.seed;
+  settings.strategy = parseStrategy(options.strategy);
+
+  const Scene scene = loadScene(options.scene);
+  // The scene file's suggested settings, where the command line is silent.
+  ViewOptions view = options.view;
+  const SceneSettings& suggested = scene.settings;
+  if (!options.widthGiven && suggested.width) view.width = *suggested.width;
+  if (!options.heightGiven && suggested.height) view.height = *suggested.height;
+  if (!options.cameraGiven && suggested.camera) view.camera = *suggested.camera;
+  if (!options.sppGiven && suggested.spp) settings.spp = *suggested.spp;
+  constexpr int kMaxSide = ViewOptions::kMaxImageSide;
+  if (view.width < 1 || view.width > kMaxSide || view.height < 1 || view.height > kMaxSide)
+    fail("{}: image size {}x{} is out of range (width and height must be 1..{})", options.scene, view.width,
+         view.height, kMaxSide);
+  if (settings.spp < 1 || settings.spp > kMaxSpp)
+    fail("{}: {} samples per pixel is out of range (1..{})", options.scene, settings.spp, kMaxSpp);
+
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  const CameraDesc cameraDesc = view.resolveCamera(scene);
+  const Camera camera = view.makeCamera(scene);
+
+  if (replay) {
+    const int x = options.pixel[0], y = options.pixel[1];
+    const RadianceEstimate e = tracer.renderPixel(camera, settings, x, y);
+    const Rgb se = glm::sqrt(e.varianceOfMean);
+    fmt::print("pixel ({}, {}) of {}x{}, {} spp, seed {}, strategy {}:\n", x, y, view.width, view.height, settings.spp,
+               settings.seed, strategyName(settings.strategy));
+    fmt::print("  radiance  {:.6g} {:.6g} {:.6g}\n", e.mean.r, e.mean.g, e.mean.b);
+    fmt::print("  std error {:.6g} {:.6g} {:.6g}\n", se.r, se.g, se.b);
+    fmt::print("  finite samples {}, non-finite samples dropped {}\n", e.samples, e.nanSamples);
+    return;
+  }
+
+  const TraceResult result = tracer.render(camera, settings);
+  const TraceStats& stats = result.stats;
+  if (stats.nanSamples > 0)
+    fmt::print(stderr,
+               "plenoptic: warning: {} of {} samples had a non-finite radiance and were left out "
+               "(first at pixel {},{} sample {}; replay with --pixel {},{})\n",
+               stats.nanSamples, stats.paths, stats.firstNanX, stats.firstNanY, stats.firstNanSample, stats.firstNanX,
+               stats.firstNanY);
+
+  view.writeImage(options.output, result.radiance);
+  if (!options.variancePath.empty()) writeHdrImage(options.variancePath, result.variance);
+
+  if (!options.statsPath.empty()) {
+    nlohmann::json json;
+    json["command"] = "trace";
+    json["scene"] = options.scene;
+    json["output"] = options.output;
+    json["camera"] = cameraDesc.name;
+    json["width"] = view.width;
+    json["height"] = view.height;
+    json["spp"] = settings.spp;
+    json["max_depth"] = settings.maxDepth;
+    json["strategy"] = strategyName(settings.strategy);
+    json["seed"] = settings.seed;
+    json["threads"] = runtime.threads();
+    json["seconds"] = stats.seconds;
+    json["paths"] = stats.paths;
+    json["paths_per_second"] = stats.pathsPerSecond();
+    json["rays"] = stats.rays;
+    json["rays_per_second"] = stats.raysPerSecond();
+    json["nan_samples"] = stats.nanSamples;
+    json["triangles"] = scene.triangleCount();
+    json["emissive_triangles"] = tracer.emissiveTriangleCount();
+    writeTextAtomically(options.statsPath, json.dump(2) + "\n");
+  }
+  fmt::print("wrote {} ({}x{}, {} spp, {:.2f} s, {:.3f} M paths/s, {:.2f} M rays/s)\n", options.output, view.width,
+             view.height, settings.spp, stats.seconds, stats.pathsPerSecond() * 1e-6, stats.raysPerSecond() * 1e-6);
+}
+
+}  // namespace
+
+void addTraceCommand(CLI::App& app, const GlobalOptions& global) {
+  auto options = std::make_shared<TraceOptions>();
+  CLI::App* command = app.add_subcommand(
+      "trace", "Render a scene with the reference path tracer (NEE + BSDF sampling, MIS, Russian roulette)");
+  command->add_option("scene", options->scene, "cornell, or a scene file (.obj, .gltf, .glb, .json)")->required();
+  command->add_option("-o,--output", options->output,
+                      "Output image: .exr/.hdr/.pfm hold radiance (x exposure), .png is tone-mapped sRGB");
+  command->add_option("--spp", options->spp, "Samples (paths) per pixel")
+      ->check(CLI::Range(1, kMaxSpp))
+      ->capture_default_str();
+  command->add_option("--max-depth", options->maxDepth,
+                      "Maximum scattering events per path (Russian roulette ends most paths earlier)")
+      ->check(CLI::Range(0, kMaxDepth))
+      ->capture_default_str();
+  command->add_option("--strategy", options->strategy,
+                      "Direct lighting: mis (default), nee (light sampling only) or bsdf (BSDF sampling only); "
+                      "the last two are for testing")
+      ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
+      ->capture_default_str();
+  command->add_option("--stats", options->statsPath, "Write timings and counts as JSON");
+  command->add_option("--variance", options->variancePath,
+                      "Also write the per-pixel variance of the mean (.exr/.hdr/.pfm; radiance², no exposure)");
+  command->add_option("--pixel", options->pixel, "Replay one pixel X,Y and print its value (writes no image)")
+      ->expected(2)
+      ->delimiter(',');
+  options->view.addCameraOptions(*command);
+  options->view.addImageOptions(*command);
+  command->callback([options, command, &global] {
+    options->sppGiven = command->count("--spp") > 0;
+    options->widthGiven = command->count("--width") > 0;
+    options->heightGiven = command->count("--height") > 0;
+    options->cameraGiven = command->count("--camera") > 0;
+    runTrace(*options, global);
+  });
+}
+
+}  // namespace pl
