@@ -128,9 +128,11 @@ class PathTracer {
 /// standard normal, so the test rejects when
 ///   * any |z| exceeds the two-sided Šidák-corrected threshold for `alpha` over all N
 ///     pixel-channels (catches local errors), or
-///   * the whole-image z of the summed radiance, (Σa − Σb)/sqrt(ΣvarA + ΣvarB), exceeds the
-///     two-sided threshold for `alpha` (catches small global biases, e.g. a 5 % scale,
-///     that no single pixel can reveal).
+///   * in any channel, the whole-image z of the summed radiance,
+///     (Σa − Σb)/sqrt(ΣvarA + ΣvarB), exceeds the two-sided threshold for alpha/6 (catches
+///     small global biases, e.g. a 5 % scale, that no single pixel can reveal). Pixels are
+///     independent, so their variances add; the channels of a pixel are not (same paths), so
+///     each channel is tested on its own, Bonferroni-corrected over the three.
 /// The two parts each use alpha/2 (Bonferroni), so the overall false-rejection rate is ≤ alpha
 /// as far as the normal approximation holds.
 struct ImageZTest {
@@ -138,7 +140,8 @@ struct ImageZTest {
   double pixelThreshold = 0.0;  ///< Šidák-corrected |z| limit
   double maxAbsZ = 0.0;
   int worstX = -1, worstY = -1, worstChannel = -1;
-  double globalZ = 0.0;           ///< whole-image z
+  double globalZ = 0.0;           ///< whole-image z of the channel with the largest |z|
+  int globalChannel = -1;
   double globalThreshold = 0.0;
   double meanSquaredZ = 0.0;      ///< ≈ 1 under the hypothesis (diagnostic)
   bool pass = false;
