@@ -21,9 +21,9 @@
 // texels. Hence the constant environment is exact to rounding in both layouts.
 //
 // Irradiance (R-H 2001, eq. 8): E(n) = Σ_k Â_l L_k Y_k(n) with Â_0 = π, Â_1 = 2π/3,
-// Â_2 = π/4 (the clamped-cosine kernel's coefficients). The neglected bands l ≥ 3 are
-// bounded by Σ_{l≥4, even} Â_l² (2l+1)/(4π) ≈ 0.0175·(max L) for any L ≥ 0 — see
-// shTruncationBound().
+// Â_2 = π/4 (the clamped-cosine kernel's coefficients). The neglected bands l ≥ 3 change
+// E by at most 0.1927·max L for any 0 ≤ L ≤ max L (tight; shTruncationBound()), and by at
+// most Σ_{l≥4, even} Â_l² (2l+1)/(4π) ≈ 0.0162 for a unit clamped-cosine lobe of light.
 #include "bsdf/bsdf.h"
 #include "env/env.h"
 
@@ -50,10 +50,10 @@ DVec3 shIrradiance(const Sh9& sh, const DVec3& normal);
 /// Â_l, the SH coefficients of the clamped cosine max(0, cos θ) scaled as in R-H 2001:
 /// π, 2π/3, π/4, 0, −π/24, … (exact formula for every l).
 double clampedCosineCoefficient(int l);
-/// Upper bound of |E − E_SH9| for unit-bounded radiance (0 ≤ L ≤ 1): Σ_{l≥3} |Â_l|·‖L_l‖...
-/// computed as Σ_{l≥3} |Â_l| · √((2l+1)/(4π)) · √(4π) (Cauchy–Schwarz with ‖L‖² ≤ 4π and
-/// the addition theorem Σ_m Y_lm(n)² = (2l+1)/(4π)). Loose but rigorous; tests also use the
-/// tight value for zonal clamped-cosine lobes (see env_test.cpp).
+/// Tight upper bound of |E(n) − E_SH(n)| for every radiance 0 ≤ L ≤ 1 when bands
+/// 0…maxBand are kept: π ∫_{−1}^{1} |max(0,t) − K(t)| dt, with K the clamped-cosine kernel
+/// truncated after maxBand (derivation in sh.cpp). For maxBand = 2 it is 0.1927, i.e. 6.1 %
+/// of the irradiance π of a unit constant environment; multiply by max L for other maps.
 double shTruncationBound(int maxBand = 2);
 /// JSON object {"basis": ..., "coefficients": [[r,g,b] × 9]}.
 std::string shToJson(const Sh9& sh, const std::string& source);

@@ -23,33 +23,48 @@ const double kY22 = 0.25 * std::sqrt(15.0 / kPiD);       // 0.546274
 
 // Exact integrals of the 9 basis functions over the lat-long texel
 // μ = cos θ ∈ [mu1, mu0], φ ∈ [phi0, phi1] (dω = dμ dφ), with y = μ, x = s cos φ,
-// z = s sin φ, s = √(1 − μ²):
-//   ∫ s dμ = ½(μ s + asin μ),  ∫ μ s dμ = −⅓(1 − μ²)^{3/2},  ∫ s² dμ = μ − μ³/3.
-std::array<double, 9> latLongTexelBasisIntegrals(double mu0, double mu1, double phi0, double phi1) {
+// z = s sin φ, s = √(1 − μ²). Every basis function is a sum of products f(μ)·g(φ), so the
+// texel integral is a sum of products of a row integral and a column integral:
+//   ∫ s dμ = ½(μ s + asin μ),  ∫ μ s dμ = −⅓(1 − μ²)^{3/2},  ∫ s² dμ = μ − μ³/3,
+//   ∫ cos φ = sin φ, ∫ sin φ = −cos φ, ∫ cos 2φ = ½ sin 2φ, ∫ sin 2φ = −½ cos 2φ.
+struct RowIntegrals {  // over μ ∈ [mu1, mu0]
+  double one, mu, muMu, s, muS, sS;
+};
+struct ColumnIntegrals {  // over φ ∈ [phi0, phi1]
+  double one, cos, sin, cos2, sin2;
+};
+
+RowIntegrals rowIntegrals(double mu0, double mu1) {
   auto s = [](double mu) { return std::sqrt(std::max(0.0, 1.0 - mu * mu)); };
   auto fS = [&](double mu) { return 0.5 * (mu * s(mu) + std::asin(std::clamp(mu, -1.0, 1.0))); };
   auto fMuS = [](double mu) { return -std::pow(std::max(0.0, 1.0 - mu * mu), 1.5) / 3.0; };
   auto fSS = [](double mu) { return mu - mu * mu * mu / 3.0; };
-  const double i1 = mu0 - mu1;
-  const double iMu = 0.5 * (mu0 * mu0 - mu1 * mu1);
-  const double iMuMu = (mu0 * mu0 * mu0 - mu1 * mu1 * mu1) / 3.0;
-  const double iS = fS(mu0) - fS(mu1);
-  const double iMuS = fMuS(mu0) - fMuS(mu1);
-  const double iSS = fSS(mu0) - fSS(mu1);
-  const double j1 = phi1 - phi0;
-  const double jCos = std::sin(phi1) - std::sin(phi0);
-  const double jSin = std::cos(phi0) - std::cos(phi1);
-  const double jCos2 = 0.5 * (std::sin(2.0 * phi1) - std::sin(2.0 * phi0));
-  const double jSin2 = 0.5 * (std::cos(2.0 * phi0) - std::cos(2.0 * phi1));
-  return {kY00 * i1 * j1,
-          kY1 * iMu * j1,                                      // y
-          kY1 * iS * jSin,                                     // z = s sin φ
-          kY1 * iS * jCos,                                     // x = s cos φ
-          kY2 * iMuS * jCos,                                   // xy
-          kY2 * iMuS * jSin,                                   // yz
-          kY20 * (1.5 * iSS * (j1 - jCos2) - i1 * j1),         // 3z² − 1, z² = s²(1 − cos 2φ)/2
-          kY2 * 0.5 * iSS * jSin2,                             // xz = s² sin 2φ / 2
-          kY22 * (0.5 * iSS * (j1 + jCos2) - iMuMu * j1)};     // x² − y², x² = s²(1 + cos 2φ)/2
+  return {mu0 - mu1,
+          0.5 * (mu0 * mu0 - mu1 * mu1),
+          (mu0 * mu0 * mu0 - mu1 * mu1 * mu1) / 3.0,
+          fS(mu0) - fS(mu1),
+          fMuS(mu0) - fMuS(mu1),
+          fSS(mu0) - fSS(mu1)};
+}
+
+ColumnIntegrals columnIntegrals(double phi0, double phi1) {
+  return {phi1 - phi0,
+          std::sin(phi1) - std::sin(phi0),
+          std::cos(phi0) - std::cos(phi1),
+          0.5 * (std::sin(2.0 * phi1) - std::sin(2.0 * phi0)),
+          0.5 * (std::cos(2.0 * phi0) - std::cos(2.0 * phi1))};
+}
+
+std::array<double, 9> texelBasisIntegrals(const RowIntegrals& r, const ColumnIntegrals& c) {
+  return {kY00 * r.one * c.one,
+          kY1 * r.mu * c.one,                                     // y
+          kY1 * r.s * c.sin,                                      // z = s sin φ
+          kY1 * r.s * c.cos,                                      // x = s cos φ
+          kY2 * r.muS * c.cos,                                    // xy
+          kY2 * r.muS * c.sin,                                    // yz
+          kY20 * (1.5 * r.sS * (c.one - c.cos2) - r.one * c.one), // 3z² − 1, z² = s²(1 − cos 2φ)/2
+          kY2 * 0.5 * r.sS * c.sin2,                              // xz = s² sin 2φ / 2
+          kY22 * (0.5 * r.sS * (c.one + c.cos2) - r.muMu * c.one)};  // x² − y², x² = s²(1 + cos 2φ)/2
 }
 
 }  // namespace
@@ -75,13 +90,15 @@ Sh9 projectSh9(const EnvImage& env) {
   };
   if (const auto* ll = std::get_if<LatLongMap>(&env)) {
     const int w = ll->width(), h = ll->height();
+    std::vector<ColumnIntegrals> columns(static_cast<size_t>(w));
+    for (int x = 0; x < w; ++x)
+      columns[size_t(x)] = columnIntegrals(2.0 * kPiD * (double(x) / w - 0.5), 2.0 * kPiD * (double(x + 1) / w - 0.5));
     parallelForRange(uint64_t(h), 8, [&](uint64_t y0, uint64_t y1) {
       Sh9 part;
       for (uint64_t y = y0; y < y1; ++y) {
-        const double mu0 = std::cos(kPiD * double(y) / h), mu1 = std::cos(kPiD * double(y + 1) / h);
+        const RowIntegrals row = rowIntegrals(std::cos(kPiD * double(y) / h), std::cos(kPiD * double(y + 1) / h));
         for (int x = 0; x < w; ++x) {
-          const double phi0 = 2.0 * kPiD * (double(x) / w - 0.5), phi1 = 2.0 * kPiD * (double(x + 1) / w - 0.5);
-          const auto integral = latLongTexelBasisIntegrals(mu0, mu1, phi0, phi1);
+          const auto integral = texelBasisIntegrals(row, columns[size_t(x)]);
           const DVec3 L(ll->image.at(x, int(y)));
           for (int k = 0; k < 9; ++k) part.coefficients[size_t(k)] += integral[size_t(k)] * L;
         }
