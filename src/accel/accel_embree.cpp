@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "scene/scene.h"
@@ -70,6 +71,9 @@ RayHit fromRtc(const RTCRayHit& rh) {
 
 struct Accel::Impl {
   ErrorState errors;
+  /// Padded copies of vertex buffers that were not padded (see the constructor); empty for
+  /// scenes that came out of Scene::finalize() unchanged.
+  std::vector<std::vector<Vec3>> paddedPositions;
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
 
@@ -100,8 +104,17 @@ Accel::Accel(const Scene& scene) : impl_(std::make_unique<Impl>()) {
     const Mesh& mesh = scene.meshes[m];
     RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     // Shared, not copied. Scene::finalize() padded `positions` so that Embree's 16-byte
-    // read of the last vertex stays inside the allocation.
-    rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0,
+    // read of the last vertex stays inside the allocation. A copy of a Scene loses that
+    // spare capacity; rather than let Embree read 4 bytes past the end of the heap block,
+    // such a mesh's positions are copied once into a padded buffer owned by the Accel.
+    const Vec3* positions = mesh.positions.data();
+    if (mesh.positions.capacity() < mesh.positions.size() + 1) {
+      std::vector<Vec3>& copy = impl_->paddedPositions.emplace_back();
+      copy.reserve(mesh.positions.size() + 1);
+      copy.assign(mesh.positions.begin(), mesh.positions.end());
+      positions = copy.data();
+    }
+    rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, positions, 0,
                                sizeof(Vec3), mesh.positions.size());
     rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.triangles.data(), 0,
                                sizeof(UVec3), mesh.triangles.size());
