@@ -425,6 +425,21 @@ TEST(JsonScene, CombinesFilesWithTransformsOverridesLightsCamerasAndEnvironment)
   EXPECT_EQ(scene.settings.camera, "main");
 }
 
+TEST(JsonScene, MirroringTransformKeepsTheFrontSide) {
+  // The OBJ quad faces +z. Mirroring x (det = −1) would flip the winding's normal to −z unless
+  // the loader swaps the winding; the front must stay +z, and vertex x coordinates negate.
+  const fs::path dir = scratchDir("mirror_transform");
+  const std::string path = writeFile(dir / "m.json", "{\"meshes\": [{\"file\": \"" + kDataDir +
+                                                         "textured/quad.obj\", \"transform\": {\"scale\": [-1, 1, 1]}}]}");
+  const Scene scene = loadScene(path);
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  EXPECT_VEC3_NEAR(lo, Vec3(-1.0f, 0.0f, 0.0f), 0.0f);
+  EXPECT_VEC3_NEAR(hi, Vec3(0.0f, 1.0f, 0.0f), 0.0f);
+  for (uint32_t t = 0; t < scene.meshes[0].triangles.size(); ++t)
+    EXPECT_VEC3_NEAR(surfaceAt(scene, 0, t, Vec2(0.25f)).geometricNormal, Vec3(0, 0, 1), kTight);
+}
+
 TEST(JsonScene, IncludeCornell) {
   const fs::path dir = scratchDir("include_cornell");
   const std::string path = writeFile(dir / "c.json", R"({"include_cornell": true, "environment": {"color": 0.5}})");
