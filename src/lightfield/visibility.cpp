@@ -60,10 +60,13 @@ uint32_t gatherGridSide(uint32_t gatherDirections) {
 }
 
 Vec3 gatherDirectionLocal(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed) {
-  Pcg32 rng = Pcg32::forKey(tixel, k, seed ^ 0x5649534942494c59ULL);
+  // The jitter inside the cell: 2 × 24 random bits from one 64-bit hash of (tixel, k, seed)
+  // (a full PCG stream per ray costs more than the ray's own set-up).
+  const uint64_t h = hashCombine(hashCombine(tixel, k), seed ^ 0x5649534942494c59ULL);
+  const float jitterU = float(uint32_t(h) >> 8) * 0x1p-24f, jitterV = float(uint32_t(h >> 32) >> 8) * 0x1p-24f;
   const float a = float(k % gridSide), b = float(k / gridSide);
   const float inv = 1.0f / float(gridSide);
-  const Vec2 u((a + rng.uniform()) * inv, (b + rng.uniform()) * inv);
+  const Vec2 u((a + jitterU) * inv, (b + jitterV) * inv);
   return sampleCosineHemisphere(u);
 }
 
@@ -134,6 +137,8 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
     std::vector<Ray> rays, nextRays;
     std::vector<RayHit> hits;
     std::vector<PathState> states, nextStates;
+    rays.reserve((t1 - t0) * n);
+    states.reserve((t1 - t0) * n);
     auto& extras = blockExtras[block];
     for (uint64_t g = t0; g < t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
@@ -197,8 +202,8 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
         const LinearTap tu = linearTap(grid.x, c.resU), tv = linearTap(grid.y, c.resV);
         const uint64_t base = c.firstTixel + uint64_t(tv.i0) * c.resU + tu.i0;
         entry.target = uint32_t(base) | (back ? VisibilityEntry::kBackSide : 0u);
-        entry.fu = uint16_t(std::lround(tu.f * 65535.0f));
-        entry.fv = uint16_t(std::lround(tv.f * 65535.0f));
+        entry.fu = uint16_t(tu.f * 65535.0f + 0.5f);  // f ∈ [0, 1): rounds to 0 … 65535
+        entry.fv = uint16_t(tv.f * 65535.0f + 0.5f);
         if (state.viaMirror || c.kind == ChartKind::Glossy) {
           entry.target |= VisibilityEntry::kHasExtra;
           const Vec2 st = directionToParaboloid(chartLocalDirection(c, -ray.direction));
