@@ -608,7 +608,7 @@ nlohmann::json statsToJson(const BakeStats& s) {
 }
 
 std::vector<unsigned char> encodeMeta(const LightField& lf) {
-  const nlohmann::json meta = {{"writer", "plenoptic 0.1.0"},
+  const nlohmann::json meta = {{"writer", "plenoptic"},
                                {"settings", settingsToJson(lf.settings)},
                                {"stats", statsToJson(lf.stats)}};
   const std::string text = meta.dump(2);

@@ -406,6 +406,28 @@ TEST_F(PlfFileTest, InfoSummarisesWithoutLoadingValues) {
   EXPECT_EQ(previousEnd, info.fileBytes);
 }
 
+TEST_F(PlfFileTest, InfoVerifiesLargeSectionsChunkByChunk) {
+  // 200 000 values = 2.4 MB: the info reader checksums VALS in 1 MiB chunks (three here), so
+  // a flipped bit in the last chunk must still be found, and --no-verify must skip it.
+  LightField lf = makeTestLightField();
+  lf.charts[2].resU = 2;
+  lf.charts[2].resV = 3;
+  lf.values.resize(200000, Rgb(0.25f));
+  const std::string path = file("large.plf");
+  writeLightField(path, lf);
+  EXPECT_TRUE(readLightFieldInfo(path).checksumsVerified);
+  auto bytes = readBytes(path);
+  const Section values = sections(bytes)[3];
+  ASSERT_EQ(values.id, "VALS");
+  ASSERT_GT(values.size, uint64_t(2) << 20);
+  bytes[values.offset + values.size - 5] ^= 0x80;
+  writeBytes(path, bytes);
+  expectRefused(path, {"checksum mismatch", "(VALS)"});
+  const PlfInfo unverified = readLightFieldInfo(path, false);
+  EXPECT_FALSE(unverified.checksumsVerified);
+  EXPECT_EQ(unverified.values, 200000u);
+}
+
 TEST_F(PlfFileTest, OverwritesAtomicallyAndLeavesNoTemporaryFiles) {
   const std::string path = file("out.plf");
   writeBytes(path, {'o', 'l', 'd'});

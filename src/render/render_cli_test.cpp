@@ -209,5 +209,39 @@ TEST_F(RenderCliTest, RefusesBadInputWithoutWritingAnything) {
   EXPECT_FALSE(fs::exists(path("d.exr")));
 }
 
+// tests/data/render/quad-v1.plf is makeQuadLightField() as written by the version-1 writer.
+// It pins the format: a change of the byte layout without a new version number fails here.
+// Regenerate deliberately (after bumping kPlfVersion and keeping a reader for old files) with
+//   PLENOPTIC_REGENERATE_FIXTURES=1 ./render_cli_test --gtest_filter='*Fixture*'
+TEST_F(RenderCliTest, Version1FixtureStillReadsAndRewritesByteForByte) {
+  const std::string fixture = std::string(PLENOPTIC_TEST_DATA_DIR) + "/render/quad-v1.plf";
+  if (std::getenv("PLENOPTIC_REGENERATE_FIXTURES")) writeLightField(fixture, makeQuadLightField());
+  const LightField expected = makeQuadLightField();
+  const LightField lf = readLightField(fixture);
+  EXPECT_EQ(lf.scene.sourcePath, expected.scene.sourcePath);
+  ASSERT_EQ(lf.scene.meshes.size(), 1u);
+  EXPECT_EQ(lf.scene.meshes[0].positions, expected.scene.meshes[0].positions);
+  EXPECT_EQ(lf.scene.meshes[0].triangles, expected.scene.meshes[0].triangles);
+  ASSERT_EQ(lf.scene.cameras.size(), 2u);
+  EXPECT_EQ(lf.scene.cameras[1].name, "top");
+  EXPECT_EQ(lf.scene.cameras[1].eye, expected.scene.cameras[1].eye);
+  EXPECT_EQ(lf.scene.environment.constant, expected.scene.environment.constant);
+  ASSERT_EQ(lf.charts.size(), 1u);
+  EXPECT_EQ(lf.charts[0].tixelSize, 0.25f);
+  EXPECT_EQ(lf.values, expected.values);
+  EXPECT_EQ(lf.settings.preset, "handmade");
+  EXPECT_EQ(lf.stats.iterations, 3u);
+
+  // The writer is deterministic: writing what was read reproduces the fixture exactly.
+  writeLightField(path("rewritten.plf"), lf);
+  const std::string original = slurp(fixture), rewritten = slurp(path("rewritten.plf"));
+  EXPECT_EQ(original.size(), rewritten.size());
+  EXPECT_TRUE(original == rewritten) << "the version-1 byte layout changed";
+
+  std::string out, err;
+  ASSERT_EQ(run("info " + fixture, &out, &err), 0) << err;
+  EXPECT_NE(out.find("format version 1"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace pl
