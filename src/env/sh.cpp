@@ -221,13 +221,11 @@ EnvImage irradianceBruteForce(const EnvImage& source, bool cube, int size) {
   auto irradiance = [&](const Vec3& n) {
     const double nx = n.x, ny = n.y, nz = n.z;
     double er = 0.0, eg = 0.0, eb = 0.0;
-    for (size_t i = 0; i < count; ++i) {
-      const double c = nx * dx[i] + ny * dy[i] + nz * dz[i];
-      if (c > 0.0) {
-        er += c * wr[i];
-        eg += c * wg[i];
-        eb += c * wb[i];
-      }
+    for (size_t i = 0; i < count; ++i) {  // branch-free so that the compiler vectorises it
+      const double c = std::max(0.0, nx * dx[i] + ny * dy[i] + nz * dz[i]);
+      er += c * wr[i];
+      eg += c * wg[i];
+      eb += c * wb[i];
     }
     progress.advance();
     return Rgb(float(er), float(eg), float(eb));
