@@ -10,6 +10,7 @@
 //   Outside the outermost centres the edge values are held (clamp-to-edge), never extrapolated.
 #include "core/math.h"
 #include "lightfield/lightfield.h"
+#include "lightfield/paraboloid.h"
 #include "scene/scene.h"
 
 #include <cstdint>
@@ -54,7 +55,33 @@ inline Vec3 chartWorldDirection(const Chart& c, const Vec3& local) {
 
 /// Bilinear × bilinear interpolation over a raw value array laid out like LightField::values
 /// (the bake uses it on its working arrays). Specular charts give 0.
-Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 st);
+inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 st) {
+  if (c.kind == ChartKind::Specular || c.dirRes == 0) return Rgb(0.0f);
+  const LinearTap tu = linearTap(grid.x, c.resU);
+  const LinearTap tv = linearTap(grid.y, c.resV);
+  const uint32_t is[2] = {tu.i0, tu.i1}, js[2] = {tv.i0, tv.i1};
+  const float wu[2] = {1.0f - tu.f, tu.f}, wv[2] = {1.0f - tv.f, tv.f};
+  Rgb sum(0.0f);
+  if (c.dirRes == 1) {
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < 2; ++x) sum += (wu[x] * wv[y]) * values[c.valueIndex(is[x], js[y])];
+    return sum;
+  }
+  const LinearTap ta = linearTap(paraboloidTexelCoordinate(st.x, c.dirRes), c.dirRes);
+  const LinearTap tb = linearTap(paraboloidTexelCoordinate(st.y, c.dirRes), c.dirRes);
+  const uint32_t as[2] = {ta.i0, ta.i1}, bs[2] = {tb.i0, tb.i1};
+  const float wa[2] = {1.0f - ta.f, ta.f}, wb[2] = {1.0f - tb.f, tb.f};
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 2; ++x) {
+      const float wPos = wu[x] * wv[y];
+      if (wPos == 0.0f) continue;
+      Rgb inner(0.0f);
+      for (int b = 0; b < 2; ++b)
+        for (int a = 0; a < 2; ++a) inner += (wa[a] * wb[b]) * values[c.valueIndex(is[x], js[y], as[a], bs[b])];
+      sum += wPos * inner;
+    }
+  return sum;
+}
 
 /// Bilinear interpolation of the stored values of chart c at tixel grid coordinates `grid`
 /// and paraboloid coordinates st (ignored for diffuse charts, which store one value).
@@ -82,11 +109,6 @@ struct ChartShading {
 };
 ChartShading chartShading(const Scene& scene, const Chart& c);
 
-/// exitantRadiance (below) given the chart's precomputed shading and the value array laid out
-/// like LightField::values: the one implementation every caller goes through.
-Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
-                    const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv);
-
 /// Exitant radiance (W·sr⁻¹·m⁻²) of chart `chart` at worldPosition towards the viewer:
 ///   diffuse chart:  Le + albedo(uv)·E/π with E bilinearly interpolated over the 2×2 nearest
 ///                   tixels and the albedo texture applied at full resolution at `uv`;
@@ -100,5 +122,28 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
 
 /// The same for a ray hit (chart from lf.triangleChart, uv from the hit).
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer);
+
+/// exitantRadiance given the chart's precomputed shading and a value array laid out like
+/// LightField::values: the one implementation every caller goes through. Defined inline so
+/// that the fast renderer's per-pixel loop inlines it instead of calling across files.
+inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
+                           const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
+  if (c.kind == ChartKind::Specular) return Rgb(0.0f);
+  const Vec2 grid = tixelGridCoordinates(c, worldPosition);
+  const Vec3 local = chartLocalDirection(c, worldDirectionTowardsViewer);
+  // emittedRadiance (above) on the precomputed emission.
+  const Rgb emitted = (local.z > 0.0f || shading.twoSidedEmission) ? shading.emission : Rgb(0.0f);
+  if (c.kind == ChartKind::Diffuse) {
+    const Rgb irradiance = interpolateValues(values, c, grid, Vec2(0.0f));
+    const Rgb albedo = shading.texturedAlbedo ? diffuseAlbedoAt(scene, c.material, uv) : shading.albedo;
+    return emitted + albedo * irradiance * kInvPi;
+  }
+  // Glossy: the stored values already include emission towards the front side.
+  const Rgb stored = interpolateValues(values, c, grid, directionToParaboloid(local));
+  if (local.z >= 0.0f) return stored;
+  // Behind a one-sided chart: its front-side value at the horizon, minus the one-sided
+  // emission it contains, plus the back-side emission (nonzero only for two-sided emitters).
+  return glm::max(stored - shading.emission, Rgb(0.0f)) + emitted;
+}
 
 }  // namespace pl

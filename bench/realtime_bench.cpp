@@ -1,0 +1,223 @@
+// Real-time walk-through speed: median milliseconds per frame of the fast light-field
+// renderer (src/realtime), next to Embree primary-ray casting alone for the same view (the
+// limit of this design: the renderer casts exactly these rays, then looks the light field up).
+//
+// Scenes (each baked once, at the first benchmark that needs it, with the default preset
+// through the bake API; the bake time is printed, not measured):
+//   cornell   the built-in measured Cornell box (32 triangles)
+//   glossy    CornellBox-Glossy (Morgan McGuire's archive, ../shared/scenes): glossy floor
+//             and spheres, so lookups are 16-neighbour ones
+//   mirror    CornellBox-Mirror: a mirror sphere (reflection rays, bounded depth)
+//   million   the built-in Cornell box with every triangle regularly subdivided into 180²
+//             triangles: 1.04 M triangles. Subdivision keeps the faces planar, so the charts
+//             (and the bake) stay those of the box, while primary visibility pays for a
+//             million-triangle BVH: it isolates what the design claims, a frame cost that
+//             does not depend on how complex the lighting or the light field is.
+// Counters: ms_median (fast renderer, radiance only), primary_ms_median (rays only),
+// ratio = ms_median / primary_ms_median, display_ms_median (exposure + Reinhard + sRGB into
+// 8-bit pixels, as the viewer does), fps = 1000 / ms_median.
+// Run:  build/bench/realtime_bench --benchmark_min_time=1
+#include <benchmark/benchmark.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "accel/accel.h"
+#include "camera/camera.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "lightfield/bake.h"
+#include "realtime/display.h"
+#include "realtime/realtime.h"
+#include "scene/scene.h"
+
+#ifndef PLENOPTIC_SHARED_DIR
+#define PLENOPTIC_SHARED_DIR "../shared"
+#endif
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Splits every triangle of every mesh into n² triangles (regular subdivision: barycentric
+/// grid of step 1/n), interpolating normals and uvs; materials are kept.
+pl::Scene subdivided(pl::Scene scene, int n) {
+  for (pl::Mesh& mesh : scene.meshes) {
+    pl::Mesh out;
+    out.name = mesh.name;
+    const bool hasNormals = !mesh.normals.empty(), hasUvs = !mesh.uvs.empty();
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const pl::UVec3 tri = mesh.triangles[t];
+      const uint32_t base = uint32_t(out.positions.size());
+      // Vertex (i, j) with i + j ≤ n at barycentrics (i/n, j/n) towards p1 and p2.
+      auto index = [&](int i, int j) { return base + uint32_t(j * (n + 1) - j * (j - 1) / 2 + i); };
+      for (int j = 0; j <= n; ++j)
+        for (int i = 0; i + j <= n; ++i) {
+          const float b1 = float(i) / float(n), b2 = float(j) / float(n), b0 = 1.0f - b1 - b2;
+          out.positions.push_back(b0 * mesh.positions[tri.x] + b1 * mesh.positions[tri.y] + b2 * mesh.positions[tri.z]);
+          if (hasNormals)
+            out.normals.push_back(glm::normalize(b0 * mesh.normals[tri.x] + b1 * mesh.normals[tri.y] + b2 * mesh.normals[tri.z]));
+          if (hasUvs) out.uvs.push_back(b0 * mesh.uvs[tri.x] + b1 * mesh.uvs[tri.y] + b2 * mesh.uvs[tri.z]);
+        }
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i + j < n; ++i) {
+          out.triangles.push_back({index(i, j), index(i + 1, j), index(i, j + 1)});
+          out.materials.push_back(mesh.materials[t]);
+          if (i + j + 1 < n) {
+            out.triangles.push_back({index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)});
+            out.materials.push_back(mesh.materials[t]);
+          }
+        }
+    }
+    mesh = std::move(out);
+  }
+  scene.finalize();
+  return scene;
+}
+
+struct BakedScene {
+  pl::LightField lightField;
+  std::unique_ptr<pl::Accel> accel;
+  std::unique_ptr<pl::FastRenderer> renderer;
+  pl::CameraDesc camera;
+  float metresPerUnit = 1.0f;
+};
+
+pl::Scene sceneNamed(const std::string& name) {
+  const std::string mcguire = std::string(PLENOPTIC_SHARED_DIR) + "/scenes/cornell-mcguire/";
+  if (name == "cornell") return pl::makeCornellBox();
+  if (name == "glossy") return pl::loadScene(mcguire + "CornellBox-Glossy.obj");
+  if (name == "mirror") return pl::loadScene(mcguire + "CornellBox-Mirror.obj");
+  if (name == "million") return subdivided(pl::makeCornellBox(), 180);
+  throw pl::Error("unknown benchmark scene " + name);
+}
+
+/// The baked scene `name` (baked on first use, kept for the other benchmarks).
+BakedScene& baked(const std::string& name) {
+  static std::map<std::string, std::unique_ptr<BakedScene>> cache;
+  auto& slot = cache[name];
+  if (!slot) {
+    pl::Progress::setEnabled(false);
+    const auto start = Clock::now();
+    pl::Scene scene = sceneNamed(name);
+    const bool cornellUnits = scene.sourcePath == "cornell";
+    slot = std::make_unique<BakedScene>();
+    slot->camera = scene.cameras.empty() ? scene.automaticCamera() : scene.cameras.front();
+    slot->metresPerUnit = cornellUnits ? 0.001f : 1.0f;
+    slot->lightField = pl::bake(std::move(scene), pl::bakePreset("default"));
+    slot->lightField.scene.finalize();
+    slot->accel = std::make_unique<pl::Accel>(slot->lightField.scene);
+    slot->renderer = std::make_unique<pl::FastRenderer>(slot->lightField, *slot->accel);
+    std::fprintf(stderr, "[setup] %s: %zu triangles, %zu charts, baked (default preset) in %.1f s\n", name.c_str(),
+                 slot->lightField.scene.triangleCount(), slot->lightField.charts.size(),
+                 std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return *slot;
+}
+
+/// Embree primary-ray casting alone, organised exactly like the fast renderer's first pass
+/// (16×16 tiles in parallel, 4×4-pixel blocks per 16-ray packet); writes t to `depth` so
+/// nothing is optimised away.
+void castPrimaryRays(const pl::Accel& accel, const pl::Camera& camera, std::vector<float>& depth) {
+  const int width = camera.width(), height = camera.height(), tile = 16;
+  const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+  depth.resize(size_t(width) * size_t(height));
+  pl::parallelForRange(uint64_t(tilesX * tilesY), 1, [&](uint64_t begin, uint64_t end) {
+    static thread_local std::vector<pl::Ray> rays;
+    static thread_local std::vector<pl::RayHit> hits;
+    static thread_local std::vector<uint32_t> pixel;
+    for (uint64_t t = begin; t < end; ++t) {
+      const int x0 = int(t % uint64_t(tilesX)) * tile, y0 = int(t / uint64_t(tilesX)) * tile;
+      const int x1 = std::min(x0 + tile, width), y1 = std::min(y0 + tile, height);
+      rays.clear();
+      pixel.clear();
+      for (int by = y0; by < y1; by += 4)
+        for (int bx = x0; bx < x1; bx += 4)
+          for (int y = by; y < std::min(by + 4, y1); ++y)
+            for (int x = bx; x < std::min(bx + 4, x1); ++x) {
+              rays.push_back(camera.generateRay(pl::Vec2(float(x) + 0.5f, float(y) + 0.5f), pl::Vec2(0.5f)).ray);
+              pixel.push_back(uint32_t(y * width + x));
+            }
+      hits.resize(rays.size());
+      accel.intersectCoherent(rays, hits);
+      for (size_t i = 0; i < rays.size(); ++i) depth[pixel[i]] = hits[i].t;
+    }
+  });
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+double msSince(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
+
+void BM_Frame(benchmark::State& state, const std::string& name, int width, int height, float fNumber, int spp) {
+  pl::ThreadPool pool(0);
+  BakedScene& scene = baked(name);
+  pl::CameraDesc desc = scene.camera;
+  desc.fNumber = fNumber;
+  const pl::Camera camera(desc, width, height, false, scene.metresPerUnit);
+  pl::RenderSettings settings;
+  settings.samplesPerPixel = spp;
+  pl::Image image;
+  std::vector<float> depth;
+  pl::DisplayEncoder display;
+  std::vector<uint32_t> pixels(size_t(width) * size_t(height));
+  pl::ToneMapSettings toneMap;
+  std::vector<double> frameMs, primaryMs, displayMs;
+  scene.renderer->render(camera, settings, image);  // warm-up: scratch buffers, caches
+  for (auto _ : state) {
+    auto start = Clock::now();
+    scene.renderer->render(camera, settings, image);
+    frameMs.push_back(msSince(start));
+    benchmark::DoNotOptimize(image.pixels.data());
+    state.PauseTiming();
+    start = Clock::now();
+    castPrimaryRays(*scene.accel, camera, depth);
+    primaryMs.push_back(msSince(start));
+    start = Clock::now();
+    display.encode(image, 1.0f, toneMap, pixels.data(), width * 4);
+    displayMs.push_back(msSince(start));
+    state.ResumeTiming();
+  }
+  const double ms = median(frameMs), primary = median(primaryMs);
+  state.counters["ms_median"] = ms;
+  state.counters["fps"] = ms > 0 ? 1e3 / ms : 0.0;
+  state.counters["primary_ms_median"] = primary;
+  state.counters["ratio"] = primary > 0 ? ms / primary : 0.0;
+  state.counters["display_ms_median"] = median(displayMs);
+  state.counters["spp"] = pl::FastRenderer::samplesPerPixel(camera, settings);
+  state.counters["threads"] = pool.threads();
+}
+
+void registerAll() {
+  for (const char* name : {"cornell", "glossy", "mirror", "million"})
+    for (auto [w, h] : {std::pair{640, 480}, std::pair{1280, 720}})
+      benchmark::RegisterBenchmark(fmt::format("frame/{}/{}x{}", name, w, h).c_str(), BM_Frame, name, w, h, 0.0f, 1)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+  // The lens model: a thin lens (f/1.4, focused at the target) with 4 and 16 aperture samples.
+  for (int spp : {4, 16})
+    benchmark::RegisterBenchmark(fmt::format("thinlens/cornell/640x480/spp{}", spp).c_str(), BM_Frame,
+                                 std::string("cornell"), 640, 480, 1.4f, spp)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  registerAll();
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,225 @@
+// The fast light-field renderer (see realtime.h).
+#include <algorithm>
+#include <optional>
+
+#include "accel/accel.h"
+#include "bsdf/bsdf.h"
+#include "camera/camera.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "realtime/realtime.h"
+#include "scene/scene.h"
+
+namespace pl {
+
+/// Per-thread buffers of one tile, reused across tiles and frames (grown, never shrunk).
+struct FastRenderer::Scratch {
+  // Camera samples of the tile, in packet order.
+  std::vector<Ray> rays;
+  std::vector<RayHit> hits;
+  std::vector<Rgb> radiance;       ///< radiance along each camera ray
+  std::vector<float> weight;       ///< camera weight (cos⁴θ or 1)
+  std::vector<uint32_t> pixel;     ///< per pixel of the tile (spp samples each): y·width + x
+  // The mirror wavefront: reflected rays, their sample and accumulated reflectance.
+  std::vector<Ray> mirrorRays, nextRays;
+  std::vector<RayHit> mirrorHits;
+  std::vector<uint32_t> mirrorSlot, nextSlot;
+  std::vector<Rgb> mirrorThroughput, nextThroughput;
+};
+
+FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel) : lightField_(lightField), accel_(accel) {
+  const Scene& scene = lightField.scene;
+  shading_.reserve(lightField.charts.size());
+  needsUv_.reserve(lightField.charts.size());
+  for (const Chart& c : lightField.charts) {
+    if (c.material >= scene.materials.size()) fail("fast renderer: chart material {} out of range", c.material);
+    shading_.push_back(chartShading(scene, c));
+    needsUv_.push_back(uint8_t(c.kind == ChartKind::Diffuse && shading_.back().texturedAlbedo));
+  }
+}
+
+int FastRenderer::samplesPerPixel(const Camera& camera, const RenderSettings& settings) {
+  return settings.samplesPerPixel > 0 ? settings.samplesPerPixel
+         : camera.isThinLens()        ? RenderSettings::kThinLensSamples
+                                      : 1;
+}
+
+/// One mirror bounce, the same steps as the reference (render.cpp radianceFromHit): the
+/// mirror's own emission, then — within the depth limit — the reflected ray, weighted by the
+/// reflectance (the BSDF's delta sample, with Fresnel when the material asks for it). BSDFs
+/// are two-sided: the frame faces the arriving ray. Returns false when the chain ends here.
+static bool reflectOffMirror(const Scene& scene, const Ray& ray, const RayHit& hit, bool mayReflect, Rgb& emitted,
+                             Ray& reflected, Rgb& reflectance) {
+  const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+  const Vec3 wo = -ray.direction;
+  const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
+  emitted = emittedRadiance(scene.materials[surface.material], cosWoGeometric);
+  if (!mayReflect) return false;
+  const bool back = cosWoGeometric < 0.0f;
+  const Vec3 geometricNormal = back ? -surface.geometricNormal : surface.geometricNormal;
+  const Frame frame = Frame::fromNormal(back ? -surface.shadingNormal : surface.shadingNormal);
+  // A delta lobe ignores the random numbers: (½, ½) is as good as any.
+  const std::optional<BsdfSample> bs = sample(bsdfAt(scene, surface), frame.toLocal(wo), Vec2(0.5f));
+  if (!bs || !bs->delta) return false;
+  const Vec3 wi = frame.toWorld(bs->wi);
+  if (glm::dot(wi, geometricNormal) <= 0.0f) return false;  // grazing: the reflection is below the surface
+  reflected = Ray{offsetRayOrigin(surface.position, geometricNormal, wi), wi, 0.0f, kInfinity};
+  reflectance = bs->weight;
+  return true;
+}
+
+void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDepth, uint64_t seed, int x0, int y0,
+                              int x1, int y1, Scratch& s, Image& image) const {
+  const Scene& scene = lightField_.scene;
+  const Chart* charts = lightField_.charts.data();
+  const ChartShading* shading = shading_.data();
+  const Rgb* values = lightField_.values.data();
+  const int width = camera.width();
+  const size_t pixels = size_t(x1 - x0) * size_t(y1 - y0);
+  const size_t samples = pixels * size_t(spp);
+  s.rays.resize(samples);
+  s.hits.resize(samples);
+  s.radiance.resize(samples);
+  s.weight.resize(samples);
+  s.pixel.resize(pixels);
+
+  // 1. Camera rays in 4×4-pixel blocks (all samples of a pixel consecutive), so that the
+  //    16-wide packets of intersectCoherent stay compact on screen.
+  size_t n = 0, p = 0;
+  for (int by = y0; by < y1; by += 4)
+    for (int bx = x0; bx < x1; bx += 4)
+      for (int y = by; y < std::min(by + 4, y1); ++y)
+        for (int x = bx; x < std::min(bx + 4, x1); ++x) {
+          const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
+          s.pixel[p++] = uint32_t(pixel);
+          for (int k = 0; k < spp; ++k, ++n) {
+            // Exactly the reference's sample positions (render.cpp): pixel and lens centre
+            // for one sample, Pcg32::forKey(pixel, k, seed) otherwise.
+            Vec2 film(float(x) + 0.5f, float(y) + 0.5f), lens(0.5f);
+            if (spp > 1) {
+              Pcg32 rng = Pcg32::forKey(pixel, uint64_t(k), seed);
+              film = Vec2(float(x) + rng.uniform(), float(y) + rng.uniform());
+              lens = Vec2(rng.uniform(), rng.uniform());
+            }
+            const Camera::Sample cs = camera.generateRay(film, lens);
+            s.rays[n] = cs.ray;
+            s.weight[n] = cs.weight;
+          }
+        }
+  accel_.intersectCoherent(std::span<const Ray>(s.rays.data(), n), std::span<RayHit>(s.hits.data(), n));
+
+  // 2. Shade the camera hits; mirror hits start the reflection wavefront.
+  s.mirrorRays.clear();
+  s.mirrorSlot.clear();
+  s.mirrorThroughput.clear();
+  for (size_t i = 0; i < n; ++i) {
+    const Ray& ray = s.rays[i];
+    const RayHit& hit = s.hits[i];
+    Rgb radiance(0.0f);
+    if (!(s.weight[i] > 0.0f)) {
+      // The reference skips samples of zero weight.
+    } else if (!hit.hit()) {
+      radiance = backgroundRadiance(scene.environment, ray.direction);
+    } else {
+      const uint32_t chart = lightField_.triangleChart[hit.mesh][hit.triangle];
+      const Chart& c = charts[chart];
+      if (c.kind != ChartKind::Specular) {
+        Vec2 uv(0.0f);
+        if (needsUv_[chart]) uv = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics).uv;
+        radiance = exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, -ray.direction, uv);
+      } else {
+        Ray reflected;
+        Rgb reflectance;
+        if (reflectOffMirror(scene, ray, hit, mirrorDepth > 0, radiance, reflected, reflectance)) {
+          s.mirrorRays.push_back(reflected);
+          s.mirrorSlot.push_back(uint32_t(i));
+          s.mirrorThroughput.push_back(reflectance);
+        }
+      }
+    }
+    s.radiance[i] = radiance;
+  }
+
+  // 3. Reflection wavefronts, intersected as packets (a planar mirror keeps them coherent).
+  for (uint32_t reflections = 1; !s.mirrorRays.empty(); ++reflections) {
+    const size_t active = s.mirrorRays.size();
+    s.mirrorHits.resize(active);
+    accel_.intersectCoherent(s.mirrorRays, s.mirrorHits);
+    s.nextRays.clear();
+    s.nextSlot.clear();
+    s.nextThroughput.clear();
+    for (size_t i = 0; i < active; ++i) {
+      const Ray& ray = s.mirrorRays[i];
+      const RayHit& hit = s.mirrorHits[i];
+      const uint32_t slot = s.mirrorSlot[i];
+      const Rgb throughput = s.mirrorThroughput[i];
+      if (!hit.hit()) {
+        s.radiance[slot] += throughput * backgroundRadiance(scene.environment, ray.direction);
+        continue;
+      }
+      const uint32_t chart = lightField_.triangleChart[hit.mesh][hit.triangle];
+      const Chart& c = charts[chart];
+      if (c.kind != ChartKind::Specular) {
+        Vec2 uv(0.0f);
+        if (needsUv_[chart]) uv = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics).uv;
+        s.radiance[slot] +=
+            throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, -ray.direction, uv);
+        continue;
+      }
+      Rgb emitted;
+      Ray reflected;
+      Rgb reflectance;
+      const bool more = reflectOffMirror(scene, ray, hit, reflections < mirrorDepth, emitted, reflected, reflectance);
+      s.radiance[slot] += throughput * emitted;
+      if (more) {
+        s.nextRays.push_back(reflected);
+        s.nextSlot.push_back(slot);
+        s.nextThroughput.push_back(throughput * reflectance);
+      }
+    }
+    std::swap(s.mirrorRays, s.nextRays);
+    std::swap(s.mirrorSlot, s.nextSlot);
+    std::swap(s.mirrorThroughput, s.nextThroughput);
+  }
+
+  // Pixel = mean over its samples of weight × radiance (the reference's order of sums).
+  Rgb* out = image.pixels.data();
+  if (spp == 1) {
+    for (size_t i = 0; i < n; ++i) out[s.pixel[i]] = s.weight[i] > 0.0f ? s.weight[i] * s.radiance[i] : Rgb(0.0f);
+    return;
+  }
+  for (size_t q = 0; q < pixels; ++q) {
+    Rgb sum(0.0f);
+    for (size_t k = q * size_t(spp); k < (q + 1) * size_t(spp); ++k)
+      if (s.weight[k] > 0.0f) sum += s.weight[k] * s.radiance[k];
+    out[s.pixel[q]] = sum / float(spp);
+  }
+}
+
+void FastRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) const {
+  if (settings.samplesPerPixel < 0) fail("render: samples per pixel must be ≥ 0, got {}", settings.samplesPerPixel);
+  if (settings.tileSize < 1) fail("render: tile size must be ≥ 1, got {}", settings.tileSize);
+  const int spp = samplesPerPixel(camera, settings);
+  const uint32_t mirrorDepth = settings.mirrorDepth >= 0 ? uint32_t(settings.mirrorDepth) : lightField_.settings.mirrorDepth;
+  const int width = camera.width(), height = camera.height();
+  if (image.width != width || image.height != height) image = Image(width, height);
+  const int tile = settings.tileSize;
+  const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+  parallelForRange(uint64_t(tilesX) * uint64_t(tilesY), 1, [&](uint64_t begin, uint64_t end) {
+    static thread_local Scratch scratch;
+    for (uint64_t t = begin; t < end; ++t) {
+      const int x0 = int(t % uint64_t(tilesX)) * tile, y0 = int(t / uint64_t(tilesX)) * tile;
+      renderTile(camera, spp, mirrorDepth, settings.seed, x0, y0, std::min(x0 + tile, width), std::min(y0 + tile, height),
+                 scratch, image);
+    }
+  });
+}
+
+Image FastRenderer::render(const Camera& camera, const RenderSettings& settings) const {
+  Image image;
+  render(camera, settings, image);
+  return image;
+}
+
+}  // namespace pl

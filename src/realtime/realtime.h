@@ -1,0 +1,69 @@
+#pragma once
+// The fast light-field renderer: the same image as the straightforward renderer
+// (render/render.h, the reference), built for frame rates.
+//
+// Per frame the image is cut into square tiles rendered in parallel (pl::parallelForRange).
+// Per tile:
+//   1. camera rays for all samples of the tile, ordered in 4×4-pixel blocks so that each
+//      16-ray Embree packet (Accel::intersectCoherent) covers a compact footprint;
+//   2. shading of every hit without building a SurfaceHit: the hit point is ray.origin +
+//      t·ray.direction, the chart comes from LightField::triangleChart, and the radiance from
+//      exitantRadiance() of lightfield/lookup.h with the chart's ChartShading precomputed once
+//      (the one 16-neighbour formula the reference also runs; only textured diffuse charts
+//      need the hit's uv and build the SurfaceHit);
+//   3. mirrors as a wavefront of reflection rays: all samples of the tile that hit an
+//      ideal-specular chart spawn their reflected ray (same steps as the reference: shading
+//      normal frame, the BSDF's delta sample with its Fresnel weight, offset origin), and
+//      the wavefront is intersected again as packets, up to mirrorDepth reflections.
+// The light-field values are read in place: LightField::values is already float RGB,
+// tixel-major (all direction texels of a tixel contiguous), so a glossy lookup touches two
+// cache lines per tixel and a diffuse lookup four values of one or two rows.
+//
+// Sampling, camera weights, mirror depth, background and the pixel value are exactly those
+// of renderLightField (RenderSettings has the same meaning); results differ from the
+// reference only by float rounding (the hit point is computed from the ray, not from the
+// barycentrics). Scratch buffers are per thread and reused from frame to frame: after the
+// first frame of a given size no allocation happens while rendering.
+#include <cstdint>
+#include <vector>
+
+#include "image/image.h"
+#include "lightfield/lightfield.h"
+#include "lightfield/lookup.h"
+#include "render/render.h"
+
+namespace pl {
+
+class Accel;
+class Camera;
+
+class FastRenderer {
+ public:
+  /// Precomputes the per-chart shading table. `lightField` and `accel` (built over
+  /// lightField.scene) must outlive the renderer.
+  FastRenderer(const LightField& lightField, const Accel& accel);
+
+  /// Renders camera.width() × camera.height() pixels of radiance (W·sr⁻¹·m⁻², camera weight
+  /// included, no exposure) into `image`, which is resized only when its size differs.
+  /// settings.showProgress is ignored (a frame takes milliseconds).
+  void render(const Camera& camera, const RenderSettings& settings, Image& image) const;
+  Image render(const Camera& camera, const RenderSettings& settings) const;
+
+  /// Samples per pixel that `settings` gives for `camera` (same rule as renderLightField).
+  static int samplesPerPixel(const Camera& camera, const RenderSettings& settings);
+
+  const LightField& lightField() const { return lightField_; }
+  const Accel& accel() const { return accel_; }
+
+ private:
+  struct Scratch;
+  void renderTile(const Camera& camera, int spp, uint32_t mirrorDepth, uint64_t seed, int x0, int y0, int x1, int y1,
+                  Scratch& scratch, Image& image) const;
+
+  const LightField& lightField_;
+  const Accel& accel_;
+  std::vector<ChartShading> shading_;  ///< per chart
+  std::vector<uint8_t> needsUv_;       ///< per chart: textured diffuse (the lookup needs the hit's uv)
+};
+
+}  // namespace pl
