@@ -116,6 +116,8 @@ CameraDesc ViewOptions::resolveCamera(const Scene& scene) const {
   CameraDesc desc;
   if (!camera.empty()) {
     desc = scene.camera(camera);
+  } else if (scene.settings.camera) {  // the scene file's suggestion ("settings": {"camera": ...})
+    desc = scene.camera(*scene.settings.camera);
   } else if (!scene.cameras.empty()) {
     desc = scene.cameras.front();
   } else {

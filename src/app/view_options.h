@@ -22,8 +22,10 @@ struct ViewOptions {
   // Image size in pixels.
   int width = 640;
   int height = 480;
-  // Camera: --camera NAME, or --eye/--target/--up/--fov; otherwise the scene's first camera,
-  // otherwise an automatic camera framing the scene.
+  // Camera: --camera NAME, or --eye/--target/--up/--fov; otherwise the camera the scene
+  // file's settings name, otherwise the scene's first camera, otherwise an automatic camera
+  // framing the scene. --eye/--target/--up/--fov/--aperture/--focus-distance override the
+  // chosen camera's values.
   std::string camera;
   std::vector<float> eye, target, up;  ///< 3 components each when given
   float fovDegrees = 0.0f;             ///< vertical; 0 = keep the camera's own
