@@ -96,6 +96,39 @@ float EnvironmentMap::pdf(const Vec3& dir) const {
   return float(pdfUv / (2.0 * kPiD * kPiD * sinTheta));
 }
 
+// ─── Constant + map ────────────────────────────────────────────────────────────────────────
+
+EnvironmentLight::EnvironmentLight(const Rgb& constant, std::shared_ptr<const EnvironmentMap> map)
+    : constant_(constant), isBlackConstant_(pl::isBlack(constant)), map_(std::move(map)) {
+  if (!isFinite(constant) || constant.r < 0.0f || constant.g < 0.0f || constant.b < 0.0f)
+    fail("environment constant radiance must be finite and ≥ 0 (got {}, {}, {})", constant.r, constant.g, constant.b);
+  const double constantPower = 4.0 * kPiD * double(luminance(constant));
+  const double mapPower = map_ ? map_->integratedLuminance() : 0.0;
+  integratedLuminance_ = constantPower + mapPower;
+  if (map_ && mapPower > 0.0) mapProbability_ = float(mapPower / (constantPower + mapPower));
+}
+
+EnvironmentSample EnvironmentLight::sample(Vec2 u) const {
+  EnvironmentSample s;
+  if (isBlack()) return s;
+  if (u.x < mapProbability_) {
+    u.x = std::min(u.x / mapProbability_, 0x1.fffffep-1f);
+    s.direction = map_->sample(u).direction;
+  } else {
+    u.x = std::min((u.x - mapProbability_) / (1.0f - mapProbability_), 0x1.fffffep-1f);
+    s.direction = sampleUniformSphere(u);
+  }
+  s.pdf = pdf(s.direction);
+  s.radiance = radiance(s.direction);
+  return s;
+}
+
+float EnvironmentLight::pdf(const Vec3& dir) const {
+  if (isBlack()) return 0.0f;
+  const float uniform = (1.0f - mapProbability_) * kUniformSpherePdf;
+  return mapProbability_ > 0.0f ? uniform + mapProbability_ * map_->pdf(dir) : uniform;
+}
+
 std::shared_ptr<const EnvironmentMap> loadEnvironmentMap(const std::string& path, float scale, float rotationDegrees) {
   EnvImage env = loadEnvironment(path);
   LatLongMap ll = std::holds_alternative<LatLongMap>(env) ? std::move(std::get<LatLongMap>(env))
