@@ -19,7 +19,8 @@
 //   point light        4π · Y(I)
 //   spot light         2π · (1 − (cos θinner + cos θouter)/2) · Y(I)   (pbrt's estimate)
 //   directional light  π R² · Y(E)             flux through the scene's bounding disk
-//   environment        4π · π R² · Y(Le)        (pbrt-v4's UniformInfiniteLight::Phi)
+//   environment        π R² · ∫ Y(Le) dω        (= 4π·πR²·Y(Le) for a constant one, as pbrt-v4's
+//                                                UniformInfiniteLight::Phi)
 // where R is the radius of the scene's bounding sphere. Any positive weights give an
 // unbiased estimator; these make the variance small when emitters differ a lot.
 #include <algorithm>
@@ -63,25 +64,9 @@ TraceStrategy parseStrategy(const std::string& name) {
 
 namespace {
 
-// ---------------------------------------------------------------------------------------
-// The environment: light arriving from infinity where no geometry is hit. Every query of
-// it goes through this one struct so that an importance-sampled environment map only has
-// to change radiance(), sample() and pdf() here.
-struct EnvironmentLight {
-  Rgb constant{0.0f};
-
-  bool isBlack() const { return pl::isBlack(constant); }
-  /// Radiance arriving from direction `towardsLight` (pointing away from the scene).
-  Rgb radiance(const Vec3& /*towardsLight*/) const { return constant; }
-  /// Uniform on the sphere: the right density for a constant environment.
-  Vec3 sample(Vec2 u, float& pdfSolidAngle) const {
-    pdfSolidAngle = kUniformSpherePdf;
-    return sampleUniformSphere(u);
-  }
-  float pdf(const Vec3& /*towardsLight*/) const { return kUniformSpherePdf; }
-  /// Power estimate for light selection (see the file comment).
-  float power(float sceneRadius) const { return 4.0f * kPi * kPi * sceneRadius * sceneRadius * luminance(constant); }
-};
+// The environment (constant + optional importance-sampled map) is env/env.h's
+// EnvironmentLight: radiance(), sample() and pdf() are its only uses here, so a better
+// environment sampler changes nothing in this file.
 
 struct EmissiveTriangle {
   Vec3 p0, edge1, edge2;  ///< point = p0 + b1·edge1 + b2·edge2
@@ -195,7 +180,7 @@ struct PathTracer::Impl {
 };
 
 PathTracer::Impl::Impl(const Scene& s, const Accel& a) : scene(s), accel(a) {
-  environment.constant = scene.environment.constant;
+  environment = EnvironmentLight(scene.environment.constant, scene.environment.map);
   Vec3 lo, hi;
   scene.bounds(lo, hi);
   const float sceneRadius = std::max(0.5f * glm::length(hi - lo), 1e-6f);
@@ -264,7 +249,8 @@ PathTracer::Impl::Impl(const Scene& s, const Accel& a) : scene(s), accel(a) {
   }
 
   if (!environment.isBlack()) {
-    const float power = environment.power(sceneRadius);
+    const float power =
+        static_cast<float>(kPiD * double(sceneRadius) * double(sceneRadius) * environment.integratedLuminance());
     if (power > 0.0f) {
       environmentEntry = static_cast<int32_t>(entries.size());
       entries.push_back({LightKind::Environment, 0});
@@ -322,10 +308,11 @@ Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNor
       break;
     }
     case LightKind::Environment: {
-      float pdfSolidAngle = 0.0f;
-      wi = environment.sample(u, pdfSolidAngle);
-      lightPdf = selectProbability * pdfSolidAngle;
-      incident = environment.radiance(wi);
+      const EnvironmentSample e = environment.sample(u);
+      if (!(e.pdf > 0.0f)) return Rgb(0.0f);
+      wi = e.direction;
+      lightPdf = selectProbability * e.pdf;
+      incident = e.radiance;
       infinite = true;
       break;
     }
