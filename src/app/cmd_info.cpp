@@ -69,7 +69,14 @@ nlohmann::json toJson(const PlfInfo& info) {
             {"textures", info.textures},
             {"lights", info.lights},
             {"cameras", info.cameraNames},
-            {"environment", {info.environment.r, info.environment.g, info.environment.b}}}},
+            {"environment", {info.environment.r, info.environment.g, info.environment.b}},
+            {"environment_map",
+             info.environmentMapWidth == 0
+                 ? nlohmann::json(nullptr)
+                 : nlohmann::json({{"width", info.environmentMapWidth},
+                                   {"height", info.environmentMapHeight},
+                                   {"scale", info.environmentMapScale},
+                                   {"rotation_degrees", info.environmentMapRotationDegrees}})}}},
           {"charts",
            {{"total", info.charts},
             {"diffuse", info.diffuseCharts},
@@ -116,8 +123,12 @@ void printHuman(const PlfInfo& info) {
   std::string cameras;
   for (const std::string& c : info.cameraNames) cameras += (cameras.empty() ? "" : ", ") + (c.empty() ? "(unnamed)" : c);
   fmt::print("  cameras    {}{}\n", info.cameraNames.size(), cameras.empty() ? "" : ": " + cameras);
-  fmt::print("  environment  {:.4g} {:.4g} {:.4g} W·sr⁻¹·m⁻²\n", info.environment.r, info.environment.g,
+  fmt::print("  environment  constant {:.4g} {:.4g} {:.4g} W·sr⁻¹·m⁻²", info.environment.r, info.environment.g,
              info.environment.b);
+  if (info.environmentMapWidth > 0)
+    fmt::print(" + lat-long map {}×{} (scale {:.4g}, rotated {:.4g}° about +y)", info.environmentMapWidth,
+               info.environmentMapHeight, info.environmentMapScale, info.environmentMapRotationDegrees);
+  fmt::print("\n");
   fmt::print("charts       {} ({} diffuse, {} glossy, {} specular)\n", info.charts, info.diffuseCharts,
              info.glossyCharts, info.specularCharts);
   fmt::print("tixels       {}\n", info.tixels);

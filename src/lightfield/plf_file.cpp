@@ -16,6 +16,7 @@
 #include <type_traits>
 
 #include "core/error.h"
+#include "lightfield/compression.h"
 
 namespace pl {
 
@@ -373,6 +374,16 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
     w.put(c.aspectRatio.value_or(0.0f));
   }
   w.put(scene.environment.constant);
+  // The environment map (optional): its scale and rotation, then the lat-long radiance.
+  const EnvironmentMap* map = scene.environment.map.get();
+  w.put(uint8_t(map != nullptr));
+  if (map) {
+    w.put(map->scale());
+    w.put(map->rotationDegrees());
+    w.put(int32_t(map->map().width()));
+    w.put(int32_t(map->map().height()));
+    w.putArray(map->map().image.pixels);
+  }
   // The scene file's suggested render settings: each a presence byte and a value.
   for (const std::optional<int>& value : {scene.settings.width, scene.settings.height, scene.settings.spp}) {
     w.put(uint8_t(value.has_value()));
@@ -441,6 +452,20 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path)
     if (hasAspect) c.aspectRatio = aspect;
   }
   scene.environment.constant = r.get<Rgb>();
+  if (r.get<uint8_t>() != 0) {
+    const float scale = r.get<float>(), rotationDegrees = r.get<float>();
+    LatLongMap map;
+    map.image.width = r.get<int32_t>();
+    map.image.height = r.get<int32_t>();
+    map.image.pixels = r.getArray<Rgb>("environment texels");
+    if (map.image.height <= 0 || map.image.width != 2 * map.image.height ||
+        uint64_t(map.image.width) * uint64_t(map.image.height) != map.image.pixels.size())
+      r.corrupt(fmt::format("environment map is {}×{} (must be 2H×H) with {} texels", map.image.width,
+                            map.image.height, map.image.pixels.size()));
+    if (!std::isfinite(scale) || !std::isfinite(rotationDegrees))
+      r.corrupt("non-finite environment scale or rotation");
+    scene.environment.map = std::make_shared<const EnvironmentMap>(std::move(map), scale, rotationDegrees);
+  }
   for (std::optional<int>* value : {&scene.settings.width, &scene.settings.height, &scene.settings.spp}) {
     const bool present = r.get<uint8_t>() != 0;
     const int32_t v = r.get<int32_t>();
@@ -770,9 +795,14 @@ class PlfReader {
       if (kind == kSectionKinds) fail("{}: unknown section '{}' in a version {} file", path, id, version_);
       if (found[kind] >= 0) fail("{}: section {} appears twice", path, id);
       found[kind] = int(i);
-      if (e.encoding != uint32_t(PlfEncoding::Raw))
+      const bool compressedValues = kind == kValues && e.encoding != uint32_t(PlfEncoding::Raw);
+      if (e.encoding != uint32_t(PlfEncoding::Raw) && !(kind == kValues && isKnownValuesCodec(e.encoding)))
         fail("{}: section {} uses encoding {}, which this build does not know", path, id, e.encoding);
-      if (e.decodedSize != e.storedSize)
+      if (compressedValues && e.decodedSize % sizeof(Rgb) != 0)
+        fail("{}: corrupt section table: compressed section {} decodes to {} bytes, not a whole number of RGB "
+             "float triplets",
+             path, id, e.decodedSize);
+      if (!compressedValues && e.decodedSize != e.storedSize)
         fail("{}: section {} is raw but its decoded size {} differs from its stored size {}", path, id,
              e.decodedSize, e.storedSize);
       if (e.offset < previousEnd || e.storedSize > fileSize_ || e.offset > fileSize_ - e.storedSize)
@@ -874,16 +904,25 @@ std::vector<PlfSectionInfo> sectionInfos(const PlfReader& reader) {
 
 }  // namespace
 
-void writeLightField(const std::string& path, const LightField& lf) {
-  // Encode the small sections; the values are written straight from the LightField.
+void writeLightField(const std::string& path, const LightField& lf, PlfEncoding valuesEncoding) {
+  // Encode the small sections; raw values are written straight from the LightField,
+  // compressed ones from their encoded stream (compression.h).
   static_assert(sizeof(Rgb) == 12, "VALS stores float32 RGB triplets");
   const std::vector<unsigned char> scene = encodeScene(lf.scene);
   const std::vector<unsigned char> charts = encodeCharts(lf.charts);
   const std::vector<unsigned char> triangleCharts = encodeTriangleCharts(lf.triangleChart);
   const std::vector<unsigned char> meta = encodeMeta(lf);
+  std::vector<unsigned char> compressedValues;
+  if (valuesEncoding != PlfEncoding::Raw) {
+    if (!isKnownValuesCodec(uint32_t(valuesEncoding)))
+      fail("{}: unknown values encoding {}", path, uint32_t(valuesEncoding));
+    compressedValues = encodeValues(ValuesCodec(valuesEncoding), lf.charts, lf.values);
+  }
+  const std::span<const unsigned char> rawValues{reinterpret_cast<const unsigned char*>(lf.values.data()),
+                                                 lf.values.size() * sizeof(Rgb)};
   const std::span<const unsigned char> sections[kSectionKinds] = {
       scene, charts, triangleCharts,
-      {reinterpret_cast<const unsigned char*>(lf.values.data()), lf.values.size() * sizeof(Rgb)}, meta};
+      valuesEncoding == PlfEncoding::Raw ? rawValues : std::span<const unsigned char>(compressedValues), meta};
 
   Header header{};
   std::memcpy(header.magic, kPlfMagic.data(), kPlfMagic.size());
@@ -894,9 +933,10 @@ void writeLightField(const std::string& path, const LightField& lf) {
   for (int kind = 0; kind < kSectionKinds; ++kind) {
     SectionEntry& e = table[size_t(kind)];
     std::memcpy(e.id, kSectionIds[kind], 4);
-    e.encoding = uint32_t(PlfEncoding::Raw);
+    e.encoding = uint32_t(kind == kValues ? valuesEncoding : PlfEncoding::Raw);
     e.offset = offset;
     e.storedSize = e.decodedSize = sections[kind].size();
+    if (kind == kValues) e.decodedSize = rawValues.size();
     e.checksum = xxh64(sections[kind].data(), sections[kind].size());
     e.reserved = 0;
     offset = alignUp(offset + e.storedSize);
@@ -953,11 +993,20 @@ LightField readLightField(const std::string& path) {
   lf.scene = decodeScene(reader.read(kScene), path);
   lf.charts = decodeCharts(reader.read(kCharts), path, lf.scene.materials.size());
   lf.triangleChart = decodeTriangleCharts(reader.read(kTriangleCharts), path, lf.scene, lf.charts.size());
-  const uint64_t valueBytes = reader.entry(kValues).storedSize;
+  const SectionEntry& values = reader.entry(kValues);
+  const uint64_t valueBytes = values.decodedSize;
   if (valueBytes % sizeof(Rgb) != 0)
     fail("{}: corrupt values section: {} bytes is not a whole number of RGB float triplets", path, valueBytes);
-  lf.values.resize(valueBytes / sizeof(Rgb));  // bounded by the file's size, checked above
-  reader.readInto(kValues, lf.values.data());
+  if (values.encoding == uint32_t(PlfEncoding::Raw)) {
+    lf.values.resize(valueBytes / sizeof(Rgb));  // bounded by the file's size, checked above
+    reader.readInto(kValues, lf.values.data());
+  } else {
+    // The charts are checked against the declared count before anything is decoded.
+    checkChartRanges(lf.charts, valueBytes / sizeof(Rgb), path);
+    lf.values = decodeValues(ValuesCodec(values.encoding), lf.charts, valueBytes / sizeof(Rgb), reader.read(kValues),
+                             fmt::format("{}: {} values in the values section (VALS)", path,
+                                         valuesCodecName(ValuesCodec(values.encoding))));
+  }
   checkChartRanges(lf.charts, lf.values.size(), path);
   decodeMeta(reader.read(kMeta), path, lf.settings, lf.stats);
   return lf;
@@ -984,6 +1033,12 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
   info.lights = scene.lights.size();
   for (const CameraDesc& c : scene.cameras) info.cameraNames.push_back(c.name);
   info.environment = scene.environment.constant;
+  if (const EnvironmentMap* map = scene.environment.map.get()) {
+    info.environmentMapWidth = uint32_t(map->map().width());
+    info.environmentMapHeight = uint32_t(map->map().height());
+    info.environmentMapScale = map->scale();
+    info.environmentMapRotationDegrees = map->rotationDegrees();
+  }
 
   const std::vector<Chart> charts = decodeCharts(reader.read(kCharts), path, scene.materials.size());
   info.charts = charts.size();
@@ -993,7 +1048,7 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
     info.specularCharts += c.kind == ChartKind::Specular;
     info.tixels += c.tixelCount();
   }
-  info.values = reader.entry(kValues).storedSize / sizeof(Rgb);
+  info.values = reader.entry(kValues).decodedSize / sizeof(Rgb);
   decodeMeta(reader.read(kMeta), path, info.settings, info.stats);
   if (verifyChecksums) {
     reader.verify(kTriangleCharts);

@@ -14,20 +14,25 @@
 //                                     section table: covers every field except itself
 //   offset 32  section table: sectionCount entries of 48 bytes
 //              id           4 bytes  four-character code, see PlfSection
-//              encoding     u32      0 = raw (see PlfEncoding; room for compressed modes)
+//              encoding     u32      0 = raw; VALS may also be 1 = lossless, 2 = bc1, 3 = hdr
+//                                     (see PlfEncoding and lightfield/compression.h)
 //              offset       u64      from the start of the file, 64-byte aligned
 //              storedSize   u64      bytes in the file
-//              decodedSize  u64      bytes after decoding (= storedSize when raw)
+//              decodedSize  u64      bytes after decoding (= storedSize when raw; for a
+//                                     compressed VALS, 12 × the value count)
 //              checksum     u64      XXH64 of the stored bytes (seed 0)
 //              reserved     u64      0
 //   sections, each at its offset, in table order, zero padding between them (checked).
 //
 // Sections (each present exactly once):
 //   SCNE  the Scene: meshes, materials (every BSDF variant's parameters), textures with
-//         their pixels, lights, cameras, environment. Everything a renderer needs.
+//         their pixels, lights, cameras, the environment (constant and lat-long map with its
+//         scale and rotation) and the scene file's suggested settings. Everything a
+//         renderer needs.
 //   CHRT  the charts: u64 count, then fixed 85-byte records (see writeCharts in plf_file.cpp).
 //   TRCH  triangle → chart: u64 mesh count, then per mesh u64 triangle count + u32 indices.
 //   VALS  the values: float32 RGB triplets (12 bytes each), in LightField::values order.
+//         Compressed (encoding ≠ 0): a stream of lightfield/compression.h.
 //   META  UTF-8 JSON: {"settings": BakeSettings, "stats": BakeStats}.
 //
 // The version is checked right after the magic, before anything else is interpreted, so a
@@ -51,9 +56,11 @@ inline constexpr size_t kPlfHeaderSize = 32;
 inline constexpr size_t kPlfSectionEntrySize = 48;
 inline constexpr std::array<char, 8> kPlfMagic = {'P', 'L', 'F', '\0', '\r', '\n', '\x1a', '\n'};
 
-/// How a section's bytes are stored. Only Raw exists in version 1; the compression work
-/// adds modes here (a reader refuses modes it does not know, naming the section).
-enum class PlfEncoding : uint32_t { Raw = 0 };
+/// How a section's bytes are stored (a reader refuses modes it does not know, naming the
+/// section). Every section may be Raw; only VALS may use the value codecs of
+/// lightfield/compression.h, whose ValuesCodec numbers these are. The checksum covers the
+/// stored (compressed) bytes; decoding happens in readLightField, so every reader gets it.
+enum class PlfEncoding : uint32_t { Raw = 0, Lossless = 1, Bc1 = 2, Hdr = 3 };
 
 /// One entry of the section table, as stored.
 struct PlfSectionInfo {
@@ -75,7 +82,9 @@ struct PlfInfo {
   uint64_t meshes = 0, triangles = 0, vertices = 0, materials = 0, textures = 0, lights = 0;
   std::vector<std::string> cameraNames;
   std::vector<std::string> materialModels;  ///< modelName() of every material, in order
-  Rgb environment{0.0f};
+  Rgb environment{0.0f};  ///< the constant part
+  uint32_t environmentMapWidth = 0, environmentMapHeight = 0;  ///< lat-long map; 0 = none
+  float environmentMapScale = 1.0f, environmentMapRotationDegrees = 0.0f;
   // Charts (decoded from CHRT).
   uint64_t charts = 0, diffuseCharts = 0, glossyCharts = 0, specularCharts = 0;
   uint64_t tixels = 0, values = 0;
@@ -86,7 +95,9 @@ struct PlfInfo {
 
 /// Writes the light field atomically: a temporary file beside `path` is written, fsynced
 /// and renamed over it; on any failure the temporary file is removed and pl::Error thrown.
-void writeLightField(const std::string& path, const LightField& lightField);
+/// `valuesEncoding` selects how the VALS section is stored (compression.h).
+void writeLightField(const std::string& path, const LightField& lightField,
+                     PlfEncoding valuesEncoding = PlfEncoding::Raw);
 
 /// Reads and fully validates a .plf file (see the header comment). The embedded scene is
 /// finalized (vertex buffers padded for Embree) and ready for an Accel.

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <memory>
 
 #include "core/error.h"
 
@@ -103,6 +104,10 @@ LightField makeTestLightField() {
   lens.aspectRatio = 1.5f;
   s.cameras = {front, lens};
   s.environment.constant = Rgb(0.1f, 0.2f, 0.3f);
+  LatLongMap sky;
+  sky.image = Image(8, 4);
+  for (size_t i = 0; i < sky.image.pixels.size(); ++i) sky.image.pixels[i] = Rgb(float(i), 1.0f, 0.5f * float(i));
+  s.environment.map = std::make_shared<const EnvironmentMap>(sky, 2.5f, 30.0f);
   s.settings.width = 320;
   s.settings.spp = 1024;
   s.settings.camera = "lens";
@@ -319,6 +324,13 @@ TEST_F(PlfFileTest, RoundTripPreservesEveryField) {
     EXPECT_EQ(cb.aspectRatio, ca.aspectRatio);
   }
   EXPECT_EQ(b.environment.constant, a.environment.constant);
+  ASSERT_TRUE(b.environment.map);
+  EXPECT_EQ(b.environment.map->map().image.pixels, a.environment.map->map().image.pixels);
+  EXPECT_EQ(b.environment.map->map().width(), 8);
+  EXPECT_EQ(b.environment.map->scale(), 2.5f);
+  EXPECT_EQ(b.environment.map->rotationDegrees(), 30.0f);
+  for (const Vec3& dir : {Vec3(0, 1, 0), glm::normalize(Vec3(1, -0.3f, 0.4f))})
+    EXPECT_EQ(b.environment.radiance(dir), a.environment.radiance(dir));
   EXPECT_EQ(b.settings.width, a.settings.width);
   EXPECT_EQ(b.settings.height, a.settings.height);
   EXPECT_FALSE(b.settings.height.has_value());
@@ -386,6 +398,9 @@ TEST_F(PlfFileTest, InfoSummarisesWithoutLoadingValues) {
   EXPECT_EQ(info.textures, 1u);
   EXPECT_EQ(info.lights, 3u);
   EXPECT_EQ(info.cameraNames, (std::vector<std::string>{"front", "lens"}));
+  EXPECT_EQ(info.environmentMapWidth, 8u);
+  EXPECT_EQ(info.environmentMapHeight, 4u);
+  EXPECT_EQ(info.environmentMapScale, 2.5f);
   EXPECT_EQ(info.charts, 3u);
   EXPECT_EQ(info.diffuseCharts, 1u);
   EXPECT_EQ(info.glossyCharts, 1u);

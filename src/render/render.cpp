@@ -18,7 +18,9 @@
 
 namespace pl {
 
-Rgb backgroundRadiance(const Environment& environment, const Vec3& /*direction*/) { return environment.constant; }
+Rgb backgroundRadiance(const Environment& environment, const Vec3& direction) {
+  return environment.radiance(direction);
+}
 
 namespace {
 
