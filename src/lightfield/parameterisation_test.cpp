@@ -101,6 +101,63 @@ TEST(Parameterisation, CapOnTixelsPerSide) {
   }
 }
 
+TEST(Parameterisation, TexturedTixelsUseTheFootprintAverageAlbedo) {
+  // A unit quad (uv = xy) whose albedo texture is black for u < ½ and white for u > ½, with a
+  // 4 × 4 tixel grid: each tixel's transport albedo is the mean of the texture over its
+  // footprint, compared with a brute-force 64 × 64 average of Texture::sample. The bake's
+  // 4 × 4 sub-samples differ from it only where the texture's bilinear transition (1/64 wide)
+  // cuts a footprint, hence 0.05.
+  Scene scene;
+  scene.sourcePath = "textured quad";
+  Texture texture;
+  texture.path = "halves";
+  texture.image = Image(64, 1);
+  for (int x = 32; x < 64; ++x) texture.image.at(x, 0) = Rgb(1.0f, 0.5f, 0.25f);
+  texture.average = Rgb(0.5f, 0.25f, 0.125f);
+  scene.textures.push_back(texture);
+  Material m;
+  m.name = "textured";
+  m.bsdf = LambertBsdf{Rgb(0.8f)};
+  m.albedoTexture = 0;
+  scene.materials.push_back(m);
+  Mesh quad;
+  quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  quad.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+  quad.materials = {0, 0};
+  scene.meshes.push_back(quad);
+  scene.finalize();
+  BakeSettings settings;
+  settings.tixelsAcrossScene = 4;
+  const Parameterisation p = buildParameterisation(scene, settings);
+  ASSERT_EQ(p.charts.size(), 1u);
+  const Chart& c = p.charts[0];
+  ASSERT_EQ(c.tixelCount(), 16u);
+  for (uint32_t j = 0; j < 4; ++j)
+    for (uint32_t i = 0; i < 4; ++i) {
+      // The tixel's footprint in world (= uv) space, from the chart frame.
+      Rgb expected(0.0f);
+      for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+          const Vec3 q = c.origin + (float(i) + (x + 0.5f) / 64.0f) * c.tixelSize * c.axisU +
+                         (float(j) + (y + 0.5f) / 64.0f) * c.tixelSize * c.axisV;
+          expected += 0.8f * texture.sample(Vec2(q.x, q.y));
+        }
+      expected /= 64.0f * 64.0f;
+      const Rgb got = p.transportAlbedo[c.firstTixel + j * 4 + i];
+      EXPECT_NEAR(got.r, expected.r, 0.05f) << i << "," << j;
+      EXPECT_NEAR(got.b, expected.b, 0.05f) << i << "," << j;
+    }
+  // And the texture did make a difference across the quad.
+  float lo = 1.0f, hi = 0.0f;
+  for (uint32_t t = 0; t < 16; ++t) {
+    lo = std::min(lo, p.transportAlbedo[t].r);
+    hi = std::max(hi, p.transportAlbedo[t].r);
+  }
+  EXPECT_LT(lo, 0.05f);
+  EXPECT_GT(hi, 0.75f);
+}
+
 TEST(Parameterisation, DirectionalResolutionByMaterial) {
   BakeSettings settings;
   settings.glossyDirRes = 16;
