@@ -215,6 +215,56 @@ TEST_F(RenderTest, SeveralSamplesAverageTheLookupAndAreReproducible) {
   for (const Rgb& pixel : a.pixels) EXPECT_NEAR(pixel.g, expected, 1e-5f * expected);
 }
 
+TEST_F(RenderTest, GlossyChartIsLookedUpInTheDirectionTowardsTheViewer) {
+  // A glossy chart (8×8 paraboloid map per tixel) whose stored radiance is linear in the
+  // direction texel coordinates, L(a, b) = 1 + 0.5a + 0.25b, the same at every tixel. The
+  // direction bilinear interpolation reproduces it exactly, so the pixel must equal
+  // 1 + 0.5·ca + 0.25·cb at the continuous texel coordinates of the direction *towards the
+  // camera* in the chart frame: (s, t) = (x, y)/(1 + z) (lightfield.h), texel centres at
+  // s = −1 + (2a + 1)/R. Looking the map up with the ray direction instead (pointing into
+  // the surface) or with swapped axes gives other values.
+  LightField lf;
+  lf.scene.materials = {Material{"glossy", GgxBsdf{}, -1, Rgb(0.0f), false}};
+  lf.scene.meshes = {makeQuad("quad", {-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}, 0)};
+  lf.scene.finalize();
+  Chart c;
+  c.material = 0;
+  c.kind = ChartKind::Glossy;
+  c.origin = {-3, -3, 0};
+  c.tixelSize = 3.0f;
+  c.resU = c.resV = 2;
+  const uint32_t R = 8;
+  c.dirRes = R;
+  for (uint32_t tixel = 0; tixel < 4; ++tixel)
+    for (uint32_t b = 0; b < R; ++b)
+      for (uint32_t a = 0; a < R; ++a) lf.values.push_back(Rgb(1.0f + 0.5f * float(a) + 0.25f * float(b)));
+  lf.charts = {c};
+  lf.triangleChart = {{0, 0}};
+  const Accel accel(lf.scene);
+  CameraDesc desc;
+  desc.eye = {-1.5f, -0.7f, 1.2f};  // oblique: s and t both vary across the image
+  desc.target = {0.0f, 0.0f, 0.0f};
+  desc.fovYDegrees = 30.0f;
+  const Camera camera(desc, 20, 16);
+  const Image image = renderLightField(lf, accel, camera, RenderSettings{});
+  float lo = kInfinity, hi = 0.0f;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const Ray ray = camera.generateRay(Vec2(float(x) + 0.5f, float(y) + 0.5f), Vec2(0.5f)).ray;
+      const Vec3 p = ray.origin + (-ray.origin.z / ray.direction.z) * ray.direction;
+      ASSERT_LT(std::max(std::abs(p.x), std::abs(p.y)), 3.0f) << "camera must see only the chart";
+      const Vec3 towardsViewer = -ray.direction;  // chart frame = world frame here
+      const Vec2 st = Vec2(towardsViewer.x, towardsViewer.y) / (1.0f + towardsViewer.z);
+      auto texel = [&](float v) { return std::clamp((v + 1.0f) * 0.5f * float(R) - 0.5f, 0.0f, float(R - 1)); };
+      const float expected = 1.0f + 0.5f * texel(st.x) + 0.25f * texel(st.y);
+      // Relative 1e-5: float rounding of (s, t) and of the bilinear weights.
+      EXPECT_NEAR(image.at(x, y).g, expected, 1e-5f * expected) << "pixel " << x << "," << y;
+      lo = std::min(lo, expected);
+      hi = std::max(hi, expected);
+    }
+  EXPECT_GT(hi - lo, 0.5f) << "the view must sweep several direction texels";
+}
+
 /// A closed cube [−1, 1]³ whose six faces point inwards, all Lambertian with albedo a and
 /// emitting Le: the white furnace. Radiance everywhere inside is L = Le/(1 − a) (the Neumann
 /// series Le·(1 + a + a² + …)).
