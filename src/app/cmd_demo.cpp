@@ -21,10 +21,10 @@ namespace {
 
 struct DemoOptions {
   std::string outputDir = "out/demo";
-  // Path-traced reference. 512² × 96 spp ≈ 25 M paths: about half a minute on 2 cores at the
-  // tracer's ≈ 1 M paths/s, and nearly noise-free in the Cornell box.
+  // Path-traced reference. 512² × 256 spp ≈ 67 M paths: the tracer does ≈ 1.5 M paths per
+  // CPU-second on this machine, so ≈ 20–25 s on 2 idle cores; nearly noise-free.
   int traceSize = 512;
-  int traceSpp = 96;
+  int traceSpp = 256;
 };
 
 struct DemoFile {

@@ -318,6 +318,43 @@ TEST_F(TraceTest, EmissionIsOneSidedUnlessTwoSided) {
   }
 }
 
+// ---- ideal mirrors -------------------------------------------------------------------------------
+
+// An ideal mirror of reflectance R facing a large emitter of radiance Le: the mirror shows
+// R·Le. Light reaches the eye only through the delta bounce, which next-event estimation cannot
+// produce, so every strategy must count the emission found after the mirror bounce fully; the
+// estimate is deterministic (no variance) and exact to float rounding. The mirror does not
+// show the point light beside it (a delta light seen through a delta bounce has zero measure).
+TEST_F(TraceTest, MirrorReflectsEmitterFully) {
+  Scene s;
+  Mesh mesh;
+  mesh.name = "mirror";
+  const Rgb reflectance(0.9f, 0.8f, 0.7f), le(3.0f, 2.0f, 1.0f);
+  Material mirror;
+  mirror.name = "mirror";
+  mirror.bsdf = MirrorBsdf{reflectance, false};
+  s.materials.push_back(mirror);
+  addHorizontalSquare(mesh, 0.0f, 1.0f, /*facingUp=*/true, 0);
+  addHorizontalSquare(mesh, 1.0f, 50.0f, /*facingUp=*/false, addMaterial(s, Rgb(0.0f), le));
+  s.meshes.push_back(mesh);
+  s.lights.push_back(PointLight{{0.3f, 0.5f, 0.0f}, Rgb(5.0f)});
+  const Scene scene = finished(std::move(s));
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  Ray ray;
+  ray.origin = {-0.2f, 0.6f, 0.1f};
+  ray.direction = glm::normalize(Vec3(0.1f, 0.0f, -0.1f) - ray.origin);
+  for (TraceStrategy strategy : {TraceStrategy::Mis, TraceStrategy::NeeOnly, TraceStrategy::BsdfOnly}) {
+    TraceSettings settings;
+    settings.spp = 4;
+    settings.strategy = strategy;
+    const RadianceEstimate e = tracer.estimateRadiance(ray, settings, 0);
+    EXPECT_EQ(e.varianceOfMean, Rgb(0.0f)) << strategyName(strategy);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(e.mean[c], reflectance[c] * le[c], 1e-5f * le[c]) << strategyName(strategy);  // float rounding
+  }
+}
+
 // ---- non-finite samples are counted, never silently dropped ---------------------------------------
 
 // A point light of intensity 3e37 W/sr (finite, so the scene is valid) 0.1 units above a
