@@ -51,7 +51,7 @@ struct PrefilterCliOptions {
   std::string layout = "latlong";
   int levels = 6;
   int size = 128;       ///< lat-long height of level 0
-  int samples = 256;    ///< BSDF samples per texel
+  int samples = PrefilterOptions{}.samples;  ///< BSDF samples per texel
   int lutSize = 64;
   int lutSamples = 1024;
 };

@@ -561,6 +561,46 @@ TEST(EnvPrefilter, RoughLevelsBlurASpot) {
   EXPECT_GT(levels[2].map.lookup(side).r, 0.05f);
 }
 
+TEST(EnvPrefilter, MatchesQuadratureOfItsDefinition) {
+  // P(R) = ∫ L f(R, ω) cos θ dω / ∫ f cos θ dω, evaluated by brute-force quadrature over the
+  // texels of the source (64-row map, exact solid angles) against prefilter()'s default 1024
+  // filtered-importance samples (Hammersley points). FIS reads pre-averaged texels and the
+  // point set is finite; measured ≤ 0.62 % (Blinn-Phong at r = 1), tolerance 1.5 %.
+  const EnvImage env = makeEnvImage(false, 64, [](const Vec3& d) {
+    return Rgb(0.2f + 4.0f * std::pow(std::max(0.0f, glm::dot(d, glm::normalize(Vec3(1, 1, 0)))), 8.0f));
+  });
+  const SphereTexels texels = sphereTexels(env);
+  for (SpecularModel model : {SpecularModel::Ggx, SpecularModel::BlinnPhong}) {
+    PrefilterOptions o;
+    o.model = model;
+    o.levels = 3;  // roughness 0, 0.5, 1
+    o.height = 16;
+    const auto levels = prefilter(env, o);
+    for (int k = 1; k < 3; ++k) {
+      const Bsdf bsdf = specularBsdf(model, levels[size_t(k)].roughness, 1.0f);
+      for (const Vec3 r : {Vec3(1, 1, 0), Vec3(0, 1, 0), Vec3(-1, 0.2f, 0.5f)}) {
+        const Vec3 rn = glm::normalize(r);
+        // Evaluate at the level's texel centre nearest to R, to avoid interpolation error.
+        const LatLongMap& map = levels[size_t(k)].map;
+        const Vec2 uv = LatLongMap::uv(rn);
+        const int x = std::min(int(uv.x * map.width()), map.width() - 1), y = std::min(int(uv.y * map.height()), map.height() - 1);
+        const Vec3 centre = LatLongMap::direction((x + 0.5) / map.width(), (y + 0.5) / map.height());
+        const Frame frameC = Frame::fromNormal(centre);
+        double num = 0.0, den = 0.0;
+        for (size_t i = 0; i < texels.size(); ++i) {
+          const Vec3 wi = frameC.toLocal(Vec3(texels.direction[i]));
+          if (wi.z <= 0.0f) continue;
+          const double w = eval(bsdf, Vec3(0, 0, 1), wi).g * wi.z * texels.solidAngle[i];
+          num += w * texels.radiance[i].r;
+          den += w;
+        }
+        EXPECT_NEAR(map.image.at(x, y).r / (num / den), 1.0, 0.015)
+            << specularModelName(model) << " roughness " << levels[size_t(k)].roughness;
+      }
+    }
+  }
+}
+
 TEST(EnvPrefilter, DfgTermMatchesBsdfAlbedo) {
   // A + B at f0 = 1 is the lobe's directional albedo, which bsdf.h computes independently.
   for (float roughness : {0.2f, 0.5f, 0.9f})

@@ -107,7 +107,7 @@ struct PrefilterOptions {
   SpecularModel model = SpecularModel::Ggx;
   int levels = 6;        ///< roughness r_k = k/(levels−1), k = 0 … levels−1
   int height = 128;      ///< lat-long height of level 0; halved per level, not below 16
-  int samples = 256;     ///< BSDF samples per texel
+  int samples = 1024;    ///< BSDF samples per texel
 };
 struct PrefilteredLevel {
   float roughness = 0.0f;
