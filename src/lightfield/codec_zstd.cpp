@@ -1,0 +1,47 @@
+// libzstd behind one file (see codec_backends.h).
+#include <zstd.h>
+
+#include <memory>
+
+#include "core/error.h"
+#include "lightfield/codec_backends.h"
+
+namespace pl::detail {
+
+std::vector<unsigned char> zstdCompress(std::span<const unsigned char> input, int level) {
+  const std::unique_ptr<ZSTD_CCtx, size_t (*)(ZSTD_CCtx*)> context(ZSTD_createCCtx(), ZSTD_freeCCtx);
+  if (!context) fail("zstd: cannot create a compression context (out of memory)");
+  auto check = [](size_t code) {
+    if (ZSTD_isError(code)) fail("zstd compression failed: {}", ZSTD_getErrorName(code));
+    return code;
+  };
+  check(ZSTD_CCtx_setParameter(context.get(), ZSTD_c_compressionLevel, level));
+  check(ZSTD_CCtx_setParameter(context.get(), ZSTD_c_checksumFlag, 1));
+  check(ZSTD_CCtx_setParameter(context.get(), ZSTD_c_contentSizeFlag, 1));
+  std::vector<unsigned char> frame(ZSTD_compressBound(input.size()));
+  const size_t size = check(ZSTD_compress2(context.get(), frame.data(), frame.size(), input.data(), input.size()));
+  frame.resize(size);
+  return frame;
+}
+
+std::vector<unsigned char> zstdDecompress(std::span<const unsigned char> frame, uint64_t expectedSize,
+                                          const std::string& context) {
+  const size_t frameSize = ZSTD_findFrameCompressedSize(frame.data(), frame.size());
+  if (ZSTD_isError(frameSize))
+    fail("{}: corrupt zstd frame: {}", context, ZSTD_getErrorName(frameSize));
+  if (frameSize != frame.size())
+    fail("{}: {} unexpected bytes after the zstd frame", context, frame.size() - frameSize);
+  const unsigned long long contentSize = ZSTD_getFrameContentSize(frame.data(), frame.size());
+  if (contentSize == ZSTD_CONTENTSIZE_ERROR || contentSize == ZSTD_CONTENTSIZE_UNKNOWN)
+    fail("{}: corrupt zstd frame: no valid content size", context);
+  if (contentSize != expectedSize)
+    fail("{}: the zstd frame holds {} bytes but the layout needs {}", context, contentSize, expectedSize);
+  std::vector<unsigned char> output(expectedSize);
+  const size_t size = ZSTD_decompress(output.data(), output.size(), frame.data(), frame.size());
+  if (ZSTD_isError(size)) fail("{}: corrupt zstd frame: {}", context, ZSTD_getErrorName(size));
+  if (size != expectedSize)
+    fail("{}: the zstd frame decoded to {} bytes but the layout needs {}", context, size, expectedSize);
+  return output;
+}
+
+}  // namespace pl::detail
