@@ -46,9 +46,62 @@ Rgb texelAverageBsdf(const Bsdf& bsdf, const std::vector<Vec3>& outputs, const V
   return sum / float(outputs.size());
 }
 
+// Entries of a glossy operator row below this fraction of the row's largest (above-floor)
+// entry are folded into the row's constant floor (see SparseOperator).
+constexpr float kSparseThreshold = 1e-3f;
+
+/// The glossy operator W (R² × N) stored as, per row c, a constant floor b_c (weights every
+/// gather cell alike — the diffuse part of the BSDF and far-tail of the lobe) plus a sparse
+/// list of the entries that rise above it (the lobe):  Lo(c) = b_c·Σ_k L_k + Σ_sparse w_k L_k.
+/// Entries whose excess over the floor is below kSparseThreshold × the row's largest excess
+/// are dropped and their sum is spread evenly over the floor, so every row keeps its exact
+/// total (energy) and only a negligible amount of light is moved in angle. For a narrow lobe
+/// this replaces N multiply-adds per output texel by a few dozen.
+struct SparseOperator {
+  std::vector<Rgb> floor;           ///< per row
+  std::vector<uint32_t> rowStart;   ///< R² + 1
+  std::vector<uint32_t> column;     ///< gather cell k
+  std::vector<Rgb> weight;          ///< excess over the floor
+
+  static SparseOperator fromDense(const std::vector<Rgb>& dense, uint32_t rows, uint32_t n) {
+    SparseOperator op;
+    op.floor.resize(rows);
+    op.rowStart.push_back(0);
+    for (uint32_t c = 0; c < rows; ++c) {
+      const Rgb* row = dense.data() + size_t(c) * n;
+      Rgb lo(kInfinity);
+      for (uint32_t k = 0; k < n; ++k) lo = glm::min(lo, row[k]);
+      float largest = 0.0f;
+      for (uint32_t k = 0; k < n; ++k) largest = std::max(largest, maxComponent(row[k] - lo));
+      Rgb dropped(0.0f);
+      for (uint32_t k = 0; k < n; ++k) {
+        const Rgb excess = row[k] - lo;
+        if (maxComponent(excess) > kSparseThreshold * largest) {
+          op.column.push_back(k);
+          op.weight.push_back(excess);
+        } else {
+          dropped += excess;
+        }
+      }
+      op.floor[c] = lo + dropped / float(n);
+      op.rowStart.push_back(uint32_t(op.column.size()));
+    }
+    return op;
+  }
+
+  /// out[c] += Lo(c) for incoming radiance per gather cell (and its sum).
+  void apply(const Rgb* incoming, const Rgb& incomingSum, Rgb* out) const {
+    for (size_t c = 0; c < floor.size(); ++c) {
+      Rgb sum = floor[c] * incomingSum;
+      for (uint32_t e = rowStart[c]; e < rowStart[c + 1]; ++e) sum += weight[e] * incoming[column[e]];
+      out[c] += sum;
+    }
+  }
+};
+
 struct GlossyMaterial {
   uint32_t dirRes = 0;
-  std::vector<Rgb> op;                        ///< R² × N
+  SparseOperator op;
   std::vector<std::vector<Vec3>> outputs;     ///< per output texel, its sub-sample directions
   std::vector<float> projectedSolidAngle;     ///< per output texel, ≈ Ω·cos θ (for the power sum)
 };
@@ -140,10 +193,11 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   // Glossy operators, one per material used by a glossy chart.
   std::vector<GlossyMaterial> glossy(scene.materials.size());
   for (const Chart& c : param.charts) {
-    if (c.kind != ChartKind::Glossy || !glossy[c.material].op.empty()) continue;
+    if (c.kind != ChartKind::Glossy || glossy[c.material].dirRes != 0) continue;
     GlossyMaterial& g = glossy[c.material];
     g.dirRes = c.dirRes;
-    g.op = glossyOperator(scene.materials[c.material].bsdf, c.dirRes, vis.gridSide);
+    g.op = SparseOperator::fromDense(glossyOperator(scene.materials[c.material].bsdf, c.dirRes, vis.gridSide),
+                                     c.dirRes * c.dirRes, n);
     const std::vector<float>& omega = paraboloidTexelSolidAngles(c.dirRes);
     for (uint32_t t = 0; t < c.dirRes * c.dirRes; ++t) {
       g.outputs.push_back(outputTexelDirections(t % c.dirRes, t / c.dirRes, c.dirRes));
@@ -308,19 +362,12 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
       }
       if (!any) continue;
       const uint64_t vb = valueBase(g, c);
-      if (c.kind == ChartKind::Diffuse) {
-        Rgb sum(0.0f);
-        for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
+      Rgb sum(0.0f);
+      for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
+      if (c.kind == ChartKind::Diffuse)
         direct[vb] += sum * (kPi / float(n));
-      } else {
-        const std::vector<Rgb>& op = glossy[c.material].op;
-        for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) {
-          Rgb sum(0.0f);
-          const Rgb* row = op.data() + size_t(t) * n;
-          for (uint32_t k = 0; k < n; ++k) sum += row[k] * incoming[k];
-          direct[vb + t] += sum;
-        }
-      }
+      else
+        glossy[c.material].op.apply(incoming.data(), sum, direct.data() + vb);
     }
   });
 
@@ -395,18 +442,13 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           incoming[k] = L;
         }
         const uint64_t vb = valueBase(g, c);
+        Rgb sum(0.0f);
+        for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
         if (c.kind == ChartKind::Diffuse) {
-          Rgb sum(0.0f);
-          for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
           next[vb] = direct[vb] + sum * (kPi / float(n));
         } else {
-          const std::vector<Rgb>& op = glossy[c.material].op;
-          for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) {
-            Rgb sum(0.0f);
-            const Rgb* row = op.data() + size_t(t) * n;
-            for (uint32_t k = 0; k < n; ++k) sum += row[k] * incoming[k];
-            next[vb + t] = direct[vb + t] + sum;
-          }
+          std::copy_n(direct.data() + vb, c.valuesPerTixel(), next.data() + vb);
+          glossy[c.material].op.apply(incoming.data(), sum, next.data() + vb);
         }
       }
     });

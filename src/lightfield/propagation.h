@@ -19,8 +19,11 @@
 // texels) and applies the local operator:
 //   diffuse  E = (π/N) Σ_k L_k                      (each gather cell has projected solid angle π/N)
 //   glossy   Lo(c) = Σ_k W[c][k] L_k,  W[c][k] = mean over output texel c of ∫_cell k f cos θ dω
-//            (precomputed per material by sub-sampling both the output texel and the cell)
+//            (precomputed per material by sub-sampling both the output texel and the cell,
+//            and applied as a constant floor plus a sparse lobe, which keeps each row's sum)
 //   mirror   already folded into the visibility field (a reordering of what is seen).
+// Gather rays that hit a chart from behind (the inside of a closed solid, or the unlit back of
+// a one-sided surface) bring no reflected light, only two-sided emission.
 // It stops when the relative change of the total outgoing power Σ area·(exitant flux density)
 // drops below the tolerance, or at maxIterations.
 #include "lightfield/parameterisation.h"
