@@ -7,6 +7,9 @@
 //                     (Accel::intersectIncoherent)
 //   Incoherent/Single the same rays one at a time
 //   Occlusion/Stream  shadow segments between two random surface points (Accel::occludedMany)
+//   Bounce/Stream     a path tracer's second-bounce rays: cosine-distributed directions from
+//                     the points the camera sees (jittered pixels), on the side facing the
+//                     camera (Accel::intersectIncoherent)
 // on two scenes: the built-in Cornell box (32 triangles) and a generated ~1M-triangle scene
 // (4×4 bumpy spheres of 65,024 triangles each inside an open box). Rays are generated once,
 // outside the timed loop; only the traversal is timed. Run all (medians of 5 repetitions):
@@ -110,31 +113,57 @@ struct Workload {
   std::vector<Ray> primary;     ///< in 4×4-pixel block order (16 consecutive = one packet)
   std::vector<Ray> incoherent;  ///< random surface point, random direction
   std::vector<Ray> shadow;      ///< segment between two random surface points
+  std::vector<Ray> bounce;      ///< diffuse bounce from a camera-visible point
 
   explicit Workload(pl::Scene s) : scene(std::move(s)) {
     accel = std::make_unique<pl::Accel>(scene);
     makePrimaryRays();
     makeRandomRays();
+    makeBounceRays();
   }
 
-  /// Pinhole camera rays through pixel centres (the camera module's convention: vertical
-  /// field of view, square pixels, row 0 at the top).
-  void makePrimaryRays() {
+  /// The pinhole camera ray through image position (px, py) in pixels (the camera module's
+  /// convention: vertical field of view, square pixels, row 0 at the top).
+  Ray cameraRay(float px, float py) const {
     const pl::CameraDesc& cam = scene.cameras.front();
     const Vec3 forward = glm::normalize(cam.target - cam.eye);
     const Vec3 right = glm::normalize(glm::cross(forward, cam.up));
     const Vec3 up = glm::cross(right, forward);
     const float tanHalf = std::tan(glm::radians(cam.fovYDegrees) * 0.5f);
     const float aspect = static_cast<float>(kWidth) / kHeight;
+    const float sx = (2.0f * px / kWidth - 1.0f) * tanHalf * aspect;
+    const float sy = (1.0f - 2.0f * py / kHeight) * tanHalf;
+    return {cam.eye, glm::normalize(forward + sx * right + sy * up)};
+  }
+
+  /// Rays through pixel centres, ordered in 4×4-pixel blocks.
+  void makePrimaryRays() {
     primary.reserve(kWidth * kHeight);
     for (int by = 0; by < kHeight; by += kBlock)
       for (int bx = 0; bx < kWidth; bx += kBlock)
         for (int y = by; y < by + kBlock; ++y)
-          for (int x = bx; x < bx + kBlock; ++x) {
-            const float sx = (2.0f * (x + 0.5f) / kWidth - 1.0f) * tanHalf * aspect;
-            const float sy = (1.0f - 2.0f * (y + 0.5f) / kHeight) * tanHalf;
-            primary.push_back({cam.eye, glm::normalize(forward + sx * right + sy * up)});
-          }
+          for (int x = bx; x < bx + kBlock; ++x) primary.push_back(cameraRay(x + 0.5f, y + 0.5f));
+  }
+
+  /// Second-bounce rays of a path tracer: from the first hit of a random camera ray, a
+  /// cosine-distributed direction about the geometric normal turned towards the camera.
+  /// Camera rays that miss are drawn again.
+  void makeBounceRays() {
+    pl::Pcg32 rng(2027, 13);
+    bounce.reserve(kRandomRays);
+    while (bounce.size() < static_cast<size_t>(kRandomRays)) {
+      const Ray ray = cameraRay(kWidth * rng.uniform(), kHeight * rng.uniform());
+      RayHit hit;
+      if (!accel->intersect(ray, hit)) continue;
+      const pl::Mesh& mesh = scene.meshes[hit.mesh];
+      const pl::UVec3 tri = mesh.triangles[hit.triangle];
+      const Vec3 p0 = mesh.positions[tri.x], p1 = mesh.positions[tri.y], p2 = mesh.positions[tri.z];
+      Vec3 normal = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+      if (glm::dot(normal, ray.direction) > 0.0f) normal = -normal;
+      const Vec3 position = ray.origin + hit.t * ray.direction;
+      const Vec3 d = pl::Frame::fromNormal(normal).toWorld(pl::sampleCosineHemisphere({rng.uniform(), rng.uniform()}));
+      bounce.push_back({pl::offsetRayOrigin(position, normal, d), d});
+    }
   }
 
   struct SurfacePoint {
@@ -260,6 +289,15 @@ void BM_IncoherentSingle(benchmark::State& state) {
   benchmark::DoNotOptimize(hits.data());
 }
 
+void BM_BounceStream(benchmark::State& state) {
+  const Workload& w = workload(static_cast<int>(state.range(0)));
+  std::vector<RayHit> hits(w.bounce.size());
+  runRays(state, w.bounce.size(), [&](uint64_t b, uint64_t e) {
+    w.accel->intersectIncoherent(std::span(w.bounce).subspan(b, e - b), std::span(hits).subspan(b, e - b));
+  });
+  benchmark::DoNotOptimize(hits.data());
+}
+
 void BM_OcclusionStream(benchmark::State& state) {
   const Workload& w = workload(static_cast<int>(state.range(0)));
   std::vector<uint8_t> blocked(w.shadow.size());
@@ -275,6 +313,7 @@ BENCHMARK(BM_PrimarySingle)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseR
 BENCHMARK(BM_IncoherentStream)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_IncoherentSingle)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_OcclusionStream)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BounceStream)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 
