@@ -93,6 +93,7 @@ std::string shSibling(const std::string& path, EnvLayout layout) {
 void checkEnvOutput(const std::string& path, EnvLayout layout) {
   if (layout == EnvLayout::Cube && path.find("{face}") == std::string::npos) return;  // a directory, created
   if (!isHdrExtension(path)) fail("-o {}: expected an .exr, .hdr or .pfm file name", path);
+  if (layout == EnvLayout::Cube) return;  // a {face} pattern: its directory is created
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty() && !fs::is_directory(parent))
     fail("-o {}: directory '{}' does not exist", path, parent.string());
