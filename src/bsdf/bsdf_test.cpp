@@ -432,7 +432,9 @@ Chi2Outcome chi2Test(const SampleFn& sampler, const PdfFn& density, int samples,
     out.chi2 += diff * diff / pooledExpected;
     ++cells;
   } else if (pooledObserved > 0.0 && cells > 0) {
-    // Too little expected mass left to form a cell: charge it to the last (largest) cell.
+    // Too little expected mass left to form a cell of its own: its discrepancy still counts
+    // (with expected ≥ 1, so a few stray samples cannot blow up), but adds no degree of
+    // freedom, which can only make the test stricter.
     const double diff = pooledObserved - pooledExpected;
     out.chi2 += diff * diff / std::max(pooledExpected, 1.0);
   }
