@@ -158,6 +158,36 @@ TEST(Parameterisation, TexturedTixelsUseTheFootprintAverageAlbedo) {
   EXPECT_GT(hi, 0.75f);
 }
 
+TEST(Parameterisation, TixelsOutsideTheTriangleGatherFromInsideIt) {
+  // A right triangle covers half of its bounding rectangle: the tixels beyond its hypotenuse
+  // must still gather from a point on the triangle (closest point, pulled slightly inside).
+  Scene scene;
+  scene.sourcePath = "triangle";
+  scene.materials.push_back(Material{"grey", LambertBsdf{Rgb(0.5f)}});
+  Mesh tri;
+  tri.positions = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+  tri.triangles = {{0, 1, 2}};
+  tri.materials = {0};
+  scene.meshes.push_back(tri);
+  scene.finalize();
+  BakeSettings settings;
+  settings.tixelsAcrossScene = 8;
+  const Parameterisation p = buildParameterisation(scene, settings);
+  ASSERT_EQ(p.charts.size(), 1u);
+  const Chart& c = p.charts[0];
+  int outside = 0;
+  for (uint64_t t = 0; t < c.tixelCount(); ++t) {
+    const Vec3 q = p.gatherPoint[c.firstTixel + t];
+    // Inside the triangle x ≥ 0, y ≥ 0, x + y ≤ 2 (up to float round-off), on its plane.
+    EXPECT_GE(q.x, -1e-5f);
+    EXPECT_GE(q.y, -1e-5f);
+    EXPECT_LE(q.x + q.y, 2.0f + 1e-5f);
+    EXPECT_EQ(q.z, 0.0f);
+    if (p.coverage[c.firstTixel + t] == 0.0f) ++outside;
+  }
+  EXPECT_GT(outside, 0);  // the grid does have tixels entirely outside the polygon
+}
+
 TEST(Parameterisation, DirectionalResolutionByMaterial) {
   BakeSettings settings;
   settings.glossyDirRes = 16;
