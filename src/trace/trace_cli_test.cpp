@@ -72,6 +72,32 @@ TEST_F(TraceCliTest, WritesImageAndStats) {
   EXPECT_FALSE(fs::exists(stats + ".tmp"));
 }
 
+TEST_F(TraceCliTest, PixelReplayPrintsTheRenderedValue) {
+  // Render a tiny image to PFM (float, exact), then replay one pixel: the printed radiance
+  // must be the pixel's value (same streams), to the 6 significant digits printed.
+  const std::string out = path("small.pfm");
+  const std::string common = " --width 8 --height 8 --spp 16 --seed 3";
+  ASSERT_EQ(run("trace cornell -o " + out + common), 0);
+  const Image image = readImage(out);
+  const fs::path printed = dir_ / "pixel.txt";
+  const std::string command = std::string("\"") + PLENOPTIC_BINARY + "\" trace cornell --pixel 5,6" + common +
+                              " --quiet > \"" + printed.string() + "\"";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  std::ifstream in(printed);
+  std::string line, word;
+  while (std::getline(in, line) && line.find("radiance") == std::string::npos) {
+  }
+  std::istringstream values(line);
+  float r = 0, g = 0, b = 0;
+  values >> word >> r >> g >> b;
+  ASSERT_EQ(word, "radiance") << line;
+  const Rgb expected = image.at(5, 6);
+  EXPECT_NEAR(r, expected.r, 1e-5f * std::max(1.0f, expected.r));
+  EXPECT_NEAR(g, expected.g, 1e-5f * std::max(1.0f, expected.g));
+  EXPECT_NEAR(b, expected.b, 1e-5f * std::max(1.0f, expected.b));
+  EXPECT_GT(r + g + b, 0.0f);
+}
+
 TEST_F(TraceCliTest, MissingSceneFileFailsCleanly) {
   const std::string out = path("never.exr");
   std::string errors;
