@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace pl {
 
@@ -225,10 +226,51 @@ int supersampling(const EnvImage& src, int targetLatLongHeight) {
   return std::clamp(int(std::ceil(ratio - 1e-9)), 1, 8);
 }
 
+// Box-downsamples a cube by an integer factor with exact texel solid-angle weights.
+CubeMap downsampleCube(const CubeMap& cube, int factor) {
+  const int n = cube.size / factor;
+  CubeMap out(n);
+  parallelFor(uint64_t(6) * uint64_t(n), [&](uint64_t row) {
+    const int f = int(row / uint64_t(n)), y = int(row % uint64_t(n));
+    for (int x = 0; x < n; ++x) {
+      DVec3 sum(0.0);
+      double omega = 0.0;
+      for (int j = 0; j < factor; ++j)
+        for (int i = 0; i < factor; ++i) {
+          const double dOmega = CubeMap::texelSolidAngle(cube.size, x * factor + i, y * factor + j);
+          sum += dOmega * DVec3(cube.faces[size_t(f)].at(x * factor + i, y * factor + j));
+          omega += dOmega;
+        }
+      out.faces[size_t(f)].at(x, y) = Rgb(sum / omega);
+    }
+  });
+  return out;
+}
+
+// Supersampling takes at most 8×8 points per target texel. When the source is much finer
+// than that, first average it down (exactly, by an integer factor that divides its size)
+// to at most 4× the target's angular resolution, so that no source texel is skipped.
+std::optional<EnvImage> reduceForTarget(const EnvImage& env, int targetLatLongHeight) {
+  const int sourceHeight = equivalentLatLongHeight(env);
+  int factor = 1;
+  while (sourceHeight / (2 * factor) >= 4 * targetLatLongHeight) factor *= 2;
+  if (const auto* ll = std::get_if<LatLongMap>(&env)) {
+    while (factor > 1 && ll->height() % factor != 0) factor /= 2;
+    if (factor > 1) return downsampleLatLong(*ll, factor);
+  } else {
+    const auto& cube = std::get<CubeMap>(env);
+    while (factor > 1 && cube.size % factor != 0) factor /= 2;
+    if (factor > 1) return downsampleCube(cube, factor);
+  }
+  return std::nullopt;  // use the source as it is
+}
+
 }  // namespace
 
-LatLongMap toLatLong(const EnvImage& env, int height) {
+LatLongMap toLatLong(const EnvImage& original, int height) {
   if (height < 1) fail("lat-long height must be at least 1 (got {})", height);
+  const std::optional<EnvImage> reduced = reduceForTarget(original, height);
+  const EnvImage& env = reduced ? *reduced : original;
   const int w = 2 * height, h = height;
   const int k = supersampling(env, height);
   LatLongMap out{Image(w, h)};
@@ -251,8 +293,10 @@ LatLongMap toLatLong(const EnvImage& env, int height) {
   return out;
 }
 
-CubeMap toCube(const EnvImage& env, int faceSize) {
+CubeMap toCube(const EnvImage& original, int faceSize) {
   if (faceSize < 1) fail("cube face size must be at least 1 (got {})", faceSize);
+  const std::optional<EnvImage> reduced = reduceForTarget(original, 2 * faceSize);
+  const EnvImage& env = reduced ? *reduced : original;
   const int n = faceSize;
   const int k = supersampling(env, 2 * n);
   CubeMap out(n);
