@@ -1,5 +1,8 @@
-// `plenoptic render IN.plf -o OUT.exr|png`: the straightforward light-field renderer
-// (src/render/render.h) through the shared camera, exposure and tone-mapping flags.
+// `plenoptic render IN.plf -o OUT.exr|png`: the fast light-field renderer (src/realtime, the
+// default) or, with --reference, the straightforward one (src/render/render.h), through the
+// shared camera, exposure and tone-mapping flags. With --path PATH.json it renders a
+// walk-through (realtime/camera_path.h) to an image sequence (-o frames/%04d.png) or an MP4
+// video (-o walk.mp4, through ffmpeg).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -9,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -18,7 +22,12 @@
 #include "app/view_options.h"
 #include "camera/camera.h"
 #include "core/error.h"
+#include "core/progress.h"
+#include "image/tonemap.h"
 #include "lightfield/plf_file.h"
+#include "realtime/camera_path.h"
+#include "realtime/frame_output.h"
+#include "realtime/realtime.h"
 #include "render/render.h"
 
 namespace pl {
@@ -37,6 +46,9 @@ struct RenderOptions {
   int frames = 1;         ///< --frames N: render N times (timing); the last frame is written
   int samples = 0;        ///< --samples N: camera samples per pixel (0 = automatic, see render.h)
   int mirrorDepth = -1;   ///< --mirror-depth N (-1 = the bake's)
+  bool reference = false;  ///< --reference: the straightforward renderer instead of the fast one
+  bool fast = false;       ///< --fast: the fast renderer (the default; excludes --reference)
+  std::string pathFile;    ///< --path PATH.json: render a walk-through, one output per frame
   ViewOptions view;
 };
 
@@ -89,7 +101,29 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
   if (view.width < 1 || view.width > kMaxImageSide || view.height < 1 || view.height > kMaxImageSide)
     fail("image size {}x{} is out of range (width and height must be 1..{})", view.width, view.height, kMaxImageSide);
   if (options.output.empty()) fail("render: an output image is required (-o OUT.exr|png)");
-  checkOutputPath(options.output, "-o", true);
+  const bool video = isVideoOutput(options.output);
+  const bool sequence = isFramePattern(options.output);
+  if (options.pathFile.empty() && (video || sequence))
+    fail("-o {}: a frame pattern or .mp4 output needs a camera path (--path PATH.json)", options.output);
+  if (!options.pathFile.empty() && !video && !sequence)
+    fail("-o {}: a camera path renders many frames: give a frame pattern like frames/%04d.png or an .mp4 file",
+         options.output);
+  if (!options.pathFile.empty() && options.frames != 1) fail("--frames cannot be combined with --path (the path sets the frames)");
+  if (sequence) {
+    // Frames go into the pattern's directory, created if needed.
+    const std::filesystem::path parent = std::filesystem::path(options.output).parent_path();
+    std::error_code error;
+    if (!parent.empty()) std::filesystem::create_directories(parent, error);
+    if (error) fail("-o {}: cannot create directory '{}': {}", options.output, parent.string(), error.message());
+  }
+  if (!video) checkOutputPath(options.output, "-o", true);
+  else checkOutputPath(options.output, "-o", false);
+  std::optional<CameraPath> cameraPath;
+  if (!options.pathFile.empty()) cameraPath = loadCameraPath(options.pathFile);
+  if (video && findFfmpeg().empty())
+    fail("-o {}: MP4 output needs ffmpeg, which is not installed (not found on PATH); write an image sequence "
+         "instead, e.g. -o frames/%04d.png",
+         options.output);
   if (!options.statsPath.empty()) checkOutputPath(options.statsPath, "--stats", false);
 
   const auto loadStart = Clock::now();
@@ -99,21 +133,52 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
   const Accel accel(lightField.scene);
   const double accelSeconds = secondsSince(accelStart);
   const CameraDesc cameraDesc = view.resolveCamera(lightField.scene);
-  const Camera camera(cameraDesc, view.width, view.height, view.vignetting);
+  const Camera camera(cameraDesc, view.width, view.height, view.vignetting, view.metresPerUnit(lightField.scene));
+  const FastRenderer fastRenderer(lightField, accel);
 
   RenderSettings settings;
   settings.samplesPerPixel = options.samples;
   settings.mirrorDepth = options.mirrorDepth;
   settings.seed = global.seed;
-  settings.showProgress = options.frames == 1;
+  settings.showProgress = options.frames == 1 && options.reference;
   Image image;
   std::vector<double> frameMs;
-  for (int frame = 0; frame < options.frames; ++frame) {
+  // One frame through the chosen renderer; frame time excludes writing files.
+  auto renderFrame = [&](const Camera& frameCamera) {
     const auto start = Clock::now();
-    image = renderLightField(lightField, accel, camera, settings);
+    if (options.reference) {
+      image = renderLightField(lightField, accel, frameCamera, settings);
+    } else {
+      fastRenderer.render(frameCamera, settings, image);
+    }
     frameMs.push_back(1e3 * secondsSince(start));
+  };
+  int frames = options.frames;
+  if (!cameraPath) {
+    for (int frame = 0; frame < options.frames; ++frame) renderFrame(camera);
+    view.writeImage(options.output, image);
+  } else {
+    // The walk-through: frame k at time t₀ + k/fps, the path's pose on the resolved camera
+    // (which keeps its lens and, when the path has no fov, its fov).
+    frames = cameraPath->frameCount();
+    std::unique_ptr<VideoWriter> videoWriter;
+    if (video) videoWriter = std::make_unique<VideoWriter>(options.output, view.width, view.height, cameraPath->fps);
+    Progress progress("walk-through", uint64_t(frames));
+    for (int frame = 0; frame < frames; ++frame) {
+      const CameraDesc desc = applyPose(cameraDesc, cameraPath->at(cameraPath->frameTime(frame)));
+      renderFrame(Camera(desc, view.width, view.height, view.vignetting, view.metresPerUnit(lightField.scene)));
+      if (videoWriter) {
+        const float scale = view.exposureScale();
+        Image exposed = image;
+        for (Rgb& p : exposed.pixels) p *= scale;
+        videoWriter->write(toneMap(exposed, view.toneMapSettings()));
+      } else {
+        view.writeImage(formatFramePath(options.output, frame), image);
+      }
+      progress.advance();
+    }
+    if (videoWriter) videoWriter->finish();
   }
-  view.writeImage(options.output, image);
 
   const double medianMs = median(frameMs);
   const double fps = medianMs > 0.0 ? 1e3 / medianMs : 0.0;
@@ -129,7 +194,9 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
     json["samples_per_pixel"] = spp;
     json["mirror_depth"] = options.mirrorDepth >= 0 ? uint32_t(options.mirrorDepth) : lightField.settings.mirrorDepth;
     json["threads"] = runtime.threads();
-    json["frames"] = options.frames;
+    json["renderer"] = options.reference ? "reference" : "fast";
+    if (cameraPath) json["path"] = options.pathFile;
+    json["frames"] = frames;
     json["ms_per_frame_median"] = medianMs;
     json["ms_per_frame_min"] = *std::min_element(frameMs.begin(), frameMs.end());
     json["ms_per_frame_max"] = *std::max_element(frameMs.begin(), frameMs.end());
@@ -139,10 +206,10 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
     json["file_bytes"] = std::filesystem::file_size(options.input);
     writeTextAtomically(options.statsPath, json.dump(2) + "\n");
   }
-  fmt::print("wrote {} ({}x{}, {} sample{}/pixel, {} frame{}: median {:.2f} ms/frame = {:.1f} fps; "
+  fmt::print("wrote {} ({}x{}, {} sample{}/pixel, {} renderer, {} frame{}: median {:.2f} ms/frame = {:.1f} fps; "
              "load {:.3f} s, BVH {:.3f} s)\n",
-             options.output, view.width, view.height, spp, spp == 1 ? "" : "s", options.frames,
-             options.frames == 1 ? "" : "s", medianMs, fps, loadSeconds, accelSeconds);
+             options.output, view.width, view.height, spp, spp == 1 ? "" : "s", options.reference ? "reference" : "fast",
+             frames, frames == 1 ? "" : "s", medianMs, fps, loadSeconds, accelSeconds);
 }
 
 }  // namespace
@@ -166,6 +233,11 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
                       "Mirror reflections followed (-1 = the bake's own mirror depth)")
       ->check(CLI::Range(-1, kMaxMirrorDepth))
       ->capture_default_str();
+  auto* reference = command->add_flag("--reference", options->reference,
+                                      "Use the straightforward reference renderer (src/render) instead of the fast one");
+  command->add_flag("--fast", options->fast, "Use the fast renderer (the default)")->excludes(reference);
+  command->add_option("--path", options->pathFile,
+                      "Camera path JSON (keyframes; see README): render a walk-through to -o frames/%04d.png or -o walk.mp4");
   command->add_option("--stats", options->statsPath,
                       "Write JSON: frames, ms_per_frame_median, fps, load and BVH times");
   options->view.addCameraOptions(*command);

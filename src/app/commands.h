@@ -36,6 +36,7 @@ void addTonemapCommand(CLI::App& app, const GlobalOptions& global);
 void addBakeCommand(CLI::App& app, const GlobalOptions& global);
 void addInfoCommand(CLI::App& app, const GlobalOptions& global);
 void addRenderCommand(CLI::App& app, const GlobalOptions& global);
+void addViewCommand(CLI::App& app, const GlobalOptions& global);
 void addEnvCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace pl

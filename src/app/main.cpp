@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   pl::addBakeCommand(app, global);
   pl::addInfoCommand(app, global);
   pl::addRenderCommand(app, global);
+  pl::addViewCommand(app, global);
   pl::addCompareCommand(app, global);
   pl::addTonemapCommand(app, global);
   pl::addEnvCommand(app, global);

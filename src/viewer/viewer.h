@@ -1,0 +1,72 @@
+#pragma once
+// `plenoptic view`: an interactive walk-through of a baked light field in an SDL2 window,
+// rendered every frame by the fast renderer (realtime/realtime.h). SDL is behind viewer.cpp
+// only.
+//
+// Controls:
+//   W/S, A/D, Q/E   move forward/back, left/right, down/up (E up, Q down, along the world up)
+//   Shift / Ctrl    4× faster / 4× slower
+//   mouse drag      look around (left button held)
+//   + / −           exposure ±0.5 EV          T   cycle tone mapping (reinhard → linear → clamp)
+//   F12             screenshot (PNG: exposure + tone mapping as `plenoptic render` writes it)
+//   P or R          start/stop recording the flown path (saved as camera-path JSON)
+//   Esc             quit (a recording in progress is saved first)
+// The window is resizable; the image is rendered at the window's size. The HUD shows fps,
+// frame time (render + display), camera position, exposure and tone mapping.
+//
+// Headless use (tests, CI): `frames` > 0 renders that many frames and quits; `screenshotPath`
+// is then written from the last frame; `path` drives the camera (frame k at the path's time
+// t₀ + k/fps, independent of the wall clock). Works under SDL_VIDEODRIVER=dummy (no window
+// on screen, SDL's software framebuffer) or offscreen, or xvfb-run.
+#include <optional>
+#include <string>
+
+#include "camera/exposure.h"
+#include "image/tonemap.h"
+#include "lightfield/lightfield.h"
+#include "realtime/camera_path.h"
+#include "render/render.h"
+
+namespace pl {
+
+class Accel;
+
+struct ViewerOptions {
+  int width = 1024, height = 768;    ///< initial window (and image) size
+  CameraDesc camera;                 ///< starting camera
+  bool vignetting = false;
+  float metresPerUnit = 1.0f;        ///< scene unit in metres (sizes a thin lens; camera.h)
+  float exposureScale = 1.0f;        ///< radiance → pixel value at the start (exposure.h)
+  ToneMapSettings toneMap;           ///< at the start; T changes the operator
+  RenderSettings render;             ///< samples, mirror depth, seed
+  int frames = 0;                    ///< > 0: quit after this many frames
+  std::string screenshotPath;        ///< written after the last frame (.png or .exr/.hdr/.pfm)
+  std::optional<CameraPath> path;    ///< scripted camera (overrides keys and mouse)
+  std::string recordPath = "walk-path.json";     ///< where P/R saves the flown path
+  std::string screenshotPattern = "screenshot-%04d.png";  ///< F12 (frame pattern, numbered from 0)
+  float speed = 0.0f;                ///< scene units per second; 0 = a quarter of the scene diagonal
+  double recordInterval = 0.25;      ///< seconds between recorded keyframes
+  std::string title = "plenoptic";
+};
+
+/// What a viewer session did (for messages and tests).
+struct ViewerResult {
+  int frames = 0;
+  double msPerFrameMedian = 0.0;  ///< render + display + present
+  double renderMsMedian = 0.0;    ///< the fast renderer alone
+};
+
+/// Opens the window and runs until Esc/close, or for options.frames frames. Throws pl::Error
+/// when SDL cannot open a window (the message names the video driver and suggests
+/// SDL_VIDEODRIVER=dummy or xvfb-run), and for bad options.
+ViewerResult runViewer(const LightField& lightField, const Accel& accel, const ViewerOptions& options);
+
+/// True when SDL can open a window here (a display, or SDL_VIDEODRIVER set to a headless
+/// driver). `make demo` uses it to choose between the viewer and a rendered walk-through.
+bool displayAvailable();
+
+/// Writes a frame of radiance the way `plenoptic render` does (ViewOptions::writeImage):
+/// HDR formats get radiance × exposureScale, PNG additionally the tone mapping. Atomic.
+void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap);
+
+}  // namespace pl

@@ -1,0 +1,187 @@
+// `plenoptic view` headless (SDL_VIDEODRIVER=dummy): the screenshot after N frames is the
+// image `plenoptic render` writes for the same view, with and without a scripted camera
+// path; the walk-through output of `render --path`; and the error paths.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "core/rng.h"
+#include "image/image.h"
+#include "lightfield/parameterisation.h"
+#include "lightfield/plf_file.h"
+
+namespace pl {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The built-in Cornell box with the default preset's charts and smooth pseudo-random
+/// values (fast to make: no bake; the renderers do not care how the values were computed).
+LightField cornellLightField() {
+  LightField lf;
+  Scene scene = makeCornellBox();
+  Parameterisation param = buildParameterisation(scene, lf.settings);
+  lf.charts = std::move(param.charts);
+  lf.triangleChart = std::move(param.triangleChart);
+  lf.values.resize(param.valueCount);
+  Pcg32 rng(11, 3);
+  for (Rgb& v : lf.values) v = Rgb(0.5f + rng.uniform(), 0.5f + rng.uniform(), 0.5f + rng.uniform());
+  lf.scene = std::move(scene);
+  return lf;
+}
+
+class ViewerCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("plenoptic_viewer_cli_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    writeLightField(path("cornell.plf"), cornellLightField());
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  /// Runs plenoptic headless (SDL's dummy video driver) with `arguments`.
+  int run(const std::string& arguments, std::string* errors = nullptr) const {
+    const fs::path outFile = dir_ / "stdout.txt", errFile = dir_ / "stderr.txt";
+    const std::string command = std::string("SDL_VIDEODRIVER=dummy \"") + PLENOPTIC_BINARY + "\" " + arguments +
+                                " --quiet > \"" + outFile.string() + "\" 2> \"" + errFile.string() + "\"";
+    const int status = std::system(command.c_str());
+    if (errors) {
+      std::ifstream in(errFile);
+      std::stringstream text;
+      text << in.rdbuf();
+      *errors = text.str();
+    }
+    return status;
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  /// Number of pixels whose 8-bit values differ between two PNGs (read back as linear).
+  static int differingPixels(const std::string& a, const std::string& b) {
+    const Image ia = readImage(a), ib = readImage(b);
+    EXPECT_EQ(ia.width, ib.width);
+    EXPECT_EQ(ia.height, ib.height);
+    if (ia.width != ib.width || ia.height != ib.height) return -1;
+    int differ = 0;
+    for (size_t i = 0; i < ia.pixels.size(); ++i) differ += ia.pixels[i] != ib.pixels[i];
+    return differ;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(ViewerCliTest, ScreenshotAfterFramesEqualsRender) {
+  const std::string size = " --width 160 --height 120";
+  ASSERT_EQ(run("render " + path("cornell.plf") + " -o " + path("render.png") + size), 0);
+  std::string errors;
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --frames 3 --screenshot " + path("view.png") + size, &errors), 0)
+      << errors;
+  // Same fast renderer, same camera, same exposure and tone-mapping code: identical pixels
+  // (the HUD is drawn on the window only, never into screenshots).
+  EXPECT_EQ(differingPixels(path("render.png"), path("view.png")), 0);
+  // The same holds with exposure and tone-mapping flags.
+  const std::string look = size + " --exposure 1.5 --tonemap clamp";
+  ASSERT_EQ(run("render " + path("cornell.plf") + " -o " + path("render2.png") + look), 0);
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --frames 2 --screenshot " + path("view2.png") + look), 0);
+  EXPECT_EQ(differingPixels(path("render2.png"), path("view2.png")), 0);
+  // And the image is not the same for both looks (the flags reached the viewer).
+  EXPECT_GT(differingPixels(path("view.png"), path("view2.png")), 0);
+}
+
+TEST_F(ViewerCliTest, ScriptedPathEndsWhereRenderOfTheLastKeyframeIs) {
+  {
+    std::ofstream json(path("walk.json"));
+    json << R"({"fps": 4, "keyframes": [
+      {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0], "fov": 39},
+      {"time": 0.5, "eye": [200, 300, -500], "target": [300, 250, 200]},
+      {"time": 1, "eye": [350, 250, -300], "target": [250, 150, 300], "fov": 55}]})";
+  }
+  const std::string size = " --width 96 --height 72";
+  std::string errors;
+  // 1 s at 4 fps: frames at 0, 0.25, 0.5, 0.75, 1 — the last one on the last keyframe.
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --path " + path("walk.json") + " --screenshot " + path("view.png") + size,
+                &errors),
+            0)
+      << errors;
+  ASSERT_EQ(run("render " + path("cornell.plf") + " -o " + path("last.png") +
+                " --eye 350,250,-300 --target 250,150,300 --fov 55" + size),
+            0);
+  EXPECT_EQ(differingPixels(path("view.png"), path("last.png")), 0);
+
+  // The walk-through through `render --path`: 5 frames; its last frame is the same image.
+  ASSERT_EQ(run("render " + path("cornell.plf") + " --path " + path("walk.json") + " -o " + path("frames/f%02d.png") +
+                    " --stats " + path("stats.json") + size,
+                &errors),
+            0)
+      << errors;
+  for (int k = 0; k < 5; ++k) EXPECT_TRUE(fs::exists(path("frames/f0" + std::to_string(k) + ".png"))) << k;
+  EXPECT_FALSE(fs::exists(path("frames/f05.png")));
+  EXPECT_EQ(differingPixels(path("frames/f04.png"), path("last.png")), 0);
+  EXPECT_GT(differingPixels(path("frames/f00.png"), path("frames/f02.png")), 0);  // the camera moved
+  std::ifstream stats(path("stats.json"));
+  std::stringstream text;
+  text << stats.rdbuf();
+  EXPECT_NE(text.str().find("\"frames\": 5"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("\"ms_per_frame_median\""), std::string::npos);
+  EXPECT_NE(text.str().find("\"fps\""), std::string::npos);
+}
+
+TEST_F(ViewerCliTest, BadInputsAreClearErrors) {
+  std::string errors;
+  EXPECT_NE(run("view " + path("cornell.plf") + " --screenshot " + path("x.png"), &errors), 0);
+  EXPECT_NE(errors.find("--screenshot needs --frames"), std::string::npos) << errors;
+  {
+    std::ofstream json(path("bad.json"));
+    json << R"({"keyframes": [{"time": 0, "eye": [0, 0, 1]}]})";
+  }
+  EXPECT_NE(run("view " + path("cornell.plf") + " --frames 1 --path " + path("bad.json"), &errors), 0);
+  EXPECT_NE(errors.find(path("bad.json") + ": keyframe 0: missing 'target'"), std::string::npos) << errors;
+  EXPECT_NE(run("render " + path("cornell.plf") + " --path " + path("bad.json") + " -o " + path("f%03d.png"), &errors), 0);
+  EXPECT_NE(errors.find("missing 'target'"), std::string::npos) << errors;
+  EXPECT_NE(run("render " + path("cornell.plf") + " --path " + path("missing.json") + " -o " + path("f%03d.png"), &errors), 0);
+  EXPECT_NE(errors.find(path("missing.json") + ": cannot open"), std::string::npos) << errors;
+  // A path needs several outputs; a pattern needs a path.
+  EXPECT_NE(run("render " + path("cornell.plf") + " --path " + path("bad.json") + " -o " + path("one.png"), &errors), 0);
+  EXPECT_NE(errors.find("frame pattern"), std::string::npos) << errors;
+  EXPECT_NE(run("render " + path("cornell.plf") + " -o " + path("f%03d.png"), &errors), 0);
+  EXPECT_NE(errors.find("needs a camera path"), std::string::npos) << errors;
+  EXPECT_NE(run("render " + path("cornell.plf") + " --fast --reference -o " + path("x.png"), &errors), 0);
+  // MP4 without ffmpeg on PATH: a clear message, before any rendering.
+  {
+    std::ofstream json(path("good.json"));
+    json << R"({"keyframes": [{"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0]}]})";
+  }
+  const std::string command = "PATH=/nonexistent-plenoptic-dir \"" + std::string(PLENOPTIC_BINARY) + "\" render " +
+                              path("cornell.plf") + " --path " + path("good.json") + " -o " + path("walk.mp4") +
+                              " --quiet 2> " + path("err.txt");
+  EXPECT_NE(std::system(command.c_str()), 0);
+  std::ifstream err(path("err.txt"));
+  std::stringstream text;
+  text << err.rdbuf();
+  EXPECT_NE(text.str().find("MP4 output needs ffmpeg, which is not installed"), std::string::npos) << text.str();
+  EXPECT_FALSE(fs::exists(path("walk.mp4")));
+}
+
+TEST_F(ViewerCliTest, FastAndReferenceRenderersWriteTheSameImage) {
+  const std::string size = " --width 80 --height 60";
+  ASSERT_EQ(run("render " + path("cornell.plf") + " -o " + path("fast.pfm") + size), 0);
+  ASSERT_EQ(run("render " + path("cornell.plf") + " --reference -o " + path("reference.pfm") + size), 0);
+  const Image fast = readImage(path("fast.pfm")), reference = readImage(path("reference.pfm"));
+  ASSERT_EQ(fast.pixels.size(), reference.pixels.size());
+  double maxDifference = 0.0;
+  for (size_t i = 0; i < fast.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) maxDifference = std::max(maxDifference, double(std::abs(fast.pixels[i][c] - reference.pixels[i][c])));
+  // Float rounding of the hit point only (see realtime/fast_renderer_test.cpp): values ≈ 1.
+  EXPECT_LT(maxDifference, 1e-4);
+}
+
+}  // namespace
+}  // namespace pl
