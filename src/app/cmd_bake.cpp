@@ -12,6 +12,7 @@
 #include "app/commands.h"
 #include "core/error.h"
 #include "lightfield/bake.h"
+#include "lightfield/compression.h"
 #include "lightfield/plf_file.h"
 #include "scene/scene.h"
 
@@ -30,6 +31,7 @@ struct BakeCommandOptions {
   uint32_t gatherDirections = 0;
   uint32_t lightSamples = 0;
   float tolerance = 0.0f;
+  std::string compress = "none";  ///< how the values are stored: none|lossless|bc1|hdr (compression.h)
 };
 
 void checkParentDirectory(const std::string& path, const char* option) {
@@ -84,7 +86,7 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
     if (!global.quiet) fmt::print(stderr, "{}\n", line);
   };
   LightField lf = bake(std::move(scene), settings, bakeOptions);
-  writeLightField(options.output, lf);
+  writeLightField(options.output, lf, PlfEncoding(uint32_t(parseValuesCodec(options.compress))));
   const uint64_t fileBytes = std::filesystem::file_size(options.output);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const BakeStats& s = lf.stats;
@@ -111,6 +113,7 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
     json["visibility_file"] = visibilityPath;
     json["peak_rss_bytes"] = s.peakRssBytes;
     json["file_bytes"] = fileBytes;
+    json["compression"] = options.compress;
     writeTextAtomically(options.statsPath, json.dump(2) + "\n");
   }
   fmt::print("wrote {} ({} charts, {} tixels, {} values, {:.1f} MB; {} iterations, residual {:.2e}; {:.2f} s)\n",
@@ -134,6 +137,10 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--visibility", options->visibilityPath,
                       "Where the visibility field is saved/looked for (default: OUT with extension .plv)");
   command->add_option("--stats", options->statsPath, "Write timings and counts as JSON");
+  command->add_option("--compress", options->compress,
+                      "How the values are stored: none (float32), lossless (bit-exact), bc1 (S3TC), hdr (log codes)")
+      ->check(CLI::IsMember({"none", "lossless", "bc1", "hdr"}))
+      ->capture_default_str();
   command->add_option("--tixels-across", options->tixelsAcross,
                       "Override the preset: tixels along the scene's largest extent")
       ->check(CLI::Range(1.0f, 4096.0f));

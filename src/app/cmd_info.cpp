@@ -6,9 +6,11 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "lightfield/compression.h"
 #include "lightfield/plf_file.h"
 
 namespace pl {
@@ -27,7 +29,28 @@ std::string humanBytes(uint64_t bytes) {
   return fmt::format("{:.2f} GiB", double(bytes) / double(1 << 30));
 }
 
-const char* encodingName(uint32_t encoding) { return encoding == uint32_t(PlfEncoding::Raw) ? "raw" : "unknown"; }
+std::string_view encodingName(uint32_t encoding) {
+  if (encoding == uint32_t(PlfEncoding::Raw)) return "raw";
+  return isKnownValuesCodec(encoding) ? valuesCodecName(ValuesCodec(encoding)) : "unknown";
+}
+
+/// The values section's storage: mode, stored and decoded bytes, their ratio.
+struct ValuesStorage {
+  std::string_view mode = "none";
+  uint64_t storedBytes = 0, decodedBytes = 0;
+  double ratio = 1.0;  ///< decoded / stored
+};
+ValuesStorage valuesStorage(const PlfInfo& info) {
+  ValuesStorage v;
+  for (const PlfSectionInfo& s : info.sections)
+    if (s.id == "VALS") {
+      v.mode = s.encoding == uint32_t(PlfEncoding::Raw) ? "none" : encodingName(s.encoding);
+      v.storedBytes = s.storedSize;
+      v.decodedBytes = s.decodedSize;
+      v.ratio = s.storedSize > 0 ? double(s.decodedSize) / double(s.storedSize) : 1.0;
+    }
+  return v;
+}
 
 /// "lambert ×4, mirror ×1" in first-seen order.
 std::string modelCounts(const std::vector<std::string>& models) {
@@ -48,13 +71,14 @@ nlohmann::json toJson(const PlfInfo& info) {
   nlohmann::json sections = nlohmann::json::array();
   for (const PlfSectionInfo& s : info.sections)
     sections.push_back({{"id", s.id},
-                        {"encoding", encodingName(s.encoding)},
+                        {"encoding", std::string(encodingName(s.encoding))},
                         {"offset", s.offset},
                         {"stored_bytes", s.storedSize},
                         {"decoded_bytes", s.decodedSize},
                         {"checksum_xxh64", fmt::format("{:016x}", s.checksum)}});
   const BakeSettings& bs = info.settings;
   const BakeStats& st = info.stats;
+  const ValuesStorage storage = valuesStorage(info);
   return {{"file", info.path},
           {"format_version", info.version},
           {"file_bytes", info.fileBytes},
@@ -85,6 +109,11 @@ nlohmann::json toJson(const PlfInfo& info) {
           {"tixels", info.tixels},
           {"values", info.values},
           {"sections", sections},
+          {"compression",
+           {{"mode", std::string(storage.mode)},
+            {"values_stored_bytes", storage.storedBytes},
+            {"values_decoded_bytes", storage.decodedBytes},
+            {"ratio", storage.ratio}}},
           {"settings",
            {{"preset", bs.preset},
             {"tixels_per_unit", bs.tixelsPerUnit},
@@ -133,6 +162,9 @@ void printHuman(const PlfInfo& info) {
              info.glossyCharts, info.specularCharts);
   fmt::print("tixels       {}\n", info.tixels);
   fmt::print("values       {} RGB (float32, {})\n", info.values, humanBytes(info.values * 12));
+  const ValuesStorage storage = valuesStorage(info);
+  fmt::print("compression  {}: values {} stored as {} ({:.2f}:1)\n", storage.mode, humanBytes(storage.decodedBytes),
+             humanBytes(storage.storedBytes), storage.ratio);
   fmt::print("sections     id    encoding        offset        bytes  xxh64\n");
   for (const PlfSectionInfo& s : info.sections)
     fmt::print("             {}  {:8} {:>13} {:>12}  {:016x}  ({})\n", s.id, encodingName(s.encoding), s.offset,

@@ -38,5 +38,6 @@ void addInfoCommand(CLI::App& app, const GlobalOptions& global);
 void addRenderCommand(CLI::App& app, const GlobalOptions& global);
 void addViewCommand(CLI::App& app, const GlobalOptions& global);
 void addEnvCommand(CLI::App& app, const GlobalOptions& global);
+void addCompressCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace pl

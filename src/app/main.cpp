@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   pl::addCompareCommand(app, global);
   pl::addTonemapCommand(app, global);
   pl::addEnvCommand(app, global);
+  pl::addCompressCommand(app, global);
 
   try {
     app.parse(argc, argv);
