@@ -4,6 +4,7 @@
 // repeats it and reports the median. Run:
 //   build/bench/trace_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
+#include <time.h>
 
 #include "accel/accel.h"
 #include "camera/camera.h"
@@ -13,6 +14,15 @@
 #include "trace/trace.h"
 
 namespace {
+
+/// CPU time of the whole process (all threads), seconds. paths per CPU-second does not depend
+/// on how many cores other processes leave us, so it is the figure to compare across runs on
+/// a shared machine; multiply by the core count for the idle-machine rate.
+double processCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 void BM_TraceCornell512(benchmark::State& state) {
   pl::Progress::setEnabled(false);
@@ -25,6 +35,7 @@ void BM_TraceCornell512(benchmark::State& state) {
   settings.spp = static_cast<int>(state.range(0));
   settings.showProgress = false;
   uint64_t paths = 0, rays = 0;
+  const double cpuStart = processCpuSeconds();
   for (auto _ : state) {
     const pl::TraceResult result = tracer.render(camera, settings);
     benchmark::DoNotOptimize(result.radiance.pixels.data());
@@ -32,7 +43,9 @@ void BM_TraceCornell512(benchmark::State& state) {
     rays += result.stats.rays;
     ++settings.seed;  // a fresh image each iteration
   }
+  const double cpuSeconds = processCpuSeconds() - cpuStart;
   state.SetItemsProcessed(static_cast<int64_t>(paths));
+  state.counters["paths_per_cpu_s"] = static_cast<double>(paths) / cpuSeconds;
   state.counters["paths_per_s"] = benchmark::Counter(static_cast<double>(paths), benchmark::Counter::kIsRate);
   state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(rays), benchmark::Counter::kIsRate);
   state.counters["rays_per_path"] = static_cast<double>(rays) / static_cast<double>(paths ? paths : 1);
