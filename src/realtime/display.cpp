@@ -18,20 +18,20 @@ DisplayEncoder::DisplayEncoder() : srgbTable_(kSrgbTableSize) {
 void DisplayEncoder::encode(const Image& radiance, float exposureScale, const ToneMapSettings& settings,
                             uint32_t* pixels, int pitchBytes) {
   const int width = radiance.width, height = radiance.height;
-  if (exposed_.width != width || exposed_.height != height) exposed_ = Image(width, height);
-  parallelForRange(uint64_t(height), 16, [&](uint64_t begin, uint64_t end) {
-    for (size_t i = size_t(begin) * size_t(width); i < size_t(end) * size_t(width); ++i)
-      exposed_.pixels[i] = radiance.pixels[i] * exposureScale;
-  });
-  curve_ = resolveToneMap(exposed_, settings);
+  const int stride = kStatisticsStride;
+  const int sw = (width + stride - 1) / stride, sh = (height + stride - 1) / stride;
+  if (statistics_.width != sw || statistics_.height != sh) statistics_ = Image(sw, sh);
+  for (int y = 0; y < sh; ++y)
+    for (int x = 0; x < sw; ++x) statistics_.at(x, y) = radiance.at(x * stride, y * stride) * exposureScale;
+  curve_ = resolveToneMap(statistics_, settings);
   const uint8_t* table = srgbTable_.data();
   const float scale = float(kSrgbTableSize - 1);
   parallelForRange(uint64_t(height), 16, [&](uint64_t begin, uint64_t end) {
     for (int y = int(begin); y < int(end); ++y) {
       uint32_t* row = reinterpret_cast<uint32_t*>(reinterpret_cast<uint8_t*>(pixels) + size_t(y) * size_t(pitchBytes));
-      const Rgb* in = &exposed_.pixels[size_t(y) * size_t(width)];
+      const Rgb* in = &radiance.pixels[size_t(y) * size_t(width)];
       for (int x = 0; x < width; ++x) {
-        const Rgb d = curve_.apply(in[x]);
+        const Rgb d = curve_.apply(in[x] * exposureScale);
         if (!isFinite(d)) {
           row[x] = 0xFFFF00FFu;  // magenta, as encodeSrgb8
           continue;
