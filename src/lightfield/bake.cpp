@@ -17,14 +17,14 @@ BakeSettings bakePreset(const std::string& name) {
   s.preset = name;
   s.tixelsPerUnit = 0.0f;  // density from the scene size
   if (name == "draft") {
-    s.tixelsAcrossScene = 24;
+    s.tixelsAcrossScene = 32;
     s.maxTixelsPerChartSide = 32;
     s.gatherDirections = 144;
     s.glossyDirRes = 8;
     s.areaLightSamples = 16;
     s.tolerance = 5e-3f;
   } else if (name == "default") {
-    s.tixelsAcrossScene = 48;
+    s.tixelsAcrossScene = 64;
     s.maxTixelsPerChartSide = 64;
     s.gatherDirections = 256;
     s.glossyDirRes = 12;
