@@ -70,7 +70,6 @@ struct TraceStats {
   uint64_t nanSamples = 0;      ///< samples dropped because their radiance was not finite
   int firstNanX = -1, firstNanY = -1;  ///< a pixel with a dropped sample (-1 when none)
   uint64_t firstNanSample = 0;
-  int threads = 0;              ///< worker threads available to the render
   double pathsPerSecond() const { return seconds > 0.0 ? double(paths) / seconds : 0.0; }
   double raysPerSecond() const { return seconds > 0.0 ? double(rays) / seconds : 0.0; }
 };
