@@ -1,0 +1,99 @@
+// Runs `plenoptic bake` end to end (PLENOPTIC_BINARY): the .plf and .plv it writes, --stats,
+// --reuse-visibility, and how it refuses bad input.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "lightfield/plf_file.h"
+
+namespace pl {
+namespace {
+
+namespace fs = std::filesystem;
+
+class BakeCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("plenoptic_bake_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Exit status of the command (0 = success), with its stdout and stderr.
+  int run(const std::string& arguments, std::string* output = nullptr, std::string* errors = nullptr) const {
+    const fs::path outFile = dir_ / "stdout.txt", errFile = dir_ / "stderr.txt";
+    const std::string command = std::string("\"") + PLENOPTIC_BINARY + "\" " + arguments + " > \"" + outFile.string() +
+                                "\" 2> \"" + errFile.string() + "\"";
+    const int status = std::system(command.c_str());
+    if (output) *output = slurp(outFile);
+    if (errors) *errors = slurp(errFile);
+    return status;
+  }
+  static std::string slurp(const fs::path& file) {
+    std::ifstream in(file);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+TEST_F(BakeCli, BakesWritesStatsAndReusesVisibility) {
+  const std::string plf = path("cornell.plf"), stats = path("stats.json");
+  std::string out, err;
+  // Small overrides keep the test fast; the flags are part of the contract.
+  const std::string base = "bake cornell -o \"" + plf + "\" --preset draft --tixels-across 12";
+  const std::string common = base + " --directions 64";
+  ASSERT_EQ(run(common + " --stats \"" + stats + "\"", &out, &err), 0) << err;
+  EXPECT_TRUE(fs::exists(plf));
+  EXPECT_TRUE(fs::exists(path("cornell.plv")));  // the visibility field beside the .plf
+  std::ifstream in(stats);
+  const nlohmann::json json = nlohmann::json::parse(in);
+  for (const char* key : {"seconds", "visibility_seconds", "propagation_seconds", "iterations", "residual", "tixels",
+                          "peak_rss_bytes", "file_bytes"})
+    EXPECT_TRUE(json.contains(key)) << key;
+  EXPECT_EQ(json["file_bytes"].get<uint64_t>(), fs::file_size(plf));
+  EXPECT_GT(json["tixels"].get<uint64_t>(), 0u);
+  EXPECT_GT(json["iterations"].get<uint32_t>(), 0u);
+  EXPECT_FALSE(json["reused_visibility"].get<bool>());
+
+  const LightField lf = readLightField(plf);
+  EXPECT_EQ(lf.charts.size(), 16u);
+  EXPECT_EQ(lf.stats.tixels, json["tixels"].get<uint64_t>());
+
+  // Same scene and settings: the saved field is reused (and said so on stderr).
+  ASSERT_EQ(run(common + " --reuse-visibility --stats \"" + stats + "\"", &out, &err), 0) << err;
+  EXPECT_NE(err.find("reusing"), std::string::npos) << err;
+  std::ifstream in2(stats);
+  EXPECT_TRUE(nlohmann::json::parse(in2)["reused_visibility"].get<bool>());
+
+  // Different settings: recomputed, and the message says why.
+  ASSERT_EQ(run(base + " --directions 100 --reuse-visibility", &out, &err), 0) << err;
+  EXPECT_NE(err.find("recomputing"), std::string::npos) << err;
+}
+
+TEST_F(BakeCli, RefusesBadInput) {
+  std::string out, err;
+  EXPECT_NE(run("bake \"" + path("missing.obj") + "\" -o \"" + path("x.plf") + "\"", &out, &err), 0);
+  EXPECT_NE(err.find("missing.obj"), std::string::npos) << err;
+  EXPECT_NE(run("bake cornell -o \"" + path("no/such/dir/x.plf") + "\"", &out, &err), 0);
+  EXPECT_NE(err.find("does not exist"), std::string::npos) << err;
+  EXPECT_NE(run("bake cornell -o \"" + path("x.plf") + "\" --preset ultra", &out, &err), 0);
+  EXPECT_FALSE(fs::exists(path("x.plf")));
+  // A corrupt visibility field is an error, not a silent recompute.
+  const std::string plf = path("c.plf");
+  const std::string common = "bake cornell -o \"" + plf + "\" --preset draft --tixels-across 8 --directions 16 --quiet";
+  ASSERT_EQ(run(common, &out, &err), 0) << err;
+  fs::resize_file(path("c.plv"), fs::file_size(path("c.plv")) - 3);
+  EXPECT_NE(run(common + " --reuse-visibility", &out, &err), 0);
+  EXPECT_NE(err.find("c.plv"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace pl
