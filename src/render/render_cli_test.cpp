@@ -129,14 +129,14 @@ TEST_F(RenderCliTest, InfoJsonHasEveryFigure) {
 TEST_F(RenderCliTest, RenderWritesTheLookedUpRadianceAndStats) {
   const std::string out = path("top.exr"), stats = path("stats.json");
   std::string err;
-  ASSERT_EQ(run("render " + path("quad.plf") + " -o " + out + " --camera top --width 40 --height 30 --frames 3 --stats " +
-                    stats,
+  ASSERT_EQ(run("render " + path("quad.plf") + " -o " + out +
+                    " --reference --camera top --width 40 --height 30 --frames 3 --stats " + stats,
                 nullptr, &err),
             0)
       << err;
 
-  // The same render through the library: the command must add nothing (no exposure flag,
-  // so the EXR holds radiance) and pick the named camera from the embedded scene.
+  // The same render through the library: `render --reference` must add nothing (no exposure
+  // flag, so the EXR holds radiance) and pick the named camera from the embedded scene.
   Progress::setEnabled(false);
   const ThreadPool pool(2);
   const LightField lf = readLightField(path("quad.plf"));
@@ -155,6 +155,7 @@ TEST_F(RenderCliTest, RenderWritesTheLookedUpRadianceAndStats) {
   EXPECT_GT(quadPixels, 200) << "the quad must fill the middle of the top view";
 
   const auto json = nlohmann::json::parse(slurp(stats));
+  EXPECT_EQ(json["renderer"], "reference");
   EXPECT_EQ(json["frames"], 3);
   EXPECT_EQ(json["camera"], "top");
   EXPECT_EQ(json["samples_per_pixel"], 1);
