@@ -220,12 +220,21 @@ std::vector<unsigned char> encodeLossless(const std::vector<Grid>& images, std::
   parallelFor(images.size(), [&](uint64_t k) {
     const Grid& image = images[k];
     uint32_t* out = residuals.data() + 3 * offsets[k];
-    for (int c = 0; c < 3; ++c) {
-      auto get = [&](uint32_t x, uint32_t y) { return orderedBits(component(values[image.at(x, y)], c)); };
-      for (uint32_t y = 0; y < image.height; ++y)
-        for (uint32_t x = 0; x < image.width; ++x)
-          *out++ = zigzag32(get(x, y) - predict<uint32_t>(x, y, get));
-    }
+    const uint64_t n = image.pixels();
+    for (uint32_t y = 0; y < image.height; ++y)
+      for (uint32_t x = 0; x < image.width; ++x) {
+        uint32_t e[3];
+        for (int c = 0; c < 3; ++c) {
+          auto get = [&](uint32_t gx, uint32_t gy) { return orderedBits(component(values[image.at(gx, gy)], c)); };
+          e[c] = get(x, y) - predict<uint32_t>(x, y, get);
+        }
+        // The channels of one value share their noise (the same gather rays), so green's
+        // and blue's prediction errors are coded relative to red's.
+        const uint64_t i = uint64_t(y) * image.width + x;
+        out[i] = zigzag32(e[0]);
+        out[n + i] = zigzag32(e[1] - e[0]);
+        out[2 * n + i] = zigzag32(e[2] - e[0]);
+      }
   });
   const std::vector<unsigned char> payload = shuffleBytes(residuals);
   StreamWriter w;
@@ -244,13 +253,19 @@ void decodeLossless(const std::vector<Grid>& images, StreamReader& r, std::vecto
   parallelFor(images.size(), [&](uint64_t k) {
     const Grid& image = images[k];
     const uint32_t* in = residuals.data() + 3 * offsets[k];
-    for (int c = 0; c < 3; ++c) {
-      // The decoded values themselves are the prediction context (bit exact).
-      auto get = [&](uint32_t x, uint32_t y) { return orderedBits(component(values[image.at(x, y)], c)); };
-      for (uint32_t y = 0; y < image.height; ++y)
-        for (uint32_t x = 0; x < image.width; ++x)
-          component(values[image.at(x, y)], c) = fromOrderedBits(predict<uint32_t>(x, y, get) + unzigzag32(*in++));
-    }
+    const uint64_t n = image.pixels();
+    for (uint32_t y = 0; y < image.height; ++y)
+      for (uint32_t x = 0; x < image.width; ++x) {
+        const uint64_t i = uint64_t(y) * image.width + x;
+        const uint32_t eR = unzigzag32(in[i]);
+        const uint32_t e[3] = {eR, unzigzag32(in[n + i]) + eR, unzigzag32(in[2 * n + i]) + eR};
+        Rgb& v = values[image.at(x, y)];
+        for (int c = 0; c < 3; ++c) {
+          // The decoded values themselves are the prediction context (bit exact).
+          auto get = [&](uint32_t gx, uint32_t gy) { return orderedBits(component(values[image.at(gx, gy)], c)); };
+          component(v, c) = fromOrderedBits(predict<uint32_t>(x, y, get) + e[c]);
+        }
+      }
   });
 }
 

@@ -134,7 +134,8 @@ TEST(ValuesCodec, HdrRelativeErrorIsBoundedByTheStepSize) {
   uint64_t count = 0;
   const std::vector<Chart> charts = makeCharts(count);
   const std::vector<Rgb> values = makeSmoothValues(charts, count);
-  for (uint32_t steps : {8u, 32u, 128u}) {
+  size_t previousSize = std::numeric_limits<size_t>::max();
+  for (uint32_t steps : {128u, 32u, 8u}) {
     ValuesCodecOptions options;
     options.hdrStepsPerStop = steps;
     const std::vector<unsigned char> stored = encodeValues(ValuesCodec::Hdr, charts, values, options);
@@ -155,7 +156,11 @@ TEST(ValuesCodec, HdrRelativeErrorIsBoundedByTheStepSize) {
       }
     EXPECT_LE(worst, bound) << steps << " steps per stop";
     EXPECT_GT(worst, 0.5 * bound) << "the quantisation should actually be used";
-    if (steps == 32) { EXPECT_GT(double(rawBytes(values)) / double(stored.size()), 4.0); }
+    // Coarser steps mean smaller residuals: the size must fall with the step count, and
+    // even the finest step (128 per stop, 0.27 % max error) beats raw storage by 3:1.
+    EXPECT_LT(stored.size(), previousSize) << steps << " steps per stop";
+    previousSize = stored.size();
+    EXPECT_GT(double(rawBytes(values)) / double(stored.size()), 3.0);
   }
 }
 
@@ -360,7 +365,7 @@ TEST(CompressedPlf, EveryModeIsReadBackAndReportedByInfo) {
       EXPECT_EQ(std::memcmp(back.values.data(), lf.values.data(), rawBytes(lf.values)), 0);
     else
       EXPECT_GT(error.rmse, 0.0);  // lossy, and the decoded values are the ones used
-    if (encoding == PlfEncoding::Hdr) { EXPECT_LT(error.maxRelative, 0.011); }  // 2^(1/64) − 1 = 1.09 %
+    if (encoding == PlfEncoding::Hdr) { EXPECT_LT(error.maxRelative, 0.022); }  // 2^(1/32) − 1 = 2.19 %
   }
 }
 

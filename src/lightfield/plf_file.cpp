@@ -905,6 +905,11 @@ std::vector<PlfSectionInfo> sectionInfos(const PlfReader& reader) {
 }  // namespace
 
 void writeLightField(const std::string& path, const LightField& lf, PlfEncoding valuesEncoding) {
+  writeLightField(path, lf, valuesEncoding, ValuesCodecOptions{});
+}
+
+void writeLightField(const std::string& path, const LightField& lf, PlfEncoding valuesEncoding,
+                     const ValuesCodecOptions& codecOptions) {
   // Encode the small sections; raw values are written straight from the LightField,
   // compressed ones from their encoded stream (compression.h).
   static_assert(sizeof(Rgb) == 12, "VALS stores float32 RGB triplets");
@@ -916,7 +921,7 @@ void writeLightField(const std::string& path, const LightField& lf, PlfEncoding 
   if (valuesEncoding != PlfEncoding::Raw) {
     if (!isKnownValuesCodec(uint32_t(valuesEncoding)))
       fail("{}: unknown values encoding {}", path, uint32_t(valuesEncoding));
-    compressedValues = encodeValues(ValuesCodec(valuesEncoding), lf.charts, lf.values);
+    compressedValues = encodeValues(ValuesCodec(valuesEncoding), lf.charts, lf.values, codecOptions);
   }
   const std::span<const unsigned char> rawValues{reinterpret_cast<const unsigned char*>(lf.values.data()),
                                                  lf.values.size() * sizeof(Rgb)};

@@ -99,6 +99,11 @@ struct PlfInfo {
 void writeLightField(const std::string& path, const LightField& lightField,
                      PlfEncoding valuesEncoding = PlfEncoding::Raw);
 
+struct ValuesCodecOptions;  // lightfield/compression.h
+/// The same with the value codec's tuning (zstd level, hdr steps per stop).
+void writeLightField(const std::string& path, const LightField& lightField, PlfEncoding valuesEncoding,
+                     const ValuesCodecOptions& codecOptions);
+
 /// Reads and fully validates a .plf file (see the header comment). The embedded scene is
 /// finalized (vertex buffers padded for Embree) and ready for an Accel.
 LightField readLightField(const std::string& path);
