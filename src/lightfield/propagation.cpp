@@ -372,7 +372,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   });
 
   // ---- Iteration ---------------------------------------------------------------------------
-  std::vector<Rgb> current = direct, next(param.valueCount);
+  std::vector<Rgb> current = direct;
   std::vector<Rgb> transport(tixels, Rgb(0.0f));  // diffuse tixels: ρ̄·E/π
   auto totalPower = [&](const std::vector<Rgb>& values) {
     // Σ area · luminance of the radiant exitance (W): diffuse ρ̄E, glossy Σ Lo·cosθ·Ω.
@@ -401,58 +401,91 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     return total;
   };
 
-  double previousPower = totalPower(current);
-  Progress progress("propagation", settings.maxIterations);
-  for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
-    parallelForRange(tixels, 256, [&](uint64_t t0, uint64_t t1) {
-      for (uint64_t g = t0; g < t1; ++g) {
+  // Gauss–Seidel by batches of whole charts: batches are updated one after another, so a
+  // batch already sees this iteration's values of the batches before it (about half the
+  // iterations of Jacobi). Inside a batch, tixels are updated in parallel and read the
+  // previous iteration's values of their own batch, so no value is read while it is written
+  // and the result does not depend on thread timing.
+  constexpr uint64_t kBatchTixels = 2048;
+  std::vector<uint64_t> batchStart{0};
+  std::vector<uint32_t> chartBatch(param.charts.size(), 0);
+  {
+    uint64_t count = 0;
+    for (size_t ci = 0; ci < param.charts.size(); ++ci) {
+      chartBatch[ci] = uint32_t(batchStart.size() - 1);
+      count += param.charts[ci].tixelCount();
+      if (count >= kBatchTixels) {
+        batchStart.push_back(param.charts[ci].firstTixel + param.charts[ci].tixelCount());
+        count = 0;
+      }
+    }
+    if (batchStart.back() != tixels) batchStart.push_back(tixels);
+  }
+  auto updateTransport = [&](uint64_t begin, uint64_t end) {
+    parallelForRange(end - begin, 256, [&](uint64_t t0, uint64_t t1) {
+      for (uint64_t g = begin + t0; g < begin + t1; ++g) {
         const Chart& c = param.charts[param.tixelChart[g]];
         if (c.kind == ChartKind::Diffuse) transport[g] = param.transportAlbedo[g] * current[c.firstValue + (g - c.firstTixel)] * kInvPi;
       }
     });
-    parallelForRange(tixels, 16, [&](uint64_t t0, uint64_t t1) {
-      std::vector<Rgb> incoming(n);
-      for (uint64_t g = t0; g < t1; ++g) {
-        const Chart& c = param.charts[param.tixelChart[g]];
-        if (c.kind == ChartKind::Specular) continue;
-        uint64_t cursor = vis.extraOffset[g];
-        const VisibilityEntry* entries = vis.entries.data() + g * n;
-        for (uint32_t k = 0; k < n; ++k) {
-          const VisibilityEntry e = entries[k];
-          const VisibilityExtra* extra = e.hasExtra() ? &vis.extras[cursor++] : nullptr;
-          Rgb L(0.0f);
-          // Back-side hits see the inside of a closed solid (or the unlit back of a one-sided
-          // surface): no reflected light. Emission from behind is in the constant part.
-          if (!e.escaped() && !e.backSide()) {
-            const uint32_t base = e.tixel();
-            const Chart& seen = param.charts[param.tixelChart[base]];
-            const float fu = float(e.fu) * (1.0f / 65535.0f), fv = float(e.fv) * (1.0f / 65535.0f);
-            if (seen.kind == ChartKind::Diffuse) {
-              L = (1.0f - fu) * (1.0f - fv) * transport[base];
-              if (e.fu) L += fu * (1.0f - fv) * transport[base + 1];
-              if (e.fv) L += (1.0f - fu) * fv * transport[base + seen.resU];
-              if (e.fu && e.fv) L += fu * fv * transport[base + seen.resU + 1];
-            } else if (seen.kind == ChartKind::Glossy && extra) {
-              const uint64_t local = base - seen.firstTixel;
-              const Vec2 grid(float(local % seen.resU) + fu, float(local / seen.resU) + fv);
-              L = interpolateValues(current.data(), seen, grid, extra->st);
+  };
+  updateTransport(0, tixels);
+  std::vector<Rgb> previousValues, previousTransport;
+
+  double previousPower = totalPower(current);
+  Progress progress("propagation", settings.maxIterations);
+  for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
+    previousValues = current;
+    previousTransport = transport;
+    for (size_t batch = 0; batch + 1 < batchStart.size(); ++batch) {
+      const uint64_t begin = batchStart[batch], end = batchStart[batch + 1];
+      parallelForRange(end - begin, 16, [&](uint64_t t0, uint64_t t1) {
+        std::vector<Rgb> incoming(n);
+        for (uint64_t g = begin + t0; g < begin + t1; ++g) {
+          const Chart& c = param.charts[param.tixelChart[g]];
+          if (c.kind == ChartKind::Specular) continue;
+          uint64_t cursor = vis.extraOffset[g];
+          const VisibilityEntry* entries = vis.entries.data() + g * n;
+          for (uint32_t k = 0; k < n; ++k) {
+            const VisibilityEntry e = entries[k];
+            const VisibilityExtra* extra = e.hasExtra() ? &vis.extras[cursor++] : nullptr;
+            Rgb L(0.0f);
+            // Back-side hits see the inside of a closed solid (or the unlit back of a one-sided
+            // surface): no reflected light. Emission from behind is in the constant part.
+            if (!e.escaped() && !e.backSide()) {
+              const uint32_t base = e.tixel();
+              const uint32_t seenIndex = param.tixelChart[base];
+              const Chart& seen = param.charts[seenIndex];
+              const bool sameBatch = chartBatch[seenIndex] == batch;
+              const float fu = float(e.fu) * (1.0f / 65535.0f), fv = float(e.fv) * (1.0f / 65535.0f);
+              if (seen.kind == ChartKind::Diffuse) {
+                const Rgb* t = sameBatch ? previousTransport.data() : transport.data();
+                L = (1.0f - fu) * (1.0f - fv) * t[base];
+                if (e.fu) L += fu * (1.0f - fv) * t[base + 1];
+                if (e.fv) L += (1.0f - fu) * fv * t[base + seen.resU];
+                if (e.fu && e.fv) L += fu * fv * t[base + seen.resU + 1];
+              } else if (seen.kind == ChartKind::Glossy && extra) {
+                const uint64_t local = base - seen.firstTixel;
+                const Vec2 grid(float(local % seen.resU) + fu, float(local / seen.resU) + fv);
+                L = interpolateValues(sameBatch ? previousValues.data() : current.data(), seen, grid, extra->st);
+              }
+              if (extra) L *= extra->throughput;
             }
-            if (extra) L *= extra->throughput;
+            incoming[k] = L;
           }
-          incoming[k] = L;
+          const uint64_t vb = valueBase(g, c);
+          Rgb sum(0.0f);
+          for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
+          if (c.kind == ChartKind::Diffuse) {
+            current[vb] = direct[vb] + sum * (kPi / float(n));
+          } else {
+            std::copy_n(direct.data() + vb, c.valuesPerTixel(), current.data() + vb);
+            glossy[c.material].op.apply(incoming.data(), sum, current.data() + vb);
+          }
         }
-        const uint64_t vb = valueBase(g, c);
-        Rgb sum(0.0f);
-        for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
-        if (c.kind == ChartKind::Diffuse) {
-          next[vb] = direct[vb] + sum * (kPi / float(n));
-        } else {
-          std::copy_n(direct.data() + vb, c.valuesPerTixel(), next.data() + vb);
-          glossy[c.material].op.apply(incoming.data(), sum, next.data() + vb);
-        }
-      }
-    });
-    std::swap(current, next);
+      });
+      updateTransport(begin, end);
+    }
     const double power = totalPower(current);
     result.iterations = iteration;
     result.residual = power > 0.0 ? std::abs(power - previousPower) / power : 0.0;

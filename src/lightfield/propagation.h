@@ -14,7 +14,8 @@
 //     triangles (chosen ∝ area·luminance(Le)) combined by the balance heuristic with the gather
 //     rays that hit emitters; glossy tixels receive emission through their gather rays;
 //   * the environment (constant radiance) through gather rays that escape.
-// Iteration (Jacobi): R ← direct + M R, where M gathers the transport radiance of the seen
+// Iteration (block Gauss–Seidel over batches of whole charts, deterministic; see the .cpp):
+// R ← direct + M R, where M gathers the transport radiance of the seen
 // tixels (bilinear over 2×2 tixels, and for glossy targets bilinear over 2×2 directional
 // texels) and applies the local operator:
 //   diffuse  E = (π/N) Σ_k L_k                      (each gather cell has projected solid angle π/N)

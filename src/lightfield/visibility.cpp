@@ -8,7 +8,7 @@
 //   tixelCount   u64
 //   entryCount   u64      = tixelCount · N
 //   extraCount   u64
-//   payloadHash  u64      FNV-1a 64 of every byte after the header
+//   payloadHash  u64      XXH64 (seed 0, as the .plf checksums) of every byte after the header
 //   payload      entries (8 bytes each), extraOffset (u64 × (tixelCount + 1)), extras (24 bytes each)
 #include "lightfield/visibility.h"
 
@@ -27,6 +27,7 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "lightfield/lookup.h"
+#include "lightfield/plf_file.h"
 
 namespace pl {
 
@@ -234,10 +235,11 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 }
 
 void writeVisibility(const std::string& path, const VisibilityField& field) {
-  Fnv1a payload;
-  payload.bytes(field.entries.data(), field.entries.size() * sizeof(VisibilityEntry));
-  payload.bytes(field.extraOffset.data(), field.extraOffset.size() * sizeof(uint64_t));
-  payload.bytes(field.extras.data(), field.extras.size() * sizeof(VisibilityExtra));
+  Xxh64Stream payloadStream;
+  payloadStream.update(field.entries.data(), field.entries.size() * sizeof(VisibilityEntry));
+  payloadStream.update(field.extraOffset.data(), field.extraOffset.size() * sizeof(uint64_t));
+  payloadStream.update(field.extras.data(), field.extras.size() * sizeof(VisibilityExtra));
+  const uint64_t payloadHash = payloadStream.digest();
 
   const std::string temp = path + ".tmp";
   {
@@ -252,7 +254,7 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
     put(&field.tixelCount, 8);
     put(&entryCount, 8);
     put(&extraCount, 8);
-    put(&payload.state, 8);
+    put(&payloadHash, 8);
     put(field.entries.data(), field.entries.size() * sizeof(VisibilityEntry));
     put(field.extraOffset.data(), field.extraOffset.size() * sizeof(uint64_t));
     put(field.extras.data(), field.extras.size() * sizeof(VisibilityExtra));
@@ -320,11 +322,11 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   get(f.extraOffset.data(), f.extraOffset.size() * sizeof(uint64_t));
   get(f.extras.data(), extraCount * sizeof(VisibilityExtra));
   if (!in) fail("{}: read failed", path);
-  Fnv1a payload;
-  payload.bytes(f.entries.data(), entryCount * sizeof(VisibilityEntry));
-  payload.bytes(f.extraOffset.data(), f.extraOffset.size() * sizeof(uint64_t));
-  payload.bytes(f.extras.data(), extraCount * sizeof(VisibilityExtra));
-  if (payload.state != payloadHash) fail("{}: corrupt visibility field (payload checksum mismatch)", path);
+  Xxh64Stream payload;
+  payload.update(f.entries.data(), entryCount * sizeof(VisibilityEntry));
+  payload.update(f.extraOffset.data(), f.extraOffset.size() * sizeof(uint64_t));
+  payload.update(f.extras.data(), extraCount * sizeof(VisibilityExtra));
+  if (payload.digest() != payloadHash) fail("{}: corrupt visibility field (payload checksum mismatch)", path);
   // Structural checks, so that propagation can index without bounds checks.
   const uint32_t n = gridSide * gridSide;
   if (f.extraOffset[0] != 0 || f.extraOffset.back() != extraCount) fail("{}: corrupt extra-record offsets", path);
