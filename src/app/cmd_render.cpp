@@ -22,12 +22,11 @@
 #include "app/view_options.h"
 #include "camera/camera.h"
 #include "core/error.h"
-#include "core/progress.h"
-#include "image/tonemap.h"
 #include "lightfield/plf_file.h"
 #include "realtime/camera_path.h"
 #include "realtime/frame_output.h"
 #include "realtime/realtime.h"
+#include "realtime/walkthrough.h"
 #include "render/render.h"
 
 namespace pl {
@@ -158,26 +157,22 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
     for (int frame = 0; frame < options.frames; ++frame) renderFrame(camera);
     view.writeImage(options.output, image);
   } else {
-    // The walk-through: frame k at time t₀ + k/fps, the path's pose on the resolved camera
-    // (which keeps its lens and, when the path has no fov, its fov).
-    frames = cameraPath->frameCount();
-    std::unique_ptr<VideoWriter> videoWriter;
-    if (video) videoWriter = std::make_unique<VideoWriter>(options.output, view.width, view.height, cameraPath->fps);
-    Progress progress("walk-through", uint64_t(frames));
-    for (int frame = 0; frame < frames; ++frame) {
-      const CameraDesc desc = applyPose(cameraDesc, cameraPath->at(cameraPath->frameTime(frame)));
-      renderFrame(Camera(desc, view.width, view.height, view.vignetting, view.metresPerUnit(lightField.scene)));
-      if (videoWriter) {
-        const float scale = view.exposureScale();
-        Image exposed = image;
-        for (Rgb& p : exposed.pixels) p *= scale;
-        videoWriter->write(toneMap(exposed, view.toneMapSettings()));
-      } else {
-        view.writeImage(formatFramePath(options.output, frame), image);
-      }
-      progress.advance();
-    }
-    if (videoWriter) videoWriter->finish();
+    // The walk-through (realtime/walkthrough.h): frame k at time t₀ + k/fps, the path's pose
+    // on the resolved camera (which keeps its lens and, without a path fov, its fov).
+    WalkthroughOptions walk;
+    walk.output = options.output;
+    walk.width = view.width;
+    walk.height = view.height;
+    walk.vignetting = view.vignetting;
+    walk.metresPerUnit = view.metresPerUnit(lightField.scene);
+    walk.exposureScale = view.exposureScale();
+    walk.toneMap = view.toneMapSettings();
+    const WalkthroughResult result =
+        renderWalkthrough(*cameraPath, cameraDesc, walk, [&](const Camera& frameCamera, Image& frameImage) {
+          renderFrame(frameCamera);
+          std::swap(frameImage, image);
+        });
+    frames = result.frames;
   }
 
   const double medianMs = median(frameMs);

@@ -37,6 +37,18 @@ FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel) : l
     shading_.push_back(chartShading(scene, c));
     needsUv_.push_back(uint8_t(c.kind == ChartKind::Diffuse && shading_.back().texturedAlbedo));
   }
+  if (lightField.triangleChart.size() != scene.meshes.size())
+    fail("fast renderer: triangle → chart map has {} meshes, the scene {}", lightField.triangleChart.size(), scene.meshes.size());
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    if (lightField.triangleChart[m].size() != scene.meshes[m].triangles.size())
+      fail("fast renderer: mesh {} has {} triangles but {} chart entries", m, scene.meshes[m].triangles.size(),
+           lightField.triangleChart[m].size());
+    meshFirstTriangle_.push_back(uint32_t(triangleChart_.size()));
+    for (uint32_t chart : lightField.triangleChart[m]) {
+      if (chart >= lightField.charts.size()) fail("fast renderer: mesh {}: chart index {} out of range", m, chart);
+      triangleChart_.push_back(chart);
+    }
+  }
 }
 
 int FastRenderer::samplesPerPixel(const Camera& camera, const RenderSettings& settings) {
@@ -122,7 +134,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     } else if (!hit.hit()) {
       radiance = backgroundRadiance(scene.environment, ray.direction);
     } else {
-      const uint32_t chart = lightField_.triangleChart[hit.mesh][hit.triangle];
+      const uint32_t chart = triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle];
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv(0.0f);
@@ -158,7 +170,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         s.radiance[slot] += throughput * backgroundRadiance(scene.environment, ray.direction);
         continue;
       }
-      const uint32_t chart = lightField_.triangleChart[hit.mesh][hit.triangle];
+      const uint32_t chart = triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle];
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv(0.0f);

@@ -64,6 +64,9 @@ class FastRenderer {
   const Accel& accel_;
   std::vector<ChartShading> shading_;  ///< per chart
   std::vector<uint8_t> needsUv_;       ///< per chart: textured diffuse (the lookup needs the hit's uv)
+  /// LightField::triangleChart flattened: chart of triangle t of mesh m at
+  /// triangleChart_[meshFirstTriangle_[m] + t] (one dependent load less per pixel).
+  std::vector<uint32_t> meshFirstTriangle_, triangleChart_;
 };
 
 }  // namespace pl

@@ -103,20 +103,6 @@ ToneMapOperator nextOperator(ToneMapOperator op) {
 
 }  // namespace
 
-void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap) {
-  const bool hdr = isHdrExtension(path);
-  if (!hdr && fileExtensionLower(path) != ".png")
-    fail("{}: unknown output type '{}' (use .exr, .hdr, .pfm or .png)", path, fileExtensionLower(path));
-  Image exposed = radiance;
-  if (exposureScale != 1.0f)
-    for (Rgb& p : exposed.pixels) p *= exposureScale;
-  if (hdr) {
-    writeHdrImage(path, exposed);
-  } else {
-    writePng(path, pl::toneMap(exposed, toneMap));
-  }
-}
-
 bool displayAvailable() {
   if (SDL_Init(SDL_INIT_VIDEO) != 0) return false;
   SDL_Window* window = SDL_CreateWindow("plenoptic", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, 16, 16, SDL_WINDOW_HIDDEN);

@@ -25,6 +25,7 @@
 #include "image/tonemap.h"
 #include "lightfield/lightfield.h"
 #include "realtime/camera_path.h"
+#include "realtime/walkthrough.h"
 #include "render/render.h"
 
 namespace pl {
@@ -64,9 +65,5 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
 /// True when SDL can open a window here (a display, or SDL_VIDEODRIVER set to a headless
 /// driver). `make demo` uses it to choose between the viewer and a rendered walk-through.
 bool displayAvailable();
-
-/// Writes a frame of radiance the way `plenoptic render` does (ViewOptions::writeImage):
-/// HDR formats get radiance × exposureScale, PNG additionally the tone mapping. Atomic.
-void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap);
 
 }  // namespace pl

@@ -1,0 +1,112 @@
+// Rendering camera paths to files (see walkthrough.h).
+#include "realtime/walkthrough.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include "camera/camera.h"
+#include "core/error.h"
+#include "core/progress.h"
+#include "realtime/frame_output.h"
+
+namespace pl {
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+Image exposedCopy(const Image& radiance, float exposureScale) {
+  Image exposed = radiance;
+  if (exposureScale != 1.0f)
+    for (Rgb& p : exposed.pixels) p *= exposureScale;
+  return exposed;
+}
+
+}  // namespace
+
+void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap) {
+  const bool hdr = isHdrExtension(path);
+  if (!hdr && fileExtensionLower(path) != ".png")
+    fail("{}: unknown output type '{}' (use .exr, .hdr, .pfm or .png)", path, fileExtensionLower(path));
+  if (hdr) {
+    writeHdrImage(path, exposedCopy(radiance, exposureScale));
+  } else {
+    writePng(path, pl::toneMap(exposedCopy(radiance, exposureScale), toneMap));
+  }
+}
+
+WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& baseCamera, const WalkthroughOptions& options,
+                                    const std::function<void(const Camera&, Image&)>& renderFrame) {
+  const bool video = isVideoOutput(options.output);
+  if (!video && !isFramePattern(options.output))
+    fail("-o {}: a camera path renders many frames: give a frame pattern like frames/%04d.png or an .mp4 file",
+         options.output);
+  if (!video) {
+    const std::string ext = fileExtensionLower(options.output);
+    if (!isHdrExtension(options.output) && ext != ".png")
+      fail("-o {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", options.output, ext);
+  }
+  const std::filesystem::path parent = std::filesystem::path(options.output).parent_path();
+  if (!parent.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(parent, error);
+    if (error) fail("-o {}: cannot create directory '{}': {}", options.output, parent.string(), error.message());
+  }
+  std::unique_ptr<VideoWriter> videoWriter;
+  if (video) videoWriter = std::make_unique<VideoWriter>(options.output, options.width, options.height, path.fps);
+
+  WalkthroughResult result;
+  result.frames = path.frameCount();
+  std::unique_ptr<Progress> progress;
+  if (options.showProgress) progress = std::make_unique<Progress>("walk-through", uint64_t(result.frames));
+  Image image;
+  for (int frame = 0; frame < result.frames; ++frame) {
+    const CameraDesc desc = applyPose(baseCamera, path.at(path.frameTime(frame)));
+    const Camera camera(desc, options.width, options.height, options.vignetting, options.metresPerUnit);
+    const auto start = std::chrono::steady_clock::now();
+    renderFrame(camera, image);
+    result.frameMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    if (videoWriter) {
+      videoWriter->write(toneMap(exposedCopy(image, options.exposureScale), options.toneMap));
+    } else {
+      writeFrame(formatFramePath(options.output, frame), image, options.exposureScale, options.toneMap);
+    }
+    if (progress) progress->advance();
+  }
+  if (videoWriter) videoWriter->finish();
+  result.msPerFrameMedian = median(result.frameMs);
+  result.fps = result.msPerFrameMedian > 0.0 ? 1e3 / result.msPerFrameMedian : 0.0;
+  return result;
+}
+
+WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& baseCamera, const WalkthroughOptions& options,
+                                    const FastRenderer& renderer, const RenderSettings& settings) {
+  return renderWalkthrough(path, baseCamera, options,
+                           [&](const Camera& camera, Image& image) { renderer.render(camera, settings, image); });
+}
+
+CameraPath orbitPath(const CameraDesc& camera, double seconds, double fps, float degrees) {
+  if (!(seconds > 0.0) || !(fps > 0.0)) fail("orbit path: duration and fps must be positive");
+  const Vec3 up = glm::normalize(camera.up);
+  const Vec3 offset = camera.eye - camera.target;
+  CameraPath path;
+  path.fps = fps;
+  // Angles of the 5 keyframes: 0, +a, 0, −a, 0 (a smooth swing with Catmull–Rom).
+  const float angles[5] = {0.0f, degrees, 0.0f, -degrees, 0.0f};
+  for (int k = 0; k < 5; ++k) {
+    const float a = angles[k] * kPi / 180.0f;
+    // Rodrigues' rotation of the eye offset about the up axis through the target.
+    const Vec3 rotated = offset * std::cos(a) + glm::cross(up, offset) * std::sin(a) + up * glm::dot(up, offset) * (1.0f - std::cos(a));
+    path.keyframes.push_back(CameraKeyframe{seconds * double(k) / 4.0, camera.target + rotated, camera.target, up, camera.fovYDegrees});
+  }
+  return path;
+}
+
+}  // namespace pl

@@ -1,0 +1,56 @@
+#pragma once
+// Rendering a camera path to files: the loop behind `plenoptic render --path` and the
+// non-interactive `make demo`. Frame k shows the path's pose at t₀ + k/fps on the base camera
+// (which keeps its lens and, when the path has no fov, its fov); each frame is written as
+// `plenoptic render` writes a single image (writeFrame), or piped into an MP4 (frame_output.h).
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+#include "image/tonemap.h"
+#include "realtime/camera_path.h"
+#include "realtime/realtime.h"
+#include "render/render.h"
+
+namespace pl {
+
+class Camera;
+
+struct WalkthroughOptions {
+  std::string output;  ///< frame pattern ("frames/%04d.png", .png/.exr/.hdr/.pfm) or an .mp4 file
+  int width = 640, height = 480;
+  bool vignetting = false;
+  float metresPerUnit = 1.0f;         ///< sizes a thin lens (camera.h)
+  float exposureScale = 1.0f;         ///< radiance → pixel value (exposure.h)
+  ToneMapSettings toneMap;            ///< for PNG and MP4 frames
+  bool showProgress = true;
+};
+
+struct WalkthroughResult {
+  int frames = 0;
+  std::vector<double> frameMs;        ///< render time of each frame (files excluded)
+  double msPerFrameMedian = 0.0;
+  double fps = 0.0;                   ///< 1000 / msPerFrameMedian
+};
+
+/// Renders every frame of `path` with `renderFrame` (which fills the image for a camera) and
+/// writes it. Frame-pattern directories are created. Throws pl::Error for a bad output name,
+/// a missing ffmpeg (MP4) or any write failure.
+WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& baseCamera, const WalkthroughOptions& options,
+                                    const std::function<void(const Camera&, Image&)>& renderFrame);
+/// The same with the fast renderer and `settings`.
+WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& baseCamera, const WalkthroughOptions& options,
+                                    const FastRenderer& renderer, const RenderSettings& settings);
+
+/// A path for demos: the eye swings around the camera's target by ±degrees about its up axis
+/// and back (5 keyframes over `seconds`), at the camera's own fov.
+CameraPath orbitPath(const CameraDesc& camera, double seconds = 4.0, double fps = CameraPath::kDefaultFps,
+                     float degrees = 25.0f);
+
+/// Writes a frame of radiance the way `plenoptic render` writes its image
+/// (ViewOptions::writeImage): .exr/.hdr/.pfm get radiance × exposureScale, .png additionally
+/// the tone mapping and sRGB encoding. Atomic.
+void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap);
+
+}  // namespace pl
