@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <memory>
 #include <string>
 
 #include "accel/accel.h"
@@ -263,6 +264,43 @@ TEST_F(RenderTest, GlossyChartIsLookedUpInTheDirectionTowardsTheViewer) {
       hi = std::max(hi, expected);
     }
   EXPECT_GT(hi - lo, 0.5f) << "the view must sweep several direction texels";
+}
+
+TEST_F(RenderTest, MissesSeeTheEnvironmentMapAlongTheRay) {
+  // Rays that leave the scene see Le(direction) = constant + map radiance along the ray's own
+  // direction (towards the sky). The map varies with direction, so a sign error or a frame
+  // mix-up shows. The only geometry is a small quad behind the camera.
+  LightField lf;
+  lf.scene.materials = {Material{"wall", LambertBsdf{Rgb(0.5f)}, -1, Rgb(0.0f), false}};
+  lf.scene.meshes = {makeQuad("behind", {-1, -1, 10}, {1, -1, 10}, {1, 1, 10}, {-1, 1, 10}, 0)};
+  lf.scene.environment.constant = Rgb(0.05f);
+  LatLongMap sky;
+  sky.image = Image(16, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x) sky.image.at(x, y) = Rgb(float(x), float(y), 1.0f);
+  lf.scene.environment.map = std::make_shared<const EnvironmentMap>(sky, 0.5f, 20.0f);
+  lf.scene.finalize();
+  lf.charts = {linearIrradianceChart(lf, 0, {-1, -1, 10}, {1, 0, 0}, {0, 1, 0}, 2.0f, 1, 1.0f, Vec3(0.0f))};
+  lf.triangleChart = {{0, 0}};
+  const Accel accel(lf.scene);
+  CameraDesc desc;
+  desc.eye = {0, 0, 0};
+  desc.target = {0.3f, 0.4f, -1.0f};
+  desc.fovYDegrees = 90.0f;
+  const Camera camera(desc, 24, 18);
+  const Image image = renderLightField(lf, accel, camera, RenderSettings{});
+  float lo = kInfinity, hi = 0.0f;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const Ray ray = camera.generateRay(Vec2(float(x) + 0.5f, float(y) + 0.5f), Vec2(0.5f)).ray;
+      const Rgb expected = lf.scene.environment.radiance(ray.direction);
+      // The same function evaluated on the same ray: equal up to float rounding.
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(image.at(x, y)[ch], expected[ch], 1e-6f * expected[ch]) << "pixel " << x << "," << y;
+      lo = std::min(lo, expected.r);
+      hi = std::max(hi, expected.r);
+    }
+  EXPECT_GT(hi - lo, 1.0f) << "the view must sweep a varying part of the map";
 }
 
 /// A closed cube [−1, 1]³ whose six faces point inwards, all Lambertian with albedo a and
