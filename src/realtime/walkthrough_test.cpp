@@ -1,0 +1,68 @@
+// renderWalkthrough and orbitPath: frame count and times, files, errors.
+#include "realtime/walkthrough.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "camera/camera.h"
+#include "core/error.h"
+#include "core/progress.h"
+
+namespace pl {
+namespace {
+
+CameraDesc baseCamera() {
+  CameraDesc d;
+  d.eye = {0, 0, 5};
+  d.target = {0, 0, 0};
+  d.fovYDegrees = 30.0f;
+  return d;
+}
+
+TEST(Walkthrough, OrbitKeepsDistanceAndReturnsToTheStart) {
+  const CameraPath path = orbitPath(baseCamera(), 2.0, 10.0, 30.0f);
+  ASSERT_EQ(path.keyframes.size(), 5u);
+  EXPECT_EQ(path.frameCount(), 21);
+  for (const CameraKeyframe& k : path.keyframes) EXPECT_NEAR(glm::length(k.eye - k.target), 5.0f, 1e-5f);
+  // Keyframe 1 is rotated by +30° about +y: x = 5·sin 30° = 2.5 (right-handed, counter-clockwise from above).
+  EXPECT_NEAR(path.keyframes[1].eye.x, 2.5f, 1e-5f);
+  EXPECT_NEAR(glm::length(path.keyframes[4].eye - baseCamera().eye), 0.0f, 1e-5f);
+  EXPECT_THROW(orbitPath(baseCamera(), 0.0), Error);
+}
+
+TEST(Walkthrough, RendersEveryFrameAtItsTimeAndWritesFiles) {
+  Progress::setEnabled(false);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_walkthrough_test";
+  std::filesystem::remove_all(dir);
+  const CameraPath path = orbitPath(baseCamera(), 1.0, 4.0, 20.0f);  // 5 frames
+  WalkthroughOptions options;
+  options.output = (dir / "sub" / "f%02d.pfm").string();  // the directory is created
+  options.width = 8;
+  options.height = 6;
+  options.exposureScale = 2.0f;
+  options.showProgress = false;
+  std::vector<Vec3> eyes;
+  const WalkthroughResult result = renderWalkthrough(path, baseCamera(), options, [&](const Camera& camera, Image& image) {
+    eyes.push_back(camera.eye());
+    image = Image(camera.width(), camera.height(), Rgb(float(eyes.size())));
+  });
+  EXPECT_EQ(result.frames, 5);
+  ASSERT_EQ(eyes.size(), 5u);
+  for (int k = 0; k < 5; ++k) EXPECT_NEAR(glm::length(eyes[size_t(k)] - path.at(path.frameTime(k)).eye), 0.0f, 1e-5f);
+  // HDR frames hold radiance × exposure: frame 2 (third) rendered value 3 → 6.
+  const Image third = readImage((dir / "sub" / "f02.pfm").string());
+  EXPECT_EQ(third.at(0, 0), Rgb(6.0f));
+  EXPECT_FALSE(std::filesystem::exists(dir / "sub" / "f05.pfm"));
+  EXPECT_EQ(result.frameMs.size(), 5u);
+  std::filesystem::remove_all(dir);
+
+  options.output = (dir / "single.png").string();
+  EXPECT_THROW(renderWalkthrough(path, baseCamera(), options, [](const Camera&, Image&) {}), Error);
+  options.output = (dir / "f%02d.jpg").string();
+  EXPECT_THROW(renderWalkthrough(path, baseCamera(), options, [](const Camera&, Image&) {}), Error);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace pl
