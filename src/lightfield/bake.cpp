@@ -63,10 +63,12 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   bool reused = false;
   if (options.reuseVisibility && !options.visibilityPath.empty()) {
     std::string why;
+    const auto readStart = std::chrono::steady_clock::now();
     reused = readVisibility(options.visibilityPath, hash, visibility, &why);
     if (reused)
-      note(fmt::format("visibility: reusing {} ({} tixels × {} directions)", options.visibilityPath, visibility.tixelCount,
-                       visibility.directionsPerTixel()));
+      note(fmt::format("visibility: reusing {} ({} tixels × {} directions, read in {:.2f} s)", options.visibilityPath,
+                       visibility.tixelCount, visibility.directionsPerTixel(),
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - readStart).count()));
     else
       note(fmt::format("visibility: recomputing, because {}", why));
   }
@@ -78,7 +80,8 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   }
 
   PropagationResult prop = propagate(lf.scene, accel, param, visibility, settings);
-  note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s", prop.iterations, prop.residual, prop.seconds));
+  note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s (first shot {:.2f} s, {} shadow rays)",
+                   prop.iterations, prop.residual, prop.seconds, prop.firstShotSeconds, prop.shadowRays));
 
   lf.charts = param.charts;
   lf.triangleChart = param.triangleChart;

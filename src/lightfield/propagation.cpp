@@ -371,6 +371,8 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     }
   });
 
+  result.firstShotSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
   // ---- Iteration ---------------------------------------------------------------------------
   std::vector<Rgb> current = direct;
   std::vector<Rgb> transport(tixels, Rgb(0.0f));  // diffuse tixels: ρ̄·E/π

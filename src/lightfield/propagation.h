@@ -41,6 +41,7 @@ struct PropagationResult {
   uint32_t iterations = 0;
   double residual = 0.0;    ///< relative change of total outgoing power at the last iteration
   double seconds = 0.0;
+  double firstShotSeconds = 0.0;  ///< of `seconds`: operators, shadow rays, constant gather part
   uint64_t shadowRays = 0;
 };
 
