@@ -15,6 +15,8 @@
 #include <iterator>
 #include <limits>
 #include <random>
+#include <utility>
+#include <cstdlib>
 
 #include "core/error.h"
 #include "lightfield/plf_file.h"
@@ -78,6 +80,22 @@ std::vector<Rgb> makeSmoothValues(const std::vector<Chart>& charts, uint64_t val
 }
 
 uint64_t rawBytes(const std::vector<Rgb>& values) { return values.size() * sizeof(Rgb); }
+
+/// PSNR (dB) of decoded against original values after the tone mapping (x / max)^(1/2.2)
+/// with the largest original component as max (peak 1).
+double toneMappedPsnr(const std::vector<Rgb>& original, const std::vector<Rgb>& decoded) {
+  double maxValue = 0.0, squared = 0.0;
+  for (const Rgb& v : original) maxValue = std::max({maxValue, double(v.r), double(v.g), double(v.b)});
+  for (size_t i = 0; i < original.size(); ++i) {
+    const double o[3] = {original[i].r, original[i].g, original[i].b};
+    const double d[3] = {decoded[i].r, decoded[i].g, decoded[i].b};
+    for (int c = 0; c < 3; ++c) {
+      const double a = std::pow(std::max(o[c], 0.0) / maxValue, 1 / 2.2), b = std::pow(std::max(d[c], 0.0) / maxValue, 1 / 2.2);
+      squared += (a - b) * (a - b);
+    }
+  }
+  return -10.0 * std::log10(squared / (3.0 * double(original.size())));
+}
 
 TEST(ValuesCodec, NamesRoundTripAndUnknownIsRefused) {
   for (ValuesCodec c : {ValuesCodec::Raw, ValuesCodec::Lossless, ValuesCodec::Bc1, ValuesCodec::Hdr})
@@ -178,18 +196,7 @@ TEST(ValuesCodec, Bc1KeepsToneMappedValuesCloseAndRatioAboveSix) {
   // inside one chart, harder than a real bake's images.
   const ValuesError error = measureValuesError(values, decoded);
   EXPECT_LT(error.relativeRmse, 0.5);
-  double squared = 0.0;
-  double maxValue = 0.0;
-  for (const Rgb& v : values) maxValue = std::max({maxValue, double(v.r), double(v.g), double(v.b)});
-  for (size_t i = 0; i < count; ++i) {
-    const double toneO[3] = {values[i].r, values[i].g, values[i].b};
-    const double toneD[3] = {decoded[i].r, decoded[i].g, decoded[i].b};
-    for (int c = 0; c < 3; ++c) {
-      const double a = std::pow(toneO[c] / maxValue, 1 / 2.2), b = std::pow(toneD[c] / maxValue, 1 / 2.2);
-      squared += (a - b) * (a - b);
-    }
-  }
-  const double psnr = -10.0 * std::log10(squared / (3.0 * count));
+  const double psnr = toneMappedPsnr(values, decoded);
   EXPECT_GT(psnr, 35.0);
   EXPECT_EQ(decoded[3].r, 0.0f);
 }
@@ -419,6 +426,34 @@ TEST(CompressedPlf, CorruptCompressedValuesNameTheFileAndSection) {
   // A truncated compressed section (the file ends inside it).
   std::vector<unsigned char> truncated(good.begin(), good.begin() + std::ptrdiff_t(offset + stored / 2));
   expectError(truncated, "truncated");
+}
+
+/// Files written by this version of the codecs (tests/data/compress/{none,lossless,bc1,hdr}.plf,
+/// the light field of makeLightField(); regenerate with PLENOPTIC_REGENERATE_COMPRESS_FIXTURES=1
+/// only when the format changes on purpose, which also needs a new codec number). Every
+/// later build must decode them: lossless bit-exact to none.plf, hdr within its bound.
+TEST(CompressedPlf, FilesOfEarlierBuildsStillDecode) {
+  const std::string dir = std::string(PLENOPTIC_TEST_DATA_DIR) + "/compress/";
+  const std::pair<const char*, PlfEncoding> modes[] = {{"none.plf", PlfEncoding::Raw},
+                                                       {"lossless.plf", PlfEncoding::Lossless},
+                                                       {"bc1.plf", PlfEncoding::Bc1},
+                                                       {"hdr.plf", PlfEncoding::Hdr}};
+  if (std::getenv("PLENOPTIC_REGENERATE_COMPRESS_FIXTURES")) {
+    const LightField lf = makeLightField();
+    for (const auto& [name, encoding] : modes) writeLightField(dir + name, lf, encoding);
+  }
+  const LightField raw = readLightField(dir + "none.plf");
+  const LightField lossless = readLightField(dir + "lossless.plf");
+  ASSERT_EQ(lossless.values.size(), raw.values.size());
+  EXPECT_EQ(std::memcmp(lossless.values.data(), raw.values.data(), rawBytes(raw.values)), 0);
+  const LightField hdr = readLightField(dir + "hdr.plf");
+  // Written with the default 16 steps per stop: ≤ 2^(1/32) − 1 relative, + float32 rounding.
+  EXPECT_LE(measureValuesError(raw.values, hdr.values).maxRelative, std::exp2(1.0 / 32) - 1.0 + 1e-6);
+  const LightField bc1 = readLightField(dir + "bc1.plf");
+  // The same tone-mapped PSNR bound as for freshly encoded BC1 (Bc1KeepsToneMappedValues…).
+  EXPECT_GT(toneMappedPsnr(raw.values, bc1.values), 35.0);
+  for (const auto& [name, encoding] : modes)
+    EXPECT_EQ(readLightFieldInfo(dir + name).sections[3].encoding, uint32_t(encoding)) << name;
 }
 
 }  // namespace
