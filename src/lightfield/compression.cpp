@@ -7,10 +7,12 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/progress.h"
 #include "lightfield/codec_backends.h"
 
 namespace pl {
@@ -22,6 +24,7 @@ static_assert(std::endian::native == std::endian::little, "the stream format is 
 constexpr char kMagic[4] = {'P', 'L', 'V', 'C'};
 constexpr float kBc1Gamma = 2.2f;
 constexpr uint32_t kMaxHdrStepsPerStop = 200;  // 277 stops of float range · 200 + 1 < 2^16 codes
+constexpr uint64_t kBc1BlocksWorthAProgressBar = 50000;
 constexpr uint64_t kMaxRunWidth = uint64_t(1) << 20;  // uncovered values: 1-high images of at most this
 
 // --- Layout -------------------------------------------------------------------------------
@@ -390,8 +393,14 @@ std::vector<unsigned char> encodeBc1(const std::vector<Grid>& images, std::span<
                                      const ValuesCodecOptions& options) {
   const std::vector<uint64_t> offsets = bc1Offsets(images);
   std::vector<unsigned char> payload(offsets.back());
+  // libsquish's iterative cluster fit takes ~20 µs per block: show progress from ~1 s on.
+  uint64_t blocks = 0;
+  for (const Grid& image : images) blocks += blockCount(image);
+  std::optional<Progress> progress;
+  if (blocks >= kBc1BlocksWorthAProgressBar) progress.emplace("bc1 encoding", blocks);
   parallelFor(images.size(), [&](uint64_t k) {
     const Grid& image = images[k];
+    if (progress) progress->advance(blockCount(image));
     float scale = 0.0f;
     for (uint32_t y = 0; y < image.height; ++y)
       for (uint32_t x = 0; x < image.width; ++x) {
