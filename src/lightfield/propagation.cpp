@@ -103,6 +103,7 @@ struct GlossyMaterial {
   uint32_t dirRes = 0;
   SparseOperator op;
   std::vector<std::vector<Vec3>> outputs;     ///< per output texel, its sub-sample directions
+  std::vector<Vec3> centres;                  ///< per output texel, its representative direction
   std::vector<float> projectedSolidAngle;     ///< per output texel, ≈ Ω·cos θ (for the power sum)
 };
 
@@ -201,6 +202,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     const std::vector<float>& omega = paraboloidTexelSolidAngles(c.dirRes);
     for (uint32_t t = 0; t < c.dirRes * c.dirRes; ++t) {
       g.outputs.push_back(outputTexelDirections(t % c.dirRes, t / c.dirRes, c.dirRes));
+      g.centres.push_back(paraboloidTexelDirection(t % c.dirRes, t / c.dirRes, c.dirRes));
       g.projectedSolidAngle.push_back(omega[t] * std::max(0.0f, paraboloidTexelDirection(t % c.dirRes, t / c.dirRes, c.dirRes).z));
     }
   }
@@ -240,6 +242,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
       uint64_t tixel;
       Vec3 wi;
       Rgb irradiance;  ///< already multiplied by cos θ at the receiver (and MIS-weighted)
+      bool areaSample;  ///< a sample of an emissive surface (glossy: texel-centre BSDF value)
     };
     parallelFor(blocks, [&](uint64_t block) {
       const uint64_t t0 = block * tixelsPerBlock, t1 = std::min(tixels, t0 + tixelsPerBlock);
@@ -261,9 +264,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           ray.direction = wi;
           ray.tMax = std::isfinite(distance) ? distance * (1.0f - 1e-4f) : kInfinity;
           rays.push_back(ray);
-          pending.push_back({g, wi, incident * cosTheta});
+          pending.push_back({g, wi, incident * cosTheta, false});
         }
-        if (c.kind != ChartKind::Diffuse || lightSamples == 0) continue;
+        if (lightSamples == 0) continue;
         Pcg32 rng = Pcg32::forKey(g, 0x4e4545, settings.seed);
         for (uint32_t s = 0; s < lightSamples; ++s) {
           float remapped = 0.0f;
@@ -295,7 +298,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           ray.direction = wi;
           ray.tMax = dist * (1.0f - 1e-4f);
           rays.push_back(ray);
-          pending.push_back({g, wi, material.emission * (cosX / pl * weight / float(lightSamples))});
+          pending.push_back({g, wi, material.emission * (cosX / pl * weight / float(lightSamples)), true});
         }
       }
       std::vector<uint8_t> occluded(rays.size());
@@ -312,8 +315,12 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           const GlossyMaterial& gm = glossy[c.material];
           const Bsdf& bsdf = scene.materials[c.material].bsdf;
           const Vec3 wiLocal = chartLocalDirection(c, p.wi);
+          // Punctual lights: the BSDF averaged over each output texel (a delta light would
+          // otherwise alias between texel centres). Area-light samples are many per tixel and
+          // already spread over the emitter: the texel-centre value suffices and costs 9× less.
           for (uint32_t t = 0; t < c.valuesPerTixel(); ++t)
-            direct[vb + t] += texelAverageBsdf(bsdf, gm.outputs[t], wiLocal) * p.irradiance;
+            direct[vb + t] += (p.areaSample ? eval(bsdf, gm.centres[t], wiLocal) : texelAverageBsdf(bsdf, gm.outputs[t], wiLocal)) *
+                              p.irradiance;
         }
       }
       progress.advance(t1 - t0);
@@ -340,7 +347,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           const Material& material = scene.materials[seen.material];
           if (material.isEmissive() && (!e.backSide() || material.twoSidedEmission)) {
             float weight = 1.0f;
-            if (c.kind == ChartKind::Diffuse && lightSamples > 0 && !(extra && extra->viaMirror) && areaPdf[seen.material] > 0.0f) {
+            if (lightSamples > 0 && !(extra && extra->viaMirror) && areaPdf[seen.material] > 0.0f) {
               // The same balance heuristic as the shadow rays, evaluated for this gather ray
               // against the seen chart's plane (exact for a direct hit on a planar emitter).
               const Vec3 local = gatherDirectionLocal(g, k, vis.gridSide, settings.seed);

@@ -10,9 +10,9 @@
 //
 // First shot (constant over the iteration, "direct"):
 //   * point, spot and directional lights: shadow rays from every tixel's gather point;
-//   * emissive surfaces: for diffuse tixels, areaLightSamples shadow rays towards emissive
-//     triangles (chosen ∝ area·luminance(Le)) combined by the balance heuristic with the gather
-//     rays that hit emitters; glossy tixels receive emission through their gather rays;
+//   * emissive surfaces: areaLightSamples shadow rays per tixel towards emissive triangles
+//     (chosen ∝ area·luminance(Le)) combined by the balance heuristic with the gather rays
+//     that hit emitters directly (emitters seen through mirrors come through the gather only);
 //   * the environment (constant radiance) through gather rays that escape.
 // Iteration (block Gauss–Seidel over batches of whole charts, deterministic; see the .cpp):
 // R ← direct + M R, where M gathers the transport radiance of the seen
