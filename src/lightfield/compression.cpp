@@ -14,11 +14,17 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "lightfield/codec_backends.h"
+#include "lightfield/plf_file.h"
 
 namespace pl {
 namespace {
 
 static_assert(sizeof(Rgb) == 12, "values are float32 RGB triplets");
+// The .plf section table stores ValuesCodec numbers as PlfEncoding values.
+static_assert(uint32_t(PlfEncoding::Raw) == uint32_t(ValuesCodec::Raw) &&
+              uint32_t(PlfEncoding::Lossless) == uint32_t(ValuesCodec::Lossless) &&
+              uint32_t(PlfEncoding::Bc1) == uint32_t(ValuesCodec::Bc1) &&
+              uint32_t(PlfEncoding::Hdr) == uint32_t(ValuesCodec::Hdr));
 static_assert(std::endian::native == std::endian::little, "the stream format is little-endian");
 
 constexpr char kMagic[4] = {'P', 'L', 'V', 'C'};
