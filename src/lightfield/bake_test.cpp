@@ -152,6 +152,53 @@ TEST_F(BakeTest, MirrorFurnace) {
   EXPECT_EQ(specular, 1);
 }
 
+// A single upward-facing quad under a constant environment Le: every gather ray escapes, so the
+// outgoing radiance is Le times the directional albedo — ρ·Le for a Lambertian quad, and
+// Le·albedo(ωo) for a glossy one (through the precomputed glossy operator and the paraboloid
+// map). Tolerance 2 %: the glossy values are texel averages, bilinearly interpolated, of an
+// albedo that varies by a few percent across the lobe's texels. (Exactly at the normal the
+// albedo of a normalised Blinn-Phong lobe has a cusp — it falls 2 % within 7° — which a 16²
+// map smooths by about that much, so the directions checked stay 10° or more away from it.)
+TEST_F(BakeTest, QuadUnderUniformSkyReflectsLeTimesAlbedo) {
+  const Rgb sky(0.5f, 1.0f, 2.0f);
+  for (int glossyCase = 0; glossyCase < 2; ++glossyCase) {
+    Scene scene;
+    scene.sourcePath = "quad under sky";
+    const BlinnPhongBsdf bp{Rgb(0.2f), Rgb(0.6f), 20.0f};
+    const LambertBsdf lambert{Rgb(0.7f, 0.5f, 0.3f)};
+    Material m;
+    m.name = "patch";
+    if (glossyCase) m.bsdf = bp;
+    else m.bsdf = lambert;
+    scene.materials.push_back(m);
+    Mesh quad;
+    quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+    quad.materials = {0, 0};
+    scene.meshes.push_back(quad);
+    scene.environment.constant = sky;
+    scene.finalize();
+    BakeSettings settings = smallSettings();
+    settings.tixelsAcrossScene = 2;
+    settings.gatherDirections = 256;
+    settings.glossyDirRes = 16;
+    const LightField lf = bake(scene, settings);
+    ASSERT_EQ(lf.charts.size(), 1u);
+    const Chart& c = lf.charts[0];
+    EXPECT_EQ(c.kind, glossyCase ? ChartKind::Glossy : ChartKind::Diffuse);
+    for (float thetaDeg : {10.0f, 25.0f, 40.0f}) {
+      const float th = thetaDeg * kPi / 180.0f;
+      const Vec3 local(std::sin(th) * 0.6f, std::sin(th) * 0.8f, std::cos(th));
+      const Vec3 w = chartWorldDirection(c, local);
+      const Rgb got = exitantRadiance(lf, 0, Vec3(0.5f, 0.5f, 0.0f), w, Vec2(0.5f));
+      const Rgb expected = glossyCase ? sky * albedo(bp, local) : sky * lambert.albedo;
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(got[ch], expected[ch], (glossyCase ? 0.02f : 1e-4f) * expected[ch])
+            << (glossyCase ? "glossy" : "lambert") << " θ=" << thetaDeg << " channel " << ch;
+    }
+  }
+}
+
 TEST_F(BakeTest, GlossyOperatorRowsIntegrateTheBsdf) {
   // Σ_k W[c][k] = mean over texel c of ∫ f cos θi dωi = the directional albedo. For Lambert it
   // is exactly ρ; for Blinn-Phong the albedo at the texel's direction, compared with the BSDF

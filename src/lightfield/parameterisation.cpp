@@ -30,7 +30,9 @@ uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings) {
   //   GGX D ∝ 1/(α² + tan²θh)² (the cos⁴ factor ignored) = ½ D(0) → tan θh = α·√(√2 − 1).
   // The reflected lobe is about twice as wide as the half-vector lobe, so its full width at
   // half maximum is ≈ 4θh. Near the map centre s = tan(θ/2), so a texel 2/R wide in s spans
-  // ≈ 4/R radians; two texels across the lobe's FWHM needs R ≈ 8 / FWHM.
+  // ≈ 4/R radians; four texels across the lobe's FWHM needs R ≈ 16 / FWHM. (Two are not
+  // enough: the directional albedo of a normalised lobe already falls by ~8 % within 20° of
+  // the normal, and bilinear interpolation between texels 20° apart misses that.)
   float thetaH = 0.5f;
   if (const auto* bp = std::get_if<BlinnPhongBsdf>(&bsdf)) {
     thetaH = std::acos(std::pow(0.5f, 1.0f / std::max(bp->exponent, 1e-3f)));
@@ -38,7 +40,7 @@ uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings) {
     thetaH = std::atan(ggx->alpha * std::sqrt(std::sqrt(2.0f) - 1.0f));
   }
   const float fwhm = std::max(4.0f * thetaH, 1e-4f);
-  const float wanted = std::ceil(8.0f / fwhm);
+  const float wanted = std::ceil(16.0f / fwhm);
   const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
   return uint32_t(std::clamp(wanted, 2.0f, float(cap)));
 }
