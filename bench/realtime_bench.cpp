@@ -15,10 +15,12 @@
 //             does not depend on how complex the lighting or the light field is.
 // Counters: ms_median (fast renderer, radiance only), primary_ms_median (rays only),
 // ratio = ms_median / primary_ms_median, the same with minima (ms_min, primary_ms_min,
-// ratio_min: steadier on a shared machine), display_ms_median (exposure + Reinhard + sRGB into
+// ratio_min), CPU milliseconds per frame summed over threads (cpu_ms, primary_cpu_ms,
+// cpu_ratio: independent of other processes' load on a shared machine), display_ms_median (exposure + Reinhard + sRGB into
 // 8-bit pixels, as the viewer does), fps = 1000 / ms_median.
 // Run:  build/bench/realtime_bench --benchmark_min_time=1
 #include <benchmark/benchmark.h>
+#include <sys/resource.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -158,6 +160,14 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
+/// CPU time of the whole process (all threads, user + system) in milliseconds.
+double processCpuMs() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return 1e3 * (double(usage.ru_utime.tv_sec) + double(usage.ru_stime.tv_sec)) +
+         1e-3 * (double(usage.ru_utime.tv_usec) + double(usage.ru_stime.tv_usec));
+}
+
 double msSince(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
 
 void BM_Frame(benchmark::State& state, const std::string& name, int width, int height, float fNumber, int spp) {
@@ -174,16 +184,21 @@ void BM_Frame(benchmark::State& state, const std::string& name, int width, int h
   std::vector<uint32_t> pixels(size_t(width) * size_t(height));
   pl::ToneMapSettings toneMap;
   std::vector<double> frameMs, primaryMs, displayMs;
+  double fastCpuMs = 0.0, primaryCpuMs = 0.0;
   scene.renderer->render(camera, settings, image);  // warm-up: scratch buffers, caches
   for (auto _ : state) {
+    double cpu = processCpuMs();
     auto start = Clock::now();
     scene.renderer->render(camera, settings, image);
     frameMs.push_back(msSince(start));
+    fastCpuMs += processCpuMs() - cpu;
     benchmark::DoNotOptimize(image.pixels.data());
     state.PauseTiming();
+    cpu = processCpuMs();
     start = Clock::now();
     castPrimaryRays(*scene.accel, camera, depth);
     primaryMs.push_back(msSince(start));
+    primaryCpuMs += processCpuMs() - cpu;
     start = Clock::now();
     display.encode(image, 1.0f, toneMap, pixels.data(), width * 4);
     displayMs.push_back(msSince(start));
@@ -197,6 +212,12 @@ void BM_Frame(benchmark::State& state, const std::string& name, int width, int h
   state.counters["ms_min"] = msMin;
   state.counters["primary_ms_min"] = primaryMin;
   state.counters["ratio_min"] = primaryMin > 0 ? msMin / primaryMin : 0.0;
+  // CPU time (all threads) per frame: what the frame costs the machine, independent of how
+  // much of it other processes took; cpu_ratio is the load-independent cost ratio.
+  const double frames = double(frameMs.size());
+  state.counters["cpu_ms"] = fastCpuMs / frames;
+  state.counters["primary_cpu_ms"] = primaryCpuMs / frames;
+  state.counters["cpu_ratio"] = primaryCpuMs > 0 ? fastCpuMs / primaryCpuMs : 0.0;
   state.counters["ms_median"] = ms;
   state.counters["fps"] = ms > 0 ? 1e3 / ms : 0.0;
   state.counters["primary_ms_median"] = primary;
