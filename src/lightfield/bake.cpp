@@ -27,14 +27,14 @@ BakeSettings bakePreset(const std::string& name) {
     s.tixelsAcrossScene = 64;
     s.maxTixelsPerChartSide = 64;
     s.gatherDirections = 256;
-    s.glossyDirRes = 12;
+    s.glossyDirRes = 16;
     s.areaLightSamples = 32;
     s.tolerance = 1e-3f;
   } else if (name == "high") {
     s.tixelsAcrossScene = 96;
     s.maxTixelsPerChartSide = 128;
     s.gatherDirections = 576;
-    s.glossyDirRes = 16;
+    s.glossyDirRes = 24;
     s.areaLightSamples = 64;
     s.tolerance = 2e-4f;
   } else {

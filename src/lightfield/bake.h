@@ -6,8 +6,8 @@
 // one in metres get the same grids):
 //   preset   tixels across   max per side   gather dirs   glossy map ≤   area-light rays   tolerance
 //   draft          32              32        144 (12²)         8              16             5e-3
-//   default        64              64        256 (16²)        12              32             1e-3
-//   high           96             128        576 (24²)        16              64             2e-4
+//   default        64              64        256 (16²)        16              32             1e-3
+//   high           96             128        576 (24²)        24              64             2e-4
 // "tolerance" is the relative change of total outgoing power at which iteration stops; the
 // remaining error of the Neumann series is about tolerance·a/(1−a) for mean albedo a.
 #include "lightfield/lightfield.h"
