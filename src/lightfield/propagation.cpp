@@ -358,7 +358,8 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
               const float cosY = std::abs(denom);
               const float pl = t > 0.0f && cosY > 0.0f ? areaPdf[seen.material] * t * t / cosY : 0.0f;
               const float pg = local.z * kInvPi;
-              weight = float(n) * pg / (float(n) * pg + float(lightSamples) * pl);
+              const float denominator = float(n) * pg + float(lightSamples) * pl;
+              weight = denominator > 0.0f ? float(n) * pg / denominator : 1.0f;
             }
             L = material.emission * weight;
           }
