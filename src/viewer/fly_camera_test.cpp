@@ -67,3 +67,20 @@ TEST(FlyCamera, RefusesDegenerateCameras) {
 
 }  // namespace
 }  // namespace pl
+
+#include <cstdlib>
+
+#include "viewer/viewer.h"
+
+namespace pl {
+namespace {
+
+TEST(Viewer, HeadlessDriversAreNoDisplay) {
+  // Under SDL's dummy driver (as ctest runs us) a window can be made, but nobody sees it:
+  // `make demo` must render a walk-through to files instead of opening the viewer.
+  ::setenv("SDL_VIDEODRIVER", "dummy", 1);
+  EXPECT_FALSE(displayAvailable());
+}
+
+}  // namespace
+}  // namespace pl

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "accel/accel.h"
@@ -105,9 +106,15 @@ ToneMapOperator nextOperator(ToneMapOperator op) {
 
 bool displayAvailable() {
   if (SDL_Init(SDL_INIT_VIDEO) != 0) return false;
-  SDL_Window* window = SDL_CreateWindow("plenoptic", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, 16, 16, SDL_WINDOW_HIDDEN);
-  const bool ok = window != nullptr;
-  if (window) SDL_DestroyWindow(window);
+  // SDL falls back to its headless drivers when no display is reachable: those do not count.
+  const char* driver = SDL_GetCurrentVideoDriver();
+  const std::string name = driver ? driver : "";
+  bool ok = !name.empty() && name != "dummy" && name != "offscreen";
+  if (ok) {
+    SDL_Window* window = SDL_CreateWindow("plenoptic", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, 16, 16, SDL_WINDOW_HIDDEN);
+    ok = window != nullptr;
+    if (window) SDL_DestroyWindow(window);
+  }
   SDL_Quit();
   return ok;
 }

@@ -62,8 +62,9 @@ struct ViewerResult {
 /// SDL_VIDEODRIVER=dummy or xvfb-run), and for bad options.
 ViewerResult runViewer(const LightField& lightField, const Accel& accel, const ViewerOptions& options);
 
-/// True when SDL can open a window here (a display, or SDL_VIDEODRIVER set to a headless
-/// driver). `make demo` uses it to choose between the viewer and a rendered walk-through.
+/// True when SDL can open a window on a real display here (x11, wayland, ...; SDL's headless
+/// "dummy" and "offscreen" drivers do not count). `make demo` uses it to choose between the
+/// viewer and a rendered walk-through.
 bool displayAvailable();
 
 }  // namespace pl
