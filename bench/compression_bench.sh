@@ -8,8 +8,10 @@
 # Usage: bench/compression_bench.sh [PLENOPTIC_BINARY] [WORK_DIR]
 #   PLENOPTIC_BINARY  default: build/plenoptic
 #   WORK_DIR          default: a new temporary directory (kept, printed at the end)
-# Environment: SHARED_DIR (default /work/shared), RENDER_FLAGS (extra `render` flags, e.g.
-# "--threads 1"), MODES (default "lossless bc1 hdr").
+# Environment: SHARED_DIR (default /work/shared), RENDER_FLAGS (`render` flags; default
+# "--reference": the straightforward renderer of src/render, so the figures measure the
+# light field, not a renderer's approximations; "" for the fast renderer), MODES (default
+# "lossless bc1 hdr").
 #
 # Columns: values ratio = raw float32 values / stored VALS section; file ratio = the whole
 # .plf stored raw / as written; encode = encode + write + fsync of the whole file (s);
@@ -20,7 +22,7 @@ plenoptic="${1:-build/plenoptic}"
 work="${2:-$(mktemp -d -t plenoptic-compression-XXXXXX)}"
 shared="${SHARED_DIR:-/work/shared}"
 modes="${MODES:-lossless bc1 hdr}"
-read -r -a renderFlags <<< "${RENDER_FLAGS:-}"
+read -r -a renderFlags <<< "${RENDER_FLAGS---reference}"
 mkdir -p "$work"
 
 json() {  # json FILE KEY: one top-level value of a JSON file

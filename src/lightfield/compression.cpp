@@ -43,8 +43,9 @@ struct Grid {
   uint64_t at(uint32_t x, uint32_t y) const { return base + x * strideX + y * strideY; }
 };
 
-/// The images of compression.h's layout, in a fixed order (charts in order, direction texels
-/// t-major; then the uncovered runs in value order). Every value lies in exactly one image.
+/// The images of compression.h's layout, in a fixed order (charts in order, a glossy chart's
+/// tixels row by row; then the uncovered runs in value order). Every value lies in exactly
+/// one image.
 std::vector<Grid> buildLayout(const std::vector<Chart>& charts, uint64_t valueCount, const std::string& context) {
   std::vector<Grid> images;
   std::vector<std::pair<uint64_t, uint64_t>> covered;  // [begin, end) value ranges of charts
@@ -56,10 +57,14 @@ std::vector<Grid> buildLayout(const std::vector<Chart>& charts, uint64_t valueCo
       fail("{}: chart {} needs values [{}, {} + {}·{}) but the section holds {} values", context, i, c.firstValue,
            c.firstValue, tixels, perTixel, valueCount);
     covered.emplace_back(c.firstValue, c.firstValue + tixels * perTixel);
-    for (uint32_t t = 0; t < c.dirRes; ++t)
-      for (uint32_t s = 0; s < c.dirRes; ++s)
-        images.push_back({c.firstValue + uint64_t(t) * c.dirRes + s, perTixel, uint64_t(c.resU) * perTixel, c.resU,
-                          c.resV});
+    if (c.dirRes == 1) {
+      // Diffuse: the tixel grid (value (i, j) at firstValue + i + j·resU).
+      images.push_back({c.firstValue, 1, c.resU, c.resU, c.resV});
+    } else {
+      // Glossy: every tixel's dirRes × dirRes paraboloid texture (texel (s, t) at s + t·dirRes).
+      for (uint64_t tixel = 0; tixel < tixels; ++tixel)
+        images.push_back({c.firstValue + tixel * perTixel, 1, c.dirRes, c.dirRes, c.dirRes});
+    }
   }
   std::sort(covered.begin(), covered.end());
   uint64_t next = 0;
