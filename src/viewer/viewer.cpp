@@ -294,4 +294,41 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
   return result;
 }
 
+std::vector<std::string> runDemoWalkthrough(const LightField& lightField, const Accel& accel, const CameraDesc& camera,
+                                            float metresPerUnit, const std::string& outputDirectory) {
+  std::vector<std::string> done;
+  if (displayAvailable()) {
+    ViewerOptions options;
+    options.width = 1024;
+    options.height = 768;
+    options.camera = camera;
+    options.metresPerUnit = metresPerUnit;
+    options.recordPath = outputDirectory + "/walk-path.json";
+    options.screenshotPattern = outputDirectory + "/screenshot-%04d.png";
+    options.title = "plenoptic demo (W/A/S/D/Q/E move, drag to look, Esc quits)";
+    const ViewerResult result = runViewer(lightField, accel, options);
+    done.push_back(fmt::format("viewer: {} frames, median {:.2f} ms/frame", result.frames, result.msPerFrameMedian));
+    return done;
+  }
+  const FastRenderer renderer(lightField, accel);
+  const CameraPath path = orbitPath(camera);
+  WalkthroughOptions options;
+  options.width = 640;
+  options.height = 480;
+  options.metresPerUnit = metresPerUnit;
+  options.output = outputDirectory + "/frames/%04d.png";
+  const WalkthroughResult frames = renderWalkthrough(path, camera, options, renderer, RenderSettings{});
+  done.push_back(fmt::format("no display: rendered a {}-frame walk-through to {} (median {:.2f} ms/frame = {:.0f} fps)",
+                             frames.frames, options.output, frames.msPerFrameMedian, frames.fps));
+  if (!findFfmpeg().empty()) {
+    options.output = outputDirectory + "/walk.mp4";
+    options.showProgress = false;
+    renderWalkthrough(path, camera, options, renderer, RenderSettings{});
+    done.push_back("video: " + options.output);
+  } else {
+    done.push_back("ffmpeg is not installed: no MP4 (the PNG frames are there)");
+  }
+  return done;
+}
+
 }  // namespace pl

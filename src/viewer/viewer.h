@@ -20,6 +20,7 @@
 // on screen, SDL's software framebuffer) or offscreen, or xvfb-run.
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "camera/exposure.h"
 #include "image/tonemap.h"
@@ -66,5 +67,13 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
 /// "dummy" and "offscreen" drivers do not count). `make demo` uses it to choose between the
 /// viewer and a rendered walk-through.
 bool displayAvailable();
+
+/// The walk-through step of `plenoptic demo` / `make demo`: with a display (displayAvailable)
+/// it opens the viewer on `lightField` from `camera` until Esc; otherwise it renders
+/// orbitPath(camera) (4 s at 30 fps, 640×480) with the fast renderer to
+/// outputDirectory/frames/%04d.png and, when ffmpeg is installed, outputDirectory/walk.mp4.
+/// Returns one line per thing done, for the demo to print.
+std::vector<std::string> runDemoWalkthrough(const LightField& lightField, const Accel& accel, const CameraDesc& camera,
+                                            float metresPerUnit, const std::string& outputDirectory);
 
 }  // namespace pl

@@ -14,7 +14,12 @@
 #include "core/rng.h"
 #include "image/image.h"
 #include "lightfield/parameterisation.h"
+#include "accel/accel.h"
+#include "core/parallel.h"
+#include "core/progress.h"
 #include "lightfield/plf_file.h"
+#include "realtime/frame_output.h"
+#include "viewer/viewer.h"
 
 namespace pl {
 namespace {
@@ -181,6 +186,24 @@ TEST_F(ViewerCliTest, FastAndReferenceRenderersWriteTheSameImage) {
     for (int c = 0; c < 3; ++c) maxDifference = std::max(maxDifference, double(std::abs(fast.pixels[i][c] - reference.pixels[i][c])));
   // Float rounding of the hit point only (see realtime/fast_renderer_test.cpp): values ≈ 1.
   EXPECT_LT(maxDifference, 1e-4);
+}
+
+TEST_F(ViewerCliTest, DemoWithoutDisplayRendersTheWalkThroughToFiles) {
+  ::setenv("SDL_VIDEODRIVER", "dummy", 1);  // no display: the demo must write files
+  Progress::setEnabled(false);
+  ThreadPool pool(2);
+  LightField lf = cornellLightField();
+  lf.scene.finalize();
+  const Accel accel(lf.scene);
+  const std::vector<std::string> done =
+      runDemoWalkthrough(lf, accel, lf.scene.cameras.front(), 0.001f, (dir_ / "demo").string());
+  ASSERT_FALSE(done.empty());
+  EXPECT_NE(done.front().find("no display"), std::string::npos) << done.front();
+  // orbitPath: 4 s at 30 fps = 121 frames.
+  EXPECT_TRUE(fs::exists(dir_ / "demo" / "frames" / "0000.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "demo" / "frames" / "0120.png"));
+  EXPECT_FALSE(fs::exists(dir_ / "demo" / "frames" / "0121.png"));
+  EXPECT_EQ(fs::exists(dir_ / "demo" / "walk.mp4"), !findFfmpeg().empty());
 }
 
 }  // namespace
