@@ -383,7 +383,6 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
 
   // ---- Iteration ---------------------------------------------------------------------------
   std::vector<Rgb> current = direct;
-  std::vector<Rgb> transport(tixels, Rgb(0.0f));  // diffuse tixels: ρ̄·E/π
   auto totalPower = [&](const std::vector<Rgb>& values) {
     // Σ area · luminance of the radiant exitance (W): diffuse ρ̄E, glossy Σ Lo·cosθ·Ω.
     std::vector<double> perChart(param.charts.size(), 0.0);
@@ -416,7 +415,8 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   // iterations of Jacobi). Inside a batch, tixels are updated in parallel and read the
   // previous iteration's values of their own batch, so no value is read while it is written
   // and the result does not depend on thread timing.
-  constexpr uint64_t kBatchTixels = 2048;
+  // At least 2048 tixels per batch, and at most 2^14 batches (see TargetTixel).
+  const uint64_t kBatchTixels = std::max<uint64_t>(2048, tixels / 16000 + 1);
   std::vector<uint64_t> batchStart{0};
   std::vector<uint32_t> chartBatch(param.charts.size(), 0);
   {
@@ -431,22 +431,38 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     }
     if (batchStart.back() != tixels) batchStart.push_back(tixels);
   }
+  // Everything a gather ray needs about the tixel it sees, in one 16-byte record (one cache
+  // access instead of three): the transport radiance ρ̄·E/π of diffuse tixels, and `info` =
+  // the chart's row stride resU (bits 0–15) | chart kind (bits 16–17) | batch (bits 18–31).
+  struct alignas(16) TargetTixel {
+    Rgb transport{0.0f};
+    uint32_t info = 0;
+  };
+  std::vector<TargetTixel> targets(tixels);
+  for (size_t ci = 0; ci < param.charts.size(); ++ci) {
+    const Chart& c = param.charts[ci];
+    if (c.resU > 0xffffu) fail("{}: chart {} has {} tixels per row (at most 65535)", scene.sourcePath, ci, c.resU);
+    const uint32_t info = c.resU | (uint32_t(c.kind) << 16) | (chartBatch[ci] << 18);
+    for (uint64_t t = 0; t < c.tixelCount(); ++t) targets[c.firstTixel + t].info = info;
+  }
   auto updateTransport = [&](uint64_t begin, uint64_t end) {
     parallelForRange(end - begin, 256, [&](uint64_t t0, uint64_t t1) {
       for (uint64_t g = begin + t0; g < begin + t1; ++g) {
         const Chart& c = param.charts[param.tixelChart[g]];
-        if (c.kind == ChartKind::Diffuse) transport[g] = param.transportAlbedo[g] * current[c.firstValue + (g - c.firstTixel)] * kInvPi;
+        if (c.kind == ChartKind::Diffuse)
+          targets[g].transport = param.transportAlbedo[g] * current[c.firstValue + (g - c.firstTixel)] * kInvPi;
       }
     });
   };
   updateTransport(0, tixels);
-  std::vector<Rgb> previousValues, previousTransport;
+  std::vector<Rgb> previousValues;
+  std::vector<TargetTixel> previousTargets;
 
   double previousPower = totalPower(current);
   Progress progress("propagation", settings.maxIterations);
   for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
     previousValues = current;
-    previousTransport = transport;
+    previousTargets = targets;
     for (size_t batch = 0; batch + 1 < batchStart.size(); ++batch) {
       const uint64_t begin = batchStart[batch], end = batchStart[batch + 1];
       parallelForRange(end - begin, 16, [&](uint64_t t0, uint64_t t1) {
@@ -464,17 +480,19 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
             // surface): no reflected light. Emission from behind is in the constant part.
             if (!e.escaped() && !e.backSide()) {
               const uint32_t base = e.tixel();
-              const uint32_t seenIndex = param.tixelChart[base];
-              const Chart& seen = param.charts[seenIndex];
-              const bool sameBatch = chartBatch[seenIndex] == batch;
+              const uint32_t info = targets[base].info;
+              const auto kind = ChartKind((info >> 16) & 3u);
+              const bool sameBatch = (info >> 18) == batch;
               const float fu = float(e.fu) * (1.0f / 65535.0f), fv = float(e.fv) * (1.0f / 65535.0f);
-              if (seen.kind == ChartKind::Diffuse) {
-                const Rgb* t = sameBatch ? previousTransport.data() : transport.data();
-                L = (1.0f - fu) * (1.0f - fv) * t[base];
-                if (e.fu) L += fu * (1.0f - fv) * t[base + 1];
-                if (e.fv) L += (1.0f - fu) * fv * t[base + seen.resU];
-                if (e.fu && e.fv) L += fu * fv * t[base + seen.resU + 1];
-              } else if (seen.kind == ChartKind::Glossy && extra) {
+              if (kind == ChartKind::Diffuse) {
+                const TargetTixel* t = sameBatch ? previousTargets.data() : targets.data();
+                const uint32_t stride = info & 0xffffu;
+                L = (1.0f - fu) * (1.0f - fv) * t[base].transport;
+                if (e.fu) L += fu * (1.0f - fv) * t[base + 1].transport;
+                if (e.fv) L += (1.0f - fu) * fv * t[base + stride].transport;
+                if (e.fu && e.fv) L += fu * fv * t[base + stride + 1].transport;
+              } else if (kind == ChartKind::Glossy && extra) {
+                const Chart& seen = param.charts[param.tixelChart[base]];
                 const uint64_t local = base - seen.firstTixel;
                 const Vec2 grid(float(local % seen.resU) + fu, float(local / seen.resU) + fv);
                 L = interpolateValues(sameBatch ? previousValues.data() : current.data(), seen, grid, extra->st);
@@ -501,7 +519,11 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     result.residual = power > 0.0 ? std::abs(power - previousPower) / power : 0.0;
     previousPower = power;
     progress.advance(1);
-    if (result.residual < settings.tolerance) break;
+    if (result.residual < settings.tolerance) {
+      // Converged: the iterations left are not needed, so the bar completes.
+      progress.advance(settings.maxIterations - iteration);
+      break;
+    }
   }
   progress.finish();
 
