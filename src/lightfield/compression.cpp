@@ -30,6 +30,7 @@ static_assert(std::endian::native == std::endian::little, "the stream format is 
 constexpr char kMagic[4] = {'P', 'L', 'V', 'C'};
 constexpr float kBc1Gamma = 2.2f;
 constexpr uint32_t kMaxHdrStepsPerStop = 200;  // 277 stops of float range · 200 + 1 < 2^16 codes
+constexpr uint64_t kMaxValueCount = uint64_t(1) << 36;
 constexpr uint64_t kBc1BlocksWorthAProgressBar = 50000;
 constexpr uint64_t kMaxRunWidth = uint64_t(1) << 20;  // uncovered values: 1-high images of at most this
 
@@ -540,6 +541,10 @@ std::vector<Rgb> decodeValues(ValuesCodec codec, const std::vector<Chart>& chart
     return values;
   }
   if (!isKnownValuesCodec(uint32_t(codec))) fail("{}: unknown values codec {}", context, uint32_t(codec));
+  // A bound far above any real light field (0.8 TB of float values) that keeps a corrupt
+  // count from turning into an absurd allocation or layout loop.
+  if (valueCount > kMaxValueCount)
+    fail("{}: {} values declared; more than {} cannot be a light field", context, valueCount, kMaxValueCount);
   const std::vector<Grid> images = buildLayout(charts, valueCount, context);
   StreamReader r(stored, context);
   checkHeader(r, codec, valueCount, images.size(), context);

@@ -277,6 +277,8 @@ TEST(ValuesCodec, ChartsOutsideTheValuesAreRefused) {
   const std::vector<Rgb> values = makeSmoothValues(charts, count);
   const std::vector<unsigned char> stored = encodeValues(ValuesCodec::Hdr, charts, values);
   EXPECT_THROW(decodeValues(ValuesCodec::Hdr, charts, 100, stored, "x"), Error);
+  // An absurd count (as from a hand-made section table) is refused before any allocation.
+  EXPECT_THROW(decodeValues(ValuesCodec::Hdr, charts, uint64_t(1) << 60, stored, "x"), Error);
   std::vector<Chart> overlapping = charts;
   overlapping[3].firstValue = overlapping[1].firstValue + 1;
   EXPECT_THROW(encodeValues(ValuesCodec::Hdr, overlapping, values), Error);
