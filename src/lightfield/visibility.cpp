@@ -61,15 +61,34 @@ uint32_t gatherGridSide(uint32_t gatherDirections) {
   return std::max<uint32_t>(1, uint32_t(std::lround(std::sqrt(double(gatherDirections)))));
 }
 
-Vec3 gatherDirectionLocal(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed) {
-  // The jitter inside the cell: 2 × 24 random bits from one 64-bit hash of (tixel, k, seed)
-  // (a full PCG stream per ray costs more than the ray's own set-up).
-  const uint64_t h = hashCombine(hashCombine(tixel, k), seed ^ 0x5649534942494c59ULL);
-  const float jitterU = float(uint32_t(h) >> 8) * 0x1p-24f, jitterV = float(uint32_t(h >> 32) >> 8) * 0x1p-24f;
-  const float a = float(k % gridSide), b = float(k / gridSide);
+namespace {
+
+// Inside its cell, a tixel's ray goes through one of kJitterSide² sub-cells, chosen by a hash
+// of (tixel, cell, seed), at a point of that sub-cell fixed by a hash of (cell, sub-cell,
+// seed): stratified within the cell, decorrelated between tixels, and cheap — the directions
+// of every (cell, sub-cell) pair are tabulated once per field. (Sub-cell *centres* would put
+// the directions on a regular lattice, and rays from regularly spaced tixels would then hit
+// the exact edges and corners of axis-aligned boxes, where ray-triangle tests may miss.)
+constexpr uint32_t kJitterSide = 4;
+constexpr uint32_t kJitterCount = kJitterSide * kJitterSide;
+
+inline uint32_t jitterIndex(uint64_t tixel, uint32_t k, uint64_t seed) {
+  return uint32_t(hashCombine(hashCombine(tixel, k), seed ^ 0x5649534942494c59ULL) >> 60) & (kJitterCount - 1);
+}
+
+inline Vec3 cellDirection(uint32_t k, uint32_t jitter, uint32_t gridSide, uint64_t seed) {
+  const uint64_t h = hashCombine(hashCombine(k, jitter), seed ^ 0x4a4954544552ULL);
+  const float offsetU = float(uint32_t(h) >> 8) * 0x1p-24f, offsetV = float(uint32_t(h >> 32) >> 8) * 0x1p-24f;
+  const float a = float(k % gridSide) + (float(jitter % kJitterSide) + offsetU) / kJitterSide;
+  const float b = float(k / gridSide) + (float(jitter / kJitterSide) + offsetV) / kJitterSide;
   const float inv = 1.0f / float(gridSide);
-  const Vec2 u((a + jitterU) * inv, (b + jitterV) * inv);
-  return sampleCosineHemisphere(u);
+  return sampleCosineHemisphere(Vec2(a * inv, b * inv));
+}
+
+}  // namespace
+
+Vec3 gatherDirectionLocal(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed) {
+  return cellDirection(k, jitterIndex(tixel, k, seed), gridSide, seed);
 }
 
 uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings) {
@@ -121,6 +140,9 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
          VisibilityEntry::kIndexMask - 1);
   const uint32_t n = field.directionsPerTixel();
   field.entries.resize(param.tixelCount * n);
+  std::vector<Vec3> directionTable(size_t(n) * kJitterCount);  // [cell][sub-cell]
+  for (uint32_t k = 0; k < n; ++k)
+    for (uint32_t j = 0; j < kJitterCount; ++j) directionTable[size_t(k) * kJitterCount + j] = cellDirection(k, j, field.gridSide, settings.seed);
 
   // Blocks of tixels whose rays are traced as one Embree stream (~4096 rays).
   const uint64_t tixelsPerBlock = std::max<uint64_t>(1, 4096 / n);
@@ -149,11 +171,14 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
         // are never read. No rays are spent on them.
         continue;
       }
+      // Every gather direction is in the upper hemisphere, so all rays of a tixel share one
+      // origin, offset off the surface along the normal. The frame is orthonormal and the
+      // local directions are unit, so the world directions need no renormalisation.
+      const Vec3 origin = offsetRayOrigin(param.gatherPoint[g], c.normal, c.normal);
       for (uint32_t k = 0; k < n; ++k) {
-        const Vec3 dir = glm::normalize(chartWorldDirection(c, gatherDirectionLocal(g, k, field.gridSide, settings.seed)));
         Ray ray;
-        ray.origin = offsetRayOrigin(param.gatherPoint[g], c.normal, dir);
-        ray.direction = dir;
+        ray.origin = origin;
+        ray.direction = chartWorldDirection(c, directionTable[size_t(k) * kJitterCount + jitterIndex(g, k, settings.seed)]);
         rays.push_back(ray);
         states.push_back({g * n + k, Rgb(1.0f), false});
       }

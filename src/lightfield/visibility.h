@@ -8,8 +8,9 @@
 // Gather directions. Each tixel has N = m² directions, one per cell of an m × m grid over the
 // unit square mapped to the hemisphere by the concentric cosine-weighted map
 // (sampleCosineHemisphere). Every cell has the same projected solid angle π/N, so a cell's
-// contribution to irradiance is (π/N)·L. Inside its cell each tixel's ray is jittered by a
-// hash of (tixel, cell, seed): stratified, and decorrelated between neighbouring tixels.
+// contribution to irradiance is (π/N)·L. Inside its cell each tixel's ray passes through one
+// of 4 × 4 sub-cell centres picked by a hash of (tixel, cell, seed): stratified, and
+// decorrelated between neighbouring tixels.
 //
 // Entries (8 bytes, tixel-major: entry k of tixel g at g·N + k):
 //   target  bits 0–29: global index of the tixel at the lower-left of the 2×2 bilinear
