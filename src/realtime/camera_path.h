@@ -16,8 +16,9 @@
 // time; frameCount = ⌊(t_last − t₀)·fps⌋ + 1, so a path of duration D at 30 fps gives 30·D+1
 // frames, the last one on (or just before) the last keyframe.
 //
-// Interpolation. eye and target each follow a centripetal Catmull–Rom spline (α = ½; Yury
-// et al. 2011: no cusps or self-intersections within a segment, unlike the uniform variant)
+// Interpolation. eye and target each follow a centripetal Catmull–Rom spline (α = ½; Yuksel,
+// Schaefer & Keyser 2011, "Parameterization and applications of Catmull–Rom curves": no
+// cusps or self-intersections within a segment, unlike the uniform variant)
 // through the keyframe positions. Between keyframes i and i+1 the spline's own parameter
 // runs linearly with time from the knot of i to the knot of i+1, so the curve passes through
 // every keyframe at its time and is C¹ in its parameter. The end segments use phantom
