@@ -200,6 +200,43 @@ TEST_F(BakeTest, QuadUnderUniformSkyReflectsLeTimesAlbedo) {
   }
 }
 
+// An environment *map* bright (radiance c) above the horizon (world y > 0) and black below:
+// a Lambertian quad facing up sees only the bright half, E = π·c, L = ρ·c; one facing down
+// sees only the black half. Checks that escaping gather rays look the map up in their world
+// direction. Tolerance 2 % of ρ·c: bilinear filtering blurs the map's horizon over one texel
+// row (5.6°), where cos θ, and so the weight, is small.
+TEST_F(BakeTest, EnvironmentMapIsLookedUpInTheLeavingDirection) {
+  const float c = 2.0f;
+  LatLongMap map;
+  map.image = Image(64, 32);
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x)
+      if (LatLongMap::direction((x + 0.5) / 64.0, (y + 0.5) / 32.0).y > 0.0f) map.image.at(x, y) = Rgb(c);
+  for (const float facing : {1.0f, -1.0f}) {
+    Scene scene;
+    scene.sourcePath = "quad under half sky";
+    Material m;
+    m.name = "patch";
+    m.bsdf = LambertBsdf{Rgb(0.5f)};
+    scene.materials.push_back(m);
+    Mesh quad;
+    quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};  // in y = 0
+    quad.triangles = {facing > 0.0f ? UVec3(0, 2, 1) : UVec3(0, 1, 2), facing > 0.0f ? UVec3(0, 3, 2) : UVec3(0, 2, 3)};
+    quad.materials = {0, 0};
+    scene.meshes.push_back(quad);
+    scene.environment.map = std::make_shared<const EnvironmentMap>(map);
+    scene.finalize();
+    BakeSettings settings = smallSettings();
+    settings.tixelsAcrossScene = 2;
+    settings.gatherDirections = 256;
+    const LightField lf = bake(scene, settings);
+    ASSERT_EQ(lf.charts.size(), 1u);
+    ASSERT_NEAR(lf.charts[0].normal.y, facing, 1e-6f);
+    const Rgb L = exitantRadiance(lf, 0, Vec3(0.5f, 0.0f, 0.5f), lf.charts[0].normal, Vec2(0.5f));
+    EXPECT_NEAR(L.g, facing > 0.0f ? 0.5f * c : 0.0f, 0.02f * 0.5f * c) << "facing " << facing;
+  }
+}
+
 TEST_F(BakeTest, GlossyOperatorRowsIntegrateTheBsdf) {
   // Σ_k W[c][k] = mean over texel c of ∫ f cos θi dωi = the directional albedo. For Lambert it
   // is exactly ρ; for Blinn-Phong the albedo at the texel's direction, compared with the BSDF

@@ -328,7 +328,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   }
 
   // Emission and environment arriving through the gather rays (constant over the iteration).
-  const Rgb environment = scene.environment.constant;
+  const Environment& environment = scene.environment;
   parallelForRange(tixels, 16, [&](uint64_t t0, uint64_t t1) {
     std::vector<Rgb> incoming(n);
     for (uint64_t g = t0; g < t1; ++g) {
@@ -341,7 +341,13 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
         const VisibilityExtra* extra = e.hasExtra() ? &vis.extras[cursor++] : nullptr;
         Rgb L(0.0f);
         if (e.escaped()) {
-          L = environment;
+          // The environment in the direction the path left: the gather direction itself, or
+          // after mirrors the final direction stored with the path.
+          if (!environment.isBlack()) {
+            const Vec3 leaving = extra ? octahedralDecode(extra->st)
+                                       : chartWorldDirection(c, gatherDirectionLocal(g, k, vis.gridSide, settings.seed));
+            L = environment.radiance(leaving);
+          }
         } else {
           const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
           const Material& material = scene.materials[seen.material];

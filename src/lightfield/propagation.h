@@ -13,7 +13,8 @@
 //   * emissive surfaces: areaLightSamples shadow rays per tixel towards emissive triangles
 //     (chosen ∝ area·luminance(Le)) combined by the balance heuristic with the gather rays
 //     that hit emitters directly (emitters seen through mirrors come through the gather only);
-//   * the environment (constant radiance) through gather rays that escape.
+//   * the environment (Environment::radiance of the leaving direction) through gather rays
+//     that escape, directly or after mirrors.
 // Iteration (block Gauss–Seidel over batches of whole charts, deterministic; see the .cpp):
 // R ← direct + M R, where M gathers the transport radiance of the seen
 // tixels (bilinear over 2×2 tixels, and for glossy targets bilinear over 2×2 directional

@@ -198,7 +198,7 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
           entry.target = VisibilityEntry::kEscape;
           if (state.viaMirror) {
             entry.target |= VisibilityEntry::kHasExtra;
-            extras.push_back({state.entry, VisibilityExtra{state.throughput, Vec2(0.0f), 1}});
+            extras.push_back({state.entry, VisibilityExtra{state.throughput, octahedralEncode(ray.direction), 1}});
           }
           continue;
         }

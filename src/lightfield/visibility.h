@@ -22,11 +22,14 @@
 // starting at extraOffset[g]:
 //   throughput  product of the mirror reflectances along the chain (1 without mirrors)
 //   st          paraboloid coordinates, in the seen chart's frame, of the direction in which
-//               the seen point sends light back along the path (glossy targets)
+//               the seen point sends light back along the path (glossy targets); for a path
+//               that leaves the scene after mirrors, the octahedral encoding of its final
+//               world direction (to look the environment up)
 //   viaMirror   whether the path went through at least one mirror
 #include "core/math.h"
 #include "lightfield/parameterisation.h"
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -73,6 +76,22 @@ struct VisibilityField {
            extras.size() * sizeof(VisibilityExtra);
   }
 };
+
+/// Octahedral map of unit vectors to [−1, 1]² and back (exact round trip up to float error).
+inline Vec2 octahedralEncode(const Vec3& d) {
+  const Vec3 a = d / (std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
+  if (a.z >= 0.0f) return {a.x, a.y};
+  return {(1.0f - std::abs(a.y)) * (a.x >= 0.0f ? 1.0f : -1.0f), (1.0f - std::abs(a.x)) * (a.y >= 0.0f ? 1.0f : -1.0f)};
+}
+inline Vec3 octahedralDecode(Vec2 e) {
+  Vec3 d(e.x, e.y, 1.0f - std::abs(e.x) - std::abs(e.y));
+  if (d.z < 0.0f) {
+    const float x = d.x;
+    d.x = (1.0f - std::abs(d.y)) * (x >= 0.0f ? 1.0f : -1.0f);
+    d.y = (1.0f - std::abs(x)) * (d.y >= 0.0f ? 1.0f : -1.0f);
+  }
+  return glm::normalize(d);
+}
 
 /// m for a requested number of gather directions: round(√N), at least 1.
 uint32_t gatherGridSide(uint32_t gatherDirections);
