@@ -52,4 +52,29 @@ CameraDesc FlyCamera::desc() const {
   return d;
 }
 
+void PathRecorder::start(double seconds, const CameraDesc& camera) {
+  recording_ = true;
+  start_ = seconds;
+  path_ = CameraPath{};
+  path_.fps = CameraPath::kDefaultFps;
+  sample(seconds, camera, true);
+}
+
+void PathRecorder::sample(double seconds, const CameraDesc& camera, bool force) {
+  if (!recording_) return;
+  const double t = seconds - start_;
+  if (!path_.keyframes.empty()) {
+    if (!(t > path_.keyframes.back().time)) return;  // times must increase strictly
+    if (!force && seconds - last_ < interval_) return;
+  }
+  path_.keyframes.push_back(CameraKeyframe{t, camera.eye, camera.target, glm::normalize(camera.up), camera.fovYDegrees});
+  last_ = seconds;
+}
+
+CameraPath PathRecorder::stop(double seconds, const CameraDesc& camera) {
+  sample(seconds, camera, true);
+  recording_ = false;
+  return std::move(path_);
+}
+
 }  // namespace pl

@@ -7,6 +7,7 @@
 // kept within ±kMaxPitchDegrees so the view never flips over the pole. The target stays at
 // the initial eye–target distance in front of the eye (a thin lens stays focused there).
 #include "core/math.h"
+#include "realtime/camera_path.h"
 #include "scene/scene.h"
 
 namespace pl {
@@ -40,6 +41,27 @@ class FlyCamera {
   float distance_ = 1.0f;  ///< eye–target distance kept in front of the eye
   float speed_;
   bool moved_ = false;
+};
+
+/// Records a flown camera into a camera path (realtime/camera_path.h): a keyframe at the start,
+/// then at most one every `interval` seconds, and one at the end; times are seconds since
+/// the start of the recording. The viewer toggles it with P (or R).
+class PathRecorder {
+ public:
+  explicit PathRecorder(double interval = 0.25) : interval_(interval) {}
+  bool recording() const { return recording_; }
+  /// Starts a new recording with the camera at `seconds` (any clock, e.g. since program start).
+  void start(double seconds, const CameraDesc& camera);
+  /// Adds a keyframe if `interval` has passed since the last one (or `force`).
+  void sample(double seconds, const CameraDesc& camera, bool force = false);
+  /// Ends the recording with a final keyframe and returns the path (fps = kDefaultFps).
+  CameraPath stop(double seconds, const CameraDesc& camera);
+
+ private:
+  double interval_;
+  bool recording_ = false;
+  double start_ = 0.0, last_ = 0.0;
+  CameraPath path_;
 };
 
 }  // namespace pl

@@ -84,3 +84,40 @@ TEST(Viewer, HeadlessDriversAreNoDisplay) {
 
 }  // namespace
 }  // namespace pl
+
+namespace pl {
+namespace {
+
+TEST(PathRecorder, RecordsKeyframesAtTheIntervalAndRoundTrips) {
+  CameraDesc camera;
+  camera.eye = {0, 0, 5};
+  camera.target = {0, 0, 0};
+  camera.fovYDegrees = 50.0f;
+  FlyCamera fly(camera, 1.0f);
+  PathRecorder recorder(0.25);
+  EXPECT_FALSE(recorder.recording());
+  recorder.start(10.0, fly.desc());  // any clock: times become relative to the start
+  EXPECT_TRUE(recorder.recording());
+  // 60 Hz frames for one second, moving right at 1 unit/s.
+  for (int frame = 1; frame <= 60; ++frame) {
+    fly.move(Vec3(1, 0, 0), 1.0f / 60.0f);
+    recorder.sample(10.0 + frame / 60.0, fly.desc());
+  }
+  const CameraPath path = recorder.stop(11.05, fly.desc());
+  EXPECT_FALSE(recorder.recording());
+  // Keyframes at 0, then the first frames at or after 0.25, 0.5, 0.75, 1.0, and the end.
+  ASSERT_EQ(path.keyframes.size(), 6u);
+  EXPECT_EQ(path.keyframes.front().time, 0.0);
+  EXPECT_NEAR(path.keyframes.back().time, 1.05, 1e-9);
+  EXPECT_NEAR(path.keyframes[4].eye.x, 1.0f, 1e-4f);  // sampled at t = 1 s
+  EXPECT_EQ(*path.keyframes[2].fovYDegrees, 50.0f);
+  // It is a valid path file: the JSON parses back with the same keyframes.
+  const CameraPath back = parseCameraPath(cameraPathToJson(path), "recorded");
+  ASSERT_EQ(back.keyframes.size(), path.keyframes.size());
+  for (size_t i = 0; i < path.keyframes.size(); ++i) EXPECT_EQ(back.keyframes[i].eye, path.keyframes[i].eye);
+  // Playing it back passes through the recorded positions.
+  EXPECT_NEAR(glm::length(back.at(path.keyframes[3].time).eye - path.keyframes[3].eye), 0.0f, 1e-5f);
+}
+
+}  // namespace
+}  // namespace pl

@@ -142,30 +142,17 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
   std::vector<double> recentMs;
   int screenshots = 0;
   bool dragging = false, quit = false;
-  // Recording state: keyframes with times relative to the start of the recording.
-  std::optional<CameraPath> recording;
-  Clock::time_point recordStart, lastKeyframe;
+  PathRecorder recorder(options.recordInterval);
+  const Clock::time_point sessionStart = Clock::now();
+  auto secondsAt = [&](Clock::time_point t) { return std::chrono::duration<double>(t - sessionStart).count(); };
   std::string message;  // a transient HUD line (saved files)
   Clock::time_point messageUntil;
-
-  auto saveRecording = [&] {
-    if (!recording || recording->keyframes.empty()) return;
-    saveCameraPath(options.recordPath, *recording);
-    message = fmt::format("saved {} keyframes to {}", recording->keyframes.size(), options.recordPath);
+  auto stopRecording = [&](Clock::time_point now) {
+    const CameraPath path = recorder.stop(secondsAt(now), fly.desc());
+    saveCameraPath(options.recordPath, path);
+    message = fmt::format("saved {} keyframes to {}", path.keyframes.size(), options.recordPath);
     fmt::print("{}\n", message);
     messageUntil = Clock::now() + std::chrono::seconds(3);
-    recording.reset();
-  };
-  auto record = [&](Clock::time_point now, bool force) {
-    if (!recording) return;
-    const double t = std::chrono::duration<double>(now - recordStart).count();
-    if (!force && !recording->keyframes.empty() &&
-        std::chrono::duration<double>(now - lastKeyframe).count() < options.recordInterval)
-      return;
-    if (!recording->keyframes.empty() && !(t > recording->keyframes.back().time)) return;
-    const CameraDesc d = fly.desc();
-    recording->keyframes.push_back(CameraKeyframe{t, d.eye, d.target, d.up, d.fovYDegrees});
-    lastKeyframe = now;
   };
 
   Clock::time_point previous = Clock::now();
@@ -202,14 +189,10 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
             messageUntil = Clock::now() + std::chrono::seconds(3);
           }
           if ((key == SDLK_p || key == SDLK_r) && event.key.repeat == 0) {
-            if (recording) {
-              record(frameStart, true);
-              saveRecording();
+            if (recorder.recording()) {
+              stopRecording(frameStart);
             } else {
-              recording = CameraPath{};
-              recording->fps = CameraPath::kDefaultFps;
-              recordStart = frameStart;
-              record(frameStart, true);
+              recorder.start(secondsAt(frameStart), fly.desc());
             }
           }
           break;
@@ -233,7 +216,7 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
         fly.move(direction, dt, factor);
       }
     }
-    if (recording) record(frameStart, false);
+    recorder.sample(secondsAt(frameStart), fly.desc());
 
     int width = 0, height = 0;
     window.outputSize(width, height);
@@ -262,7 +245,7 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
                     renderMs.back(), width, height),
         fmt::format("EYE {:.3g} {:.3g} {:.3g}", eye.x, eye.y, eye.z),
         fmt::format("EXPOSURE {:+.1f} EV  TONEMAP {}{}", exposureEv, toneMapOperatorName(toneMap.op),
-                    recording ? "  [REC]" : ""),
+                    recorder.recording() ? "  [REC]" : ""),
     };
     if (!message.empty() && frameStart < messageUntil) lines.push_back(message);
     int hudWidth = 0;
@@ -280,10 +263,7 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
     recentMs.push_back(ms);
     if (recentMs.size() > kTimingWindow) recentMs.erase(recentMs.begin());
   }
-  if (recording) {
-    record(Clock::now(), true);
-    saveRecording();
-  }
+  if (recorder.recording()) stopRecording(Clock::now());
   if (!options.screenshotPath.empty() && !radiance.empty())
     writeFrame(options.screenshotPath, radiance, options.exposureScale * std::exp2(exposureEv), toneMap);
 
