@@ -105,6 +105,11 @@ ToneMapOperator nextOperator(ToneMapOperator op) {
 }  // namespace
 
 bool displayAvailable() {
+  // No X11 or Wayland display in the environment: nothing to open a window on. Deciding this
+  // before SDL_Init keeps SDL's own complaints (e.g. about XDG_RUNTIME_DIR) off the terminal.
+  const char* x11 = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  if ((!x11 || !*x11) && (!wayland || !*wayland)) return false;
   if (SDL_Init(SDL_INIT_VIDEO) != 0) return false;
   // SDL falls back to its headless drivers when no display is reachable: those do not count.
   const char* driver = SDL_GetCurrentVideoDriver();
