@@ -59,6 +59,7 @@ void runCompare(const CompareOptions& options, const GlobalOptions& global) {
     j["psnr_peak"] = c.peak;
     j["identical"] = c.rmse == 0.0 && c.nonFinitePixels == 0;
     j["mean_ratio_rgb"] = {number(c.meanRatio[0]), number(c.meanRatio[1]), number(c.meanRatio[2])};
+    j["mean_luminance_ratio"] = number(c.meanLuminanceRatio);  // Rec.709 Y, mean A / mean B
     j["max_abs_error"] = number(c.maxAbsError);
     j["max_abs_error_pixel"] = {c.maxErrorX, c.maxErrorY};
     j["nonfinite_pixels"] = c.nonFinitePixels;
@@ -71,7 +72,8 @@ void runCompare(const CompareOptions& options, const GlobalOptions& global) {
                c.relMse[2]);
     fmt::print("PSNR:          {} dB (peak {})\n", std::isinf(c.psnr) ? std::string("inf") : fmt::format("{:.3f}", c.psnr),
                c.peak);
-    fmt::print("mean A/B:      R {:.6g}, G {:.6g}, B {:.6g}\n", c.meanRatio[0], c.meanRatio[1], c.meanRatio[2]);
+    fmt::print("mean A/B:      R {:.6g}, G {:.6g}, B {:.6g}; luminance {:.6g}\n", c.meanRatio[0], c.meanRatio[1],
+               c.meanRatio[2], c.meanLuminanceRatio);
     fmt::print("max |A-B|:     {:.6g} at pixel ({}, {})\n", c.maxAbsError, c.maxErrorX, c.maxErrorY);
     if (c.nonFinitePixels)
       fmt::print("non-finite:    {} pixels (NaN/Inf in A or B; left out of the figures above)\n", c.nonFinitePixels);

@@ -71,6 +71,14 @@ ImageComparison compareImages(const Image& a, const Image& reference, double pea
     mseAll += result.mse[c] / 3.0;
     relAll += result.relMse[c] / 3.0;
   }
+  // Rec.709 weights, as luminance() in core/math.h, applied to the per-channel sums.
+  const double weights[3] = {0.2126, 0.7152, 0.0722};
+  double lumA = 0.0, lumB = 0.0;
+  for (size_t c = 0; c < 3; ++c) {
+    lumA += weights[c] * sumA[c];
+    lumB += weights[c] * sumB[c];
+  }
+  result.meanLuminanceRatio = n ? lumA / lumB : nan;
   result.rmse = std::sqrt(mseAll);
   result.relMseAverage = relAll;
   result.psnr = mseAll > 0.0 ? 10.0 * std::log10(peak * peak / mseAll)

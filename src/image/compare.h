@@ -10,6 +10,9 @@
 //               The peak is 1.0 by default for HDR images (radiance has no natural maximum;
 //               1 is "white" after exposure), settable.
 //   meanRatio_c = mean a_c / mean b_c (1 = same average brightness; ∞ or NaN if mean b_c = 0)
+//   meanLuminanceRatio = mean Y(a) / mean Y(b), Y = 0.2126 R + 0.7152 G + 0.0722 B (Rec.709
+//               relative luminance, core/math.h); luminance is linear, so this equals
+//               Σ_c w_c·mean a_c / Σ_c w_c·mean b_c (not the weighted sum of the ratios)
 //   maxAbsError = max |a − b| over pixels and channels, at maxErrorX/Y
 // relMse's 0.01 keeps the figure finite where the reference is black (Rousselle et al. 2011).
 #include <array>
@@ -23,6 +26,7 @@ struct ImageComparison {
   int width = 0, height = 0;
   size_t nonFinitePixels = 0;
   std::array<double, 3> mse{}, relMse{}, meanRatio{};
+  double meanLuminanceRatio = 0.0;
   double rmse = 0.0, relMseAverage = 0.0, psnr = 0.0, peak = 1.0;
   double maxAbsError = 0.0;
   int maxErrorX = 0, maxErrorY = 0;

@@ -52,6 +52,9 @@ TEST(Compare, KnownPerturbationGivesTheExpectedFigures) {
   EXPECT_NEAR(c.meanRatio[0], 1.25, 1e-12);
   EXPECT_NEAR(c.meanRatio[1], (0.5 * (n - 1) + 2.0) / (0.5 * n), 1e-12);
   EXPECT_DOUBLE_EQ(c.meanRatio[2], 1.0);
+  // Mean luminance ratio: Σ w_c Σa_c / Σ w_c Σb_c with the Rec.709 weights.
+  const double sumAR = 0.625 * n, sumAG = 0.5 * (n - 1) + 2.0, sumAB = 0.5 * n, sumB = 0.5 * n;
+  EXPECT_NEAR(c.meanLuminanceRatio, (0.2126 * sumAR + 0.7152 * sumAG + 0.0722 * sumAB) / sumB, 1e-12);
   EXPECT_DOUBLE_EQ(c.maxAbsError, 1.5);
   EXPECT_EQ(c.maxErrorX, 3);
   EXPECT_EQ(c.maxErrorY, 7);
@@ -69,6 +72,17 @@ TEST(Compare, DifferentSizesAreRefusedWithBothSizes) {
     EXPECT_NE(message.find("4x2"), std::string::npos) << message;
   }
   EXPECT_THROW(relativeErrorHeatmap(Image(3, 2), Image(2, 3)), Error);
+}
+
+TEST(Compare, MeanLuminanceRatioWeightsChannelMeansNotRatios) {
+  // Reference (1, 0.25, 4): its luminance is 0.2126 + 0.7152/4 + 0.0722·4 = 0.6802. A doubles red
+  // only: ratios (2, 1, 1), luminance 0.6802 + 0.2126 = 0.8928, ratio 0.8928/0.6802 ≈ 1.3126 —
+  // not Σ w_c·ratio_c = 1.2126, which would ignore how bright each channel is.
+  const Image reference(4, 2, Rgb(1.0f, 0.25f, 4.0f));
+  const Image a(4, 2, Rgb(2.0f, 0.25f, 4.0f));
+  const ImageComparison c = compareImages(a, reference);
+  EXPECT_NEAR(c.meanLuminanceRatio, 0.8928 / 0.6802, 1e-9);  // exact inputs, double sums
+  EXPECT_TRUE(std::isnan(compareImages(Image(2, 2, Rgb(0.0f)), Image(2, 2, Rgb(0.0f))).meanLuminanceRatio));
 }
 
 TEST(Compare, NonFinitePixelsAreCountedAndExcluded) {

@@ -72,6 +72,8 @@ TEST_F(ImageCli, CompareReportsAKnownPerturbationAcrossFormats) {
   EXPECT_NEAR(j["relmse"].get<double>(), 0.125 * 0.125 / 0.26 / 3.0, 1e-12);
   EXPECT_NEAR(j["psnr"].get<double>(), 10.0 * std::log10(3.0 / (0.125 * 0.125)), 1e-9);
   EXPECT_NEAR(j["mean_ratio_rgb"][0].get<double>(), 1.25, 1e-12);
+  // Grey reference: luminance ratio = 1 + 0.2126·0.125/0.5 (Rec.709 red weight).
+  EXPECT_NEAR(j["mean_luminance_ratio"].get<double>(), 1.0 + 0.2126 * 0.25, 1e-9);
   EXPECT_EQ(readImage(path("heat.png")).width, 8);
   // --max-relmse turns the figure into an exit status.
   EXPECT_NE(run("compare " + path("test.exr") + " " + path("ref.pfm") + " --max-relmse 0.001").status, 0);

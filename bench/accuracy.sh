@@ -1,0 +1,151 @@
+#!/usr/bin/env bash
+# Accuracy of the light field against the path tracer (issue 4's figures), and the
+# reuse-visibility check.
+#
+# For the built-in Cornell box and McGuire's CornellBox-Glossy and CornellBox-Mirror, at the
+# default bake preset:
+#   1. plenoptic bake SCENE -o NAME.plf --stats NAME.bake.json
+#   2. plenoptic render NAME.plf --samples 16 (SIZE×SIZE) -o NAME.lf.exr      light field
+#   3. plenoptic trace SCENE --spp REF_SPP (SIZE×SIZE) -o NAME.ref.pfm         reference,
+#      with --variance NAME.refvar.pfm (the reference's own squared standard error per pixel)
+#   4. plenoptic compare NAME.lf.exr NAME.ref.pfm --json --heatmap NAME.heat.png
+# and prints one row per scene:
+#   bake s, tixels, .plf bytes, mean-luminance ratio (light field / reference, Rec.709 Y; the
+#   issue asks for 1 ± 0.02), relMSE (compare.h: mean (a−b)²/(b²+0.01)), and "ref noise": the
+#   part of that relMSE the reference's own Monte Carlo noise accounts for, mean var/(b²+0.01)
+#   over pixels and channels (E[(a−b)²] = bias² + var_b when a is noise-free, so the light
+#   field's own error is relMSE − ref noise; a ref-noise column far below relMSE means the
+#   reference is converged enough for the figure).
+#
+# Then the reuse-visibility check (issue 4, item 2): a JSON scene of the built-in box with the
+# light recoloured is baked twice — once reusing the visibility field saved by a bake of the
+# original colour (--reuse-visibility --visibility), once from scratch — and the two light
+# fields' renders are compared (relMSE ≈ 0 expected; the bake is deterministic for a seed).
+#
+# Usage: bench/accuracy.sh [PLENOPTIC] [WORKDIR]
+#   PLENOPTIC  the executable (default: build/plenoptic)
+#   WORKDIR    where every file goes (default: out/accuracy)
+# Environment: SIZE (image side, default 256), REF_SPP (reference samples per pixel, default
+# 2048: about 40–90 s per scene on 2 cores), LF_SAMPLES (light-field camera samples per
+# pixel, default 16), SCENES_DIR (default: the McGuire scenes in ../shared/scenes).
+set -euo pipefail
+
+here=$(cd "$(dirname "$0")" && pwd)
+plenoptic=${1:-build/plenoptic}
+workdir=${2:-out/accuracy}
+size=${SIZE:-256}
+ref_spp=${REF_SPP:-2048}
+lf_samples=${LF_SAMPLES:-16}
+scenes_dir=${SCENES_DIR:-$here/../../shared/scenes/cornell-mcguire}
+
+if [[ ! -x "$plenoptic" ]]; then
+  echo "$0: $plenoptic is not an executable (build it: cmake --build build --target plenoptic)" >&2
+  exit 1
+fi
+for f in CornellBox-Glossy.obj CornellBox-Mirror.obj; do
+  if [[ ! -f "$scenes_dir/$f" ]]; then
+    echo "$0: $scenes_dir/$f not found (set SCENES_DIR)" >&2
+    exit 1
+  fi
+done
+mkdir -p "$workdir"
+
+names=(cornell glossy mirror)
+scenes=(cornell "$scenes_dir/CornellBox-Glossy.obj" "$scenes_dir/CornellBox-Mirror.obj")
+size_flags=(--width "$size" --height "$size")
+
+for i in "${!names[@]}"; do
+  name=${names[$i]}
+  scene=${scenes[$i]}
+  out="$workdir/$name"
+  echo "== $name: bake (default preset)" >&2
+  "$plenoptic" --quiet bake "$scene" -o "$out.plf" --stats "$out.bake.json" >&2
+  echo "== $name: light-field render ($lf_samples samples per pixel)" >&2
+  "$plenoptic" --quiet render "$out.plf" -o "$out.lf.exr" --samples "$lf_samples" "${size_flags[@]}" >&2
+  echo "== $name: reference ($ref_spp spp)" >&2
+  "$plenoptic" --quiet trace "$scene" -o "$out.ref.pfm" --variance "$out.refvar.pfm" --spp "$ref_spp" \
+    "${size_flags[@]}" --stats "$out.trace.json" >&2
+  "$plenoptic" --quiet compare "$out.lf.exr" "$out.ref.pfm" --json --heatmap "$out.heat.png" >"$out.compare.json"
+done
+
+# ---- reuse-visibility check ------------------------------------------------------------------
+echo "== reuse-visibility check" >&2
+cat >"$workdir/light_original.json" <<'EOF'
+{"include_cornell": true}
+EOF
+# The built-in box's light material is "light" (src/scene/cornell.cpp): recolour it (bluish
+# instead of the measured warm white), same geometry, same material type.
+cat >"$workdir/light_recoloured.json" <<'EOF'
+{"include_cornell": true,
+ "materials": {"light": {"type": "lambert", "albedo": [0.78, 0.78, 0.78], "emission": [6.0, 12.0, 20.0]}}}
+EOF
+reuse="$workdir/reuse"
+"$plenoptic" --quiet bake "$workdir/light_original.json" -o "$reuse.original.plf" --visibility "$reuse.plv" \
+  --stats "$reuse.original.json" >&2
+"$plenoptic" --quiet bake "$workdir/light_recoloured.json" -o "$reuse.reused.plf" --visibility "$reuse.plv" \
+  --reuse-visibility --stats "$reuse.reused.json" >&2
+"$plenoptic" --quiet bake "$workdir/light_recoloured.json" -o "$reuse.full.plf" --visibility "$reuse.full.plv" \
+  --stats "$reuse.full.json" >&2
+for kind in reused full original; do
+  "$plenoptic" --quiet render "$reuse.$kind.plf" -o "$reuse.$kind.exr" --samples "$lf_samples" "${size_flags[@]}" >&2
+done
+"$plenoptic" --quiet compare "$reuse.reused.exr" "$reuse.full.exr" --json >"$reuse.compare.json"
+"$plenoptic" --quiet compare "$reuse.original.exr" "$reuse.full.exr" --json >"$reuse.changed.json"
+
+# ---- table ---------------------------------------------------------------------------------
+python3 - "$workdir" "$size" "$ref_spp" "$lf_samples" "${names[@]}" <<'PY'
+import json, os, struct, sys
+
+workdir, size, ref_spp, lf_samples, names = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5:]
+
+def read_pfm(path):
+    """Colour PFM ('PF'): header lines, then float32 rows bottom to top (order irrelevant here)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    parts, pos = [], 0
+    while len(parts) < 4:  # "PF", width, height, scale (whitespace-separated)
+        while data[pos:pos + 1].isspace():
+            pos += 1
+        start = pos
+        while not data[pos:pos + 1].isspace():
+            pos += 1
+        parts.append(data[start:pos].decode())
+    pos += 1  # the single whitespace byte after the scale
+    if parts[0] != "PF":
+        sys.exit(f"{path}: not a colour PFM")
+    w, h, scale = int(parts[1]), int(parts[2]), float(parts[3])
+    fmt = ("<" if scale < 0 else ">") + "f" * (3 * w * h)
+    return struct.unpack(fmt, data[pos:pos + 12 * w * h])
+
+rows = []
+for name in names:
+    out = os.path.join(workdir, name)
+    bake = json.load(open(out + ".bake.json"))
+    trace = json.load(open(out + ".trace.json"))
+    cmp = json.load(open(out + ".compare.json"))
+    ref, var = read_pfm(out + ".ref.pfm"), read_pfm(out + ".refvar.pfm")
+    noise = sum(v / (r * r + 0.01) for r, v in zip(ref, var)) / len(ref)
+    rows.append((name, bake["seconds"], bake["tixels"], bake["file_bytes"], cmp["mean_luminance_ratio"],
+                 cmp["relmse"], noise, trace["seconds"], out + ".heat.png"))
+
+print(f"light field (render --samples {lf_samples}) vs path-traced reference ({ref_spp} spp), {size}x{size}, default preset")
+header = ("scene", "bake s", "tixels", ".plf bytes", "mean Y ratio", "relMSE", "ref noise", "ref s", "heat map")
+print(f"{header[0]:<8} {header[1]:>7} {header[2]:>8} {header[3]:>11} {header[4]:>12} {header[5]:>9} {header[6]:>9} {header[7]:>7}  {header[8]}")
+for r in rows:
+    print(f"{r[0]:<8} {r[1]:7.2f} {r[2]:8d} {r[3]:11d} {r[4]:12.4f} {r[5]:9.2e} {r[6]:9.1e} {r[7]:7.1f}  {r[8]}")
+
+reuse = os.path.join(workdir, "reuse")
+orig = json.load(open(reuse + ".original.json"))
+reused = json.load(open(reuse + ".reused.json"))
+full = json.load(open(reuse + ".full.json"))
+same = json.load(open(reuse + ".compare.json"))
+changed = json.load(open(reuse + ".changed.json"))
+print()
+print("reuse-visibility check (built-in box, light recoloured):")
+print(f"  bake original colour          {orig['seconds']:6.2f} s  (visibility saved)")
+print(f"  re-bake, --reuse-visibility   {reused['seconds']:6.2f} s  reused_visibility={str(reused['reused_visibility']).lower()}"
+      f"  ({100.0 * reused['seconds'] / full['seconds']:.0f} % of the full bake)")
+print(f"  full bake of the changed scene {full['seconds']:5.2f} s")
+print(f"  render(reused) vs render(full):  relMSE {same['relmse']:.3e}, max |diff| {same['max_abs_error']:.3e}, identical {str(same['identical']).lower()}")
+print(f"  (for scale: original colour vs changed, relMSE {changed['relmse']:.3e})")
+PY
