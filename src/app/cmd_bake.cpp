@@ -4,13 +4,13 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "lightfield/bake.h"
 #include "lightfield/compression.h"
 #include "lightfield/plf_file.h"
@@ -34,42 +34,16 @@ struct BakeCommandOptions {
   std::string compress = "none";  ///< how the values are stored: none|lossless|bc1|hdr (compression.h)
 };
 
-void checkParentDirectory(const std::string& path, const char* option) {
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent))
-    fail("{} {}: directory '{}' does not exist", option, path, parent.string());
-}
-
-void writeTextAtomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) fail("{}: cannot open for writing", temporary);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::remove(temporary.c_str());
-      fail("{}: write failed", temporary);
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::remove(temporary.c_str());
-    fail("{}: cannot rename the finished file into place: {}", path, error.message());
-  }
-}
-
 void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
   const auto start = std::chrono::steady_clock::now();
   if (options.output.empty()) fail("bake: an output file is required (-o OUT.plf)");
-  checkParentDirectory(options.output, "-o");
-  if (!options.statsPath.empty()) checkParentDirectory(options.statsPath, "--stats");
+  requireParentDirectory(options.output, "-o");
+  if (!options.statsPath.empty()) requireParentDirectory(options.statsPath, "--stats");
   const std::string visibilityPath =
       options.visibilityPath.empty() ? std::filesystem::path(options.output).replace_extension(".plv").string()
                                      : options.visibilityPath;
-  checkParentDirectory(visibilityPath, "--visibility");
+  requireParentDirectory(visibilityPath, "--visibility");
 
   BakeSettings settings = bakePreset(options.preset);
   if (options.tixelsAcross > 0.0f) settings.tixelsAcrossScene = options.tixelsAcross;
@@ -114,7 +88,7 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
     json["peak_rss_bytes"] = s.peakRssBytes;
     json["file_bytes"] = fileBytes;
     json["compression"] = options.compress;
-    writeTextAtomically(options.statsPath, json.dump(2) + "\n");
+    writeFileAtomically(options.statsPath, json.dump(2) + "\n");
   }
   fmt::print("wrote {} ({} charts, {} tixels, {} values, {:.1f} MB; {} iterations, residual {:.2e}; {:.2f} s)\n",
              options.output, lf.charts.size(), s.tixels, s.values, fileBytes / 1e6, s.iterations, s.residual, seconds);

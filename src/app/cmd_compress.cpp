@@ -6,10 +6,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -17,6 +15,7 @@
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "lightfield/compression.h"
 #include "lightfield/plf_file.h"
 
@@ -39,26 +38,6 @@ const PlfSectionInfo& valuesSection(const PlfInfo& info) {
   for (const PlfSectionInfo& s : info.sections)
     if (s.id == "VALS") return s;
   fail("{}: no values section", info.path);  // readLightFieldInfo refuses such files already
-}
-
-void writeJsonAtomically(const std::string& path, const nlohmann::json& json) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) fail("{}: cannot open for writing", temporary);
-    out << json.dump(2) << "\n";
-    out.flush();
-    if (!out) {
-      std::remove(temporary.c_str());
-      fail("{}: write failed", temporary);
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::remove(temporary.c_str());
-    fail("{}: cannot rename the finished file into place: {}", path, error.message());
-  }
 }
 
 void runCompress(const CompressOptions& options, const GlobalOptions& global) {
@@ -126,7 +105,7 @@ void runCompress(const CompressOptions& options, const GlobalOptions& global) {
     json["values_rmse"] = error.rmse;
     json["values_relative_rmse"] = error.relativeRmse;
     json["values_max_relative_error"] = error.maxRelative;
-    writeJsonAtomically(options.statsPath, json);
+    writeFileAtomically(options.statsPath, json.dump(2) + "\n");
   }
   fmt::print("wrote {} ({} values): values {} → {} bytes ({}, {:.2f}:1), file {} bytes ({:.2f}:1 against raw); "
              "encode+write {:.3f} s, read+decode {:.3f} s; {}\n",

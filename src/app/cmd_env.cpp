@@ -11,6 +11,7 @@
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "env/env.h"
 #include "env/ibl.h"
 
@@ -94,9 +95,7 @@ void checkEnvOutput(const std::string& path, EnvLayout layout) {
   if (layout == EnvLayout::Cube && path.find("{face}") == std::string::npos) return;  // a directory, created
   if (!isHdrExtension(path)) fail("-o {}: expected an .exr, .hdr or .pfm file name", path);
   if (layout == EnvLayout::Cube) return;  // a {face} pattern: its directory is created
-  const fs::path parent = fs::path(path).parent_path();
-  if (!parent.empty() && !fs::is_directory(parent))
-    fail("-o {}: directory '{}' does not exist", path, parent.string());
+  requireParentDirectory(path, "-o");
 }
 
 void runConvert(const ConvertOptions& o, const GlobalOptions& global) {
@@ -227,8 +226,7 @@ void runSplitSum(const SplitSumCliOptions& o, const GlobalOptions& global) {
   Runtime runtime(global);
   if (!o.plot.empty()) {
     if (fs::path(o.plot).extension() != ".png") fail("--plot {}: expected a .png file name", o.plot);
-    const fs::path parent = fs::path(o.plot).parent_path();
-    if (!parent.empty() && !fs::is_directory(parent)) fail("--plot {}: directory '{}' does not exist", o.plot, parent.string());
+    requireParentDirectory(o.plot, "--plot");
   }
   SplitSumOptions s;
   s.model = parseSpecularModel(o.model);

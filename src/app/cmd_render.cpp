@@ -6,11 +6,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <nlohmann/json.hpp>
@@ -22,6 +19,8 @@
 #include "app/view_options.h"
 #include "camera/camera.h"
 #include "core/error.h"
+#include "core/file_io.h"
+#include "image/image.h"
 #include "lightfield/plf_file.h"
 #include "realtime/camera_path.h"
 #include "realtime/frame_output.h"
@@ -57,35 +56,11 @@ double secondsSince(Clock::time_point start) { return std::chrono::duration<doub
 /// Fails before any work is done if `path` cannot be written as an image or a JSON file.
 void checkOutputPath(const std::string& path, const char* option, bool image) {
   if (image) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    const std::string ext = fileExtensionLower(path);
     if (!isHdrExtension(path) && ext != ".png")
       fail("{} {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", option, path, ext);
   }
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent))
-    fail("{} {}: directory '{}' does not exist", option, path, parent.string());
-}
-
-/// Writes text to path atomically (temporary file beside it, then rename).
-void writeTextAtomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) fail("{}: cannot open for writing", temporary);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::remove(temporary.c_str());
-      fail("{}: write failed", temporary);
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::remove(temporary.c_str());
-    fail("{}: cannot rename the finished file into place: {}", path, error.message());
-  }
+  requireParentDirectory(path, option);
 }
 
 double median(std::vector<double> v) {
@@ -199,7 +174,7 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
     json["load_seconds"] = loadSeconds;
     json["accel_build_seconds"] = accelSeconds;
     json["file_bytes"] = std::filesystem::file_size(options.input);
-    writeTextAtomically(options.statsPath, json.dump(2) + "\n");
+    writeFileAtomically(options.statsPath, json.dump(2) + "\n");
   }
   fmt::print("wrote {} ({}x{}, {} sample{}/pixel, {} renderer, {} frame{}: median {:.2f} ms/frame = {:.1f} fps; "
              "load {:.3f} s, BVH {:.3f} s)\n",

@@ -1,10 +1,8 @@
 // `plenoptic trace SCENE -o OUT.exr|png`: the reference path tracer (src/trace/trace.h).
 #include <fmt/format.h>
 
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -15,6 +13,8 @@
 #include "app/view_options.h"
 #include "camera/camera.h"
 #include "core/error.h"
+#include "core/file_io.h"
+#include "image/image.h"
 #include "scene/scene.h"
 #include "trace/trace.h"
 
@@ -39,42 +39,13 @@ struct TraceOptions {
   bool sppGiven = false, widthGiven = false, heightGiven = false, cameraGiven = false;
 };
 
-std::string lowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 /// Fails before any work is done if `path` cannot be an output of the given kind.
 void checkOutputPath(const std::string& path, const char* option, bool hdrOnly) {
-  const std::string ext = lowerExtension(path);
+  const std::string ext = fileExtensionLower(path);
   const bool hdr = isHdrExtension(path);
   if (hdrOnly && !hdr) fail("{} {}: expected an .exr, .hdr or .pfm file name", option, path);
   if (!hdr && ext != ".png") fail("{} {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", option, path, ext);
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent))
-    fail("{} {}: directory '{}' does not exist", option, path, parent.string());
-}
-
-/// Writes text to path atomically (temporary file beside it, then rename).
-void writeTextAtomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) fail("{}: cannot open for writing", temporary);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::remove(temporary.c_str());
-      fail("{}: write failed", temporary);
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::remove(temporary.c_str());
-    fail("{}: cannot rename the finished file into place: {}", path, error.message());
-  }
+  requireParentDirectory(path, option);
 }
 
 void runTrace(const TraceOptions& options, const GlobalOptions& global) {
@@ -85,11 +56,7 @@ void runTrace(const TraceOptions& options, const GlobalOptions& global) {
     checkOutputPath(options.output, "-o", false);
   }
   if (!options.variancePath.empty()) checkOutputPath(options.variancePath, "--variance", true);
-  if (!options.statsPath.empty()) {
-    const std::filesystem::path parent = std::filesystem::path(options.statsPath).parent_path();
-    if (!parent.empty() && !std::filesystem::is_directory(parent))
-      fail("--stats {}: directory '{}' does not exist", options.statsPath, parent.string());
-  }
+  if (!options.statsPath.empty()) requireParentDirectory(options.statsPath, "--stats");
 
   TraceSettings settings;
   settings.spp = options.spp;
@@ -162,7 +129,7 @@ void runTrace(const TraceOptions& options, const GlobalOptions& global) {
     json["nan_samples"] = stats.nanSamples;
     json["triangles"] = scene.triangleCount();
     json["emissive_triangles"] = tracer.emissiveTriangleCount();
-    writeTextAtomically(options.statsPath, json.dump(2) + "\n");
+    writeFileAtomically(options.statsPath, json.dump(2) + "\n");
   }
   fmt::print("wrote {} ({}x{}, {} spp, {:.2f} s, {:.3f} M paths/s, {:.2f} M rays/s)\n", options.output, view.width,
              view.height, settings.spp, stats.seconds, stats.pathsPerSecond() * 1e-6, stats.raysPerSecond() * 1e-6);

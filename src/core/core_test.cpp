@@ -1,5 +1,14 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "core/file_io.h"
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -72,6 +81,126 @@ TEST(Distribution1D, SamplesProportionallyToWeights) {
   float remapped = -1;
   d.sample(0.625f, &remapped);
   EXPECT_NEAR(remapped, 0.5f, 1e-6f);
+}
+
+
+// --- core/file_io.h: atomic writes ---
+
+/// A fresh empty directory per test, removed afterwards.
+class AtomicWriteTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("pl_core_file_io_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  /// Names of everything in the directory (temporaries are hidden files, so list them all).
+  std::vector<std::string> entries() const {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(dir_)) names.push_back(entry.path().filename().string());
+    return names;
+  }
+  static std::string contents(const std::string& file) {
+    std::ifstream in(file, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+
+  std::filesystem::path dir_;
+};
+
+TEST_F(AtomicWriteTest, WritesAndReplacesContentLeavingNoTemporary) {
+  const std::string target = path("out.json");
+  writeFileAtomically(target, std::string_view("first version, longer than the second\n"));
+  EXPECT_EQ(contents(target), "first version, longer than the second\n");
+  writeFileAtomically(target, std::string_view("second\n"), FileSync::durable);
+  EXPECT_EQ(contents(target), "second\n");  // replaced, not overwritten in place (no old tail)
+  EXPECT_EQ(entries(), std::vector<std::string>{"out.json"});
+}
+
+TEST_F(AtomicWriteTest, FailureKeepsTheOldFileAndRemovesTheTemporary) {
+  const std::string target = path("image.exr");
+  writeFileAtomically(target, std::string_view("old"));
+  std::string temporarySeen;
+  try {
+    writeFileAtomically(target, [&](const std::string& temporary) {
+      temporarySeen = temporary;
+      std::ofstream(temporary) << "half of the new";
+      ASSERT_TRUE(std::filesystem::exists(temporary));
+      fail("encoder gave up");
+    });
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(target), std::string::npos) << message;
+    EXPECT_NE(message.find("encoder gave up"), std::string::npos) << message;
+  }
+  EXPECT_EQ(std::filesystem::path(temporarySeen).parent_path(), dir_);  // beside the target: same file system
+  EXPECT_FALSE(std::filesystem::exists(temporarySeen));
+  EXPECT_EQ(contents(target), "old");
+  EXPECT_EQ(entries(), std::vector<std::string>{"image.exr"});
+}
+
+TEST_F(AtomicWriteTest, FailureOnANewTargetLeavesNothing) {
+  EXPECT_THROW(writeFileAtomically(path("new.plf"),
+                                   [](const std::string& temporary) {
+                                     std::ofstream(temporary) << "partial";
+                                     throw std::runtime_error("disk full");
+                                   }),
+               Error);
+  EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(AtomicWriteTest, MissingDirectoryOrDirectoryTargetIsAnErrorNamingTheFile) {
+  const std::string inMissing = path("missing/out.png");
+  try {
+    writeFileAtomically(inMissing, std::string_view("x"));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(inMissing), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos) << e.what();
+  }
+  std::filesystem::create_directory(path("sub"));
+  EXPECT_THROW(writeFileAtomically(path("sub"), std::string_view("x")), Error);
+  EXPECT_EQ(entries(), std::vector<std::string>{"sub"});
+  EXPECT_TRUE(std::filesystem::is_empty(path("sub")));
+}
+
+TEST_F(AtomicWriteTest, UncommittedPendingFileIsRemoved) {
+  const std::string target = path("video.mp4");
+  std::string temporary;
+  {
+    PendingFile pending(target);
+    temporary = pending.temporaryPath();
+    std::ofstream(temporary) << "frames";
+    EXPECT_TRUE(std::filesystem::exists(temporary));
+  }  // e.g. an exception between the frames: never committed
+  EXPECT_FALSE(std::filesystem::exists(temporary));
+  EXPECT_TRUE(entries().empty());
+  {
+    PendingFile pending(target);
+    std::ofstream(pending.temporaryPath()) << "all frames";
+    pending.commit();
+  }
+  EXPECT_EQ(contents(target), "all frames");
+  EXPECT_EQ(entries(), std::vector<std::string>{"video.mp4"});
+}
+
+TEST(RequireParentDirectory, NamesOptionPathAndDirectory) {
+  EXPECT_NO_THROW(requireParentDirectory("stats.json", "--stats"));  // working directory
+  EXPECT_NO_THROW(requireParentDirectory(std::filesystem::temp_directory_path().string() + "/x.json", "--stats"));
+  try {
+    requireParentDirectory("/no/such/dir/out.exr", "-o");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "-o /no/such/dir/out.exr: directory '/no/such/dir' does not exist");
+  }
 }
 
 }  // namespace

@@ -1,10 +1,7 @@
 // Image basics: the sRGB transfer function, dispatch on the file extension, atomic writes.
 #include "image/image.h"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -14,6 +11,7 @@
 #include <system_error>
 
 #include "core/error.h"
+#include "core/file_io.h"
 #include "image/image_io.h"
 
 namespace pl {
@@ -58,15 +56,6 @@ std::vector<unsigned char> readFileBytes(const std::string& path) {
   return bytes;
 }
 
-void writeFileBytes(const std::string& path, const void* data, size_t size) {
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) fail("cannot create file: {}", std::strerror(errno));
-  const bool written = std::fwrite(data, 1, size, file) == size && std::fflush(file) == 0;
-  const int writeErrno = errno;
-  const bool closed = std::fclose(file) == 0;
-  if (!written || !closed) fail("write failed: {}", std::strerror(written ? errno : writeErrno));
-}
-
 void checkImageSize(const std::string& path, long long width, long long height) {
   if (width < 1 || height < 1 || width > kMaxImageDimension || height > kMaxImageDimension ||
       uint64_t(width) * uint64_t(height) > kMaxImagePixels) {
@@ -88,38 +77,6 @@ Image readImage(const std::string& path) {
   fail("{}: unknown image extension '{}' (readable: .exr .hdr .pfm .png .jpg .jpeg .tga .bmp)", path, ext);
 }
 
-namespace {
-
-/// A unique name in the target's directory, so that the final rename is atomic (same file
-/// system). Pid + counter keep concurrent writers (threads, processes) apart.
-std::string temporaryPathFor(const std::string& target) {
-  static std::atomic<uint64_t> counter{0};
-  const std::filesystem::path p(target);
-  const std::string name = fmt::format(".{}.tmp-{}-{}", p.filename().string(), long(::getpid()), counter++);
-  return (p.parent_path() / name).string();
-}
-
-/// Runs write(tempPath), then renames the temporary over `target`. On any failure the
-/// temporary is removed and pl::Error names the target and the problem.
-template <typename WriteFn>
-void writeAtomically(const std::string& target, WriteFn&& write) {
-  const std::filesystem::path parent = std::filesystem::path(target).parent_path();
-  std::error_code ec;
-  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
-    fail("{}: cannot write: directory '{}' does not exist", target, parent.string());
-  if (std::filesystem::is_directory(target, ec)) fail("{}: cannot write: is a directory", target);
-  const std::string temp = temporaryPathFor(target);
-  try {
-    write(temp);
-    std::filesystem::rename(temp, target);
-  } catch (const std::exception& e) {
-    std::filesystem::remove(temp, ec);
-    fail("{}: cannot write: {}", target, e.what());
-  }
-}
-
-}  // namespace
-
 void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOptions& options) {
   const std::string ext = fileExtensionLower(path);
   if (ext != ".exr" && ext != ".hdr" && ext != ".pfm")
@@ -128,7 +85,7 @@ void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOp
     fail("{}: cannot write: pixel buffer holds {} pixels, expected {}x{}", path, image.pixels.size(), image.width,
          image.height);
   detail::checkImageSize(path, image.width, image.height);
-  writeAtomically(path, [&](const std::string& temp) {
+  writeFileAtomically(path, [&](const std::string& temp) {
     if (ext == ".exr") detail::writeExr(temp, image, options.exrHalf);
     else if (ext == ".hdr") detail::writeRadianceHdr(temp, image);
     else detail::writePfm(temp, image);
@@ -141,7 +98,7 @@ void writePng(const std::string& path, const Image8& image) {
     fail("{}: cannot write: 8-bit buffer holds {} bytes, expected {}x{}x3", path, image.rgb.size(), image.width,
          image.height);
   detail::checkImageSize(path, image.width, image.height);
-  writeAtomically(path, [&](const std::string& temp) { detail::writePngFile(temp, image); });
+  writeFileAtomically(path, [&](const std::string& temp) { detail::writePngFile(temp, image); });
 }
 
 }  // namespace pl

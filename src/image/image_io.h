@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/file_io.h"
 #include "image/image.h"
 
 namespace pl::detail {
@@ -27,9 +28,7 @@ void writePfm(const std::string& path, const Image& image);
 
 /// The whole file as bytes; pl::Error "<path>: no such file" / "cannot read: <reason>".
 std::vector<unsigned char> readFileBytes(const std::string& path);
-/// Writes bytes to path and checks every step (open, write, flush, close); pl::Error with
-/// the system's reason (disk full, permission) and no path.
-void writeFileBytes(const std::string& path, const void* data, size_t size);
+// Writing bytes: pl::writeFileBytes (core/file_io.h), called on the temporary of an atomic write.
 
 /// Throws pl::Error "<path>: image size W×H ..." unless 1 ≤ W,H ≤ kMaxImageDimension and
 /// W·H ≤ kMaxImagePixels.

@@ -16,6 +16,7 @@
 #include <type_traits>
 
 #include "core/error.h"
+#include "core/file_io.h"
 #include "lightfield/compression.h"
 
 namespace pl {
@@ -950,46 +951,29 @@ void writeLightField(const std::string& path, const LightField& lf, PlfEncoding 
   header.fileSize = table.back().offset + table.back().storedSize;
   header.headerHash = headerHash(header, table);
 
-  // Atomic write: temporary file in the same directory (same file system), fsync, rename.
-  std::string tempPath = path + ".tmp-XXXXXX";
-  FileHandle file;
-  file.fd = ::mkstemp(tempPath.data());
-  if (file.fd < 0) fail("{}: cannot create a temporary file beside it: {}", path, errnoText());
-  struct TempGuard {
-    const std::string& path;
-    bool keep = false;
-    ~TempGuard() {
-      if (!keep) ::unlink(path.c_str());
-    }
-  } guard{tempPath};
-
-  const mode_t umaskValue = ::umask(0);
-  ::umask(umaskValue);
-  if (::fchmod(file.fd, 0666 & ~umaskValue) != 0) fail("{}: cannot set permissions: {}", tempPath, errnoText());
-  writeAll(file.fd, &header, sizeof(header), tempPath);
-  writeAll(file.fd, table.data(), table.size() * sizeof(SectionEntry), tempPath);
-  uint64_t written = sizeof(header) + table.size() * sizeof(SectionEntry);
-  const unsigned char zeros[kSectionAlignment] = {};
-  for (int kind = 0; kind < kSectionKinds; ++kind) {
-    writeAll(file.fd, zeros, table[size_t(kind)].offset - written, tempPath);
-    writeAll(file.fd, sections[kind].data(), sections[kind].size(), tempPath);
-    written = table[size_t(kind)].offset + sections[kind].size();
-  }
-  if (::fsync(file.fd) != 0) fail("{}: fsync failed: {}", tempPath, errnoText());
-  if (::close(file.fd) != 0) {
-    file.fd = -1;
-    fail("{}: close failed: {}", tempPath, errnoText());
-  }
-  file.fd = -1;
-  if (::rename(tempPath.c_str(), path.c_str()) != 0)
-    fail("{}: cannot rename {} over it: {}", path, tempPath, errnoText());
-  guard.keep = true;
-  // Make the rename itself durable.
-  const auto slash = path.find_last_of('/');
-  const std::string directory = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-  FileHandle dir;
-  dir.fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir.fd >= 0) ::fsync(dir.fd);
+  // Atomic and durable (core/file_io.h): a temporary file in the same directory (same file
+  // system), fsynced, renamed over `path`, then the directory fsynced; removed on any failure.
+  writeFileAtomically(
+      path,
+      [&](const std::string& tempPath) {
+        FileHandle file;
+        // Mode 0666 before the umask, like any newly created file.
+        file.fd = ::open(tempPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+        if (file.fd < 0) fail("cannot create the temporary file {}: {}", tempPath, errnoText());
+        writeAll(file.fd, &header, sizeof(header), tempPath);
+        writeAll(file.fd, table.data(), table.size() * sizeof(SectionEntry), tempPath);
+        uint64_t written = sizeof(header) + table.size() * sizeof(SectionEntry);
+        const unsigned char zeros[kSectionAlignment] = {};
+        for (int kind = 0; kind < kSectionKinds; ++kind) {
+          writeAll(file.fd, zeros, table[size_t(kind)].offset - written, tempPath);
+          writeAll(file.fd, sections[kind].data(), sections[kind].size(), tempPath);
+          written = table[size_t(kind)].offset + sections[kind].size();
+        }
+        const int fd = file.fd;
+        file.fd = -1;
+        if (::close(fd) != 0) fail("{}: close failed: {}", tempPath, errnoText());
+      },
+      FileSync::durable);
 }
 
 LightField readLightField(const std::string& path) {

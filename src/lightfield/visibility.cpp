@@ -23,6 +23,7 @@
 
 #include "accel/accel.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/rng.h"
@@ -267,10 +268,9 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
   payloadStream.update(field.extras.data(), field.extras.size() * sizeof(VisibilityExtra));
   const uint64_t payloadHash = payloadStream.digest();
 
-  const std::string temp = path + ".tmp";
-  {
+  writeFileAtomically(path, [&](const std::string& temp) {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) fail("{}: cannot open for writing", temp);
+    if (!out) fail("cannot create the temporary file {}", temp);
     auto put = [&](const void* data, size_t size) { out.write(static_cast<const char*>(data), std::streamsize(size)); };
     const uint64_t entryCount = field.entries.size(), extraCount = field.extras.size();
     put(kPlvMagic, 8);
@@ -285,18 +285,8 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
     put(field.extraOffset.data(), field.extraOffset.size() * sizeof(uint64_t));
     put(field.extras.data(), field.extras.size() * sizeof(VisibilityExtra));
     out.flush();
-    if (!out) {
-      out.close();
-      std::remove(temp.c_str());
-      fail("{}: write failed (disk full?)", temp);
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temp, path, ec);
-  if (ec) {
-    std::remove(temp.c_str());
-    fail("{}: cannot move into place: {}", path, ec.message());
-  }
+    if (!out) fail("write failed (disk full?)");
+  });
 }
 
 bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why) {

@@ -5,12 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file_io.h"
 
 namespace pl {
 namespace {
@@ -214,24 +213,7 @@ std::string cameraPathToJson(const CameraPath& path) {
 }
 
 void saveCameraPath(const std::string& path, const CameraPath& cameraPath) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) fail("{}: cannot open for writing", temporary);
-    out << cameraPathToJson(cameraPath);
-    out.flush();
-    if (!out) {
-      out.close();
-      std::remove(temporary.c_str());
-      fail("{}: write failed", path);
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::remove(temporary.c_str());
-    fail("{}: cannot rename the finished file into place: {}", path, error.message());
-  }
+  writeFileAtomically(path, cameraPathToJson(cameraPath));
 }
 
 CameraDesc applyPose(CameraDesc base, const CameraPose& pose) {

@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <cstdlib>
-#include <filesystem>
 
 #include "core/error.h"
 
@@ -92,7 +91,7 @@ std::string findFfmpeg() {
 }
 
 VideoWriter::VideoWriter(const std::string& path, int width, int height, double fps)
-    : path_(path), temporary_(path + ".tmp"), width_(width), height_(height) {
+    : file_(path), width_(width), height_(height) {
   const std::string ffmpeg = findFfmpeg();
   if (ffmpeg.empty())
     fail("-o {}: MP4 output needs ffmpeg, which is not installed (not found on PATH); write an image sequence "
@@ -109,7 +108,7 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
   const std::string command =
       fmt::format("{} -loglevel error -y -f rawvideo -pix_fmt rgb24 -s {}x{} -r {} -i - -c:v libx264 -pix_fmt yuv420p "
                   "-crf 18 -movflags +faststart -f mp4 {}",
-                  quote(ffmpeg), width, height, fps, quote(temporary_));
+                  quote(ffmpeg), width, height, fps, quote(file_.temporaryPath()));
   // If ffmpeg dies, writing to its pipe must fail with EPIPE (reported below), not kill us.
   ::signal(SIGPIPE, SIG_IGN);
   pipe_ = ::popen(command.c_str(), "w");
@@ -117,33 +116,25 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, double 
 }
 
 VideoWriter::~VideoWriter() {
-  if (pipe_) {
-    ::pclose(pipe_);
-    std::error_code ignored;
-    std::filesystem::remove(temporary_, ignored);
-  }
+  if (pipe_) ::pclose(pipe_);
+  // file_ (destroyed next) removes the partial video unless finish() committed it.
 }
 
 void VideoWriter::write(const Image8& frame) {
   if (frame.width != width_ || frame.height != height_)
-    fail("{}: frame of {}x{} pixels in a {}x{} video", path_, frame.width, frame.height, width_, height_);
+    fail("{}: frame of {}x{} pixels in a {}x{} video", file_.target(), frame.width, frame.height, width_, height_);
   if (std::fwrite(frame.rgb.data(), 1, frame.rgb.size(), pipe_) != frame.rgb.size())
-    fail("{}: ffmpeg stopped accepting frames (see its message above)", path_);
+    fail("{}: ffmpeg stopped accepting frames (see its message above)", file_.target());
 }
 
 void VideoWriter::finish() {
   const int status = ::pclose(pipe_);
   pipe_ = nullptr;
-  std::error_code error;
   if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    std::filesystem::remove(temporary_, error);
-    fail("{}: ffmpeg failed (exit status {})", path_, WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+    file_.discard();
+    fail("{}: ffmpeg failed (exit status {})", file_.target(), WIFEXITED(status) ? WEXITSTATUS(status) : -1);
   }
-  std::filesystem::rename(temporary_, path_, error);
-  if (error) {
-    std::filesystem::remove(temporary_, error);
-    fail("{}: cannot rename the finished video into place: {}", path_, error.message());
-  }
+  file_.commit();
 }
 
 }  // namespace pl

@@ -7,12 +7,13 @@
 //
 // Video: frames (8-bit sRGB, already tone-mapped) are piped as raw RGB24 into
 //   ffmpeg -f rawvideo -pix_fmt rgb24 -s W×H -r FPS -i - -c:v libx264 -pix_fmt yuv420p
-//          -crf 18 -movflags +faststart -f mp4 OUT.mp4.tmp
-// and the finished file is renamed to OUT.mp4 (never a half-written video under the final
-// name). libx264 needs even sizes: an odd width or height is refused before rendering.
+//          -crf 18 -movflags +faststart -f mp4 .OUT.mp4.tmp-PID-N
+// (a hidden temporary beside OUT.mp4, core/file_io.h) and the finished file is renamed to
+// OUT.mp4 (never a half-written video under the final name). libx264 needs even sizes: an odd width or height is refused before rendering.
 #include <cstdio>
 #include <string>
 
+#include "core/file_io.h"
 #include "image/image.h"
 
 namespace pl {
@@ -42,7 +43,7 @@ class VideoWriter {
   void finish();
 
  private:
-  std::string path_, temporary_;
+  PendingFile file_;  ///< the target and the temporary ffmpeg writes to
   int width_, height_;
   FILE* pipe_ = nullptr;
 };

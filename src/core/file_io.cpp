@@ -1,0 +1,111 @@
+#include "core/file_io.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "core/error.h"
+
+namespace pl {
+namespace {
+
+/// A unique hidden name in the target's directory, so that the final rename is atomic (same
+/// file system). Pid + counter keep concurrent writers (threads, processes) apart.
+std::string temporaryPathBeside(const std::string& target) {
+  static std::atomic<uint64_t> counter{0};
+  const std::filesystem::path p(target);
+  const std::string name = fmt::format(".{}.tmp-{}-{}", p.filename().string(), long(::getpid()), counter++);
+  return (p.parent_path() / name).string();
+}
+
+/// fsync of an existing file or directory (opened read-only, which suffices on Linux and
+/// BSD). Returns 0 or the errno of the failure.
+int syncPath(const std::string& path, bool directory) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | (directory ? O_DIRECTORY : 0));
+  if (fd < 0) return errno;
+  const int result = ::fsync(fd) == 0 ? 0 : errno;
+  ::close(fd);
+  return result;
+}
+
+}  // namespace
+
+void requireParentDirectory(const std::string& path, std::string_view option) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+    fail("{} {}: directory '{}' does not exist", option, path, parent.string());
+}
+
+PendingFile::PendingFile(std::string target) : target_(std::move(target)) {
+  const std::filesystem::path parent = std::filesystem::path(target_).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+    fail("{}: cannot write: directory '{}' does not exist", target_, parent.string());
+  if (std::filesystem::is_directory(target_, ec)) fail("{}: cannot write: is a directory", target_);
+  temporary_ = temporaryPathBeside(target_);
+}
+
+PendingFile::~PendingFile() { discard(); }
+
+void PendingFile::discard() noexcept {
+  if (!open_) return;
+  open_ = false;
+  std::error_code ignored;
+  std::filesystem::remove(temporary_, ignored);
+}
+
+void PendingFile::commit(FileSync sync) {
+  if (!open_) fail("{}: cannot write: the temporary file was already committed or discarded", target_);
+  try {
+    if (sync == FileSync::durable) {
+      if (const int error = syncPath(temporary_, false)) fail("fsync failed: {}", std::strerror(error));
+    }
+    std::filesystem::rename(temporary_, target_);
+  } catch (const std::exception& e) {
+    discard();
+    fail("{}: cannot write: {}", target_, e.what());
+  }
+  open_ = false;
+  if (sync == FileSync::durable) {
+    // Make the rename itself durable. The file is complete and in place at this point, so a
+    // failure here is not reported (there is nothing the caller could undo).
+    const std::filesystem::path parent = std::filesystem::path(target_).parent_path();
+    syncPath(parent.empty() ? std::string(".") : parent.string(), true);
+  }
+}
+
+void writeFileAtomically(const std::string& path, const std::function<void(const std::string&)>& write,
+                         FileSync sync) {
+  PendingFile file(path);
+  try {
+    write(file.temporaryPath());
+  } catch (const std::exception& e) {
+    file.discard();
+    fail("{}: cannot write: {}", path, e.what());
+  }
+  file.commit(sync);
+}
+
+void writeFileBytes(const std::string& path, const void* data, size_t size) {
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (!file) fail("cannot create file: {}", std::strerror(errno));
+  const bool written = std::fwrite(data, 1, size, file) == size && std::fflush(file) == 0;
+  const int writeErrno = errno;
+  const bool closed = std::fclose(file) == 0;
+  if (!written || !closed) fail("write failed: {}", std::strerror(written ? errno : writeErrno));
+}
+
+void writeFileAtomically(const std::string& path, std::string_view bytes, FileSync sync) {
+  writeFileAtomically(
+      path, [&](const std::string& temporaryPath) { writeFileBytes(temporaryPath, bytes.data(), bytes.size()); },
+      sync);
+}
+
+}  // namespace pl

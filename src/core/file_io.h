@@ -1,0 +1,71 @@
+#pragma once
+// Writing output files without ever leaving a half-written one behind, and checking output
+// paths before any work is done. The one implementation every writer of the project uses
+// (images, .plf/.plv, --stats JSON, camera paths, videos).
+//
+// Atomic write: the bytes go to a temporary file in the target's directory (same file
+// system, so the final std::filesystem::rename is atomic), which replaces the target only
+// once it is complete. On any failure the temporary is removed, the target is untouched
+// and pl::Error names the target and the problem.
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <string_view>
+
+namespace pl {
+
+/// How hard a finished file is pushed to the disk before it counts as written.
+enum class FileSync {
+  none,     ///< rename only: atomic against crashes of this process (images, JSON)
+  durable,  ///< fsync the file before the rename and its directory after it: also survives a power loss (.plf)
+};
+
+/// Fails with "OPTION PATH: directory 'D' does not exist" unless the directory that would
+/// hold `path` exists (an empty parent means the working directory, which always does).
+/// `option` is the command-line flag the path came from, e.g. "-o" or "--stats".
+void requireParentDirectory(const std::string& path, std::string_view option);
+
+/// A temporary file beside `target` that becomes `target` on commit(); if it is never
+/// committed (error, exception), the destructor removes it. For writers whose output is
+/// produced over a longer time or by another process (e.g. ffmpeg); the simple cases use
+/// writeFileAtomically below.
+class PendingFile {
+ public:
+  /// Checks that target's directory exists and that target is not a directory (pl::Error
+  /// naming target otherwise) and picks a unique temporary name (nothing is created yet).
+  explicit PendingFile(std::string target);
+  ~PendingFile();
+  PendingFile(const PendingFile&) = delete;
+  PendingFile& operator=(const PendingFile&) = delete;
+
+  const std::string& target() const { return target_; }
+  /// Where to write: ".NAME.tmp-PID-N" in the target's directory (hidden, unique per process and call).
+  const std::string& temporaryPath() const { return temporary_; }
+
+  /// Renames the temporary over the target (after an fsync if `sync` is durable). On failure
+  /// the temporary is removed and pl::Error names the target.
+  void commit(FileSync sync = FileSync::none);
+  /// Removes the temporary now (idempotent); the target is untouched.
+  void discard() noexcept;
+
+ private:
+  std::string target_;
+  std::string temporary_;
+  bool open_ = true;  ///< not yet committed or discarded
+};
+
+/// Runs write(temporaryPath), which must create and fill that file, then moves it over
+/// `path`. Any exception from `write` (or the rename) removes the temporary and becomes
+/// pl::Error("PATH: cannot write: <what>"), so `write` may report problems without naming a file.
+void writeFileAtomically(const std::string& path, const std::function<void(const std::string& temporaryPath)>& write,
+                         FileSync sync = FileSync::none);
+
+/// Creates (or truncates) `path` and writes the bytes to it, checking every step (open,
+/// write, flush, close). NOT atomic: meant for the temporary inside a writeFileAtomically
+/// callback, so pl::Error gives the system's reason (disk full, permission) and no path.
+void writeFileBytes(const std::string& path, const void* data, size_t size);
+
+/// Writes `bytes` as the whole content of `path`, atomically (see above).
+void writeFileAtomically(const std::string& path, std::string_view bytes, FileSync sync = FileSync::none);
+
+}  // namespace pl
