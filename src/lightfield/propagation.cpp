@@ -5,6 +5,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "accel/accel.h"
 #include "core/error.h"
@@ -150,6 +153,92 @@ bool punctualIncident(const Light& light, const Vec3& x, Vec3& wi, float& distan
 struct EmissiveTriangle {
   uint32_t mesh, triangle, material;
 };
+
+// ---- The gather kernel of the iteration ------------------------------------------------------
+// Four float lanes (r, g, b, unused): SSE where the target has it (every x86-64), else a plain
+// array. Both do the same IEEE single-precision operations in the same order per lane, so the
+// results are identical.
+#if defined(__SSE2__)
+using F4 = __m128;
+inline F4 f4Zero() { return _mm_setzero_ps(); }
+inline F4 f4Splat(float s) { return _mm_set1_ps(s); }
+inline F4 f4Load(const float* aligned) { return _mm_load_ps(aligned); }
+inline F4 f4Add(F4 a, F4 b) { return _mm_add_ps(a, b); }
+inline F4 f4Mul(F4 a, F4 b) { return _mm_mul_ps(a, b); }
+inline Rgb f4Rgb(F4 a) {
+  alignas(16) float v[4];
+  _mm_store_ps(v, a);
+  return {v[0], v[1], v[2]};
+}
+#else
+struct F4 {
+  float v[4];
+};
+inline F4 f4Zero() { return {{0.0f, 0.0f, 0.0f, 0.0f}}; }
+inline F4 f4Splat(float s) { return {{s, s, s, s}}; }
+inline F4 f4Load(const float* aligned) { return {{aligned[0], aligned[1], aligned[2], aligned[3]}}; }
+inline F4 f4Add(F4 a, F4 b) { return {{a.v[0] + b.v[0], a.v[1] + b.v[1], a.v[2] + b.v[2], a.v[3] + b.v[3]}}; }
+inline F4 f4Mul(F4 a, F4 b) { return {{a.v[0] * b.v[0], a.v[1] * b.v[1], a.v[2] * b.v[2], a.v[3] * b.v[3]}}; }
+inline Rgb f4Rgb(F4 a) { return {a.v[0], a.v[1], a.v[2]}; }
+#endif
+inline F4 f4FromRgb(const Rgb& c) {
+  alignas(16) const float v[4] = {c.r, c.g, c.b, 0.0f};
+  return f4Load(v);
+}
+
+/// The transport radiance ρ̄·E/π (W·sr⁻¹·m⁻²) of a diffuse tixel g and of its neighbours
+/// (i+1, j), (i, j+1), (i+1, j+1) in g's chart: everything a bilinear lookup at g needs, in one
+/// 64-byte cache line. Neighbours outside the chart and non-diffuse tixels hold 0 (a visibility
+/// entry never gives them a non-zero weight: linearTap holds the last row and column).
+struct alignas(64) TransportQuad {
+  float tap[4][4];  ///< [(i, j), (i+1, j), (i, j+1), (i+1, j+1)][r, g, b, 0]
+};
+
+/// Bilinear lookup of visibility entry e in the quads: ((w₀t₀ + w₁t₁) + w₂t₂) + w₃t₃ with
+/// w = (1−fu)(1−fv), fu(1−fv), (1−fu)fv, fu·fv (a zero weight times a finite value adds +0,
+/// which leaves the sum unchanged: the same value as adding only the taps with weight > 0).
+inline F4 lookupQuad(const TransportQuad& q, VisibilityEntry e) {
+  const float fu = float(e.fu) * (1.0f / 65535.0f), fv = float(e.fv) * (1.0f / 65535.0f);
+  F4 L = f4Mul(f4Splat((1.0f - fu) * (1.0f - fv)), f4Load(q.tap[0]));
+  L = f4Add(L, f4Mul(f4Splat(fu * (1.0f - fv)), f4Load(q.tap[1])));
+  L = f4Add(L, f4Mul(f4Splat((1.0f - fu) * fv), f4Load(q.tap[2])));
+  return f4Add(L, f4Mul(f4Splat(fu * fv), f4Load(q.tap[3])));
+}
+
+// How many entries ahead the quad of a gather ray is prefetched: the quads are read in
+// visibility order, i.e. at random, and are larger than L2 at the default preset, so each
+// lookup would otherwise wait for an L3 (or memory) access.
+constexpr uint32_t kPrefetchDistance = 16;
+
+/// Σ_k L_k over one tixel's n visibility entries, in gather order k = 0 … n−1 (also writing
+/// each L_k to incoming when KeepIncoming). Entries without an extra record that hit a front
+/// side are direct views of diffuse tixels (a mirror-free path to a glossy chart always has
+/// one) and are looked up in the quads; the others go through slowPath(entry, extra), which
+/// returns their radiance. Escaped and back-side entries without an extra bring nothing.
+template <bool KeepIncoming, typename SlowPath>
+F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* quads, uint64_t quadCount,
+               const VisibilityExtra* extras, Rgb* incoming, SlowPath&& slowPath) {
+  F4 sum = f4Zero();
+  for (uint32_t k = 0; k < n; ++k) {
+    if (k + kPrefetchDistance < n)
+      __builtin_prefetch(quads + std::min<uint64_t>(entries[k + kPrefetchDistance].tixel(), quadCount - 1));
+    const VisibilityEntry e = entries[k];
+    if ((e.target & (VisibilityEntry::kBackSide | VisibilityEntry::kHasExtra)) == 0) {
+      if (!e.escaped()) {
+        const F4 L = lookupQuad(quads[e.tixel()], e);
+        sum = f4Add(sum, L);
+        if constexpr (KeepIncoming) incoming[k] = f4Rgb(L);
+      } else if constexpr (KeepIncoming) {
+        incoming[k] = Rgb(0.0f);
+      }
+    } else {
+      const Rgb L = slowPath(e, e.hasExtra() ? extras++ : nullptr);
+      sum = f4Add(sum, f4FromRgb(L));
+      if constexpr (KeepIncoming) incoming[k] = L;
+    }
+  }
+  return sum;
+}
 
 }  // namespace
 
@@ -421,9 +510,13 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   // iterations of Jacobi). Inside a batch, tixels are updated in parallel and read the
   // previous iteration's values of their own batch, so no value is read while it is written
   // and the result does not depend on thread timing.
-  // At least 2048 tixels per batch, and at most 2^14 batches (see TargetTixel).
+  // At least 2048 tixels per batch, and at most ~16000 batches.
   const uint64_t kBatchTixels = std::max<uint64_t>(2048, tixels / 16000 + 1);
   std::vector<uint64_t> batchStart{0};
+  // The previous iteration's values are needed only by lookups in glossy charts of the batch
+  // being updated (diffuse lookups read the quads, which lag by a batch; see below).
+  const bool anyGlossy = std::any_of(param.charts.begin(), param.charts.end(),
+                                     [](const Chart& c) { return c.kind == ChartKind::Glossy; });
   std::vector<uint32_t> chartBatch(param.charts.size(), 0);
   {
     uint64_t count = 0;
@@ -437,38 +530,39 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     }
     if (batchStart.back() != tixels) batchStart.push_back(tixels);
   }
-  // Everything a gather ray needs about the tixel it sees, in one 16-byte record (one cache
-  // access instead of three): the transport radiance ρ̄·E/π of diffuse tixels, and `info` =
-  // the chart's row stride resU (bits 0–15) | chart kind (bits 16–17) | batch (bits 18–31).
-  struct alignas(16) TargetTixel {
-    Rgb transport{0.0f};
-    uint32_t info = 0;
-  };
-  std::vector<TargetTixel> targets(tixels);
-  for (size_t ci = 0; ci < param.charts.size(); ++ci) {
-    const Chart& c = param.charts[ci];
-    if (c.resU > 0xffffu) fail("{}: chart {} has {} tixels per row (at most 65535)", scene.sourcePath, ci, c.resU);
-    const uint32_t info = c.resU | (uint32_t(c.kind) << 16) | (chartBatch[ci] << 18);
-    for (uint64_t t = 0; t < c.tixelCount(); ++t) targets[c.firstTixel + t].info = info;
-  }
+  // The quads (TransportQuad) of every tixel. A quad is rewritten only after its batch has
+  // been updated, so during the batch it still holds the previous iteration's values
+  // (Gauss–Seidel between batches, Jacobi inside).
+  std::vector<TransportQuad> quads(tixels);
   auto updateTransport = [&](uint64_t begin, uint64_t end) {
     parallelForRange(end - begin, 256, [&](uint64_t t0, uint64_t t1) {
       for (uint64_t g = begin + t0; g < begin + t1; ++g) {
         const Chart& c = param.charts[param.tixelChart[g]];
-        if (c.kind == ChartKind::Diffuse)
-          targets[g].transport = param.transportAlbedo[g] * current[c.firstValue + (g - c.firstTixel)] * kInvPi;
+        TransportQuad& q = quads[g];
+        q = TransportQuad{};
+        if (c.kind != ChartKind::Diffuse) continue;
+        const uint64_t local = g - c.firstTixel;
+        const uint32_t i = uint32_t(local % c.resU), j = uint32_t(local / c.resU);
+        auto put = [&](int slot, uint64_t tixel) {
+          const Rgb t = param.transportAlbedo[tixel] * current[c.firstValue + (tixel - c.firstTixel)] * kInvPi;
+          q.tap[slot][0] = t.r;
+          q.tap[slot][1] = t.g;
+          q.tap[slot][2] = t.b;
+        };
+        put(0, g);
+        if (i + 1 < c.resU) put(1, g + 1);
+        if (j + 1 < c.resV) put(2, g + c.resU);
+        if (i + 1 < c.resU && j + 1 < c.resV) put(3, g + c.resU + 1);
       }
     });
   };
   updateTransport(0, tixels);
   std::vector<Rgb> previousValues;
-  std::vector<TargetTixel> previousTargets;
 
   double previousPower = totalPower(current);
   Progress progress("propagation", settings.maxIterations);
   for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
-    previousValues = current;
-    previousTargets = targets;
+    if (anyGlossy) previousValues = current;
     for (size_t batch = 0; batch + 1 < batchStart.size(); ++batch) {
       const uint64_t begin = batchStart[batch], end = batchStart[batch + 1];
       parallelForRange(end - begin, 16, [&](uint64_t t0, uint64_t t1) {
@@ -476,45 +570,38 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
         for (uint64_t g = begin + t0; g < begin + t1; ++g) {
           const Chart& c = param.charts[param.tixelChart[g]];
           if (c.kind == ChartKind::Specular) continue;
-          uint64_t cursor = vis.extraOffset[g];
-          const VisibilityEntry* entries = vis.entries.data() + g * n;
-          for (uint32_t k = 0; k < n; ++k) {
-            const VisibilityEntry e = entries[k];
-            const VisibilityExtra* extra = e.hasExtra() ? &vis.extras[cursor++] : nullptr;
-            Rgb L(0.0f);
+          // Entries with an extra record, or that hit a back side.
+          auto slowPath = [&](VisibilityEntry e, const VisibilityExtra* extra) {
             // Back-side hits see the inside of a closed solid (or the unlit back of a one-sided
             // surface): no reflected light. Emission from behind is in the constant part.
-            if (!e.escaped() && !e.backSide()) {
-              const uint32_t base = e.tixel();
-              const uint32_t info = targets[base].info;
-              const auto kind = ChartKind((info >> 16) & 3u);
-              const bool sameBatch = (info >> 18) == batch;
+            if (!extra || e.escaped() || e.backSide()) return Rgb(0.0f);
+            const uint32_t base = e.tixel();
+            const uint32_t seenChart = param.tixelChart[base];
+            const Chart& seen = param.charts[seenChart];
+            Rgb L(0.0f);
+            if (seen.kind == ChartKind::Diffuse) {
+              L = f4Rgb(lookupQuad(quads[base], e));
+            } else if (seen.kind == ChartKind::Glossy) {
+              const bool sameBatch = chartBatch[seenChart] == batch;
               const float fu = float(e.fu) * (1.0f / 65535.0f), fv = float(e.fv) * (1.0f / 65535.0f);
-              if (kind == ChartKind::Diffuse) {
-                const TargetTixel* t = sameBatch ? previousTargets.data() : targets.data();
-                const uint32_t stride = info & 0xffffu;
-                L = (1.0f - fu) * (1.0f - fv) * t[base].transport;
-                if (e.fu) L += fu * (1.0f - fv) * t[base + 1].transport;
-                if (e.fv) L += (1.0f - fu) * fv * t[base + stride].transport;
-                if (e.fu && e.fv) L += fu * fv * t[base + stride + 1].transport;
-              } else if (kind == ChartKind::Glossy && extra) {
-                const Chart& seen = param.charts[param.tixelChart[base]];
-                const uint64_t local = base - seen.firstTixel;
-                const Vec2 grid(float(local % seen.resU) + fu, float(local / seen.resU) + fv);
-                L = interpolateValues(sameBatch ? previousValues.data() : current.data(), seen, grid, extra->st);
-              }
-              if (extra) L *= extra->throughput;
+              const uint64_t local = base - seen.firstTixel;
+              const Vec2 grid(float(local % seen.resU) + fu, float(local / seen.resU) + fv);
+              L = interpolateValues(sameBatch ? previousValues.data() : current.data(), seen, grid, extra->st);
             }
-            incoming[k] = L;
-          }
+            return L * extra->throughput;
+          };
+          const VisibilityEntry* entries = vis.entries.data() + g * n;
+          const VisibilityExtra* extras = vis.extras.data() + vis.extraOffset[g];
+          const F4 sum = c.kind == ChartKind::Glossy
+                             ? gatherTixel<true>(entries, n, quads.data(), tixels, extras, incoming.data(), slowPath)
+                             : gatherTixel<false>(entries, n, quads.data(), tixels, extras, nullptr, slowPath);
           const uint64_t vb = valueBase(g, c);
-          Rgb sum(0.0f);
-          for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
+          const Rgb total = f4Rgb(sum);
           if (c.kind == ChartKind::Diffuse) {
-            current[vb] = direct[vb] + sum * (kPi / float(n));
+            current[vb] = direct[vb] + total * (kPi / float(n));
           } else {
             std::copy_n(direct.data() + vb, c.valuesPerTixel(), current.data() + vb);
-            glossy[c.material].op.apply(incoming.data(), sum, current.data() + vb);
+            glossy[c.material].op.apply(incoming.data(), total, current.data() + vb);
           }
         }
       });
