@@ -28,6 +28,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -125,32 +126,25 @@ BakedScene& baked(const std::string& name) {
   return *slot;
 }
 
-/// Embree primary-ray casting alone, organised exactly like the fast renderer's first pass
-/// (16×16 tiles in parallel, 4×4-pixel blocks per 16-ray packet); writes t to `depth` so
-/// nothing is optimised away.
+/// Embree primary-ray casting alone: exactly the fast renderer's first pass (16×16 tiles in
+/// parallel, FastRenderer::tileCameraRays — 4×4-pixel blocks per 16-ray packet — then
+/// intersectCoherent); writes t to `depth` so nothing is optimised away.
 void castPrimaryRays(const pl::Accel& accel, const pl::Camera& camera, std::vector<float>& depth) {
   const int width = camera.width(), height = camera.height(), tile = 16;
   const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
   depth.resize(size_t(width) * size_t(height));
   pl::parallelForRange(uint64_t(tilesX * tilesY), 1, [&](uint64_t begin, uint64_t end) {
-    static thread_local std::vector<pl::Ray> rays;
-    static thread_local std::vector<pl::RayHit> hits;
-    static thread_local std::vector<uint32_t> pixel;
+    static thread_local std::vector<pl::Ray> rays(size_t(tile) * size_t(tile));
+    static thread_local std::vector<pl::RayHit> hits(size_t(tile) * size_t(tile));
+    static thread_local std::vector<float> weight(size_t(tile) * size_t(tile));
+    static thread_local std::vector<uint32_t> pixel(size_t(tile) * size_t(tile));
     for (uint64_t t = begin; t < end; ++t) {
       const int x0 = int(t % uint64_t(tilesX)) * tile, y0 = int(t / uint64_t(tilesX)) * tile;
       const int x1 = std::min(x0 + tile, width), y1 = std::min(y0 + tile, height);
-      rays.clear();
-      pixel.clear();
-      for (int by = y0; by < y1; by += 4)
-        for (int bx = x0; bx < x1; bx += 4)
-          for (int y = by; y < std::min(by + 4, y1); ++y)
-            for (int x = bx; x < std::min(bx + 4, x1); ++x) {
-              rays.push_back(camera.generateRay(pl::Vec2(float(x) + 0.5f, float(y) + 0.5f), pl::Vec2(0.5f)).ray);
-              pixel.push_back(uint32_t(y * width + x));
-            }
-      hits.resize(rays.size());
-      accel.intersectCoherent(rays, hits);
-      for (size_t i = 0; i < rays.size(); ++i) depth[pixel[i]] = hits[i].t;
+      const size_t n =
+          pl::FastRenderer::tileCameraRays(camera, 1, 0, x0, y0, x1, y1, rays.data(), weight.data(), pixel.data());
+      accel.intersectCoherent(std::span<const pl::Ray>(rays.data(), n), std::span<pl::RayHit>(hits.data(), n));
+      for (size_t i = 0; i < n; ++i) depth[pixel[i]] = hits[i].t;
     }
   });
 }

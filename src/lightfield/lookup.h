@@ -23,18 +23,23 @@ struct LinearTap {
   float f = 0.0f;
 };
 
-/// The tap for continuous coordinate x over `count` samples centred at 0 … count−1.
+/// The tap for continuous coordinate x over `count` samples centred at 0 … count−1:
+///   x ≤ 0 or NaN   → (0, 0, f = 0)            (hold the first sample)
+///   x ≥ count − 1  → (count−1, count−1, f = 0) (hold the last sample)
+///   otherwise      → (⌊x⌋, ⌊x⌋ + 1, x − ⌊x⌋).
+/// Written without branches (the renderers call it four times per pixel with data-dependent
+/// clamping): the clamp compiles to maxss/minss, `x > 0 ? x : 0` maps NaN to 0, and the
+/// upper index is ⌊x⌋ + [x > 0] capped at count − 1, which is exactly the case list above.
 inline LinearTap linearTap(float x, uint32_t count) {
+  const uint32_t last = count - 1;
+  const float positive = x > 0.0f ? x : 0.0f;  // NaN → 0
+  const float lastF = float(last);
+  const float clamped = positive < lastF ? positive : lastF;
   LinearTap tap;
-  if (!(x > 0.0f)) return tap;  // also catches NaN: hold the first sample
-  const float last = float(count - 1);
-  if (x >= last) {
-    tap.i0 = tap.i1 = count - 1;
-    return tap;
-  }
-  tap.i0 = uint32_t(x);
-  tap.i1 = tap.i0 + 1;
-  tap.f = x - float(tap.i0);
+  tap.i0 = uint32_t(clamped);
+  const uint32_t next = tap.i0 + uint32_t(clamped > 0.0f);
+  tap.i1 = next < last ? next : last;
+  tap.f = clamped - float(tap.i0);
   return tap;
 }
 

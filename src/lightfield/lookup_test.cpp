@@ -1,6 +1,11 @@
 // Tests of the 16-neighbour light-field lookup.
 #include "lightfield/lookup.h"
 
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "core/rng.h"
@@ -123,6 +128,38 @@ TEST(Lookup, LinearTapClampsAndInterpolates) {
   EXPECT_FLOAT_EQ(t.f, 0.25f);
   EXPECT_EQ(linearTap(0.7f, 1).i1, 0u);  // a single sample: always that sample
   EXPECT_EQ(linearTap(std::nanf(""), 3).i0, 0u);
+}
+
+TEST(Lookup, BranchFreeLinearTapEqualsTheCaseList) {
+  // linearTap is written without branches; it must give exactly (bitwise) the taps of the
+  // plain case list of its comment, for every count and every kind of x: random values over
+  // and beyond the range, exact integers, both clamping edges, ±0, ±∞ and NaN.
+  auto reference = [](float x, uint32_t count) {
+    LinearTap tap;
+    if (!(x > 0.0f)) return tap;
+    if (x >= float(count - 1)) {
+      tap.i0 = tap.i1 = count - 1;
+      return tap;
+    }
+    tap.i0 = uint32_t(x);
+    tap.i1 = tap.i0 + 1;
+    tap.f = x - float(tap.i0);
+    return tap;
+  };
+  Pcg32 rng(11, 3);
+  for (uint32_t count : {1u, 2u, 3u, 8u, 17u, 64u}) {
+    std::vector<float> xs = {0.0f, -0.0f, 1.0f, float(count) - 1.0f, float(count), -1.0f, 1e30f, -1e30f,
+                             std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                             std::nanf(""), std::nextafter(float(count) - 1.0f, 0.0f), std::nextafter(0.0f, 1.0f)};
+    for (uint32_t k = 0; k < count; ++k) xs.push_back(float(k));
+    for (int i = 0; i < 2000; ++i) xs.push_back((rng.uniform() * 1.4f - 0.2f) * float(count));
+    for (float x : xs) {
+      const LinearTap got = linearTap(x, count), want = reference(x, count);
+      EXPECT_EQ(got.i0, want.i0) << "x = " << x << ", count = " << count;
+      EXPECT_EQ(got.i1, want.i1) << "x = " << x << ", count = " << count;
+      EXPECT_EQ(std::bit_cast<uint32_t>(got.f), std::bit_cast<uint32_t>(want.f)) << "x = " << x << ", count = " << count;
+    }
+  }
 }
 
 }  // namespace

@@ -52,6 +52,16 @@ class FastRenderer {
   /// Samples per pixel that `settings` gives for `camera` (same rule as renderLightField).
   static int samplesPerPixel(const Camera& camera, const RenderSettings& settings);
 
+  /// The first pass of a tile, also what realtime_bench times as "primary rays alone": the
+  /// camera rays of every sample of pixels [x0, x1) × [y0, y1), in 4×4-pixel blocks (all
+  /// samples of a pixel consecutive) so that each 16-ray packet covers a compact footprint,
+  /// with the reference's sample positions (pixel and lens centre for spp = 1, else
+  /// Pcg32::forKey(pixel, k, seed)). Writes rays[n], weight[n] (camera weight) and, per
+  /// pixel, pixel[q] = y·width + x; returns the number of samples n. The arrays must hold
+  /// (x1 − x0)·(y1 − y0)·spp samples.
+  static size_t tileCameraRays(const Camera& camera, int spp, uint64_t seed, int x0, int y0, int x1, int y1, Ray* rays,
+                               float* weight, uint32_t* pixel);
+
   const LightField& lightField() const { return lightField_; }
   const Accel& accel() const { return accel_; }
 
