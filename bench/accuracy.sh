@@ -17,8 +17,8 @@
 #   field's own error is relMSE − ref noise; a ref-noise column far below relMSE means the
 #   reference is converged enough for the figure).
 #
-# Then the reuse-visibility check (issue 4, item 2): a JSON scene of the built-in box with the
-# light recoloured is baked twice — once reusing the visibility field saved by a bake of the
+# Then the reuse-visibility check (issue 4, item 2): a JSON scene of McGuire's CornellBox-Original
+# with the light recoloured is baked twice — once reusing the visibility field saved by a bake of the
 # original colour (--reuse-visibility --visibility), once from scratch — and the two light
 # fields' renders are compared (relMSE ≈ 0 expected; the bake is deterministic for a seed).
 #
@@ -27,7 +27,8 @@
 #   WORKDIR    where every file goes (default: out/accuracy)
 # Environment: SIZE (image side, default 256), REF_SPP (reference samples per pixel, default
 # 2048: about 40–90 s per scene on 2 cores), LF_SAMPLES (light-field camera samples per
-# pixel, default 16), SCENES_DIR (default: the McGuire scenes in ../shared/scenes).
+# pixel, default 16), SCENES_DIR (default: the McGuire scenes in ../shared/scenes), SCENES
+# (which of "cornell glossy mirror" to measure; empty = only the reuse-visibility check).
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -42,7 +43,7 @@ if [[ ! -x "$plenoptic" ]]; then
   echo "$0: $plenoptic is not an executable (build it: cmake --build build --target plenoptic)" >&2
   exit 1
 fi
-for f in CornellBox-Glossy.obj CornellBox-Mirror.obj; do
+for f in CornellBox-Glossy.obj CornellBox-Mirror.obj CornellBox-Original.obj; do
   if [[ ! -f "$scenes_dir/$f" ]]; then
     echo "$0: $scenes_dir/$f not found (set SCENES_DIR)" >&2
     exit 1
@@ -50,11 +51,19 @@ for f in CornellBox-Glossy.obj CornellBox-Mirror.obj; do
 done
 mkdir -p "$workdir"
 
-names=(cornell glossy mirror)
-scenes=(cornell "$scenes_dir/CornellBox-Glossy.obj" "$scenes_dir/CornellBox-Mirror.obj")
+all_names=(cornell glossy mirror)
+all_scenes=(cornell "$scenes_dir/CornellBox-Glossy.obj" "$scenes_dir/CornellBox-Mirror.obj")
+names=()
+scenes=()
+for i in "${!all_names[@]}"; do
+  if [[ " ${SCENES-cornell glossy mirror} " == *" ${all_names[$i]} "* ]]; then
+    names+=("${all_names[$i]}")
+    scenes+=("${all_scenes[$i]}")
+  fi
+done
 size_flags=(--width "$size" --height "$size")
 
-for i in "${!names[@]}"; do
+for i in ${names[@]+"${!names[@]}"}; do
   name=${names[$i]}
   scene=${scenes[$i]}
   out="$workdir/$name"
@@ -70,15 +79,20 @@ done
 
 # ---- reuse-visibility check ------------------------------------------------------------------
 echo "== reuse-visibility check" >&2
-cat >"$workdir/light_original.json" <<'EOF'
-{"include_cornell": true}
+# McGuire's CornellBox-Original through two JSON scenes that differ only in the light's
+# emission: its .mtl has "light" with Kd 0.78 and Ke (17, 12, 4); the JSON material of the same
+# name replaces it. Both files define the material, so the scenes' material lists (and with
+# them the charts' material indices, which the visibility hash covers) are the same.
+# (The JSON scene's same-name replacement applies to loaded mesh files, not to
+# "include_cornell", hence the OBJ box here.)
+original_obj=$(realpath "$scenes_dir/CornellBox-Original.obj")
+for variant in "original 17 12 4" "recoloured 4 12 17"; do
+  read -r label r g b <<<"$variant"
+  cat >"$workdir/light_$label.json" <<EOF
+{"meshes": [{"file": "$original_obj"}],
+ "materials": {"light": {"type": "lambert", "albedo": [0.78, 0.78, 0.78], "emission": [$r, $g, $b]}}}
 EOF
-# The built-in box's light material is "light" (src/scene/cornell.cpp): recolour it (bluish
-# instead of the measured warm white), same geometry, same material type.
-cat >"$workdir/light_recoloured.json" <<'EOF'
-{"include_cornell": true,
- "materials": {"light": {"type": "lambert", "albedo": [0.78, 0.78, 0.78], "emission": [6.0, 12.0, 20.0]}}}
-EOF
+done
 reuse="$workdir/reuse"
 "$plenoptic" --quiet bake "$workdir/light_original.json" -o "$reuse.original.plf" --visibility "$reuse.plv" \
   --stats "$reuse.original.json" >&2
@@ -93,7 +107,7 @@ done
 "$plenoptic" --quiet compare "$reuse.original.exr" "$reuse.full.exr" --json >"$reuse.changed.json"
 
 # ---- table ---------------------------------------------------------------------------------
-python3 - "$workdir" "$size" "$ref_spp" "$lf_samples" "${names[@]}" <<'PY'
+python3 - "$workdir" "$size" "$ref_spp" "$lf_samples" ${names[@]+"${names[@]}"} <<'PY'
 import json, os, struct, sys
 
 workdir, size, ref_spp, lf_samples, names = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5:]
@@ -128,11 +142,13 @@ for name in names:
     rows.append((name, bake["seconds"], bake["tixels"], bake["file_bytes"], cmp["mean_luminance_ratio"],
                  cmp["relmse"], noise, trace["seconds"], out + ".heat.png"))
 
-print(f"light field (render --samples {lf_samples}) vs path-traced reference ({ref_spp} spp), {size}x{size}, default preset")
-header = ("scene", "bake s", "tixels", ".plf bytes", "mean Y ratio", "relMSE", "ref noise", "ref s", "heat map")
-print(f"{header[0]:<8} {header[1]:>7} {header[2]:>8} {header[3]:>11} {header[4]:>12} {header[5]:>9} {header[6]:>9} {header[7]:>7}  {header[8]}")
-for r in rows:
-    print(f"{r[0]:<8} {r[1]:7.2f} {r[2]:8d} {r[3]:11d} {r[4]:12.4f} {r[5]:9.2e} {r[6]:9.1e} {r[7]:7.1f}  {r[8]}")
+if rows:
+    print(f"light field (render --samples {lf_samples}) vs path-traced reference ({ref_spp} spp), {size}x{size}, default preset")
+    header = ("scene", "bake s", "tixels", ".plf bytes", "mean Y ratio", "relMSE", "ref noise", "ref s", "heat map")
+    print(f"{header[0]:<8} {header[1]:>7} {header[2]:>8} {header[3]:>11} {header[4]:>12} {header[5]:>9} {header[6]:>9} {header[7]:>7}  {header[8]}")
+    for r in rows:
+        print(f"{r[0]:<8} {r[1]:7.2f} {r[2]:8d} {r[3]:11d} {r[4]:12.4f} {r[5]:9.2e} {r[6]:9.1e} {r[7]:7.1f}  {r[8]}")
+    print()
 
 reuse = os.path.join(workdir, "reuse")
 orig = json.load(open(reuse + ".original.json"))
@@ -140,12 +156,13 @@ reused = json.load(open(reuse + ".reused.json"))
 full = json.load(open(reuse + ".full.json"))
 same = json.load(open(reuse + ".compare.json"))
 changed = json.load(open(reuse + ".changed.json"))
-print()
-print("reuse-visibility check (built-in box, light recoloured):")
+print("reuse-visibility check (CornellBox-Original, light (17, 12, 4) recoloured to (4, 12, 17)):")
 print(f"  bake original colour          {orig['seconds']:6.2f} s  (visibility saved)")
 print(f"  re-bake, --reuse-visibility   {reused['seconds']:6.2f} s  reused_visibility={str(reused['reused_visibility']).lower()}"
       f"  ({100.0 * reused['seconds'] / full['seconds']:.0f} % of the full bake)")
 print(f"  full bake of the changed scene {full['seconds']:5.2f} s")
 print(f"  render(reused) vs render(full):  relMSE {same['relmse']:.3e}, max |diff| {same['max_abs_error']:.3e}, identical {str(same['identical']).lower()}")
 print(f"  (for scale: original colour vs changed, relMSE {changed['relmse']:.3e})")
+if not reused["reused_visibility"]:
+    print("  WARNING: the visibility field was NOT reused (see the bake's message without --quiet)")
 PY
