@@ -418,6 +418,15 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
 
   // Emission and environment arriving through the gather rays (constant over the iteration).
   const Environment& environment = scene.environment;
+  // Per tixel: whether its chart emits from the front (bit 0) and from the back (bit 1), so
+  // that the pass below looks the seen chart and material up only for entries that see light.
+  std::vector<uint8_t> tixelEmits(tixels, 0);
+  for (const Chart& c : param.charts) {
+    const Material& material = scene.materials[c.material];
+    if (!material.isEmissive()) continue;
+    const uint8_t bits = material.twoSidedEmission ? 3 : 1;
+    std::fill_n(tixelEmits.begin() + int64_t(c.firstTixel), c.tixelCount(), bits);
+  }
   parallelForRange(tixels, 16, [&](uint64_t t0, uint64_t t1) {
     std::vector<Rgb> incoming(n);
     for (uint64_t g = t0; g < t1; ++g) {
@@ -437,7 +446,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
                                        : chartWorldDirection(c, gatherDirectionLocal(g, k, vis.gridSide, settings.seed));
             L = environment.radiance(leaving);
           }
-        } else {
+        } else if (tixelEmits[e.tixel()] & (e.backSide() ? 2 : 1)) {
           const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
           const Material& material = scene.materials[seen.material];
           if (material.isEmissive() && (!e.backSide() || material.twoSidedEmission)) {
