@@ -16,6 +16,8 @@ function(pl_add_test name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} pl_warnings GTest::gtest GTest::gtest_main)
+  # tests/support: helpers shared by test files (e.g. support/cli_test_support.h).
+  target_include_directories(${name} PRIVATE ${CMAKE_SOURCE_DIR}/tests)
   target_compile_definitions(${name} PRIVATE
     PLENOPTIC_SHARED_DIR="${PLENOPTIC_SHARED_DIR}"
     PLENOPTIC_TEST_DATA_DIR="${PLENOPTIC_TEST_DATA_DIR}"

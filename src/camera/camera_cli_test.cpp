@@ -6,15 +6,14 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <string>
 
 #include "image/image.h"
+#include "support/cli_test_support.h"
 
 namespace pl {
 namespace {
@@ -24,26 +23,14 @@ namespace fs = std::filesystem;
 constexpr int kWidth = 201, kHeight = 101;
 constexpr float kFovY = 40.0f, kRadiance = 2.0f;
 
-int run(const std::string& arguments, std::string& output) {
-  const std::string command = std::string(PLENOPTIC_BINARY) + " --quiet " + arguments + " 2>&1";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[4096];
-  size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) output.append(buffer, n);
-  const int status = ::pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 /// Traces the wall with extra flags and returns the EXR.
 Image traceWall(const std::string& flags) {
   const std::string out = (fs::path(::testing::TempDir()) / ("pl_wall_" + std::to_string(::getpid()) + ".exr")).string();
-  std::string output;
-  const int status = run(fmt::format("trace {}/image/emissive_wall.json -o {} --width {} --height {} --spp 16 {}",
-                                     PLENOPTIC_TEST_DATA_DIR, out, kWidth, kHeight, flags),
-                         output);
-  EXPECT_EQ(status, 0) << output;
-  Image image = status == 0 ? readImage(out) : Image();
+  const cli_test::CommandResult result =
+      cli_test::runPlenopticCombined(fmt::format("trace {}/image/emissive_wall.json -o {} --width {} --height {} --spp 16 {}",
+                                                 PLENOPTIC_TEST_DATA_DIR, out, kWidth, kHeight, flags));
+  EXPECT_EQ(result.exitCode, 0) << result.output;
+  Image image = result.exitCode == 0 ? readImage(out) : Image();
   fs::remove(out);
   return image;
 }

@@ -2,17 +2,15 @@
 // says, numbers equal to the library's, clear errors and no output on bad input.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
-#include <unistd.h>
 #include <string>
 
 #include "env/env.h"
 #include "env/ibl.h"
 #include "image/image.h"
+#include "support/cli_test_support.h"
 
 namespace pl {
 namespace {
@@ -21,36 +19,7 @@ namespace fs = std::filesystem;
 const std::string kShared = PLENOPTIC_SHARED_DIR;
 const std::string kVenice = kShared + "/envmaps/venice_sunset_1k.hdr";
 
-class EnvCliTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("plenoptic_env_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  /// Runs plenoptic with `arguments`; returns the exit status, stdout and stderr.
-  int run(const std::string& arguments, std::string* out = nullptr, std::string* err = nullptr) const {
-    const fs::path outFile = dir_ / "stdout.txt", errFile = dir_ / "stderr.txt";
-    const std::string command = std::string("\"") + PLENOPTIC_BINARY + "\" " + arguments + " --quiet > \"" +
-                                outFile.string() + "\" 2> \"" + errFile.string() + "\"";
-    const int status = std::system(command.c_str());
-    auto slurp = [](const fs::path& p) {
-      std::ifstream in(p);
-      std::stringstream text;
-      text << in.rdbuf();
-      return text.str();
-    };
-    if (out) *out = slurp(outFile);
-    if (err) *err = slurp(errFile);
-    return status;
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-  fs::path dir_;
-};
+class EnvCliTest : public cli_test::CliTest {};
 
 TEST_F(EnvCliTest, ShJsonMatchesLibrary) {
   std::string out;

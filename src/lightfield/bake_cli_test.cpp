@@ -2,46 +2,23 @@
 // --reuse-visibility, and how it refuses bad input.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 
 #include "lightfield/plf_file.h"
+#include "support/cli_test_support.h"
 
 namespace pl {
 namespace {
 
 namespace fs = std::filesystem;
 
-class BakeCli : public ::testing::Test {
+class BakeCli : public cli_test::CliTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("plenoptic_bake_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  // Exit status of the command (0 = success), with its stdout and stderr.
-  int run(const std::string& arguments, std::string* output = nullptr, std::string* errors = nullptr) const {
-    const fs::path outFile = dir_ / "stdout.txt", errFile = dir_ / "stderr.txt";
-    const std::string command = std::string("\"") + PLENOPTIC_BINARY + "\" " + arguments + " > \"" + outFile.string() +
-                                "\" 2> \"" + errFile.string() + "\"";
-    const int status = std::system(command.c_str());
-    if (output) *output = slurp(outFile);
-    if (errors) *errors = slurp(errFile);
-    return status;
-  }
-  static std::string slurp(const fs::path& file) {
-    std::ifstream in(file);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  // What bake says on stderr (e.g. "reusing" the visibility field) is tested: not --quiet.
+  BakeCli() { quiet_ = false; }
 };
 
 TEST_F(BakeCli, BakesWritesStatsAndReusesVisibility) {

@@ -2,13 +2,11 @@
 // light field: what they print and write, and how they refuse bad input.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 
 #include "accel/accel.h"
@@ -18,6 +16,7 @@
 #include "image/image.h"
 #include "lightfield/plf_file.h"
 #include "render/render.h"
+#include "support/cli_test_support.h"
 
 namespace pl {
 namespace {
@@ -65,37 +64,12 @@ LightField makeQuadLightField() {
   return lf;
 }
 
-class RenderCliTest : public ::testing::Test {
+class RenderCliTest : public cli_test::CliTest {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("plenoptic_render_cli_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    CliTest::SetUp();
     writeLightField(path("quad.plf"), makeQuadLightField());
   }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  /// Runs plenoptic with `arguments`; returns the exit status, stdout and stderr.
-  int run(const std::string& arguments, std::string* output = nullptr, std::string* errors = nullptr) const {
-    const fs::path outFile = dir_ / "stdout.txt", errFile = dir_ / "stderr.txt";
-    const std::string command = std::string("\"") + PLENOPTIC_BINARY + "\" " + arguments + " --quiet > \"" +
-                                outFile.string() + "\" 2> \"" + errFile.string() + "\"";
-    const int status = std::system(command.c_str());
-    if (output) *output = slurp(outFile);
-    if (errors) *errors = slurp(errFile);
-    return status;
-  }
-  static std::string slurp(const fs::path& file) {
-    std::ifstream in(file);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-  fs::path dir_;
 };
 
 TEST_F(RenderCliTest, InfoPrintsContentsAndSizes) {
@@ -154,7 +128,7 @@ TEST_F(RenderCliTest, RenderWritesTheLookedUpRadianceAndStats) {
   }
   EXPECT_GT(quadPixels, 200) << "the quad must fill the middle of the top view";
 
-  const auto json = nlohmann::json::parse(slurp(stats));
+  const auto json = nlohmann::json::parse(cli_test::readFileText(stats));
   EXPECT_EQ(json["renderer"], "reference");
   EXPECT_EQ(json["frames"], 3);
   EXPECT_EQ(json["camera"], "top");
@@ -185,7 +159,7 @@ TEST_F(RenderCliTest, RefusesBadInputWithoutWritingAnything) {
   EXPECT_NE(err.find("cannot open"), std::string::npos) << err;
 
   // A corrupt file: one bit flipped in the last byte (inside the metadata section).
-  std::string bytes = slurp(path("quad.plf"));
+  std::string bytes = cli_test::readFileText(path("quad.plf"));
   bytes.back() ^= 0x04;
   std::ofstream(path("corrupt.plf"), std::ios::binary) << bytes;
   EXPECT_NE(run("render " + path("corrupt.plf") + " -o " + path("b.exr"), nullptr, &err), 0);
@@ -235,7 +209,7 @@ TEST_F(RenderCliTest, Version1FixtureStillReadsAndRewritesByteForByte) {
 
   // The writer is deterministic: writing what was read reproduces the fixture exactly.
   writeLightField(path("rewritten.plf"), lf);
-  const std::string original = slurp(fixture), rewritten = slurp(path("rewritten.plf"));
+  const std::string original = cli_test::readFileText(fixture), rewritten = cli_test::readFileText(path("rewritten.plf"));
   EXPECT_EQ(original.size(), rewritten.size());
   EXPECT_TRUE(original == rewritten) << "the version-1 byte layout changed";
 

@@ -19,6 +19,7 @@
 #include "core/progress.h"
 #include "lightfield/plf_file.h"
 #include "realtime/frame_output.h"
+#include "support/cli_test_support.h"
 #include "viewer/viewer.h"
 
 namespace pl {
@@ -41,33 +42,14 @@ LightField cornellLightField() {
   return lf;
 }
 
-class ViewerCliTest : public ::testing::Test {
+class ViewerCliTest : public cli_test::CliTest {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("plenoptic_viewer_cli_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    CliTest::SetUp();
+    // Headless: SDL's dummy video driver, inherited by every run() (ctest sets it too).
+    ::setenv("SDL_VIDEODRIVER", "dummy", 1);
     writeLightField(path("cornell.plf"), cornellLightField());
   }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  /// Runs plenoptic headless (SDL's dummy video driver) with `arguments`.
-  int run(const std::string& arguments, std::string* errors = nullptr) const {
-    const fs::path outFile = dir_ / "stdout.txt", errFile = dir_ / "stderr.txt";
-    const std::string command = std::string("SDL_VIDEODRIVER=dummy \"") + PLENOPTIC_BINARY + "\" " + arguments +
-                                " --quiet > \"" + outFile.string() + "\" 2> \"" + errFile.string() + "\"";
-    const int status = std::system(command.c_str());
-    if (errors) {
-      std::ifstream in(errFile);
-      std::stringstream text;
-      text << in.rdbuf();
-      *errors = text.str();
-    }
-    return status;
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   /// Number of pixels whose 8-bit values differ between two PNGs (read back as linear).
   static int differingPixels(const std::string& a, const std::string& b) {
@@ -79,15 +61,13 @@ class ViewerCliTest : public ::testing::Test {
     for (size_t i = 0; i < ia.pixels.size(); ++i) differ += ia.pixels[i] != ib.pixels[i];
     return differ;
   }
-
-  fs::path dir_;
 };
 
 TEST_F(ViewerCliTest, ScreenshotAfterFramesEqualsRender) {
   const std::string size = " --width 160 --height 120";
   ASSERT_EQ(run("render " + path("cornell.plf") + " -o " + path("render.png") + size), 0);
   std::string errors;
-  ASSERT_EQ(run("view " + path("cornell.plf") + " --frames 3 --screenshot " + path("view.png") + size, &errors), 0)
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --frames 3 --screenshot " + path("view.png") + size, nullptr, &errors), 0)
       << errors;
   // Same fast renderer, same camera, same exposure and tone-mapping code: identical pixels
   // (the HUD is drawn on the window only, never into screenshots).
@@ -113,7 +93,7 @@ TEST_F(ViewerCliTest, ScriptedPathEndsWhereRenderOfTheLastKeyframeIs) {
   std::string errors;
   // 1 s at 4 fps: frames at 0, 0.25, 0.5, 0.75, 1 — the last one on the last keyframe.
   ASSERT_EQ(run("view " + path("cornell.plf") + " --path " + path("walk.json") + " --screenshot " + path("view.png") + size,
-                &errors),
+                nullptr, &errors),
             0)
       << errors;
   ASSERT_EQ(run("render " + path("cornell.plf") + " -o " + path("last.png") +
@@ -124,7 +104,7 @@ TEST_F(ViewerCliTest, ScriptedPathEndsWhereRenderOfTheLastKeyframeIs) {
   // The walk-through through `render --path`: 5 frames; its last frame is the same image.
   ASSERT_EQ(run("render " + path("cornell.plf") + " --path " + path("walk.json") + " -o " + path("frames/f%02d.png") +
                     " --stats " + path("stats.json") + size,
-                &errors),
+                nullptr, &errors),
             0)
       << errors;
   for (int k = 0; k < 5; ++k) EXPECT_TRUE(fs::exists(path("frames/f0" + std::to_string(k) + ".png"))) << k;
@@ -141,37 +121,40 @@ TEST_F(ViewerCliTest, ScriptedPathEndsWhereRenderOfTheLastKeyframeIs) {
 
 TEST_F(ViewerCliTest, BadInputsAreClearErrors) {
   std::string errors;
-  EXPECT_NE(run("view " + path("cornell.plf") + " --screenshot " + path("x.png"), &errors), 0);
+  EXPECT_NE(run("view " + path("cornell.plf") + " --screenshot " + path("x.png"), nullptr, &errors), 0);
   EXPECT_NE(errors.find("--screenshot needs --frames"), std::string::npos) << errors;
   {
     std::ofstream json(path("bad.json"));
     json << R"({"keyframes": [{"time": 0, "eye": [0, 0, 1]}]})";
   }
-  EXPECT_NE(run("view " + path("cornell.plf") + " --frames 1 --path " + path("bad.json"), &errors), 0);
+  EXPECT_NE(run("view " + path("cornell.plf") + " --frames 1 --path " + path("bad.json"), nullptr, &errors), 0);
   EXPECT_NE(errors.find(path("bad.json") + ": keyframe 0: missing 'target'"), std::string::npos) << errors;
-  EXPECT_NE(run("render " + path("cornell.plf") + " --path " + path("bad.json") + " -o " + path("f%03d.png"), &errors), 0);
+  EXPECT_NE(run("render " + path("cornell.plf") + " --path " + path("bad.json") + " -o " + path("f%03d.png"),
+                nullptr, &errors),
+            0);
   EXPECT_NE(errors.find("missing 'target'"), std::string::npos) << errors;
-  EXPECT_NE(run("render " + path("cornell.plf") + " --path " + path("missing.json") + " -o " + path("f%03d.png"), &errors), 0);
+  EXPECT_NE(run("render " + path("cornell.plf") + " --path " + path("missing.json") + " -o " + path("f%03d.png"),
+                nullptr, &errors),
+            0);
   EXPECT_NE(errors.find(path("missing.json") + ": cannot open"), std::string::npos) << errors;
   // A path needs several outputs; a pattern needs a path.
-  EXPECT_NE(run("render " + path("cornell.plf") + " --path " + path("bad.json") + " -o " + path("one.png"), &errors), 0);
+  EXPECT_NE(run("render " + path("cornell.plf") + " --path " + path("bad.json") + " -o " + path("one.png"),
+                nullptr, &errors),
+            0);
   EXPECT_NE(errors.find("frame pattern"), std::string::npos) << errors;
-  EXPECT_NE(run("render " + path("cornell.plf") + " -o " + path("f%03d.png"), &errors), 0);
+  EXPECT_NE(run("render " + path("cornell.plf") + " -o " + path("f%03d.png"), nullptr, &errors), 0);
   EXPECT_NE(errors.find("needs a camera path"), std::string::npos) << errors;
-  EXPECT_NE(run("render " + path("cornell.plf") + " --fast --reference -o " + path("x.png"), &errors), 0);
+  EXPECT_NE(run("render " + path("cornell.plf") + " --fast --reference -o " + path("x.png"), nullptr, &errors), 0);
   // MP4 without ffmpeg on PATH: a clear message, before any rendering.
   {
     std::ofstream json(path("good.json"));
     json << R"({"keyframes": [{"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0]}]})";
   }
-  const std::string command = "PATH=/nonexistent-plenoptic-dir \"" + std::string(PLENOPTIC_BINARY) + "\" render " +
-                              path("cornell.plf") + " --path " + path("good.json") + " -o " + path("walk.mp4") +
-                              " --quiet 2> " + path("err.txt");
-  EXPECT_NE(std::system(command.c_str()), 0);
-  std::ifstream err(path("err.txt"));
-  std::stringstream text;
-  text << err.rdbuf();
-  EXPECT_NE(text.str().find("MP4 output needs ffmpeg, which is not installed"), std::string::npos) << text.str();
+  EXPECT_NE(cli_test::runPlenoptic("render " + path("cornell.plf") + " --path " + path("good.json") + " -o " +
+                                        path("walk.mp4") + " --quiet",
+                                    dir_, nullptr, &errors, "PATH=/nonexistent-plenoptic-dir"),
+            0);
+  EXPECT_NE(errors.find("MP4 output needs ffmpeg, which is not installed"), std::string::npos) << errors;
   EXPECT_FALSE(fs::exists(path("walk.mp4")));
 }
 
