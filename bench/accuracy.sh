@@ -5,17 +5,22 @@
 # For the built-in Cornell box and McGuire's CornellBox-Glossy and CornellBox-Mirror, at the
 # default bake preset:
 #   1. plenoptic bake SCENE -o NAME.plf --stats NAME.bake.json
-#   2. plenoptic render NAME.plf --samples 16 (SIZE×SIZE) -o NAME.lf.exr      light field
+#   2. plenoptic render NAME.plf --samples 16 (SIZE×SIZE) -o NAME.lf.pfm      light field
 #   3. plenoptic trace SCENE --spp REF_SPP (SIZE×SIZE) -o NAME.ref.pfm         reference,
 #      with --variance NAME.refvar.pfm (the reference's own squared standard error per pixel)
-#   4. plenoptic compare NAME.lf.exr NAME.ref.pfm --json --heatmap NAME.heat.png
+#   4. plenoptic compare NAME.lf.pfm NAME.ref.pfm --json --heatmap NAME.heat.png
 # and prints one row per scene:
 #   bake s, tixels, .plf bytes, mean-luminance ratio (light field / reference, Rec.709 Y; the
 #   issue asks for 1 ± 0.02), relMSE (compare.h: mean (a−b)²/(b²+0.01)), and "ref noise": the
 #   part of that relMSE the reference's own Monte Carlo noise accounts for, mean var/(b²+0.01)
 #   over pixels and channels (E[(a−b)²] = bias² + var_b when a is noise-free, so the light
-#   field's own error is relMSE − ref noise; a ref-noise column far below relMSE means the
-#   reference is converged enough for the figure).
+#   field's own error is relMSE − ref noise, printed as "LF error"; a ref-noise column far below
+#   relMSE means the reference is converged enough for the figure), and "relMSE@0.18": the relMSE after scaling
+#   both images so that the reference's mean luminance is 0.18 (mid-grey). relMSE's +0.01 in the
+#   denominator is an absolute radiance, so the raw figure depends on the scene's brightness:
+#   McGuire's Glossy and Mirror boxes have a light of radiance 1 (mean image luminance ≈ 0.006)
+#   where the built-in box's light is ≈ 14 (mean ≈ 0.16); the normalised columns (relMSE and
+#   reference noise at mean luminance 0.18) compare them.
 #
 # Then the reuse-visibility check (issue 4, item 2): a JSON scene of McGuire's CornellBox-Original
 # with the light recoloured is baked twice — once reusing the visibility field saved by a bake of the
@@ -70,11 +75,11 @@ for i in ${names[@]+"${!names[@]}"}; do
   echo "== $name: bake (default preset)" >&2
   "$plenoptic" --quiet bake "$scene" -o "$out.plf" --stats "$out.bake.json" >&2
   echo "== $name: light-field render ($lf_samples samples per pixel)" >&2
-  "$plenoptic" --quiet render "$out.plf" -o "$out.lf.exr" --samples "$lf_samples" "${size_flags[@]}" >&2
+  "$plenoptic" --quiet render "$out.plf" -o "$out.lf.pfm" --samples "$lf_samples" "${size_flags[@]}" >&2
   echo "== $name: reference ($ref_spp spp)" >&2
   "$plenoptic" --quiet trace "$scene" -o "$out.ref.pfm" --variance "$out.refvar.pfm" --spp "$ref_spp" \
     "${size_flags[@]}" --stats "$out.trace.json" >&2
-  "$plenoptic" --quiet compare "$out.lf.exr" "$out.ref.pfm" --json --heatmap "$out.heat.png" >"$out.compare.json"
+  "$plenoptic" --quiet compare "$out.lf.pfm" "$out.ref.pfm" --json --heatmap "$out.heat.png" >"$out.compare.json"
 done
 
 # ---- reuse-visibility check ------------------------------------------------------------------
@@ -139,15 +144,20 @@ for name in names:
     cmp = json.load(open(out + ".compare.json"))
     ref, var = read_pfm(out + ".ref.pfm"), read_pfm(out + ".refvar.pfm")
     noise = sum(v / (r * r + 0.01) for r, v in zip(ref, var)) / len(ref)
+    lf = read_pfm(out + ".lf.pfm")
+    mean_y = sum(0.2126 * ref[i] + 0.7152 * ref[i + 1] + 0.0722 * ref[i + 2] for i in range(0, len(ref), 3)) / (len(ref) / 3)
+    k = 0.18 / mean_y
+    normalised = sum((k * (a - b)) ** 2 / ((k * b) ** 2 + 0.01) for a, b in zip(lf, ref)) / len(ref)
+    normalised_noise = sum(k * k * v / ((k * b) ** 2 + 0.01) for b, v in zip(ref, var)) / len(ref)
     rows.append((name, bake["seconds"], bake["tixels"], bake["file_bytes"], cmp["mean_luminance_ratio"],
-                 cmp["relmse"], noise, trace["seconds"], out + ".heat.png"))
+                 cmp["relmse"], noise, normalised, normalised_noise, trace["seconds"], out + ".heat.png"))
 
 if rows:
     print(f"light field (render --samples {lf_samples}) vs path-traced reference ({ref_spp} spp), {size}x{size}, default preset")
-    header = ("scene", "bake s", "tixels", ".plf bytes", "mean Y ratio", "relMSE", "ref noise", "ref s", "heat map")
-    print(f"{header[0]:<8} {header[1]:>7} {header[2]:>8} {header[3]:>11} {header[4]:>12} {header[5]:>9} {header[6]:>9} {header[7]:>7}  {header[8]}")
+    header = ("scene", "bake s", "tixels", ".plf bytes", "mean Y ratio", "relMSE", "ref noise", "LF error", "relMSE@0.18", "noise@0.18", "ref s", "heat map")
+    print(f"{header[0]:<8} {header[1]:>7} {header[2]:>8} {header[3]:>11} {header[4]:>12} {header[5]:>9} {header[6]:>9} {header[7]:>9} {header[8]:>11} {header[9]:>10} {header[10]:>7}  {header[11]}")
     for r in rows:
-        print(f"{r[0]:<8} {r[1]:7.2f} {r[2]:8d} {r[3]:11d} {r[4]:12.4f} {r[5]:9.2e} {r[6]:9.1e} {r[7]:7.1f}  {r[8]}")
+        print(f"{r[0]:<8} {r[1]:7.2f} {r[2]:8d} {r[3]:11d} {r[4]:12.4f} {r[5]:9.2e} {r[6]:9.1e} {r[5] - r[6]:9.2e} {r[7]:11.2e} {r[8]:10.1e} {r[9]:7.1f}  {r[10]}")
     print()
 
 reuse = os.path.join(workdir, "reuse")
