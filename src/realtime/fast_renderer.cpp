@@ -59,30 +59,6 @@ int FastRenderer::samplesPerPixel(const Camera& camera, const RenderSettings& se
                                       : 1;
 }
 
-/// One mirror bounce, the same steps as the reference (render.cpp radianceFromHit): the
-/// mirror's own emission, then — within the depth limit — the reflected ray, weighted by the
-/// reflectance (the BSDF's delta sample, with Fresnel when the material asks for it). BSDFs
-/// are two-sided: the frame faces the arriving ray. Returns false when the chain ends here.
-static bool reflectOffMirror(const Scene& scene, const Ray& ray, const RayHit& hit, bool mayReflect, Rgb& emitted,
-                             Ray& reflected, Rgb& reflectance) {
-  const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
-  const Vec3 wo = -ray.direction;
-  const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
-  emitted = emittedRadiance(scene.materials[surface.material], cosWoGeometric);
-  if (!mayReflect) return false;
-  const bool back = cosWoGeometric < 0.0f;
-  const Vec3 geometricNormal = back ? -surface.geometricNormal : surface.geometricNormal;
-  const Frame frame = Frame::fromNormal(back ? -surface.shadingNormal : surface.shadingNormal);
-  // A delta lobe ignores the random numbers: (½, ½) is as good as any.
-  const std::optional<BsdfSample> bs = sample(bsdfAt(scene, surface), frame.toLocal(wo), Vec2(0.5f));
-  if (!bs || !bs->delta) return false;
-  const Vec3 wi = frame.toWorld(bs->wi);
-  if (glm::dot(wi, geometricNormal) <= 0.0f) return false;  // grazing: the reflection is below the surface
-  reflected = Ray{offsetRayOrigin(surface.position, geometricNormal, wi), wi, 0.0f, kInfinity};
-  reflectance = bs->weight;
-  return true;
-}
-
 size_t FastRenderer::tileCameraRays(const Camera& camera, int spp, uint64_t seed, int x0, int y0, int x1, int y1,
                                     Ray* rays, float* weight, uint32_t* pixelIndex) {
   // Camera::generateRay returns its Sample through memory. Copying it out right after the

@@ -32,31 +32,48 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hi
   Rgb throughput(1.0f), result(0.0f);
   for (uint32_t reflections = 0;; ++reflections) {
     if (!hit.hit()) return result + throughput * backgroundRadiance(scene.environment, ray.direction);
-    const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
-    const Vec3 wo = -ray.direction;
     const Chart& chart = lf.charts[lf.triangleChart[hit.mesh][hit.triangle]];
-    if (chart.kind != ChartKind::Specular) return result + throughput * exitantRadiance(lf, surface, wo);
+    if (chart.kind != ChartKind::Specular)
+      return result +
+             throughput * exitantRadiance(lf, surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics), -ray.direction);
 
     // An ideal mirror: its own emission (if any) plus the reflectance times what the
-    // mirrored direction sees. BSDFs are two-sided: the frame faces the arriving ray, as in
-    // the path tracer.
-    const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
-    result += throughput * emittedRadiance(scene.materials[surface.material], cosWoGeometric);
-    if (reflections >= mirrorDepth) return result;
-    const bool back = cosWoGeometric < 0.0f;
-    const Vec3 geometricNormal = back ? -surface.geometricNormal : surface.geometricNormal;
-    const Frame frame = Frame::fromNormal(back ? -surface.shadingNormal : surface.shadingNormal);
-    // A delta lobe ignores the random numbers: (½, ½) is as good as any.
-    const std::optional<BsdfSample> s = sample(bsdfAt(scene, surface), frame.toLocal(wo), Vec2(0.5f));
-    if (!s || !s->delta) return result;
-    const Vec3 wi = frame.toWorld(s->wi);
-    if (glm::dot(wi, geometricNormal) <= 0.0f) return result;  // grazing: the reflection is below the surface
-    throughput *= s->weight;
-    ray = Ray{offsetRayOrigin(surface.position, geometricNormal, wi), wi, 0.0f, kInfinity};
+    // mirrored direction sees.
+    Rgb emitted, reflectance;
+    Ray reflected;
+    const bool more = reflectOffMirror(scene, ray, hit, reflections < mirrorDepth, emitted, reflected, reflectance);
+    result += throughput * emitted;
+    if (!more) return result;
+    throughput *= reflectance;
+    ray = reflected;
     hit = RayHit{};
     accel.intersect(ray, hit);
   }
 }
+
+}  // namespace
+
+bool reflectOffMirror(const Scene& scene, const Ray& ray, const RayHit& hit, bool mayReflect, Rgb& emitted,
+                      Ray& reflected, Rgb& reflectance) {
+  const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+  const Vec3 wo = -ray.direction;
+  const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
+  emitted = emittedRadiance(scene.materials[surface.material], cosWoGeometric);
+  if (!mayReflect) return false;
+  const bool back = cosWoGeometric < 0.0f;
+  const Vec3 geometricNormal = back ? -surface.geometricNormal : surface.geometricNormal;
+  const Frame frame = Frame::fromNormal(back ? -surface.shadingNormal : surface.shadingNormal);
+  // A delta lobe ignores the random numbers: (½, ½) is as good as any.
+  const std::optional<BsdfSample> bs = sample(bsdfAt(scene, surface), frame.toLocal(wo), Vec2(0.5f));
+  if (!bs || !bs->delta) return false;
+  const Vec3 wi = frame.toWorld(bs->wi);
+  if (glm::dot(wi, geometricNormal) <= 0.0f) return false;  // grazing: the reflection is below the surface
+  reflected = Ray{offsetRayOrigin(surface.position, geometricNormal, wi), wi, 0.0f, kInfinity};
+  reflectance = bs->weight;
+  return true;
+}
+
+namespace {
 
 uint32_t effectiveMirrorDepth(const LightField& lf, const RenderSettings& settings) {
   return settings.mirrorDepth >= 0 ? uint32_t(settings.mirrorDepth) : lf.settings.mirrorDepth;

@@ -30,6 +30,7 @@ namespace pl {
 class Accel;
 class Camera;
 struct Environment;
+struct RayHit;
 
 struct RenderSettings {
   /// Camera samples per pixel; 0 = automatic: 1 (pixel centre) for a pinhole camera,
@@ -52,6 +53,16 @@ Image renderLightField(const LightField& lightField, const Accel& accel, const C
 /// Radiance (W·sr⁻¹·m⁻²) arriving at ray.origin from ray.direction (unit), looked up in the
 /// light field, following at most mirrorDepth mirror reflections.
 Rgb lightFieldRadiance(const LightField& lightField, const Accel& accel, const Ray& ray, uint32_t mirrorDepth);
+
+/// One mirror bounce at `hit` (a specular chart's surface) of `ray`, the step both this
+/// renderer and the fast one (realtime) take: `emitted` gets the mirror's own emission, then
+/// — if `mayReflect` (within the depth limit) — `reflected` the mirrored ray (offset off the
+/// surface) and `reflectance` its weight (the BSDF's delta sample, with Fresnel when the
+/// material asks for it). BSDFs are two-sided: the frame faces the arriving ray, as in the
+/// path tracer. Returns false when the chain ends here (depth limit, no delta lobe, or a
+/// reflection below the geometric surface at grazing angles).
+bool reflectOffMirror(const Scene& scene, const Ray& ray, const RayHit& hit, bool mayReflect, Rgb& emitted,
+                      Ray& reflected, Rgb& reflectance);
 
 /// Radiance from infinity towards −direction for a ray leaving the scene along `direction`.
 /// The only place the renderer reads the environment (an environment map plugs in here).
