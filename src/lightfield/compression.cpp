@@ -217,6 +217,13 @@ void checkHeader(StreamReader& r, ValuesCodec codec, uint64_t valueCount, uint64
          imageCount);
 }
 
+/// Appends the payload size field and the payload as one zstd frame (read by readPayload).
+void putPayload(StreamWriter& w, const std::vector<unsigned char>& payload, int zstdLevel) {
+  w.put(uint64_t(payload.size()));
+  const std::vector<unsigned char> frame = detail::zstdCompress(payload, zstdLevel);
+  w.bytes.insert(w.bytes.end(), frame.begin(), frame.end());
+}
+
 /// Reads the payload size field, checks it against the layout's, and decodes the frame.
 std::vector<unsigned char> readPayload(StreamReader& r, uint64_t expectedBytes, const std::string& context) {
   const uint64_t payloadBytes = r.get<uint64_t>("payload size");
@@ -254,9 +261,7 @@ std::vector<unsigned char> encodeLossless(const std::vector<Grid>& images, std::
   const std::vector<unsigned char> payload = shuffleBytes(residuals);
   StreamWriter w;
   putHeader(w, ValuesCodec::Lossless, values.size(), images.size());
-  w.put(uint64_t(payload.size()));
-  const std::vector<unsigned char> frame = detail::zstdCompress(payload, options.zstdLevel);
-  w.bytes.insert(w.bytes.end(), frame.begin(), frame.end());
+  putPayload(w, payload, options.zstdLevel);
   return std::move(w.bytes);
 }
 
@@ -337,9 +342,7 @@ std::vector<unsigned char> encodeHdr(const std::vector<Grid>& images, std::span<
   putHeader(w, ValuesCodec::Hdr, values.size(), images.size());
   w.put(p.log2Min);
   w.put(p.stepsPerStop);
-  w.put(uint64_t(payload.size()));
-  const std::vector<unsigned char> frame = detail::zstdCompress(payload, options.zstdLevel);
-  w.bytes.insert(w.bytes.end(), frame.begin(), frame.end());
+  putPayload(w, payload, options.zstdLevel);
   return std::move(w.bytes);
 }
 
@@ -445,9 +448,7 @@ std::vector<unsigned char> encodeBc1(const std::vector<Grid>& images, std::span<
   StreamWriter w;
   putHeader(w, ValuesCodec::Bc1, values.size(), images.size());
   w.put(kBc1Gamma);
-  w.put(uint64_t(payload.size()));
-  const std::vector<unsigned char> frame = detail::zstdCompress(payload, options.zstdLevel);
-  w.bytes.insert(w.bytes.end(), frame.begin(), frame.end());
+  putPayload(w, payload, options.zstdLevel);
   return std::move(w.bytes);
 }
 
