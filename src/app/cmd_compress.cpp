@@ -43,6 +43,9 @@ const PlfSectionInfo& valuesSection(const PlfInfo& info) {
 void runCompress(const CompressOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
   const ValuesCodec codec = parseValuesCodec(options.mode);
+  // Unwritable outputs fail before the work, as in trace, bake and render.
+  requireParentDirectory(options.output, "-o");
+  if (!options.statsPath.empty()) requireParentDirectory(options.statsPath, "--stats");
   const PlfInfo inputInfo = readLightFieldInfo(options.input, /*verifyChecksums=*/false);
   const PlfSectionInfo inputValues = valuesSection(inputInfo);
 

@@ -116,6 +116,12 @@ TEST_F(CompressCli, BadModesAndCorruptFilesFailCleanly) {
   ASSERT_NE(badBake, -1) << "terminated by a signal: a crash";
   EXPECT_NE(badBake, 0);
   EXPECT_FALSE(fs::exists(out));
+  // --stats into a missing directory: refused before any work, nothing written.
+  expectCleanFailure(run("compress \"" + raw + "\" -o \"" + out + "\" --stats \"" + path("no/such/dir/s.json") + "\"",
+                         nullptr, &err));
+  EXPECT_NE(err.find("--stats"), std::string::npos) << err;
+  EXPECT_NE(err.find("does not exist"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(out));
 
   // A compressed file with damaged values (checksums re-sealed by hand would be the
   // codec's job, tested in compression_test; here the file's own checksum names it) and a
