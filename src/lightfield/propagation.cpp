@@ -22,6 +22,52 @@ namespace pl {
 
 namespace {
 
+// ---- Four-lane arithmetic -------------------------------------------------------------------
+// Four float lanes (r, g, b, unused): SSE where the target has it (every x86-64), else a plain
+// array. Both do the same IEEE single-precision operations in the same order per lane, so the
+// results are identical.
+#if defined(__SSE2__)
+using F4 = __m128;
+inline F4 f4Zero() { return _mm_setzero_ps(); }
+inline F4 f4Splat(float s) { return _mm_set1_ps(s); }
+inline F4 f4Load(const float* aligned) { return _mm_load_ps(aligned); }
+inline F4 f4Add(F4 a, F4 b) { return _mm_add_ps(a, b); }
+inline F4 f4Mul(F4 a, F4 b) { return _mm_mul_ps(a, b); }
+inline Rgb f4Rgb(F4 a) {
+  alignas(16) float v[4];
+  _mm_store_ps(v, a);
+  return {v[0], v[1], v[2]};
+}
+#else
+struct F4 {
+  float v[4];
+};
+inline F4 f4Zero() { return {{0.0f, 0.0f, 0.0f, 0.0f}}; }
+inline F4 f4Splat(float s) { return {{s, s, s, s}}; }
+inline F4 f4Load(const float* aligned) { return {{aligned[0], aligned[1], aligned[2], aligned[3]}}; }
+inline F4 f4Add(F4 a, F4 b) { return {{a.v[0] + b.v[0], a.v[1] + b.v[1], a.v[2] + b.v[2], a.v[3] + b.v[3]}}; }
+inline F4 f4Mul(F4 a, F4 b) { return {{a.v[0] * b.v[0], a.v[1] * b.v[1], a.v[2] * b.v[2], a.v[3] * b.v[3]}}; }
+inline Rgb f4Rgb(F4 a) { return {a.v[0], a.v[1], a.v[2]}; }
+#endif
+inline F4 f4FromRgb(const Rgb& c) {
+  alignas(16) const float v[4] = {c.r, c.g, c.b, 0.0f};
+  return f4Load(v);
+}
+/// Storage for an F4 (lanes r, g, b, 0), aligned for f4Load.
+struct alignas(16) Lanes4 {
+  float v[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+};
+inline Lanes4 lanes4(F4 a) {
+  Lanes4 l;
+#if defined(__SSE2__)
+  _mm_store_ps(l.v, a);
+#else
+  l = Lanes4{{a.v[0], a.v[1], a.v[2], a.v[3]}};
+#endif
+  return l;
+}
+inline Lanes4 lanes4(const Rgb& c) { return Lanes4{{c.r, c.g, c.b, 0.0f}}; }
+
 // Sub-samples per side of an output texel (directions averaged over the texel's part inside the
 // disk) and of a gather cell (directions averaged over the cell) for the glossy operator.
 constexpr int kOutputSubsamples = 3;
@@ -61,10 +107,10 @@ constexpr float kSparseThreshold = 1e-3f;
 /// total (energy) and only a negligible amount of light is moved in angle. For a narrow lobe
 /// this replaces N multiply-adds per output texel by a few dozen.
 struct SparseOperator {
-  std::vector<Rgb> floor;           ///< per row
+  std::vector<Lanes4> floor;        ///< per row
   std::vector<uint32_t> rowStart;   ///< R² + 1
   std::vector<uint32_t> column;     ///< gather cell k
-  std::vector<Rgb> weight;          ///< excess over the floor
+  std::vector<Lanes4> weight;       ///< excess over the floor
 
   static SparseOperator fromDense(const std::vector<Rgb>& dense, uint32_t rows, uint32_t n) {
     SparseOperator op;
@@ -81,23 +127,25 @@ struct SparseOperator {
         const Rgb excess = row[k] - lo;
         if (maxComponent(excess) > kSparseThreshold * largest) {
           op.column.push_back(k);
-          op.weight.push_back(excess);
+          op.weight.push_back(lanes4(excess));
         } else {
           dropped += excess;
         }
       }
-      op.floor[c] = lo + dropped / float(n);
+      op.floor[c] = lanes4(lo + dropped / float(n));
       op.rowStart.push_back(uint32_t(op.column.size()));
     }
     return op;
   }
 
-  /// out[c] += Lo(c) for incoming radiance per gather cell (and its sum).
-  void apply(const Rgb* incoming, const Rgb& incomingSum, Rgb* out) const {
+  /// out[c] += Lo(c) for incoming radiance per gather cell (and its sum), lane-wise the same
+  /// products and sums, in the same order, as floor·ΣL + Σ w·L in RGB.
+  void apply(const Lanes4* incoming, F4 incomingSum, Rgb* out) const {
     for (size_t c = 0; c < floor.size(); ++c) {
-      Rgb sum = floor[c] * incomingSum;
-      for (uint32_t e = rowStart[c]; e < rowStart[c + 1]; ++e) sum += weight[e] * incoming[column[e]];
-      out[c] += sum;
+      F4 sum = f4Mul(f4Load(floor[c].v), incomingSum);
+      for (uint32_t e = rowStart[c]; e < rowStart[c + 1]; ++e)
+        sum = f4Add(sum, f4Mul(f4Load(weight[e].v), f4Load(incoming[column[e]].v)));
+      out[c] += f4Rgb(sum);
     }
   }
 };
@@ -155,37 +203,6 @@ struct EmissiveTriangle {
 };
 
 // ---- The gather kernel of the iteration ------------------------------------------------------
-// Four float lanes (r, g, b, unused): SSE where the target has it (every x86-64), else a plain
-// array. Both do the same IEEE single-precision operations in the same order per lane, so the
-// results are identical.
-#if defined(__SSE2__)
-using F4 = __m128;
-inline F4 f4Zero() { return _mm_setzero_ps(); }
-inline F4 f4Splat(float s) { return _mm_set1_ps(s); }
-inline F4 f4Load(const float* aligned) { return _mm_load_ps(aligned); }
-inline F4 f4Add(F4 a, F4 b) { return _mm_add_ps(a, b); }
-inline F4 f4Mul(F4 a, F4 b) { return _mm_mul_ps(a, b); }
-inline Rgb f4Rgb(F4 a) {
-  alignas(16) float v[4];
-  _mm_store_ps(v, a);
-  return {v[0], v[1], v[2]};
-}
-#else
-struct F4 {
-  float v[4];
-};
-inline F4 f4Zero() { return {{0.0f, 0.0f, 0.0f, 0.0f}}; }
-inline F4 f4Splat(float s) { return {{s, s, s, s}}; }
-inline F4 f4Load(const float* aligned) { return {{aligned[0], aligned[1], aligned[2], aligned[3]}}; }
-inline F4 f4Add(F4 a, F4 b) { return {{a.v[0] + b.v[0], a.v[1] + b.v[1], a.v[2] + b.v[2], a.v[3] + b.v[3]}}; }
-inline F4 f4Mul(F4 a, F4 b) { return {{a.v[0] * b.v[0], a.v[1] * b.v[1], a.v[2] * b.v[2], a.v[3] * b.v[3]}}; }
-inline Rgb f4Rgb(F4 a) { return {a.v[0], a.v[1], a.v[2]}; }
-#endif
-inline F4 f4FromRgb(const Rgb& c) {
-  alignas(16) const float v[4] = {c.r, c.g, c.b, 0.0f};
-  return f4Load(v);
-}
-
 /// The transport radiance ρ̄·E/π (W·sr⁻¹·m⁻²) of a diffuse tixel g and of its neighbours
 /// (i+1, j), (i, j+1), (i+1, j+1) in g's chart: everything a bilinear lookup at g needs, in one
 /// 64-byte cache line. Neighbours outside the chart and non-diffuse tixels hold 0 (a visibility
@@ -217,7 +234,7 @@ constexpr uint32_t kPrefetchDistance = 16;
 /// returns their radiance. Escaped and back-side entries without an extra bring nothing.
 template <bool KeepIncoming, typename SlowPath>
 F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* quads, uint64_t quadCount,
-               const VisibilityExtra* extras, Rgb* incoming, SlowPath&& slowPath) {
+               const VisibilityExtra* extras, Lanes4* incoming, SlowPath&& slowPath) {
   F4 sum = f4Zero();
   for (uint32_t k = 0; k < n; ++k) {
     if (k + kPrefetchDistance < n)
@@ -227,14 +244,14 @@ F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* 
       if (!e.escaped()) {
         const F4 L = lookupQuad(quads[e.tixel()], e);
         sum = f4Add(sum, L);
-        if constexpr (KeepIncoming) incoming[k] = f4Rgb(L);
+        if constexpr (KeepIncoming) incoming[k] = lanes4(L);
       } else if constexpr (KeepIncoming) {
-        incoming[k] = Rgb(0.0f);
+        incoming[k] = Lanes4{};
       }
     } else {
       const Rgb L = slowPath(e, e.hasExtra() ? extras++ : nullptr);
       sum = f4Add(sum, f4FromRgb(L));
-      if constexpr (KeepIncoming) incoming[k] = L;
+      if constexpr (KeepIncoming) incoming[k] = lanes4(L);
     }
   }
   return sum;
@@ -429,6 +446,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   }
   parallelForRange(tixels, 16, [&](uint64_t t0, uint64_t t1) {
     std::vector<Rgb> incoming(n);
+    std::vector<Lanes4> incoming4(n);
     for (uint64_t g = t0; g < t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
@@ -476,10 +494,12 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
       const uint64_t vb = valueBase(g, c);
       Rgb sum(0.0f);
       for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
-      if (c.kind == ChartKind::Diffuse)
+      if (c.kind == ChartKind::Diffuse) {
         direct[vb] += sum * (kPi / float(n));
-      else
-        glossy[c.material].op.apply(incoming.data(), sum, direct.data() + vb);
+      } else {
+        for (uint32_t k = 0; k < n; ++k) incoming4[k] = lanes4(incoming[k]);
+        glossy[c.material].op.apply(incoming4.data(), f4FromRgb(sum), direct.data() + vb);
+      }
     }
   });
 
@@ -575,7 +595,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     for (size_t batch = 0; batch + 1 < batchStart.size(); ++batch) {
       const uint64_t begin = batchStart[batch], end = batchStart[batch + 1];
       parallelForRange(end - begin, 16, [&](uint64_t t0, uint64_t t1) {
-        std::vector<Rgb> incoming(n);
+        std::vector<Lanes4> incoming(n);
         for (uint64_t g = begin + t0; g < begin + t1; ++g) {
           const Chart& c = param.charts[param.tixelChart[g]];
           if (c.kind == ChartKind::Specular) continue;
@@ -610,7 +630,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
             current[vb] = direct[vb] + total * (kPi / float(n));
           } else {
             std::copy_n(direct.data() + vb, c.valuesPerTixel(), current.data() + vb);
-            glossy[c.material].op.apply(incoming.data(), total, current.data() + vb);
+            glossy[c.material].op.apply(incoming.data(), sum, current.data() + vb);
           }
         }
       });
