@@ -11,6 +11,7 @@
 #include "app/commands.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/timing.h"
 #include "lightfield/bake.h"
 #include "lightfield/compression.h"
 #include "lightfield/plf_file.h"
@@ -62,7 +63,7 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
   LightField lf = bake(std::move(scene), settings, bakeOptions);
   writeLightField(options.output, lf, PlfEncoding(uint32_t(parseValuesCodec(options.compress))));
   const uint64_t fileBytes = std::filesystem::file_size(options.output);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = secondsSince(start);
   const BakeStats& s = lf.stats;
 
   if (!options.statsPath.empty()) {

@@ -16,6 +16,7 @@
 #include "app/commands.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/timing.h"
 #include "lightfield/compression.h"
 #include "lightfield/plf_file.h"
 
@@ -29,10 +30,6 @@ struct CompressOptions {
   std::string statsPath;  ///< --stats: the figures as JSON
   ValuesCodecOptions codec;  ///< --hdr-steps, --zstd-level
 };
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 const PlfSectionInfo& valuesSection(const PlfInfo& info) {
   for (const PlfSectionInfo& s : info.sections)

@@ -12,6 +12,7 @@
 #include "app/commands.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/timing.h"
 #include "env/env.h"
 #include "env/ibl.h"
 
@@ -68,10 +69,6 @@ struct SplitSumCliOptions {
   std::vector<float> roughness = SplitSumOptions{}.roughness;
   std::vector<float> viewDegrees = SplitSumOptions{}.viewDegrees;
 };
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 /// `dir/name.ext` + tag → `dir/name.tag.ext`.
 std::string withTag(const std::string& path, const std::string& tag) {

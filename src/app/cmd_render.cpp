@@ -20,6 +20,7 @@
 #include "camera/camera.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/timing.h"
 #include "image/image.h"
 #include "lightfield/plf_file.h"
 #include "realtime/camera_path.h"
@@ -50,9 +51,6 @@ struct RenderOptions {
   ViewOptions view;
 };
 
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
 /// Fails before any work is done if `path` cannot be written as an image or a JSON file.
 void checkOutputPath(const std::string& path, const char* option, bool image) {
   if (image) {
@@ -61,12 +59,6 @@ void checkOutputPath(const std::string& path, const char* option, bool image) {
       fail("{} {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", option, path, ext);
   }
   requireParentDirectory(path, option);
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 void runRender(const RenderOptions& options, const GlobalOptions& global) {
@@ -100,10 +92,10 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
          options.output);
   if (!options.statsPath.empty()) checkOutputPath(options.statsPath, "--stats", false);
 
-  const auto loadStart = Clock::now();
+  const auto loadStart = SteadyClock::now();
   const LightField lightField = readLightField(options.input);
   const double loadSeconds = secondsSince(loadStart);
-  const auto accelStart = Clock::now();
+  const auto accelStart = SteadyClock::now();
   const Accel accel(lightField.scene);
   const double accelSeconds = secondsSince(accelStart);
   const CameraDesc cameraDesc = view.resolveCamera(lightField.scene);
@@ -119,7 +111,7 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
   std::vector<double> frameMs;
   // One frame through the chosen renderer; frame time excludes writing files.
   auto renderFrame = [&](const Camera& frameCamera) {
-    const auto start = Clock::now();
+    const auto start = SteadyClock::now();
     if (options.reference) {
       image = renderLightField(lightField, accel, frameCamera, settings);
     } else {

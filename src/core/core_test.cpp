@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/error.h"
@@ -12,6 +13,7 @@
 #include "core/math.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "core/timing.h"
 
 namespace pl {
 namespace {
@@ -190,6 +192,21 @@ TEST_F(AtomicWriteTest, UncommittedPendingFileIsRemoved) {
   }
   EXPECT_EQ(contents(target), "all frames");
   EXPECT_EQ(entries(), std::vector<std::string>{"video.mp4"});
+}
+
+TEST(Timing, MedianOfOddEvenAndNoValues) {
+  EXPECT_EQ(median({3.0, 1.0, 2.0}), 2.0);       // unsorted input, odd count: the middle one
+  EXPECT_EQ(median({4.0, 1.0, 3.0, 2.0}), 2.5);  // even count: mean of the two middle ones
+  EXPECT_EQ(median({}), 0.0);
+  EXPECT_EQ(median({7.0}), 7.0);
+}
+
+TEST(Timing, SecondsSinceMeasuresElapsedWallTime) {
+  const auto start = SteadyClock::now();
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const double seconds = secondsSince(start);
+  EXPECT_GE(seconds, 0.020);  // sleep_for waits at least the duration asked for
+  EXPECT_LT(seconds, 5.0);    // generous bound for a loaded machine; catches unit mix-ups (ms vs s)
 }
 
 TEST(RequireParentDirectory, NamesOptionPathAndDirectory) {

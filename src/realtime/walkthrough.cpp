@@ -10,17 +10,11 @@
 #include "camera/camera.h"
 #include "core/error.h"
 #include "core/progress.h"
+#include "core/timing.h"
 #include "realtime/frame_output.h"
 
 namespace pl {
 namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 Image exposedCopy(const Image& radiance, float exposureScale) {
   Image exposed = radiance;

@@ -14,6 +14,7 @@
 #include "accel/accel.h"
 #include "camera/camera.h"
 #include "core/error.h"
+#include "core/timing.h"
 #include "image/image.h"
 #include "realtime/display.h"
 #include "realtime/frame_output.h"
@@ -31,12 +32,6 @@ constexpr float kFastFactor = 4.0f, kSlowFactor = 0.25f;
 constexpr float kRadiansPerPixel = 0.004f;  ///< mouse look sensitivity
 constexpr int kHudScale = 2;
 constexpr size_t kTimingWindow = 60;  ///< frames averaged for the HUD's fps
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 /// Owns SDL's window, renderer and streaming texture; releases them in reverse order.
 class Window {
