@@ -32,8 +32,7 @@
 namespace pl {
 namespace {
 
-// Ranges of the options, declared once.
-constexpr int kMaxImageSide = 16384;
+// Ranges of the options, declared once (image size: ViewOptions::kMaxImageSide).
 constexpr int kMaxFrames = 100000;
 constexpr int kMaxSamples = 1 << 16;
 constexpr int kMaxMirrorDepth = 1000;
@@ -51,21 +50,12 @@ struct RenderOptions {
   ViewOptions view;
 };
 
-/// Fails before any work is done if `path` cannot be written as an image or a JSON file.
-void checkOutputPath(const std::string& path, const char* option, bool image) {
-  if (image) {
-    const std::string ext = fileExtensionLower(path);
-    if (!isHdrExtension(path) && ext != ".png")
-      fail("{} {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", option, path, ext);
-  }
-  requireParentDirectory(path, option);
-}
-
 void runRender(const RenderOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
   const ViewOptions& view = options.view;
-  if (view.width < 1 || view.width > kMaxImageSide || view.height < 1 || view.height > kMaxImageSide)
-    fail("image size {}x{} is out of range (width and height must be 1..{})", view.width, view.height, kMaxImageSide);
+  constexpr int kMaxSide = ViewOptions::kMaxImageSide;
+  if (view.width < 1 || view.width > kMaxSide || view.height < 1 || view.height > kMaxSide)
+    fail("image size {}x{} is out of range (width and height must be 1..{})", view.width, view.height, kMaxSide);
   if (options.output.empty()) fail("render: an output image is required (-o OUT.exr|png)");
   const bool video = isVideoOutput(options.output);
   const bool sequence = isFramePattern(options.output);
@@ -82,15 +72,15 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
     if (!parent.empty()) std::filesystem::create_directories(parent, error);
     if (error) fail("-o {}: cannot create directory '{}': {}", options.output, parent.string(), error.message());
   }
-  if (!video) checkOutputPath(options.output, "-o", true);
-  else checkOutputPath(options.output, "-o", false);
+  if (!video) ViewOptions::checkImageOutput(options.output, "-o");
+  else requireParentDirectory(options.output, "-o");
   std::optional<CameraPath> cameraPath;
   if (!options.pathFile.empty()) cameraPath = loadCameraPath(options.pathFile);
   if (video && findFfmpeg().empty())
     fail("-o {}: MP4 output needs ffmpeg, which is not installed (not found on PATH); write an image sequence "
          "instead, e.g. -o frames/%04d.png",
          options.output);
-  if (!options.statsPath.empty()) checkOutputPath(options.statsPath, "--stats", false);
+  if (!options.statsPath.empty()) requireParentDirectory(options.statsPath, "--stats");
 
   const auto loadStart = SteadyClock::now();
   const LightField lightField = readLightField(options.input);

@@ -21,9 +21,8 @@ struct TonemapOptions {
 
 void runTonemap(const TonemapOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
+  ViewOptions::checkImageOutput(options.output, "-o");
   const std::string ext = fileExtensionLower(options.output);
-  if (ext != ".png" && !isHdrExtension(options.output))
-    fail("-o {}: unknown output type '{}' (use .png, or .exr/.hdr/.pfm for an exposed HDR copy)", options.output, ext);
   const Image image = readImage(options.input);
   options.view.writeImage(options.output, image);
   const ToneMapSettings t = options.view.toneMapSettings();

@@ -39,23 +39,18 @@ struct TraceOptions {
   bool sppGiven = false, widthGiven = false, heightGiven = false, cameraGiven = false;
 };
 
-/// Fails before any work is done if `path` cannot be an output of the given kind.
-void checkOutputPath(const std::string& path, const char* option, bool hdrOnly) {
-  const std::string ext = fileExtensionLower(path);
-  const bool hdr = isHdrExtension(path);
-  if (hdrOnly && !hdr) fail("{} {}: expected an .exr, .hdr or .pfm file name", option, path);
-  if (!hdr && ext != ".png") fail("{} {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", option, path, ext);
-  requireParentDirectory(path, option);
-}
-
 void runTrace(const TraceOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
   const bool replay = !options.pixel.empty();
   if (!replay) {
     if (options.output.empty()) fail("trace: an output image is required (-o OUT.exr|png)");
-    checkOutputPath(options.output, "-o", false);
+    ViewOptions::checkImageOutput(options.output, "-o");
   }
-  if (!options.variancePath.empty()) checkOutputPath(options.variancePath, "--variance", true);
+  if (!options.variancePath.empty()) {
+    if (!isHdrExtension(options.variancePath))
+      fail("--variance {}: expected an .exr, .hdr or .pfm file name", options.variancePath);
+    requireParentDirectory(options.variancePath, "--variance");
+  }
   if (!options.statsPath.empty()) requireParentDirectory(options.statsPath, "--stats");
 
   TraceSettings settings;

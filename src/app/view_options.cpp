@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "core/error.h"
+#include "core/file_io.h"
 
 namespace pl {
 namespace {
@@ -163,6 +164,13 @@ ToneMapSettings ViewOptions::toneMapSettings() const {
   settings.key = key ? key : (exposureGiven ? std::nullopt : std::optional<float>(kDefaultKey));
   settings.white = white;
   return settings;
+}
+
+void ViewOptions::checkImageOutput(const std::string& path, std::string_view option) {
+  const std::string ext = fileExtensionLower(path);
+  if (!isHdrExtension(path) && ext != ".png")
+    fail("{} {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", option, path, ext);
+  requireParentDirectory(path, option);
 }
 
 void ViewOptions::writeImage(const std::string& path, const Image& radiance) const {

@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "camera/camera.h"
@@ -74,6 +75,9 @@ struct ViewOptions {
   /// Writes radiance (already including vignetting) to path: HDR formats get radiance times
   /// exposureScale(); PNG gets exposure, tone mapping and sRGB encoding. Atomic.
   void writeImage(const std::string& path, const Image& radiance) const;
+  /// Fails, before any work is done, unless writeImage can write `path`: an .exr, .hdr, .pfm
+  /// or .png name in an existing directory. Messages start with "OPTION PATH: ".
+  static void checkImageOutput(const std::string& path, std::string_view option);
 };
 
 }  // namespace pl
