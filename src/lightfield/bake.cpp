@@ -2,6 +2,7 @@
 #include "lightfield/bake.h"
 
 #include <chrono>
+#include <future>
 
 #include "accel/accel.h"
 #include "core/error.h"
@@ -61,25 +62,39 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
 
   VisibilityField visibility;
   bool reused = false;
-  if (options.reuseVisibility && !options.visibilityPath.empty()) {
-    std::string why;
-    const auto readStart = std::chrono::steady_clock::now();
-    reused = readVisibility(options.visibilityPath, hash, visibility, &why);
-    if (reused)
-      note(fmt::format("visibility: reusing {} ({} tixels × {} directions, read in {:.2f} s)", options.visibilityPath,
-                       visibility.tixelCount, visibility.directionsPerTixel(),
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - readStart).count()));
-    else
-      note(fmt::format("visibility: recomputing, because {}", why));
-  }
-  if (!reused) {
+  auto computeAndSave = [&] {
     visibility = computeVisibility(lf.scene, accel, param, settings);
     note(fmt::format("visibility: {} rays in {:.2f} s ({:.1f} Mrays/s), {:.1f} MB", visibility.rays, visibility.seconds,
                      visibility.seconds > 0 ? visibility.rays / visibility.seconds * 1e-6 : 0.0, visibility.bytes() / 1e6));
     if (!options.visibilityPath.empty()) writeVisibility(options.visibilityPath, visibility);
+  };
+  PropagationResult prop;
+  if (options.reuseVisibility && !options.visibilityPath.empty()) {
+    // The saved field is read on its own thread while propagation starts with the shadow rays
+    // of the first shot, which do not need it; propagation waits for it after them.
+    std::string why;
+    double readSeconds = 0.0;
+    std::future<bool> read = std::async(std::launch::async, [&] {
+      const auto readStart = std::chrono::steady_clock::now();
+      const bool ok = readVisibility(options.visibilityPath, hash, visibility, &why);
+      readSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - readStart).count();
+      return ok;
+    });
+    prop = propagate(lf.scene, accel, param, [&]() -> const VisibilityField& {
+      reused = read.get();
+      if (reused) {
+        note(fmt::format("visibility: reusing {} ({} tixels × {} directions, read in {:.2f} s, overlapping the shadow rays)",
+                         options.visibilityPath, visibility.tixelCount, visibility.directionsPerTixel(), readSeconds));
+      } else {
+        note(fmt::format("visibility: recomputing, because {}", why));
+        computeAndSave();
+      }
+      return visibility;
+    }, settings);
+  } else {
+    computeAndSave();
+    prop = propagate(lf.scene, accel, param, visibility, settings);
   }
-
-  PropagationResult prop = propagate(lf.scene, accel, param, visibility, settings);
   note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s (first shot {:.2f} s, {} shadow rays)",
                    prop.iterations, prop.residual, prop.seconds, prop.firstShotSeconds, prop.shadowRays));
 

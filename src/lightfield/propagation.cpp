@@ -290,10 +290,16 @@ std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t grid
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const VisibilityField& vis, const BakeSettings& settings) {
+  return propagate(scene, accel, param, [&]() -> const VisibilityField& { return vis; }, settings);
+}
+
+PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                            const std::function<const VisibilityField&()>& visibility, const BakeSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
-  if (vis.tixelCount != param.tixelCount)
-    fail("{}: visibility field has {} tixels, the parameterisation {}", scene.sourcePath, vis.tixelCount, param.tixelCount);
-  const uint32_t n = vis.directionsPerTixel();
+  // The gather grid follows from the settings (the field's hash covers them); the field itself
+  // is first needed after the shadow rays of the first shot.
+  const uint32_t gridSide = gatherGridSide(settings.gatherDirections);
+  const uint32_t n = gridSide * gridSide;
   const uint64_t tixels = param.tixelCount;
   PropagationResult result;
 
@@ -303,7 +309,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     if (c.kind != ChartKind::Glossy || glossy[c.material].dirRes != 0) continue;
     GlossyMaterial& g = glossy[c.material];
     g.dirRes = c.dirRes;
-    g.op = SparseOperator::fromDense(glossyOperator(scene.materials[c.material].bsdf, c.dirRes, vis.gridSide),
+    g.op = SparseOperator::fromDense(glossyOperator(scene.materials[c.material].bsdf, c.dirRes, gridSide),
                                      c.dirRes * c.dirRes, n);
     const std::vector<float>& omega = paraboloidTexelSolidAngles(c.dirRes);
     for (uint32_t t = 0; t < c.dirRes * c.dirRes; ++t) {
@@ -433,6 +439,15 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     });
   }
 
+  // From here on the visibility field is needed. Time spent obtaining it (waiting for a read
+  // that overlapped the shadow rays, or tracing it) is not propagation time.
+  const auto waitStart = std::chrono::steady_clock::now();
+  const VisibilityField& vis = visibility();
+  const double waitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - waitStart).count();
+  if (vis.tixelCount != param.tixelCount || vis.gridSide != gridSide)
+    fail("{}: visibility field has {} tixels × {}² directions, the parameterisation and settings {} × {}²", scene.sourcePath,
+         vis.tixelCount, vis.gridSide, param.tixelCount, gridSide);
+
   // Emission and environment arriving through the gather rays (constant over the iteration).
   const Environment& environment = scene.environment;
   // Per tixel: whether its chart emits from the front (bit 0) and from the back (bit 1), so
@@ -503,7 +518,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     }
   });
 
-  result.firstShotSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.firstShotSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - waitSeconds;
 
   // ---- Iteration ---------------------------------------------------------------------------
   std::vector<Rgb> current = direct;
@@ -658,7 +673,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   }
   result.values = std::move(current);
   result.shadowRays = shadowRays.load();
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - waitSeconds;
   return result;
 }
 

@@ -31,6 +31,7 @@
 #include "lightfield/parameterisation.h"
 #include "lightfield/visibility.h"
 
+#include <functional>
 #include <vector>
 
 namespace pl {
@@ -48,6 +49,13 @@ struct PropagationResult {
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const VisibilityField& visibility, const BakeSettings& settings);
+
+/// The same, with the visibility field supplied late: `visibility` is called once, after the
+/// shadow rays of the first shot (which do not need the field), so that reading a saved field
+/// can overlap them. Its field must have param.tixelCount tixels and the settings' gather grid.
+/// The time spent inside `visibility` is excluded from `seconds` and `firstShotSeconds`.
+PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                            const std::function<const VisibilityField&()>& visibility, const BakeSettings& settings);
 
 /// The glossy operator W of one material for an R-texel output map and an m × m gather grid:
 /// R² × m² RGB weights, row c (output texel a + b·R) times column k (gather cell).
