@@ -200,6 +200,7 @@ bool punctualIncident(const Light& light, const Vec3& x, Vec3& wi, float& distan
 
 struct EmissiveTriangle {
   uint32_t mesh, triangle, material;
+  Vec3 normal;  ///< unit geometric normal, (p1 − p0) × (p2 − p0) normalised
 };
 
 // ---- The gather kernel of the iteration ------------------------------------------------------
@@ -334,7 +335,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
                                                        mesh.positions[tri[2]] - mesh.positions[tri[0]]));
       const float lum = luminance(scene.materials[mat].emission);
       if (!(area > 0.0f) || !(lum > 0.0f)) continue;
-      emitters.push_back({m, t, mat});
+      emitters.push_back({m, t, mat,
+                          glm::normalize(glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]],
+                                                    mesh.positions[tri[2]] - mesh.positions[tri[0]]))});
       emitterWeights.push_back(area * lum);
     }
   const Distribution1D emitterDistribution(emitterWeights);
@@ -360,6 +363,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
       const uint64_t t0 = block * tixelsPerBlock, t1 = std::min(tixels, t0 + tixelsPerBlock);
       std::vector<Ray> rays;
       std::vector<Pending> pending;
+      // At most one ray per punctual light and area-light sample per tixel.
+      rays.reserve((t1 - t0) * (scene.lights.size() + lightSamples));
+      pending.reserve(rays.capacity());
       for (uint64_t g = t0; g < t1; ++g) {
         const Chart& c = param.charts[param.tixelChart[g]];
         if (c.kind == ChartKind::Specular) continue;
@@ -389,7 +395,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           const Vec2 b = sampleUniformTriangle(Vec2(remapped, rng.uniform()));
           const Vec3 p0 = mesh.positions[tri[0]], p1 = mesh.positions[tri[1]], p2 = mesh.positions[tri[2]];
           const Vec3 y = (1.0f - b.x - b.y) * p0 + b.x * p1 + b.y * p2;
-          const Vec3 ny = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+          const Vec3 ny = em.normal;
           const Vec3 d = y - x;
           const float dist = glm::length(d);
           if (!(dist > 0.0f)) continue;
@@ -460,13 +466,14 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     std::fill_n(tixelEmits.begin() + int64_t(c.firstTixel), c.tixelCount(), bits);
   }
   parallelForRange(tixels, 16, [&](uint64_t t0, uint64_t t1) {
-    std::vector<Rgb> incoming(n);
-    std::vector<Lanes4> incoming4(n);
+    std::vector<Lanes4> incoming(n);  // per gather cell, kept for glossy tixels
     for (uint64_t g = t0; g < t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
       uint64_t cursor = vis.extraOffset[g];
+      const bool keepIncoming = c.kind == ChartKind::Glossy;
       bool any = false;
+      Rgb sum(0.0f);  // Σ_k L_k in gather order
       for (uint32_t k = 0; k < n; ++k) {
         const VisibilityEntry e = vis.entries[g * n + k];
         const VisibilityExtra* extra = e.hasExtra() ? &vis.extras[cursor++] : nullptr;
@@ -502,19 +509,16 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           }
         }
         if (extra) L *= extra->throughput;
-        incoming[k] = L;
+        if (keepIncoming) incoming[k] = lanes4(L);
+        sum += L;
         any = any || !isBlack(L);
       }
       if (!any) continue;
       const uint64_t vb = valueBase(g, c);
-      Rgb sum(0.0f);
-      for (uint32_t k = 0; k < n; ++k) sum += incoming[k];
-      if (c.kind == ChartKind::Diffuse) {
+      if (c.kind == ChartKind::Diffuse)
         direct[vb] += sum * (kPi / float(n));
-      } else {
-        for (uint32_t k = 0; k < n; ++k) incoming4[k] = lanes4(incoming[k]);
-        glossy[c.material].op.apply(incoming4.data(), f4FromRgb(sum), direct.data() + vb);
-      }
+      else
+        glossy[c.material].op.apply(incoming.data(), f4FromRgb(sum), direct.data() + vb);
     }
   });
 
