@@ -1,9 +1,7 @@
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -14,6 +12,7 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "core/timing.h"
+#include "support/temp_dir_test.h"
 
 namespace pl {
 namespace {
@@ -88,33 +87,15 @@ TEST(Distribution1D, SamplesProportionallyToWeights) {
 
 // --- core/file_io.h: atomic writes ---
 
-/// A fresh empty directory per test, removed afterwards.
-class AtomicWriteTest : public ::testing::Test {
+/// A fresh empty directory per test; entries() lists it, hidden temporaries included.
+class AtomicWriteTest : public test_support::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("pl_core_file_io_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  /// Names of everything in the directory (temporaries are hidden files, so list them all).
   std::vector<std::string> entries() const {
     std::vector<std::string> names;
     for (const auto& entry : std::filesystem::directory_iterator(dir_)) names.push_back(entry.path().filename().string());
     return names;
   }
-  static std::string contents(const std::string& file) {
-    std::ifstream in(file, std::ios::binary);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-  }
-
-  std::filesystem::path dir_;
+  static std::string contents(const std::string& file) { return test_support::readFileText(file); }
 };
 
 TEST_F(AtomicWriteTest, WritesAndReplacesContentLeavingNoTemporary) {

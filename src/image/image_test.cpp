@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "image/image.h"
+#include "support/temp_dir_test.h"
 
 namespace pl {
 namespace {
@@ -22,19 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// A fresh directory per test, removed afterwards.
-class ImageFiles : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / fmt::format("pl_image_test_{}_{}", long(::getpid()), info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  size_t fileCount() const { return size_t(std::distance(fs::directory_iterator(dir_), fs::directory_iterator())); }
-  fs::path dir_;
-};
+class ImageFiles : public test_support::TempDirTest {};
 
 /// Random HDR content spanning many orders of magnitude (1e-4 .. 1e4), as radiance does.
 Image randomHdrImage(int w, int h, uint64_t seed) {

@@ -1,8 +1,8 @@
 #pragma once
 // Shared by the *_cli_test.cpp files: runs the plenoptic executable (PLENOPTIC_BINARY, a
 // compile definition of every pl_add_test target) the way a user does, through the shell,
-// and gives each test a fresh temporary directory. Header-only; include as
-// "support/cli_test_support.h" (tests/ is on the include path of pl_add_test targets).
+// and gives each test a fresh temporary directory (support/temp_dir_test.h). Header-only;
+// include as "support/cli_test_support.h" (tests/ is on the include path of pl_add_test targets).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -10,19 +10,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
+
+#include "support/temp_dir_test.h"
 
 namespace pl::cli_test {
 
-/// The whole content of a file ("" when it cannot be read).
-inline std::string readFileText(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using test_support::readFileText;
 
 /// The exit code in a std::system / pclose status: the program's exit status, or -1 when it
 /// did not exit normally (killed by a signal, i.e. crashed) or could not be started.
@@ -62,32 +56,16 @@ inline CommandResult runPlenopticCombined(const std::string& arguments) {
   return result;
 }
 
-/// Fixture: a fresh empty directory per test (named after the suite, the test and the
-/// process, so parallel ctest runs never share one), removed afterwards; run() keeps the
-/// captured stdout/stderr files there.
-class CliTest : public ::testing::Test {
+/// Fixture: test_support::TempDirTest (a fresh directory per test, path(name)) whose run()
+/// keeps the captured stdout/stderr files in that directory.
+class CliTest : public test_support::TempDirTest {
  protected:
-  void SetUp() override {
-    const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = std::filesystem::temp_directory_path() / ("plenoptic_" + std::string(test->test_suite_name()) + "_" +
-                                                     test->name() + "_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    std::filesystem::remove_all(dir_, ignored);
-  }
-
-  /// `name` inside the test's directory.
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
   /// runPlenoptic() of `ARGUMENTS --quiet` (no progress bars; with quiet_ false, as given)
   /// with this test's directory as scratch space.
   int run(const std::string& arguments, std::string* out = nullptr, std::string* err = nullptr) const {
     return runPlenoptic(quiet_ ? arguments + " --quiet" : arguments, dir_, out, err);
   }
 
-  std::filesystem::path dir_;
   bool quiet_ = true;
 };
 
