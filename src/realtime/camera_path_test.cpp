@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "support/temp_dir_test.h"
 
 namespace pl {
 namespace {
@@ -150,12 +151,14 @@ TEST(CameraPath, StandingStillStaysStill) {
   for (double t = 0.0; t <= 1.0; t += 0.1) EXPECT_EQ(path.at(t).eye, Vec3(0.0f));
 }
 
-TEST(CameraPath, RoundTripsThroughTheFile) {
+/// Path files go into a fresh directory per test.
+class CameraPathFile : public test_support::TempDirTest {};
+
+TEST_F(CameraPathFile, RoundTripsThroughTheFile) {
   const CameraPath path = squarePath();
-  const std::string file = (std::filesystem::temp_directory_path() / "plenoptic_camera_path_test.json").string();
+  const std::string file = this->path("walk.json");
   saveCameraPath(file, path);
   const CameraPath back = loadCameraPath(file);
-  std::remove(file.c_str());
   ASSERT_EQ(back.keyframes.size(), path.keyframes.size());
   EXPECT_EQ(back.fps, path.fps);
   for (size_t i = 0; i < path.keyframes.size(); ++i) {

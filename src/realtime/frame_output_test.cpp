@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "support/temp_dir_test.h"
 
 namespace pl {
 namespace {
@@ -59,10 +60,12 @@ TEST(FrameOutput, MissingFfmpegIsAClearError) {
   }
 }
 
-TEST(FrameOutput, WritesAnMp4WhenFfmpegIsInstalled) {
+/// Video files go into a fresh directory per test.
+class VideoFiles : public test_support::TempDirTest {};
+
+TEST_F(VideoFiles, WritesAnMp4WhenFfmpegIsInstalled) {
   if (findFfmpeg().empty()) GTEST_SKIP() << "ffmpeg is not installed";
-  const std::filesystem::path path = std::filesystem::temp_directory_path() / "plenoptic_frame_output_test.mp4";
-  std::filesystem::remove(path);
+  const std::filesystem::path path = dir_ / "walk.mp4";
   EXPECT_THROW(VideoWriter(path.string(), 15, 16, 30.0), Error);  // odd width
   {
     VideoWriter writer(path.string(), 32, 16, 30.0);
@@ -76,21 +79,17 @@ TEST(FrameOutput, WritesAnMp4WhenFfmpegIsInstalled) {
   }
   ASSERT_TRUE(std::filesystem::exists(path));
   EXPECT_GT(std::filesystem::file_size(path), 100u);
-  std::filesystem::remove(path);
+  EXPECT_EQ(fileCount(), 1u);  // no temporary left beside it
 }
 
-TEST(FrameOutput, AnUnfinishedVideoLeavesNoFile) {
+TEST_F(VideoFiles, AnUnfinishedVideoLeavesNoFile) {
   if (findFfmpeg().empty()) GTEST_SKIP() << "ffmpeg is not installed";
-  const std::filesystem::path path = std::filesystem::temp_directory_path() / "plenoptic_frame_output_abandoned.mp4";
+  const std::filesystem::path path = dir_ / "abandoned.mp4";
   {
     VideoWriter writer(path.string(), 16, 16, 30.0);
     writer.write(Image8{16, 16, std::vector<uint8_t>(16 * 16 * 3, 128)});
   }  // destroyed without finish(), as when rendering fails half-way
-  EXPECT_FALSE(std::filesystem::exists(path));
-  // Nor its temporary (".NAME.tmp-PID-N" beside it, core/file_io.h).
-  for (const auto& entry : std::filesystem::directory_iterator(path.parent_path()))
-    EXPECT_NE(entry.path().filename().string().rfind("." + path.filename().string() + ".tmp", 0), 0u)
-        << "left behind: " << entry.path();
+  EXPECT_EQ(fileCount(), 0u);  // neither the video nor its temporary (core/file_io.h)
 }
 
 }  // namespace

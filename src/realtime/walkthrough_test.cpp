@@ -7,6 +7,7 @@
 
 #include "camera/camera.h"
 #include "core/error.h"
+#include "support/temp_dir_test.h"
 #include "core/progress.h"
 
 namespace pl {
@@ -31,10 +32,12 @@ TEST(Walkthrough, OrbitKeepsDistanceAndReturnsToTheStart) {
   EXPECT_THROW(orbitPath(baseCamera(), 0.0), Error);
 }
 
-TEST(Walkthrough, RendersEveryFrameAtItsTimeAndWritesFiles) {
+/// Frames go into a fresh directory per test.
+class WalkthroughFiles : public test_support::TempDirTest {};
+
+TEST_F(WalkthroughFiles, RendersEveryFrameAtItsTimeAndWritesFiles) {
   Progress::setEnabled(false);
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_walkthrough_test";
-  std::filesystem::remove_all(dir);
+  const std::filesystem::path dir = dir_;
   const CameraPath path = orbitPath(baseCamera(), 1.0, 4.0, 20.0f);  // 5 frames
   WalkthroughOptions options;
   options.output = (dir / "sub" / "f%02d.pfm").string();  // the directory is created
@@ -55,13 +58,11 @@ TEST(Walkthrough, RendersEveryFrameAtItsTimeAndWritesFiles) {
   EXPECT_EQ(third.at(0, 0), Rgb(6.0f));
   EXPECT_FALSE(std::filesystem::exists(dir / "sub" / "f05.pfm"));
   EXPECT_EQ(result.frameMs.size(), 5u);
-  std::filesystem::remove_all(dir);
 
   options.output = (dir / "single.png").string();
   EXPECT_THROW(renderWalkthrough(path, baseCamera(), options, [](const Camera&, Image&) {}), Error);
   options.output = (dir / "f%02d.jpg").string();
   EXPECT_THROW(renderWalkthrough(path, baseCamera(), options, [](const Camera&, Image&) {}), Error);
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
