@@ -276,6 +276,7 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
     for (const auto& [entry, extra] : list) ++field.extraOffset[entry / n + 1];
   for (uint64_t g = 0; g < param.tixelCount; ++g) field.extraOffset[g + 1] += field.extraOffset[g];
   field.extras.reserve(field.extraOffset.back());
+  adviseHugePages(field.extras.data(), field.extras.capacity() * sizeof(VisibilityExtra));
   for (auto& list : blockExtras) {
     for (const auto& item : list) field.extras.push_back(item.second);
     std::vector<std::pair<uint64_t, VisibilityExtra>>().swap(list);
@@ -359,6 +360,8 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   adviseHugePages(f.entries.data(), entryCount * sizeof(VisibilityEntry));
   f.entries.resize(entryCount);
   f.extraOffset.resize(tixelCount + 1);
+  f.extras.reserve(extraCount);
+  adviseHugePages(f.extras.data(), extraCount * sizeof(VisibilityExtra));
   f.extras.resize(extraCount);
   get(f.entries.data(), entryCount * sizeof(VisibilityEntry));
   get(f.extraOffset.data(), f.extraOffset.size() * sizeof(uint64_t));
