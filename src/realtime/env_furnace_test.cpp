@@ -17,13 +17,12 @@
 //   * the straightforward light-field renderer (src/render) and the fast one (src/realtime):
 //     a·Le on the sphere, Le in the background, pixel by pixel;
 // once with a constant environment (Environment::constant) and once with an environment MAP
-// of constant value (a 16×8 lat-long .hdr written by the test and read back through
-// loadEnvironmentMap), so that the map's lookup and its importance sampling are exercised.
+// of constant value (a 16×8 lat-long .hdr written by the test into its own temporary
+// directory and read back through loadEnvironmentMap), so that the map's lookup and its importance sampling are exercised.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <map>
 #include <string>
 #include <utility>
@@ -40,12 +39,14 @@
 #include "realtime/realtime.h"
 #include "render/render.h"
 #include "scene/scene.h"
+#include "support/temp_dir_test.h"
 #include "trace/trace.h"
 
 namespace pl {
 namespace {
 
-class EnvFurnaceTest : public ::testing::Test {
+/// Each test writes its constant map into its own fresh directory (test_support::TempDirTest).
+class EnvFurnaceTest : public test_support::TempDirTest {
  protected:
   static void SetUpTestSuite() { Progress::setEnabled(false); }
 };
@@ -96,22 +97,17 @@ const char* envName(EnvKind kind) { return kind == EnvKind::Constant ? "constant
 /// within 1/64 relative of these (the test uses the values actually read).
 const Rgb kLe(0.5f, 1.0f, 2.0f);
 
-/// A 16×8 lat-long .hdr of constant radiance kLe, written once per test run and loaded through
-/// the same function the JSON scene's "environment": {"file": ...} uses.
-std::shared_ptr<const EnvironmentMap> constantMap() {
-  static const std::shared_ptr<const EnvironmentMap> map = [] {
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_env_furnace_test";
-    std::filesystem::create_directories(dir);
-    const std::string path = (dir / "constant.hdr").string();
-    writeHdrImage(path, Image(16, 8, kLe));
-    return loadEnvironmentMap(path);
-  }();
-  return map;
+/// Writes a 16×8 lat-long .hdr of constant radiance kLe to `path` and loads it through the same
+/// function the JSON scene's "environment": {"file": ...} uses.
+std::shared_ptr<const EnvironmentMap> constantMap(const std::string& path) {
+  writeHdrImage(path, Image(16, 8, kLe));
+  return loadEnvironmentMap(path);
 }
 
-/// The sphere of albedo a under the chosen environment; returns the radiance the environment
-/// actually delivers (kLe, or what RGBE stored), after checking that it is constant.
-Scene makeSphereScene(float albedo, EnvKind kind, Rgb& le) {
+/// The sphere of albedo a under the chosen environment (the map written to mapPath for
+/// EnvKind::Map); returns the radiance the environment actually delivers (kLe, or what RGBE
+/// stored), after checking that it is constant.
+Scene makeSphereScene(float albedo, EnvKind kind, const std::string& mapPath, Rgb& le) {
   Scene scene;
   scene.sourcePath = "sphere under a constant environment";
   Material m;
@@ -122,7 +118,7 @@ Scene makeSphereScene(float albedo, EnvKind kind, Rgb& le) {
   if (kind == EnvKind::Constant) {
     scene.environment.constant = kLe;
   } else {
-    scene.environment.map = constantMap();
+    scene.environment.map = constantMap(mapPath);
   }
   scene.finalize();
   le = scene.environment.radiance(Vec3(0.0f, 1.0f, 0.0f));
@@ -175,9 +171,9 @@ std::vector<std::pair<int, int>> pixelsWhollyOnSphere(const Camera& camera, cons
 ///    the tracer's own variance estimate), and their mean within 1 % relative, with the
 ///    standard error of that mean required to be below a third of it (a 3σ margin, so the
 ///    pass is meaningful). All streams are seeded: the test is deterministic, not flaky.
-void checkTracedSphere(float albedo, EnvKind kind) {
+void checkTracedSphere(float albedo, EnvKind kind, const std::string& mapPath = {}) {
   Rgb le;
-  const Scene scene = makeSphereScene(albedo, kind, le);
+  const Scene scene = makeSphereScene(albedo, kind, mapPath, le);
   const Accel accel(scene);
   const PathTracer tracer(scene, accel);
   const Rgb expected = le * albedo;
@@ -248,7 +244,7 @@ TEST_F(EnvFurnaceTest, PathTracerSphereUnderConstantEnvironment) {
 }
 
 TEST_F(EnvFurnaceTest, PathTracerSphereUnderConstantEnvironmentMap) {
-  for (float albedo : {0.5f, 0.8f}) checkTracedSphere(albedo, EnvKind::Map);
+  for (float albedo : {0.5f, 0.8f}) checkTracedSphere(albedo, EnvKind::Map, path("constant.hdr"));
 }
 
 // ---- bake and light-field renderers -------------------------------------------------------
@@ -265,9 +261,9 @@ TEST_F(EnvFurnaceTest, PathTracerSphereUnderConstantEnvironmentMap) {
 ///    1e-5 relative. Background pixels see the environment through backgroundRadiance(),
 ///    i.e. the same lookup: also 1e-5. Each pixel is classified by casting its centre ray
 ///    (1 sample per pixel goes through the pixel centre, render.h).
-void checkBakedSphere(float albedo, EnvKind kind) {
+void checkBakedSphere(float albedo, EnvKind kind, const std::string& mapPath = {}) {
   Rgb le;
-  Scene scene = makeSphereScene(albedo, kind, le);
+  Scene scene = makeSphereScene(albedo, kind, mapPath, le);
   const size_t triangles = scene.triangleCount();
   BakeSettings settings = bakePreset("draft");
   settings.tixelsAcrossScene = 24;  // tixel side 2/24: a few tixels per facet, many outside it
@@ -323,7 +319,7 @@ TEST_F(EnvFurnaceTest, BakedSphereUnderConstantEnvironment) {
 }
 
 TEST_F(EnvFurnaceTest, BakedSphereUnderConstantEnvironmentMap) {
-  for (float albedo : {0.5f, 0.8f}) checkBakedSphere(albedo, EnvKind::Map);
+  for (float albedo : {0.5f, 0.8f}) checkBakedSphere(albedo, EnvKind::Map, path("constant.hdr"));
 }
 
 }  // namespace
