@@ -191,8 +191,9 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
   }
   checkKeys(ctx, value, known, where);
   if (const json* texture = find(value, "texture")) material.albedoTexture = loadTexture(ctx, scene, *texture, where + ".texture");
-  // Ranges (reflectances in [0, 1], Blinn-Phong diffuse + specular <= 1) are checked by
-  // Scene::finalize() for every loader.
+  // Checked here, not only by Scene::finalize(): a JSON material enters the scene only where
+  // it is used, and an unused one that creates energy is still a mistake in the file.
+  validateMaterial(material, ctx.path);
   return material;
 }
 
@@ -227,17 +228,27 @@ Scene parseScene(const JsonContext& ctx, const json& root) {
             "top level");
   Scene scene;
   scene.sourcePath = ctx.path;
-  if (boolOr(ctx, root, "include_cornell", false, "top level")) appendScene(scene, makeCornellBox());
-
-  std::map<std::string, uint32_t> namedMaterials;  // JSON materials by name → scene index
+  // JSON materials are parsed first but enter the scene only where they are used, so the
+  // loaded files keep their own material indices (a JSON override of a file's material then
+  // leaves the geometry/material layout, and the bake's visibility hash, unchanged):
+  //  - a JSON material whose name equals a loaded file's material replaces it in place;
+  //  - one forced on a mesh ("material": NAME) is appended once, at first use.
+  std::map<std::string, Material> jsonMaterials;
   if (const json* materials = find(root, "materials")) {
     if (!materials->is_object()) fail("{}: \"materials\" must be an object of name → material", ctx.path);
-    for (auto it = materials->begin(); it != materials->end(); ++it) {
-      namedMaterials[it.key()] = uint32_t(scene.materials.size());
-      Material material = parseMaterial(ctx, scene, it.key(), it.value());
-      scene.materials.push_back(std::move(material));
-    }
+    for (auto it = materials->begin(); it != materials->end(); ++it)
+      jsonMaterials.emplace(it.key(), parseMaterial(ctx, scene, it.key(), it.value()));
   }
+  std::map<std::string, uint32_t> appendedMaterials;  // forced JSON materials → scene index
+  auto appendPart = [&](Scene part) {
+    const size_t materialOffset = scene.materials.size();
+    appendScene(scene, std::move(part));
+    for (size_t m = materialOffset; m < scene.materials.size(); ++m)
+      if (auto it = jsonMaterials.find(scene.materials[m].name); it != jsonMaterials.end())
+        scene.materials[m] = it->second;  // textures are shared: their indices are global
+  };
+
+  if (boolOr(ctx, root, "include_cornell", false, "top level")) appendPart(makeCornellBox());
 
   if (const json* meshes = find(root, "meshes")) {
     if (!meshes->is_array()) fail("{}: \"meshes\" must be an array", ctx.path);
@@ -263,16 +274,14 @@ Scene parseScene(const JsonContext& ctx, const json& root) {
       std::optional<uint32_t> forced;
       if (const json* name = find(entry, "material")) {
         const std::string materialName = stringOf(ctx, *name, where + ".material");
-        auto it = namedMaterials.find(materialName);
-        if (it == namedMaterials.end()) fail("{}: {}.material: no material named '{}' in \"materials\"", ctx.path, where, materialName);
-        forced = it->second;
+        auto it = jsonMaterials.find(materialName);
+        if (it == jsonMaterials.end()) fail("{}: {}.material: no material named '{}' in \"materials\"", ctx.path, where, materialName);
+        auto [slot, inserted] = appendedMaterials.emplace(materialName, uint32_t(scene.materials.size()));
+        if (inserted) scene.materials.push_back(it->second);
+        forced = slot->second;
       }
-      const size_t materialOffset = scene.materials.size(), meshOffset = scene.meshes.size();
-      appendScene(scene, std::move(part));
-      // Same-named JSON materials replace the file's own (textures are shared, indices global).
-      for (size_t m = materialOffset; m < scene.materials.size(); ++m)
-        if (auto it = namedMaterials.find(scene.materials[m].name); it != namedMaterials.end())
-          scene.materials[m] = scene.materials[it->second];
+      const size_t meshOffset = scene.meshes.size();
+      appendPart(std::move(part));
       if (forced)
         for (size_t m = meshOffset; m < scene.meshes.size(); ++m)
           std::fill(scene.meshes[m].materials.begin(), scene.meshes[m].materials.end(), *forced);

@@ -43,12 +43,38 @@ Rgb diffuseAlbedoOf(const Bsdf& bsdf) {
 
 bool inUnitRange(const Rgb& c) { return isFinite(c) && glm::all(glm::greaterThanEqual(c, Rgb(0.0f))) && maxComponent(c) <= 1.0f; }
 
+void validateLights(const Scene& scene) {
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    std::visit(
+        [&](const auto& light) {
+          using T = std::decay_t<decltype(light)>;
+          if constexpr (std::is_same_v<T, PointLight>) {
+            if (!isFinite(light.position) || !isFinite(light.intensity))
+              fail("{}: point light {} has a non-finite position or intensity", scene.sourcePath, i);
+          } else if constexpr (std::is_same_v<T, SpotLight>) {
+            if (!isFinite(light.position) || !isFinite(light.intensity) || !isFinite(light.direction) ||
+                glm::length(light.direction) == 0.0f)
+              fail("{}: spot light {} has a non-finite position/intensity or no direction", scene.sourcePath, i);
+            if (!(light.innerAngle >= 0.0f && light.innerAngle <= light.outerAngle && light.outerAngle <= kPi))
+              fail("{}: spot light {} needs 0 <= inner angle ({}) <= outer angle ({}) <= pi", scene.sourcePath,
+                   i, light.innerAngle, light.outerAngle);
+          } else {
+            if (!isFinite(light.direction) || !isFinite(light.irradiance) || glm::length(light.direction) == 0.0f)
+              fail("{}: directional light {} has a non-finite irradiance or no direction", scene.sourcePath, i);
+          }
+        },
+        scene.lights[i]);
+  }
+}
+
+}  // namespace
+
 /// Reflectances must lie in [0, 1] (more would create energy; bsdf.h's contract); Blinn-Phong
 /// needs diffuse + specular ≤ 1 per channel and GGX a roughness α in (0, 1].
-void validateBsdf(const Scene& scene, const Material& material) {
+void validateMaterial(const Material& material, const std::string& sourcePath) {
   // Slack for decimal inputs such as 0.7 + 0.3 that round to a hair above 1 in float.
   constexpr float kSumSlack = 1e-6f;
-  const std::string& src = scene.sourcePath;
+  const std::string& src = sourcePath;
   std::visit(
       [&](const auto& model) {
         using T = std::decay_t<decltype(model)>;
@@ -76,31 +102,6 @@ void validateBsdf(const Scene& scene, const Material& material) {
       material.bsdf);
 }
 
-void validateLights(const Scene& scene) {
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    std::visit(
-        [&](const auto& light) {
-          using T = std::decay_t<decltype(light)>;
-          if constexpr (std::is_same_v<T, PointLight>) {
-            if (!isFinite(light.position) || !isFinite(light.intensity))
-              fail("{}: point light {} has a non-finite position or intensity", scene.sourcePath, i);
-          } else if constexpr (std::is_same_v<T, SpotLight>) {
-            if (!isFinite(light.position) || !isFinite(light.intensity) || !isFinite(light.direction) ||
-                glm::length(light.direction) == 0.0f)
-              fail("{}: spot light {} has a non-finite position/intensity or no direction", scene.sourcePath, i);
-            if (!(light.innerAngle >= 0.0f && light.innerAngle <= light.outerAngle && light.outerAngle <= kPi))
-              fail("{}: spot light {} needs 0 <= inner angle ({}) <= outer angle ({}) <= pi", scene.sourcePath,
-                   i, light.innerAngle, light.outerAngle);
-          } else {
-            if (!isFinite(light.direction) || !isFinite(light.irradiance) || glm::length(light.direction) == 0.0f)
-              fail("{}: directional light {} has a non-finite irradiance or no direction", scene.sourcePath, i);
-          }
-        },
-        scene.lights[i]);
-  }
-}
-
-}  // namespace
 
 Rgb Texture::sample(Vec2 uv) const {
   if (image.empty()) return Rgb(1.0f);
@@ -134,7 +135,7 @@ void Scene::finalize() {
     if (!isFinite(material.emission) || material.emission.r < 0.0f || material.emission.g < 0.0f ||
         material.emission.b < 0.0f)
       fail("{}: material '{}' has an invalid emission {}", src, material.name, vecString(material.emission));
-    validateBsdf(*this, material);
+    validateMaterial(material, sourcePath);
     if (material.albedoTexture < -1 || material.albedoTexture >= int(textures.size()))
       fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name,
            material.albedoTexture, textures.size());

@@ -161,6 +161,11 @@ struct SurfaceHit {
 /// (point = (1−b1−b2)·p0 + b1·p1 + b2·p2, as Embree reports u, v).
 SurfaceHit surfaceAt(const Scene& scene, uint32_t mesh, uint32_t triangle, Vec2 barycentrics);
 
+/// Throws pl::Error (naming sourcePath and the material) unless the material conserves
+/// energy: reflectances in [0, 1], Blinn-Phong diffuse + specular ≤ 1, GGX α in (0, 1].
+/// Scene::finalize() checks every material of a scene with it.
+void validateMaterial(const Material& material, const std::string& sourcePath);
+
 /// The material's BSDF with its albedo texture applied at uv.
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit);
 

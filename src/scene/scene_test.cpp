@@ -742,6 +742,26 @@ TEST(BadInput, MutatedGltfNumbersAreRejectedCleanly) {
   EXPECT_GT(rejected, variants / 4);
 }
 
+TEST(JsonScene, SameNamedMaterialsReplaceInPlaceAndKeepTheLayout) {
+  // A JSON material named like a loaded one replaces it where it stands, so the material list
+  // (and with it the light-field bake's visibility hash) is the same as without the override.
+  const fs::path dir = scratchDir("override");
+  const Scene plain = makeCornellBox();
+  const Scene recoloured = loadScene(writeFile(dir / "blue.json", R"({"include_cornell": true,
+      "materials": {"light": {"type": "lambert", "albedo": 0.78, "emission": [4, 12, 17]},
+                    "unused": {"type": "mirror"}}})"));
+  ASSERT_EQ(recoloured.materials.size(), plain.materials.size());
+  for (size_t m = 0; m < plain.materials.size(); ++m) {
+    EXPECT_EQ(recoloured.materials[m].name, plain.materials[m].name);
+    if (plain.materials[m].name == "light") {
+      EXPECT_EQ(recoloured.materials[m].emission, Rgb(4, 12, 17));
+    } else {
+      EXPECT_EQ(recoloured.materials[m].emission, plain.materials[m].emission);
+    }
+  }
+  for (size_t i = 0; i < plain.meshes.size(); ++i) EXPECT_EQ(recoloured.meshes[i].materials, plain.meshes[i].materials);
+}
+
 TEST(BadInput, EnergyCreatingMaterials) {
   const fs::path dir = scratchDir("energy");
   const std::string bright = writeFile(dir / "b.json", R"({"include_cornell": true,
