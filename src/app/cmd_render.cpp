@@ -32,10 +32,9 @@
 namespace pl {
 namespace {
 
-// Ranges of the options, declared once (image size: ViewOptions::kMaxImageSide).
+// Ranges of the options, declared once (image size: ViewOptions::kMaxImageSide; samples and
+// mirror depth: RenderSettings).
 constexpr int kMaxFrames = 100000;
-constexpr int kMaxSamples = 1 << 16;
-constexpr int kMaxMirrorDepth = 1000;
 
 struct RenderOptions {
   std::string input;      ///< .plf light field
@@ -179,11 +178,11 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   command->add_option("--samples", options->samples,
                       "Camera samples per pixel (0 = 1 at the pixel centre for a pinhole, 16 for a thin lens)")
-      ->check(CLI::Range(0, kMaxSamples))
+      ->check(CLI::Range(0, RenderSettings::kMaxSamplesPerPixel))
       ->capture_default_str();
   command->add_option("--mirror-depth", options->mirrorDepth,
                       "Mirror reflections followed (-1 = the bake's own mirror depth)")
-      ->check(CLI::Range(-1, kMaxMirrorDepth))
+      ->check(CLI::Range(-1, RenderSettings::kMaxMirrorDepth))
       ->capture_default_str();
   auto* reference = command->add_flag("--reference", options->reference,
                                       "Use the straightforward reference renderer (src/render) instead of the fast one");

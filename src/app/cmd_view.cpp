@@ -17,8 +17,6 @@ namespace pl {
 namespace {
 
 constexpr int kMaxFrames = 10000000;
-constexpr int kMaxSamples = 1 << 16;
-constexpr int kMaxMirrorDepth = 1000;
 
 struct ViewCommandOptions {
   std::string input;           ///< .plf light field
@@ -80,9 +78,9 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--speed", options->speed, "Movement speed in scene units per second (0 = automatic)")
       ->check(CLI::Range(0.0f, 1e9f));
   command->add_option("--samples", options->samples, "Camera samples per pixel (0 = automatic, as render)")
-      ->check(CLI::Range(0, kMaxSamples));
+      ->check(CLI::Range(0, RenderSettings::kMaxSamplesPerPixel));
   command->add_option("--mirror-depth", options->mirrorDepth, "Mirror reflections followed (-1 = the bake's)")
-      ->check(CLI::Range(-1, kMaxMirrorDepth));
+      ->check(CLI::Range(-1, RenderSettings::kMaxMirrorDepth));
   options->view.width = 1024;
   options->view.height = 768;
   options->view.addCameraOptions(*command);

@@ -37,9 +37,11 @@ struct RenderSettings {
   /// kThinLensSamples for a thin lens (its defocus blur needs several aperture samples).
   int samplesPerPixel = 0;
   static constexpr int kThinLensSamples = 16;
+  static constexpr int kMaxSamplesPerPixel = 1 << 16;  ///< upper bound the commands accept
   /// Mirror reflections followed; -1 = the bake's own BakeSettings::mirrorDepth, so the
   /// render sees exactly the chains the propagation accounted for.
   int mirrorDepth = -1;
+  static constexpr int kMaxMirrorDepth = 1000;  ///< upper bound the commands accept
   uint64_t seed = 0;
   int tileSize = 16;  ///< square tiles rendered in parallel
   bool showProgress = false;  ///< progress bar (for single large renders, not timing loops)
