@@ -367,26 +367,30 @@ void decodeHdr(const std::vector<Grid>& images, StreamReader& r, std::vector<Rgb
   const std::vector<uint64_t> offsets = pixelOffsets(images);
   const std::vector<uint16_t> residuals =
       unshuffleBytes<uint16_t>(readPayload(r, 3 * offsets.back() * sizeof(uint16_t), context));
-  parallelFor(images.size(), [&](uint64_t k) {
-    const Grid& image = images[k];
-    const uint16_t* in = residuals.data() + 3 * offsets[k];
-    const uint64_t n = image.pixels();
+  // Images come in ranges so that the row buffers are allocated once per range, not once per
+  // image (a glossy chart has one small image per tixel).
+  parallelForRange(images.size(), 1, [&](uint64_t firstImage, uint64_t endImage) {
     // Codes of the previous and current row per channel (the prediction context).
     std::vector<int32_t> rows[3][2];
-    for (auto& channel : rows)
-      for (auto& row : channel) row.assign(image.width, 0);
-    for (uint32_t y = 0; y < image.height; ++y) {
-      for (int c = 0; c < 3; ++c) std::swap(rows[c][0], rows[c][1]);  // [0] = previous row
-      for (uint32_t x = 0; x < image.width; ++x) {
-        const uint64_t i = uint64_t(y) * image.width + x;
-        const uint16_t eR = unzigzag16(in[i]);
-        const uint16_t e[3] = {eR, uint16_t(unzigzag16(in[n + i]) + eR), uint16_t(unzigzag16(in[2 * n + i]) + eR)};
-        Rgb& v = values[image.at(x, y)];
-        for (int c = 0; c < 3; ++c) {
-          auto get = [&](uint32_t gx, uint32_t gy) { return rows[c][gy == y ? 1 : 0][gx]; };
-          const uint16_t code = uint16_t(predict<int32_t>(x, y, get) + e[c]);
-          rows[c][1][x] = code;
-          component(v, c) = table[code];
+    for (uint64_t k = firstImage; k < endImage; ++k) {
+      const Grid& image = images[k];
+      const uint16_t* in = residuals.data() + 3 * offsets[k];
+      const uint64_t n = image.pixels();
+      for (auto& channel : rows)
+        for (auto& row : channel) row.assign(image.width, 0);
+      for (uint32_t y = 0; y < image.height; ++y) {
+        for (int c = 0; c < 3; ++c) std::swap(rows[c][0], rows[c][1]);  // [0] = previous row
+        for (uint32_t x = 0; x < image.width; ++x) {
+          const uint64_t i = uint64_t(y) * image.width + x;
+          const uint16_t eR = unzigzag16(in[i]);
+          const uint16_t e[3] = {eR, uint16_t(unzigzag16(in[n + i]) + eR), uint16_t(unzigzag16(in[2 * n + i]) + eR)};
+          Rgb& v = values[image.at(x, y)];
+          for (int c = 0; c < 3; ++c) {
+            auto get = [&](uint32_t gx, uint32_t gy) { return rows[c][gy == y ? 1 : 0][gx]; };
+            const uint16_t code = uint16_t(predict<int32_t>(x, y, get) + e[c]);
+            rows[c][1][x] = code;
+            component(v, c) = table[code];
+          }
         }
       }
     }
