@@ -81,12 +81,6 @@ uint32_t effectiveMirrorDepth(const LightField& lf, const RenderSettings& settin
 
 }  // namespace
 
-Rgb lightFieldRadiance(const LightField& lf, const Accel& accel, const Ray& ray, uint32_t mirrorDepth) {
-  RayHit hit;
-  accel.intersect(ray, hit);
-  return radianceFromHit(lf, accel, ray, hit, mirrorDepth);
-}
-
 Image renderLightField(const LightField& lf, const Accel& accel, const Camera& camera, const RenderSettings& settings) {
   if (settings.samplesPerPixel < 0) fail("render: samples per pixel must be ≥ 0, got {}", settings.samplesPerPixel);
   if (settings.tileSize < 1) fail("render: tile size must be ≥ 1, got {}", settings.tileSize);

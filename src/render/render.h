@@ -52,10 +52,6 @@ struct RenderSettings {
 Image renderLightField(const LightField& lightField, const Accel& accel, const Camera& camera,
                        const RenderSettings& settings);
 
-/// Radiance (W·sr⁻¹·m⁻²) arriving at ray.origin from ray.direction (unit), looked up in the
-/// light field, following at most mirrorDepth mirror reflections.
-Rgb lightFieldRadiance(const LightField& lightField, const Accel& accel, const Ray& ray, uint32_t mirrorDepth);
-
 /// One mirror bounce at `hit` (a specular chart's surface) of `ray`, the step both this
 /// renderer and the fast one (realtime) take: `emitted` gets the mirror's own emission, then
 /// — if `mayReflect` (within the depth limit) — `reflected` the mirrored ray (offset off the
