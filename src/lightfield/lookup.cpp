@@ -5,10 +5,6 @@
 
 namespace pl {
 
-Rgb interpolateChartValues(const LightField& lf, const Chart& c, Vec2 grid, Vec2 st) {
-  return interpolateValues(lf.values.data(), c, grid, st);
-}
-
 Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv) {
   SurfaceHit hit;
   hit.material = material;

@@ -88,11 +88,6 @@ inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 
   return sum;
 }
 
-/// Bilinear interpolation of the stored values of chart c at tixel grid coordinates `grid`
-/// and paraboloid coordinates st (ignored for diffuse charts, which store one value).
-/// Returns 0 for specular charts (they store nothing).
-Rgb interpolateChartValues(const LightField& lf, const Chart& c, Vec2 grid, Vec2 st);
-
 /// Diffuse albedo of `material` at surface uv: the Lambertian albedo times its albedo texture
 /// (if any) sampled at full resolution, exactly as the path tracer's bsdfAt does.
 Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv);
