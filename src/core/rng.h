@@ -43,10 +43,6 @@ class Pcg32 {
   }
   /// Uniform float in [0, 1): 24 random mantissa bits, never returns 1.
   float uniform() { return static_cast<float>(next() >> 8) * 0x1p-24f; }
-  double uniformDouble() {
-    const uint64_t hi = next(), lo = next();
-    return static_cast<double>(((hi << 32) | lo) >> 11) * 0x1p-53;
-  }
 
  private:
   uint64_t state_ = 0, inc_ = 0;
