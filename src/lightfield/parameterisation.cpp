@@ -176,7 +176,7 @@ FootprintSample locate(const ChartRaster& r, uint32_t bin, Vec2 q) {
 }
 
 void fillChartTixels(const Scene& scene, const Chart& c, const std::vector<std::pair<uint32_t, uint32_t>>& tris,
-                     Parameterisation& p, bool gatherPoints) {
+                     Parameterisation& p) {
   const ChartRaster r = rasteriseChart(scene, c, tris);
   const std::vector<uint32_t> nearest = nearestNonEmptyBin(c, r);
   const Material& material = scene.materials[c.material];
@@ -200,7 +200,7 @@ void fillChartTixels(const Scene& scene, const Chart& c, const std::vector<std::
             albedoSum += diffuseAlbedoAt(scene, c.material, hit.uv);
           }
         }
-      if (gatherPoints) p.coverage[g] = float(inside) / float(kFootprintSamples * kFootprintSamples);
+      p.coverage[g] = float(inside) / float(kFootprintSamples * kFootprintSamples);
 
       // Gather point: the centre if it lies on the polygon, else the closest polygon point.
       const Vec2 centre(float(i) + 0.5f, float(j) + 0.5f);
@@ -234,7 +234,7 @@ void fillChartTixels(const Scene& scene, const Chart& c, const std::vector<std::
         s.bary = barycentric2(tr, bestQ);
       }
       if (!r.tris.empty()) point = pointOnTriangle(scene, r.tris[s.tri], s.bary);
-      if (gatherPoints) p.gatherPoint[g] = point;
+      p.gatherPoint[g] = point;
 
       if (c.kind == ChartKind::Diffuse) {
         if (!textured) {
@@ -447,12 +447,8 @@ Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& s
   p.transportAlbedo.resize(p.tixelCount);
   for (uint32_t ci = 0; ci < chartCount; ++ci)
     std::fill_n(p.tixelChart.begin() + int64_t(p.charts[ci].firstTixel), p.charts[ci].tixelCount(), ci);
-  parallelFor(chartCount, [&](uint64_t ci) { fillChartTixels(scene, p.charts[ci], p.chartTriangles[ci], p, true); });
+  parallelFor(chartCount, [&](uint64_t ci) { fillChartTixels(scene, p.charts[ci], p.chartTriangles[ci], p); });
   return p;
-}
-
-void computeTransportAlbedo(const Scene& scene, Parameterisation& p) {
-  parallelFor(p.charts.size(), [&](uint64_t ci) { fillChartTixels(scene, p.charts[ci], p.chartTriangles[ci], p, false); });
 }
 
 }  // namespace pl

@@ -60,7 +60,4 @@ float baseTixelSize(const Scene& scene, const BakeSettings& settings);
 /// Builds charts, tixel grids and per-tixel data. Deterministic for a given scene + settings.
 Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& settings);
 
-/// Recomputes transportAlbedo only (after a material edit; geometry unchanged).
-void computeTransportAlbedo(const Scene& scene, Parameterisation& param);
-
 }  // namespace pl
