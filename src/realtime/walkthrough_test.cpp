@@ -25,6 +25,7 @@ TEST(Walkthrough, OrbitKeepsDistanceAndReturnsToTheStart) {
   const CameraPath path = orbitPath(baseCamera(), 2.0, 10.0, 30.0f);
   ASSERT_EQ(path.keyframes.size(), 5u);
   EXPECT_EQ(path.frameCount(), 21);
+  // 1e-5: float rounding of the rotation (sin, cos and products) on coordinates of size 5.
   for (const CameraKeyframe& k : path.keyframes) EXPECT_NEAR(glm::length(k.eye - k.target), 5.0f, 1e-5f);
   // Keyframe 1 is rotated by +30° about +y: x = 5·sin 30° = 2.5 (right-handed, counter-clockwise from above).
   EXPECT_NEAR(path.keyframes[1].eye.x, 2.5f, 1e-5f);
@@ -52,6 +53,7 @@ TEST_F(WalkthroughFiles, RendersEveryFrameAtItsTimeAndWritesFiles) {
   });
   EXPECT_EQ(result.frames, 5);
   ASSERT_EQ(eyes.size(), 5u);
+  // 1e-5: the camera is built from the same pose; only float rounding in Camera separates them.
   for (int k = 0; k < 5; ++k) EXPECT_NEAR(glm::length(eyes[size_t(k)] - path.at(path.frameTime(k)).eye), 0.0f, 1e-5f);
   // HDR frames hold radiance × exposure: frame 2 (third) rendered value 3 → 6.
   const Image third = readImage((dir / "sub" / "f02.pfm").string());
