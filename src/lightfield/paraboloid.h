@@ -21,7 +21,7 @@
 namespace pl {
 
 /// Centres of texels outside the disk are projected to this radius: cos θ there is
-/// (1 − r²)/(1 + r²) ≈ 1e-3, i.e. 0.06° above the horizon, where BSDFs are still defined.
+/// (1 − r²)/(1 + r²) ≈ 5e-4, i.e. 0.03° above the horizon, where BSDFs are still defined.
 inline constexpr float kHorizonRadius = 0.9995f;
 
 /// Continuous texel coordinate of paraboloid coordinate x ∈ [−1, 1] in an R-texel map:
