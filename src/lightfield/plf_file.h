@@ -4,7 +4,7 @@
 //
 // Layout (all integers and floats little-endian; offsets and sizes in bytes):
 //
-//   offset 0   header (kHeaderSize = 32 bytes)
+//   offset 0   header (kPlfHeaderSize = 32 bytes)
 //              magic        8 bytes  "PLF\0\r\n\x1a\n"  (the PNG trick: a text-mode transfer
 //                                     or a truncation to 7 bits corrupts it visibly)
 //              version      u32      kPlfVersion
@@ -13,7 +13,7 @@
 //              headerHash   u64      XXH64 (seed 0) of header bytes [0, 24) followed by the
 //                                     section table: covers every field except itself
 //   offset 32  section table: sectionCount entries of 48 bytes
-//              id           4 bytes  four-character code, see PlfSection
+//              id           4 bytes  four-character code, see Sections below
 //              encoding     u32      0 = raw; VALS may also be 1 = lossless, 2 = bc1, 3 = hdr
 //                                     (see PlfEncoding and lightfield/compression.h)
 //              offset       u64      from the start of the file, 64-byte aligned
@@ -29,7 +29,7 @@
 //         their pixels, lights, cameras, the environment (constant and lat-long map with its
 //         scale and rotation) and the scene file's suggested settings. Everything a
 //         renderer needs.
-//   CHRT  the charts: u64 count, then fixed 85-byte records (see writeCharts in plf_file.cpp).
+//   CHRT  the charts: u64 count, then fixed 85-byte records (see encodeCharts in plf_file.cpp).
 //   TRCH  triangle → chart: u64 mesh count, then per mesh u64 triangle count + u32 indices.
 //   VALS  the values: float32 RGB triplets (12 bytes each), in LightField::values order.
 //         Compressed (encoding ≠ 0): a stream of lightfield/compression.h.
