@@ -46,7 +46,8 @@ TEST(Parameterisation, CornellBoxCharts) {
 
   for (uint32_t c = 0; c < p.charts.size(); ++c) {
     const Chart& chart = p.charts[c];
-    // Orthonormal, right-handed frames; the normal is the triangles' winding normal.
+    // Orthonormal, right-handed frames; the normal is the triangles' winding normal. 1e-5: float
+    // rounding of unit vectors (a few ulps of 1).
     EXPECT_NEAR(glm::dot(chart.axisU, chart.axisV), 0.0f, 1e-5f);
     EXPECT_NEAR(glm::length(glm::cross(chart.axisU, chart.axisV) - chart.normal), 0.0f, 1e-5f);
     const auto [m, t] = p.chartTriangles[c][0];
@@ -56,7 +57,8 @@ TEST(Parameterisation, CornellBoxCharts) {
     EXPECT_GT(glm::dot(n, chart.normal), 0.999f);
     EXPECT_EQ(chart.kind, ChartKind::Diffuse);
     EXPECT_EQ(chart.dirRes, 1u);
-    // The grid covers the chart: every vertex maps inside [−½, res − ½] in grid coordinates.
+    // The grid covers the chart: every vertex maps inside [−½, res − ½] in grid coordinates
+    // (1e-3 of a tixel: float rounding of coordinates up to res ≤ 64).
     for (const auto& [mm, tt] : p.chartTriangles[c])
       for (int k = 0; k < 3; ++k) {
         const Vec2 g = tixelGridCoordinates(chart, scene.meshes[mm].positions[scene.meshes[mm].triangles[tt][k]]);
