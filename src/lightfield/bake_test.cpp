@@ -460,3 +460,26 @@ TEST_F(BakeTest, PresetsAndUnknownPreset) {
 
 }  // namespace
 }  // namespace pl
+
+namespace pl {
+namespace {
+
+TEST(BakePresets, DefaultConstructedSettingsAreTheDefaultPreset) {
+  // lightfield.h promises that BakeSettings{} is bakePreset("default"): code that builds
+  // settings without naming a preset gets the documented default, not a third variant.
+  const BakeSettings constructed;
+  const BakeSettings preset = bakePreset("default");
+  EXPECT_EQ(constructed.preset, preset.preset);
+  EXPECT_EQ(constructed.tixelsPerUnit, preset.tixelsPerUnit);
+  EXPECT_EQ(constructed.tixelsAcrossScene, preset.tixelsAcrossScene);
+  EXPECT_EQ(constructed.maxTixelsPerChartSide, preset.maxTixelsPerChartSide);
+  EXPECT_EQ(constructed.gatherDirections, preset.gatherDirections);
+  EXPECT_EQ(constructed.glossyDirRes, preset.glossyDirRes);
+  EXPECT_EQ(constructed.areaLightSamples, preset.areaLightSamples);
+  EXPECT_EQ(constructed.tolerance, preset.tolerance);
+  EXPECT_EQ(constructed.maxIterations, preset.maxIterations);
+  EXPECT_EQ(constructed.mirrorDepth, preset.mirrorDepth);
+}
+
+}  // namespace
+}  // namespace pl

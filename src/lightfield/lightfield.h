@@ -53,14 +53,16 @@ struct Chart {
   }
 };
 
-/// Quality preset parameters (see presets in bake.cpp and the README).
+/// Quality preset parameters (see presets in bake.cpp and the README). The member defaults are
+/// those of the "default" preset, so a default-constructed BakeSettings equals
+/// bakePreset("default") (a test checks it).
 struct BakeSettings {
   std::string preset = "default";
   float tixelsPerUnit = 0.0f;      ///< world-space density; 0 = derive from the scene size
   uint32_t maxTixelsPerChartSide = 64;
-  float tixelsAcrossScene = 48.0f;  ///< used when tixelsPerUnit = 0: tixels along the scene's largest extent
+  float tixelsAcrossScene = 64.0f;  ///< used when tixelsPerUnit = 0: tixels along the scene's largest extent
   uint32_t gatherDirections = 256; ///< gather rays per tixel (visibility field)
-  uint32_t glossyDirRes = 8;       ///< cap on the paraboloid map size of glossy charts
+  uint32_t glossyDirRes = 16;      ///< cap on the paraboloid map size of glossy charts
   float tolerance = 1e-3f;         ///< relative change of total outgoing power to stop at
   uint32_t maxIterations = 200;
   uint32_t mirrorDepth = 8;        ///< ideal-specular chain length followed
