@@ -59,7 +59,7 @@ Camera::Camera(const CameraDesc& desc, int width, int height, bool vignetting, f
   if (desc.fNumber > 0.0f) {
     if (!(metresPerUnit > 0.0f && std::isfinite(metresPerUnit)))
       fail("camera '{}': scene unit {} m must be positive", name, metresPerUnit);
-    if (!(desc.focusDistance >= 0.0f)) fail("camera '{}': focus distance {} must be positive", name, desc.focusDistance);
+    if (!(desc.focusDistance >= 0.0f)) fail("camera '{}': focus distance {} must be positive (or 0 for the distance to the target)", name, desc.focusDistance);
     const float focalLength = focalLengthMm_ * 0.001f / metresPerUnit;  // scene units
     focusDistance_ = desc.focusDistance > 0.0f ? desc.focusDistance : viewLength;
     if (!(focusDistance_ > focalLength))
