@@ -158,7 +158,8 @@ void runDemo(const DemoOptions& options, const GlobalOptions& global) {
   if (options.walkthrough) {
     const ViewOptions view = demoView(options);
     walkthrough = runDemoWalkthrough(lightField, accel, view.resolveCamera(lightField.scene),
-                                     view.metresPerUnit(lightField.scene), options.outputDir);
+                                     view.metresPerUnit(lightField.scene),
+                                     std::filesystem::absolute(options.outputDir).string());
   }
 
   fmt::print("plenoptic demo: the built-in Cornell box\n");
