@@ -111,15 +111,27 @@ EnvironmentLight::EnvironmentLight(const Rgb& constant, std::shared_ptr<const En
 EnvironmentSample EnvironmentLight::sample(Vec2 u) const {
   EnvironmentSample s;
   if (isBlack()) return s;
+  // The mixture's pdf and radiance need the map's pdf and radiance at the chosen direction;
+  // a map sample already carries both (same formulas as pdf() and radiance()), so only a
+  // uniform sample looks them up.
+  float mapPdf = 0.0f;
+  Rgb mapRadiance(0.0f);
   if (u.x < mapProbability_) {
     u.x = std::min(u.x / mapProbability_, 0x1.fffffep-1f);
-    s.direction = map_->sample(u).direction;
+    const EnvironmentSample fromMap = map_->sample(u);
+    s.direction = fromMap.direction;
+    mapPdf = fromMap.pdf;
+    mapRadiance = fromMap.radiance;
   } else {
     u.x = std::min((u.x - mapProbability_) / (1.0f - mapProbability_), 0x1.fffffep-1f);
     s.direction = sampleUniformSphere(u);
+    if (map_) {
+      if (mapProbability_ > 0.0f) mapPdf = map_->pdf(s.direction);
+      mapRadiance = map_->radiance(s.direction);
+    }
   }
-  s.pdf = pdf(s.direction);
-  s.radiance = radiance(s.direction);
+  s.pdf = (1.0f - mapProbability_) * kUniformSpherePdf + mapProbability_ * mapPdf;
+  s.radiance = constant_ + mapRadiance;
   return s;
 }
 
