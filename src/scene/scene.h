@@ -23,6 +23,9 @@ struct Texture {
   Image image;
   Rgb average{0.0f};  ///< mean over all texels (used where one albedo per region is needed)
 
+  /// Bilinear, repeat. A non-finite uv (only possible from a NaN hit, since loaders reject
+  /// non-finite uvs) returns `average` rather than spreading the NaN into the albedo; the
+  /// renderers count and report non-finite radiance where it arises.
   Rgb sample(Vec2 uv) const;
 };
 
