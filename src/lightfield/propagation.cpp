@@ -526,8 +526,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
 
   // ---- Iteration ---------------------------------------------------------------------------
   std::vector<Rgb> current = direct;
-  auto totalPower = [&](const std::vector<Rgb>& values) {
-    // Σ area · luminance of the radiant exitance (W): diffuse ρ̄E, glossy Σ Lo·cosθ·Ω.
+  // Σ over tixels of perTixel(g, chart, first value) · coverage · tixel area, summed per chart and
+  // then over charts in chart order (deterministic whatever the thread timing).
+  auto areaWeightedSum = [&](auto&& perTixel) {
     std::vector<double> perChart(param.charts.size(), 0.0);
     parallelFor(param.charts.size(), [&](uint64_t ci) {
       const Chart& c = param.charts[ci];
@@ -536,15 +537,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
       const double tixelArea = double(c.tixelSize) * c.tixelSize;
       for (uint64_t local = 0; local < c.tixelCount(); ++local) {
         const uint64_t g = c.firstTixel + local;
-        const uint64_t vb = c.firstValue + local * c.valuesPerTixel();
-        double exitance = 0.0;
-        if (c.kind == ChartKind::Diffuse) {
-          exitance = luminance(param.transportAlbedo[g] * values[vb]);
-        } else {
-          const GlossyMaterial& gm = glossy[c.material];
-          for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) exitance += double(luminance(values[vb + t])) * gm.projectedSolidAngle[t];
-        }
-        sum += exitance * param.coverage[g] * tixelArea;
+        sum += perTixel(g, c, c.firstValue + local * c.valuesPerTixel()) * param.coverage[g] * tixelArea;
       }
       perChart[ci] = sum;
     });
@@ -552,12 +545,51 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     for (double p : perChart) total += p;
     return total;
   };
+  // Luminance of the radiant exitance per unit area (W·m⁻²) of the values of tixel g:
+  // diffuse ρ̄E, glossy Σ Lo·cosθ·Ω.
+  auto exitance = [&](const Rgb* values, uint64_t g, const Chart& c) {
+    if (c.kind == ChartKind::Diffuse) return double(luminance(param.transportAlbedo[g] * values[0]));
+    double sum = 0.0;
+    const GlossyMaterial& gm = glossy[c.material];
+    for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) sum += double(luminance(values[t])) * gm.projectedSolidAngle[t];
+    return sum;
+  };
+  auto totalPower = [&](const std::vector<Rgb>& values) {
+    return areaWeightedSum([&](uint64_t g, const Chart& c, uint64_t vb) { return exitance(values.data() + vb, g, c); });
+  };
+  // |change| of that exitance from `before` to `after`, texel by texel (so that changes of
+  // opposite sign in different texels do not cancel).
+  auto exitanceChange = [&](const Rgb* before, const Rgb* after, uint64_t g, const Chart& c) {
+    if (c.kind == ChartKind::Diffuse) return std::abs(luminance(param.transportAlbedo[g] * (after[0] - before[0])));
+    float sum = 0.0f;
+    const GlossyMaterial& gm = glossy[c.material];
+    for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) sum += std::abs(luminance(after[t] - before[t])) * gm.projectedSolidAngle[t];
+    return sum;
+  };
 
   // Gauss–Seidel by batches of whole charts: batches are updated one after another, so a
   // batch already sees this iteration's values of the batches before it (about half the
   // iterations of Jacobi). Inside a batch, tixels are updated in parallel and read the
   // previous iteration's values of their own batch, so no value is read while it is written
   // and the result does not depend on thread timing.
+  //
+  // Over-relaxed (SOR): a tixel's new values are old + ω·(update − old), clamped at 0. Plain
+  // Gauss–Seidel (ω = 1) from the first shot only ever adds light, so it approaches the
+  // solution from below, each iteration closing a fixed fraction (1 − ρ) of the gap; stepping
+  // past the update by ω − 1 closes more of it. Measured with the default preset (iterations
+  // to the 1e-3 tolerance, ω = 1 → 1.2): built-in Cornell box 8 → 4, CornellBox-Glossy 8 → 6,
+  // CornellBox-Mirror 6 → 5, each ending closer to the converged solution than before;
+  // furnace a = 0.9 (tolerance 1e-7) 107 → 89. ω = 1.3 is already slower on the Cornell box
+  // (it overshoots), ω ≥ 2 diverges. If the residual ever grows, the rest of the iteration
+  // falls back to ω = 1, which converges for any ρ < 1.
+  //
+  // The residual is the relative L1 change of the outgoing power, Σ area·|Δ exitance| / total
+  // power: for plain Gauss–Seidel every change is ≥ 0, so this is exactly the relative change
+  // of total power; with over-relaxation it cannot look small by cancellation while the
+  // values still swing around the solution.
+  constexpr float kOverRelaxation = 1.2f;
+  float omega = kOverRelaxation;
+  std::vector<float> change(tixels, 0.0f);  // per tixel, of this iteration (exitanceChange)
   // At least 2048 tixels per batch, and at most ~16000 batches.
   const uint64_t kBatchTixels = std::max<uint64_t>(2048, tixels / 16000 + 1);
   std::vector<uint64_t> batchStart{0};
@@ -607,7 +639,6 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   updateTransport(0, tixels);
   std::vector<Rgb> previousValues;
 
-  double previousPower = totalPower(current);
   Progress progress("propagation", settings.maxIterations);
   for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
     if (anyGlossy) previousValues = current;
@@ -644,21 +675,29 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
                              ? gatherTixel<true>(entries, n, quads.data(), tixels, extras, incoming.data(), slowPath)
                              : gatherTixel<false>(entries, n, quads.data(), tixels, extras, nullptr, slowPath);
           const uint64_t vb = valueBase(g, c);
-          const Rgb total = f4Rgb(sum);
+          auto relax = [&](const Rgb& before, const Rgb& update) { return glm::max(Rgb(0.0f), before + omega * (update - before)); };
           if (c.kind == ChartKind::Diffuse) {
-            current[vb] = direct[vb] + total * (kPi / float(n));
+            const Rgb before = current[vb];
+            current[vb] = relax(before, direct[vb] + f4Rgb(sum) * (kPi / float(n)));
+            change[g] = exitanceChange(&before, &current[vb], g, c);
           } else {
-            std::copy_n(direct.data() + vb, c.valuesPerTixel(), current.data() + vb);
-            glossy[c.material].op.apply(incoming.data(), sum, current.data() + vb);
+            Rgb* out = current.data() + vb;
+            std::copy_n(direct.data() + vb, c.valuesPerTixel(), out);
+            glossy[c.material].op.apply(incoming.data(), sum, out);
+            const Rgb* before = previousValues.data() + vb;
+            for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) out[t] = relax(before[t], out[t]);
+            change[g] = exitanceChange(before, out, g, c);
           }
         }
       });
       updateTransport(begin, end);
     }
     const double power = totalPower(current);
+    const double changed = areaWeightedSum([&](uint64_t g, const Chart&, uint64_t) { return double(change[g]); });
+    const double residual = power > 0.0 ? changed / power : 0.0;
+    if (iteration > 1 && residual > result.residual) omega = 1.0f;
     result.iterations = iteration;
-    result.residual = power > 0.0 ? std::abs(power - previousPower) / power : 0.0;
-    previousPower = power;
+    result.residual = residual;
     progress.advance(1);
     if (result.residual < settings.tolerance) {
       // Converged: the iterations left are not needed, so the bar completes.
