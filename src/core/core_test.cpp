@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -182,6 +183,29 @@ TEST_F(AtomicWriteTest, UncommittedPendingFileIsRemoved) {
   }
   EXPECT_EQ(contents(target), "all frames");
   EXPECT_EQ(entries(), std::vector<std::string>{"video.mp4"});
+}
+
+TEST_F(AtomicWriteTest, MappedFileSeesTheBytesAndOutlivesAReplacement) {
+  const std::string file = path("field.plv");
+  std::string bytes(1 << 20, '\0');
+  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i * 2654435761u >> 24);
+  writeFileAtomically(file, std::string_view(bytes));
+  const MappedFile mapped(file);
+  ASSERT_EQ(mapped.bytes().size(), bytes.size());
+  EXPECT_EQ(std::memcmp(mapped.bytes().data(), bytes.data(), bytes.size()), 0);
+  // A new version renamed over the file (how every writer here replaces files) leaves the
+  // mapped old version intact.
+  writeFileAtomically(file, std::string_view("new"));
+  EXPECT_EQ(std::memcmp(mapped.bytes().data(), bytes.data(), bytes.size()), 0);
+  EXPECT_EQ(MappedFile(file).bytes().size(), 3u);
+  writeFileAtomically(path("empty"), std::string_view());
+  EXPECT_TRUE(MappedFile(path("empty")).bytes().empty());
+  try {
+    MappedFile missing(path("missing.plv"));
+    FAIL() << "no error for a missing file";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.plv: cannot open for reading"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Timing, MedianOfOddEvenAndNoValues) {

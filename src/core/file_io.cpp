@@ -1,7 +1,11 @@
 #include "core/file_io.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include <atomic>
 #include <cerrno>
@@ -106,6 +110,52 @@ void writeFileAtomically(const std::string& path, std::string_view bytes, FileSy
   writeFileAtomically(
       path, [&](const std::string& temporaryPath) { writeFileBytes(temporaryPath, bytes.data(), bytes.size()); },
       sync);
+}
+
+MappedFile::MappedFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail("{}: cannot open for reading: {}", path, std::strerror(errno));
+  struct stat info {};
+  if (::fstat(fd, &info) != 0) {
+    const int error = errno;
+    ::close(fd);
+    fail("{}: cannot determine its size: {}", path, std::strerror(error));
+  }
+  size_ = size_t(info.st_size);
+#if defined(__linux__)
+  if (size_ > 0) {
+    void* mapping = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    if (mapping != MAP_FAILED) {
+      ::madvise(mapping, size_, MADV_SEQUENTIAL);
+      data_ = static_cast<const unsigned char*>(mapping);
+      mapped_ = true;
+    }
+  }
+#endif
+  if (!mapped_ && size_ > 0) {
+    // No mmap (or it failed, e.g. on a special file system): read the bytes instead.
+    copy_.resize(size_);
+    size_t done = 0;
+    while (done < size_) {
+      const ssize_t got = ::read(fd, copy_.data() + done, size_ - done);
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) {
+        const int error = got < 0 ? errno : 0;
+        ::close(fd);
+        fail("{}: read failed after {} of {} bytes{}{}", path, done, size_, error ? ": " : " (file shrank)",
+             error ? std::strerror(error) : "");
+      }
+      done += size_t(got);
+    }
+    data_ = copy_.data();
+  }
+  ::close(fd);  // a mapping stays valid without its descriptor
+}
+
+MappedFile::~MappedFile() {
+#if defined(__linux__)
+  if (mapped_) ::munmap(const_cast<unsigned char*>(data_), size_);
+#endif
 }
 
 }  // namespace pl

@@ -9,8 +9,10 @@
 // and pl::Error names the target and the problem.
 #include <cstddef>
 #include <functional>
+#include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace pl {
 
@@ -67,5 +69,29 @@ void writeFileBytes(const std::string& path, const void* data, size_t size);
 
 /// Writes `bytes` as the whole content of `path`, atomically (see above).
 void writeFileAtomically(const std::string& path, std::string_view bytes, FileSync sync = FileSync::none);
+
+/// A whole file's bytes, read-only: memory-mapped where the system can (Linux: the page
+/// cache's pages themselves, pre-faulted, so opening a large file costs neither a copy nor
+/// zeroed memory), else read into memory. For large binary inputs read once per run (.plv).
+/// Files are replaced by renaming a complete new file over them (writeFileAtomically), which
+/// leaves a mapping of the old one intact; truncating a file in place while it is mapped
+/// would fault, as for any mapped file.
+class MappedFile {
+ public:
+  /// Opens and maps (or reads) `path`; pl::Error naming the path and the system's reason on
+  /// failure. An empty file gives an empty span.
+  explicit MappedFile(const std::string& path);
+  ~MappedFile();
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+
+  std::span<const unsigned char> bytes() const { return {data_, size_}; }
+
+ private:
+  const unsigned char* data_ = nullptr;
+  size_t size_ = 0;
+  bool mapped_ = false;
+  std::vector<unsigned char> copy_;  ///< when not mapped
+};
 
 }  // namespace pl

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -204,23 +205,44 @@ struct EmissiveTriangle {
 };
 
 // ---- The gather kernel of the iteration ------------------------------------------------------
-/// The transport radiance ρ̄·E/π (W·sr⁻¹·m⁻²) of a diffuse tixel g and of its neighbours
-/// (i+1, j), (i, j+1), (i+1, j+1) in g's chart: everything a bilinear lookup at g needs, in one
-/// 64-byte cache line. Neighbours outside the chart and non-diffuse tixels hold 0 (a visibility
-/// entry never gives them a non-zero weight: linearTap holds the last row and column).
+/// The transport radiance ρ̄·E/π (W·sr⁻¹·m⁻²) around a diffuse tixel g, as the coefficients of
+/// the bilinear interpolant over g and its neighbours t₀₀ = (i, j), t₁₀ = (i+1, j), t₀₁ = (i, j+1),
+/// t₁₁ = (i+1, j+1) in g's chart:
+///     L(fu, fv) = a + fu·b + fv·(c + fu·d),
+///     a = t₀₀,  b = t₁₀ − t₀₀,  c = t₀₁ − t₀₀,  d = t₁₁ − t₁₀ − t₀₁ + t₀₀,
+/// everything a lookup at g needs in one 64-byte cache line, and 3 multiply-adds per lookup
+/// instead of the 4 weights and 4 multiply-adds of the tap form. Neighbours outside the chart
+/// and non-diffuse tixels count as 0 (a visibility entry never gives them a non-zero weight:
+/// linearTap holds the last row and column, so fu or fv is exactly 0 there).
 struct alignas(64) TransportQuad {
-  float tap[4][4];  ///< [(i, j), (i+1, j), (i, j+1), (i+1, j+1)][r, g, b, 0]
+  float coefficient[4][4];  ///< [a, b, c, d][r, g, b, 0]
 };
 
-/// Bilinear lookup of visibility entry e in the quads: ((w₀t₀ + w₁t₁) + w₂t₂) + w₃t₃ with
-/// w = (1−fu)(1−fv), fu(1−fv), (1−fu)fv, fu·fv (a zero weight times a finite value adds +0,
-/// which leaves the sum unchanged: the same value as adding only the taps with weight > 0).
+/// The bilinear fractions (fu, fv) of an entry in lanes 0 and 1 (lanes 2, 3: 0).
+inline F4 entryFractions(VisibilityEntry e) {
+#if defined(__SSE2__)
+  // The entry's bytes as 16-bit lanes [target lo, target hi, fu, fv]: shift fu, fv down, widen to
+  // 32 bits and convert — exactly float(fu), float(fv), as in the portable branch.
+  static_assert(offsetof(VisibilityEntry, fu) == 4 && offsetof(VisibilityEntry, fv) == 6);
+  const __m128i raw = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(&e));
+  const __m128i wide = _mm_unpacklo_epi16(_mm_srli_epi64(raw, 32), _mm_setzero_si128());
+  return _mm_mul_ps(_mm_cvtepi32_ps(wide), _mm_set1_ps(1.0f / 65535.0f));
+#else
+  return {{float(e.fu) * (1.0f / 65535.0f), float(e.fv) * (1.0f / 65535.0f), 0.0f, 0.0f}};
+#endif
+}
+
+/// Bilinear lookup of visibility entry e in the quads: a + fu·b + fv·(c + fu·d), lane-wise.
 inline F4 lookupQuad(const TransportQuad& q, VisibilityEntry e) {
-  const float fu = float(e.fu) * (1.0f / 65535.0f), fv = float(e.fv) * (1.0f / 65535.0f);
-  F4 L = f4Mul(f4Splat((1.0f - fu) * (1.0f - fv)), f4Load(q.tap[0]));
-  L = f4Add(L, f4Mul(f4Splat(fu * (1.0f - fv)), f4Load(q.tap[1])));
-  L = f4Add(L, f4Mul(f4Splat((1.0f - fu) * fv), f4Load(q.tap[2])));
-  return f4Add(L, f4Mul(f4Splat(fu * fv), f4Load(q.tap[3])));
+  const F4 f = entryFractions(e);
+#if defined(__SSE2__)
+  const F4 fu = _mm_shuffle_ps(f, f, _MM_SHUFFLE(0, 0, 0, 0)), fv = _mm_shuffle_ps(f, f, _MM_SHUFFLE(1, 1, 1, 1));
+#else
+  const F4 fu = f4Splat(f.v[0]), fv = f4Splat(f.v[1]);
+#endif
+  const F4 inner = f4Add(f4Load(q.coefficient[2]), f4Mul(fu, f4Load(q.coefficient[3])));
+  const F4 row = f4Add(f4Load(q.coefficient[0]), f4Mul(fu, f4Load(q.coefficient[1])));
+  return f4Add(row, f4Mul(fv, inner));
 }
 
 // How many entries ahead the quad of a gather ray is prefetched: the quads are read in
@@ -344,6 +366,23 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   std::vector<float> areaPdf(scene.materials.size(), 0.0f);
   for (uint32_t m = 0; m < scene.materials.size(); ++m)
     if (emitterDistribution.total() > 0.0) areaPdf[m] = float(luminance(scene.materials[m].emission) / emitterDistribution.total());
+  // What a shadow-ray sample needs of each emitter, gathered in one place.
+  struct EmitterSampler {
+    Vec3 p0, edge1, edge2;  ///< y = p0 + b₁·edge1 + b₂·edge2 for barycentrics (b₁, b₂)
+    Vec3 normal;
+    Rgb emission;
+    float areaPdf;
+    bool twoSided;
+  };
+  std::vector<EmitterSampler> emitterSamplers;
+  for (const EmissiveTriangle& em : emitters) {
+    const Mesh& mesh = scene.meshes[em.mesh];
+    const UVec3 tri = mesh.triangles[em.triangle];
+    const Material& material = scene.materials[em.material];
+    const Vec3 p0 = mesh.positions[tri[0]];
+    emitterSamplers.push_back({p0, mesh.positions[tri[1]] - p0, mesh.positions[tri[2]] - p0, em.normal, material.emission,
+                               areaPdf[em.material], material.twoSidedEmission});
+  }
   const uint32_t lightSamples = emitters.empty() ? 0 : settings.areaLightSamples;
 
   // ---- First shot ------------------------------------------------------------------------
@@ -385,38 +424,30 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           pending.push_back({g, wi, incident * cosTheta, false});
         }
         if (lightSamples == 0) continue;
+        // Every accepted sample direction has cos θx > 0, so all of this tixel's shadow rays
+        // start at the same offset origin.
+        const Vec3 origin = offsetRayOrigin(x, c.normal, c.normal);
         Pcg32 rng = Pcg32::forKey(g, 0x4e4545, settings.seed);
         for (uint32_t s = 0; s < lightSamples; ++s) {
           float remapped = 0.0f;
-          const size_t e = emitterDistribution.sample((float(s) + rng.uniform()) / float(lightSamples), &remapped);
-          const EmissiveTriangle& em = emitters[e];
-          const Mesh& mesh = scene.meshes[em.mesh];
-          const UVec3 tri = mesh.triangles[em.triangle];
+          const EmitterSampler& em = emitterSamplers[emitterDistribution.sample((float(s) + rng.uniform()) / float(lightSamples), &remapped)];
           const Vec2 b = sampleUniformTriangle(Vec2(remapped, rng.uniform()));
-          const Vec3 p0 = mesh.positions[tri[0]], p1 = mesh.positions[tri[1]], p2 = mesh.positions[tri[2]];
-          const Vec3 y = (1.0f - b.x - b.y) * p0 + b.x * p1 + b.y * p2;
-          const Vec3 ny = em.normal;
-          const Vec3 d = y - x;
-          const float dist = glm::length(d);
-          if (!(dist > 0.0f)) continue;
-          const Vec3 wi = d / dist;
+          const Vec3 d = em.p0 + b.x * em.edge1 + b.y * em.edge2 - x;
+          const float dist2 = glm::dot(d, d);
+          if (!(dist2 > 0.0f)) continue;
+          const float dist = std::sqrt(dist2);
+          const Vec3 wi = d * (1.0f / dist);
           const float cosX = glm::dot(c.normal, wi);
-          float cosY = -glm::dot(ny, wi);
-          const Material& material = scene.materials[em.material];
-          if (!(cosX > 0.0f) || (cosY <= 0.0f && !material.twoSidedEmission)) continue;
+          float cosY = -glm::dot(em.normal, wi);
+          if (!(cosX > 0.0f) || (cosY <= 0.0f && !em.twoSided)) continue;
           cosY = std::abs(cosY);
           if (!(cosY > 0.0f)) continue;
-          // Balance heuristic between this strategy (S samples, solid-angle pdf pl) and the N
-          // cosine-distributed gather rays (pdf cos θx / π).
-          const float pl = areaPdf[em.material] * dist * dist / cosY;
-          const float pg = cosX * kInvPi;
-          const float weight = float(lightSamples) * pl / (float(lightSamples) * pl + float(n) * pg);
-          Ray ray;
-          ray.origin = offsetRayOrigin(x, c.normal, wi);
-          ray.direction = wi;
-          ray.tMax = dist * (1.0f - 1e-4f);
-          rays.push_back(ray);
-          pending.push_back({g, wi, material.emission * (cosX / pl * weight / float(lightSamples)), true});
+          // Balance heuristic between this strategy (S samples, solid-angle pdf
+          // pl = areaPdf·r²/cos θy) and the N cosine-distributed gather rays (pdf pg = cos θx/π):
+          //   Le·cos θx/(S·pl) · S·pl/(S·pl + N·pg) = Le·cos θx·cos θy / (S·areaPdf·r² + N·cos θx·cos θy/π).
+          const float denominator = float(lightSamples) * em.areaPdf * dist2 + float(n) * kInvPi * cosX * cosY;
+          rays.push_back(Ray{origin, wi, 0.0f, dist * (1.0f - 1e-4f)});
+          pending.push_back({g, wi, em.emission * (cosX * cosY / denominator), true});
         }
       }
       std::vector<uint8_t> occluded(rays.size());
@@ -465,6 +496,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     const uint8_t bits = material.twoSidedEmission ? 3 : 1;
     std::fill_n(tixelEmits.begin() + int64_t(c.firstTixel), c.tixelCount(), bits);
   }
+  const bool environmentLit = !environment.isBlack();
   parallelForRange(tixels, 16, [&](uint64_t t0, uint64_t t1) {
     std::vector<Lanes4> incoming(n);  // per gather cell, kept for glossy tixels
     for (uint64_t g = t0; g < t1; ++g) {
@@ -477,16 +509,22 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
       for (uint32_t k = 0; k < n; ++k) {
         const VisibilityEntry e = vis.entries[g * n + k];
         const VisibilityExtra* extra = e.hasExtra() ? &vis.extras[cursor++] : nullptr;
+        // Most entries see neither a lit sky nor an emitter: they add nothing (skipping them
+        // leaves every sum the same; this pass reads every entry of the field).
+        if (e.escaped() ? !environmentLit : (tixelEmits[e.tixel()] & (e.backSide() ? 2 : 1)) == 0) {
+          if (keepIncoming) incoming[k] = Lanes4{};
+          continue;
+        }
         Rgb L(0.0f);
         if (e.escaped()) {
           // The environment in the direction the path left: the gather direction itself, or
           // after mirrors the final direction stored with the path.
-          if (!environment.isBlack()) {
+          {
             const Vec3 leaving = extra ? octahedralDecode(extra->st)
                                        : chartWorldDirection(c, gatherDirectionLocal(g, k, vis.gridSide, settings.seed));
             L = environment.radiance(leaving);
           }
-        } else if (tixelEmits[e.tixel()] & (e.backSide() ? 2 : 1)) {
+        } else {
           const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
           const Material& material = scene.materials[seen.material];
           if (material.isEmissive() && (!e.backSide() || material.twoSidedEmission)) {
@@ -623,16 +661,18 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
         if (c.kind != ChartKind::Diffuse) continue;
         const uint64_t local = g - c.firstTixel;
         const uint32_t i = uint32_t(local % c.resU), j = uint32_t(local / c.resU);
-        auto put = [&](int slot, uint64_t tixel) {
-          const Rgb t = param.transportAlbedo[tixel] * current[c.firstValue + (tixel - c.firstTixel)] * kInvPi;
-          q.tap[slot][0] = t.r;
-          q.tap[slot][1] = t.g;
-          q.tap[slot][2] = t.b;
+        auto transport = [&](uint64_t tixel) {
+          return param.transportAlbedo[tixel] * current[c.firstValue + (tixel - c.firstTixel)] * kInvPi;
         };
-        put(0, g);
-        if (i + 1 < c.resU) put(1, g + 1);
-        if (j + 1 < c.resV) put(2, g + c.resU);
-        if (i + 1 < c.resU && j + 1 < c.resV) put(3, g + c.resU + 1);
+        const bool right = i + 1 < c.resU, up = j + 1 < c.resV;
+        const Rgb t00 = transport(g), t10 = right ? transport(g + 1) : Rgb(0.0f),
+                  t01 = up ? transport(g + c.resU) : Rgb(0.0f), t11 = right && up ? transport(g + c.resU + 1) : Rgb(0.0f);
+        const Rgb coefficients[4] = {t00, t10 - t00, t01 - t00, t11 - t10 - t01 + t00};
+        for (int k = 0; k < 4; ++k) {
+          q.coefficient[k][0] = coefficients[k].r;
+          q.coefficient[k][1] = coefficients[k].g;
+          q.coefficient[k][2] = coefficients[k].b;
+        }
       }
     });
   };

@@ -162,9 +162,10 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
     fail("{}: {} tixels exceed the visibility field's limit of {}", scene.sourcePath, param.tixelCount,
          VisibilityEntry::kIndexMask - 1);
   const uint32_t n = field.directionsPerTixel();
-  field.entries.reserve(param.tixelCount * n);
-  adviseHugePages(field.entries.data(), param.tixelCount * n * sizeof(VisibilityEntry));
-  field.entries.resize(param.tixelCount * n);
+  std::vector<VisibilityEntry> entries;
+  entries.reserve(param.tixelCount * n);
+  adviseHugePages(entries.data(), param.tixelCount * n * sizeof(VisibilityEntry));
+  entries.resize(param.tixelCount * n);
   std::vector<Vec3> directionTable(size_t(n) * kJitterCount);  // [cell][sub-cell]
   for (uint32_t k = 0; k < n; ++k)
     for (uint32_t j = 0; j < kJitterCount; ++j) directionTable[size_t(k) * kJitterCount + j] = cellDirection(k, j, field.gridSide, settings.seed);
@@ -217,7 +218,7 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
       for (size_t r = 0; r < rays.size(); ++r) {
         const Ray& ray = rays[r];
         const PathState& state = states[r];
-        VisibilityEntry& entry = field.entries[state.entry];
+        VisibilityEntry& entry = entries[state.entry];
         const RayHit& hit = hits[r];
         if (!hit.hit()) {
           entry.target = VisibilityEntry::kEscape;
@@ -271,16 +272,20 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
   progress.finish();
 
   // Per-tixel offsets of the extra records, then the records in entry order.
-  field.extraOffset.assign(param.tixelCount + 1, 0);
+  std::vector<uint64_t> extraOffset(param.tixelCount + 1, 0);
   for (const auto& list : blockExtras)
-    for (const auto& [entry, extra] : list) ++field.extraOffset[entry / n + 1];
-  for (uint64_t g = 0; g < param.tixelCount; ++g) field.extraOffset[g + 1] += field.extraOffset[g];
-  field.extras.reserve(field.extraOffset.back());
-  adviseHugePages(field.extras.data(), field.extras.capacity() * sizeof(VisibilityExtra));
+    for (const auto& [entry, extra] : list) ++extraOffset[entry / n + 1];
+  for (uint64_t g = 0; g < param.tixelCount; ++g) extraOffset[g + 1] += extraOffset[g];
+  std::vector<VisibilityExtra> extras;
+  extras.reserve(extraOffset.back());
+  adviseHugePages(extras.data(), extras.capacity() * sizeof(VisibilityExtra));
   for (auto& list : blockExtras) {
-    for (const auto& item : list) field.extras.push_back(item.second);
+    for (const auto& item : list) extras.push_back(item.second);
     std::vector<std::pair<uint64_t, VisibilityExtra>>().swap(list);
   }
+  field.entries = FieldArray<VisibilityEntry>(std::move(entries));
+  field.extraOffset = FieldArray<uint64_t>(std::move(extraOffset));
+  field.extras = FieldArray<VisibilityExtra>(std::move(extras));
   field.rays = rayCount.load();
   field.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return field;
@@ -321,15 +326,18 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   };
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return reason(fmt::format("{} does not exist", path));
-  const uint64_t fileSize = std::filesystem::file_size(path, ec);
-  if (ec) fail("{}: cannot determine its size: {}", path, ec.message());
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail("{}: cannot open for reading", path);
+  auto file = std::make_shared<const MappedFile>(path);
+  const std::span<const unsigned char> bytes = file->bytes();
+  const uint64_t fileSize = bytes.size();
   if (fileSize < kPlvHeaderSize) fail("{}: truncated visibility field ({} bytes, header needs {})", path, fileSize, kPlvHeaderSize);
+  size_t at = 0;
+  auto get = [&](void* data, size_t size) {
+    std::memcpy(data, bytes.data() + at, size);
+    at += size;
+  };
   char magic[8];
   uint32_t version = 0, gridSide = 0;
   uint64_t hash = 0, tixelCount = 0, entryCount = 0, extraCount = 0, payloadHash = 0;
-  auto get = [&](void* data, size_t size) { in.read(static_cast<char*>(data), std::streamsize(size)); };
   get(magic, 8);
   if (std::memcmp(magic, kPlvMagic, 8) != 0) fail("{}: not a plenoptic visibility field (bad magic)", path);
   get(&version, 4);
@@ -340,7 +348,6 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   get(&entryCount, 8);
   get(&extraCount, 8);
   get(&payloadHash, 8);
-  if (!in) fail("{}: truncated header", path);
   if (hash != expectedHash)
     return reason(fmt::format("{} was traced for different geometry, parameterisation or settings (hash {:016x}, expected {:016x})",
                               path, hash, expectedHash));
@@ -352,39 +359,55 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
       fileSize != expectedSize + extraCount * sizeof(VisibilityExtra))
     fail("{}: truncated or oversized: {} bytes, the header describes {}", path, fileSize,
          expectedSize + extraCount * sizeof(VisibilityExtra));
+  // The arrays view the mapping in place (offsets 48, 48 + 8·entries, …: aligned for their
+  // element types, as the header size and the element sizes are multiples of 8).
+  const unsigned char* payload = bytes.data() + kPlvHeaderSize;
+  const auto* entries = reinterpret_cast<const VisibilityEntry*>(payload);
+  const auto* extraOffset = reinterpret_cast<const uint64_t*>(payload + entryCount * sizeof(VisibilityEntry));
+  const auto* extras = reinterpret_cast<const VisibilityExtra*>(extraOffset + tixelCount + 1);
+  static_assert(kPlvHeaderSize % alignof(uint64_t) == 0 && sizeof(VisibilityEntry) % alignof(uint64_t) == 0 &&
+                alignof(VisibilityEntry) <= 8 && alignof(VisibilityExtra) <= 8);
+
+  // One pass over the payload: the checksum, and, while each block of tixels' entries is in
+  // the cache, the structural checks that let propagation index without bounds checks. A
+  // structural error is reported only once the checksum has matched (a damaged file is
+  // "corrupt", whatever its damage happens to break).
+  const uint32_t n = gridSide * gridSide;
+  std::string structural;
+  auto structuralError = [&](std::string text) {
+    if (structural.empty()) structural = std::move(text);
+  };
+  if (extraOffset[0] != 0 || extraOffset[tixelCount] != extraCount) structuralError("corrupt extra-record offsets");
+  Xxh64Stream checksum;
+  const uint64_t tixelsPerBlock = std::max<uint64_t>(1, (uint64_t(1) << 16) / n);  // ~512 KB of entries
+  for (uint64_t t0 = 0; t0 < tixelCount; t0 += tixelsPerBlock) {
+    const uint64_t t1 = std::min(tixelCount, t0 + tixelsPerBlock);
+    checksum.update(entries + t0 * n, (t1 - t0) * n * sizeof(VisibilityEntry));
+    for (uint64_t g = t0; g < t1 && structural.empty(); ++g) {
+      uint64_t flagged = 0;
+      bool outside = false;
+      for (uint32_t k = 0; k < n; ++k) {
+        const VisibilityEntry e = entries[g * n + k];
+        outside |= !e.escaped() && e.tixel() >= tixelCount;
+        flagged += e.hasExtra() ? 1 : 0;
+      }
+      if (outside) structuralError(fmt::format("an entry of tixel {} points outside the field", g));
+      if (extraOffset[g + 1] < extraOffset[g] || extraOffset[g + 1] - extraOffset[g] != flagged)
+        structuralError(fmt::format("corrupt extra-record offsets at tixel {}", g));
+    }
+  }
+  checksum.update(extraOffset, (tixelCount + 1) * sizeof(uint64_t));
+  checksum.update(extras, extraCount * sizeof(VisibilityExtra));
+  if (checksum.digest() != payloadHash) fail("{}: corrupt visibility field (payload checksum mismatch)", path);
+  if (!structural.empty()) fail("{}: {}", path, structural);
+
   VisibilityField f;
   f.gridSide = gridSide;
   f.tixelCount = tixelCount;
   f.hash = hash;
-  f.entries.reserve(entryCount);
-  adviseHugePages(f.entries.data(), entryCount * sizeof(VisibilityEntry));
-  f.entries.resize(entryCount);
-  f.extraOffset.resize(tixelCount + 1);
-  f.extras.reserve(extraCount);
-  adviseHugePages(f.extras.data(), extraCount * sizeof(VisibilityExtra));
-  f.extras.resize(extraCount);
-  get(f.entries.data(), entryCount * sizeof(VisibilityEntry));
-  get(f.extraOffset.data(), f.extraOffset.size() * sizeof(uint64_t));
-  get(f.extras.data(), extraCount * sizeof(VisibilityExtra));
-  if (!in) fail("{}: read failed", path);
-  Xxh64Stream payload;
-  payload.update(f.entries.data(), entryCount * sizeof(VisibilityEntry));
-  payload.update(f.extraOffset.data(), f.extraOffset.size() * sizeof(uint64_t));
-  payload.update(f.extras.data(), extraCount * sizeof(VisibilityExtra));
-  if (payload.digest() != payloadHash) fail("{}: corrupt visibility field (payload checksum mismatch)", path);
-  // Structural checks, so that propagation can index without bounds checks.
-  const uint32_t n = gridSide * gridSide;
-  if (f.extraOffset[0] != 0 || f.extraOffset.back() != extraCount) fail("{}: corrupt extra-record offsets", path);
-  for (uint64_t g = 0; g < tixelCount; ++g) {
-    uint64_t flagged = 0;
-    for (uint32_t k = 0; k < n; ++k) {
-      const VisibilityEntry& e = f.entries[g * n + k];
-      if (!e.escaped() && e.tixel() >= tixelCount) fail("{}: entry {} of tixel {} points outside the field", path, k, g);
-      flagged += e.hasExtra() ? 1 : 0;
-    }
-    if (f.extraOffset[g + 1] < f.extraOffset[g] || f.extraOffset[g + 1] - f.extraOffset[g] != flagged)
-      fail("{}: corrupt extra-record offsets at tixel {}", path, g);
-  }
+  f.entries = FieldArray<VisibilityEntry>(file, entries, entryCount);
+  f.extraOffset = FieldArray<uint64_t>(file, extraOffset, tixelCount + 1);
+  f.extras = FieldArray<VisibilityExtra>(std::move(file), extras, extraCount);
   field = std::move(f);
   return true;
 }

@@ -31,6 +31,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -60,13 +61,42 @@ struct VisibilityExtra {
 };
 static_assert(sizeof(VisibilityExtra) == 24);
 
+/// Read-only elements of a visibility field: either its own storage (a field just traced) or
+/// a view into the mapped .plv file it was read from (no copy). Copies share the storage.
+template <typename T>
+class FieldArray {
+ public:
+  FieldArray() = default;
+  explicit FieldArray(std::vector<T> owned) {
+    auto storage = std::make_shared<const std::vector<T>>(std::move(owned));
+    data_ = storage->data();
+    size_ = storage->size();
+    keepAlive_ = std::move(storage);
+  }
+  /// `size` elements at `data`, which stay valid while `owner` lives.
+  FieldArray(std::shared_ptr<const void> owner, const T* data, size_t size)
+      : keepAlive_(std::move(owner)), data_(data), size_(size) {}
+
+  const T* data() const { return data_; }
+  size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  const T& operator[](size_t i) const { return data_[i]; }
+  const T* begin() const { return data_; }
+  const T* end() const { return data_ + size_; }
+
+ private:
+  std::shared_ptr<const void> keepAlive_;
+  const T* data_ = nullptr;
+  size_t size_ = 0;
+};
+
 struct VisibilityField {
   uint32_t gridSide = 0;          ///< m: N = m² gather directions per tixel
   uint64_t tixelCount = 0;
   uint64_t hash = 0;              ///< of geometry + parameterisation + settings (visibilityHash)
-  std::vector<VisibilityEntry> entries;   ///< tixelCount × N
-  std::vector<uint64_t> extraOffset;      ///< tixelCount + 1
-  std::vector<VisibilityExtra> extras;
+  FieldArray<VisibilityEntry> entries;    ///< tixelCount × N
+  FieldArray<uint64_t> extraOffset;       ///< tixelCount + 1
+  FieldArray<VisibilityExtra> extras;
   uint64_t rays = 0;              ///< rays traced to build it (gather + mirror continuations)
   double seconds = 0.0;
 
@@ -112,9 +142,10 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 /// Writes the field atomically (temp + rename). Format: see visibility.cpp.
 void writeVisibility(const std::string& path, const VisibilityField& field);
 
-/// Reads a field. Returns false and sets *why when the file is absent or its hash differs
-/// from expectedHash (a stale field is not an error); throws pl::Error naming the file when
-/// it is present but corrupt or truncated.
+/// Reads a field (memory-mapped: the field's arrays view the file's pages). Returns false and
+/// sets *why when the file is absent or its hash differs from expectedHash (a stale field is
+/// not an error); throws pl::Error naming the file when it is present but corrupt or
+/// truncated (header, payload checksum and every index are checked before it returns).
 bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why);
 
 }  // namespace pl
