@@ -253,8 +253,9 @@ constexpr uint32_t kPrefetchDistance = 16;
 /// Σ_k L_k over one tixel's n visibility entries, in gather order k = 0 … n−1 (also writing
 /// each L_k to incoming when KeepIncoming). Entries without an extra record that hit a front
 /// side are direct views of diffuse tixels (a mirror-free path to a glossy chart always has
-/// one) and are looked up in the quads; the others go through slowPath(entry, extra), which
-/// returns their radiance. Escaped and back-side entries without an extra bring nothing.
+/// one) or escaped, and are looked up in the quads (quadCount − 1 is an all-zero quad for the
+/// escaped ones); the others go through slowPath(entry, extra), which returns their radiance.
+/// Back-side entries without an extra bring nothing.
 template <bool KeepIncoming, typename SlowPath>
 F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* quads, uint64_t quadCount,
                const VisibilityExtra* extras, Lanes4* incoming, SlowPath&& slowPath) {
@@ -264,13 +265,10 @@ F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* 
       __builtin_prefetch(quads + std::min<uint64_t>(entries[k + kPrefetchDistance].tixel(), quadCount - 1));
     const VisibilityEntry e = entries[k];
     if ((e.target & (VisibilityEntry::kBackSide | VisibilityEntry::kHasExtra)) == 0) {
-      if (!e.escaped()) {
-        const F4 L = lookupQuad(quads[e.tixel()], e);
-        sum = f4Add(sum, L);
-        if constexpr (KeepIncoming) incoming[k] = lanes4(L);
-      } else if constexpr (KeepIncoming) {
-        incoming[k] = Lanes4{};
-      }
+      // An escaped entry (tixel() = kEscape, above every index) reads the all-zero last quad.
+      const F4 L = lookupQuad(quads[std::min<uint64_t>(e.tixel(), quadCount - 1)], e);
+      sum = f4Add(sum, L);
+      if constexpr (KeepIncoming) incoming[k] = lanes4(L);
     } else {
       const Rgb L = slowPath(e, e.hasExtra() ? extras++ : nullptr);
       sum = f4Add(sum, f4FromRgb(L));
@@ -651,7 +649,8 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   // The quads (TransportQuad) of every tixel. A quad is rewritten only after its batch has
   // been updated, so during the batch it still holds the previous iteration's values
   // (Gauss–Seidel between batches, Jacobi inside).
-  std::vector<TransportQuad> quads(tixels);
+  // One more, all zero, for the entries that escaped (see gatherTixel).
+  std::vector<TransportQuad> quads(tixels + 1);
   auto updateTransport = [&](uint64_t begin, uint64_t end) {
     parallelForRange(end - begin, 256, [&](uint64_t t0, uint64_t t1) {
       for (uint64_t g = begin + t0; g < begin + t1; ++g) {
@@ -712,8 +711,8 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           const VisibilityEntry* entries = vis.entries.data() + g * n;
           const VisibilityExtra* extras = vis.extras.data() + vis.extraOffset[g];
           const F4 sum = c.kind == ChartKind::Glossy
-                             ? gatherTixel<true>(entries, n, quads.data(), tixels, extras, incoming.data(), slowPath)
-                             : gatherTixel<false>(entries, n, quads.data(), tixels, extras, nullptr, slowPath);
+                             ? gatherTixel<true>(entries, n, quads.data(), quads.size(), extras, incoming.data(), slowPath)
+                             : gatherTixel<false>(entries, n, quads.data(), quads.size(), extras, nullptr, slowPath);
           const uint64_t vb = valueBase(g, c);
           auto relax = [&](const Rgb& before, const Rgb& update) { return glm::max(Rgb(0.0f), before + omega * (update - before)); };
           if (c.kind == ChartKind::Diffuse) {
