@@ -42,6 +42,9 @@ class Accel {
   void intersectIncoherent(std::span<const Ray> rays, std::span<RayHit> hits) const;
   /// Occlusion for many rays at once; occluded[i] = 1 when ray i is blocked.
   void occludedMany(std::span<const Ray> rays, std::span<uint8_t> occluded) const;
+  /// The same for coherent rays (e.g. shadow rays from one point towards one light, in
+  /// order): traced as 16-wide packets, which share the BVH traversal.
+  void occludedCoherent(std::span<const Ray> rays, std::span<uint8_t> occluded) const;
 
   /// World-space bounds of the scene.
   Vec3 boundsMin() const { return boundsMin_; }

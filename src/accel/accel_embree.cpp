@@ -223,4 +223,34 @@ void Accel::occludedMany(std::span<const Ray> rays, std::span<uint8_t> occluded)
   }
 }
 
+void Accel::occludedCoherent(std::span<const Ray> rays, std::span<uint8_t> occluded) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(64) RTCRay16 packet;
+  alignas(64) int valid[16];
+  for (size_t base = 0; base < rays.size(); base += 16) {
+    const size_t n = std::min<size_t>(16, rays.size() - base);
+    for (size_t i = 0; i < 16; ++i) {
+      const bool active = i < n;
+      valid[i] = active ? -1 : 0;
+      const Ray& r = rays[base + (active ? i : 0)];
+      packet.org_x[i] = r.origin.x;
+      packet.org_y[i] = r.origin.y;
+      packet.org_z[i] = r.origin.z;
+      packet.dir_x[i] = r.direction.x;
+      packet.dir_y[i] = r.direction.y;
+      packet.dir_z[i] = r.direction.z;
+      packet.tnear[i] = r.tMin;
+      packet.tfar[i] = r.tMax;
+      packet.time[i] = 0.0f;
+      packet.mask[i] = 0xffffffffu;
+      packet.id[i] = static_cast<unsigned>(i);
+      packet.flags[i] = 0;
+    }
+    rtcOccluded16(valid, impl_->scene, &context, &packet);
+    for (size_t i = 0; i < n; ++i) occluded[base + i] = packet.tfar[i] < 0.0f ? 1 : 0;  // −inf on a hit
+  }
+}
+
 }  // namespace pl

@@ -257,14 +257,17 @@ TEST(Accel, OcclusionAgreesWithIntersection) {
   auto rays = makeRandomRays(scene, 4000, 7);
   Pcg32 rng(8, 8);
   for (Ray& r : rays) r.tMax = 0.2f + 1.5f * rng.uniform();  // finite segments, as shadow rays
-  std::vector<uint8_t> many(rays.size());
+  rays.resize(rays.size() - 5);  // not a multiple of the 16-ray packets
+  std::vector<uint8_t> many(rays.size()), packets(rays.size());
   accel.occludedMany(rays, many);
+  accel.occludedCoherent(rays, packets);
   int blocked = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
     RayHit hit;
     const bool hits = accel.intersect(rays[i], hit);
     EXPECT_EQ(accel.occluded(rays[i]), hits) << "ray " << i;
     EXPECT_EQ(many[i] != 0, hits) << "ray " << i;
+    EXPECT_EQ(packets[i] != 0, hits) << "ray " << i;
     blocked += hits;
   }
   EXPECT_GT(blocked, 400);
@@ -335,6 +338,7 @@ TEST(Accel, BoundsAndEmptySpans) {
   accel.intersectCoherent({}, {});
   accel.intersectIncoherent({}, {});
   accel.occludedMany({}, {});
+  accel.occludedCoherent({}, {});
   // A ray pointing away from everything misses.
   RayHit hit;
   EXPECT_FALSE(accel.intersect({hi + Vec3(1.0f), glm::normalize(Vec3(1, 1, 1))}, hit));
