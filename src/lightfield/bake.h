@@ -8,8 +8,8 @@
 //   draft          32              32        144 (12²)         8              16             5e-3
 //   default        64              64        256 (16²)        16              32             1e-3
 //   high           96             128        576 (24²)        24              64             2e-4
-// "tolerance" is the relative change of total outgoing power at which iteration stops; the
-// remaining error of the Neumann series is about tolerance·a/(1−a) for mean albedo a.
+// "tolerance" is the relative change of total outgoing power at which iteration stops, once
+// the remaining error estimated from the rate of convergence is below it too (propagation.h).
 #include "lightfield/lightfield.h"
 
 #include <functional>
