@@ -18,10 +18,14 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv) {
 ChartShading chartShading(const Scene& scene, const Chart& c) {
   const Material& material = scene.materials[c.material];
   ChartShading shading;
-  shading.emission = material.emission;
+  shading.emission = lanes4(material.emission);
+  shading.emissive = !isBlack(material.emission);
+  shading.inverseTixelSize = 1.0f / c.tixelSize;
   shading.twoSidedEmission = material.twoSidedEmission;
   shading.texturedAlbedo = material.albedoTexture >= 0;
-  if (c.kind == ChartKind::Diffuse && !shading.texturedAlbedo) shading.albedo = diffuseAlbedoAt(scene, c.material, Vec2(0.0f));
+  if (c.kind == ChartKind::Diffuse && !shading.texturedAlbedo)
+    shading.albedoOverPi = lanes4(diffuseAlbedoAt(scene, c.material, Vec2(0.0f)) * kInvPi);
+  shading.needsUv = c.kind == ChartKind::Diffuse && shading.texturedAlbedo;
   return shading;
 }
 

@@ -9,6 +9,7 @@
 //   paraboloid texel (a, b) has its centre at continuous coordinate (a, b), see paraboloid.h.
 //   Outside the outermost centres the edge values are held (clamp-to-edge), never extrapolated.
 #include "core/math.h"
+#include "core/simd4.h"
 #include "lightfield/lightfield.h"
 #include "lightfield/paraboloid.h"
 #include "scene/scene.h"
@@ -43,12 +44,13 @@ inline LinearTap linearTap(float x, uint32_t count) {
   return tap;
 }
 
-/// Continuous tixel grid coordinates of world point p on chart c (p need not lie on it).
-inline Vec2 tixelGridCoordinates(const Chart& c, const Vec3& p) {
+/// Continuous tixel grid coordinates of world point p on chart c (p need not lie on it), given
+/// inverseTixelSize = 1 / c.tixelSize (the lookups precompute it per chart).
+inline Vec2 tixelGridCoordinates(const Chart& c, const Vec3& p, float inverseTixelSize) {
   const Vec3 d = p - c.origin;
-  const float inv = 1.0f / c.tixelSize;
-  return {glm::dot(d, c.axisU) * inv - 0.5f, glm::dot(d, c.axisV) * inv - 0.5f};
+  return {glm::dot(d, c.axisU) * inverseTixelSize - 0.5f, glm::dot(d, c.axisV) * inverseTixelSize - 0.5f};
 }
+inline Vec2 tixelGridCoordinates(const Chart& c, const Vec3& p) { return tixelGridCoordinates(c, p, 1.0f / c.tixelSize); }
 
 /// A world direction in the chart's local frame (z along the chart normal).
 inline Vec3 chartLocalDirection(const Chart& c, const Vec3& w) {
@@ -58,19 +60,35 @@ inline Vec3 chartWorldDirection(const Chart& c, const Vec3& local) {
   return local.x * c.axisU + local.y * c.axisV + local.z * c.normal;
 }
 
-/// Bilinear × bilinear interpolation over a raw value array laid out like LightField::values
-/// (the bake uses it on its working arrays). Specular charts give 0.
-inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 st) {
-  if (c.kind == ChartKind::Specular || c.dirRes == 0) return Rgb(0.0f);
+/// Where the interpolation reads values from, as four lanes: a LightField::values-style Rgb
+/// array, or the same values padded to 16 bytes (Lanes4), which loads in one aligned access —
+/// the fast renderer's layout. Both give the same lanes, so the same results.
+struct RgbValues {
+  const Rgb* values;
+  F4 operator()(uint64_t i) const { return f4FromRgb(values[i]); }
+};
+struct PaddedValues {
+  const Lanes4* values;
+  F4 operator()(uint64_t i) const { return f4Load(values[i].v); }
+};
+
+/// Bilinear × bilinear interpolation over values laid out like LightField::values, read
+/// through `load` (RgbValues or PaddedValues), four lanes at a time. Specular charts give 0.
+template <typename Load>
+inline F4 interpolateLanes(const Load& load, const Chart& c, Vec2 grid, Vec2 st) {
+  if (c.kind == ChartKind::Specular || c.dirRes == 0) return f4Zero();
   const LinearTap tu = linearTap(grid.x, c.resU);
   const LinearTap tv = linearTap(grid.y, c.resV);
   const uint32_t is[2] = {tu.i0, tu.i1}, js[2] = {tv.i0, tv.i1};
   const float wu[2] = {1.0f - tu.f, tu.f}, wv[2] = {1.0f - tv.f, tv.f};
-  Rgb sum(0.0f);
+  F4 sum = f4Zero();
   if (c.dirRes == 1) {
-    for (int y = 0; y < 2; ++y)
-      for (int x = 0; x < 2; ++x) sum += (wu[x] * wv[y]) * values[c.valueIndex(is[x], js[y])];
-    return sum;
+    // c.valueIndex(i, j) with one value per tixel; the rows summed separately, then together
+    // (a shorter chain of dependent additions than one running sum).
+    const uint64_t row0 = c.firstValue + uint64_t(js[0]) * c.resU, row1 = c.firstValue + uint64_t(js[1]) * c.resU;
+    const F4 lower = f4Add(f4Mul(f4Splat(wu[0] * wv[0]), load(row0 + is[0])), f4Mul(f4Splat(wu[1] * wv[0]), load(row0 + is[1])));
+    const F4 upper = f4Add(f4Mul(f4Splat(wu[0] * wv[1]), load(row1 + is[0])), f4Mul(f4Splat(wu[1] * wv[1]), load(row1 + is[1])));
+    return f4Add(lower, upper);
   }
   const LinearTap ta = linearTap(paraboloidTexelCoordinate(st.x, c.dirRes), c.dirRes);
   const LinearTap tb = linearTap(paraboloidTexelCoordinate(st.y, c.dirRes), c.dirRes);
@@ -80,12 +98,18 @@ inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 
     for (int x = 0; x < 2; ++x) {
       const float wPos = wu[x] * wv[y];
       if (wPos == 0.0f) continue;
-      Rgb inner(0.0f);
+      F4 inner = f4Zero();
       for (int b = 0; b < 2; ++b)
-        for (int a = 0; a < 2; ++a) inner += (wa[a] * wb[b]) * values[c.valueIndex(is[x], js[y], as[a], bs[b])];
-      sum += wPos * inner;
+        for (int a = 0; a < 2; ++a)
+          inner = f4Add(inner, f4Mul(f4Splat(wa[a] * wb[b]), load(c.valueIndex(is[x], js[y], as[a], bs[b]))));
+      sum = f4Add(sum, f4Mul(f4Splat(wPos), inner));
     }
   return sum;
+}
+
+/// interpolateLanes over a raw Rgb value array (the bake uses it on its working arrays).
+inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 st) {
+  return f4Rgb(interpolateLanes(RgbValues{values}, c, grid, st));
 }
 
 /// Diffuse albedo of `material` at surface uv: the Lambertian albedo times its albedo texture
@@ -102,10 +126,13 @@ inline Rgb emittedRadiance(const Material& m, float cosTheta) {
 /// varies it, its diffuse albedo). The fast renderer (src/realtime) precomputes one per chart;
 /// the plain exitantRadiance below builds it on the fly, so both run the same formula.
 struct ChartShading {
-  Rgb emission{0.0f};             ///< Le of the chart's material (W·sr⁻¹·m⁻²)
+  Lanes4 emission;                ///< Le of the chart's material (W·sr⁻¹·m⁻²), as lanes r, g, b, 0
+  Lanes4 albedoOverPi;            ///< diffuse albedo / π when !texturedAlbedo (diffuse charts only)
+  float inverseTixelSize = 1.0f;  ///< 1 / chart.tixelSize (tixelGridCoordinates)
+  bool emissive = false;          ///< emission is not black
   bool twoSidedEmission = false;
   bool texturedAlbedo = false;    ///< diffuse albedo varies with uv: diffuseAlbedoAt per point
-  Rgb albedo{0.0f};               ///< diffuse albedo when !texturedAlbedo (diffuse charts only)
+  bool needsUv = false;           ///< a diffuse chart with an albedo texture: the lookup needs the hit's uv
 };
 ChartShading chartShading(const Scene& scene, const Chart& c);
 
@@ -123,27 +150,45 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
 /// The same for a ray hit (chart from lf.triangleChart, uv from the hit).
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer);
 
-/// exitantRadiance given the chart's precomputed shading and a value array laid out like
-/// LightField::values: the one implementation every caller goes through. Defined inline so
-/// that the fast renderer's per-pixel loop inlines it instead of calling across files.
-inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
-                           const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
-  if (c.kind == ChartKind::Specular) return Rgb(0.0f);
-  const Vec2 grid = tixelGridCoordinates(c, worldPosition);
-  const Vec3 local = chartLocalDirection(c, worldDirectionTowardsViewer);
+/// exitantRadiance given the chart's precomputed shading and the values read through `load`
+/// (RgbValues over LightField::values, or PaddedValues): the one implementation every caller
+/// goes through, as four lanes (r, g, b, 0). Defined inline so that the fast renderer's
+/// per-pixel loop inlines it instead of calling across files.
+template <typename Load>
+inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
+                               const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
+  if (c.kind == ChartKind::Specular) return f4Zero();
+  const Vec2 grid = tixelGridCoordinates(c, worldPosition, shading.inverseTixelSize);
+  // cos θ towards the viewer (chartLocalDirection's z; a diffuse lookup needs no more of it).
+  const float cosTheta = glm::dot(worldDirectionTowardsViewer, c.normal);
   // emittedRadiance (above) on the precomputed emission.
-  const Rgb emitted = (local.z > 0.0f || shading.twoSidedEmission) ? shading.emission : Rgb(0.0f);
+  const bool emits = cosTheta > 0.0f || shading.twoSidedEmission;
   if (c.kind == ChartKind::Diffuse) {
-    const Rgb irradiance = interpolateValues(values, c, grid, Vec2(0.0f));
-    const Rgb albedo = shading.texturedAlbedo ? diffuseAlbedoAt(scene, c.material, uv) : shading.albedo;
-    return emitted + albedo * irradiance * kInvPi;
+    // Le + (albedo/π) · E, lane by lane.
+    const F4 irradiance = interpolateLanes(load, c, grid, Vec2(0.0f));
+    const F4 albedoOverPi = shading.texturedAlbedo ? f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv)), f4Splat(kInvPi))
+                                                   : f4Load(shading.albedoOverPi.v);
+    const F4 reflected = f4Mul(albedoOverPi, irradiance);
+    return shading.emissive && emits ? f4Add(f4Load(shading.emission.v), reflected) : reflected;
   }
+  const Rgb emission = f4Rgb(f4Load(shading.emission.v));
+  const Rgb emitted = emits ? emission : Rgb(0.0f);
   // Glossy: the stored values already include emission towards the front side.
-  const Rgb stored = interpolateValues(values, c, grid, directionToParaboloid(local));
-  if (local.z >= 0.0f) return stored;
+  const Vec3 local = chartLocalDirection(c, worldDirectionTowardsViewer);
+  const Rgb stored = f4Rgb(interpolateLanes(load, c, grid, directionToParaboloid(local)));
+  if (cosTheta >= 0.0f) return f4FromRgb(stored);
   // Behind a one-sided chart: its front-side value at the horizon, minus the one-sided
   // emission it contains, plus the back-side emission (nonzero only for two-sided emitters).
-  return glm::max(stored - shading.emission, Rgb(0.0f)) + emitted;
+  return f4FromRgb(glm::max(stored - emission, Rgb(0.0f)) + emitted);
+}
+template <typename Load>
+inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
+                           const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
+  return f4Rgb(exitantRadianceLanes(scene, c, shading, load, worldPosition, worldDirectionTowardsViewer, uv));
+}
+inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
+                           const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
+  return exitantRadiance(scene, c, shading, RgbValues{values}, worldPosition, worldDirectionTowardsViewer, uv);
 }
 
 }  // namespace pl

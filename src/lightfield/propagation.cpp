@@ -6,9 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include "accel/accel.h"
 #include "core/error.h"
@@ -16,58 +13,13 @@
 #include "core/progress.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "core/simd4.h"
 #include "lightfield/lookup.h"
 #include "lightfield/paraboloid.h"
 
 namespace pl {
 
 namespace {
-
-// ---- Four-lane arithmetic -------------------------------------------------------------------
-// Four float lanes (r, g, b, unused): SSE where the target has it (every x86-64), else a plain
-// array. Both do the same IEEE single-precision operations in the same order per lane, so the
-// results are identical.
-#if defined(__SSE2__)
-using F4 = __m128;
-inline F4 f4Zero() { return _mm_setzero_ps(); }
-inline F4 f4Splat(float s) { return _mm_set1_ps(s); }
-inline F4 f4Load(const float* aligned) { return _mm_load_ps(aligned); }
-inline F4 f4Add(F4 a, F4 b) { return _mm_add_ps(a, b); }
-inline F4 f4Mul(F4 a, F4 b) { return _mm_mul_ps(a, b); }
-inline Rgb f4Rgb(F4 a) {
-  alignas(16) float v[4];
-  _mm_store_ps(v, a);
-  return {v[0], v[1], v[2]};
-}
-#else
-struct F4 {
-  float v[4];
-};
-inline F4 f4Zero() { return {{0.0f, 0.0f, 0.0f, 0.0f}}; }
-inline F4 f4Splat(float s) { return {{s, s, s, s}}; }
-inline F4 f4Load(const float* aligned) { return {{aligned[0], aligned[1], aligned[2], aligned[3]}}; }
-inline F4 f4Add(F4 a, F4 b) { return {{a.v[0] + b.v[0], a.v[1] + b.v[1], a.v[2] + b.v[2], a.v[3] + b.v[3]}}; }
-inline F4 f4Mul(F4 a, F4 b) { return {{a.v[0] * b.v[0], a.v[1] * b.v[1], a.v[2] * b.v[2], a.v[3] * b.v[3]}}; }
-inline Rgb f4Rgb(F4 a) { return {a.v[0], a.v[1], a.v[2]}; }
-#endif
-inline F4 f4FromRgb(const Rgb& c) {
-  alignas(16) const float v[4] = {c.r, c.g, c.b, 0.0f};
-  return f4Load(v);
-}
-/// Storage for an F4 (lanes r, g, b, 0), aligned for f4Load.
-struct alignas(16) Lanes4 {
-  float v[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-};
-inline Lanes4 lanes4(F4 a) {
-  Lanes4 l;
-#if defined(__SSE2__)
-  _mm_store_ps(l.v, a);
-#else
-  l = Lanes4{{a.v[0], a.v[1], a.v[2], a.v[3]}};
-#endif
-  return l;
-}
-inline Lanes4 lanes4(const Rgb& c) { return Lanes4{{c.r, c.g, c.b, 0.0f}}; }
 
 // Sub-samples per side of an output texel (directions averaged over the texel's part inside the
 // disk) and of a gather cell (directions averaged over the cell) for the glossy operator.

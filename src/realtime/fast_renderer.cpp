@@ -28,16 +28,20 @@ struct FastRenderer::Scratch {
   std::vector<RayHit> mirrorHits;
   std::vector<uint32_t> mirrorSlot, nextSlot;
   std::vector<Rgb> mirrorThroughput, nextThroughput;
+  std::vector<uint32_t> reflectedSamples;  ///< camera samples that hit a mirror (one sample per pixel)
 };
+
+/// A one-sample pixel: weight × radiance, or 0 for a sample of zero weight (as the reference).
+inline Rgb pixelValue(float weight, const Rgb& radiance) { return weight > 0.0f ? weight * radiance : Rgb(0.0f); }
 
 FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel) : lightField_(lightField), accel_(accel) {
   const Scene& scene = lightField.scene;
+  paddedValues_.reserve(lightField.values.size());
+  for (const Rgb& v : lightField.values) paddedValues_.push_back(lanes4(v));
   shading_.reserve(lightField.charts.size());
-  needsUv_.reserve(lightField.charts.size());
   for (const Chart& c : lightField.charts) {
     if (c.material >= scene.materials.size()) fail("fast renderer: chart material {} out of range", c.material);
     shading_.push_back(chartShading(scene, c));
-    needsUv_.push_back(uint8_t(c.kind == ChartKind::Diffuse && shading_.back().texturedAlbedo));
   }
   if (lightField.triangleChart.size() != scene.meshes.size())
     fail("fast renderer: triangle → chart map has {} meshes, the scene {}", lightField.triangleChart.size(), scene.meshes.size());
@@ -118,7 +122,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   const Scene& scene = lightField_.scene;
   const Chart* charts = lightField_.charts.data();
   const ChartShading* shading = shading_.data();
-  const Rgb* values = lightField_.values.data();
+  const PaddedValues values{paddedValues_.data()};
   const size_t pixels = size_t(x1 - x0) * size_t(y1 - y0);
   const size_t samples = pixels * size_t(spp);
   s.rays.resize(samples);
@@ -131,10 +135,12 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   const size_t n = tileCameraRays(camera, spp, seed, x0, y0, x1, y1, s.rays.data(), s.weight.data(), s.pixel.data());
   accel_.intersectCoherent(std::span<const Ray>(s.rays.data(), n), std::span<RayHit>(s.hits.data(), n));
 
-  // 2. Shade the camera hits; mirror hits start the reflection wavefront.
+  // 2. Shade the camera hits; mirror hits start the reflection wavefront. With one sample
+  // per pixel, a pixel that needs no reflection is written as soon as it is shaded.
   s.mirrorRays.clear();
   s.mirrorSlot.clear();
   s.mirrorThroughput.clear();
+  Rgb* out = image.pixels.data();
   for (size_t i = 0; i < n; ++i) {
     const Ray& ray = s.rays[i];
     const RayHit& hit = s.hits[i];
@@ -148,8 +154,15 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv(0.0f);
-        if (needsUv_[chart]) uv = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics).uv;
-        radiance = exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, -ray.direction, uv);
+        if (shading[chart].needsUv) uv = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics).uv;
+        const F4 lanes =
+            exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, -ray.direction, uv);
+        if (spp == 1) {
+          // The pixel, straight from the lanes (weight > 0 here): pixelValue's weight × radiance.
+          f4StoreRgb(out + s.pixel[i], f4Mul(f4Splat(s.weight[i]), lanes));
+          continue;
+        }
+        radiance = f4Rgb(lanes);
       } else {
         Ray reflected;
         Rgb reflectance;
@@ -161,7 +174,10 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       }
     }
     s.radiance[i] = radiance;
+    if (spp == 1) out[s.pixel[i]] = pixelValue(s.weight[i], radiance);
   }
+  // The samples whose pixels the reflections below complete (one sample per pixel).
+  if (spp == 1) s.reflectedSamples.assign(s.mirrorSlot.begin(), s.mirrorSlot.end());
 
   // 3. Reflection wavefronts, intersected as packets (a planar mirror keeps them coherent).
   for (uint32_t reflections = 1; !s.mirrorRays.empty(); ++reflections) {
@@ -184,7 +200,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv(0.0f);
-        if (needsUv_[chart]) uv = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics).uv;
+        if (shading[chart].needsUv) uv = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics).uv;
         s.radiance[slot] +=
             throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, -ray.direction, uv);
         continue;
@@ -206,9 +222,8 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   }
 
   // Pixel = mean over its samples of weight × radiance (the reference's order of sums).
-  Rgb* out = image.pixels.data();
   if (spp == 1) {
-    for (size_t i = 0; i < n; ++i) out[s.pixel[i]] = s.weight[i] > 0.0f ? s.weight[i] * s.radiance[i] : Rgb(0.0f);
+    for (uint32_t i : s.reflectedSamples) out[s.pixel[i]] = pixelValue(s.weight[i], s.radiance[i]);
     return;
   }
   for (size_t q = 0; q < pixels; ++q) {

@@ -73,7 +73,8 @@ class FastRenderer {
   const LightField& lightField_;
   const Accel& accel_;
   std::vector<ChartShading> shading_;  ///< per chart
-  std::vector<uint8_t> needsUv_;       ///< per chart: textured diffuse (the lookup needs the hit's uv)
+  /// The light field's values padded to 16 bytes (PaddedValues): one aligned load per tap.
+  std::vector<Lanes4> paddedValues_;
   /// LightField::triangleChart flattened: chart of triangle t of mesh m at
   /// triangleChart_[meshFirstTriangle_[m] + t] (one dependent load less per pixel).
   std::vector<uint32_t> meshFirstTriangle_, triangleChart_;
