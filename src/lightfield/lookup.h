@@ -186,6 +186,82 @@ inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShadin
                            const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
   return f4Rgb(exitantRadianceLanes(scene, c, shading, load, worldPosition, worldDirectionTowardsViewer, uv));
 }
+/// Four light-field lookups on one diffuse chart without an albedo texture: the camera rays
+/// origin + t·direction (structure of arrays: x[k], y[k], z[k] for lookups k = 0…3), seen
+/// against their directions. result[k] = exitantRadianceLanes(…, origin_k + t_k·direction_k,
+/// −direction_k, …) to the bit — the same IEEE operations lane by lane, with the four lookups
+/// in the four SSE lanes for everything up to the value reads (the fast renderer's common case,
+/// where a dependent chain of ~40 scalar operations per pixel would otherwise dominate).
+struct RaysSoA4 {
+  alignas(16) float ox[4], oy[4], oz[4], dx[4], dy[4], dz[4], t[4];
+};
+inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const ChartShading& shading, const Lanes4* values,
+                                    const RaysSoA4& r, F4 result[4]) {
+#if defined(__SSE2__)
+  (void)scene;  // no albedo texture
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), half = _mm_set1_ps(0.5f);
+  const __m128 t = _mm_load_ps(r.t), dx = _mm_load_ps(r.dx), dy = _mm_load_ps(r.dy), dz = _mm_load_ps(r.dz);
+  // Position o + t·d, then d − chart origin (tixelGridCoordinates).
+  const __m128 px = _mm_sub_ps(_mm_add_ps(_mm_load_ps(r.ox), _mm_mul_ps(t, dx)), _mm_set1_ps(c.origin.x));
+  const __m128 py = _mm_sub_ps(_mm_add_ps(_mm_load_ps(r.oy), _mm_mul_ps(t, dy)), _mm_set1_ps(c.origin.y));
+  const __m128 pz = _mm_sub_ps(_mm_add_ps(_mm_load_ps(r.oz), _mm_mul_ps(t, dz)), _mm_set1_ps(c.origin.z));
+  auto dot = [&](const Vec3& axis) {  // glm::dot's order: (x·ax + y·ay) + z·az
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(px, _mm_set1_ps(axis.x)), _mm_mul_ps(py, _mm_set1_ps(axis.y))),
+                      _mm_mul_ps(pz, _mm_set1_ps(axis.z)));
+  };
+  const __m128 inverse = _mm_set1_ps(shading.inverseTixelSize);
+  const __m128 gridU = _mm_sub_ps(_mm_mul_ps(dot(c.axisU), inverse), half);
+  const __m128 gridV = _mm_sub_ps(_mm_mul_ps(dot(c.axisV), inverse), half);
+  // cos θ = dot(−d, normal).
+  const __m128 sign = _mm_set1_ps(-0.0f);
+  const __m128 cosTheta = _mm_add_ps(
+      _mm_add_ps(_mm_mul_ps(_mm_xor_ps(dx, sign), _mm_set1_ps(c.normal.x)), _mm_mul_ps(_mm_xor_ps(dy, sign), _mm_set1_ps(c.normal.y))),
+      _mm_mul_ps(_mm_xor_ps(dz, sign), _mm_set1_ps(c.normal.z)));
+  // linearTap, lane by lane (see its comment for the case list).
+  struct Taps {
+    alignas(16) uint32_t i0[4], i1[4];
+    alignas(16) float w0[4], w1[4];  // 1 − f, f
+  };
+  auto taps = [&](__m128 x, uint32_t count) {
+    const uint32_t last = count - 1;
+    const __m128 positive = _mm_and_ps(_mm_cmpgt_ps(x, zero), x);  // NaN → 0
+    const __m128 clamped = _mm_min_ps(positive, _mm_set1_ps(float(last)));
+    const __m128i i0 = _mm_cvttps_epi32(clamped);
+    const __m128i next = _mm_sub_epi32(i0, _mm_castps_si128(_mm_cmpgt_ps(clamped, zero)));  // + [clamped > 0]
+    const __m128i lastI = _mm_set1_epi32(int(last));
+    const __m128i below = _mm_cmplt_epi32(next, lastI);
+    const __m128i i1 = _mm_or_si128(_mm_and_si128(below, next), _mm_andnot_si128(below, lastI));
+    const __m128 f = _mm_sub_ps(clamped, _mm_cvtepi32_ps(i0));
+    Taps out;
+    _mm_store_si128(reinterpret_cast<__m128i*>(out.i0), i0);
+    _mm_store_si128(reinterpret_cast<__m128i*>(out.i1), i1);
+    _mm_store_ps(out.w0, _mm_sub_ps(one, f));
+    _mm_store_ps(out.w1, f);
+    return out;
+  };
+  const Taps u = taps(gridU, c.resU), v = taps(gridV, c.resV);
+  const int frontSide = _mm_movemask_ps(_mm_cmpgt_ps(cosTheta, zero));  // bit k: cos θ_k > 0
+  const F4 albedoOverPi = f4Load(shading.albedoOverPi.v), emission = f4Load(shading.emission.v);
+  for (int k = 0; k < 4; ++k) {
+    // interpolateLanes' diffuse branch and exitantRadianceLanes' diffuse return, for lookup k.
+    const uint64_t row0 = c.firstValue + uint64_t(v.i0[k]) * c.resU, row1 = c.firstValue + uint64_t(v.i1[k]) * c.resU;
+    const F4 lower = f4Add(f4Mul(f4Splat(u.w0[k] * v.w0[k]), f4Load(values[row0 + u.i0[k]].v)),
+                           f4Mul(f4Splat(u.w1[k] * v.w0[k]), f4Load(values[row0 + u.i1[k]].v)));
+    const F4 upper = f4Add(f4Mul(f4Splat(u.w0[k] * v.w1[k]), f4Load(values[row1 + u.i0[k]].v)),
+                           f4Mul(f4Splat(u.w1[k] * v.w1[k]), f4Load(values[row1 + u.i1[k]].v)));
+    const F4 reflected = f4Mul(albedoOverPi, f4Add(lower, upper));
+    const bool emits = ((frontSide >> k) & 1) != 0 || shading.twoSidedEmission;
+    result[k] = shading.emissive && emits ? f4Add(emission, reflected) : reflected;
+  }
+#else
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 d(r.dx[k], r.dy[k], r.dz[k]);
+    result[k] = exitantRadianceLanes(scene, c, shading, PaddedValues{values}, Vec3(r.ox[k], r.oy[k], r.oz[k]) + r.t[k] * d, -d,
+                                     Vec2(0.0f));
+  }
+#endif
+}
+
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
                            const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
   return exitantRadiance(scene, c, shading, RgbValues{values}, worldPosition, worldDirectionTowardsViewer, uv);

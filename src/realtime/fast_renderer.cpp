@@ -136,12 +136,40 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   accel_.intersectCoherent(std::span<const Ray>(s.rays.data(), n), std::span<RayHit>(s.hits.data(), n));
 
   // 2. Shade the camera hits; mirror hits start the reflection wavefront. With one sample
-  // per pixel, a pixel that needs no reflection is written as soon as it is shaded.
+  // per pixel, a pixel that needs no reflection is written as soon as it is shaded, and four
+  // consecutive samples on the same plain diffuse chart (most of a frame) are looked up
+  // together (exitantRadianceDiffuse4: the same values as one at a time).
   s.mirrorRays.clear();
   s.mirrorSlot.clear();
   s.mirrorThroughput.clear();
   Rgb* out = image.pixels.data();
-  for (size_t i = 0; i < n; ++i) {
+  auto chartOf = [&](const RayHit& hit) { return triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle]; };
+  // Whether samples i … i+3 all hit one diffuse chart without an albedo texture (→ *chart).
+  auto sameDiffuseChart = [&](size_t i, uint32_t* chart) {
+    for (size_t k = i; k < i + 4; ++k)
+      if (!(s.weight[k] > 0.0f) || !s.hits[k].hit()) return false;
+    *chart = chartOf(s.hits[i]);
+    if (charts[*chart].kind != ChartKind::Diffuse || shading[*chart].needsUv) return false;
+    for (size_t k = i + 1; k < i + 4; ++k)
+      if (chartOf(s.hits[k]) != *chart) return false;
+    return true;
+  };
+  RaysSoA4 four;
+  F4 fourRadiance[4];
+  for (size_t i = 0; i < n;) {
+    uint32_t chart = 0;
+    if (spp == 1 && i + 4 <= n && sameDiffuseChart(i, &chart)) {
+      for (int k = 0; k < 4; ++k) {
+        const Ray& ray = s.rays[i + k];
+        four.ox[k] = ray.origin.x, four.oy[k] = ray.origin.y, four.oz[k] = ray.origin.z;
+        four.dx[k] = ray.direction.x, four.dy[k] = ray.direction.y, four.dz[k] = ray.direction.z;
+        four.t[k] = s.hits[i + k].t;
+      }
+      exitantRadianceDiffuse4(scene, charts[chart], shading[chart], paddedValues_.data(), four, fourRadiance);
+      for (int k = 0; k < 4; ++k) f4StoreRgb(out + s.pixel[i + k], f4Mul(f4Splat(s.weight[i + k]), fourRadiance[k]));
+      i += 4;
+      continue;
+    }
     const Ray& ray = s.rays[i];
     const RayHit& hit = s.hits[i];
     Rgb radiance(0.0f);
@@ -150,7 +178,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     } else if (!hit.hit()) {
       radiance = backgroundRadiance(scene.environment, ray.direction);
     } else {
-      const uint32_t chart = triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle];
+      chart = chartOf(hit);
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv(0.0f);
@@ -160,6 +188,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         if (spp == 1) {
           // The pixel, straight from the lanes (weight > 0 here): pixelValue's weight × radiance.
           f4StoreRgb(out + s.pixel[i], f4Mul(f4Splat(s.weight[i]), lanes));
+          ++i;
           continue;
         }
         radiance = f4Rgb(lanes);
@@ -175,6 +204,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     }
     s.radiance[i] = radiance;
     if (spp == 1) out[s.pixel[i]] = pixelValue(s.weight[i], radiance);
+    ++i;
   }
   // The samples whose pixels the reflections below complete (one sample per pixel).
   if (spp == 1) s.reflectedSamples.assign(s.mirrorSlot.begin(), s.mirrorSlot.end());
