@@ -19,6 +19,9 @@ inline F4 f4Splat(float s) { return _mm_set1_ps(s); }
 inline F4 f4Load(const float* aligned) { return _mm_load_ps(aligned); }
 inline F4 f4Add(F4 a, F4 b) { return _mm_add_ps(a, b); }
 inline F4 f4Mul(F4 a, F4 b) { return _mm_mul_ps(a, b); }
+inline F4 f4Sub(F4 a, F4 b) { return _mm_sub_ps(a, b); }
+/// glm::max(a, b) lane-wise: (a < b) ? b : a (so a NaN in a is kept, as glm does).
+inline F4 f4Max(F4 a, F4 b) { return _mm_max_ps(b, a); }
 inline F4 f4FromRgb(const Rgb& c) { return _mm_setr_ps(c.r, c.g, c.b, 0.0f); }
 inline Rgb f4Rgb(F4 a) {
   alignas(16) float v[4];
@@ -34,6 +37,12 @@ inline F4 f4Splat(float s) { return {{s, s, s, s}}; }
 inline F4 f4Load(const float* aligned) { return {{aligned[0], aligned[1], aligned[2], aligned[3]}}; }
 inline F4 f4Add(F4 a, F4 b) { return {{a.v[0] + b.v[0], a.v[1] + b.v[1], a.v[2] + b.v[2], a.v[3] + b.v[3]}}; }
 inline F4 f4Mul(F4 a, F4 b) { return {{a.v[0] * b.v[0], a.v[1] * b.v[1], a.v[2] * b.v[2], a.v[3] * b.v[3]}}; }
+inline F4 f4Sub(F4 a, F4 b) { return {{a.v[0] - b.v[0], a.v[1] - b.v[1], a.v[2] - b.v[2], a.v[3] - b.v[3]}}; }
+inline F4 f4Max(F4 a, F4 b) {
+  F4 m;
+  for (int k = 0; k < 4; ++k) m.v[k] = a.v[k] < b.v[k] ? b.v[k] : a.v[k];
+  return m;
+}
 inline F4 f4FromRgb(const Rgb& c) { return {{c.r, c.g, c.b, 0.0f}}; }
 inline Rgb f4Rgb(F4 a) { return {a.v[0], a.v[1], a.v[2]}; }
 #endif

@@ -171,15 +171,14 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
     const F4 reflected = f4Mul(albedoOverPi, irradiance);
     return shading.emissive && emits ? f4Add(f4Load(shading.emission.v), reflected) : reflected;
   }
-  const Rgb emission = f4Rgb(f4Load(shading.emission.v));
-  const Rgb emitted = emits ? emission : Rgb(0.0f);
   // Glossy: the stored values already include emission towards the front side.
   const Vec3 local = chartLocalDirection(c, worldDirectionTowardsViewer);
-  const Rgb stored = f4Rgb(interpolateLanes(load, c, grid, directionToParaboloid(local)));
-  if (cosTheta >= 0.0f) return f4FromRgb(stored);
+  const F4 stored = interpolateLanes(load, c, grid, directionToParaboloid(local));
+  if (cosTheta >= 0.0f) return stored;
   // Behind a one-sided chart: its front-side value at the horizon, minus the one-sided
   // emission it contains, plus the back-side emission (nonzero only for two-sided emitters).
-  return f4FromRgb(glm::max(stored - emission, Rgb(0.0f)) + emitted);
+  const F4 emission = f4Load(shading.emission.v);
+  return f4Add(f4Max(f4Sub(stored, emission), f4Zero()), emits ? emission : f4Zero());
 }
 template <typename Load>
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
