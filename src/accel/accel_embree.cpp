@@ -150,30 +150,48 @@ bool Accel::occluded(const Ray& ray) const {
   return r.tfar < 0.0f;  // Embree sets tfar = −inf on an occlusion hit
 }
 
-void Accel::intersectCoherent(std::span<const Ray> rays, std::span<RayHit> hits) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  alignas(64) RTCRayHit16 packet;
+namespace {
+/// Lane `lane` of a 16-ray packet = r.
+void setPacketRay(RTCRay16& packet, size_t lane, const Ray& r) {
+  packet.org_x[lane] = r.origin.x;
+  packet.org_y[lane] = r.origin.y;
+  packet.org_z[lane] = r.origin.z;
+  packet.dir_x[lane] = r.direction.x;
+  packet.dir_y[lane] = r.direction.y;
+  packet.dir_z[lane] = r.direction.z;
+  packet.tnear[lane] = r.tMin;
+  packet.tfar[lane] = r.tMax;
+  packet.time[lane] = 0.0f;
+  packet.mask[lane] = 0xffffffffu;
+  packet.id[lane] = static_cast<unsigned>(lane);
+  packet.flags[lane] = 0;
+}
+
+/// The rays in 16-ray packets: for each packet, setPacketRay for all 16 lanes of `packet`
+/// (an inactive lane — past the end — gets a copy of the packet's first ray and valid 0),
+/// then trace(valid, first ray index, active lanes).
+template <typename Trace>
+void forEachPacket16(std::span<const Ray> rays, RTCRay16& packet, Trace&& trace) {
   alignas(64) int valid[16];
   for (size_t base = 0; base < rays.size(); base += 16) {
     const size_t n = std::min<size_t>(16, rays.size() - base);
     for (size_t i = 0; i < 16; ++i) {
       const bool active = i < n;
       valid[i] = active ? -1 : 0;
-      const Ray& r = rays[base + (active ? i : 0)];
-      packet.ray.org_x[i] = r.origin.x;
-      packet.ray.org_y[i] = r.origin.y;
-      packet.ray.org_z[i] = r.origin.z;
-      packet.ray.dir_x[i] = r.direction.x;
-      packet.ray.dir_y[i] = r.direction.y;
-      packet.ray.dir_z[i] = r.direction.z;
-      packet.ray.tnear[i] = r.tMin;
-      packet.ray.tfar[i] = r.tMax;
-      packet.ray.time[i] = 0.0f;
-      packet.ray.mask[i] = 0xffffffffu;
-      packet.ray.id[i] = static_cast<unsigned>(i);
-      packet.ray.flags[i] = 0;
+      setPacketRay(packet, i, rays[base + (active ? i : 0)]);
+    }
+    trace(valid, base, n);
+  }
+}
+}  // namespace
+
+void Accel::intersectCoherent(std::span<const Ray> rays, std::span<RayHit> hits) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(64) RTCRayHit16 packet;
+  forEachPacket16(rays, packet.ray, [&](int* valid, size_t base, size_t n) {
+    for (size_t i = 0; i < 16; ++i) {
       packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
       packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
     }
@@ -188,7 +206,7 @@ void Accel::intersectCoherent(std::span<const Ray> rays, std::span<RayHit> hits)
         hit.barycentrics = Vec2(packet.hit.u[i], packet.hit.v[i]);
       }
     }
-  }
+  });
 }
 
 void Accel::intersectIncoherent(std::span<const Ray> rays, std::span<RayHit> hits) const {
@@ -228,29 +246,10 @@ void Accel::occludedCoherent(std::span<const Ray> rays, std::span<uint8_t> occlu
   rtcInitIntersectContext(&context);
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   alignas(64) RTCRay16 packet;
-  alignas(64) int valid[16];
-  for (size_t base = 0; base < rays.size(); base += 16) {
-    const size_t n = std::min<size_t>(16, rays.size() - base);
-    for (size_t i = 0; i < 16; ++i) {
-      const bool active = i < n;
-      valid[i] = active ? -1 : 0;
-      const Ray& r = rays[base + (active ? i : 0)];
-      packet.org_x[i] = r.origin.x;
-      packet.org_y[i] = r.origin.y;
-      packet.org_z[i] = r.origin.z;
-      packet.dir_x[i] = r.direction.x;
-      packet.dir_y[i] = r.direction.y;
-      packet.dir_z[i] = r.direction.z;
-      packet.tnear[i] = r.tMin;
-      packet.tfar[i] = r.tMax;
-      packet.time[i] = 0.0f;
-      packet.mask[i] = 0xffffffffu;
-      packet.id[i] = static_cast<unsigned>(i);
-      packet.flags[i] = 0;
-    }
+  forEachPacket16(rays, packet, [&](int* valid, size_t base, size_t n) {
     rtcOccluded16(valid, impl_->scene, &context, &packet);
     for (size_t i = 0; i < n; ++i) occluded[base + i] = packet.tfar[i] < 0.0f ? 1 : 0;  // −inf on a hit
-  }
+  });
 }
 
 }  // namespace pl
