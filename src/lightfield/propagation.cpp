@@ -473,11 +473,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
         if (e.escaped()) {
           // The environment in the direction the path left: the gather direction itself, or
           // after mirrors the final direction stored with the path.
-          {
-            const Vec3 leaving = extra ? octahedralDecode(extra->st)
-                                       : chartWorldDirection(c, gatherDirectionLocal(g, k, vis.gridSide, settings.seed));
-            L = environment.radiance(leaving);
-          }
+          const Vec3 leaving = extra ? octahedralDecode(extra->st)
+                                     : chartWorldDirection(c, gatherDirectionLocal(g, k, vis.gridSide, settings.seed));
+          L = environment.radiance(leaving);
         } else {
           const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
           const Material& material = scene.materials[seen.material];
@@ -571,9 +569,10 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   // past the update by ω − 1 closes more of it. Measured with the default preset (iterations
   // to the 1e-3 tolerance, ω = 1 → 1.2): built-in Cornell box 8 → 4, CornellBox-Glossy 8 → 4,
   // CornellBox-Mirror 6 → 5, each ending closer to the converged solution than before;
-  // furnace a = 0.9 (tolerance 1e-7) 107 → 89. ω = 1.15 and 1.25 take more iterations on the
-  // Cornell box, ω = 1.3 overshoots, ω ≥ 2 diverges. If the L1 change below ever grows, the
-  // rest of the iteration falls back to ω = 1, which converges for any ρ < 1.
+  // white furnace a = 0.9 (gather only, tolerance 1e-7) 107 → 90. ω = 1.15 and 1.25 take more
+  // iterations on the Cornell box, ω = 1.3 overshoots, ω ≥ 2 diverges. If the L1 change below
+  // grows after the second iteration, the rest of the iteration falls back to ω = 1, which
+  // converges for any ρ < 1.
   //
   // Stopping. The residual is the relative change of the total outgoing power, |ΔP| / P, and
   // iteration stops once it is below the tolerance — and once, too, the error that remains is:

@@ -359,7 +359,7 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
       fileSize != expectedSize + extraCount * sizeof(VisibilityExtra))
     fail("{}: truncated or oversized: {} bytes, the header describes {}", path, fileSize,
          expectedSize + extraCount * sizeof(VisibilityExtra));
-  // The arrays view the mapping in place (offsets 48, 48 + 8·entries, …: aligned for their
+  // The arrays view the mapping in place (offsets 56, 56 + 8·entries, …: aligned for their
   // element types, as the header size and the element sizes are multiples of 8).
   const unsigned char* payload = bytes.data() + kPlvHeaderSize;
   const auto* entries = reinterpret_cast<const VisibilityEntry*>(payload);

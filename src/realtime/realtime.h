@@ -8,16 +8,20 @@
 //      16-ray Embree packet (Accel::intersectCoherent) covers a compact footprint;
 //   2. shading of every hit without building a SurfaceHit: the hit point is ray.origin +
 //      t·ray.direction, the chart comes from LightField::triangleChart, and the radiance from
-//      exitantRadiance() of lightfield/lookup.h with the chart's ChartShading precomputed once
-//      (the one 16-neighbour formula the reference also runs; only textured diffuse charts
-//      need the hit's uv and build the SurfaceHit);
+//      exitantRadianceLanes() of lightfield/lookup.h with the chart's ChartShading precomputed
+//      once (the one 16-neighbour formula the reference also runs, in four SSE lanes; only
+//      textured diffuse charts need the hit's uv and build the SurfaceHit). With one sample
+//      per pixel, four consecutive samples on one plain diffuse chart go through
+//      exitantRadianceDiffuse4 together (bit-identical), and a pixel is written from the
+//      lanes as soon as it is shaded;
 //   3. mirrors as a wavefront of reflection rays: all samples of the tile that hit an
 //      ideal-specular chart spawn their reflected ray (same steps as the reference: shading
 //      normal frame, the BSDF's delta sample with its Fresnel weight, offset origin), and
 //      the wavefront is intersected again as packets, up to mirrorDepth reflections.
-// The light-field values are read in place: LightField::values is already float RGB,
-// tixel-major (all direction texels of a tixel contiguous), so a glossy lookup touches two
-// cache lines per tixel and a diffuse lookup four values of one or two rows.
+// The light-field values are copied once, padded to 16 bytes (Lanes4: one aligned load per
+// tap), in LightField::values' tixel-major order (all direction texels of a tixel
+// contiguous), so a glossy lookup touches two cache lines per tixel and a diffuse lookup four
+// values of one or two rows.
 //
 // Sampling, camera weights, mirror depth, background and the pixel value are exactly those
 // of renderLightField (RenderSettings has the same meaning); results differ from the
