@@ -100,7 +100,8 @@ void writeFileAtomically(const std::string& path, const std::function<void(const
 void writeFileBytes(const std::string& path, const void* data, size_t size) {
   std::FILE* file = std::fopen(path.c_str(), "wb");
   if (!file) fail("cannot create file: {}", std::strerror(errno));
-  const bool written = std::fwrite(data, 1, size, file) == size && std::fflush(file) == 0;
+  // (fwrite's buffer may not be null even for 0 bytes: an empty file writes nothing.)
+  const bool written = (size == 0 || std::fwrite(data, 1, size, file) == size) && std::fflush(file) == 0;
   const int writeErrno = errno;
   const bool closed = std::fclose(file) == 0;
   if (!written || !closed) fail("write failed: {}", std::strerror(written ? errno : writeErrno));

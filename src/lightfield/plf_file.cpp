@@ -70,6 +70,7 @@ Xxh64Stream::Xxh64Stream(uint64_t seed) : seed_(seed) {
 }
 
 void Xxh64Stream::update(const void* data, size_t size) {
+  if (size == 0) return;  // (data may then be null, e.g. an empty array's, which memcpy may not see)
   auto* p = static_cast<const unsigned char*>(data);
   totalLength_ += size;
   auto consumeStripe = [this](const unsigned char* stripe) {
@@ -200,7 +201,7 @@ class ByteReader {
   std::vector<T> getArray(const char* what) {
     const uint64_t count = getCount(sizeof(T), what);
     std::vector<T> v(count);
-    std::memcpy(v.data(), bytes_.data() + pos_, count * sizeof(T));
+    if (count > 0) std::memcpy(v.data(), bytes_.data() + pos_, count * sizeof(T));  // (an empty v's data() may be null)
     pos_ += count * sizeof(T);
     return v;
   }
