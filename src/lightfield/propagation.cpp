@@ -111,51 +111,6 @@ struct GlossyMaterial {
   std::vector<float> projectedSolidAngle;     ///< per output texel, ≈ Ω·cos θ (for the power sum)
 };
 
-// Incident radiance from point, spot and directional lights: returns false when the light
-// does not reach direction/position (outside a spot cone, behind, zero). `incident` is the
-// irradiance on a surface normal to wi, `distance` the shadow-ray length (∞ for directional).
-bool punctualIncident(const Light& light, const Vec3& x, Vec3& wi, float& distance, Rgb& incident) {
-  if (const auto* point = std::get_if<PointLight>(&light)) {
-    const Vec3 d = point->position - x;
-    const float d2 = glm::dot(d, d);
-    if (!(d2 > 0.0f)) return false;
-    distance = std::sqrt(d2);
-    wi = d / distance;
-    incident = point->intensity / d2;
-    return true;
-  }
-  if (const auto* spot = std::get_if<SpotLight>(&light)) {
-    const Vec3 d = spot->position - x;
-    const float d2 = glm::dot(d, d);
-    if (!(d2 > 0.0f)) return false;
-    distance = std::sqrt(d2);
-    wi = d / distance;
-    // Smoothstep in cos between the outer and inner cone angles, as the path tracer does.
-    const float cosOuter = std::cos(spot->outerAngle), cosInner = std::cos(spot->innerAngle);
-    const float c = glm::dot(glm::normalize(spot->direction), -wi);
-    float falloff;
-    if (cosInner <= cosOuter) {
-      falloff = c >= cosInner ? 1.0f : 0.0f;
-    } else {
-      const float t = std::clamp((c - cosOuter) / (cosInner - cosOuter), 0.0f, 1.0f);
-      falloff = t * t * (3.0f - 2.0f * t);
-    }
-    if (!(falloff > 0.0f)) return false;
-    incident = spot->intensity * (falloff / d2);
-    return true;
-  }
-  const auto& directional = std::get<DirectionalLight>(light);
-  wi = -glm::normalize(directional.direction);
-  distance = kInfinity;
-  incident = directional.irradiance;
-  return true;
-}
-
-struct EmissiveTriangle {
-  uint32_t mesh, triangle, material;
-  Vec3 normal;  ///< unit geometric normal, (p1 − p0) × (p2 − p0) normalised
-};
-
 // ---- The gather kernel of the iteration ------------------------------------------------------
 /// The transport radiance ρ̄·E/π (W·sr⁻¹·m⁻²) around a diffuse tixel g, as the coefficients of
 /// the bilinear interpolant over g and its neighbours t₀₀ = (i, j), t₁₀ = (i+1, j), t₀₁ = (i, j+1),
@@ -297,43 +252,19 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   // a point on material m is then luminance(Le_m) / Σ(area·luminance): constant per material.
   std::vector<EmissiveTriangle> emitters;
   std::vector<float> emitterWeights;
-  for (uint32_t m = 0; m < scene.meshes.size(); ++m)
-    for (uint32_t t = 0; t < scene.meshes[m].triangles.size(); ++t) {
-      const uint32_t mat = scene.meshes[m].materials[t];
-      if (!scene.materials[mat].isEmissive()) continue;
-      const Mesh& mesh = scene.meshes[m];
-      const UVec3 tri = mesh.triangles[t];
-      const float area = 0.5f * glm::length(glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]],
-                                                       mesh.positions[tri[2]] - mesh.positions[tri[0]]));
-      const float lum = luminance(scene.materials[mat].emission);
-      if (!(area > 0.0f) || !(lum > 0.0f)) continue;
-      emitters.push_back({m, t, mat,
-                          glm::normalize(glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]],
-                                                    mesh.positions[tri[2]] - mesh.positions[tri[0]]))});
-      emitterWeights.push_back(area * lum);
-    }
+  for (const EmissiveTriangle& e : emissiveTriangles(scene)) {
+    const float lum = luminance(e.radiance);
+    if (!(lum > 0.0f)) continue;
+    emitters.push_back(e);
+    emitterWeights.push_back(e.area * lum);
+  }
   const Distribution1D emitterDistribution(emitterWeights);
   std::vector<float> areaPdf(scene.materials.size(), 0.0f);
   for (uint32_t m = 0; m < scene.materials.size(); ++m)
     if (emitterDistribution.total() > 0.0) areaPdf[m] = float(luminance(scene.materials[m].emission) / emitterDistribution.total());
-  // What a shadow-ray sample needs of each emitter, gathered in one place.
-  struct EmitterSampler {
-    Vec3 p0, edge1, edge2;  ///< y = p0 + b₁·edge1 + b₂·edge2 for barycentrics (b₁, b₂)
-    Vec3 normal;
-    Rgb emission;
-    float areaPdf;
-    bool twoSided;
-  };
-  std::vector<EmitterSampler> emitterSamplers;
-  for (const EmissiveTriangle& em : emitters) {
-    const Mesh& mesh = scene.meshes[em.mesh];
-    const UVec3 tri = mesh.triangles[em.triangle];
-    const Material& material = scene.materials[em.material];
-    const Vec3 p0 = mesh.positions[tri[0]];
-    emitterSamplers.push_back({p0, mesh.positions[tri[1]] - p0, mesh.positions[tri[2]] - p0, em.normal, material.emission,
-                               areaPdf[em.material], material.twoSidedEmission});
-  }
   const uint32_t lightSamples = emitters.empty() ? 0 : settings.areaLightSamples;
+  std::vector<PunctualLight> punctualLights;
+  for (const Light& light : scene.lights) punctualLights.push_back(PunctualLight::from(light));
 
   // ---- First shot ------------------------------------------------------------------------
   std::vector<Rgb> direct(param.valueCount, Rgb(0.0f));
@@ -359,11 +290,11 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
         const Chart& c = param.charts[param.tixelChart[g]];
         if (c.kind == ChartKind::Specular) continue;
         const Vec3 x = param.gatherPoint[g];
-        for (const Light& light : scene.lights) {
+        for (const PunctualLight& light : punctualLights) {
           Vec3 wi;
           float distance;
           Rgb incident;
-          if (!punctualIncident(light, x, wi, distance, incident)) continue;
+          if (!light.incidentAt(x, wi, distance, incident)) continue;
           const float cosTheta = glm::dot(c.normal, wi);
           if (!(cosTheta > 0.0f) || isBlack(incident)) continue;
           Ray ray;
@@ -380,7 +311,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
         Pcg32 rng = Pcg32::forKey(g, 0x4e4545, settings.seed);
         for (uint32_t s = 0; s < lightSamples; ++s) {
           float remapped = 0.0f;
-          const EmitterSampler& em = emitterSamplers[emitterDistribution.sample((float(s) + rng.uniform()) / float(lightSamples), &remapped)];
+          const EmissiveTriangle& em = emitters[emitterDistribution.sample((float(s) + rng.uniform()) / float(lightSamples), &remapped)];
           const Vec2 b = sampleUniformTriangle(Vec2(remapped, rng.uniform()));
           const Vec3 d = em.p0 + b.x * em.edge1 + b.y * em.edge2 - x;
           const float dist2 = glm::dot(d, d);
@@ -395,9 +326,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           // Balance heuristic between this strategy (S samples, solid-angle pdf
           // pl = areaPdf·r²/cos θy) and the N cosine-distributed gather rays (pdf pg = cos θx/π):
           //   Le·cos θx/(S·pl) · S·pl/(S·pl + N·pg) = Le·cos θx·cos θy / (S·areaPdf·r² + N·cos θx·cos θy/π).
-          const float denominator = float(lightSamples) * em.areaPdf * dist2 + float(n) * kInvPi * cosX * cosY;
+          const float denominator = float(lightSamples) * areaPdf[em.material] * dist2 + float(n) * kInvPi * cosX * cosY;
           rays.push_back(Ray{origin, wi, 0.0f, dist * (1.0f - 1e-4f)});
-          pending.push_back({g, wi, em.emission * (cosX * cosY / denominator), true});
+          pending.push_back({g, wi, em.radiance * (cosX * cosY / denominator), true});
         }
       }
       std::vector<uint8_t> occluded(rays.size());

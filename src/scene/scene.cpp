@@ -319,4 +319,81 @@ Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit) {
   return withDiffuseAlbedo(material.bsdf, diffuseAlbedoOf(material.bsdf) * texel);
 }
 
+PunctualLight PunctualLight::from(const Light& light) {
+  PunctualLight p;
+  if (const auto* point = std::get_if<PointLight>(&light)) {
+    p.kind = Kind::Point;
+    p.position = point->position;
+    p.intensity = point->intensity;
+  } else if (const auto* spot = std::get_if<SpotLight>(&light)) {
+    p.kind = Kind::Spot;
+    p.position = spot->position;
+    p.direction = glm::normalize(spot->direction);
+    p.intensity = spot->intensity;
+    p.cosInner = std::cos(spot->innerAngle);
+    p.cosOuter = std::cos(spot->outerAngle);
+  } else {
+    const auto& directional = std::get<DirectionalLight>(light);
+    p.kind = Kind::Directional;
+    p.direction = glm::normalize(directional.direction);
+    p.intensity = directional.irradiance;
+  }
+  return p;
+}
+
+bool PunctualLight::incidentAt(const Vec3& x, Vec3& wi, float& distance, Rgb& irradiance) const {
+  if (kind == Kind::Directional) {
+    wi = -direction;
+    distance = kInfinity;
+    irradiance = intensity;
+    return true;
+  }
+  const Vec3 toLight = position - x;
+  const float distanceSquared = glm::dot(toLight, toLight);
+  if (!(distanceSquared > 0.0f)) return false;
+  distance = std::sqrt(distanceSquared);
+  wi = toLight / distance;
+  float falloff = 1.0f;
+  if (kind == Kind::Spot) {
+    const float c = glm::dot(direction, -wi);
+    if (cosInner <= cosOuter) {
+      falloff = c >= cosInner ? 1.0f : 0.0f;
+    } else {
+      const float t = std::clamp((c - cosOuter) / (cosInner - cosOuter), 0.0f, 1.0f);
+      falloff = t * t * (3.0f - 2.0f * t);
+    }
+  }
+  if (!(falloff > 0.0f)) return false;
+  irradiance = intensity * (falloff / distanceSquared);
+  return true;
+}
+
+std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene) {
+  std::vector<EmissiveTriangle> list;
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      const Material& material = scene.materials[mesh.materials[t]];
+      if (!material.isEmissive()) continue;
+      const UVec3 tri = mesh.triangles[t];
+      EmissiveTriangle e;
+      e.mesh = m;
+      e.triangle = t;
+      e.material = mesh.materials[t];
+      e.p0 = mesh.positions[tri.x];
+      e.edge1 = mesh.positions[tri.y] - e.p0;
+      e.edge2 = mesh.positions[tri.z] - e.p0;
+      const Vec3 cross = glm::cross(e.edge1, e.edge2);
+      const float length = glm::length(cross);
+      if (!(length > 0.0f)) continue;  // degenerate: cannot emit (and finalize() drops these)
+      e.normal = cross / length;
+      e.area = 0.5f * length;
+      e.radiance = material.emission;
+      e.twoSided = material.twoSidedEmission;
+      list.push_back(e);
+    }
+  }
+  return list;
+}
+
 }  // namespace pl

@@ -78,6 +78,38 @@ struct DirectionalLight {
 
 using Light = std::variant<PointLight, SpotLight, DirectionalLight>;
 
+/// A triangle of an emissive material, prepared for sampling points on it: the one list the
+/// path tracer and the bake sample their area lights from.
+struct EmissiveTriangle {
+  uint32_t mesh = 0, triangle = 0, material = 0;
+  Vec3 p0{0.0f}, edge1{0.0f}, edge2{0.0f};  ///< point = p0 + b₁·edge1 + b₂·edge2
+  Vec3 normal{0.0f};                        ///< unit geometric normal (winding), the emitting side
+  float area = 0.0f;
+  Rgb radiance{0.0f};                       ///< Le (W·sr⁻¹·m⁻²)
+  bool twoSided = false;
+};
+
+/// A point, spot or directional light prepared for evaluation at many points (axis
+/// normalised, cone cosines computed once). The one place the path tracer and the bake
+/// evaluate these lights.
+struct PunctualLight {
+  enum class Kind : uint8_t { Point, Spot, Directional };
+  Kind kind = Kind::Point;
+  Vec3 position{0.0f};
+  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< spot axis / directional travel direction (unit)
+  Rgb intensity{0.0f};                ///< W·sr⁻¹ (point, spot) or irradiance W·m⁻² (directional)
+  float cosInner = 1.0f, cosOuter = 1.0f;
+
+  static PunctualLight from(const Light& light);
+
+  /// The light arriving at x: wi (unit, towards the light), the shadow-ray length
+  /// (∞ for directional) and the irradiance on a surface normal to wi (W·m⁻²): I·falloff/d²
+  /// for point and spot lights — the spot's falloff a smoothstep in cos between the outer and
+  /// inner cone (a step when they coincide) — the light's irradiance for directional ones.
+  /// False when nothing arrives (x at the light's position, outside a spot's cone).
+  bool incidentAt(const Vec3& x, Vec3& wi, float& distance, Rgb& irradiance) const;
+};
+
 /// A camera as a scene file describes it. The camera module turns it into rays.
 struct CameraDesc {
   std::string name;
@@ -143,6 +175,9 @@ struct Scene {
   /// sphere fits its 40° vertical field of view (and any image at least as wide as high).
   CameraDesc automaticCamera() const;
 };
+
+/// Every non-degenerate triangle of an emissive material, mesh by mesh in triangle order.
+std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene);
 
 /// Loads `cornell`, .obj, .gltf/.glb or .json (see README for the JSON schema).
 /// Throws pl::Error with the file name and the problem for any malformed input.

@@ -68,23 +68,6 @@ namespace {
 // EnvironmentLight: radiance(), sample() and pdf() are its only uses here, so a better
 // environment sampler changes nothing in this file.
 
-struct EmissiveTriangle {
-  Vec3 p0, edge1, edge2;  ///< point = p0 + b1·edge1 + b2·edge2
-  Vec3 normal;            ///< unit geometric normal (winding), the emitting side
-  float area = 0.0f;
-  Rgb radiance{0.0f};
-  bool twoSided = false;
-};
-
-enum class PunctualKind : uint8_t { Point, Spot, Directional };
-struct PunctualLight {
-  PunctualKind kind = PunctualKind::Point;
-  Vec3 position{0.0f};
-  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< spot axis / directional travel direction (unit)
-  Rgb intensity{0.0f};                ///< W·sr⁻¹ (point, spot) or irradiance W·m⁻² (directional)
-  float cosInner = 1.0f, cosOuter = 1.0f;
-};
-
 enum class LightKind : uint8_t { Triangle, Punctual, Environment };
 struct LightEntry {
   LightKind kind;
@@ -133,12 +116,6 @@ struct PixelAccumulator {
 /// emitters (whose estimated power overflows float) to the largest float instead of letting
 /// an infinity turn the whole distribution into NaNs.
 float selectionWeight(float power) { return std::min(power, std::numeric_limits<float>::max()); }
-
-float smoothStep(float edge0, float edge1, float x) {
-  if (edge1 <= edge0) return x >= edge1 ? 1.0f : 0.0f;
-  const float t = std::clamp((x - edge0) / (edge1 - edge0), 0.0f, 1.0f);
-  return t * t * (3.0f - 2.0f * t);
-}
 
 }  // namespace
 
@@ -192,54 +169,25 @@ PathTracer::Impl::Impl(const Scene& s, const Accel& a) : scene(s), accel(a) {
     base += static_cast<uint32_t>(mesh.triangles.size());
   }
   entryOfTriangle.assign(base, -1);
-  for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    const Mesh& mesh = scene.meshes[m];
-    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-      const Material& material = scene.materials[mesh.materials[t]];
-      if (!material.isEmissive()) continue;
-      const UVec3 tri = mesh.triangles[t];
-      EmissiveTriangle e;
-      e.p0 = mesh.positions[tri.x];
-      e.edge1 = mesh.positions[tri.y] - e.p0;
-      e.edge2 = mesh.positions[tri.z] - e.p0;
-      const Vec3 cross = glm::cross(e.edge1, e.edge2);
-      const float length = glm::length(cross);
-      if (!(length > 0.0f)) continue;  // degenerate: cannot emit (and finalize() drops these)
-      e.normal = cross / length;
-      e.area = 0.5f * length;
-      e.radiance = material.emission;
-      e.twoSided = material.twoSidedEmission;
-      const float power = kPi * e.area * luminance(e.radiance) * (e.twoSided ? 2.0f : 1.0f);
-      if (!(power > 0.0f)) continue;
-      entryOfTriangle[meshTriangleBase[m] + t] = static_cast<int32_t>(entries.size());
-      entries.push_back({LightKind::Triangle, static_cast<uint32_t>(triangles.size())});
-      triangles.push_back(e);
-      weights.push_back(selectionWeight(power));
-    }
+  for (const EmissiveTriangle& e : emissiveTriangles(scene)) {
+    const float power = kPi * e.area * luminance(e.radiance) * (e.twoSided ? 2.0f : 1.0f);
+    if (!(power > 0.0f)) continue;
+    entryOfTriangle[meshTriangleBase[e.mesh] + e.triangle] = static_cast<int32_t>(entries.size());
+    entries.push_back({LightKind::Triangle, static_cast<uint32_t>(triangles.size())});
+    triangles.push_back(e);
+    weights.push_back(selectionWeight(power));
   }
 
   std::vector<float> punctualWeights;
   for (const Light& light : scene.lights) {
-    PunctualLight p;
+    const PunctualLight p = PunctualLight::from(light);
     float power = 0.0f;
-    if (const auto* point = std::get_if<PointLight>(&light)) {
-      p.kind = PunctualKind::Point;
-      p.position = point->position;
-      p.intensity = point->intensity;
-      power = 4.0f * kPi * luminance(p.intensity);
-    } else if (const auto* spot = std::get_if<SpotLight>(&light)) {
-      p.kind = PunctualKind::Spot;
-      p.position = spot->position;
-      p.direction = glm::normalize(spot->direction);
-      p.intensity = spot->intensity;
-      p.cosInner = std::cos(spot->innerAngle);
-      p.cosOuter = std::cos(spot->outerAngle);
-      power = 2.0f * kPi * (1.0f - 0.5f * (p.cosInner + p.cosOuter)) * luminance(p.intensity);
-    } else if (const auto* directional = std::get_if<DirectionalLight>(&light)) {
-      p.kind = PunctualKind::Directional;
-      p.direction = glm::normalize(directional->direction);
-      p.intensity = directional->irradiance;
-      power = kPi * sceneRadius * sceneRadius * luminance(p.intensity);
+    switch (p.kind) {
+      case PunctualLight::Kind::Point: power = 4.0f * kPi * luminance(p.intensity); break;
+      case PunctualLight::Kind::Spot:
+        power = 2.0f * kPi * (1.0f - 0.5f * (p.cosInner + p.cosOuter)) * luminance(p.intensity);
+        break;
+      case PunctualLight::Kind::Directional: power = kPi * sceneRadius * sceneRadius * luminance(p.intensity); break;
     }
     if (!(power > 0.0f)) continue;
     entries.push_back({LightKind::Punctual, static_cast<uint32_t>(punctual.size())});
@@ -320,22 +268,10 @@ Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNor
       const PunctualLight& p = punctual[entry.index];
       isDeltaLight = true;
       lightPdf = selectProbability;  // a discrete choice; the direction is fixed
-      if (p.kind == PunctualKind::Directional) {
-        wi = -p.direction;
-        incident = p.intensity;  // irradiance normal to the beam
-        infinite = true;
-      } else {
-        const Vec3 toLight = p.position - position;
-        const float distanceSquared = glm::dot(toLight, toLight);
-        if (!(distanceSquared > 0.0f)) return Rgb(0.0f);
-        wi = toLight / std::sqrt(distanceSquared);
-        // Irradiance normal to the ray from intensity I at distance d: I / d².
-        float falloff = 1.0f;
-        if (p.kind == PunctualKind::Spot) falloff = smoothStep(p.cosOuter, p.cosInner, glm::dot(p.direction, -wi));
-        if (!(falloff > 0.0f)) return Rgb(0.0f);
-        incident = p.intensity * (falloff / distanceSquared);
-        shadowTarget = p.position;
-      }
+      float distance;
+      if (!p.incidentAt(position, wi, distance, incident)) return Rgb(0.0f);  // irradiance normal to wi
+      infinite = p.kind == PunctualLight::Kind::Directional;
+      shadowTarget = p.position;
       break;
     }
   }
