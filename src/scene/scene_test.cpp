@@ -721,7 +721,13 @@ TEST(BadInput, PathComponentsLongerThanTheSystemAllowsAreCleanErrors) {
   ASSERT_NE(uri, std::string::npos);
   gltf.replace(uri, 11, tooLong + ".png");
   const std::string longUri = writeFile(dir / "quad.gltf", gltf);
-  expectError([&] { loadScene(longUri); }, {"quad.gltf"});
+  expectError([&] { loadScene(longUri); }, {"quad.gltf", "File name too long"});
+}
+
+TEST(BadInput, GlbOnWhichTinygltfThrowsIsAnInvalidFile) {
+  // A GLB buffer of byteLength 0 beside a BIN chunk: tinygltf throws std::out_of_range.
+  expectError([] { loadScene(kFuzzCorpus + "gltf/zero_length_buffer.glb"); },
+              {"zero_length_buffer.glb", "not a valid glTF file"});
 }
 
 TEST(BadInput, JsonNumberBeyondADoubleIsAMalformedFile) {
