@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs the libFuzzer targets built by `make fuzz`: fuzz/run.sh BUILD_DIR SECONDS TARGET...
-# Each target runs for SECONDS (or FUZZ_RUNS=N executions when set), niced, starting from its
+# Each target runs for SECONDS (or until FUZZ_RUNS=N executions when set, if sooner), niced, starting from its
 # regression corpus tests/data/fuzz/<target>/ plus the matching sample files of tests/data.
 # New coverage goes to BUILD_DIR/corpus/<target>/ (kept between runs), crashing inputs to
 # BUILD_DIR/findings/<target>/, the log to BUILD_DIR/logs/<target>.log. A crash found here
@@ -40,8 +40,8 @@ for target in "$@"; do
   done
   [ -d "$data/fuzz/$target" ] && cp "$data/fuzz/$target"/* "$seeds/" 2>/dev/null
   limit=(-max_total_time="$seconds")
-  [ -n "${FUZZ_RUNS:-}" ] && limit=(-runs="$FUZZ_RUNS")
-  echo "fuzz $target: ${FUZZ_RUNS:+$FUZZ_RUNS runs}${FUZZ_RUNS:-$seconds s} ..." >&2
+  [ -n "${FUZZ_RUNS:-}" ] && limit+=(-runs="$FUZZ_RUNS")
+  echo "fuzz $target: $seconds s${FUZZ_RUNS:+ or $FUZZ_RUNS executions, whichever comes first} ..." >&2
   # 64 KiB inputs at most; 2 GB of memory and 10 s per input before libFuzzer calls it a bug.
   TMPDIR=$scratch nice -n 10 "$binary" "${limit[@]}" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
     -print_final_stats=1 -artifact_prefix="$findings/" "$corpus" "$seeds" >"$log" 2>&1

@@ -13,7 +13,9 @@
 #include <ImfTestFile.h>
 #include <Imath/half.h>
 
+#include <cstdint>
 #include <exception>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -22,11 +24,56 @@
 
 namespace pl::detail {
 
+namespace {
+
+/// OpenEXR trusts the sizes in a file's header: an attribute claiming 2 GB is allocated before
+/// the read finds the file ends (found by fuzzing: a 209-byte file). So the headers are walked
+/// first — name, type, 32-bit size, value, until an empty name —
+/// and every size is checked against the bytes that remain. Nothing is allocated from it.
+void checkHeaderAttributeSizes(const std::string& path, bool multiPart) {
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const long long fileBytes = in.tellg();
+  in.seekg(8);  // magic and version flags
+  auto readName = [&](std::string& name) {
+    name.clear();
+    for (char c; in.get(c) && c != '\0';)
+      if (name.size() < 256) name += c;  // OpenEXR's longest names are 255 characters
+    return bool(in);
+  };
+  std::string name, type;
+  // A multi-part file has a header per part, the list ending with an empty header.
+  for (size_t attributes = 1; attributes > 0 && in;) {
+    attributes = 0;
+    while (readName(name) && !name.empty()) {
+      int32_t size = 0;
+      if (!readName(type) || !in.read(reinterpret_cast<char*>(&size), 4))
+        fail("{}: truncated OpenEXR header (attribute '{}')", path, name);
+      if (size < 0 || size > fileBytes - (long long)in.tellg())
+        fail("{}: corrupt OpenEXR header: attribute '{}' claims {} bytes, the file has {}", path, name, size, fileBytes);
+      in.seekg(size, std::ios::cur);
+      ++attributes;
+    }
+    if (!multiPart) break;
+  }
+}
+
+}  // namespace
+
 Image readExr(const std::string& path) {
   bool tiled = false, deep = false, multiPart = false;
   if (!Imf::isOpenExrFile(path.c_str(), tiled, deep, multiPart))
     fail("{}: not an OpenEXR file (bad magic number or unreadable header)", path);
   if (deep) fail("{}: deep OpenEXR images are not supported", path);
+  checkHeaderAttributeSizes(path, multiPart);
+  // Header::sanityCheck then refuses larger data windows and tiles before anything is
+  // allocated for them (line-offset tables, tile buffers).
+  static const bool limitsSet = [] {
+    Imf::Header::setMaxImageSize(kMaxImageDimension, kMaxImageDimension);
+    Imf::Header::setMaxTileSize(kMaxImageDimension, kMaxImageDimension);
+    return true;
+  }();
+  (void)limitsSet;
   try {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i window = file.header().dataWindow();

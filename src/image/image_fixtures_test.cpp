@@ -41,6 +41,21 @@ TEST(ImageFixtures, TiledExr) {
   for (int i = 0; i < 20; ++i) EXPECT_EQ(image.pixels[size_t(i)], Rgb(float(i), 0.5f, -1.0f)) << i;
 }
 
+TEST(ImageFixtures, ExrHeaderAttributeLargerThanTheFileIsRefusedBeforeAllocating) {
+  // Found by fuzzing (tests/data/fuzz/exr/): a 209-byte file whose header attribute claims
+  // 1.8 GB, which OpenEXR would allocate before finding the file ends.
+  const std::string path = std::string(PLENOPTIC_TEST_DATA_DIR) + "/fuzz/exr/attribute-claims-1.8GB.exr";
+  try {
+    readImage(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("attribute-claims-1.8GB.exr: corrupt OpenEXR header: attribute"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("claims 1851877475 bytes, the file has 209"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ImageFixtures, RadianceHdrFromPolyHaven) {
   const std::string path = std::string(PLENOPTIC_SHARED_DIR) + "/envmaps/venice_sunset_1k.hdr";
   const Image image = readImage(path);
