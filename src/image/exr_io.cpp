@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <exception>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -26,32 +27,57 @@ namespace pl::detail {
 
 namespace {
 
-/// OpenEXR trusts the sizes in a file's header: an attribute claiming 2 GB is allocated before
-/// the read finds the file ends (found by fuzzing: a 209-byte file). So the headers are walked
-/// first — name, type, 32-bit size, value, until an empty name —
-/// and every size is checked against the bytes that remain. Nothing is allocated from it.
-void checkHeaderAttributeSizes(const std::string& path, bool multiPart) {
+/// OpenEXR trusts the sizes in a file's header: an attribute of unknown type claiming 2 GB is
+/// allocated before the read finds that the file ends (found by fuzzing: a 209-byte file), and
+/// so is a preview image of the size it declares. So the headers are walked first, the way
+/// OpenEXR 3.1's Header::readFrom walks them — name, type, 32-bit declared size, value, until
+/// an empty name; a multi-part file has one header per part and an empty one at the end — and
+/// every allocation it would make is checked against the bytes that remain. OpenEXR reads the
+/// value of a known fixed-size type by that size and a channel list up to its empty name,
+/// whatever the declared size; everything else (strings, vectors, unknown types) by the
+/// declared size. Nothing is allocated here.
+void checkHeaderAllocations(const std::string& path, bool multiPart) {
+  static const std::map<std::string, int> kFixedSizes = {
+      {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"deepImageState", 1},
+      {"double", 8}, {"envmap", 1}, {"float", 4}, {"int", 4}, {"keycode", 28}, {"lineOrder", 1},
+      {"m33f", 36}, {"m33d", 72}, {"m44f", 64}, {"m44d", 128}, {"rational", 8}, {"tiledesc", 9},
+      {"timecode", 8}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16}, {"v3i", 12}, {"v3f", 12}, {"v3d", 24}};
   std::ifstream in(path, std::ios::binary);
   in.seekg(0, std::ios::end);
   const long long fileBytes = in.tellg();
   in.seekg(8);  // magic and version flags
+  auto remaining = [&] { return fileBytes - (long long)in.tellg(); };
   auto readName = [&](std::string& name) {
     name.clear();
     for (char c; in.get(c) && c != '\0';)
       if (name.size() < 256) name += c;  // OpenEXR's longest names are 255 characters
     return bool(in);
   };
-  std::string name, type;
-  // A multi-part file has a header per part, the list ending with an empty header.
+  auto tooBig = [&](const std::string& name, long long bytes) {
+    fail("{}: corrupt OpenEXR header: attribute '{}' needs {} bytes, the file has {}", path, name, bytes, fileBytes);
+  };
+  std::string name, type, channel;
   for (size_t attributes = 1; attributes > 0 && in;) {
     attributes = 0;
     while (readName(name) && !name.empty()) {
       int32_t size = 0;
       if (!readName(type) || !in.read(reinterpret_cast<char*>(&size), 4))
         fail("{}: truncated OpenEXR header (attribute '{}')", path, name);
-      if (size < 0 || size > fileBytes - (long long)in.tellg())
-        fail("{}: corrupt OpenEXR header: attribute '{}' claims {} bytes, the file has {}", path, name, size, fileBytes);
-      in.seekg(size, std::ios::cur);
+      if (size < 0) tooBig(name, size);
+      if (const auto fixed = kFixedSizes.find(type); fixed != kFixedSizes.end()) {
+        in.seekg(fixed->second, std::ios::cur);
+      } else if (type == "chlist") {
+        while (readName(channel) && !channel.empty()) in.seekg(16, std::ios::cur);  // type, pLinear, 3 reserved, x/y sampling
+      } else if (type == "preview") {
+        uint32_t dimensions[2] = {0, 0};
+        in.read(reinterpret_cast<char*>(dimensions), 8);
+        const long long bytes = 4LL * dimensions[0] * dimensions[1];  // RGBA8
+        if (bytes > remaining()) tooBig(name, bytes);
+        in.seekg(bytes, std::ios::cur);
+      } else {
+        if (size > remaining()) tooBig(name, size);
+        in.seekg(size, std::ios::cur);
+      }
       ++attributes;
     }
     if (!multiPart) break;
@@ -65,7 +91,7 @@ Image readExr(const std::string& path) {
   if (!Imf::isOpenExrFile(path.c_str(), tiled, deep, multiPart))
     fail("{}: not an OpenEXR file (bad magic number or unreadable header)", path);
   if (deep) fail("{}: deep OpenEXR images are not supported", path);
-  checkHeaderAttributeSizes(path, multiPart);
+  checkHeaderAllocations(path, multiPart);
   // Header::sanityCheck then refuses larger data windows and tiles before anything is
   // allocated for them (line-offset tables, tile buffers).
   static const bool limitsSet = [] {
@@ -96,6 +122,9 @@ Image readExr(const std::string& path) {
              c->xSampling, c->ySampling);
     }
 
+    // Before the pixels are allocated: a few hundred bytes may declare a data window of
+    // 2^28 pixels (3 GB), but cannot also hold every chunk of it.
+    if (!file.isComplete()) fail("{}: truncated OpenEXR file (pixel data incomplete)", path);
     Image image(static_cast<int>(width), static_cast<int>(height));
     const size_t xStride = sizeof(Rgb), yStride = sizeof(Rgb) * size_t(width);
     Imf::FrameBuffer frame;
@@ -108,7 +137,6 @@ Image readExr(const std::string& path) {
       frame.insert("Y", Imf::Slice::Make(Imf::FLOAT, base + 0, window, xStride, yStride));
     }
     file.setFrameBuffer(frame);
-    if (!file.isComplete()) fail("{}: truncated OpenEXR file (pixel data incomplete)", path);
     file.readPixels(window.min.y, window.max.y);
     if (!hasRgb)
       for (Rgb& p : image.pixels) p = Rgb(p.r);
