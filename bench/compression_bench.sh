@@ -8,10 +8,10 @@
 # Usage: bench/compression_bench.sh [PLENOPTIC_BINARY] [WORK_DIR]
 #   PLENOPTIC_BINARY  default: build/plenoptic
 #   WORK_DIR          default: a new temporary directory (kept, printed at the end)
-# Environment: SCENES_DIR (default: the McGuire scenes in tests/data/cornell-mcguire), RENDER_FLAGS (`render` flags; default
-# "--reference": the straightforward renderer of src/render, so the figures measure the
-# light field, not a renderer's approximations; "" for the fast renderer), MODES (default
-# "lossless bc1 hdr").
+# Environment: SCENES_DIR (default: the McGuire scenes in tests/data/cornell-mcguire),
+# RENDER_FLAGS (`render` flags; default "--reference": the straightforward renderer of
+# src/render, so the figures measure the light field, not a renderer's approximations; "" for
+# the fast renderer), MODES (default "lossless bc1 hdr").
 #
 # Columns: values ratio = raw float32 values / stored VALS section; file ratio = the whole
 # .plf stored raw / as written; encode = encode + write + fsync of the whole file (s);

@@ -677,7 +677,7 @@ TEST(EnvFiles, LoadsPisaCubeAndVeniceLatLong) {
   const EnvImage pisa = loadEnvironment(kData + "/envmaps/pisa-cube");
   ASSERT_TRUE(std::holds_alternative<CubeMap>(pisa));
   // 64²: the three.js 256² faces box-filtered 4×4 in their own pixel grids
-  // (tests/data/envmaps/README.md), so orientation and seams are the distributed ones.
+  // (tests/data/THIRD_PARTY.md), so orientation and seams are the distributed ones.
   EXPECT_EQ(std::get<CubeMap>(pisa).size, 64);
   const EnvImage pattern = loadEnvironment(kData + "/envmaps/pisa-cube/{face}.hdr");
   EXPECT_EQ(std::get<CubeMap>(pattern).faces[3].pixels, std::get<CubeMap>(pisa).faces[3].pixels);
