@@ -4,7 +4,11 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all bootstrap configure build test demo bench clean
+FUZZ_BUILD_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS ?= obj gltf json_scene camera_path hdr exr plf plf_fixed plv plv_fixed
+
+.PHONY: all bootstrap configure build test demo bench fuzz clean
 
 all: build
 
@@ -26,5 +30,14 @@ demo: build
 bench: build
 	@bash bench/run.sh $(BUILD_DIR)
 
+# libFuzzer targets (fuzz/) built with clang, ASan and UBSan in $(FUZZ_BUILD_DIR), each run for
+# FUZZ_SECONDS; crashes are saved as $(FUZZ_BUILD_DIR)/findings/<target>/crash-*.
+fuzz:
+	@bash scripts/bootstrap.sh --fuzz
+	@cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+	  -DPLENOPTIC_FUZZ=ON -DPLENOPTIC_WERROR=OFF -DBUILD_TESTING=OFF -DPLENOPTIC_BENCHMARKS=OFF >/dev/null
+	@cmake --build $(FUZZ_BUILD_DIR) -j $(JOBS) --target fuzz_targets
+	@bash fuzz/run.sh $(FUZZ_BUILD_DIR) $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+
 clean:
-	@rm -rf $(BUILD_DIR)
+	@rm -rf $(BUILD_DIR) $(FUZZ_BUILD_DIR)

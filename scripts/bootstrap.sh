@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages plenoptic needs to build, test and run its demo.
 # Idempotent and quiet when everything is already present; run as root (or with sudo).
+# --fuzz: also clang and its runtime libraries (libclang_rt.fuzzer, ASan, UBSan) for `make fuzz`.
 set -euo pipefail
 
 packages=(
@@ -11,6 +12,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth
 )
+if [ "${1:-}" = "--fuzz" ]; then
+  packages+=(clang libclang-rt-14-dev)
+fi
 # Optional: ffmpeg turns rendered walk-throughs into MP4. Installed when it is available.
 optional_packages=(ffmpeg)
 

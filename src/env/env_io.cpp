@@ -73,7 +73,8 @@ std::array<std::string, 6> facePathsInDirectory(const std::string& dir) {
   for (int f = 0; f < 6; ++f) {
     for (const char* ext : kImageExtensions) {
       const fs::path candidate = fs::path(dir) / (std::string(kCubeFaceNames[size_t(f)]) + ext);
-      if (fs::exists(candidate)) {
+      std::error_code ec;
+      if (fs::exists(candidate, ec)) {
         paths[size_t(f)] = candidate.string();
         break;
       }
@@ -128,7 +129,8 @@ EnvImage loadEnvironment(const std::string& path) {
     std::array<std::string, 6> paths;
     for (int f = 0; f < 6; ++f) {
       paths[size_t(f)] = replaceFace(path, kCubeFaceNames[size_t(f)]);
-      if (!fs::exists(paths[size_t(f)]))
+      std::error_code ec;
+      if (!fs::exists(paths[size_t(f)], ec))
         fail("{}: cube face '{}' missing ({} does not exist)", path, kCubeFaceNames[size_t(f)], paths[size_t(f)]);
     }
     return facesToCube(paths);

@@ -398,6 +398,22 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   }
   checksum.update(extraOffset, (tixelCount + 1) * sizeof(uint64_t));
   checksum.update(extras, extraCount * sizeof(VisibilityExtra));
+  // The records' contents, as computeVisibility writes them: a throughput is a product of
+  // mirror reflectances (each channel in [0, 1]); st is a paraboloid coordinate (unit disk) or
+  // an octahedral one ([−1, 1]²), so both components lie in [−1, 1] (kStSlack: float rounding
+  // of x / r and x / (1 + z)); viaMirror is 0 or 1. Anything else — NaN, 1e9 — would flow
+  // unchecked into every propagated value.
+  constexpr float kStSlack = 1e-4f;
+  for (uint64_t i = 0; i < extraCount && structural.empty(); ++i) {
+    const VisibilityExtra& x = extras[i];
+    for (int c = 0; c < 3; ++c)
+      if (!(x.throughput[c] >= 0.0f && x.throughput[c] <= 1.0f))
+        structuralError(fmt::format("extra record {} has throughput {} outside [0, 1]", i, x.throughput[c]));
+    for (int c = 0; c < 2; ++c)
+      if (!(std::abs(x.st[c]) <= 1.0f + kStSlack))
+        structuralError(fmt::format("extra record {} has direction coordinate {} outside [-1, 1]", i, x.st[c]));
+    if (x.viaMirror > 1) structuralError(fmt::format("extra record {} has a mirror flag of {} (0 or 1)", i, x.viaMirror));
+  }
   if (checksum.digest() != payloadHash) fail("{}: corrupt visibility field (payload checksum mismatch)", path);
   if (!structural.empty()) fail("{}: {}", path, structural);
 

@@ -115,7 +115,7 @@ CameraPath parseCameraPath(const std::string& text, const std::string& source) {
   Json root;
   try {
     root = Json::parse(text);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {  // parse_error, or out_of_range for a number beyond a double (1e400)
     fail("{}: not valid JSON: {}", source, e.what());
   }
   if (!root.is_object()) fail("{}: expected a JSON object with \"keyframes\"", source);

@@ -51,6 +51,8 @@ TEST(CameraPath, DefaultsFpsAndLeavesFovToTheCamera) {
 TEST(CameraPath, BadFilesNameTheFileAndTheProblem) {
   EXPECT_NE(errorOf("{").find("walk.json: not valid JSON"), std::string::npos);
   EXPECT_NE(errorOf("[]").find("walk.json: expected a JSON object"), std::string::npos);
+  // A number beyond a double: nlohmann throws out_of_range, not parse_error.
+  EXPECT_NE(errorOf(R"({"fps": 1e400, "keyframes": []})").find("walk.json: not valid JSON"), std::string::npos);
   EXPECT_NE(errorOf(R"({"fps": 30})").find("missing \"keyframes\""), std::string::npos);
   EXPECT_NE(errorOf(R"({"keyframes": []})").find("non-empty array"), std::string::npos);
   EXPECT_NE(errorOf(R"({"fps": 0, "keyframes": [{"time": 0, "eye": [0,0,1], "target": [0,0,0]}]})").find("'fps' must be in"),

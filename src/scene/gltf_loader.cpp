@@ -182,7 +182,8 @@ int textureFor(GltfContext& ctx, int textureIndex) {
   const std::string label = gltfImage.uri.empty() ? fmt::format("image {}", source) : gltfImage.uri;
   if (gltfImage.image.empty() && !gltfImage.uri.empty() && gltfImage.uri.rfind("data:", 0) != 0) {
     const std::filesystem::path file = std::filesystem::path(ctx.path).parent_path() / gltfImage.uri;
-    if (!std::filesystem::exists(file)) fail("{}: texture file '{}' not found", ctx.path, file.string());
+    if (const std::string problem = inputFileProblem(file); !problem.empty())
+      fail("{}: texture file '{}' {}", ctx.path, file.string(), problem);
   }
   if (gltfImage.image.empty() || gltfImage.width <= 0 || gltfImage.height <= 0 || gltfImage.component < 1 ||
       (gltfImage.bits != 8 && gltfImage.bits != 16))
@@ -396,8 +397,15 @@ Scene loadGltf(const std::string& path) {
   std::string error, warning;
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  const bool ok = extension == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                                      : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+  bool ok = false;
+  try {
+    ok = extension == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
+                             : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+  } catch (const std::exception& e) {
+    // tinygltf mostly reports through `error`, but some malformed files make it (or the JSON
+    // library inside it) throw, e.g. std::out_of_range on a GLB whose chunk lengths lie.
+    fail("{}: not a valid glTF file: {}", path, e.what());
+  }
   while (!warning.empty() && std::isspace(static_cast<unsigned char>(warning.back()))) warning.pop_back();
   if (!warning.empty()) spdlog::warn("{}: {}", path, warning);
   if (!ok) {

@@ -141,7 +141,8 @@ Mat4 parseTransform(const JsonContext& ctx, const json& value, const std::string
 
 int loadTexture(const JsonContext& ctx, Scene& scene, const json& value, const std::string& where) {
   const fs::path file = ctx.dir / stringOf(ctx, value, where);
-  if (!fs::exists(file)) fail("{}: {}: texture file '{}' not found", ctx.path, where, file.string());
+  if (const std::string problem = inputFileProblem(file); !problem.empty())
+    fail("{}: {}: texture file '{}' {}", ctx.path, where, file.string(), problem);
   Texture texture;
   texture.path = file.string();
   texture.image = readImage(texture.path);
@@ -386,6 +387,8 @@ Scene loadJsonScene(const std::string& path) {
     root = json::parse(in);
   } catch (const json::parse_error& e) {
     fail("{}: malformed JSON at byte {}: {}", path, e.byte, e.what());
+  } catch (const json::exception& e) {  // e.g. out_of_range: a number beyond a double (1e400)
+    fail("{}: malformed JSON: {}", path, e.what());
   }
   const JsonContext ctx{path, fs::path(path).parent_path()};
   try {

@@ -12,6 +12,12 @@ namespace pl {
 
 namespace detail {
 
+std::string inputFileProblem(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec)) return "";
+  return ec ? ec.message() : "not found";
+}
+
 void appendScene(Scene& scene, Scene&& part) {
   const auto materialOffset = uint32_t(scene.materials.size());
   const auto textureOffset = int(scene.textures.size());

@@ -105,7 +105,11 @@ std::vector<std::string> validateObj(const std::string& path) {
         for (int part = 0; part < 3 && start <= token.size(); ++part) {
           const size_t slash = token.find('/', start);
           const std::string field = token.substr(start, slash == std::string::npos ? std::string::npos : slash - start);
-          if (!field.empty() || part == 0) {
+          // Only the texture coordinate of v//vn may be empty: "1/", "1//", "1/2/" name an
+          // element without giving its index (tinyobjloader would read it as index 0).
+          if (field.empty() && !(part == 1 && slash != std::string::npos))
+            fail("{}:{}: empty {} index in '{}'", path, lineNumber, names[part], token);
+          if (!field.empty()) {
             long index;
             if (!parseInt(field, index) || index == 0)
               fail("{}:{}: bad face index '{}' in '{}'", path, lineNumber, field, token);
@@ -186,13 +190,13 @@ Material convertMaterial(const tinyobj::material_t& mtl, const std::string& mtlP
       // Resolve against the MTL file's directory (the first library directory holding it).
       fs::path resolved = mtlDirs.empty() ? fs::path(mtl.diffuse_texname) : mtlDirs.front() / mtl.diffuse_texname;
       for (const fs::path& dir : mtlDirs)
-        if (fs::exists(dir / mtl.diffuse_texname)) {
+        if (inputFileProblem(dir / mtl.diffuse_texname).empty()) {
           resolved = dir / mtl.diffuse_texname;
           break;
         }
       const std::string key = resolved.lexically_normal().string();
-      if (!fs::exists(resolved))
-        fail("{}: material '{}': texture file '{}' not found", mtlPath, mtl.name, key);
+      if (const std::string problem = inputFileProblem(resolved); !problem.empty())
+        fail("{}: material '{}': texture file '{}' {}", mtlPath, mtl.name, key, problem);
       auto [it, inserted] = textureIndex.try_emplace(key, int(scene.textures.size()));
       if (inserted) {
         Texture texture;
@@ -247,9 +251,9 @@ Scene loadObj(const std::string& path) {
   std::string mtlNames;
   for (const std::string& library : libraries) {
     const fs::path mtlPath = objDir / library;
-    if (!fs::exists(mtlPath)) {
-      spdlog::warn("{}: material library '{}' not found; its materials become grey Lambert", path,
-                   mtlPath.string());
+    if (const std::string problem = inputFileProblem(mtlPath); !problem.empty()) {
+      spdlog::warn("{}: material library '{}' {}; its materials become grey Lambert", path, mtlPath.string(),
+                   problem);
       continue;
     }
     validateMtl(mtlPath.string());
@@ -307,6 +311,8 @@ Scene loadObj(const std::string& path) {
             Vec3 n(0.0f);
             if (index.normal_index >= 0) {
               const auto q = size_t(index.normal_index);
+              if (3 * q + 2 >= attrib.normals.size())
+                fail("{}: shape '{}': normal index {} out of range", path, shape.name, index.normal_index);
               n = Vec3(attrib.normals[3 * q], attrib.normals[3 * q + 1], attrib.normals[3 * q + 2]);
             }
             mesh.normals.push_back(n);
@@ -315,6 +321,8 @@ Scene loadObj(const std::string& path) {
             Vec2 uv(0.0f);
             if (index.texcoord_index >= 0) {
               const auto q = size_t(index.texcoord_index);
+              if (2 * q + 1 >= attrib.texcoords.size())
+                fail("{}: shape '{}': texture coordinate index {} out of range", path, shape.name, index.texcoord_index);
               uv = Vec2(attrib.texcoords[2 * q], attrib.texcoords[2 * q + 1]);
             }
             mesh.uvs.push_back(uv);

@@ -19,6 +19,8 @@ namespace fs = std::filesystem;
 
 const std::string kMcGuireDir = std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/";
 const std::string kDataDir = std::string(PLENOPTIC_TEST_DATA_DIR) + "/scene/";
+// The fuzzing regression corpus (fuzz/fuzz_targets.h), one folder per target.
+const std::string kFuzzCorpus = std::string(PLENOPTIC_TEST_DATA_DIR) + "/fuzz/";
 
 // Float tolerance for values that went through a few float operations (products, sums of
 // magnitude ≲ 10): a few ulps of float (6e-8 relative) at that scale.
@@ -675,6 +677,62 @@ TEST(BadInput, JsonTyposAndDanglingNamesAreErrors) {
   expectError([&] { loadScene(camera); }, {"c.json", "no camera named 'top'", "'cornell'"});
   const std::string type = writeFile(dir / "t.json", R"({"include_cornell": true, "lights": [{"type": "point", "position": "up"}]})");
   expectError([&] { loadScene(type); }, {"t.json", "lights[0].position"});
+}
+
+TEST(BadInput, EmptyFaceIndexFieldsAreErrorsWithTheLine) {
+  // tinyobjloader reads an empty texture or normal index as index 0 of an empty array (a
+  // crash before the validator refused these): "v/" "v/vt/" and "v//" name an element
+  // without an index; only the "v//vn" form may leave the texture coordinate empty.
+  expectError([] { loadScene(kFuzzCorpus + "obj/empty_texcoord_index.obj"); },
+              {"empty_texcoord_index.obj:2", "empty texture coordinate index in '1/'"});
+  expectError([] { loadScene(kFuzzCorpus + "obj/empty_texcoord_index_middle.obj"); },
+              {"empty_texcoord_index_middle.obj:4", "empty texture coordinate index in '2/'"});
+  expectError([] { loadScene(kFuzzCorpus + "obj/empty_normal_index.obj"); },
+              {"empty_normal_index.obj:2", "empty normal index in '1//'"});
+  const fs::path dir = scratchDir("empty_index");
+  const std::string trailing = writeFile(dir / "t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1/ 2 3\n");
+  expectError([&] { loadScene(trailing); }, {"t.obj:5", "empty normal index in '1/1/'"});
+  // v//vn stays valid.
+  const std::string normals = writeFile(dir / "n.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n");
+  EXPECT_EQ(loadScene(normals).triangleCount(), 1u);
+}
+
+TEST(BadInput, PathComponentsLongerThanTheSystemAllowsAreCleanErrors) {
+  // std::filesystem::exists throws on ENAMETOOLONG; every referenced file goes through
+  // inputFileProblem instead, which gives the system's reason.
+  const std::string tooLong(300, 'a');
+  const fs::path dir = scratchDir("long_names");
+  const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl m\nf 1/1 2/1 3/1\n";
+  // A material library that cannot be opened is a warning, as a missing one is.
+  const std::string mtllib = writeFile(dir / "lib.obj", "mtllib " + tooLong + ".mtl\n" + triangle);
+  EXPECT_EQ(loadScene(mtllib).triangleCount(), 1u);
+  writeFile(dir / "tex.mtl", "newmtl m\nKd 1 1 1\nmap_Kd " + tooLong + ".png\n");
+  const std::string texture = writeFile(dir / "tex.obj", "mtllib tex.mtl\n" + triangle);
+  expectError([&] { loadScene(texture); }, {"tex.mtl", "material 'm'", "File name too long"});
+  const std::string json = writeFile(dir / "t.json", R"({"include_cornell": true,
+      "materials": {"m": {"type": "lambert", "texture": ")" + tooLong + R"(.png"}}})");
+  expectError([&] { loadScene(json); }, {"t.json", "materials.m", "File name too long"});
+  const std::string environment = writeFile(dir / "e.json", R"({"include_cornell": true,
+      "environment": {"file": ")" + tooLong + R"(/{face}.hdr"}})");
+  expectError([&] { loadScene(environment); }, {"e.json", "environment.file"});
+  std::ifstream in(kDataDir + "quad.gltf", std::ios::binary);
+  std::string gltf((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t uri = gltf.find("checker.png");
+  ASSERT_NE(uri, std::string::npos);
+  gltf.replace(uri, 11, tooLong + ".png");
+  const std::string longUri = writeFile(dir / "quad.gltf", gltf);
+  expectError([&] { loadScene(longUri); }, {"quad.gltf", "File name too long"});
+}
+
+TEST(BadInput, GlbOnWhichTinygltfThrowsIsAnInvalidFile) {
+  // A GLB buffer of byteLength 0 beside a BIN chunk: tinygltf throws std::out_of_range.
+  expectError([] { loadScene(kFuzzCorpus + "gltf/zero_length_buffer.glb"); },
+              {"zero_length_buffer.glb", "not a valid glTF file"});
+}
+
+TEST(BadInput, JsonNumberBeyondADoubleIsAMalformedFile) {
+  // nlohmann::json throws out_of_range (not parse_error) for 1e400.
+  expectError([] { loadScene(kFuzzCorpus + "json_scene/number_overflow.json"); }, {"number_overflow.json", "malformed JSON", "1e400"});
 }
 
 /// Loads prefixes of `source`, saved as `name` (every length up to 48 bytes, where the headers
