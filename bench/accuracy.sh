@@ -32,8 +32,8 @@
 #   WORKDIR    where every file goes (default: out/accuracy)
 # Environment: SIZE (image side, default 256), REF_SPP (reference samples per pixel, default
 # 2048: about 40–90 s per scene on 2 cores), LF_SAMPLES (light-field camera samples per
-# pixel, default 16), SCENES_DIR (default: the McGuire scenes in ../shared/scenes), SCENES
-# (which of "cornell glossy mirror" to measure; empty = only the reuse-visibility check).
+# pixel, default 16), SCENES_DIR (default: the McGuire scenes in tests/data/cornell-mcguire),
+# SCENES (which of "cornell glossy mirror" to measure; empty = only the reuse-visibility check).
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -42,7 +42,7 @@ workdir=${2:-out/accuracy}
 size=${SIZE:-256}
 ref_spp=${REF_SPP:-2048}
 lf_samples=${LF_SAMPLES:-16}
-scenes_dir=${SCENES_DIR:-$here/../../shared/scenes/cornell-mcguire}
+scenes_dir=${SCENES_DIR:-$here/../tests/data/cornell-mcguire}
 
 if [[ ! -x "$plenoptic" ]]; then
   echo "$0: $plenoptic is not an executable (build it: cmake --build build --target plenoptic)" >&2

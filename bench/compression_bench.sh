@@ -8,10 +8,10 @@
 # Usage: bench/compression_bench.sh [PLENOPTIC_BINARY] [WORK_DIR]
 #   PLENOPTIC_BINARY  default: build/plenoptic
 #   WORK_DIR          default: a new temporary directory (kept, printed at the end)
-# Environment: SHARED_DIR (default /work/shared), RENDER_FLAGS (`render` flags; default
-# "--reference": the straightforward renderer of src/render, so the figures measure the
-# light field, not a renderer's approximations; "" for the fast renderer), MODES (default
-# "lossless bc1 hdr").
+# Environment: SCENES_DIR (default: the McGuire scenes in tests/data/cornell-mcguire),
+# RENDER_FLAGS (`render` flags; default "--reference": the straightforward renderer of
+# src/render, so the figures measure the light field, not a renderer's approximations; "" for
+# the fast renderer), MODES (default "lossless bc1 hdr").
 #
 # Columns: values ratio = raw float32 values / stored VALS section; file ratio = the whole
 # .plf stored raw / as written; encode = encode + write + fsync of the whole file (s);
@@ -20,7 +20,7 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 plenoptic="${1:-build/plenoptic}"
 work="${2:-$(mktemp -d -t plenoptic-compression-XXXXXX)}"
-shared="${SHARED_DIR:-/work/shared}"
+scenes_dir="${SCENES_DIR:-$here/../tests/data/cornell-mcguire}"
 modes="${MODES:-lossless bc1 hdr}"
 read -r -a renderFlags <<< "${RENDER_FLAGS---reference}"
 mkdir -p "$work"
@@ -31,7 +31,7 @@ json() {  # json FILE KEY: one top-level value of a JSON file
 
 printf '| scene | mode | file bytes | values ratio | file ratio | encode s | decode s | render relMSE | PNG PSNR dB |\n'
 printf '|---|---|---:|---:|---:|---:|---:|---:|---:|\n'
-for entry in "cornell:cornell" "glossy:$shared/scenes/cornell-mcguire/CornellBox-Glossy.obj"; do
+for entry in "cornell:cornell" "glossy:$scenes_dir/CornellBox-Glossy.obj"; do
   name="${entry%%:*}"
   scene="${entry#*:}"
   base="$work/$name"

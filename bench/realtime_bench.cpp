@@ -5,7 +5,7 @@
 // Scenes (each baked once, at the first benchmark that needs it, with the default preset
 // through the bake API; the bake time is printed, not measured):
 //   cornell   the built-in measured Cornell box (32 triangles)
-//   glossy    CornellBox-Glossy (Morgan McGuire's archive, ../shared/scenes): glossy floor
+//   glossy    CornellBox-Glossy (Morgan McGuire's archive, tests/data/cornell-mcguire): glossy floor
 //             and spheres, so lookups are 16-neighbour ones
 //   mirror    CornellBox-Mirror: a mirror sphere (reflection rays, bounded depth)
 //   million   the built-in Cornell box with every triangle regularly subdivided into 180²
@@ -41,10 +41,6 @@
 #include "realtime/display.h"
 #include "realtime/realtime.h"
 #include "scene/scene.h"
-
-#ifndef PLENOPTIC_SHARED_DIR
-#define PLENOPTIC_SHARED_DIR "../shared"
-#endif
 
 namespace {
 
@@ -95,7 +91,7 @@ struct BakedScene {
 };
 
 pl::Scene sceneNamed(const std::string& name) {
-  const std::string mcguire = std::string(PLENOPTIC_SHARED_DIR) + "/scenes/cornell-mcguire/";
+  const std::string mcguire = std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/";
   if (name == "cornell") return pl::makeCornellBox();
   if (name == "glossy") return pl::loadScene(mcguire + "CornellBox-Glossy.obj");
   if (name == "mirror") return pl::loadScene(mcguire + "CornellBox-Mirror.obj");

@@ -1,6 +1,6 @@
 // Path tracer throughput: paths (camera samples) per second on the built-in Cornell box at
-// 512×512, all threads, default settings (MIS, Russian roulette after 3 bounces, max depth
-// 32). One iteration renders the whole image at 4 spp (≈ 1 M paths); Google Benchmark
+// 512×512, all threads, default settings (MIS, Russian roulette after 3 bounces, no depth
+// cap). One iteration renders the whole image at 4 spp (≈ 1 M paths); Google Benchmark
 // repeats it and reports the median. Run:
 //   build/bench/trace_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>

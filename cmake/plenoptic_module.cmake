@@ -19,7 +19,6 @@ function(pl_add_test name)
   # tests/support: helpers shared by test files (e.g. support/cli_test_support.h).
   target_include_directories(${name} PRIVATE ${CMAKE_SOURCE_DIR}/tests)
   target_compile_definitions(${name} PRIVATE
-    PLENOPTIC_SHARED_DIR="${PLENOPTIC_SHARED_DIR}"
     PLENOPTIC_TEST_DATA_DIR="${PLENOPTIC_TEST_DATA_DIR}"
     PLENOPTIC_BINARY="$<TARGET_FILE:plenoptic>")
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60

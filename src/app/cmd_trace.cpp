@@ -143,8 +143,10 @@ void addTraceCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(1, kMaxSpp))
       ->capture_default_str();
   command->add_option("--max-depth", options->maxDepth,
-                      "Maximum scattering events per path (Russian roulette ends most paths earlier)")
-      ->check(CLI::Range(0, kMaxDepth))
+                      fmt::format("Maximum scattering events per path: {} = no cap (unbiased: Russian roulette "
+                                  "alone ends paths; safety cap {}), 0 = emission seen directly, 1 = direct light, ...",
+                                  kUnboundedDepth, kSafetyDepth))
+      ->check(CLI::Range(kUnboundedDepth, kMaxDepth))
       ->capture_default_str();
   command->add_option("--strategy", options->strategy,
                       "Direct lighting: mis (default), nee (light sampling only) or bsdf (BSDF sampling only); "

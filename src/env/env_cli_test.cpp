@@ -16,17 +16,17 @@ namespace pl {
 namespace {
 
 namespace fs = std::filesystem;
-const std::string kShared = PLENOPTIC_SHARED_DIR;
-const std::string kVenice = kShared + "/envmaps/venice_sunset_1k.hdr";
+const std::string kData = PLENOPTIC_TEST_DATA_DIR;
+const std::string kVenice = kData + "/envmaps/venice_sunset_1k.hdr";
 
 class EnvCliTest : public cli_test::CliTest {};
 
 TEST_F(EnvCliTest, ShJsonMatchesLibrary) {
   std::string out;
-  ASSERT_EQ(run("env sh " + kShared + "/envmaps/pisa-cube --json", &out), 0);
+  ASSERT_EQ(run("env sh " + kData + "/envmaps/pisa-cube --json", &out), 0);
   const auto j = nlohmann::json::parse(out);
   ASSERT_EQ(j["coefficients"].size(), 9u);
-  const Sh9 sh = projectSh9(loadEnvironment(kShared + "/envmaps/pisa-cube"));
+  const Sh9 sh = projectSh9(loadEnvironment(kData + "/envmaps/pisa-cube"));
   for (int k = 0; k < 9; ++k)
     for (int c = 0; c < 3; ++c)  // JSON prints doubles round-trip exactly; summation order may differ (threads)
       EXPECT_NEAR(j["coefficients"][size_t(k)][size_t(c)].get<double>(), sh.coefficients[size_t(k)][c],

@@ -1,5 +1,5 @@
 // Reading files written by other software: OpenEXR fixtures (tests/data/image/README.md)
-// and a Radiance .hdr environment map from ../shared/envmaps (Poly Haven).
+// and a Radiance .hdr environment map as distributed by Poly Haven (tests/data/envmaps).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -57,7 +57,7 @@ TEST(ImageFixtures, ExrHeaderAttributeLargerThanTheFileIsRefusedBeforeAllocating
 }
 
 TEST(ImageFixtures, RadianceHdrFromPolyHaven) {
-  const std::string path = std::string(PLENOPTIC_SHARED_DIR) + "/envmaps/venice_sunset_1k.hdr";
+  const std::string path = std::string(PLENOPTIC_TEST_DATA_DIR) + "/envmaps/venice_sunset_1k.hdr";
   const Image image = readImage(path);
   ASSERT_EQ(image.width, 1024);
   ASSERT_EQ(image.height, 512);
@@ -74,7 +74,7 @@ TEST(ImageFixtures, RadianceHdrFromPolyHaven) {
 }
 
 TEST(ImageFixtures, RealHdrContentSurvivesOurWriters) {
-  const Image image = readImage(std::string(PLENOPTIC_SHARED_DIR) + "/envmaps/venice_sunset_1k.hdr");
+  const Image image = readImage(std::string(PLENOPTIC_TEST_DATA_DIR) + "/envmaps/venice_sunset_1k.hdr");
   const std::string dir = ::testing::TempDir();
   writeHdrImage(dir + "pl_venice.exr", image);
   writeHdrImage(dir + "pl_venice.hdr", image);

@@ -83,7 +83,7 @@ void expectSameAsReference(const LightField& lf, const CameraDesc& desc, int wid
   EXPECT_GT(sum, 0.0);
 }
 
-const std::string kMcGuire = std::string(PLENOPTIC_SHARED_DIR) + "/scenes/cornell-mcguire/";
+const std::string kMcGuire = std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/";
 
 TEST_F(FastRendererTest, MatchesReferenceOnGlossyCornellBox) {
   const LightField lf = randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 1);

@@ -17,7 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kMcGuireDir = std::string(PLENOPTIC_SHARED_DIR) + "/scenes/cornell-mcguire/";
+const std::string kMcGuireDir = std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/";
 const std::string kDataDir = std::string(PLENOPTIC_TEST_DATA_DIR) + "/scene/";
 // The fuzzing regression corpus (fuzz/fuzz_targets.h), one folder per target.
 const std::string kFuzzCorpus = std::string(PLENOPTIC_TEST_DATA_DIR) + "/fuzz/";

@@ -309,6 +309,7 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
   const bool useMis = settings.strategy == TraceStrategy::Mis;
   const bool bsdfOnly = settings.strategy == TraceStrategy::BsdfOnly;
 
+  const int maxDepth = settings.maxDepth == kUnboundedDepth ? kSafetyDepth : settings.maxDepth;
   for (int depth = 0;; ++depth) {
     RayHit hit;
     ++counters.rays;
@@ -347,7 +348,7 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
         }
       }
     }
-    if (depth >= settings.maxDepth) break;
+    if (depth >= maxDepth) break;
 
     // Two-sided shading: both normals face the side the ray came from.
     Vec3 geometricNormal = surface.geometricNormal;
@@ -380,12 +381,12 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
     ray.tMax = kInfinity;
 
     // Russian roulette (unbiased): continue with probability q, divide the throughput by q.
+    // q < 1 always (kRouletteMaxContinue), so every path ends with probability 1 without a
+    // depth cap; written as !(u < q) so that a NaN throughput ends the path too.
     if (depth + 1 >= settings.rouletteDepth) {
-      const float q = maxComponent(throughput);
-      if (q < 1.0f) {
-        if (rng.uniform() >= q) break;
-        throughput /= q;
-      }
+      const float q = std::min(maxComponent(throughput), kRouletteMaxContinue);
+      if (!(rng.uniform() < q)) break;
+      throughput /= q;
     }
   }
   return result;
@@ -415,7 +416,8 @@ size_t PathTracer::lightCount() const { return impl_->entries.size(); }
 namespace {
 void checkSettings(const TraceSettings& settings) {
   if (settings.spp < 1) fail("samples per pixel must be at least 1 (got {})", settings.spp);
-  if (settings.maxDepth < 0) fail("maximum depth must be at least 0 (got {})", settings.maxDepth);
+  if (settings.maxDepth < 0 && settings.maxDepth != kUnboundedDepth)
+    fail("maximum depth must be at least 0, or {} for no cap (got {})", kUnboundedDepth, settings.maxDepth);
   if (settings.tileSize < 1) fail("tile size must be at least 1 (got {})", settings.tileSize);
 }
 }  // namespace
