@@ -17,17 +17,23 @@ constexpr size_t kSlots = 256;
 std::array<std::atomic<const char*>, kSlots> temporaryPaths{};
 static_assert(std::atomic<const char*>::is_always_lock_free);
 
+/// On a terminal the message starts on a line of its own (after the "^C" echo or a progress
+/// bar); decided when the handler is installed, since isatty is not async-signal-safe.
+bool stderrIsTerminal = false;
+
 extern "C" void onInterrupt(int signal) {
   for (std::atomic<const char*>& slot : temporaryPaths)
     if (const char* path = slot.load(std::memory_order_acquire)) ::unlink(path);
-  static const char kMessage[] = "plenoptic: interrupted\n";
-  [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+  static const char kMessage[] = "\nplenoptic: interrupted\n";
+  const size_t skip = stderrIsTerminal ? 0 : 1;
+  [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, kMessage + skip, sizeof kMessage - 1 - skip);
   ::_exit(128 + signal);
 }
 
 }  // namespace
 
 void installInterruptHandlers() {
+  stderrIsTerminal = ::isatty(STDERR_FILENO) == 1;
   struct sigaction action {};
   action.sa_handler = onInterrupt;
   sigemptyset(&action.sa_mask);
