@@ -163,7 +163,7 @@ TEST_F(AppCli, MemoryGuardRefusesWhatWouldNotFitWithTheEstimateAndTheFlag) {
                                    &out, &err, limit),
             1)
       << err;
-  EXPECT_NE(err.find("plenoptic: error: trace at 16384x16384 needs an estimated 12.00 GiB of memory, but only "),
+  EXPECT_NE(err.find("plenoptic: error: trace at 16384x16384: estimated memory 12.00 GiB exceeds the "),
             std::string::npos)
       << err;
   EXPECT_NE(err.find("lower --width/--height"), std::string::npos) << err;
@@ -172,7 +172,7 @@ TEST_F(AppCli, MemoryGuardRefusesWhatWouldNotFitWithTheEstimateAndTheFlag) {
                                    limit),
             1)
       << err;
-  EXPECT_NE(err.find("bake: the visibility field and the light-field values needs an estimated "), std::string::npos)
+  EXPECT_NE(err.find("bake (visibility field and light-field values): estimated memory "), std::string::npos)
       << err;
   EXPECT_NE(err.find("lower --preset, --tixels-across or --directions"), std::string::npos) << err;
   // Render: a small light field, a frame too large for the limit.
@@ -183,7 +183,7 @@ TEST_F(AppCli, MemoryGuardRefusesWhatWouldNotFitWithTheEstimateAndTheFlag) {
                                    dir_, &out, &err, limit),
             1)
       << err;
-  EXPECT_NE(err.find("render at 16384x16384 needs an estimated 9.00 GiB"), std::string::npos)
+  EXPECT_NE(err.find("render at 16384x16384: estimated memory 9.00 GiB exceeds the "), std::string::npos)
       << err;
   EXPECT_EQ(outputs(), (std::vector<std::string>{"small.plf", "small.plv"}));
 }

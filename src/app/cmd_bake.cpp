@@ -65,7 +65,7 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
     if (!global.quiet) fmt::print(stderr, "{}\n", line);
   };
   bakeOptions.checkMemory = [](uint64_t bytes) {
-    requireMemory(bytes, "bake: the visibility field and the light-field values",
+    requireMemory(bytes, "bake (visibility field and light-field values)",
                   "lower --preset, --tixels-across or --directions");
   };
   LightField lf = bake(std::move(scene), settings, bakeOptions);

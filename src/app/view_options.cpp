@@ -174,7 +174,9 @@ void ViewOptions::checkImageOutput(const std::string& path, std::string_view opt
 void ViewOptions::requireImageMemory(int frameBuffers, std::string_view what) const {
   // Per pixel: `frameBuffers` float RGB images (12 B each) and, while writing, the exposed
   // copy (12 B) and the encoder's buffer (at most 12 B: float RGB for EXR and PFM; half
-  // floats, RGBE and 8-bit PNG take less).
+  // floats, RGBE and 8-bit PNG take less). Measured peak RSS of `trace cornell --spp 1` at
+  // 2048² (estimate 48 B/px, 192 MiB): 220 MiB writing .png (50 B/px above the 17 MiB of a
+  // 64² run), 113 MiB writing .exr without exposure (no exposed copy: 23 B/px).
   constexpr uint64_t kRgbBytes = 3 * sizeof(float), kWriteBytesPerPixel = 2 * kRgbBytes;
   const uint64_t pixels = uint64_t(width) * uint64_t(height);
   requireMemory(pixels * (uint64_t(frameBuffers) * kRgbBytes + kWriteBytesPerPixel),

@@ -347,8 +347,8 @@ TEST(Memory, AvailableMemoryIsKnownAndTheGuardNamesEstimateAndFlags) {
     FAIL() << "4 EiB were accepted";
   } catch (const Error& e) {
     const std::string m = e.what();
-    EXPECT_EQ(m.rfind("trace at 9x9 needs an estimated 4294967296.00 GiB of memory, but only ", 0), 0u) << m;
-    EXPECT_NE(m.find(" GiB is available; lower --width/--height"), std::string::npos) << m;
+    EXPECT_EQ(m.rfind("trace at 9x9: estimated memory 4294967296.00 GiB exceeds the ", 0), 0u) << m;
+    EXPECT_NE(m.find(" GiB available; lower --width/--height"), std::string::npos) << m;
   }
 }
 

@@ -54,8 +54,7 @@ std::optional<uint64_t> availableMemoryBytes() {
 void requireMemory(uint64_t bytes, std::string_view what, std::string_view how) {
   const std::optional<uint64_t> available = availableMemoryBytes();
   if (available && bytes > *available)
-    fail("{} needs an estimated {} of memory, but only {} is available; {}", what, gibibytes(bytes),
-         gibibytes(*available), how);
+    fail("{}: estimated memory {} exceeds the {} available; {}", what, gibibytes(bytes), gibibytes(*available), how);
 }
 
 }  // namespace pl

@@ -18,8 +18,8 @@ uint64_t peakRssBytes();
 /// when none of these is known (not Linux).
 std::optional<uint64_t> availableMemoryBytes();
 
-/// Fails (pl::Error) with "WHAT needs an estimated X GiB of memory, but only Y GiB is
-/// available; HOW" when `bytes` exceeds availableMemoryBytes(). `how` names the flags that
+/// Fails (pl::Error) with "WHAT: estimated memory X GiB exceeds the Y GiB available; HOW"
+/// when `bytes` exceeds availableMemoryBytes(). `how` names the flags that
 /// lower the estimate, e.g. "lower --width/--height". Does nothing when the available memory
 /// is unknown.
 void requireMemory(uint64_t bytes, std::string_view what, std::string_view how);
