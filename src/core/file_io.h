@@ -55,10 +55,10 @@ void checkDistinctOutputs(std::initializer_list<OutputFlag> outputs);
 void requireRegularFile(const std::string& path);
 
 /// A temporary file beside `target` that becomes `target` on commit(); if it is never
-/// committed (error, exception), the destructor removes it; if the program is interrupted
-/// (SIGINT, SIGTERM), the interruption handler does (core/interrupt.h). For writers whose output is
-/// produced over a longer time or by another process (e.g. ffmpeg); the simple cases use
-/// writeFileAtomically below.
+/// committed (error, exception), the destructor removes it, and if the program is
+/// interrupted (SIGINT, SIGTERM), the interruption handler does (core/interrupt.h). For
+/// writers whose output is produced over a longer time or by another process (e.g. ffmpeg);
+/// the simple cases use writeFileAtomically below.
 class PendingFile {
  public:
   /// Checks that target's directory exists and that target is not a directory (pl::Error

@@ -187,7 +187,6 @@ F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* 
   return sum;
 }
 
-
 /// The scene's brightest emitter, for messages: "material 'NAME' (emission R G B)" or
 /// "point light I (intensity R G B)"; empty when nothing emits.
 std::string brightestEmitter(const Scene& scene) {
