@@ -11,6 +11,9 @@
 // written, an ffmpeg pipe) would leave the user waiting. The handler does only
 // async-signal-safe things: it reads a fixed table of lock-free atomic pointers to the
 // registered paths (no allocation, no locks), calls unlink(2), write(2) and _exit(2).
+// PendingFile registers its temporary's name before creating the file and unregisters it
+// in its destructor, after the rename or removal; unlinking a name that is already gone is
+// harmless, and the names are unique per process and call, so no other file is touched.
 #include <cstddef>
 
 namespace pl {
