@@ -11,6 +11,7 @@
 #include "app/commands.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/memory.h"
 #include "core/timing.h"
 #include "lightfield/bake.h"
 #include "lightfield/compression.h"
@@ -38,13 +39,16 @@ struct BakeCommandOptions {
 void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
   const auto start = std::chrono::steady_clock::now();
-  if (options.output.empty()) fail("bake: an output file is required (-o OUT.plf)");
-  requireParentDirectory(options.output, "-o");
-  if (!options.statsPath.empty()) requireParentDirectory(options.statsPath, "--stats");
+  // Every output is checked before the scene is loaded (core/file_io.h): a bake that could
+  // not save its results is refused before it traces anything.
+  if (options.output.empty()) failUsage("bake: an output file is required (-o OUT.plf)");
+  checkOutputPath(options.output, {".plf"}, "-o");
   const std::string visibilityPath =
       options.visibilityPath.empty() ? std::filesystem::path(options.output).replace_extension(".plv").string()
                                      : options.visibilityPath;
-  requireParentDirectory(visibilityPath, "--visibility");
+  checkOutputPath(visibilityPath, {".plv"}, "--visibility");
+  if (!options.statsPath.empty()) checkOutputPath(options.statsPath, {}, "--stats");
+  checkDistinctOutputs({{"-o", options.output}, {"--visibility", visibilityPath}, {"--stats", options.statsPath}});
 
   BakeSettings settings = bakePreset(options.preset);
   if (options.tixelsAcross > 0.0f) settings.tixelsAcrossScene = options.tixelsAcross;
@@ -59,6 +63,10 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
   bakeOptions.reuseVisibility = options.reuseVisibility;
   bakeOptions.log = [&](const std::string& line) {
     if (!global.quiet) fmt::print(stderr, "{}\n", line);
+  };
+  bakeOptions.checkMemory = [](uint64_t bytes) {
+    requireMemory(bytes, "bake (visibility field and light-field values)",
+                  "lower --preset, --tixels-across or --directions");
   };
   LightField lf = bake(std::move(scene), settings, bakeOptions);
   writeLightField(options.output, lf, PlfEncoding(uint32_t(parseValuesCodec(options.compress))));

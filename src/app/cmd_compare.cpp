@@ -9,6 +9,7 @@
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "image/compare.h"
 #include "image/image.h"
 
@@ -36,8 +37,7 @@ nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : 
 
 void runCompare(const CompareOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
-  if (!options.heatmap.empty() && fileExtensionLower(options.heatmap) != ".png")
-    fail("--heatmap {}: the heat map is written as PNG (use a .png name)", options.heatmap);
+  if (!options.heatmap.empty()) checkOutputPath(options.heatmap, {".png"}, "--heatmap");
   const Image a = readHdrInput(options.test);
   const Image b = readHdrInput(options.reference);
   if (a.width != b.width || a.height != b.height)

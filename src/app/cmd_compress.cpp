@@ -41,8 +41,9 @@ void runCompress(const CompressOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
   const ValuesCodec codec = parseValuesCodec(options.mode);
   // Unwritable outputs fail before the work, as in trace, bake and render.
-  requireParentDirectory(options.output, "-o");
-  if (!options.statsPath.empty()) requireParentDirectory(options.statsPath, "--stats");
+  checkOutputPath(options.output, {".plf"}, "-o");
+  if (!options.statsPath.empty()) checkOutputPath(options.statsPath, {}, "--stats");
+  checkDistinctOutputs({{"-o", options.output}, {"--stats", options.statsPath}});
   const PlfInfo inputInfo = readLightFieldInfo(options.input, /*verifyChecksums=*/false);
   const PlfSectionInfo inputValues = valuesSection(inputInfo);
 

@@ -90,9 +90,11 @@ std::string shSibling(const std::string& path, EnvLayout layout) {
 /// Fails before any work if `path` cannot receive an environment in `layout`.
 void checkEnvOutput(const std::string& path, EnvLayout layout) {
   if (layout == EnvLayout::Cube && path.find("{face}") == std::string::npos) return;  // a directory, created
-  if (!isHdrExtension(path)) fail("-o {}: expected an .exr, .hdr or .pfm file name", path);
-  if (layout == EnvLayout::Cube) return;  // a {face} pattern: its directory is created
-  requireParentDirectory(path, "-o");
+  if (layout == EnvLayout::Cube) {  // a {face} pattern: its directory is created
+    if (!isHdrExtension(path)) failUsage("-o {}: expected an .exr, .hdr or .pfm file name", path);
+    return;
+  }
+  checkOutputPath(path, {".exr", ".hdr", ".pfm"}, "-o");
 }
 
 void runConvert(const ConvertOptions& o, const GlobalOptions& global) {
@@ -222,8 +224,7 @@ void runPrefilter(const PrefilterCliOptions& o, const GlobalOptions& global) {
 void runSplitSum(const SplitSumCliOptions& o, const GlobalOptions& global) {
   Runtime runtime(global);
   if (!o.plot.empty()) {
-    if (fs::path(o.plot).extension() != ".png") fail("--plot {}: expected a .png file name", o.plot);
-    requireParentDirectory(o.plot, "--plot");
+    checkOutputPath(o.plot, {".png"}, "--plot");
   }
   SplitSumOptions s;
   s.model = parseSpecularModel(o.model);

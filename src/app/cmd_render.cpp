@@ -55,15 +55,17 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
   constexpr int kMaxSide = ViewOptions::kMaxImageSide;
   if (view.width < 1 || view.width > kMaxSide || view.height < 1 || view.height > kMaxSide)
     fail("image size {}x{} is out of range (width and height must be 1..{})", view.width, view.height, kMaxSide);
-  if (options.output.empty()) fail("render: an output image is required (-o OUT.exr|png)");
+  // Every output is checked before the light field is read (core/file_io.h).
+  if (options.output.empty()) failUsage("render: an output image is required (-o OUT.exr|png)");
   const bool video = isVideoOutput(options.output);
   const bool sequence = isFramePattern(options.output);
   if (options.pathFile.empty() && (video || sequence))
-    fail("-o {}: a frame pattern or .mp4 output needs a camera path (--path PATH.json)", options.output);
+    failUsage("-o {}: a frame pattern or .mp4 output needs a camera path (--path PATH.json)", options.output);
   if (!options.pathFile.empty() && !video && !sequence)
-    fail("-o {}: a camera path renders many frames: give a frame pattern like frames/%04d.png or an .mp4 file",
-         options.output);
-  if (!options.pathFile.empty() && options.frames != 1) fail("--frames cannot be combined with --path (the path sets the frames)");
+    failUsage("-o {}: a camera path renders many frames: give a frame pattern like frames/%04d.png or an .mp4 file",
+              options.output);
+  if (!options.pathFile.empty() && options.frames != 1)
+    failUsage("--frames cannot be combined with --path (the path sets the frames)");
   if (sequence) {
     // Frames go into the pattern's directory, created if needed.
     const std::filesystem::path parent = std::filesystem::path(options.output).parent_path();
@@ -72,18 +74,21 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
     if (error) fail("-o {}: cannot create directory '{}': {}", options.output, parent.string(), error.message());
   }
   if (!video) ViewOptions::checkImageOutput(options.output, "-o");
-  else requireParentDirectory(options.output, "-o");
+  else checkOutputPath(options.output, {".mp4"}, "-o");
+  if (!options.statsPath.empty()) checkOutputPath(options.statsPath, {}, "--stats");
+  checkDistinctOutputs({{"-o", options.output}, {"--stats", options.statsPath}});
   std::optional<CameraPath> cameraPath;
   if (!options.pathFile.empty()) cameraPath = loadCameraPath(options.pathFile);
   if (video && findFfmpeg().empty())
     fail("-o {}: MP4 output needs ffmpeg, which is not installed (not found on PATH); write an image sequence "
          "instead, e.g. -o frames/%04d.png",
          options.output);
-  if (!options.statsPath.empty()) requireParentDirectory(options.statsPath, "--stats");
-
   const auto loadStart = SteadyClock::now();
   const LightField lightField = readLightField(options.input);
   const double loadSeconds = secondsSince(loadStart);
+  // The frame (two for a walk-through: the one being rendered and the one being written); the
+  // light field, read by now, is already taken from the available memory.
+  view.requireImageMemory(cameraPath ? 2 : 1, "render");
   const auto accelStart = SteadyClock::now();
   const Accel accel(lightField.scene);
   const double accelSeconds = secondsSince(accelStart);

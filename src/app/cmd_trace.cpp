@@ -42,16 +42,14 @@ struct TraceOptions {
 void runTrace(const TraceOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
   const bool replay = !options.pixel.empty();
+  // Every output is checked before the scene is even loaded (core/file_io.h).
   if (!replay) {
-    if (options.output.empty()) fail("trace: an output image is required (-o OUT.exr|png)");
+    if (options.output.empty()) failUsage("trace: an output image is required (-o OUT.exr|png)");
     ViewOptions::checkImageOutput(options.output, "-o");
   }
-  if (!options.variancePath.empty()) {
-    if (!isHdrExtension(options.variancePath))
-      fail("--variance {}: expected an .exr, .hdr or .pfm file name", options.variancePath);
-    requireParentDirectory(options.variancePath, "--variance");
-  }
-  if (!options.statsPath.empty()) requireParentDirectory(options.statsPath, "--stats");
+  if (!options.variancePath.empty()) checkOutputPath(options.variancePath, {".exr", ".hdr", ".pfm"}, "--variance");
+  if (!options.statsPath.empty()) checkOutputPath(options.statsPath, {}, "--stats");
+  checkDistinctOutputs({{"-o", options.output}, {"--variance", options.variancePath}, {"--stats", options.statsPath}});
 
   TraceSettings settings;
   settings.spp = options.spp;
@@ -73,6 +71,8 @@ void runTrace(const TraceOptions& options, const GlobalOptions& global) {
          view.height, kMaxSide);
   if (settings.spp < 1 || settings.spp > kMaxSpp)
     fail("{}: {} samples per pixel is out of range (1..{})", options.scene, settings.spp, kMaxSpp);
+  // The radiance and variance images (replaying one pixel needs neither).
+  if (!replay) view.requireImageMemory(2, "trace");
 
   const Accel accel(scene);
   const PathTracer tracer(scene, accel);

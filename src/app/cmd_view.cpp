@@ -33,6 +33,7 @@ struct ViewCommandOptions {
 void runView(const ViewCommandOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
   const ViewOptions& view = options.view;
+  if (!options.screenshot.empty()) ViewOptions::checkImageOutput(options.screenshot, "--screenshot");
   const LightField lightField = readLightField(options.input);
   const Accel accel(lightField.scene);
 

@@ -76,8 +76,12 @@ struct ViewOptions {
   /// exposureScale(); PNG gets exposure, tone mapping and sRGB encoding. Atomic.
   void writeImage(const std::string& path, const Image& radiance) const;
   /// Fails, before any work is done, unless writeImage can write `path`: an .exr, .hdr, .pfm
-  /// or .png name in an existing directory. Messages start with "OPTION PATH: ".
+  /// or .png name in an existing, writable directory (checkOutputPath, core/file_io.h).
   static void checkImageOutput(const std::string& path, std::string_view option);
+  /// Fails, before the images are allocated, unless `frameBuffers` float RGB images of this
+  /// size and the buffers of writing one fit in the available memory (requireMemory,
+  /// core/memory.h); the message names `what` (e.g. "trace") and --width/--height.
+  void requireImageMemory(int frameBuffers, std::string_view what) const;
 };
 
 }  // namespace pl

@@ -1,15 +1,23 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/interrupt.h"
 #include "core/math.h"
+#include "core/memory.h"
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "core/timing.h"
@@ -223,14 +231,124 @@ TEST(Timing, SecondsSinceMeasuresElapsedWallTime) {
   EXPECT_LT(seconds, 5.0);    // generous bound for a loaded machine; catches unit mix-ups (ms vs s)
 }
 
-TEST(RequireParentDirectory, NamesOptionPathAndDirectory) {
-  EXPECT_NO_THROW(requireParentDirectory("stats.json", "--stats"));  // working directory
-  EXPECT_NO_THROW(requireParentDirectory(std::filesystem::temp_directory_path().string() + "/x.json", "--stats"));
+// --- core/file_io.h: output and input checks ---
+
+TEST_F(AtomicWriteTest, CheckOutputPathRefusesWrongExtensionsDirectoriesAndMissingDirectories) {
+  auto message = [](const std::function<void()>& check) {
+    try {
+      check();
+    } catch (const UsageError& e) {
+      return "usage: " + std::string(e.what());
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message([&] { checkOutputPath(path("out.plf"), {".plf"}, "-o"); }), "no error");
+  EXPECT_EQ(message([&] { checkOutputPath(path("OUT.PLF"), {".plf"}, "-o"); }), "no error");  // case-insensitive
+  EXPECT_EQ(message([&] { checkOutputPath("stats.json", {}, "--stats"); }), "no error");  // working directory
+  EXPECT_EQ(message([&] { checkOutputPath(path("out.exr"), {".plf"}, "-o"); }),
+            "usage: -o " + path("out.exr") + ": expected a .plf file name, not '.exr'");
+  EXPECT_EQ(message([&] { checkOutputPath(path("out"), {".exr", ".pfm", ".png"}, "-o"); }),
+            "usage: -o " + path("out") + ": expected a .exr, .pfm or .png file name, not 'no extension'");
+  std::filesystem::create_directory(path("renders.plf"));
+  EXPECT_EQ(message([&] { checkOutputPath(path("renders.plf"), {".plf"}, "-o"); }),
+            "-o " + path("renders.plf") + ": is a directory");
+  EXPECT_EQ(message([] { checkOutputPath("/no/such/dir/out.exr", {}, "-o"); }),
+            "-o /no/such/dir/out.exr: directory '/no/such/dir' does not exist");
+  writeFileAtomically(path("file"), std::string_view("x"));
+  EXPECT_EQ(message([&] { checkOutputPath(path("file/s.json"), {}, "--stats"); }),
+            "--stats " + path("file/s.json") + ": '" + path("file") + "' is not a directory");
+  ASSERT_EQ(::mkfifo(path("pipe.png").c_str(), 0600), 0);
+  EXPECT_EQ(message([&] { checkOutputPath(path("pipe.png"), {".png"}, "-o"); }),
+            "-o " + path("pipe.png") + ": exists and is not a regular file");
+  // A directory without write permission (root may write anyway, so only checked for others).
+  std::filesystem::create_directory(path("readonly"));
+  std::filesystem::permissions(path("readonly"), std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
+  if (::geteuid() != 0) {
+    EXPECT_NE(message([&] { checkOutputPath(path("readonly/a.png"), {".png"}, "-o"); }).find("cannot write in directory"),
+              std::string::npos);
+  }
+  std::filesystem::permissions(path("readonly"), std::filesystem::perms::owner_all);
+}
+
+TEST_F(AtomicWriteTest, CheckDistinctOutputsComparesResolvedPaths) {
+  std::filesystem::create_directory(path("sub"));
+  EXPECT_NO_THROW(checkDistinctOutputs({{"-o", path("a.plf")}, {"--visibility", path("a.plv")}, {"--stats", ""}}));
+  EXPECT_NO_THROW(checkDistinctOutputs({{"-o", ""}, {"--stats", ""}}));
   try {
-    requireParentDirectory("/no/such/dir/out.exr", "-o");
+    checkDistinctOutputs({{"-o", path("a.plf")}, {"--stats", ""}, {"--visibility", path("sub/../a.plf")}});
     FAIL() << "no error";
+  } catch (const UsageError& e) {
+    EXPECT_EQ(std::string(e.what()), "-o " + path("a.plf") + " and --visibility " + path("sub/../a.plf") +
+                                         " are the same file: one output would overwrite the other");
+  }
+}
+
+TEST_F(AtomicWriteTest, ReadersRefuseNonRegularFilesWithoutOpeningThem) {
+  ASSERT_EQ(::mkfifo(path("fifo.plv").c_str(), 0600), 0);
+  std::filesystem::create_directory(path("dir.plv"));
+  auto message = [](const std::string& file) {
+    try {
+      const MappedFile mapped(file);  // would block in open(2) on the FIFO without the check
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(path("fifo.plv")), path("fifo.plv") + ": not a regular file (a FIFO)");
+  EXPECT_EQ(message(path("dir.plv")), path("dir.plv") + ": not a regular file (a directory)");
+  EXPECT_EQ(message("/dev/null"), "/dev/null: not a regular file (a character device)");
+  EXPECT_NO_THROW(requireRegularFile(path("missing")));  // the reader's own open reports it
+  writeFileAtomically(path("regular"), std::string_view("x"));
+  EXPECT_NO_THROW(requireRegularFile(path("regular")));
+}
+
+// --- core/interrupt.h ---
+
+TEST_F(AtomicWriteTest, InterruptRemovesPendingTemporariesAndExitsWith128PlusTheSignal) {
+  for (const int signal : {SIGINT, SIGTERM}) {
+    const std::string target = path("out.plv");
+    const std::string marker = path("temporary-name");
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      // The child: what a command does while writing a large output.
+      installInterruptHandlers();
+      PendingFile pending(target);
+      std::ofstream(pending.temporaryPath()) << "half of the visibility field";
+      std::ofstream(marker) << pending.temporaryPath();
+      ::raise(signal);
+      ::_exit(0);  // not reached: the handler exits
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of handling it";
+    EXPECT_EQ(WEXITSTATUS(status), 128 + signal);
+    const std::string temporary = contents(marker);
+    EXPECT_FALSE(temporary.empty());
+    EXPECT_FALSE(std::filesystem::exists(temporary)) << "left behind: " << temporary;
+    EXPECT_FALSE(std::filesystem::exists(target));
+    std::filesystem::remove(marker);
+  }
+  EXPECT_TRUE(entries().empty());
+}
+
+// --- core/memory.h ---
+
+TEST(Memory, AvailableMemoryIsKnownAndTheGuardNamesEstimateAndFlags) {
+  const std::optional<uint64_t> available = availableMemoryBytes();
+  ASSERT_TRUE(available.has_value());  // Linux: /proc/meminfo
+  EXPECT_GT(*available, 0u);
+  EXPECT_GE(peakRssBytes(), 1u << 20);  // this test binary takes more than a megabyte
+  EXPECT_NO_THROW(requireMemory(1 << 20, "test", "lower --size"));
+  try {
+    requireMemory(uint64_t(1) << 62, "trace at 9x9", "lower --width/--height");
+    FAIL() << "4 EiB were accepted";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), "-o /no/such/dir/out.exr: directory '/no/such/dir' does not exist");
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("trace at 9x9: estimated memory 4294967296.00 GiB exceeds the ", 0), 0u) << m;
+    EXPECT_NE(m.find(" GiB available; lower --width/--height"), std::string::npos) << m;
   }
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Errors that reach the user. Every message says what was wrong and where (file, line,
 // element), e.g. "scene.obj:12: face index 40 out of range (30 vertices)". The command-line
-// front end prints what() to stderr and exits non-zero.
+// front end prints "plenoptic: error: " + what() to stderr and exits with one of the
+// statuses below (the same for every command; README "Commands").
 #include <fmt/format.h>
 
 #include <stdexcept>
@@ -9,15 +10,36 @@
 
 namespace pl {
 
+/// Exit statuses of the `plenoptic` program.
+enum ExitStatus : int {
+  kExitSuccess = 0,
+  kExitFailure = 1,  ///< the command ran into a problem: bad input file, output not writable, not enough memory, internal error
+  kExitUsage = 2,    ///< the command line is wrong: unknown flag, missing or malformed value, out of range, bad combination
+  // Interrupted by signal S: 128 + S (SIGINT 130, SIGTERM 143), as shells report it (core/interrupt.h).
+};
+
 class Error : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+/// An Error in how the program was called (flags, their values and combinations), found
+/// before any work is done: exit status kExitUsage instead of kExitFailure.
+class UsageError : public Error {
+ public:
+  using Error::Error;
 };
 
 /// Throws pl::Error with a fmt-formatted message.
 template <typename... Args>
 [[noreturn]] void fail(fmt::format_string<Args...> format, Args&&... args) {
   throw Error(fmt::format(format, std::forward<Args>(args)...));
+}
+
+/// Throws pl::UsageError with a fmt-formatted message.
+template <typename... Args>
+[[noreturn]] void failUsage(fmt::format_string<Args...> format, Args&&... args) {
+  throw UsageError(fmt::format(format, std::forward<Args>(args)...));
 }
 
 }  // namespace pl

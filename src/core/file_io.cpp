@@ -7,7 +7,9 @@
 #include <sys/mman.h>
 #endif
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -15,6 +17,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 
 namespace pl {
 namespace {
@@ -40,11 +43,60 @@ int syncPath(const std::string& path, bool directory) {
 
 }  // namespace
 
-void requireParentDirectory(const std::string& path, std::string_view option) {
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+std::string fileExtensionLower(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+void checkOutputPath(const std::string& path, std::initializer_list<std::string_view> extensions,
+                     std::string_view option) {
+  namespace fs = std::filesystem;
+  const std::string ext = fileExtensionLower(path);
+  if (extensions.size() > 0 && std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) {
+    std::string list;
+    size_t i = 0;
+    for (const std::string_view e : extensions)
+      list += fmt::format("{}{}", i++ == 0 ? "" : i == extensions.size() ? " or " : ", ", e);
+    failUsage("{} {}: expected a {} file name, not '{}'", option, path, list, ext.empty() ? "no extension" : ext);
+  }
   std::error_code ec;
-  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
-    fail("{} {}: directory '{}' does not exist", option, path, parent.string());
+  const fs::file_status status = fs::status(path, ec);
+  if (fs::is_directory(status)) fail("{} {}: is a directory", option, path);
+  if (fs::exists(status) && !fs::is_regular_file(status)) fail("{} {}: exists and is not a regular file", option, path);
+  const fs::path parentPath = fs::path(path).parent_path();
+  const std::string parent = parentPath.empty() ? std::string(".") : parentPath.string();
+  const fs::file_status parentStatus = fs::status(parent, ec);
+  if (!fs::exists(parentStatus)) fail("{} {}: directory '{}' does not exist", option, path, parent);
+  if (!fs::is_directory(parentStatus)) fail("{} {}: '{}' is not a directory", option, path, parent);
+  // access(2) also reports a read-only file system (EROFS), which permission bits do not show.
+  if (::access(parent.c_str(), W_OK | X_OK) != 0)
+    fail("{} {}: cannot write in directory '{}': {}", option, path, parent, std::strerror(errno));
+}
+
+void checkDistinctOutputs(std::initializer_list<OutputFlag> outputs) {
+  auto resolved = [](const std::string& path) {
+    std::error_code ec;
+    const std::filesystem::path p = std::filesystem::weakly_canonical(path, ec);
+    return ec ? std::filesystem::path(path).lexically_normal() : p;
+  };
+  for (auto a = outputs.begin(); a != outputs.end(); ++a)
+    for (auto b = a + 1; b != outputs.end(); ++b)
+      if (!a->path.empty() && !b->path.empty() && resolved(a->path) == resolved(b->path))
+        failUsage("{} {} and {} {} are the same file: one output would overwrite the other", a->option, a->path,
+                  b->option, b->path);
+}
+
+void requireRegularFile(const std::string& path) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0 || S_ISREG(info.st_mode)) return;
+  const char* kind = S_ISDIR(info.st_mode)    ? "a directory"
+                     : S_ISFIFO(info.st_mode) ? "a FIFO"
+                     : S_ISCHR(info.st_mode)  ? "a character device"
+                     : S_ISBLK(info.st_mode)  ? "a block device"
+                     : S_ISSOCK(info.st_mode) ? "a socket"
+                                              : "not a file";
+  fail("{}: not a regular file ({})", path, kind);
 }
 
 PendingFile::PendingFile(std::string target) : target_(std::move(target)) {
@@ -54,9 +106,13 @@ PendingFile::PendingFile(std::string target) : target_(std::move(target)) {
     fail("{}: cannot write: directory '{}' does not exist", target_, parent.string());
   if (std::filesystem::is_directory(target_, ec)) fail("{}: cannot write: is a directory", target_);
   temporary_ = temporaryPathBeside(target_);
+  interruptSlot_ = registerTemporaryFile(temporary_.c_str());
 }
 
-PendingFile::~PendingFile() { discard(); }
+PendingFile::~PendingFile() {
+  discard();
+  unregisterTemporaryFile(interruptSlot_);
+}
 
 void PendingFile::discard() noexcept {
   if (!open_) return;
@@ -114,6 +170,7 @@ void writeFileAtomically(const std::string& path, std::string_view bytes, FileSy
 }
 
 MappedFile::MappedFile(const std::string& path) {
+  requireRegularFile(path);
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) fail("{}: cannot open for reading: {}", path, std::strerror(errno));
   struct stat info {};

@@ -9,6 +9,7 @@
 // and pl::Error names the target and the problem.
 #include <cstddef>
 #include <functional>
+#include <initializer_list>
 #include <span>
 #include <string>
 #include <string_view>
@@ -22,15 +23,42 @@ enum class FileSync {
   durable,  ///< fsync the file before the rename and its directory after it: also survives a power loss (.plf)
 };
 
-/// Fails with "OPTION PATH: directory 'D' does not exist" unless the directory that would
-/// hold `path` exists (an empty parent means the working directory, which always does).
-/// `option` is the command-line flag the path came from, e.g. "-o" or "--stats".
-void requireParentDirectory(const std::string& path, std::string_view option);
+/// "name.EXR" → ".exr": the extension of `path`'s file name, lower-case ("" when it has none).
+std::string fileExtensionLower(const std::string& path);
+
+/// The one check of an output path, done by every command before any work starts. Fails
+/// with a message starting "OPTION PATH: " (`option` is the flag the path came from, e.g.
+/// "-o" or "--stats"):
+///   * pl::UsageError unless the extension is one of `extensions` (lower-case with the dot,
+///     e.g. {".plf"}; an empty list accepts any name);
+///   * pl::Error when the path is a directory or another non-regular file (FIFO, device),
+///     or its directory does not exist, is not a directory or is not writable.
+/// The target itself may exist: it is replaced by renaming a temporary over it.
+void checkOutputPath(const std::string& path, std::initializer_list<std::string_view> extensions,
+                     std::string_view option);
+
+/// An output path and the flag it came from.
+struct OutputFlag {
+  std::string_view option;
+  std::string path;  ///< empty = not given
+};
+/// pl::UsageError when two of the given outputs are the same file (compared after resolving
+/// ".", ".." and symbolic links), e.g. --visibility equal to -o, which would overwrite one
+/// output with the other.
+void checkDistinctOutputs(std::initializer_list<OutputFlag> outputs);
+
+/// Fails with "PATH: not a regular file (a FIFO)" (directory, device, socket) when `path`
+/// exists and is not a regular file (symbolic links are followed). Every reader calls it
+/// before opening its input: opening a FIFO would block until something writes to it, and a
+/// directory or device has no content to parse. A missing file passes (the reader's own
+/// open reports it).
+void requireRegularFile(const std::string& path);
 
 /// A temporary file beside `target` that becomes `target` on commit(); if it is never
-/// committed (error, exception), the destructor removes it. For writers whose output is
-/// produced over a longer time or by another process (e.g. ffmpeg); the simple cases use
-/// writeFileAtomically below.
+/// committed (error, exception), the destructor removes it, and if the program is
+/// interrupted (SIGINT, SIGTERM), the interruption handler does (core/interrupt.h). For
+/// writers whose output is produced over a longer time or by another process (e.g. ffmpeg);
+/// the simple cases use writeFileAtomically below.
 class PendingFile {
  public:
   /// Checks that target's directory exists and that target is not a directory (pl::Error
@@ -53,6 +81,7 @@ class PendingFile {
  private:
   std::string target_;
   std::string temporary_;
+  size_t interruptSlot_;  ///< temporary_'s registration for removal on Ctrl-C (core/interrupt.h)
   bool open_ = true;  ///< not yet committed or discarded
 };
 

@@ -8,9 +8,7 @@
 #include <tbb/task_scheduler_observer.h>
 #include <xmmintrin.h>
 
-#include <fstream>
 #include <optional>
-#include <string>
 
 namespace pl {
 
@@ -46,15 +44,6 @@ void parallelForRange(uint64_t count, uint64_t grain, const std::function<void(u
   if (count == 0) return;
   tbb::parallel_for(tbb::blocked_range<uint64_t>(0, count, grain ? grain : 1),
                     [&](const tbb::blocked_range<uint64_t>& r) { body(r.begin(), r.end()); });
-}
-
-uint64_t peakRssBytes() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) * 1024ull;  // reported in kB
-  }
-  return 0;
 }
 
 }  // namespace pl

@@ -37,7 +37,4 @@ inline void parallelFor(uint64_t count, const std::function<void(uint64_t)>& bod
   });
 }
 
-/// Peak resident set size of this process in bytes (from /proc/self/status VmHWM).
-uint64_t peakRssBytes();
-
 }  // namespace pl

@@ -30,13 +30,6 @@ float linearToSrgb(float linear) {
   return 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
 }
 
-std::string fileExtensionLower(const std::string& path) {
-  const std::filesystem::path p(path);
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
-
 bool isHdrExtension(const std::string& path) {
   const std::string ext = fileExtensionLower(path);
   return ext == ".exr" || ext == ".hdr" || ext == ".pfm";
@@ -69,6 +62,7 @@ Image readImage(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail("{}: no such file", path);
   if (std::filesystem::is_directory(path, ec)) fail("{}: is a directory, not an image file", path);
+  requireRegularFile(path);
   const std::string ext = fileExtensionLower(path);
   if (ext == ".exr") return detail::readExr(path);
   if (ext == ".hdr") return detail::readRadianceHdr(path);

@@ -15,6 +15,7 @@
 // failed write never leaves a half-written file.
 //
 // Tone mapping (Image → Image8) is in image/tonemap.h, error metrics in image/compare.h.
+#include "core/file_io.h"  // fileExtensionLower
 #include "core/math.h"
 
 #include <cstdint>
@@ -70,7 +71,5 @@ void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOp
 void writePng(const std::string& path, const Image8& image);
 /// True for the extensions writeHdrImage accepts (.exr, .hdr, .pfm; case-insensitive).
 bool isHdrExtension(const std::string& path);
-/// The file's extension, lower-case, with the dot (".exr"); empty when there is none.
-std::string fileExtensionLower(const std::string& path);
 
 }  // namespace pl

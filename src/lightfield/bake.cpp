@@ -6,6 +6,7 @@
 
 #include "accel/accel.h"
 #include "core/error.h"
+#include "core/memory.h"
 #include "core/parallel.h"
 #include "lightfield/parameterisation.h"
 #include "lightfield/propagation.h"
@@ -46,6 +47,13 @@ BakeSettings bakePreset(const std::string& name) {
   return s;
 }
 
+uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings) {
+  const uint64_t directions = uint64_t(gatherGridSide(settings.gatherDirections)) * gatherGridSide(settings.gatherDirections);
+  const uint64_t visibility = tixels * (directions * sizeof(VisibilityEntry) + sizeof(uint64_t));
+  constexpr uint64_t kQuadBytes = 64, kChangeBytes = 4, kValueArrays = 3;
+  return visibility + values * kValueArrays * sizeof(Rgb) + tixels * (kQuadBytes + kChangeBytes);
+}
+
 std::vector<std::string> bakePresetNames() { return {"draft", "default", "high"}; }
 
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options) {
@@ -59,6 +67,7 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   const Accel accel(lf.scene);
   const Parameterisation param = buildParameterisation(lf.scene, settings);
   const uint64_t hash = visibilityHash(lf.scene, param, settings);
+  if (options.checkMemory) options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings));
 
   VisibilityField visibility;
   bool reused = false;

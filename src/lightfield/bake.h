@@ -29,7 +29,18 @@ struct BakeOptions {
   bool reuseVisibility = false;
   /// Receives one-line notes for the user (reuse decisions, rates). May be empty.
   std::function<void(const std::string&)> log;
+  /// Called once the parameterisation is known, before the visibility field and the values
+  /// are allocated, with bakeMemoryEstimate() of this bake; may throw to refuse it (the
+  /// command line calls requireMemory, core/memory.h). May be empty.
+  std::function<void(uint64_t bytes)> checkMemory;
 };
+
+/// Bytes of the bake's large arrays for this parameterisation and these settings: the
+/// visibility field (an 8-byte entry per tixel and gather direction, plus a 64-bit offset per
+/// tixel) and, during propagation, three arrays of RGB values (current, first shot, previous
+/// iteration) and a 64-byte transport quad plus a 4-byte change per tixel. A lower bound: the
+/// scene, the BVH and the field's extra records (mirror chains, back sides) come on top.
+uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings);
 
 /// Bakes `scene` (moved into the result). Throws pl::Error on failures.
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options = {});

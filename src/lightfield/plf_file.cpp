@@ -750,6 +750,7 @@ uint64_t headerHash(const Header& header, const std::vector<SectionEntry>& table
 class PlfReader {
  public:
   explicit PlfReader(const std::string& path) : path_(path) {
+    requireRegularFile(path);  // before open(2), which would block on a FIFO
     file_.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (file_.fd < 0) fail("{}: cannot open light field: {}", path, errnoText());
     struct stat st {};

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <string>
+#include <variant>
 
 #include "accel/accel.h"
 #include "core/error.h"
@@ -183,6 +185,49 @@ F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* 
     }
   }
   return sum;
+}
+
+/// The scene's brightest emitter, for messages: "material 'NAME' (emission R G B)" or
+/// "point light I (intensity R G B)"; empty when nothing emits.
+std::string brightestEmitter(const Scene& scene) {
+  std::string name;
+  float brightest = 0.0f;
+  auto consider = [&](const Rgb& value, const std::string& what, const char* quantity) {
+    if (!(maxComponent(value) > brightest)) return;
+    brightest = maxComponent(value);
+    name = fmt::format("{} ({} {:.3g} {:.3g} {:.3g})", what, quantity, value.r, value.g, value.b);
+  };
+  for (const Material& m : scene.materials) consider(m.emission, fmt::format("material '{}'", m.name), "emission");
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    std::visit(
+        [&](const auto& light) {
+          using T = std::decay_t<decltype(light)>;
+          if constexpr (std::is_same_v<T, PointLight>) consider(light.intensity, fmt::format("point light {}", i), "intensity");
+          else if constexpr (std::is_same_v<T, SpotLight>) consider(light.intensity, fmt::format("spot light {}", i), "intensity");
+          else consider(light.irradiance, fmt::format("directional light {}", i), "irradiance");
+        },
+        scene.lights[i]);
+  return name;
+}
+
+/// Fails when `values` holds a NaN or an infinity (32-bit floats overflowed: an emission or
+/// light so strong that sums of it exceed 3.4e38), naming the first chart and material where
+/// one is, the stage, and the brightest emitter. Without this check the bake would finish,
+/// write the non-finite values and a NaN residual, and the file's own reader refuse it.
+void requireFiniteValues(const Scene& scene, const Parameterisation& param, const std::vector<Rgb>& values,
+                         const std::string& stage) {
+  for (size_t ci = 0; ci < param.charts.size(); ++ci) {
+    const Chart& c = param.charts[ci];
+    const uint64_t count = c.kind == ChartKind::Specular ? 0 : c.tixelCount() * c.valuesPerTixel();
+    for (uint64_t v = c.firstValue; v < c.firstValue + count; ++v) {
+      if (isFinite(values[v])) continue;
+      const std::string emitter = brightestEmitter(scene);
+      fail("{}: light propagation overflowed {}: non-finite radiance in chart {} (material '{}'){}; "
+           "scale the emission down",
+           scene.sourcePath, stage, ci, scene.materials[c.material].name,
+           emitter.empty() ? std::string() : fmt::format("; the brightest emitter is {}", emitter));
+    }
+  }
 }
 
 }  // namespace
@@ -446,6 +491,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   result.firstShotSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - waitSeconds;
 
   // ---- Iteration ---------------------------------------------------------------------------
+  requireFiniteValues(scene, param, direct, "in the first shot (direct light)");
   std::vector<Rgb> current = direct;
   // Σ over tixels of perTixel(g, chart, first value) · coverage · tixel area, summed per chart and
   // then over charts in chart order (deterministic whatever the thread timing).
@@ -627,6 +673,11 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
       updateTransport(begin, end);
     }
     const double power = totalPower(current);
+    if (!std::isfinite(power)) {
+      requireFiniteValues(scene, param, current, fmt::format("in iteration {}", iteration));
+      fail("{}: light propagation overflowed in iteration {}: the total power is not finite; scale the emission down",
+           scene.sourcePath, iteration);
+    }
     const double changed = areaWeightedSum([&](uint64_t g, const Chart&, uint64_t) { return double(change[g]); });
     const double l1Change = power > 0.0 ? changed / power : 0.0;
     if (iteration > 2 && l1Change > previousL1Change) omega = 1.0f;
@@ -652,6 +703,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     if (isBlack(le)) continue;
     for (uint64_t v = 0; v < c.tixelCount() * c.valuesPerTixel(); ++v) current[c.firstValue + v] += le;
   }
+  requireFiniteValues(scene, param, current, "when adding the glossy charts' emission");
   result.values = std::move(current);
   result.shadowRays = shadowRays.load();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - waitSeconds;

@@ -175,7 +175,7 @@ TEST_F(RenderCliTest, RefusesBadInputWithoutWritingAnything) {
 
   // An output type no writer knows, refused before any work.
   EXPECT_NE(run("render " + path("quad.plf") + " -o " + path("c.txt"), nullptr, &err), 0);
-  EXPECT_NE(err.find("unknown image type"), std::string::npos) << err;
+  EXPECT_NE(err.find(": expected a .exr, .hdr, .pfm or .png file name, not '.txt'"), std::string::npos) << err;
   EXPECT_FALSE(fs::exists(path("c.txt")));
 
   // A camera the file does not have.

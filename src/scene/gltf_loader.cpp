@@ -28,6 +28,7 @@
 //    reverse: I [W/sr] = color · intensity[cd] / 683 and E [W/m²] = color · intensity[lx] / 683.
 //    `range` is ignored (physically lights have no cut-off).
 #include "core/error.h"
+#include "core/file_io.h"
 #include "scene/loaders.h"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -392,6 +393,7 @@ void visitNode(GltfContext& ctx, int nodeIndex, const Mat4& parent, int depth) {
 }  // namespace
 
 Scene loadGltf(const std::string& path) {
+  requireRegularFile(path);
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
   std::string error, warning;

@@ -1,5 +1,6 @@
 // loadScene(): picks the loader by name or file extension.
 #include "core/error.h"
+#include "core/file_io.h"
 #include "scene/loaders.h"
 #include "scene/scene.h"
 
@@ -44,6 +45,7 @@ Scene loadScene(const std::string& pathOrName) {
   const fs::path path(pathOrName);
   if (!fs::exists(path, ec)) fail("{}: no such file", pathOrName);
   if (fs::is_directory(path, ec)) fail("{}: is a directory, not a scene file", pathOrName);
+  requireRegularFile(pathOrName);
 
   std::string extension = path.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),

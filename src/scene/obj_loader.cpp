@@ -17,6 +17,7 @@
 //    MTL file, PNG/JPG decoded from sRGB by readImage().
 //  * A missing .mtl file: warning, and its materials become a grey Lambert (albedo 0.8).
 #include "core/error.h"
+#include "core/file_io.h"
 #include "scene/loaders.h"
 
 #include <spdlog/spdlog.h>
@@ -62,6 +63,7 @@ bool parseInt(const std::string& text, long& value) {
 
 /// Reads a text file into lines, stripping a trailing '\r' (CRLF files) and comments.
 std::vector<std::string> readLines(const std::string& path) {
+  requireRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) fail("{}: cannot open file", path);
   std::vector<std::string> lines;

@@ -135,6 +135,14 @@ void Scene::finalize() {
     if (!isFinite(material.emission) || material.emission.r < 0.0f || material.emission.g < 0.0f ||
         material.emission.b < 0.0f)
       fail("{}: material '{}' has an invalid emission {}", src, material.name, vecString(material.emission));
+    // Radiance sums (irradiance = π·L over many tixels, pixel sums over many samples) are
+    // 32-bit floats: an emission near FLT_MAX (3.4e38) overflows them into infinities and
+    // NaN. 1e12 W·sr⁻¹·m⁻² is 5·10⁴ times the sun's disc (2·10⁷) and leaves 26 orders of
+    // magnitude of headroom.
+    constexpr float kMaxEmission = 1e12f;
+    if (maxComponent(material.emission) > kMaxEmission)
+      fail("{}: material '{}' has an emission {} above {:g} W/(sr m^2), too large to compute with", src,
+           material.name, vecString(material.emission), kMaxEmission);
     validateMaterial(material, sourcePath);
     if (material.albedoTexture < -1 || material.albedoTexture >= int(textures.size()))
       fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name,
