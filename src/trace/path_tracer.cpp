@@ -112,6 +112,17 @@ struct PixelAccumulator {
   }
 };
 
+/// Whether world direction w (local wLocal in the shading frame) is on a side of the surface
+/// the BSDF may use: for a reflecting BSDF (frame turned to the viewer's side) above the
+/// geometric surface; for a transmitting one (frame unflipped, bsdf.h) on the same side of the
+/// geometric and the shading normal, so that interpolated normals cannot send a path through
+/// the surface on the wrong side.
+bool sameSideOfSurface(const Vec3& w, const Vec3& wLocal, const Vec3& geometricNormal, const Bsdf& bsdf) {
+  const float cosGeometric = glm::dot(w, geometricNormal);
+  if (!hasTransmission(bsdf)) return cosGeometric > 0.0f;
+  return cosGeometric * wLocal.z > 0.0f;
+}
+
 /// Light-selection weights only need to be positive and finite: clamp absurdly bright
 /// emitters (whose estimated power overflows float) to the largest float instead of letting
 /// an infinity turn the whole distribution into NaNs.
@@ -276,12 +287,13 @@ Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNor
     }
   }
 
-  // BSDFs here reflect only: a direction below the geometric surface cannot receive light
-  // (this also stops light leaking through when shading normals bend over the horizon).
-  if (glm::dot(wi, geometricNormal) <= 0.0f) return Rgb(0.0f);
+  // A reflecting BSDF receives light only from above the geometric surface (this also stops
+  // light leaking through when shading normals bend over the horizon); a transmitting one
+  // from the side where the shading frame puts wi (both normals agree on it).
   const Vec3 wiLocal = frame.toLocal(wi);
+  if (!sameSideOfSurface(wi, wiLocal, geometricNormal, bsdf)) return Rgb(0.0f);
   const Rgb f = eval(bsdf, woLocal, wiLocal);
-  const float cosIn = wiLocal.z;
+  const float cosIn = std::abs(wiLocal.z);
   if (isBlack(f) || !(cosIn > 0.0f)) return Rgb(0.0f);
 
   const Vec3 origin = offsetRayOrigin(position, geometricNormal, wi);
@@ -306,6 +318,10 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
   // ray, after a delta bounce, and always with the Bsdf strategy.
   bool countEmissionFully = true;
   float previousBsdfPdf = 0.0f;  // solid-angle density with which the current ray was sampled
+  // Product of η'² over the refractions so far: the throughput's radiance scaling across
+  // interfaces (bsdf.h), which Russian roulette must not mistake for absorption (pbrt-v4's
+  // etaScale). After entering glass the throughput is 1/η² of what it will be on leaving.
+  float etaScale = 1.0f;
   const bool useMis = settings.strategy == TraceStrategy::Mis;
   const bool bsdfOnly = settings.strategy == TraceStrategy::BsdfOnly;
 
@@ -329,6 +345,11 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
     const Material& material = scene.materials[surface.material];
     const Vec3 wo = -ray.direction;
     const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
+    // Beer–Lambert: a segment that ends on the inside (back) of a dielectric ran through its
+    // interior (the front side of a closed mesh is its outside), losing exp(−σa t).
+    if (const auto* glass = std::get_if<DielectricBsdf>(&material.bsdf); glass && cosWoGeometric < 0.0f) {
+      if (!isBlack(glass->absorption)) throughput *= glm::exp(-glass->absorption * hit.t);
+    }
 
     if (material.isEmissive() && (cosWoGeometric > 0.0f || material.twoSidedEmission)) {
       if (countEmissionFully) {
@@ -349,16 +370,18 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
     }
     if (depth >= settings.maxDepth) break;
 
-    // Two-sided shading: both normals face the side the ray came from.
+    // Two-sided shading: both normals face the side the ray came from — except for
+    // transmitting BSDFs, whose frame keeps +z on the outside (bsdf.h).
+    const Bsdf bsdf = bsdfAt(scene, surface);
     Vec3 geometricNormal = surface.geometricNormal;
     Vec3 shadingNormal = surface.shadingNormal;
-    if (cosWoGeometric < 0.0f) {
+    if (cosWoGeometric < 0.0f && !hasTransmission(bsdf)) {
       geometricNormal = -geometricNormal;
       shadingNormal = -shadingNormal;
     }
-    const Bsdf bsdf = bsdfAt(scene, surface);
     const Frame frame = Frame::fromNormal(shadingNormal);
     const Vec3 woLocal = frame.toLocal(wo);
+    if (!sameSideOfSurface(wo, woLocal, geometricNormal, bsdf) && hasTransmission(bsdf)) break;
 
     if (!isDelta(bsdf)) {
       result += throughput *
@@ -369,9 +392,13 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
     const std::optional<BsdfSample> s = sample(bsdf, woLocal, u);
     if (!s) break;
     const Vec3 wi = frame.toWorld(s->wi);
-    if (glm::dot(wi, geometricNormal) <= 0.0f) break;  // reflection only (see directLight)
+    if (!sameSideOfSurface(wi, s->wi, geometricNormal, bsdf)) break;  // see directLight
     throughput *= s->weight;
     if (isBlack(throughput)) break;
+    if (const auto* glass = std::get_if<DielectricBsdf>(&bsdf); glass && !glass->thin && woLocal.z * s->wi.z < 0.0f) {
+      const float etap = woLocal.z > 0.0f ? glass->ior : 1.0f / glass->ior;  // η(wi side) / η(wo side)
+      etaScale *= etap * etap;
+    }
     countEmissionFully = s->delta || bsdfOnly;
     previousBsdfPdf = s->pdf;
     ray.origin = offsetRayOrigin(surface.position, geometricNormal, wi);
@@ -381,7 +408,7 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
 
     // Russian roulette (unbiased): continue with probability q, divide the throughput by q.
     if (depth + 1 >= settings.rouletteDepth) {
-      const float q = maxComponent(throughput);
+      const float q = maxComponent(throughput) * etaScale;
       if (q < 1.0f) {
         if (rng.uniform() >= q) break;
         throughput /= q;
