@@ -143,6 +143,7 @@ struct PathTracer::Impl {
   std::vector<uint32_t> meshTriangleBase;  ///< first global triangle index of each mesh
   std::vector<int32_t> entryOfTriangle;    ///< light entry of each global triangle, or −1
   int32_t environmentEntry = -1;
+  bool hasThinGlass = false;  ///< shadow rays pass thin glass sheets (shadowTransmittance)
 
   Impl(const Scene& s, const Accel& a);
 
@@ -160,6 +161,31 @@ struct PathTracer::Impl {
     return accel.occluded(shadow);
   }
 
+  /// The fraction of light that travels unscattered from origin along `direction` for tMax:
+  /// 0 when something blocks it, else the product of the straight transmittances T' of the
+  /// thin glass sheets it crosses (bsdf.h). Other glass blocks it (next-event estimation does
+  /// not refract). Scenes without thin glass take one occlusion ray.
+  Rgb shadowTransmittance(Vec3 origin, const Vec3& direction, float tMax, Counters& counters) const {
+    if (!hasThinGlass) return occluded(origin, direction, tMax, counters) ? Rgb(0.0f) : Rgb(1.0f);
+    Rgb transmittance(1.0f);
+    for (;;) {
+      ++counters.rays;
+      Ray shadow{origin, direction, 0.0f, tMax};
+      RayHit hit;
+      if (!accel.intersect(shadow, hit)) return transmittance;
+      const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+      const auto* sheet = std::get_if<DielectricBsdf>(&scene.materials[surface.material].bsdf);
+      if (!sheet || !sheet->thin) return Rgb(0.0f);
+      Rgb reflectance, straight;
+      thinSheetReflectanceTransmittance(*sheet, glm::dot(surface.shadingNormal, direction), reflectance, straight);
+      transmittance *= straight;
+      if (isBlack(transmittance)) return transmittance;
+      origin = offsetRayOrigin(surface.position, surface.geometricNormal, direction);
+      tMax = std::isfinite(tMax) ? tMax - glm::dot(origin - shadow.origin, direction) : tMax;
+      if (!(tMax > 0.0f)) return transmittance;
+    }
+  }
+
   Rgb directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame, const Vec3& woLocal,
                   const Bsdf& bsdf, const TraceSettings& settings, Pcg32& rng, Counters& counters) const;
   Rgb radiance(Ray ray, Pcg32& rng, const TraceSettings& settings, Counters& counters) const;
@@ -169,6 +195,8 @@ struct PathTracer::Impl {
 
 PathTracer::Impl::Impl(const Scene& s, const Accel& a) : scene(s), accel(a) {
   environment = EnvironmentLight(scene.environment.constant, scene.environment.map);
+  for (const Material& m : scene.materials)
+    if (const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf); glass && glass->thin) hasThinGlass = true;
   Vec3 lo, hi;
   scene.bounds(lo, hi);
   const float sceneRadius = std::max(0.5f * glm::length(hi - lo), 1e-6f);
@@ -297,16 +325,18 @@ Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNor
   if (isBlack(f) || !(cosIn > 0.0f)) return Rgb(0.0f);
 
   const Vec3 origin = offsetRayOrigin(position, geometricNormal, wi);
+  Rgb visible;
   if (infinite) {
-    if (occluded(origin, wi, kInfinity, counters)) return Rgb(0.0f);
+    visible = shadowTransmittance(origin, wi, kInfinity, counters);
   } else {
     const Vec3 toTarget = shadowTarget - origin;
     const float distance = glm::length(toTarget);
     if (!(distance > 0.0f)) return Rgb(0.0f);
-    if (occluded(origin, toTarget / distance, distance, counters)) return Rgb(0.0f);
+    visible = shadowTransmittance(origin, toTarget / distance, distance, counters);
   }
+  if (isBlack(visible)) return Rgb(0.0f);
 
-  const Rgb unweighted = f * cosIn * incident / lightPdf;
+  const Rgb unweighted = visible * f * cosIn * incident / lightPdf;
   if (isDeltaLight || settings.strategy != TraceStrategy::Mis) return unweighted;
   return unweighted * powerHeuristic(lightPdf, pdf(bsdf, woLocal, wiLocal));
 }
@@ -318,6 +348,10 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
   // ray, after a delta bounce, and always with the Bsdf strategy.
   bool countEmissionFully = true;
   float previousBsdfPdf = 0.0f;  // solid-angle density with which the current ray was sampled
+  // Distance travelled since the vertex that sampled the current direction: straight passes
+  // through thin glass keep the direction (and that vertex's MIS weights, since next-event
+  // estimation there sees through the sheets too), so an emitter's density is measured from it.
+  float distanceBefore = 0.0f;
   // Product of η'² over the refractions so far: the throughput's radiance scaling across
   // interfaces (bsdf.h), which Russian roulette must not mistake for absorption (pbrt-v4's
   // etaScale). After entering glass the throughput is 1/η² of what it will be on leaving.
@@ -359,10 +393,12 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
         if (entry >= 0) {
           const EmissiveTriangle& e = triangles[entries[static_cast<size_t>(entry)].index];
           // The density NEE would have had for this point, in solid angle at the previous
-          // vertex: P(select) · (1/A) · t² / |cos θlight|.
+          // vertex: P(select) · (1/A) · t² / |cos θlight| (t from that vertex, through any
+          // thin glass crossed straight).
           const float cosLight = std::abs(cosWoGeometric);
+          const float distance = distanceBefore + hit.t;
           const float lightPdf = cosLight > 0.0f
-                                     ? selectionProbability(entry) * hit.t * hit.t / (cosLight * e.area)
+                                     ? selectionProbability(entry) * distance * distance / (cosLight * e.area)
                                      : 0.0f;
           result += throughput * material.emission * powerHeuristic(previousBsdfPdf, lightPdf);
         }
@@ -399,8 +435,14 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
       const float etap = woLocal.z > 0.0f ? glass->ior : 1.0f / glass->ior;  // η(wi side) / η(wo side)
       etaScale *= etap * etap;
     }
-    countEmissionFully = s->delta || bsdfOnly;
-    previousBsdfPdf = s->pdf;
+    const auto* sheet = std::get_if<DielectricBsdf>(&bsdf);
+    if (sheet && sheet->thin && woLocal.z * s->wi.z < 0.0f) {
+      distanceBefore += hit.t;  // straight through: the previous vertex's sample continues
+    } else {
+      countEmissionFully = s->delta || bsdfOnly;
+      previousBsdfPdf = s->pdf;
+      distanceBefore = 0.0f;
+    }
     ray.origin = offsetRayOrigin(surface.position, geometricNormal, wi);
     ray.direction = wi;
     ray.tMin = 0.0f;
