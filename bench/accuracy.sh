@@ -56,8 +56,9 @@ for f in CornellBox-Glossy.obj CornellBox-Mirror.obj CornellBox-Original.obj; do
 done
 mkdir -p "$workdir"
 
-all_names=(cornell glossy mirror)
-all_scenes=(cornell "$scenes_dir/CornellBox-Glossy.obj" "$scenes_dir/CornellBox-Mirror.obj")
+all_names=(cornell glossy mirror sphere water)
+all_scenes=(cornell "$scenes_dir/CornellBox-Glossy.obj" "$scenes_dir/CornellBox-Mirror.obj"
+            "$scenes_dir/CornellBox-Sphere.obj" "$scenes_dir/CornellBox-Water.obj")
 names=()
 scenes=()
 for i in "${!all_names[@]}"; do

@@ -306,6 +306,157 @@ std::optional<Vec3> sampleGgxDirection(const GgxBsdf& b, const Vec3& wo, Vec2 u)
   return reflectAbout(wo, sampleGgxVisibleNormal(clampAlpha(b.alpha), wo, u));
 }
 
+// ---------------------------------------------------------------------------------------
+// Dielectrics. Local +z is the outside; η = n_inside / n_outside. For a pair (wo, wi) on
+// opposite sides, η' = η(wi side) / η(wo side) = η when wo is outside, 1/η when inside.
+//
+// Smooth: f = F δ(wi − mirror(wo))/|cos θi| + t (1 − F)/η'² δ(wi − refract(wo))/|cos θi|.
+// The 1/η'² is the radiance scaling across the interface (radiance per solid angle is
+// compressed by η'² on entering a denser medium); it makes f obey f(wo, wi)/η(wo)² =
+// f(wi, wo)/η(wi)² once the Jacobian of refraction, η(wo)² cos θo dωo = η(wi)² cos θi dωi,
+// is accounted for in the deltas.
+//
+// Rough (Walter et al. 2007, in pbrt-v4's form): with the generalised half vector
+// wm = normalize(η' wi + wo) turned to +z,
+//   reflection:    f = F(wo·wm) D(wm) G2(wo, wi) / |4 cos θo cos θi|
+//   transmission:  f = t (1 − F(wo·wm)) D(wm) G2(wo, wi) |wi·wm| |wo·wm|
+//                      / (|cos θi cos θo| (wi·wm + wo·wm/η')² η'²)
+// zero when wm is back-facing to wo or wi (wo·wm and cos θo of different signs, or wi's).
+// Sampling: the lobe first, reflection with the fixed probability P_R(wo) (the macro-surface
+// Fresnel F(cos θo) clamped to [0.05, 0.95], so that both lobes keep support where the
+// micro-surface sees them even under total internal reflection), then a visible normal wm
+// with density D_wo(wm) = G1(wo) |wo·wm| D(wm)/|cos θo| (Heitz 2018, for wo turned to +z),
+// then wi = reflect(wo, wm) or refract(wo, wm). Solid-angle densities:
+//   reflection:    P_R D_wo(wm) / (4 |wo·wm|)
+//   transmission:  (1 − P_R) D_wo(wm) |wi·wm| / (wi·wm + wo·wm/η')²
+// (the Jacobians of the reflected and refracted directions with respect to wm). A sample
+// that leaves its hemisphere or meets total internal reflection at the microfacet is
+// rejected, so pdf() is exactly the density of what sample() returns.
+
+inline float sqr(float x) { return x * x; }
+
+/// Refraction of w (pointing away from the surface) through the interface with normal n,
+/// where `eta` is the index ratio of the far side to w's side and w·n > 0. False under total
+/// internal reflection.
+bool refractDirection(const Vec3& w, const Vec3& n, float eta, Vec3& refracted) {
+  const float cosI = glm::dot(n, w);
+  const float sin2T = std::max(0.0f, 1.0f - cosI * cosI) / (eta * eta);
+  if (sin2T >= 1.0f) return false;
+  const float cosT = std::sqrt(1.0f - sin2T);
+  refracted = -w / eta + (cosI / eta - cosT) * n;
+  return true;
+}
+
+/// η' for a transmission with wo on the side given by cosO.
+inline float relativeEta(const DielectricBsdf& b, float cosO) { return cosO > 0.0f ? b.ior : 1.0f / b.ior; }
+
+float roughReflectProbability(const DielectricBsdf& b, const Vec3& wo) {
+  return std::clamp(fresnelDielectric(wo.z, b.ior), 0.05f, 0.95f);
+}
+
+/// The generalised half vector of (wo, wi) turned to +z, with η' (1 for reflection). False
+/// when it is undefined or back-facing to wo or wi.
+bool dielectricHalfVector(const DielectricBsdf& b, const Vec3& wo, const Vec3& wi, Vec3& wm, float& etap) {
+  const float cosO = wo.z, cosI = wi.z;
+  if (cosO == 0.0f || cosI == 0.0f) return false;
+  etap = cosO * cosI > 0.0f ? 1.0f : relativeEta(b, cosO);
+  wm = wi * etap + wo;
+  const float len2 = glm::dot(wm, wm);
+  if (!(len2 > 0.0f)) return false;
+  wm /= std::sqrt(len2);
+  if (wm.z < 0.0f) wm = -wm;
+  return glm::dot(wm, wi) * cosI > 0.0f && glm::dot(wm, wo) * cosO > 0.0f;
+}
+
+Rgb evalRoughDielectric(const DielectricBsdf& b, const Vec3& wo, const Vec3& wi) {
+  Vec3 wm;
+  float etap;
+  if (!dielectricHalfVector(b, wo, wi, wm, etap)) return Rgb(0.0f);
+  const float alpha = clampAlpha(b.alpha);
+  const float dg = ggxD(alpha, wm) / (1.0f + ggxLambda(alpha, wo) + ggxLambda(alpha, wi));
+  if (wo.z * wi.z > 0.0f) return Rgb(fresnelDielectric(glm::dot(wo, wm), b.ior) * dg / std::abs(4.0f * wo.z * wi.z));
+  const float denom = sqr(glm::dot(wi, wm) + glm::dot(wo, wm) / etap) * wi.z * wo.z;
+  const float ft = fresnelDielectricTransmittance(glm::dot(wo, wm), b.ior) * dg * std::abs(glm::dot(wi, wm) * glm::dot(wo, wm) / denom) / (etap * etap);
+  return b.transmittance * ft;
+}
+
+float pdfRoughDielectric(const DielectricBsdf& b, const Vec3& wo, const Vec3& wi) {
+  Vec3 wm;
+  float etap;
+  if (!dielectricHalfVector(b, wo, wi, wm, etap)) return 0.0f;
+  const float alpha = clampAlpha(b.alpha);
+  const float woDotM = std::abs(glm::dot(wo, wm));
+  const float visibleNormal = ggxD(alpha, wm) * woDotM / ((1.0f + ggxLambda(alpha, wo)) * std::abs(wo.z));
+  const float pR = roughReflectProbability(b, wo);
+  if (wo.z * wi.z > 0.0f) return pR * visibleNormal / (4.0f * woDotM);
+  return (1.0f - pR) * visibleNormal * std::abs(glm::dot(wi, wm)) / sqr(glm::dot(wi, wm) + glm::dot(wo, wm) / etap);
+}
+
+std::optional<BsdfSample> sampleRoughDielectric(const DielectricBsdf& b, const Vec3& wo, Vec2 u) {
+  const bool reflectLobe = chooseFirst(roughReflectProbability(b, wo), u.x);
+  const Vec3 woUp = wo.z < 0.0f ? -wo : wo;
+  const Vec3 wm = sampleGgxVisibleNormal(clampAlpha(b.alpha), woUp, u);
+  Vec3 wi;
+  if (reflectLobe) {
+    wi = reflectAbout(wo, wm);
+    if (!(wi.z * wo.z > 0.0f)) return std::nullopt;
+  } else {
+    // wo·wm has the sign of cos θo (wm is a visible normal of woUp).
+    const bool outside = glm::dot(wo, wm) > 0.0f;
+    if (!refractDirection(wo, outside ? wm : -wm, outside ? b.ior : 1.0f / b.ior, wi)) return std::nullopt;
+    if (!(wi.z * wo.z < 0.0f)) return std::nullopt;
+  }
+  if (!isFinite(wi)) return std::nullopt;
+  BsdfSample s;
+  s.wi = glm::normalize(wi);
+  s.pdf = pdfRoughDielectric(b, wo, s.wi);
+  if (!(s.pdf > 0.0f)) return std::nullopt;
+  s.f = evalRoughDielectric(b, wo, s.wi);
+  s.weight = s.f * (std::abs(s.wi.z) / s.pdf);
+  return s;
+}
+
+std::optional<BsdfSample> sampleSmoothDielectric(const DielectricBsdf& b, const Vec3& wo, Vec2 u) {
+  BsdfSample s;
+  s.delta = true;
+  if (b.thin) {
+    Rgb r, t;
+    thinSheetReflectanceTransmittance(b, wo.z, r, t);
+    const float lr = std::max(0.0f, luminance(r)), lt = std::max(0.0f, luminance(t));
+    if (!(lr + lt > 0.0f)) return std::nullopt;
+    const float pR = lr / (lr + lt);
+    if (u.x < pR) {
+      s.wi = mirrorLocal(wo);
+      s.weight = r / pR;
+    } else {
+      s.wi = -wo;
+      s.weight = t / (1.0f - pR);
+    }
+    return s;
+  }
+  const float F = fresnelDielectric(wo.z, b.ior);
+  if (u.x < F) {
+    s.wi = mirrorLocal(wo);
+    s.weight = Rgb(1.0f);  // F / F
+    return s;
+  }
+  const float etap = relativeEta(b, wo.z);
+  const Vec3 n(0.0f, 0.0f, wo.z > 0.0f ? 1.0f : -1.0f);
+  if (!refractDirection(wo, n, etap, s.wi)) return std::nullopt;  // F = 1 there: not reached
+  s.weight = b.transmittance / (etap * etap);  // t (1 − F) / η'² / (1 − F)
+  return s;
+}
+
+Rgb dielectricAlbedo(const DielectricBsdf& b, const Vec3& wo) {
+  if (b.thin) {
+    Rgb r, t;
+    thinSheetReflectanceTransmittance(b, wo.z, r, t);
+    return r + t;
+  }
+  const float F = fresnelDielectric(wo.z, b.ior), etap = relativeEta(b, wo.z);
+  return Rgb(F) + b.transmittance * ((1.0f - F) / (etap * etap));
+}
+
 /// Shared tail of the non-delta samplers: reject, evaluate f and pdf, form the weight.
 std::optional<BsdfSample> finishSample(const Bsdf& bsdf, const Vec3& wo, const std::optional<Vec3>& wi) {
   if (!wi || wi->z <= 0.0f || !isFinite(*wi)) return std::nullopt;
@@ -319,6 +470,40 @@ std::optional<BsdfSample> finishSample(const Bsdf& bsdf, const Vec3& wo, const s
 }
 
 }  // namespace
+
+float fresnelDielectric(float cosTheta, float eta) { return 1.0f - fresnelDielectricTransmittance(cosTheta, eta); }
+
+float fresnelDielectricTransmittance(float cosTheta, float eta) {
+  cosTheta = std::clamp(cosTheta, -1.0f, 1.0f);
+  if (cosTheta < 0.0f) {  // arriving from the inside: the ratio is seen the other way round
+    eta = 1.0f / eta;
+    cosTheta = -cosTheta;
+  }
+  const float sin2T = (1.0f - cosTheta * cosTheta) / (eta * eta);
+  if (sin2T >= 1.0f) return 0.0f;  // total internal reflection
+  const float cosT = std::sqrt(std::max(0.0f, 1.0f - sin2T));
+  // With r = (a − b)/(a + b): 1 − r² = 4ab/(a + b)², free of the cancellation 1 − r² suffers
+  // near grazing (where F → 1), so that both sides of an interface agree to float precision.
+  auto transmitted = [](float a, float b) { return 4.0f * a * b / ((a + b) * (a + b)); };
+  return 0.5f * (transmitted(eta * cosTheta, cosT) + transmitted(cosTheta, eta * cosT));
+}
+
+void thinSheetReflectanceTransmittance(const DielectricBsdf& b, float cosTheta, Rgb& reflectance, Rgb& transmittance) {
+  // Both faces have the same |cos θ| and reflectance R (the sheet does not bend light).
+  // Summing the paths that bounce 2k times inside, each pass attenuated by t:
+  //   R' = R + T² t² R Σ (R² t²)^k = R + T² t² R / (1 − R² t²)
+  //   T' = T² t Σ (R² t²)^k       = T² t / (1 − R² t²)
+  const float R = fresnelDielectric(std::abs(cosTheta), b.ior), T = fresnelDielectricTransmittance(std::abs(cosTheta), b.ior);
+  if (!(T > 0.0f)) {
+    reflectance = Rgb(1.0f);
+    transmittance = Rgb(0.0f);
+    return;
+  }
+  const Rgb t = b.transmittance;
+  const Rgb denom = Rgb(1.0f) - R * R * t * t;
+  reflectance = Rgb(R) + T * T * R * t * t / denom;
+  transmittance = T * T * t / denom;
+}
 
 float blinnPhongNormalization(float exponent) {
   const float n = std::max(0.0f, exponent);
@@ -341,6 +526,9 @@ Rgb eval(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) {
                         [&](const MirrorBsdf&) { return Rgb(0.0f); },
                         [&](const BlinnPhongBsdf& b) { return evalBlinnPhong(b, wo, wi); },
                         [&](const GgxBsdf& b) { return evalGgx(b, wo, wi); },
+                        [&](const DielectricBsdf& b) {
+                          return b.isSmooth() ? Rgb(0.0f) : evalRoughDielectric(b, wo, wi);
+                        },
                     },
                     bsdf);
 }
@@ -353,11 +541,18 @@ float pdf(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) {
                         [&](const MirrorBsdf&) { return 0.0f; },
                         [&](const BlinnPhongBsdf& b) { return pdfBlinnPhong(b, wo, wi); },
                         [&](const GgxBsdf& b) { return pdfGgx(b, wo, wi); },
+                        [&](const DielectricBsdf& b) {
+                          return b.isSmooth() ? 0.0f : pdfRoughDielectric(b, wo, wi);
+                        },
                     },
                     bsdf);
 }
 
 std::optional<BsdfSample> sample(const Bsdf& bsdf, const Vec3& wo, Vec2 u) {
+  if (const auto* d = std::get_if<DielectricBsdf>(&bsdf)) {
+    if (!(wo.z != 0.0f) || !isFinite(wo)) return std::nullopt;
+    return d->isSmooth() ? sampleSmoothDielectric(*d, wo, u) : sampleRoughDielectric(*d, wo, u);
+  }
   if (!(cosTheta(wo) > 0.0f)) return std::nullopt;
   return std::visit(Overloaded{
                         [&](const LambertBsdf& b) -> std::optional<BsdfSample> {
@@ -380,16 +575,24 @@ std::optional<BsdfSample> sample(const Bsdf& bsdf, const Vec3& wo, Vec2 u) {
                           return finishSample(bsdf, wo, sampleBlinnPhongDirection(b, wo, u));
                         },
                         [&](const GgxBsdf& b) { return finishSample(bsdf, wo, sampleGgxDirection(b, wo, u)); },
+                        [&](const DielectricBsdf&) -> std::optional<BsdfSample> { return std::nullopt; },  // above
                     },
                     bsdf);
 }
 
-bool isDelta(const Bsdf& bsdf) { return std::holds_alternative<MirrorBsdf>(bsdf); }
+bool isDelta(const Bsdf& bsdf) {
+  if (const auto* d = std::get_if<DielectricBsdf>(&bsdf)) return d->isSmooth();
+  return std::holds_alternative<MirrorBsdf>(bsdf);
+}
+
+bool hasTransmission(const Bsdf& bsdf) { return std::holds_alternative<DielectricBsdf>(bsdf); }
 
 bool isDiffuse(const Bsdf& bsdf) { return std::holds_alternative<LambertBsdf>(bsdf); }
 
 Rgb albedo(const Bsdf& bsdf, const Vec3& wo) {
-  if (!(wo.z > 0.0f)) return Rgb(0.0f);
+  const auto* dielectric = std::get_if<DielectricBsdf>(&bsdf);
+  if (!(wo.z > 0.0f) && !(dielectric && wo.z < 0.0f)) return Rgb(0.0f);
+  if (dielectric && dielectric->isSmooth()) return dielectricAlbedo(*dielectric, wo);
   if (const auto* l = std::get_if<LambertBsdf>(&bsdf)) return l->albedo;
   if (const auto* m = std::get_if<MirrorBsdf>(&bsdf)) return mirrorReflectance(*m, wo.z);
   // Deterministic importance-sampled quadrature: the mean of sample() weights over a
@@ -420,6 +623,7 @@ Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo) {
                           b.diffuse = albedo;
                           return b;
                         },
+                        [&](DielectricBsdf b) -> Bsdf { return b; },
                     },
                     bsdf);
 }
@@ -430,6 +634,9 @@ const char* modelName(const Bsdf& bsdf) {
                         [](const MirrorBsdf&) { return "mirror"; },
                         [](const BlinnPhongBsdf&) { return "blinn-phong"; },
                         [](const GgxBsdf&) { return "ggx"; },
+                        [](const DielectricBsdf& b) {
+                          return b.thin ? "thin-dielectric" : b.isSmooth() ? "dielectric" : "rough-dielectric";
+                        },
                     },
                     bsdf);
 }

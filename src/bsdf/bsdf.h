@@ -1,22 +1,35 @@
 #pragma once
-// Reflection models (BRDFs). The contract, written once:
+// Scattering models (BRDFs, and BTDFs for dielectrics). The contract, written once:
 //
 //  * All directions are unit vectors in the *local shading frame*: the normal is +z, and both
 //    wo (towards the viewer / where light goes) and wi (towards where light comes from) point
 //    away from the surface. cos θ of a local direction is its z.
-//  * eval(b, wo, wi) returns f_r(wo, wi) in sr⁻¹ per RGB channel, WITHOUT the cos θi factor.
-//    It is zero when wo or wi lies below the surface (z <= 0), and zero for delta (ideal
-//    specular) components, which only sample() can produce.
+//  * Reflection-only models (everything but DielectricBsdf) live in the upper hemisphere:
+//    callers flip the frame to the side wo is on (two-sided shading), and eval/pdf are zero
+//    and sample returns nothing whenever wo or wi has z <= 0.
+//  * Transmissive models (hasTransmission(): DielectricBsdf) are defined on both sides. +z is
+//    the surface's *outside* (the front side of the geometry, the side the winding normal
+//    points to), and the frame is NOT flipped: wo.z < 0 means the viewer is inside. wo and wi
+//    on opposite sides (wo.z · wi.z < 0) is transmission. Radiance is not symmetric across an
+//    interface: it scales by η² (η the refractive index on each side), and the models obey
+//    the generalised reciprocity f(wo, wi) / η(wo)² = f(wi, wo) / η(wi)², where η(w) is the
+//    index of the medium w lies in (Veach 1997, §5.2; Walter et al. 2007, eq. 21). Energy is
+//    conserved in the flux form ∫ f(wo, wi) |cos θo| dωo ≤ 1 for every wi (light arriving
+//    from wi is reflected or transmitted, never amplified); in the radiance form ∫ … dωi a
+//    BTDF from the dense side exceeds 1 by up to η².
+//  * eval(b, wo, wi) returns f(wo, wi) in sr⁻¹ per RGB channel, WITHOUT the |cos θi| factor.
+//    It is zero for delta (ideal specular) components, which only sample() can produce.
 //  * pdf(b, wo, wi) is the solid-angle density of sample() choosing wi given wo, for the
-//    non-delta part of the model (0 for a pure mirror). It integrates over the hemisphere to
-//    1 minus the probability that sample() returns nothing (a lobe sample that left the
-//    hemisphere), so pdf() is exactly the density of the directions sample() returns.
-//  * sample(b, wo, u) draws wi from a density approximately proportional to f_r·cos θi and
-//    returns the *weight* f_r·cos θi / pdf (for a delta lobe: the reflectance itself), the
-//    value f_r (zero for delta lobes) and the pdf. It returns nothing when the sample is
-//    invalid (below the surface, zero pdf).
-//  * Every model conserves energy (∫ f_r cos θi dωi ≤ 1 for every wo) and is reciprocal
-//    (f_r(wo, wi) = f_r(wi, wo)); the tests check both numerically.
+//    non-delta part of the model (0 for a pure mirror or smooth glass). It integrates over
+//    the sphere to 1 minus the probability that sample() returns nothing (a lobe sample that
+//    left its hemisphere), so pdf() is exactly the density of the directions sample() returns.
+//  * sample(b, wo, u) draws wi from a density approximately proportional to f·|cos θi| and
+//    returns the *weight* f·|cos θi| / pdf (for a delta lobe: the reflectance or radiance
+//    transmittance of the branch taken, divided by the probability of taking it), the value f
+//    (zero for delta lobes) and the pdf. It returns nothing when the sample is invalid
+//    (outside its hemisphere, zero pdf).
+//  * Every model conserves energy and is reciprocal in the forms above (for reflection-only
+//    models: ∫ f cos θi dωi ≤ 1 and f(wo, wi) = f(wi, wo)); the tests check both numerically.
 //
 // Models form a closed set dispatched statically through std::variant.
 #include "core/math.h"
@@ -87,7 +100,48 @@ inline Rgb fresnelSchlick(const Rgb& f0, float cosTheta) {
   return f0 + (Rgb(1.0f) - f0) * (m2 * m2 * m);
 }
 
-using Bsdf = std::variant<LambertBsdf, MirrorBsdf, BlinnPhongBsdf, GgxBsdf>;
+/// A dielectric interface (glass, water) between the outside (+z, index 1) and an inside of
+/// relative index η = n_inside / n_outside, in one of three forms:
+///  * smooth (alpha == 0, thin == false): ideal reflection and refraction, with the exact
+///    unpolarised Fresnel reflectance F (fresnelDielectric) and total internal reflection;
+///    sample() takes reflection with probability F and refraction otherwise, so its weight is
+///    1 for reflection and transmittance/η'² for refraction (η' the ratio of the index on wi's
+///    side to that on wo's side: radiance entering a denser medium grows by η'²).
+///  * rough (alpha > 0, thin == false): GGX microfacet reflection + transmission (Walter et
+///    al. 2007), height-correlated Smith masking, sampled with visible normals (Heitz 2018).
+///  * thin (thin == true): a sheet with two parallel interfaces and nothing between them
+///    bending light: a ray passes straight through (wi = −wo) or reflects, with the
+///    inter-reflections inside summed in closed form:
+///      R' = R + T² t² R / (1 − R² t²),   T' = T² t / (1 − R² t²)
+///    with R = F(cos θ), T = 1 − R, and t the `transmittance` of one pass through the sheet.
+///    Thin sheets are smooth (alpha is ignored).
+/// `transmittance` multiplies every refraction (a closed object filters by its square); it is
+/// the only colour of the model (reflection is white, as Fresnel's is). `absorption` is the
+/// Beer–Lambert coefficient σa (per scene unit, per channel) of the inside, applied by the
+/// path tracer over the distance a path travels inside a closed mesh; the BSDF ignores it.
+struct DielectricBsdf {
+  float ior = 1.5f;          ///< η = n_inside / n_outside (> 0)
+  Rgb transmittance{1.0f};   ///< in [0, 1]
+  float alpha = 0.0f;        ///< GGX roughness α (= perceptual roughness²); 0 = smooth
+  bool thin = false;
+  Rgb absorption{0.0f};      ///< σa ≥ 0 per scene unit (inside a closed mesh)
+
+  bool isSmooth() const { return thin || alpha < kGgxMinAlpha; }
+};
+
+/// Exact unpolarised Fresnel reflectance of a dielectric interface for light arriving at
+/// cos θ (> 0: from the outside, < 0: from the inside) with η = n_inside / n_outside:
+///   F = (r∥² + r⊥²)/2,  r∥ = (η cos θi − cos θt)/(η cos θi + cos θt),
+///                       r⊥ = (cos θi − η cos θt)/(cos θi + η cos θt)   (η relative to θi's side)
+/// and 1 beyond the critical angle (total internal reflection).
+float fresnelDielectric(float cosTheta, float eta);
+/// 1 − fresnelDielectric, computed without cancellation near grazing incidence.
+float fresnelDielectricTransmittance(float cosTheta, float eta);
+
+/// Thin-sheet reflectance R' and transmittance T' (DielectricBsdf, thin) at |cos θ|.
+void thinSheetReflectanceTransmittance(const DielectricBsdf& b, float cosTheta, Rgb& reflectance, Rgb& transmittance);
+
+using Bsdf = std::variant<LambertBsdf, MirrorBsdf, BlinnPhongBsdf, GgxBsdf, DielectricBsdf>;
 
 struct BsdfSample {
   Vec3 wi{0.0f};      ///< sampled incident direction (local frame)
@@ -101,18 +155,23 @@ Rgb eval(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi);
 float pdf(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi);
 std::optional<BsdfSample> sample(const Bsdf& bsdf, const Vec3& wo, Vec2 u);
 
-/// True when the whole model is a Dirac delta (ideal mirror): no eval, only sample.
+/// True when the whole model is a Dirac delta (ideal mirror, smooth or thin dielectric): no
+/// eval, only sample.
 bool isDelta(const Bsdf& bsdf);
+/// True for models that transmit (DielectricBsdf): defined on both sides, frame not flipped
+/// (see the contract above).
+bool hasTransmission(const Bsdf& bsdf);
 /// True when f is constant (Lambertian): one value per tixel suffices in the light field.
 bool isDiffuse(const Bsdf& bsdf);
-/// Hemispherical-directional reflectance ∫ f cos θi dωi for outgoing wo (numerically
-/// integrated for models without a closed form). Used by tests and by the bake's energy
+/// Directional albedo ∫ f |cos θi| dωi for outgoing wo (over both hemispheres for
+/// transmissive models; numerically integrated for models without a closed form). Used by tests and by the bake's energy
 /// bookkeeping.
 Rgb albedo(const Bsdf& bsdf, const Vec3& wo);
 /// The model with its diffuse albedo replaced (texture lookups at a hit point). Models with
 /// no diffuse part are returned unchanged.
 Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo);
-/// A short name for messages and `info`: "lambert", "mirror", "blinn-phong", "ggx".
+/// A short name for messages and `info`: "lambert", "mirror", "blinn-phong", "ggx",
+/// "dielectric" (smooth), "rough-dielectric", "thin-dielectric".
 const char* modelName(const Bsdf& bsdf);
 
 }  // namespace pl

@@ -3,6 +3,11 @@
 
 #include "lightfield/paraboloid.h"
 
+#include <bit>
+#include <optional>
+
+#include "core/rng.h"
+
 namespace pl {
 
 Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv) {
@@ -13,6 +18,42 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv) {
   if (const auto* lambert = std::get_if<LambertBsdf>(&bsdf)) return lambert->albedo;
   // Any other model a chart was classified diffuse for: its hemispherical reflectance.
   return albedo(bsdf, Vec3(0.0f, 0.0f, 1.0f));
+}
+
+float specularBranchU(const Ray& ray) {
+  uint64_t h = 0x5350454355ULL;
+  for (const float v : {ray.origin.x, ray.origin.y, ray.origin.z, ray.direction.x, ray.direction.y, ray.direction.z})
+    h = hashCombine(h, std::bit_cast<uint32_t>(v));
+  return float(h >> 40) * 0x1p-24f;
+}
+
+bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, bool mayContinue, Rgb& emitted, Ray& next,
+                    Rgb& weight) {
+  const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+  const Material& material = scene.materials[surface.material];
+  const Vec3 wo = -ray.direction;
+  const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
+  Rgb attenuation(1.0f);
+  if (const auto* glass = std::get_if<DielectricBsdf>(&material.bsdf); glass && cosWoGeometric < 0.0f)
+    attenuation = glm::exp(-glass->absorption * hit.t);
+  emitted = emittedRadiance(material, cosWoGeometric) * attenuation;
+  if (!mayContinue) return false;
+  Bsdf bsdf = bsdfAt(scene, surface);
+  if (auto* glass = std::get_if<DielectricBsdf>(&bsdf)) glass->alpha = 0.0f;  // rough glass followed as smooth
+  const bool transmissive = hasTransmission(bsdf);
+  const bool flip = cosWoGeometric < 0.0f && !transmissive;
+  const Vec3 geometricNormal = flip ? -surface.geometricNormal : surface.geometricNormal;
+  const Frame frame = Frame::fromNormal(flip ? -surface.shadingNormal : surface.shadingNormal);
+  const Vec3 woLocal = frame.toLocal(wo);
+  if (transmissive && !(woLocal.z * cosWoGeometric > 0.0f)) return false;  // normals disagree on the side
+  const std::optional<BsdfSample> bs = sample(bsdf, woLocal, Vec2(specularBranchU(ray), 0.5f));
+  if (!bs || !bs->delta) return false;
+  const Vec3 wi = frame.toWorld(bs->wi);
+  const float cosWiGeometric = glm::dot(wi, geometricNormal);
+  if (transmissive ? !(cosWiGeometric * bs->wi.z > 0.0f) : !(cosWiGeometric > 0.0f)) return false;  // grazing
+  next = Ray{offsetRayOrigin(surface.position, geometricNormal, wi), wi, 0.0f, kInfinity};
+  weight = bs->weight * attenuation;
+  return true;
 }
 
 ChartShading chartShading(const Scene& scene, const Chart& c) {

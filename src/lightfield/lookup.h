@@ -8,6 +8,7 @@
 //   grid coordinates ((p − origin)·axisU / tixelSize − ½, (p − origin)·axisV / tixelSize − ½);
 //   paraboloid texel (a, b) has its centre at continuous coordinate (a, b), see paraboloid.h.
 //   Outside the outermost centres the edge values are held (clamp-to-edge), never extrapolated.
+#include "accel/accel.h"
 #include "core/math.h"
 #include "core/simd4.h"
 #include "lightfield/lightfield.h"
@@ -121,6 +122,31 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv);
 inline Rgb emittedRadiance(const Material& m, float cosTheta) {
   return (cosTheta > 0.0f || m.twoSidedEmission) ? m.emission : Rgb(0.0f);
 }
+
+/// One step of an ideal-specular chain at `hit` (a specular chart: a mirror or glass) of
+/// `ray`, the step every light-field stage takes — gather rays in the visibility field, view
+/// rays in the reference and the fast renderer. `emitted` gets the surface's own emission
+/// towards the arriving ray; then, if `mayContinue` (within the chain-length limit), `next`
+/// is the reflected or refracted ray (offset off the surface) and `weight` its throughput.
+///  * Mirrors: the BSDF's delta sample (Schlick Fresnel when the material asks for it), with
+///    the frame facing the arriving ray (two-sided, as in the path tracer).
+///  * Glass (DielectricBsdf, frame unflipped: +z outside): reflection or refraction is chosen
+///    stochastically with the BSDF's own probabilities (Fresnel F for solid glass, R'/(R'+T')
+///    by luminance for thin sheets), so the weight is the branch's reflectance or radiance
+///    transmittance over its probability: 1 for reflection, t/η'² for refraction. The random
+///    number is a hash of the arriving ray's bits (specularBranchU): deterministic, identical
+///    in every stage that traces the same ray, and decorrelated between rays, so averages
+///    over pixels, samples or gather directions are unbiased. Rough glass is followed as if
+///    it were smooth (the light field has no transmitting glossy charts).
+///  * A segment that arrives on the inside (back) of glass ran through it: `weight` and
+///    `emitted` include its Beer–Lambert attenuation exp(−σa t).
+/// Returns false when the chain ends here (depth limit, no delta lobe, a direction on the
+/// wrong side of the geometric surface at grazing angles).
+bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, bool mayContinue, Rgb& emitted, Ray& next,
+                    Rgb& weight);
+
+/// The uniform number in [0, 1) that followSpecular draws its branch with for `ray`.
+float specularBranchU(const Ray& ray);
 
 /// The per-chart constants of exitantRadiance (its material's emission and, when no texture
 /// varies it, its diffuse albedo). The fast renderer (src/realtime) precomputes one per chart;

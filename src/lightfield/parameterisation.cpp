@@ -14,7 +14,9 @@
 namespace pl {
 
 ChartKind chartKindOf(const Bsdf& bsdf) {
-  if (isDelta(bsdf)) return ChartKind::Specular;
+  // Glass, smooth or rough, is followed through (followSpecular): the light field has no
+  // transmitting charts.
+  if (isDelta(bsdf) || hasTransmission(bsdf)) return ChartKind::Specular;
   if (isDiffuse(bsdf)) return ChartKind::Diffuse;
   return ChartKind::Glossy;
 }

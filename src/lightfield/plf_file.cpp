@@ -241,11 +241,17 @@ void putBsdf(ByteWriter& w, const Bsdf& bsdf) {
           w.put(b.diffuse);
           w.put(b.specular);
           w.put(b.exponent);
-        } else {
-          static_assert(std::is_same_v<T, GgxBsdf>, "a new BSDF model needs its .plf encoding");
+        } else if constexpr (std::is_same_v<T, GgxBsdf>) {
           w.put(b.diffuse);
           w.put(b.f0);
           w.put(b.alpha);
+        } else {
+          static_assert(std::is_same_v<T, DielectricBsdf>, "a new BSDF model needs its .plf encoding");
+          w.put(b.ior);
+          w.put(b.transmittance);
+          w.put(b.alpha);
+          w.put(uint8_t(b.thin));
+          w.put(b.absorption);
         }
       },
       bsdf);
@@ -275,10 +281,21 @@ Bsdf getBsdf(ByteReader& r) {
       b.alpha = r.get<float>();
       return b;
     }
+    case 4: {
+      // Added without a version bump: older files never contain it, and an older build
+      // reading a newer file refuses it here as "unknown BSDF model 4".
+      DielectricBsdf b;
+      b.ior = r.get<float>();
+      b.transmittance = r.get<Rgb>();
+      b.alpha = r.get<float>();
+      b.thin = r.get<uint8_t>() != 0;
+      b.absorption = r.get<Rgb>();
+      return b;
+    }
     default: r.corrupt(fmt::format("unknown BSDF model {}", model));
   }
 }
-static_assert(std::variant_size_v<Bsdf> == 4, "getBsdf must decode every BSDF model");
+static_assert(std::variant_size_v<Bsdf> == 5, "getBsdf must decode every BSDF model");
 
 void putLight(ByteWriter& w, const Light& light) {
   w.put(uint32_t(light.index()));

@@ -81,7 +81,9 @@ LightField makeTestLightField() {
   Material phong{"phong", BlinnPhongBsdf{Rgb(0.3f, 0.2f, 0.1f), Rgb(0.2f, 0.25f, 0.3f), 123.5f}, -1,
                  Rgb(1.0f, 2.0f, 3.0f), true};
   Material ggx{"ggx", GgxBsdf{Rgb(0.1f), Rgb(0.04f, 0.05f, 0.06f), 0.33f}, -1, Rgb(17.0f, 12.0f, 4.0f), false};
-  s.materials = {lambert, mirror, phong, ggx};
+  DielectricBsdf water{1.33f, Rgb(0.9f, 0.95f, 1.0f), 0.04f, false, Rgb(0.1f, 0.05f, 0.02f)};
+  Material glass{"glass", water, -1, Rgb(0.0f), false};
+  s.materials = {lambert, mirror, phong, ggx, glass};
 
   Texture texture;
   texture.path = "textures/checker.png";
@@ -283,6 +285,13 @@ TEST_F(PlfFileTest, RoundTripPreservesEveryField) {
   EXPECT_EQ(ggxB.diffuse, ggxA.diffuse);
   EXPECT_EQ(ggxB.f0, ggxA.f0);
   EXPECT_EQ(ggxB.alpha, ggxA.alpha);
+  const auto &glassA = std::get<DielectricBsdf>(a.materials[4].bsdf),
+             &glassB = std::get<DielectricBsdf>(b.materials[4].bsdf);
+  EXPECT_EQ(glassB.ior, glassA.ior);
+  EXPECT_EQ(glassB.transmittance, glassA.transmittance);
+  EXPECT_EQ(glassB.alpha, glassA.alpha);
+  EXPECT_EQ(glassB.thin, glassA.thin);
+  EXPECT_EQ(glassB.absorption, glassA.absorption);
 
   ASSERT_EQ(b.textures.size(), 1u);
   EXPECT_EQ(b.textures[0].path, a.textures[0].path);
@@ -388,8 +397,8 @@ TEST_F(PlfFileTest, InfoSummarisesWithoutLoadingValues) {
   EXPECT_EQ(info.meshes, 2u);
   EXPECT_EQ(info.triangles, 5u);
   EXPECT_EQ(info.vertices, 9u);
-  EXPECT_EQ(info.materials, 4u);
-  EXPECT_EQ(info.materialModels, (std::vector<std::string>{"lambert", "mirror", "blinn-phong", "ggx"}));
+  EXPECT_EQ(info.materials, 5u);
+  EXPECT_EQ(info.materialModels, (std::vector<std::string>{"lambert", "mirror", "blinn-phong", "ggx", "rough-dielectric"}));
   EXPECT_EQ(info.textures, 1u);
   EXPECT_EQ(info.lights, 3u);
   EXPECT_EQ(info.cameraNames, (std::vector<std::string>{"front", "lens"}));

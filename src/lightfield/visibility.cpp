@@ -131,6 +131,12 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
       h.value(mirror->reflectance);
       h.value(uint8_t(mirror->fresnel));
     }
+    if (const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf)) {
+      h.value(glass->ior);
+      h.value(glass->transmittance);
+      h.value(uint8_t(glass->thin));
+      h.value(glass->absorption);
+    }
   }
   for (const Chart& c : param.charts) {
     h.value(c.material);
@@ -233,22 +239,18 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
         const Vec3 pos = ray.origin + hit.t * ray.direction;
         const bool back = glm::dot(ray.direction, c.normal) > 0.0f;
         if (c.kind == ChartKind::Specular) {
-          const Vec3 n2 = back ? -c.normal : c.normal;
-          const Frame frame = Frame::fromNormal(n2);
-          const auto s = depth < settings.mirrorDepth ? sample(scene.materials[c.material].bsdf, frame.toLocal(-ray.direction), Vec2(0.5f))
-                                                      : std::nullopt;
-          if (!s) {
-            // Chain longer than mirrorDepth (or a sample below the surface): absorbed.
+          // A mirror or glass: the step the renderers take too (followSpecular). Its own
+          // emission is not gathered (as before glass: mirrors were never lamps here).
+          Rgb emitted, weight;
+          Ray next;
+          if (!followSpecular(scene, ray, hit, depth < settings.mirrorDepth, emitted, next, weight)) {
+            // Chain longer than mirrorDepth (or a direction below the surface): absorbed.
             entry.target = VisibilityEntry::kEscape | VisibilityEntry::kHasExtra;
             extras.push_back({state.entry, VisibilityExtra{Rgb(0.0f), Vec2(0.0f), 1}});
             continue;
           }
-          const Vec3 reflected = glm::normalize(reflect(-ray.direction, n2));
-          Ray next;
-          next.origin = offsetRayOrigin(pos, n2, reflected);
-          next.direction = reflected;
           nextRays.push_back(next);
-          nextStates.push_back({state.entry, state.throughput * s->weight, true});
+          nextStates.push_back({state.entry, state.throughput * weight, true});
           continue;
         }
         const Vec2 grid = tixelGridCoordinates(c, pos);

@@ -25,7 +25,7 @@ Rgb backgroundRadiance(const Environment& environment, const Vec3& direction) {
 namespace {
 
 /// Radiance along `ray` whose closest hit is `hit` (hit.hit() false: it left the scene).
-/// Mirrors are followed as a chain of reflections with the reflectance multiplied in
+/// Mirrors and glass are followed as a chain of reflections/refractions with the weights multiplied in
 /// (`throughput`); the first non-specular chart ends it with the light-field lookup.
 Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hit, uint32_t mirrorDepth) {
   const Scene& scene = lf.scene;
@@ -37,11 +37,11 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hi
       return result +
              throughput * exitantRadiance(lf, surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics), -ray.direction);
 
-    // An ideal mirror: its own emission (if any) plus the reflectance times what the
-    // mirrored direction sees.
+    // An ideal mirror or glass: its own emission (if any) plus the branch weight times what
+    // the reflected or refracted direction sees.
     Rgb emitted, reflectance;
     Ray reflected;
-    const bool more = reflectOffMirror(scene, ray, hit, reflections < mirrorDepth, emitted, reflected, reflectance);
+    const bool more = followSpecular(scene, ray, hit, reflections < mirrorDepth, emitted, reflected, reflectance);
     result += throughput * emitted;
     if (!more) return result;
     throughput *= reflectance;
@@ -52,26 +52,6 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hi
 }
 
 }  // namespace
-
-bool reflectOffMirror(const Scene& scene, const Ray& ray, const RayHit& hit, bool mayReflect, Rgb& emitted,
-                      Ray& reflected, Rgb& reflectance) {
-  const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
-  const Vec3 wo = -ray.direction;
-  const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
-  emitted = emittedRadiance(scene.materials[surface.material], cosWoGeometric);
-  if (!mayReflect) return false;
-  const bool back = cosWoGeometric < 0.0f;
-  const Vec3 geometricNormal = back ? -surface.geometricNormal : surface.geometricNormal;
-  const Frame frame = Frame::fromNormal(back ? -surface.shadingNormal : surface.shadingNormal);
-  // A delta lobe ignores the random numbers: (½, ½) is as good as any.
-  const std::optional<BsdfSample> bs = sample(bsdfAt(scene, surface), frame.toLocal(wo), Vec2(0.5f));
-  if (!bs || !bs->delta) return false;
-  const Vec3 wi = frame.toWorld(bs->wi);
-  if (glm::dot(wi, geometricNormal) <= 0.0f) return false;  // grazing: the reflection is below the surface
-  reflected = Ray{offsetRayOrigin(surface.position, geometricNormal, wi), wi, 0.0f, kInfinity};
-  reflectance = bs->weight;
-  return true;
-}
 
 namespace {
 

@@ -4,11 +4,11 @@
 // Per camera sample: the primary hit (Embree, 16-wide packets per tile) → SurfaceHit → the
 // hit triangle's chart → exitantRadiance() of lightfield/lookup.h (the one 16-neighbour
 // lookup: bilinear in position × bilinear in paraboloid direction; diffuse charts get their
-// albedo texture at full resolution). Ideal-specular (mirror) charts store nothing: the view
-// ray is reflected about the shading normal, weighted by the mirror's reflectance (the
-// BSDF's delta sample, so Schlick Fresnel is applied when the material asks for it), and
-// followed, up to mirrorDepth reflections; a chain longer than that contributes nothing, as
-// in the bake. Rays that leave the scene see backgroundRadiance().
+// albedo texture at full resolution). Ideal-specular charts (mirrors, glass) store nothing:
+// the view ray is reflected or refracted by followSpecular (lightfield/lookup.h: the
+// mirror's reflectance; for glass one Fresnel branch chosen stochastically with the right
+// weight), and followed, up to mirrorDepth steps; a chain longer than that contributes
+// nothing, as in the bake. Rays that leave the scene see backgroundRadiance().
 //
 // Pixel value = mean over the pixel's samples of (camera weight × radiance), in
 // W·sr⁻¹·m⁻² (camera weight = cos⁴θ with vignetting, else 1). No exposure or tone mapping
@@ -51,16 +51,6 @@ struct RenderSettings {
 /// must have been built over lightField.scene.
 Image renderLightField(const LightField& lightField, const Accel& accel, const Camera& camera,
                        const RenderSettings& settings);
-
-/// One mirror bounce at `hit` (a specular chart's surface) of `ray`, the step both this
-/// renderer and the fast one (realtime) take: `emitted` gets the mirror's own emission, then
-/// — if `mayReflect` (within the depth limit) — `reflected` the mirrored ray (offset off the
-/// surface) and `reflectance` its weight (the BSDF's delta sample, with Fresnel when the
-/// material asks for it). BSDFs are two-sided: the frame faces the arriving ray, as in the
-/// path tracer. Returns false when the chain ends here (depth limit, no delta lobe, or a
-/// reflection below the geometric surface at grazing angles).
-bool reflectOffMirror(const Scene& scene, const Ray& ray, const RayHit& hit, bool mayReflect, Rgb& emitted,
-                      Ray& reflected, Rgb& reflectance);
 
 /// Radiance from infinity towards −direction for a ray leaving the scene along `direction`.
 /// The only place the renderer reads the environment (an environment map plugs in here).

@@ -17,6 +17,13 @@
 //    sRGB 8/16-bit texels decoded to linear; v is flipped to our bottom-left convention
 //    (uv_ours = (u, 1 − v)) since glTF's (0,0) is the image's top-left. A primitive without a
 //    material gets the spec's default material (baseColor 1, metallic 1, roughness 1).
+//  * KHR_materials_transmission (transmissionFactor > 0) → DielectricBsdf: index from
+//    KHR_materials_ior (default 1.5), transmittance = baseColor · transmissionFactor (a factor
+//    below 1 is absorbed rather than mixed with a diffuse base: warning), α = roughness²
+//    (smooth below 1e-3). Without KHR_materials_volume, or with thicknessFactor 0, the
+//    surface is a thin sheet (smooth); with a thickness it is a closed volume whose
+//    attenuationColor c and attenuationDistance d give the absorption σa = −ln(c)/d.
+//    transmissionTexture, thicknessTexture and a baseColorTexture on it are ignored (warning).
 //  * emissiveFactor × KHR_materials_emissive_strength.emissiveStrength → emitted radiance in
 //    W·sr⁻¹·m⁻²; doubleSided materials emit from both sides.
 //  * Perspective cameras: yfov (radians) and aspectRatio; the camera looks down its node's
@@ -220,6 +227,55 @@ int textureFor(GltfContext& ctx, int textureIndex) {
   return ours;
 }
 
+/// A number of an extension object, or `fallback` when absent.
+float extensionNumber(const tinygltf::Value& extension, const char* key, float fallback) {
+  return extension.Has(key) && extension.Get(key).IsNumber() ? float(extension.Get(key).GetNumberAsDouble()) : fallback;
+}
+
+/// KHR_materials_transmission (+ _ior, _volume) → DielectricBsdf (see the header comment).
+void applyTransmission(GltfContext& ctx, const tinygltf::Material& gltf, Material& material, const Rgb& baseColor,
+                       float roughness) {
+  const auto transmission = gltf.extensions.find("KHR_materials_transmission");
+  if (transmission == gltf.extensions.end()) return;
+  const float factor = std::clamp(extensionNumber(transmission->second, "transmissionFactor", 0.0f), 0.0f, 1.0f);
+  if (!(factor > 0.0f)) return;
+  if (transmission->second.Has("transmissionTexture"))
+    spdlog::warn("{}: material '{}': transmissionTexture is not supported; transmissionFactor used alone", ctx.path,
+                 material.name);
+  if (factor < 1.0f)
+    spdlog::warn("{}: material '{}': transmissionFactor {} < 1: the rest is absorbed, not diffusely reflected",
+                 ctx.path, material.name, factor);
+  DielectricBsdf glass;
+  if (auto ior = gltf.extensions.find("KHR_materials_ior"); ior != gltf.extensions.end())
+    glass.ior = extensionNumber(ior->second, "ior", 1.5f);
+  if (!(glass.ior > 1.0f && std::isfinite(glass.ior)))
+    fail("{}: material '{}': KHR_materials_ior.ior {} must be a finite number > 1", ctx.path, material.name, glass.ior);
+  glass.transmittance = baseColor * factor;
+  glass.alpha = roughness * roughness < kGgxMinAlpha ? 0.0f : roughness * roughness;
+  glass.thin = true;
+  if (auto volume = gltf.extensions.find("KHR_materials_volume"); volume != gltf.extensions.end()) {
+    const tinygltf::Value& v = volume->second;
+    glass.thin = !(extensionNumber(v, "thicknessFactor", 0.0f) > 0.0f);
+    const float distance = extensionNumber(v, "attenuationDistance", kInfinity);
+    Rgb colour(1.0f);
+    if (v.Has("attenuationColor") && v.Get("attenuationColor").IsArray() && v.Get("attenuationColor").ArrayLen() >= 3)
+      for (int c = 0; c < 3; ++c) colour[c] = float(v.Get("attenuationColor").Get(c).GetNumberAsDouble());
+    if (!(distance > 0.0f) || !isFinite(colour) || glm::any(glm::lessThanEqual(colour, Rgb(0.0f))) ||
+        maxComponent(colour) > 1.0f)
+      fail("{}: material '{}': KHR_materials_volume needs attenuationDistance > 0 and attenuationColor in (0, 1]",
+           ctx.path, material.name);
+    // Beer–Lambert: after `distance` the colour is left, exp(−σa d) = c.
+    if (!glass.thin && std::isfinite(distance))
+      for (int c = 0; c < 3; ++c) glass.absorption[c] = -std::log(colour[c]) / distance;
+  }
+  if (glass.thin) glass.alpha = 0.0f;  // thin sheets are smooth (bsdf.h)
+  if (material.albedoTexture >= 0) {
+    spdlog::warn("{}: material '{}': baseColorTexture is ignored on a transmissive material", ctx.path, material.name);
+    material.albedoTexture = -1;
+  }
+  material.bsdf = glass;
+}
+
 Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int index) {
   const auto& pbr = gltf.pbrMetallicRoughness;
   Rgb baseColor(1.0f);
@@ -242,6 +298,7 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
                    material.name, pbr.baseColorTexture.texCoord);
     material.albedoTexture = textureFor(ctx, pbr.baseColorTexture.index);
   }
+  applyTransmission(ctx, gltf, material, baseColor, roughness);
   if (gltf.emissiveFactor.size() >= 3) {
     float strength = 1.0f;
     if (auto it = gltf.extensions.find("KHR_materials_emissive_strength"); it != gltf.extensions.end()) {

@@ -154,7 +154,7 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
   const std::string where = "materials." + name;
   if (!value.is_object()) fail("{}: {}: expected an object", ctx.path, where);
   const json* typeValue = find(value, "type");
-  if (!typeValue) fail("{}: {}: missing \"type\" (lambert, mirror, blinn-phong, ggx)", ctx.path, where);
+  if (!typeValue) fail("{}: {}: missing \"type\" (lambert, mirror, blinn-phong, ggx, dielectric)", ctx.path, where);
   const std::string type = stringOf(ctx, *typeValue, where + ".type");
   Material material;
   material.name = name;
@@ -187,8 +187,20 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
     if (!(ggx.alpha > 0.0f && ggx.alpha <= 1.0f)) fail("{}: {}: GGX alpha {} must be in (0, 1]", ctx.path, where, ggx.alpha);
     material.bsdf = ggx;
     known.insert({"diffuse", "f0", "alpha", "roughness", "texture"});
+  } else if (type == "dielectric") {
+    DielectricBsdf glass;
+    glass.ior = numberOr(ctx, value, "ior", glass.ior, where);
+    glass.transmittance = colourOr(ctx, value, "transmittance", Rgb(1.0f), where);
+    const float roughness = numberOr(ctx, value, "roughness", 0.0f, where);
+    if (!(roughness >= 0.0f && roughness <= 1.0f)) fail("{}: {}: roughness {} must be in [0, 1]", ctx.path, where, roughness);
+    glass.alpha = roughness * roughness < kGgxMinAlpha ? 0.0f : roughness * roughness;
+    glass.thin = boolOr(ctx, value, "thin", false, where);
+    glass.absorption = colourOr(ctx, value, "absorption", Rgb(0.0f), where);
+    if (glass.thin && roughness > 0.0f) fail("{}: {}: a thin dielectric is smooth (roughness must be 0)", ctx.path, where);
+    material.bsdf = glass;
+    known.insert({"ior", "transmittance", "roughness", "thin", "absorption"});
   } else {
-    fail("{}: {}: unknown material type '{}' (lambert, mirror, blinn-phong, ggx)", ctx.path, where, type);
+    fail("{}: {}: unknown material type '{}' (lambert, mirror, blinn-phong, ggx, dielectric)", ctx.path, where, type);
   }
   checkKeys(ctx, value, known, where);
   if (const json* texture = find(value, "texture")) material.albedoTexture = loadTexture(ctx, scene, *texture, where + ".texture");

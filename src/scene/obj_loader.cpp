@@ -4,7 +4,16 @@
 // handing a file to it we scan the OBJ and its MTL files line by line (CRLF tolerated) and
 // reject what it would silently misread, with "file:line: problem" messages.
 //
-// MTL → BSDF mapping (Ka, Ni, Pe, d/Tr/Tf are ignored; refraction is not modelled):
+// MTL → BSDF mapping (Ka, Pe, Pr, Pm are ignored). A key given twice in one material: the
+// last one wins (tinyobjloader overwrites; scene_test checks it).
+//  * dielectric (DielectricBsdf) when the material asks for refraction: illum 4, 6 or 7, or no
+//    illum at all (tinyobjloader's 0) with Ni > 1 and a non-black Tf (McGuire's
+//    CornellBox-Sphere states only Ni and Tf). Smooth; index = Ni (1.5 when Ni is absent or
+//    ≤ 1); transmittance (per refraction) = Tf (1 when absent or black). Kd, Ks, Ns and map_Kd
+//    are ignored on it (Fresnel gives the reflection).
+//  * thin glass (DielectricBsdf, thin) when d < 1 (or Tr > 0) on any other material: a
+//    smooth sheet of index Ni (1.5 when absent or ≤ 1) whose one-pass transmittance is
+//    (1 − d)·Tf (Tf as above).
 //  * mirror when the material is mirror-like: illum 3 or 5 (with non-black Ks), or
 //    Ks ≥ 0.9 with Ns ≥ 1000 (a lobe narrower than ~2°), or Kd ≈ 0 (≤ 0.02) with Ks ≥ 0.5
 //    and Ns ≥ 1000. Reflectance = Ks; illum 5 ("Fresnel on") → Schlick Fresnel with F0 = Ks.
@@ -182,9 +191,21 @@ Material convertMaterial(const tinyobj::material_t& mtl, const std::string& mtlP
   const bool mirrorLike = (hasSpecular && (mtl.illum == 3 || mtl.illum == 5)) ||
                           (maxComponent(ks) >= 0.9f && ns >= 1000.0f) ||
                           (maxComponent(kd) <= 0.02f && maxComponent(ks) >= 0.5f && ns >= 1000.0f);
-  if (mtl.illum >= 6 || mtl.dissolve < 1.0f)
-    spdlog::warn("{}: material '{}': transparency/refraction (illum {}, d {}) is not modelled; treated as opaque",
-                 mtlPath, mtl.name, mtl.illum, mtl.dissolve);
+  const Rgb tf = rgbOf(mtl.transmittance);
+  const bool refracts = mtl.illum == 4 || mtl.illum == 6 || mtl.illum == 7 ||
+                        (mtl.illum == 0 && mtl.ior > 1.0 && !isBlack(tf));
+  const bool thinGlass = !refracts && mtl.dissolve < 1.0f;
+  if (refracts || thinGlass) {
+    DielectricBsdf glass;
+    glass.ior = mtl.ior > 1.0 ? float(mtl.ior) : 1.5f;
+    glass.transmittance = isBlack(tf) ? Rgb(1.0f) : glm::min(tf, Rgb(1.0f));
+    if (thinGlass) {
+      glass.thin = true;
+      glass.transmittance *= std::clamp(1.0f - float(mtl.dissolve), 0.0f, 1.0f);
+    }
+    material.bsdf = glass;
+    return material;
+  }
 
   if (!mtl.diffuse_texname.empty()) {
     if (mirrorLike) spdlog::warn("{}: material '{}': map_Kd ignored on a mirror", mtlPath, mtl.name);

@@ -70,7 +70,8 @@ void validateLights(const Scene& scene) {
 }  // namespace
 
 /// Reflectances must lie in [0, 1] (more would create energy; bsdf.h's contract); Blinn-Phong
-/// needs diffuse + specular ≤ 1 per channel and GGX a roughness α in (0, 1].
+/// needs diffuse + specular ≤ 1 per channel and GGX a roughness α in (0, 1]; a dielectric a
+/// finite positive index, transmittance in [0, 1], α in [0, 1] and absorption ≥ 0.
 void validateMaterial(const Material& material, const std::string& sourcePath) {
   // Slack for decimal inputs such as 0.7 + 0.3 that round to a hair above 1 in float.
   constexpr float kSumSlack = 1e-6f;
@@ -91,7 +92,19 @@ void validateMaterial(const Material& material, const std::string& sourcePath) {
                  "(diffuse {}, specular {})", src, material.name, vecString(model.diffuse), vecString(model.specular));
           if (!(model.exponent >= 0.0f && std::isfinite(model.exponent)))
             fail("{}: material '{}': Blinn-Phong exponent {} must be finite and >= 0", src, material.name, model.exponent);
+        } else if constexpr (std::is_same_v<T, DielectricBsdf>) {
+          if (!(model.ior > 0.0f && std::isfinite(model.ior)))
+            fail("{}: material '{}': dielectric index of refraction {} must be finite and > 0", src, material.name, model.ior);
+          if (!inUnitRange(model.transmittance))
+            fail("{}: material '{}': dielectric transmittance {} outside [0, 1]", src, material.name,
+                 vecString(model.transmittance));
+          if (!(model.alpha >= 0.0f && model.alpha <= 1.0f))
+            fail("{}: material '{}': dielectric roughness alpha {} must lie in [0, 1]", src, material.name, model.alpha);
+          if (!isFinite(model.absorption) || glm::any(glm::lessThan(model.absorption, Rgb(0.0f))))
+            fail("{}: material '{}': dielectric absorption {} must be finite and >= 0", src, material.name,
+                 vecString(model.absorption));
         } else {
+          static_assert(std::is_same_v<T, GgxBsdf>, "a new BSDF model needs its validation");
           if (!inUnitRange(model.diffuse) || !inUnitRange(model.f0))
             fail("{}: material '{}': GGX diffuse {} and f0 {} must lie in [0, 1]", src, material.name,
                  vecString(model.diffuse), vecString(model.f0));

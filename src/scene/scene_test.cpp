@@ -246,12 +246,28 @@ TEST(McGuire, MirrorHasAFresnelMirror) {
   EXPECT_VEC3_NEAR(mirror->reflectance, Rgb(0.95f), 0.0f);
 }
 
-TEST(McGuire, SphereHasAPlainMirrorAndAGlossySphere) {
+TEST(McGuire, SphereHasAPlainMirrorAndAGlassSphere) {
   const Scene scene = loadScene(kMcGuireDir + "CornellBox-Sphere.obj");
   const auto* mirror = std::get_if<MirrorBsdf>(&materialNamed(scene, "leftSphere").bsdf);
   ASSERT_NE(mirror, nullptr);  // Ks 1 with Ns 1000, no illum
   EXPECT_FALSE(mirror->fresnel);
-  EXPECT_TRUE(std::holds_alternative<BlinnPhongBsdf>(materialNamed(scene, "rightSphere").bsdf));
+  // Ni 1.6 and Tf 0.95 without an illum: solid smooth glass.
+  const auto* glass = std::get_if<DielectricBsdf>(&materialNamed(scene, "rightSphere").bsdf);
+  ASSERT_NE(glass, nullptr);
+  EXPECT_FLOAT_EQ(glass->ior, 1.6f);
+  EXPECT_VEC3_NEAR(glass->transmittance, Rgb(0.95f), kTight);
+  EXPECT_TRUE(glass->isSmooth());
+  EXPECT_FALSE(glass->thin);
+}
+
+TEST(McGuire, WaterIsSmoothDielectric) {
+  const Scene scene = loadScene(kMcGuireDir + "CornellBox-Water.obj");
+  const auto* water = std::get_if<DielectricBsdf>(&materialNamed(scene, "water").bsdf);
+  ASSERT_NE(water, nullptr);  // illum 7, Ni 1.33, Tf 0.1
+  EXPECT_FLOAT_EQ(water->ior, 1.33f);
+  EXPECT_VEC3_NEAR(water->transmittance, Rgb(0.1f), kTight);
+  EXPECT_TRUE(std::holds_alternative<DielectricBsdf>(materialNamed(scene, "rightSphere").bsdf));  // illum 7, Ni 2.5
+  EXPECT_TRUE(std::holds_alternative<LambertBsdf>(materialNamed(scene, "light").bsdf));  // illum 2 with Tf 1, d 1
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -315,6 +331,108 @@ TEST(ObjLoader, MtlMappingRules) {
   const SurfaceHit hit = surfaceAt(scene, 0, 4, Vec2(0.25f, 0.25f));
   EXPECT_EQ(scene.materials[hit.material].name, "painted");
   EXPECT_VEC3_NEAR(std::get<LambertBsdf>(bsdfAt(scene, hit)).albedo, Rgb(0.0f, 0.0f, 1.0f), kTight);
+}
+
+TEST(ObjLoader, GlassMappingAndRepeatedKeys) {
+  const fs::path dir = scratchDir("glass");
+  writeFile(dir / "g.mtl",
+            // Keys given twice: tinyobjloader keeps the last.
+            "newmtl water\nKd 0.01 0.01 0.01\nKs 0.3 0.3 0.3\nTf 0.5 0.5 0.5\nNi 1.2\nillum 7\nNi 1.33\nTf 0.9 0.8 0.7\n"
+            "newmtl crystal\nKs 0.04 0.04 0.04\nNs 200\nNi 1.6\nTf 0.95 0.95 0.95\n"  // no illum: glass
+            "newmtl pane\nKd 0.5 0.5 0.5\nd 0.25\n"                                   // d < 1: thin
+            "newmtl plain\nillum 6\n"                                                 // no Ni, no Tf
+            "newmtl lamp\nKd 0.78 0.78 0.78\nNi 1.5\nd 1.0\nTr 0.0\nTf 1 1 1\nillum 2\nKe 1 1 1\n");
+  std::string obj = "mtllib g.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  for (const char* name : {"water", "crystal", "pane", "plain", "lamp"}) obj += std::string("usemtl ") + name + "\nf 1 2 3\n";
+  const Scene scene = loadScene(writeFile(dir / "g.obj", obj));
+  const auto& water = std::get<DielectricBsdf>(materialNamed(scene, "water").bsdf);
+  EXPECT_FLOAT_EQ(water.ior, 1.33f);
+  EXPECT_VEC3_NEAR(water.transmittance, Rgb(0.9f, 0.8f, 0.7f), kTight);
+  EXPECT_FALSE(water.thin);
+  const auto& crystal = std::get<DielectricBsdf>(materialNamed(scene, "crystal").bsdf);
+  EXPECT_FLOAT_EQ(crystal.ior, 1.6f);
+  EXPECT_TRUE(crystal.isSmooth());
+  const auto& pane = std::get<DielectricBsdf>(materialNamed(scene, "pane").bsdf);
+  EXPECT_TRUE(pane.thin);
+  EXPECT_FLOAT_EQ(pane.ior, 1.5f);
+  EXPECT_VEC3_NEAR(pane.transmittance, Rgb(0.75f), kTight);  // (1 − d)·Tf, Tf absent = 1
+  const auto& plain = std::get<DielectricBsdf>(materialNamed(scene, "plain").bsdf);
+  EXPECT_FLOAT_EQ(plain.ior, 1.5f);
+  EXPECT_VEC3_NEAR(plain.transmittance, Rgb(1.0f), 0.0f);
+  EXPECT_TRUE(std::holds_alternative<LambertBsdf>(materialNamed(scene, "lamp").bsdf));
+}
+
+TEST(JsonScene, DielectricMaterials) {
+  const fs::path dir = scratchDir("json_glass");
+  writeFile(dir / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const Scene scene = loadScene(writeFile(dir / "g.json", R"({"materials": {
+      "glass": {"type": "dielectric", "ior": 1.5, "transmittance": [0.9, 0.9, 0.8], "absorption": [0.1, 0.2, 0.3]},
+      "frosted": {"type": "dielectric", "ior": 1.33, "roughness": 0.3},
+      "window": {"type": "dielectric", "thin": true}},
+    "meshes": [{"file": "tri.obj", "material": "glass"}, {"file": "tri.obj", "material": "frosted"},
+               {"file": "tri.obj", "material": "window"}]})"));
+  const auto& glass = std::get<DielectricBsdf>(materialNamed(scene, "glass").bsdf);
+  EXPECT_FLOAT_EQ(glass.ior, 1.5f);
+  EXPECT_VEC3_NEAR(glass.transmittance, Rgb(0.9f, 0.9f, 0.8f), kTight);
+  EXPECT_VEC3_NEAR(glass.absorption, Rgb(0.1f, 0.2f, 0.3f), kTight);
+  EXPECT_TRUE(glass.isSmooth());
+  EXPECT_NEAR(std::get<DielectricBsdf>(materialNamed(scene, "frosted").bsdf).alpha, 0.09f, kTight);
+  EXPECT_TRUE(std::get<DielectricBsdf>(materialNamed(scene, "window").bsdf).thin);
+  const fs::path bad = dir / "bad.json";
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "dielectric", "thin": true, "roughness": 0.2}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "thin", "roughness"});
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "dielectric", "transmittance": 1.5}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "transmittance"});
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "dielectric", "ior": -1}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "index of refraction"});
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "dielectric", "absorption": -1}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "absorption"});
+}
+
+/// A one-triangle glTF whose material carries `extensions` (a JSON object body).
+std::string gltfTriangleWithMaterial(const fs::path& path, const std::string& extensions) {
+  return writeFile(path, R"({"asset": {"version": "2.0"},
+    "buffers": [{"byteLength": 44, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA="}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]},
+                  {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}],
+    "materials": [{"name": "glass", "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.8, 0.7, 1], "metallicFactor": 0,
+                   "roughnessFactor": 0.5}, "extensions": {)" + extensions + R"(}}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+    "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]})");
+}
+
+TEST(GltfLoader, TransmissionIorAndVolume) {
+  const fs::path dir = scratchDir("gltf_glass");
+  {
+    // Transmission alone: a thin (smooth) sheet tinted by baseColor, default index 1.5.
+    const Scene scene = loadScene(gltfTriangleWithMaterial(dir / "thin.gltf", R"("KHR_materials_transmission": {"transmissionFactor": 1})"));
+    const auto& glass = std::get<DielectricBsdf>(materialNamed(scene, "glass").bsdf);
+    EXPECT_TRUE(glass.thin);
+    EXPECT_FLOAT_EQ(glass.ior, 1.5f);
+    EXPECT_VEC3_NEAR(glass.transmittance, Rgb(0.9f, 0.8f, 0.7f), kTight);
+  }
+  {
+    // With a volume: solid rough glass, absorption −ln(c)/d.
+    const Scene scene = loadScene(gltfTriangleWithMaterial(dir / "solid.gltf",
+        R"("KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.33},
+           "KHR_materials_volume": {"thicknessFactor": 0.2, "attenuationDistance": 2.0, "attenuationColor": [0.5, 0.25, 1.0]})"));
+    const auto& glass = std::get<DielectricBsdf>(materialNamed(scene, "glass").bsdf);
+    EXPECT_FALSE(glass.thin);
+    EXPECT_FLOAT_EQ(glass.ior, 1.33f);
+    EXPECT_FLOAT_EQ(glass.alpha, 0.25f);  // roughness 0.5²
+    EXPECT_VEC3_NEAR(glass.absorption, Rgb(std::log(2.0f) / 2.0f, std::log(4.0f) / 2.0f, 0.0f), kTight);
+  }
+  {
+    // thicknessFactor 0: thin again.
+    const Scene scene = loadScene(gltfTriangleWithMaterial(dir / "zero.gltf",
+        R"("KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_volume": {"thicknessFactor": 0})"));
+    EXPECT_TRUE(std::get<DielectricBsdf>(materialNamed(scene, "glass").bsdf).thin);
+  }
+  expectError([&] {
+    loadScene(gltfTriangleWithMaterial(dir / "bad.gltf",
+        R"("KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": -1})"));
+  }, {"bad.gltf", "attenuationDistance"});
 }
 
 // ---------------------------------------------------------------------------------------------

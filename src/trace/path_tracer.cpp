@@ -112,6 +112,17 @@ struct PixelAccumulator {
   }
 };
 
+/// Whether world direction w (local wLocal in the shading frame) is on a side of the surface
+/// the BSDF may use: for a reflecting BSDF (frame turned to the viewer's side) above the
+/// geometric surface; for a transmitting one (frame unflipped, bsdf.h) on the same side of the
+/// geometric and the shading normal, so that interpolated normals cannot send a path through
+/// the surface on the wrong side.
+bool sameSideOfSurface(const Vec3& w, const Vec3& wLocal, const Vec3& geometricNormal, const Bsdf& bsdf) {
+  const float cosGeometric = glm::dot(w, geometricNormal);
+  if (!hasTransmission(bsdf)) return cosGeometric > 0.0f;
+  return cosGeometric * wLocal.z > 0.0f;
+}
+
 /// Light-selection weights only need to be positive and finite: clamp absurdly bright
 /// emitters (whose estimated power overflows float) to the largest float instead of letting
 /// an infinity turn the whole distribution into NaNs.
@@ -132,6 +143,7 @@ struct PathTracer::Impl {
   std::vector<uint32_t> meshTriangleBase;  ///< first global triangle index of each mesh
   std::vector<int32_t> entryOfTriangle;    ///< light entry of each global triangle, or −1
   int32_t environmentEntry = -1;
+  bool hasThinGlass = false;  ///< shadow rays pass thin glass sheets (shadowTransmittance)
 
   Impl(const Scene& s, const Accel& a);
 
@@ -149,6 +161,31 @@ struct PathTracer::Impl {
     return accel.occluded(shadow);
   }
 
+  /// The fraction of light that travels unscattered from origin along `direction` for tMax:
+  /// 0 when something blocks it, else the product of the straight transmittances T' of the
+  /// thin glass sheets it crosses (bsdf.h). Other glass blocks it (next-event estimation does
+  /// not refract). Scenes without thin glass take one occlusion ray.
+  Rgb shadowTransmittance(Vec3 origin, const Vec3& direction, float tMax, Counters& counters) const {
+    if (!hasThinGlass) return occluded(origin, direction, tMax, counters) ? Rgb(0.0f) : Rgb(1.0f);
+    Rgb transmittance(1.0f);
+    for (;;) {
+      ++counters.rays;
+      Ray shadow{origin, direction, 0.0f, tMax};
+      RayHit hit;
+      if (!accel.intersect(shadow, hit)) return transmittance;
+      const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+      const auto* sheet = std::get_if<DielectricBsdf>(&scene.materials[surface.material].bsdf);
+      if (!sheet || !sheet->thin) return Rgb(0.0f);
+      Rgb reflectance, straight;
+      thinSheetReflectanceTransmittance(*sheet, glm::dot(surface.shadingNormal, direction), reflectance, straight);
+      transmittance *= straight;
+      if (isBlack(transmittance)) return transmittance;
+      origin = offsetRayOrigin(surface.position, surface.geometricNormal, direction);
+      tMax = std::isfinite(tMax) ? tMax - glm::dot(origin - shadow.origin, direction) : tMax;
+      if (!(tMax > 0.0f)) return transmittance;
+    }
+  }
+
   Rgb directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame, const Vec3& woLocal,
                   const Bsdf& bsdf, const TraceSettings& settings, Pcg32& rng, Counters& counters) const;
   Rgb radiance(Ray ray, Pcg32& rng, const TraceSettings& settings, Counters& counters) const;
@@ -158,6 +195,8 @@ struct PathTracer::Impl {
 
 PathTracer::Impl::Impl(const Scene& s, const Accel& a) : scene(s), accel(a) {
   environment = EnvironmentLight(scene.environment.constant, scene.environment.map);
+  for (const Material& m : scene.materials)
+    if (const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf); glass && glass->thin) hasThinGlass = true;
   Vec3 lo, hi;
   scene.bounds(lo, hi);
   const float sceneRadius = std::max(0.5f * glm::length(hi - lo), 1e-6f);
@@ -276,25 +315,28 @@ Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNor
     }
   }
 
-  // BSDFs here reflect only: a direction below the geometric surface cannot receive light
-  // (this also stops light leaking through when shading normals bend over the horizon).
-  if (glm::dot(wi, geometricNormal) <= 0.0f) return Rgb(0.0f);
+  // A reflecting BSDF receives light only from above the geometric surface (this also stops
+  // light leaking through when shading normals bend over the horizon); a transmitting one
+  // from the side where the shading frame puts wi (both normals agree on it).
   const Vec3 wiLocal = frame.toLocal(wi);
+  if (!sameSideOfSurface(wi, wiLocal, geometricNormal, bsdf)) return Rgb(0.0f);
   const Rgb f = eval(bsdf, woLocal, wiLocal);
-  const float cosIn = wiLocal.z;
+  const float cosIn = std::abs(wiLocal.z);
   if (isBlack(f) || !(cosIn > 0.0f)) return Rgb(0.0f);
 
   const Vec3 origin = offsetRayOrigin(position, geometricNormal, wi);
+  Rgb visible;
   if (infinite) {
-    if (occluded(origin, wi, kInfinity, counters)) return Rgb(0.0f);
+    visible = shadowTransmittance(origin, wi, kInfinity, counters);
   } else {
     const Vec3 toTarget = shadowTarget - origin;
     const float distance = glm::length(toTarget);
     if (!(distance > 0.0f)) return Rgb(0.0f);
-    if (occluded(origin, toTarget / distance, distance, counters)) return Rgb(0.0f);
+    visible = shadowTransmittance(origin, toTarget / distance, distance, counters);
   }
+  if (isBlack(visible)) return Rgb(0.0f);
 
-  const Rgb unweighted = f * cosIn * incident / lightPdf;
+  const Rgb unweighted = visible * f * cosIn * incident / lightPdf;
   if (isDeltaLight || settings.strategy != TraceStrategy::Mis) return unweighted;
   return unweighted * powerHeuristic(lightPdf, pdf(bsdf, woLocal, wiLocal));
 }
@@ -306,6 +348,14 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
   // ray, after a delta bounce, and always with the Bsdf strategy.
   bool countEmissionFully = true;
   float previousBsdfPdf = 0.0f;  // solid-angle density with which the current ray was sampled
+  // Distance travelled since the vertex that sampled the current direction: straight passes
+  // through thin glass keep the direction (and that vertex's MIS weights, since next-event
+  // estimation there sees through the sheets too), so an emitter's density is measured from it.
+  float distanceBefore = 0.0f;
+  // Product of η'² over the refractions so far: the throughput's radiance scaling across
+  // interfaces (bsdf.h), which Russian roulette must not mistake for absorption (pbrt-v4's
+  // etaScale). After entering glass the throughput is 1/η² of what it will be on leaving.
+  float etaScale = 1.0f;
   const bool useMis = settings.strategy == TraceStrategy::Mis;
   const bool bsdfOnly = settings.strategy == TraceStrategy::BsdfOnly;
 
@@ -330,6 +380,11 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
     const Material& material = scene.materials[surface.material];
     const Vec3 wo = -ray.direction;
     const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
+    // Beer–Lambert: a segment that ends on the inside (back) of a dielectric ran through its
+    // interior (the front side of a closed mesh is its outside), losing exp(−σa t).
+    if (const auto* glass = std::get_if<DielectricBsdf>(&material.bsdf); glass && cosWoGeometric < 0.0f) {
+      if (!isBlack(glass->absorption)) throughput *= glm::exp(-glass->absorption * hit.t);
+    }
 
     if (material.isEmissive() && (cosWoGeometric > 0.0f || material.twoSidedEmission)) {
       if (countEmissionFully) {
@@ -339,10 +394,12 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
         if (entry >= 0) {
           const EmissiveTriangle& e = triangles[entries[static_cast<size_t>(entry)].index];
           // The density NEE would have had for this point, in solid angle at the previous
-          // vertex: P(select) · (1/A) · t² / |cos θlight|.
+          // vertex: P(select) · (1/A) · t² / |cos θlight| (t from that vertex, through any
+          // thin glass crossed straight).
           const float cosLight = std::abs(cosWoGeometric);
+          const float distance = distanceBefore + hit.t;
           const float lightPdf = cosLight > 0.0f
-                                     ? selectionProbability(entry) * hit.t * hit.t / (cosLight * e.area)
+                                     ? selectionProbability(entry) * distance * distance / (cosLight * e.area)
                                      : 0.0f;
           result += throughput * material.emission * powerHeuristic(previousBsdfPdf, lightPdf);
         }
@@ -350,16 +407,18 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
     }
     if (depth >= maxDepth) break;
 
-    // Two-sided shading: both normals face the side the ray came from.
+    // Two-sided shading: both normals face the side the ray came from — except for
+    // transmitting BSDFs, whose frame keeps +z on the outside (bsdf.h).
+    const Bsdf bsdf = bsdfAt(scene, surface);
     Vec3 geometricNormal = surface.geometricNormal;
     Vec3 shadingNormal = surface.shadingNormal;
-    if (cosWoGeometric < 0.0f) {
+    if (cosWoGeometric < 0.0f && !hasTransmission(bsdf)) {
       geometricNormal = -geometricNormal;
       shadingNormal = -shadingNormal;
     }
-    const Bsdf bsdf = bsdfAt(scene, surface);
     const Frame frame = Frame::fromNormal(shadingNormal);
     const Vec3 woLocal = frame.toLocal(wo);
+    if (!sameSideOfSurface(wo, woLocal, geometricNormal, bsdf) && hasTransmission(bsdf)) break;
 
     if (!isDelta(bsdf)) {
       result += throughput *
@@ -370,11 +429,21 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
     const std::optional<BsdfSample> s = sample(bsdf, woLocal, u);
     if (!s) break;
     const Vec3 wi = frame.toWorld(s->wi);
-    if (glm::dot(wi, geometricNormal) <= 0.0f) break;  // reflection only (see directLight)
+    if (!sameSideOfSurface(wi, s->wi, geometricNormal, bsdf)) break;  // see directLight
     throughput *= s->weight;
     if (isBlack(throughput)) break;
-    countEmissionFully = s->delta || bsdfOnly;
-    previousBsdfPdf = s->pdf;
+    if (const auto* glass = std::get_if<DielectricBsdf>(&bsdf); glass && !glass->thin && woLocal.z * s->wi.z < 0.0f) {
+      const float etap = woLocal.z > 0.0f ? glass->ior : 1.0f / glass->ior;  // η(wi side) / η(wo side)
+      etaScale *= etap * etap;
+    }
+    const auto* sheet = std::get_if<DielectricBsdf>(&bsdf);
+    if (sheet && sheet->thin && woLocal.z * s->wi.z < 0.0f) {
+      distanceBefore += hit.t;  // straight through: the previous vertex's sample continues
+    } else {
+      countEmissionFully = s->delta || bsdfOnly;
+      previousBsdfPdf = s->pdf;
+      distanceBefore = 0.0f;
+    }
     ray.origin = offsetRayOrigin(surface.position, geometricNormal, wi);
     ray.direction = wi;
     ray.tMin = 0.0f;
@@ -384,7 +453,9 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
     // q < 1 always (kRouletteMaxContinue), so every path ends with probability 1 without a
     // depth cap; written as !(u < q) so that a NaN throughput ends the path too.
     if (depth + 1 >= settings.rouletteDepth) {
-      const float q = std::min(maxComponent(throughput), kRouletteMaxContinue);
+      // etaScale undoes the η² radiance scaling of refractions (as pbrt-v4 does), so a path
+      // that entered glass is not ended more or less often than one that left it.
+      const float q = std::min(maxComponent(throughput) * etaScale, kRouletteMaxContinue);
       if (!(rng.uniform() < q)) break;
       throughput /= q;
     }

@@ -16,6 +16,7 @@
 #include "core/progress.h"
 #include "image/image.h"
 #include "scene/scene.h"
+#include "support/sphere_mesh.h"
 #include "trace/trace.h"
 
 namespace pl {
@@ -92,12 +93,16 @@ Scene finished(Scene scene) {
 /// Checks every pixel of a render against a known constant image with a per-pixel z-test
 /// (Šidák-corrected at α = 0.01 over all pixel-channels), and the image mean against
 /// `relativeTolerance`. Also requires the standard error of that mean to be at most a third
-/// of the tolerance, so that passing is meaningful (a 3σ margin) rather than lucky.
-void expectConstantImage(const TraceResult& r, const Rgb& expected, double relativeTolerance, const char* what) {
+/// of the tolerance, so that passing is meaningful (a 3σ margin) rather than lucky. Without
+/// `exactExpected` (a model known to be off by less than the tolerance) the z-test is skipped.
+void expectConstantImage(const TraceResult& r, const Rgb& expected, double relativeTolerance, const char* what,
+                         bool exactExpected = true) {
   const Image exact(r.radiance.width, r.radiance.height, expected);
   const Image zero(r.radiance.width, r.radiance.height, Rgb(0.0f));
   const ImageZTest z = compareImagesZ(r.radiance, r.variance, exact, zero, 0.01);
-  EXPECT_TRUE(z.pass) << what << ": " << z.summary();
+  if (exactExpected) {
+    EXPECT_TRUE(z.pass) << what << ": " << z.summary();
+  }
   EXPECT_EQ(r.stats.nanSamples, 0u) << what;
   for (int c = 0; c < 3; ++c) {
     double sum = 0.0, variance = 0.0;
@@ -240,6 +245,123 @@ TEST_F(TraceTest, UncappedPathsEndInAClosedMirrorBox) {
   for (const Rgb& p : r.radiance.pixels) EXPECT_TRUE(isFinite(p));
 }
 
+// ---- glass ----------------------------------------------------------------------------------
+
+uint32_t addDielectric(Scene& scene, const DielectricBsdf& glass) {
+  Material m;
+  m.name = "glass" + std::to_string(scene.materials.size());
+  m.bsdf = glass;
+  scene.materials.push_back(m);
+  return static_cast<uint32_t>(scene.materials.size() - 1);
+}
+
+/// The box [lo, hi] with its faces wound outwards.
+void addBox(Mesh& mesh, const Vec3& lo, const Vec3& hi, uint32_t material) {
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      Vec3 corners[4];
+      const int cu[4] = {0, 1, 1, 0}, cv[4] = {0, 0, 1, 1};
+      for (int k = 0; k < 4; ++k) {
+        corners[k][axis] = side ? hi[axis] : lo[axis];
+        corners[k][u] = cu[k] ? hi[u] : lo[u];
+        corners[k][v] = cv[k] ? hi[v] : lo[v];
+      }
+      Vec3 outward(0.0f);
+      outward[axis] = side ? 1.0f : -1.0f;
+      addQuad(mesh, corners[0], corners[1], corners[2], corners[3], outward, material);
+    }
+}
+
+// Glass furnace: a clear dielectric sphere under a constant environment Le. Whatever a path
+// does inside, it leaves the sphere again (refraction weights 1/η² in and η² out, Fresnel
+// choices with weight 1), so every pixel sees Le: energy is neither lost nor created. For the
+// smooth sphere every sample is exactly Le (zero variance) unless Russian roulette cuts a
+// path trapped by total internal reflection. A rough sphere loses what single-scattering
+// GGX loses (light that would meet a second microfacet, mostly at grazing angles near the
+// silhouette): within 0.5 % at α = 0.01 (0.1–0.2 %, which a per-pixel z-test at 512 spp
+// does detect, so the rough sphere is checked on the image mean only), but 1.1–1.5 % already
+// at α = 0.05 (measured; the model has no multiple-scattering compensation, bsdf_test bounds
+// the loss per direction).
+void runGlassFurnace(float alpha, int spp) {
+  Scene s;
+  const Rgb le(0.5f, 1.0f, 2.0f);
+  Mesh mesh;
+  mesh.name = "sphere";
+  test_support::addSphere(mesh, Vec3(0.0f), 1.0f, 48, 96, addDielectric(s, DielectricBsdf{1.5f, Rgb(1.0f), alpha}));
+  s.meshes.push_back(mesh);
+  s.environment.constant = le;
+  const Scene scene = finished(std::move(s));
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  const Camera camera(lookAt({0.3f, 0.4f, 4.0f}, {0, 0, 0}, {0, 1, 0}, 22.0f), 8, 8);
+  for (TraceStrategy strategy : {TraceStrategy::Mis, TraceStrategy::BsdfOnly}) {
+    TraceSettings settings;
+    settings.spp = spp;
+    settings.maxDepth = 1000;
+    settings.strategy = strategy;
+    const TraceResult r = tracer.render(camera, settings);
+    expectConstantImage(r, le, 0.005, strategyName(strategy), alpha == 0.0f);
+  }
+}
+
+TEST_F(TraceTest, SmoothGlassSphereFurnace) { runGlassFurnace(0.0f, 64); }
+TEST_F(TraceTest, RoughGlassSphereFurnace) { runGlassFurnace(0.01f, 512); }
+
+// A slab of glass (index n, thickness d, absorption σa) in front of a large uniform emitter
+// seen at normal incidence: the camera sees Le times the slab's transmittance, the sum over
+// the light's 2k internal reflections,
+//   T_slab = T² a / (1 − R² a²),   R = ((n − 1)/(n + 1))²,  T = 1 − R,  a = exp(−σa d)
+// (times t² for a transmittance t on each of the two refractions)
+// (for a clear slab 2n/(n² + 1)); a thin sheet of one-pass transmittance t gives T' = T² t /
+// (1 − R² t²) (bsdf.h). The emitter is black (it reflects nothing), the environment too.
+Rgb slabTransmission(const DielectricBsdf& glass, float thickness, int spp) {
+  Scene s;
+  const Rgb le(1.0f, 2.0f, 4.0f);
+  Mesh mesh;
+  mesh.name = "slab";
+  const uint32_t emitter = addMaterial(s, Rgb(0.0f), le);
+  addQuad(mesh, {-50, -50, -3}, {50, -50, -3}, {50, 50, -3}, {-50, 50, -3}, {0, 0, 1}, emitter);
+  const uint32_t m = addDielectric(s, glass);
+  if (glass.thin) addQuad(mesh, {-20, -20, 0}, {20, -20, 0}, {20, 20, 0}, {-20, 20, 0}, {0, 0, 1}, m);
+  else addBox(mesh, {-20, -20, -thickness}, {20, 20, 0}, m);
+  s.meshes.push_back(mesh);
+  const Scene scene = finished(std::move(s));
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  const Camera camera(lookAt({0.0f, 0.0f, 30.0f}, {0, 0, 0}, {0, 1, 0}, 1.0f), 8, 8);
+  TraceSettings settings;
+  settings.spp = spp;
+  settings.maxDepth = 1000;
+  const TraceResult r = tracer.render(camera, settings);
+  const Rgb expected = le * [&] {
+    const float R = fresnelDielectric(1.0f, glass.ior), T = 1.0f - R;
+    Rgb transmission;
+    for (int c = 0; c < 3; ++c) {
+      // Per crossing of the interior: the sheet's t, or the slab's exp(−σa d); a solid slab's
+      // transmittance t multiplies its two refractions.
+      const float t = glass.transmittance[c];
+      const float pass = glass.thin ? t : std::exp(-glass.absorption[c] * thickness);
+      transmission[c] = T * T * pass * (glass.thin ? 1.0f : t * t) / (1.0f - R * R * pass * pass);
+    }
+    return transmission;
+  }();
+  expectConstantImage(r, expected, 0.005, modelName(glass));
+  return expected / le;
+}
+
+TEST_F(TraceTest, GlassSlabTransmitsTheFresnelClosedForm) {
+  // Clear slab of index 1.5: 2n/(n² + 1) = 0.923077.
+  const Rgb clear = slabTransmission(DielectricBsdf{1.5f}, 0.5f, 512);
+  EXPECT_NEAR(clear.g, 2.0f * 1.5f / (1.5f * 1.5f + 1.0f), 1e-5f);
+  // Absorbing water-like slab (Beer–Lambert over the 0.5 units crossed, repeatedly).
+  DielectricBsdf water{1.33f};
+  water.absorption = Rgb(0.1f, 0.4f, 1.2f);
+  slabTransmission(water, 0.5f, 1024);
+  // A thin tinted sheet: no bending, inter-reflections summed.
+  slabTransmission(DielectricBsdf{1.5f, Rgb(0.9f, 0.7f, 0.5f), 0.0f, true}, 0.0f, 512);
+}
+
 // ---- Lambertian patch under the constant environment -----------------------------------------
 
 // A lone patch facing up under an environment of radiance Le sees Le over its whole upper
@@ -376,6 +498,75 @@ TEST_F(TraceTest, DirectionalLightAndShadow) {
 }
 
 // ---- one-sided emission ------------------------------------------------------------------------
+
+// A point light above a thin glass sheet above a Lambertian plane: next-event estimation sees
+// the light through the sheet, attenuated by its straight transmittance T'(cos θ) (bsdf.h), so
+// L = ρ/π · I cos θ / D² · T'(cos θ). Direct light only (max depth 1): deterministic.
+TEST_F(TraceTest, PointLightShinesThroughThinGlass) {
+  const DielectricBsdf sheet{1.5f, Rgb(0.9f, 0.6f, 0.3f), 0.0f, true};
+  const Rgb albedo(0.8f), intensity(10.0f);
+  Scene s;
+  Mesh mesh;
+  mesh.name = "plane";
+  addHorizontalSquare(mesh, 0.0f, 100.0f, true, addMaterial(s, albedo));
+  addHorizontalSquare(mesh, 1.0f, 50.0f, true, addDielectric(s, sheet));
+  s.meshes.push_back(mesh);
+  s.lights.push_back(PointLight{{0.0f, 2.0f, 0.0f}, intensity});
+  const Scene scene = finished(std::move(s));
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  for (const float x : {0.0f, 1.0f, 3.0f}) {
+    Ray ray;
+    ray.origin = Vec3(x, 0.5f, 0.3f);  // below the sheet, looking at (x, 0, 0)
+    ray.direction = glm::normalize(Vec3(x, 0.0f, 0.0f) - ray.origin);
+    TraceSettings settings;
+    settings.spp = 4;
+    settings.maxDepth = 1;
+    const RadianceEstimate e = tracer.estimateRadiance(ray, settings, 1);
+    const float distance2 = x * x + 4.0f, cosTheta = 2.0f / std::sqrt(distance2);
+    Rgb reflectance, straight;
+    thinSheetReflectanceTransmittance(sheet, cosTheta, reflectance, straight);
+    for (int c = 0; c < 3; ++c) {
+      const float expected = albedo[c] * kInvPi * intensity[c] * cosTheta / distance2 * straight[c];
+      EXPECT_NEAR(e.mean[c], expected, 1e-4f * expected) << "x=" << x;
+    }
+  }
+}
+
+// An area light seen through a thin tinted sheet: light sampling (through the sheet), BSDF
+// sampling (straight through the sheet, a delta choice) and MIS must agree — which they only
+// do if the emission found after a straight pass is weighted against the light density at the
+// vertex before the sheet, at the full distance.
+TEST_F(TraceTest, StrategiesAgreeThroughThinGlass) {
+  Scene s;
+  Mesh mesh;
+  mesh.name = "room";
+  addHorizontalSquare(mesh, 0.0f, 3.0f, true, addMaterial(s, Rgb(0.5f)));
+  addHorizontalSquare(mesh, 1.0f, 3.0f, true, addDielectric(s, DielectricBsdf{1.5f, Rgb(0.9f, 0.6f, 0.3f), 0.0f, true}));
+  addHorizontalSquare(mesh, 2.0f, 0.5f, false, addMaterial(s, Rgb(0.0f), Rgb(5.0f)));
+  s.meshes.push_back(mesh);
+  const Scene scene = finished(std::move(s));
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  const Camera camera(lookAt({0.0f, 0.9f, -0.6f}, {0, 0, 0}, {0, 1, 0}, 50.0f), 8, 8);
+  TraceResult results[3];
+  const TraceStrategy strategies[3] = {TraceStrategy::Mis, TraceStrategy::NeeOnly, TraceStrategy::BsdfOnly};
+  for (int k = 0; k < 3; ++k) {
+    TraceSettings settings;
+    settings.spp = 2048;
+    settings.maxDepth = 2;  // floor, sheet, light: the direct light through the sheet
+    settings.strategy = strategies[k];
+    results[k] = tracer.render(camera, settings);
+  }
+  double mean = 0.0;
+  for (const Rgb& p : results[0].radiance.pixels) mean += p.b;
+  EXPECT_GT(mean / 64.0, 0.02) << "light must reach the floor through the sheet";  // measured 0.046
+  for (int k = 1; k < 3; ++k) {
+    const ImageZTest z = compareImagesZ(results[0].radiance, results[0].variance, results[k].radiance,
+                                        results[k].variance, 0.01);
+    EXPECT_TRUE(z.pass) << "mis vs " << strategyName(strategies[k]) << ": " << z.summary();
+  }
+}
 
 TEST_F(TraceTest, EmissionIsOneSidedUnlessTwoSided) {
   for (bool twoSided : {false, true}) {
