@@ -43,7 +43,7 @@ BakeSettings bakePreset(const std::string& name) {
     fail("unknown bake preset '{}' (choose draft, default or high)", name);
   }
   s.maxIterations = 200;
-  s.mirrorDepth = 8;
+  s.mirrorDepth = 256;
   return s;
 }
 

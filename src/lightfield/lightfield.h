@@ -65,7 +65,7 @@ struct BakeSettings {
   uint32_t glossyDirRes = 16;      ///< cap on the paraboloid map size of glossy charts
   float tolerance = 1e-3f;         ///< relative change of total outgoing power to stop at
   uint32_t maxIterations = 200;
-  uint32_t mirrorDepth = 8;        ///< ideal-specular chain length followed
+  uint32_t mirrorDepth = 256;      ///< longest ideal-specular chain followed (roulette from step 8: lookup.h)
   uint32_t areaLightSamples = 32;  ///< shadow rays per tixel towards emissive surfaces (MIS with the gather); 0 = gather only
   uint64_t seed = 0;
 };

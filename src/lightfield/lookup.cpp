@@ -3,6 +3,7 @@
 
 #include "lightfield/paraboloid.h"
 
+#include <algorithm>
 #include <bit>
 #include <optional>
 
@@ -20,15 +21,25 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv) {
   return albedo(bsdf, Vec3(0.0f, 0.0f, 1.0f));
 }
 
-float specularBranchU(const Ray& ray) {
+namespace {
+
+/// A 64-bit hash of the ray's bits (origin and direction): the source of followSpecular's
+/// two uniform numbers, the branch (bits 40–63) and the roulette (bits 16–39).
+uint64_t specularRayHash(const Ray& ray) {
   uint64_t h = 0x5350454355ULL;
   for (const float v : {ray.origin.x, ray.origin.y, ray.origin.z, ray.direction.x, ray.direction.y, ray.direction.z})
     h = hashCombine(h, std::bit_cast<uint32_t>(v));
-  return float(h >> 40) * 0x1p-24f;
+  return h;
 }
 
-bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, bool mayContinue, Rgb& emitted, Ray& next,
-                    Rgb& weight) {
+}  // namespace
+
+float specularBranchU(const Ray& ray) { return float(specularRayHash(ray) >> 40) * 0x1p-24f; }
+
+float specularRouletteU(const Ray& ray) { return float((specularRayHash(ray) >> 16) & 0xffffffULL) * 0x1p-24f; }
+
+bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint32_t step, uint32_t stepLimit,
+                    Rgb& emitted, Ray& next, Rgb& weight) {
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
   const Material& material = scene.materials[surface.material];
   const Vec3 wo = -ray.direction;
@@ -37,7 +48,7 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, bool 
   if (const auto* glass = std::get_if<DielectricBsdf>(&material.bsdf); glass && cosWoGeometric < 0.0f)
     attenuation = glm::exp(-glass->absorption * hit.t);
   emitted = emittedRadiance(material, cosWoGeometric) * attenuation;
-  if (!mayContinue) return false;
+  if (step >= stepLimit) return false;
   Bsdf bsdf = bsdfAt(scene, surface);
   if (auto* glass = std::get_if<DielectricBsdf>(&bsdf)) glass->alpha = 0.0f;  // rough glass followed as smooth
   const bool transmissive = hasTransmission(bsdf);
@@ -53,6 +64,14 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, bool 
   if (transmissive ? !(cosWiGeometric * bs->wi.z > 0.0f) : !(cosWiGeometric > 0.0f)) return false;  // grazing
   next = Ray{offsetRayOrigin(surface.position, geometricNormal, wi), wi, 0.0f, kInfinity};
   weight = bs->weight * attenuation;
+  if (step >= kSpecularRouletteStep) {
+    // Russian roulette on the branch weight: continue with probability q = min(1, max
+    // channel) and divide by q, so the expected weight is unchanged (unbiased). Weights ≥ 1
+    // (glass reflection, refraction out of glass) always continue.
+    const float survival = std::min(1.0f, maxComponent(weight));
+    if (!(specularRouletteU(ray) < survival)) return false;
+    weight /= survival;
+  }
   return true;
 }
 

@@ -126,8 +126,9 @@ inline Rgb emittedRadiance(const Material& m, float cosTheta) {
 /// One step of an ideal-specular chain at `hit` (a specular chart: a mirror or glass) of
 /// `ray`, the step every light-field stage takes — gather rays in the visibility field, view
 /// rays in the reference and the fast renderer. `emitted` gets the surface's own emission
-/// towards the arriving ray; then, if `mayContinue` (within the chain-length limit), `next`
-/// is the reflected or refracted ray (offset off the surface) and `weight` its throughput.
+/// towards the arriving ray; then, if `step` (the reflections/refractions already followed in
+/// this chain, 0 at the first specular hit) is below `stepLimit`, `next` is the reflected or
+/// refracted ray (offset off the surface) and `weight` its throughput.
 ///  * Mirrors: the BSDF's delta sample (Schlick Fresnel when the material asks for it), with
 ///    the frame facing the arriving ray (two-sided, as in the path tracer).
 ///  * Glass (DielectricBsdf, frame unflipped: +z outside): reflection or refraction is chosen
@@ -140,13 +141,25 @@ inline Rgb emittedRadiance(const Material& m, float cosTheta) {
 ///    it were smooth (the light field has no transmitting glossy charts).
 ///  * A segment that arrives on the inside (back) of glass ran through it: `weight` and
 ///    `emitted` include its Beer–Lambert attenuation exp(−σa t).
-/// Returns false when the chain ends here (depth limit, no delta lobe, a direction on the
-/// wrong side of the geometric surface at grazing angles).
-bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, bool mayContinue, Rgb& emitted, Ray& next,
-                    Rgb& weight);
+///  * From step kSpecularRouletteStep on, the chain survives with probability
+///    q = min(1, max channel of the weight) and the weight is divided by q (Russian roulette,
+///    unbiased), drawn with a second hash of the ray's bits (specularRouletteU). Chains up to
+///    that length cost what they did with a hard cut there; longer ones (light circling inside
+///    a glass ball by near-total internal reflection, mirror corridors) go on to `stepLimit`.
+/// Returns false when the chain ends here (step limit, roulette, no delta lobe, a direction
+/// on the wrong side of the geometric surface at grazing angles).
+bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint32_t step, uint32_t stepLimit,
+                    Rgb& emitted, Ray& next, Rgb& weight);
+
+/// The chain step from which followSpecular plays Russian roulette on the branch weight.
+inline constexpr uint32_t kSpecularRouletteStep = 8;
 
 /// The uniform number in [0, 1) that followSpecular draws its branch with for `ray`.
 float specularBranchU(const Ray& ray);
+
+/// The uniform number in [0, 1) that followSpecular plays its roulette with for `ray`
+/// (other bits of the same hash as specularBranchU: independent of the branch).
+float specularRouletteU(const Ray& ray);
 
 /// The per-chart constants of exitantRadiance (its material's emission and, when no texture
 /// varies it, its diffuse albedo). The fast renderer (src/realtime) precomputes one per chart;

@@ -153,6 +153,7 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
   h.bytes(param.gatherPoint.data(), param.gatherPoint.size() * sizeof(Vec3));
   h.value(gatherGridSide(settings.gatherDirections));
   h.value(settings.mirrorDepth);
+  h.value(kSpecularRouletteStep);  // chains end differently with another roulette start
   h.value(settings.seed);
   return h.state;
 }
@@ -243,8 +244,8 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
           // emission is not gathered (as before glass: mirrors were never lamps here).
           Rgb emitted, weight;
           Ray next;
-          if (!followSpecular(scene, ray, hit, depth < settings.mirrorDepth, emitted, next, weight)) {
-            // Chain longer than mirrorDepth (or a direction below the surface): absorbed.
+          if (!followSpecular(scene, ray, hit, depth, settings.mirrorDepth, emitted, next, weight)) {
+            // Chain longer than mirrorDepth, ended by roulette or a direction below the surface: absorbed.
             entry.target = VisibilityEntry::kEscape | VisibilityEntry::kHasExtra;
             extras.push_back({state.entry, VisibilityExtra{Rgb(0.0f), Vec2(0.0f), 1}});
             continue;

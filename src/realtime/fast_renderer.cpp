@@ -195,7 +195,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       } else {
         Ray reflected;
         Rgb reflectance;
-        if (followSpecular(scene, ray, hit, mirrorDepth > 0, radiance, reflected, reflectance)) {
+        if (followSpecular(scene, ray, hit, 0, mirrorDepth, radiance, reflected, reflectance)) {
           s.mirrorRays.push_back(reflected);
           s.mirrorSlot.push_back(uint32_t(i));
           s.mirrorThroughput.push_back(reflectance);
@@ -238,7 +238,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       Rgb emitted;
       Ray reflected;
       Rgb reflectance;
-      const bool more = followSpecular(scene, ray, hit, reflections < mirrorDepth, emitted, reflected, reflectance);
+      const bool more = followSpecular(scene, ray, hit, reflections, mirrorDepth, emitted, reflected, reflectance);
       s.radiance[slot] += throughput * emitted;
       if (more) {
         s.nextRays.push_back(reflected);

@@ -41,7 +41,7 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hi
     // the reflected or refracted direction sees.
     Rgb emitted, reflectance;
     Ray reflected;
-    const bool more = followSpecular(scene, ray, hit, reflections < mirrorDepth, emitted, reflected, reflectance);
+    const bool more = followSpecular(scene, ray, hit, reflections, mirrorDepth, emitted, reflected, reflectance);
     result += throughput * emitted;
     if (!more) return result;
     throughput *= reflectance;
