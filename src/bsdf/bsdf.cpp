@@ -4,6 +4,9 @@
 
 #include <array>
 #include <cmath>
+#include <memory>
+#include <mutex>
+#include <vector>
 
 #include "core/sampling.h"
 
@@ -322,11 +325,11 @@ std::optional<Vec3> sampleGgxDirection(const GgxBsdf& b, const Vec3& wo, Vec2 u)
 //   transmission:  f = t (1 − F(wo·wm)) D(wm) G2(wo, wi) |wi·wm| |wo·wm|
 //                      / (|cos θi cos θo| (wi·wm + wo·wm/η')² η'²)
 // zero when wm is back-facing to wo or wi (wo·wm and cos θo of different signs, or wi's).
-// Sampling: the lobe first, reflection with the fixed probability P_R(wo) (the macro-surface
-// Fresnel F(cos θo) clamped to [0.05, 0.95], so that both lobes keep support where the
-// micro-surface sees them even under total internal reflection), then a visible normal wm
-// with density D_wo(wm) = G1(wo) |wo·wm| D(wm)/|cos θo| (Heitz 2018, for wo turned to +z),
-// then wi = reflect(wo, wm) or refract(wo, wm). Solid-angle densities:
+// Sampling: a visible normal wm with density D_wo(wm) = G1(wo) |wo·wm| D(wm)/|cos θo|
+// (Heitz 2018, for wo turned to +z), then reflection with the microfacet's Fresnel
+// P_R = F(wo·wm) (so the weight is G2/G1 on either branch, times t/η'² for refraction; no
+// fireflies under total internal reflection of the macro-surface), wi = reflect(wo, wm) or
+// refract(wo, wm). Solid-angle densities:
 //   reflection:    P_R D_wo(wm) / (4 |wo·wm|)
 //   transmission:  (1 − P_R) D_wo(wm) |wi·wm| / (wi·wm + wo·wm/η')²
 // (the Jacobians of the reflected and refracted directions with respect to wm). A sample
@@ -350,9 +353,6 @@ bool refractDirection(const Vec3& w, const Vec3& n, float eta, Vec3& refracted) 
 /// η' for a transmission with wo on the side given by cosO.
 inline float relativeEta(const DielectricBsdf& b, float cosO) { return cosO > 0.0f ? b.ior : 1.0f / b.ior; }
 
-float roughReflectProbability(const DielectricBsdf& b, const Vec3& wo) {
-  return std::clamp(fresnelDielectric(wo.z, b.ior), 0.05f, 0.95f);
-}
 
 /// The generalised half vector of (wo, wi) turned to +z, with η' (1 for reflection). False
 /// when it is undefined or back-facing to wo or wi.
@@ -368,7 +368,7 @@ bool dielectricHalfVector(const DielectricBsdf& b, const Vec3& wo, const Vec3& w
   return glm::dot(wm, wi) * cosI > 0.0f && glm::dot(wm, wo) * cosO > 0.0f;
 }
 
-Rgb evalRoughDielectric(const DielectricBsdf& b, const Vec3& wo, const Vec3& wi) {
+Rgb evalRoughDielectricSingle(const DielectricBsdf& b, const Vec3& wo, const Vec3& wi) {
   Vec3 wm;
   float etap;
   if (!dielectricHalfVector(b, wo, wi, wm, etap)) return Rgb(0.0f);
@@ -380,38 +380,309 @@ Rgb evalRoughDielectric(const DielectricBsdf& b, const Vec3& wo, const Vec3& wi)
   return b.transmittance * ft;
 }
 
-float pdfRoughDielectric(const DielectricBsdf& b, const Vec3& wo, const Vec3& wi) {
+float pdfRoughDielectricSingle(const DielectricBsdf& b, const Vec3& wo, const Vec3& wi) {
   Vec3 wm;
   float etap;
   if (!dielectricHalfVector(b, wo, wi, wm, etap)) return 0.0f;
   const float alpha = clampAlpha(b.alpha);
   const float woDotM = std::abs(glm::dot(wo, wm));
   const float visibleNormal = ggxD(alpha, wm) * woDotM / ((1.0f + ggxLambda(alpha, wo)) * std::abs(wo.z));
-  const float pR = roughReflectProbability(b, wo);
+  const float pR = fresnelDielectric(glm::dot(wo, wm), b.ior);  // the microfacet's Fresnel
   if (wo.z * wi.z > 0.0f) return pR * visibleNormal / (4.0f * woDotM);
   return (1.0f - pR) * visibleNormal * std::abs(glm::dot(wi, wm)) / sqr(glm::dot(wi, wm) + glm::dot(wo, wm) / etap);
 }
 
+// Multiple-scattering compensation of the rough dielectric (Kulla & Conty 2017, "Revisiting
+// Physically Based Shading at Imageworks", the dielectric extension of their Kelemen-style
+// lobe). The single-scattering model above loses the light that scatters more than once
+// among the microfacets: its flux-form directional albedo
+//   E_s(μ) = ∫ f_ss(wo, w) |cos θo| dωo          (light arriving from w on side s, |cos θ| = μ)
+// is below 1 (most at grazing angles and from the inside, where total internal reflection
+// sends light back into the micro-surface). A separable lobe adds it back:
+//   f_ms(wo, wi) = t_ab c_ab (1 − E_a(|cos θo|)) (1 − E_b(|cos θi|)),   wo on side a, wi on b,
+// with t_ab = `transmittance` when a ≠ b (1 otherwise). Its flux-form albedo for light from
+// wi on side b is (1 − E_b(μi)) Σ_a t_ab c_ab K_a with K_a = ∫ (1 − E_a) |cos| dω = π(1 − Ē_a)
+// (Ē_a = 2∫ E_a(μ) μ dμ), so with t = 1 the total albedo is exactly 1 when
+//   outside (b = o):  c_oo K_o + c_io K_i = 1,     inside (b = i):  c_oi K_o + c_ii K_i = 1.
+// The generalised reciprocity f(wo, wi)/η(wo)² = f(wi, wo)/η(wi)² holds when
+// c_ab/η_a² = c_ba/η_b², i.e. c_io = η² c_oi (η_o = 1, η_i = η). One freedom is left: the
+// share x = c_io K_i of the compensated light from the outside that is transmitted. We take
+// the macro-surface's hemispherical Fresnel transmittance from the outside, x = 1 − F̄_o,
+// capped at η² K_i / K_o so that c_ii ≥ 0:
+//   c_io = x/K_i,  c_oo = (1 − x)/K_o,  c_oi = x/(η² K_i),  c_ii = (1 − c_oi K_o)/K_i.
+// E_s(μ, α) comes from a table per index of refraction, built on first use (below), for
+// each side: from the inside the interface is an outside one of index 1/η.
+// Sampling: the compensation lobe is chosen with probability P_ms(wo) (its share of the
+// radiance-form albedo, estimated from the tables, at most 1/2), then the side b with
+// probability ∝ t_ab c_ab K_b, then μ with the table's piecewise-constant density of
+// (1 − E_b(μ)) μ and φ uniform; pdf() is the full mixture.
+
+/// Flux-form directional albedo E(μ, α) of the single-scattering rough dielectric for light
+/// arriving from the side of relative index `eta` (the far side's index over the near
+/// side's), on nodes μ_i = (i/(N−1))² × r_j = √α uniform, with its cosine-weighted means Ē
+/// and the hemispherical Fresnel transmittance 1 − F̄. One table per index (both sides).
+class DielectricAlbedoTable {
+ public:
+  static constexpr int kMuNodes = 32;
+  static constexpr int kRoughNodes = 16;
+  static constexpr int kQuadrature = 64;  ///< midpoint rule per axis over the visible-normal square
+
+  /// The table for index `ior` (built on first use, thread-safe; cached per thread).
+  static const DielectricAlbedoTable& get(float ior);
+
+  /// E at (μ, α) and Ē at α for the outside (inside == false) or the inside.
+  void lookup(bool inside, float mu, float alpha, float& e, float& mean) const {
+    const int s = inside ? 1 : 0;
+    int r0, i0;
+    float tr;
+    locate(mu, alpha, r0, tr, i0);
+    mu = std::clamp(mu, 0.0f, 1.0f);
+    const float tm = std::clamp((mu - mu_[i0]) / (mu_[i0 + 1] - mu_[i0]), 0.0f, 1.0f);
+    auto at = [&](int r) { return e_[s][r][i0] + tm * (e_[s][r][i0 + 1] - e_[s][r][i0]); };
+    e = at(r0) + tr * (at(r0 + 1) - at(r0));
+    mean = mean_[s][r0] + tr * (mean_[s][r0 + 1] - mean_[s][r0]);
+  }
+  float ior() const { return ior_; }
+
+  /// Density over μ ∈ [0, 1] of sampleMissingMu: (1 − E(μ)) μ averaged per segment, mixed
+  /// between the two roughness nodes as lookup interpolates E.
+  float missingMuPdf(bool inside, float mu, float alpha) const {
+    int r0, i0;
+    float tr;
+    locate(mu, alpha, r0, tr, i0);
+    const int s = inside ? 1 : 0;
+    const double total = (1.0f - tr) * segments_[s][r0].total() + tr * segments_[s][r0 + 1].total();
+    if (!(total > 0.0)) return 0.0f;
+    const double w = (1.0f - tr) * segmentWeight_[s][r0][i0] + tr * segmentWeight_[s][r0 + 1][i0];
+    return static_cast<float>(w / (total * (mu_[i0 + 1] - mu_[i0])));
+  }
+  /// μ with density missingMuPdf: a roughness node, a segment, uniform within it.
+  float sampleMissingMu(bool inside, float alpha, float u) const {
+    int r0, i0;
+    float tr;
+    locate(0.5f, alpha, r0, tr, i0);
+    const int s = inside ? 1 : 0;
+    const double w0 = (1.0f - tr) * segments_[s][r0].total(), w1 = tr * segments_[s][r0 + 1].total();
+    const int r = chooseFirst(static_cast<float>(w0 / (w0 + w1)), u) ? r0 : r0 + 1;
+    float within = 0.0f;
+    const size_t i = segments_[s][r].sample(u, &within);
+    return mu_[i] + within * (mu_[i + 1] - mu_[i]);
+  }
+  /// 1 − F̄_o = 2∫ (1 − F(μ)) μ dμ from the outside.
+  float meanTransmittanceOutside() const { return meanTransmittanceOutside_; }
+
+  explicit DielectricAlbedoTable(float ior) : ior_(ior) {
+    const float rMin = std::sqrt(kGgxMinAlpha);
+    for (int i = 0; i < kMuNodes; ++i) {
+      const float x = static_cast<float>(i) / (kMuNodes - 1);
+      mu_[i] = x * x;
+    }
+    for (int s = 0; s < 2; ++s) {
+      const float eta = s == 0 ? ior : 1.0f / ior;
+      for (int r = 0; r < kRoughNodes; ++r) {
+        const float rough = rMin + (1.0f - rMin) * static_cast<float>(r) / (kRoughNodes - 1);
+        const float alpha = rough * rough;
+        for (int i = 0; i < kMuNodes; ++i) {
+          const float mu = std::max(mu_[i], 1e-4f);  // just above the horizon at μ = 0
+          const Vec3 w(std::sqrt(1.0f - mu * mu), 0.0f, mu);
+          const float lambdaW = ggxLambda(alpha, w);
+          double sum = 0.0;
+          for (int a = 0; a < kQuadrature; ++a)
+            for (int b = 0; b < kQuadrature; ++b) {
+              // Visible normal m of w; both the reflected and the refracted direction, each
+              // with its Fresnel share: flux-form estimator F G2/G1 and (1 − F) G2/G1.
+              const Vec3 m = sampleGgxVisibleNormal(alpha, w, Vec2((a + 0.5f) / kQuadrature, (b + 0.5f) / kQuadrature));
+              const float cosM = glm::dot(w, m);
+              if (!(cosM > 0.0f)) continue;
+              const float F = fresnelDielectric(cosM, eta);
+              const Vec3 wr = reflectAbout(w, m);
+              if (wr.z > 0.0f) sum += F * (1.0f + lambdaW) / (1.0f + lambdaW + ggxLambda(alpha, wr));
+              Vec3 wt;
+              if (F < 1.0f && refractDirection(w, m, eta, wt) && wt.z < 0.0f)
+                sum += (1.0f - F) * (1.0f + lambdaW) / (1.0f + lambdaW + ggxLambda(alpha, wt));
+            }
+          e_[s][r][i] = static_cast<float>(std::min(1.0, sum / (kQuadrature * kQuadrature)));
+        }
+        // Exact 2∫ E μ dμ of the piecewise-linear table (as GgxAlbedoTable), and per segment
+        // [μ_i, μ_i+1] the integral w_i = ∫ (1 − E) μ dμ of the compensation lobe's shape,
+        // which its sampler picks segments by (Σ w_i = (1 − Ē)/2).
+        double m = 0.0;
+        std::array<float, kMuNodes - 1> w{};
+        for (int i = 0; i + 1 < kMuNodes; ++i) {
+          const double a = mu_[i], b = mu_[i + 1];
+          m += (b - a) * (e_[s][r][i] * (2 * a + b) + e_[s][r][i + 1] * (a + 2 * b)) / 6.0;
+          w[i] = static_cast<float>((b - a) * ((1.0 - e_[s][r][i]) * (2 * a + b) + (1.0 - e_[s][r][i + 1]) * (a + 2 * b)) / 6.0);
+        }
+        mean_[s][r] = static_cast<float>(2.0 * m);
+        segmentWeight_[s][r] = w;
+        segments_[s][r] = Distribution1D(w);
+      }
+    }
+    // 2∫ (1 − F(μ)) μ dμ by the midpoint rule in μ² (= ∫ (1 − F(√v)) dv).
+    constexpr int kSteps = 4096;
+    double t = 0.0;
+    for (int k = 0; k < kSteps; ++k) t += fresnelDielectricTransmittance(std::sqrt((k + 0.5f) / kSteps), ior);
+    meanTransmittanceOutside_ = static_cast<float>(t / kSteps);
+  }
+
+ private:
+  /// The roughness node r0 below α (and the weight tr of r0 + 1) and the μ segment i0.
+  void locate(float mu, float alpha, int& r0, float& tr, int& i0) const {
+    const float rMin = std::sqrt(kGgxMinAlpha);
+    const float rPos = (std::sqrt(clampAlpha(alpha)) - rMin) / (1.0f - rMin) * (kRoughNodes - 1);
+    r0 = std::clamp(static_cast<int>(rPos), 0, kRoughNodes - 2);
+    tr = std::clamp(rPos - static_cast<float>(r0), 0.0f, 1.0f);
+    const float iPos = std::sqrt(std::clamp(mu, 0.0f, 1.0f)) * (kMuNodes - 1);
+    i0 = std::clamp(static_cast<int>(iPos), 0, kMuNodes - 2);
+  }
+
+  float ior_;
+  float meanTransmittanceOutside_ = 0.0f;
+  std::array<float, kMuNodes> mu_{};
+  std::array<std::array<std::array<float, kMuNodes>, kRoughNodes>, 2> e_{};
+  std::array<std::array<float, kRoughNodes>, 2> mean_{};
+  std::array<std::array<std::array<float, kMuNodes - 1>, kRoughNodes>, 2> segmentWeight_{};
+  std::array<std::array<Distribution1D, kRoughNodes>, 2> segments_{};
+};
+
+const DielectricAlbedoTable& DielectricAlbedoTable::get(float ior) {
+  thread_local const DielectricAlbedoTable* last = nullptr;
+  if (last && last->ior() == ior) return *last;
+  static std::mutex mutex;
+  static std::vector<std::unique_ptr<const DielectricAlbedoTable>> tables;  // never freed: pointers stay valid
+  const std::lock_guard<std::mutex> lock(mutex);
+  for (const auto& t : tables)
+    if (t->ior() == ior) return *(last = t.get());
+  tables.push_back(std::make_unique<const DielectricAlbedoTable>(ior));
+  return *(last = tables.back().get());
+}
+
+/// The compensation lobe's constants at (α, η) and the per-direction factors 1 − E.
+struct DielectricCompensation {
+  float c[2][2] = {{0.0f, 0.0f}, {0.0f, 0.0f}};  ///< c[a][b]: wo on side a, wi on side b (0 = outside)
+  float k[2] = {0.0f, 0.0f};                     ///< K_s = π (1 − Ē_s)
+  const DielectricAlbedoTable* table = nullptr;
+  float alpha = 0.0f;
+
+  /// 1 − E_s(μ), ≥ 0.
+  float missing(int side, float mu) const {
+    float e, mean;
+    table->lookup(side == 1, mu, alpha, e, mean);
+    return std::max(0.0f, 1.0f - e);
+  }
+};
+
+DielectricCompensation dielectricCompensation(const DielectricBsdf& b) {
+  DielectricCompensation comp;
+  comp.table = &DielectricAlbedoTable::get(b.ior);
+  comp.alpha = b.alpha;
+  float e, meanO, meanI;
+  comp.table->lookup(false, 1.0f, b.alpha, e, meanO);
+  comp.table->lookup(true, 1.0f, b.alpha, e, meanI);
+  const float kO = kPi * std::max(0.0f, 1.0f - meanO), kI = kPi * std::max(0.0f, 1.0f - meanI);
+  constexpr float kTiny = 1e-6f;  // below this the lobe carries no energy worth adding
+  if (!(kO > kTiny) || !(kI > kTiny)) return comp;
+  const float eta2 = b.ior * b.ior;
+  const float x = std::clamp(comp.table->meanTransmittanceOutside(), 0.0f, std::min(1.0f, eta2 * kI / kO));
+  comp.k[0] = kO;
+  comp.k[1] = kI;
+  comp.c[1][0] = x / kI;
+  comp.c[0][0] = (1.0f - x) / kO;
+  comp.c[0][1] = x / (eta2 * kI);
+  comp.c[1][1] = std::max(0.0f, 1.0f - comp.c[0][1] * kO) / kI;
+  return comp;
+}
+
+inline int dielectricSide(const Vec3& w) { return w.z > 0.0f ? 0 : 1; }
+
+Rgb evalDielectricCompensation(const DielectricBsdf& b, const DielectricCompensation& comp, const Vec3& wo,
+                               const Vec3& wi) {
+  const int a = dielectricSide(wo), s = dielectricSide(wi);
+  const float value = comp.c[a][s] * comp.missing(a, std::abs(wo.z)) * comp.missing(s, std::abs(wi.z));
+  return a == s ? Rgb(value) : b.transmittance * value;
+}
+
+/// The compensation lobe's radiance-form albedo at wo towards each side: t_ab c_ab (1 − E_a) K_b.
+void dielectricCompensationShares(const DielectricBsdf& b, const DielectricCompensation& comp, const Vec3& wo,
+                                  float share[2]) {
+  const int a = dielectricSide(wo);
+  const float missing = comp.missing(a, std::abs(wo.z));
+  for (int s = 0; s < 2; ++s) {
+    const float t = s == a ? 1.0f : std::max(0.0f, luminance(b.transmittance));
+    share[s] = t * comp.c[a][s] * missing * comp.k[s];
+  }
+}
+
+/// Probability that sample() takes the compensation lobe at wo: its share of the albedo,
+/// against the single-scattering albedo (flux form, E_a(μo): close enough for a mixture
+/// weight), and 0 when it carries nothing.
+float dielectricCompensationProbability(const float share[2], const DielectricCompensation& comp, const Vec3& wo) {
+  const float ms = share[0] + share[1];
+  if (!(ms > 0.0f)) return 0.0f;
+  const int a = dielectricSide(wo);
+  const float ss = std::max(0.0f, 1.0f - comp.missing(a, std::abs(wo.z)));
+  return std::clamp(ms / (ms + ss), 0.0f, 0.5f);
+}
+
+/// Solid-angle density of the compensation lobe's sampler: side b ∝ share, then μ with the
+/// table's density of (1 − E_b(μ)) μ and φ uniform.
+float pdfDielectricCompensation(const DielectricCompensation& comp, const float share[2], const Vec3& wi) {
+  const float total = share[0] + share[1];
+  if (!(total > 0.0f)) return 0.0f;
+  const int b = dielectricSide(wi);
+  return share[b] / total * comp.table->missingMuPdf(b == 1, std::abs(wi.z), comp.alpha) * (0.5f * kInvPi);
+}
+
+Rgb evalRoughDielectric(const DielectricBsdf& b, const Vec3& wo, const Vec3& wi) {
+  return evalRoughDielectricSingle(b, wo, wi) + evalDielectricCompensation(b, dielectricCompensation(b), wo, wi);
+}
+
+float pdfRoughDielectric(const DielectricBsdf& b, const Vec3& wo, const Vec3& wi) {
+  const DielectricCompensation comp = dielectricCompensation(b);
+  float share[2];
+  dielectricCompensationShares(b, comp, wo, share);
+  const float pMs = dielectricCompensationProbability(share, comp, wo);
+  return (1.0f - pMs) * pdfRoughDielectricSingle(b, wo, wi) + pMs * pdfDielectricCompensation(comp, share, wi);
+}
+
 std::optional<BsdfSample> sampleRoughDielectric(const DielectricBsdf& b, const Vec3& wo, Vec2 u) {
-  const bool reflectLobe = chooseFirst(roughReflectProbability(b, wo), u.x);
-  const Vec3 woUp = wo.z < 0.0f ? -wo : wo;
-  const Vec3 wm = sampleGgxVisibleNormal(clampAlpha(b.alpha), woUp, u);
+  const DielectricCompensation comp = dielectricCompensation(b);
+  float share[2];
+  dielectricCompensationShares(b, comp, wo, share);
+  const float pMs = dielectricCompensationProbability(share, comp, wo);
   Vec3 wi;
-  if (reflectLobe) {
-    wi = reflectAbout(wo, wm);
-    if (!(wi.z * wo.z > 0.0f)) return std::nullopt;
+  if (pMs > 0.0f && chooseFirst(pMs, u.x)) {
+    // The compensation lobe: a side ∝ its share, then μ ∝ (1 − E(μ)) μ, φ uniform.
+    const int a = dielectricSide(wo);
+    const bool sameSide = chooseFirst(share[a] / (share[0] + share[1]), u.x);
+    const int side = sameSide ? a : 1 - a;
+    const float mu = comp.table->sampleMissingMu(side == 1, comp.alpha, u.x);
+    if (!(mu > 0.0f)) return std::nullopt;
+    const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - mu * mu)), phi = kTwoPi * u.y;
+    wi = Vec3(sinTheta * std::cos(phi), sinTheta * std::sin(phi), side == 0 ? mu : -mu);
   } else {
-    // wo·wm has the sign of cos θo (wm is a visible normal of woUp).
-    const bool outside = glm::dot(wo, wm) > 0.0f;
-    if (!refractDirection(wo, outside ? wm : -wm, outside ? b.ior : 1.0f / b.ior, wi)) return std::nullopt;
-    if (!(wi.z * wo.z < 0.0f)) return std::nullopt;
+    // A visible normal, then reflection with the microfacet's Fresnel F(wo·wm), drawn with
+    // the low-order bits of u.x (fract(4096 u.x): independent of u.x to within 1/4096).
+    const Vec3 woUp = wo.z < 0.0f ? -wo : wo;
+    const Vec3 wm = sampleGgxVisibleNormal(clampAlpha(b.alpha), woUp, u);
+    const float scaled = u.x * 4096.0f;
+    const bool reflectLobe = scaled - std::floor(scaled) < fresnelDielectric(glm::dot(wo, wm), b.ior);
+    if (reflectLobe) {
+      wi = reflectAbout(wo, wm);
+      if (!(wi.z * wo.z > 0.0f)) return std::nullopt;
+    } else {
+      // wo·wm has the sign of cos θo (wm is a visible normal of woUp).
+      const bool outside = glm::dot(wo, wm) > 0.0f;
+      if (!refractDirection(wo, outside ? wm : -wm, outside ? b.ior : 1.0f / b.ior, wi)) return std::nullopt;
+      if (!(wi.z * wo.z < 0.0f)) return std::nullopt;
+    }
   }
   if (!isFinite(wi)) return std::nullopt;
   BsdfSample s;
   s.wi = glm::normalize(wi);
-  s.pdf = pdfRoughDielectric(b, wo, s.wi);
+  s.pdf = (1.0f - pMs) * pdfRoughDielectricSingle(b, wo, s.wi) + pMs * pdfDielectricCompensation(comp, share, s.wi);
   if (!(s.pdf > 0.0f)) return std::nullopt;
-  s.f = evalRoughDielectric(b, wo, s.wi);
+  s.f = evalRoughDielectricSingle(b, wo, s.wi) + evalDielectricCompensation(b, comp, wo, s.wi);
   s.weight = s.f * (std::abs(s.wi.z) / s.pdf);
   return s;
 }

@@ -693,20 +693,25 @@ double fluxAlbedo(const Bsdf& b, const Vec3& wi) {
 }
 
 TEST(Dielectric, RoughConservesEnergyOverBothHemispheres) {
-  // Clear rough glass never reflects + transmits more than arrives, from either side, and
-  // loses only what single scattering misses (light masked by a second microfacet, lobes cut
-  // by the horizon): measured up to 8 % at α = 0.1 and 24 % at α = 0.3, both from inside at
-  // grazing incidence (75°), a few % elsewhere.
-  for (const float alpha : {0.1f, 0.3f})
+  // Clear rough glass reflects + transmits all the light that arrives, from either side: the
+  // single-scattering lobes lose up to 8 % at α = 0.1 and 24 % at α = 0.3 (from inside at
+  // grazing incidence, 75°; measured before the compensation), and the multiple-scattering
+  // compensation lobe gives it back (bsdf.cpp), up to the error of its albedo tables.
+  double worst = 0.0;
+  for (const float alpha : {0.05f, 0.1f, 0.3f, 0.5f})
     for (const float side : {1.0f, -1.0f})
       for (const float t : {0.0f, 40.0f, 75.0f}) {
         const DielectricBsdf b{1.5f, Rgb(1.0f), alpha};
         Vec3 wi = directionAt(t, 15.0f);
         wi.z *= side;
         const double a = fluxAlbedo(b, wi);
+        worst = std::max(worst, std::abs(a - 1.0));
         EXPECT_LE(a, 1.0 + kQuadratureTolerance) << "alpha=" << alpha << " side=" << side << " t=" << t;
-        EXPECT_GT(a, alpha < 0.2f ? 0.9 : 0.75) << "alpha=" << alpha << " side=" << side << " t=" << t;
+        // Measured within 2.6e-3 of 1 (the worst at α = 0.05 from inside, where this
+        // quadrature is coarsest for the narrow lobe); without the compensation, 0.76.
+        EXPECT_NEAR(a, 1.0, 3e-3) << "alpha=" << alpha << " side=" << side << " t=" << t;
       }
+  std::printf("rough glass, flux albedo: worst |albedo - 1| = %.2e\n", worst);
 }
 
 TEST(Dielectric, RoughSampleWeightsAgreeWithEvalAndPdf) {

@@ -301,12 +301,26 @@ void runGlassFurnace(float alpha, int spp) {
     settings.maxDepth = 1000;
     settings.strategy = strategy;
     const TraceResult r = tracer.render(camera, settings);
+    double sum = 0.0;
+    for (const Rgb& p : r.radiance.pixels) sum += p.g;
+    std::printf("glass furnace alpha %.2f %s: mean/Le - 1 = %+.2e\n", alpha, strategyName(strategy),
+                sum / double(r.radiance.pixels.size()) / le.g - 1.0);
     expectConstantImage(r, le, 0.005, strategyName(strategy), alpha == 0.0f);
   }
 }
 
 TEST_F(TraceTest, SmoothGlassSphereFurnace) { runGlassFurnace(0.0f, 64); }
 TEST_F(TraceTest, RoughGlassSphereFurnace) { runGlassFurnace(0.01f, 512); }
+// Rough glass is invisible in the furnace only with the multiple-scattering compensation
+// (bsdf.cpp): single scattering alone loses 1.3–1.4 % at α = 0.05, 12–15 % at α = 0.2 and
+// 40 % at α = 0.5 here. Compensated (measured, MIS / BSDF-only): −0.44 / −0.46 % at
+// α = 0.05 (near the tolerance: from inside at α = 0.05 the compensated flux albedo is still
+// 0.25 % short, bsdf_test's largest deficit, and light bounces inside the ball many times),
+// +0.06 / +0.02 % at α = 0.2,
+// −0.12 / −0.04 % at α = 0.5.
+TEST_F(TraceTest, RoughGlassSphereFurnaceAlpha005) { runGlassFurnace(0.05f, 8192); }
+TEST_F(TraceTest, RoughGlassSphereFurnaceAlpha02) { runGlassFurnace(0.2f, 8192); }
+TEST_F(TraceTest, RoughGlassSphereFurnaceAlpha05) { runGlassFurnace(0.5f, 8192); }
 
 // A slab of glass (index n, thickness d, absorption σa) in front of a large uniform emitter
 // seen at normal incidence: the camera sees Le times the slab's transmittance, the sum over
