@@ -39,7 +39,7 @@ namespace pl {
 namespace {
 
 constexpr char kPlvMagic[8] = {'P', 'L', 'V', 'I', 'S', '\0', '\r', '\n'};
-constexpr uint32_t kPlvVersion = 1;
+constexpr uint32_t kPlvVersion = 2;  // 2: multi-jittered gather directions
 constexpr size_t kPlvHeaderSize = 8 + 4 + 4 + 8 * 5;
 
 // FNV-1a, 64 bit: a change detector over bytes (not a cryptographic hash).
@@ -86,18 +86,67 @@ uint32_t gatherGridSide(uint32_t gatherDirections) {
 
 namespace {
 
-// Inside its cell, a tixel's ray goes through one of kJitterSide² sub-cells, chosen by a hash
-// of (tixel, cell, seed), at a point of that sub-cell fixed by a hash of (cell, sub-cell,
-// seed): stratified within the cell, decorrelated between tixels, and cheap — the directions
-// of every (cell, sub-cell) pair are tabulated once per field. (Sub-cell *centres* would put
-// the directions on a regular lattice, and rays from regularly spaced tixels would then hit
-// the exact edges and corners of axis-aligned boxes, where ray-triangle tests may miss.)
-constexpr uint32_t kJitterSide = 4;
+// Inside its cell, a tixel's ray goes through one of kJitterSide² sub-cells, at a point of
+// that sub-cell fixed by a hash of (cell, sub-cell, seed): the directions of every (cell,
+// sub-cell) pair are tabulated once per field. (Sub-cell *centres* would put the directions
+// on a regular lattice, and rays from regularly spaced tixels would then hit the exact edges
+// and corners of axis-aligned boxes, where ray-triangle tests may miss.)
+//
+// The sub-cells are chosen per tixel as a multi-jittered pattern (Chiu, Shirley & Wang 1994):
+// in each column of cells the G cells take sub-columns rank mod kJitterSide, where rank is
+// the cell's position in a random order of that column keyed by (tixel, column, seed), and
+// likewise sub-rows along each row of cells. When kJitterSide divides G every sub-column of a
+// column of cells (and every sub-row of a row) is used equally often, so besides one
+// direction per cell the projections onto each axis are stratified kJitterSide times finer
+// (jittered sampling stratifies the cells only); the random orders keep tixels decorrelated.
+constexpr uint32_t kJitterSide = kGatherJitterSide;
 constexpr uint32_t kJitterCount = kJitterSide * kJitterSide;
 
-inline uint32_t jitterIndex(uint64_t tixel, uint32_t k, uint64_t seed) {
-  return uint32_t(hashCombine(hashCombine(tixel, k), seed ^ 0x5649534942494c59ULL) >> 60) & (kJitterCount - 1);
+/// The random order of cell `index` along line `line` (a column when row == false).
+inline uint64_t jitterKey(uint64_t tixel, uint32_t line, uint32_t index, bool row, uint64_t seed) {
+  return hashCombine(hashCombine(tixel, (uint64_t(line) << 33) | (uint64_t(row) << 32) | index),
+                     seed ^ 0x5649534942494c59ULL);
 }
+
+/// Rank of `index` among 0..gridSide-1 ordered by jitterKey (ties, vanishingly rare, by index).
+inline uint32_t jitterRank(uint64_t tixel, uint32_t line, uint32_t index, bool row, uint32_t gridSide, uint64_t seed) {
+  const uint64_t key = jitterKey(tixel, line, index, row, seed);
+  uint32_t rank = 0;
+  for (uint32_t other = 0; other < gridSide; ++other) {
+    const uint64_t otherKey = jitterKey(tixel, line, other, row, seed);
+    rank += otherKey < key || (otherKey == key && other < index);
+  }
+  return rank;
+}
+
+}  // namespace
+
+uint32_t gatherSubCell(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed) {
+  const uint32_t column = k % gridSide, row = k / gridSide;
+  const uint32_t subColumn = jitterRank(tixel, column, row, false, gridSide, seed) % kJitterSide;
+  const uint32_t subRow = jitterRank(tixel, row, column, true, gridSide, seed) % kJitterSide;
+  return subColumn + kJitterSide * subRow;
+}
+
+void gatherSubCells(uint64_t tixel, uint32_t gridSide, uint64_t seed, std::vector<uint8_t>& out) {
+  // Sorts each column and row once instead of ranking each cell on its own.
+  out.assign(size_t(gridSide) * gridSide, 0);
+  std::vector<std::pair<uint64_t, uint32_t>> order(gridSide);  // (key, index), sorted = the ranks
+  for (int pass = 0; pass < 2; ++pass) {
+    const bool row = pass == 1;
+    for (uint32_t line = 0; line < gridSide; ++line) {
+      for (uint32_t i = 0; i < gridSide; ++i) order[i] = {jitterKey(tixel, line, i, row, seed), i};
+      std::sort(order.begin(), order.end());
+      for (uint32_t rank = 0; rank < gridSide; ++rank) {
+        const uint32_t index = order[rank].second;
+        const uint32_t k = row ? index + line * gridSide : line + index * gridSide;
+        out[k] = uint8_t(out[k] + (rank % kJitterSide) * (row ? kJitterSide : 1));
+      }
+    }
+  }
+}
+
+namespace {
 
 inline Vec3 cellDirection(uint32_t k, uint32_t jitter, uint32_t gridSide, uint64_t seed) {
   const uint64_t h = hashCombine(hashCombine(k, jitter), seed ^ 0x4a4954544552ULL);
@@ -111,7 +160,7 @@ inline Vec3 cellDirection(uint32_t k, uint32_t jitter, uint32_t gridSide, uint64
 }  // namespace
 
 Vec3 gatherDirectionLocal(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed) {
-  return cellDirection(k, jitterIndex(tixel, k, seed), gridSide, seed);
+  return cellDirection(k, gatherSubCell(tixel, k, gridSide, seed), gridSide, seed);
 }
 
 uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings) {
@@ -187,6 +236,7 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
     std::vector<Ray> rays, nextRays;
     std::vector<RayHit> hits;
     std::vector<PathState> states, nextStates;
+    std::vector<uint8_t> jitters;
     rays.reserve((t1 - t0) * n);
     states.reserve((t1 - t0) * n);
     auto& extras = blockExtras[block];
@@ -201,10 +251,11 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
       // origin, offset off the surface along the normal. The frame is orthonormal and the
       // local directions are unit, so the world directions need no renormalisation.
       const Vec3 origin = offsetRayOrigin(param.gatherPoint[g], c.normal, c.normal);
+      gatherSubCells(g, field.gridSide, settings.seed, jitters);
       for (uint32_t k = 0; k < n; ++k) {
         Ray ray;
         ray.origin = origin;
-        ray.direction = chartWorldDirection(c, directionTable[size_t(k) * kJitterCount + jitterIndex(g, k, settings.seed)]);
+        ray.direction = chartWorldDirection(c, directionTable[size_t(k) * kJitterCount + jitters[k]]);
         rays.push_back(ray);
         states.push_back({g * n + k, Rgb(1.0f), false});
       }

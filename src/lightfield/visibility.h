@@ -126,6 +126,17 @@ inline Vec3 octahedralDecode(Vec2 e) {
 /// m for a requested number of gather directions: round(√N), at least 1.
 uint32_t gatherGridSide(uint32_t gatherDirections);
 
+/// Side of the grid of sub-cells inside each gather cell: a tixel's ray through cell k goes
+/// through one sub-cell of it, at a point of that sub-cell fixed per (cell, sub-cell, seed).
+inline constexpr uint32_t kGatherJitterSide = 4;
+/// The sub-cell (column + kGatherJitterSide·row) that gather cell k (column + gridSide·row) of
+/// `tixel` uses: multi-jittered, i.e. along each column of cells the sub-columns are used
+/// equally often (exactly, when kGatherJitterSide divides gridSide), and the sub-rows along
+/// each row of cells, in a random order per (tixel, column or row, seed).
+uint32_t gatherSubCell(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed);
+/// gatherSubCell of every cell of a tixel at once (out.size() becomes gridSide²).
+void gatherSubCells(uint64_t tixel, uint32_t gridSide, uint64_t seed, std::vector<uint8_t>& out);
+
 /// Gather direction k of global tixel `tixel`, in the chart's local frame (z = normal).
 Vec3 gatherDirectionLocal(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed);
 
