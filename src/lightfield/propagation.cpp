@@ -393,10 +393,16 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   tixelEmits[tixels] = environment.isBlack() ? 0 : 3;
   parallelForRange(tixels, 16, [&](uint64_t t0, uint64_t t1) {
     std::vector<Lanes4> incoming(n);  // per gather cell, kept for glossy tixels
+    std::vector<uint8_t> subCells;
     for (uint64_t g = t0; g < t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
       uint64_t cursor = vis.extraOffset[g];
+      subCells.clear();  // this tixel's gather sub-cells, computed when first needed
+      auto direction = [&](uint32_t k) {
+        if (subCells.empty()) gatherSubCells(g, vis.gridSide, settings.seed, subCells);
+        return gatherCellDirection(k, subCells[k], vis.gridSide, settings.seed);
+      };
       const bool keepIncoming = c.kind == ChartKind::Glossy;
       bool any = false;
       Rgb sum(0.0f);  // Σ_k L_k in gather order
@@ -414,7 +420,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           // The environment in the direction the path left: the gather direction itself, or
           // after mirrors the final direction stored with the path.
           const Vec3 leaving = extra ? octahedralDecode(extra->st)
-                                     : chartWorldDirection(c, gatherDirectionLocal(g, k, vis.gridSide, settings.seed));
+                                     : chartWorldDirection(c, direction(k));
           L = environment.radiance(leaving);
         } else {
           const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
@@ -424,7 +430,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
             if (lightSamples > 0 && !(extra && extra->viaMirror) && areaPdf[seen.material] > 0.0f) {
               // The same power heuristic as the shadow rays, evaluated for this gather ray
               // against the seen chart's plane (exact for a direct hit on a planar emitter).
-              const Vec3 local = gatherDirectionLocal(g, k, vis.gridSide, settings.seed);
+              const Vec3 local = direction(k);
               const Vec3 w = glm::normalize(chartWorldDirection(c, local));
               const Vec3 o = offsetRayOrigin(param.gatherPoint[g], c.normal, w);
               const float denom = glm::dot(w, seen.normal);

@@ -94,55 +94,42 @@ namespace {
 //
 // The sub-cells are chosen per tixel as a multi-jittered pattern (Chiu, Shirley & Wang 1994):
 // in each column of cells the G cells take sub-columns rank mod kJitterSide, where rank is
-// the cell's position in a random order of that column keyed by (tixel, column, seed), and
-// likewise sub-rows along each row of cells. When kJitterSide divides G every sub-column of a
-// column of cells (and every sub-row of a row) is used equally often, so besides one
-// direction per cell the projections onto each axis are stratified kJitterSide times finer
-// (jittered sampling stratifies the cells only); the random orders keep tixels decorrelated.
+// the cell's position in a random permutation of that column (Fisher–Yates with hashed
+// choices, keyed by (tixel, column, seed)), and likewise sub-rows along each row of cells.
+// When kJitterSide divides G every sub-column of a column of cells (and every sub-row of a
+// row) is used equally often, so besides one direction per cell the projections onto each
+// axis are stratified kJitterSide times finer (jittered sampling stratifies the cells only);
+// the random permutations keep tixels decorrelated.
 constexpr uint32_t kJitterSide = kGatherJitterSide;
 constexpr uint32_t kJitterCount = kJitterSide * kJitterSide;
+constexpr uint32_t kMaxGatherGridSide = 256;  // gatherDirections ≤ 65 536
 
-/// The random order of cell `index` along line `line` (a column when row == false).
-inline uint64_t jitterKey(uint64_t tixel, uint32_t line, uint32_t index, bool row, uint64_t seed) {
-  return hashCombine(hashCombine(tixel, (uint64_t(line) << 33) | (uint64_t(row) << 32) | index),
-                     seed ^ 0x5649534942494c59ULL);
-}
-
-/// Rank of `index` among 0..gridSide-1 ordered by jitterKey (ties, vanishingly rare, by index).
-inline uint32_t jitterRank(uint64_t tixel, uint32_t line, uint32_t index, bool row, uint32_t gridSide, uint64_t seed) {
-  const uint64_t key = jitterKey(tixel, line, index, row, seed);
-  uint32_t rank = 0;
-  for (uint32_t other = 0; other < gridSide; ++other) {
-    const uint64_t otherKey = jitterKey(tixel, line, other, row, seed);
-    rank += otherKey < key || (otherKey == key && other < index);
+/// The random permutation of line `line` (a column when row == false) of a tixel's cells:
+/// order[rank] = index of the cell (along the line) with that rank.
+void linePermutation(uint64_t tixelSalt, uint32_t line, bool row, uint32_t gridSide, uint8_t* order) {
+  for (uint32_t i = 0; i < gridSide; ++i) order[i] = uint8_t(i);
+  const uint64_t lineSalt = tixelSalt ^ ((uint64_t(line) << 1 | uint64_t(row)) * 0x9e3779b97f4a7c15ULL);
+  for (uint32_t i = gridSide; i > 1; --i) {
+    // 32 random bits scaled to [0, i) (Lemire's multiply-shift; the bias is < i/2^32).
+    const uint32_t j = uint32_t((uint64_t(uint32_t(mix64(lineSalt + i))) * i) >> 32);
+    std::swap(order[i - 1], order[j]);
   }
-  return rank;
 }
+
+uint64_t tixelSalt(uint64_t tixel, uint64_t seed) { return hashCombine(tixel, seed ^ 0x5649534942494c59ULL); }
 
 }  // namespace
 
-uint32_t gatherSubCell(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed) {
-  const uint32_t column = k % gridSide, row = k / gridSide;
-  const uint32_t subColumn = jitterRank(tixel, column, row, false, gridSide, seed) % kJitterSide;
-  const uint32_t subRow = jitterRank(tixel, row, column, true, gridSide, seed) % kJitterSide;
-  return subColumn + kJitterSide * subRow;
-}
-
 void gatherSubCells(uint64_t tixel, uint32_t gridSide, uint64_t seed, std::vector<uint8_t>& out) {
-  // Sorts each column and row once instead of ranking each cell on its own.
   out.assign(size_t(gridSide) * gridSide, 0);
-  std::vector<std::pair<uint64_t, uint32_t>> order(gridSide);  // (key, index), sorted = the ranks
-  for (int pass = 0; pass < 2; ++pass) {
-    const bool row = pass == 1;
-    for (uint32_t line = 0; line < gridSide; ++line) {
-      for (uint32_t i = 0; i < gridSide; ++i) order[i] = {jitterKey(tixel, line, i, row, seed), i};
-      std::sort(order.begin(), order.end());
-      for (uint32_t rank = 0; rank < gridSide; ++rank) {
-        const uint32_t index = order[rank].second;
-        const uint32_t k = row ? index + line * gridSide : line + index * gridSide;
-        out[k] = uint8_t(out[k] + (rank % kJitterSide) * (row ? kJitterSide : 1));
-      }
-    }
+  const uint64_t salt = tixelSalt(tixel, seed);
+  uint8_t order[kMaxGatherGridSide];
+  for (uint32_t line = 0; line < gridSide; ++line) {
+    linePermutation(salt, line, false, gridSide, order);  // column `line`: cells line + i·G
+    for (uint32_t rank = 0; rank < gridSide; ++rank) out[line + order[rank] * gridSide] += uint8_t(rank % kJitterSide);
+    linePermutation(salt, line, true, gridSide, order);  // row `line`: cells i + line·G
+    for (uint32_t rank = 0; rank < gridSide; ++rank)
+      out[order[rank] + line * gridSide] += uint8_t(kJitterSide * (rank % kJitterSide));
   }
 }
 
@@ -159,8 +146,8 @@ inline Vec3 cellDirection(uint32_t k, uint32_t jitter, uint32_t gridSide, uint64
 
 }  // namespace
 
-Vec3 gatherDirectionLocal(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed) {
-  return cellDirection(k, gatherSubCell(tixel, k, gridSide, seed), gridSide, seed);
+Vec3 gatherCellDirection(uint32_t k, uint32_t subCell, uint32_t gridSide, uint64_t seed) {
+  return cellDirection(k, subCell, gridSide, seed);
 }
 
 uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings) {
