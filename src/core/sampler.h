@@ -65,21 +65,7 @@ constexpr std::array<uint32_t, 32> secondDimensionColumns() {
 }
 inline constexpr std::array<uint32_t, 32> kSecondDimension = secondDimensionColumns();
 
-/// The second dimension's matrix applied to each byte of the index: kSecondDimensionBytes[j][v]
-/// is the XOR of the columns 8j..8j+7 selected by the bits of v, so a point costs 4 lookups.
-constexpr std::array<std::array<uint32_t, 256>, 4> secondDimensionByteTables() {
-  std::array<std::array<uint32_t, 256>, 4> t{};
-  for (int j = 0; j < 4; ++j)
-    for (uint32_t v = 0; v < 256; ++v)
-      for (int bit = 0; bit < 8; ++bit)
-        if (v & (1u << bit)) t[size_t(j)][v] ^= kSecondDimension[size_t(8 * j + bit)];
-  return t;
-}
-inline constexpr std::array<std::array<uint32_t, 256>, 4> kSecondDimensionBytes = secondDimensionByteTables();
-
-}  // namespace sobol_detail
-
-inline uint32_t reverseBits32(uint32_t v) {
+constexpr uint32_t reverseBits32(uint32_t v) {
   v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
   v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
   v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
@@ -87,26 +73,49 @@ inline uint32_t reverseBits32(uint32_t v) {
   return (v >> 16) | (v << 16);
 }
 
+/// The second dimension's matrix, columns bit-reversed, applied to each byte of the index:
+/// kSecondDimensionBytes[j][v] is the XOR of the reversed columns 8j..8j+7 selected by the bits
+/// of v, so a point costs 4 lookups.
+constexpr std::array<std::array<uint32_t, 256>, 4> secondDimensionByteTables() {
+  std::array<std::array<uint32_t, 256>, 4> t{};
+  for (int j = 0; j < 4; ++j)
+    for (uint32_t v = 0; v < 256; ++v)
+      for (int bit = 0; bit < 8; ++bit)
+        if (v & (1u << bit)) t[size_t(j)][v] ^= reverseBits32(kSecondDimension[size_t(8 * j + bit)]);
+  return t;
+}
+inline constexpr std::array<std::array<uint32_t, 256>, 4> kSecondDimensionBytes = secondDimensionByteTables();
+
+}  // namespace sobol_detail
+
+using sobol_detail::reverseBits32;
+
 /// Point `index` of the first (dimension 0) or second (dimension 1) Sobol dimension, as 0.32
-/// fixed point.
-inline uint32_t sobolPoint(uint32_t index, int dimension) {
-  if (dimension == 0) return reverseBits32(index);
+/// fixed point with its bits reversed (the form the scramble works on: the first dimension,
+/// the van der Corput sequence, is then the index itself).
+inline uint32_t reversedSobolPoint(uint32_t index, int dimension) {
+  if (dimension == 0) return index;
   const auto& t = sobol_detail::kSecondDimensionBytes;
   return t[0][index & 0xffu] ^ t[1][(index >> 8) & 0xffu] ^ t[2][(index >> 16) & 0xffu] ^ t[3][index >> 24];
 }
 
-/// Hash-based Owen scrambling of a 0.32 fixed-point value (Burley 2020, after Laine & Karras
-/// 2011): in bit-reversed order, a multiply-xor hash in which every bit only depends on the
-/// bits below it is a nested uniform scramble, i.e. each bit is flipped by a random function of
-/// the more significant bits. A different seed gives an independent scramble.
-inline uint32_t owenScramble(uint32_t v, uint32_t seed) {
-  v = reverseBits32(v);
+/// Hash-based Owen scrambling (Burley 2020, after Laine & Karras 2011) of a 0.32 fixed-point
+/// value given bit-reversed: a multiply-xor hash in which every bit only depends on the bits
+/// below it is, in reversed order, a nested uniform scramble — each bit is flipped by a random
+/// function of the more significant bits. A different seed gives an independent scramble.
+/// Returns the scrambled value, still reversed.
+inline uint32_t owenScrambleReversed(uint32_t v, uint32_t seed) {
   v ^= v * 0x3d20adeau;
   v += seed;
   v *= (seed >> 16) | 1u;
   v ^= v * 0x05526c56u;
   v ^= v * 0x53a22864u;
-  return reverseBits32(v);
+  return v;
+}
+
+/// An Owen-scrambled Sobol value: dimension 0 or 1 of point `index`, as 0.32 fixed point.
+inline uint32_t scrambledSobol(uint32_t index, int dimension, uint32_t seed) {
+  return reverseBits32(owenScrambleReversed(reversedSobolPoint(index, dimension), seed));
 }
 
 /// 0.32 fixed point to a float in [0, 1): the top 24 bits, so never 1.
@@ -186,7 +195,7 @@ class Sampler {
     if (kind_ == SamplerKind::Independent) return rng_.uniform();
     const uint64_t h = dimensionHash(dimension_++);
     const uint32_t index = shuffledIndex(h);
-    return fixedToUnit(owenScramble(sobolPoint(index, 0), uint32_t(h >> 32)));
+    return fixedToUnit(scrambledSobol(index, 0, uint32_t(h >> 32)));
   }
   Vec2 get2D() {
     if (kind_ == SamplerKind::Independent) {
@@ -195,8 +204,7 @@ class Sampler {
     }
     const uint64_t h = dimensionHash(dimension_++);
     const uint32_t index = shuffledIndex(h);
-    return {fixedToUnit(owenScramble(sobolPoint(index, 0), uint32_t(h >> 32))),
-            fixedToUnit(owenScramble(sobolPoint(index, 1), uint32_t(h)))};
+    return {fixedToUnit(scrambledSobol(index, 0, uint32_t(h >> 32))), fixedToUnit(scrambledSobol(index, 1, uint32_t(h)))};
   }
 
  private:
@@ -217,7 +225,7 @@ class Sampler {
     if (bits == 0) return 0;
     const int shift = 32 - bits;
     const uint32_t seed = uint32_t((h * 0x9e3779b97f4a7c15ULL) >> 32);
-    return owenScramble(uint32_t(mortonIndex_) << shift, seed) >> shift;
+    return reverseBits32(owenScrambleReversed(reverseBits32(uint32_t(mortonIndex_) << shift), seed)) >> shift;
   }
 
   SamplerKind kind_ = SamplerKind::Independent;

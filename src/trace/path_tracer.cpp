@@ -227,8 +227,8 @@ PathTracer::Impl::Impl(const Scene& s, const Accel& a) : scene(s), accel(a) {
 Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame,
                                   const Vec3& woLocal, const Bsdf& bsdf, const TraceSettings& settings, int depth,
                                   Sampler& sampler, Counters& counters) const {
-  // Always draw the same three numbers so that the stream layout does not depend on which
-  // light is picked (not needed for correctness, but keeps replays easy to reason about).
+  // Always draw the same three numbers, from this bounce's light dimensions, whichever light
+  // is picked: the independent stream's layout then does not depend on the choice either.
   sampler.setDimension(bounceDimension(depth, kLightSelect));
   const float uSelect = sampler.get1D();
   sampler.setDimension(bounceDimension(depth, kLightPoint));
