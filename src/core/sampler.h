@@ -14,9 +14,10 @@
 //    dimension d sees that index through its own random nested shuffle (Burley 2020,
 //    "Practical hash-based Owen scrambling": a hash-based Owen scramble of the index bits,
 //    most significant first, so aligned blocks of indices stay aligned blocks; pbrt-v4 permutes
-//    base-4 digits with one hash per digit instead, which measured 2× slower per path here
-//    for the same per-pixel stratification). Dimension d's value is then the first (1-D) or
-//    the first two (2-D) dimensions of the Sobol sequence at that index, Owen-scrambled with
+//    base-4 digits with one hash per digit instead: a first implementation of that here (with
+//    more hashing per dimension too) made paths 2× slower, for the same per-pixel
+//    stratification). Dimension d's value is then the first (1-D) or the first two (2-D)
+//    dimensions of the Sobol sequence at that index, Owen-scrambled with
 //    seeds hashed from (d, seed) (Burley 2020, after Laine & Karras 2011). So:
 //      - a pixel's 2^k samples are an aligned block of 2^k consecutive points of an
 //        Owen-scrambled (0,2)-sequence in every 2-D dimension: every elementary interval of
