@@ -14,7 +14,7 @@
 //    Pcg32::forKey(pixel index, sample index, seed) — so an image depends on the seed only,
 //    never on the number of threads or the tile schedule. With the sobol sampler a pixel's
 //    samples are stratified, not independent: the per-pixel variance (sample variance / n)
-//    is then an upper bound on the variance of the mean, not an estimate of it.
+//    then usually overestimates the variance of the mean (which stratification lowers).
 //  * Samples whose radiance is not finite (NaN or ±inf) are NOT added to the pixel (that
 //    would poison it) and NOT silently replaced by black either: they are counted in
 //    TraceStats::nanSamples and the first offending (pixel, sample) is reported so that it

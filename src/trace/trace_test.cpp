@@ -404,7 +404,9 @@ TraceResult renderCornell(const Cornell& box, int size, int spp, TraceStrategy s
 }
 
 /// Averages factor × factor blocks of pixels; the variance of a block mean is the sum of the
-/// pixel variances over factor⁴ (pixels are independent).
+/// pixel variances over factor⁴ (pixels are independent with the independent sampler; with
+/// sobol, neighbouring pixels take complementary parts of one sequence, their errors are
+/// anti-correlated and the sum overestimates: the test only becomes more conservative).
 ///
 /// Why blocks: the per-sample radiance of a path tracer is skewed (most samples are small, a
 /// few — the paths that find a light through a gap, into a penumbra — are large). With a few
