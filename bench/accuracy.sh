@@ -113,29 +113,13 @@ done
 "$plenoptic" --quiet compare "$reuse.original.exr" "$reuse.full.exr" --json >"$reuse.changed.json"
 
 # ---- table ---------------------------------------------------------------------------------
-python3 - "$workdir" "$size" "$ref_spp" "$lf_samples" ${names[@]+"${names[@]}"} <<'PY'
-import json, os, struct, sys
+BENCH_DIR="$(cd "$(dirname "$0")" && pwd)" python3 - "$workdir" "$size" "$ref_spp" "$lf_samples" ${names[@]+"${names[@]}"} <<'PY'
+import json, os, sys
+
+sys.path.insert(0, os.environ["BENCH_DIR"])
+from pfm import read_pfm
 
 workdir, size, ref_spp, lf_samples, names = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5:]
-
-def read_pfm(path):
-    """Colour PFM ('PF'): header lines, then float32 rows bottom to top (order irrelevant here)."""
-    with open(path, "rb") as f:
-        data = f.read()
-    parts, pos = [], 0
-    while len(parts) < 4:  # "PF", width, height, scale (whitespace-separated)
-        while data[pos:pos + 1].isspace():
-            pos += 1
-        start = pos
-        while not data[pos:pos + 1].isspace():
-            pos += 1
-        parts.append(data[start:pos].decode())
-    pos += 1  # the single whitespace byte after the scale
-    if parts[0] != "PF":
-        sys.exit(f"{path}: not a colour PFM")
-    w, h, scale = int(parts[1]), int(parts[2]), float(parts[3])
-    fmt = ("<" if scale < 0 else ">") + "f" * (3 * w * h)
-    return struct.unpack(fmt, data[pos:pos + 12 * w * h])
 
 rows = []
 for name in names:

@@ -4,6 +4,7 @@
 # are in the counters column). Extra arguments are passed to every binary, e.g.
 #   bench/run.sh build --benchmark_filter=Primary
 # Usage: bench/run.sh BUILD_DIR [benchmark flags...]
+# Environment: VS_CYCLES=1 also runs bench/vs_cycles.sh (plenoptic against Blender Cycles).
 set -euo pipefail
 
 if [[ $# -lt 1 ]]; then
@@ -41,4 +42,10 @@ for binary in "${binaries[@]}"; do
   fi
   echo "$output" | grep -E '^(Benchmark|-{10,}|.*_median)' || true
 done
+# Optional: plenoptic against Blender Cycles (many minutes; says so and skips when Blender is
+# not installed). Only with VS_CYCLES=1, e.g. `make bench VS_CYCLES=1`.
+if [[ ${VS_CYCLES:-0} == 1 ]]; then
+  echo "== vs_cycles"
+  bash "$(dirname "$0")/vs_cycles.sh" "$build_dir/plenoptic" || status=1
+fi
 exit $status

@@ -79,27 +79,13 @@ print(int(json.load(open(sys.argv[1]))["relmse"] <= float(sys.argv[2])))' "$w/pt
   spp=$((spp * 2))
 done
 
-python3 - "$w" "$width" "$height" "$ref_spp" "$lf_samples" <<'PY'
-import glob, json, math, os, struct, sys
+BENCH_DIR="$(cd "$(dirname "$0")" && pwd)" python3 - "$w" "$width" "$height" "$ref_spp" "$lf_samples" <<'PY'
+import glob, json, math, os, sys
+
+sys.path.insert(0, os.environ["BENCH_DIR"])
+from pfm import read_pfm
 
 w, width, height, ref_spp, lf_samples = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5].split()
-
-def read_pfm(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    parts, pos = [], 0
-    while len(parts) < 4:
-        while data[pos:pos + 1].isspace():
-            pos += 1
-        start = pos
-        while not data[pos:pos + 1].isspace():
-            pos += 1
-        parts.append(data[start:pos].decode())
-    pos += 1
-    if parts[0] != "PF":
-        sys.exit(f"{path}: not a colour PFM")
-    n = 3 * int(parts[1]) * int(parts[2])
-    return struct.unpack(("<" if float(parts[3]) < 0 else ">") + "f" * n, data[pos:pos + 4 * n])
 
 ref, var = read_pfm(os.path.join(w, "ref.pfm")), read_pfm(os.path.join(w, "refvar.pfm"))
 ref_noise = sum(v / (r * r + 0.01) for r, v in zip(ref, var)) / len(ref)

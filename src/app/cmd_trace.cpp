@@ -31,6 +31,7 @@ struct TraceOptions {
   int spp = 64;
   int maxDepth = TraceSettings{}.maxDepth;
   std::string strategy = "mis";
+  std::string sampler = samplerName(TraceSettings{}.sampler);
   std::string statsPath;     ///< --stats: JSON with timings
   std::string variancePath;  ///< --variance: per-pixel variance of the mean (HDR file)
   std::vector<int> pixel;    ///< --pixel X,Y: replay one pixel, print it, write no image
@@ -56,6 +57,7 @@ void runTrace(const TraceOptions& options, const GlobalOptions& global) {
   settings.maxDepth = options.maxDepth;
   settings.seed = global.seed;
   settings.strategy = parseStrategy(options.strategy);
+  settings.sampler = parseSampler(options.sampler);
 
   const Scene scene = loadScene(options.scene);
   // The scene file's suggested settings, where the command line is silent.
@@ -83,8 +85,8 @@ void runTrace(const TraceOptions& options, const GlobalOptions& global) {
     const int x = options.pixel[0], y = options.pixel[1];
     const RadianceEstimate e = tracer.renderPixel(camera, settings, x, y);
     const Rgb se = glm::sqrt(e.varianceOfMean);
-    fmt::print("pixel ({}, {}) of {}x{}, {} spp, seed {}, strategy {}:\n", x, y, view.width, view.height, settings.spp,
-               settings.seed, strategyName(settings.strategy));
+    fmt::print("pixel ({}, {}) of {}x{}, {} spp, seed {}, strategy {}, sampler {}:\n", x, y, view.width, view.height,
+               settings.spp, settings.seed, strategyName(settings.strategy), samplerName(settings.sampler));
     fmt::print("  radiance  {:.6g} {:.6g} {:.6g}\n", e.mean.r, e.mean.g, e.mean.b);
     fmt::print("  std error {:.6g} {:.6g} {:.6g}\n", se.r, se.g, se.b);
     fmt::print("  finite samples {}, non-finite samples dropped {}\n", e.samples, e.nanSamples);
@@ -114,6 +116,7 @@ void runTrace(const TraceOptions& options, const GlobalOptions& global) {
     json["spp"] = settings.spp;
     json["max_depth"] = settings.maxDepth;
     json["strategy"] = strategyName(settings.strategy);
+    json["sampler"] = samplerName(settings.sampler);
     json["seed"] = settings.seed;
     json["threads"] = runtime.threads();
     json["seconds"] = stats.seconds;
@@ -152,6 +155,11 @@ void addTraceCommand(CLI::App& app, const GlobalOptions& global) {
                       "Direct lighting: mis (default), nee (light sampling only) or bsdf (BSDF sampling only); "
                       "the last two are for testing")
       ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
+      ->capture_default_str();
+  command->add_option("--sampler", options->sampler,
+                      "Sample numbers: sobol (default; Owen-scrambled ZSobol, stratified per pixel) or independent "
+                      "(PCG32 streams; exact per-pixel variance estimates)")
+      ->check(CLI::IsMember({"independent", "sobol"}))
       ->capture_default_str();
   command->add_option("--stats", options->statsPath, "Write timings and counts as JSON");
   command->add_option("--variance", options->variancePath,

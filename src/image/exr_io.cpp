@@ -13,9 +13,11 @@
 #include <ImfTestFile.h>
 #include <Imath/half.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <exception>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -71,9 +73,12 @@ void checkHeaderAllocations(const std::string& path, bool multiPart) {
       } else if (type == "preview") {
         uint32_t dimensions[2] = {0, 0};
         in.read(reinterpret_cast<char*>(dimensions), 8);
-        const long long bytes = 4LL * dimensions[0] * dimensions[1];  // RGBA8
-        if (bytes > remaining()) tooBig(name, bytes);
-        in.seekg(bytes, std::ios::cur);
+        // RGBA8: 4·w·h bytes. w·h < 2⁶⁴ always, 4·w·h may not be: compare w·h with a quarter
+        // of what remains instead (fuzzing found the overflow).
+        const unsigned long long pixels = static_cast<unsigned long long>(dimensions[0]) * dimensions[1];
+        if (pixels > static_cast<unsigned long long>(std::max(0LL, remaining())) / 4)
+          tooBig(name, pixels > (1ULL << 61) ? std::numeric_limits<long long>::max() : static_cast<long long>(4 * pixels));
+        in.seekg(static_cast<std::streamoff>(4 * pixels), std::ios::cur);
       } else {
         if (size > remaining()) tooBig(name, size);
         in.seekg(size, std::ios::cur);

@@ -483,6 +483,36 @@ TEST_F(BakeTest, CornellBoxVisibilityFieldIsSane) {
   EXPECT_LT(fraction, 0.4);
 }
 
+// The gather's sub-cells are multi-jittered: along each column of cells every sub-column is
+// used gridSide/kGatherJitterSide times, and along each row every sub-row; the same tixel
+// gets the same pattern, other tixels other patterns.
+TEST(GatherJitter, SubCellsAreMultiJitteredPerTixel) {
+  constexpr uint32_t J = kGatherJitterSide;
+  for (uint32_t gridSide : {12u, 16u, 24u}) {
+    for (uint64_t tixel : {0ull, 7ull, 123456ull}) {
+      std::vector<uint8_t> subCells;
+      gatherSubCells(tixel, gridSide, 3, subCells);
+      ASSERT_EQ(subCells.size(), size_t(gridSide) * gridSide);
+      for (uint32_t line = 0; line < gridSide; ++line) {
+        std::vector<int> columnUse(J, 0), rowUse(J, 0);
+        for (uint32_t i = 0; i < gridSide; ++i) {
+          ++columnUse[subCells[line + i * gridSide] % J];  // cells of column `line`
+          ++rowUse[subCells[i + line * gridSide] / J];     // cells of row `line`
+        }
+        for (uint32_t j = 0; j < J; ++j) {
+          EXPECT_EQ(columnUse[j], int(gridSide / J)) << "grid " << gridSide << " column " << line;
+          EXPECT_EQ(rowUse[j], int(gridSide / J)) << "grid " << gridSide << " row " << line;
+        }
+      }
+      std::vector<uint8_t> again, other;
+      gatherSubCells(tixel, gridSide, 3, again);
+      EXPECT_EQ(again, subCells);
+      gatherSubCells(tixel + 1, gridSide, 3, other);
+      EXPECT_NE(other, subCells);
+    }
+  }
+}
+
 TEST_F(BakeTest, DeterministicWhateverTheThreadCount) {
   // Every random stream is keyed by (tixel, sample), every sum runs in a fixed order and the
   // Gauss–Seidel batches never read what they write: 1 and 2 threads give identical bits.

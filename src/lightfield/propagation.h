@@ -11,7 +11,7 @@
 // First shot (constant over the iteration, "direct"):
 //   * point, spot and directional lights: shadow rays from every tixel's gather point;
 //   * emissive surfaces: areaLightSamples shadow rays per tixel towards emissive triangles
-//     (chosen ∝ area·luminance(Le)) combined by the balance heuristic with the gather rays
+//     (chosen ∝ area·luminance(Le)) combined by the power heuristic with the gather rays
 //     that hit emitters directly (emitters seen through mirrors come through the gather only);
 //   * the environment (Environment::radiance of the leaving direction) through gather rays
 //     that escape, directly or after mirrors.

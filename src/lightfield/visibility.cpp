@@ -39,7 +39,7 @@ namespace pl {
 namespace {
 
 constexpr char kPlvMagic[8] = {'P', 'L', 'V', 'I', 'S', '\0', '\r', '\n'};
-constexpr uint32_t kPlvVersion = 1;
+constexpr uint32_t kPlvVersion = 2;  // 2: multi-jittered gather directions
 constexpr size_t kPlvHeaderSize = 8 + 4 + 4 + 8 * 5;
 
 // FNV-1a, 64 bit: a change detector over bytes (not a cryptographic hash).
@@ -86,18 +86,54 @@ uint32_t gatherGridSide(uint32_t gatherDirections) {
 
 namespace {
 
-// Inside its cell, a tixel's ray goes through one of kJitterSide² sub-cells, chosen by a hash
-// of (tixel, cell, seed), at a point of that sub-cell fixed by a hash of (cell, sub-cell,
-// seed): stratified within the cell, decorrelated between tixels, and cheap — the directions
-// of every (cell, sub-cell) pair are tabulated once per field. (Sub-cell *centres* would put
-// the directions on a regular lattice, and rays from regularly spaced tixels would then hit
-// the exact edges and corners of axis-aligned boxes, where ray-triangle tests may miss.)
-constexpr uint32_t kJitterSide = 4;
+// Inside its cell, a tixel's ray goes through one of kJitterSide² sub-cells, at a point of
+// that sub-cell fixed by a hash of (cell, sub-cell, seed): the directions of every (cell,
+// sub-cell) pair are tabulated once per field. (Sub-cell *centres* would put the directions
+// on a regular lattice, and rays from regularly spaced tixels would then hit the exact edges
+// and corners of axis-aligned boxes, where ray-triangle tests may miss.)
+//
+// The sub-cells are chosen per tixel as a multi-jittered pattern (Chiu, Shirley & Wang 1994):
+// in each column of cells the G cells take sub-columns rank mod kJitterSide, where rank is
+// the cell's position in a random permutation of that column (Fisher–Yates with hashed
+// choices, keyed by (tixel, column, seed)), and likewise sub-rows along each row of cells.
+// When kJitterSide divides G every sub-column of a column of cells (and every sub-row of a
+// row) is used equally often, so besides one direction per cell the projections onto each
+// axis are stratified kJitterSide times finer (jittered sampling stratifies the cells only);
+// the random permutations keep tixels decorrelated.
+constexpr uint32_t kJitterSide = kGatherJitterSide;
 constexpr uint32_t kJitterCount = kJitterSide * kJitterSide;
+constexpr uint32_t kMaxGatherGridSide = 256;  // gatherDirections ≤ 65 536
 
-inline uint32_t jitterIndex(uint64_t tixel, uint32_t k, uint64_t seed) {
-  return uint32_t(hashCombine(hashCombine(tixel, k), seed ^ 0x5649534942494c59ULL) >> 60) & (kJitterCount - 1);
+/// The random permutation of line `line` (a column when row == false) of a tixel's cells:
+/// order[rank] = index of the cell (along the line) with that rank.
+void linePermutation(uint64_t tixelSalt, uint32_t line, bool row, uint32_t gridSide, uint8_t* order) {
+  for (uint32_t i = 0; i < gridSide; ++i) order[i] = uint8_t(i);
+  const uint64_t lineSalt = tixelSalt ^ ((uint64_t(line) << 1 | uint64_t(row)) * 0x9e3779b97f4a7c15ULL);
+  for (uint32_t i = gridSide; i > 1; --i) {
+    // 32 random bits scaled to [0, i) (Lemire's multiply-shift; the bias is < i/2^32).
+    const uint32_t j = uint32_t((uint64_t(uint32_t(mix64(lineSalt + i))) * i) >> 32);
+    std::swap(order[i - 1], order[j]);
+  }
 }
+
+uint64_t tixelSalt(uint64_t tixel, uint64_t seed) { return hashCombine(tixel, seed ^ 0x5649534942494c59ULL); }
+
+}  // namespace
+
+void gatherSubCells(uint64_t tixel, uint32_t gridSide, uint64_t seed, std::vector<uint8_t>& out) {
+  out.assign(size_t(gridSide) * gridSide, 0);
+  const uint64_t salt = tixelSalt(tixel, seed);
+  uint8_t order[kMaxGatherGridSide];
+  for (uint32_t line = 0; line < gridSide; ++line) {
+    linePermutation(salt, line, false, gridSide, order);  // column `line`: cells line + i·G
+    for (uint32_t rank = 0; rank < gridSide; ++rank) out[line + order[rank] * gridSide] += uint8_t(rank % kJitterSide);
+    linePermutation(salt, line, true, gridSide, order);  // row `line`: cells i + line·G
+    for (uint32_t rank = 0; rank < gridSide; ++rank)
+      out[order[rank] + line * gridSide] += uint8_t(kJitterSide * (rank % kJitterSide));
+  }
+}
+
+namespace {
 
 inline Vec3 cellDirection(uint32_t k, uint32_t jitter, uint32_t gridSide, uint64_t seed) {
   const uint64_t h = hashCombine(hashCombine(k, jitter), seed ^ 0x4a4954544552ULL);
@@ -110,8 +146,8 @@ inline Vec3 cellDirection(uint32_t k, uint32_t jitter, uint32_t gridSide, uint64
 
 }  // namespace
 
-Vec3 gatherDirectionLocal(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed) {
-  return cellDirection(k, jitterIndex(tixel, k, seed), gridSide, seed);
+Vec3 gatherCellDirection(uint32_t k, uint32_t subCell, uint32_t gridSide, uint64_t seed) {
+  return cellDirection(k, subCell, gridSide, seed);
 }
 
 uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings) {
@@ -194,6 +230,7 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
     std::vector<Ray> rays, nextRays;
     std::vector<RayHit> hits;
     std::vector<PathState> states, nextStates;
+    std::vector<uint8_t> jitters;
     rays.reserve((t1 - t0) * n);
     states.reserve((t1 - t0) * n);
     auto& extras = blockExtras[block];
@@ -208,10 +245,11 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
       // origin, offset off the surface along the normal. The frame is orthonormal and the
       // local directions are unit, so the world directions need no renormalisation.
       const Vec3 origin = offsetRayOrigin(param.gatherPoint[g], c.normal, c.normal);
+      gatherSubCells(g, field.gridSide, settings.seed, jitters);
       for (uint32_t k = 0; k < n; ++k) {
         Ray ray;
         ray.origin = origin;
-        ray.direction = chartWorldDirection(c, directionTable[size_t(k) * kJitterCount + jitterIndex(g, k, settings.seed)]);
+        ray.direction = chartWorldDirection(c, directionTable[size_t(k) * kJitterCount + jitters[k]]);
         rays.push_back(ray);
         states.push_back({g * n + k, Rgb(1.0f), false});
       }

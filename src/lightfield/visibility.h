@@ -9,8 +9,9 @@
 // unit square mapped to the hemisphere by the concentric cosine-weighted map
 // (sampleCosineHemisphere). Every cell has the same projected solid angle π/N, so a cell's
 // contribution to irradiance is (π/N)·L. Inside its cell each tixel's ray passes through one
-// of 4 × 4 sub-cell centres picked by a hash of (tixel, cell, seed): stratified, and
-// decorrelated between neighbouring tixels.
+// of 4 × 4 sub-cells (at a jittered point fixed per cell, sub-cell and seed), chosen per tixel
+// as a multi-jittered pattern (gatherSubCells): stratified per cell and, more finely, along
+// each axis, and decorrelated between neighbouring tixels.
 //
 // Entries (8 bytes, tixel-major: entry k of tixel g at g·N + k):
 //   target  bits 0–29: global index of the tixel at the lower-left of the 2×2 bilinear
@@ -126,8 +127,18 @@ inline Vec3 octahedralDecode(Vec2 e) {
 /// m for a requested number of gather directions: round(√N), at least 1.
 uint32_t gatherGridSide(uint32_t gatherDirections);
 
-/// Gather direction k of global tixel `tixel`, in the chart's local frame (z = normal).
-Vec3 gatherDirectionLocal(uint64_t tixel, uint32_t k, uint32_t gridSide, uint64_t seed);
+/// Side of the grid of sub-cells inside each gather cell: a tixel's ray through cell k goes
+/// through one sub-cell of it, at a point of that sub-cell fixed per (cell, sub-cell, seed).
+inline constexpr uint32_t kGatherJitterSide = 4;
+/// The sub-cell (column + kGatherJitterSide·row) that each gather cell k (column + gridSide·row)
+/// of `tixel` uses, in out[k] (out.size() becomes gridSide²): multi-jittered, i.e. along each
+/// column of cells the sub-columns are used equally often (exactly, when kGatherJitterSide
+/// divides gridSide), and the sub-rows along each row of cells, in a random order per (tixel,
+/// column or row, seed).
+void gatherSubCells(uint64_t tixel, uint32_t gridSide, uint64_t seed, std::vector<uint8_t>& out);
+/// Gather direction of cell k through sub-cell `subCell`, in the chart's local frame.
+Vec3 gatherCellDirection(uint32_t k, uint32_t subCell, uint32_t gridSide, uint64_t seed);
+
 
 /// Hash of everything the visibility field depends on: vertex positions, triangles and their
 /// materials' *transport class* (chart kind, and mirror parameters, which the field's

@@ -39,7 +39,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/progress.h"
-#include "core/rng.h"
+#include "core/sampler.h"
 #include "core/sampling.h"
 #include "scene/scene.h"
 #include "trace/trace.h"
@@ -78,6 +78,18 @@ struct LightEntry {
 struct Counters {
   uint64_t rays = 0;
 };
+
+/// The sampler dimensions of a path (core/sampler.h): the camera's film and lens positions,
+/// then per bounce (scattering event) `depth` a block of kDimensionsPerBounce starting at
+/// bounceDimension(depth): light selection (1-D), the point on the light (2-D), the BSDF
+/// sample (2-D: lobe choice stretched into the direction) and Russian roulette (1-D). A
+/// decision always uses the same dimension whatever the path did before it.
+constexpr uint32_t kFilmDimension = 0, kLensDimension = 1, kFirstBounceDimension = 2;
+constexpr uint32_t kDimensionsPerBounce = 4;
+enum BounceDimension : uint32_t { kLightSelect = 0, kLightPoint = 1, kBsdfSample = 2, kRoulette = 3 };
+uint32_t bounceDimension(int depth, BounceDimension which) {
+  return kFirstBounceDimension + kDimensionsPerBounce * uint32_t(depth) + which;
+}
 
 /// Running sums of one pixel's samples in double precision.
 struct PixelAccumulator {
@@ -187,10 +199,11 @@ struct PathTracer::Impl {
   }
 
   Rgb directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame, const Vec3& woLocal,
-                  const Bsdf& bsdf, const TraceSettings& settings, Pcg32& rng, Counters& counters) const;
-  Rgb radiance(Ray ray, Pcg32& rng, const TraceSettings& settings, Counters& counters) const;
-  void tracePixel(const Camera& camera, const TraceSettings& settings, int x, int y, PixelAccumulator& acc,
+                  const Bsdf& bsdf, const TraceSettings& settings, int depth, Sampler& sampler,
                   Counters& counters) const;
+  Rgb radiance(Ray ray, Sampler& sampler, const TraceSettings& settings, Counters& counters) const;
+  void tracePixel(const Camera& camera, const ZSobolLayout& layout, const TraceSettings& settings, int x, int y,
+                  PixelAccumulator& acc, Counters& counters) const;
 };
 
 PathTracer::Impl::Impl(const Scene& s, const Accel& a) : scene(s), accel(a) {
@@ -251,12 +264,14 @@ PathTracer::Impl::Impl(const Scene& s, const Accel& a) : scene(s), accel(a) {
 // Next-event estimation at a non-delta vertex: one light sample, MIS-weighted against the
 // BSDF's density when the light could also be hit by BSDF sampling.
 Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame,
-                                  const Vec3& woLocal, const Bsdf& bsdf, const TraceSettings& settings, Pcg32& rng,
-                                  Counters& counters) const {
-  // Always draw the same three numbers so that the stream layout does not depend on which
-  // light is picked (not needed for correctness, but keeps replays easy to reason about).
-  const float uSelect = rng.uniform();
-  const Vec2 u(rng.uniform(), rng.uniform());
+                                  const Vec3& woLocal, const Bsdf& bsdf, const TraceSettings& settings, int depth,
+                                  Sampler& sampler, Counters& counters) const {
+  // Always draw the same three numbers, from this bounce's light dimensions, whichever light
+  // is picked: the independent stream's layout then does not depend on the choice either.
+  sampler.setDimension(bounceDimension(depth, kLightSelect));
+  const float uSelect = sampler.get1D();
+  sampler.setDimension(bounceDimension(depth, kLightPoint));
+  const Vec2 u = sampler.get2D();
 
   const bool punctualOnly = settings.strategy == TraceStrategy::BsdfOnly;
   const Distribution1D& distribution = punctualOnly ? punctualLights : allLights;
@@ -341,7 +356,7 @@ Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNor
   return unweighted * powerHeuristic(lightPdf, pdf(bsdf, woLocal, wiLocal));
 }
 
-Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& settings, Counters& counters) const {
+Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& settings, Counters& counters) const {
   Rgb result(0.0f);
   Rgb throughput(1.0f);
   // Whether emission found by the current ray counts with full weight: true for the camera
@@ -422,10 +437,11 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
 
     if (!isDelta(bsdf)) {
       result += throughput *
-                directLight(surface.position, geometricNormal, frame, woLocal, bsdf, settings, rng, counters);
+                directLight(surface.position, geometricNormal, frame, woLocal, bsdf, settings, depth, sampler, counters);
     }
 
-    const Vec2 u(rng.uniform(), rng.uniform());
+    sampler.setDimension(bounceDimension(depth, kBsdfSample));
+    const Vec2 u = sampler.get2D();
     const std::optional<BsdfSample> s = sample(bsdf, woLocal, u);
     if (!s) break;
     const Vec3 wi = frame.toWorld(s->wi);
@@ -456,23 +472,28 @@ Rgb PathTracer::Impl::radiance(Ray ray, Pcg32& rng, const TraceSettings& setting
       // etaScale undoes the η² radiance scaling of refractions (as pbrt-v4 does), so a path
       // that entered glass is not ended more or less often than one that left it.
       const float q = std::min(maxComponent(throughput) * etaScale, kRouletteMaxContinue);
-      if (!(rng.uniform() < q)) break;
+      sampler.setDimension(bounceDimension(depth, kRoulette));
+      if (!(sampler.get1D() < q)) break;
       throughput /= q;
     }
   }
   return result;
 }
 
-void PathTracer::Impl::tracePixel(const Camera& camera, const TraceSettings& settings, int x, int y,
-                                  PixelAccumulator& acc, Counters& counters) const {
+void PathTracer::Impl::tracePixel(const Camera& camera, const ZSobolLayout& layout, const TraceSettings& settings,
+                                  int x, int y, PixelAccumulator& acc, Counters& counters) const {
   const uint64_t pixelIndex = static_cast<uint64_t>(y) * static_cast<uint64_t>(camera.width()) + static_cast<uint64_t>(x);
   for (int i = 0; i < settings.spp; ++i) {
-    Pcg32 rng = Pcg32::forKey(pixelIndex, static_cast<uint64_t>(i), settings.seed);
-    const Vec2 film(static_cast<float>(x) + rng.uniform(), static_cast<float>(y) + rng.uniform());
-    const Vec2 lens(rng.uniform(), rng.uniform());
+    Sampler sampler =
+        Sampler::make(settings.sampler, layout, pixelIndex, x, y, static_cast<uint64_t>(i), settings.seed);
+    sampler.setDimension(kFilmDimension);
+    const Vec2 film = Vec2(static_cast<float>(x), static_cast<float>(y)) + sampler.get2D();
+    sampler.setDimension(kLensDimension);
+    const Vec2 lens = sampler.get2D();
     const Camera::Sample cameraSample = camera.generateRay(film, lens);
     Rgb value(0.0f);
-    if (cameraSample.weight > 0.0f) value = cameraSample.weight * radiance(cameraSample.ray, rng, settings, counters);
+    if (cameraSample.weight > 0.0f)
+      value = cameraSample.weight * radiance(cameraSample.ray, sampler, settings, counters);
     acc.add(value, static_cast<uint64_t>(i));
   }
 }
@@ -502,6 +523,7 @@ TraceResult PathTracer::render(const Camera& camera, const TraceSettings& settin
   result.radiance = Image(width, height);
   result.variance = Image(width, height);
 
+  const ZSobolLayout layout(width, height, settings.spp, settings.seed);
   const int tile = settings.tileSize;
   const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
   const uint64_t tileCount = static_cast<uint64_t>(tilesX) * static_cast<uint64_t>(tilesY);
@@ -524,7 +546,7 @@ TraceResult PathTracer::render(const Camera& camera, const TraceSettings& settin
       for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
           PixelAccumulator acc;
-          impl_->tracePixel(camera, settings, x, y, acc, counters);
+          impl_->tracePixel(camera, layout, settings, x, y, acc, counters);
           const RadianceEstimate e = acc.estimate();
           result.radiance.at(x, y) = e.mean;
           result.variance.at(x, y) = e.varianceOfMean;
@@ -567,7 +589,8 @@ RadianceEstimate PathTracer::renderPixel(const Camera& camera, const TraceSettin
     fail("pixel ({}, {}) is outside the {}x{} image", x, y, camera.width(), camera.height());
   PixelAccumulator acc;
   Counters counters;
-  impl_->tracePixel(camera, settings, x, y, acc, counters);
+  impl_->tracePixel(camera, ZSobolLayout(camera.width(), camera.height(), settings.spp, settings.seed), settings, x, y,
+                    acc, counters);
   return acc.estimate();
 }
 
@@ -575,9 +598,11 @@ RadianceEstimate PathTracer::estimateRadiance(const Ray& ray, const TraceSetting
   checkSettings(settings);
   PixelAccumulator acc;
   Counters counters;
+  const ZSobolLayout layout = ZSobolLayout::forKey(key, settings.spp, settings.seed);
   for (int i = 0; i < settings.spp; ++i) {
-    Pcg32 rng = Pcg32::forKey(key, static_cast<uint64_t>(i), settings.seed);
-    acc.add(impl_->radiance(ray, rng, settings, counters), static_cast<uint64_t>(i));
+    Sampler sampler = Sampler::make(settings.sampler, layout, key, 0, 0, static_cast<uint64_t>(i), settings.seed);
+    // The camera's dimensions are unused here: the bounces keep their usual dimensions.
+    acc.add(impl_->radiance(ray, sampler, settings, counters), static_cast<uint64_t>(i));
   }
   return acc.estimate();
 }

@@ -9,8 +9,12 @@
 //  * A pixel value is the mean over the pixel's area (box filter) of camera weight × radiance
 //    (W·sr⁻¹·m⁻², linear Rec.709), where the camera weight is cos⁴θ with vignetting on, else 1.
 //    No exposure is applied here (the caller's ViewOptions do that when writing files).
-//  * Every sample's random stream is Pcg32::forKey(pixel index, sample index, seed), so an
-//    image depends on the seed only, never on the number of threads or the tile schedule.
+//  * Every sample's numbers come from a Sampler (core/sampler.h) of (pixel, sample index,
+//    seed) — Owen-scrambled ZSobol by default, or the independent PCG32 stream
+//    Pcg32::forKey(pixel index, sample index, seed) — so an image depends on the seed only,
+//    never on the number of threads or the tile schedule. With the sobol sampler a pixel's
+//    samples are stratified, not independent: the per-pixel variance (sample variance / n)
+//    then usually overestimates the variance of the mean (which stratification lowers).
 //  * Samples whose radiance is not finite (NaN or ±inf) are NOT added to the pixel (that
 //    would poison it) and NOT silently replaced by black either: they are counted in
 //    TraceStats::nanSamples and the first offending (pixel, sample) is reported so that it
@@ -23,6 +27,7 @@
 #include <string>
 
 #include "core/math.h"
+#include "core/sampler.h"
 #include "image/image.h"
 
 namespace pl {
@@ -74,6 +79,10 @@ struct TraceSettings {
   int rouletteDepth = 3;
   uint64_t seed = 0;
   TraceStrategy strategy = TraceStrategy::Mis;
+  /// Where the path's numbers come from (core/sampler.h). Sobol stratifies each pixel's
+  /// samples; Independent is the plain PCG32 stream, whose per-pixel variance estimates are
+  /// exact (tests that need independent samples for their statistics ask for it).
+  SamplerKind sampler = SamplerKind::Sobol;
   int tileSize = 16;           ///< square tiles, rendered in parallel
   bool showProgress = true;    ///< progress bar with ETA on stderr (still subject to --quiet)
 };
@@ -119,7 +128,7 @@ class PathTracer {
   /// Replays one pixel exactly as render() computes it (same random streams, same result).
   RadianceEstimate renderPixel(const Camera& camera, const TraceSettings& settings, int x, int y) const;
 
-  /// settings.spp independent estimates of the radiance arriving at ray.origin from
+  /// settings.spp estimates (independent with the independent sampler) of the radiance arriving at ray.origin from
   /// direction −ray.direction (i.e. the radiance the ray "sees"), streams keyed by
   /// (key, sample index, settings.seed). For tests and for checking other renderers at
   /// chosen points.

@@ -17,7 +17,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class TraceCliTest : public cli_test::CliTest {};
+class TraceCliTest : public cli_test::CliTest {
+ protected:
+  void checkPixelReplay(const std::string& flags);
+};
 
 TEST_F(TraceCliTest, WritesImageAndStats) {
   const std::string out = path("cornell.exr"), stats = path("stats.json");
@@ -38,6 +41,7 @@ TEST_F(TraceCliTest, WritesImageAndStats) {
   EXPECT_EQ(json.at("width").get<int>(), 32);
   EXPECT_EQ(json.at("height").get<int>(), 24);
   EXPECT_EQ(json.at("nan_samples").get<int>(), 0);
+  EXPECT_EQ(json.at("sampler").get<std::string>(), "sobol");  // the default
   EXPECT_GE(json.at("threads").get<int>(), 1);
   EXPECT_GT(json.at("seconds").get<double>(), 0.0);
   // paths/s is consistent with the counts it is derived from. 1e-3 of 3072 paths: the JSON
@@ -50,10 +54,23 @@ TEST_F(TraceCliTest, WritesImageAndStats) {
 }
 
 TEST_F(TraceCliTest, PixelReplayPrintsTheRenderedValue) {
+  for (const std::string sampler : {"sobol", "independent"}) {
+    SCOPED_TRACE(sampler);
+    checkPixelReplay(" --width 8 --height 8 --spp 16 --seed 3 --sampler " + sampler);
+  }
+}
+
+TEST_F(TraceCliTest, UnknownSamplerFailsCleanly) {
+  std::string err;
+  EXPECT_NE(run("trace cornell -o " + path("x.exr") + " --sampler halton", nullptr, &err), 0);
+  EXPECT_NE(err.find("--sampler"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("x.exr")));
+}
+
+void TraceCliTest::checkPixelReplay(const std::string& common) {
   // Render a tiny image to PFM (float, exact), then replay one pixel: the printed radiance
-  // must be the pixel's value (same streams), to the 6 significant digits printed.
+  // must be the pixel's value (same samples), to the 6 significant digits printed.
   const std::string out = path("small.pfm");
-  const std::string common = " --width 8 --height 8 --spp 16 --seed 3";
   ASSERT_EQ(run("trace cornell -o " + out + common), 0);
   const Image image = readImage(out);
   std::string printed;
