@@ -8,7 +8,9 @@ orientation table (which the tests check against these files).
 
     python3 tests/data/envmaps/downscale_cube.py SOURCE_DIR tests/data/envmaps/pisa-cube
 
-SOURCE_DIR: the directory holding {px,nx,py,ny,pz,nz}.hdr (e.g. ../shared/envmaps/pisa-cube).
+SOURCE_DIR: the directory holding the six 256 x 256 {px,nx,py,ny,pz,nz}.hdr faces (three.js:
+examples/textures/cube/pisaHDR/). Only this maintenance script needs them; the tests read the
+committed 64 x 64 result.
 """
 import math
 import os
