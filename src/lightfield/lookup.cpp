@@ -51,17 +51,12 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
   if (step >= stepLimit) return false;
   Bsdf bsdf = bsdfAt(scene, surface);
   if (auto* glass = std::get_if<DielectricBsdf>(&bsdf)) glass->alpha = 0.0f;  // rough glass followed as smooth
-  const bool transmissive = hasTransmission(bsdf);
-  const bool flip = cosWoGeometric < 0.0f && !transmissive;
-  const Vec3 geometricNormal = flip ? -surface.geometricNormal : surface.geometricNormal;
-  const Frame frame = Frame::fromNormal(flip ? -surface.shadingNormal : surface.shadingNormal);
-  const Vec3 woLocal = frame.toLocal(wo);
-  if (transmissive && !(woLocal.z * cosWoGeometric > 0.0f)) return false;  // normals disagree on the side
+  const auto [geometricNormal, frame, woLocal] = scatteringFrame(surface, wo, bsdf);  // sidedness: scene.h
+  if (!usableSide(wo, woLocal, geometricNormal, bsdf)) return false;
   const std::optional<BsdfSample> bs = sample(bsdf, woLocal, Vec2(specularBranchU(ray), 0.5f));
   if (!bs || !bs->delta) return false;
   const Vec3 wi = frame.toWorld(bs->wi);
-  const float cosWiGeometric = glm::dot(wi, geometricNormal);
-  if (transmissive ? !(cosWiGeometric * bs->wi.z > 0.0f) : !(cosWiGeometric > 0.0f)) return false;  // grazing
+  if (!usableSide(wi, bs->wi, geometricNormal, bsdf)) return false;  // grazing
   next = Ray{offsetRayOrigin(surface.position, geometricNormal, wi), wi, 0.0f, kInfinity};
   weight = bs->weight * attenuation;
   if (step >= kSpecularRouletteStep) {

@@ -417,4 +417,19 @@ std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene) {
   return list;
 }
 
+ScatteringFrame scatteringFrame(const SurfaceHit& surface, const Vec3& wo, const Bsdf& bsdf) {
+  const bool turn = glm::dot(surface.geometricNormal, wo) < 0.0f && !hasTransmission(bsdf);
+  ScatteringFrame f;
+  f.geometricNormal = turn ? -surface.geometricNormal : surface.geometricNormal;
+  f.frame = Frame::fromNormal(turn ? -surface.shadingNormal : surface.shadingNormal);
+  f.woLocal = f.frame.toLocal(wo);
+  return f;
+}
+
+bool usableSide(const Vec3& w, const Vec3& wLocal, const Vec3& geometricNormal, const Bsdf& bsdf) {
+  const float cosGeometric = glm::dot(w, geometricNormal);
+  if (!hasTransmission(bsdf)) return cosGeometric > 0.0f;
+  return cosGeometric * wLocal.z > 0.0f;
+}
+
 }  // namespace pl

@@ -199,6 +199,25 @@ struct SurfaceHit {
 /// (point = (1−b1−b2)·p0 + b1·p1 + b2·p2, as Embree reports u, v).
 SurfaceHit surfaceAt(const Scene& scene, uint32_t mesh, uint32_t triangle, Vec2 barycentrics);
 
+/// The sidedness rule for scattering, written once for the path tracer, the bake's specular
+/// chains and the renderers. A reflecting BSDF is two-sided: both normals are turned to the
+/// side wo comes from. A transmitting one keeps +z on the outside (bsdf.h), so its frame is
+/// never turned. `frame` is the shading frame, woLocal = frame.toLocal(wo).
+struct ScatteringFrame {
+  Vec3 geometricNormal{0.0f, 0.0f, 1.0f};
+  Frame frame;
+  Vec3 woLocal{0.0f, 0.0f, 1.0f};
+};
+ScatteringFrame scatteringFrame(const SurfaceHit& surface, const Vec3& wo, const Bsdf& bsdf);
+
+/// Whether world direction w (local wLocal in a ScatteringFrame) is on a side of the surface
+/// the BSDF may use: for a reflecting BSDF above the (turned) geometric surface, which also
+/// stops light leaking through where shading normals bend over the horizon; for a transmitting
+/// one on the same side of the geometric and the shading normal, so that interpolated normals
+/// cannot send a path through the surface on the wrong side. Scattering needs both wo and wi
+/// on usable sides.
+bool usableSide(const Vec3& w, const Vec3& wLocal, const Vec3& geometricNormal, const Bsdf& bsdf);
+
 /// Throws pl::Error (naming sourcePath and the material) unless the material conserves
 /// energy: reflectances in [0, 1], Blinn-Phong diffuse + specular ≤ 1, GGX α in (0, 1].
 /// Scene::finalize() checks every material of a scene with it.

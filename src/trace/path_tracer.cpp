@@ -124,17 +124,6 @@ struct PixelAccumulator {
   }
 };
 
-/// Whether world direction w (local wLocal in the shading frame) is on a side of the surface
-/// the BSDF may use: for a reflecting BSDF (frame turned to the viewer's side) above the
-/// geometric surface; for a transmitting one (frame unflipped, bsdf.h) on the same side of the
-/// geometric and the shading normal, so that interpolated normals cannot send a path through
-/// the surface on the wrong side.
-bool sameSideOfSurface(const Vec3& w, const Vec3& wLocal, const Vec3& geometricNormal, const Bsdf& bsdf) {
-  const float cosGeometric = glm::dot(w, geometricNormal);
-  if (!hasTransmission(bsdf)) return cosGeometric > 0.0f;
-  return cosGeometric * wLocal.z > 0.0f;
-}
-
 /// Light-selection weights only need to be positive and finite: clamp absurdly bright
 /// emitters (whose estimated power overflows float) to the largest float instead of letting
 /// an infinity turn the whole distribution into NaNs.
@@ -334,7 +323,7 @@ Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNor
   // light leaking through when shading normals bend over the horizon); a transmitting one
   // from the side where the shading frame puts wi (both normals agree on it).
   const Vec3 wiLocal = frame.toLocal(wi);
-  if (!sameSideOfSurface(wi, wiLocal, geometricNormal, bsdf)) return Rgb(0.0f);
+  if (!usableSide(wi, wiLocal, geometricNormal, bsdf)) return Rgb(0.0f);
   const Rgb f = eval(bsdf, woLocal, wiLocal);
   const float cosIn = std::abs(wiLocal.z);
   if (isBlack(f) || !(cosIn > 0.0f)) return Rgb(0.0f);
@@ -422,18 +411,10 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
     }
     if (depth >= maxDepth) break;
 
-    // Two-sided shading: both normals face the side the ray came from — except for
-    // transmitting BSDFs, whose frame keeps +z on the outside (bsdf.h).
+    // The sidedness rule (scene.h): reflecting BSDFs two-sided, transmitting ones unturned.
     const Bsdf bsdf = bsdfAt(scene, surface);
-    Vec3 geometricNormal = surface.geometricNormal;
-    Vec3 shadingNormal = surface.shadingNormal;
-    if (cosWoGeometric < 0.0f && !hasTransmission(bsdf)) {
-      geometricNormal = -geometricNormal;
-      shadingNormal = -shadingNormal;
-    }
-    const Frame frame = Frame::fromNormal(shadingNormal);
-    const Vec3 woLocal = frame.toLocal(wo);
-    if (!sameSideOfSurface(wo, woLocal, geometricNormal, bsdf) && hasTransmission(bsdf)) break;
+    const auto [geometricNormal, frame, woLocal] = scatteringFrame(surface, wo, bsdf);
+    if (!usableSide(wo, woLocal, geometricNormal, bsdf)) break;
 
     if (!isDelta(bsdf)) {
       result += throughput *
@@ -445,7 +426,7 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
     const std::optional<BsdfSample> s = sample(bsdf, woLocal, u);
     if (!s) break;
     const Vec3 wi = frame.toWorld(s->wi);
-    if (!sameSideOfSurface(wi, s->wi, geometricNormal, bsdf)) break;  // see directLight
+    if (!usableSide(wi, s->wi, geometricNormal, bsdf)) break;  // see directLight
     throughput *= s->weight;
     if (isBlack(throughput)) break;
     if (const auto* glass = std::get_if<DielectricBsdf>(&bsdf); glass && !glass->thin && woLocal.z * s->wi.z < 0.0f) {
