@@ -42,8 +42,10 @@ for target in "$@"; do
   limit=(-max_total_time="$seconds")
   [ -n "${FUZZ_RUNS:-}" ] && limit+=(-runs="$FUZZ_RUNS")
   echo "fuzz $target: $seconds s${FUZZ_RUNS:+ or $FUZZ_RUNS executions, whichever comes first} ..." >&2
-  # 64 KiB inputs at most; 2 GB of memory and 10 s per input before libFuzzer calls it a bug.
-  TMPDIR=$scratch nice -n 10 "$binary" "${limit[@]}" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
+  # 64 KiB inputs at most; 2 GB of memory and FUZZ_TIMEOUT seconds per input (default 10) before
+  # libFuzzer calls it a bug. On a loaded machine a niced fuzzer can be starved for longer than
+  # 10 s on one input (a 272 ms EXR input was reported at load 18): raise it there.
+  TMPDIR=$scratch nice -n 10 "$binary" "${limit[@]}" -max_len=65536 -rss_limit_mb=2048 -timeout="${FUZZ_TIMEOUT:-10}" \
     -print_final_stats=1 -artifact_prefix="$findings/" "$corpus" "$seeds" >"$log" 2>&1
   rc=$?
   executions=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
