@@ -256,8 +256,11 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
     // depth cap; written as !(u < q) so that a NaN throughput ends the path too.
     if (depth + 1 >= settings.rouletteDepth) {
       // etaScale undoes the η² radiance scaling of refractions (as pbrt-v4 does), so a path
-      // that entered glass is not ended more or less often than one that left it.
-      const float q = std::min(maxComponent(throughput) * etaScale, kRouletteMaxContinue);
+      // that entered glass is not ended more or less often than one that left it. The square
+      // root (as Cycles does) ends dim paths later than q = throughput would: on McGuire's
+      // CornellBox-Original it traces 9 % more rays per path for 23 % less noise (relMSE) at
+      // equal samples, 16 % less rays × noise; CornellBox-Glossy 12 % less (README).
+      const float q = std::min(std::sqrt(maxComponent(throughput) * etaScale), kRouletteMaxContinue);
       sampler.setDimension(bounceDimension(depth, kRoulette));
       if (!(sampler.get1D() < q)) break;
       throughput /= q;
