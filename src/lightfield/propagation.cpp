@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <variant>
 
@@ -16,6 +17,7 @@
 #include "core/sampler.h"
 #include "core/sampling.h"
 #include "core/simd4.h"
+#include "light/light.h"
 #include "lightfield/lookup.h"
 #include "lightfield/paraboloid.h"
 
@@ -293,23 +295,19 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   }
   auto valueBase = [&](uint64_t g, const Chart& c) { return c.firstValue + (g - c.firstTixel) * c.valuesPerTixel(); };
 
-  // Emissive triangles for next-event estimation, chosen ∝ area · luminance(Le). The area pdf of
-  // a point on material m is then luminance(Le_m) / Σ(area·luminance): constant per material.
-  std::vector<EmissiveTriangle> emitters;
-  std::vector<float> emitterWeights;
-  for (const EmissiveTriangle& e : emissiveTriangles(scene)) {
-    const float lum = luminance(e.radiance);
-    if (!(lum > 0.0f)) continue;
-    emitters.push_back(e);
-    emitterWeights.push_back(e.area * lum);
-  }
-  const Distribution1D emitterDistribution(emitterWeights);
+  // The light sampler the path tracer uses (light/light.h): emissive triangles chosen ∝ their
+  // power and sampled by area, whose area density is then constant per material.
+  const LightSampler lights(scene);
   std::vector<float> areaPdf(scene.materials.size(), 0.0f);
-  for (uint32_t m = 0; m < scene.materials.size(); ++m)
-    if (emitterDistribution.total() > 0.0) areaPdf[m] = float(luminance(scene.materials[m].emission) / emitterDistribution.total());
-  const uint32_t lightSamples = emitters.empty() ? 0 : settings.areaLightSamples;
+  for (uint32_t m = 0; m < scene.materials.size(); ++m) areaPdf[m] = lights.emitterAreaPdf(m);
+  const uint32_t lightSamples = lights.emissiveTriangleCount() == 0 ? 0 : settings.areaLightSamples;
   std::vector<PunctualLight> punctualLights;
   for (const Light& light : scene.lights) punctualLights.push_back(PunctualLight::from(light));
+  // Point, spot and directional lights pass thin glass (windows) as in the path tracer. Area
+  // lights' shadow rays stop at all glass: emitters behind glass reach the tixel along the
+  // gather chains, which count them with full weight (viaMirror), so crossing glass here too
+  // would count them twice.
+  const ShadowRays shadows(scene, accel);
 
   // ---- First shot ------------------------------------------------------------------------
   std::vector<Rgb> direct(param.valueCount, Rgb(0.0f));
@@ -327,7 +325,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     parallelFor(blocks, [&](uint64_t block) {
       const uint64_t t0 = block * tixelsPerBlock, t1 = std::min(tixels, t0 + tixelsPerBlock);
       std::vector<Ray> rays;
-      std::vector<Pending> pending;
+      std::vector<Pending> pending;  // one per ray, waiting for the batched occlusion test
+      std::vector<Pending> seen;     // visibility already known (shadow rays through thin glass)
+      uint64_t glassRays = 0;
       // At most one ray per punctual light and area-light sample per tixel.
       rays.reserve((t1 - t0) * (scene.lights.size() + lightSamples));
       pending.reserve(rays.capacity());
@@ -342,11 +342,16 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           if (!light.incidentAt(x, wi, distance, incident)) continue;
           const float cosTheta = glm::dot(c.normal, wi);
           if (!(cosTheta > 0.0f) || isBlack(incident)) continue;
-          Ray ray;
-          ray.origin = offsetRayOrigin(x, c.normal, wi);
-          ray.direction = wi;
-          ray.tMax = std::isfinite(distance) ? distance * (1.0f - 1e-4f) : kInfinity;
-          rays.push_back(ray);
+          const Vec3 origin = offsetRayOrigin(x, c.normal, wi);
+          const std::optional<Ray> ray = std::isfinite(distance) ? shadowRayTo(origin, light.position)
+                                                                 : std::optional<Ray>(Ray{origin, wi, 0.0f, kInfinity});
+          if (!ray) continue;
+          if (shadows.passesThinGlass()) {
+            const Rgb transmittance = shadows.transmittance(*ray, glassRays);
+            if (!isBlack(transmittance)) seen.push_back({g, wi, incident * cosTheta * transmittance, false});
+            continue;
+          }
+          rays.push_back(*ray);
           pending.push_back({g, wi, incident * cosTheta, false});
         }
         if (lightSamples == 0) continue;
@@ -360,11 +365,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
         // noise of the default Cornell box from 1.63 % to 1.40 %.
         const ZSobolLayout layout = ZSobolLayout::forKey(g, int(lightSamples), settings.seed ^ 0x4e4545ULL);
         for (uint32_t s = 0; s < lightSamples; ++s) {
-          const Vec2 u = Sampler::sobol(layout, 0, 0, s).get2D();
-          float remapped = 0.0f;
-          const EmissiveTriangle& em = emitters[emitterDistribution.sample(u.x, &remapped)];
-          const Vec2 b = sampleUniformTriangle(Vec2(remapped, u.y));
-          const Vec3 d = em.p0 + b.x * em.edge1 + b.y * em.edge2 - x;
+          const EmitterPoint sample = lights.sampleEmitterPoint(Sampler::sobol(layout, 0, 0, s).get2D());
+          const EmissiveTriangle& em = *sample.triangle;
+          const Vec3 d = sample.point - x;
           const float dist2 = glm::dot(d, d);
           if (!(dist2 > 0.0f)) continue;
           const float dist = std::sqrt(dist2);
@@ -381,19 +384,21 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           // gather rays that hit a small light from afar, whose count varies from tixel to
           // tixel: the power heuristic took the median per-tixel noise of the default Cornell
           // box from 1.40 % to 0.80 %.)
-          const float sPl = float(lightSamples) * areaPdf[em.material] * dist2 / cosY;
+          const float sPl = float(lightSamples) * sample.areaPdf * dist2 / cosY;
           const float nPg = float(n) * kInvPi * cosX;
-          rays.push_back(Ray{origin, wi, 0.0f, dist * (1.0f - 1e-4f)});
+          const std::optional<Ray> ray = shadowRayTo(origin, emitterShadowTarget(sample.point, em.normal, wi));
+          if (!ray) continue;
+          rays.push_back(*ray);
           pending.push_back({g, wi, em.radiance * (cosX / sPl * powerHeuristic(sPl, nPg)), true});
         }
       }
       std::vector<uint8_t> occluded(rays.size());
       // A tixel's rays leave one point towards the same lights: coherent.
       accel.occludedCoherent(rays, occluded);
-      shadowRays += rays.size();
-      for (size_t r = 0; r < rays.size(); ++r) {
-        if (occluded[r]) continue;
-        const Pending& p = pending[r];
+      shadowRays += rays.size() + glassRays;
+      for (size_t r = 0; r < rays.size(); ++r)
+        if (!occluded[r]) seen.push_back(pending[r]);
+      for (const Pending& p : seen) {
         const Chart& c = param.charts[param.tixelChart[p.tixel]];
         const uint64_t vb = valueBase(p.tixel, c);
         if (c.kind == ChartKind::Diffuse) {

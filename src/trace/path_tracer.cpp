@@ -12,17 +12,8 @@
 // only be followed by BSDF sampling, so emission seen right after one counts fully, as does
 // emission seen by the camera ray.
 //
-// Light selection: one discrete distribution over every emitter, proportional to an estimate
-// of its emitted power (luminance):
-//   emissive triangle  π · A · Y(Le)            (×2 when two-sided): exitant flux of a
-//                                                Lambertian emitter of radiance Le and area A
-//   point light        4π · Y(I)
-//   spot light         2π · (1 − (cos θinner + cos θouter)/2) · Y(I)   (pbrt's estimate)
-//   directional light  π R² · Y(E)             flux through the scene's bounding disk
-//   environment        π R² · ∫ Y(Le) dω        (= 4π·πR²·Y(Le) for a constant one, as pbrt-v4's
-//                                                UniformInfiniteLight::Phi)
-// where R is the radius of the scene's bounding sphere. Any positive weights give an
-// unbiased estimator; these make the variance small when emitters differ a lot.
+// Light selection, the points sampled on lights, their densities and what blocks a shadow ray
+// are light/light.h's (LightSampler, ShadowRays): the bake's first shot uses the same ones.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -41,6 +32,7 @@
 #include "core/progress.h"
 #include "core/sampler.h"
 #include "core/sampling.h"
+#include "light/light.h"
 #include "scene/scene.h"
 #include "trace/trace.h"
 
@@ -64,16 +56,6 @@ TraceStrategy parseStrategy(const std::string& name) {
 
 namespace {
 
-// The environment (constant + optional importance-sampled map) is env/env.h's
-// EnvironmentLight: radiance(), sample() and pdf() are its only uses here, so a better
-// environment sampler changes nothing in this file.
-
-enum class LightKind : uint8_t { Triangle, Punctual, Environment };
-struct LightEntry {
-  LightKind kind;
-  uint32_t index;  ///< into triangles_ or punctual_
-};
-
 /// Per-render counters, accumulated per tile and added atomically at the end of each tile.
 struct Counters {
   uint64_t rays = 0;
@@ -81,12 +63,12 @@ struct Counters {
 
 /// The sampler dimensions of a path (core/sampler.h): the camera's film and lens positions,
 /// then per bounce (scattering event) `depth` a block of kDimensionsPerBounce starting at
-/// bounceDimension(depth): light selection (1-D), the point on the light (2-D), the BSDF
-/// sample (2-D: lobe choice stretched into the direction) and Russian roulette (1-D). A
-/// decision always uses the same dimension whatever the path did before it.
+/// bounceDimension(depth): the light sample (2-D: light choice stretched into the point on
+/// it, light.h), the BSDF sample (2-D: lobe choice stretched into the direction) and Russian
+/// roulette (1-D). A decision always uses the same dimension whatever the path did before it.
 constexpr uint32_t kFilmDimension = 0, kLensDimension = 1, kFirstBounceDimension = 2;
-constexpr uint32_t kDimensionsPerBounce = 4;
-enum BounceDimension : uint32_t { kLightSelect = 0, kLightPoint = 1, kBsdfSample = 2, kRoulette = 3 };
+constexpr uint32_t kDimensionsPerBounce = 3;
+enum BounceDimension : uint32_t { kLightSample = 0, kBsdfSample = 1, kRoulette = 2 };
 uint32_t bounceDimension(int depth, BounceDimension which) {
   return kFirstBounceDimension + kDimensionsPerBounce * uint32_t(depth) + which;
 }
@@ -124,68 +106,16 @@ struct PixelAccumulator {
   }
 };
 
-/// Light-selection weights only need to be positive and finite: clamp absurdly bright
-/// emitters (whose estimated power overflows float) to the largest float instead of letting
-/// an infinity turn the whole distribution into NaNs.
-float selectionWeight(float power) { return std::min(power, std::numeric_limits<float>::max()); }
-
 }  // namespace
 
 // -----------------------------------------------------------------------------------------
 struct PathTracer::Impl {
   const Scene& scene;
   const Accel& accel;
-  EnvironmentLight environment;
-  std::vector<EmissiveTriangle> triangles;
-  std::vector<PunctualLight> punctual;
-  std::vector<LightEntry> entries;
-  Distribution1D allLights;          ///< over entries
-  Distribution1D punctualLights;     ///< over punctual (used by the Bsdf strategy)
-  std::vector<uint32_t> meshTriangleBase;  ///< first global triangle index of each mesh
-  std::vector<int32_t> entryOfTriangle;    ///< light entry of each global triangle, or −1
-  int32_t environmentEntry = -1;
-  bool hasThinGlass = false;  ///< shadow rays pass thin glass sheets (shadowTransmittance)
+  LightSampler lights;
+  ShadowRays shadows;
 
-  Impl(const Scene& s, const Accel& a);
-
-  float selectionProbability(int32_t entry) const {
-    return entry >= 0 ? allLights.probability(static_cast<size_t>(entry)) : 0.0f;
-  }
-
-  bool occluded(const Vec3& origin, const Vec3& direction, float tMax, Counters& counters) const {
-    ++counters.rays;
-    Ray shadow;
-    shadow.origin = origin;
-    shadow.direction = direction;
-    shadow.tMin = 0.0f;
-    shadow.tMax = tMax;
-    return accel.occluded(shadow);
-  }
-
-  /// The fraction of light that travels unscattered from origin along `direction` for tMax:
-  /// 0 when something blocks it, else the product of the straight transmittances T' of the
-  /// thin glass sheets it crosses (bsdf.h). Other glass blocks it (next-event estimation does
-  /// not refract). Scenes without thin glass take one occlusion ray.
-  Rgb shadowTransmittance(Vec3 origin, const Vec3& direction, float tMax, Counters& counters) const {
-    if (!hasThinGlass) return occluded(origin, direction, tMax, counters) ? Rgb(0.0f) : Rgb(1.0f);
-    Rgb transmittance(1.0f);
-    for (;;) {
-      ++counters.rays;
-      Ray shadow{origin, direction, 0.0f, tMax};
-      RayHit hit;
-      if (!accel.intersect(shadow, hit)) return transmittance;
-      const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
-      const auto* sheet = std::get_if<DielectricBsdf>(&scene.materials[surface.material].bsdf);
-      if (!sheet || !sheet->thin) return Rgb(0.0f);
-      Rgb reflectance, straight;
-      thinSheetReflectanceTransmittance(*sheet, glm::dot(surface.shadingNormal, direction), reflectance, straight);
-      transmittance *= straight;
-      if (isBlack(transmittance)) return transmittance;
-      origin = offsetRayOrigin(surface.position, surface.geometricNormal, direction);
-      tMax = std::isfinite(tMax) ? tMax - glm::dot(origin - shadow.origin, direction) : tMax;
-      if (!(tMax > 0.0f)) return transmittance;
-    }
-  }
+  Impl(const Scene& s, const Accel& a) : scene(s), accel(a), lights(s), shadows(s, a) {}
 
   Rgb directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame, const Vec3& woLocal,
                   const Bsdf& bsdf, const TraceSettings& settings, int depth, Sampler& sampler,
@@ -195,129 +125,17 @@ struct PathTracer::Impl {
                   PixelAccumulator& acc, Counters& counters) const;
 };
 
-PathTracer::Impl::Impl(const Scene& s, const Accel& a) : scene(s), accel(a) {
-  environment = EnvironmentLight(scene.environment.constant, scene.environment.map);
-  for (const Material& m : scene.materials)
-    if (const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf); glass && glass->thin) hasThinGlass = true;
-  Vec3 lo, hi;
-  scene.bounds(lo, hi);
-  const float sceneRadius = std::max(0.5f * glm::length(hi - lo), 1e-6f);
-
-  std::vector<float> weights;
-  uint32_t base = 0;
-  for (const Mesh& mesh : scene.meshes) {
-    meshTriangleBase.push_back(base);
-    base += static_cast<uint32_t>(mesh.triangles.size());
-  }
-  entryOfTriangle.assign(base, -1);
-  for (const EmissiveTriangle& e : emissiveTriangles(scene)) {
-    const float power = kPi * e.area * luminance(e.radiance) * (e.twoSided ? 2.0f : 1.0f);
-    if (!(power > 0.0f)) continue;
-    entryOfTriangle[meshTriangleBase[e.mesh] + e.triangle] = static_cast<int32_t>(entries.size());
-    entries.push_back({LightKind::Triangle, static_cast<uint32_t>(triangles.size())});
-    triangles.push_back(e);
-    weights.push_back(selectionWeight(power));
-  }
-
-  std::vector<float> punctualWeights;
-  for (const Light& light : scene.lights) {
-    const PunctualLight p = PunctualLight::from(light);
-    float power = 0.0f;
-    switch (p.kind) {
-      case PunctualLight::Kind::Point: power = 4.0f * kPi * luminance(p.intensity); break;
-      case PunctualLight::Kind::Spot:
-        power = 2.0f * kPi * (1.0f - 0.5f * (p.cosInner + p.cosOuter)) * luminance(p.intensity);
-        break;
-      case PunctualLight::Kind::Directional: power = kPi * sceneRadius * sceneRadius * luminance(p.intensity); break;
-    }
-    if (!(power > 0.0f)) continue;
-    entries.push_back({LightKind::Punctual, static_cast<uint32_t>(punctual.size())});
-    punctual.push_back(p);
-    weights.push_back(selectionWeight(power));
-    punctualWeights.push_back(selectionWeight(power));
-  }
-
-  if (!environment.isBlack()) {
-    const float power =
-        static_cast<float>(kPiD * double(sceneRadius) * double(sceneRadius) * environment.integratedLuminance());
-    if (power > 0.0f) {
-      environmentEntry = static_cast<int32_t>(entries.size());
-      entries.push_back({LightKind::Environment, 0});
-      weights.push_back(selectionWeight(power));
-    }
-  }
-  if (!weights.empty()) allLights = Distribution1D(weights);
-  if (!punctualWeights.empty()) punctualLights = Distribution1D(punctualWeights);
-}
-
 // Next-event estimation at a non-delta vertex: one light sample, MIS-weighted against the
 // BSDF's density when the light could also be hit by BSDF sampling.
 Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame,
                                   const Vec3& woLocal, const Bsdf& bsdf, const TraceSettings& settings, int depth,
                                   Sampler& sampler, Counters& counters) const {
-  // Always draw the same three numbers, from this bounce's light dimensions, whichever light
-  // is picked: the independent stream's layout then does not depend on the choice either.
-  sampler.setDimension(bounceDimension(depth, kLightSelect));
-  const float uSelect = sampler.get1D();
-  sampler.setDimension(bounceDimension(depth, kLightPoint));
+  sampler.setDimension(bounceDimension(depth, kLightSample));
   const Vec2 u = sampler.get2D();
-
-  const bool punctualOnly = settings.strategy == TraceStrategy::BsdfOnly;
-  const Distribution1D& distribution = punctualOnly ? punctualLights : allLights;
-  if (distribution.size() == 0) return Rgb(0.0f);
-  const size_t chosen = distribution.sample(uSelect);
-  const float selectProbability = distribution.probability(chosen);
-  if (!(selectProbability > 0.0f)) return Rgb(0.0f);
-  const LightEntry entry = punctualOnly ? LightEntry{LightKind::Punctual, static_cast<uint32_t>(chosen)}
-                                        : entries[chosen];
-
-  Vec3 wi;                  // towards the light, world space
-  Rgb incident(0.0f);       // radiance (area/environment) or irradiance-like term (punctual)
-  float lightPdf = 0.0f;    // solid angle density including selection (area/environment)
-  bool isDeltaLight = false;
-  Vec3 shadowTarget(0.0f);  // finite lights: the point the shadow ray must reach
-  bool infinite = false;
-
-  switch (entry.kind) {
-    case LightKind::Triangle: {
-      const EmissiveTriangle& e = triangles[entry.index];
-      const Vec2 b = sampleUniformTriangle(u);
-      const Vec3 point = e.p0 + b.x * e.edge1 + b.y * e.edge2;
-      const Vec3 toLight = point - position;
-      const float distanceSquared = glm::dot(toLight, toLight);
-      if (!(distanceSquared > 0.0f)) return Rgb(0.0f);
-      wi = toLight / std::sqrt(distanceSquared);
-      float cosLight = -glm::dot(e.normal, wi);
-      if (e.twoSided) cosLight = std::abs(cosLight);
-      if (!(cosLight > 0.0f)) return Rgb(0.0f);  // the back of a one-sided emitter
-      // Area density 1/A converted to solid angle at `position`: dA = r² dω / cos θlight.
-      lightPdf = selectProbability * distanceSquared / (cosLight * e.area);
-      incident = e.radiance;
-      // Offset the target off the emitter towards the shading point so the shadow ray does
-      // not hit the emitter itself (nor a coplanar ceiling right behind it).
-      shadowTarget = offsetRayOrigin(point, e.normal, -wi);
-      break;
-    }
-    case LightKind::Environment: {
-      const EnvironmentSample e = environment.sample(u);
-      if (!(e.pdf > 0.0f)) return Rgb(0.0f);
-      wi = e.direction;
-      lightPdf = selectProbability * e.pdf;
-      incident = e.radiance;
-      infinite = true;
-      break;
-    }
-    case LightKind::Punctual: {
-      const PunctualLight& p = punctual[entry.index];
-      isDeltaLight = true;
-      lightPdf = selectProbability;  // a discrete choice; the direction is fixed
-      float distance;
-      if (!p.incidentAt(position, wi, distance, incident)) return Rgb(0.0f);  // irradiance normal to wi
-      infinite = p.kind == PunctualLight::Kind::Directional;
-      shadowTarget = p.position;
-      break;
-    }
-  }
+  const std::optional<LightSample> light =
+      lights.sample(position, u, /*punctualOnly=*/settings.strategy == TraceStrategy::BsdfOnly);
+  if (!light) return Rgb(0.0f);
+  const Vec3& wi = light->wi;  // towards the light, world space
 
   // A reflecting BSDF receives light only from above the geometric surface (this also stops
   // light leaking through when shading normals bend over the horizon); a transmitting one
@@ -329,20 +147,15 @@ Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNor
   if (isBlack(f) || !(cosIn > 0.0f)) return Rgb(0.0f);
 
   const Vec3 origin = offsetRayOrigin(position, geometricNormal, wi);
-  Rgb visible;
-  if (infinite) {
-    visible = shadowTransmittance(origin, wi, kInfinity, counters);
-  } else {
-    const Vec3 toTarget = shadowTarget - origin;
-    const float distance = glm::length(toTarget);
-    if (!(distance > 0.0f)) return Rgb(0.0f);
-    visible = shadowTransmittance(origin, toTarget / distance, distance, counters);
-  }
+  const std::optional<Ray> shadow =
+      light->infinite ? std::optional<Ray>(Ray{origin, wi, 0.0f, kInfinity}) : shadowRayTo(origin, light->target);
+  if (!shadow) return Rgb(0.0f);
+  const Rgb visible = shadows.transmittance(*shadow, counters.rays);
   if (isBlack(visible)) return Rgb(0.0f);
 
-  const Rgb unweighted = visible * f * cosIn * incident / lightPdf;
-  if (isDeltaLight || settings.strategy != TraceStrategy::Mis) return unweighted;
-  return unweighted * powerHeuristic(lightPdf, pdf(bsdf, woLocal, wiLocal));
+  const Rgb unweighted = visible * f * cosIn * light->incident / light->pdf;
+  if (light->delta || settings.strategy != TraceStrategy::Mis) return unweighted;
+  return unweighted * powerHeuristic(light->pdf, pdf(bsdf, woLocal, wiLocal));
 }
 
 Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& settings, Counters& counters) const {
@@ -368,13 +181,12 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
     RayHit hit;
     ++counters.rays;
     if (!accel.intersect(ray, hit)) {
-      if (environmentEntry >= 0) {
-        const Rgb le = environment.radiance(ray.direction);
+      if (lights.hasEnvironment()) {
+        const Rgb le = lights.environment().radiance(ray.direction);
         if (countEmissionFully) {
           result += throughput * le;
         } else if (useMis) {
-          const float lightPdf = selectionProbability(environmentEntry) * environment.pdf(ray.direction);
-          result += throughput * le * powerHeuristic(previousBsdfPdf, lightPdf);
+          result += throughput * le * powerHeuristic(previousBsdfPdf, lights.environmentPdf(ray.direction));
         }
       }
       break;
@@ -394,19 +206,12 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
       if (countEmissionFully) {
         result += throughput * material.emission;
       } else if (useMis) {
-        const int32_t entry = entryOfTriangle[meshTriangleBase[hit.mesh] + hit.triangle];
-        if (entry >= 0) {
-          const EmissiveTriangle& e = triangles[entries[static_cast<size_t>(entry)].index];
-          // The density NEE would have had for this point, in solid angle at the previous
-          // vertex: P(select) · (1/A) · t² / |cos θlight| (t from that vertex, through any
-          // thin glass crossed straight).
-          const float cosLight = std::abs(cosWoGeometric);
-          const float distance = distanceBefore + hit.t;
-          const float lightPdf = cosLight > 0.0f
-                                     ? selectionProbability(entry) * distance * distance / (cosLight * e.area)
-                                     : 0.0f;
-          result += throughput * material.emission * powerHeuristic(previousBsdfPdf, lightPdf);
-        }
+        // The density NEE would have had for this point, in solid angle at the previous
+        // vertex (t from that vertex, through any thin glass crossed straight). A triangle
+        // that is no light (zero power) has density 0: BSDF sampling alone finds it.
+        const float lightPdf =
+            lights.emitterPdf(hit.mesh, hit.triangle, distanceBefore + hit.t, std::abs(cosWoGeometric));
+        result += throughput * material.emission * powerHeuristic(previousBsdfPdf, lightPdf);
       }
     }
     if (depth >= maxDepth) break;
@@ -451,8 +256,11 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
     // depth cap; written as !(u < q) so that a NaN throughput ends the path too.
     if (depth + 1 >= settings.rouletteDepth) {
       // etaScale undoes the η² radiance scaling of refractions (as pbrt-v4 does), so a path
-      // that entered glass is not ended more or less often than one that left it.
-      const float q = std::min(maxComponent(throughput) * etaScale, kRouletteMaxContinue);
+      // that entered glass is not ended more or less often than one that left it. The square
+      // root (as Cycles does) ends dim paths later than q = throughput would: on McGuire's
+      // CornellBox-Original it traces 9 % more rays per path for 23 % less noise (relMSE) at
+      // equal samples, 16 % less rays × noise; CornellBox-Glossy 12 % less (README).
+      const float q = std::min(std::sqrt(maxComponent(throughput) * etaScale), kRouletteMaxContinue);
       sampler.setDimension(bounceDimension(depth, kRoulette));
       if (!(sampler.get1D() < q)) break;
       throughput /= q;
@@ -483,8 +291,8 @@ void PathTracer::Impl::tracePixel(const Camera& camera, const ZSobolLayout& layo
 PathTracer::PathTracer(const Scene& scene, const Accel& accel) : impl_(std::make_unique<Impl>(scene, accel)) {}
 PathTracer::~PathTracer() = default;
 
-size_t PathTracer::emissiveTriangleCount() const { return impl_->triangles.size(); }
-size_t PathTracer::lightCount() const { return impl_->entries.size(); }
+size_t PathTracer::emissiveTriangleCount() const { return impl_->lights.emissiveTriangleCount(); }
+size_t PathTracer::lightCount() const { return impl_->lights.lightCount(); }
 
 namespace {
 void checkSettings(const TraceSettings& settings) {

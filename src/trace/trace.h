@@ -74,8 +74,8 @@ struct TraceSettings {
   /// it loses the fraction a^(N+1) of the light (3 % for a = 0.9, N = 32).
   int maxDepth = kUnboundedDepth;
   /// Russian roulette starts after this many scattering events. It is unbiased: a path
-  /// continues with probability q = min(kRouletteMaxContinue, max RGB component of its
-  /// throughput) and its throughput is divided by q.
+  /// continues with probability q = min(kRouletteMaxContinue, √(max RGB component of its
+  /// throughput)) and its throughput is divided by q.
   int rouletteDepth = 3;
   uint64_t seed = 0;
   TraceStrategy strategy = TraceStrategy::Mis;

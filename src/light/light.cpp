@@ -1,0 +1,210 @@
+// The light sampler and shadow rays (see light.h).
+#include "light/light.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <variant>
+
+#include "accel/accel.h"
+#include "bsdf/bsdf.h"
+
+namespace pl {
+
+namespace {
+/// Light-selection weights only need to be positive and finite: clamp absurdly bright
+/// emitters (whose estimated power overflows float) to the largest float instead of letting
+/// an infinity turn the whole distribution into NaNs.
+float selectionWeight(float power) { return std::min(power, std::numeric_limits<float>::max()); }
+}  // namespace
+
+// ---- Shadow rays -------------------------------------------------------------------------
+
+Vec3 emitterShadowTarget(const Vec3& point, const Vec3& normal, const Vec3& wi) {
+  return offsetRayOrigin(point, normal, -wi);
+}
+
+std::optional<Ray> shadowRayTo(const Vec3& origin, const Vec3& target) {
+  const Vec3 toTarget = target - origin;
+  const float distance = glm::length(toTarget);
+  if (!(distance > 0.0f)) return std::nullopt;
+  return Ray{origin, toTarget / distance, 0.0f, distance};
+}
+
+ShadowRays::ShadowRays(const Scene& scene, const Accel& accel) : scene_(scene), accel_(accel) {
+  for (const Material& m : scene.materials)
+    if (const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf); glass && glass->thin) hasThinGlass_ = true;
+}
+
+Rgb ShadowRays::transmittance(Ray ray, uint64_t& rays) const {
+  ++rays;
+  if (!hasThinGlass_) return accel_.occluded(ray) ? Rgb(0.0f) : Rgb(1.0f);
+  Rgb transmittance(1.0f);
+  const Vec3 start = ray.origin;
+  const float tEnd = ray.tMax;
+  for (;;) {
+    RayHit hit;
+    if (!accel_.intersect(ray, hit)) return transmittance;
+    const SurfaceHit surface = surfaceAt(scene_, hit.mesh, hit.triangle, hit.barycentrics);
+    const auto* sheet = std::get_if<DielectricBsdf>(&scene_.materials[surface.material].bsdf);
+    if (!sheet || !sheet->thin) return Rgb(0.0f);
+    Rgb reflectance, straight;
+    thinSheetReflectanceTransmittance(*sheet, glm::dot(surface.shadingNormal, ray.direction), reflectance, straight);
+    transmittance *= straight;
+    if (isBlack(transmittance)) return transmittance;
+    // Continue from just past the sheet; the remaining length is measured from the start.
+    ray.origin = offsetRayOrigin(surface.position, surface.geometricNormal, ray.direction);
+    ray.tMin = 0.0f;
+    ray.tMax = std::isfinite(tEnd) ? tEnd - glm::dot(ray.origin - start, ray.direction) : tEnd;
+    if (!(ray.tMax > 0.0f)) return transmittance;
+    ++rays;
+  }
+}
+
+// ---- The light sampler -------------------------------------------------------------------
+
+LightSampler::LightSampler(const Scene& scene) {
+  environment_ = EnvironmentLight(scene.environment.constant, scene.environment.map);
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  const float sceneRadius = std::max(0.5f * glm::length(hi - lo), 1e-6f);
+
+  std::vector<float> weights, triangleWeights, punctualWeights;
+  uint32_t base = 0;
+  for (const Mesh& mesh : scene.meshes) {
+    meshTriangleBase_.push_back(base);
+    base += static_cast<uint32_t>(mesh.triangles.size());
+  }
+  entryOfTriangle_.assign(base, -1);
+  for (const EmissiveTriangle& e : emissiveTriangles(scene)) {
+    const float power = kPi * e.area * luminance(e.radiance) * (e.twoSided ? 2.0f : 1.0f);
+    if (!(power > 0.0f)) continue;
+    entryOfTriangle_[meshTriangleBase_[e.mesh] + e.triangle] = static_cast<int32_t>(entries_.size());
+    entries_.push_back({Kind::Triangle, static_cast<uint32_t>(triangles_.size())});
+    triangles_.push_back(e);
+    weights.push_back(selectionWeight(power));
+    triangleWeights.push_back(selectionWeight(power));
+  }
+
+  for (const Light& light : scene.lights) {
+    const PunctualLight p = PunctualLight::from(light);
+    float power = 0.0f;
+    switch (p.kind) {
+      case PunctualLight::Kind::Point: power = 4.0f * kPi * luminance(p.intensity); break;
+      case PunctualLight::Kind::Spot:
+        power = 2.0f * kPi * (1.0f - 0.5f * (p.cosInner + p.cosOuter)) * luminance(p.intensity);
+        break;
+      case PunctualLight::Kind::Directional: power = kPi * sceneRadius * sceneRadius * luminance(p.intensity); break;
+    }
+    if (!(power > 0.0f)) continue;
+    entries_.push_back({Kind::Punctual, static_cast<uint32_t>(punctual_.size())});
+    punctual_.push_back(p);
+    weights.push_back(selectionWeight(power));
+    punctualWeights.push_back(selectionWeight(power));
+  }
+
+  if (!environment_.isBlack()) {
+    const float power =
+        static_cast<float>(kPiD * double(sceneRadius) * double(sceneRadius) * environment_.integratedLuminance());
+    if (power > 0.0f) {
+      environmentEntry_ = static_cast<int32_t>(entries_.size());
+      entries_.push_back({Kind::Environment, 0});
+      weights.push_back(selectionWeight(power));
+    }
+  }
+  if (!weights.empty()) all_ = Distribution1D(weights);
+  if (!punctualWeights.empty()) punctualDistribution_ = Distribution1D(punctualWeights);
+  if (!triangleWeights.empty()) triangleDistribution_ = Distribution1D(triangleWeights);
+
+  // Area density of sampleEmitterPoint: P(triangle)/A = (π·A·Y·s/Σ)/A = π·Y·s/Σ, the same for
+  // every triangle of a material (s = 2 when two-sided). Σ is in double, as the distribution's.
+  areaPdfOfMaterial_.assign(scene.materials.size(), 0.0f);
+  if (triangleDistribution_.total() > 0.0)
+    for (size_t m = 0; m < scene.materials.size(); ++m) {
+      const Material& material = scene.materials[m];
+      const double power = kPiD * luminance(material.emission) * (material.twoSidedEmission ? 2.0 : 1.0);
+      areaPdfOfMaterial_[m] = power > 0.0 ? static_cast<float>(power / triangleDistribution_.total()) : 0.0f;
+    }
+}
+
+std::optional<LightSample> LightSampler::sample(const Vec3& position, Vec2 u, bool punctualOnly) const {
+  const Distribution1D& distribution = punctualOnly ? punctualDistribution_ : all_;
+  if (distribution.size() == 0) return std::nullopt;
+  float remapped = 0.0f;
+  const size_t chosen = distribution.sample(u.x, &remapped);
+  const float selectProbability = distribution.probability(chosen);
+  if (!(selectProbability > 0.0f)) return std::nullopt;
+  const Entry entry = punctualOnly ? Entry{Kind::Punctual, static_cast<uint32_t>(chosen)} : entries_[chosen];
+  return sampleEntry(entry, selectProbability, position, Vec2(remapped, u.y));
+}
+
+std::optional<LightSample> LightSampler::sampleEntry(const Entry& entry, float selectProbability, const Vec3& position,
+                                                     Vec2 u) const {
+  LightSample s;
+  switch (entry.kind) {
+    case Kind::Triangle: {
+      const EmissiveTriangle& e = triangles_[entry.index];
+      const Vec2 b = sampleUniformTriangle(u);
+      const Vec3 point = e.p0 + b.x * e.edge1 + b.y * e.edge2;
+      const Vec3 toLight = point - position;
+      const float distanceSquared = glm::dot(toLight, toLight);
+      if (!(distanceSquared > 0.0f)) return std::nullopt;
+      s.wi = toLight / std::sqrt(distanceSquared);
+      float cosLight = -glm::dot(e.normal, s.wi);
+      if (e.twoSided) cosLight = std::abs(cosLight);
+      if (!(cosLight > 0.0f)) return std::nullopt;  // the back of a one-sided emitter
+      // Area density 1/A converted to solid angle at `position`: dA = r² dω / cos θlight.
+      s.pdf = selectProbability * distanceSquared / (cosLight * e.area);
+      s.incident = e.radiance;
+      s.target = emitterShadowTarget(point, e.normal, s.wi);
+      break;
+    }
+    case Kind::Environment: {
+      const EnvironmentSample e = environment_.sample(u);
+      if (!(e.pdf > 0.0f)) return std::nullopt;
+      s.wi = e.direction;
+      s.pdf = selectProbability * e.pdf;
+      s.incident = e.radiance;
+      s.infinite = true;
+      break;
+    }
+    case Kind::Punctual: {
+      const PunctualLight& p = punctual_[entry.index];
+      s.delta = true;
+      s.pdf = selectProbability;  // a discrete choice; the direction is fixed
+      float distance;
+      if (!p.incidentAt(position, s.wi, distance, s.incident)) return std::nullopt;
+      s.infinite = p.kind == PunctualLight::Kind::Directional;
+      s.target = p.position;
+      break;
+    }
+  }
+  if (!(s.pdf > 0.0f)) return std::nullopt;
+  return s;
+}
+
+float LightSampler::emitterPdf(uint32_t mesh, uint32_t triangle, float distance, float cosLight) const {
+  if (mesh >= meshTriangleBase_.size()) return 0.0f;
+  const int32_t entry = entryOfTriangle_[meshTriangleBase_[mesh] + triangle];
+  if (entry < 0 || !(cosLight > 0.0f)) return 0.0f;
+  const EmissiveTriangle& e = triangles_[entries_[static_cast<size_t>(entry)].index];
+  return all_.probability(static_cast<size_t>(entry)) * distance * distance / (cosLight * e.area);
+}
+
+float LightSampler::environmentPdf(const Vec3& dir) const {
+  if (environmentEntry_ < 0) return 0.0f;
+  return all_.probability(static_cast<size_t>(environmentEntry_)) * environment_.pdf(dir);
+}
+
+EmitterPoint LightSampler::sampleEmitterPoint(Vec2 u) const {
+  float remapped = 0.0f;
+  const EmissiveTriangle& e = triangles_[triangleDistribution_.sample(u.x, &remapped)];
+  const Vec2 b = sampleUniformTriangle(Vec2(remapped, u.y));
+  return {&e, e.p0 + b.x * e.edge1 + b.y * e.edge2, areaPdfOfMaterial_[e.material]};
+}
+
+float LightSampler::emitterAreaPdf(uint32_t material) const {
+  return material < areaPdfOfMaterial_.size() ? areaPdfOfMaterial_[material] : 0.0f;
+}
+
+}  // namespace pl

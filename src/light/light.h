@@ -1,0 +1,151 @@
+#pragma once
+// Light: the one light sampler of plenoptic, used by the path tracer's next-event estimation
+// and by the bake's first shot, and the one definition of a shadow ray (where it ends, and how
+// much light passes along it).
+//
+// Emitters are the scene's emissive triangles (scene.h EmissiveTriangle), point, spot and
+// directional lights (PunctualLight) and the environment (env.h EnvironmentLight).
+//
+// Light selection: one discrete distribution over every emitter, proportional to an estimate
+// of its emitted power (luminance):
+//   emissive triangle  π · A · Y(Le)            (×2 when two-sided): exitant flux of a
+//                                                Lambertian emitter of radiance Le and area A
+//   point light        4π · Y(I)
+//   spot light         2π · (1 − (cos θinner + cos θouter)/2) · Y(I)   (pbrt's estimate)
+//   directional light  π R² · Y(E)             flux through the scene's bounding disk
+//   environment        π R² · ∫ Y(Le) dω        (= 4π·πR²·Y(Le) for a constant one, as pbrt-v4's
+//                                                UniformInfiniteLight::Phi)
+// where R is the radius of the scene's bounding sphere. Any positive weights give an
+// unbiased estimator; these make the variance small when emitters differ a lot. The bake,
+// which samples emissive surfaces by area, uses the same weights restricted to the triangles.
+//
+// Sample numbers: the choice of emitter and the point on it come from ONE 2-D sample: u.x
+// picks the emitter and is stretched back onto [0, 1) within its bin, then (u.x', u.y) picks
+// the point. A stratified 2-D point set (the path tracer's sobol dimensions, the bake's
+// per-tixel net) is thereby stratified over the union of all emitters — over a quad light made
+// of two triangles as over one rectangle — instead of over each emitter separately.
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "core/math.h"
+#include "core/sampling.h"
+#include "env/env.h"
+#include "scene/scene.h"
+
+namespace pl {
+
+class Accel;
+
+// ---- Shadow rays -------------------------------------------------------------------------
+
+/// The point a shadow ray towards `point` on an emitter of geometric normal `normal` ends at:
+/// moved off the emitter towards the receiver (wi points from the receiver to the emitter),
+/// so the ray hits neither the emitter itself nor a coplanar surface right behind it.
+Vec3 emitterShadowTarget(const Vec3& point, const Vec3& normal, const Vec3& wi);
+
+/// The shadow ray from `origin` (already offset off the receiver) to `target`: unit direction,
+/// tMin 0, tMax the distance. Nullopt when the two points coincide.
+std::optional<Ray> shadowRayTo(const Vec3& origin, const Vec3& target);
+
+/// Light travelling along shadow rays: the one place that decides what blocks them.
+class ShadowRays {
+ public:
+  /// The scene and accel must outlive this object.
+  ShadowRays(const Scene& scene, const Accel& accel);
+
+  /// Whether some material is thin glass, which shadow rays pass (see transmittance). When
+  /// false, transmittance is a plain occlusion test, and batches of rays may be tested with
+  /// Accel::occludedCoherent instead.
+  bool passesThinGlass() const { return hasThinGlass_; }
+
+  /// The fraction of light that travels unscattered along `ray` (unit direction, from
+  /// ray.tMin to ray.tMax): 0 when something blocks it, else the product of the straight
+  /// transmittances T'(cos θ) of the thin glass sheets it crosses (bsdf.h
+  /// thinSheetReflectanceTransmittance). Other glass blocks it: next-event estimation does not
+  /// refract. `rays` is increased by the number of rays traced (one without thin glass).
+  Rgb transmittance(Ray ray, uint64_t& rays) const;
+
+ private:
+  const Scene& scene_;
+  const Accel& accel_;
+  bool hasThinGlass_ = false;
+};
+
+// ---- The light sampler -------------------------------------------------------------------
+
+/// One next-event sample of incident light at a receiver.
+struct LightSample {
+  Vec3 wi{0.0f};       ///< unit, from the receiver towards the light
+  Rgb incident{0.0f};  ///< radiance Le (area lights, environment), or for delta lights the
+                       ///< irradiance on a surface normal to wi (W·m⁻²)
+  float pdf = 0.0f;    ///< solid-angle density of wi including the light's selection
+                       ///< probability; for delta lights the selection probability alone
+  bool delta = false;     ///< point, spot or directional: reachable by next-event estimation only
+  bool infinite = false;  ///< directional or environment: the shadow ray is unbounded
+  Vec3 target{0.0f};      ///< finite lights: the point the shadow ray ends at
+};
+
+/// A point on an emissive triangle, sampled by area (the bake's first shot).
+struct EmitterPoint {
+  const EmissiveTriangle* triangle = nullptr;
+  Vec3 point{0.0f};
+  float areaPdf = 0.0f;  ///< density per unit area (m⁻²), selection included
+};
+
+class LightSampler {
+ public:
+  LightSampler() = default;
+  explicit LightSampler(const Scene& scene);
+
+  /// Emitters with positive power: emissive triangles + punctual lights + environment.
+  size_t lightCount() const { return entries_.size(); }
+  size_t emissiveTriangleCount() const { return triangles_.size(); }
+  const EnvironmentLight& environment() const { return environment_; }
+  /// Whether the environment is one of the lights (it is lit).
+  bool hasEnvironment() const { return environmentEntry_ >= 0; }
+
+  /// Chooses a light with probability ∝ its power (only among point, spot and directional
+  /// lights when punctualOnly) and a point or direction on it, for a receiver at `position`:
+  /// u.x chooses the light (stretched, see the top of this file), the rest the point.
+  /// Nullopt when nothing is sampled (no lights, the back of a one-sided emitter, outside a
+  /// spot's cone, a zero density).
+  std::optional<LightSample> sample(const Vec3& position, Vec2 u, bool punctualOnly = false) const;
+
+  /// The density sample() has for reaching emissive triangle `triangle` of mesh `mesh` from a
+  /// receiver at `distance`, arriving at the emitter with |cos θlight| = cosLight (solid angle
+  /// at the receiver: P(select) · r² / (cos θlight · A)). 0 when that triangle is no light.
+  float emitterPdf(uint32_t mesh, uint32_t triangle, float distance, float cosLight) const;
+  /// The density sample() has for direction `dir` (unit, towards the sky) on the environment.
+  float environmentPdf(const Vec3& dir) const;
+
+  /// A point on the emissive triangles alone, chosen with probability ∝ their power and then
+  /// uniformly by area (the bake's area-light shadow rays). Requires emissiveTriangleCount() > 0.
+  EmitterPoint sampleEmitterPoint(Vec2 u) const;
+  /// sampleEmitterPoint's area density on triangles of material `material`: constant per
+  /// material (π·Y(Le)·(2 if two-sided) / Σ triangle power); 0 for a material that emits nothing.
+  float emitterAreaPdf(uint32_t material) const;
+
+ private:
+  enum class Kind : uint8_t { Triangle, Punctual, Environment };
+  struct Entry {
+    Kind kind;
+    uint32_t index;  ///< into triangles_ or punctual_
+  };
+  std::optional<LightSample> sampleEntry(const Entry& entry, float selectProbability, const Vec3& position,
+                                         Vec2 u) const;
+
+  EnvironmentLight environment_;
+  std::vector<EmissiveTriangle> triangles_;
+  std::vector<PunctualLight> punctual_;
+  std::vector<Entry> entries_;
+  Distribution1D all_;        ///< over entries_
+  Distribution1D punctualDistribution_;  ///< over punctual_
+  Distribution1D triangleDistribution_;  ///< over triangles_
+  std::vector<uint32_t> meshTriangleBase_;  ///< first global triangle index of each mesh
+  std::vector<int32_t> entryOfTriangle_;    ///< entry of each global triangle, or −1
+  std::vector<float> areaPdfOfMaterial_;
+  int32_t environmentEntry_ = -1;
+};
+
+}  // namespace pl
