@@ -4,7 +4,8 @@
 # are in the counters column). Extra arguments are passed to every binary, e.g.
 #   bench/run.sh build --benchmark_filter=Primary
 # Usage: bench/run.sh BUILD_DIR [benchmark flags...]
-# Environment: VS_CYCLES=1 also runs bench/vs_cycles.sh (plenoptic against Blender Cycles).
+# Environment: VS_CYCLES=1 also runs bench/vs_cycles.sh (plenoptic against Blender Cycles);
+# PRODUCTION=1 also runs bench/production.sh (Sponza and the Cornell box at every preset).
 set -euo pipefail
 
 if [[ $# -lt 1 ]]; then
@@ -47,5 +48,11 @@ done
 if [[ ${VS_CYCLES:-0} == 1 ]]; then
   echo "== vs_cycles"
   bash "$(dirname "$0")/vs_cycles.sh" "$build_dir/plenoptic" || status=1
+fi
+# Optional: the production-scene benchmark (tens of minutes; measures the Cornell box alone when
+# Sponza is absent). Only with PRODUCTION=1, e.g. `make bench PRODUCTION=1`.
+if [[ ${PRODUCTION:-0} == 1 ]]; then
+  echo "== production"
+  bash "$(dirname "$0")/production.sh" "$build_dir/plenoptic" || status=1
 fi
 exit $status

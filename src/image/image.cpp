@@ -58,17 +58,43 @@ void checkImageSize(const std::string& path, long long width, long long height) 
 }
 }  // namespace detail
 
-Image readImage(const std::string& path) {
+namespace {
+/// The path names an existing regular file (else pl::Error naming it).
+void requireImageFile(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail("{}: no such file", path);
   if (std::filesystem::is_directory(path, ec)) fail("{}: is a directory, not an image file", path);
   requireRegularFile(path);
+}
+}  // namespace
+
+Image readImage(const std::string& path) {
+  requireImageFile(path);
   const std::string ext = fileExtensionLower(path);
   if (ext == ".exr") return detail::readExr(path);
   if (ext == ".hdr") return detail::readRadianceHdr(path);
   if (ext == ".pfm") return detail::readPfm(path);
-  if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tga" || ext == ".bmp") return detail::readLdr(path);
+  if (isLdrImageExtension(ext)) return detail::decodeLdr(detail::readFileBytes(path), path, ext == ".png");
   fail("{}: unknown image extension '{}' (readable: .exr .hdr .pfm .png .jpg .jpeg .tga .bmp)", path, ext);
+}
+
+bool isLdrImageExtension(const std::string& extension) {
+  return extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".tga" ||
+         extension == ".bmp";
+}
+
+ImageFile readImageFile(const std::string& path) {
+  const std::string ext = fileExtensionLower(path);
+  if (!isLdrImageExtension(ext)) return {readImage(path), {}};
+  requireImageFile(path);
+  ImageFile file;
+  file.ldrBytes = detail::readFileBytes(path);
+  file.image = detail::decodeLdr(file.ldrBytes, path, ext == ".png");
+  return file;
+}
+
+Image decodeLdrImage(std::span<const unsigned char> bytes, const std::string& label) {
+  return detail::decodeLdr(bytes, label, false);
 }
 
 void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOptions& options) {

@@ -19,6 +19,7 @@
 #include "core/math.h"
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,26 @@ float linearToSrgb(float linear);
 /// to linear). Throws pl::Error naming the file and the problem (missing, truncated,
 /// corrupt, unsupported variant, absurd size, unknown extension).
 Image readImage(const std::string& path);
+
+/// True for the extensions (lower case, with the dot) of the 8-bit formats: .png .jpg .jpeg
+/// .tga .bmp.
+bool isLdrImageExtension(const std::string& extension);
+
+/// An image file as a texture keeps it: the decoded pixels (as readImage gives them) and, for
+/// the 8-bit formats, the file's own bytes (else empty: HDR files are kept decoded only), so
+/// that a light-field file can embed the compact encoded file instead of float pixels.
+struct ImageFile {
+  Image image;
+  std::vector<unsigned char> ldrBytes;
+};
+ImageFile readImageFile(const std::string& path);
+
+/// Decodes an 8-bit-format image held in memory (PNG, JPEG, TGA, BMP, recognised from the
+/// content; a file's bytes, a glTF buffer, a .plf's embedded texture), sRGB-decoded to
+/// linear: the same pixels readImage gives for the same bytes in a file. The size is checked
+/// (kMaxImagePixels) before decoding. Throws pl::Error starting with `label` when the bytes are
+/// corrupt, truncated or not an image.
+Image decodeLdrImage(std::span<const unsigned char> bytes, const std::string& label);
 
 /// How writeHdrImage stores pixels where the format offers a choice.
 struct HdrWriteOptions {

@@ -4,6 +4,7 @@
 // writes atomic. Readers throw pl::Error naming `path`; writers write to `path` (a temporary
 // file) and throw pl::Error describing the problem *without* the path, which image.cpp
 // prefixes with the user's target name.
+#include <span>
 #include <string>
 #include <vector>
 
@@ -17,7 +18,10 @@ Image readExr(const std::string& path);
 void writeExr(const std::string& path, const Image& image, bool half);
 
 // stb_io.cpp (stb_image / stb_image_write) and the Radiance RGBE format
-Image readLdr(const std::string& path);  ///< PNG/JPEG/TGA/BMP, sRGB-decoded to linear
+/// PNG/JPEG/TGA/BMP bytes (format recognised from the content), sRGB-decoded to linear;
+/// `label` names them in errors. mustBePng: refuse anything without the PNG signature (a
+/// file named .png); PNG content is always checked for truncated chunks first.
+Image decodeLdr(std::span<const unsigned char> bytes, const std::string& label, bool mustBePng);
 void writePngFile(const std::string& path, const Image8& image);
 Image readRadianceHdr(const std::string& path);
 void writeRadianceHdr(const std::string& path, const Image& image);

@@ -36,6 +36,7 @@
 #include <cstdlib>
 #include <cmath>
 #include <cstring>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -48,7 +49,7 @@ namespace {
 
 /// stb_image's PNG decoder may accept a file cut inside its last chunks. Walk the chunk
 /// structure first: every chunk's length must fit in the file and the file must end with IEND.
-void checkPngStructure(const std::string& path, const std::vector<unsigned char>& bytes) {
+void checkPngStructure(const std::string& path, std::span<const unsigned char> bytes) {
   static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (bytes.size() < 8 || std::memcmp(bytes.data(), kSignature, 8) != 0) fail("{}: not a PNG file (bad signature)", path);
   size_t at = 8;
@@ -67,29 +68,29 @@ void checkPngStructure(const std::string& path, const std::vector<unsigned char>
 
 }  // namespace
 
-Image readLdr(const std::string& path) {
-  const std::vector<unsigned char> bytes = readFileBytes(path);
-  if (bytes.empty()) fail("{}: empty file", path);
-  if (bytes.size() > size_t(INT32_MAX)) fail("{}: file too large for the 8-bit image reader", path);
-  const std::string ext = fileExtensionLower(path);
-  if (ext == ".png") checkPngStructure(path, bytes);
+Image decodeLdr(std::span<const unsigned char> bytes, const std::string& label, bool mustBePng) {
+  static const unsigned char kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (bytes.empty()) fail("{}: empty file", label);
+  if (bytes.size() > size_t(INT32_MAX)) fail("{}: file too large for the 8-bit image reader", label);
+  if (mustBePng || (bytes.size() >= 8 && std::memcmp(bytes.data(), kPngSignature, 8) == 0))
+    checkPngStructure(label, bytes);
   const int size = int(bytes.size());
   int width = 0, height = 0, channels = 0;
   if (!stbi_info_from_memory(bytes.data(), size, &width, &height, &channels))
-    fail("{}: corrupt or unsupported image: {}", path, stbi_failure_reason());
-  checkImageSize(path, width, height);
+    fail("{}: corrupt or unsupported image: {}", label, stbi_failure_reason());
+  checkImageSize(label, width, height);
 
   Image image(width, height);
   // 16-bit PNGs keep their precision; everything else is 8-bit. Both are sRGB-encoded.
   if (stbi_is_16_bit_from_memory(bytes.data(), size)) {
     stbi_us* data = stbi_load_16_from_memory(bytes.data(), size, &width, &height, &channels, 3);
-    if (!data) fail("{}: corrupt image: {}", path, stbi_failure_reason());
+    if (!data) fail("{}: corrupt image: {}", label, stbi_failure_reason());
     for (size_t i = 0; i < image.pixels.size(); ++i)
       for (int c = 0; c < 3; ++c) image.pixels[i][c] = srgbToLinear(float(data[3 * i + size_t(c)]) / 65535.0f);
     stbi_image_free(data);
   } else {
     stbi_uc* data = stbi_load_from_memory(bytes.data(), size, &width, &height, &channels, 3);
-    if (!data) fail("{}: corrupt image: {}", path, stbi_failure_reason());
+    if (!data) fail("{}: corrupt image: {}", label, stbi_failure_reason());
     std::array<float, 256> table;
     for (int v = 0; v < 256; ++v) table[size_t(v)] = srgbToLinear(float(v) / 255.0f);
     for (size_t i = 0; i < image.pixels.size(); ++i)

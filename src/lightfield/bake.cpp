@@ -51,7 +51,9 @@ uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings
   const uint64_t directions = uint64_t(gatherGridSide(settings.gatherDirections)) * gatherGridSide(settings.gatherDirections);
   const uint64_t visibility = tixels * (directions * sizeof(VisibilityEntry) + sizeof(uint64_t));
   constexpr uint64_t kQuadBytes = 64, kChangeBytes = 4, kValueArrays = 3;
-  return visibility + values * kValueArrays * sizeof(Rgb) + tixels * (kQuadBytes + kChangeBytes);
+  // Writing the .plv compresses it a batch of blocks at a time beside the field.
+  const uint64_t writeBuffers = visibilityWriteBufferBytes(gatherGridSide(settings.gatherDirections));
+  return visibility + writeBuffers + values * kValueArrays * sizeof(Rgb) + tixels * (kQuadBytes + kChangeBytes);
 }
 
 std::vector<std::string> bakePresetNames() { return {"draft", "default", "high"}; }

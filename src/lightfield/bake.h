@@ -37,9 +37,11 @@ struct BakeOptions {
 
 /// Bytes of the bake's large arrays for this parameterisation and these settings: the
 /// visibility field (an 8-byte entry per tixel and gather direction, plus a 64-bit offset per
-/// tixel) and, during propagation, three arrays of RGB values (current, first shot, previous
-/// iteration) and a 64-byte transport quad plus a 4-byte change per tixel. A lower bound: the
-/// scene, the BVH and the field's extra records (mirror chains, back sides) come on top.
+/// tixel) with the .plv writer's buffers (visibilityWriteBufferBytes) and, during propagation,
+/// three arrays of RGB values (current, first shot, previous iteration) and a 64-byte
+/// transport quad plus a 4-byte change per tixel. What the bake allocates after the check: the
+/// scene and the BVH, already resident then, are not in it (nor the field's rare extra
+/// records: mirror chains, glossy targets).
 uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings);
 
 /// Bakes `scene` (moved into the result). Throws pl::Error on failures.

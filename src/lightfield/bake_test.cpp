@@ -3,10 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "accel/accel.h"
@@ -17,6 +19,7 @@
 #include "lightfield/lookup.h"
 #include "lightfield/paraboloid.h"
 #include "lightfield/parameterisation.h"
+#include "lightfield/plf_file.h"
 #include "lightfield/propagation.h"
 #include "lightfield/visibility.h"
 
@@ -388,6 +391,11 @@ TEST_F(BakeTest, StaleOrCorruptVisibilityFiles) {
   EXPECT_EQ(read.entries.size(), field.entries.size());
   EXPECT_EQ(read.extras.size(), field.extras.size());
   EXPECT_EQ(std::memcmp(read.entries.data(), field.entries.data(), field.entries.size() * sizeof(VisibilityEntry)), 0);
+  ASSERT_EQ(read.extraOffset.size(), field.extraOffset.size());
+  EXPECT_TRUE(std::equal(read.extraOffset.begin(), read.extraOffset.end(), field.extraOffset.begin()));
+  EXPECT_EQ(std::memcmp(read.extras.data(), field.extras.data(), field.extras.size() * sizeof(VisibilityExtra)), 0);
+  // Compressed: fewer bytes than the 8-byte entries alone (index and fraction planes + zstd).
+  EXPECT_LT(std::filesystem::file_size(plv), field.entries.size() * sizeof(VisibilityEntry));
 
   // Stale: a different expected hash is not an error, but a reason.
   EXPECT_FALSE(readVisibility(plv, field.hash ^ 1, read, &why));
@@ -411,6 +419,67 @@ TEST_F(BakeTest, StaleOrCorruptVisibilityFiles) {
     f.write(&junk, 1);
   }
   EXPECT_THROW(readVisibility(plv, field.hash, read, &why), Error);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_F(BakeTest, VisibilityFileOfAnOlderVersionIsRetracedAndLyingFramesAreRefused) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_format_test";
+  std::filesystem::create_directories(dir);
+  const std::string plv = (dir / "box.plv").string();
+  const Scene scene = makeCornellBox();
+  const BakeSettings settings = smallSettings();
+  const Parameterisation param = buildParameterisation(scene, settings);
+  const VisibilityField field = computeVisibility(scene, Accel(scene), param, settings);
+  writeVisibility(plv, field);
+  std::ifstream in(plv, std::ios::binary);
+  const std::vector<char> good{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  auto writeVariant = [&](const std::vector<char>& bytes) {
+    std::ofstream out(plv, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+  };
+  auto resignPayload = [](std::vector<char>& bytes) {  // header: payload XXH64 at byte 48, payload from 56
+    const uint64_t hash = xxh64(bytes.data() + 56, bytes.size() - 56);
+    std::memcpy(bytes.data() + 48, &hash, 8);
+  };
+  VisibilityField read;
+  std::string why;
+  // Version 2 (raw entries): not an error, a reason to trace again.
+  auto older = good;
+  const uint32_t two = 2;
+  std::memcpy(older.data() + 8, &two, 4);
+  writeVariant(older);
+  EXPECT_FALSE(readVisibility(plv, field.hash, read, &why));
+  EXPECT_NE(why.find("older format version 2"), std::string::npos) << why;
+  // The frame table at the end made to lie (two frames' sizes swapped, consistent total, valid
+  // checksum): refused by the frame check before the field is allocated, naming the file.
+  auto lying = good;
+  uint64_t first, last;
+  const size_t lastAt = lying.size() - 8, firstAt = lastAt - 8;  // the last entry block's and the extras' sizes
+  std::memcpy(&first, lying.data() + firstAt, 8);
+  std::memcpy(&last, lying.data() + lastAt, 8);
+  ASSERT_NE(first, last);
+  std::memcpy(lying.data() + firstAt, &last, 8);
+  std::memcpy(lying.data() + lastAt, &first, 8);
+  resignPayload(lying);
+  writeVariant(lying);
+  try {
+    readVisibility(plv, field.hash, read, &why);
+    ADD_FAILURE() << "a lying frame table was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("box.plv: visibility frame"), std::string::npos) << e.what();
+  }
+  // A tixel index past the field's end inside a valid frame (written through writeVisibility).
+  std::vector<VisibilityEntry> entries(field.entries.begin(), field.entries.end());
+  entries[5].target = uint32_t(field.tixelCount) + 3;
+  VisibilityField bad = field;
+  bad.entries = FieldArray<VisibilityEntry>(std::move(entries));
+  writeVisibility(plv, bad);
+  try {
+    readVisibility(plv, field.hash, read, &why);
+    ADD_FAILURE() << "an out-of-range tixel index was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("an entry of tixel 0 points outside the field"), std::string::npos) << e.what();
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -1,6 +1,6 @@
 #pragma once
-// Private to the light-field module: the two third-party codecs used by compression.cpp,
-// each behind one .cpp file (codec_zstd.cpp: libzstd; codec_bc1.cpp: libsquish).
+// Private to the light-field module: the two third-party codecs used by compression.cpp (and
+// zstd by the .plv file, visibility.cpp), each behind one .cpp file (codec_zstd.cpp: libzstd; codec_bc1.cpp: libsquish).
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -19,6 +19,12 @@ std::vector<unsigned char> zstdCompress(std::span<const unsigned char> input, in
 /// size, trailing bytes) throws pl::Error starting with `context`.
 std::vector<unsigned char> zstdDecompress(std::span<const unsigned char> frame, uint64_t expectedSize,
                                           const std::string& context);
+/// Checks, without decoding, that `frame` is exactly one zstd frame declaring `expectedSize`
+/// content bytes (so a reader can refuse a lying layout before allocating for it).
+void zstdCheckFrame(std::span<const unsigned char> frame, uint64_t expectedSize, const std::string& context);
+/// The same into `output`, whose size is the expected content size (no allocation).
+void zstdDecompressInto(std::span<const unsigned char> frame, std::span<unsigned char> output,
+                        const std::string& context);
 
 /// BC1 (S3TC DXT1) of one 4×4 block of 8-bit RGB texels, row-major (texel x + 4·y);
 /// texels whose bit (x + 4·y) is clear in `validMask` are padding and do not influence

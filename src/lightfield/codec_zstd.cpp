@@ -24,8 +24,7 @@ std::vector<unsigned char> zstdCompress(std::span<const unsigned char> input, in
   return frame;
 }
 
-std::vector<unsigned char> zstdDecompress(std::span<const unsigned char> frame, uint64_t expectedSize,
-                                          const std::string& context) {
+void zstdCheckFrame(std::span<const unsigned char> frame, uint64_t expectedSize, const std::string& context) {
   const size_t frameSize = ZSTD_findFrameCompressedSize(frame.data(), frame.size());
   if (ZSTD_isError(frameSize))
     fail("{}: corrupt zstd frame: {}", context, ZSTD_getErrorName(frameSize));
@@ -36,11 +35,29 @@ std::vector<unsigned char> zstdDecompress(std::span<const unsigned char> frame, 
     fail("{}: corrupt zstd frame: no valid content size", context);
   if (contentSize != expectedSize)
     fail("{}: the zstd frame holds {} bytes but the layout needs {}", context, contentSize, expectedSize);
-  std::vector<unsigned char> output(expectedSize);
+}
+
+namespace {
+void decompressChecked(std::span<const unsigned char> frame, std::span<unsigned char> output,
+                       const std::string& context) {
   const size_t size = ZSTD_decompress(output.data(), output.size(), frame.data(), frame.size());
   if (ZSTD_isError(size)) fail("{}: corrupt zstd frame: {}", context, ZSTD_getErrorName(size));
-  if (size != expectedSize)
-    fail("{}: the zstd frame decoded to {} bytes but the layout needs {}", context, size, expectedSize);
+  if (size != output.size())
+    fail("{}: the zstd frame decoded to {} bytes but the layout needs {}", context, size, output.size());
+}
+}  // namespace
+
+void zstdDecompressInto(std::span<const unsigned char> frame, std::span<unsigned char> output,
+                        const std::string& context) {
+  zstdCheckFrame(frame, output.size(), context);
+  decompressChecked(frame, output, context);
+}
+
+std::vector<unsigned char> zstdDecompress(std::span<const unsigned char> frame, uint64_t expectedSize,
+                                          const std::string& context) {
+  zstdCheckFrame(frame, expectedSize, context);
+  std::vector<unsigned char> output(expectedSize);
+  decompressChecked(frame, output, context);
   return output;
 }
 

@@ -349,6 +349,10 @@ Light getLight(ByteReader& r) {
 }
 static_assert(std::variant_size_v<Light> == 3, "getLight must decode every light type");
 
+/// How a texture record stores its image (the byte after its path).
+constexpr uint8_t kTexturePixels = 0;       ///< i32 width, i32 height, u64 count, float32 RGB texels
+constexpr uint8_t kTextureEncodedFile = 1;  ///< u64 count, the image file's bytes (PNG/JPEG/TGA/BMP)
+
 std::vector<unsigned char> encodeScene(const Scene& scene) {
   ByteWriter w;
   w.putString(scene.sourcePath);
@@ -372,10 +376,16 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
   w.put(uint64_t(scene.textures.size()));
   for (const Texture& t : scene.textures) {
     w.putString(t.path);
-    w.put(int32_t(t.image.width));
-    w.put(int32_t(t.image.height));
-    w.putArray(t.image.pixels);
-    w.put(t.average);
+    // The image file's bytes when the texture has them (decoded on load), else the pixels.
+    const bool encoded = t.encoded && !t.encoded->empty();
+    w.put(uint8_t(encoded ? kTextureEncodedFile : kTexturePixels));
+    if (encoded) {
+      w.putArray(*t.encoded);
+    } else {
+      w.put(int32_t(t.image.width));
+      w.put(int32_t(t.image.height));
+      w.putArray(t.image.pixels);
+    }
   }
   w.put(uint64_t(scene.lights.size()));
   for (const Light& l : scene.lights) putLight(w, l);
@@ -416,12 +426,17 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
 // Smallest encoded size of one element, used to bound counts before allocating.
 constexpr uint64_t kMinMeshBytes = 4 + 5 * 8;
 constexpr uint64_t kMinMaterialBytes = 4 + 4 + 12 + 4 + 12 + 1;
-constexpr uint64_t kMinTextureBytes = 4 + 4 + 4 + 8 + 12;
+constexpr uint64_t kMinTextureBytes = 4 + 1 + 8;
 constexpr uint64_t kMinLightBytes = 4 + 24;
 constexpr uint64_t kMinCameraBytes = 4 + 36 + 16 + 1 + 4;
 
-/// Decodes SCNE and checks every index and size; the scene is ready for an Accel.
-Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path) {
+/// Whether decodeScene decodes embedded image files (`info` only counts textures).
+enum class TextureDecoding { Decode, Skip };
+
+/// Decodes SCNE and checks every index and size; the scene is ready for an Accel (with
+/// TextureDecoding::Skip, encoded textures have no pixels: for summaries only).
+Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path, uint32_t version,
+                  TextureDecoding textures = TextureDecoding::Decode) {
   ByteReader r(bytes, path, kSectionNames[kScene]);
   Scene scene;
   scene.sourcePath = r.getString();
@@ -445,14 +460,31 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path)
   scene.textures.resize(r.getCount(kMinTextureBytes, "textures"));
   for (Texture& t : scene.textures) {
     t.path = r.getString();
-    t.image.width = r.get<int32_t>();
-    t.image.height = r.get<int32_t>();
-    t.image.pixels = r.getArray<Rgb>("texels");
-    t.average = r.get<Rgb>();
-    if (t.image.width <= 0 || t.image.height <= 0 ||
-        uint64_t(t.image.width) * uint64_t(t.image.height) != t.image.pixels.size())
-      r.corrupt(fmt::format("texture '{}' is {}×{} but holds {} texels", t.path, t.image.width, t.image.height,
-                            t.image.pixels.size()));
+    // Version 1 had no storage byte: always pixels, followed by their (recomputed) average.
+    const uint8_t storage = version >= 2 ? r.get<uint8_t>() : kTexturePixels;
+    if (storage == kTextureEncodedFile) {
+      std::vector<unsigned char> file = r.getArray<unsigned char>("encoded image bytes");
+      if (file.empty()) r.corrupt(fmt::format("texture '{}' has an empty image file", t.path));
+      const std::string label = fmt::format("{}: texture '{}' embedded in the scene section", path, t.path);
+      if (textures == TextureDecoding::Decode) {
+        t = textureFromEncoded(std::move(t.path), std::move(file), label);  // size checked before decoding
+        t.finish(path);
+      } else {
+        t.encoded = std::make_shared<const std::vector<unsigned char>>(std::move(file));
+      }
+    } else if (storage == kTexturePixels) {
+      t.image.width = r.get<int32_t>();
+      t.image.height = r.get<int32_t>();
+      t.image.pixels = r.getArray<Rgb>("texels");
+      if (version < 2) r.get<Rgb>();  // the version-1 average
+      if (t.image.width <= 0 || t.image.height <= 0 ||
+          uint64_t(t.image.width) * uint64_t(t.image.height) != t.image.pixels.size())
+        r.corrupt(fmt::format("texture '{}' is {}×{} but holds {} texels", t.path, t.image.width, t.image.height,
+                              t.image.pixels.size()));
+      t.finish(path);
+    } else {
+      r.corrupt(fmt::format("texture '{}' has unknown storage {}", t.path, storage));
+    }
   }
   scene.lights.resize(r.getCount(kMinLightBytes, "lights"));
   for (Light& l : scene.lights) l = getLight(r);
@@ -785,10 +817,10 @@ class PlfReader {
       fail("{}: truncated: the file ends at byte {} inside the {}-byte header", path, actualSize_, kPlfHeaderSize);
     if (actualSize_ < offsetof(Header, sectionCount))
       fail("{}: truncated: the file ends at byte {} inside the {}-byte header", path, actualSize_, kPlfHeaderSize);
-    if (header.version != kPlfVersion)
-      fail("{}: unsupported .plf format version {} (this build of plenoptic reads version {}); "
+    if (header.version < kPlfOldestReadableVersion || header.version > kPlfVersion)
+      fail("{}: unsupported .plf format version {} (this build of plenoptic reads versions {} to {}); "
            "re-bake the scene with this build",
-           path, header.version, kPlfVersion);
+           path, header.version, kPlfOldestReadableVersion, kPlfVersion);
     if (actualSize_ < sizeof(Header))
       fail("{}: truncated: the file ends at byte {} inside the {}-byte header", path, actualSize_, kPlfHeaderSize);
     version_ = header.version;
@@ -998,7 +1030,7 @@ void writeLightField(const std::string& path, const LightField& lf, PlfEncoding 
 LightField readLightField(const std::string& path) {
   const PlfReader reader(path);
   LightField lf;
-  lf.scene = decodeScene(reader.read(kScene), path);
+  lf.scene = decodeScene(reader.read(kScene), path, reader.version());
   lf.charts = decodeCharts(reader.read(kCharts), path, lf.scene.materials.size());
   lf.triangleChart = decodeTriangleCharts(reader.read(kTriangleCharts), path, lf.scene, lf.charts.size());
   const SectionEntry& values = reader.entry(kValues);
@@ -1028,7 +1060,7 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
   info.fileBytes = reader.fileSize();
   info.sections = sectionInfos(reader);
 
-  const Scene scene = decodeScene(reader.read(kScene), path);
+  const Scene scene = decodeScene(reader.read(kScene), path, reader.version(), TextureDecoding::Skip);
   info.sceneSource = scene.sourcePath;
   info.meshes = scene.meshes.size();
   for (const Mesh& m : scene.meshes) {

@@ -25,10 +25,13 @@
 //   sections, each at its offset, in table order, zero padding between them (checked).
 //
 // Sections (each present exactly once):
-//   SCNE  the Scene: meshes, materials (every BSDF variant's parameters), textures with
-//         their pixels, lights, cameras, the environment (constant and lat-long map with its
-//         scale and rotation) and the scene file's suggested settings. Everything a
-//         renderer needs.
+//   SCNE  the Scene: meshes, materials (every BSDF variant's parameters), textures, lights,
+//         cameras, the environment (constant and lat-long map with its scale and rotation)
+//         and the scene file's suggested settings. Everything a renderer needs. A texture
+//         is its path, a storage byte and either (1) the bytes of its image file as the
+//         scene had it (PNG/JPEG/TGA/BMP, decoded on load with decodeLdrImage: the pixels the
+//         scene loader had) or (0) float32 RGB pixels (textures from HDR files); see
+//         encodeScene in plf_file.cpp.
 //   CHRT  the charts: u64 count, then fixed 85-byte records (see encodeCharts in plf_file.cpp).
 //   TRCH  triangle → chart: u64 mesh count, then per mesh u64 triangle count + u32 indices.
 //   VALS  the values: float32 RGB triplets (12 bytes each), in LightField::values order.
@@ -36,7 +39,7 @@
 //   META  UTF-8 JSON: {"settings": BakeSettings, "stats": BakeStats}.
 //
 // The version is checked right after the magic, before anything else is interpreted, so a
-// future layout can change everything after it. Reading never trusts the file: the magic,
+// future layout can change everything after it (versions 1 to kPlfVersion are read). Reading never trusts the file: the magic,
 // version, header hash, every section's bounds and
 // checksum, and every count inside a section (against the bytes that remain) are checked
 // before anything is allocated, and all indices are range-checked. Any problem throws
@@ -51,7 +54,10 @@
 
 namespace pl {
 
-inline constexpr uint32_t kPlfVersion = 1;
+/// The version written. 2: textures store their image file's bytes (PNG/JPEG/…) instead of
+/// float pixels. Readers also read version 1 (the same but for the texture records).
+inline constexpr uint32_t kPlfVersion = 2;
+inline constexpr uint32_t kPlfOldestReadableVersion = 1;
 inline constexpr size_t kPlfHeaderSize = 32;
 inline constexpr size_t kPlfSectionEntrySize = 48;
 inline constexpr std::array<char, 8> kPlfMagic = {'P', 'L', 'F', '\0', '\r', '\n', '\x1a', '\n'};

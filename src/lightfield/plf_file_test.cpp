@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,7 @@
 #include <memory>
 
 #include "core/error.h"
+#include "scene/scene.h"
 #include "support/temp_dir_test.h"
 
 namespace pl {
@@ -58,6 +60,9 @@ TEST(Xxh64, StreamingInAnyPiecesEqualsOneShot) {
 
 // --- A light field exercising every field ------------------------------------------------
 
+/// A 2×2 PNG (75 bytes) of the repository's test data.
+const std::string kCheckerPng = std::string(PLENOPTIC_TEST_DATA_DIR) + "/scene/textured/mat/checker.png";
+
 LightField makeTestLightField() {
   LightField lf;
   Scene& s = lf.scene;
@@ -90,7 +95,10 @@ LightField makeTestLightField() {
   texture.image = Image(3, 2);
   for (size_t i = 0; i < texture.image.pixels.size(); ++i) texture.image.pixels[i] = Rgb(float(i), 0.5f, -1.0f);
   texture.average = Rgb(2.5f, 0.5f, -1.0f);
-  s.textures = {texture};
+  // A texture from a PNG file: stored as the file's bytes, decoded on load.
+  Texture png = loadTextureFile(kCheckerPng);
+  png.finish(s.sourcePath);  // its average, as Scene::finalize computes it
+  s.textures = {texture, png};
 
   s.lights = {PointLight{{1, 2, 3}, {4, 5, 6}}, SpotLight{{0, 5, 0}, {0, -1, 0}, {7, 8, 9}, 0.2f, 0.4f},
               DirectionalLight{{0.6f, -0.8f, 0.0f}, {1.5f, 2.5f, 3.5f}}};
@@ -293,12 +301,20 @@ TEST_F(PlfFileTest, RoundTripPreservesEveryField) {
   EXPECT_EQ(glassB.thin, glassA.thin);
   EXPECT_EQ(glassB.absorption, glassA.absorption);
 
-  ASSERT_EQ(b.textures.size(), 1u);
+  ASSERT_EQ(b.textures.size(), 2u);
   EXPECT_EQ(b.textures[0].path, a.textures[0].path);
   EXPECT_EQ(b.textures[0].image.width, 3);
   EXPECT_EQ(b.textures[0].image.height, 2);
   EXPECT_EQ(b.textures[0].image.pixels, a.textures[0].image.pixels);
   EXPECT_EQ(b.textures[0].average, a.textures[0].average);
+  EXPECT_FALSE(b.textures[0].encoded);  // float pixels stay float pixels
+  // The PNG texture: the file's bytes, and the pixels they decode to, exactly.
+  EXPECT_EQ(b.textures[1].path, a.textures[1].path);
+  ASSERT_TRUE(b.textures[1].encoded);
+  EXPECT_EQ(*b.textures[1].encoded, readBytes(kCheckerPng));
+  EXPECT_EQ(b.textures[1].image.width, 2);
+  EXPECT_EQ(b.textures[1].image.pixels, a.textures[1].image.pixels);
+  EXPECT_EQ(b.textures[1].average, a.textures[1].average);
 
   ASSERT_EQ(b.lights.size(), 3u);
   const auto &pa = std::get<PointLight>(a.lights[0]), &pb = std::get<PointLight>(b.lights[0]);
@@ -399,7 +415,7 @@ TEST_F(PlfFileTest, InfoSummarisesWithoutLoadingValues) {
   EXPECT_EQ(info.vertices, 9u);
   EXPECT_EQ(info.materials, 5u);
   EXPECT_EQ(info.materialModels, (std::vector<std::string>{"lambert", "mirror", "blinn-phong", "ggx", "rough-dielectric"}));
-  EXPECT_EQ(info.textures, 1u);
+  EXPECT_EQ(info.textures, 2u);
   EXPECT_EQ(info.lights, 3u);
   EXPECT_EQ(info.cameraNames, (std::vector<std::string>{"front", "lens"}));
   EXPECT_EQ(info.environmentMapWidth, 8u);
@@ -496,7 +512,7 @@ TEST_F(PlfFileTest, RefusesOtherVersionNamingBoth) {
   const uint32_t version = 7;
   std::memcpy(bytes.data() + 8, &version, 4);
   writeBytes(path, bytes);
-  expectRefused(path, {"unsupported .plf format version 7", "reads version 1"});
+  expectRefused(path, {"unsupported .plf format version 7", "reads versions 1 to " + std::to_string(kPlfVersion)});
 }
 
 TEST_F(PlfFileTest, RefusesTruncationNamingTheSection) {
@@ -609,6 +625,59 @@ TEST_F(PlfFileTest, RefusesAbsurdCountsWithoutAllocating) {
     std::memcpy(bad.data() + 12, &absurd, 4);
     writeBytes(file("count.plf"), bad);
     expectRefused(file("count.plf"), {"corrupt header", "sections"});
+  }
+}
+
+TEST_F(PlfFileTest, RefusesACorruptEmbeddedImageEvenWithValidChecksums) {
+  const std::string path = file("good.plf");
+  writeLightField(path, makeTestLightField());
+  const auto good = readBytes(path);
+  const auto table = sections(good);
+  const std::vector<unsigned char> png = readBytes(kCheckerPng);
+  // The PNG's bytes lie in SCNE as they were in the file.
+  const auto at = std::search(good.begin() + long(table[0].offset), good.begin() + long(table[0].offset + table[0].size),
+                              png.begin(), png.end());
+  ASSERT_NE(at, good.begin() + long(table[0].offset + table[0].size));
+  const size_t pngAt = size_t(at - good.begin());
+  auto expectLoadRefused = [&](const std::vector<unsigned char>& bad, const std::string& name,
+                               const std::vector<std::string>& fragments) {
+    writeBytes(file(name), bad);
+    try {
+      readLightField(file(name));
+      ADD_FAILURE() << name << ": a corrupt embedded image was accepted";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(file(name)), std::string::npos) << message;
+      for (const std::string& fragment : fragments)
+        EXPECT_NE(message.find(fragment), std::string::npos) << "'" << fragment << "' not in: " << message;
+    }
+  };
+  // Its image data damaged (the IDAT chunk's compressed bytes zeroed): a decoding error naming
+  // the file and the texture, never a crash or garbage pixels.
+  {
+    auto bad = good;
+    const auto idat = std::search(bad.begin() + long(pngAt), bad.begin() + long(pngAt + png.size()),
+                                  std::begin("IDAT"), std::begin("IDAT") + 4);
+    ASSERT_NE(idat, bad.begin() + long(pngAt + png.size()));
+    std::fill(idat + 4, idat + 10, 0);
+    resign(bad);
+    expectLoadRefused(bad, "idat.plf", {"texture '" + kCheckerPng + "'", "embedded", "corrupt"});
+  }
+  // Its chunk structure cut (the last chunk's length made to run past the image's end).
+  {
+    auto bad = good;
+    const uint32_t huge = 0x7fffffffu;
+    std::memcpy(bad.data() + pngAt + png.size() - 12, &huge, 4);
+    resign(bad);
+    expectLoadRefused(bad, "chunk.plf", {"truncated PNG"});
+  }
+  // An unknown storage byte (the byte before the u64 size of the embedded file).
+  {
+    auto bad = good;
+    bad[pngAt - 9] = 7;
+    resign(bad);
+    writeBytes(file("storage.plf"), bad);
+    expectRefused(file("storage.plf"), {"corrupt scene section", "unknown storage 7"});
   }
 }
 

@@ -1,6 +1,7 @@
 // The visibility field: tracing, hashing and its .plv file.
 //
-// .plv layout (little-endian; written by writeVisibility, validated by readVisibility):
+// .plv layout (version 3; little-endian; written by writeVisibility, validated by readVisibility):
+//   header, 56 bytes:
 //   magic        8 bytes  "PLVIS\0\r\n"
 //   version      u32      kPlvVersion
 //   gridSide     u32      m (N = m² gather directions per tixel)
@@ -9,7 +10,16 @@
 //   entryCount   u64      = tixelCount · N
 //   extraCount   u64
 //   payloadHash  u64      XXH64 (seed 0, as the .plf checksums) of every byte after the header
-//   payload      entries (8 bytes each), extraOffset (u64 × (tixelCount + 1)), extras (24 bytes each)
+//   payload:
+//   tixelsPerBlock u64    tixels per entry block (≈ 512 KiB of entries; the last block may
+//                         hold fewer): B = ⌈tixelCount / tixelsPerBlock⌉ blocks
+//   frames       B zstd frames of entry blocks, in tixel order, then one zstd frame of
+//                extraOffset (u64 × (tixelCount + 1)) followed by the extras (24 bytes each)
+//   frameSizes   u64 × (B + 1): the stored bytes of each frame, in order
+// An entry block of k entries, before zstd (encodeEntryBlock): the k targets (u32), then the
+// k fu (u16), then the k fv (u16). Decoding restores the 8-byte entries of visibility.h exactly,
+// so a reused field gives the same light field bit for bit. Version 2 was the raw entries
+// (8 bytes each, memory-mapped): a version-2 file is traced again, like a stale one.
 #include "lightfield/visibility.h"
 
 #include <algorithm>
@@ -31,6 +41,8 @@
 #include "core/progress.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "core/memory.h"
+#include "lightfield/codec_backends.h"
 #include "lightfield/lookup.h"
 #include "lightfield/plf_file.h"
 
@@ -39,7 +51,7 @@ namespace pl {
 namespace {
 
 constexpr char kPlvMagic[8] = {'P', 'L', 'V', 'I', 'S', '\0', '\r', '\n'};
-constexpr uint32_t kPlvVersion = 2;  // 2: multi-jittered gather directions
+constexpr uint32_t kPlvVersion = 3;  // 2: multi-jittered gather directions; 3: compressed blocks
 constexpr size_t kPlvHeaderSize = 8 + 4 + 4 + 8 * 5;
 
 // FNV-1a, 64 bit: a change detector over bytes (not a cryptographic hash).
@@ -332,18 +344,69 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
   return field;
 }
 
+namespace {
+
+/// Entry blocks of the .plv: as many whole tixels as make about kBlockEntryBytes of entries.
+constexpr uint64_t kBlockEntryBytes = uint64_t(1) << 19;
+/// A reader refuses blocks larger than this (a writer never makes them): it bounds the
+/// scratch buffer and what one frame may claim.
+constexpr uint64_t kMaxBlockEntryBytes = uint64_t(1) << 24;
+/// zstd level of the .plv frames. On Sponza's default field level 3 saves 1.5 % of the bytes
+/// (3.41 instead of 3.46 per entry) for about 1.4× the time, level 9 5 % for 3×.
+constexpr int kPlvZstdLevel = 1;
+/// Blocks compressed in parallel between two writes (bounds the writer's buffers).
+constexpr uint64_t kWriteBatchBlocks = 16;
+
+uint64_t tixelsPerBlock(uint32_t directionsPerTixel) {
+  return std::max<uint64_t>(1, kBlockEntryBytes / (uint64_t(directionsPerTixel) * sizeof(VisibilityEntry)));
+}
+
+/// The bytes of an entry block before zstd (see the layout at the top): all targets, then all
+/// fu, then all fv. Measured on Sponza's default field (43.5 M entries, zstd level 1): 3.89
+/// bytes per entry interleaved, 3.46 split so, 3.58 with the targets also delta-coded against
+/// the previous entry's (neighbouring directions mostly see the same chart, but the index
+/// jumps between charts cost more than the deltas save).
+void encodeEntryBlock(const VisibilityEntry* entries, uint64_t count, unsigned char* out) {
+  for (uint64_t i = 0; i < count; ++i) {
+    std::memcpy(out + 4 * i, &entries[i].target, 4);
+    std::memcpy(out + 4 * count + 2 * i, &entries[i].fu, 2);
+    std::memcpy(out + 6 * count + 2 * i, &entries[i].fv, 2);
+  }
+}
+
+void decodeEntryBlock(const unsigned char* in, uint64_t count, VisibilityEntry* entries) {
+  for (uint64_t i = 0; i < count; ++i) {
+    std::memcpy(&entries[i].target, in + 4 * i, 4);
+    std::memcpy(&entries[i].fu, in + 4 * count + 2 * i, 2);
+    std::memcpy(&entries[i].fv, in + 6 * count + 2 * i, 2);
+  }
+}
+
+}  // namespace
+
+uint64_t visibilityWriteBufferBytes(uint32_t gridSide) {
+  // Per block of a batch: its compressed frame (at most the raw size plus zstd's small
+  // bound, counted as the raw size twice) while a worker also holds the raw transformed copy.
+  const uint64_t blockBytes = tixelsPerBlock(gridSide * gridSide) * gridSide * gridSide * sizeof(VisibilityEntry);
+  return kWriteBatchBlocks * 2 * blockBytes;
+}
+
 void writeVisibility(const std::string& path, const VisibilityField& field) {
-  Xxh64Stream payloadStream;
-  payloadStream.update(field.entries.data(), field.entries.size() * sizeof(VisibilityEntry));
-  payloadStream.update(field.extraOffset.data(), field.extraOffset.size() * sizeof(uint64_t));
-  payloadStream.update(field.extras.data(), field.extras.size() * sizeof(VisibilityExtra));
-  const uint64_t payloadHash = payloadStream.digest();
+  const uint64_t n = field.directionsPerTixel();
+  const uint64_t perBlock = tixelsPerBlock(uint32_t(n));
+  const uint64_t blocks = (field.tixelCount + perBlock - 1) / perBlock;
+  const uint64_t entryCount = field.entries.size(), extraCount = field.extras.size();
 
   writeFileAtomically(path, [&](const std::string& temp) {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
     if (!out) fail("cannot create the temporary file {}", temp);
+    Xxh64Stream payloadHash;
     auto put = [&](const void* data, size_t size) { out.write(static_cast<const char*>(data), std::streamsize(size)); };
-    const uint64_t entryCount = field.entries.size(), extraCount = field.extras.size();
+    auto putPayload = [&](const void* data, size_t size) {
+      put(data, size);
+      payloadHash.update(data, size);
+    };
+    const uint64_t placeholder = 0;
     put(kPlvMagic, 8);
     put(&kPlvVersion, 4);
     put(&field.gridSide, 4);
@@ -351,10 +414,43 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
     put(&field.tixelCount, 8);
     put(&entryCount, 8);
     put(&extraCount, 8);
-    put(&payloadHash, 8);
-    put(field.entries.data(), field.entries.size() * sizeof(VisibilityEntry));
-    put(field.extraOffset.data(), field.extraOffset.size() * sizeof(uint64_t));
-    put(field.extras.data(), field.extras.size() * sizeof(VisibilityExtra));
+    put(&placeholder, 8);  // the payload hash, written last
+    putPayload(&perBlock, 8);
+
+    // Entry blocks compressed a batch at a time in parallel, written in order: memory stays
+    // bounded by one batch of frames whatever the field's size.
+    std::vector<uint64_t> frameSizes;
+    frameSizes.reserve(blocks + 1);
+    const uint64_t batch = kWriteBatchBlocks;
+    std::vector<std::vector<unsigned char>> frames(batch);
+    Progress progress("visibility: writing", blocks);
+    for (uint64_t b0 = 0; b0 < blocks; b0 += batch) {
+      const uint64_t b1 = std::min(blocks, b0 + batch);
+      parallelFor(b1 - b0, [&](uint64_t i) {
+        const uint64_t t0 = (b0 + i) * perBlock, t1 = std::min(field.tixelCount, t0 + perBlock);
+        std::vector<unsigned char> raw((t1 - t0) * n * sizeof(VisibilityEntry));
+        encodeEntryBlock(field.entries.data() + t0 * n, (t1 - t0) * n, raw.data());
+        frames[i] = detail::zstdCompress(raw, kPlvZstdLevel);
+      });
+      for (uint64_t i = 0; i < b1 - b0; ++i) {
+        putPayload(frames[i].data(), frames[i].size());
+        frameSizes.push_back(frames[i].size());
+      }
+      progress.advance(b1 - b0);
+    }
+    // The extra records' frame: offsets, then records.
+    std::vector<unsigned char> tail(field.extraOffset.size() * sizeof(uint64_t) + extraCount * sizeof(VisibilityExtra));
+    if (!field.extraOffset.empty()) std::memcpy(tail.data(), field.extraOffset.data(), field.extraOffset.size() * sizeof(uint64_t));
+    if (extraCount > 0)
+      std::memcpy(tail.data() + field.extraOffset.size() * sizeof(uint64_t), field.extras.data(),
+                  extraCount * sizeof(VisibilityExtra));
+    const std::vector<unsigned char> tailFrame = detail::zstdCompress(tail, kPlvZstdLevel);
+    putPayload(tailFrame.data(), tailFrame.size());
+    frameSizes.push_back(tailFrame.size());
+    putPayload(frameSizes.data(), frameSizes.size() * sizeof(uint64_t));
+    const uint64_t digest = payloadHash.digest();
+    out.seekp(kPlvHeaderSize - 8);
+    put(&digest, 8);
     out.flush();
     if (!out) fail("write failed (disk full?)");
   });
@@ -367,7 +463,7 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   };
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return reason(fmt::format("{} does not exist", path));
-  auto file = std::make_shared<const MappedFile>(path);
+  const auto file = std::make_shared<const MappedFile>(path);
   const std::span<const unsigned char> bytes = file->bytes();
   const uint64_t fileSize = bytes.size();
   if (fileSize < kPlvHeaderSize) fail("{}: truncated visibility field ({} bytes, header needs {})", path, fileSize, kPlvHeaderSize);
@@ -382,7 +478,13 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   get(magic, 8);
   if (std::memcmp(magic, kPlvMagic, 8) != 0) fail("{}: not a plenoptic visibility field (bad magic)", path);
   get(&version, 4);
-  if (version != kPlvVersion) fail("{}: visibility field version {} (this program reads version {})", path, version, kPlvVersion);
+  if (version != kPlvVersion) {
+    // An older field is not an error: it is traced again, as a stale one is.
+    if (version < kPlvVersion)
+      return reason(fmt::format("{} has the older format version {} (this program writes version {})", path, version,
+                                kPlvVersion));
+    fail("{}: visibility field version {} (this program reads version {})", path, version, kPlvVersion);
+  }
   get(&gridSide, 4);
   get(&hash, 8);
   get(&tixelCount, 8);
@@ -392,79 +494,117 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   if (hash != expectedHash)
     return reason(fmt::format("{} was traced for different geometry, parameterisation or settings (hash {:016x}, expected {:016x})",
                               path, hash, expectedHash));
-  if (gridSide == 0 || gridSide > 4096 || tixelCount > VisibilityEntry::kIndexMask ||
-      entryCount != tixelCount * uint64_t(gridSide) * gridSide)
-    fail("{}: inconsistent counts in the header (grid {}, {} tixels, {} entries)", path, gridSide, tixelCount, entryCount);
-  const uint64_t expectedSize = kPlvHeaderSize + entryCount * sizeof(VisibilityEntry) + (tixelCount + 1) * sizeof(uint64_t);
-  if (extraCount > (fileSize - std::min(fileSize, expectedSize)) / sizeof(VisibilityExtra) ||
-      fileSize != expectedSize + extraCount * sizeof(VisibilityExtra))
-    fail("{}: truncated or oversized: {} bytes, the header describes {}", path, fileSize,
-         expectedSize + extraCount * sizeof(VisibilityExtra));
-  // The arrays view the mapping in place (offsets 56, 56 + 8·entries, …: aligned for their
-  // element types, as the header size and the element sizes are multiples of 8).
-  const unsigned char* payload = bytes.data() + kPlvHeaderSize;
-  const auto* entries = reinterpret_cast<const VisibilityEntry*>(payload);
-  const auto* extraOffset = reinterpret_cast<const uint64_t*>(payload + entryCount * sizeof(VisibilityEntry));
-  const auto* extras = reinterpret_cast<const VisibilityExtra*>(extraOffset + tixelCount + 1);
-  static_assert(kPlvHeaderSize % alignof(uint64_t) == 0 && sizeof(VisibilityEntry) % alignof(uint64_t) == 0 &&
-                alignof(VisibilityEntry) <= 8 && alignof(VisibilityExtra) <= 8);
+  if (gridSide == 0 || gridSide > kMaxGatherGridSide || tixelCount > VisibilityEntry::kIndexMask ||
+      entryCount != tixelCount * uint64_t(gridSide) * gridSide || extraCount > entryCount)
+    fail("{}: inconsistent counts in the header (grid {}, {} tixels, {} entries, {} extra records)", path, gridSide,
+         tixelCount, entryCount, extraCount);
+  const uint64_t n = uint64_t(gridSide) * gridSide;
 
-  // One pass over the payload: the checksum, and, while each block of tixels' entries is in
-  // the cache, the structural checks that let propagation index without bounds checks. A
-  // structural error is reported only once the checksum has matched (a damaged file is
-  // "corrupt", whatever its damage happens to break).
-  const uint32_t n = gridSide * gridSide;
-  std::string structural;
-  auto structuralError = [&](std::string text) {
-    if (structural.empty()) structural = std::move(text);
-  };
-  if (extraOffset[0] != 0 || extraOffset[tixelCount] != extraCount) structuralError("corrupt extra-record offsets");
-  Xxh64Stream checksum;
-  const uint64_t tixelsPerBlock = std::max<uint64_t>(1, (uint64_t(1) << 16) / n);  // ~512 KB of entries
-  for (uint64_t t0 = 0; t0 < tixelCount; t0 += tixelsPerBlock) {
-    const uint64_t t1 = std::min(tixelCount, t0 + tixelsPerBlock);
-    checksum.update(entries + t0 * n, (t1 - t0) * n * sizeof(VisibilityEntry));
-    for (uint64_t g = t0; g < t1 && structural.empty(); ++g) {
-      uint64_t flagged = 0;
-      bool outside = false;
-      for (uint32_t k = 0; k < n; ++k) {
-        const VisibilityEntry e = entries[g * n + k];
-        outside |= !e.escaped() && e.tixel() >= tixelCount;
-        flagged += e.hasExtra() ? 1 : 0;
-      }
-      if (outside) structuralError(fmt::format("an entry of tixel {} points outside the field", g));
-      if (extraOffset[g + 1] < extraOffset[g] || extraOffset[g + 1] - extraOffset[g] != flagged)
-        structuralError(fmt::format("corrupt extra-record offsets at tixel {}", g));
+  // The payload: its checksum first (a damaged file is "corrupt", whatever its damage happens
+  // to break), then the frame table at its end, checked against the bytes present.
+  const std::span<const unsigned char> payload = bytes.subspan(kPlvHeaderSize);
+  if (xxh64(payload.data(), payload.size()) != payloadHash)
+    fail("{}: corrupt or truncated visibility field (payload checksum mismatch)", path);
+  if (payload.size() < 8) fail("{}: truncated visibility field (no block size)", path);
+  uint64_t perBlock;
+  std::memcpy(&perBlock, payload.data(), 8);
+  if (perBlock == 0 || perBlock > kMaxBlockEntryBytes / (n * sizeof(VisibilityEntry)))
+    fail("{}: corrupt visibility field: {} tixels per block of {} directions each", path, perBlock, n);
+  const uint64_t blocks = (tixelCount + perBlock - 1) / perBlock;
+  const uint64_t tableBytes = (blocks + 1) * sizeof(uint64_t);
+  if (payload.size() < 8 + tableBytes)
+    fail("{}: truncated visibility field: {} bytes cannot hold the table of {} frames", path, fileSize, blocks + 1);
+  std::vector<uint64_t> frameSizes(blocks + 1);
+  std::memcpy(frameSizes.data(), payload.data() + payload.size() - tableBytes, tableBytes);
+  const uint64_t framesBytes = payload.size() - 8 - tableBytes;
+  uint64_t sum = 0;
+  for (uint64_t size : frameSizes) {
+    if (size > framesBytes - sum) fail("{}: corrupt visibility field: the frame sizes exceed the {} bytes present", path, framesBytes);
+    sum += size;
+  }
+  if (sum != framesBytes)
+    fail("{}: corrupt visibility field: {} bytes of frames present, the table describes {}", path, framesBytes, sum);
+
+  // Every frame must declare the size its place in the layout gives it before anything is
+  // allocated for the decoded field; then the field must fit in memory (the same bytes as the
+  // bake's estimate for this parameterisation): a forged header is refused, not obeyed.
+  const uint64_t decodedBytes = entryCount * sizeof(VisibilityEntry) + (tixelCount + 1) * sizeof(uint64_t) +
+                                extraCount * sizeof(VisibilityExtra);
+  {
+    const unsigned char* frame = payload.data() + 8;
+    for (uint64_t b = 0; b <= blocks; ++b) {
+      const uint64_t tixels = b < blocks ? std::min(tixelCount - b * perBlock, perBlock) : 0;
+      const uint64_t expected = b < blocks ? tixels * n * sizeof(VisibilityEntry)
+                                           : (tixelCount + 1) * sizeof(uint64_t) + extraCount * sizeof(VisibilityExtra);
+      detail::zstdCheckFrame({frame, frameSizes[b]}, expected, fmt::format("{}: visibility frame {}", path, b));
+      frame += frameSizes[b];
     }
   }
-  checksum.update(extraOffset, (tixelCount + 1) * sizeof(uint64_t));
-  checksum.update(extras, extraCount * sizeof(VisibilityExtra));
+  requireMemory(decodedBytes, fmt::format("{}: the visibility field", path), "bake at a coarser --preset");
+
+  std::vector<VisibilityEntry> entries;
+  entries.reserve(entryCount);
+  adviseHugePages(entries.data(), entryCount * sizeof(VisibilityEntry));
+  entries.resize(entryCount);
+  std::vector<uint64_t> frameOffset(blocks + 2, 8);  // of each frame in the payload
+  for (uint64_t b = 0; b <= blocks; ++b) frameOffset[b + 1] = frameOffset[b] + frameSizes[b];
+  std::vector<uint64_t> flaggedPerTixel(tixelCount);
+  // Blocks decode independently, in parallel (≈ 220 MB/s of entries per core at zstd level 1).
+  parallelFor(blocks, [&](uint64_t b) {
+    const uint64_t t0 = b * perBlock, t1 = std::min(tixelCount, t0 + perBlock);
+    std::vector<unsigned char> raw((t1 - t0) * n * sizeof(VisibilityEntry));
+    detail::zstdDecompressInto(payload.subspan(frameOffset[b], frameSizes[b]), raw,
+                               fmt::format("{}: visibility block {}", path, b));
+    decodeEntryBlock(raw.data(), (t1 - t0) * n, entries.data() + t0 * n);
+    // The structural checks that let propagation index without bounds checks.
+    for (uint64_t g = t0; g < t1; ++g) {
+      uint64_t flagged = 0;
+      for (uint64_t k = 0; k < n; ++k) {
+        const VisibilityEntry e = entries[g * n + k];
+        if (!e.escaped() && e.tixel() >= tixelCount)
+          fail("{}: an entry of tixel {} points outside the field", path, g);
+        flagged += e.hasExtra() ? 1 : 0;
+      }
+      flaggedPerTixel[g] = flagged;
+    }
+  });
+  std::vector<uint64_t> extraOffset(tixelCount + 1);
+  std::vector<VisibilityExtra> extras(extraCount);
+  std::vector<unsigned char> raw(decodedBytes - entryCount * sizeof(VisibilityEntry));
+  detail::zstdDecompressInto(payload.subspan(frameOffset[blocks], frameSizes[blocks]), raw,
+                             fmt::format("{}: visibility extra records", path));
+  std::memcpy(extraOffset.data(), raw.data(), extraOffset.size() * sizeof(uint64_t));
+  if (extraCount > 0)
+    std::memcpy(extras.data(), raw.data() + extraOffset.size() * sizeof(uint64_t), extraCount * sizeof(VisibilityExtra));
+  raw = {};
+  if (extraOffset[0] != 0 || extraOffset[tixelCount] != extraCount) fail("{}: corrupt extra-record offsets", path);
+  for (uint64_t g = 0; g < tixelCount; ++g)
+    if (extraOffset[g + 1] < extraOffset[g] || extraOffset[g + 1] - extraOffset[g] != flaggedPerTixel[g])
+      fail("{}: corrupt extra-record offsets at tixel {}", path, g);
   // The records' contents, as computeVisibility writes them: a throughput is a product of
   // mirror reflectances (each channel in [0, 1]); st is a paraboloid coordinate (unit disk) or
   // an octahedral one ([−1, 1]²), so both components lie in [−1, 1] (kStSlack: float rounding
   // of x / r and x / (1 + z)); viaMirror is 0 or 1. Anything else — NaN, 1e9 — would flow
   // unchecked into every propagated value.
   constexpr float kStSlack = 1e-4f;
-  for (uint64_t i = 0; i < extraCount && structural.empty(); ++i) {
+  for (uint64_t i = 0; i < extraCount; ++i) {
     const VisibilityExtra& x = extras[i];
     for (int c = 0; c < 3; ++c)
       if (!(x.throughput[c] >= 0.0f && x.throughput[c] <= 1.0f))
-        structuralError(fmt::format("extra record {} has throughput {} outside [0, 1]", i, x.throughput[c]));
+        fail("{}: extra record {} has throughput {} outside [0, 1]", path, i, x.throughput[c]);
     for (int c = 0; c < 2; ++c)
       if (!(std::abs(x.st[c]) <= 1.0f + kStSlack))
-        structuralError(fmt::format("extra record {} has direction coordinate {} outside [-1, 1]", i, x.st[c]));
-    if (x.viaMirror > 1) structuralError(fmt::format("extra record {} has a mirror flag of {} (0 or 1)", i, x.viaMirror));
+        fail("{}: extra record {} has direction coordinate {} outside [-1, 1]", path, i, x.st[c]);
+    if (x.viaMirror > 1) fail("{}: extra record {} has a mirror flag of {} (0 or 1)", path, i, x.viaMirror);
   }
-  if (checksum.digest() != payloadHash) fail("{}: corrupt visibility field (payload checksum mismatch)", path);
-  if (!structural.empty()) fail("{}: {}", path, structural);
 
   VisibilityField f;
   f.gridSide = gridSide;
   f.tixelCount = tixelCount;
   f.hash = hash;
-  f.entries = FieldArray<VisibilityEntry>(file, entries, entryCount);
-  f.extraOffset = FieldArray<uint64_t>(file, extraOffset, tixelCount + 1);
-  f.extras = FieldArray<VisibilityExtra>(std::move(file), extras, extraCount);
+  f.entries = FieldArray<VisibilityEntry>(std::move(entries));
+  f.extraOffset = FieldArray<uint64_t>(std::move(extraOffset));
+  f.extras = FieldArray<VisibilityExtra>(std::move(extras));
   field = std::move(f);
   return true;
 }

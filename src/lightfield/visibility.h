@@ -13,7 +13,7 @@
 // as a multi-jittered pattern (gatherSubCells): stratified per cell and, more finely, along
 // each axis, and decorrelated between neighbouring tixels.
 //
-// Entries (8 bytes, tixel-major: entry k of tixel g at g·N + k):
+// Entries (8 bytes in memory, tixel-major: entry k of tixel g at g·N + k; compressed on disk):
 //   target  bits 0–29: global index of the tixel at the lower-left of the 2×2 bilinear
 //                      footprint of the seen point (kEscape: nothing was hit)
 //           bit 30:    the seen chart was hit from behind (its back side)
@@ -62,8 +62,8 @@ struct VisibilityExtra {
 };
 static_assert(sizeof(VisibilityExtra) == 24);
 
-/// Read-only elements of a visibility field: either its own storage (a field just traced) or
-/// a view into the mapped .plv file it was read from (no copy). Copies share the storage.
+/// Read-only elements of a visibility field (a field just traced, or decoded from its .plv).
+/// Copies share the storage.
 template <typename T>
 class FieldArray {
  public:
@@ -74,9 +74,6 @@ class FieldArray {
     size_ = storage->size();
     keepAlive_ = std::move(storage);
   }
-  /// `size` elements at `data`, which stay valid while `owner` lives.
-  FieldArray(std::shared_ptr<const void> owner, const T* data, size_t size)
-      : keepAlive_(std::move(owner)), data_(data), size_(size) {}
 
   const T* data() const { return data_; }
   size_t size() const { return size_; }
@@ -150,13 +147,19 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
 VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                   const BakeSettings& settings);
 
-/// Writes the field atomically (temp + rename). Format: see visibility.cpp.
+/// Writes the field atomically (temp + rename), compressed: zstd frames of blocks of
+/// entries split into index and fraction planes (format: see visibility.cpp), with a progress bar.
 void writeVisibility(const std::string& path, const VisibilityField& field);
 
-/// Reads a field (memory-mapped: the field's arrays view the file's pages). Returns false and
-/// sets *why when the file is absent or its hash differs from expectedHash (a stale field is
-/// not an error); throws pl::Error naming the file when it is present but corrupt or
-/// truncated (header, payload checksum and every index are checked before it returns).
+/// Bytes writeVisibility holds besides the field itself (one batch of blocks and frames).
+uint64_t visibilityWriteBufferBytes(uint32_t gridSide);
+
+/// Reads and decodes a field into memory (the in-memory layout above: the bytes the bake's
+/// memory estimate counts, checked with requireMemory before allocating). Returns false and
+/// sets *why when the file is absent, of an older format version, or its hash differs from
+/// expectedHash (a stale field is not an error); throws pl::Error naming the file when it is
+/// present but corrupt or truncated (header, payload checksum, every frame and every index are
+/// checked before it returns).
 bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why);
 
 }  // namespace pl

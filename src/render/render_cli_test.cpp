@@ -75,7 +75,7 @@ class RenderCliTest : public cli_test::CliTest {
 TEST_F(RenderCliTest, InfoPrintsContentsAndSizes) {
   std::string out, err;
   ASSERT_EQ(run("info " + path("quad.plf"), &out, &err), 0) << err;
-  for (const char* fragment : {"format version 1", "all sections verified", "handmade-quad", "2 triangles",
+  for (const char* fragment : {"format version 2", "all sections verified", "handmade-quad", "2 triangles",
                                "lambert ×1", "cameras    2: side, top", "1 (1 diffuse, 0 glossy, 0 specular)",
                                "tixels       16", "values       16 RGB", "VALS", "preset handmade", "3 iterations"})
     EXPECT_NE(out.find(fragment), std::string::npos) << "'" << fragment << "' not in:\n" << out;
@@ -85,7 +85,7 @@ TEST_F(RenderCliTest, InfoJsonHasEveryFigure) {
   std::string out, err;
   ASSERT_EQ(run("info --json " + path("quad.plf"), &out, &err), 0) << err;
   const auto json = nlohmann::json::parse(out);
-  EXPECT_EQ(json["format_version"], 1);
+  EXPECT_EQ(json["format_version"], kPlfVersion);
   EXPECT_EQ(json["file_bytes"], fs::file_size(path("quad.plf")));
   EXPECT_EQ(json["checksums_verified"], true);
   EXPECT_EQ(json["scene"]["triangles"], 2);
@@ -184,38 +184,51 @@ TEST_F(RenderCliTest, RefusesBadInputWithoutWritingAnything) {
   EXPECT_FALSE(fs::exists(path("d.exr")));
 }
 
-// tests/data/render/quad-v1.plf is makeQuadLightField() as written by the version-1 writer.
-// It pins the format: a change of the byte layout without a new version number fails here.
-// Regenerate deliberately (after bumping kPlfVersion and keeping a reader for old files) with
+// tests/data/render/quad-v1.plf is makeQuadLightField() as written by the version-1 writer,
+// quad-v2.plf the same by the version-2 writer (which changed only texture records; the quad
+// has none). They pin the format: a change of the byte layout without a new version number
+// fails here, and files of the older version must still read. Regenerate the current one
+// deliberately (after bumping kPlfVersion and keeping a reader for old files) with
 //   PLENOPTIC_REGENERATE_FIXTURES=1 ./render_cli_test --gtest_filter='*Fixture*'
-TEST_F(RenderCliTest, Version1FixtureStillReadsAndRewritesByteForByte) {
-  const std::string fixture = std::string(PLENOPTIC_TEST_DATA_DIR) + "/render/quad-v1.plf";
-  if (std::getenv("PLENOPTIC_REGENERATE_FIXTURES")) writeLightField(fixture, makeQuadLightField());
+TEST_F(RenderCliTest, OlderAndCurrentFixturesReadAndRewriteByteForByte) {
+  const std::string current = std::string(PLENOPTIC_TEST_DATA_DIR) + "/render/quad-v2.plf";
+  if (std::getenv("PLENOPTIC_REGENERATE_FIXTURES")) writeLightField(current, makeQuadLightField());
   const LightField expected = makeQuadLightField();
-  const LightField lf = readLightField(fixture);
-  EXPECT_EQ(lf.scene.sourcePath, expected.scene.sourcePath);
-  ASSERT_EQ(lf.scene.meshes.size(), 1u);
-  EXPECT_EQ(lf.scene.meshes[0].positions, expected.scene.meshes[0].positions);
-  EXPECT_EQ(lf.scene.meshes[0].triangles, expected.scene.meshes[0].triangles);
-  ASSERT_EQ(lf.scene.cameras.size(), 2u);
-  EXPECT_EQ(lf.scene.cameras[1].name, "top");
-  EXPECT_EQ(lf.scene.cameras[1].eye, expected.scene.cameras[1].eye);
-  EXPECT_EQ(lf.scene.environment.constant, expected.scene.environment.constant);
-  ASSERT_EQ(lf.charts.size(), 1u);
-  EXPECT_EQ(lf.charts[0].tixelSize, 0.25f);
-  EXPECT_EQ(lf.values, expected.values);
-  EXPECT_EQ(lf.settings.preset, "handmade");
-  EXPECT_EQ(lf.stats.iterations, 3u);
+  for (const std::string name : {"quad-v1.plf", "quad-v2.plf"}) {
+    const std::string fixture = std::string(PLENOPTIC_TEST_DATA_DIR) + "/render/" + name;
+    const LightField lf = readLightField(fixture);
+    EXPECT_EQ(lf.scene.sourcePath, expected.scene.sourcePath);
+    ASSERT_EQ(lf.scene.meshes.size(), 1u);
+    EXPECT_EQ(lf.scene.meshes[0].positions, expected.scene.meshes[0].positions);
+    EXPECT_EQ(lf.scene.meshes[0].triangles, expected.scene.meshes[0].triangles);
+    ASSERT_EQ(lf.scene.cameras.size(), 2u);
+    EXPECT_EQ(lf.scene.cameras[1].name, "top");
+    EXPECT_EQ(lf.scene.cameras[1].eye, expected.scene.cameras[1].eye);
+    EXPECT_EQ(lf.scene.environment.constant, expected.scene.environment.constant);
+    ASSERT_EQ(lf.charts.size(), 1u);
+    EXPECT_EQ(lf.charts[0].tixelSize, 0.25f);
+    EXPECT_EQ(lf.values, expected.values);
+    EXPECT_EQ(lf.settings.preset, "handmade");
+    EXPECT_EQ(lf.stats.iterations, 3u);
 
-  // The writer is deterministic: writing what was read reproduces the fixture exactly.
-  writeLightField(path("rewritten.plf"), lf);
-  const std::string original = cli_test::readFileText(fixture), rewritten = cli_test::readFileText(path("rewritten.plf"));
-  EXPECT_EQ(original.size(), rewritten.size());
-  EXPECT_TRUE(original == rewritten) << "the version-1 byte layout changed";
+    // The writer is deterministic: writing what was read reproduces the current fixture exactly
+    // (and an older file becomes a current one that reads back the same).
+    writeLightField(path("rewritten.plf"), lf);
+    if (fixture == current) {
+      const std::string original = cli_test::readFileText(current), rewritten = cli_test::readFileText(path("rewritten.plf"));
+      EXPECT_EQ(original.size(), rewritten.size());
+      EXPECT_TRUE(original == rewritten) << "the version-" << kPlfVersion << " byte layout changed";
+    } else {
+      const LightField again = readLightField(path("rewritten.plf"));
+      EXPECT_EQ(again.values, lf.values);
+      EXPECT_EQ(again.scene.meshes[0].positions, lf.scene.meshes[0].positions);
+      EXPECT_EQ(again.settings.preset, lf.settings.preset);
+    }
 
-  std::string out, err;
-  ASSERT_EQ(run("info " + fixture, &out, &err), 0) << err;
-  EXPECT_NE(out.find("format version 1"), std::string::npos) << out;
+    std::string out, err;
+    ASSERT_EQ(run("info " + fixture, &out, &err), 0) << err;
+    EXPECT_NE(out.find(name == "quad-v1.plf" ? "format version 1" : "format version 2"), std::string::npos) << out;
+  }
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -16,6 +17,7 @@
 #include "lightfield/bake.h"
 #include "lightfield/lookup.h"
 #include "lightfield/plf_file.h"
+#include "scene/scene.h"
 #include "support/sphere_mesh.h"
 
 namespace pl {
@@ -343,6 +345,54 @@ TEST_F(RenderTest, BakedWhiteFurnaceRendersLeOverOneMinusAlbedo) {
   // and the lookup interpolates a uniform field exactly.
   for (const Rgb& pixel : image.pixels)
     for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(pixel[ch], expected, 0.01f * expected);
+}
+
+TEST_F(RenderTest, TexturedBakeRoundTripsThroughThePlfWithTheImageFileNotItsPixels) {
+  // The OBJ's albedo texture is a PNG: the .plf stores that file's bytes and decodes them on
+  // load, which must give the very pixels the scene loader had, hence the same render.
+  const std::string png = std::string(PLENOPTIC_TEST_DATA_DIR) + "/scene/textured/mat/checker.png";
+  Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/scene/textured/quad.obj");
+  scene.environment.constant = Rgb(1.0f, 0.8f, 0.6f);  // something to light the quad with
+  BakeSettings settings = bakePreset("draft");
+  const LightField baked = bake(std::move(scene), settings);
+  ASSERT_EQ(baked.scene.textures.size(), 1u);
+  ASSERT_TRUE(baked.scene.textures[0].encoded);
+  const std::string path = ::testing::TempDir() + "textured_render_test.plf";
+  writeLightField(path, baked);
+  const LightField lf = readLightField(path);
+  const PlfInfo info = readLightFieldInfo(path);
+  std::remove(path.c_str());
+
+  ASSERT_EQ(lf.scene.textures.size(), 1u);
+  const Texture& before = baked.scene.textures[0];
+  const Texture& after = lf.scene.textures[0];
+  EXPECT_EQ(after.path, before.path);
+  ASSERT_TRUE(after.encoded);
+  EXPECT_EQ(*after.encoded, *before.encoded);
+  EXPECT_EQ(after.encoded->size(), std::filesystem::file_size(png));  // the file as it was
+  ASSERT_EQ(after.image.width, before.image.width);
+  ASSERT_EQ(after.image.height, before.image.height);
+  for (size_t i = 0; i < before.image.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(after.image.pixels[i][c], before.image.pixels[i][c]) << i;
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(after.average[c], before.average[c]);
+  EXPECT_EQ(info.textures, 1u);
+
+  CameraDesc desc;
+  desc.eye = {0.5f, 0.5f, 1.5f};
+  desc.target = {0.5f, 0.5f, 0.0f};
+  desc.fovYDegrees = 50.0f;
+  const Camera camera(desc, 24, 24);
+  const Accel accelBefore(baked.scene), accelAfter(lf.scene);
+  const Image imageBefore = renderLightField(baked, accelBefore, camera, RenderSettings{});
+  const Image imageAfter = renderLightField(lf, accelAfter, camera, RenderSettings{});
+  ASSERT_EQ(imageAfter.pixels.size(), imageBefore.pixels.size());
+  float brightest = 0.0f;
+  for (size_t i = 0; i < imageBefore.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(imageAfter.pixels[i][c], imageBefore.pixels[i][c]) << "pixel " << i;
+      brightest = std::max(brightest, imageBefore.pixels[i][c]);
+    }
+  EXPECT_GT(brightest, 0.0f);  // the comparison is of a lit, textured quad
 }
 
 TEST_F(RenderTest, GlassSphereInTheFurnaceIsInvisible) {

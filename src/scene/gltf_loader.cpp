@@ -62,6 +62,9 @@ struct GltfContext {
   const std::string& path;
   const tinygltf::Model& model;
   Scene& scene;
+  /// Each glTF image's encoded bytes (PNG/JPEG as in its file, data URI or buffer view), kept by
+  /// keepEncodedImage instead of tinygltf's decoding; decoded by us when a material uses it.
+  const std::vector<std::vector<unsigned char>>& encodedImages;
   std::vector<int> textureOfImage;  ///< scene texture index per glTF image (-1 until used)
   int defaultMaterial = -1;
   int unnamedCameras = 0;
@@ -188,39 +191,19 @@ int textureFor(GltfContext& ctx, int textureIndex) {
   if (ctx.textureOfImage[size_t(source)] >= 0) return ctx.textureOfImage[size_t(source)];
   const tinygltf::Image& gltfImage = model.images[size_t(source)];
   const std::string label = gltfImage.uri.empty() ? fmt::format("image {}", source) : gltfImage.uri;
-  if (gltfImage.image.empty() && !gltfImage.uri.empty() && gltfImage.uri.rfind("data:", 0) != 0) {
-    const std::filesystem::path file = std::filesystem::path(ctx.path).parent_path() / gltfImage.uri;
-    if (const std::string problem = inputFileProblem(file); !problem.empty())
-      fail("{}: texture file '{}' {}", ctx.path, file.string(), problem);
-  }
-  if (gltfImage.image.empty() || gltfImage.width <= 0 || gltfImage.height <= 0 || gltfImage.component < 1 ||
-      (gltfImage.bits != 8 && gltfImage.bits != 16))
-    fail("{}: texture image '{}' could not be decoded", ctx.path, label);
-  const size_t bytesPerChannel = size_t(gltfImage.bits / 8);
-  const size_t expected = size_t(gltfImage.width) * size_t(gltfImage.height) * size_t(gltfImage.component) * bytesPerChannel;
-  if (gltfImage.image.size() < expected) fail("{}: texture image '{}' is truncated", ctx.path, label);
-
-  Texture texture;
-  texture.path = label;
-  texture.image = Image(gltfImage.width, gltfImage.height);
-  const float maxValue = gltfImage.bits == 8 ? 255.0f : 65535.0f;
-  for (size_t i = 0; i < size_t(gltfImage.width) * size_t(gltfImage.height); ++i) {
-    Rgb texel;
-    for (int c = 0; c < 3; ++c) {
-      // Grey images repeat their single channel (grey + alpha: component 2).
-      const size_t channel = size_t(gltfImage.component >= 3 ? c : 0);
-      const size_t offset = (i * size_t(gltfImage.component) + channel) * bytesPerChannel;
-      float encoded;
-      if (bytesPerChannel == 1) encoded = float(gltfImage.image[offset]) / maxValue;
-      else {
-        uint16_t v;
-        std::memcpy(&v, &gltfImage.image[offset], 2);
-        encoded = float(v) / maxValue;
-      }
-      texel[c] = srgbToLinear(encoded);  // baseColorTexture is sRGB-encoded (glTF spec 3.9.2)
+  const std::vector<unsigned char>* bytes =
+      size_t(source) < ctx.encodedImages.size() ? &ctx.encodedImages[size_t(source)] : nullptr;
+  if (!bytes || bytes->empty()) {
+    if (!gltfImage.uri.empty() && gltfImage.uri.rfind("data:", 0) != 0) {
+      const std::filesystem::path file = std::filesystem::path(ctx.path).parent_path() / gltfImage.uri;
+      if (const std::string problem = inputFileProblem(file); !problem.empty())
+        fail("{}: texture file '{}' {}", ctx.path, file.string(), problem);
     }
-    texture.image.pixels[i] = texel;
+    fail("{}: texture image '{}' could not be read", ctx.path, label);
   }
+  // baseColorTexture is sRGB-encoded (glTF spec 3.9.2), as decodeLdrImage assumes; grey images
+  // repeat their single channel.
+  Texture texture = textureFromEncoded(label, *bytes, fmt::format("{}: texture image '{}'", ctx.path, label));
   const int ours = int(ctx.scene.textures.size());
   ctx.scene.textures.push_back(std::move(texture));
   ctx.textureOfImage[size_t(source)] = ours;
@@ -447,12 +430,26 @@ void visitNode(GltfContext& ctx, int nodeIndex, const Mat4& parent, int depth) {
   for (int child : node.children) visitNode(ctx, child, world, depth + 1);
 }
 
+/// tinygltf's image loader callback: keeps the bytes (user data: the vector of encoded images)
+/// and leaves decoding to textureFor, so that a texture is decoded once, by decodeLdrImage, the
+/// same decoder the .plf reader uses for the embedded bytes.
+bool keepEncodedImage(tinygltf::Image*, const int imageIndex, std::string*, std::string*, int, int,
+                      const unsigned char* bytes, int size, void* userData) {
+  auto& images = *static_cast<std::vector<std::vector<unsigned char>>*>(userData);
+  if (imageIndex < 0 || size < 0) return false;
+  if (size_t(imageIndex) >= images.size()) images.resize(size_t(imageIndex) + 1);
+  images[size_t(imageIndex)].assign(bytes, bytes + size);
+  return true;
+}
+
 }  // namespace
 
 Scene loadGltf(const std::string& path) {
   requireRegularFile(path);
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
+  std::vector<std::vector<unsigned char>> encodedImages;
+  loader.SetImageLoader(keepEncodedImage, &encodedImages);
   std::string error, warning;
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
@@ -474,7 +471,7 @@ Scene loadGltf(const std::string& path) {
 
   Scene scene;
   scene.sourcePath = path;
-  GltfContext ctx{path, model, scene, std::vector<int>(model.images.size(), -1)};
+  GltfContext ctx{path, model, scene, encodedImages, std::vector<int>(model.images.size(), -1)};
   for (size_t m = 0; m < model.materials.size(); ++m)
     scene.materials.push_back(convertMaterial(ctx, model.materials[m], int(m)));
 

@@ -143,10 +143,7 @@ int loadTexture(const JsonContext& ctx, Scene& scene, const json& value, const s
   const fs::path file = ctx.dir / stringOf(ctx, value, where);
   if (const std::string problem = inputFileProblem(file); !problem.empty())
     fail("{}: {}: texture file '{}' {}", ctx.path, where, file.string(), problem);
-  Texture texture;
-  texture.path = file.string();
-  texture.image = readImage(texture.path);
-  scene.textures.push_back(std::move(texture));
+  scene.textures.push_back(loadTextureFile(file.string()));
   return int(scene.textures.size()) - 1;
 }
 

@@ -222,10 +222,7 @@ Material convertMaterial(const tinyobj::material_t& mtl, const std::string& mtlP
         fail("{}: material '{}': texture file '{}' {}", mtlPath, mtl.name, key, problem);
       auto [it, inserted] = textureIndex.try_emplace(key, int(scene.textures.size()));
       if (inserted) {
-        Texture texture;
-        texture.path = key;
-        texture.image = readImage(key);
-        scene.textures.push_back(std::move(texture));
+        scene.textures.push_back(loadTextureFile(key));
       }
       material.albedoTexture = it->second;
       if (isBlack(kd)) kd = Rgb(1.0f);

@@ -139,6 +139,36 @@ Rgb Texture::sample(Vec2 uv) const {
   return (1.0f - fy) * top + fy * bottom;
 }
 
+void Texture::finish(const std::string& sceneSource) {
+  if (image.empty() || image.width <= 0 || image.height <= 0 ||
+      image.pixels.size() != size_t(image.width) * size_t(image.height))
+    fail("{}: texture '{}' is empty", sceneSource, path);
+  Rgb sum(0.0f);
+  for (const Rgb& texel : image.pixels) {
+    if (!isFinite(texel)) fail("{}: texture '{}' contains a non-finite texel", sceneSource, path);
+    sum += texel;
+  }
+  average = sum / float(image.pixels.size());
+}
+
+Texture loadTextureFile(const std::string& path) {
+  ImageFile file = readImageFile(path);
+  Texture texture;
+  texture.path = path;
+  texture.image = std::move(file.image);
+  if (!file.ldrBytes.empty())
+    texture.encoded = std::make_shared<const std::vector<unsigned char>>(std::move(file.ldrBytes));
+  return texture;
+}
+
+Texture textureFromEncoded(std::string path, std::vector<unsigned char> bytes, const std::string& label) {
+  Texture texture;
+  texture.path = std::move(path);
+  texture.image = decodeLdrImage(bytes, label);
+  texture.encoded = std::make_shared<const std::vector<unsigned char>>(std::move(bytes));
+  return texture;
+}
+
 void Scene::finalize() {
   const std::string& src = sourcePath;
   if (materials.empty()) fail("{}: the scene has no materials", src);
@@ -161,16 +191,7 @@ void Scene::finalize() {
       fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name,
            material.albedoTexture, textures.size());
   }
-  for (Texture& texture : textures) {
-    if (texture.image.empty() || texture.image.width <= 0 || texture.image.height <= 0)
-      fail("{}: texture '{}' is empty", src, texture.path);
-    Rgb sum(0.0f);
-    for (const Rgb& texel : texture.image.pixels) {
-      if (!isFinite(texel)) fail("{}: texture '{}' contains a non-finite texel", src, texture.path);
-      sum += texel;
-    }
-    texture.average = sum / float(texture.image.pixels.size());
-  }
+  for (Texture& texture : textures) texture.finish(src);
 
   size_t totalBefore = 0, dropped = 0;
   for (Mesh& mesh : meshes) {

@@ -21,7 +21,16 @@ namespace pl {
 struct Texture {
   std::string path;
   Image image;
+  /// The image file's own bytes (PNG/JPEG/TGA/BMP as found on disk or in a glTF buffer), from
+  /// which `image` was decoded by decodeLdrImage; null for textures read from HDR files, which
+  /// exist only decoded. A .plf embeds these bytes instead of the float pixels (8–40× smaller)
+  /// and decodes them on load. Shared, so that copying a Scene does not copy them.
+  std::shared_ptr<const std::vector<unsigned char>> encoded;
   Rgb average{0.0f};  ///< mean over all texels (used where one albedo per region is needed)
+
+  /// Checks the pixels (present, finite) and computes `average`; throws pl::Error naming
+  /// `sceneSource` and the texture. Scene::finalize and the .plf reader call it.
+  void finish(const std::string& sceneSource);
 
   /// Bilinear, repeat. A non-finite uv (only possible from a NaN hit, since loaders reject
   /// non-finite uvs) returns `average` rather than spreading the NaN into the albedo; the
@@ -178,6 +187,14 @@ struct Scene {
 
 /// Every non-degenerate triangle of an emissive material, mesh by mesh in triangle order.
 std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene);
+
+/// A texture read from an image file (any format readImage reads), keeping the bytes of
+/// 8-bit formats in `encoded`. Scene loaders call it; errors name the file.
+Texture loadTextureFile(const std::string& path);
+
+/// A texture decoded from an 8-bit image file's bytes (a glTF buffer, a .plf's scene section):
+/// path is what the texture is called, label prefixes decoding errors.
+Texture textureFromEncoded(std::string path, std::vector<unsigned char> bytes, const std::string& label);
 
 /// Loads `cornell`, .obj, .gltf/.glb or .json (see README for the JSON schema).
 /// Throws pl::Error with the file name and the problem for any malformed input.
