@@ -483,10 +483,31 @@ Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& s
     charts.reserve(chartCount);
     std::vector<uint32_t> meshBase(scene.meshes.size() + 1, 0);  // index in `tris` of each mesh's triangle 0
     for (size_t m = 0; m < scene.meshes.size(); ++m) meshBase[m + 1] = meshBase[m] + uint32_t(scene.meshes[m].triangles.size());
+    // A back side that nothing can light or see is not stored: when the environment is black,
+    // no punctual light shines on the back and the whole scene (its bounding box) lies on or in
+    // front of the chart's plane, the back's radiance is exactly 0 — what a one-sided chart
+    // shows from behind. (The walls of an open box, a floor, a ground plane under a black sky.)
+    const float behindTolerance = 1e-4f * diagonal;
+    auto somethingBehind = [&](const Chart& c) {
+      if (!scene.environment.isBlack()) return true;
+      const float d0 = glm::dot(c.normal, c.origin);
+      for (int k = 0; k < 8; ++k) {
+        const Vec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+        if (glm::dot(c.normal, corner) - d0 < -behindTolerance) return true;
+      }
+      for (const Light& light : scene.lights) {
+        const PunctualLight l = PunctualLight::from(light);
+        if (l.kind == PunctualLight::Kind::Directional ? glm::dot(l.direction, c.normal) > 0.0f
+                                                        : glm::dot(c.normal, l.position) - d0 < 0.0f)
+          return true;
+      }
+      return false;
+    };
     for (uint32_t ci = 0; ci < chartCount; ++ci) {
       const auto& [m, t] = p.chartTriangles[ci][0];  // a chart's triangles are connected: one surface
       Chart front = p.charts[ci];
-      const bool twoSided = front.kind != ChartKind::Specular && openComponent[root(meshBase[m] + t)] != 0;
+      const bool twoSided =
+          front.kind != ChartKind::Specular && openComponent[root(meshBase[m] + t)] != 0 && somethingBehind(front);
       front.sides = twoSided ? 2 : 1;
       charts.push_back(front);
       chartTriangles.push_back(p.chartTriangles[ci]);
