@@ -89,7 +89,14 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
     json["residual"] = s.residual;
     json["tixels"] = s.tixels;
     json["values"] = s.values;
-    json["charts"] = lf.charts.size();
+    json["charts"] = lf.charts.size();  // chart records: a two-sided chart counts twice (front and back)
+    uint64_t twoSided = 0, backTixels = 0;
+    for (const Chart& c : lf.charts) {
+      twoSided += c.isBack ? 1 : 0;
+      backTixels += c.isBack ? c.tixelCount() : 0;
+    }
+    json["two_sided_charts"] = twoSided;
+    json["back_side_tixels"] = backTixels;
     json["visibility_rays"] = s.visibilityRays;
     json["visibility_rays_per_second"] = s.visibilitySeconds > 0 ? double(s.visibilityRays) / s.visibilitySeconds : 0.0;
     json["reused_visibility"] = s.reusedVisibility;

@@ -41,7 +41,9 @@ TEST_F(BakeCli, BakesWritesStatsAndReusesVisibility) {
   EXPECT_FALSE(json["reused_visibility"].get<bool>());
 
   const LightField lf = readLightField(plf);
-  EXPECT_EQ(lf.charts.size(), 16u);
+  // 16 charts, 12 of them two-sided (see Parameterisation.CornellBoxCharts): 28 records.
+  EXPECT_EQ(lf.charts.size(), 28u);
+  EXPECT_EQ(json["two_sided_charts"].get<uint64_t>(), 12u);
   EXPECT_EQ(lf.stats.tixels, json["tixels"].get<uint64_t>());
 
   // Same scene and settings: the saved field is reused (and said so on stderr).

@@ -188,18 +188,22 @@ TEST_F(BakeTest, QuadUnderUniformSkyReflectsLeTimesAlbedo) {
     settings.gatherDirections = 256;
     settings.glossyDirRes = 16;
     const LightField lf = bake(scene, settings);
-    ASSERT_EQ(lf.charts.size(), 1u);
-    const Chart& c = lf.charts[0];
-    EXPECT_EQ(c.kind, glossyCase ? ChartKind::Glossy : ChartKind::Diffuse);
-    for (float thetaDeg : {10.0f, 25.0f, 40.0f}) {
-      const float th = thetaDeg * kPi / 180.0f;
-      const Vec3 local(std::sin(th) * 0.6f, std::sin(th) * 0.8f, std::cos(th));
-      const Vec3 w = chartWorldDirection(c, local);
-      const Rgb got = exitantRadiance(lf, 0, Vec3(0.5f, 0.5f, 0.0f), w, Vec2(0.5f));
-      const Rgb expected = glossyCase ? sky * albedo(bp, local) : sky * lambert.albedo;
-      for (int ch = 0; ch < 3; ++ch)
-        EXPECT_NEAR(got[ch], expected[ch], (glossyCase ? 0.02f : 1e-4f) * expected[ch])
-            << (glossyCase ? "glossy" : "lambert") << " θ=" << thetaDeg << " channel " << ch;
+    // An open quad under a sky: two-sided, and its back sees the same sky as its front.
+    ASSERT_EQ(lf.charts.size(), 2u);
+    ASSERT_TRUE(lf.charts[1].isBack);
+    for (uint32_t record = 0; record < 2; ++record) {
+      const Chart& c = lf.charts[record];
+      EXPECT_EQ(c.kind, glossyCase ? ChartKind::Glossy : ChartKind::Diffuse);
+      for (float thetaDeg : {10.0f, 25.0f, 40.0f}) {
+        const float th = thetaDeg * kPi / 180.0f;
+        const Vec3 local(std::sin(th) * 0.6f, std::sin(th) * 0.8f, std::cos(th));
+        const Vec3 w = chartWorldDirection(c, local);
+        const Rgb got = exitantRadiance(lf, 0, Vec3(0.5f, 0.5f, 0.0f), w, Vec2(0.5f));  // facingChart picks the side
+        const Rgb expected = glossyCase ? sky * albedo(bp, local) : sky * lambert.albedo;
+        for (int ch = 0; ch < 3; ++ch)
+          EXPECT_NEAR(got[ch], expected[ch], (glossyCase ? 0.02f : 1e-4f) * expected[ch])
+              << (glossyCase ? "glossy" : "lambert") << " side " << record << " θ=" << thetaDeg << " channel " << ch;
+      }
     }
   }
 }
@@ -234,10 +238,12 @@ TEST_F(BakeTest, EnvironmentMapIsLookedUpInTheLeavingDirection) {
     settings.tixelsAcrossScene = 2;
     settings.gatherDirections = 256;
     const LightField lf = bake(scene, settings);
-    ASSERT_EQ(lf.charts.size(), 1u);
+    ASSERT_EQ(lf.charts.size(), 2u);  // open: its back sees the other half of the sky
     ASSERT_NEAR(lf.charts[0].normal.y, facing, 1e-6f);
     const Rgb L = exitantRadiance(lf, 0, Vec3(0.5f, 0.0f, 0.5f), lf.charts[0].normal, Vec2(0.5f));
     EXPECT_NEAR(L.g, facing > 0.0f ? 0.5f * c : 0.0f, 0.02f * 0.5f * c) << "facing " << facing;
+    const Rgb back = exitantRadiance(lf, 0, Vec3(0.5f, 0.0f, 0.5f), -lf.charts[0].normal, Vec2(0.5f));
+    EXPECT_NEAR(back.g, facing > 0.0f ? 0.0f : 0.5f * c, 0.02f * 0.5f * c) << "back of facing " << facing;
   }
 }
 

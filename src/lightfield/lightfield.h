@@ -22,6 +22,19 @@
 //   Glossy    dirRes² values per tixel: exitant radiance Lo (W·sr⁻¹·m⁻², emission included).
 //   Specular  nothing: an ideal mirror's radiance is that of whatever the mirrored
 //             direction sees (a reordering), followed at render time.
+//
+// Sides (the light field's part of the sidedness rule; scatteringFrame in scene.h is the
+// path tracer's, emittedRadiance there the emitters'). A reflecting surface scatters on both
+// sides (scene.h), so a surface that can be seen and lit from behind stores its back side too:
+// a chart with sides = 2 is followed in `charts` by a second record, its back side, with
+// isBack set, the same material, kind, origin, axes, grid and dirRes and the normal negated
+// (a left-handed frame: axisU × axisV = −normal; nothing relies on handedness). The back record
+// has tixels and values of its own (stored like any chart's at its firstTixel / firstValue),
+// gathers over the back hemisphere and is what a ray arriving from behind sees (facingChart).
+// triangleChart maps triangles to the front record. Which charts get a back side is decided
+// by the parameterisation (parameterisation.h: charts on open surfaces); a chart with sides = 1
+// (the outside of a closed mesh, mirrors, glass) reflects nothing towards its back: a ray from
+// behind sees only two-sided emission.
 #include "core/math.h"
 #include "scene/scene.h"
 
@@ -43,6 +56,8 @@ struct Chart {
   uint32_t dirRes = 1;          ///< paraboloid map resolution (1 for diffuse, 0 for specular)
   uint64_t firstTixel = 0;      ///< index of tixel (0, 0) among all tixels of the light field
   uint64_t firstValue = 0;      ///< index of tixel (0, 0), direction texel (0, 0) in values
+  uint8_t sides = 1;            ///< 2: a two-sided surface (both records have 2), see "Sides" above
+  bool isBack = false;          ///< the back-side record of a two-sided surface (follows its front)
 
   uint64_t tixelCount() const { return uint64_t(resU) * resV; }
   uint64_t valuesPerTixel() const { return uint64_t(dirRes) * dirRes; }
@@ -89,6 +104,25 @@ struct LightField {
   BakeSettings settings;
   BakeStats stats;
 };
+
+/// The chart record holding the side of record `chart` (as triangleChart gives it) that
+/// a viewer in world direction towardsViewer (from the surface; −ray direction) sees: its back
+/// record chart + 1 when the surface is two-sided and the viewer is behind the chart normal,
+/// otherwise `chart` itself. The one place the bake's gather rays and both renderers choose a
+/// side. (The chart normal, not the hit triangle's, decides: a chart's triangles are coplanar
+/// within kChartNormalToleranceDegrees.)
+inline uint32_t facingChart(const Chart* charts, uint32_t chart, const Vec3& towardsViewer) {
+  const Chart& c = charts[chart];
+  return c.sides == 2 && !c.isBack && glm::dot(towardsViewer, c.normal) < 0.0f ? chart + 1 : chart;
+}
+
+/// Emitted radiance of chart record c's material towards a direction with cosine cosTheta
+/// against the record's own normal: emittedRadiance (scene.h) with the cosine turned back to
+/// the surface's geometric front for a back record, so a one-sided emitter's back record
+/// emits nothing and a two-sided one's emits on both.
+inline Rgb chartEmittedRadiance(const Material& m, const Chart& c, float cosTheta) {
+  return emittedRadiance(m, c.isBack ? -cosTheta : cosTheta);
+}
 
 /// Paraboloid map of the upper hemisphere (local frame, z = normal), see above.
 Vec2 directionToParaboloid(const Vec3& localDirection);

@@ -73,8 +73,10 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
 ChartShading chartShading(const Scene& scene, const Chart& c) {
   const Material& material = scene.materials[c.material];
   ChartShading shading;
-  shading.emission = lanes4(material.emission);
-  shading.emissive = !isBlack(material.emission);
+  // Emission towards the record's own front (a back record's is zero for one-sided emitters).
+  const Rgb emission = chartEmittedRadiance(material, c, 1.0f);
+  shading.emission = lanes4(emission);
+  shading.emissive = !isBlack(emission);
   shading.inverseTixelSize = 1.0f / c.tixelSize;
   shading.twoSidedEmission = material.twoSidedEmission;
   shading.texturedAlbedo = material.albedoTexture >= 0;
@@ -86,6 +88,7 @@ ChartShading chartShading(const Scene& scene, const Chart& c) {
 
 Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosition,
                     const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
+  chart = facingChart(lf.charts.data(), chart, worldDirectionTowardsViewer);
   const Chart& c = lf.charts[chart];
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   return exitantRadiance(lf.scene, c, chartShading(lf.scene, c), lf.values.data(), worldPosition,
@@ -93,7 +96,7 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
 }
 
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer) {
-  const uint32_t chart = lf.triangleChart[hit.mesh][hit.triangle];
+  const uint32_t chart = facingChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], worldDirectionTowardsViewer);
   return exitantRadiance(lf, chart, hit.position, worldDirectionTowardsViewer, hit.uv);
 }
 

@@ -117,12 +117,6 @@ inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 
 /// (if any) sampled at full resolution, exactly as the path tracer's bsdfAt does.
 Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv);
 
-/// Emitted radiance of `material` towards local direction cosθ (chart frame, z = front side):
-/// one-sided along the geometric normal unless the material is two-sided.
-inline Rgb emittedRadiance(const Material& m, float cosTheta) {
-  return (cosTheta > 0.0f || m.twoSidedEmission) ? m.emission : Rgb(0.0f);
-}
-
 /// One step of an ideal-specular chain at `hit` (a specular chart: a mirror or glass) of
 /// `ray`, the step every light-field stage takes — gather rays in the visibility field, view
 /// rays in the reference and the fast renderer. `emitted` gets the surface's own emission
@@ -181,12 +175,14 @@ ChartShading chartShading(const Scene& scene, const Chart& c);
 ///   glossy chart:   the 16-neighbour interpolation of the stored exitant radiance;
 ///   specular chart: 0 — the caller follows the mirrored ray (reordering) and looks up what it
 ///                   sees.
-/// A viewer behind the chart (one-sided parameterisation) sees the front-side reflected
-/// radiance; emission there follows emittedRadiance.
+/// `chart` may be any record; a viewer behind a front record is turned to its back record
+/// (facingChart). Behind a one-sided chart (the inside of a closed mesh) nothing is reflected:
+/// the viewer sees only emission, if the material emits on both sides — the rule the bake's
+/// gather rays follow (lightfield.h "Sides").
 Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosition,
                     const Vec3& worldDirectionTowardsViewer, Vec2 uv);
 
-/// The same for a ray hit (chart from lf.triangleChart, uv from the hit).
+/// The same for a ray hit (chart from lf.triangleChart and facingChart, uv from the hit).
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer);
 
 /// exitantRadiance given the chart's precomputed shading and the values read through `load`
@@ -200,8 +196,11 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
   const Vec2 grid = tixelGridCoordinates(c, worldPosition, shading.inverseTixelSize);
   // cos θ towards the viewer (chartLocalDirection's z; a diffuse lookup needs no more of it).
   const float cosTheta = glm::dot(worldDirectionTowardsViewer, c.normal);
-  // emittedRadiance (above) on the precomputed emission.
+  // chartEmittedRadiance (lightfield.h) on the precomputed emission of this record.
   const bool emits = cosTheta > 0.0f || shading.twoSidedEmission;
+  // Behind a one-sided record: no reflected light (the caller turned two-sided ones with
+  // facingChart), only two-sided emission.
+  if (!(cosTheta >= 0.0f)) return shading.emissive && emits ? f4Load(shading.emission.v) : f4Zero();
   if (c.kind == ChartKind::Diffuse) {
     // Le + (albedo/π) · E, lane by lane.
     const F4 irradiance = interpolateLanes(load, c, grid, Vec2(0.0f));
@@ -210,14 +209,9 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
     const F4 reflected = f4Mul(albedoOverPi, irradiance);
     return shading.emissive && emits ? f4Add(f4Load(shading.emission.v), reflected) : reflected;
   }
-  // Glossy: the stored values already include emission towards the front side.
+  // Glossy: the stored values already include the record's emission.
   const Vec3 local = chartLocalDirection(c, worldDirectionTowardsViewer);
-  const F4 stored = interpolateLanes(load, c, grid, directionToParaboloid(local));
-  if (cosTheta >= 0.0f) return stored;
-  // Behind a one-sided chart: its front-side value at the horizon, minus the one-sided
-  // emission it contains, plus the back-side emission (nonzero only for two-sided emitters).
-  const F4 emission = f4Load(shading.emission.v);
-  return f4Add(f4Max(f4Sub(stored, emission), f4Zero()), emits ? emission : f4Zero());
+  return interpolateLanes(load, c, grid, directionToParaboloid(local));
 }
 template <typename Load>
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
@@ -279,6 +273,7 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   };
   const Taps u = taps(gridU, c.resU), v = taps(gridV, c.resV);
   const int frontSide = _mm_movemask_ps(_mm_cmpgt_ps(cosTheta, zero));  // bit k: cos θ_k > 0
+  const int reflectingSide = _mm_movemask_ps(_mm_cmpge_ps(cosTheta, zero));  // bit k: cos θ_k ≥ 0
   const F4 albedoOverPi = f4Load(shading.albedoOverPi.v), emission = f4Load(shading.emission.v);
   for (int k = 0; k < 4; ++k) {
     // interpolateLanes' diffuse branch and exitantRadianceLanes' diffuse return, for lookup k.
@@ -288,8 +283,12 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
     const F4 upper = f4Add(f4Mul(f4Splat(u.w0[k] * v.w1[k]), f4Load(values[row1 + u.i0[k]].v)),
                            f4Mul(f4Splat(u.w1[k] * v.w1[k]), f4Load(values[row1 + u.i1[k]].v)));
     const F4 reflected = f4Mul(albedoOverPi, f4Add(lower, upper));
-    const bool emits = ((frontSide >> k) & 1) != 0 || shading.twoSidedEmission;
-    result[k] = shading.emissive && emits ? f4Add(emission, reflected) : reflected;
+    const bool front = ((frontSide >> k) & 1) != 0;
+    // As exitantRadianceLanes: cos θ = 0 reflects but emits only if two-sided; NaN neither.
+    const bool reflects = ((reflectingSide >> k) & 1) != 0;
+    const bool emits = front || shading.twoSidedEmission;
+    const F4 seen = reflects ? reflected : f4Zero();
+    result[k] = shading.emissive && emits ? f4Add(emission, seen) : seen;
   }
 #else
   for (int k = 0; k < 4; ++k) {

@@ -352,6 +352,45 @@ Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& s
     }
   }
 
+  // Open surfaces (lightfield.h "Sides"): the triangles of a connected surface (welded edges,
+  // any material) are a closed, consistently wound surface when every edge is shared by exactly
+  // two triangles that run along it in opposite directions. Anything else — a boundary edge (a
+  // sheet, a banner, a wall modelled as one quad), a non-manifold edge, or a neighbour wound the
+  // other way — makes the whole connected surface open, and its charts two-sided.
+  std::vector<uint32_t> component(tris.size());
+  for (uint32_t g = 0; g < tris.size(); ++g) component[g] = g;
+  auto root = [&](uint32_t g) {
+    while (component[g] != g) g = component[g] = component[component[g]];
+    return g;
+  };
+  for (size_t k = 0; k < edges.size();) {
+    size_t e = k;
+    while (e < edges.size() && edges[e].first == edges[k].first) ++e;
+    for (size_t q = k + 1; q < e; ++q) {
+      const uint32_t a = root(edges[k].second), b = root(edges[q].second);
+      if (a != b) component[std::max(a, b)] = std::min(a, b);
+    }
+    k = e;
+  }
+  // Direction of triangle g along the edge with key `key`: true when it runs from the smaller
+  // welded id to the larger.
+  auto runsUp = [&](uint32_t g, uint64_t key) {
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = tris[g].welded[e], b = tris[g].welded[(e + 1) % 3];
+      if (((uint64_t(std::min(a, b)) << 32) | std::max(a, b)) == key) return a < b;
+    }
+    return false;
+  };
+  std::vector<uint8_t> openComponent(tris.size(), 0);
+  for (size_t k = 0; k < edges.size();) {
+    size_t e = k;
+    while (e < edges.size() && edges[e].first == edges[k].first) ++e;
+    const bool closedEdge = e - k == 2 && runsUp(edges[k].second, edges[k].first) != runsUp(edges[k + 1].second, edges[k].first);
+    if (!closedEdge)
+      for (size_t q = k; q < e; ++q) openComponent[root(edges[q].second)] = 1;
+    k = e;
+  }
+
   // Frames and grids.
   const float baseSize = baseTixelSize(scene, settings);
   const uint32_t cap = std::max<uint32_t>(1, settings.maxTixelsPerChartSide);
@@ -435,21 +474,73 @@ Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& s
     c.origin = ref + (bestLo.x - padU) * c.axisU + (bestLo.y - padV) * c.axisV;
   });
 
-  for (uint32_t ci = 0; ci < chartCount; ++ci) {
+  // Two-sided charts: the back record right after the front one (lightfield.h "Sides").
+  // Specular charts store nothing and stay one-sided (followSpecular turns a mirror's frame).
+  {
+    std::vector<Chart> charts;
+    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> chartTriangles;
+    std::vector<double> chartArea;
+    charts.reserve(chartCount);
+    std::vector<uint32_t> meshBase(scene.meshes.size() + 1, 0);  // index in `tris` of each mesh's triangle 0
+    for (size_t m = 0; m < scene.meshes.size(); ++m) meshBase[m + 1] = meshBase[m] + uint32_t(scene.meshes[m].triangles.size());
+    // A back side that nothing can light or see is not stored: when the environment is black,
+    // no punctual light shines on the back and the whole scene (its bounding box) lies on or in
+    // front of the chart's plane, the back's radiance is exactly 0 — what a one-sided chart
+    // shows from behind. (The walls of an open box, a floor, a ground plane under a black sky.)
+    const float behindTolerance = 1e-4f * diagonal;
+    auto somethingBehind = [&](const Chart& c) {
+      if (!scene.environment.isBlack()) return true;
+      const float d0 = glm::dot(c.normal, c.origin);
+      for (int k = 0; k < 8; ++k) {
+        const Vec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+        if (glm::dot(c.normal, corner) - d0 < -behindTolerance) return true;
+      }
+      for (const Light& light : scene.lights) {
+        const PunctualLight l = PunctualLight::from(light);
+        if (l.kind == PunctualLight::Kind::Directional ? glm::dot(l.direction, c.normal) > 0.0f
+                                                        : glm::dot(c.normal, l.position) - d0 < 0.0f)
+          return true;
+      }
+      return false;
+    };
+    for (uint32_t ci = 0; ci < chartCount; ++ci) {
+      const auto& [m, t] = p.chartTriangles[ci][0];  // a chart's triangles are connected: one surface
+      Chart front = p.charts[ci];
+      const bool twoSided =
+          front.kind != ChartKind::Specular && openComponent[root(meshBase[m] + t)] != 0 && somethingBehind(front);
+      front.sides = twoSided ? 2 : 1;
+      charts.push_back(front);
+      chartTriangles.push_back(p.chartTriangles[ci]);
+      chartArea.push_back(p.chartArea[ci]);
+      if (!twoSided) continue;
+      Chart back = front;
+      back.isBack = true;
+      back.normal = -front.normal;
+      charts.push_back(back);
+      chartTriangles.push_back(p.chartTriangles[ci]);
+      chartArea.push_back(p.chartArea[ci]);
+    }
+    p.charts = std::move(charts);
+    p.chartTriangles = std::move(chartTriangles);
+    p.chartArea = std::move(chartArea);
+  }
+  const size_t recordCount = p.charts.size();
+  for (uint32_t ci = 0; ci < recordCount; ++ci) {
     Chart& c = p.charts[ci];
     c.firstTixel = p.tixelCount;
     c.firstValue = p.valueCount;
     p.tixelCount += c.tixelCount();
     p.valueCount += c.tixelCount() * c.valuesPerTixel();
-    for (const auto& [m, t] : p.chartTriangles[ci]) p.triangleChart[m][t] = ci;
+    if (!c.isBack)
+      for (const auto& [m, t] : p.chartTriangles[ci]) p.triangleChart[m][t] = ci;
   }
   p.tixelChart.resize(p.tixelCount);
   p.gatherPoint.resize(p.tixelCount);
   p.coverage.resize(p.tixelCount);
   p.transportAlbedo.resize(p.tixelCount);
-  for (uint32_t ci = 0; ci < chartCount; ++ci)
+  for (uint32_t ci = 0; ci < recordCount; ++ci)
     std::fill_n(p.tixelChart.begin() + int64_t(p.charts[ci].firstTixel), p.charts[ci].tixelCount(), ci);
-  parallelFor(chartCount, [&](uint64_t ci) { fillChartTixels(scene, p.charts[ci], p.chartTriangles[ci], p); });
+  parallelFor(recordCount, [&](uint64_t ci) { fillChartTixels(scene, p.charts[ci], p.chartTriangles[ci], p); });
   return p;
 }
 

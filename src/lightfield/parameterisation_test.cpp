@@ -25,13 +25,23 @@ TEST(Parameterisation, CornellBoxCharts) {
   settings.tixelsAcrossScene = 32;
   const Parameterisation p = buildParameterisation(scene, settings);
   // 5 room quads + the light + 2 blocks × 5 faces: every quad is one planar chart (the
-  // measured walls are non-planar by at most 3.2 mm, within the 0.5 % plane tolerance).
-  EXPECT_EQ(p.charts.size(), 16u);
+  // measured walls are non-planar by at most 3.2 mm, within the 0.5 % plane tolerance). All
+  // are open surfaces; the room's backs face nothing (black sky), but the light's back (the
+  // ceiling) and the blocks' insides (the room behind their planes) get back records: 16 + 12.
+  size_t backs = 0;
+  for (const Chart& c : p.charts) backs += c.isBack ? 1 : 0;
+  EXPECT_EQ(p.charts.size() - backs, 16u);
+  EXPECT_EQ(backs, 12u);
 
-  // Every triangle is in exactly one chart, and triangleChart agrees with chartTriangles.
+  // Every triangle is in exactly one front chart (and its back record), and triangleChart
+  // agrees with chartTriangles.
   std::set<std::pair<uint32_t, uint32_t>> seen;
   double chartAreaSum = 0.0, sceneArea = 0.0;
   for (uint32_t c = 0; c < p.charts.size(); ++c) {
+    if (p.charts[c].isBack) {
+      EXPECT_EQ(p.chartTriangles[c], p.chartTriangles[c - 1]);
+      continue;
+    }
     for (const auto& mt : p.chartTriangles[c]) {
       EXPECT_TRUE(seen.insert(mt).second) << "triangle in two charts";
       EXPECT_EQ(p.triangleChart[mt.first][mt.second], c);
@@ -46,15 +56,17 @@ TEST(Parameterisation, CornellBoxCharts) {
 
   for (uint32_t c = 0; c < p.charts.size(); ++c) {
     const Chart& chart = p.charts[c];
-    // Orthonormal, right-handed frames; the normal is the triangles' winding normal. 1e-5: float
-    // rounding of unit vectors (a few ulps of 1).
+    // Orthonormal, right-handed frames (left-handed for back records: the normal negated); the
+    // normal is the triangles' winding normal (negated for back records). 1e-5: float rounding
+    // of unit vectors (a few ulps of 1).
+    const float side = chart.isBack ? -1.0f : 1.0f;
     EXPECT_NEAR(glm::dot(chart.axisU, chart.axisV), 0.0f, 1e-5f);
-    EXPECT_NEAR(glm::length(glm::cross(chart.axisU, chart.axisV) - chart.normal), 0.0f, 1e-5f);
+    EXPECT_NEAR(glm::length(side * glm::cross(chart.axisU, chart.axisV) - chart.normal), 0.0f, 1e-5f);
     const auto [m, t] = p.chartTriangles[c][0];
     const Mesh& mesh = scene.meshes[m];
     const Vec3 n = glm::normalize(glm::cross(mesh.positions[mesh.triangles[t][1]] - mesh.positions[mesh.triangles[t][0]],
                                              mesh.positions[mesh.triangles[t][2]] - mesh.positions[mesh.triangles[t][0]]));
-    EXPECT_GT(glm::dot(n, chart.normal), 0.999f);
+    EXPECT_GT(side * glm::dot(n, chart.normal), 0.999f);
     EXPECT_EQ(chart.kind, ChartKind::Diffuse);
     EXPECT_EQ(chart.dirRes, 1u);
     // The grid covers the chart: every vertex maps inside [−½, res − ½] in grid coordinates

@@ -560,13 +560,17 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
 // --- Charts ------------------------------------------------------------------------------
 
 constexpr uint64_t kChartRecordBytes = 4 + 1 + 4 * 12 + 4 + 3 * 4 + 2 * 8;
+// The kind byte: ChartKind in bits 0–5, and the sides (lightfield.h "Sides"): bit 7 = two-sided
+// (on both records), bit 6 = the back record. Files written before two-sided charts have both
+// bits clear, so they read as one-sided charts, which is what they hold.
+constexpr uint8_t kChartTwoSidedBit = 0x80, kChartBackBit = 0x40, kChartKindMask = 0x3f;
 
 std::vector<unsigned char> encodeCharts(const std::vector<Chart>& charts) {
   ByteWriter w;
   w.put(uint64_t(charts.size()));
   for (const Chart& c : charts) {
     w.put(c.material);
-    w.put(uint8_t(c.kind));
+    w.put(uint8_t(uint8_t(c.kind) | (c.sides == 2 ? kChartTwoSidedBit : 0) | (c.isBack ? kChartBackBit : 0)));
     w.put(c.origin);
     w.put(c.axisU);
     w.put(c.axisV);
@@ -588,9 +592,12 @@ std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std:
   for (size_t i = 0; i < charts.size(); ++i) {
     Chart& c = charts[i];
     c.material = r.get<uint32_t>();
-    const uint8_t kind = r.get<uint8_t>();
+    const uint8_t kindByte = r.get<uint8_t>();
+    const uint8_t kind = kindByte & kChartKindMask;
     if (kind > uint8_t(ChartKind::Specular)) r.corrupt(fmt::format("chart {} has unknown kind {}", i, kind));
     c.kind = ChartKind(kind);
+    c.sides = (kindByte & kChartTwoSidedBit) ? 2 : 1;
+    c.isBack = (kindByte & kChartBackBit) != 0;
     c.origin = r.get<Vec3>();
     c.axisU = r.get<Vec3>();
     c.axisV = r.get<Vec3>();
@@ -610,7 +617,18 @@ std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std:
                             : c.kind == ChartKind::Specular ? c.dirRes == 0
                                                             : c.dirRes >= 1;
     if (!dirResFits) r.corrupt(fmt::format("chart {} of kind {} has direction resolution {}", i, kind, c.dirRes));
+    // A back record follows its two-sided front record and repeats its material, kind and grid.
+    if (c.isBack) {
+      const Chart* front = i > 0 ? &charts[i - 1] : nullptr;
+      if (c.sides != 2 || !front || front->sides != 2 || front->isBack || front->material != c.material ||
+          front->kind != c.kind || front->resU != c.resU || front->resV != c.resV || front->dirRes != c.dirRes)
+        r.corrupt(fmt::format("chart {} is a back side without a matching two-sided front chart before it", i));
+    } else if (i > 0 && charts[i - 1].sides == 2 && !charts[i - 1].isBack) {
+      r.corrupt(fmt::format("two-sided chart {} is not followed by its back side", i - 1));
+    }
   }
+  if (!charts.empty() && charts.back().sides == 2 && !charts.back().isBack)
+    r.corrupt(fmt::format("two-sided chart {} is not followed by its back side", charts.size() - 1));
   r.expectEnd();
   return charts;
 }
@@ -636,7 +654,7 @@ std::vector<unsigned char> encodeTriangleCharts(const std::vector<std::vector<ui
 }
 
 std::vector<std::vector<uint32_t>> decodeTriangleCharts(std::span<const unsigned char> bytes, const std::string& path,
-                                                        const Scene& scene, size_t charts) {
+                                                        const Scene& scene, const std::vector<Chart>& charts) {
   ByteReader r(bytes, path, kSectionNames[kTriangleCharts]);
   std::vector<std::vector<uint32_t>> triangleChart(r.getCount(8, "meshes"));
   if (triangleChart.size() != scene.meshes.size())
@@ -647,8 +665,9 @@ std::vector<std::vector<uint32_t>> decodeTriangleCharts(std::span<const unsigned
       r.corrupt(fmt::format("mesh {} maps {} triangles, but it has {}", m, triangleChart[m].size(),
                             scene.meshes[m].triangles.size()));
     for (size_t t = 0; t < triangleChart[m].size(); ++t)
-      if (triangleChart[m][t] >= charts)
-        r.corrupt(fmt::format("mesh {} triangle {} maps to chart {} of {}", m, t, triangleChart[m][t], charts));
+      if (triangleChart[m][t] >= charts.size() || charts[triangleChart[m][t]].isBack)
+        r.corrupt(fmt::format("mesh {} triangle {} maps to chart {} of {}{}", m, t, triangleChart[m][t], charts.size(),
+                              triangleChart[m][t] < charts.size() ? " (a back side, not a front chart)" : ""));
   }
   r.expectEnd();
   return triangleChart;
@@ -1032,7 +1051,7 @@ LightField readLightField(const std::string& path) {
   LightField lf;
   lf.scene = decodeScene(reader.read(kScene), path, reader.version());
   lf.charts = decodeCharts(reader.read(kCharts), path, lf.scene.materials.size());
-  lf.triangleChart = decodeTriangleCharts(reader.read(kTriangleCharts), path, lf.scene, lf.charts.size());
+  lf.triangleChart = decodeTriangleCharts(reader.read(kTriangleCharts), path, lf.scene, lf.charts);
   const SectionEntry& values = reader.entry(kValues);
   const uint64_t valueBytes = values.decodedSize;
   if (valueBytes % sizeof(Rgb) != 0)
@@ -1086,6 +1105,7 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
     info.diffuseCharts += c.kind == ChartKind::Diffuse;
     info.glossyCharts += c.kind == ChartKind::Glossy;
     info.specularCharts += c.kind == ChartKind::Specular;
+    info.twoSidedCharts += c.isBack;
     info.tixels += c.tixelCount();
   }
   info.values = reader.entry(kValues).decodedSize / sizeof(Rgb);

@@ -92,7 +92,8 @@ struct PlfInfo {
   uint32_t environmentMapWidth = 0, environmentMapHeight = 0;  ///< lat-long map; 0 = none
   float environmentMapScale = 1.0f, environmentMapRotationDegrees = 0.0f;
   // Charts (decoded from CHRT).
-  uint64_t charts = 0, diffuseCharts = 0, glossyCharts = 0, specularCharts = 0;
+  uint64_t charts = 0, diffuseCharts = 0, glossyCharts = 0, specularCharts = 0;  ///< chart records
+  uint64_t twoSidedCharts = 0;  ///< back records (each two-sided chart has one; lightfield.h "Sides")
   uint64_t tixels = 0, values = 0;
   // Bake settings and statistics (from META).
   BakeSettings settings;

@@ -372,6 +372,8 @@ TEST_F(PlfFileTest, RoundTripPreservesEveryField) {
     EXPECT_EQ(cb.dirRes, ca.dirRes);
     EXPECT_EQ(cb.firstTixel, ca.firstTixel);
     EXPECT_EQ(cb.firstValue, ca.firstValue);
+    EXPECT_EQ(cb.sides, ca.sides);
+    EXPECT_EQ(cb.isBack, ca.isBack);
   }
   EXPECT_EQ(copy.triangleChart, original.triangleChart);
   EXPECT_EQ(copy.values, original.values);  // bit-exact: float32 stored as is
@@ -711,6 +713,70 @@ TEST_F(PlfFileTest, RefusesOutOfRangeIndicesEvenWithValidChecksums) {
     ADD_FAILURE() << "out-of-range chart values accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("chart 2 needs values"), std::string::npos) << e.what();
+  }
+}
+
+// makeTestLightField with its diffuse chart two-sided: the back record (chart 1) follows it,
+// with values of its own after everything else (lightfield.h "Sides").
+LightField makeTwoSidedLightField() {
+  LightField lf = makeTestLightField();
+  Chart front = lf.charts[0];
+  front.sides = 2;
+  Chart back = front;
+  back.isBack = true;
+  back.normal = -front.normal;
+  back.firstTixel = lf.stats.tixels;
+  back.firstValue = lf.values.size();
+  for (uint64_t t = 0; t < back.tixelCount(); ++t) lf.values.push_back(Rgb(0.25f * float(t), 0.5f, 2.0f));
+  lf.charts = {front, back, lf.charts[1], lf.charts[2]};
+  lf.triangleChart = {{0, 0}, {2, 3, 3}};
+  lf.stats.tixels += back.tixelCount();
+  lf.stats.values = lf.values.size();
+  return lf;
+}
+
+TEST_F(PlfFileTest, TwoSidedChartsRoundTripAndBrokenPairsAreRefused) {
+  const LightField original = makeTwoSidedLightField();
+  const std::string path = file("sides.plf");
+  writeLightField(path, original);
+  const LightField copy = readLightField(path);
+  ASSERT_EQ(copy.charts.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(copy.charts[i].sides, original.charts[i].sides) << i;
+    EXPECT_EQ(copy.charts[i].isBack, original.charts[i].isBack) << i;
+    EXPECT_EQ(copy.charts[i].normal, original.charts[i].normal) << i;
+    EXPECT_EQ(copy.charts[i].firstValue, original.charts[i].firstValue) << i;
+  }
+  EXPECT_EQ(copy.values, original.values);
+  EXPECT_EQ(copy.triangleChart, original.triangleChart);
+
+  const auto good = readBytes(path);
+  const auto table = sections(good);
+  const uint64_t chartRecord = 4 + 1 + 48 + 4 + 12 + 16;
+  const uint64_t kindAt = table[1].offset + 8 + 4;  // record 0's kind byte
+  // The back record's "back" bit cleared: a two-sided chart without its back side.
+  auto bad = good;
+  bad[kindAt + chartRecord] &= uint8_t(~0x40);
+  resign(bad);
+  writeBytes(file("noback.plf"), bad);
+  expectRefused(file("noback.plf"), {"corrupt charts section", "two-sided chart 0 is not followed by its back side"});
+  // A back record whose front is one-sided.
+  bad = good;
+  bad[kindAt] &= uint8_t(~0x80);
+  resign(bad);
+  writeBytes(file("nofront.plf"), bad);
+  expectRefused(file("nofront.plf"), {"corrupt charts section", "chart 1 is a back side without a matching"});
+  // A triangle mapped to the back record instead of the front.
+  bad = good;
+  const uint32_t backRecord = 1;
+  std::memcpy(bad.data() + table[2].offset + 16, &backRecord, 4);
+  resign(bad);
+  writeBytes(file("trchback.plf"), bad);
+  try {
+    readLightField(file("trchback.plf"));
+    ADD_FAILURE() << "a triangle mapped to a back record was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("maps to chart 1 of 4 (a back side, not a front chart)"), std::string::npos) << e.what();
   }
 }
 

@@ -439,7 +439,8 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   for (const Chart& c : param.charts) {
     const Material& material = scene.materials[c.material];
     if (!material.isEmissive()) continue;
-    const uint8_t bits = material.twoSidedEmission ? 3 : 1;
+    const uint8_t bits = uint8_t((isBlack(chartEmittedRadiance(material, c, 1.0f)) ? 0 : 1) |
+                                 (isBlack(chartEmittedRadiance(material, c, -1.0f)) ? 0 : 2));
     std::fill_n(tixelEmits.begin() + int64_t(c.firstTixel), c.tixelCount(), bits);
   }
   tixelEmits[tixels] = environment.isBlack() ? 0 : 3;
@@ -477,7 +478,8 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
         } else {
           const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
           const Material& material = scene.materials[seen.material];
-          if (material.isEmissive() && (!e.backSide() || material.twoSidedEmission)) {
+          const Rgb emitted = chartEmittedRadiance(material, seen, e.backSide() ? -1.0f : 1.0f);
+          if (!isBlack(emitted)) {
             float weight = 1.0f;
             if (lightSamples > 0 && !(extra && extra->viaMirror) && areaPdf[seen.material] > 0.0f) {
               // The same power heuristic as the shadow rays, evaluated for this gather ray
@@ -492,7 +494,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
               const float pg = local.z * kInvPi;
               weight = pl > 0.0f ? powerHeuristic(float(n) * pg, float(lightSamples) * pl) : 1.0f;
             }
-            L = material.emission * weight;
+            L = emitted * weight;
           }
         }
         if (extra) L *= extra->throughput;
@@ -652,8 +654,8 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
           if (c.kind == ChartKind::Specular) continue;
           // Entries with an extra record, or that hit a back side.
           auto slowPath = [&](VisibilityEntry e, const VisibilityExtra* extra) {
-            // Back-side hits see the inside of a closed solid (or the unlit back of a one-sided
-            // surface): no reflected light. Emission from behind is in the constant part.
+            // Back-side hits see the inside of a closed solid (a two-sided chart's back is its
+            // own record): no reflected light. Emission from behind is in the constant part.
             if (!extra || e.escaped() || e.backSide()) return Rgb(0.0f);
             const uint32_t base = e.tixel();
             const uint32_t seenChart = param.tixelChart[base];
@@ -717,10 +719,11 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   }
   progress.finish();
 
-  // Glossy values carry their emission (front side) from here on; diffuse ones stay irradiance.
+  // Glossy values carry their emission (towards the record's own side) from here on; diffuse
+  // ones stay irradiance.
   for (const Chart& c : param.charts) {
     if (c.kind != ChartKind::Glossy) continue;
-    const Rgb le = scene.materials[c.material].emission;
+    const Rgb le = chartEmittedRadiance(scene.materials[c.material], c, 1.0f);
     if (isBlack(le)) continue;
     for (uint64_t v = 0; v < c.tixelCount() * c.valuesPerTixel(); ++v) current[c.firstValue + v] += le;
   }

@@ -25,8 +25,9 @@
 //            (precomputed per material by sub-sampling both the output texel and the cell,
 //            and applied as a constant floor plus a sparse lobe, which keeps each row's sum)
 //   mirror   already folded into the visibility field (a reordering of what is seen).
-// Gather rays that hit a chart from behind (the inside of a closed solid, or the unlit back of
-// a one-sided surface) bring no reflected light, only two-sided emission.
+// Gather rays that arrive at a two-sided chart from behind see its back record (facingChart);
+// those that hit a one-sided chart from behind (the inside of a closed solid) bring no
+// reflected light, only two-sided emission (lightfield.h "Sides").
 // It stops when the relative change of the total outgoing power Σ area·(exitant flux density)
 // drops below the tolerance and so does the error this leaves, estimated from the L1 change
 // of the values and its measured rate of convergence (see the .cpp), or at maxIterations.

@@ -197,6 +197,8 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
     h.value(c.resU);
     h.value(c.resV);
     h.value(c.dirRes);
+    h.value(c.sides);
+    h.value(uint8_t(c.isBack));
   }
   h.bytes(param.gatherPoint.data(), param.gatherPoint.size() * sizeof(Vec3));
   h.value(gatherGridSide(settings.gatherDirections));
@@ -285,7 +287,9 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
           }
           continue;
         }
-        const uint32_t chartIndex = param.triangleChart[hit.mesh][hit.triangle];
+        // The side facing the ray (a two-sided chart's back record when it arrives from
+        // behind); `back` is left only for one-sided charts seen from behind.
+        const uint32_t chartIndex = facingChart(param.charts.data(), param.triangleChart[hit.mesh][hit.triangle], -ray.direction);
         const Chart& c = param.charts[chartIndex];
         const Vec3 pos = ray.origin + hit.t * ray.direction;
         const bool back = glm::dot(ray.direction, c.normal) > 0.0f;

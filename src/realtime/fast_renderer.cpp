@@ -143,15 +143,19 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   s.mirrorSlot.clear();
   s.mirrorThroughput.clear();
   Rgb* out = image.pixels.data();
-  auto chartOf = [&](const RayHit& hit) { return triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle]; };
-  // Whether samples i … i+3 all hit one diffuse chart without an albedo texture (→ *chart).
+  // The chart record sample i sees: its triangle's chart, turned to the side facing the camera.
+  auto chartOf = [&](size_t i) {
+    const RayHit& hit = s.hits[i];
+    return facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -s.rays[i].direction);
+  };
+  // Whether samples i … i+3 all hit one diffuse chart record without an albedo texture (→ *chart).
   auto sameDiffuseChart = [&](size_t i, uint32_t* chart) {
     for (size_t k = i; k < i + 4; ++k)
       if (!(s.weight[k] > 0.0f) || !s.hits[k].hit()) return false;
-    *chart = chartOf(s.hits[i]);
+    *chart = chartOf(i);
     if (charts[*chart].kind != ChartKind::Diffuse || shading[*chart].needsUv) return false;
     for (size_t k = i + 1; k < i + 4; ++k)
-      if (chartOf(s.hits[k]) != *chart) return false;
+      if (chartOf(k) != *chart) return false;
     return true;
   };
   RaysSoA4 four;
@@ -178,7 +182,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     } else if (!hit.hit()) {
       radiance = backgroundRadiance(scene.environment, ray.direction);
     } else {
-      chart = chartOf(hit);
+      chart = chartOf(i);
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv(0.0f);
@@ -226,7 +230,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         s.radiance[slot] += throughput * backgroundRadiance(scene.environment, ray.direction);
         continue;
       }
-      const uint32_t chart = triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle];
+      const uint32_t chart = facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -ray.direction);
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv(0.0f);

@@ -51,6 +51,13 @@ struct Material {
   bool isEmissive() const { return !isBlack(emission); }
 };
 
+/// The sidedness rule for emission, written once for the path tracer, the bake and the
+/// renderers: Le towards a direction whose cosine against the geometric (winding) normal is
+/// cosFront, i.e. emission leaves the front side only, unless the material is two-sided.
+inline Rgb emittedRadiance(const Material& m, float cosFront) {
+  return (cosFront > 0.0f || m.twoSidedEmission) ? m.emission : Rgb(0.0f);
+}
+
 /// Triangles sharing vertex arrays. Vertex attributes are per vertex; materials per triangle.
 struct Mesh {
   std::string name;

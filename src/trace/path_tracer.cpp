@@ -202,7 +202,7 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
       if (!isBlack(glass->absorption)) throughput *= glm::exp(-glass->absorption * hit.t);
     }
 
-    if (material.isEmissive() && (cosWoGeometric > 0.0f || material.twoSidedEmission)) {
+    if (!isBlack(emittedRadiance(material, cosWoGeometric))) {  // the emission sidedness rule (scene.h)
       if (countEmissionFully) {
         result += throughput * material.emission;
       } else if (useMis) {
