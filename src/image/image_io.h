@@ -17,7 +17,7 @@ Image readExr(const std::string& path);
 void writeExr(const std::string& path, const Image& image, bool half);
 
 // stb_io.cpp (stb_image / stb_image_write) and the Radiance RGBE format
-Image readLdr(const std::string& path);  ///< PNG/JPEG/TGA/BMP, sRGB-decoded to linear
+Image readLdr(const std::string& path, ImageDecode decode);  ///< PNG/JPEG/TGA/BMP (decodeTexels)
 void writePngFile(const std::string& path, const Image8& image);
 Image readRadianceHdr(const std::string& path);
 void writeRadianceHdr(const std::string& path, const Image& image);
