@@ -12,7 +12,7 @@
 //        f0      = mix(0.04, baseColor, metallic)        (0.04: dielectric F0 of the spec)
 //        alpha   = max(roughness², 1e-3)                 (GGX α; the floor keeps the
 //                                                         microfacet distribution finite)
-//    baseColor = baseColorFactor.rgb (alpha ignored); baseColorTexture → albedo texture
+//    baseColor = baseColorFactor.rgb; baseColorTexture → albedo texture
 //    multiplying `diffuse` (so it tints dielectrics; a metal's f0 keeps the factor only), its
 //    sRGB 8/16-bit texels decoded to linear; v is flipped to our bottom-left convention
 //    (uv_ours = (u, 1 − v)) since glTF's (0,0) is the image's top-left. A primitive without a
@@ -24,6 +24,12 @@
 //    surface is a thin sheet (smooth); with a thickness it is a closed volume whose
 //    attenuationColor c and attenuationDistance d give the absorption σa = −ln(c)/d.
 //    transmissionTexture, thicknessTexture and a baseColorTexture on it are ignored (warning).
+//  * alphaMode MASK → alpha mask: coverage = baseColorFactor.a × the baseColorTexture's alpha
+//    channel (1 when its image has none), cut at alphaCutoff (default 0.5). BLEND is read as
+//    MASK with cutoff 0.5 (warning): ray casting has no partial coverage. OPAQUE (the
+//    default) ignores alpha.
+//  * normalTexture → tangent-space normal map (raw values, no sRGB decoding; +x = +u,
+//    +y = up the image = +v after the flip), `scale` → normalScale (scene.h normalMapped).
 //  * emissiveFactor × KHR_materials_emissive_strength.emissiveStrength → emitted radiance in
 //    W·sr⁻¹·m⁻²; doubleSided materials emit from both sides.
 //  * Perspective cameras: yfov (radians) and aspectRatio; the camera looks down its node's
@@ -48,6 +54,7 @@
 #include <cctype>
 #include <cstring>
 #include <filesystem>
+#include <map>
 
 namespace pl::detail {
 
@@ -62,7 +69,7 @@ struct GltfContext {
   const std::string& path;
   const tinygltf::Model& model;
   Scene& scene;
-  std::vector<int> textureOfImage;  ///< scene texture index per glTF image (-1 until used)
+  std::map<std::pair<int, ImageDecode>, int> textureOfImage;  ///< scene texture per (glTF image, decoding)
   int defaultMaterial = -1;
   int unnamedCameras = 0;
 };
@@ -178,53 +185,93 @@ Mat4 localTransform(const tinygltf::Node& node) {
   return m;
 }
 
-int textureFor(GltfContext& ctx, int textureIndex) {
+/// The glTF image behind texture `textureIndex`, checked: present, decoded by tinygltf, 8 or
+/// 16 bits, not truncated. `label` names it in messages.
+const tinygltf::Image& textureImage(GltfContext& ctx, int textureIndex, int& source, std::string& label) {
   const tinygltf::Model& model = ctx.model;
   if (textureIndex < 0 || size_t(textureIndex) >= model.textures.size())
     fail("{}: texture {} does not exist", ctx.path, textureIndex);
-  const int source = model.textures[size_t(textureIndex)].source;
+  source = model.textures[size_t(textureIndex)].source;
   if (source < 0 || size_t(source) >= model.images.size())
     fail("{}: texture {} has no image source", ctx.path, textureIndex);
-  if (ctx.textureOfImage[size_t(source)] >= 0) return ctx.textureOfImage[size_t(source)];
   const tinygltf::Image& gltfImage = model.images[size_t(source)];
-  const std::string label = gltfImage.uri.empty() ? fmt::format("image {}", source) : gltfImage.uri;
+  label = gltfImage.uri.empty() ? fmt::format("image {}", source) : gltfImage.uri;
   if (gltfImage.image.empty() && !gltfImage.uri.empty() && gltfImage.uri.rfind("data:", 0) != 0) {
     const std::filesystem::path file = std::filesystem::path(ctx.path).parent_path() / gltfImage.uri;
     if (const std::string problem = inputFileProblem(file); !problem.empty())
       fail("{}: texture file '{}' {}", ctx.path, file.string(), problem);
   }
   if (gltfImage.image.empty() || gltfImage.width <= 0 || gltfImage.height <= 0 || gltfImage.component < 1 ||
-      (gltfImage.bits != 8 && gltfImage.bits != 16))
+      gltfImage.component > 4 || (gltfImage.bits != 8 && gltfImage.bits != 16))
     fail("{}: texture image '{}' could not be decoded", ctx.path, label);
   const size_t bytesPerChannel = size_t(gltfImage.bits / 8);
   const size_t expected = size_t(gltfImage.width) * size_t(gltfImage.height) * size_t(gltfImage.component) * bytesPerChannel;
   if (gltfImage.image.size() < expected) fail("{}: texture image '{}' is truncated", ctx.path, label);
+  return gltfImage;
+}
 
+/// Whether the image of texture `textureIndex` has an alpha channel (grey + alpha or RGBA)
+/// with a value below opaque. tinygltf expands RGB images to RGBA with alpha at its maximum, so
+/// an all-opaque alpha channel is treated as none (it could cut nothing).
+bool textureHasAlpha(GltfContext& ctx, int textureIndex) {
+  int source = 0;
+  std::string label;
+  const tinygltf::Image& image = textureImage(ctx, textureIndex, source, label);
+  if (image.component != 2 && image.component != 4) return false;
+  const size_t pixels = size_t(image.width) * size_t(image.height), stride = size_t(image.component);
+  for (size_t i = 0; i < pixels; ++i) {
+    if (image.bits == 8 && image.image[(i + 1) * stride - 1] != 255) return true;
+    if (image.bits == 16) {
+      uint16_t alpha;
+      std::memcpy(&alpha, &image.image[((i + 1) * stride - 1) * 2], 2);
+      if (alpha != 65535) return true;
+    }
+  }
+  return false;
+}
+
+/// The scene texture for glTF texture `textureIndex` decoded as `decode` (image.h): sRGB
+/// colour for baseColorTexture (glTF spec 3.9.2), raw values for normalTexture, the alpha
+/// channel for alpha masks. One scene texture per (image, decoding).
+int textureFor(GltfContext& ctx, int textureIndex, ImageDecode decode = ImageDecode::Colour) {
+  int source = 0;
+  std::string label;
+  const tinygltf::Image& gltfImage = textureImage(ctx, textureIndex, source, label);
+  if (auto it = ctx.textureOfImage.find({source, decode}); it != ctx.textureOfImage.end()) return it->second;
   Texture texture;
   texture.path = label;
-  texture.image = Image(gltfImage.width, gltfImage.height);
-  const float maxValue = gltfImage.bits == 8 ? 255.0f : 65535.0f;
-  for (size_t i = 0; i < size_t(gltfImage.width) * size_t(gltfImage.height); ++i) {
-    Rgb texel;
-    for (int c = 0; c < 3; ++c) {
-      // Grey images repeat their single channel (grey + alpha: component 2).
-      const size_t channel = size_t(gltfImage.component >= 3 ? c : 0);
-      const size_t offset = (i * size_t(gltfImage.component) + channel) * bytesPerChannel;
-      float encoded;
-      if (bytesPerChannel == 1) encoded = float(gltfImage.image[offset]) / maxValue;
-      else {
-        uint16_t v;
-        std::memcpy(&v, &gltfImage.image[offset], 2);
-        encoded = float(v) / maxValue;
-      }
-      texel[c] = srgbToLinear(encoded);  // baseColorTexture is sRGB-encoded (glTF spec 3.9.2)
-    }
-    texture.image.pixels[i] = texel;
-  }
+  texture.decode = decode;
+  texture.image = decodeTexels(gltfImage.image.data(), gltfImage.bits, gltfImage.width, gltfImage.height,
+                               gltfImage.component, decode);
   const int ours = int(ctx.scene.textures.size());
   ctx.scene.textures.push_back(std::move(texture));
-  ctx.textureOfImage[size_t(source)] = ours;
+  ctx.textureOfImage[{source, decode}] = ours;
   return ours;
+}
+
+/// alphaMode MASK / BLEND → an alpha mask; normalTexture → a normal map (see the header).
+void applyAlphaAndNormals(GltfContext& ctx, const tinygltf::Material& gltf, Material& material) {
+  const auto& pbr = gltf.pbrMetallicRoughness;
+  if (gltf.alphaMode == "MASK" || gltf.alphaMode == "BLEND") {
+    if (gltf.alphaMode == "BLEND")
+      spdlog::warn("{}: material '{}': alphaMode BLEND is rendered as MASK with cutoff 0.5 (no partial coverage)",
+                   ctx.path, material.name);
+    material.alphaCutoff = gltf.alphaMode == "MASK" ? float(gltf.alphaCutoff) : 0.5f;
+    if (!(material.alphaCutoff >= 0.0f && material.alphaCutoff <= 1.0f))
+      fail("{}: material '{}': alphaCutoff {} must be in [0, 1]", ctx.path, material.name, gltf.alphaCutoff);
+    material.alphaFactor = pbr.baseColorFactor.size() >= 4 ? std::clamp(float(pbr.baseColorFactor[3]), 0.0f, 1.0f) : 1.0f;
+    if (pbr.baseColorTexture.index >= 0 && textureHasAlpha(ctx, pbr.baseColorTexture.index))
+      material.alphaTexture = textureFor(ctx, pbr.baseColorTexture.index, ImageDecode::Coverage);
+  } else if (!gltf.alphaMode.empty() && gltf.alphaMode != "OPAQUE") {
+    fail("{}: material '{}': unknown alphaMode '{}' (OPAQUE, MASK or BLEND)", ctx.path, material.name, gltf.alphaMode);
+  }
+  if (gltf.normalTexture.index >= 0) {
+    if (gltf.normalTexture.texCoord != 0)
+      spdlog::warn("{}: material '{}': normalTexture uses TEXCOORD_{}, only TEXCOORD_0 is read", ctx.path,
+                   material.name, gltf.normalTexture.texCoord);
+    material.normalTexture = textureFor(ctx, gltf.normalTexture.index, ImageDecode::Data);
+    material.normalScale = float(gltf.normalTexture.scale);
+  }
 }
 
 /// A number of an extension object, or `fallback` when absent.
@@ -299,6 +346,7 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
     material.albedoTexture = textureFor(ctx, pbr.baseColorTexture.index);
   }
   applyTransmission(ctx, gltf, material, baseColor, roughness);
+  applyAlphaAndNormals(ctx, gltf, material);
   if (gltf.emissiveFactor.size() >= 3) {
     float strength = 1.0f;
     if (auto it = gltf.extensions.find("KHR_materials_emissive_strength"); it != gltf.extensions.end()) {
@@ -474,7 +522,7 @@ Scene loadGltf(const std::string& path) {
 
   Scene scene;
   scene.sourcePath = path;
-  GltfContext ctx{path, model, scene, std::vector<int>(model.images.size(), -1)};
+  GltfContext ctx{path, model, scene, {}};
   for (size_t m = 0; m < model.materials.size(); ++m)
     scene.materials.push_back(convertMaterial(ctx, model.materials[m], int(m)));
 
