@@ -349,6 +349,9 @@ Light getLight(ByteReader& r) {
 }
 static_assert(std::variant_size_v<Light> == 3, "getLight must decode every light type");
 
+/// Opens SCNE's optional surface-detail block ("SDTL" read as a little-endian u32).
+constexpr uint32_t kSurfaceDetailTag = 0x4c544453u;
+
 std::vector<unsigned char> encodeScene(const Scene& scene) {
   ByteWriter w;
   w.putString(scene.sourcePath);
@@ -410,6 +413,22 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
   }
   w.put(uint8_t(scene.settings.camera.has_value()));
   w.putString(scene.settings.camera.value_or(""));
+  // Surface detail (plf_file.h): only when some material has an alpha mask or a normal map,
+  // so files without them keep the original layout byte for byte.
+  const bool detail = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) {
+    return m.isMasked() || m.normalTexture >= 0;
+  });
+  if (detail) {
+    w.put(kSurfaceDetailTag);
+    for (const Material& m : scene.materials) {
+      w.put(int32_t(m.alphaTexture));
+      w.put(m.alphaFactor);
+      w.put(m.alphaCutoff);
+      w.put(int32_t(m.normalTexture));
+      w.put(m.normalScale);
+    }
+    for (const Texture& t : scene.textures) w.put(uint8_t(t.decode));
+  }
   return std::move(w.bytes());
 }
 
@@ -493,6 +512,26 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path)
   const bool hasCamera = r.get<uint8_t>() != 0;
   std::string camera = r.getString();
   if (hasCamera) scene.settings.camera = std::move(camera);
+  if (r.remaining() > 0) {
+    if (r.get<uint32_t>() != kSurfaceDetailTag) r.corrupt("unexpected bytes after the scene's settings");
+    for (Material& m : scene.materials) {
+      m.alphaTexture = r.get<int32_t>();
+      m.alphaFactor = r.get<float>();
+      m.alphaCutoff = r.get<float>();
+      m.normalTexture = r.get<int32_t>();
+      m.normalScale = r.get<float>();
+      if (!(m.alphaFactor >= 0.0f && m.alphaFactor <= 1.0f && m.alphaCutoff >= 0.0f && m.alphaCutoff <= 1.0f) ||
+          !std::isfinite(m.normalScale))
+        r.corrupt(fmt::format("material '{}' has alpha {}, cutoff {}, normal scale {}", m.name, m.alphaFactor,
+                              m.alphaCutoff, m.normalScale));
+    }
+    for (Texture& t : scene.textures) {
+      const uint8_t decode = r.get<uint8_t>();
+      if (decode > uint8_t(ImageDecode::Coverage))
+        r.corrupt(fmt::format("texture '{}' has unknown decoding {}", t.path, decode));
+      t.decode = ImageDecode(decode);
+    }
+  }
   r.expectEnd();
 
   // Cross-references. The writer only ever stores a finalized scene, so any violation means
@@ -520,8 +559,9 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path)
     m.positions.reserve(vertices + 1);
   }
   for (const Material& m : scene.materials)
-    if (m.albedoTexture < -1 || m.albedoTexture >= int64_t(scene.textures.size()))
-      r.corrupt(fmt::format("material '{}' uses texture {} of {}", m.name, m.albedoTexture, scene.textures.size()));
+    for (const int texture : {m.albedoTexture, m.alphaTexture, m.normalTexture})
+      if (texture < -1 || texture >= int64_t(scene.textures.size()))
+        r.corrupt(fmt::format("material '{}' uses texture {} of {}", m.name, texture, scene.textures.size()));
   return scene;
 }
 
