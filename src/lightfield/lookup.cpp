@@ -104,7 +104,7 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer) {
   const uint32_t chart = lf.triangleChart[hit.mesh][hit.triangle];
   const Chart& c = lf.charts[chart];
-  const bool normalMapped = c.kind == ChartKind::Glossy && lf.scene.materials[c.material].normalTexture >= 0;
+  const bool normalMapped = chartShading(lf.scene, c).normalMapped;
   return exitantRadiance(lf, chart, hit.position,
                          normalMapped ? normalMappedLookupDirection(c, hit.shadingNormal, worldDirectionTowardsViewer)
                                       : worldDirectionTowardsViewer,
