@@ -12,6 +12,9 @@ namespace pl {
 
 struct Scene;
 
+/// Alpha masks (Material::alphaTexture/alphaFactor/alphaCutoff) are honoured by every query
+/// below: a point whose coverage is below the cutoff is not a hit, not an occluder.
+
 /// A ray's closest hit. barycentrics are Embree's (u, v): p = (1−u−v)·p0 + u·p1 + v·p2.
 struct RayHit {
   static constexpr uint32_t kNone = 0xffffffffu;

@@ -4,6 +4,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,30 @@ RayHit fromRtc(const RTCRayHit& rh) {
   return hit;
 }
 
+/// What the alpha-mask filter of one mesh needs (the geometry's user data).
+struct MaskedMesh {
+  const Scene* scene = nullptr;
+  uint32_t mesh = 0;
+};
+
+/// Embree's intersection and occlusion filter for meshes with alpha-masked materials: a
+/// candidate hit whose coverage (scene.h coverageAt) is below its material's cutoff is
+/// rejected (valid = 0), so traversal goes on past it. Single rays, packets and streams all
+/// come through here, so they agree. Meshes without masks get no filter and pay nothing.
+void alphaMaskFilter(const RTCFilterFunctionNArguments* args) {
+  const auto* masked = static_cast<const MaskedMesh*>(args->geometryUserPtr);
+  const Scene& scene = *masked->scene;
+  const Mesh& mesh = scene.meshes[masked->mesh];
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const uint32_t triangle = RTCHitN_primID(args->hit, args->N, i);
+    const Material& material = scene.materials[mesh.materials[triangle]];
+    if (!material.isMasked()) continue;
+    const Vec2 barycentrics(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+    if (coverageAt(scene, masked->mesh, triangle, barycentrics) < material.alphaCutoff) args->valid[i] = 0;
+  }
+}
+
 }  // namespace
 
 struct Accel::Impl {
@@ -74,6 +99,8 @@ struct Accel::Impl {
   /// Padded copies of vertex buffers that were not padded (see the constructor); empty for
   /// scenes that came out of Scene::finalize() unchanged.
   std::vector<std::vector<Vec3>> paddedPositions;
+  /// User data of the alpha-mask filters (one per mesh with a masked material; stable addresses).
+  std::vector<std::unique_ptr<MaskedMesh>> maskedMeshes;
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
 
@@ -118,6 +145,14 @@ Accel::Accel(const Scene& scene) : impl_(std::make_unique<Impl>()) {
                                sizeof(Vec3), mesh.positions.size());
     rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.triangles.data(), 0,
                                sizeof(UVec3), mesh.triangles.size());
+    const bool masked = std::any_of(mesh.materials.begin(), mesh.materials.end(),
+                                    [&](uint32_t material) { return scene.materials[material].isMasked(); });
+    if (masked) {
+      auto& user = impl_->maskedMeshes.emplace_back(std::make_unique<MaskedMesh>(MaskedMesh{&scene, uint32_t(m)}));
+      rtcSetGeometryUserData(geometry, user.get());
+      rtcSetGeometryIntersectFilterFunction(geometry, alphaMaskFilter);
+      rtcSetGeometryOccludedFilterFunction(geometry, alphaMaskFilter);
+    }
     rtcCommitGeometry(geometry);
     // Geometry IDs equal mesh indices so a hit's geomID is the mesh directly.
     rtcAttachGeometryByID(impl_->scene, geometry, static_cast<unsigned>(m));

@@ -3,6 +3,7 @@
 // every query path (single rays, 16-wide packets, streams, occlusion) with each other.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -343,6 +344,104 @@ TEST(Accel, BoundsAndEmptySpans) {
   RayHit hit;
   EXPECT_FALSE(accel.intersect({hi + Vec3(1.0f), glm::normalize(Vec3(1, 1, 1))}, hit));
   EXPECT_FALSE(hit.hit());
+}
+
+// ---- alpha masks ---------------------------------------------------------------------------
+
+/// A masked unit quad at z = 1 (uv = xy, random 4×4 coverage texture, cutoff `cutoff`) over
+/// an opaque one at z = 0; the masked quad's mesh also holds an opaque triangle far away so
+/// that the filter must tell materials apart within a mesh.
+Scene makeMaskedQuads(float cutoff) {
+  Scene scene;
+  scene.sourcePath = "masked quads";
+  Texture mask;
+  mask.path = "random coverage";
+  mask.decode = ImageDecode::Coverage;
+  mask.image = Image(4, 4);
+  Pcg32 rng(7, 3);
+  for (Rgb& texel : mask.image.pixels) texel = Rgb(rng.uniform());
+  scene.textures.push_back(mask);
+  Material masked{.name = "masked", .bsdf = LambertBsdf{Rgb(0.5f)}};
+  masked.alphaTexture = 0;
+  masked.alphaCutoff = cutoff;
+  scene.materials.push_back(masked);
+  scene.materials.push_back({.name = "opaque", .bsdf = LambertBsdf{Rgb(0.5f)}});
+  Mesh top;
+  top.name = "masked";
+  top.positions = {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}, {5, 5, 1}, {6, 5, 1}, {5, 6, 1}};
+  top.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}, {1, 0}, {0, 1}};
+  top.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}};
+  top.materials = {0, 0, 1};
+  Mesh bottom;
+  bottom.name = "floor";
+  bottom.positions = {{-1, -1, 0}, {2, -1, 0}, {2, 2, 0}, {-1, 2, 0}};
+  bottom.triangles = {{0, 1, 2}, {0, 2, 3}};
+  bottom.materials = {1, 1};
+  scene.meshes = {top, bottom};
+  scene.finalize();
+  return scene;
+}
+
+// Straight down through the masked quad: where the bilinear coverage at uv is below the
+// cutoff the ray reaches the floor (t = 2), elsewhere it stops on the quad (t = 1), and
+// occlusion within t < 1.5 says the same. Every query path (single rays, packets, streams)
+// goes through the same filter; three cutoffs move the boundary.
+TEST(Accel, AlphaMaskCutsHitsAndOcclusionInEveryQueryPath) {
+  for (const float cutoff : {0.25f, 0.5f, 0.75f}) {
+    const Scene scene = makeMaskedQuads(cutoff);
+    const Accel accel(scene);
+    const Texture& mask = scene.textures[0];
+    Pcg32 rng(11, 5);
+    std::vector<Ray> rays, shadowRays;
+    std::vector<bool> covered;
+    while (rays.size() < 1000) {
+      const Vec2 uv(rng.uniform(), rng.uniform());
+      const float coverage = mask.sample(uv).r;
+      if (std::abs(coverage - cutoff) < 1e-3f) continue;  // too close to call in float
+      const Ray ray{Vec3(uv.x, uv.y, 2.0f), Vec3(0.0f, 0.0f, -1.0f), 0.0f, kInfinity};
+      rays.push_back(ray);
+      shadowRays.push_back(Ray{ray.origin, ray.direction, 0.0f, 1.5f});
+      covered.push_back(coverage >= cutoff);
+    }
+    const size_t holes = size_t(std::count(covered.begin(), covered.end(), false));
+    ASSERT_GT(holes, 20u) << "cutoff " << cutoff;  // the test must see both cases
+    ASSERT_LT(holes, 980u) << "cutoff " << cutoff;
+
+    std::vector<RayHit> coherent(rays.size()), incoherent(rays.size());
+    accel.intersectCoherent(rays, coherent);
+    accel.intersectIncoherent(rays, incoherent);
+    std::vector<uint8_t> occludedMany(rays.size()), occludedCoherent(rays.size());
+    accel.occludedMany(shadowRays, occludedMany);
+    accel.occludedCoherent(shadowRays, occludedCoherent);
+    for (size_t i = 0; i < rays.size(); ++i) {
+      RayHit single;
+      ASSERT_TRUE(accel.intersect(rays[i], single));
+      EXPECT_EQ(single.mesh, covered[i] ? 0u : 1u) << "cutoff " << cutoff << " ray " << i;
+      EXPECT_NEAR(single.t, covered[i] ? 1.0f : 2.0f, 1e-5f);
+      for (const RayHit* other : {&coherent[i], &incoherent[i]}) {
+        EXPECT_EQ(other->mesh, single.mesh) << "cutoff " << cutoff << " ray " << i;
+        EXPECT_EQ(other->triangle, single.triangle);
+        EXPECT_EQ(other->t, single.t);
+      }
+      EXPECT_EQ(accel.occluded(shadowRays[i]), bool(covered[i])) << "cutoff " << cutoff << " ray " << i;
+      EXPECT_EQ(occludedMany[i], covered[i] ? 1 : 0);
+      EXPECT_EQ(occludedCoherent[i], covered[i] ? 1 : 0);
+    }
+  }
+}
+
+// alphaFactor alone (glTF baseColorFactor.a under alphaMode MASK, no texture) below the
+// cutoff removes the material's surfaces entirely; at or above it they are opaque.
+TEST(Accel, AlphaFactorWithoutTextureRemovesOrKeepsTheWholeMaterial) {
+  for (const float factor : {0.2f, 0.6f}) {
+    Scene scene = makeMaskedQuads(0.5f);
+    scene.materials[0].alphaTexture = -1;
+    scene.materials[0].alphaFactor = factor;
+    const Accel accel(scene);
+    RayHit hit;
+    ASSERT_TRUE(accel.intersect(Ray{Vec3(0.3f, 0.6f, 2.0f), Vec3(0, 0, -1), 0.0f, kInfinity}, hit));
+    EXPECT_EQ(hit.mesh, factor >= 0.5f ? 0u : 1u) << "alpha " << factor;
+  }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #include "image/image.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -58,7 +59,46 @@ void checkImageSize(const std::string& path, long long width, long long height) 
 }
 }  // namespace detail
 
+Image decodeTexels(const void* texels, int bitsPerChannel, int width, int height, int channels, ImageDecode decode) {
+  if ((bitsPerChannel != 8 && bitsPerChannel != 16) || channels < 1 || channels > 4 || width < 0 || height < 0)
+    fail("decodeTexels: unsupported layout ({} bits, {} channels)", bitsPerChannel, channels);
+  Image image(width, height);
+  const auto* bytes8 = static_cast<const uint8_t*>(texels);
+  const auto* values16 = static_cast<const uint16_t*>(texels);
+  const float maximum = bitsPerChannel == 8 ? 255.0f : 65535.0f;
+  const size_t stride = size_t(channels);
+  // Coverage: the last channel of grey + alpha and RGBA, else the first (grey or red).
+  const size_t alphaChannel = channels == 2 || channels == 4 ? stride - 1 : 0;
+  std::array<float, 256> srgb8;  // the 8-bit sRGB decode as a table (every value occurs)
+  if (bitsPerChannel == 8 && decode == ImageDecode::Colour)
+    for (int v = 0; v < 256; ++v) srgb8[size_t(v)] = srgbToLinear(float(v) / 255.0f);
+  auto value = [&](size_t index) -> float {
+    if (bitsPerChannel == 8) {
+      if (decode == ImageDecode::Colour) return srgb8[bytes8[index]];
+      return float(bytes8[index]) / maximum;
+    }
+    const float v = float(values16[index]) / maximum;
+    return decode == ImageDecode::Colour ? srgbToLinear(v) : v;
+  };
+  for (size_t i = 0; i < image.pixels.size(); ++i) {
+    const size_t base = i * stride;
+    if (decode == ImageDecode::Coverage) {
+      image.pixels[i] = Rgb(value(base + alphaChannel));
+    } else {
+      // Grey (and grey + alpha) repeat their one colour channel; alpha is not colour.
+      for (int c = 0; c < 3; ++c) image.pixels[i][c] = value(base + (channels >= 3 ? size_t(c) : 0));
+    }
+  }
+  return image;
+}
+
 namespace {
+/// An HDR image read for `decode`: as it is, or (Coverage) its red channel in R, G and B.
+Image hdrAs(Image image, ImageDecode decode) {
+  if (decode == ImageDecode::Coverage)
+    for (Rgb& p : image.pixels) p = Rgb(p.r);
+  return image;
+}
 /// The path names an existing regular file (else pl::Error naming it).
 void requireImageFile(const std::string& path) {
   std::error_code ec;
@@ -68,13 +108,13 @@ void requireImageFile(const std::string& path) {
 }
 }  // namespace
 
-Image readImage(const std::string& path) {
+Image readImage(const std::string& path, ImageDecode decode) {
   requireImageFile(path);
   const std::string ext = fileExtensionLower(path);
-  if (ext == ".exr") return detail::readExr(path);
-  if (ext == ".hdr") return detail::readRadianceHdr(path);
-  if (ext == ".pfm") return detail::readPfm(path);
-  if (isLdrImageExtension(ext)) return detail::decodeLdr(detail::readFileBytes(path), path, ext == ".png");
+  if (ext == ".exr") return hdrAs(detail::readExr(path), decode);
+  if (ext == ".hdr") return hdrAs(detail::readRadianceHdr(path), decode);
+  if (ext == ".pfm") return hdrAs(detail::readPfm(path), decode);
+  if (isLdrImageExtension(ext)) return detail::decodeLdr(detail::readFileBytes(path), path, ext == ".png", decode);
   fail("{}: unknown image extension '{}' (readable: .exr .hdr .pfm .png .jpg .jpeg .tga .bmp)", path, ext);
 }
 
@@ -83,18 +123,23 @@ bool isLdrImageExtension(const std::string& extension) {
          extension == ".bmp";
 }
 
-ImageFile readImageFile(const std::string& path) {
+ImageFile readImageFile(const std::string& path, ImageDecode decode) {
   const std::string ext = fileExtensionLower(path);
-  if (!isLdrImageExtension(ext)) return {readImage(path), {}};
+  if (!isLdrImageExtension(ext)) return {readImage(path, decode), {}};
   requireImageFile(path);
   ImageFile file;
   file.ldrBytes = detail::readFileBytes(path);
-  file.image = detail::decodeLdr(file.ldrBytes, path, ext == ".png");
+  file.image = detail::decodeLdr(file.ldrBytes, path, ext == ".png", decode);
   return file;
 }
 
-Image decodeLdrImage(std::span<const unsigned char> bytes, const std::string& label) {
-  return detail::decodeLdr(bytes, label, false);
+Image decodeLdrImage(std::span<const unsigned char> bytes, const std::string& label, ImageDecode decode) {
+  return detail::decodeLdr(bytes, label, false, decode);
+}
+
+bool ldrImageHasAlphaChannel(std::span<const unsigned char> bytes) {
+  const int channels = detail::ldrChannelCount(bytes);
+  return channels == 2 || channels == 4;
 }
 
 void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOptions& options) {

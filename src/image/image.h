@@ -54,10 +54,26 @@ inline constexpr uint64_t kMaxImagePixels = 1ull << 28;  ///< 268 M pixels = 3.2
 float srgbToLinear(float encoded);
 float linearToSrgb(float linear);
 
-/// Reads an HDR image (.exr, .hdr, .pfm) or an 8-bit one (.png, .jpg, .tga, .bmp: sRGB-decoded
-/// to linear). Throws pl::Error naming the file and the problem (missing, truncated,
-/// corrupt, unsupported variant, absurd size, unknown extension).
-Image readImage(const std::string& path);
+/// What the channels of an 8-bit (or 16-bit PNG) image become in an Image's RGB. The value
+/// is stored in .plf files: never renumber.
+enum class ImageDecode : uint8_t {
+  Colour = 0,    ///< sRGB-encoded colour decoded to linear (albedo textures, photographs)
+  Data = 1,      ///< value / maximum as stored, no transfer function (normal maps)
+  Coverage = 2,  ///< the alpha channel (grey + alpha, RGBA) or, in an image without one, the
+                 ///< first channel, value / maximum, repeated in R, G and B (alpha masks)
+};
+
+/// Reads an HDR image (.exr, .hdr, .pfm) or an 8-bit one (.png, .jpg, .tga, .bmp: decoded as
+/// `decode` says; grey images repeat their channel). HDR files are linear already: Colour and
+/// Data read them as they are, Coverage takes their red channel. Throws pl::Error naming the
+/// file and the problem (missing, truncated, corrupt, unsupported variant, absurd size,
+/// unknown extension).
+Image readImage(const std::string& path, ImageDecode decode = ImageDecode::Colour);
+
+/// Interleaved texels as an Image: `channels` values per pixel (1 grey, 2 grey + alpha, 3 RGB,
+/// 4 RGBA) of 8 or 16 bits (native byte order), row-major, top row first, decoded as `decode`
+/// says. The one conversion every 8/16-bit image reader (stb, glTF buffers) uses.
+Image decodeTexels(const void* texels, int bitsPerChannel, int width, int height, int channels, ImageDecode decode);
 
 /// True for the extensions (lower case, with the dot) of the 8-bit formats: .png .jpg .jpeg
 /// .tga .bmp.
@@ -70,14 +86,19 @@ struct ImageFile {
   Image image;
   std::vector<unsigned char> ldrBytes;
 };
-ImageFile readImageFile(const std::string& path);
+ImageFile readImageFile(const std::string& path, ImageDecode decode = ImageDecode::Colour);
 
 /// Decodes an 8-bit-format image held in memory (PNG, JPEG, TGA, BMP, recognised from the
-/// content; a file's bytes, a glTF buffer, a .plf's embedded texture), sRGB-decoded to
-/// linear: the same pixels readImage gives for the same bytes in a file. The size is checked
+/// content; a file's bytes, a glTF buffer, a .plf's embedded texture) as `decode` asks (sRGB
+/// colour to linear, raw data, or coverage): the same pixels readImage gives for the same
+/// bytes in a file. The size is checked
 /// (kMaxImagePixels) before decoding. Throws pl::Error starting with `label` when the bytes are
 /// corrupt, truncated or not an image.
-Image decodeLdrImage(std::span<const unsigned char> bytes, const std::string& label);
+Image decodeLdrImage(std::span<const unsigned char> bytes, const std::string& label,
+                     ImageDecode decode = ImageDecode::Colour);
+/// Whether 8-bit-format image bytes hold an alpha channel (grey + alpha or RGBA); false for
+/// bytes that are not a recognisable image (decodeLdrImage reports those).
+bool ldrImageHasAlphaChannel(std::span<const unsigned char> bytes);
 
 /// How writeHdrImage stores pixels where the format offers a choice.
 struct HdrWriteOptions {

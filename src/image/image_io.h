@@ -18,10 +18,13 @@ Image readExr(const std::string& path);
 void writeExr(const std::string& path, const Image& image, bool half);
 
 // stb_io.cpp (stb_image / stb_image_write) and the Radiance RGBE format
-/// PNG/JPEG/TGA/BMP bytes (format recognised from the content), sRGB-decoded to linear;
-/// `label` names them in errors. mustBePng: refuse anything without the PNG signature (a
-/// file named .png); PNG content is always checked for truncated chunks first.
-Image decodeLdr(std::span<const unsigned char> bytes, const std::string& label, bool mustBePng);
+/// PNG/JPEG/TGA/BMP bytes (format recognised from the content) decoded as `decode` asks
+/// (decodeTexels: sRGB colour, raw data or coverage, channels as stored); `label` names them in
+/// errors. mustBePng: refuse anything without the PNG signature (a file named .png); PNG
+/// content is always checked for truncated chunks first.
+Image decodeLdr(std::span<const unsigned char> bytes, const std::string& label, bool mustBePng, ImageDecode decode);
+/// Channels stored in PNG/JPEG/TGA/BMP bytes (1–4), 0 when they are not such an image.
+int ldrChannelCount(std::span<const unsigned char> bytes);
 void writePngFile(const std::string& path, const Image8& image);
 Image readRadianceHdr(const std::string& path);
 void writeRadianceHdr(const std::string& path, const Image& image);

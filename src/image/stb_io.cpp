@@ -36,6 +36,7 @@
 #include <cstdlib>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -68,7 +69,7 @@ void checkPngStructure(const std::string& path, std::span<const unsigned char> b
 
 }  // namespace
 
-Image decodeLdr(std::span<const unsigned char> bytes, const std::string& label, bool mustBePng) {
+Image decodeLdr(std::span<const unsigned char> bytes, const std::string& label, bool mustBePng, ImageDecode decode) {
   static const unsigned char kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (bytes.empty()) fail("{}: empty file", label);
   if (bytes.size() > size_t(INT32_MAX)) fail("{}: file too large for the 8-bit image reader", label);
@@ -80,24 +81,20 @@ Image decodeLdr(std::span<const unsigned char> bytes, const std::string& label, 
     fail("{}: corrupt or unsupported image: {}", label, stbi_failure_reason());
   checkImageSize(label, width, height);
 
-  Image image(width, height);
-  // 16-bit PNGs keep their precision; everything else is 8-bit. Both are sRGB-encoded.
-  if (stbi_is_16_bit_from_memory(bytes.data(), size)) {
-    stbi_us* data = stbi_load_16_from_memory(bytes.data(), size, &width, &height, &channels, 3);
-    if (!data) fail("{}: corrupt image: {}", label, stbi_failure_reason());
-    for (size_t i = 0; i < image.pixels.size(); ++i)
-      for (int c = 0; c < 3; ++c) image.pixels[i][c] = srgbToLinear(float(data[3 * i + size_t(c)]) / 65535.0f);
-    stbi_image_free(data);
-  } else {
-    stbi_uc* data = stbi_load_from_memory(bytes.data(), size, &width, &height, &channels, 3);
-    if (!data) fail("{}: corrupt image: {}", label, stbi_failure_reason());
-    std::array<float, 256> table;
-    for (int v = 0; v < 256; ++v) table[size_t(v)] = srgbToLinear(float(v) / 255.0f);
-    for (size_t i = 0; i < image.pixels.size(); ++i)
-      for (int c = 0; c < 3; ++c) image.pixels[i][c] = table[data[3 * i + size_t(c)]];
-    stbi_image_free(data);
-  }
-  return image;
+  // 16-bit PNGs keep their precision; everything else is 8-bit. Channels as stored (grey,
+  // grey + alpha, RGB, RGBA), so that an alpha channel survives for ImageDecode::Coverage.
+  const bool sixteen = stbi_is_16_bit_from_memory(bytes.data(), size) != 0;
+  void* data = sixteen ? static_cast<void*>(stbi_load_16_from_memory(bytes.data(), size, &width, &height, &channels, 0))
+                       : static_cast<void*>(stbi_load_from_memory(bytes.data(), size, &width, &height, &channels, 0));
+  if (!data) fail("{}: corrupt image: {}", label, stbi_failure_reason());
+  const std::unique_ptr<void, void (*)(void*)> owner(data, stbi_image_free);
+  return decodeTexels(data, sixteen ? 16 : 8, width, height, channels, decode);
+}
+
+int ldrChannelCount(std::span<const unsigned char> bytes) {
+  int width = 0, height = 0, channels = 0;
+  if (bytes.empty() || bytes.size() > size_t(INT32_MAX)) return 0;
+  return stbi_info_from_memory(bytes.data(), int(bytes.size()), &width, &height, &channels) ? channels : 0;
 }
 
 namespace {

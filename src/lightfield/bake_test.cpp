@@ -208,6 +208,53 @@ TEST_F(BakeTest, QuadUnderUniformSkyReflectsLeTimesAlbedo) {
   }
 }
 
+// A Lambertian floor under the sun (straight down, irradiance E) and a black blocker at
+// height 1 whose alpha mask cuts away its half z < 0 (mask along v = z + 0.5). The bake's
+// first-shot shadow rays and its visibility field go through the same ray casting as the path
+// tracer, so the floor is lit (L = ρE/π: nothing else reflects light) below the cut-out half and
+// dark below the opaque half; without the mask both halves are dark.
+TEST_F(BakeTest, AlphaMaskedBlockerCastsTheMaskedShadowInTheLightField) {
+  for (const bool masked : {true, false}) {
+    Scene scene;
+    scene.sourcePath = "masked blocker";
+    const float rho = 0.6f, e = 2.0f;
+    scene.materials.push_back({.name = "floor", .bsdf = LambertBsdf{Rgb(rho)}});
+    scene.materials.push_back({.name = "blocker", .bsdf = LambertBsdf{Rgb(0.0f)}});
+    Mesh mesh;
+    mesh.positions = {{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, {-0.5f, 1, -0.5f}, {-0.5f, 1, 0.5f},
+                      {0.5f, 1, 0.5f}, {0.5f, 1, -0.5f}};
+    for (const Vec3& p : mesh.positions) mesh.uvs.push_back(Vec2(p.x + 0.5f, p.z + 0.5f));
+    mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};  // both facing +y
+    mesh.materials = {0, 0, 1, 1};
+    scene.meshes.push_back(mesh);
+    if (masked) {
+      Texture mask;
+      mask.path = "half mask";
+      mask.decode = ImageDecode::Coverage;
+      mask.image = Image(1, 4);
+      mask.image.pixels = {Rgb(1.0f), Rgb(1.0f), Rgb(0.0f), Rgb(0.0f)};  // top rows (large v) opaque
+      scene.textures.push_back(mask);
+      scene.materials[1].alphaTexture = 0;
+    }
+    scene.lights.push_back(DirectionalLight{Vec3(0.0f, -1.0f, 0.0f), Rgb(e)});
+    scene.finalize();
+    BakeSettings settings = smallSettings();
+    settings.tixelsAcrossScene = 32;  // 1/8 unit: the probes below are 2 tixels from any edge
+    const LightField lf = bake(scene, settings);
+    const uint32_t floorChart = lf.triangleChart[0][0];
+    ASSERT_EQ(lf.charts[floorChart].kind, ChartKind::Diffuse);
+    const Vec3 up(0.0f, 1.0f, 0.0f);
+    const float lit = rho * e / kPi;
+    const Rgb underHole = exitantRadiance(lf, floorChart, Vec3(0.0f, 0.0f, -0.25f), up, Vec2(0.0f));
+    const Rgb underOpaque = exitantRadiance(lf, floorChart, Vec3(0.0f, 0.0f, 0.25f), up, Vec2(0.0f));
+    const Rgb outside = exitantRadiance(lf, floorChart, Vec3(1.25f, 0.0f, 0.25f), up, Vec2(0.0f));
+    EXPECT_NEAR(outside.g, lit, 1e-3f * lit);
+    EXPECT_NEAR(underOpaque.g, 0.0f, 1e-3f * lit);
+    if (masked) EXPECT_NEAR(underHole.g, lit, 1e-3f * lit);
+    else EXPECT_NEAR(underHole.g, 0.0f, 1e-3f * lit);
+  }
+}
+
 // An environment *map* bright (radiance c) above the horizon (world y > 0) and black below:
 // a Lambertian quad facing up sees only the bright half, E = π·c, L = ρ·c; one facing down
 // sees only the black half. Checks that escaping gather rays look the map up in their world

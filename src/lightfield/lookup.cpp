@@ -83,7 +83,16 @@ ChartShading chartShading(const Scene& scene, const Chart& c) {
   if (c.kind == ChartKind::Diffuse && !shading.texturedAlbedo)
     shading.albedoOverPi = lanes4(diffuseAlbedoAt(scene, c.material, Vec2(0.0f)) * kInvPi);
   shading.needsUv = c.kind == ChartKind::Diffuse && shading.texturedAlbedo;
+  shading.normalMapped = c.kind == ChartKind::Glossy && material.normalTexture >= 0;
   return shading;
+}
+
+Vec3 normalMappedLookupDirection(const Chart& c, const Vec3& shadingNormal, const Vec3& wo) {
+  // The viewer's side: a back-side viewer (one-sided chart) sees the front, as without a map.
+  if (!(glm::dot(wo, c.normal) > 0.0f)) return wo;
+  const Vec3 mirrored = 2.0f * glm::dot(wo, shadingNormal) * shadingNormal - wo;  // about n'
+  const Vec3 d = 2.0f * glm::dot(mirrored, c.normal) * c.normal - mirrored;       // about n
+  return glm::dot(d, c.normal) > 0.0f ? glm::normalize(d) : wo;
 }
 
 Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosition,
@@ -96,8 +105,15 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
 }
 
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer) {
+  // The chart facing the viewer (a two-sided surface's back record when seen from behind), then
+  // the lookup direction the normal map reflects to on it.
   const uint32_t chart = facingChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], worldDirectionTowardsViewer);
-  return exitantRadiance(lf, chart, hit.position, worldDirectionTowardsViewer, hit.uv);
+  const Chart& c = lf.charts[chart];
+  const bool normalMapped = chartShading(lf.scene, c).normalMapped;
+  return exitantRadiance(lf, chart, hit.position,
+                         normalMapped ? normalMappedLookupDirection(c, hit.shadingNormal, worldDirectionTowardsViewer)
+                                      : worldDirectionTowardsViewer,
+                         hit.uv);
 }
 
 }  // namespace pl

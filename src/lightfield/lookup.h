@@ -166,8 +166,30 @@ struct ChartShading {
   bool twoSidedEmission = false;
   bool texturedAlbedo = false;    ///< diffuse albedo varies with uv: diffuseAlbedoAt per point
   bool needsUv = false;           ///< a diffuse chart with an albedo texture: the lookup needs the hit's uv
+  bool normalMapped = false;      ///< a glossy chart with a normal map: lookupDirection needs the hit's normal
 };
 ChartShading chartShading(const Scene& scene, const Chart& c);
+
+/// The direction to look glossy chart c up in, for a viewer towards wo (unit, world) at a
+/// point whose shading normal n' (normal-mapped, surfaceAt) differs from the chart's flat
+/// normal n. The value stored towards d is the glossy reflection of light arriving around
+/// d mirrored about n; the normal-mapped surface reflects light arriving around wo mirrored
+/// about n'. So d = mirror about n of (wo mirrored about n'), which moves the highlight as the
+/// normal map says. wo itself when d would fall behind the chart (grazing tilts).
+Vec3 normalMappedLookupDirection(const Chart& c, const Vec3& shadingNormal, const Vec3& wo);
+
+/// What exitantRadianceLanes needs of a ray's hit on chart c besides the position: the uv
+/// (for an albedo texture) and the lookup direction (towards the viewer; bent by a normal map
+/// on glossy charts). surfaceAt is evaluated only where the chart's shading needs it.
+inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading& shading, const RayHit& hit,
+                         const Vec3& towardsViewer, Vec2& uv, Vec3& lookup) {
+  uv = Vec2(0.0f);
+  lookup = towardsViewer;
+  if (!shading.needsUv && !shading.normalMapped) return;
+  const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+  uv = surface.uv;
+  if (shading.normalMapped) lookup = normalMappedLookupDirection(c, surface.shadingNormal, towardsViewer);
+}
 
 /// Exitant radiance (W·sr⁻¹·m⁻²) of chart `chart` at worldPosition towards the viewer:
 ///   diffuse chart:  Le + albedo(uv)·E/π with E bilinearly interpolated over the 2×2 nearest

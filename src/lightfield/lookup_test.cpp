@@ -209,5 +209,26 @@ TEST(Lookup, BranchFreeLinearTapEqualsTheCaseList) {
   }
 }
 
+// A normal-mapped glossy chart is looked up where the flat chart reflects what the mapped
+// normal reflects: mirror(d, n) = mirror(wo, n'). The unmapped normal leaves wo as it is, and a
+// lookup that would fall behind the chart (or a viewer behind it) keeps wo.
+TEST(NormalMappedLookup, ReflectsAboutTheMappedNormal) {
+  Chart c;
+  c.normal = Vec3(0.0f, 0.0f, 1.0f);
+  const auto mirror = [](const Vec3& w, const Vec3& n) { return 2.0f * glm::dot(w, n) * n - w; };
+  const Vec3 wo = glm::normalize(Vec3(0.3f, -0.2f, 1.0f));
+  const Vec3 unmapped = normalMappedLookupDirection(c, c.normal, wo);  // two mirrors: float rounding
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(unmapped[k], wo[k], 1e-6f);
+  const Vec3 mapped = glm::normalize(Vec3(0.2f, 0.1f, 1.0f));
+  const Vec3 d = normalMappedLookupDirection(c, mapped, wo);
+  EXPECT_NEAR(glm::length(d), 1.0f, 1e-6f);
+  const Vec3 want = mirror(wo, mapped), got = mirror(d, c.normal);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], 1e-5f);
+  const Vec3 grazing = glm::normalize(Vec3(1.0f, 0.0f, 0.05f));
+  EXPECT_EQ(normalMappedLookupDirection(c, glm::normalize(Vec3(-0.5f, 0.0f, 1.0f)), grazing), grazing);
+  const Vec3 behind(0.0f, 0.6f, -0.8f);
+  EXPECT_EQ(normalMappedLookupDirection(c, mapped, behind), behind);
+}
+
 }  // namespace
 }  // namespace pl

@@ -352,6 +352,8 @@ static_assert(std::variant_size_v<Light> == 3, "getLight must decode every light
 /// How a texture record stores its image (the byte after its path).
 constexpr uint8_t kTexturePixels = 0;       ///< i32 width, i32 height, u64 count, float32 RGB texels
 constexpr uint8_t kTextureEncodedFile = 1;  ///< u64 count, the image file's bytes (PNG/JPEG/TGA/BMP)
+/// Opens SCNE's optional surface-detail block ("SDTL" read as a little-endian u32).
+constexpr uint32_t kSurfaceDetailTag = 0x4c544453u;
 
 std::vector<unsigned char> encodeScene(const Scene& scene) {
   ByteWriter w;
@@ -420,6 +422,22 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
   }
   w.put(uint8_t(scene.settings.camera.has_value()));
   w.putString(scene.settings.camera.value_or(""));
+  // Surface detail (plf_file.h): only when some material has an alpha mask or a normal map,
+  // so files without them keep the original layout byte for byte.
+  const bool detail = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) {
+    return m.isMasked() || m.normalTexture >= 0;
+  });
+  if (detail) {
+    w.put(kSurfaceDetailTag);
+    for (const Material& m : scene.materials) {
+      w.put(int32_t(m.alphaTexture));
+      w.put(m.alphaFactor);
+      w.put(m.alphaCutoff);
+      w.put(int32_t(m.normalTexture));
+      w.put(m.normalScale);
+    }
+    for (const Texture& t : scene.textures) w.put(uint8_t(t.decode));
+  }
   return std::move(w.bytes());
 }
 
@@ -465,13 +483,8 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
     if (storage == kTextureEncodedFile) {
       std::vector<unsigned char> file = r.getArray<unsigned char>("encoded image bytes");
       if (file.empty()) r.corrupt(fmt::format("texture '{}' has an empty image file", t.path));
-      const std::string label = fmt::format("{}: texture '{}' embedded in the scene section", path, t.path);
-      if (textures == TextureDecoding::Decode) {
-        t = textureFromEncoded(std::move(t.path), std::move(file), label);  // size checked before decoding
-        t.finish(path);
-      } else {
-        t.encoded = std::make_shared<const std::vector<unsigned char>>(std::move(file));
-      }
+      // Decoded below, once the surface-detail block has said how (colour, data or coverage).
+      t.encoded = std::make_shared<const std::vector<unsigned char>>(std::move(file));
     } else if (storage == kTexturePixels) {
       t.image.width = r.get<int32_t>();
       t.image.height = r.get<int32_t>();
@@ -525,7 +538,34 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
   const bool hasCamera = r.get<uint8_t>() != 0;
   std::string camera = r.getString();
   if (hasCamera) scene.settings.camera = std::move(camera);
+  if (r.remaining() > 0) {
+    if (r.get<uint32_t>() != kSurfaceDetailTag) r.corrupt("unexpected bytes after the scene's settings");
+    for (Material& m : scene.materials) {
+      m.alphaTexture = r.get<int32_t>();
+      m.alphaFactor = r.get<float>();
+      m.alphaCutoff = r.get<float>();
+      m.normalTexture = r.get<int32_t>();
+      m.normalScale = r.get<float>();
+      if (!(m.alphaFactor >= 0.0f && m.alphaFactor <= 1.0f && m.alphaCutoff >= 0.0f && m.alphaCutoff <= 1.0f) ||
+          !std::isfinite(m.normalScale))
+        r.corrupt(fmt::format("material '{}' has alpha {}, cutoff {}, normal scale {}", m.name, m.alphaFactor,
+                              m.alphaCutoff, m.normalScale));
+    }
+    for (Texture& t : scene.textures) {
+      const uint8_t decode = r.get<uint8_t>();
+      if (decode > uint8_t(ImageDecode::Coverage))
+        r.corrupt(fmt::format("texture '{}' has unknown decoding {}", t.path, decode));
+      t.decode = ImageDecode(decode);
+    }
+  }
   r.expectEnd();
+  if (textures == TextureDecoding::Decode)
+    for (Texture& t : scene.textures) {
+      if (!t.encoded) continue;  // stored as pixels: checked above
+      const std::string label = fmt::format("{}: texture '{}' embedded in the scene section", path, t.path);
+      t.image = decodeLdrImage(*t.encoded, label, t.decode);  // size checked before decoding
+      t.finish(path);
+    }
 
   // Cross-references. The writer only ever stores a finalized scene, so any violation means
   // the file was produced by something else or damaged in a way the checksum missed.
@@ -552,8 +592,9 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
     m.positions.reserve(vertices + 1);
   }
   for (const Material& m : scene.materials)
-    if (m.albedoTexture < -1 || m.albedoTexture >= int64_t(scene.textures.size()))
-      r.corrupt(fmt::format("material '{}' uses texture {} of {}", m.name, m.albedoTexture, scene.textures.size()));
+    for (const int texture : {m.albedoTexture, m.alphaTexture, m.normalTexture})
+      if (texture < -1 || texture >= int64_t(scene.textures.size()))
+        r.corrupt(fmt::format("material '{}' uses texture {} of {}", m.name, texture, scene.textures.size()));
   return scene;
 }
 

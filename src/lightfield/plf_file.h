@@ -29,9 +29,14 @@
 //         cameras, the environment (constant and lat-long map with its scale and rotation)
 //         and the scene file's suggested settings. Everything a renderer needs. A texture
 //         is its path, a storage byte and either (1) the bytes of its image file as the
-//         scene had it (PNG/JPEG/TGA/BMP, decoded on load with decodeLdrImage: the pixels the
-//         scene loader had) or (0) float32 RGB pixels (textures from HDR files); see
-//         encodeScene in plf_file.cpp.
+//         scene had it (PNG/JPEG/TGA/BMP, decoded on load with decodeLdrImage as the texture's
+//         ImageDecode says: the pixels the scene loader had) or (0) float32 RGB pixels
+//         (textures from HDR files); see encodeScene in plf_file.cpp. Optionally followed by
+//         a surface-detail block, written only when a material has an alpha mask or a normal
+//         map: u32 tag "SDTL", then per material i32 alphaTexture, f32 alphaFactor,
+//         f32 alphaCutoff, i32 normalTexture, f32 normalScale, then per texture u8 ImageDecode
+//         (image.h: 0 colour, 1 data, 2 coverage). Without the block materials have no mask
+//         or normal map and textures are colour.
 //   CHRT  the charts: u64 count, then fixed 85-byte records (see encodeCharts in plf_file.cpp).
 //   TRCH  triangle → chart: u64 mesh count, then per mesh u64 triangle count + u32 indices.
 //   VALS  the values: float32 RGB triplets (12 bytes each), in LightField::values order.

@@ -780,5 +780,58 @@ TEST_F(PlfFileTest, TwoSidedChartsRoundTripAndBrokenPairsAreRefused) {
   }
 }
 
+// Alpha masks and normal maps travel in SCNE's optional surface-detail block: every field and
+// every texture's decoding come back; a value out of range in it is refused.
+TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {
+  LightField original = makeTestLightField();
+  Scene& s = original.scene;
+  Texture mask = s.textures[0], normals = s.textures[0];
+  mask.path = "textures/mask.png";
+  mask.decode = ImageDecode::Coverage;
+  normals.path = "textures/normals.png";
+  normals.decode = ImageDecode::Data;
+  s.textures.push_back(mask);
+  s.textures.push_back(normals);
+  s.materials[0].alphaTexture = 1;
+  s.materials[0].alphaFactor = 0.9f;
+  s.materials[0].alphaCutoff = 0.3f;
+  s.materials[2].normalTexture = 2;
+  s.materials[2].normalScale = 0.7f;
+  const std::string path = file("detail.plf");
+  writeLightField(path, original);
+  const LightField copy = readLightField(path);
+  ASSERT_EQ(copy.scene.materials.size(), s.materials.size());
+  for (size_t m = 0; m < s.materials.size(); ++m) {
+    const Material &a = s.materials[m], &b = copy.scene.materials[m];
+    EXPECT_EQ(b.alphaTexture, a.alphaTexture) << m;
+    EXPECT_EQ(b.alphaFactor, a.alphaFactor) << m;
+    EXPECT_EQ(b.alphaCutoff, a.alphaCutoff) << m;
+    EXPECT_EQ(b.normalTexture, a.normalTexture) << m;
+    EXPECT_EQ(b.normalScale, a.normalScale) << m;
+  }
+  ASSERT_EQ(copy.scene.textures.size(), 3u);
+  EXPECT_EQ(copy.scene.textures[0].decode, ImageDecode::Colour);
+  EXPECT_EQ(copy.scene.textures[1].decode, ImageDecode::Coverage);
+  EXPECT_EQ(copy.scene.textures[2].decode, ImageDecode::Data);
+  EXPECT_EQ(copy.scene.textures[1].image.pixels, mask.image.pixels);
+
+  // The block ends SCNE: 5 materials × 20 bytes, then 3 decoding bytes. Material 0's alpha
+  // factor (4 bytes into its record) set to 2, and a decoding byte set to 9: both refused.
+  const auto good = readBytes(path);
+  const auto table = sections(good);
+  const uint64_t blockEnd = table[0].offset + table[0].size;
+  auto bad = good;
+  const float two = 2.0f;
+  std::memcpy(bad.data() + blockEnd - 3 - 5 * 20 + 4, &two, 4);
+  resign(bad);
+  writeBytes(file("alpha.plf"), bad);
+  expectRefused(file("alpha.plf"), {"scene section", "material 'white' has alpha 2"});
+  bad = good;
+  bad[blockEnd - 1] = 9;
+  resign(bad);
+  writeBytes(file("decode.plf"), bad);
+  expectRefused(file("decode.plf"), {"scene section", "unknown decoding 9"});
+}
+
 }  // namespace
 }  // namespace pl

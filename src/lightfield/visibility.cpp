@@ -185,6 +185,23 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
       h.value(uint8_t(glass->thin));
       h.value(glass->absorption);
     }
+    // An alpha mask changes what every ray sees; a normal map bends the specular chains
+    // (followSpecular shades with surfaceAt's mapped normal), not the other charts' rays.
+    auto texture = [&](int index) {
+      const Image& image = scene.textures[size_t(index)].image;
+      h.value(image.width);
+      h.value(image.height);
+      h.bytes(image.pixels.data(), image.pixels.size() * sizeof(Rgb));
+    };
+    if (m.isMasked()) {
+      h.value(m.alphaFactor);
+      h.value(m.alphaCutoff);
+      if (m.alphaTexture >= 0) texture(m.alphaTexture);
+    }
+    if (m.normalTexture >= 0 && chartKindOf(m.bsdf) == ChartKind::Specular) {
+      h.value(m.normalScale);
+      texture(m.normalTexture);
+    }
   }
   for (const Chart& c : param.charts) {
     h.value(c.material);

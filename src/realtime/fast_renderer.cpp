@@ -185,10 +185,11 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       chart = chartOf(i);
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
-        Vec2 uv(0.0f);
-        if (shading[chart].needsUv) uv = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics).uv;
+        Vec2 uv;
+        Vec3 lookup;
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, uv, lookup);
         const F4 lanes =
-            exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, -ray.direction, uv);
+            exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup, uv);
         if (spp == 1) {
           // The pixel, straight from the lanes (weight > 0 here): pixelValue's weight × radiance.
           f4StoreRgb(out + s.pixel[i], f4Mul(f4Splat(s.weight[i]), lanes));
@@ -233,10 +234,11 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const uint32_t chart = facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -ray.direction);
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
-        Vec2 uv(0.0f);
-        if (shading[chart].needsUv) uv = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics).uv;
+        Vec2 uv;
+        Vec3 lookup;
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, uv, lookup);
         s.radiance[slot] +=
-            throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, -ray.direction, uv);
+            throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup, uv);
         continue;
       }
       Rgb emitted;

@@ -12,7 +12,7 @@
 //        f0      = mix(0.04, baseColor, metallic)        (0.04: dielectric F0 of the spec)
 //        alpha   = max(roughness², 1e-3)                 (GGX α; the floor keeps the
 //                                                         microfacet distribution finite)
-//    baseColor = baseColorFactor.rgb (alpha ignored); baseColorTexture → albedo texture
+//    baseColor = baseColorFactor.rgb; baseColorTexture → albedo texture
 //    multiplying `diffuse` (so it tints dielectrics; a metal's f0 keeps the factor only), its
 //    sRGB 8/16-bit texels decoded to linear; v is flipped to our bottom-left convention
 //    (uv_ours = (u, 1 − v)) since glTF's (0,0) is the image's top-left. A primitive without a
@@ -24,6 +24,12 @@
 //    surface is a thin sheet (smooth); with a thickness it is a closed volume whose
 //    attenuationColor c and attenuationDistance d give the absorption σa = −ln(c)/d.
 //    transmissionTexture, thicknessTexture and a baseColorTexture on it are ignored (warning).
+//  * alphaMode MASK → alpha mask: coverage = baseColorFactor.a × the baseColorTexture's alpha
+//    channel (1 when its image has none), cut at alphaCutoff (default 0.5). BLEND is read as
+//    MASK with cutoff 0.5 (warning): ray casting has no partial coverage. OPAQUE (the
+//    default) ignores alpha.
+//  * normalTexture → tangent-space normal map (raw values, no sRGB decoding; +x = +u,
+//    +y = up the image = +v after the flip), `scale` → normalScale (scene.h normalMapped).
 //  * emissiveFactor × KHR_materials_emissive_strength.emissiveStrength → emitted radiance in
 //    W·sr⁻¹·m⁻²; doubleSided materials emit from both sides.
 //  * Perspective cameras: yfov (radians) and aspectRatio; the camera looks down its node's
@@ -48,6 +54,7 @@
 #include <cctype>
 #include <cstring>
 #include <filesystem>
+#include <map>
 
 namespace pl::detail {
 
@@ -65,7 +72,7 @@ struct GltfContext {
   /// Each glTF image's encoded bytes (PNG/JPEG as in its file, data URI or buffer view), kept by
   /// keepEncodedImage instead of tinygltf's decoding; decoded by us when a material uses it.
   const std::vector<std::vector<unsigned char>>& encodedImages;
-  std::vector<int> textureOfImage;  ///< scene texture index per glTF image (-1 until used)
+  std::map<std::pair<int, ImageDecode>, int> textureOfImage;  ///< scene texture per (glTF image, decoding)
   int defaultMaterial = -1;
   int unnamedCameras = 0;
 };
@@ -181,16 +188,19 @@ Mat4 localTransform(const tinygltf::Node& node) {
   return m;
 }
 
-int textureFor(GltfContext& ctx, int textureIndex) {
+/// The encoded bytes of the glTF image behind texture `textureIndex` (its file, data URI or
+/// buffer view, as keepEncodedImage kept them), checked: present. `source` is the glTF image
+/// index, `label` names it in messages.
+const std::vector<unsigned char>& textureImageBytes(GltfContext& ctx, int textureIndex, int& source,
+                                                   std::string& label) {
   const tinygltf::Model& model = ctx.model;
   if (textureIndex < 0 || size_t(textureIndex) >= model.textures.size())
     fail("{}: texture {} does not exist", ctx.path, textureIndex);
-  const int source = model.textures[size_t(textureIndex)].source;
+  source = model.textures[size_t(textureIndex)].source;
   if (source < 0 || size_t(source) >= model.images.size())
     fail("{}: texture {} has no image source", ctx.path, textureIndex);
-  if (ctx.textureOfImage[size_t(source)] >= 0) return ctx.textureOfImage[size_t(source)];
   const tinygltf::Image& gltfImage = model.images[size_t(source)];
-  const std::string label = gltfImage.uri.empty() ? fmt::format("image {}", source) : gltfImage.uri;
+  label = gltfImage.uri.empty() ? fmt::format("image {}", source) : gltfImage.uri;
   const std::vector<unsigned char>* bytes =
       size_t(source) < ctx.encodedImages.size() ? &ctx.encodedImages[size_t(source)] : nullptr;
   if (!bytes || bytes->empty()) {
@@ -201,13 +211,60 @@ int textureFor(GltfContext& ctx, int textureIndex) {
     }
     fail("{}: texture image '{}' could not be read", ctx.path, label);
   }
-  // baseColorTexture is sRGB-encoded (glTF spec 3.9.2), as decodeLdrImage assumes; grey images
-  // repeat their single channel.
-  Texture texture = textureFromEncoded(label, *bytes, fmt::format("{}: texture image '{}'", ctx.path, label));
+  return *bytes;
+}
+
+/// Whether the image of texture `textureIndex` has an alpha channel (grey + alpha or RGBA)
+/// with a value below opaque: an all-opaque alpha channel is treated as none (it could cut
+/// nothing).
+bool textureHasAlpha(GltfContext& ctx, int textureIndex) {
+  int source = 0;
+  std::string label;
+  const std::vector<unsigned char>& bytes = textureImageBytes(ctx, textureIndex, source, label);
+  if (!ldrImageHasAlphaChannel(bytes)) return false;
+  const Image alpha = decodeLdrImage(bytes, fmt::format("{}: texture image '{}'", ctx.path, label), ImageDecode::Coverage);
+  return std::any_of(alpha.pixels.begin(), alpha.pixels.end(), [](const Rgb& a) { return a.r < 1.0f; });
+}
+
+/// The scene texture for glTF texture `textureIndex` decoded as `decode` (image.h): sRGB
+/// colour for baseColorTexture (glTF spec 3.9.2), raw values for normalTexture, the alpha
+/// channel for alpha masks. One scene texture per (image, decoding); it keeps the image's
+/// encoded bytes for the .plf.
+int textureFor(GltfContext& ctx, int textureIndex, ImageDecode decode = ImageDecode::Colour) {
+  int source = 0;
+  std::string label;
+  const std::vector<unsigned char>& bytes = textureImageBytes(ctx, textureIndex, source, label);
+  if (auto it = ctx.textureOfImage.find({source, decode}); it != ctx.textureOfImage.end()) return it->second;
+  Texture texture = textureFromEncoded(label, bytes, fmt::format("{}: texture image '{}'", ctx.path, label), decode);
   const int ours = int(ctx.scene.textures.size());
   ctx.scene.textures.push_back(std::move(texture));
-  ctx.textureOfImage[size_t(source)] = ours;
+  ctx.textureOfImage[{source, decode}] = ours;
   return ours;
+}
+
+/// alphaMode MASK / BLEND → an alpha mask; normalTexture → a normal map (see the header).
+void applyAlphaAndNormals(GltfContext& ctx, const tinygltf::Material& gltf, Material& material) {
+  const auto& pbr = gltf.pbrMetallicRoughness;
+  if (gltf.alphaMode == "MASK" || gltf.alphaMode == "BLEND") {
+    if (gltf.alphaMode == "BLEND")
+      spdlog::warn("{}: material '{}': alphaMode BLEND is rendered as MASK with cutoff 0.5 (no partial coverage)",
+                   ctx.path, material.name);
+    material.alphaCutoff = gltf.alphaMode == "MASK" ? float(gltf.alphaCutoff) : 0.5f;
+    if (!(material.alphaCutoff >= 0.0f && material.alphaCutoff <= 1.0f))
+      fail("{}: material '{}': alphaCutoff {} must be in [0, 1]", ctx.path, material.name, gltf.alphaCutoff);
+    material.alphaFactor = pbr.baseColorFactor.size() >= 4 ? std::clamp(float(pbr.baseColorFactor[3]), 0.0f, 1.0f) : 1.0f;
+    if (pbr.baseColorTexture.index >= 0 && textureHasAlpha(ctx, pbr.baseColorTexture.index))
+      material.alphaTexture = textureFor(ctx, pbr.baseColorTexture.index, ImageDecode::Coverage);
+  } else if (!gltf.alphaMode.empty() && gltf.alphaMode != "OPAQUE") {
+    fail("{}: material '{}': unknown alphaMode '{}' (OPAQUE, MASK or BLEND)", ctx.path, material.name, gltf.alphaMode);
+  }
+  if (gltf.normalTexture.index >= 0) {
+    if (gltf.normalTexture.texCoord != 0)
+      spdlog::warn("{}: material '{}': normalTexture uses TEXCOORD_{}, only TEXCOORD_0 is read", ctx.path,
+                   material.name, gltf.normalTexture.texCoord);
+    material.normalTexture = textureFor(ctx, gltf.normalTexture.index, ImageDecode::Data);
+    material.normalScale = float(gltf.normalTexture.scale);
+  }
 }
 
 /// A number of an extension object, or `fallback` when absent.
@@ -282,6 +339,7 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
     material.albedoTexture = textureFor(ctx, pbr.baseColorTexture.index);
   }
   applyTransmission(ctx, gltf, material, baseColor, roughness);
+  applyAlphaAndNormals(ctx, gltf, material);
   if (gltf.emissiveFactor.size() >= 3) {
     float strength = 1.0f;
     if (auto it = gltf.extensions.find("KHR_materials_emissive_strength"); it != gltf.extensions.end()) {
@@ -471,7 +529,7 @@ Scene loadGltf(const std::string& path) {
 
   Scene scene;
   scene.sourcePath = path;
-  GltfContext ctx{path, model, scene, encodedImages, std::vector<int>(model.images.size(), -1)};
+  GltfContext ctx{path, model, scene, encodedImages, {}};
   for (size_t m = 0; m < model.materials.size(); ++m)
     scene.materials.push_back(convertMaterial(ctx, model.materials[m], int(m)));
 

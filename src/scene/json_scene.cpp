@@ -21,7 +21,10 @@
 //              "texture": "albedo.png"}
 //           | {"type": "ggx",         "diffuse": [r,g,b], "f0": [r,g,b],
 //              "alpha": a | "roughness": r (alpha = r²), "texture": "albedo.png"}
-//       (+ for every type: "emission": [r,g,b] radiance in W·sr⁻¹·m⁻², "two_sided": false)
+//       (+ for every type: "emission": [r,g,b] radiance in W·sr⁻¹·m⁻², "two_sided": false,
+//        "alpha_texture": "mask.png" (cut-out: its alpha channel, or its first channel without
+//        one), "alpha_cutoff": 0.5 (no surface where coverage < cutoff),
+//        "normal_texture": "normals.png" (tangent-space, OpenGL +y = +v), "normal_scale": 1)
 //     A material whose name equals a material of a loaded file replaces it there.
 //   },
 //   "lights": [ {"type": "point", "position": [..], "intensity": [r,g,b] | I}      // W·sr⁻¹
@@ -139,11 +142,12 @@ Mat4 parseTransform(const JsonContext& ctx, const json& value, const std::string
   return m;
 }
 
-int loadTexture(const JsonContext& ctx, Scene& scene, const json& value, const std::string& where) {
+int loadTexture(const JsonContext& ctx, Scene& scene, const json& value, const std::string& where,
+                ImageDecode decode = ImageDecode::Colour) {
   const fs::path file = ctx.dir / stringOf(ctx, value, where);
   if (const std::string problem = inputFileProblem(file); !problem.empty())
     fail("{}: {}: texture file '{}' {}", ctx.path, where, file.string(), problem);
-  scene.textures.push_back(loadTextureFile(file.string()));
+  scene.textures.push_back(loadTextureFile(file.string(), decode));
   return int(scene.textures.size()) - 1;
 }
 
@@ -157,7 +161,8 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
   material.name = name;
   material.emission = colourOr(ctx, value, "emission", Rgb(0.0f), where);
   material.twoSidedEmission = boolOr(ctx, value, "two_sided", false, where);
-  std::set<std::string> known = {"type", "emission", "two_sided"};
+  std::set<std::string> known = {"type", "emission", "two_sided", "alpha_texture", "alpha_cutoff", "normal_texture",
+                                  "normal_scale"};
   if (type == "lambert") {
     material.bsdf = LambertBsdf{colourOr(ctx, value, "albedo", Rgb(0.8f), where)};
     known.insert({"albedo", "texture"});
@@ -201,6 +206,18 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
   }
   checkKeys(ctx, value, known, where);
   if (const json* texture = find(value, "texture")) material.albedoTexture = loadTexture(ctx, scene, *texture, where + ".texture");
+  if (const json* texture = find(value, "alpha_texture"))
+    material.alphaTexture = loadTexture(ctx, scene, *texture, where + ".alpha_texture", ImageDecode::Coverage);
+  material.alphaCutoff = numberOr(ctx, value, "alpha_cutoff", material.alphaCutoff, where);
+  if (!(material.alphaCutoff >= 0.0f && material.alphaCutoff <= 1.0f))
+    fail("{}: {}: alpha_cutoff {} must be in [0, 1]", ctx.path, where, material.alphaCutoff);
+  if (find(value, "alpha_cutoff") && material.alphaTexture < 0)
+    fail("{}: {}: alpha_cutoff needs an alpha_texture", ctx.path, where);
+  if (const json* texture = find(value, "normal_texture"))
+    material.normalTexture = loadTexture(ctx, scene, *texture, where + ".normal_texture", ImageDecode::Data);
+  material.normalScale = numberOr(ctx, value, "normal_scale", material.normalScale, where);
+  if (find(value, "normal_scale") && material.normalTexture < 0)
+    fail("{}: {}: normal_scale needs a normal_texture", ctx.path, where);
   // Checked here, not only by Scene::finalize(): a JSON material enters the scene only where
   // it is used, and an unused one that creates energy is still a mistake in the file.
   validateMaterial(material, ctx.path);

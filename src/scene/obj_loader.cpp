@@ -24,6 +24,11 @@
 //  * Ke → emitted radiance (front side). map_Kd → albedo texture multiplying Kd (a Kd of
 //    exactly 0 next to a map_Kd is read as 1, the usual exporter habit), path relative to the
 //    MTL file, PNG/JPG decoded from sRGB by readImage().
+//  * map_d → alpha mask (Material::alphaTexture, cutoff 0.5): the image's alpha channel, or its
+//    first channel when it has none, times d. A scalar d < 1 without map_d is thin glass (above).
+//  * norm, or map_bump/bump when there is no norm → tangent-space normal map
+//    (Material::normalTexture, read without sRGB decoding), -bm → normalScale. A grey
+//    map_bump is a height map: warned about and ignored.
 //  * A missing .mtl file: warning, and its materials become a grey Lambert (albedo 0.8).
 #include "core/error.h"
 #include "core/file_io.h"
@@ -194,7 +199,7 @@ Material convertMaterial(const tinyobj::material_t& mtl, const std::string& mtlP
   const Rgb tf = rgbOf(mtl.transmittance);
   const bool refracts = mtl.illum == 4 || mtl.illum == 6 || mtl.illum == 7 ||
                         (mtl.illum == 0 && mtl.ior > 1.0 && !isBlack(tf));
-  const bool thinGlass = !refracts && mtl.dissolve < 1.0f;
+  const bool thinGlass = !refracts && mtl.dissolve < 1.0f && mtl.alpha_texname.empty();
   if (refracts || thinGlass) {
     DielectricBsdf glass;
     glass.ior = mtl.ior > 1.0 ? float(mtl.ior) : 1.5f;
@@ -207,25 +212,55 @@ Material convertMaterial(const tinyobj::material_t& mtl, const std::string& mtlP
     return material;
   }
 
+  // A texture file named in the MTL, resolved against the MTL file's directory (the first
+  // library directory holding it), read once per (file, decoding).
+  auto texture = [&](const std::string& name, ImageDecode decode, const char* key) {
+    fs::path resolved = mtlDirs.empty() ? fs::path(name) : mtlDirs.front() / name;
+    for (const fs::path& dir : mtlDirs)
+      if (inputFileProblem(dir / name).empty()) {
+        resolved = dir / name;
+        break;
+      }
+    const std::string file = resolved.lexically_normal().string();
+    if (const std::string problem = inputFileProblem(resolved); !problem.empty())
+      fail("{}: material '{}': {} texture file '{}' {}", mtlPath, mtl.name, key, file, problem);
+    auto [it, inserted] = textureIndex.try_emplace(fmt::format("{}\n{}", int(decode), file), int(scene.textures.size()));
+    if (inserted) {
+      scene.textures.push_back(loadTextureFile(file, decode));
+    }
+    return it->second;
+  };
+
   if (!mtl.diffuse_texname.empty()) {
     if (mirrorLike) spdlog::warn("{}: material '{}': map_Kd ignored on a mirror", mtlPath, mtl.name);
     else {
-      // Resolve against the MTL file's directory (the first library directory holding it).
-      fs::path resolved = mtlDirs.empty() ? fs::path(mtl.diffuse_texname) : mtlDirs.front() / mtl.diffuse_texname;
-      for (const fs::path& dir : mtlDirs)
-        if (inputFileProblem(dir / mtl.diffuse_texname).empty()) {
-          resolved = dir / mtl.diffuse_texname;
-          break;
-        }
-      const std::string key = resolved.lexically_normal().string();
-      if (const std::string problem = inputFileProblem(resolved); !problem.empty())
-        fail("{}: material '{}': texture file '{}' {}", mtlPath, mtl.name, key, problem);
-      auto [it, inserted] = textureIndex.try_emplace(key, int(scene.textures.size()));
-      if (inserted) {
-        scene.textures.push_back(loadTextureFile(key));
-      }
-      material.albedoTexture = it->second;
+      material.albedoTexture = texture(mtl.diffuse_texname, ImageDecode::Colour, "map_Kd");
       if (isBlack(kd)) kd = Rgb(1.0f);
+    }
+  }
+  // map_d: an alpha mask, cut out below coverage 0.5 (alpha channel, or the first channel of
+  // an image without one).
+  if (!mtl.alpha_texname.empty()) {
+    material.alphaTexture = texture(mtl.alpha_texname, ImageDecode::Coverage, "map_d");
+    material.alphaFactor = std::clamp(float(mtl.dissolve), 0.0f, 1.0f);
+  }
+  // norm, or map_bump / bump holding a tangent-space normal map (what exporters and Crytek's
+  // Sponza put there); -bm scales its x and y. A grey bump map is a height field, which this
+  // renderer does not read: warned and ignored.
+  const bool normalFromBump = mtl.normal_texname.empty() && !mtl.bump_texname.empty();
+  const std::string& normalName = normalFromBump ? mtl.bump_texname : mtl.normal_texname;
+  if (!normalName.empty()) {
+    const tinyobj::texture_option_t& option = normalFromBump ? mtl.bump_texopt : mtl.normal_texopt;
+    const int index = texture(normalName, ImageDecode::Data, normalFromBump ? "map_bump" : "norm");
+    const Image& image = scene.textures[size_t(index)].image;
+    const bool grey = std::all_of(image.pixels.begin(), image.pixels.end(),
+                                  [](const Rgb& p) { return p.r == p.g && p.g == p.b; });
+    if (grey) {
+      spdlog::warn("{}: material '{}': '{}' is a grey height (bump) map; only normal maps are read, ignored", mtlPath,
+                   mtl.name, normalName);
+    } else {
+      material.normalTexture = index;
+      material.normalScale = float(option.bump_multiplier);
     }
   }
 

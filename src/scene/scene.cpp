@@ -151,20 +151,23 @@ void Texture::finish(const std::string& sceneSource) {
   average = sum / float(image.pixels.size());
 }
 
-Texture loadTextureFile(const std::string& path) {
-  ImageFile file = readImageFile(path);
+Texture loadTextureFile(const std::string& path, ImageDecode decode) {
+  ImageFile file = readImageFile(path, decode);
   Texture texture;
   texture.path = path;
+  texture.decode = decode;
   texture.image = std::move(file.image);
   if (!file.ldrBytes.empty())
     texture.encoded = std::make_shared<const std::vector<unsigned char>>(std::move(file.ldrBytes));
   return texture;
 }
 
-Texture textureFromEncoded(std::string path, std::vector<unsigned char> bytes, const std::string& label) {
+Texture textureFromEncoded(std::string path, std::vector<unsigned char> bytes, const std::string& label,
+                           ImageDecode decode) {
   Texture texture;
   texture.path = std::move(path);
-  texture.image = decodeLdrImage(bytes, label);
+  texture.decode = decode;
+  texture.image = decodeLdrImage(bytes, label, decode);
   texture.encoded = std::make_shared<const std::vector<unsigned char>>(std::move(bytes));
   return texture;
 }
@@ -187,9 +190,16 @@ void Scene::finalize() {
       fail("{}: material '{}' has an emission {} above {:g} W/(sr m^2), too large to compute with", src,
            material.name, vecString(material.emission), kMaxEmission);
     validateMaterial(material, sourcePath);
-    if (material.albedoTexture < -1 || material.albedoTexture >= int(textures.size()))
-      fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name,
-           material.albedoTexture, textures.size());
+    for (const int texture : {material.albedoTexture, material.alphaTexture, material.normalTexture})
+      if (texture < -1 || texture >= int(textures.size()))
+        fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name, texture,
+             textures.size());
+    if (!(material.alphaFactor >= 0.0f && material.alphaFactor <= 1.0f) ||
+        !(material.alphaCutoff >= 0.0f && material.alphaCutoff <= 1.0f))
+      fail("{}: material '{}' has alpha {} and alpha cutoff {}; both must be in [0, 1]", src, material.name,
+           material.alphaFactor, material.alphaCutoff);
+    if (!std::isfinite(material.normalScale))
+      fail("{}: material '{}' has a non-finite normal-map scale", src, material.name);
   }
   for (Texture& texture : textures) texture.finish(src);
 
@@ -351,7 +361,49 @@ SurfaceHit surfaceAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, 
   }
   // Without texture coordinates uv are the barycentrics, so a texture still maps somewhere.
   hit.uv = mesh.uvs.empty() ? Vec2(b1, b2) : b0 * mesh.uvs[tri.x] + b1 * mesh.uvs[tri.y] + b2 * mesh.uvs[tri.z];
+  const Material& material = scene.materials[hit.material];
+  if (material.normalTexture >= 0 && !mesh.uvs.empty()) {
+    const Vec3 p[3] = {p0, p1, p2};
+    const Vec2 uv[3] = {mesh.uvs[tri.x], mesh.uvs[tri.y], mesh.uvs[tri.z]};
+    hit.shadingNormal = normalMapped(hit.shadingNormal, hit.geometricNormal, p, uv,
+                                     scene.textures[size_t(material.normalTexture)].sample(hit.uv), material.normalScale);
+  }
   return hit;
+}
+
+Vec3 normalMapped(const Vec3& n, const Vec3& geometricNormal, const Vec3 (&p)[3], const Vec2 (&uv)[3], Rgb texel,
+                  float scale) {
+  // p − p0 = dp/du·(u − u0) + dp/dv·(v − v0) on the triangle; solve the 2×2 system of its
+  // two edges for dp/du and dp/dv.
+  const Vec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
+  const Vec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
+  const float det = d1.x * d2.y - d1.y * d2.x;
+  if (!(std::abs(det) > 1e-12f)) return n;
+  const Vec3 dpdu = (e1 * d2.y - e2 * d1.y) / det;
+  const Vec3 dpdv = (e2 * d1.x - e1 * d2.x) / det;
+  Vec3 t = dpdu - n * glm::dot(n, dpdu);
+  const float tLength = glm::length(t);
+  if (!(tLength > 0.0f) || !std::isfinite(tLength)) return n;
+  t /= tLength;
+  const Vec3 b = glm::dot(glm::cross(n, t), dpdv) < 0.0f ? -glm::cross(n, t) : glm::cross(n, t);
+  const Vec3 m(scale * (2.0f * texel.r - 1.0f), scale * (2.0f * texel.g - 1.0f), 2.0f * texel.b - 1.0f);
+  const Vec3 mapped = m.x * t + m.y * b + m.z * n;
+  const float length = glm::length(mapped);
+  if (!(length > 0.0f) || !std::isfinite(length)) return n;
+  const Vec3 result = mapped / length;
+  return glm::dot(result, geometricNormal) > 0.01f ? result : n;
+}
+
+float coverageAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, Vec2 barycentrics) {
+  const Mesh& mesh = scene.meshes[meshIndex];
+  const Material& material = scene.materials[mesh.materials[triangle]];
+  if (material.alphaTexture < 0) return material.alphaFactor;
+  // Only uv is needed: interpolate it without the rest of surfaceAt (this runs per candidate
+  // hit inside Embree's traversal).
+  const UVec3 tri = mesh.triangles[triangle];
+  const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.0f - b1 - b2;
+  const Vec2 uv = mesh.uvs.empty() ? Vec2(b1, b2) : b0 * mesh.uvs[tri.x] + b1 * mesh.uvs[tri.y] + b2 * mesh.uvs[tri.z];
+  return material.alphaFactor * scene.textures[size_t(material.alphaTexture)].sample(uv).r;
 }
 
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit) {

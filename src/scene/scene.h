@@ -16,10 +16,14 @@
 
 namespace pl {
 
-/// An sRGB-decoded (linear) RGB texture, sampled bilinearly with wrap-around (repeat).
+/// A linear RGB texture, sampled bilinearly with wrap-around (repeat).
 /// uv = (0,0) is the *bottom-left* of the image (OBJ/OpenGL convention); glTF loaders flip v.
+/// `decode` says what the file's channels became (image.h): sRGB-decoded colour for albedo
+/// textures, raw values for normal maps, the alpha channel (coverage in [0, 1], in all three
+/// channels) for alpha masks. One file used in two roles is two textures.
 struct Texture {
   std::string path;
+  ImageDecode decode = ImageDecode::Colour;
   Image image;
   /// The image file's own bytes (PNG/JPEG/TGA/BMP as found on disk or in a glTF buffer), from
   /// which `image` was decoded by decodeLdrImage; null for textures read from HDR files, which
@@ -47,8 +51,22 @@ struct Material {
   /// given by the triangle's winding, counter-clockwise = front) unless twoSided.
   Rgb emission{0.0f};
   bool twoSidedEmission = false;
+  /// Alpha mask (cut-out): coverage α = alphaFactor × (alphaTexture's coverage at uv, or 1
+  /// without one). Where α < alphaCutoff the surface is not there at all: ray casting (Accel)
+  /// skips the hit, so every renderer, shadow ray and the bake see through it. alphaTexture is
+  /// an index into Scene::textures (decoded as ImageDecode::Coverage) or -1.
+  int alphaTexture = -1;
+  float alphaFactor = 1.0f;
+  float alphaCutoff = 0.5f;
+  /// Tangent-space normal map (index into Scene::textures, ImageDecode::Data) or -1: a texel
+  /// t ∈ [0,1]³ is the normal (2t − 1) in the frame (tangent = +u, bitangent = +v, shading
+  /// normal), its x and y scaled by normalScale (glTF `scale`, MTL `-bm`). See surfaceAt().
+  int normalTexture = -1;
+  float normalScale = 1.0f;
 
   bool isEmissive() const { return !isBlack(emission); }
+  /// Whether some of the surface may be cut away (the Accel filters hits on it).
+  bool isMasked() const { return alphaTexture >= 0 || alphaFactor < alphaCutoff; }
 };
 
 /// The sidedness rule for emission, written once for the path tracer, the bake and the
@@ -197,11 +215,12 @@ std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene);
 
 /// A texture read from an image file (any format readImage reads), keeping the bytes of
 /// 8-bit formats in `encoded`. Scene loaders call it; errors name the file.
-Texture loadTextureFile(const std::string& path);
+Texture loadTextureFile(const std::string& path, ImageDecode decode = ImageDecode::Colour);
 
 /// A texture decoded from an 8-bit image file's bytes (a glTF buffer, a .plf's scene section):
 /// path is what the texture is called, label prefixes decoding errors.
-Texture textureFromEncoded(std::string path, std::vector<unsigned char> bytes, const std::string& label);
+Texture textureFromEncoded(std::string path, std::vector<unsigned char> bytes, const std::string& label,
+                           ImageDecode decode = ImageDecode::Colour);
 
 /// Loads `cornell`, .obj, .gltf/.glb or .json (see README for the JSON schema).
 /// Throws pl::Error with the file name and the problem for any malformed input.
@@ -220,8 +239,25 @@ struct SurfaceHit {
 };
 
 /// Surface data at barycentrics (b1, b2) of triangle `triangle` of mesh `mesh`
-/// (point = (1−b1−b2)·p0 + b1·p1 + b2·p2, as Embree reports u, v).
+/// (point = (1−b1−b2)·p0 + b1·p1 + b2·p2, as Embree reports u, v). With a normal map the
+/// shading normal is the mapped one (normalMapped), so the path tracer, mirror chains and the
+/// renderers all shade with it.
 SurfaceHit surfaceAt(const Scene& scene, uint32_t mesh, uint32_t triangle, Vec2 barycentrics);
+
+/// The shading normal n perturbed by a tangent-space normal-map texel t ∈ [0,1]³ (as sampled
+/// from an ImageDecode::Data texture): m = 2t − 1, m.xy × scale, n' = normalize(m.x T + m.y B
+/// + m.z n). The tangent frame comes from the triangle's uv derivatives (one per triangle,
+/// as MikkTSpace does per face without its vertex averaging): dp/du Gram-Schmidt
+/// orthogonalised against n gives T, B = ±n × T with the sign of the uv mapping's handedness
+/// (mirrored uvs keep +v). Returns n unchanged when the uvs are degenerate (no frame) or when
+/// n' would fall behind the geometric surface (dot(n', ng) ≤ 0.01): the sidedness rule needs
+/// the shading normal on the geometric normal's side.
+Vec3 normalMapped(const Vec3& shadingNormal, const Vec3& geometricNormal, const Vec3 (&p)[3], const Vec2 (&uv)[3],
+                  Rgb texel, float scale);
+
+/// The alpha mask's coverage at barycentrics (b1, b2) of a triangle: alphaFactor × texture
+/// coverage at the interpolated uv (1 for unmasked materials). The Accel's hit filter.
+float coverageAt(const Scene& scene, uint32_t mesh, uint32_t triangle, Vec2 barycentrics);
 
 /// The sidedness rule for scattering, written once for the path tracer, the bake's specular
 /// chains and the renderers. A reflecting BSDF is two-sided: both normals are turned to the

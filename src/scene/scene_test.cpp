@@ -5,12 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <regex>
 #include <string>
+#include <tuple>
 
 namespace pl {
 namespace {
@@ -952,6 +954,201 @@ TEST(BadInput, JsonMeshFileProblemsNameBothFiles) {
   const fs::path dir = scratchDir("json_mesh");
   const std::string path = writeFile(dir / "s.json", R"({"meshes": [{"file": "missing.obj"}]})");
   expectError([&] { loadScene(path); }, {"s.json", "meshes[0]", "missing.obj", "no such file"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Surface detail: alpha masks and normal maps
+
+/// oneTriangle() with uvs = positions' xy (dp/du = +x, dp/dv = +y) and a constant normal map
+/// holding `texel` (raw values, as ImageDecode::Data gives them).
+Scene normalMappedTriangle(Rgb texel, float scale, bool mirroredU = false) {
+  Scene scene = oneTriangle();
+  scene.meshes[0].uvs = {Vec2(0, 0), Vec2(mirroredU ? -1.0f : 1.0f, 0), Vec2(0, 1)};
+  Texture map;
+  map.path = "constant normal map";
+  map.decode = ImageDecode::Data;
+  map.image = Image(1, 1, texel);
+  scene.textures.push_back(map);
+  scene.materials[0].normalTexture = 0;
+  scene.materials[0].normalScale = scale;
+  scene.finalize();
+  return scene;
+}
+
+TEST(NormalMap, FlatMapChangesNothing) {
+  const Scene scene = normalMappedTriangle(Rgb(0.5f, 0.5f, 1.0f), 1.0f);
+  const SurfaceHit hit = surfaceAt(scene, 0, 0, Vec2(0.3f, 0.3f));
+  EXPECT_EQ(hit.shadingNormal, Vec3(0, 0, 1));  // 2·0.5 − 1 = 0 exactly: no tilt at all
+}
+
+// m = 2t − 1 = (sin a, 0, cos a) tilts the normal by a towards the tangent (+u = +x here);
+// normalScale s multiplies x: tan(tilt) = s·tan a. Mirrored uvs (u running along −x) tilt
+// towards −x: the tangent follows +u.
+TEST(NormalMap, TiltedMapTiltsTheShadingNormalByTheExpectedAngle) {
+  const float a = glm::radians(30.0f);
+  const Rgb texel(0.5f * (std::sin(a) + 1.0f), 0.5f, 0.5f * (std::cos(a) + 1.0f));
+  for (const float scale : {1.0f, 2.0f})
+    for (const bool mirrored : {false, true}) {
+      const Scene scene = normalMappedTriangle(texel, scale, mirrored);
+      const Vec3 n = surfaceAt(scene, 0, 0, Vec2(0.2f, 0.3f)).shadingNormal;
+      const float expected = std::atan(scale * std::tan(a));
+      EXPECT_NEAR(std::acos(std::clamp(n.z, -1.0f, 1.0f)), expected, 1e-5f) << "scale " << scale;
+      EXPECT_NEAR(n.y, 0.0f, 1e-6f);                                // no tilt along v
+      EXPECT_NEAR(n.x, (mirrored ? -1.0f : 1.0f) * std::sin(expected), 1e-5f) << "mirrored " << mirrored;
+    }
+  // +y of the map tilts along +v (OpenGL / glTF convention).
+  const Scene up = normalMappedTriangle(Rgb(0.5f, 0.5f * (std::sin(a) + 1.0f), 0.5f * (std::cos(a) + 1.0f)), 1.0f);
+  EXPECT_NEAR(surfaceAt(up, 0, 0, Vec2(0.2f, 0.3f)).shadingNormal.y, std::sin(a), 1e-5f);
+}
+
+// The sidedness rule holds with a normal map: the mapped normal stays on the geometric
+// normal's side (a map pointing behind the surface falls back to the unmapped normal), and
+// seen from the back scatteringFrame turns the mapped normal with the geometric one.
+TEST(NormalMap, SidednessRuleStillHolds) {
+  const Scene behind = normalMappedTriangle(Rgb(1.0f, 0.5f, 0.0f), 1.0f);  // m = (1, 0, −1)
+  EXPECT_EQ(surfaceAt(behind, 0, 0, Vec2(0.2f, 0.3f)).shadingNormal, Vec3(0, 0, 1));
+  const Scene steep = normalMappedTriangle(Rgb(1.0f, 0.5f, 0.6f), 1.0f);  // m = (1, 0, 0.2)
+  const SurfaceHit hit = surfaceAt(steep, 0, 0, Vec2(0.2f, 0.3f));
+  EXPECT_GT(glm::dot(hit.shadingNormal, hit.geometricNormal), 0.0f);
+  EXPECT_VEC3_NEAR(hit.shadingNormal, glm::normalize(Vec3(1.0f, 0.0f, 0.2f)), kTight);
+  const Vec3 woBack = glm::normalize(Vec3(0.1f, 0.2f, -1.0f));
+  const ScatteringFrame back = scatteringFrame(hit, woBack, LambertBsdf{});
+  EXPECT_VEC3_NEAR(back.frame.n, -hit.shadingNormal, 0.0f);
+  EXPECT_VEC3_NEAR(back.geometricNormal, -hit.geometricNormal, 0.0f);
+  EXPECT_TRUE(usableSide(woBack, back.woLocal, back.geometricNormal, LambertBsdf{}));
+}
+
+TEST(ObjLoader, AlphaMasksAndNormalMaps) {
+  const fs::path dir = scratchDir("detail");
+  for (const char* file : {"mask_rgba.png", "mask_grey.png", "normal_tilt.png"}) fs::copy_file(kDataDir + file, dir / file);
+  writeFile(dir / "m.mtl",
+            "newmtl leaf\nKd 1 1 1\nmap_Kd mask_rgba.png\nmap_d mask_rgba.png\nmap_bump -bm 0.5 normal_tilt.png\n"
+            "newmtl grey\nKd 1 1 1\nd 0.8\nmap_d mask_grey.png\nbump mask_grey.png\n"
+            "newmtl norm\nKd 1 1 1\nnorm normal_tilt.png\n");
+  std::string obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n";
+  for (const char* name : {"leaf", "grey", "norm"}) obj += std::string("usemtl ") + name + "\nf 1/1 2/2 3/3\n";
+  const Scene scene = loadScene(writeFile(dir / "m.obj", obj));
+
+  // map_Kd and map_d name one RGBA file: two textures, sRGB colour and the alpha channel.
+  const Material& leaf = materialNamed(scene, "leaf");
+  ASSERT_GE(leaf.albedoTexture, 0);
+  ASSERT_GE(leaf.alphaTexture, 0);
+  const Texture& colour = scene.textures[size_t(leaf.albedoTexture)];
+  const Texture& alpha = scene.textures[size_t(leaf.alphaTexture)];
+  EXPECT_EQ(colour.decode, ImageDecode::Colour);
+  EXPECT_EQ(alpha.decode, ImageDecode::Coverage);
+  EXPECT_VEC3_NEAR(colour.image.at(1, 0), Rgb(0, 1, 0), 0.0f);
+  for (const auto& [x, y, a] : {std::tuple{0, 0, 0}, {1, 0, 64}, {0, 1, 192}, {1, 1, 255}})
+    EXPECT_EQ(alpha.image.at(x, y), Rgb(float(a) / 255.0f)) << x << "," << y;
+  EXPECT_EQ(leaf.alphaCutoff, 0.5f);
+  EXPECT_EQ(leaf.alphaFactor, 1.0f);
+  EXPECT_TRUE(std::holds_alternative<LambertBsdf>(leaf.bsdf));  // not thin glass: d is a mask here
+  // map_bump with -bm: a normal map read raw (192/255, not sRGB-decoded), scale 0.5.
+  ASSERT_GE(leaf.normalTexture, 0);
+  const Texture& normals = scene.textures[size_t(leaf.normalTexture)];
+  EXPECT_EQ(normals.decode, ImageDecode::Data);
+  EXPECT_VEC3_NEAR(normals.image.at(0, 0), Rgb(192.0f, 128.0f, 224.0f) / 255.0f, 0.0f);
+  EXPECT_EQ(leaf.normalScale, 0.5f);
+
+  // A grey map_d: coverage is its channel, times d. A grey bump map is a height map: ignored.
+  const Material& grey = materialNamed(scene, "grey");
+  ASSERT_GE(grey.alphaTexture, 0);
+  EXPECT_VEC3_NEAR(scene.textures[size_t(grey.alphaTexture)].image.at(0, 1), Rgb(128.0f / 255.0f), 0.0f);
+  EXPECT_NEAR(grey.alphaFactor, 0.8f, 1e-6f);
+  EXPECT_EQ(grey.normalTexture, -1);
+  // norm: a normal map, scale 1.
+  const Material& norm = materialNamed(scene, "norm");
+  EXPECT_GE(norm.normalTexture, 0);
+  EXPECT_EQ(norm.normalScale, 1.0f);
+
+  // coverageAt: barycentrics (0.25, 0.25) on uvs (0,0), (1,0), (0,1) are uv (0.25, 0.25), the
+  // centre of the bottom-left texel (alpha 192; grey 128 in mask_grey.png).
+  const Vec2 b(0.25f, 0.25f);
+  EXPECT_NEAR(coverageAt(scene, 0, 0, b), 192.0f / 255.0f, 1e-6f);
+  EXPECT_NEAR(coverageAt(scene, 0, 1, b), 0.8f * 128.0f / 255.0f, 1e-6f);
+  EXPECT_EQ(coverageAt(scene, 0, 2, b), 1.0f);  // unmasked
+}
+
+TEST(GltfLoader, AlphaModesAndNormalTexture) {
+  std::ifstream in(kDataDir + "quad.gltf", std::ios::binary);
+  const std::string original((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string anchor = "\"name\": \"textured\",";
+  ASSERT_NE(original.find(anchor), std::string::npos);
+  auto withMaterialKeys = [&](const std::string& keys, const char* image, const std::string& name) {
+    const fs::path dir = scratchDir("gltf_alpha_" + name);
+    fs::copy_file(kDataDir + image, dir / "checker.png");
+    std::string text = original;
+    text.replace(text.find(anchor), anchor.size(), anchor + keys);
+    return loadScene(writeFile(dir / "quad.gltf", text));
+  };
+  // MASK on an RGBA baseColorTexture: coverage = factor alpha (1) × the image's alpha.
+  {
+    const Scene scene = withMaterialKeys(R"("alphaMode": "MASK", "alphaCutoff": 0.3,
+        "normalTexture": {"index": 0, "scale": 2},)", "mask_rgba.png", "rgba");
+    const Material& m = materialNamed(scene, "textured");
+    EXPECT_NEAR(m.alphaCutoff, 0.3f, 1e-7f);
+    ASSERT_GE(m.alphaTexture, 0);
+    EXPECT_EQ(scene.textures[size_t(m.alphaTexture)].decode, ImageDecode::Coverage);
+    EXPECT_VEC3_NEAR(scene.textures[size_t(m.alphaTexture)].image.at(1, 0), Rgb(64.0f / 255.0f), 0.0f);
+    ASSERT_GE(m.normalTexture, 0);
+    EXPECT_EQ(scene.textures[size_t(m.normalTexture)].decode, ImageDecode::Data);
+    EXPECT_EQ(m.normalScale, 2.0f);
+    EXPECT_NE(m.normalTexture, m.albedoTexture);  // one image, three decodings
+  }
+  // MASK on an RGB texture (no alpha channel): the factor alone; cutoff defaults to 0.5.
+  {
+    const Scene scene = withMaterialKeys(R"("alphaMode": "MASK",)", "checker.png", "rgb");
+    const Material& m = materialNamed(scene, "textured");
+    EXPECT_EQ(m.alphaTexture, -1);
+    EXPECT_EQ(m.alphaCutoff, 0.5f);
+    EXPECT_FALSE(m.isMasked());  // baseColorFactor alpha 1 ≥ 0.5
+  }
+  // BLEND is read as MASK at 0.5; OPAQUE (the default) ignores alpha.
+  EXPECT_GE(materialNamed(withMaterialKeys(R"("alphaMode": "BLEND",)", "mask_rgba.png", "blend"), "textured").alphaTexture, 0);
+  EXPECT_EQ(materialNamed(withMaterialKeys("", "mask_rgba.png", "opaque"), "textured").alphaTexture, -1);
+  expectError([&] { withMaterialKeys(R"("alphaMode": "CLIP",)", "checker.png", "bad"); }, {"quad.gltf", "alphaMode 'CLIP'"});
+}
+
+TEST(JsonScene, AlphaAndNormalTextures) {
+  const fs::path dir = scratchDir("json_detail");
+  fs::copy_file(kDataDir + "mask_rgba.png", dir / "mask.png");
+  fs::copy_file(kDataDir + "normal_tilt.png", dir / "n.png");
+  fs::create_directories(dir / "textured" / "mat");
+  fs::copy_file(kDataDir + "textured/quad.obj", dir / "textured/quad.obj");
+  fs::copy_file(kDataDir + "textured/mat/quad.mtl", dir / "textured/mat/quad.mtl");
+  fs::copy_file(kDataDir + "textured/mat/checker.png", dir / "textured/mat/checker.png");
+  auto scene = [&](const std::string& material) {
+    return writeFile(dir / "s.json", R"({"meshes": [{"file": "textured/quad.obj", "material": "leaf"}],
+      "materials": {"leaf": {"type": "lambert", )" + material + "}}}");
+  };
+  const Scene loaded = loadScene(scene(R"("alpha_texture": "mask.png", "alpha_cutoff": 0.2,
+      "normal_texture": "n.png", "normal_scale": 0.5)"));
+  const Material& leaf = materialNamed(loaded, "leaf");
+  ASSERT_GE(leaf.alphaTexture, 0);
+  EXPECT_EQ(loaded.textures[size_t(leaf.alphaTexture)].decode, ImageDecode::Coverage);
+  EXPECT_NEAR(leaf.alphaCutoff, 0.2f, 1e-7f);
+  ASSERT_GE(leaf.normalTexture, 0);
+  EXPECT_EQ(loaded.textures[size_t(leaf.normalTexture)].decode, ImageDecode::Data);
+  EXPECT_EQ(leaf.normalScale, 0.5f);
+
+  // Bad input: each a clean error naming the file and the key.
+  expectError([&] { loadScene(scene(R"("alpha_texture": "gone.png")")); }, {"s.json", "alpha_texture", "gone.png", "not found"});
+  expectError([&] { loadScene(scene(R"("alpha_texture": "mask.png", "alpha_cutoff": 1.5)")); }, {"s.json", "alpha_cutoff"});
+  expectError([&] { loadScene(scene(R"("alpha_cutoff": 0.3)")); }, {"s.json", "alpha_cutoff needs an alpha_texture"});
+  std::ifstream mask(dir / "mask.png", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(mask)), std::istreambuf_iterator<char>());
+  writeFile(dir / "cut.png", bytes.substr(0, 40));  // cut inside the IDAT chunk
+  expectError([&] { loadScene(scene(R"("alpha_texture": "cut.png")")); }, {"cut.png", "truncated"});
+}
+
+TEST(BadInput, MissingOrCorruptAlphaAndNormalTexturesInMtl) {
+  const fs::path dir = scratchDir("detail_bad");
+  writeFile(dir / "t.mtl", "newmtl a\nKd 1 1 1\nmap_d nothere.png\n");
+  const std::string path = writeFile(dir / "t.obj", "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+  expectError([&] { loadScene(path); }, {"t.mtl", "map_d", "nothere.png", "not found"});
+  writeFile(dir / "t.mtl", "newmtl a\nKd 1 1 1\nnorm broken.png\n");
+  writeFile(dir / "broken.png", "not a png at all");
+  expectError([&] { loadScene(path); }, {"broken.png", "not a PNG"});
 }
 
 }  // namespace

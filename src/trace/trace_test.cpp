@@ -441,10 +441,10 @@ Scene planeWith(const Light& light, const Rgb& albedo, bool blocker = false) {
   return finished(std::move(s));
 }
 
-/// Radiance leaving the plane at (x, 0, 0) towards a viewer above it, estimated with one
+/// Radiance leaving the plane at (x, 0, z) towards a viewer above it, estimated with one
 /// deterministic sample per strategy (direct light from one punctual light has no noise).
-Rgb planeRadianceAt(const PathTracer& tracer, float x, TraceStrategy strategy) {
-  const Vec3 target(x, 0.0f, 0.0f);
+Rgb planeRadianceAt(const PathTracer& tracer, float x, TraceStrategy strategy, float z = 0.0f) {
+  const Vec3 target(x, 0.0f, z);
   Ray ray;
   ray.origin = target + Vec3(0.3f, 5.0f, -0.2f);
   ray.direction = glm::normalize(target - ray.origin);
@@ -517,6 +517,44 @@ TEST_F(TraceTest, DirectionalLightAndShadow) {
   // and x = 5 far outside it.
   EXPECT_NEAR(planeRadianceAt(tracer, 5.0f, TraceStrategy::Mis).g, expected.g, 1e-5f * expected.g);
   EXPECT_EQ(planeRadianceAt(tracer, std::tan(theta), TraceStrategy::Mis), Rgb(0.0f));
+}
+
+// The blocker above as an alpha-masked quad: its mask is 4 texels along v (= z + 0.5 on the
+// blocker), the half v < 0.5 transparent (0), the other opaque (1). The shadow is cast by the
+// opaque half only; through the cut-out half the plane gets the full direct light.
+TEST_F(TraceTest, AlphaMaskedBlockerCastsTheMaskedShadow) {
+  const Rgb albedo(0.7f), irradiance(3.0f);
+  const float theta = 0.6f;
+  const Vec3 travel(std::sin(theta), -std::cos(theta), 0.0f);
+  Scene s;
+  Mesh mesh;
+  mesh.name = "plane";
+  addHorizontalSquare(mesh, 0.0f, 100.0f, true, addMaterial(s, albedo));
+  const uint32_t blocker = addMaterial(s, Rgb(0.0f));
+  addHorizontalSquare(mesh, 1.0f, 0.5f, true, blocker);
+  mesh.uvs.resize(mesh.positions.size());
+  for (size_t v = 0; v < mesh.positions.size(); ++v)
+    mesh.uvs[v] = Vec2(mesh.positions[v].x + 0.5f, mesh.positions[v].z + 0.5f);  // blocker: [0,1]²
+  s.meshes.push_back(mesh);
+  Texture mask;
+  mask.path = "half mask";
+  mask.decode = ImageDecode::Coverage;
+  mask.image = Image(1, 4);
+  mask.image.pixels = {Rgb(1.0f), Rgb(1.0f), Rgb(0.0f), Rgb(0.0f)};  // top rows (large v) opaque
+  s.textures.push_back(mask);
+  s.materials[blocker].alphaTexture = 0;
+  s.lights.push_back(DirectionalLight{travel, irradiance});
+  const Scene scene = finished(std::move(s));
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  const Rgb lit = albedo * irradiance * std::cos(theta) / kPi;
+  // The shadow ray from (tan θ, 0, z) crosses the blocker's height at x = 0, v = z + 0.5:
+  // z = −0.25 is in the transparent half (texel centres v = 0.125, 0.375), z = 0.25 opaque.
+  for (TraceStrategy strategy : {TraceStrategy::Mis, TraceStrategy::NeeOnly}) {
+    const Rgb throughHole = planeRadianceAt(tracer, std::tan(theta), strategy, -0.25f);
+    EXPECT_NEAR(throughHole.g, lit.g, 1e-5f * lit.g) << strategyName(strategy);
+    EXPECT_EQ(planeRadianceAt(tracer, std::tan(theta), strategy, 0.25f), Rgb(0.0f)) << strategyName(strategy);
+  }
 }
 
 // ---- one-sided emission ------------------------------------------------------------------------

@@ -48,6 +48,26 @@ def png_bytes(width, height, rows):
 CHECKER = png_bytes(2, 2, [[(255, 0, 0), (0, 255, 0)], [(0, 0, 255), (255, 255, 255)]])
 
 
+def png_channels(width, height, rows, colour_type):
+    """8-bit PNG of colour type 0 (grey), 4 (grey + alpha) or 6 (RGBA); rows of tuples."""
+    raw = b"".join(b"\x00" + bytes(c for px in row for c in px) for row in rows)
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    header = struct.pack(">IIBBBBB", width, height, 8, colour_type, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+
+
+# Alpha masks and normal maps (scene_test: surface detail).
+# mask_rgba.png: 2x2 RGBA, top row (255,0,0,0) (0,255,0,64), bottom row (0,0,255,192) (255,255,255,255).
+MASK_RGBA = png_channels(2, 2, [[(255, 0, 0, 0), (0, 255, 0, 64)], [(0, 0, 255, 192), (255, 255, 255, 255)]], 6)
+# mask_grey.png: 2x2 grey, top row 0 255, bottom row 128 32 (coverage from the first channel).
+MASK_GREY = png_channels(2, 2, [[(0,), (255,)], [(128,), (32,)]], 0)
+# normal_tilt.png: 1x1 RGB (192, 128, 224): a tangent-space normal tilted towards +u.
+NORMAL_TILT = png_bytes(1, 1, [[(192, 128, 224)]])
+
+
 def pad4(data, fill=b"\x00"):
     return data + fill * ((4 - len(data) % 4) % 4)
 
@@ -147,6 +167,9 @@ def write(name, data):
 
 
 write("checker.png", CHECKER)
+write("mask_rgba.png", MASK_RGBA)
+write("mask_grey.png", MASK_GREY)
+write("normal_tilt.png", NORMAL_TILT)
 write("quad.gltf", gltf_scene(False))
 write("quad.glb", gltf_scene(True))
 write("textured/mat/checker.png", CHECKER)
