@@ -21,7 +21,8 @@
 //              "texture": "albedo.png"}
 //           | {"type": "ggx",         "diffuse": [r,g,b], "f0": [r,g,b],
 //              "alpha": a | "roughness": r (alpha = r²), "texture": "albedo.png"}
-//       (+ for every type: "emission": [r,g,b] radiance in W·sr⁻¹·m⁻², "two_sided": false)
+//       (+ for every type: "emission": [r,g,b] radiance in W·sr⁻¹·m⁻², "two_sided": false,
+//        "tixel_density": 1 (light-field tixels per length relative to the bake preset, > 0))
 //     A material whose name equals a material of a loaded file replaces it there.
 //   },
 //   "lights": [ {"type": "point", "position": [..], "intensity": [r,g,b] | I}      // W·sr⁻¹
@@ -160,7 +161,10 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
   material.name = name;
   material.emission = colourOr(ctx, value, "emission", Rgb(0.0f), where);
   material.twoSidedEmission = boolOr(ctx, value, "two_sided", false, where);
-  std::set<std::string> known = {"type", "emission", "two_sided"};
+  material.tixelDensity = numberOr(ctx, value, "tixel_density", 1.0f, where);
+  if (!(material.tixelDensity > 0.0f) || !std::isfinite(material.tixelDensity))
+    fail("{}: {}: tixel_density {} must be a positive number", ctx.path, where, material.tixelDensity);
+  std::set<std::string> known = {"type", "emission", "two_sided", "tixel_density"};
   if (type == "lambert") {
     material.bsdf = LambertBsdf{colourOr(ctx, value, "albedo", Rgb(0.8f), where)};
     known.insert({"albedo", "texture"});

@@ -38,6 +38,9 @@ struct Material {
   /// given by the triangle's winding, counter-clockwise = front) unless twoSided.
   Rgb emission{0.0f};
   bool twoSidedEmission = false;
+  /// Light-field tixel density relative to the bake preset's (2 = tixels half as wide); a
+  /// JSON scene's "tixel_density". Only the bake's parameterisation reads it.
+  float tixelDensity = 1.0f;
 
   bool isEmissive() const { return !isBlack(emission); }
 };
