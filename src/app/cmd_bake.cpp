@@ -132,7 +132,7 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::IsMember({"none", "lossless", "bc1", "hdr"}))
       ->capture_default_str();
   command->add_option("--tixels-across", options->tixelsAcross,
-                      "Override the preset: tixels along the scene's largest extent")
+                      "Override the preset: tixels across the scene's room scale (see the README)")
       ->check(CLI::Range(1.0f, 4096.0f));
   command->add_option("--directions", options->gatherDirections,
                       "Override the preset: gather directions per tixel (rounded to a square)")

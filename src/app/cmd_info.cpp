@@ -175,7 +175,7 @@ void printHuman(const PlfInfo& info) {
   if (bs.tixelsPerUnit > 0.0f)
     fmt::print("{} tixels per scene unit", bs.tixelsPerUnit);
   else
-    fmt::print("{} tixels across the scene", bs.tixelsAcrossScene);
+    fmt::print("{} tixels across the scene's room scale", bs.tixelsAcrossScene);
   fmt::print(" (≤ {} per chart side), {} gather directions, glossy maps ≤ {}², tolerance {}, ≤ {} iterations, "
              "mirror depth {}, {} area-light samples, seed {}\n",
              bs.maxTixelsPerChartSide, bs.gatherDirections, bs.glossyDirRes, bs.tolerance, bs.maxIterations,

@@ -17,24 +17,21 @@ namespace pl {
 BakeSettings bakePreset(const std::string& name) {
   BakeSettings s;
   s.preset = name;
-  s.tixelsPerUnit = 0.0f;  // density from the scene size
+  s.tixelsPerUnit = 0.0f;  // density from the scene's room scale (sceneScale)
   if (name == "draft") {
-    s.tixelsAcrossScene = 32;
-    s.maxTixelsPerChartSide = 32;
+    s.tixelsAcrossScene = 20;
     s.gatherDirections = 144;
     s.glossyDirRes = 8;
     s.areaLightSamples = 16;
     s.tolerance = 5e-3f;
   } else if (name == "default") {
-    s.tixelsAcrossScene = 64;
-    s.maxTixelsPerChartSide = 64;
+    s.tixelsAcrossScene = 40;
     s.gatherDirections = 256;
     s.glossyDirRes = 16;
     s.areaLightSamples = 32;
     s.tolerance = 1e-3f;
   } else if (name == "high") {
-    s.tixelsAcrossScene = 96;
-    s.maxTixelsPerChartSide = 128;
+    s.tixelsAcrossScene = 60;
     s.gatherDirections = 576;
     s.glossyDirRes = 24;
     s.areaLightSamples = 64;
@@ -42,6 +39,7 @@ BakeSettings bakePreset(const std::string& name) {
   } else {
     fail("unknown bake preset '{}' (choose draft, default or high)", name);
   }
+  s.maxTixelsPerChartSide = 16384;
   s.maxIterations = 200;
   s.mirrorDepth = 256;
   return s;
@@ -67,8 +65,19 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   lf.scene = std::move(scene);
   lf.settings = settings;
   const Accel accel(lf.scene);
-  const Parameterisation param = buildParameterisation(lf.scene, settings);
+  const Parameterisation param = buildParameterisation(lf.scene, accel, settings);
   const uint64_t hash = visibilityHash(lf.scene, param, settings);
+  {
+    uint64_t byKind[3] = {0, 0, 0}, tixelsByKind[3] = {0, 0, 0};
+    for (const Chart& c : param.charts) {
+      ++byKind[size_t(c.kind)];
+      tixelsByKind[size_t(c.kind)] += c.tixelCount();
+    }
+    note(fmt::format("parameterisation: {} charts ({} diffuse, {} glossy, {} specular), {} tixels ({} diffuse, {} glossy), "
+                     "{} values; room scale {:.4g}, tixel size {:.4g} (scene units)",
+                     param.charts.size(), byKind[0], byKind[1], byKind[2], param.tixelCount, tixelsByKind[0],
+                     tixelsByKind[1], param.valueCount, param.sceneScale, param.baseTixelSize));
+  }
   if (options.checkMemory) options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings));
 
   VisibilityField visibility;

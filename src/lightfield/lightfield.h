@@ -73,9 +73,9 @@ struct Chart {
 /// bakePreset("default") (a test checks it).
 struct BakeSettings {
   std::string preset = "default";
-  float tixelsPerUnit = 0.0f;      ///< world-space density; 0 = derive from the scene size
-  uint32_t maxTixelsPerChartSide = 64;
-  float tixelsAcrossScene = 64.0f;  ///< used when tixelsPerUnit = 0: tixels along the scene's largest extent
+  float tixelsPerUnit = 0.0f;      ///< world-space density; 0 = derive from the scene's room scale
+  uint32_t maxTixelsPerChartSide = 16384;  ///< only wider charts get larger tixels (indices stay in 32 bits)
+  float tixelsAcrossScene = 40.0f;  ///< used when tixelsPerUnit = 0: tixels across the room scale (sceneScale)
   uint32_t gatherDirections = 256; ///< gather rays per tixel (visibility field)
   uint32_t glossyDirRes = 16;      ///< cap on the paraboloid map size of glossy charts
   float tolerance = 1e-3f;         ///< relative change of total outgoing power to stop at

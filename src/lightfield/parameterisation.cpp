@@ -9,6 +9,8 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/rng.h"
+#include "core/sampling.h"
 #include "lightfield/lookup.h"
 
 namespace pl {
@@ -47,13 +49,63 @@ uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings) {
   return uint32_t(std::clamp(wanted, 2.0f, float(cap)));
 }
 
-float baseTixelSize(const Scene& scene, const BakeSettings& settings) {
-  if (settings.tixelsPerUnit > 0.0f) return 1.0f / settings.tixelsPerUnit;
+float sceneScale(const Scene& scene, const Accel& accel) {
   Vec3 lo, hi;
   scene.bounds(lo, hi);
   const float extent = maxComponent(hi - lo);
   if (!(extent > 0.0f) || !std::isfinite(extent)) fail("{}: scene has no extent to parameterise", scene.sourcePath);
-  return extent / std::max(1.0f, settings.tixelsAcrossScene);
+  // Cumulative triangle areas for area-uniform surface points.
+  std::vector<std::pair<uint32_t, uint32_t>> triangles;
+  std::vector<double> cumulative;
+  double total = 0.0;
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      const UVec3 tri = mesh.triangles[t];
+      const DVec3 p0 = mesh.positions[tri[0]], p1 = mesh.positions[tri[1]], p2 = mesh.positions[tri[2]];
+      const double area = 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
+      if (!(area > 0.0)) continue;
+      total += area;
+      triangles.emplace_back(m, t);
+      cumulative.push_back(total);
+    }
+  }
+  if (triangles.empty()) return extent;
+  // Free paths from area-uniform points, one side chosen at random, cosine-weighted.
+  std::vector<Ray> rays(kSceneScaleRays);
+  Pcg32 rng(0x5343414c45ULL, 1);
+  for (Ray& ray : rays) {
+    const double target = double(rng.uniform()) * total;
+    const size_t k = std::min(size_t(std::upper_bound(cumulative.begin(), cumulative.end(), target) - cumulative.begin()),
+                              triangles.size() - 1);
+    const Vec2 b = sampleUniformTriangle(Vec2(rng.uniform(), rng.uniform()));
+    const SurfaceHit s = surfaceAt(scene, triangles[k].first, triangles[k].second, b);
+    const Vec3 n = rng.uniform() < 0.5f ? s.geometricNormal : -s.geometricNormal;
+    const Vec3 d = Frame::fromNormal(n).toWorld(sampleCosineHemisphere(Vec2(rng.uniform(), rng.uniform())));
+    ray = Ray{offsetRayOrigin(s.position, s.geometricNormal, d), d, 0.0f, kInfinity};
+  }
+  std::vector<RayHit> hits(rays.size());
+  accel.intersectIncoherent(rays, hits);
+  double sum = 0.0;
+  uint32_t count = 0;
+  for (const RayHit& h : hits)
+    if (h.hit()) {
+      sum += h.t;
+      ++count;
+    }
+  // Too few rays stay in the scene (a single sheet, an open terrain): the extent is the scale.
+  if (count < kSceneScaleRays / 16) return extent;
+  return std::min(extent, float(1.5 * sum / count));
+}
+
+float baseTixelSize(const BakeSettings& settings, float scale) {
+  if (settings.tixelsPerUnit > 0.0f) return 1.0f / settings.tixelsPerUnit;
+  return scale / std::max(1.0f, settings.tixelsAcrossScene);
+}
+
+float chartTixelSize(const Scene& scene, uint32_t material, ChartKind kind, float baseSize) {
+  const float density = scene.materials[material].tixelDensity * (kind == ChartKind::Glossy ? kGlossyTixelDensity : 1.0f);
+  return baseSize / density;
 }
 
 namespace {
@@ -122,16 +174,14 @@ ChartRaster rasteriseChart(const Scene& scene, const Chart& c, const std::vector
   return r;
 }
 
-// For each tixel, the nearest tixel (4-neighbour BFS distance) whose bin is non-empty.
-std::vector<uint32_t> nearestNonEmptyBin(const Chart& c, const ChartRaster& r) {
-  const uint32_t n = uint32_t(c.tixelCount());
-  std::vector<uint32_t> nearest(n, UINT32_MAX);
+// 4-neighbour breadth-first fill over a chart's tixel grid: `from` holds k at seed tixels and
+// UINT32_MAX elsewhere; afterwards every tixel reachable from a seed holds the seed nearest
+// to it in breadth-first order. Returns false when there is no seed.
+bool fillFromNearestSeed(const Chart& c, std::vector<uint32_t>& from) {
   std::deque<uint32_t> queue;
-  for (uint32_t k = 0; k < n; ++k)
-    if (!r.bins[k].empty()) {
-      nearest[k] = k;
-      queue.push_back(k);
-    }
+  for (uint32_t k = 0; k < from.size(); ++k)
+    if (from[k] != UINT32_MAX) queue.push_back(k);
+  if (queue.empty()) return false;
   while (!queue.empty()) {
     const uint32_t k = queue.front();
     queue.pop_front();
@@ -139,11 +189,20 @@ std::vector<uint32_t> nearestNonEmptyBin(const Chart& c, const ChartRaster& r) {
     const uint32_t nb[4] = {i > 0 ? k - 1 : UINT32_MAX, i + 1 < c.resU ? k + 1 : UINT32_MAX,
                             j > 0 ? k - c.resU : UINT32_MAX, j + 1 < c.resV ? k + c.resU : UINT32_MAX};
     for (uint32_t q : nb)
-      if (q != UINT32_MAX && nearest[q] == UINT32_MAX) {
-        nearest[q] = nearest[k];
+      if (q != UINT32_MAX && from[q] == UINT32_MAX) {
+        from[q] = from[k];
         queue.push_back(q);
       }
   }
+  return true;
+}
+
+// For each tixel, the nearest tixel (4-neighbour BFS distance) whose bin is non-empty.
+std::vector<uint32_t> nearestNonEmptyBin(const Chart& c, const ChartRaster& r) {
+  std::vector<uint32_t> nearest(c.tixelCount(), UINT32_MAX);
+  for (uint32_t k = 0; k < nearest.size(); ++k)
+    if (!r.bins[k].empty()) nearest[k] = k;
+  fillFromNearestSeed(c, nearest);
   return nearest;
 }
 
@@ -177,10 +236,43 @@ FootprintSample locate(const ChartRaster& r, uint32_t bin, Vec2 q) {
   return s;
 }
 
-void fillChartTixels(const Scene& scene, const Chart& c, const std::vector<std::pair<uint32_t, uint32_t>>& tris,
-                     Parameterisation& p) {
+// A candidate gather point x on a chart (unit normal n, tangent frame axisU/axisV) is buried
+// when it lies inside other geometry — the floor under a baseboard or a block standing on it,
+// the part of a wall behind a crossing wall: at least kBuriedMinHits of its kBuriedProbes
+// probe rays hit the back side of a surface. The probes leave the front hemisphere at 8
+// azimuths, 30° above the tangent plane, plus one along the normal, with no length limit:
+// from inside a closed occluder every probe meets its inside, while a point in the open sees
+// front sides; a majority is asked for so that a few one-sided sheets wound the other way
+// (banners, leaves) do not bury the floor under them.
+constexpr int kBuriedProbes = 9;
+constexpr int kBuriedMinHits = 5;
+
+bool buried(const Scene& scene, const Accel& accel, const Chart& c, const Vec3& x) {
+  int backHits = 0;
+  for (int k = 0; k < kBuriedProbes; ++k) {
+    Vec3 d = c.normal;
+    if (k > 0) {
+      const float phi = 2.0f * kPi * float(k - 1) / float(kBuriedProbes - 1);
+      d = 0.8660254f * (std::cos(phi) * c.axisU + std::sin(phi) * c.axisV) + 0.5f * c.normal;
+    }
+    const Ray ray{offsetRayOrigin(x, c.normal, d), d, 0.0f, kInfinity};
+    RayHit hit;
+    if (!accel.intersect(ray, hit)) continue;
+    const Mesh& mesh = scene.meshes[hit.mesh];
+    const UVec3 tri = mesh.triangles[hit.triangle];
+    const Vec3 n = glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]], mesh.positions[tri[2]] - mesh.positions[tri[0]]);
+    if (glm::dot(n, d) > 0.0f) ++backHits;
+    if (backHits >= kBuriedMinHits) return true;
+  }
+  return false;
+}
+
+void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
+                     const std::vector<std::pair<uint32_t, uint32_t>>& tris, Parameterisation& p) {
   const ChartRaster r = rasteriseChart(scene, c, tris);
   const std::vector<uint32_t> nearest = nearestNonEmptyBin(c, r);
+  const bool probe = c.kind != ChartKind::Specular;
+  std::vector<uint8_t> isBuried(c.tixelCount(), 0);
   const Material& material = scene.materials[c.material];
   const bool textured = c.kind == ChartKind::Diffuse && material.albedoTexture >= 0;
   const Rgb constantAlbedo = c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, Vec2(0.0f)) : Rgb(0.0f);
@@ -191,11 +283,14 @@ void fillChartTixels(const Scene& scene, const Chart& c, const std::vector<std::
       // Footprint: coverage and mean albedo over the sub-samples inside the polygon.
       int inside = 0;
       Rgb albedoSum(0.0f);
+      std::array<std::pair<float, FootprintSample>, kFootprintSamples * kFootprintSamples> insideSamples;
       for (int b = 0; b < kFootprintSamples; ++b)
         for (int a = 0; a < kFootprintSamples; ++a) {
           const Vec2 q(float(i) + (a + 0.5f) / kFootprintSamples, float(j) + (b + 0.5f) / kFootprintSamples);
           const FootprintSample s = locate(r, local, q);
           if (!s.inside) continue;
+          const Vec2 fromCentre = q - Vec2(float(i) + 0.5f, float(j) + 0.5f);
+          insideSamples[size_t(inside)] = {glm::dot(fromCentre, fromCentre), s};
           ++inside;
           if (textured) {
             const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
@@ -236,6 +331,21 @@ void fillChartTixels(const Scene& scene, const Chart& c, const std::vector<std::
         s.bary = barycentric2(tr, bestQ);
       }
       if (!r.tris.empty()) point = pointOnTriangle(scene, r.tris[s.tri], s.bary);
+      // A buried point gathers from the nearest footprint sub-sample that is not buried; a
+      // tixel with none takes a neighbour's point below.
+      if (probe && !r.tris.empty() && buried(scene, accel, c, point)) {
+        std::sort(insideSamples.begin(), insideSamples.begin() + inside,
+                  [](const auto& x, const auto& y) { return x.first < y.first; });
+        isBuried[local] = 1;
+        for (int k = 0; k < inside; ++k) {
+          const Vec3 q = pointOnTriangle(scene, r.tris[insideSamples[size_t(k)].second.tri], insideSamples[size_t(k)].second.bary);
+          if (!buried(scene, accel, c, q)) {
+            point = q;
+            isBuried[local] = 0;
+            break;
+          }
+        }
+      }
       p.gatherPoint[g] = point;
 
       if (c.kind == ChartKind::Diffuse) {
@@ -251,11 +361,25 @@ void fillChartTixels(const Scene& scene, const Chart& c, const std::vector<std::
         p.transportAlbedo[g] = Rgb(0.0f);
       }
     }
+  // Buried tixels (wholly under other geometry) gather from the nearest unburied tixel's
+  // point (4-neighbour breadth-first order), so bilinear lookups next to a contact read the
+  // light of the visible side, not the dark inside of the occluder.
+  std::vector<uint32_t> source(isBuried.size(), UINT32_MAX);
+  for (uint32_t k = 0; k < isBuried.size(); ++k)
+    if (!isBuried[k]) source[k] = k;
+  if (!fillFromNearestSeed(c, source)) return;  // the whole chart is buried: nothing visible to borrow from
+  for (uint32_t k = 0; k < isBuried.size(); ++k)
+    if (isBuried[k]) p.gatherPoint[c.firstTixel + k] = p.gatherPoint[c.firstTixel + source[k]];
 }
 
 }  // namespace
 
 Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& settings) {
+  const Accel accel(scene);
+  return buildParameterisation(scene, accel, settings);
+}
+
+Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, const BakeSettings& settings) {
   Vec3 lo, hi;
   scene.bounds(lo, hi);
   const float diagonal = glm::length(hi - lo);
@@ -392,8 +516,9 @@ Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& s
   }
 
   // Frames and grids.
-  const float baseSize = baseTixelSize(scene, settings);
-  const uint32_t cap = std::max<uint32_t>(1, settings.maxTixelsPerChartSide);
+  p.sceneScale = settings.tixelsPerUnit > 0.0f ? 0.0f : sceneScale(scene, accel);
+  p.baseTixelSize = baseTixelSize(settings, p.sceneScale);
+  const float baseSize = p.baseTixelSize;
   const size_t chartCount = p.chartTriangles.size();
   p.charts.resize(chartCount);
   p.chartArea.assign(chartCount, 0.0);
@@ -464,7 +589,10 @@ Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& s
     c.axisU = bestU;
     c.axisV = glm::cross(n, bestU);
     const float width = bestHi.x - bestLo.x, height = bestHi.y - bestLo.y;
-    float size = baseSize;
+    float size = chartTixelSize(scene, c.material, c.kind, baseSize);
+    // Only a chart wider than maxTixelsPerChartSide tixels (16 384 in every preset: kilometres
+    // of floor at centimetre tixels) is coarsened; none is coarsened for being small.
+    const uint32_t cap = std::max<uint32_t>(1, settings.maxTixelsPerChartSide);
     if (std::max(width, height) > size * float(cap)) size = std::max(width, height) / float(cap);
     c.tixelSize = size;
     // The small slack keeps an edge that is an exact multiple of the size from gaining a tixel.
@@ -540,7 +668,7 @@ Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& s
   p.transportAlbedo.resize(p.tixelCount);
   for (uint32_t ci = 0; ci < recordCount; ++ci)
     std::fill_n(p.tixelChart.begin() + int64_t(p.charts[ci].firstTixel), p.charts[ci].tixelCount(), ci);
-  parallelFor(recordCount, [&](uint64_t ci) { fillChartTixels(scene, p.charts[ci], p.chartTriangles[ci], p); });
+  parallelFor(recordCount, [&](uint64_t ci) { fillChartTixels(scene, accel, p.charts[ci], p.chartTriangles[ci], p); });
   return p;
 }
 

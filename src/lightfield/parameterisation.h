@@ -10,9 +10,14 @@
 // its triangles' winding normals (the emitting/front side), axisU along the polygon edge that
 // gives the smallest bounding rectangle — and a square tixel grid over that rectangle.
 //
-// Tixel size: 1 / tixelsPerUnit (or scene's largest extent / tixelsAcrossScene when
-// tixelsPerUnit is 0), enlarged for a chart whose rectangle would need more than
-// maxTixelsPerChartSide tixels along a side. The grid is centred on the rectangle.
+// Tixel size (world units): 1 / tixelsPerUnit when that is set, otherwise the scene's room
+// scale (sceneScale) / tixelsAcrossScene, so a preset means the same density in a one-room
+// box and in a many-room building. The chart's material refines it: glossy charts use tixels
+// kGlossyTixelDensity times finer (their values change with position faster: highlights
+// move), and a JSON material's "tixel_density" multiplies the density (Material::tixelDensity).
+// No chart is coarsened for being small or large (a chart smaller than a tixel gets one
+// tixel of the preset's size; only a chart wider than settings.maxTixelsPerChartSide tixels is
+// coarsened, to keep grid indices in 32 bits). The grid is centred on the rectangle.
 //
 // Directional resolution by material (chartKindOf / directionalResolution):
 //   Lambertian → Diffuse, dirRes 1 (irradiance);
@@ -29,6 +34,7 @@
 // Every tixel gets a gather point on the polygon: its centre when the centre lies on one of
 // the chart's triangles, otherwise the closest point of the polygon (pulled slightly inside),
 // so tixels outside the polygon still get valid values from a nearby real surface point.
+#include "accel/accel.h"
 #include "core/math.h"
 #include "lightfield/lightfield.h"
 #include "scene/scene.h"
@@ -41,6 +47,10 @@ namespace pl {
 
 inline constexpr float kChartNormalToleranceDegrees = 2.0f;
 inline constexpr float kChartPlaneTolerance = 0.005f;  ///< relative to the scene diagonal
+/// Glossy charts' tixels are this many times finer than diffuse ones (per side).
+inline constexpr float kGlossyTixelDensity = 2.0f;
+/// Rays sceneScale traces.
+inline constexpr uint32_t kSceneScaleRays = 16384;
 
 /// What the bake needs per tixel beyond the stored Chart records.
 struct Parameterisation {
@@ -48,6 +58,8 @@ struct Parameterisation {
   std::vector<std::vector<uint32_t>> triangleChart;  ///< [mesh][triangle] → chart
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> chartTriangles;  ///< chart → (mesh, triangle)
   std::vector<double> chartArea;    ///< sum of the chart's triangle areas (scene units²)
+  float sceneScale = 0.0f;          ///< sceneScale() (0 when settings.tixelsPerUnit fixed the size)
+  float baseTixelSize = 0.0f;       ///< the preset's tixel size before the per-material factors
   uint64_t tixelCount = 0;
   uint64_t valueCount = 0;
   // Per tixel, by global tixel index (Chart::firstTixel + i + j·resU):
@@ -60,10 +72,26 @@ struct Parameterisation {
 ChartKind chartKindOf(const Bsdf& bsdf);
 /// Paraboloid map resolution for a material (1 diffuse, 0 specular, glossy from its lobe).
 uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings);
-/// World-space tixel size before the per-chart cap.
-float baseTixelSize(const Scene& scene, const BakeSettings& settings);
+/// The scene's room scale (scene units): the side of the empty cube whose mean free path
+/// equals the scene's. For a closed cavity of volume V and surface area S, the mean length of
+/// the free paths leaving its surface cosine-weighted is 4V/S (Cauchy's formula), 2a/3 for a
+/// cube of side a, so the scale is 1.5 × the mean free path, estimated from kSceneScaleRays
+/// rays leaving area-uniform surface points (either side, cosine-weighted; escaping rays left
+/// out), capped by the largest extent of the scene's bounds. When fewer than 1/16 of the rays
+/// hit anything (a lone sheet, open terrain) it is the largest extent. A one-room scene's
+/// scale is about its size; a building's is the size of its rooms and courtyards, so tixels
+/// stay a fixed fraction of the distances light travels between surfaces (what sets the width
+/// of penumbrae and the scale over which indirect light varies). Deterministic.
+float sceneScale(const Scene& scene, const Accel& accel);
+/// World-space tixel size of the preset (before the per-material factors): 1 / tixelsPerUnit,
+/// or scale / tixelsAcrossScene when tixelsPerUnit is 0.
+float baseTixelSize(const BakeSettings& settings, float scale);
+/// The tixel size of a chart of `material` and `kind` given the preset's base size.
+float chartTixelSize(const Scene& scene, uint32_t material, ChartKind kind, float baseSize);
 
 /// Builds charts, tixel grids and per-tixel data. Deterministic for a given scene + settings.
+Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, const BakeSettings& settings);
+/// The same, building its own Accel for the scene scale.
 Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& settings);
 
 }  // namespace pl

@@ -96,23 +96,90 @@ TEST(Parameterisation, CornellBoxCharts) {
       EXPECT_LE(g.x, chart.resU - 0.49f);
     }
   }
-  // The room's walls are ~550 mm, the largest extent ~559 mm: 32 tixels across the scene
-  // gives 31–32 tixels per wall side.
-  EXPECT_GE(p.charts[0].resU, 31u);
-  EXPECT_LE(p.charts[0].resU, 33u);
+  // The room's walls are ~550 mm, the largest extent ~559 mm. Its room scale is smaller than
+  // that (an open box with two blocks inside: a mean free path of ≈ 240 mm, scale ≈ 360 mm),
+  // and 32 tixels across it make every chart's tixels scale/32 wide.
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  const float scale = sceneScale(scene, Accel(scene));
+  EXPECT_GT(scale, 0.5f * maxComponent(hi - lo));
+  EXPECT_LT(scale, 0.8f * maxComponent(hi - lo));
+  for (const Chart& chart : p.charts) EXPECT_EQ(chart.tixelSize, scale / 32.0f);
+  EXPECT_GE(p.charts[0].resU, uint32_t(550.0f / (scale / 32.0f)));
   EXPECT_EQ(p.tixelCount, p.valueCount);  // all diffuse: one value per tixel
 }
 
-TEST(Parameterisation, CapOnTixelsPerSide) {
+// An axis-aligned box [0, size.x] × [0, size.y] × [0, size.z] of 12 triangles, one material.
+Scene makeBox(Vec3 size, Material material) {
+  Scene scene;
+  scene.sourcePath = "box";
+  scene.materials.push_back(material);
+  Mesh box;
+  for (int k = 0; k < 8; ++k) box.positions.push_back(Vec3(k & 1 ? size.x : 0, k & 2 ? size.y : 0, k & 4 ? size.z : 0));
+  const uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) {
+    box.triangles.push_back({f[0], f[1], f[2]});
+    box.triangles.push_back({f[0], f[2], f[3]});
+  }
+  box.materials.assign(box.triangles.size(), 0);
+  scene.meshes.push_back(box);
+  scene.finalize();
+  return scene;
+}
+
+TEST(Parameterisation, SceneScaleOfACubeIsItsSide) {
+  // A closed cube of side a: free paths leaving its walls cosine-weighted average 4V/S = 2a/3
+  // inside (Cauchy), and rays leaving outwards escape, so the scale is a (± the estimator's
+  // noise: chords have a standard deviation of ≈ 0.4a; over the ≈ 8192 inside rays the mean's
+  // is ≈ 0.5 %).
+  const Scene cube = makeBox(Vec3(3.0f), Material{"grey", LambertBsdf{Rgb(0.5f)}});
+  const Accel accel(cube);
+  EXPECT_NEAR(sceneScale(cube, accel), 3.0f, 0.06f);
+  // A long corridor 1 × 1 × 8: its free paths are those of its 1 × 1 section (mostly), so the
+  // scale stays near its width, not its length.
+  const Scene corridor = makeBox(Vec3(1.0f, 1.0f, 8.0f), Material{"grey", LambertBsdf{Rgb(0.5f)}});
+  const Accel corridorAccel(corridor);
+  const float corridorScale = sceneScale(corridor, corridorAccel);
+  EXPECT_GT(corridorScale, 0.9f);
+  EXPECT_LT(corridorScale, 1.5f);
+  // A lone quad: every ray escapes, so the scale is its extent.
+  Scene quad;
+  quad.sourcePath = "quad";
+  quad.materials.push_back(Material{"grey", LambertBsdf{Rgb(0.5f)}});
+  Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  mesh.materials = {0, 0};
+  quad.meshes.push_back(mesh);
+  quad.finalize();
+  const Accel quadAccel(quad);
+  EXPECT_EQ(sceneScale(quad, quadAccel), 2.0f);
+}
+
+TEST(Parameterisation, NoChartIsCoarsenedAndMaterialsRefine) {
+  // Every chart of the Cornell box has the preset's tixel size, however small (the light) or
+  // large (the walls), even at a density whose walls need hundreds of tixels a side.
   const Scene scene = makeCornellBox();
   BakeSettings settings;
-  settings.tixelsAcrossScene = 200;
-  settings.maxTixelsPerChartSide = 10;
+  settings.tixelsAcrossScene = 300;
   const Parameterisation p = buildParameterisation(scene, settings);
+  const float base = baseTixelSize(settings, sceneScale(scene, Accel(scene)));
+  uint32_t widest = 0;
   for (const Chart& c : p.charts) {
-    EXPECT_LE(c.resU, 10u);
-    EXPECT_LE(c.resV, 10u);
+    EXPECT_EQ(c.tixelSize, base);
+    widest = std::max(widest, std::max(c.resU, c.resV));
   }
+  EXPECT_GT(widest, 200u);
+  // A material's tixel_density and glossiness refine its charts.
+  Material dense{"dense", LambertBsdf{Rgb(0.5f)}};
+  dense.tixelDensity = 2.5f;
+  const Scene denseBox = makeBox(Vec3(1.0f), dense);
+  const Scene glossyBox = makeBox(Vec3(1.0f), Material{"glossy", BlinnPhongBsdf{Rgb(0.3f), Rgb(0.3f), 20.0f}});
+  const Scene plainBox = makeBox(Vec3(1.0f), Material{"plain", LambertBsdf{Rgb(0.5f)}});
+  settings.tixelsAcrossScene = 8;
+  const float plain = buildParameterisation(plainBox, settings).charts[0].tixelSize;
+  EXPECT_FLOAT_EQ(buildParameterisation(denseBox, settings).charts[0].tixelSize, plain / 2.5f);
+  EXPECT_FLOAT_EQ(buildParameterisation(glossyBox, settings).charts[0].tixelSize, plain / kGlossyTixelDensity);
 }
 
 TEST(Parameterisation, TexturedTixelsUseTheFootprintAverageAlbedo) {
@@ -200,6 +267,47 @@ TEST(Parameterisation, TixelsOutsideTheTriangleGatherFromInsideIt) {
     if (p.coverage[c.firstTixel + t] == 0.0f) ++outside;
   }
   EXPECT_GT(outside, 0);  // the grid does have tixels entirely outside the polygon
+}
+
+TEST(Parameterisation, GatherPointsUnderAContactMoveOut) {
+  // A 4 × 4 floor (tixels 0.25 wide) with a closed 2 × 2 × 1 box standing on [1, 3]²: the ring
+  // of floor tixels just under the box's sides would gather from inside the box (dark, the
+  // leak along baseboards); they must gather from outside its footprint. With the box lifted
+  // off the floor (no contact) the same tixels keep their own centres.
+  for (const float lift : {0.0f, 0.5f}) {
+    Scene scene = makeBox(Vec3(2.0f, 2.0f, 1.0f), Material{"box", LambertBsdf{Rgb(0.5f)}});
+    for (Vec3& v : scene.meshes[0].positions) v += Vec3(1.0f, 1.0f, lift);
+    Mesh floor;
+    floor.positions = {{0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {0, 4, 0}};
+    floor.triangles = {{0, 1, 2}, {0, 2, 3}};
+    floor.materials = {0, 0};
+    scene.meshes.push_back(floor);
+    scene.finalize();
+    BakeSettings settings;
+    settings.tixelsPerUnit = 4.0f;
+    const Parameterisation p = buildParameterisation(scene, settings);
+    const Chart& c = p.charts[p.triangleChart[1][0]];
+    ASSERT_EQ(c.tixelCount(), 256u);
+    int ring = 0, moved = 0;
+    for (uint32_t k = 0; k < c.tixelCount(); ++k) {
+      const Vec3 centre = c.origin + (float(k % c.resU) + 0.5f) * c.tixelSize * c.axisU + (float(k / c.resU) + 0.5f) * c.tixelSize * c.axisV;
+      const float inside = std::min(std::min(centre.x - 1.0f, 3.0f - centre.x), std::min(centre.y - 1.0f, 3.0f - centre.y));
+      if (!(inside > 0.0f && inside < 0.2f)) continue;  // the ring just inside the footprint's edge
+      ++ring;
+      const Vec3 q = p.gatherPoint[c.firstTixel + k];
+      const bool underBox = q.x > 1.0f && q.x < 3.0f && q.y > 1.0f && q.y < 3.0f;
+      if (lift == 0.0f) {
+        EXPECT_FALSE(underBox) << "tixel " << k << " gathers from " << q.x << "," << q.y;
+      }
+      if (glm::length(q - centre) > 1e-4f) ++moved;
+    }
+    EXPECT_EQ(ring, 28);
+    if (lift > 0.0f) {
+      EXPECT_EQ(moved, 0);
+    } else {
+      EXPECT_GT(moved, 0);
+    }
+  }
 }
 
 TEST(Parameterisation, DirectionalResolutionByMaterial) {

@@ -24,7 +24,8 @@
 //       (+ for every type: "emission": [r,g,b] radiance in W·sr⁻¹·m⁻², "two_sided": false,
 //        "alpha_texture": "mask.png" (cut-out: its alpha channel, or its first channel without
 //        one), "alpha_cutoff": 0.5 (no surface where coverage < cutoff),
-//        "normal_texture": "normals.png" (tangent-space, OpenGL +y = +v), "normal_scale": 1)
+//        "normal_texture": "normals.png" (tangent-space, OpenGL +y = +v), "normal_scale": 1,
+//        "tixel_density": 1 (light-field tixels per length relative to the bake preset, > 0))
 //     A material whose name equals a material of a loaded file replaces it there.
 //   },
 //   "lights": [ {"type": "point", "position": [..], "intensity": [r,g,b] | I}      // W·sr⁻¹
@@ -161,8 +162,11 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
   material.name = name;
   material.emission = colourOr(ctx, value, "emission", Rgb(0.0f), where);
   material.twoSidedEmission = boolOr(ctx, value, "two_sided", false, where);
+  material.tixelDensity = numberOr(ctx, value, "tixel_density", 1.0f, where);
+  if (!(material.tixelDensity > 0.0f) || !std::isfinite(material.tixelDensity))
+    fail("{}: {}: tixel_density {} must be a positive number", ctx.path, where, material.tixelDensity);
   std::set<std::string> known = {"type", "emission", "two_sided", "alpha_texture", "alpha_cutoff", "normal_texture",
-                                  "normal_scale"};
+                                  "normal_scale", "tixel_density"};
   if (type == "lambert") {
     material.bsdf = LambertBsdf{colourOr(ctx, value, "albedo", Rgb(0.8f), where)};
     known.insert({"albedo", "texture"});

@@ -63,6 +63,9 @@ struct Material {
   /// normal), its x and y scaled by normalScale (glTF `scale`, MTL `-bm`). See surfaceAt().
   int normalTexture = -1;
   float normalScale = 1.0f;
+  /// Light-field tixel density relative to the bake preset's (2 = tixels half as wide); a
+  /// JSON scene's "tixel_density". Only the bake's parameterisation reads it.
+  float tixelDensity = 1.0f;
 
   bool isEmissive() const { return !isBlack(emission); }
   /// Whether some of the surface may be cut away (the Accel filters hits on it).

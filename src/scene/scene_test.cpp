@@ -391,6 +391,22 @@ TEST(JsonScene, DielectricMaterials) {
   expectError([&] { loadScene(bad.string()); }, {"bad.json", "absorption"});
 }
 
+TEST(JsonScene, TixelDensityPerMaterial) {
+  const fs::path dir = scratchDir("json_tixel_density");
+  writeFile(dir / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const Scene scene = loadScene(writeFile(dir / "d.json", R"({"materials": {
+      "fine": {"type": "lambert", "tixel_density": 4}, "plain": {"type": "lambert"}},
+    "meshes": [{"file": "tri.obj", "material": "fine"}, {"file": "tri.obj", "material": "plain"}]})"));
+  EXPECT_FLOAT_EQ(materialNamed(scene, "fine").tixelDensity, 4.0f);
+  EXPECT_FLOAT_EQ(materialNamed(scene, "plain").tixelDensity, 1.0f);
+  const fs::path bad = dir / "bad.json";
+  for (const char* value : {"0", "-2", "\"x\""}) {
+    writeFile(bad, std::string(R"({"include_cornell": true, "materials": {"w": {"type": "lambert", "tixel_density": )") +
+                       value + "}}}");
+    expectError([&] { loadScene(bad.string()); }, {"bad.json", "materials.w", "tixel_density"});
+  }
+}
+
 /// A one-triangle glTF whose material carries `extensions` (a JSON object body).
 std::string gltfTriangleWithMaterial(const fs::path& path, const std::string& extensions) {
   return writeFile(path, R"({"asset": {"version": "2.0"},
