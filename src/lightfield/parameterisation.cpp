@@ -243,7 +243,9 @@ FootprintSample locate(const ChartRaster& r, uint32_t bin, Vec2 q) {
 // azimuths, 30° above the tangent plane, plus one along the normal, with no length limit:
 // from inside a closed occluder every probe meets its inside, while a point in the open sees
 // front sides; a majority is asked for so that a few one-sided sheets wound the other way
-// (banners, leaves) do not bury the floor under them.
+// (banners, leaves) do not bury the floor under them. Glass is not counted. Known limit: an
+// opaque one-sided sheet facing away from the point and covering most of the probes (a single-
+// quad roof whose normal points up, seen from the floor below) still buries it.
 constexpr int kBuriedProbes = 9;
 constexpr int kBuriedMinHits = 5;
 
@@ -259,6 +261,9 @@ bool buried(const Scene& scene, const Accel& accel, const Chart& c, const Vec3& 
     RayHit hit;
     if (!accel.intersect(ray, hit)) continue;
     const Mesh& mesh = scene.meshes[hit.mesh];
+    // Glass buries nothing: light passes through it, and a window or a glass table top seen
+    // from below is the back of an open sheet, not the inside of a solid.
+    if (std::holds_alternative<DielectricBsdf>(scene.materials[mesh.materials[hit.triangle]].bsdf)) continue;
     const UVec3 tri = mesh.triangles[hit.triangle];
     const Vec3 n = glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]], mesh.positions[tri[2]] - mesh.positions[tri[0]]);
     if (glm::dot(n, d) > 0.0f) ++backHits;

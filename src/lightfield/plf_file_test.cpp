@@ -785,17 +785,24 @@ TEST_F(PlfFileTest, TwoSidedChartsRoundTripAndBrokenPairsAreRefused) {
 TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {
   LightField original = makeTestLightField();
   Scene& s = original.scene;
-  Texture mask = s.textures[0], normals = s.textures[0];
+  // The embedded PNG (stored as its file's bytes) as the mask, which the reader must decode as
+  // coverage (its red channel: it has no alpha), not as colour; a float-pixel texture as the
+  // normal map.
+  const int base = int(s.textures.size());
+  Texture mask = s.textures[1], normals = s.textures[0];
+  ASSERT_TRUE(mask.encoded);
+  ASSERT_FALSE(normals.encoded);
   mask.path = "textures/mask.png";
   mask.decode = ImageDecode::Coverage;
+  mask.image = decodeLdrImage(*mask.encoded, "mask", ImageDecode::Coverage);
   normals.path = "textures/normals.png";
   normals.decode = ImageDecode::Data;
   s.textures.push_back(mask);
   s.textures.push_back(normals);
-  s.materials[0].alphaTexture = 1;
+  s.materials[0].alphaTexture = base;
   s.materials[0].alphaFactor = 0.9f;
   s.materials[0].alphaCutoff = 0.3f;
-  s.materials[2].normalTexture = 2;
+  s.materials[2].normalTexture = base + 1;
   s.materials[2].normalScale = 0.7f;
   const std::string path = file("detail.plf");
   writeLightField(path, original);
@@ -809,20 +816,22 @@ TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {
     EXPECT_EQ(b.normalTexture, a.normalTexture) << m;
     EXPECT_EQ(b.normalScale, a.normalScale) << m;
   }
-  ASSERT_EQ(copy.scene.textures.size(), 3u);
+  ASSERT_EQ(copy.scene.textures.size(), size_t(base) + 2);
   EXPECT_EQ(copy.scene.textures[0].decode, ImageDecode::Colour);
-  EXPECT_EQ(copy.scene.textures[1].decode, ImageDecode::Coverage);
-  EXPECT_EQ(copy.scene.textures[2].decode, ImageDecode::Data);
-  EXPECT_EQ(copy.scene.textures[1].image.pixels, mask.image.pixels);
+  EXPECT_EQ(copy.scene.textures[size_t(base)].decode, ImageDecode::Coverage);
+  EXPECT_EQ(copy.scene.textures[size_t(base) + 1].decode, ImageDecode::Data);
+  EXPECT_EQ(copy.scene.textures[size_t(base)].image.pixels, mask.image.pixels);
+  EXPECT_EQ(copy.scene.textures[size_t(base) + 1].image.pixels, normals.image.pixels);
+  EXPECT_NE(copy.scene.textures[size_t(base)].image.pixels, s.textures[1].image.pixels);  // coverage ≠ colour
 
-  // The block ends SCNE: 5 materials × 20 bytes, then 3 decoding bytes. Material 0's alpha
+  // The block ends SCNE: 5 materials × 20 bytes, then one decoding byte per texture. Material 0's alpha
   // factor (4 bytes into its record) set to 2, and a decoding byte set to 9: both refused.
   const auto good = readBytes(path);
   const auto table = sections(good);
   const uint64_t blockEnd = table[0].offset + table[0].size;
   auto bad = good;
   const float two = 2.0f;
-  std::memcpy(bad.data() + blockEnd - 3 - 5 * 20 + 4, &two, 4);
+  std::memcpy(bad.data() + blockEnd - s.textures.size() - 5 * 20 + 4, &two, 4);
   resign(bad);
   writeBytes(file("alpha.plf"), bad);
   expectRefused(file("alpha.plf"), {"scene section", "material 'white' has alpha 2"});
