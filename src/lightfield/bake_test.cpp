@@ -22,6 +22,7 @@
 #include "lightfield/plf_file.h"
 #include "lightfield/propagation.h"
 #include "lightfield/visibility.h"
+#include "support/quad_mesh.h"
 
 namespace pl {
 namespace {
@@ -37,12 +38,7 @@ Scene makeClosedBox(float size, const Material& walls, const Material& special =
   const Vec3 centre(0.5f * size);
   auto quad = [&](Vec3 a, Vec3 b, Vec3 c, Vec3 d, uint32_t material) {
     if (glm::dot(glm::cross(b - a, c - a), centre - a) < 0.0f) std::swap(b, d);
-    const auto base = uint32_t(mesh.positions.size());
-    for (const Vec3& p : {a, b, c, d}) mesh.positions.push_back(p);
-    mesh.triangles.push_back(UVec3(base, base + 1, base + 2));
-    mesh.triangles.push_back(UVec3(base, base + 2, base + 3));
-    mesh.materials.push_back(material);
-    mesh.materials.push_back(material);
+    test_support::addQuad(mesh, a, b, c, d, material);
   };
   const float s = size;
   const Vec3 p000(0, 0, 0), p100(s, 0, 0), p010(0, s, 0), p110(s, s, 0), p001(0, 0, s), p101(s, 0, s), p011(0, s, s),

@@ -28,6 +28,7 @@
 #include "render/render.h"
 #include "scene/scene.h"
 #include "trace/trace.h"
+#include "support/quad_mesh.h"
 
 namespace pl {
 namespace {
@@ -37,14 +38,7 @@ class TwoSidedTest : public ::testing::Test {
   static void SetUpTestSuite() { Progress::setEnabled(false); }
 };
 
-void addQuad(Mesh& mesh, Vec3 a, Vec3 b, Vec3 c, Vec3 d, uint32_t material) {
-  const auto base = uint32_t(mesh.positions.size());
-  for (const Vec3& p : {a, b, c, d}) mesh.positions.push_back(p);
-  mesh.triangles.push_back(UVec3(base, base + 1, base + 2));
-  mesh.triangles.push_back(UVec3(base, base + 2, base + 3));
-  mesh.materials.push_back(material);
-  mesh.materials.push_back(material);
-}
+using test_support::addQuad;
 
 Scene makeSheetScene() {
   Scene scene;
