@@ -106,14 +106,15 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
 
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer) {
   // The chart facing the viewer (a two-sided surface's back record when seen from behind), then
-  // the lookup direction the normal map reflects to on it.
+  // the lookup direction the normal map reflects to on it. The shading is made once per call.
   const uint32_t chart = facingChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], worldDirectionTowardsViewer);
   const Chart& c = lf.charts[chart];
-  const bool normalMapped = chartShading(lf.scene, c).normalMapped;
-  return exitantRadiance(lf, chart, hit.position,
-                         normalMapped ? normalMappedLookupDirection(c, hit.shadingNormal, worldDirectionTowardsViewer)
-                                      : worldDirectionTowardsViewer,
-                         hit.uv);
+  if (c.kind == ChartKind::Specular) return Rgb(0.0f);
+  const ChartShading shading = chartShading(lf.scene, c);
+  const Vec3 lookupDirection = shading.normalMapped
+                                   ? normalMappedLookupDirection(c, hit.shadingNormal, worldDirectionTowardsViewer)
+                                   : worldDirectionTowardsViewer;
+  return exitantRadiance(lf.scene, c, shading, lf.values.data(), hit.position, lookupDirection, hit.uv);
 }
 
 }  // namespace pl
