@@ -23,6 +23,7 @@
 #include "lightfield/propagation.h"
 #include "lightfield/visibility.h"
 #include "support/quad_mesh.h"
+#include "support/mask_texture.h"
 
 namespace pl {
 namespace {
@@ -224,12 +225,7 @@ TEST_F(BakeTest, AlphaMaskedBlockerCastsTheMaskedShadowInTheLightField) {
     mesh.materials = {0, 0, 1, 1};
     scene.meshes.push_back(mesh);
     if (masked) {
-      Texture mask;
-      mask.path = "half mask";
-      mask.decode = ImageDecode::Coverage;
-      mask.image = Image(1, 4);
-      mask.image.pixels = {Rgb(1.0f), Rgb(1.0f), Rgb(0.0f), Rgb(0.0f)};  // top rows (large v) opaque
-      scene.textures.push_back(mask);
+      scene.textures.push_back(test_support::halfMaskTexture());  // top half opaque
       scene.materials[1].alphaTexture = 0;
     }
     scene.lights.push_back(DirectionalLight{Vec3(0.0f, -1.0f, 0.0f), Rgb(e)});

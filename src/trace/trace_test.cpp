@@ -18,6 +18,7 @@
 #include "image/compare.h"
 #include "image/image.h"
 #include "scene/scene.h"
+#include "support/mask_texture.h"
 #include "support/sphere_mesh.h"
 #include "trace/trace.h"
 
@@ -536,12 +537,7 @@ TEST_F(TraceTest, AlphaMaskedBlockerCastsTheMaskedShadow) {
   for (size_t v = 0; v < mesh.positions.size(); ++v)
     mesh.uvs[v] = Vec2(mesh.positions[v].x + 0.5f, mesh.positions[v].z + 0.5f);  // blocker: [0,1]²
   s.meshes.push_back(mesh);
-  Texture mask;
-  mask.path = "half mask";
-  mask.decode = ImageDecode::Coverage;
-  mask.image = Image(1, 4);
-  mask.image.pixels = {Rgb(1.0f), Rgb(1.0f), Rgb(0.0f), Rgb(0.0f)};  // top rows (large v) opaque
-  s.textures.push_back(mask);
+  s.textures.push_back(test_support::halfMaskTexture());  // top half opaque
   s.materials[blocker].alphaTexture = 0;
   s.lights.push_back(DirectionalLight{travel, irradiance});
   const Scene scene = finished(std::move(s));
