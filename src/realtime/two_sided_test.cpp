@@ -179,10 +179,11 @@ TEST_F(TwoSidedTest, EmissionRuleOnBackRecords) {
 //
 // Tolerances. Path tracer: 64 × 48 pixels × 256 independent samples; the mean over ~1500
 // sheet pixels has a standard error below 0.3 % (checked: the test requires it below a fifth
-// of the tolerance). Light field: tixels of 4/24 ≈ 0.17 scene units on a sheet lit by a point
-// light 1.5 away, bilinear between tixel centres, and 256 gather rays per tixel for the
-// interreflected light; the mean over the sheet is within 2 % on the front and 6 % on the back
-// (all of whose light is interreflection, the bake's noisiest part), measured 0.02 % and 2.0 %.
+// of the tolerance). Light field: tixels a small fraction of the sheet (default preset) on a
+// sheet lit by a point light 1.5 away, bilinear between tixel centres, and 256 gather rays per
+// tixel for the interreflected light; the mean over the sheet is within 2 % on the front and 6 %
+// on the back (all of whose light is interreflection, the bake's noisiest part), measured
+// 0.02 % and 2.0 % with the extent-based density, 0.13 % and 2.2 % with the room-scale one.
 // The one-sided light field failed the back by a factor ≈ 40.
 TEST_F(TwoSidedTest, ThinSheetMatchesThePathTracerFromBothSides) {
   const Scene traced = makeSheetScene();
