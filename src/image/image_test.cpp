@@ -205,6 +205,10 @@ TEST_F(ImageFiles, MissingUnknownAndAbsurdFilesAreRefused) {
   expectReadError(path("negative.pfm"), "out of range");
   writeBytes(path("huge.hdr"), "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 900000 +X 900000\n");
   expectReadError(path("huge.hdr"), "out of range");
+  // In range (8192² = 67 M pixels) but holding one pixel: refused as truncated. The reader
+  // decodes before allocating the image, so this costs the few bytes read, not 800 MB.
+  writeBytes(path("short.hdr"), std::string("#?RADIANCE\n\n-Y 8192 +X 8192\n\x02\x02\x20\x00", 32));
+  expectReadError(path("short.hdr"), "truncated");
   writeBytes(path("xyz.hdr"), "#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 1 +X 1\n");
   expectReadError(path("xyz.hdr"), "unsupported");
 }

@@ -222,22 +222,31 @@ Image readRadianceHdr(const std::string& path) {
     fail("{}: unsupported Radiance HDR orientation '{}' (only '±Y H ±X W')", path, resolution);
   checkImageSize(path, width, height);
 
-  Image image(static_cast<int>(width), static_cast<int>(height));
+  // The scan lines are decoded before the image is made: a short file that declares a huge size
+  // fails at its end after holding what it decoded, instead of first allocating and clearing
+  // width × height pixels (up to kMaxImagePixels × 12 bytes) for a few bytes of input.
+  std::vector<Rgb> rows;  // in file order, `width` pixels each
   std::vector<unsigned char> rgbe(size_t(width) * 4);
   const float scale = float(1.0 / exposure);
   for (int row = 0; row < int(height); ++row) {
     readScanline(in, path, row, int(width), rgbe.data());
-    // "-Y" stores the top row first; "+Y" the bottom row first. "-X" runs right to left.
-    const int y = ySign == '-' ? row : int(height) - 1 - row;
     for (int i = 0; i < int(width); ++i) {
-      const int x = xSign == '+' ? i : int(width) - 1 - i;
       const unsigned char* p = &rgbe[size_t(i) * 4];
       Rgb value(0.0f);
       if (p[3] != 0) {
         const float f = std::ldexp(1.0f, int(p[3]) - (128 + 8));
         value = Rgb((float(p[0]) + 0.5f) * f, (float(p[1]) + 0.5f) * f, (float(p[2]) + 0.5f) * f) * scale;
       }
-      image.at(x, y) = value;
+      rows.push_back(value);
+    }
+  }
+  Image image(static_cast<int>(width), static_cast<int>(height));
+  for (int row = 0; row < int(height); ++row) {
+    // "-Y" stores the top row first; "+Y" the bottom row first. "-X" runs right to left.
+    const int y = ySign == '-' ? row : int(height) - 1 - row;
+    for (int i = 0; i < int(width); ++i) {
+      const int x = xSign == '+' ? i : int(width) - 1 - i;
+      image.at(x, y) = rows[size_t(row) * size_t(width) + size_t(i)];
     }
   }
   return image;
