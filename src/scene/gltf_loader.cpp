@@ -488,15 +488,37 @@ void visitNode(GltfContext& ctx, int nodeIndex, const Mat4& parent, int depth) {
   for (int child : node.children) visitNode(ctx, child, world, depth + 1);
 }
 
-/// tinygltf's image loader callback: keeps the bytes (user data: the vector of encoded images)
-/// and leaves decoding to textureFor, so that a texture is decoded once, by decodeLdrImage, the
-/// same decoder the .plf reader uses for the embedded bytes.
-bool keepEncodedImage(tinygltf::Image*, const int imageIndex, std::string*, std::string*, int, int,
+/// What keepEncodedImage reads and fills while tinygltf loads: the model being loaded (its
+/// buffers and buffer views are parsed before the images) and each image's encoded bytes.
+struct EncodedImages {
+  const tinygltf::Model* model = nullptr;
+  std::vector<std::vector<unsigned char>> bytes;  ///< per glTF image
+};
+
+/// Whether buffer view `viewIndex` of `model` exists and `size` bytes from its start lie inside its buffer.
+bool bufferViewHolds(const tinygltf::Model& model, int viewIndex, size_t size) {
+  if (size_t(viewIndex) >= model.bufferViews.size()) return false;
+  const tinygltf::BufferView& view = model.bufferViews[size_t(viewIndex)];
+  if (view.buffer < 0 || size_t(view.buffer) >= model.buffers.size()) return false;
+  const size_t bufferSize = model.buffers[size_t(view.buffer)].data.size();
+  return view.byteOffset <= bufferSize && size <= bufferSize - view.byteOffset;
+}
+
+/// tinygltf's image loader callback: keeps the bytes (user data: EncodedImages) and leaves
+/// decoding to textureFor, so that a texture is decoded once, by decodeLdrImage, the same
+/// decoder the .plf reader uses for the embedded bytes. An image stored in a buffer view is
+/// checked against its buffer first: tinygltf checks only the view's start, and hands over
+/// byteLength bytes from there even when they run past the buffer's end.
+bool keepEncodedImage(tinygltf::Image* image, const int imageIndex, std::string* error, std::string*, int, int,
                       const unsigned char* bytes, int size, void* userData) {
-  auto& images = *static_cast<std::vector<std::vector<unsigned char>>*>(userData);
+  auto& images = *static_cast<EncodedImages*>(userData);
   if (imageIndex < 0 || size < 0) return false;
-  if (size_t(imageIndex) >= images.size()) images.resize(size_t(imageIndex) + 1);
-  images[size_t(imageIndex)].assign(bytes, bytes + size);
+  if (image && image->bufferView >= 0 && !bufferViewHolds(*images.model, image->bufferView, size_t(size))) {
+    if (error) *error += fmt::format("image {}: buffer view {} runs past the end of its buffer", imageIndex, image->bufferView);
+    return false;
+  }
+  if (size_t(imageIndex) >= images.bytes.size()) images.bytes.resize(size_t(imageIndex) + 1);
+  images.bytes[size_t(imageIndex)].assign(bytes, bytes + size);
   return true;
 }
 
@@ -506,7 +528,7 @@ Scene loadGltf(const std::string& path) {
   requireRegularFile(path);
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
-  std::vector<std::vector<unsigned char>> encodedImages;
+  EncodedImages encodedImages{&model, {}};
   loader.SetImageLoader(keepEncodedImage, &encodedImages);
   std::string error, warning;
   std::string extension = std::filesystem::path(path).extension().string();
@@ -529,7 +551,7 @@ Scene loadGltf(const std::string& path) {
 
   Scene scene;
   scene.sourcePath = path;
-  GltfContext ctx{path, model, scene, encodedImages, {}};
+  GltfContext ctx{path, model, scene, encodedImages.bytes, {}};
   for (size_t m = 0; m < model.materials.size(); ++m)
     scene.materials.push_back(convertMaterial(ctx, model.materials[m], int(m)));
 

@@ -864,6 +864,10 @@ TEST(BadInput, GlbOnWhichTinygltfThrowsIsAnInvalidFile) {
   // A GLB buffer of byteLength 0 beside a BIN chunk: tinygltf throws std::out_of_range.
   expectError([] { loadScene(kFuzzCorpus + "gltf/zero_length_buffer.glb"); },
               {"zero_length_buffer.glb", "not a valid glTF file"});
+  // Found by fuzz_gltf: an embedded PNG whose buffer view runs past its buffer (tinygltf read
+  // past the end; ASan saw a use-after-free).
+  expectError([] { loadScene(kFuzzCorpus + "gltf/image-view-past-buffer-end.glb"); },
+              {"image-view-past-buffer-end.glb", "buffer view 5 runs past the end of its buffer"});
 }
 
 TEST(BadInput, JsonNumberBeyondADoubleIsAMalformedFile) {
