@@ -215,12 +215,16 @@ TEST(Accel, ClosestHitMatchesBruteForceInTheCornellBox) {
   const Scene scene = makeCornellBox();
   const Accel accel(scene);
   const auto rays = makeRandomRays(scene, 2000, 3);
+  int hits = 0;
   for (const Ray& ray : rays) {
     RayHit hit;
-    accel.intersect(ray, hit);
+    hits += accel.intersect(ray, hit);
     const Verdict v = checkAgainstReference(scene, ray, hit);
     EXPECT_TRUE(v.ok) << v.why;
   }
+  // An accel that missed everything would pass the checks above whenever no ray surely hits;
+  // the rays must exercise hits in numbers (1109 of 2000 measured).
+  EXPECT_GT(hits, 500);
 }
 
 TEST(Accel, RespectsTMinAndTMax) {
@@ -275,11 +279,16 @@ TEST(Accel, OcclusionAgreesWithIntersection) {
   EXPECT_LT(blocked, 3600);
 }
 
-void expectSameHits(const std::vector<RayHit>& a, const std::vector<RayHit>& b, const char* what) {
-  ASSERT_EQ(a.size(), b.size());
+/// Expects the same answers from two query paths; returns the number of hits (so callers can
+/// require that the comparison was not made on misses alone).
+int expectSameHits(const std::vector<RayHit>& a, const std::vector<RayHit>& b, const char* what) {
+  EXPECT_EQ(a.size(), b.size());
+  if (a.size() != b.size()) return 0;
+  int hits = 0;
   for (size_t i = 0; i < a.size(); ++i) {
-    ASSERT_EQ(a[i].hit(), b[i].hit()) << what << " ray " << i;
-    if (!a[i].hit()) continue;
+    EXPECT_EQ(a[i].hit(), b[i].hit()) << what << " ray " << i;
+    if (!a[i].hit() || !b[i].hit()) continue;
+    ++hits;
     EXPECT_EQ(a[i].mesh, b[i].mesh) << what << " ray " << i;
     EXPECT_EQ(a[i].triangle, b[i].triangle) << what << " ray " << i;
     // Packet and single-ray kernels may round differently in the last bits.
@@ -287,6 +296,7 @@ void expectSameHits(const std::vector<RayHit>& a, const std::vector<RayHit>& b, 
     EXPECT_NEAR(a[i].barycentrics.x, b[i].barycentrics.x, 1e-4f) << what << " ray " << i;
     EXPECT_NEAR(a[i].barycentrics.y, b[i].barycentrics.y, 1e-4f) << what << " ray " << i;
   }
+  return hits;
 }
 
 TEST(Accel, PacketsAndStreamsAgreeWithSingleRays) {
@@ -301,8 +311,9 @@ TEST(Accel, PacketsAndStreamsAgreeWithSingleRays) {
   for (size_t i = 0; i < rays.size(); ++i) accel.intersect(rays[i], single[i]);
   accel.intersectCoherent(rays, packet);
   accel.intersectIncoherent(rays, stream);
-  expectSameHits(single, packet, "packet");
-  expectSameHits(single, stream, "stream");
+  // Agreement on misses alone would prove nothing: require hits (1798 of 4007 measured).
+  EXPECT_GT(expectSameHits(single, packet, "packet"), 900);
+  EXPECT_GT(expectSameHits(single, stream, "stream"), 900);
   // Coherent camera-like rays too: a fan from one point.
   std::vector<Ray> fan;
   for (int y = 0; y < 37; ++y)
@@ -311,7 +322,7 @@ TEST(Accel, PacketsAndStreamsAgreeWithSingleRays) {
   std::vector<RayHit> fanSingle(fan.size()), fanPacket(fan.size());
   for (size_t i = 0; i < fan.size(); ++i) accel.intersect(fan[i], fanSingle[i]);
   accel.intersectCoherent(fan, fanPacket);
-  expectSameHits(fanSingle, fanPacket, "fan packet");
+  EXPECT_GT(expectSameHits(fanSingle, fanPacket, "fan packet"), 600);  // 1288 of 1517 measured
 }
 
 TEST(Accel, WorksOnACopiedSceneWhoseBuffersLostTheirPadding) {
@@ -326,7 +337,7 @@ TEST(Accel, WorksOnACopiedSceneWhoseBuffersLostTheirPadding) {
     original.intersect(rays[i], a[i]);
     fromCopy.intersect(rays[i], b[i]);
   }
-  expectSameHits(a, b, "copied scene");
+  EXPECT_GT(expectSameHits(a, b, "copied scene"), 130);  // 273 of 1000 measured
 }
 
 TEST(Accel, BoundsAndEmptySpans) {

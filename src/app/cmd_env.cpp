@@ -207,9 +207,9 @@ void runPrefilter(const PrefilterCliOptions& o, const GlobalOptions& global) {
   for (size_t k = 0; k < levels.size(); ++k) {
     const std::string path = withTag(o.output, fmt::format("level{}", k));
     saveEnvironment(path, levels[k].map, layout);
-    const float alpha = std::max(levels[k].roughness * levels[k].roughness, kGgxMinAlpha);
+    const float alpha = ggxAlphaFromRoughness(levels[k].roughness);
     fmt::print("  {}  roughness {:.3f} (α = {:.4g}{})  {}\n", path, levels[k].roughness, alpha,
-               p.model == SpecularModel::BlinnPhong ? fmt::format(", exponent {:.4g}", 2.0f / (alpha * alpha) - 2.0f)
+               p.model == SpecularModel::BlinnPhong ? fmt::format(", exponent {:.4g}", blinnPhongExponentFromAlpha(alpha))
                                                     : std::string(),
                describe(levels[k].map));
   }

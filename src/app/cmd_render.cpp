@@ -44,7 +44,6 @@ struct RenderOptions {
   int samples = 0;        ///< --samples N: camera samples per pixel (0 = automatic, see render.h)
   int mirrorDepth = -1;   ///< --mirror-depth N (-1 = the bake's)
   bool reference = false;  ///< --reference: the straightforward renderer instead of the fast one
-  bool fast = false;       ///< --fast: the fast renderer (the default; excludes --reference)
   std::string pathFile;    ///< --path PATH.json: render a walk-through, one output per frame
   ViewOptions view;
 };
@@ -189,9 +188,8 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
                       "Mirror reflections followed (-1 = the bake's own mirror depth)")
       ->check(CLI::Range(-1, RenderSettings::kMaxMirrorDepth))
       ->capture_default_str();
-  auto* reference = command->add_flag("--reference", options->reference,
-                                      "Use the straightforward reference renderer (src/render) instead of the fast one");
-  command->add_flag("--fast", options->fast, "Use the fast renderer (the default)")->excludes(reference);
+  command->add_flag("--reference", options->reference,
+                    "Use the straightforward reference renderer (src/render) instead of the fast one (the default)");
   command->add_option("--path", options->pathFile,
                       "Camera path JSON (keyframes; see README): render a walk-through to -o frames/%04d.png or -o walk.mp4");
   command->add_option("--stats", options->statsPath,

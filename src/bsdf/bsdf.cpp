@@ -206,7 +206,11 @@ class GgxAlbedoTable {
       const float rough = rMin + (1.0f - rMin) * static_cast<float>(r) / (kRoughNodes - 1);
       const float alpha = rough * rough;
       for (int i = 0; i < kMuNodes; ++i) {
-        // At grazing (μ = 0) the lobe is evaluated just above the horizon.
+        // At grazing (μ = 0) the lobe is evaluated just above the horizon: exactly at μ = 0,
+        // Λ(wo) is infinite and the estimator G2/G1 is 0/0. μ = 1e-4 (θ = 89.994°) is the
+        // limit's stand-in: E(μ) is continuous at 0 and its slope there is finite, so the
+        // node differs from E(0) by O(1e-4), far below the table's interpolation error
+        // between nodes (first node after 0 is μ = 1/(kMuNodes−1)²).
         const float mu = std::max(mu_[i], 1e-4f);
         const Vec3 wo(std::sqrt(1.0f - mu * mu), 0.0f, mu);
         const float g1o = 1.0f / (1.0f + ggxLambda(alpha, wo));
@@ -483,7 +487,8 @@ class DielectricAlbedoTable {
         const float rough = rMin + (1.0f - rMin) * static_cast<float>(r) / (kRoughNodes - 1);
         const float alpha = rough * rough;
         for (int i = 0; i < kMuNodes; ++i) {
-          const float mu = std::max(mu_[i], 1e-4f);  // just above the horizon at μ = 0
+          // Just above the horizon at μ = 0, where Λ is infinite (see GgxAlbedoTable).
+          const float mu = std::max(mu_[i], 1e-4f);
           const Vec3 w(std::sqrt(1.0f - mu * mu), 0.0f, mu);
           const float lambdaW = ggxLambda(alpha, w);
           double sum = 0.0;
@@ -781,16 +786,6 @@ float blinnPhongNormalization(float exponent) {
   return (n + 2.0f) * (n + 4.0f) / (8.0f * kPi * (std::exp2(-0.5f * n) + n));
 }
 
-GgxBsdf ggxFromMetallicRoughness(const Rgb& baseColor, float metallic, float roughness) {
-  metallic = std::clamp(metallic, 0.0f, 1.0f);
-  roughness = std::clamp(roughness, 0.0f, 1.0f);
-  GgxBsdf b;
-  b.f0 = glm::mix(Rgb(0.04f), baseColor, metallic);
-  b.diffuse = baseColor * (1.0f - metallic);
-  b.alpha = clampAlpha(roughness * roughness);
-  return b;
-}
-
 Rgb eval(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) {
   return std::visit(Overloaded{
                         [&](const LambertBsdf& b) { return evalLambert(b, wo, wi); },
@@ -850,15 +845,6 @@ std::optional<BsdfSample> sample(const Bsdf& bsdf, const Vec3& wo, Vec2 u) {
                     },
                     bsdf);
 }
-
-bool isDelta(const Bsdf& bsdf) {
-  if (const auto* d = std::get_if<DielectricBsdf>(&bsdf)) return d->isSmooth();
-  return std::holds_alternative<MirrorBsdf>(bsdf);
-}
-
-bool hasTransmission(const Bsdf& bsdf) { return std::holds_alternative<DielectricBsdf>(bsdf); }
-
-bool isDiffuse(const Bsdf& bsdf) { return std::holds_alternative<LambertBsdf>(bsdf); }
 
 Rgb albedo(const Bsdf& bsdf, const Vec3& wo) {
   const auto* dielectric = std::get_if<DielectricBsdf>(&bsdf);

@@ -35,7 +35,9 @@
 #include "core/math.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <optional>
+#include <string>
 #include <variant>
 
 namespace pl {
@@ -43,6 +45,11 @@ namespace pl {
 /// Ideal diffuse: f = albedo / π.
 struct LambertBsdf {
   Rgb albedo{0.8f};
+
+  /// The serialisation hook every model has: f(field) for each parameter, in the order of
+  /// the .plf encoding (lightfield/plf_file.cpp); Self is the model, const or not.
+  template <class Self, class F>
+  static void parameters(Self& b, F&& f) { f(b.albedo); }
 };
 
 /// Ideal specular reflection. With fresnel = false the reflectance is `reflectance`; with
@@ -50,6 +57,9 @@ struct LambertBsdf {
 struct MirrorBsdf {
   Rgb reflectance{1.0f};
   bool fresnel = false;
+
+  template <class Self, class F>
+  static void parameters(Self& b, F&& f) { f(b.reflectance), f(b.fresnel); }
 };
 
 /// Normalised Blinn-Phong (tri-Ace, Gotanda 2010):
@@ -65,6 +75,9 @@ struct BlinnPhongBsdf {
   Rgb diffuse{0.5f};
   Rgb specular{0.04f};
   float exponent = 64.0f;  ///< n, the Phong exponent (MTL Ns)
+
+  template <class Self, class F>
+  static void parameters(Self& b, F&& f) { f(b.diffuse), f(b.specular), f(b.exponent); }
 };
 
 /// GGX (Trowbridge–Reitz) microfacet specular with Schlick Fresnel over a Lambertian base:
@@ -79,12 +92,36 @@ struct GgxBsdf {
   Rgb diffuse{0.0f};  ///< Lambertian base albedo
   Rgb f0{0.04f};      ///< Fresnel reflectance at normal incidence
   float alpha = 0.25f;  ///< GGX roughness α (= perceptual roughness²)
+
+  template <class Self, class F>
+  static void parameters(Self& b, F&& f) { f(b.diffuse), f(b.f0), f(b.alpha); }
 };
 inline constexpr float kGgxMinAlpha = 1e-3f;
 
+// ---- Parameter conversions (the only place they are written) ----------------------------
+//
+// Perceptual roughness r ∈ [0, 1] (glTF, Disney/UE4 "roughness") maps to the GGX α = r²
+// (Burley 2012; glTF 2.0 appendix B). A Blinn-Phong lobe cosⁿθh matches the Beckmann
+// distribution of roughness α near its peak when n = 2/α² − 2 (Walter et al. 2007, §5.2), so
+// α = √(2/(n + 2)) the other way; GGX of the same α has a narrower core (half width at half
+// maximum tan θh = 0.64α against Beckmann's 0.83α) and longer tails.
+
+/// α = r², unclamped (for loaders that validate the result themselves).
+inline float alphaFromRoughness(float roughness) { return roughness * roughness; }
+/// GGX α of perceptual roughness r (clamped to [0, 1]): r², floored at kGgxMinAlpha (α → 0
+/// makes the distribution a Dirac delta, which GgxBsdf does not model).
+float ggxAlphaFromRoughness(float roughness);
+/// Dielectric α of perceptual roughness r (clamped to [0, 1]): r², or exactly 0 (the smooth,
+/// delta form of DielectricBsdf) when r² < kGgxMinAlpha.
+float dielectricAlphaFromRoughness(float roughness);
+/// The Blinn-Phong exponent n = 2/α² − 2 whose lobe matches GGX α near the peak (≥ 0).
+float blinnPhongExponentFromAlpha(float alpha);
+/// The inverse, α = √(2/(n + 2)).
+float alphaFromBlinnPhongExponent(float exponent);
+
 /// The glTF 2.0 metallic-roughness material as a GgxBsdf (the mapping of the glTF spec's
 /// appendix B): f0 = mix(0.04, baseColor, metallic), diffuse = baseColor·(1 − metallic),
-/// α = roughness².
+/// α = ggxAlphaFromRoughness(roughness). metallic and roughness are clamped to [0, 1].
 GgxBsdf ggxFromMetallicRoughness(const Rgb& baseColor, float metallic, float roughness);
 
 /// Exact normalisation of the Blinn-Phong lobe cos^n θh so that ∫ N cos^n θh cos θi dωi = 1
@@ -127,6 +164,9 @@ struct DielectricBsdf {
   Rgb absorption{0.0f};      ///< σa ≥ 0 per scene unit (inside a closed mesh)
 
   bool isSmooth() const { return thin || alpha < kGgxMinAlpha; }
+
+  template <class Self, class F>
+  static void parameters(Self& b, F&& f) { f(b.ior), f(b.transmittance), f(b.alpha), f(b.thin), f(b.absorption); }
 };
 
 /// Exact unpolarised Fresnel reflectance of a dielectric interface for light arriving at
@@ -141,7 +181,54 @@ float fresnelDielectricTransmittance(float cosTheta, float eta);
 /// Thin-sheet reflectance R' and transmittance T' (DielectricBsdf, thin) at |cos θ|.
 void thinSheetReflectanceTransmittance(const DielectricBsdf& b, float cosTheta, Rgb& reflectance, Rgb& transmittance);
 
+/// The closed set of models. Adding one: its struct (parameters, and a parameters() hook for
+/// serialisation), an entry here (at the end: the index is the .plf model number), and its
+/// per-model functions in bsdf.cpp (eval/pdf/sample) and lobe.cpp (lobe, validation) — the
+/// compiler names every function a new entry still lacks. Nothing outside bsdf/ switches on it.
 using Bsdf = std::variant<LambertBsdf, MirrorBsdf, BlinnPhongBsdf, GgxBsdf, DielectricBsdf>;
+
+/// A default-constructed model of variant index `index` (the serialised model number);
+/// nullopt for an index no model has.
+std::optional<Bsdf> bsdfOfIndex(size_t index);
+
+// ---- What other modules need to know about a model (the lobe descriptor) ----------------
+
+/// How a model scatters, as the light field classifies it.
+enum class LobeKind : uint8_t {
+  Delta,    ///< ideal specular only (mirror, smooth or thin glass): no eval, only sample()
+  Diffuse,  ///< f constant (Lambert): one value per tixel suffices
+  Glossy,   ///< a directional lobe (Blinn-Phong, GGX, rough glass)
+};
+
+/// Everything the scene, the bake and the renderers ask about a model, in one place.
+struct LobeDescriptor {
+  LobeKind kind = LobeKind::Diffuse;
+  /// Defined on both sides, frame not flipped (DielectricBsdf; the contract above); reflecting
+  /// models are two-sided by flipping the frame to wo's side (scene.h scatteringFrame).
+  bool transmits = false;
+  /// θh: half width at half maximum of the lobe in half-vector angle (radians); the reflected
+  /// lobe's full width at half maximum is ≈ 4θh. 0 for delta models, π/2 for diffuse ones.
+  float halfWidth = 0.0f;
+  /// The diffuse reflectance a texture multiplies (black for models without a diffuse part).
+  Rgb diffuseAlbedo{0.0f};
+};
+LobeDescriptor describe(const Bsdf& bsdf);
+
+/// The lobe half width θh of describe() alone (see LobeDescriptor::halfWidth):
+///   Blinn-Phong cosⁿθh = ½           → θh = acos(2^(−1/n));
+///   GGX D ∝ 1/(α² + tan²θh)² (the cos⁴ factor ignored) = ½ D(0) → tan θh = α·√(√2 − 1).
+float lobeHalfWidth(const Bsdf& bsdf);
+/// The diffuse albedo a texture multiplies (describe().diffuseAlbedo alone; per hit).
+Rgb diffuseAlbedo(const Bsdf& bsdf);
+/// The Beer–Lambert absorption σa (per scene unit) inside a closed dielectric; black for
+/// every other model (per hit).
+Rgb interiorAbsorption(const Bsdf& bsdf);
+
+/// The reason the model's parameters violate the contract above ("" when valid): reflectances
+/// in [0, 1] (more would create energy), Blinn-Phong diffuse + specular ≤ 1 per channel and a
+/// finite exponent ≥ 0, GGX α in (0, 1], a dielectric's finite positive index, transmittance in
+/// [0, 1], α in [0, 1] and finite absorption ≥ 0. Callers prefix file and material.
+std::string bsdfProblem(const Bsdf& bsdf);
 
 struct BsdfSample {
   Vec3 wi{0.0f};      ///< sampled incident direction (local frame)

@@ -73,7 +73,6 @@ class Camera {
 
   Vec3 eye() const { return eye_; }
   Vec3 forward() const { return forward_; }  ///< optical axis, unit
-  float tanHalfFovY() const { return tanHalfFovY_; }
   float focalLengthMm() const { return focalLengthMm_; }   ///< physical (35 mm format)
   float apertureRadius() const { return apertureRadius_; }  ///< scene units (0 = pinhole)
   float focusDistance() const { return focusDistance_; }    ///< scene units

@@ -236,33 +236,8 @@ class EnvironmentMap {
   double integratedLuminance_ = 0.0;
 };
 
-/// Everything that arrives from infinity as one light: a constant radiance plus an optional
-/// map (exactly what scene.h's Environment holds). radiance(dir) = constant + map(dir).
-/// sample() is a one-sample mixture: the map's importance sampling with probability
-/// P_map / (P_map + P_const) and uniform sphere sampling otherwise, P = ∫ Y(L) dω of each
-/// part. pdf() is the mixture density (per solid angle), and sample() returns pdf() of the
-/// direction it chose, so MIS weights built from either agree. Cheap to copy (shared map).
-class EnvironmentLight {
- public:
-  EnvironmentLight() = default;
-  EnvironmentLight(const Rgb& constant, std::shared_ptr<const EnvironmentMap> map);
-
-  bool isBlack() const { return !map_ && isBlackConstant_; }
-  Rgb radiance(const Vec3& dir) const { return map_ ? constant_ + map_->radiance(dir) : constant_; }
-  EnvironmentSample sample(Vec2 u) const;
-  float pdf(const Vec3& dir) const;
-  /// ∫ Y(L) dω over the sphere (luminance-weighted, W·m⁻²). The power an environment
-  /// delivers into a scene bounded by a sphere of radius R is at most π R² times this.
-  double integratedLuminance() const { return integratedLuminance_; }
-  float mapProbability() const { return mapProbability_; }
-
- private:
-  Rgb constant_{0.0f};
-  bool isBlackConstant_ = true;
-  std::shared_ptr<const EnvironmentMap> map_;
-  float mapProbability_ = 0.0f;
-  double integratedLuminance_ = 0.0;
-};
+// The environment as one light (constant + map, sampled as a mixture) is light/emitters.h
+// EnvironmentLight.
 
 /// Loads any environment file (see loadEnvironment) as a light. A cube input is converted
 /// to lat-long at the equivalent resolution.

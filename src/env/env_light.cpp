@@ -98,49 +98,6 @@ float EnvironmentMap::pdf(const Vec3& dir) const {
 
 // ─── Constant + map ────────────────────────────────────────────────────────────────────────
 
-EnvironmentLight::EnvironmentLight(const Rgb& constant, std::shared_ptr<const EnvironmentMap> map)
-    : constant_(constant), isBlackConstant_(pl::isBlack(constant)), map_(std::move(map)) {
-  if (!isFinite(constant) || constant.r < 0.0f || constant.g < 0.0f || constant.b < 0.0f)
-    fail("environment constant radiance must be finite and ≥ 0 (got {}, {}, {})", constant.r, constant.g, constant.b);
-  const double constantPower = 4.0 * kPiD * double(luminance(constant));
-  const double mapPower = map_ ? map_->integratedLuminance() : 0.0;
-  integratedLuminance_ = constantPower + mapPower;
-  if (map_ && mapPower > 0.0) mapProbability_ = float(mapPower / (constantPower + mapPower));
-}
-
-EnvironmentSample EnvironmentLight::sample(Vec2 u) const {
-  EnvironmentSample s;
-  if (isBlack()) return s;
-  // The mixture's pdf and radiance need the map's pdf and radiance at the chosen direction;
-  // a map sample already carries both (same formulas as pdf() and radiance()), so only a
-  // uniform sample looks them up.
-  float mapPdf = 0.0f;
-  Rgb mapRadiance(0.0f);
-  if (u.x < mapProbability_) {
-    u.x = std::min(u.x / mapProbability_, 0x1.fffffep-1f);
-    const EnvironmentSample fromMap = map_->sample(u);
-    s.direction = fromMap.direction;
-    mapPdf = fromMap.pdf;
-    mapRadiance = fromMap.radiance;
-  } else {
-    u.x = std::min((u.x - mapProbability_) / (1.0f - mapProbability_), 0x1.fffffep-1f);
-    s.direction = sampleUniformSphere(u);
-    if (map_) {
-      if (mapProbability_ > 0.0f) mapPdf = map_->pdf(s.direction);
-      mapRadiance = map_->radiance(s.direction);
-    }
-  }
-  s.pdf = (1.0f - mapProbability_) * kUniformSpherePdf + mapProbability_ * mapPdf;
-  s.radiance = constant_ + mapRadiance;
-  return s;
-}
-
-float EnvironmentLight::pdf(const Vec3& dir) const {
-  if (isBlack()) return 0.0f;
-  const float uniform = (1.0f - mapProbability_) * kUniformSpherePdf;
-  return mapProbability_ > 0.0f ? uniform + mapProbability_ * map_->pdf(dir) : uniform;
-}
-
 std::shared_ptr<const EnvironmentMap> loadEnvironmentMap(const std::string& path, float scale, float rotationDegrees) {
   EnvImage env = loadEnvironment(path);
   LatLongMap ll = std::holds_alternative<LatLongMap>(env) ? std::move(std::get<LatLongMap>(env))

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <numeric>
 
 #include <unistd.h>
 
@@ -15,6 +16,8 @@
 #include "core/rng.h"
 #include "env/env.h"
 #include "env/ibl.h"
+#include "support/chi_square.h"
+#include "support/sky_map.h"
 
 namespace pl {
 namespace {
@@ -376,19 +379,9 @@ TEST(EnvConvert, DownsamplePreservesPower) {
 
 // ─── Environment light: importance sampling ────────────────────────────────────────────────
 
-EnvironmentMap testLight(float rotation) {
-  // 32×16 map: smooth sky gradient, a bright 2×1-texel "sun", a black row near the bottom.
-  LatLongMap m{Image(32, 16)};
-  for (int y = 0; y < 16; ++y)
-    for (int x = 0; x < 32; ++x) m.image.at(x, y) = Rgb(0.2f + 0.1f * float(x % 5), 0.3f, 0.5f + 0.02f * float(y));
-  for (int x = 0; x < 32; ++x) m.image.at(x, 13) = Rgb(0.0f);
-  m.image.at(7, 4) = m.image.at(8, 4) = Rgb(200.0f, 180.0f, 150.0f);
-  return EnvironmentMap(std::move(m), 2.0f, rotation);
-}
-
 TEST(EnvLight, PdfIntegratesToOne) {
   for (float rotation : {0.0f, 37.0f}) {
-    const EnvironmentMap env = testLight(rotation);
+    const EnvironmentMap env = test_support::skyWithSun(rotation);
     // Midpoint rule over a 20× finer lat-long grid in WORLD directions with exact solid
     // angles. The pdf is constant in (u,v) per map texel, so ∫ pdf dω = ∫ p(u,v) du dv = 1;
     // the only error is sin θ varying inside a fine texel and texels straddling map texel
@@ -404,7 +397,7 @@ TEST(EnvLight, PdfIntegratesToOne) {
 }
 
 TEST(EnvLight, SampleMatchesPdfAndRadiance) {
-  const EnvironmentMap env = testLight(37.0f);
+  const EnvironmentMap env = test_support::skyWithSun(37.0f);
   Pcg32 rng(7, 3);
   for (int i = 0; i < 20000; ++i) {
     const EnvironmentSample s = env.sample({rng.uniform(), rng.uniform()});
@@ -422,10 +415,10 @@ TEST(EnvLight, ChiSquareOfSampleHistogram) {
   // Samples binned per map texel (after undoing the rotation with toMap, so rotation is
   // tested too). pdf() is constant in (u, v) inside a texel, so the expected count of a
   // texel is exactly n·p(u,v)·ΔuΔv with p(u,v) = pdf(centre)·2π² sin θ_centre — computed
-  // from pdf() alone. Pearson's statistic (bins with expectation < 5 pooled); threshold =
-  // the 1e-4 upper quantile (Wilson–Hilferty): a correct sampler fails with probability
-  // 1e-4, a sample/pdf mismatch by orders of magnitude more.
-  const EnvironmentMap env = testLight(37.0f);
+  // from pdf() alone. Pearson's statistic (support/chi_square.h); rejected below p = 1e-4:
+  // a correct sampler fails with probability 1e-4, a sample/pdf mismatch by orders of
+  // magnitude more.
+  const EnvironmentMap env = test_support::skyWithSun(37.0f);
   const int w = env.map().width(), h = env.map().height(), n = 400000;
   std::vector<double> expected(size_t(w) * h, 0.0), observed(size_t(w) * h, 0.0);
   for (int y = 0; y < h; ++y)
@@ -449,33 +442,18 @@ TEST(EnvLight, ChiSquareOfSampleHistogram) {
     observed[size_t(std::min(int(uv.y * h), h - 1)) * w + size_t(std::min(int(uv.x * w), w - 1))] += 1.0;
   }
   EXPECT_LT(poleSamples, n / 10000);
-  double chi2 = 0.0, pooledE = 0.0, pooledO = 0.0, totalE = 0.0;
-  int dof = -1;
-  for (size_t i = 0; i < expected.size(); ++i) {
-    totalE += expected[i];
-    if (expected[i] < 5.0) {
-      pooledE += expected[i];
-      pooledO += observed[i];
-      continue;
-    }
-    chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-    ++dof;
-  }
-  if (pooledE > 0.0) {
-    chi2 += (pooledO - pooledE) * (pooledO - pooledE) / pooledE;
-    ++dof;
-  }
+  const double totalE = std::accumulate(expected.begin(), expected.end(), 0.0);
   EXPECT_NEAR(totalE, n, 1e-3 * n);  // the per-texel probabilities sum to 1 (float pdf)
-  const double z = 3.719;  // standard normal 1e-4 upper quantile
-  const double k = dof, threshold = k * std::pow(1.0 - 2.0 / (9.0 * k) + z * std::sqrt(2.0 / (9.0 * k)), 3.0);
-  EXPECT_LT(chi2, threshold) << "dof " << dof;
+  const test_support::ChiSquareOutcome r = test_support::pearsonChiSquare(observed, expected);
+  EXPECT_FALSE(r.impossibleSample);
+  EXPECT_GT(r.pValue, 1e-4) << "chi2 " << r.chi2 << " dof " << r.dof;
 }
 
 TEST(EnvLight, ImportanceSampledIntegralIsUnbiased) {
   // ∫ L dω by sampling (mean of L/pdf) against fine quadrature of radiance(); the estimator
   // is unbiased only if pdf > 0 wherever L > 0 (including the bilinear spill into the black
   // row). 5σ tolerance from the estimator's own variance.
-  const EnvironmentMap env = testLight(0.0f);
+  const EnvironmentMap env = test_support::skyWithSun(0.0f);
   const int h = 512;
   LatLongMap grid{Image(2 * h, h)};
   double reference = 0.0;
@@ -496,51 +474,12 @@ TEST(EnvLight, ImportanceSampledIntegralIsUnbiased) {
   // Quadrature error of the reference (512 rows for a 16-row map): ~1e-4 relative.
   EXPECT_NEAR(mean, reference, 5.0 * sigma + 1e-3 * reference);
   // Rotation moves the radiance: the sun seen through a rotated map.
-  const EnvironmentMap rotated = testLight(90.0f);
+  const EnvironmentMap rotated = test_support::skyWithSun(90.0f);
   const Vec3 sunMap = LatLongMap::direction(8.0 / 32.0, 4.5 / 16.0);
   EXPECT_GT(luminance(rotated.radiance(rotated.toWorld(sunMap))), 100.0f);
   EXPECT_LT(luminance(rotated.radiance(sunMap)), 10.0f);
   // toWorld(+x) for +90° is −z (counter-clockwise seen from +y).
   EXPECT_NEAR(rotated.toWorld(Vec3(1, 0, 0)).z, -1.0f, 1e-6f);
-}
-
-TEST(EnvLight, ConstantPlusMapMixture) {
-  // EnvironmentLight = constant + map. Its pdf integrates to 1, sample() reports pdf() and
-  // radiance() of its direction, and L/pdf is an unbiased estimator of ∫ L dω.
-  const auto map = std::make_shared<const EnvironmentMap>(testLight(20.0f));
-  const Rgb constant(0.3f, 0.2f, 0.1f);
-  const EnvironmentLight light(constant, map);
-  const double constantPower = 4.0 * kPiD * luminance(constant);
-  EXPECT_NEAR(light.mapProbability(), map->integratedLuminance() / (map->integratedLuminance() + constantPower), 1e-6);
-  EXPECT_GT(light.mapProbability(), 0.5f);  // the sun dominates
-  const int h = 320;
-  LatLongMap grid{Image(2 * h, h)};
-  double pdfIntegral = 0.0, radianceIntegral = 0.0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < 2 * h; ++x) {
-      const Vec3 d = LatLongMap::direction((x + 0.5) / (2 * h), (y + 0.5) / h);
-      pdfIntegral += light.pdf(d) * grid.texelSolidAngle(y);
-      radianceIntegral += luminance(light.radiance(d)) * grid.texelSolidAngle(y);
-    }
-  EXPECT_NEAR(pdfIntegral, 1.0, 3e-3);  // same quadrature error as PdfIntegratesToOne
-  Pcg32 rng(5, 1);
-  const int n = 200000;
-  double sum = 0.0, sum2 = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const EnvironmentSample s = light.sample({rng.uniform(), rng.uniform()});
-    ASSERT_EQ(s.pdf, light.pdf(s.direction));
-    ASSERT_EQ(s.radiance, light.radiance(s.direction));
-    const double v = s.pdf > 0.0f ? luminance(s.radiance) / s.pdf : 0.0;
-    sum += v;
-    sum2 += v * v;
-  }
-  const double mean = sum / n, sigma = std::sqrt((sum2 / n - mean * mean) / n);
-  EXPECT_NEAR(mean, radianceIntegral, 5.0 * sigma + 1e-3 * radianceIntegral);  // 5σ + quadrature
-  // Constant only: uniform sphere sampling, pdf 1/(4π); nothing at all: black, pdf 0.
-  const EnvironmentLight uniform(Rgb(1.0f), nullptr);
-  EXPECT_FLOAT_EQ(uniform.pdf(Vec3(0, 1, 0)), kUniformSpherePdf);
-  EXPECT_TRUE(EnvironmentLight().isBlack());
-  EXPECT_EQ(EnvironmentLight().sample({0.5f, 0.5f}).pdf, 0.0f);
 }
 
 TEST(EnvLight, RefusesNonFiniteTexels) {

@@ -41,9 +41,9 @@ SpecularModel parseSpecularModel(const std::string& name) {
 const char* specularModelName(SpecularModel model) { return model == SpecularModel::Ggx ? "ggx" : "blinn-phong"; }
 
 Bsdf specularBsdf(SpecularModel model, float roughness, float f0) {
-  const float alpha = std::max(roughness * roughness, kGgxMinAlpha);
+  const float alpha = ggxAlphaFromRoughness(roughness);
   if (model == SpecularModel::Ggx) return GgxBsdf{Rgb(0.0f), Rgb(f0), alpha};
-  return BlinnPhongBsdf{Rgb(0.0f), Rgb(f0), 2.0f / (alpha * alpha) - 2.0f};
+  return BlinnPhongBsdf{Rgb(0.0f), Rgb(f0), blinnPhongExponentFromAlpha(alpha)};
 }
 
 // ─── Pyramid ───────────────────────────────────────────────────────────────────────────────

@@ -119,7 +119,6 @@ namespace {
 class ByteReader {
  public:
   ByteReader(const std::string& path, const std::vector<unsigned char>& bytes) : path_(path), bytes_(bytes) {}
-  bool atEnd() const { return at_ >= bytes_.size(); }
   size_t offset() const { return at_; }
   unsigned char next() {
     if (at_ >= bytes_.size()) fail("{}: truncated Radiance HDR file (pixel data ends at byte {})", path_, bytes_.size());

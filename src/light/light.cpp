@@ -77,7 +77,7 @@ LightSampler::LightSampler(const Scene& scene) {
   }
   entryOfTriangle_.assign(base, -1);
   for (const EmissiveTriangle& e : emissiveTriangles(scene)) {
-    const float power = kPi * e.area * luminance(e.radiance) * (e.twoSided ? 2.0f : 1.0f);
+    const float power = e.power();
     if (!(power > 0.0f)) continue;
     entryOfTriangle_[meshTriangleBase_[e.mesh] + e.triangle] = static_cast<int32_t>(entries_.size());
     entries_.push_back({Kind::Triangle, static_cast<uint32_t>(triangles_.size())});
@@ -88,14 +88,7 @@ LightSampler::LightSampler(const Scene& scene) {
 
   for (const Light& light : scene.lights) {
     const PunctualLight p = PunctualLight::from(light);
-    float power = 0.0f;
-    switch (p.kind) {
-      case PunctualLight::Kind::Point: power = 4.0f * kPi * luminance(p.intensity); break;
-      case PunctualLight::Kind::Spot:
-        power = 2.0f * kPi * (1.0f - 0.5f * (p.cosInner + p.cosOuter)) * luminance(p.intensity);
-        break;
-      case PunctualLight::Kind::Directional: power = kPi * sceneRadius * sceneRadius * luminance(p.intensity); break;
-    }
+    const float power = p.power(sceneRadius);
     if (!(power > 0.0f)) continue;
     entries_.push_back({Kind::Punctual, static_cast<uint32_t>(punctual_.size())});
     punctual_.push_back(p);
@@ -104,8 +97,7 @@ LightSampler::LightSampler(const Scene& scene) {
   }
 
   if (!environment_.isBlack()) {
-    const float power =
-        static_cast<float>(kPiD * double(sceneRadius) * double(sceneRadius) * environment_.integratedLuminance());
+    const auto power = static_cast<float>(environment_.power(sceneRadius));
     if (power > 0.0f) {
       environmentEntry_ = static_cast<int32_t>(entries_.size());
       entries_.push_back({Kind::Environment, 0});
@@ -144,18 +136,17 @@ std::optional<LightSample> LightSampler::sampleEntry(const Entry& entry, float s
   switch (entry.kind) {
     case Kind::Triangle: {
       const EmissiveTriangle& e = triangles_[entry.index];
-      const Vec2 b = sampleUniformTriangle(u);
-      const Vec3 point = e.p0 + b.x * e.edge1 + b.y * e.edge2;
+      const Vec3 point = e.pointAt(u);
       const Vec3 toLight = point - position;
       const float distanceSquared = glm::dot(toLight, toLight);
       if (!(distanceSquared > 0.0f)) return std::nullopt;
       s.wi = toLight / std::sqrt(distanceSquared);
-      float cosLight = -glm::dot(e.normal, s.wi);
-      if (e.twoSided) cosLight = std::abs(cosLight);
-      if (!(cosLight > 0.0f)) return std::nullopt;  // the back of a one-sided emitter
+      const float cosFront = -glm::dot(e.normal, s.wi);
+      s.incident = e.Le(cosFront);
+      const float cosLight = std::abs(cosFront);
+      if (isBlack(s.incident) || !(cosLight > 0.0f)) return std::nullopt;  // the back of a one-sided emitter
       // Area density 1/A converted to solid angle at `position`: dA = r² dω / cos θlight.
       s.pdf = selectProbability * distanceSquared / (cosLight * e.area);
-      s.incident = e.radiance;
       s.target = emitterShadowTarget(point, e.normal, s.wi);
       break;
     }
@@ -199,8 +190,7 @@ float LightSampler::environmentPdf(const Vec3& dir) const {
 EmitterPoint LightSampler::sampleEmitterPoint(Vec2 u) const {
   float remapped = 0.0f;
   const EmissiveTriangle& e = triangles_[triangleDistribution_.sample(u.x, &remapped)];
-  const Vec2 b = sampleUniformTriangle(Vec2(remapped, u.y));
-  return {&e, e.p0 + b.x * e.edge1 + b.y * e.edge2, areaPdfOfMaterial_[e.material]};
+  return {&e, e.pointAt(Vec2(remapped, u.y)), areaPdfOfMaterial_[e.material]};
 }
 
 float LightSampler::emitterAreaPdf(uint32_t material) const {

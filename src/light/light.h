@@ -3,18 +3,16 @@
 // and by the bake's first shot, and the one definition of a shadow ray (where it ends, and how
 // much light passes along it).
 //
-// Emitters are the scene's emissive triangles (scene.h EmissiveTriangle), point, spot and
-// directional lights (PunctualLight) and the environment (env.h EnvironmentLight).
+// Emitters (emitters.h) are the scene's emissive triangles (EmissiveTriangle), point, spot and
+// directional lights (PunctualLight) and the environment (EnvironmentLight).
 //
 // Light selection: one discrete distribution over every emitter, proportional to an estimate
-// of its emitted power (luminance):
-//   emissive triangle  π · A · Y(Le)            (×2 when two-sided): exitant flux of a
-//                                                Lambertian emitter of radiance Le and area A
+// of its emitted power (luminance), each emitter's power() in emitters.h:
+//   emissive triangle  π · A · Y(Le)            (×2 when two-sided)
 //   point light        4π · Y(I)
-//   spot light         2π · (1 − (cos θinner + cos θouter)/2) · Y(I)   (pbrt's estimate)
-//   directional light  π R² · Y(E)             flux through the scene's bounding disk
-//   environment        π R² · ∫ Y(Le) dω        (= 4π·πR²·Y(Le) for a constant one, as pbrt-v4's
-//                                                UniformInfiniteLight::Phi)
+//   spot light         2π · (1 − (cos θinner + cos θouter)/2) · Y(I)
+//   directional light  π R² · Y(E)
+//   environment        π R² · ∫ Y(Le) dω
 // where R is the radius of the scene's bounding sphere. Any positive weights give an
 // unbiased estimator; these make the variance small when emitters differ a lot. The bake,
 // which samples emissive surfaces by area, uses the same weights restricted to the triangles.
@@ -31,6 +29,7 @@
 #include "core/math.h"
 #include "core/sampling.h"
 #include "env/env.h"
+#include "light/emitters.h"
 #include "scene/scene.h"
 
 namespace pl {

@@ -5,10 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 
 #include "accel/accel.h"
 #include "bsdf/bsdf.h"
 #include "core/rng.h"
+#include "core/sampling.h"
+#include "support/sky_map.h"
 
 namespace pl {
 namespace {
@@ -219,6 +222,45 @@ TEST(ShadowRays, ThinGlassTransmitsSolidGlassAndWallsBlock) {
   EXPECT_EQ(opaqueShadows.transmittance(*shadowRayTo(Vec3(0.0f), 1.5f / cosTheta * up), rays), Rgb(0.0f));
   EXPECT_EQ(opaqueShadows.transmittance(*shadowRayTo(Vec3(0.0f), 0.5f / cosTheta * up), rays), Rgb(1.0f));
   EXPECT_EQ(rays, 2u);
+}
+
+TEST(EnvironmentLight, ConstantPlusMapMixture) {
+  // EnvironmentLight = constant + map. Its pdf integrates to 1, sample() reports pdf() and
+  // radiance() of its direction, and L/pdf is an unbiased estimator of ∫ L dω.
+  const auto map = std::make_shared<const EnvironmentMap>(test_support::skyWithSun(20.0f));
+  const Rgb constant(0.3f, 0.2f, 0.1f);
+  const EnvironmentLight light(constant, map);
+  const double constantPower = 4.0 * kPiD * luminance(constant);
+  EXPECT_NEAR(light.mapProbability(), map->integratedLuminance() / (map->integratedLuminance() + constantPower), 1e-6);
+  EXPECT_GT(light.mapProbability(), 0.5f);  // the sun dominates
+  const int h = 320;
+  LatLongMap grid{Image(2 * h, h)};
+  double pdfIntegral = 0.0, radianceIntegral = 0.0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < 2 * h; ++x) {
+      const Vec3 d = LatLongMap::direction((x + 0.5) / (2 * h), (y + 0.5) / h);
+      pdfIntegral += light.pdf(d) * grid.texelSolidAngle(y);
+      radianceIntegral += luminance(light.radiance(d)) * grid.texelSolidAngle(y);
+    }
+  EXPECT_NEAR(pdfIntegral, 1.0, 3e-3);  // same quadrature error as PdfIntegratesToOne
+  Pcg32 rng(5, 1);
+  const int n = 200000;
+  double sum = 0.0, sum2 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const EnvironmentSample s = light.sample({rng.uniform(), rng.uniform()});
+    ASSERT_EQ(s.pdf, light.pdf(s.direction));
+    ASSERT_EQ(s.radiance, light.radiance(s.direction));
+    const double v = s.pdf > 0.0f ? luminance(s.radiance) / s.pdf : 0.0;
+    sum += v;
+    sum2 += v * v;
+  }
+  const double mean = sum / n, sigma = std::sqrt((sum2 / n - mean * mean) / n);
+  EXPECT_NEAR(mean, radianceIntegral, 5.0 * sigma + 1e-3 * radianceIntegral);  // 5σ + quadrature
+  // Constant only: uniform sphere sampling, pdf 1/(4π); nothing at all: black, pdf 0.
+  const EnvironmentLight uniform(Rgb(1.0f), nullptr);
+  EXPECT_FLOAT_EQ(uniform.pdf(Vec3(0, 1, 0)), kUniformSpherePdf);
+  EXPECT_TRUE(EnvironmentLight().isBlack());
+  EXPECT_EQ(EnvironmentLight().sample({0.5f, 0.5f}).pdf, 0.0f);
 }
 
 }  // namespace

@@ -15,10 +15,9 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv) {
   SurfaceHit hit;
   hit.material = material;
   hit.uv = uv;
-  const Bsdf bsdf = bsdfAt(scene, hit);
-  if (const auto* lambert = std::get_if<LambertBsdf>(&bsdf)) return lambert->albedo;
-  // Any other model a chart was classified diffuse for: its hemispherical reflectance.
-  return albedo(bsdf, Vec3(0.0f, 0.0f, 1.0f));
+  // The directional albedo at normal incidence: a Lambertian model's albedo, and for any other
+  // model a chart was classified diffuse for its hemispherical reflectance.
+  return albedo(bsdfAt(scene, hit), Vec3(0.0f, 0.0f, 1.0f));
 }
 
 namespace {
@@ -44,21 +43,18 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
   const Material& material = scene.materials[surface.material];
   const Vec3 wo = -ray.direction;
   const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
-  Rgb attenuation(1.0f);
-  if (const auto* glass = std::get_if<DielectricBsdf>(&material.bsdf); glass && cosWoGeometric < 0.0f)
-    attenuation = glm::exp(-glass->absorption * hit.t);
+  const Rgb attenuation = interiorTransmittance(material, cosWoGeometric, hit.t);  // Beer–Lambert (scene.h)
   emitted = emittedRadiance(material, cosWoGeometric) * attenuation;
   if (step >= stepLimit) return false;
   Bsdf bsdf = bsdfAt(scene, surface);
   if (auto* glass = std::get_if<DielectricBsdf>(&bsdf)) glass->alpha = 0.0f;  // rough glass followed as smooth
-  const auto [geometricNormal, frame, woLocal] = scatteringFrame(surface, wo, bsdf);  // sidedness: scene.h
-  if (!usableSide(wo, woLocal, geometricNormal, bsdf)) return false;
-  const std::optional<BsdfSample> bs = sample(bsdf, woLocal, Vec2(specularBranchU(ray), 0.5f));
-  if (!bs || !bs->delta) return false;
-  const Vec3 wi = frame.toWorld(bs->wi);
-  if (!usableSide(wi, bs->wi, geometricNormal, bsdf)) return false;  // grazing
-  next = Ray{offsetRayOrigin(surface.position, geometricNormal, wi), wi, 0.0f, kInfinity};
-  weight = bs->weight * attenuation;
+  const ScatteringFrame scattering = scatteringFrame(surface, wo, bsdf);  // sidedness: scene.h
+  if (!usableSide(wo, scattering.woLocal, scattering.geometricNormal, bsdf)) return false;
+  // The one bounce (scene.h scatter), about the shading normal as in the path tracer.
+  const std::optional<Scattered> bs = scatter(scattering, bsdf, Vec2(specularBranchU(ray), 0.5f));
+  if (!bs || !bs->sample.delta) return false;
+  next = Ray{offsetRayOrigin(surface.position, scattering.geometricNormal, bs->wi), bs->wi, 0.0f, kInfinity};
+  weight = bs->sample.weight * attenuation;
   if (step >= kSpecularRouletteStep) {
     // Russian roulette on the branch weight: continue with probability q = min(1, max
     // channel) and divide by q, so the expected weight is unchanged (unbiased). Weights ≥ 1

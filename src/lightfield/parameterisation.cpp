@@ -11,6 +11,7 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "light/emitters.h"
 #include "lightfield/lookup.h"
 
 namespace pl {
@@ -29,20 +30,13 @@ uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings) {
     case ChartKind::Specular: return 0;
     case ChartKind::Glossy: break;
   }
-  // Angular half width θh of the microfacet/half-vector lobe at half maximum:
-  //   Blinn-Phong cosⁿθh = ½           → θh = acos(2^(−1/n));
-  //   GGX D ∝ 1/(α² + tan²θh)² (the cos⁴ factor ignored) = ½ D(0) → tan θh = α·√(√2 − 1).
+  // θh, the half width at half maximum of the half-vector lobe (bsdf.h lobeHalfWidth).
   // The reflected lobe is about twice as wide as the half-vector lobe, so its full width at
   // half maximum is ≈ 4θh. Near the map centre s = tan(θ/2), so a texel 2/R wide in s spans
   // ≈ 4/R radians; four texels across the lobe's FWHM needs R ≈ 16 / FWHM. (Two are not
   // enough: the directional albedo of a normalised lobe already falls by ~8 % within 20° of
   // the normal, and bilinear interpolation between texels 20° apart misses that.)
-  float thetaH = 0.5f;
-  if (const auto* bp = std::get_if<BlinnPhongBsdf>(&bsdf)) {
-    thetaH = std::acos(std::pow(0.5f, 1.0f / std::max(bp->exponent, 1e-3f)));
-  } else if (const auto* ggx = std::get_if<GgxBsdf>(&bsdf)) {
-    thetaH = std::atan(ggx->alpha * std::sqrt(std::sqrt(2.0f) - 1.0f));
-  }
+  const float thetaH = lobeHalfWidth(bsdf);
   const float fwhm = std::max(4.0f * thetaH, 1e-4f);
   const float wanted = std::ceil(16.0f / fwhm);
   const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);

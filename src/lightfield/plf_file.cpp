@@ -227,75 +227,38 @@ class ByteReader {
 
 // --- Scene -------------------------------------------------------------------------------
 
+// A model is its variant index (uint32) followed by its parameters in the order of the
+// model's parameters() hook (bsdf.h): Rgb as three floats, float, bool as one byte. The
+// model numbers 0–4 (Lambert, mirror, Blinn-Phong, GGX, dielectric) are the file format;
+// the dielectric (4) was added without a version bump: older files never contain it, and an
+// older build reading a newer file refuses it as "unknown BSDF model 4".
 void putBsdf(ByteWriter& w, const Bsdf& bsdf) {
   w.put(uint32_t(bsdf.index()));
   std::visit(
       [&](const auto& b) {
-        using T = std::decay_t<decltype(b)>;
-        if constexpr (std::is_same_v<T, LambertBsdf>) {
-          w.put(b.albedo);
-        } else if constexpr (std::is_same_v<T, MirrorBsdf>) {
-          w.put(b.reflectance);
-          w.put(uint8_t(b.fresnel));
-        } else if constexpr (std::is_same_v<T, BlinnPhongBsdf>) {
-          w.put(b.diffuse);
-          w.put(b.specular);
-          w.put(b.exponent);
-        } else if constexpr (std::is_same_v<T, GgxBsdf>) {
-          w.put(b.diffuse);
-          w.put(b.f0);
-          w.put(b.alpha);
-        } else {
-          static_assert(std::is_same_v<T, DielectricBsdf>, "a new BSDF model needs its .plf encoding");
-          w.put(b.ior);
-          w.put(b.transmittance);
-          w.put(b.alpha);
-          w.put(uint8_t(b.thin));
-          w.put(b.absorption);
-        }
+        std::decay_t<decltype(b)>::parameters(b, [&](const auto& field) {
+          if constexpr (std::is_same_v<std::decay_t<decltype(field)>, bool>) w.put(uint8_t(field));
+          else w.put(field);
+        });
       },
       bsdf);
 }
 
 Bsdf getBsdf(ByteReader& r) {
   const uint32_t model = r.get<uint32_t>();
-  switch (model) {
-    case 0: return LambertBsdf{r.get<Rgb>()};
-    case 1: {
-      MirrorBsdf b;
-      b.reflectance = r.get<Rgb>();
-      b.fresnel = r.get<uint8_t>() != 0;
-      return b;
-    }
-    case 2: {
-      BlinnPhongBsdf b;
-      b.diffuse = r.get<Rgb>();
-      b.specular = r.get<Rgb>();
-      b.exponent = r.get<float>();
-      return b;
-    }
-    case 3: {
-      GgxBsdf b;
-      b.diffuse = r.get<Rgb>();
-      b.f0 = r.get<Rgb>();
-      b.alpha = r.get<float>();
-      return b;
-    }
-    case 4: {
-      // Added without a version bump: older files never contain it, and an older build
-      // reading a newer file refuses it here as "unknown BSDF model 4".
-      DielectricBsdf b;
-      b.ior = r.get<float>();
-      b.transmittance = r.get<Rgb>();
-      b.alpha = r.get<float>();
-      b.thin = r.get<uint8_t>() != 0;
-      b.absorption = r.get<Rgb>();
-      return b;
-    }
-    default: r.corrupt(fmt::format("unknown BSDF model {}", model));
-  }
+  std::optional<Bsdf> bsdf = bsdfOfIndex(model);
+  if (!bsdf) r.corrupt(fmt::format("unknown BSDF model {}", model));
+  std::visit(
+      [&](auto& b) {
+        std::decay_t<decltype(b)>::parameters(b, [&](auto& field) {
+          using Field = std::decay_t<decltype(field)>;
+          if constexpr (std::is_same_v<Field, bool>) field = r.get<uint8_t>() != 0;
+          else field = r.get<Field>();
+        });
+      },
+      *bsdf);
+  return *bsdf;
 }
-static_assert(std::variant_size_v<Bsdf> == 5, "getBsdf must decode every BSDF model");
 
 void putLight(ByteWriter& w, const Light& light) {
   w.put(uint32_t(light.index()));

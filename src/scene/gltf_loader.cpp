@@ -62,8 +62,6 @@ namespace {
 
 /// Photometric efficacy used to turn lumens into watts (see the header comment).
 constexpr double kLumensPerWatt = 683.0;
-/// Smallest GGX α we emit (roughness ≈ 0.03); α → 0 makes the distribution a Dirac delta.
-constexpr float kMinGgxAlpha = 1e-3f;
 
 struct GltfContext {
   const std::string& path;
@@ -291,7 +289,7 @@ void applyTransmission(GltfContext& ctx, const tinygltf::Material& gltf, Materia
   if (!(glass.ior > 1.0f && std::isfinite(glass.ior)))
     fail("{}: material '{}': KHR_materials_ior.ior {} must be a finite number > 1", ctx.path, material.name, glass.ior);
   glass.transmittance = baseColor * factor;
-  glass.alpha = roughness * roughness < kGgxMinAlpha ? 0.0f : roughness * roughness;
+  glass.alpha = dielectricAlphaFromRoughness(roughness);
   glass.thin = true;
   if (auto volume = gltf.extensions.find("KHR_materials_volume"); volume != gltf.extensions.end()) {
     const tinygltf::Value& v = volume->second;
@@ -327,11 +325,7 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
 
   Material material;
   material.name = gltf.name.empty() ? fmt::format("material{}", index) : gltf.name;
-  GgxBsdf ggx;
-  ggx.diffuse = baseColor * (1.0f - metallic);
-  ggx.f0 = glm::mix(Rgb(0.04f), baseColor, metallic);
-  ggx.alpha = std::max(roughness * roughness, kMinGgxAlpha);
-  material.bsdf = ggx;
+  material.bsdf = ggxFromMetallicRoughness(baseColor, metallic, roughness);
   if (pbr.baseColorTexture.index >= 0) {
     if (pbr.baseColorTexture.texCoord != 0)
       spdlog::warn("{}: material '{}': baseColorTexture uses TEXCOORD_{}, only TEXCOORD_0 is read", ctx.path,

@@ -185,8 +185,7 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
     if (find(value, "alpha") && find(value, "roughness"))
       fail("{}: {}: give either \"alpha\" or \"roughness\", not both", ctx.path, where);
     if (const json* roughness = find(value, "roughness")) {
-      const float r = number(ctx, *roughness, where + ".roughness");
-      ggx.alpha = r * r;
+      ggx.alpha = alphaFromRoughness(number(ctx, *roughness, where + ".roughness"));
     } else {
       ggx.alpha = numberOr(ctx, value, "alpha", ggx.alpha, where);
     }
@@ -199,7 +198,7 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
     glass.transmittance = colourOr(ctx, value, "transmittance", Rgb(1.0f), where);
     const float roughness = numberOr(ctx, value, "roughness", 0.0f, where);
     if (!(roughness >= 0.0f && roughness <= 1.0f)) fail("{}: {}: roughness {} must be in [0, 1]", ctx.path, where, roughness);
-    glass.alpha = roughness * roughness < kGgxMinAlpha ? 0.0f : roughness * roughness;
+    glass.alpha = dielectricAlphaFromRoughness(roughness);
     glass.thin = boolOr(ctx, value, "thin", false, where);
     glass.absorption = colourOr(ctx, value, "absorption", Rgb(0.0f), where);
     if (glass.thin && roughness > 0.0f) fail("{}: {}: a thin dielectric is smooth (roughness must be 0)", ctx.path, where);

@@ -28,21 +28,6 @@ bool isDegenerate(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
 
 std::string vecString(const Vec3& v) { return fmt::format("({}, {}, {})", v.x, v.y, v.z); }
 
-/// The diffuse albedo a texture multiplies (models without one return black).
-Rgb diffuseAlbedoOf(const Bsdf& bsdf) {
-  return std::visit(
-      [](const auto& model) -> Rgb {
-        using T = std::decay_t<decltype(model)>;
-        if constexpr (std::is_same_v<T, LambertBsdf>) return model.albedo;
-        else if constexpr (std::is_same_v<T, BlinnPhongBsdf>) return model.diffuse;
-        else if constexpr (std::is_same_v<T, GgxBsdf>) return model.diffuse;
-        else return Rgb(0.0f);
-      },
-      bsdf);
-}
-
-bool inUnitRange(const Rgb& c) { return isFinite(c) && glm::all(glm::greaterThanEqual(c, Rgb(0.0f))) && maxComponent(c) <= 1.0f; }
-
 void validateLights(const Scene& scene) {
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     std::visit(
@@ -69,52 +54,11 @@ void validateLights(const Scene& scene) {
 
 }  // namespace
 
-/// Reflectances must lie in [0, 1] (more would create energy; bsdf.h's contract); Blinn-Phong
-/// needs diffuse + specular ≤ 1 per channel and GGX a roughness α in (0, 1]; a dielectric a
-/// finite positive index, transmittance in [0, 1], α in [0, 1] and absorption ≥ 0.
+/// The model's own validation (bsdf.h bsdfProblem), prefixed with the file and material.
 void validateMaterial(const Material& material, const std::string& sourcePath) {
-  // Slack for decimal inputs such as 0.7 + 0.3 that round to a hair above 1 in float.
-  constexpr float kSumSlack = 1e-6f;
-  const std::string& src = sourcePath;
-  std::visit(
-      [&](const auto& model) {
-        using T = std::decay_t<decltype(model)>;
-        if constexpr (std::is_same_v<T, LambertBsdf>) {
-          if (!inUnitRange(model.albedo))
-            fail("{}: material '{}': Lambert albedo {} outside [0, 1]", src, material.name, vecString(model.albedo));
-        } else if constexpr (std::is_same_v<T, MirrorBsdf>) {
-          if (!inUnitRange(model.reflectance))
-            fail("{}: material '{}': mirror reflectance {} outside [0, 1]", src, material.name, vecString(model.reflectance));
-        } else if constexpr (std::is_same_v<T, BlinnPhongBsdf>) {
-          if (!inUnitRange(model.diffuse) || !inUnitRange(model.specular) ||
-              maxComponent(model.diffuse + model.specular) > 1.0f + kSumSlack)
-            fail("{}: material '{}': Blinn-Phong needs diffuse, specular >= 0 and diffuse + specular <= 1 "
-                 "(diffuse {}, specular {})", src, material.name, vecString(model.diffuse), vecString(model.specular));
-          if (!(model.exponent >= 0.0f && std::isfinite(model.exponent)))
-            fail("{}: material '{}': Blinn-Phong exponent {} must be finite and >= 0", src, material.name, model.exponent);
-        } else if constexpr (std::is_same_v<T, DielectricBsdf>) {
-          if (!(model.ior > 0.0f && std::isfinite(model.ior)))
-            fail("{}: material '{}': dielectric index of refraction {} must be finite and > 0", src, material.name, model.ior);
-          if (!inUnitRange(model.transmittance))
-            fail("{}: material '{}': dielectric transmittance {} outside [0, 1]", src, material.name,
-                 vecString(model.transmittance));
-          if (!(model.alpha >= 0.0f && model.alpha <= 1.0f))
-            fail("{}: material '{}': dielectric roughness alpha {} must lie in [0, 1]", src, material.name, model.alpha);
-          if (!isFinite(model.absorption) || glm::any(glm::lessThan(model.absorption, Rgb(0.0f))))
-            fail("{}: material '{}': dielectric absorption {} must be finite and >= 0", src, material.name,
-                 vecString(model.absorption));
-        } else {
-          static_assert(std::is_same_v<T, GgxBsdf>, "a new BSDF model needs its validation");
-          if (!inUnitRange(model.diffuse) || !inUnitRange(model.f0))
-            fail("{}: material '{}': GGX diffuse {} and f0 {} must lie in [0, 1]", src, material.name,
-                 vecString(model.diffuse), vecString(model.f0));
-          if (!(model.alpha > 0.0f && model.alpha <= 1.0f))
-            fail("{}: material '{}': GGX alpha {} must lie in (0, 1]", src, material.name, model.alpha);
-        }
-      },
-      material.bsdf);
+  if (const std::string problem = bsdfProblem(material.bsdf); !problem.empty())
+    fail("{}: material '{}': {}", sourcePath, material.name, problem);
 }
-
 
 Rgb Texture::sample(Vec2 uv) const {
   if (image.empty()) return Rgb(1.0f);
@@ -410,84 +354,7 @@ Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit) {
   const Material& material = scene.materials[hit.material];
   if (material.albedoTexture < 0) return material.bsdf;
   const Rgb texel = scene.textures[size_t(material.albedoTexture)].sample(hit.uv);
-  return withDiffuseAlbedo(material.bsdf, diffuseAlbedoOf(material.bsdf) * texel);
-}
-
-PunctualLight PunctualLight::from(const Light& light) {
-  PunctualLight p;
-  if (const auto* point = std::get_if<PointLight>(&light)) {
-    p.kind = Kind::Point;
-    p.position = point->position;
-    p.intensity = point->intensity;
-  } else if (const auto* spot = std::get_if<SpotLight>(&light)) {
-    p.kind = Kind::Spot;
-    p.position = spot->position;
-    p.direction = glm::normalize(spot->direction);
-    p.intensity = spot->intensity;
-    p.cosInner = std::cos(spot->innerAngle);
-    p.cosOuter = std::cos(spot->outerAngle);
-  } else {
-    const auto& directional = std::get<DirectionalLight>(light);
-    p.kind = Kind::Directional;
-    p.direction = glm::normalize(directional.direction);
-    p.intensity = directional.irradiance;
-  }
-  return p;
-}
-
-bool PunctualLight::incidentAt(const Vec3& x, Vec3& wi, float& distance, Rgb& irradiance) const {
-  if (kind == Kind::Directional) {
-    wi = -direction;
-    distance = kInfinity;
-    irradiance = intensity;
-    return true;
-  }
-  const Vec3 toLight = position - x;
-  const float distanceSquared = glm::dot(toLight, toLight);
-  if (!(distanceSquared > 0.0f)) return false;
-  distance = std::sqrt(distanceSquared);
-  wi = toLight / distance;
-  float falloff = 1.0f;
-  if (kind == Kind::Spot) {
-    const float c = glm::dot(direction, -wi);
-    if (cosInner <= cosOuter) {
-      falloff = c >= cosInner ? 1.0f : 0.0f;
-    } else {
-      const float t = std::clamp((c - cosOuter) / (cosInner - cosOuter), 0.0f, 1.0f);
-      falloff = t * t * (3.0f - 2.0f * t);
-    }
-  }
-  if (!(falloff > 0.0f)) return false;
-  irradiance = intensity * (falloff / distanceSquared);
-  return true;
-}
-
-std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene) {
-  std::vector<EmissiveTriangle> list;
-  for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
-    const Mesh& mesh = scene.meshes[m];
-    for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-      const Material& material = scene.materials[mesh.materials[t]];
-      if (!material.isEmissive()) continue;
-      const UVec3 tri = mesh.triangles[t];
-      EmissiveTriangle e;
-      e.mesh = m;
-      e.triangle = t;
-      e.material = mesh.materials[t];
-      e.p0 = mesh.positions[tri.x];
-      e.edge1 = mesh.positions[tri.y] - e.p0;
-      e.edge2 = mesh.positions[tri.z] - e.p0;
-      const Vec3 cross = glm::cross(e.edge1, e.edge2);
-      const float length = glm::length(cross);
-      if (!(length > 0.0f)) continue;  // degenerate: cannot emit (and finalize() drops these)
-      e.normal = cross / length;
-      e.area = 0.5f * length;
-      e.radiance = material.emission;
-      e.twoSided = material.twoSidedEmission;
-      list.push_back(e);
-    }
-  }
-  return list;
+  return withDiffuseAlbedo(material.bsdf, diffuseAlbedo(material.bsdf) * texel);
 }
 
 ScatteringFrame scatteringFrame(const SurfaceHit& surface, const Vec3& wo, const Bsdf& bsdf) {
@@ -503,6 +370,14 @@ bool usableSide(const Vec3& w, const Vec3& wLocal, const Vec3& geometricNormal, 
   const float cosGeometric = glm::dot(w, geometricNormal);
   if (!hasTransmission(bsdf)) return cosGeometric > 0.0f;
   return cosGeometric * wLocal.z > 0.0f;
+}
+
+std::optional<Scattered> scatter(const ScatteringFrame& f, const Bsdf& bsdf, Vec2 u) {
+  const std::optional<BsdfSample> s = sample(bsdf, f.woLocal, u);
+  if (!s) return std::nullopt;
+  const Vec3 wi = f.frame.toWorld(s->wi);
+  if (!usableSide(wi, s->wi, f.geometricNormal, bsdf)) return std::nullopt;  // grazing / wrong side
+  return Scattered{*s, wi};
 }
 
 }  // namespace pl

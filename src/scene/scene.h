@@ -75,8 +75,22 @@ struct Material {
 /// The sidedness rule for emission, written once for the path tracer, the bake and the
 /// renderers: Le towards a direction whose cosine against the geometric (winding) normal is
 /// cosFront, i.e. emission leaves the front side only, unless the material is two-sided.
+inline Rgb emittedRadiance(const Rgb& emission, bool twoSided, float cosFront) {
+  return (cosFront > 0.0f || twoSided) ? emission : Rgb(0.0f);
+}
 inline Rgb emittedRadiance(const Material& m, float cosFront) {
-  return (cosFront > 0.0f || m.twoSidedEmission) ? m.emission : Rgb(0.0f);
+  return emittedRadiance(m.emission, m.twoSidedEmission, cosFront);
+}
+
+/// Beer–Lambert, written once for the path tracer and the light field's specular chains: a
+/// segment of length `distance` (scene units) that ends on the back of a surface (cosFront < 0,
+/// the cosine of the direction back along the segment against the geometric normal) ran through
+/// the inside of that closed mesh — its front side is the outside — and keeps exp(−σa·distance)
+/// of its radiance, σa the model's interior absorption (bsdf.h; black for all but dielectrics).
+inline Rgb interiorTransmittance(const Material& m, float cosFront, float distance) {
+  if (!(cosFront < 0.0f)) return Rgb(1.0f);
+  const Rgb sigma = interiorAbsorption(m.bsdf);
+  return isBlack(sigma) ? Rgb(1.0f) : glm::exp(-sigma * distance);
 }
 
 /// Triangles sharing vertex arrays. Vertex attributes are per vertex; materials per triangle.
@@ -114,38 +128,6 @@ struct DirectionalLight {
 };
 
 using Light = std::variant<PointLight, SpotLight, DirectionalLight>;
-
-/// A triangle of an emissive material, prepared for sampling points on it: the one list the
-/// path tracer and the bake sample their area lights from.
-struct EmissiveTriangle {
-  uint32_t mesh = 0, triangle = 0, material = 0;
-  Vec3 p0{0.0f}, edge1{0.0f}, edge2{0.0f};  ///< point = p0 + b₁·edge1 + b₂·edge2
-  Vec3 normal{0.0f};                        ///< unit geometric normal (winding), the emitting side
-  float area = 0.0f;
-  Rgb radiance{0.0f};                       ///< Le (W·sr⁻¹·m⁻²)
-  bool twoSided = false;
-};
-
-/// A point, spot or directional light prepared for evaluation at many points (axis
-/// normalised, cone cosines computed once). The one place the path tracer and the bake
-/// evaluate these lights.
-struct PunctualLight {
-  enum class Kind : uint8_t { Point, Spot, Directional };
-  Kind kind = Kind::Point;
-  Vec3 position{0.0f};
-  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< spot axis / directional travel direction (unit)
-  Rgb intensity{0.0f};                ///< W·sr⁻¹ (point, spot) or irradiance W·m⁻² (directional)
-  float cosInner = 1.0f, cosOuter = 1.0f;
-
-  static PunctualLight from(const Light& light);
-
-  /// The light arriving at x: wi (unit, towards the light), the shadow-ray length
-  /// (∞ for directional) and the irradiance on a surface normal to wi (W·m⁻²): I·falloff/d²
-  /// for point and spot lights — the spot's falloff a smoothstep in cos between the outer and
-  /// inner cone (a step when they coincide) — the light's irradiance for directional ones.
-  /// False when nothing arrives (x at the light's position, outside a spot's cone).
-  bool incidentAt(const Vec3& x, Vec3& wi, float& distance, Rgb& irradiance) const;
-};
 
 /// A camera as a scene file describes it. The camera module turns it into rays.
 struct CameraDesc {
@@ -213,9 +195,6 @@ struct Scene {
   CameraDesc automaticCamera() const;
 };
 
-/// Every non-degenerate triangle of an emissive material, mesh by mesh in triangle order.
-std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene);
-
 /// A texture read from an image file (any format readImage reads), keeping the bytes of
 /// 8-bit formats in `encoded`. Scene loaders call it; errors name the file.
 Texture loadTextureFile(const std::string& path, ImageDecode decode = ImageDecode::Colour);
@@ -281,9 +260,22 @@ ScatteringFrame scatteringFrame(const SurfaceHit& surface, const Vec3& wo, const
 /// on usable sides.
 bool usableSide(const Vec3& w, const Vec3& wLocal, const Vec3& geometricNormal, const Bsdf& bsdf);
 
-/// Throws pl::Error (naming sourcePath and the material) unless the material conserves
-/// energy: reflectances in [0, 1], Blinn-Phong diffuse + specular ≤ 1, GGX α in (0, 1].
-/// Scene::finalize() checks every material of a scene with it.
+/// One scattering step, the bounce written once for the path tracer and the light field's
+/// specular chains (lookup.h followSpecular: the bake's visibility field and both renderers):
+/// sample() in the shading frame of `f` — mirror reflection and dielectric refraction about
+/// the (possibly normal-mapped) shading normal, like every other lobe — then the sidedness
+/// check of wi (usableSide). Nullopt when the BSDF returns nothing or wi is on an unusable
+/// side (the path ends). The caller offsets the next ray's origin (accel.h offsetRayOrigin
+/// along f.geometricNormal towards wi).
+struct Scattered {
+  BsdfSample sample;  ///< in f's local frame
+  Vec3 wi{0.0f};      ///< the same direction in world space (unit)
+};
+std::optional<Scattered> scatter(const ScatteringFrame& f, const Bsdf& bsdf, Vec2 u);
+
+/// Throws pl::Error (naming sourcePath and the material) unless the material's model is valid
+/// (bsdf.h bsdfProblem: energy conserved, parameters in range). Scene::finalize() checks every
+/// material of a scene with it.
 void validateMaterial(const Material& material, const std::string& sourcePath);
 
 /// The material's BSDF with its albedo texture applied at uv.

@@ -196,11 +196,7 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
     const Material& material = scene.materials[surface.material];
     const Vec3 wo = -ray.direction;
     const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
-    // Beer–Lambert: a segment that ends on the inside (back) of a dielectric ran through its
-    // interior (the front side of a closed mesh is its outside), losing exp(−σa t).
-    if (const auto* glass = std::get_if<DielectricBsdf>(&material.bsdf); glass && cosWoGeometric < 0.0f) {
-      if (!isBlack(glass->absorption)) throughput *= glm::exp(-glass->absorption * hit.t);
-    }
+    throughput *= interiorTransmittance(material, cosWoGeometric, hit.t);  // Beer–Lambert (scene.h)
 
     if (!isBlack(emittedRadiance(material, cosWoGeometric))) {  // the emission sidedness rule (scene.h)
       if (countEmissionFully) {
@@ -218,7 +214,8 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
 
     // The sidedness rule (scene.h): reflecting BSDFs two-sided, transmitting ones unturned.
     const Bsdf bsdf = bsdfAt(scene, surface);
-    const auto [geometricNormal, frame, woLocal] = scatteringFrame(surface, wo, bsdf);
+    const ScatteringFrame scattering = scatteringFrame(surface, wo, bsdf);
+    const auto& [geometricNormal, frame, woLocal] = scattering;
     if (!usableSide(wo, woLocal, geometricNormal, bsdf)) break;
 
     if (!isDelta(bsdf)) {
@@ -228,22 +225,22 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
 
     sampler.setDimension(bounceDimension(depth, kBsdfSample));
     const Vec2 u = sampler.get2D();
-    const std::optional<BsdfSample> s = sample(bsdf, woLocal, u);
-    if (!s) break;
-    const Vec3 wi = frame.toWorld(s->wi);
-    if (!usableSide(wi, s->wi, geometricNormal, bsdf)) break;  // see directLight
-    throughput *= s->weight;
+    const std::optional<Scattered> scattered = scatter(scattering, bsdf, u);  // the one bounce (scene.h)
+    if (!scattered) break;
+    const BsdfSample& s = scattered->sample;
+    const Vec3 wi = scattered->wi;
+    throughput *= s.weight;
     if (isBlack(throughput)) break;
-    if (const auto* glass = std::get_if<DielectricBsdf>(&bsdf); glass && !glass->thin && woLocal.z * s->wi.z < 0.0f) {
+    if (const auto* glass = std::get_if<DielectricBsdf>(&bsdf); glass && !glass->thin && woLocal.z * s.wi.z < 0.0f) {
       const float etap = woLocal.z > 0.0f ? glass->ior : 1.0f / glass->ior;  // η(wi side) / η(wo side)
       etaScale *= etap * etap;
     }
     const auto* sheet = std::get_if<DielectricBsdf>(&bsdf);
-    if (sheet && sheet->thin && woLocal.z * s->wi.z < 0.0f) {
+    if (sheet && sheet->thin && woLocal.z * s.wi.z < 0.0f) {
       distanceBefore += hit.t;  // straight through: the previous vertex's sample continues
     } else {
-      countEmissionFully = s->delta || bsdfOnly;
-      previousBsdfPdf = s->pdf;
+      countEmissionFully = s.delta || bsdfOnly;
+      previousBsdfPdf = s.pdf;
       distanceBefore = 0.0f;
     }
     ray.origin = offsetRayOrigin(surface.position, geometricNormal, wi);

@@ -79,7 +79,6 @@ class Window {
     SDL_RenderCopy(renderer_, texture_, nullptr, nullptr);
     SDL_RenderPresent(renderer_);
   }
-  void setTitle(const std::string& title) { SDL_SetWindowTitle(window_, title.c_str()); }
 
  private:
   SDL_Window* window_ = nullptr;

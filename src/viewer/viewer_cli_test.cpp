@@ -144,7 +144,8 @@ TEST_F(ViewerCliTest, BadInputsAreClearErrors) {
   EXPECT_NE(errors.find("frame pattern"), std::string::npos) << errors;
   EXPECT_NE(run("render " + path("cornell.plf") + " -o " + path("f%03d.png"), nullptr, &errors), 0);
   EXPECT_NE(errors.find("needs a camera path"), std::string::npos) << errors;
-  EXPECT_NE(run("render " + path("cornell.plf") + " --fast --reference -o " + path("x.png"), nullptr, &errors), 0);
+  // The removed `--fast` flag (the fast renderer is the default) is now an unknown option.
+  EXPECT_NE(run("render " + path("cornell.plf") + " --fast -o " + path("x.png"), nullptr, &errors), 0);
   // MP4 without ffmpeg on PATH: a clear message, before any rendering.
   {
     std::ofstream json(path("good.json"));

@@ -1,0 +1,147 @@
+// Emitters (see emitters.h): emissive triangles, punctual lights and the environment light.
+#include "light/emitters.h"
+
+#include <algorithm>
+#include <cmath>
+#include <variant>
+
+#include "core/error.h"
+#include "core/sampling.h"
+
+namespace pl {
+
+Vec3 EmissiveTriangle::pointAt(Vec2 u) const {
+  const Vec2 b = sampleUniformTriangle(u);
+  return p0 + b.x * edge1 + b.y * edge2;
+}
+
+PunctualLight PunctualLight::from(const Light& light) {
+  PunctualLight p;
+  if (const auto* point = std::get_if<PointLight>(&light)) {
+    p.kind = Kind::Point;
+    p.position = point->position;
+    p.intensity = point->intensity;
+  } else if (const auto* spot = std::get_if<SpotLight>(&light)) {
+    p.kind = Kind::Spot;
+    p.position = spot->position;
+    p.direction = glm::normalize(spot->direction);
+    p.intensity = spot->intensity;
+    p.cosInner = std::cos(spot->innerAngle);
+    p.cosOuter = std::cos(spot->outerAngle);
+  } else {
+    const auto& directional = std::get<DirectionalLight>(light);
+    p.kind = Kind::Directional;
+    p.direction = glm::normalize(directional.direction);
+    p.intensity = directional.irradiance;
+  }
+  return p;
+}
+
+bool PunctualLight::incidentAt(const Vec3& x, Vec3& wi, float& distance, Rgb& irradiance) const {
+  if (kind == Kind::Directional) {
+    wi = -direction;
+    distance = kInfinity;
+    irradiance = intensity;
+    return true;
+  }
+  const Vec3 toLight = position - x;
+  const float distanceSquared = glm::dot(toLight, toLight);
+  if (!(distanceSquared > 0.0f)) return false;
+  distance = std::sqrt(distanceSquared);
+  wi = toLight / distance;
+  float falloff = 1.0f;
+  if (kind == Kind::Spot) {
+    const float c = glm::dot(direction, -wi);
+    if (cosInner <= cosOuter) {
+      falloff = c >= cosInner ? 1.0f : 0.0f;
+    } else {
+      const float t = std::clamp((c - cosOuter) / (cosInner - cosOuter), 0.0f, 1.0f);
+      falloff = t * t * (3.0f - 2.0f * t);
+    }
+  }
+  if (!(falloff > 0.0f)) return false;
+  irradiance = intensity * (falloff / distanceSquared);
+  return true;
+}
+
+std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene) {
+  std::vector<EmissiveTriangle> list;
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      const Material& material = scene.materials[mesh.materials[t]];
+      if (!material.isEmissive()) continue;
+      const UVec3 tri = mesh.triangles[t];
+      EmissiveTriangle e;
+      e.mesh = m;
+      e.triangle = t;
+      e.material = mesh.materials[t];
+      e.p0 = mesh.positions[tri.x];
+      e.edge1 = mesh.positions[tri.y] - e.p0;
+      e.edge2 = mesh.positions[tri.z] - e.p0;
+      const Vec3 cross = glm::cross(e.edge1, e.edge2);
+      const float length = glm::length(cross);
+      if (!(length > 0.0f)) continue;  // degenerate: cannot emit (and finalize() drops these)
+      e.normal = cross / length;
+      e.area = 0.5f * length;
+      e.radiance = material.emission;
+      e.twoSided = material.twoSidedEmission;
+      list.push_back(e);
+    }
+  }
+  return list;
+}
+
+float PunctualLight::power(float sceneRadius) const {
+  switch (kind) {
+    case Kind::Point: return 4.0f * kPi * luminance(intensity);
+    case Kind::Spot: return 2.0f * kPi * (1.0f - 0.5f * (cosInner + cosOuter)) * luminance(intensity);
+    case Kind::Directional: return kPi * sceneRadius * sceneRadius * luminance(intensity);
+  }
+  return 0.0f;
+}
+
+EnvironmentLight::EnvironmentLight(const Rgb& constant, std::shared_ptr<const EnvironmentMap> map)
+    : constant_(constant), isBlackConstant_(pl::isBlack(constant)), map_(std::move(map)) {
+  if (!isFinite(constant) || constant.r < 0.0f || constant.g < 0.0f || constant.b < 0.0f)
+    fail("environment constant radiance must be finite and ≥ 0 (got {}, {}, {})", constant.r, constant.g, constant.b);
+  const double constantPower = 4.0 * kPiD * double(luminance(constant));
+  const double mapPower = map_ ? map_->integratedLuminance() : 0.0;
+  integratedLuminance_ = constantPower + mapPower;
+  if (map_ && mapPower > 0.0) mapProbability_ = float(mapPower / (constantPower + mapPower));
+}
+
+EnvironmentSample EnvironmentLight::sample(Vec2 u) const {
+  EnvironmentSample s;
+  if (isBlack()) return s;
+  // The mixture's pdf and radiance need the map's pdf and radiance at the chosen direction;
+  // a map sample already carries both (same formulas as pdf() and radiance()), so only a
+  // uniform sample looks them up.
+  float mapPdf = 0.0f;
+  Rgb mapRadiance(0.0f);
+  if (u.x < mapProbability_) {
+    u.x = std::min(u.x / mapProbability_, 0x1.fffffep-1f);
+    const EnvironmentSample fromMap = map_->sample(u);
+    s.direction = fromMap.direction;
+    mapPdf = fromMap.pdf;
+    mapRadiance = fromMap.radiance;
+  } else {
+    u.x = std::min((u.x - mapProbability_) / (1.0f - mapProbability_), 0x1.fffffep-1f);
+    s.direction = sampleUniformSphere(u);
+    if (map_) {
+      if (mapProbability_ > 0.0f) mapPdf = map_->pdf(s.direction);
+      mapRadiance = map_->radiance(s.direction);
+    }
+  }
+  s.pdf = (1.0f - mapProbability_) * kUniformSpherePdf + mapProbability_ * mapPdf;
+  s.radiance = constant_ + mapRadiance;
+  return s;
+}
+
+float EnvironmentLight::pdf(const Vec3& dir) const {
+  if (isBlack()) return 0.0f;
+  const float uniform = (1.0f - mapProbability_) * kUniformSpherePdf;
+  return mapProbability_ > 0.0f ? uniform + mapProbability_ * map_->pdf(dir) : uniform;
+}
+
+}  // namespace pl

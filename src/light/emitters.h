@@ -1,0 +1,102 @@
+#pragma once
+// Emitters: every kind of light source, prepared for sampling — emissive triangles, point,
+// spot and directional lights, and the environment. Each gives its emitted radiance (or
+// intensity), a way to sample it, the density of that sampling and an estimate of its power
+// (the light sampler's selection weight, light.h). The scene description the loaders fill in
+// (scene.h: Material emission, Light, Environment) stays in scene/; this is where it becomes
+// something that can be sampled. Adding a kind of light: its struct here, its entry in
+// LightSampler (light.h/.cpp).
+//
+// Units: radiance Le in W·sr⁻¹·m⁻², intensity I in W·sr⁻¹, irradiance E in W·m⁻²; "power" is
+// a luminance-weighted flux estimate (Y of the RGB), used only to choose between lights.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/math.h"
+#include "env/env.h"
+#include "scene/scene.h"
+
+namespace pl {
+
+/// A triangle of an emissive material, prepared for sampling points on it: the one list the
+/// path tracer and the bake sample their area lights from.
+struct EmissiveTriangle {
+  uint32_t mesh = 0, triangle = 0, material = 0;
+  Vec3 p0{0.0f}, edge1{0.0f}, edge2{0.0f};  ///< point = p0 + b₁·edge1 + b₂·edge2
+  Vec3 normal{0.0f};                        ///< unit geometric normal (winding), the emitting side
+  float area = 0.0f;
+  Rgb radiance{0.0f};                       ///< Le (W·sr⁻¹·m⁻²)
+  bool twoSided = false;
+
+  /// Le towards a direction whose cosine against `normal` is cosFront (the emission sidedness
+  /// rule of scene.h emittedRadiance: the front only, unless two-sided).
+  Rgb Le(float cosFront) const { return emittedRadiance(radiance, twoSided, cosFront); }
+  /// A point uniformly distributed by area for u ∈ [0, 1)² (density 1/area).
+  Vec3 pointAt(Vec2 u) const;
+  /// Exitant flux of a Lambertian emitter, π·A·Y(Le) (×2 when two-sided).
+  float power() const { return kPi * area * luminance(radiance) * (twoSided ? 2.0f : 1.0f); }
+};
+
+/// Every non-degenerate triangle of an emissive material, mesh by mesh in triangle order.
+std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene);
+
+/// A point, spot or directional light prepared for evaluation at many points (axis
+/// normalised, cone cosines computed once). The one place the path tracer and the bake
+/// evaluate these lights. Delta lights: sampling one is evaluating it (incidentAt), its
+/// density is the selection probability alone.
+struct PunctualLight {
+  enum class Kind : uint8_t { Point, Spot, Directional };
+  Kind kind = Kind::Point;
+  Vec3 position{0.0f};
+  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< spot axis / directional travel direction (unit)
+  Rgb intensity{0.0f};                ///< W·sr⁻¹ (point, spot) or irradiance W·m⁻² (directional)
+  float cosInner = 1.0f, cosOuter = 1.0f;
+
+  static PunctualLight from(const Light& light);
+
+  /// The light arriving at x: wi (unit, towards the light), the shadow-ray length
+  /// (∞ for directional) and the irradiance on a surface normal to wi (W·m⁻²): I·falloff/d²
+  /// for point and spot lights — the spot's falloff a smoothstep in cos between the outer and
+  /// inner cone (a step when they coincide) — the light's irradiance for directional ones.
+  /// False when nothing arrives (x at the light's position, outside a spot's cone).
+  bool incidentAt(const Vec3& x, Vec3& wi, float& distance, Rgb& irradiance) const;
+
+  /// Emitted power estimate: point 4π·Y(I); spot 2π·(1 − (cos θinner + cos θouter)/2)·Y(I)
+  /// (pbrt's estimate); directional π R²·Y(E), the flux through the disk of the scene's
+  /// bounding sphere of radius `sceneRadius`.
+  float power(float sceneRadius) const;
+};
+
+/// Everything that arrives from infinity as one light: a constant radiance plus an optional
+/// map (exactly what scene.h's Environment holds). radiance(dir) = constant + map(dir).
+/// sample() is a one-sample mixture: the map's importance sampling (env.h EnvironmentMap) with
+/// probability P_map / (P_map + P_const) and uniform sphere sampling otherwise, P = ∫ Y(L) dω
+/// of each part. pdf() is the mixture density (per solid angle), and sample() returns pdf() of
+/// the direction it chose, so MIS weights built from either agree. Cheap to copy (shared map).
+class EnvironmentLight {
+ public:
+  EnvironmentLight() = default;
+  EnvironmentLight(const Rgb& constant, std::shared_ptr<const EnvironmentMap> map);
+
+  bool isBlack() const { return !map_ && isBlackConstant_; }
+  /// Le arriving from unit world direction `dir`.
+  Rgb radiance(const Vec3& dir) const { return map_ ? constant_ + map_->radiance(dir) : constant_; }
+  EnvironmentSample sample(Vec2 u) const;
+  float pdf(const Vec3& dir) const;
+  /// ∫ Y(L) dω over the sphere (luminance-weighted, W·m⁻²). The power an environment
+  /// delivers into a scene bounded by a sphere of radius R is at most π R² times this.
+  double integratedLuminance() const { return integratedLuminance_; }
+  /// π R²·∫ Y(L) dω (= 4π·πR²·Y(Le) for a constant one, as pbrt-v4's UniformInfiniteLight::Phi).
+  double power(float sceneRadius) const { return kPiD * double(sceneRadius) * double(sceneRadius) * integratedLuminance_; }
+  float mapProbability() const { return mapProbability_; }
+
+ private:
+  Rgb constant_{0.0f};
+  bool isBlackConstant_ = true;
+  std::shared_ptr<const EnvironmentMap> map_;
+  float mapProbability_ = 0.0f;
+  double integratedLuminance_ = 0.0;
+};
+
+}  // namespace pl
