@@ -11,7 +11,7 @@
 #include "image/tonemap.h"
 #include "realtime/camera_path.h"
 #include "realtime/realtime.h"
-#include "render/render.h"
+#include "lightfield/render_settings.h"
 
 namespace pl {
 
