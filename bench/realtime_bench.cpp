@@ -37,7 +37,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/progress.h"
-#include "lightfield/bake.h"
+#include "bake/bake.h"
 #include "realtime/display.h"
 #include "realtime/realtime.h"
 #include "scene/scene.h"

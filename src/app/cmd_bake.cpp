@@ -1,4 +1,4 @@
-// `plenoptic bake SCENE -o OUT.plf`: the light-field bake (src/lightfield/bake.h) through BakeJob
+// `plenoptic bake SCENE -o OUT.plf`: the light-field bake (src/bake/bake.h) through BakeJob
 // (src/jobs/jobs.h): flags → job → printed summary.
 #include <fmt/format.h>
 

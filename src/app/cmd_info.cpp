@@ -1,6 +1,6 @@
 // `plenoptic info IN.plf [--json] [--no-verify]`: what a light-field file holds — format
 // version, the embedded scene, charts by kind, tixels, values, section sizes, and the bake's
-// settings and statistics — read without decoding the values (lightfield/plf_file.h).
+// settings and statistics — read without decoding the values (plf/plf_file.h).
 #include <fmt/format.h>
 
 #include <map>
@@ -10,8 +10,8 @@
 
 #include "app/commands.h"
 #include "core/error.h"
-#include "lightfield/compression.h"
-#include "lightfield/plf_file.h"
+#include "plf/compression.h"
+#include "plf/plf_file.h"
 
 namespace pl {
 namespace {

@@ -10,9 +10,9 @@
 #include "core/parallel.h"
 #include "core/timing.h"
 #include "jobs/jobs.h"
-#include "lightfield/bake.h"
-#include "lightfield/compression.h"
-#include "lightfield/plf_file.h"
+#include "bake/bake.h"
+#include "plf/compression.h"
+#include "plf/plf_file.h"
 
 namespace pl {
 

@@ -135,7 +135,7 @@ class TraceJob {
 };
 
 // ---------------------------------------------------------------------------------------
-// Bake: scene → light field (lightfield/bake.h), written as .plf (+ its .plv).
+// Bake: scene → light field (bake/bake.h), written as .plf (+ its .plv).
 
 struct BakeJobOptions {
   std::string sceneName;       ///< what the stats call the scene
@@ -149,7 +149,7 @@ struct BakeJobOptions {
   uint32_t lightSamples = 0;
   float tolerance = 0.0f;
   bool reuseVisibility = false;
-  std::string compress = "none";  ///< none | lossless | bc1 | hdr (lightfield/compression.h)
+  std::string compress = "none";  ///< none | lossless | bc1 | hdr (plf/compression.h)
   uint64_t seed = 0;
   int threads = 0;  ///< 0 = all hardware threads
   /// One-line notes (reuse decisions, rates); empty = dropped.

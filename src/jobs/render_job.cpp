@@ -11,7 +11,7 @@
 #include "core/parallel.h"
 #include "core/timing.h"
 #include "jobs/jobs.h"
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 #include "realtime/frame_output.h"
 #include "realtime/realtime.h"
 #include "realtime/walkthrough.h"

@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "lightfield/compression.h"
-#include "lightfield/plf_file.h"
+#include "plf/compression.h"
+#include "plf/plf_file.h"
 #include "support/cli_test_support.h"
 
 namespace pl {

@@ -20,7 +20,7 @@
 // k fu (u16), then the k fv (u16). Decoding restores the 8-byte entries of visibility.h exactly,
 // so a reused field gives the same light field bit for bit. Version 2 was the raw entries
 // (8 bytes each, memory-mapped): a version-2 file is traced again, like a stale one.
-#include "lightfield/visibility.h"
+#include "bake/visibility.h"
 
 #include <algorithm>
 #include <atomic>
@@ -42,9 +42,9 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "core/memory.h"
-#include "lightfield/codec_backends.h"
+#include "plf/codec_backends.h"
 #include "lightfield/lookup.h"
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 
 namespace pl {
 

@@ -40,7 +40,7 @@
 //   CHRT  the charts: u64 count, then fixed 85-byte records (see encodeCharts in plf_file.cpp).
 //   TRCH  triangle → chart: u64 mesh count, then per mesh u64 triangle count + u32 indices.
 //   VALS  the values: float32 RGB triplets (12 bytes each), in LightField::values order.
-//         Compressed (encoding ≠ 0): a stream of lightfield/compression.h.
+//         Compressed (encoding ≠ 0): a stream of plf/compression.h.
 //   META  UTF-8 JSON: {"settings": BakeSettings, "stats": BakeStats}.
 //
 // The version is checked right after the magic, before anything else is interpreted, so a

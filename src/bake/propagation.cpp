@@ -1,5 +1,5 @@
 // Propagation: first shot + Neumann-series iteration (see propagation.h).
-#include "lightfield/propagation.h"
+#include "bake/propagation.h"
 
 #include <algorithm>
 #include <atomic>

@@ -1,5 +1,5 @@
 // Light-field value codecs: see compression.h for the formats and their rationale.
-#include "lightfield/compression.h"
+#include "plf/compression.h"
 
 #include <algorithm>
 #include <array>
@@ -13,8 +13,8 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/progress.h"
-#include "lightfield/codec_backends.h"
-#include "lightfield/plf_file.h"
+#include "plf/codec_backends.h"
+#include "plf/plf_file.h"
 
 namespace pl {
 namespace {

@@ -1,5 +1,5 @@
 // The .plf light-field file: layout in plf_file.h.
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -17,7 +17,7 @@
 
 #include "core/error.h"
 #include "core/file_io.h"
-#include "lightfield/compression.h"
+#include "plf/compression.h"
 
 namespace pl {
 

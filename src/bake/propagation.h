@@ -31,8 +31,8 @@
 // It stops when the relative change of the total outgoing power Σ area·(exitant flux density)
 // drops below the tolerance and so does the error this leaves, estimated from the L1 change
 // of the values and its measured rate of convergence (see the .cpp), or at maxIterations.
-#include "lightfield/parameterisation.h"
-#include "lightfield/visibility.h"
+#include "bake/parameterisation.h"
+#include "bake/visibility.h"
 
 #include <functional>
 #include <vector>

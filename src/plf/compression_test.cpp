@@ -2,7 +2,7 @@
 // (special floats included), the error bounds of the lossy codecs, their ratios on smooth
 // data, and corrupt or truncated streams (a pl::Error naming the context, never a crash);
 // then the same through .plf files (writeLightField / readLightField / readLightFieldInfo).
-#include "lightfield/compression.h"
+#include "plf/compression.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -19,7 +19,7 @@
 #include <cstdlib>
 
 #include "core/error.h"
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 
 namespace pl {
 namespace {

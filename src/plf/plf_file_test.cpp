@@ -1,7 +1,7 @@
 // Tests of the .plf file: XXH64 against reference vectors, a round trip of every field, and
 // one test per way a file can be bad (each must be refused with a message naming the file
 // and the problem, never a crash).
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
