@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/hash.h"
 #include "image/image.h"
 #include "plf/plf_file.h"
 #include "bake/visibility.h"

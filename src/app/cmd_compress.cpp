@@ -52,7 +52,7 @@ void runCompress(const CompressOptions& options, const GlobalOptions& global) {
   const double inputReadSeconds = secondsSince(start);
 
   start = std::chrono::steady_clock::now();
-  writeLightField(options.output, lf, PlfEncoding(uint32_t(codec)), options.codec);
+  writeLightField(options.output, lf, codec, options.codec);
   const double writeSeconds = secondsSince(start);
 
   // Read the result back as every reader will (readLightField decodes): the median of

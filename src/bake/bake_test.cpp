@@ -13,6 +13,7 @@
 
 #include "accel/accel.h"
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/rng.h"

@@ -37,6 +37,7 @@
 #include "accel/accel.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/hash.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/rng.h"
@@ -44,7 +45,6 @@
 #include "core/memory.h"
 #include "plf/codec_backends.h"
 #include "lightfield/lookup.h"
-#include "plf/plf_file.h"
 
 namespace pl {
 

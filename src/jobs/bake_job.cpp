@@ -92,7 +92,7 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
   const LightField& lf = result.lightField;
   BakeJobStats& stats = result.stats;
   if (!options_.output.empty()) {
-    writeLightField(options_.output, lf, PlfEncoding(uint32_t(parseValuesCodec(options_.compress))));
+    writeLightField(options_.output, lf, parseValuesCodec(options_.compress));
     stats.fileBytes = std::filesystem::file_size(options_.output);
   }
   stats.seconds = loadSeconds + secondsSince(start);

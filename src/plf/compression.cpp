@@ -14,17 +14,11 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "plf/codec_backends.h"
-#include "plf/plf_file.h"
 
 namespace pl {
 namespace {
 
 static_assert(sizeof(Rgb) == 12, "values are float32 RGB triplets");
-// The .plf section table stores ValuesCodec numbers as PlfEncoding values.
-static_assert(uint32_t(PlfEncoding::Raw) == uint32_t(ValuesCodec::Raw) &&
-              uint32_t(PlfEncoding::Lossless) == uint32_t(ValuesCodec::Lossless) &&
-              uint32_t(PlfEncoding::Bc1) == uint32_t(ValuesCodec::Bc1) &&
-              uint32_t(PlfEncoding::Hdr) == uint32_t(ValuesCodec::Hdr));
 static_assert(std::endian::native == std::endian::little, "the stream format is little-endian");
 
 constexpr char kMagic[4] = {'P', 'L', 'V', 'C'};
