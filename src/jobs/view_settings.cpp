@@ -6,6 +6,7 @@
 #include "core/file_io.h"
 #include "core/memory.h"
 #include "jobs/jobs.h"
+#include "realtime/walkthrough.h"
 
 namespace pl {
 
@@ -79,21 +80,7 @@ void ViewSettings::requireImageMemory(int frameBuffers, std::string_view what) c
 }
 
 void ViewSettings::writeImage(const std::string& path, const Image& radiance) const {
-  const float scale = exposureScale();
-  const bool hdr = isHdrExtension(path);
-  if (!hdr && fileExtensionLower(path) != ".png")
-    fail("{}: unknown output type '{}' (use .exr, .hdr, .pfm or .png)", path, fileExtensionLower(path));
-  if (scale == 1.0f && hdr) {
-    writeHdrImage(path, radiance);
-    return;
-  }
-  Image exposed = radiance;
-  for (Rgb& p : exposed.pixels) p *= scale;
-  if (hdr) {
-    writeHdrImage(path, exposed);
-  } else {
-    writePng(path, toneMap(exposed, toneMapSettings()));
-  }
+  writeFrame(path, radiance, exposureScale(), toneMapSettings());
 }
 
 void ViewSettings::checkImageSize(std::string_view where) const {
