@@ -1,8 +1,9 @@
 // `plenoptic render IN.plf -o OUT.exr|png`: the fast light-field renderer (src/realtime, the
 // default) or, with --reference, the straightforward one (src/render/render.h), through the
-// shared camera, exposure and tone-mapping flags, through RenderJob (src/jobs/jobs.h). With --path PATH.json it renders a
+// shared camera, exposure and tone-mapping flags. With --path PATH.json it renders a
 // walk-through (realtime/camera_path.h) to an image sequence (-o frames/%04d.png) or an MP4
-// video (-o walk.mp4, through ffmpeg).
+// video (-o walk.mp4, through ffmpeg). The work is RenderJob's (src/jobs/jobs.h): flags → job →
+// printed summary.
 #include <fmt/format.h>
 
 #include <memory>
