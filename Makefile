@@ -8,7 +8,7 @@ FUZZ_BUILD_DIR ?= build-fuzz
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS ?= obj gltf json_scene camera_path hdr exr plf plf_fixed plv plv_fixed
 
-.PHONY: all bootstrap configure build test demo bench fuzz clean
+.PHONY: all bootstrap configure build python test demo bench fuzz clean
 
 all: build
 
@@ -20,6 +20,10 @@ configure: bootstrap
 
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
+
+# The Python module alone (build/python/plenoptic*.so; `build` makes it too).
+python: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target plenoptic_python
 
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)

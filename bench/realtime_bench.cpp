@@ -37,7 +37,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/progress.h"
-#include "lightfield/bake.h"
+#include "bake/bake.h"
 #include "realtime/display.h"
 #include "realtime/realtime.h"
 #include "scene/scene.h"
@@ -213,7 +213,7 @@ void BM_Frame(benchmark::State& state, const std::string& name, int width, int h
   state.counters["primary_ms_median"] = primary;
   state.counters["ratio"] = primary > 0 ? ms / primary : 0.0;
   state.counters["display_ms_median"] = median(displayMs);
-  state.counters["spp"] = pl::FastRenderer::samplesPerPixel(camera, settings);
+  state.counters["spp"] = pl::effectiveSamplesPerPixel(settings, camera.isThinLens());
   state.counters["threads"] = pool.threads();
 }
 

@@ -7,6 +7,8 @@ function(pl_add_module name)
   add_library(pl_${name} STATIC ${ARG_SOURCES})
   target_include_directories(pl_${name} PUBLIC ${CMAKE_SOURCE_DIR}/src)
   target_link_libraries(pl_${name} PUBLIC ${ARG_DEPS} PRIVATE pl_warnings ${ARG_PRIVATE_DEPS})
+  # -fPIC: the modules are also linked into the Python extension (a shared object).
+  set_target_properties(pl_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
 endfunction()
 
 function(pl_add_test name)

@@ -13,9 +13,10 @@
 
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/hash.h"
 #include "image/image.h"
-#include "lightfield/plf_file.h"
-#include "lightfield/visibility.h"
+#include "plf/plf_file.h"
+#include "bake/visibility.h"
 #include "realtime/camera_path.h"
 #include "scene/scene.h"
 

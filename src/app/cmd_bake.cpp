@@ -1,22 +1,15 @@
-// `plenoptic bake SCENE -o OUT.plf`: the light-field bake (src/lightfield/bake.h).
+// `plenoptic bake SCENE -o OUT.plf`: the light-field bake (src/bake/bake.h) through BakeJob
+// (src/jobs/jobs.h): flags → job → printed summary.
 #include <fmt/format.h>
 
-#include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 #include "app/commands.h"
 #include "core/error.h"
-#include "core/file_io.h"
-#include "core/memory.h"
-#include "core/timing.h"
-#include "lightfield/bake.h"
-#include "lightfield/compression.h"
-#include "lightfield/plf_file.h"
-#include "scene/scene.h"
+#include "jobs/jobs.h"
 
 namespace pl {
 namespace {
@@ -37,77 +30,32 @@ struct BakeCommandOptions {
 };
 
 void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
-  Runtime runtime(global);
-  const auto start = std::chrono::steady_clock::now();
-  // Every output is checked before the scene is loaded (core/file_io.h): a bake that could
-  // not save its results is refused before it traces anything.
+  applyGlobalOptions(global);
   if (options.output.empty()) failUsage("bake: an output file is required (-o OUT.plf)");
-  checkOutputPath(options.output, {".plf"}, "-o");
-  const std::string visibilityPath =
-      options.visibilityPath.empty() ? std::filesystem::path(options.output).replace_extension(".plv").string()
-                                     : options.visibilityPath;
-  checkOutputPath(visibilityPath, {".plv"}, "--visibility");
-  if (!options.statsPath.empty()) checkOutputPath(options.statsPath, {}, "--stats");
-  checkDistinctOutputs({{"-o", options.output}, {"--visibility", visibilityPath}, {"--stats", options.statsPath}});
-
-  BakeSettings settings = bakePreset(options.preset);
-  if (options.tixelsAcross > 0.0f) settings.tixelsAcrossScene = options.tixelsAcross;
-  if (options.gatherDirections > 0) settings.gatherDirections = options.gatherDirections;
-  if (options.lightSamples > 0) settings.areaLightSamples = options.lightSamples;
-  if (options.tolerance > 0.0f) settings.tolerance = options.tolerance;
-  settings.seed = global.seed;
-
-  Scene scene = loadScene(options.scene);
-  BakeOptions bakeOptions;
-  bakeOptions.visibilityPath = visibilityPath;
-  bakeOptions.reuseVisibility = options.reuseVisibility;
-  bakeOptions.log = [&](const std::string& line) {
+  BakeJobOptions jobOptions;
+  jobOptions.sceneName = options.scene;
+  jobOptions.output = options.output;
+  jobOptions.visibilityPath = options.visibilityPath;
+  jobOptions.statsPath = options.statsPath;
+  jobOptions.preset = options.preset;
+  jobOptions.tixelsAcross = options.tixelsAcross;
+  jobOptions.gatherDirections = options.gatherDirections;
+  jobOptions.lightSamples = options.lightSamples;
+  jobOptions.tolerance = options.tolerance;
+  jobOptions.reuseVisibility = options.reuseVisibility;
+  jobOptions.compress = options.compress;
+  jobOptions.seed = global.seed;
+  jobOptions.threads = global.threads;
+  jobOptions.log = [&](const std::string& line) {
     if (!global.quiet) fmt::print(stderr, "{}\n", line);
   };
-  bakeOptions.checkMemory = [](uint64_t bytes) {
-    requireMemory(bytes, "bake (visibility field and light-field values)",
-                  "lower --preset, --tixels-across or --directions");
-  };
-  LightField lf = bake(std::move(scene), settings, bakeOptions);
-  writeLightField(options.output, lf, PlfEncoding(uint32_t(parseValuesCodec(options.compress))));
-  const uint64_t fileBytes = std::filesystem::file_size(options.output);
-  const double seconds = secondsSince(start);
-  const BakeStats& s = lf.stats;
-
-  if (!options.statsPath.empty()) {
-    nlohmann::json json;
-    json["command"] = "bake";
-    json["scene"] = options.scene;
-    json["output"] = options.output;
-    json["preset"] = settings.preset;
-    json["threads"] = runtime.threads();
-    json["seconds"] = seconds;
-    json["bake_seconds"] = s.seconds;
-    json["visibility_seconds"] = s.visibilitySeconds;
-    json["propagation_seconds"] = s.propagationSeconds;
-    json["iterations"] = s.iterations;
-    json["residual"] = s.residual;
-    json["tixels"] = s.tixels;
-    json["values"] = s.values;
-    json["charts"] = lf.charts.size();  // chart records: a two-sided chart counts twice (front and back)
-    uint64_t twoSided = 0, backTixels = 0;
-    for (const Chart& c : lf.charts) {
-      twoSided += c.isBack ? 1 : 0;
-      backTixels += c.isBack ? c.tixelCount() : 0;
-    }
-    json["two_sided_charts"] = twoSided;
-    json["back_side_tixels"] = backTixels;
-    json["visibility_rays"] = s.visibilityRays;
-    json["visibility_rays_per_second"] = s.visibilitySeconds > 0 ? double(s.visibilityRays) / s.visibilitySeconds : 0.0;
-    json["reused_visibility"] = s.reusedVisibility;
-    json["visibility_file"] = visibilityPath;
-    json["peak_rss_bytes"] = s.peakRssBytes;
-    json["file_bytes"] = fileBytes;
-    json["compression"] = options.compress;
-    writeFileAtomically(options.statsPath, json.dump(2) + "\n");
-  }
+  const BakeJob job(std::move(jobOptions));  // checks every output before the scene is loaded
+  const BakeJobResult result = job.run(options.scene);
+  const BakeJobStats& stats = result.stats;
+  const BakeStats& s = stats.bake;
   fmt::print("wrote {} ({} charts, {} tixels, {} values, {:.1f} MB; {} iterations, residual {:.2e}; {:.2f} s)\n",
-             options.output, lf.charts.size(), s.tixels, s.values, fileBytes / 1e6, s.iterations, s.residual, seconds);
+             options.output, stats.charts, s.tixels, s.values, stats.fileBytes / 1e6, s.iterations, s.residual,
+             stats.seconds);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // `plenoptic compress IN.plf -o OUT.plf --mode none|lossless|bc1|hdr`: rewrites a light
-// field with its values stored in another mode (lightfield/compression.h), atomically, and
+// field with its values stored in another mode (plf/compression.h), atomically, and
 // reports sizes, the ratio, encode and decode times and the error of the decoded values
 // against the input's.
 #include <fmt/format.h>
@@ -17,8 +17,8 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/timing.h"
-#include "lightfield/compression.h"
-#include "lightfield/plf_file.h"
+#include "plf/compression.h"
+#include "plf/plf_file.h"
 
 namespace pl {
 namespace {
@@ -52,7 +52,7 @@ void runCompress(const CompressOptions& options, const GlobalOptions& global) {
   const double inputReadSeconds = secondsSince(start);
 
   start = std::chrono::steady_clock::now();
-  writeLightField(options.output, lf, PlfEncoding(uint32_t(codec)), options.codec);
+  writeLightField(options.output, lf, codec, options.codec);
   const double writeSeconds = secondsSince(start);
 
   // Read the result back as every reader will (readLightField decodes): the median of

@@ -1,6 +1,6 @@
 // `plenoptic info IN.plf [--json] [--no-verify]`: what a light-field file holds — format
 // version, the embedded scene, charts by kind, tixels, values, section sizes, and the bake's
-// settings and statistics — read without decoding the values (lightfield/plf_file.h).
+// settings and statistics — read without decoding the values (plf/plf_file.h).
 #include <fmt/format.h>
 
 #include <map>
@@ -10,8 +10,8 @@
 
 #include "app/commands.h"
 #include "core/error.h"
-#include "lightfield/compression.h"
-#include "lightfield/plf_file.h"
+#include "plf/compression.h"
+#include "plf/plf_file.h"
 
 namespace pl {
 namespace {
@@ -30,7 +30,7 @@ std::string humanBytes(uint64_t bytes) {
 }
 
 std::string_view encodingName(uint32_t encoding) {
-  if (encoding == uint32_t(PlfEncoding::Raw)) return "raw";
+  if (encoding == uint32_t(ValuesCodec::Raw)) return "raw";
   return isKnownValuesCodec(encoding) ? valuesCodecName(ValuesCodec(encoding)) : "unknown";
 }
 
@@ -44,7 +44,7 @@ ValuesStorage valuesStorage(const PlfInfo& info) {
   ValuesStorage v;
   for (const PlfSectionInfo& s : info.sections)
     if (s.id == "VALS") {
-      v.mode = s.encoding == uint32_t(PlfEncoding::Raw) ? "none" : encodingName(s.encoding);
+      v.mode = s.encoding == uint32_t(ValuesCodec::Raw) ? "none" : encodingName(s.encoding);
       v.storedBytes = s.storedSize;
       v.decodedBytes = s.decodedSize;
       v.ratio = s.storedSize > 0 ? double(s.decodedSize) / double(s.storedSize) : 1.0;

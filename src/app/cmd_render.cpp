@@ -2,46 +2,28 @@
 // default) or, with --reference, the straightforward one (src/render/render.h), through the
 // shared camera, exposure and tone-mapping flags. With --path PATH.json it renders a
 // walk-through (realtime/camera_path.h) to an image sequence (-o frames/%04d.png) or an MP4
-// video (-o walk.mp4, through ffmpeg).
+// video (-o walk.mp4, through ffmpeg). The work is RenderJob's (src/jobs/jobs.h): flags → job →
+// printed summary.
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <chrono>
-#include <filesystem>
 #include <memory>
-#include <optional>
-#include <nlohmann/json.hpp>
 #include <string>
-#include <vector>
+#include <utility>
 
-#include "accel/accel.h"
 #include "app/commands.h"
 #include "app/view_options.h"
-#include "camera/camera.h"
 #include "core/error.h"
-#include "core/file_io.h"
-#include "core/timing.h"
-#include "image/image.h"
-#include "lightfield/plf_file.h"
-#include "realtime/camera_path.h"
-#include "realtime/frame_output.h"
-#include "realtime/realtime.h"
-#include "realtime/walkthrough.h"
-#include "render/render.h"
+#include "jobs/jobs.h"
 
 namespace pl {
 namespace {
-
-// Ranges of the options, declared once (image size: ViewOptions::kMaxImageSide; samples and
-// mirror depth: RenderSettings).
-constexpr int kMaxFrames = 100000;
 
 struct RenderOptions {
   std::string input;      ///< .plf light field
   std::string output;     ///< .exr/.hdr/.pfm (radiance × exposure) or .png (tone-mapped)
   std::string statsPath;  ///< --stats: JSON with frames, ms_per_frame_median, fps
   int frames = 1;         ///< --frames N: render N times (timing); the last frame is written
-  int samples = 0;        ///< --samples N: camera samples per pixel (0 = automatic, see render.h)
+  int samples = 0;        ///< --samples N: camera samples per pixel (0 = automatic, see render_settings.h)
   int mirrorDepth = -1;   ///< --mirror-depth N (-1 = the bake's)
   bool reference = false;  ///< --reference: the straightforward renderer instead of the fast one
   std::string pathFile;    ///< --path PATH.json: render a walk-through, one output per frame
@@ -49,122 +31,28 @@ struct RenderOptions {
 };
 
 void runRender(const RenderOptions& options, const GlobalOptions& global) {
-  Runtime runtime(global);
-  const ViewOptions& view = options.view;
-  constexpr int kMaxSide = ViewOptions::kMaxImageSide;
-  if (view.width < 1 || view.width > kMaxSide || view.height < 1 || view.height > kMaxSide)
-    fail("image size {}x{} is out of range (width and height must be 1..{})", view.width, view.height, kMaxSide);
-  // Every output is checked before the light field is read (core/file_io.h).
+  applyGlobalOptions(global);
   if (options.output.empty()) failUsage("render: an output image is required (-o OUT.exr|png)");
-  const bool video = isVideoOutput(options.output);
-  const bool sequence = isFramePattern(options.output);
-  if (options.pathFile.empty() && (video || sequence))
-    failUsage("-o {}: a frame pattern or .mp4 output needs a camera path (--path PATH.json)", options.output);
-  if (!options.pathFile.empty() && !video && !sequence)
-    failUsage("-o {}: a camera path renders many frames: give a frame pattern like frames/%04d.png or an .mp4 file",
-              options.output);
-  if (!options.pathFile.empty() && options.frames != 1)
-    failUsage("--frames cannot be combined with --path (the path sets the frames)");
-  if (sequence) {
-    // Frames go into the pattern's directory, created if needed.
-    const std::filesystem::path parent = std::filesystem::path(options.output).parent_path();
-    std::error_code error;
-    if (!parent.empty()) std::filesystem::create_directories(parent, error);
-    if (error) fail("-o {}: cannot create directory '{}': {}", options.output, parent.string(), error.message());
-  }
-  if (!video) ViewOptions::checkImageOutput(options.output, "-o");
-  else checkOutputPath(options.output, {".mp4"}, "-o");
-  if (!options.statsPath.empty()) checkOutputPath(options.statsPath, {}, "--stats");
-  checkDistinctOutputs({{"-o", options.output}, {"--stats", options.statsPath}});
-  std::optional<CameraPath> cameraPath;
-  if (!options.pathFile.empty()) cameraPath = loadCameraPath(options.pathFile);
-  if (video && findFfmpeg().empty())
-    fail("-o {}: MP4 output needs ffmpeg, which is not installed (not found on PATH); write an image sequence "
-         "instead, e.g. -o frames/%04d.png",
-         options.output);
-  const auto loadStart = SteadyClock::now();
-  const LightField lightField = readLightField(options.input);
-  const double loadSeconds = secondsSince(loadStart);
-  // The frame (two for a walk-through: the one being rendered and the one being written); the
-  // light field, read by now, is already taken from the available memory.
-  view.requireImageMemory(cameraPath ? 2 : 1, "render");
-  const auto accelStart = SteadyClock::now();
-  const Accel accel(lightField.scene);
-  const double accelSeconds = secondsSince(accelStart);
-  const CameraDesc cameraDesc = view.resolveCamera(lightField.scene);
-  const Camera camera(cameraDesc, view.width, view.height, view.vignetting, view.metresPerUnit(lightField.scene));
-  const FastRenderer fastRenderer(lightField, accel);
-
-  RenderSettings settings;
-  settings.samplesPerPixel = options.samples;
-  settings.mirrorDepth = options.mirrorDepth;
-  settings.seed = global.seed;
-  settings.showProgress = options.frames == 1 && options.reference;
-  Image image;
-  std::vector<double> frameMs;
-  // One frame through the chosen renderer; frame time excludes writing files.
-  auto renderFrame = [&](const Camera& frameCamera) {
-    const auto start = SteadyClock::now();
-    if (options.reference) {
-      image = renderLightField(lightField, accel, frameCamera, settings);
-    } else {
-      fastRenderer.render(frameCamera, settings, image);
-    }
-    frameMs.push_back(1e3 * secondsSince(start));
-  };
-  int frames = options.frames;
-  if (!cameraPath) {
-    for (int frame = 0; frame < options.frames; ++frame) renderFrame(camera);
-    view.writeImage(options.output, image);
-  } else {
-    // The walk-through (realtime/walkthrough.h): frame k at time t₀ + k/fps, the path's pose
-    // on the resolved camera (which keeps its lens and, without a path fov, its fov).
-    WalkthroughOptions walk;
-    walk.output = options.output;
-    walk.width = view.width;
-    walk.height = view.height;
-    walk.vignetting = view.vignetting;
-    walk.metresPerUnit = view.metresPerUnit(lightField.scene);
-    walk.exposureScale = view.exposureScale();
-    walk.toneMap = view.toneMapSettings();
-    const WalkthroughResult result =
-        renderWalkthrough(*cameraPath, cameraDesc, walk, [&](const Camera& frameCamera, Image& frameImage) {
-          renderFrame(frameCamera);
-          std::swap(frameImage, image);
-        });
-    frames = result.frames;
-  }
-
-  const double medianMs = median(frameMs);
-  const double fps = medianMs > 0.0 ? 1e3 / medianMs : 0.0;
-  const int spp = options.samples > 0 ? options.samples : camera.isThinLens() ? RenderSettings::kThinLensSamples : 1;
-  if (!options.statsPath.empty()) {
-    nlohmann::json json;
-    json["command"] = "render";
-    json["input"] = options.input;
-    json["output"] = options.output;
-    json["camera"] = cameraDesc.name;
-    json["width"] = view.width;
-    json["height"] = view.height;
-    json["samples_per_pixel"] = spp;
-    json["mirror_depth"] = options.mirrorDepth >= 0 ? uint32_t(options.mirrorDepth) : lightField.settings.mirrorDepth;
-    json["threads"] = runtime.threads();
-    json["renderer"] = options.reference ? "reference" : "fast";
-    if (cameraPath) json["path"] = options.pathFile;
-    json["frames"] = frames;
-    json["ms_per_frame_median"] = medianMs;
-    json["ms_per_frame_min"] = *std::min_element(frameMs.begin(), frameMs.end());
-    json["ms_per_frame_max"] = *std::max_element(frameMs.begin(), frameMs.end());
-    json["fps"] = fps;
-    json["load_seconds"] = loadSeconds;
-    json["accel_build_seconds"] = accelSeconds;
-    json["file_bytes"] = std::filesystem::file_size(options.input);
-    writeFileAtomically(options.statsPath, json.dump(2) + "\n");
-  }
+  RenderJobOptions jobOptions;
+  jobOptions.inputName = options.input;
+  jobOptions.output = options.output;
+  jobOptions.statsPath = options.statsPath;
+  jobOptions.frames = options.frames;
+  jobOptions.render.samplesPerPixel = options.samples;
+  jobOptions.render.mirrorDepth = options.mirrorDepth;
+  jobOptions.render.seed = global.seed;
+  jobOptions.reference = options.reference;
+  jobOptions.pathFile = options.pathFile;
+  jobOptions.view = options.view;
+  jobOptions.threads = global.threads;
+  const RenderJob job(std::move(jobOptions));  // checks every output before the light field is read
+  const RenderJobStats stats = job.run(options.input).stats;
+  const int spp = stats.samplesPerPixel;
   fmt::print("wrote {} ({}x{}, {} sample{}/pixel, {} renderer, {} frame{}: median {:.2f} ms/frame = {:.1f} fps; "
              "load {:.3f} s, BVH {:.3f} s)\n",
-             options.output, view.width, view.height, spp, spp == 1 ? "" : "s", options.reference ? "reference" : "fast",
-             frames, frames == 1 ? "" : "s", medianMs, fps, loadSeconds, accelSeconds);
+             options.output, stats.width, stats.height, spp, spp == 1 ? "" : "s", stats.renderer, stats.frames,
+             stats.frames == 1 ? "" : "s", stats.msPerFrameMedian, stats.fps, stats.loadSeconds,
+             stats.accelBuildSeconds);
 }
 
 }  // namespace
@@ -178,7 +66,7 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
                       "Output image: .exr/.hdr/.pfm hold radiance (x exposure), .png is tone-mapped sRGB")
       ->required();
   command->add_option("--frames", options->frames, "Render N times for timing (the median goes to --stats)")
-      ->check(CLI::Range(1, kMaxFrames))
+      ->check(CLI::Range(1, RenderJobOptions::kMaxFrames))
       ->capture_default_str();
   command->add_option("--samples", options->samples,
                       "Camera samples per pixel (0 = 1 at the pixel centre for a pinhole, 16 for a thin lens)")

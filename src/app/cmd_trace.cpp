@@ -1,27 +1,24 @@
-// `plenoptic trace SCENE -o OUT.exr|png`: the reference path tracer (src/trace/trace.h).
+// `plenoptic trace SCENE -o OUT.exr|png`: the reference path tracer (src/trace/trace.h) through
+// TraceJob (src/jobs/jobs.h): flags → job → printed summary.
 #include <fmt/format.h>
 
 #include <cstdio>
-#include <filesystem>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "accel/accel.h"
 #include "app/commands.h"
 #include "app/view_options.h"
-#include "camera/camera.h"
 #include "core/error.h"
-#include "core/file_io.h"
-#include "image/image.h"
+#include "jobs/jobs.h"
 #include "scene/scene.h"
 #include "trace/trace.h"
 
 namespace pl {
 namespace {
 
-// Ranges of the options, declared once (image size: ViewOptions::kMaxImageSide).
+// Ranges of the options, declared once (image size: ViewSettings::kMaxImageSide).
 constexpr int kMaxSpp = 1 << 24;
 constexpr int kMaxDepth = 100000;
 
@@ -41,49 +38,33 @@ struct TraceOptions {
 };
 
 void runTrace(const TraceOptions& options, const GlobalOptions& global) {
-  Runtime runtime(global);
+  applyGlobalOptions(global);
   const bool replay = !options.pixel.empty();
-  // Every output is checked before the scene is even loaded (core/file_io.h).
-  if (!replay) {
-    if (options.output.empty()) failUsage("trace: an output image is required (-o OUT.exr|png)");
-    ViewOptions::checkImageOutput(options.output, "-o");
-  }
-  if (!options.variancePath.empty()) checkOutputPath(options.variancePath, {".exr", ".hdr", ".pfm"}, "--variance");
-  if (!options.statsPath.empty()) checkOutputPath(options.statsPath, {}, "--stats");
-  checkDistinctOutputs({{"-o", options.output}, {"--variance", options.variancePath}, {"--stats", options.statsPath}});
-
-  TraceSettings settings;
-  settings.spp = options.spp;
-  settings.maxDepth = options.maxDepth;
-  settings.seed = global.seed;
-  settings.strategy = parseStrategy(options.strategy);
-  settings.sampler = parseSampler(options.sampler);
-
+  if (!replay && options.output.empty()) failUsage("trace: an output image is required (-o OUT.exr|png)");
+  TraceJobOptions jobOptions;
+  jobOptions.sceneName = options.scene;
+  jobOptions.output = replay ? std::string() : options.output;
+  jobOptions.variancePath = options.variancePath;
+  jobOptions.statsPath = options.statsPath;
+  jobOptions.trace.spp = options.spp;
+  jobOptions.trace.maxDepth = options.maxDepth;
+  jobOptions.trace.seed = global.seed;
+  jobOptions.trace.strategy = parseStrategy(options.strategy);
+  jobOptions.trace.sampler = parseSampler(options.sampler);
+  jobOptions.view = options.view;
+  jobOptions.threads = global.threads;
+  jobOptions.sppGiven = options.sppGiven;
+  jobOptions.widthGiven = options.widthGiven;
+  jobOptions.heightGiven = options.heightGiven;
+  jobOptions.cameraGiven = options.cameraGiven;
+  const TraceJob job(std::move(jobOptions));  // checks every output before the scene is loaded
   const Scene scene = loadScene(options.scene);
-  // The scene file's suggested settings, where the command line is silent.
-  ViewOptions view = options.view;
-  const SceneSettings& suggested = scene.settings;
-  if (!options.widthGiven && suggested.width) view.width = *suggested.width;
-  if (!options.heightGiven && suggested.height) view.height = *suggested.height;
-  if (!options.cameraGiven && suggested.camera) view.camera = *suggested.camera;
-  if (!options.sppGiven && suggested.spp) settings.spp = *suggested.spp;
-  constexpr int kMaxSide = ViewOptions::kMaxImageSide;
-  if (view.width < 1 || view.width > kMaxSide || view.height < 1 || view.height > kMaxSide)
-    fail("{}: image size {}x{} is out of range (width and height must be 1..{})", options.scene, view.width,
-         view.height, kMaxSide);
-  if (settings.spp < 1 || settings.spp > kMaxSpp)
-    fail("{}: {} samples per pixel is out of range (1..{})", options.scene, settings.spp, kMaxSpp);
-  // The radiance and variance images (replaying one pixel needs neither).
-  if (!replay) view.requireImageMemory(2, "trace");
-
-  const Accel accel(scene);
-  const PathTracer tracer(scene, accel);
-  const CameraDesc cameraDesc = view.resolveCamera(scene);
-  const Camera camera = view.makeCamera(scene);
 
   if (replay) {
     const int x = options.pixel[0], y = options.pixel[1];
-    const RadianceEstimate e = tracer.renderPixel(camera, settings, x, y);
+    TraceSettings settings;
+    ViewSettings view;
+    const RadianceEstimate e = job.runPixel(scene, x, y, &settings, &view);
     const Rgb se = glm::sqrt(e.varianceOfMean);
     fmt::print("pixel ({}, {}) of {}x{}, {} spp, seed {}, strategy {}, sampler {}:\n", x, y, view.width, view.height,
                settings.spp, settings.seed, strategyName(settings.strategy), samplerName(settings.sampler));
@@ -93,44 +74,15 @@ void runTrace(const TraceOptions& options, const GlobalOptions& global) {
     return;
   }
 
-  const TraceResult result = tracer.render(camera, settings);
-  const TraceStats& stats = result.stats;
-  if (stats.nanSamples > 0)
+  const TraceJobStats stats = job.run(scene).stats;
+  const TraceStats& t = stats.trace;
+  if (t.nanSamples > 0)
     fmt::print(stderr,
                "plenoptic: warning: {} of {} samples had a non-finite radiance and were left out "
                "(first at pixel {},{} sample {}; replay with --pixel {},{})\n",
-               stats.nanSamples, stats.paths, stats.firstNanX, stats.firstNanY, stats.firstNanSample, stats.firstNanX,
-               stats.firstNanY);
-
-  view.writeImage(options.output, result.radiance);
-  if (!options.variancePath.empty()) writeHdrImage(options.variancePath, result.variance);
-
-  if (!options.statsPath.empty()) {
-    nlohmann::json json;
-    json["command"] = "trace";
-    json["scene"] = options.scene;
-    json["output"] = options.output;
-    json["camera"] = cameraDesc.name;
-    json["width"] = view.width;
-    json["height"] = view.height;
-    json["spp"] = settings.spp;
-    json["max_depth"] = settings.maxDepth;
-    json["strategy"] = strategyName(settings.strategy);
-    json["sampler"] = samplerName(settings.sampler);
-    json["seed"] = settings.seed;
-    json["threads"] = runtime.threads();
-    json["seconds"] = stats.seconds;
-    json["paths"] = stats.paths;
-    json["paths_per_second"] = stats.pathsPerSecond();
-    json["rays"] = stats.rays;
-    json["rays_per_second"] = stats.raysPerSecond();
-    json["nan_samples"] = stats.nanSamples;
-    json["triangles"] = scene.triangleCount();
-    json["emissive_triangles"] = tracer.emissiveTriangleCount();
-    writeFileAtomically(options.statsPath, json.dump(2) + "\n");
-  }
-  fmt::print("wrote {} ({}x{}, {} spp, {:.2f} s, {:.3f} M paths/s, {:.2f} M rays/s)\n", options.output, view.width,
-             view.height, settings.spp, stats.seconds, stats.pathsPerSecond() * 1e-6, stats.raysPerSecond() * 1e-6);
+               t.nanSamples, t.paths, t.firstNanX, t.firstNanY, t.firstNanSample, t.firstNanX, t.firstNanY);
+  fmt::print("wrote {} ({}x{}, {} spp, {:.2f} s, {:.3f} M paths/s, {:.2f} M rays/s)\n", options.output, stats.width,
+             stats.height, stats.spp, t.seconds, t.pathsPerSecond() * 1e-6, t.raysPerSecond() * 1e-6);
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 #include "app/commands.h"
 #include "app/view_options.h"
 #include "core/error.h"
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 #include "realtime/camera_path.h"
 #include "viewer/viewer.h"
 

@@ -16,7 +16,11 @@ struct GlobalOptions {
   bool quiet = false;     ///< no progress bars
 };
 
-/// What every command's callback creates first: the thread pool (with FTZ/DAZ workers)
+/// Applies what the library jobs do not own: --quiet silences progress bars. (The jobs make
+/// their own thread pool of --threads.)
+void applyGlobalOptions(const GlobalOptions& global);
+
+/// What every command's callback not built on a job (jobs/jobs.h) creates first: the thread pool (with FTZ/DAZ workers)
 /// sized by --threads, and progress bars silenced by --quiet.
 class Runtime {
  public:

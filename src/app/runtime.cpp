@@ -8,8 +8,10 @@ struct Runtime::Impl {
   ThreadPool pool;
 };
 
+void applyGlobalOptions(const GlobalOptions& global) { Progress::setEnabled(!global.quiet); }
+
 Runtime::Runtime(const GlobalOptions& global) : impl_(new Impl{ThreadPool(global.threads)}) {
-  Progress::setEnabled(!global.quiet);
+  applyGlobalOptions(global);
 }
 Runtime::~Runtime() = default;
 int Runtime::threads() const { return impl_->pool.threads(); }

@@ -4,10 +4,6 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "core/error.h"
-#include "core/file_io.h"
-#include "core/memory.h"
-
 namespace pl {
 namespace {
 
@@ -112,93 +108,6 @@ void ViewOptions::addImageOptions(CLI::App& command) {
   addExposureOptions(command);
   command.add_flag("--vignetting", vignetting, "Natural vignetting: weight each pixel by cos⁴ of its angle off the axis");
   addToneMapOptions(command);
-}
-
-CameraDesc ViewOptions::resolveCamera(const Scene& scene) const {
-  CameraDesc desc;
-  if (!camera.empty()) {
-    desc = scene.camera(camera);
-  } else if (scene.settings.camera) {  // the scene file's suggestion ("settings": {"camera": ...})
-    desc = scene.camera(*scene.settings.camera);
-  } else if (!scene.cameras.empty()) {
-    desc = scene.cameras.front();
-  } else {
-    desc = scene.automaticCamera();
-  }
-  if (eye.size() == 3) desc.eye = Vec3(eye[0], eye[1], eye[2]);
-  if (target.size() == 3) desc.target = Vec3(target[0], target[1], target[2]);
-  if (up.size() == 3) desc.up = Vec3(up[0], up[1], up[2]);
-  if (fovDegrees > 0.0f) {
-    desc.fovYDegrees = fovDegrees;
-    desc.focalLengthMm = 0.0f;  // a new fov implies the focal length that gives it
-  }
-  if (fNumberLens > 0.0f) desc.fNumber = fNumberLens;
-  if (focusDistance > 0.0f) desc.focusDistance = focusDistance;
-  return desc;
-}
-
-float ViewOptions::metresPerUnit(const Scene& scene) const {
-  if (sceneUnitMetres) return *sceneUnitMetres;
-  return scene.sourcePath == "cornell" ? 0.001f : 1.0f;
-}
-
-Camera ViewOptions::makeCamera(const Scene& scene) const {
-  return Camera(resolveCamera(scene), width, height, vignetting, metresPerUnit(scene));
-}
-
-ExposureSettings ViewOptions::exposureSettings() const {
-  ExposureSettings settings;
-  settings.compensationEv = exposureEv;
-  const int given = int(fstop.has_value()) + int(shutterSeconds.has_value()) + int(iso.has_value());
-  if (given != 0 && given != 3) fail("--fstop, --shutter and --iso: give all three (photographic exposure) or none");
-  if (given == 3) settings.photographic = PhotographicExposure{*fstop, *shutterSeconds, *iso};
-  return settings;
-}
-
-float ViewOptions::exposureScale() const { return pl::exposureScale(exposureSettings()); }
-
-ToneMapSettings ViewOptions::toneMapSettings() const {
-  ToneMapSettings settings;
-  settings.op = parseToneMapOperator(tonemap);
-  settings.autoKey = autoKey;
-  const bool exposureGiven = exposureEv.has_value() || fstop.has_value();
-  settings.key = key ? key : (exposureGiven ? std::nullopt : std::optional<float>(kDefaultKey));
-  settings.white = white;
-  return settings;
-}
-
-void ViewOptions::checkImageOutput(const std::string& path, std::string_view option) {
-  checkOutputPath(path, {".exr", ".hdr", ".pfm", ".png"}, option);
-}
-
-void ViewOptions::requireImageMemory(int frameBuffers, std::string_view what) const {
-  // Per pixel: `frameBuffers` float RGB images (12 B each) and, while writing, the exposed
-  // copy (12 B) and the encoder's buffer (at most 12 B: float RGB for EXR and PFM; half
-  // floats, RGBE and 8-bit PNG take less). Measured peak RSS of `trace cornell --spp 1` at
-  // 2048² (estimate 48 B/px, 192 MiB): 220 MiB writing .png (50 B/px above the 17 MiB of a
-  // 64² run), 113 MiB writing .exr without exposure (no exposed copy: 23 B/px).
-  constexpr uint64_t kRgbBytes = 3 * sizeof(float), kWriteBytesPerPixel = 2 * kRgbBytes;
-  const uint64_t pixels = uint64_t(width) * uint64_t(height);
-  requireMemory(pixels * (uint64_t(frameBuffers) * kRgbBytes + kWriteBytesPerPixel),
-                fmt::format("{} at {}x{}", what, width, height), "lower --width/--height");
-}
-
-void ViewOptions::writeImage(const std::string& path, const Image& radiance) const {
-  const float scale = exposureScale();
-  const bool hdr = isHdrExtension(path);
-  if (!hdr && fileExtensionLower(path) != ".png")
-    fail("{}: unknown output type '{}' (use .exr, .hdr, .pfm or .png)", path, fileExtensionLower(path));
-  if (scale == 1.0f && hdr) {
-    writeHdrImage(path, radiance);
-    return;
-  }
-  Image exposed = radiance;
-  for (Rgb& p : exposed.pixels) p *= scale;
-  if (hdr) {
-    writeHdrImage(path, exposed);
-  } else {
-    writePng(path, toneMap(exposed, toneMapSettings()));
-  }
 }
 
 }  // namespace pl

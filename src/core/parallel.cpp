@@ -24,24 +24,33 @@ class DenormalObserver : public tbb::task_scheduler_observer {
   ~DenormalObserver() override { observe(false); }
   void on_scheduler_entry(bool) override { enableFlushDenormals(); }
 };
+
+/// Installs the observer once per process (thread-safe static initialisation) and sets FTZ/DAZ
+/// on the calling thread, which takes part in the loops it starts. The observer is never
+/// destroyed: worker threads may outlive any object that owns it (until TBB shuts down).
+void ensureDenormalObserver() {
+  static DenormalObserver* const observer = new DenormalObserver();
+  (void)observer;
+  enableFlushDenormals();
+}
 }  // namespace
 
 struct ThreadPool::Impl {
   std::optional<tbb::global_control> control;
-  DenormalObserver observer;
 };
 
 ThreadPool::ThreadPool(int threads) : impl_(std::make_unique<Impl>()) {
   const int hardware = tbb::info::default_concurrency();
   threads_ = threads > 0 ? threads : hardware;
   impl_->control.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads_));
-  enableFlushDenormals();
+  ensureDenormalObserver();
 }
 
 ThreadPool::~ThreadPool() = default;
 
 void parallelForRange(uint64_t count, uint64_t grain, const std::function<void(uint64_t, uint64_t)>& body) {
   if (count == 0) return;
+  ensureDenormalObserver();
   tbb::parallel_for(tbb::blocked_range<uint64_t>(0, count, grain ? grain : 1),
                     [&](const tbb::blocked_range<uint64_t>& r) { body(r.begin(), r.end()); });
 }

@@ -2,15 +2,18 @@
 // Thread pool control and parallel loops (oneTBB behind this header).
 //
 // Every worker thread runs with flush-to-zero and denormals-are-zero set, as Embree asks
-// for, and so that denormal arithmetic never slows a kernel by 100×.
+// for, and so that denormal arithmetic never slows a kernel by 100×. The pool initialises
+// itself: the first parallel loop installs the FTZ/DAZ observer (and sets FTZ/DAZ on the
+// calling thread), so a library caller (a Python script, a job) needs no set-up; a ThreadPool
+// object only limits the number of threads.
 #include <cstdint>
 #include <functional>
 #include <memory>
 
 namespace pl {
 
-/// Limits the number of worker threads for its lifetime (0 = all hardware threads) and
-/// installs the FTZ/DAZ observer. Create one in main() before any parallel work.
+/// Limits the number of worker threads for its lifetime (0 = all hardware threads). Optional:
+/// without one, parallel loops use every hardware thread.
 class ThreadPool {
  public:
   explicit ThreadPool(int threads = 0);

@@ -2,6 +2,7 @@
 #include "lightfield/lookup.h"
 
 #include "lightfield/paraboloid.h"
+#include "lightfield/render_settings.h"
 
 #include <algorithm>
 #include <bit>
@@ -10,6 +11,10 @@
 #include "core/rng.h"
 
 namespace pl {
+
+Rgb backgroundRadiance(const Environment& environment, const Vec3& direction) {
+  return environment.radiance(direction);
+}
 
 Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv) {
   SurfaceHit hit;

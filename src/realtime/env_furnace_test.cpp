@@ -35,7 +35,7 @@
 #include "core/sampling.h"
 #include "env/env.h"
 #include "image/image.h"
-#include "lightfield/bake.h"
+#include "bake/bake.h"
 #include "realtime/realtime.h"
 #include "render/render.h"
 #include "scene/scene.h"

@@ -57,12 +57,6 @@ FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel) : l
   }
 }
 
-int FastRenderer::samplesPerPixel(const Camera& camera, const RenderSettings& settings) {
-  return settings.samplesPerPixel > 0 ? settings.samplesPerPixel
-         : camera.isThinLens()        ? RenderSettings::kThinLensSamples
-                                      : 1;
-}
-
 size_t FastRenderer::tileCameraRays(const Camera& camera, int spp, uint64_t seed, int x0, int y0, int x1, int y1,
                                     Ray* rays, float* weight, uint32_t* pixelIndex) {
   // Camera::generateRay returns its Sample through memory. Copying it out right after the
@@ -273,8 +267,8 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
 void FastRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) const {
   if (settings.samplesPerPixel < 0) fail("render: samples per pixel must be ≥ 0, got {}", settings.samplesPerPixel);
   if (settings.tileSize < 1) fail("render: tile size must be ≥ 1, got {}", settings.tileSize);
-  const int spp = samplesPerPixel(camera, settings);
-  const uint32_t mirrorDepth = settings.mirrorDepth >= 0 ? uint32_t(settings.mirrorDepth) : lightField_.settings.mirrorDepth;
+  const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
+  const uint32_t mirrorDepth = effectiveMirrorDepth(settings, lightField_.settings.mirrorDepth);
   const int width = camera.width(), height = camera.height();
   if (image.width != width || image.height != height) image = Image(width, height);
   const int tile = settings.tileSize;

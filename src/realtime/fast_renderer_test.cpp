@@ -14,7 +14,7 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/rng.h"
-#include "lightfield/parameterisation.h"
+#include "bake/parameterisation.h"
 #include "render/render.h"
 
 namespace pl {

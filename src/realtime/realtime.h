@@ -34,7 +34,7 @@
 #include "image/image.h"
 #include "lightfield/lightfield.h"
 #include "lightfield/lookup.h"
-#include "render/render.h"
+#include "lightfield/render_settings.h"
 
 namespace pl {
 
@@ -52,9 +52,6 @@ class FastRenderer {
   /// settings.showProgress is ignored (a frame takes milliseconds).
   void render(const Camera& camera, const RenderSettings& settings, Image& image) const;
   Image render(const Camera& camera, const RenderSettings& settings) const;
-
-  /// Samples per pixel that `settings` gives for `camera` (same rule as renderLightField).
-  static int samplesPerPixel(const Camera& camera, const RenderSettings& settings);
 
   /// The first pass of a tile, also what realtime_bench times as "primary rays alone": the
   /// camera rays of every sample of pixels [x0, x1) × [y0, y1), in 4×4-pixel blocks (all

@@ -29,7 +29,9 @@ void writeFrame(const std::string& path, const Image& radiance, float exposureSc
   const bool hdr = isHdrExtension(path);
   if (!hdr && fileExtensionLower(path) != ".png")
     fail("{}: unknown output type '{}' (use .exr, .hdr, .pfm or .png)", path, fileExtensionLower(path));
-  if (hdr) {
+  if (hdr && exposureScale == 1.0f) {
+    writeHdrImage(path, radiance);  // radiance as it is: no exposed copy (half the memory)
+  } else if (hdr) {
     writeHdrImage(path, exposedCopy(radiance, exposureScale));
   } else {
     writePng(path, pl::toneMap(exposedCopy(radiance, exposureScale), toneMap));

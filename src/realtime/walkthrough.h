@@ -11,7 +11,7 @@
 #include "image/tonemap.h"
 #include "realtime/camera_path.h"
 #include "realtime/realtime.h"
-#include "render/render.h"
+#include "lightfield/render_settings.h"
 
 namespace pl {
 
@@ -48,9 +48,9 @@ WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& ba
 CameraPath orbitPath(const CameraDesc& camera, double seconds = 4.0, double fps = CameraPath::kDefaultFps,
                      float degrees = 25.0f);
 
-/// Writes a frame of radiance the way `plenoptic render` writes its image
-/// (ViewOptions::writeImage): .exr/.hdr/.pfm get radiance × exposureScale, .png additionally
-/// the tone mapping and sRGB encoding. Atomic.
+/// Writes a frame of radiance, the one way every command writes an image (ViewSettings::
+/// writeImage in jobs/jobs.h calls this): .exr/.hdr/.pfm get radiance × exposureScale, .png
+/// additionally the tone mapping and sRGB encoding. Atomic.
 void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap);
 
 }  // namespace pl

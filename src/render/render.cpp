@@ -18,10 +18,6 @@
 
 namespace pl {
 
-Rgb backgroundRadiance(const Environment& environment, const Vec3& direction) {
-  return environment.radiance(direction);
-}
-
 namespace {
 
 /// Radiance along `ray` whose closest hit is `hit` (hit.hit() false: it left the scene).
@@ -53,21 +49,11 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hi
 
 }  // namespace
 
-namespace {
-
-uint32_t effectiveMirrorDepth(const LightField& lf, const RenderSettings& settings) {
-  return settings.mirrorDepth >= 0 ? uint32_t(settings.mirrorDepth) : lf.settings.mirrorDepth;
-}
-
-}  // namespace
-
 Image renderLightField(const LightField& lf, const Accel& accel, const Camera& camera, const RenderSettings& settings) {
   if (settings.samplesPerPixel < 0) fail("render: samples per pixel must be ≥ 0, got {}", settings.samplesPerPixel);
   if (settings.tileSize < 1) fail("render: tile size must be ≥ 1, got {}", settings.tileSize);
-  const int spp = settings.samplesPerPixel > 0 ? settings.samplesPerPixel
-                  : camera.isThinLens()        ? RenderSettings::kThinLensSamples
-                                               : 1;
-  const uint32_t mirrorDepth = effectiveMirrorDepth(lf, settings);
+  const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
+  const uint32_t mirrorDepth = effectiveMirrorDepth(settings, lf.settings.mirrorDepth);
   const int width = camera.width(), height = camera.height();
   const int tile = settings.tileSize;
   const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;

@@ -8,7 +8,8 @@
 // the view ray is reflected or refracted by followSpecular (lightfield/lookup.h: the
 // mirror's reflectance; for glass one Fresnel branch chosen stochastically with the right
 // weight), and followed, up to mirrorDepth steps; a chain longer than that contributes
-// nothing, as in the bake. Rays that leave the scene see backgroundRadiance().
+// nothing, as in the bake. Rays that leave the scene see backgroundRadiance()
+// (lightfield/render_settings.h).
 //
 // Pixel value = mean over the pixel's samples of (camera weight × radiance), in
 // W·sr⁻¹·m⁻² (camera weight = cos⁴θ with vignetting, else 1). No exposure or tone mapping
@@ -24,36 +25,17 @@
 #include "core/math.h"
 #include "image/image.h"
 #include "lightfield/lightfield.h"
+#include "lightfield/render_settings.h"
 
 namespace pl {
 
 class Accel;
 class Camera;
-struct Environment;
 struct RayHit;
-
-struct RenderSettings {
-  /// Camera samples per pixel; 0 = automatic: 1 (pixel centre) for a pinhole camera,
-  /// kThinLensSamples for a thin lens (its defocus blur needs several aperture samples).
-  int samplesPerPixel = 0;
-  static constexpr int kThinLensSamples = 16;
-  static constexpr int kMaxSamplesPerPixel = 1 << 16;  ///< upper bound the commands accept
-  /// Mirror reflections followed; -1 = the bake's own BakeSettings::mirrorDepth, so the
-  /// render sees exactly the chains the propagation accounted for.
-  int mirrorDepth = -1;
-  static constexpr int kMaxMirrorDepth = 1000;  ///< upper bound the commands accept
-  uint64_t seed = 0;
-  int tileSize = 16;  ///< square tiles rendered in parallel
-  bool showProgress = false;  ///< progress bar (for single large renders, not timing loops)
-};
 
 /// Renders the light field from `camera` (camera.width() × camera.height() pixels). `accel`
 /// must have been built over lightField.scene.
 Image renderLightField(const LightField& lightField, const Accel& accel, const Camera& camera,
                        const RenderSettings& settings);
-
-/// Radiance from infinity towards −direction for a ray leaving the scene along `direction`.
-/// The only place the renderer reads the environment (an environment map plugs in here).
-Rgb backgroundRadiance(const Environment& environment, const Vec3& direction);
 
 }  // namespace pl

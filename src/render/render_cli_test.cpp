@@ -14,7 +14,7 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "image/image.h"
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 #include "render/render.h"
 #include "support/cli_test_support.h"
 

@@ -14,9 +14,9 @@
 #include "camera/camera.h"
 #include "core/parallel.h"
 #include "core/progress.h"
-#include "lightfield/bake.h"
+#include "bake/bake.h"
 #include "lightfield/lookup.h"
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 #include "scene/scene.h"
 #include "support/sphere_mesh.h"
 

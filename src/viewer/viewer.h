@@ -25,9 +25,9 @@
 #include "camera/exposure.h"
 #include "image/tonemap.h"
 #include "lightfield/lightfield.h"
+#include "lightfield/render_settings.h"
 #include "realtime/camera_path.h"
 #include "realtime/walkthrough.h"
-#include "render/render.h"
 
 namespace pl {
 

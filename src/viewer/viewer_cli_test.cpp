@@ -13,11 +13,11 @@
 
 #include "core/rng.h"
 #include "image/image.h"
-#include "lightfield/parameterisation.h"
+#include "bake/parameterisation.h"
 #include "accel/accel.h"
 #include "core/parallel.h"
 #include "core/progress.h"
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 #include "realtime/frame_output.h"
 #include "support/cli_test_support.h"
 #include "viewer/viewer.h"

@@ -20,7 +20,7 @@
 // k fu (u16), then the k fv (u16). Decoding restores the 8-byte entries of visibility.h exactly,
 // so a reused field gives the same light field bit for bit. Version 2 was the raw entries
 // (8 bytes each, memory-mapped): a version-2 file is traced again, like a stale one.
-#include "lightfield/visibility.h"
+#include "bake/visibility.h"
 
 #include <algorithm>
 #include <atomic>
@@ -37,14 +37,14 @@
 #include "accel/accel.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/hash.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "core/memory.h"
-#include "lightfield/codec_backends.h"
+#include "plf/codec_backends.h"
 #include "lightfield/lookup.h"
-#include "lightfield/plf_file.h"
 
 namespace pl {
 

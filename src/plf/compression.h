@@ -2,7 +2,7 @@
 // Compression of a light field's values (the VALS section of a .plf file).
 //
 // Three codecs besides raw float32 storage, selected by the section's encoding field
-// (PlfEncoding, whose numbers are the ValuesCodec numbers):
+// (a ValuesCodec number, stored as it is in the .plf section table):
 //
 //   lossless  bit-exact. Each float's IEEE bits are mapped to an order-preserving unsigned
 //             integer (negative floats reversed below positive ones), predicted from its

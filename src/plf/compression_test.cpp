@@ -2,7 +2,7 @@
 // (special floats included), the error bounds of the lossy codecs, their ratios on smooth
 // data, and corrupt or truncated streams (a pl::Error naming the context, never a crash);
 // then the same through .plf files (writeLightField / readLightField / readLightFieldInfo).
-#include "lightfield/compression.h"
+#include "plf/compression.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -19,7 +19,8 @@
 #include <cstdlib>
 
 #include "core/error.h"
-#include "lightfield/plf_file.h"
+#include "core/hash.h"
+#include "plf/plf_file.h"
 
 namespace pl {
 namespace {
@@ -353,7 +354,7 @@ void reseal(std::vector<unsigned char>& file) {
 
 TEST(CompressedPlf, EveryModeIsReadBackAndReportedByInfo) {
   const LightField lf = makeLightField();
-  for (PlfEncoding encoding : {PlfEncoding::Raw, PlfEncoding::Lossless, PlfEncoding::Bc1, PlfEncoding::Hdr}) {
+  for (ValuesCodec encoding : {ValuesCodec::Raw, ValuesCodec::Lossless, ValuesCodec::Bc1, ValuesCodec::Hdr}) {
     TempFile file("modes.plf");
     writeLightField(file.path, lf, encoding);
     const LightField back = readLightField(file.path);
@@ -366,22 +367,22 @@ TEST(CompressedPlf, EveryModeIsReadBackAndReportedByInfo) {
         found = true;
         EXPECT_EQ(s.encoding, uint32_t(encoding));
         EXPECT_EQ(s.decodedSize, lf.values.size() * sizeof(Rgb));
-        if (encoding != PlfEncoding::Raw) { EXPECT_LT(s.storedSize, s.decodedSize); }
+        if (encoding != ValuesCodec::Raw) { EXPECT_LT(s.storedSize, s.decodedSize); }
       }
     EXPECT_TRUE(found);
     const ValuesError error = measureValuesError(lf.values, back.values);
-    if (encoding == PlfEncoding::Raw || encoding == PlfEncoding::Lossless)
+    if (encoding == ValuesCodec::Raw || encoding == ValuesCodec::Lossless)
       EXPECT_EQ(std::memcmp(back.values.data(), lf.values.data(), rawBytes(lf.values)), 0);
     else
       EXPECT_GT(error.rmse, 0.0);  // lossy, and the decoded values are the ones used
-    if (encoding == PlfEncoding::Hdr) { EXPECT_LT(error.maxRelative, 0.022); }  // 2^(1/32) − 1 = 2.19 %
+    if (encoding == ValuesCodec::Hdr) { EXPECT_LT(error.maxRelative, 0.022); }  // 2^(1/32) − 1 = 2.19 %
   }
 }
 
 TEST(CompressedPlf, CorruptCompressedValuesNameTheFileAndSection) {
   const LightField lf = makeLightField();
   TempFile file("corrupt.plf");
-  writeLightField(file.path, lf, PlfEncoding::Lossless);
+  writeLightField(file.path, lf, ValuesCodec::Lossless);
   const std::vector<unsigned char> good = readBytes(file.path);
   const size_t entry = valuesEntryOffset(good);
   uint64_t offset = 0, stored = 0;
@@ -436,10 +437,10 @@ TEST(CompressedPlf, CorruptCompressedValuesNameTheFileAndSection) {
 /// later build must decode them: lossless bit-exact to none.plf, hdr within its bound.
 TEST(CompressedPlf, FilesOfEarlierBuildsStillDecode) {
   const std::string dir = std::string(PLENOPTIC_TEST_DATA_DIR) + "/compress/";
-  const std::pair<const char*, PlfEncoding> modes[] = {{"none.plf", PlfEncoding::Raw},
-                                                       {"lossless.plf", PlfEncoding::Lossless},
-                                                       {"bc1.plf", PlfEncoding::Bc1},
-                                                       {"hdr.plf", PlfEncoding::Hdr}};
+  const std::pair<const char*, ValuesCodec> modes[] = {{"none.plf", ValuesCodec::Raw},
+                                                       {"lossless.plf", ValuesCodec::Lossless},
+                                                       {"bc1.plf", ValuesCodec::Bc1},
+                                                       {"hdr.plf", ValuesCodec::Hdr}};
   if (std::getenv("PLENOPTIC_REGENERATE_COMPRESS_FIXTURES")) {
     const LightField lf = makeLightField();
     for (const auto& [name, encoding] : modes) writeLightField(dir + name, lf, encoding);

@@ -1,5 +1,5 @@
 // Light-field value codecs: see compression.h for the formats and their rationale.
-#include "lightfield/compression.h"
+#include "plf/compression.h"
 
 #include <algorithm>
 #include <array>
@@ -13,18 +13,12 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/progress.h"
-#include "lightfield/codec_backends.h"
-#include "lightfield/plf_file.h"
+#include "plf/codec_backends.h"
 
 namespace pl {
 namespace {
 
 static_assert(sizeof(Rgb) == 12, "values are float32 RGB triplets");
-// The .plf section table stores ValuesCodec numbers as PlfEncoding values.
-static_assert(uint32_t(PlfEncoding::Raw) == uint32_t(ValuesCodec::Raw) &&
-              uint32_t(PlfEncoding::Lossless) == uint32_t(ValuesCodec::Lossless) &&
-              uint32_t(PlfEncoding::Bc1) == uint32_t(ValuesCodec::Bc1) &&
-              uint32_t(PlfEncoding::Hdr) == uint32_t(ValuesCodec::Hdr));
 static_assert(std::endian::native == std::endian::little, "the stream format is little-endian");
 
 constexpr char kMagic[4] = {'P', 'L', 'V', 'C'};

@@ -1,5 +1,5 @@
 // Charts, tixel grids and per-tixel gather points (see parameterisation.h).
-#include "lightfield/parameterisation.h"
+#include "bake/parameterisation.h"
 
 #include <algorithm>
 #include <array>

@@ -1,5 +1,5 @@
 // Tests of chart construction and tixel grids.
-#include "lightfield/parameterisation.h"
+#include "bake/parameterisation.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // The .plf light-field file: layout in plf_file.h.
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -17,7 +17,8 @@
 
 #include "core/error.h"
 #include "core/file_io.h"
-#include "lightfield/compression.h"
+#include "core/hash.h"
+#include "plf/compression.h"
 
 namespace pl {
 
@@ -26,102 +27,6 @@ namespace pl {
 static_assert(std::endian::native == std::endian::little, ".plf I/O assumes a little-endian host");
 static_assert(sizeof(Vec2) == 8 && sizeof(Vec3) == 12 && sizeof(UVec3) == 12, "packed GLM vectors expected");
 static_assert(std::is_trivially_copyable_v<Vec3> && std::is_trivially_copyable_v<UVec3>);
-
-// ---------------------------------------------------------------------------------------
-// XXH64 (xxHash specification, https://github.com/Cyan4973/xxHash/blob/dev/doc/xxhash_spec.md):
-// four 64-bit accumulator lanes consume 32-byte stripes; the tail and the length are mixed
-// in at the end and the result is avalanched. ~10 GB/s here, so verifying a file costs far
-// less than reading it.
-namespace {
-
-constexpr uint64_t kPrime1 = 0x9E3779B185EBCA87ull;
-constexpr uint64_t kPrime2 = 0xC2B2AE3D27D4EB4Full;
-constexpr uint64_t kPrime3 = 0x165667B19E3779F9ull;
-constexpr uint64_t kPrime4 = 0x85EBCA77C2B2AE63ull;
-constexpr uint64_t kPrime5 = 0x27D4EB2F165667C5ull;
-
-uint64_t load64(const unsigned char* p) {
-  uint64_t v;
-  std::memcpy(&v, p, 8);
-  return v;
-}
-uint32_t load32(const unsigned char* p) {
-  uint32_t v;
-  std::memcpy(&v, p, 4);
-  return v;
-}
-uint64_t xxhRound(uint64_t acc, uint64_t input) {
-  acc += input * kPrime2;
-  acc = std::rotl(acc, 31);
-  return acc * kPrime1;
-}
-uint64_t xxhMerge(uint64_t acc, uint64_t lane) {
-  acc ^= xxhRound(0, lane);
-  return acc * kPrime1 + kPrime4;
-}
-
-}  // namespace
-
-Xxh64Stream::Xxh64Stream(uint64_t seed) : seed_(seed) {
-  lanes_[0] = seed + kPrime1 + kPrime2;
-  lanes_[1] = seed + kPrime2;
-  lanes_[2] = seed;
-  lanes_[3] = seed - kPrime1;
-}
-
-void Xxh64Stream::update(const void* data, size_t size) {
-  if (size == 0) return;  // (data may then be null, e.g. an empty array's, which memcpy may not see)
-  auto* p = static_cast<const unsigned char*>(data);
-  totalLength_ += size;
-  auto consumeStripe = [this](const unsigned char* stripe) {
-    for (int lane = 0; lane < 4; ++lane) lanes_[lane] = xxhRound(lanes_[lane], load64(stripe + 8 * lane));
-  };
-  if (buffered_ > 0) {
-    const size_t take = std::min(size, sizeof(buffer_) - buffered_);
-    std::memcpy(buffer_ + buffered_, p, take);
-    buffered_ += take;
-    p += take;
-    size -= take;
-    if (buffered_ < sizeof(buffer_)) return;
-    consumeStripe(buffer_);
-    buffered_ = 0;
-  }
-  for (; size >= 32; p += 32, size -= 32) consumeStripe(p);
-  std::memcpy(buffer_, p, size);
-  buffered_ = size;
-}
-
-uint64_t Xxh64Stream::digest() const {
-  uint64_t h;
-  if (totalLength_ >= 32) {
-    h = std::rotl(lanes_[0], 1) + std::rotl(lanes_[1], 7) + std::rotl(lanes_[2], 12) + std::rotl(lanes_[3], 18);
-    for (uint64_t lane : lanes_) h = xxhMerge(h, lane);
-  } else {
-    h = seed_ + kPrime5;
-  }
-  h += totalLength_;
-  const unsigned char* p = buffer_;
-  size_t size = buffered_;
-  for (; size >= 8; p += 8, size -= 8) h = std::rotl(h ^ xxhRound(0, load64(p)), 27) * kPrime1 + kPrime4;
-  if (size >= 4) {
-    h = std::rotl(h ^ uint64_t(load32(p)) * kPrime1, 23) * kPrime2 + kPrime3;
-    p += 4;
-    size -= 4;
-  }
-  for (; size > 0; ++p, --size) h = std::rotl(h ^ uint64_t(*p) * kPrime5, 11) * kPrime1;
-  h ^= h >> 33;
-  h *= kPrime2;
-  h ^= h >> 29;
-  h *= kPrime3;
-  h ^= h >> 32;
-  return h;
-}
-
-uint64_t xxh64(const void* data, size_t size, uint64_t seed) {
-  Xxh64Stream stream(seed);
-  stream.update(data, size);
-  return stream.digest();
-}
 
 // ---------------------------------------------------------------------------------------
 namespace {
@@ -870,8 +775,8 @@ class PlfReader {
       if (kind == kSectionKinds) fail("{}: unknown section '{}' in a version {} file", path, id, version_);
       if (found[kind] >= 0) fail("{}: section {} appears twice", path, id);
       found[kind] = int(i);
-      const bool compressedValues = kind == kValues && e.encoding != uint32_t(PlfEncoding::Raw);
-      if (e.encoding != uint32_t(PlfEncoding::Raw) && !(kind == kValues && isKnownValuesCodec(e.encoding)))
+      const bool compressedValues = kind == kValues && e.encoding != uint32_t(ValuesCodec::Raw);
+      if (e.encoding != uint32_t(ValuesCodec::Raw) && !(kind == kValues && isKnownValuesCodec(e.encoding)))
         fail("{}: section {} uses encoding {}, which this build does not know", path, id, e.encoding);
       if (compressedValues && e.decodedSize % sizeof(Rgb) != 0)
         fail("{}: corrupt section table: compressed section {} decodes to {} bytes, not a whole number of RGB "
@@ -979,11 +884,11 @@ std::vector<PlfSectionInfo> sectionInfos(const PlfReader& reader) {
 
 }  // namespace
 
-void writeLightField(const std::string& path, const LightField& lf, PlfEncoding valuesEncoding) {
+void writeLightField(const std::string& path, const LightField& lf, ValuesCodec valuesEncoding) {
   writeLightField(path, lf, valuesEncoding, ValuesCodecOptions{});
 }
 
-void writeLightField(const std::string& path, const LightField& lf, PlfEncoding valuesEncoding,
+void writeLightField(const std::string& path, const LightField& lf, ValuesCodec valuesEncoding,
                      const ValuesCodecOptions& codecOptions) {
   // Encode the small sections; raw values are written straight from the LightField,
   // compressed ones from their encoded stream (compression.h).
@@ -993,7 +898,7 @@ void writeLightField(const std::string& path, const LightField& lf, PlfEncoding 
   const std::vector<unsigned char> triangleCharts = encodeTriangleCharts(lf.triangleChart);
   const std::vector<unsigned char> meta = encodeMeta(lf);
   std::vector<unsigned char> compressedValues;
-  if (valuesEncoding != PlfEncoding::Raw) {
+  if (valuesEncoding != ValuesCodec::Raw) {
     if (!isKnownValuesCodec(uint32_t(valuesEncoding)))
       fail("{}: unknown values encoding {}", path, uint32_t(valuesEncoding));
     compressedValues = encodeValues(ValuesCodec(valuesEncoding), lf.charts, lf.values, codecOptions);
@@ -1002,7 +907,7 @@ void writeLightField(const std::string& path, const LightField& lf, PlfEncoding 
                                                  lf.values.size() * sizeof(Rgb)};
   const std::span<const unsigned char> sections[kSectionKinds] = {
       scene, charts, triangleCharts,
-      valuesEncoding == PlfEncoding::Raw ? rawValues : std::span<const unsigned char>(compressedValues), meta};
+      valuesEncoding == ValuesCodec::Raw ? rawValues : std::span<const unsigned char>(compressedValues), meta};
 
   Header header{};
   std::memcpy(header.magic, kPlfMagic.data(), kPlfMagic.size());
@@ -1013,7 +918,7 @@ void writeLightField(const std::string& path, const LightField& lf, PlfEncoding 
   for (int kind = 0; kind < kSectionKinds; ++kind) {
     SectionEntry& e = table[size_t(kind)];
     std::memcpy(e.id, kSectionIds[kind], 4);
-    e.encoding = uint32_t(kind == kValues ? valuesEncoding : PlfEncoding::Raw);
+    e.encoding = uint32_t(kind == kValues ? valuesEncoding : ValuesCodec::Raw);
     e.offset = offset;
     e.storedSize = e.decodedSize = sections[kind].size();
     if (kind == kValues) e.decodedSize = rawValues.size();
@@ -1060,7 +965,7 @@ LightField readLightField(const std::string& path) {
   const uint64_t valueBytes = values.decodedSize;
   if (valueBytes % sizeof(Rgb) != 0)
     fail("{}: corrupt values section: {} bytes is not a whole number of RGB float triplets", path, valueBytes);
-  if (values.encoding == uint32_t(PlfEncoding::Raw)) {
+  if (values.encoding == uint32_t(ValuesCodec::Raw)) {
     lf.values.resize(valueBytes / sizeof(Rgb));  // bounded by the file's size, checked above
     reader.readInto(kValues, lf.values.data());
   } else {

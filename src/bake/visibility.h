@@ -28,7 +28,7 @@
 //               world direction (to look the environment up)
 //   viaMirror   whether the path went through at least one mirror
 #include "core/math.h"
-#include "lightfield/parameterisation.h"
+#include "bake/parameterisation.h"
 
 #include <cmath>
 #include <cstdint>

@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "core/error.h"
-#include "lightfield/codec_backends.h"
+#include "plf/codec_backends.h"
 
 namespace pl::detail {
 

@@ -1,5 +1,5 @@
 // End-to-end tests of the bake: white furnace, mirror furnace, visibility reuse and its hash.
-#include "lightfield/bake.h"
+#include "bake/bake.h"
 
 #include <gtest/gtest.h>
 
@@ -13,15 +13,16 @@
 
 #include "accel/accel.h"
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/rng.h"
 #include "lightfield/lookup.h"
 #include "lightfield/paraboloid.h"
-#include "lightfield/parameterisation.h"
-#include "lightfield/plf_file.h"
-#include "lightfield/propagation.h"
-#include "lightfield/visibility.h"
+#include "bake/parameterisation.h"
+#include "plf/plf_file.h"
+#include "bake/propagation.h"
+#include "bake/visibility.h"
 #include "support/quad_mesh.h"
 #include "support/mask_texture.h"
 

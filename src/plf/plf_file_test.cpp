@@ -1,7 +1,7 @@
 // Tests of the .plf file: XXH64 against reference vectors, a round trip of every field, and
 // one test per way a file can be bad (each must be refused with a message naming the file
 // and the problem, never a crash).
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -15,6 +15,7 @@
 #include <memory>
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "scene/scene.h"
 #include "support/temp_dir_test.h"
 
@@ -22,41 +23,6 @@ namespace pl {
 namespace {
 
 namespace fs = std::filesystem;
-
-// --- XXH64 ---------------------------------------------------------------------------------
-
-TEST(Xxh64, MatchesReferenceVectors) {
-  // Reference values from the xxhashjs implementation of XXH64 (seeds 0 and 42). The inputs
-  // cover the short path (< 32 bytes: 0, 1, 3, 39 bytes → tail of 8-, 4- and 1-byte steps)
-  // and the four-lane stripe loop (62 bytes).
-  struct Vector {
-    const char* text;
-    uint64_t seed0, seed42;
-  };
-  const Vector vectors[] = {
-      {"", 0xef46db3751d8e999ull, 0x98b1582b0977e704ull},
-      {"a", 0xd24ec4f1a98c6e5bull, 0x88e4fe59adf7b0ccull},
-      {"abc", 0x44bc2cf5ad770999ull, 0x13c1d910702770e6ull},
-      {"Nobody inspects the spammish repetition", 0xfbcea83c8a378bf1ull, 0x44582824ca1018b5ull},
-      {"0123456789abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ", 0x7639d419de614eedull,
-       0xe023c8f961330a31ull},
-  };
-  for (const Vector& v : vectors) {
-    EXPECT_EQ(xxh64(v.text, std::strlen(v.text), 0), v.seed0) << v.text;
-    EXPECT_EQ(xxh64(v.text, std::strlen(v.text), 42), v.seed42) << v.text;
-  }
-}
-
-TEST(Xxh64, StreamingInAnyPiecesEqualsOneShot) {
-  std::vector<unsigned char> data(1000);
-  for (size_t i = 0; i < data.size(); ++i) data[i] = static_cast<unsigned char>(i * 131 + 7);
-  const uint64_t expected = xxh64(data.data(), data.size(), 5);
-  for (size_t piece : {1, 3, 7, 31, 32, 33, 64, 999}) {
-    Xxh64Stream stream(5);
-    for (size_t at = 0; at < data.size(); at += piece) stream.update(data.data() + at, std::min(piece, data.size() - at));
-    EXPECT_EQ(stream.digest(), expected) << "pieces of " << piece;
-  }
-}
 
 // --- A light field exercising every field ------------------------------------------------
 

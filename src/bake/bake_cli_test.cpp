@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "lightfield/plf_file.h"
+#include "plf/plf_file.h"
 #include "support/cli_test_support.h"
 
 namespace pl {

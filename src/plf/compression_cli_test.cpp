@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "lightfield/compression.h"
-#include "lightfield/plf_file.h"
+#include "plf/compression.h"
+#include "plf/plf_file.h"
 #include "support/cli_test_support.h"
 
 namespace pl {
@@ -92,7 +92,7 @@ TEST_F(CompressCli, LosslessRoundTripsThroughTheProgramAndInPlace) {
   // hdr → lossless in place (atomic rename over the input) → none: the hdr-decoded values
   // survive both steps bit for bit.
   ASSERT_EQ(run("compress \"" + hdr + "\" -o \"" + hdr + "\" --mode lossless --quiet", nullptr, &err), 0) << err;
-  EXPECT_EQ(readLightFieldInfo(hdr).sections[3].encoding, uint32_t(PlfEncoding::Lossless));
+  EXPECT_EQ(readLightFieldInfo(hdr).sections[3].encoding, uint32_t(ValuesCodec::Lossless));
   const std::string back = path("back.plf");
   ASSERT_EQ(run("compress \"" + hdr + "\" -o \"" + back + "\" --mode none --quiet", nullptr, &err), 0) << err;
   const LightField final = readLightField(back);

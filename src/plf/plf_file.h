@@ -15,7 +15,7 @@
 //   offset 32  section table: sectionCount entries of 48 bytes
 //              id           4 bytes  four-character code, see Sections below
 //              encoding     u32      0 = raw; VALS may also be 1 = lossless, 2 = bc1, 3 = hdr
-//                                     (see PlfEncoding and lightfield/compression.h)
+//                                     (ValuesCodec numbers, plf/compression.h)
 //              offset       u64      from the start of the file, 64-byte aligned
 //              storedSize   u64      bytes in the file
 //              decodedSize  u64      bytes after decoding (= storedSize when raw; for a
@@ -40,7 +40,7 @@
 //   CHRT  the charts: u64 count, then fixed 85-byte records (see encodeCharts in plf_file.cpp).
 //   TRCH  triangle → chart: u64 mesh count, then per mesh u64 triangle count + u32 indices.
 //   VALS  the values: float32 RGB triplets (12 bytes each), in LightField::values order.
-//         Compressed (encoding ≠ 0): a stream of lightfield/compression.h.
+//         Compressed (encoding ≠ 0): a stream of plf/compression.h.
 //   META  UTF-8 JSON: {"settings": BakeSettings, "stats": BakeStats}.
 //
 // The version is checked right after the magic, before anything else is interpreted, so a
@@ -50,6 +50,7 @@
 // before anything is allocated, and all indices are range-checked. Any problem throws
 // pl::Error naming the file and the section.
 #include "lightfield/lightfield.h"
+#include "plf/compression.h"
 
 #include <array>
 #include <cstddef>
@@ -67,11 +68,10 @@ inline constexpr size_t kPlfHeaderSize = 32;
 inline constexpr size_t kPlfSectionEntrySize = 48;
 inline constexpr std::array<char, 8> kPlfMagic = {'P', 'L', 'F', '\0', '\r', '\n', '\x1a', '\n'};
 
-/// How a section's bytes are stored (a reader refuses modes it does not know, naming the
-/// section). Every section may be Raw; only VALS may use the value codecs of
-/// lightfield/compression.h, whose ValuesCodec numbers these are. The checksum covers the
-/// stored (compressed) bytes; decoding happens in readLightField, so every reader gets it.
-enum class PlfEncoding : uint32_t { Raw = 0, Lossless = 1, Bc1 = 2, Hdr = 3 };
+// How a section's bytes are stored is a ValuesCodec number (plf/compression.h; a reader
+// refuses modes it does not know, naming the section). Every section may be Raw; only VALS
+// may use the value codecs. The checksum covers the stored (compressed) bytes; decoding
+// happens in readLightField, so every reader gets it.
 
 /// One entry of the section table, as stored.
 struct PlfSectionInfo {
@@ -109,11 +109,10 @@ struct PlfInfo {
 /// and renamed over it; on any failure the temporary file is removed and pl::Error thrown.
 /// `valuesEncoding` selects how the VALS section is stored (compression.h).
 void writeLightField(const std::string& path, const LightField& lightField,
-                     PlfEncoding valuesEncoding = PlfEncoding::Raw);
+                     ValuesCodec valuesEncoding = ValuesCodec::Raw);
 
-struct ValuesCodecOptions;  // lightfield/compression.h
 /// The same with the value codec's tuning (zstd level, hdr steps per stop).
-void writeLightField(const std::string& path, const LightField& lightField, PlfEncoding valuesEncoding,
+void writeLightField(const std::string& path, const LightField& lightField, ValuesCodec valuesEncoding,
                      const ValuesCodecOptions& codecOptions);
 
 /// Reads and fully validates a .plf file (see the header comment). The embedded scene is
@@ -123,23 +122,5 @@ LightField readLightField(const std::string& path);
 /// Reads the header, the section table, the scene, charts and metadata; the checksums of
 /// the other sections are recomputed in bounded chunks when verifyChecksums is set.
 PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums = true);
-
-/// XXH64 (Yann Collet's xxHash, 64-bit variant) of `size` bytes: the checksum of .plf files.
-uint64_t xxh64(const void* data, size_t size, uint64_t seed = 0);
-
-/// Incremental XXH64 for data that arrives in pieces; equals xxh64() of the concatenation.
-class Xxh64Stream {
- public:
-  explicit Xxh64Stream(uint64_t seed = 0);
-  void update(const void* data, size_t size);
-  uint64_t digest() const;
-
- private:
-  uint64_t lanes_[4];
-  uint64_t seed_;
-  uint64_t totalLength_ = 0;
-  unsigned char buffer_[32];
-  size_t buffered_ = 0;
-};
 
 }  // namespace pl

@@ -8,7 +8,7 @@
 
 #include "accel/accel.h"
 #include "core/progress.h"
-#include "lightfield/bake.h"
+#include "bake/bake.h"
 #include "lightfield/lookup.h"
 #include "scene/scene.h"
 #include "trace/trace.h"

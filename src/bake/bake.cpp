@@ -1,5 +1,5 @@
 // The bake driver and its presets (see bake.h).
-#include "lightfield/bake.h"
+#include "bake/bake.h"
 
 #include <chrono>
 #include <future>
@@ -8,9 +8,9 @@
 #include "core/error.h"
 #include "core/memory.h"
 #include "core/parallel.h"
-#include "lightfield/parameterisation.h"
-#include "lightfield/propagation.h"
-#include "lightfield/visibility.h"
+#include "bake/parameterisation.h"
+#include "bake/propagation.h"
+#include "bake/visibility.h"
 
 namespace pl {
 

@@ -1,7 +1,7 @@
 // libsquish behind one file (see codec_backends.h).
 #include <squish.h>
 
-#include "lightfield/codec_backends.h"
+#include "plf/codec_backends.h"
 
 namespace pl::detail {
 

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Before/after check of a change that must not change bake results: bakes SCENE with two
+# builds of plenoptic (same preset, seed 5) and compares the .plf sections but META (which
+# holds timings) by their XXH64 checksums, and the .plv byte for byte.
+#   bench/compare_bakes.sh NEW_PLENOPTIC OLD_PLENOPTIC SCENE [PRESET]
+set -euo pipefail
+NEW=$1; OLD=$2; SCENE=$3; PRESET=${4:-draft}
+D=$(mktemp -d)
+trap 'rm -rf "$D"' EXIT
+"$NEW" bake "$SCENE" -o "$D/new.plf" --preset "$PRESET" --seed 5 --quiet >/dev/null
+"$OLD" bake "$SCENE" -o "$D/old.plf" --preset "$PRESET" --seed 5 --quiet >/dev/null
+sums() {
+  "$OLD" info "$1" --json | python3 -c \
+    "import json,sys; print([(s['id'], s['checksum_xxh64']) for s in json.load(sys.stdin)['sections'] if s['id'] != 'META'])"
+}
+a=$(sums "$D/new.plf"); b=$(sums "$D/old.plf")
+if [ "$a" = "$b" ] && cmp -s "$D/new.plv" "$D/old.plv"; then
+  echo "identical: $SCENE ($PRESET)"
+else
+  echo "DIFFERENT: $SCENE ($PRESET)"; echo "  new $a"; echo "  old $b"; exit 1
+fi

@@ -1,0 +1,130 @@
+#pragma once
+// Propagation (DESIGN.md "Light-field pipeline" step 3; seed slides 8, 18–27): solves
+// L = Le + M L over the parameterised surfaces by a Neumann series, with the transport operator
+// M split into gathering through the visibility field and a local BRDF operator per tixel.
+//
+// Quantities per tixel (the LightField value layout):
+//   diffuse  irradiance E (W·m⁻²); its transport radiance is ρ̄·E/π, ρ̄ the footprint albedo;
+//   glossy   exitant radiance per paraboloid texel, without emission during the iteration
+//            (emission is added when the values are written out).
+//
+// First shot (constant over the iteration, "direct"):
+//   * point, spot and directional lights: shadow rays from every tixel's gather point;
+//   * emissive surfaces: areaLightSamples shadow rays per tixel towards emissive triangles
+//     (chosen ∝ area·luminance(Le)) combined by the power heuristic with the gather rays
+//     that hit emitters directly (emitters seen through mirrors come through the gather only);
+//   * the environment (Environment::radiance of the leaving direction) through gather rays
+//     that escape, directly or after mirrors.
+// Iteration (block Gauss–Seidel over batches of whole charts, over-relaxed with ω = 1.2,
+// deterministic; see the .cpp):
+// R ← direct + M R, where M gathers the transport radiance of the seen
+// tixels (bilinear over 2×2 tixels, and for glossy targets bilinear over 2×2 directional
+// texels) and applies the local operator:
+//   diffuse  E = (π/N) Σ_k L_k                      (each gather cell has projected solid angle π/N)
+//   glossy   Lo(c) = Σ_k W[c][k] L_k,  W[c][k] = mean over output texel c of ∫_cell k f cos θ dω
+//            (precomputed per material by sub-sampling both the output texel and the cell,
+//            and applied as a constant floor plus a sparse lobe, which keeps each row's sum)
+//   mirror   already folded into the visibility field (a reordering of what is seen).
+// Gather rays that arrive at a two-sided chart from behind see its back record (facingChart);
+// those that hit a one-sided chart from behind (the inside of a closed solid) bring no
+// reflected light, only two-sided emission (lightfield.h "Sides").
+// It stops when the relative change of the total outgoing power Σ area·(exitant flux density)
+// drops below the tolerance and so does the error this leaves, estimated from the L1 change
+// of the values and its measured rate of convergence (see the .cpp), or at maxIterations.
+#include "bake/parameterisation.h"
+#include "bake/visibility.h"
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <vector>
+
+namespace pl {
+
+class Accel;
+class Progress;
+
+struct PropagationResult {
+  std::vector<Rgb> values;  ///< in LightField::values layout, emission included for glossy charts
+  uint32_t iterations = 0;
+  double residual = 0.0;    ///< relative change of total outgoing power at the last iteration
+  double seconds = 0.0;
+  double firstShotSeconds = 0.0;  ///< of `seconds`: operators, shadow rays, constant gather part
+  uint64_t shadowRays = 0;
+};
+
+PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                            const VisibilityField& visibility, const BakeSettings& settings);
+
+/// The same, with the visibility field supplied late: `visibility` is called once, after the
+/// shadow rays of the first shot (which do not need the field), so that reading a saved field
+/// can overlap them. Its field must have param.tixelCount tixels and the settings' gather grid.
+/// The time spent inside `visibility` is excluded from `seconds` and `firstShotSeconds`.
+PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                            const std::function<const VisibilityField&()>& visibility, const BakeSettings& settings);
+
+// ---- The stages, over an explicit transport state -------------------------------------------
+// propagate() above is: TransportState → shootShadowRays (all tixels) → [the visibility field]
+// → gatherEmission (all tixels) → beginIteration → per iteration, for each batch of
+// state.batchStart: gatherIteration + updateTransport → finishTransport. Every stage that
+// works per tixel takes a range [begin, end) of tixel indices, so that a distributed bake can
+// shard the tixels: the results for a range depend only on the state, never on the other
+// ranges being run or on thread timing (the first shot is per tixel; an iteration update of
+// a range reads the other ranges' current values and its own previous ones).
+
+/// What the stages share. Values are in LightField::values layout.
+struct TransportState {
+  /// Builds the glossy operators, the light sampler and the batches; `direct` all zero. The
+  /// scene, accel and parameterisation must outlive the state.
+  TransportState(const Scene& scene, const Accel& accel, const Parameterisation& param, const BakeSettings& settings);
+  ~TransportState();
+  TransportState(const TransportState&) = delete;
+  TransportState& operator=(const TransportState&) = delete;
+
+  const Scene& scene;
+  const Accel& accel;
+  const Parameterisation& param;
+  const BakeSettings settings;
+  uint32_t gridSide = 0, n = 0;    ///< gather grid side, gather directions per tixel (n = side²)
+  std::vector<Rgb> direct;          ///< the first shot, constant over the iteration (glossy: no emission)
+  std::vector<Rgb> current;         ///< the iterate (from beginIteration on)
+  std::vector<Rgb> previousValues;  ///< current as it was before this iteration (needed with glossy charts)
+  std::vector<float> change;        ///< per tixel, |Δ exitance| of its last update (W·m⁻², luminance)
+  std::atomic<uint64_t> shadowRays{0};
+  /// Batches of whole charts in tixel order, each ≥ 2048 tixels: batch b is tixels
+  /// [batchStart[b], batchStart[b + 1]).
+  std::vector<uint64_t> batchStart;
+
+  struct Operators;  ///< glossy operators, lights, transport quads (propagation.cpp)
+  std::unique_ptr<Operators> ops;
+};
+
+/// First shot, shadow rays: point, spot and directional lights and emissive surfaces seen from
+/// tixels [begin, end) are added to state.direct. Needs no visibility field. Advances
+/// `progress` (may be null) by the tixels done.
+void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progress* progress = nullptr);
+/// First shot, gather: emission and environment arriving along the gather rays of tixels
+/// [begin, end) are added to state.direct. Throws pl::Error when `vis` does not fit the state.
+void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t begin, uint64_t end);
+/// Starts the iteration: checks direct is finite, current = direct, every tixel's transport.
+void beginIteration(TransportState& state);
+/// One update of tixels [begin, end): current ← max(0, current + ω·(direct + M·current −
+/// current)), over-relaxation ω = omega; state.change gets each tixel's change. Charts
+/// overlapping the range are looked up at state.previousValues (Jacobi inside the range, so no
+/// value is read while it is written), the others at current (Gauss–Seidel between ranges).
+/// Diffuse charts are looked up through their transport, refreshed by updateTransport.
+void gatherIteration(TransportState& state, const VisibilityField& vis, uint64_t begin, uint64_t end, float omega);
+/// Refreshes the transport (the bilinear interpolants of ρ̄E/π) of tixels [begin, end) from current.
+void updateTransport(TransportState& state, uint64_t begin, uint64_t end);
+/// Σ area × exitance luminance of `values` (W): the total outgoing power the stopping rule watches.
+double transportPower(const TransportState& state, const std::vector<Rgb>& values);
+/// Σ area × state.change (W): the L1 change of the last iteration.
+double transportChange(const TransportState& state);
+/// Ends the propagation: glossy values get their emission. state.current is then the result.
+void finishTransport(TransportState& state);
+
+/// The glossy operator W of one material for an R-texel output map and an m × m gather grid:
+/// R² × m² RGB weights, row c (output texel a + b·R) times column k (gather cell).
+std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide);
+
+}  // namespace pl

@@ -1,0 +1,115 @@
+// BakeJob (jobs.h): `plenoptic bake` as a library call.
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <utility>
+
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/memory.h"
+#include "core/parallel.h"
+#include "core/timing.h"
+#include "jobs/jobs.h"
+#include "bake/bake.h"
+#include "plf/compression.h"
+#include "plf/plf_file.h"
+
+namespace pl {
+
+std::string BakeJobStats::toJson() const {
+  nlohmann::json json;
+  json["command"] = "bake";
+  json["scene"] = scene;
+  json["output"] = output;
+  json["preset"] = preset;
+  json["threads"] = threads;
+  json["seconds"] = seconds;
+  json["bake_seconds"] = bake.seconds;
+  json["visibility_seconds"] = bake.visibilitySeconds;
+  json["propagation_seconds"] = bake.propagationSeconds;
+  json["iterations"] = bake.iterations;
+  json["residual"] = bake.residual;
+  json["tixels"] = bake.tixels;
+  json["values"] = bake.values;
+  json["charts"] = charts;  // chart records: a two-sided chart counts twice (front and back)
+  json["two_sided_charts"] = twoSidedCharts;
+  json["back_side_tixels"] = backSideTixels;
+  json["visibility_rays"] = bake.visibilityRays;
+  json["visibility_rays_per_second"] =
+      bake.visibilitySeconds > 0 ? double(bake.visibilityRays) / bake.visibilitySeconds : 0.0;
+  json["reused_visibility"] = bake.reusedVisibility;
+  json["visibility_file"] = visibilityFile;
+  json["peak_rss_bytes"] = bake.peakRssBytes;
+  json["file_bytes"] = fileBytes;
+  json["compression"] = compression;
+  return json.dump(2) + "\n";
+}
+
+BakeJob::BakeJob(BakeJobOptions options) : options_(std::move(options)) {
+  // Every output is checked before the scene is loaded (core/file_io.h): a bake that could
+  // not save its results is refused before it traces anything.
+  if (!options_.output.empty()) checkOutputPath(options_.output, {".plf"}, "-o");
+  visibilityPath_ = options_.visibilityPath;
+  if (visibilityPath_.empty() && !options_.output.empty())
+    visibilityPath_ = std::filesystem::path(options_.output).replace_extension(".plv").string();
+  if (!visibilityPath_.empty()) checkOutputPath(visibilityPath_, {".plv"}, "--visibility");
+  if (!options_.statsPath.empty()) checkOutputPath(options_.statsPath, {}, "--stats");
+  checkDistinctOutputs({{"-o", options_.output}, {"--visibility", visibilityPath_}, {"--stats", options_.statsPath}});
+  (void)bakePreset(options_.preset);          // an unknown preset names the known ones
+  (void)parseValuesCodec(options_.compress);  // an unknown codec names the known ones
+}
+
+BakeSettings BakeJob::settings() const {
+  BakeSettings settings = bakePreset(options_.preset);
+  if (options_.tixelsAcross > 0.0f) settings.tixelsAcrossScene = options_.tixelsAcross;
+  if (options_.gatherDirections > 0) settings.gatherDirections = options_.gatherDirections;
+  if (options_.lightSamples > 0) settings.areaLightSamples = options_.lightSamples;
+  if (options_.tolerance > 0.0f) settings.tolerance = options_.tolerance;
+  settings.seed = options_.seed;
+  return settings;
+}
+
+BakeJobResult BakeJob::run(Scene scene) const { return runFrom(std::move(scene), 0.0); }
+
+BakeJobResult BakeJob::run(const std::string& scenePath) const {
+  const auto start = SteadyClock::now();
+  Scene scene = loadScene(scenePath);
+  return runFrom(std::move(scene), secondsSince(start));
+}
+
+BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
+  const auto start = SteadyClock::now();
+  const ThreadPool pool(options_.threads);
+  BakeOptions bakeOptions;
+  bakeOptions.visibilityPath = visibilityPath_;
+  bakeOptions.reuseVisibility = options_.reuseVisibility;
+  bakeOptions.log = options_.log;
+  bakeOptions.checkMemory = [](uint64_t bytes) {
+    requireMemory(bytes, "bake (visibility field and light-field values)",
+                  "lower --preset, --tixels-across or --directions");
+  };
+  BakeJobResult result{bake(std::move(scene), settings(), bakeOptions), {}};
+  const LightField& lf = result.lightField;
+  BakeJobStats& stats = result.stats;
+  if (!options_.output.empty()) {
+    writeLightField(options_.output, lf, parseValuesCodec(options_.compress));
+    stats.fileBytes = std::filesystem::file_size(options_.output);
+  }
+  stats.seconds = loadSeconds + secondsSince(start);
+  stats.scene = options_.sceneName;
+  stats.output = options_.output;
+  stats.preset = options_.preset;
+  stats.visibilityFile = visibilityPath_;
+  stats.compression = options_.compress;
+  stats.threads = pool.threads();
+  stats.bake = lf.stats;
+  stats.charts = lf.charts.size();
+  for (const Chart& c : lf.charts) {
+    stats.twoSidedCharts += c.isBack ? 1 : 0;
+    stats.backSideTixels += c.isBack ? c.tixelCount() : 0;
+  }
+  if (!options_.statsPath.empty()) writeFileAtomically(options_.statsPath, stats.toJson());
+  return result;
+}
+
+}  // namespace pl

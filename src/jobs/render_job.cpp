@@ -1,0 +1,164 @@
+// RenderJob (jobs.h): `plenoptic render` as a library call.
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <utility>
+
+#include "accel/accel.h"
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/parallel.h"
+#include "core/timing.h"
+#include "jobs/jobs.h"
+#include "plf/plf_file.h"
+#include "realtime/frame_output.h"
+#include "realtime/realtime.h"
+#include "realtime/walkthrough.h"
+#include "render/render.h"
+
+namespace pl {
+
+std::string RenderJobStats::toJson() const {
+  nlohmann::json json;
+  json["command"] = "render";
+  json["input"] = input;
+  json["output"] = output;
+  json["camera"] = camera;
+  json["width"] = width;
+  json["height"] = height;
+  json["samples_per_pixel"] = samplesPerPixel;
+  json["mirror_depth"] = mirrorDepth;
+  json["threads"] = threads;
+  json["renderer"] = renderer;
+  if (!path.empty()) json["path"] = path;
+  json["frames"] = frames;
+  json["ms_per_frame_median"] = msPerFrameMedian;
+  json["ms_per_frame_min"] = msPerFrameMin;
+  json["ms_per_frame_max"] = msPerFrameMax;
+  json["fps"] = fps;
+  json["load_seconds"] = loadSeconds;
+  json["accel_build_seconds"] = accelBuildSeconds;
+  json["file_bytes"] = fileBytes;
+  return json.dump(2) + "\n";
+}
+
+RenderJob::RenderJob(RenderJobOptions options) : options_(std::move(options)) {
+  const RenderJobOptions& o = options_;
+  o.view.checkImageSize("");
+  if (o.frames < 1 || o.frames > RenderJobOptions::kMaxFrames)
+    failUsage("--frames {} is out of range (1..{})", o.frames, RenderJobOptions::kMaxFrames);
+  // Every output is checked before the light field is read (core/file_io.h).
+  const bool video = !o.output.empty() && isVideoOutput(o.output);
+  const bool sequence = !o.output.empty() && isFramePattern(o.output);
+  if (o.pathFile.empty() && (video || sequence))
+    failUsage("-o {}: a frame pattern or .mp4 output needs a camera path (--path PATH.json)", o.output);
+  if (!o.pathFile.empty() && !video && !sequence)
+    failUsage("-o {}: a camera path renders many frames: give a frame pattern like frames/%04d.png or an .mp4 file",
+              o.output);
+  if (!o.pathFile.empty() && o.frames != 1)
+    failUsage("--frames cannot be combined with --path (the path sets the frames)");
+  if (sequence) {
+    // Frames go into the pattern's directory, created if needed.
+    const std::filesystem::path parent = std::filesystem::path(o.output).parent_path();
+    std::error_code error;
+    if (!parent.empty()) std::filesystem::create_directories(parent, error);
+    if (error) fail("-o {}: cannot create directory '{}': {}", o.output, parent.string(), error.message());
+  }
+  if (video) checkOutputPath(o.output, {".mp4"}, "-o");
+  else if (!o.output.empty()) ViewSettings::checkImageOutput(o.output, "-o");
+  if (!o.statsPath.empty()) checkOutputPath(o.statsPath, {}, "--stats");
+  checkDistinctOutputs({{"-o", o.output}, {"--stats", o.statsPath}});
+  if (!o.pathFile.empty()) cameraPath_ = loadCameraPath(o.pathFile);
+  if (video && findFfmpeg().empty())
+    fail("-o {}: MP4 output needs ffmpeg, which is not installed (not found on PATH); write an image sequence "
+         "instead, e.g. -o frames/%04d.png",
+         o.output);
+}
+
+RenderJobResult RenderJob::run(const std::string& plfPath) const {
+  const auto loadStart = SteadyClock::now();
+  const LightField lightField = readLightField(plfPath);
+  const double loadSeconds = secondsSince(loadStart);
+  return render(lightField, loadSeconds, std::filesystem::file_size(plfPath));
+}
+
+RenderJobResult RenderJob::run(const LightField& lightField) const { return render(lightField, 0.0, 0); }
+
+RenderJobResult RenderJob::render(const LightField& lightField, double loadSeconds, uint64_t fileBytes) const {
+  const RenderJobOptions& o = options_;
+  const ThreadPool pool(o.threads);
+  const ViewSettings& view = o.view;
+  // The frame (two for a walk-through: the one being rendered and the one being written); the
+  // light field, read by now, is already taken from the available memory.
+  view.requireImageMemory(cameraPath_ ? 2 : 1, "render");
+  const auto accelStart = SteadyClock::now();
+  const Accel accel(lightField.scene);
+  const double accelSeconds = secondsSince(accelStart);
+  const CameraDesc cameraDesc = view.resolveCamera(lightField.scene);
+  const Camera camera(cameraDesc, view.width, view.height, view.vignetting, view.metresPerUnit(lightField.scene));
+  const FastRenderer fastRenderer(lightField, accel);
+
+  RenderSettings settings = o.render;
+  settings.showProgress = o.frames == 1 && o.reference;
+  RenderJobResult result;
+  Image& image = result.image;
+  std::vector<double> frameMs;
+  // One frame through the chosen renderer; frame time excludes writing files.
+  auto renderFrame = [&](const Camera& frameCamera) {
+    const auto start = SteadyClock::now();
+    if (o.reference) {
+      image = renderLightField(lightField, accel, frameCamera, settings);
+    } else {
+      fastRenderer.render(frameCamera, settings, image);
+    }
+    frameMs.push_back(1e3 * secondsSince(start));
+  };
+  int frames = o.frames;
+  if (!cameraPath_) {
+    for (int frame = 0; frame < o.frames; ++frame) renderFrame(camera);
+    if (!o.output.empty()) view.writeImage(o.output, image);
+  } else {
+    // The walk-through (realtime/walkthrough.h): frame k at time t₀ + k/fps, the path's pose
+    // on the resolved camera (which keeps its lens and, without a path fov, its fov).
+    WalkthroughOptions walk;
+    walk.output = o.output;
+    walk.width = view.width;
+    walk.height = view.height;
+    walk.vignetting = view.vignetting;
+    walk.metresPerUnit = view.metresPerUnit(lightField.scene);
+    walk.exposureScale = view.exposureScale();
+    walk.toneMap = view.toneMapSettings();
+    const WalkthroughResult walked =
+        renderWalkthrough(*cameraPath_, cameraDesc, walk, [&](const Camera& frameCamera, Image& frameImage) {
+          renderFrame(frameCamera);
+          std::swap(frameImage, image);
+        });
+    frames = walked.frames;
+    image = Image();  // the frames went to their files; the swapped buffer is not the last one
+  }
+
+  RenderJobStats& stats = result.stats;
+  stats.input = o.inputName;
+  stats.output = o.output;
+  stats.camera = cameraDesc.name;
+  stats.width = view.width;
+  stats.height = view.height;
+  stats.samplesPerPixel = effectiveSamplesPerPixel(settings, camera.isThinLens());
+  stats.mirrorDepth = effectiveMirrorDepth(settings, lightField.settings.mirrorDepth);
+  stats.threads = pool.threads();
+  stats.renderer = o.reference ? "reference" : "fast";
+  stats.path = o.pathFile;
+  stats.frames = frames;
+  stats.msPerFrameMedian = median(frameMs);
+  stats.msPerFrameMin = *std::min_element(frameMs.begin(), frameMs.end());
+  stats.msPerFrameMax = *std::max_element(frameMs.begin(), frameMs.end());
+  stats.fps = stats.msPerFrameMedian > 0.0 ? 1e3 / stats.msPerFrameMedian : 0.0;
+  stats.loadSeconds = loadSeconds;
+  stats.accelBuildSeconds = accelSeconds;
+  stats.fileBytes = fileBytes;
+  if (!o.statsPath.empty()) writeFileAtomically(o.statsPath, stats.toJson());
+  return result;
+}
+
+}  // namespace pl

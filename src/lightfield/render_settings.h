@@ -1,0 +1,46 @@
+#pragma once
+// What a light-field renderer is asked to do, and the two rules that turn a request into
+// numbers: samples per pixel and mirror depth. Shared by the reference renderer (render/), the
+// fast renderer (realtime/), the viewer and the library jobs (jobs/), which must all agree: one
+// home for both rules.
+#include <cstdint>
+
+#include "core/math.h"
+
+namespace pl {
+
+struct Environment;
+struct LightField;
+
+struct RenderSettings {
+  /// Camera samples per pixel; 0 = automatic: 1 (pixel centre) for a pinhole camera,
+  /// kThinLensSamples for a thin lens (its defocus blur needs several aperture samples).
+  int samplesPerPixel = 0;
+  static constexpr int kThinLensSamples = 16;
+  static constexpr int kMaxSamplesPerPixel = 1 << 16;  ///< upper bound the commands accept
+  /// Mirror reflections followed; -1 = the bake's own BakeSettings::mirrorDepth, so the
+  /// render sees exactly the chains the propagation accounted for.
+  int mirrorDepth = -1;
+  static constexpr int kMaxMirrorDepth = 1000;  ///< upper bound the commands accept
+  uint64_t seed = 0;
+  int tileSize = 16;  ///< square tiles rendered in parallel
+  bool showProgress = false;  ///< progress bar (for single large renders, not timing loops)
+};
+
+/// The samples-per-pixel rule: settings.samplesPerPixel when > 0, else kThinLensSamples for a
+/// thin-lens camera and 1 (the pixel centre) for a pinhole.
+inline int effectiveSamplesPerPixel(const RenderSettings& settings, bool thinLens) {
+  return settings.samplesPerPixel > 0 ? settings.samplesPerPixel : thinLens ? RenderSettings::kThinLensSamples : 1;
+}
+
+/// The mirror-depth rule: settings.mirrorDepth when ≥ 0, else the bake's own
+/// (bakeMirrorDepth = LightField::settings.mirrorDepth).
+inline uint32_t effectiveMirrorDepth(const RenderSettings& settings, uint32_t bakeMirrorDepth) {
+  return settings.mirrorDepth >= 0 ? uint32_t(settings.mirrorDepth) : bakeMirrorDepth;
+}
+
+/// Radiance from infinity towards −direction for a ray leaving the scene along `direction`.
+/// The only place the renderers read the environment (an environment map plugs in here).
+Rgb backgroundRadiance(const Environment& environment, const Vec3& direction);
+
+}  // namespace pl
