@@ -49,8 +49,7 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
     attenuation = glm::exp(-glass->absorption * hit.t);
   emitted = emittedRadiance(material, cosWoGeometric) * attenuation;
   if (step >= stepLimit) return false;
-  Bsdf bsdf = bsdfAt(scene, surface);
-  if (auto* glass = std::get_if<DielectricBsdf>(&bsdf)) glass->alpha = 0.0f;  // rough glass followed as smooth
+  const Bsdf bsdf = bsdfAt(scene, surface);
   const auto [geometricNormal, frame, woLocal] = scatteringFrame(surface, wo, bsdf);  // sidedness: scene.h
   if (!usableSide(wo, woLocal, geometricNormal, bsdf)) return false;
   const std::optional<BsdfSample> bs = sample(bsdf, woLocal, Vec2(specularBranchU(ray), 0.5f));
