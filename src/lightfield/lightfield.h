@@ -35,7 +35,7 @@
 // gathers over the back hemisphere and is what a ray arriving from behind sees (facingChart).
 // triangleChart maps triangles to the front record. Which charts get a back side is decided
 // by the parameterisation (parameterisation.h: charts on open surfaces); a chart with sides = 1
-// (the outside of a closed mesh, mirrors, glass) reflects nothing towards its back: a ray from
+// (the outside of a closed mesh, mirrors, smooth glass) reflects nothing towards its back: a ray from
 // behind sees only two-sided emission.
 //
 // Rough glass (isRoughGlassChart): both records, always present (closed surfaces too: the back

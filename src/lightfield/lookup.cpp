@@ -49,7 +49,10 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
     attenuation = glm::exp(-glass->absorption * hit.t);
   emitted = emittedRadiance(material, cosWoGeometric) * attenuation;
   if (step >= stepLimit) return false;
-  const Bsdf bsdf = bsdfAt(scene, surface);
+  Bsdf bsdf = bsdfAt(scene, surface);
+  // Rough glass is a glossy chart and never comes here, except in a .plf baked before it was
+  // (where it was a specular chart): followed as smooth, as that bake followed it.
+  if (auto* glass = std::get_if<DielectricBsdf>(&bsdf)) glass->alpha = 0.0f;
   const auto [geometricNormal, frame, woLocal] = scatteringFrame(surface, wo, bsdf);  // sidedness: scene.h
   if (!usableSide(wo, woLocal, geometricNormal, bsdf)) return false;
   const std::optional<BsdfSample> bs = sample(bsdf, woLocal, Vec2(specularBranchU(ray), 0.5f));

@@ -129,7 +129,7 @@ struct GlossyMaterial {
   // 1 back) the transmission into that side of the light the other record gathers:
   //   Lo_s(c) = Σ_k R_s[c][k] L_s,k + Σ_k T_s[c][k] L_other,k,
   // each W[c][k] = mean over output texel c of ∫_cell k f |cos θ| dω with f the dielectric
-  // BSDF in its own frame (glassOperator). f is the radiance form of bsdf.h, so T already
+  // BSDF in its own frame (glossyOperator's sides). f is the radiance form of bsdf.h, so T already
   // carries the 1/η'² by which radiance changes across the interface.
   bool glass = false;
   SparseOperator backReflection;
@@ -440,9 +440,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
         }
         if (lightSamples == 0) continue;
         // Every accepted sample direction has cos θx > 0, so all of this tixel's shadow rays
-        // start at the same offset origin.
+        // start at the same offset origin (rough glass: one on each side).
         const Vec3 origin = offsetRayOrigin(x, c.normal, c.normal);
-        const Vec3 originBehind = offsetRayOrigin(x, c.normal, -c.normal);  // rough glass only
+        const Vec3 originBehind = offsetRayOrigin(x, c.normal, -c.normal);
         // The tixel's S samples are an Owen-scrambled Sobol (0,2)-net of its own (a scramble
         // keyed by the tixel): the emitter choice, stretched back onto [0, 1), and the second
         // coordinate are stratified jointly (before: stratified emitter choice, random second
