@@ -397,8 +397,8 @@ TEST_F(RenderTest, TexturedBakeRoundTripsThroughThePlfWithTheImageFileNotItsPixe
 
 /// The white furnace (L = Le/(1 − a) = 2 everywhere, a = ½, Le = 1) with a clear glass sphere
 /// in it, baked (draft preset, converged) and rendered at 16 samples per pixel: the mean of
-/// the green channel and its brightest pixel, over the expected 2 (the sphere fills about
-/// half of the 32 × 24 view).
+/// the green channel and its brightest pixel over a 32 × 24 view of the sphere and the walls
+/// around it, each divided by the expected 2.
 void glassFurnace(const DielectricBsdf& glass, double& meanOverExpected, double& brightestOverExpected) {
   const float albedo = 0.5f, emission = 1.0f;
   Scene scene = makeFurnace(albedo, emission);
