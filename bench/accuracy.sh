@@ -33,7 +33,9 @@
 # Environment: SIZE (image side, default 256), REF_SPP (reference samples per pixel, default
 # 2048: about 40–90 s per scene on 2 cores), LF_SAMPLES (light-field camera samples per
 # pixel, default 16), SCENES_DIR (default: the McGuire scenes in tests/data/cornell-mcguire),
-# SCENES (which of "cornell glossy mirror" to measure; empty = only the reuse-visibility check).
+# SCENES (which of "cornell glossy mirror sphere water sphere-rough water-rough" to measure,
+# default the first three; empty = only the reuse-visibility check). sphere-rough and
+# water-rough are McGuire's Sphere and Water with their glass made rough (bench/scenes/*.json).
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -56,9 +58,10 @@ for f in CornellBox-Glossy.obj CornellBox-Mirror.obj CornellBox-Original.obj; do
 done
 mkdir -p "$workdir"
 
-all_names=(cornell glossy mirror sphere water)
+all_names=(cornell glossy mirror sphere water sphere-rough water-rough)
 all_scenes=(cornell "$scenes_dir/CornellBox-Glossy.obj" "$scenes_dir/CornellBox-Mirror.obj"
-            "$scenes_dir/CornellBox-Sphere.obj" "$scenes_dir/CornellBox-Water.obj")
+            "$scenes_dir/CornellBox-Sphere.obj" "$scenes_dir/CornellBox-Water.obj"
+            "$here/scenes/CornellBox-Sphere-rough.json" "$here/scenes/CornellBox-Water-rough.json")
 names=()
 scenes=()
 for i in "${!all_names[@]}"; do

@@ -17,9 +17,9 @@
 namespace pl {
 
 ChartKind chartKindOf(const Bsdf& bsdf) {
-  // Glass, smooth or rough, is followed through (followSpecular): the light field has no
-  // transmitting charts.
-  if (isDelta(bsdf) || hasTransmission(bsdf)) return ChartKind::Specular;
+  // Mirrors and smooth glass are followed through (followSpecular); rough glass stores its
+  // exitant radiance on both sides like a glossy chart (isRoughGlassChart).
+  if (isDelta(bsdf)) return ChartKind::Specular;
   if (isDiffuse(bsdf)) return ChartKind::Diffuse;
   return ChartKind::Glossy;
 }
@@ -603,6 +603,8 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
 
   // Two-sided charts: the back record right after the front one (lightfield.h "Sides").
   // Specular charts store nothing and stay one-sided (followSpecular turns a mirror's frame).
+  // Rough glass is always two-sided, closed or not: its back record holds the light on the
+  // other side of the interface (the inside of a solid), which the front transmits.
   {
     std::vector<Chart> charts;
     std::vector<std::vector<std::pair<uint32_t, uint32_t>>> chartTriangles;
@@ -633,8 +635,8 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
     for (uint32_t ci = 0; ci < chartCount; ++ci) {
       const auto& [m, t] = p.chartTriangles[ci][0];  // a chart's triangles are connected: one surface
       Chart front = p.charts[ci];
-      const bool twoSided =
-          front.kind != ChartKind::Specular && openComponent[root(meshBase[m] + t)] != 0 && somethingBehind(front);
+      const bool twoSided = isRoughGlassChart(front, scene.materials[front.material].bsdf) ||
+                            (front.kind != ChartKind::Specular && openComponent[root(meshBase[m] + t)] != 0 && somethingBehind(front));
       front.sides = twoSided ? 2 : 1;
       charts.push_back(front);
       chartTriangles.push_back(p.chartTriangles[ci]);

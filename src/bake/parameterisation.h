@@ -21,15 +21,16 @@
 //
 // Directional resolution by material (chartKindOf / directionalResolution):
 //   Lambertian → Diffuse, dirRes 1 (irradiance);
-//   ideal mirror → Specular, dirRes 0 (a reordering, nothing stored);
-//   Blinn-Phong / GGX → Glossy, dirRes from the lobe width (see the .cpp), capped by
-//   glossyDirRes.
+//   ideal mirror, smooth or thin glass → Specular, dirRes 0 (a reordering, nothing stored);
+//   Blinn-Phong / GGX / rough glass → Glossy, dirRes from the lobe width (see the .cpp),
+//   capped by glossyDirRes.
 //
 // Sides (lightfield.h "Sides"): the diffuse and glossy charts of an open surface — a connected
 // set of triangles (welded edges, any material) that is not closed and consistently wound —
 // get a back record right after their front record, unless nothing can light or see the back
 // (black environment, no punctual light behind, the scene's bounding box on or in front of the
-// plane: its radiance is exactly 0); closed surfaces stay one-sided.
+// plane: its radiance is exactly 0); closed surfaces stay one-sided. Rough glass charts are
+// always two-sided (lightfield.h "Rough glass").
 //
 // Every tixel gets a gather point on the polygon: its centre when the centre lies on one of
 // the chart's triangles, otherwise the closest point of the polygon (pulled slightly inside),

@@ -45,11 +45,26 @@ std::vector<Vec3> outputTexelDirections(uint32_t a, uint32_t b, uint32_t res) {
   return dirs;
 }
 
-/// Mean of f(wo, wi) over the output texel's sub-sample directions.
-Rgb texelAverageBsdf(const Bsdf& bsdf, const std::vector<Vec3>& outputs, const Vec3& wi) {
+/// f(wo, wi) for directions in a record's local frame: in the record's own frame, or, for a
+/// rough-glass record (glass non-null), in its BSDF's frame (glassBsdfDirection).
+Rgb recordEval(const Bsdf& bsdf, const Chart* glass, const Vec3& wo, const Vec3& wi) {
+  if (!glass) return eval(bsdf, wo, wi);
+  return eval(bsdf, glassBsdfDirection(glass->isBack, wo), glassBsdfDirection(glass->isBack, wi));
+}
+
+/// Mean of f(wo, wi) over the output texel's sub-sample directions (recordEval).
+Rgb texelAverageBsdf(const Bsdf& bsdf, const std::vector<Vec3>& outputs, const Vec3& wi, const Chart* glass = nullptr) {
   Rgb sum(0.0f);
-  for (const Vec3& wo : outputs) sum += eval(bsdf, wo, wi);
+  for (const Vec3& wo : outputs) sum += recordEval(bsdf, glass, wo, wi);
   return sum / float(outputs.size());
+}
+
+/// The tixel of the other record of rough-glass tixel g (its twin: the back record follows
+/// the front one, with the same grid).
+uint64_t twinTixel(const Parameterisation& param, uint64_t g) {
+  const uint32_t ci = param.tixelChart[g];
+  const Chart& c = param.charts[ci];
+  return param.charts[c.isBack ? ci - 1 : ci + 1].firstTixel + (g - c.firstTixel);
 }
 
 // Entries of a glossy operator row below this fraction of the row's largest (above-floor)
@@ -109,10 +124,74 @@ struct SparseOperator {
 
 struct GlossyMaterial {
   uint32_t dirRes = 0;
-  SparseOperator op;
+  SparseOperator op;  ///< reflection (of a rough-glass material: the front record's)
+  // Rough glass (isRoughGlassChart): the back record's reflection, and per side s (0 front,
+  // 1 back) the transmission into that side of the light the other record gathers:
+  //   Lo_s(c) = Σ_k R_s[c][k] L_s,k + Σ_k T_s[c][k] L_other,k,
+  // each W[c][k] = mean over output texel c of ∫_cell k f |cos θ| dω with f the dielectric
+  // BSDF in its own frame (glossyOperator's sides). f is the radiance form of bsdf.h, so T already
+  // carries the 1/η'² by which radiance changes across the interface.
+  bool glass = false;
+  SparseOperator backReflection;
+  SparseOperator transmission[2];
+  const SparseOperator& reflection(const Chart& c) const { return glass && c.isBack ? backReflection : op; }
   std::vector<std::vector<Vec3>> outputs;     ///< per output texel, its sub-sample directions
   std::vector<Vec3> centres;                  ///< per output texel, its representative direction
   std::vector<float> projectedSolidAngle;     ///< per output texel, ≈ Ω·cos θ (for the power sum)
+};
+
+// ---- Rough glass (lightfield.h "Rough glass") -------------------------------------------------
+/// The rough-glass operators of g (the front reflection, g.op, is already built): the back
+/// record's reflection and the transmission into each side.
+void addGlassOperators(GlossyMaterial& g, const Bsdf& bsdf, uint32_t gridSide) {
+  const uint32_t rows = g.dirRes * g.dirRes, n = gridSide * gridSide;
+  g.glass = true;
+  g.backReflection = SparseOperator::fromDense(glossyOperator(bsdf, g.dirRes, gridSide, true, true), rows, n);
+  g.transmission[0] = SparseOperator::fromDense(glossyOperator(bsdf, g.dirRes, gridSide, false, true), rows, n);
+  g.transmission[1] = SparseOperator::fromDense(glossyOperator(bsdf, g.dirRes, gridSide, true, false), rows, n);
+}
+
+/// The light the rough-glass tixels gather in the first shot (emission and sky, constant over
+/// the iteration), per gather cell, kept so that each record can transmit its twin's.
+class GlassFirstShot {
+ public:
+  GlassFirstShot(const Scene& scene, const Parameterisation& param, uint32_t n) : n_(n), slotOfChart_(param.charts.size(), kNone) {
+    uint64_t slots = 0;
+    for (size_t ci = 0; ci < param.charts.size(); ++ci) {
+      const Chart& c = param.charts[ci];
+      if (!isRoughGlassChart(c, scene.materials[c.material].bsdf)) continue;
+      slotOfChart_[ci] = slots;
+      slots += c.tixelCount();
+    }
+    incoming_.resize(slots * n);
+  }
+  /// Where tixel g (of chart ci) keeps its n cells; null for tixels that are not rough glass.
+  Lanes4* cells(const Parameterisation& param, uint64_t g) {
+    const uint32_t ci = param.tixelChart[g];
+    if (slotOfChart_[ci] == kNone) return nullptr;
+    return incoming_.data() + (slotOfChart_[ci] + (g - param.charts[ci].firstTixel)) * n_;
+  }
+  /// Adds to every rough-glass tixel's first shot the transmission of what its twin gathered.
+  void addTransmission(const Parameterisation& param, const std::vector<GlossyMaterial>& glossy, std::vector<Rgb>& direct) {
+    if (incoming_.empty()) return;
+    parallelFor(param.charts.size(), [&](uint64_t ci) {
+      if (slotOfChart_[ci] == kNone) return;
+      const Chart& c = param.charts[ci];
+      const SparseOperator& transmission = glossy[c.material].transmission[c.isBack ? 1 : 0];
+      for (uint64_t local = 0; local < c.tixelCount(); ++local) {
+        const Lanes4* twin = cells(param, twinTixel(param, c.firstTixel + local));
+        F4 sum = f4Zero();
+        for (uint32_t k = 0; k < n_; ++k) sum = f4Add(sum, f4Load(twin[k].v));
+        transmission.apply(twin, sum, direct.data() + c.firstValue + local * c.valuesPerTixel());
+      }
+    });
+  }
+
+ private:
+  static constexpr uint64_t kNone = ~uint64_t(0);
+  uint32_t n_;
+  std::vector<uint64_t> slotOfChart_;  ///< per chart: slot of its tixel 0, kNone if not rough glass
+  std::vector<Lanes4> incoming_;       ///< per slot, n gather cells
 };
 
 // ---- The gather kernel of the iteration ------------------------------------------------------
@@ -234,7 +313,7 @@ void requireFiniteValues(const Scene& scene, const Parameterisation& param, cons
 
 }  // namespace
 
-std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide) {
+std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide, bool outputOnBack, bool gatherOnBack) {
   const uint32_t n = gridSide * gridSide, texels = dirRes * dirRes;
   std::vector<Rgb> op(size_t(texels) * n);
   // Incident sub-sample directions of every cell (same for every output texel).
@@ -256,7 +335,8 @@ std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t grid
       Rgb sum(0.0f);
       for (const Vec3& wo : outputs)
         for (int s = 0; s < kCellSubsamples * kCellSubsamples; ++s)
-          sum += eval(bsdf, wo, cellDirs[size_t(k) * kCellSubsamples * kCellSubsamples + s]);
+          sum += eval(bsdf, glassBsdfDirection(outputOnBack, wo),
+                      glassBsdfDirection(gatherOnBack, cellDirs[size_t(k) * kCellSubsamples * kCellSubsamples + s]));
       op[c * n + k] = sum * norm;
     }
   });
@@ -274,6 +354,9 @@ struct TransportState::Operators {
   uint32_t lightSamples = 0;           ///< area-light shadow rays per tixel (0 without emitters)
   std::vector<PunctualLight> punctualLights;
   std::optional<ShadowRays> shadows;
+  /// The first-shot gather of rough-glass tixels, kept until every range has gathered, when
+  /// each record adds the transmission of its twin's (beginIteration).
+  std::optional<GlassFirstShot> glassFirstShot;
   /// The quads (TransportQuad) of every tixel, plus one, all zero, for the entries that
   /// escaped (see gatherTixel).
   std::vector<TransportQuad> quads;
@@ -342,6 +425,7 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
     g.dirRes = c.dirRes;
     g.op = SparseOperator::fromDense(glossyOperator(scene.materials[c.material].bsdf, c.dirRes, gridSide),
                                      c.dirRes * c.dirRes, n);
+    if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) addGlassOperators(g, scene.materials[c.material].bsdf, gridSide);
     const std::vector<float>& omega = paraboloidTexelSolidAngles(c.dirRes);
     for (uint32_t t = 0; t < c.dirRes * c.dirRes; ++t) {
       g.outputs.push_back(outputTexelDirections(t % c.dirRes, t / c.dirRes, c.dirRes));
@@ -362,6 +446,7 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   // gather chains, which count them with full weight (viaMirror), so crossing glass here too
   // would count them twice.
   ops->shadows.emplace(scene, accel);
+  ops->glassFirstShot.emplace(scene, param, n);
 
   direct.assign(param.valueCount, Rgb(0.0f));
   change.assign(tixels, 0.0f);
@@ -418,12 +503,15 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
       const Vec3 x = param.gatherPoint[g];
+      // Rough glass takes light from both sides: reflected from its own, transmitted from
+      // the other (|cos θ|; the BSDF chooses, see the Pending loop below).
+      const bool bothSides = isRoughGlassChart(c, scene.materials[c.material].bsdf);
       for (const PunctualLight& light : punctualLights) {
         Vec3 wi;
         float distance;
         Rgb incident;
         if (!light.incidentAt(x, wi, distance, incident)) continue;
-        const float cosTheta = glm::dot(c.normal, wi);
+        const float cosTheta = bothSides ? std::abs(glm::dot(c.normal, wi)) : glm::dot(c.normal, wi);
         if (!(cosTheta > 0.0f) || isBlack(incident)) continue;
         const Vec3 origin = offsetRayOrigin(x, c.normal, wi);
         const std::optional<Ray> ray = std::isfinite(distance) ? shadowRayTo(origin, light.position)
@@ -439,8 +527,9 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       }
       if (lightSamples == 0) continue;
       // Every accepted sample direction has cos θx > 0, so all of this tixel's shadow rays
-      // start at the same offset origin.
+      // start at the same offset origin (rough glass: one on each side).
       const Vec3 origin = offsetRayOrigin(x, c.normal, c.normal);
+      const Vec3 originBehind = offsetRayOrigin(x, c.normal, -c.normal);
       // The tixel's S samples are an Owen-scrambled Sobol (0,2)-net of its own (a scramble
       // keyed by the tixel): the emitter choice, stretched back onto [0, 1), and the second
       // coordinate are stratified jointly (before: stratified emitter choice, random second
@@ -455,7 +544,8 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         if (!(dist2 > 0.0f)) continue;
         const float dist = std::sqrt(dist2);
         const Vec3 wi = d * (1.0f / dist);
-        const float cosX = glm::dot(c.normal, wi);
+        const float cosSigned = glm::dot(c.normal, wi);
+        const float cosX = bothSides ? std::abs(cosSigned) : cosSigned;
         float cosY = -glm::dot(em.normal, wi);
         if (!(cosX > 0.0f) || (cosY <= 0.0f && !em.twoSided)) continue;
         cosY = std::abs(cosY);
@@ -469,7 +559,8 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         // box from 1.40 % to 0.80 %.)
         const float sPl = float(lightSamples) * sample.areaPdf * dist2 / cosY;
         const float nPg = float(n) * kInvPi * cosX;
-        const std::optional<Ray> ray = shadowRayTo(origin, emitterShadowTarget(sample.point, em.normal, wi));
+        const std::optional<Ray> ray =
+            shadowRayTo(cosSigned < 0.0f ? originBehind : origin, emitterShadowTarget(sample.point, em.normal, wi));
         if (!ray) continue;
         rays.push_back(*ray);
         pending.push_back({g, wi, em.radiance * (cosX / sPl * powerHeuristic(sPl, nPg)), true});
@@ -489,12 +580,14 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       } else {
         const GlossyMaterial& gm = glossy[c.material];
         const Bsdf& bsdf = scene.materials[c.material].bsdf;
+        const Chart* glass = isRoughGlassChart(c, bsdf) ? &c : nullptr;
         const Vec3 wiLocal = chartLocalDirection(c, p.wi);
         // Punctual lights: the BSDF averaged over each output texel (a delta light would
         // otherwise alias between texel centres). Area-light samples are many per tixel and
         // already spread over the emitter: the texel-centre value suffices and costs 9× less.
         for (uint32_t t = 0; t < c.valuesPerTixel(); ++t)
-          direct[vb + t] += (p.areaSample ? eval(bsdf, gm.centres[t], wiLocal) : texelAverageBsdf(bsdf, gm.outputs[t], wiLocal)) *
+          direct[vb + t] += (p.areaSample ? recordEval(bsdf, glass, gm.centres[t], wiLocal)
+                                          : texelAverageBsdf(bsdf, gm.outputs[t], wiLocal, glass)) *
                             p.irradiance;
       }
     }
@@ -507,6 +600,7 @@ void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t 
   const Parameterisation& param = state.param;
   const BakeSettings& settings = state.settings;
   const std::vector<GlossyMaterial>& glossy = state.ops->glossy;
+  GlassFirstShot& glassFirstShot = *state.ops->glassFirstShot;
   const std::vector<float>& areaPdf = state.ops->areaPdf;
   const uint32_t lightSamples = state.ops->lightSamples, n = state.n;
   const uint64_t tixels = param.tixelCount;
@@ -590,17 +684,20 @@ void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t 
         sum += L;
         any = any || !isBlack(L);
       }
+      if (Lanes4* glassCells = glassFirstShot.cells(param, g)) std::copy_n(incoming.data(), n, glassCells);
       if (!any) continue;
       const uint64_t vb = valueBase(g, c);
       if (c.kind == ChartKind::Diffuse)
         direct[vb] += sum * (kPi / float(n));
       else
-        glossy[c.material].op.apply(incoming.data(), f4FromRgb(sum), direct.data() + vb);
+        glossy[c.material].reflection(c).apply(incoming.data(), f4FromRgb(sum), direct.data() + vb);
     }
   });
 }
 
 void beginIteration(TransportState& state) {
+  // Every range has gathered its first shot: each rough-glass record adds its twin's.
+  state.ops->glassFirstShot->addTransmission(state.param, state.ops->glossy, state.direct);
   requireFiniteValues(state.scene, state.param, state.direct, "in the first shot (direct light)");
   state.current = state.direct;
   state.ops->quads.assign(state.param.tixelCount + 1, TransportQuad{});
@@ -648,7 +745,7 @@ void gatherIteration(TransportState& state, const VisibilityField& vis, uint64_t
   std::vector<Rgb>& current = state.current;
   std::vector<float>& change = state.change;
   parallelForRange(end - begin, 16, [&](uint64_t t0, uint64_t t1) {
-    std::vector<Lanes4> incoming(n);
+    std::vector<Lanes4> incoming(n), twinIncoming;
     for (uint64_t g = begin + t0; g < begin + t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
@@ -687,7 +784,16 @@ void gatherIteration(TransportState& state, const VisibilityField& vis, uint64_t
       } else {
         Rgb* out = current.data() + vb;
         std::copy_n(direct.data() + vb, c.valuesPerTixel(), out);
-        glossy[c.material].op.apply(incoming.data(), sum, out);
+        const GlossyMaterial& gm = glossy[c.material];
+        gm.reflection(c).apply(incoming.data(), sum, out);
+        if (gm.glass) {
+          // Rough glass: plus the transmission of what the twin record gathers now.
+          const uint64_t twin = twinTixel(param, g);
+          twinIncoming.resize(n);
+          const F4 twinSum = gatherTixel<true>(vis.entries.data() + twin * n, n, ops.quads.data(), ops.quads.size(),
+                                               vis.extras.data() + vis.extraOffset[twin], twinIncoming.data(), slowPath);
+          gm.transmission[c.isBack ? 1 : 0].apply(twinIncoming.data(), twinSum, out);
+        }
         const Rgb* before = previousValues.data() + vb;
         for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) out[t] = relax(before[t], out[t]);
         change[g] = exitanceChange(state, before, out, g, c);

@@ -24,6 +24,9 @@
 //   glossy   Lo(c) = Σ_k W[c][k] L_k,  W[c][k] = mean over output texel c of ∫_cell k f cos θ dω
 //            (precomputed per material by sub-sampling both the output texel and the cell,
 //            and applied as a constant floor plus a sparse lobe, which keeps each row's sum)
+//   rough glass  as glossy, on each record (front, back) the reflection of its own gather
+//            plus the transmission of its twin record's: Lo_s = R_s L_s + T_s L_other
+//            (GlossyMaterial in the .cpp); first-shot lights on both sides of the surface
 //   mirror   already folded into the visibility field (a reordering of what is seen).
 // Gather rays that arrive at a two-sided chart from behind see its back record (facingChart);
 // those that hit a one-sided chart from behind (the inside of a closed solid) bring no
@@ -125,6 +128,12 @@ void finishTransport(TransportState& state);
 
 /// The glossy operator W of one material for an R-texel output map and an m × m gather grid:
 /// R² × m² RGB weights, row c (output texel a + b·R) times column k (gather cell).
-std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide);
+/// For rough glass (lightfield.h "Rough glass") the output map and the gather grid may each
+/// belong to the back record (outputOnBack, gatherOnBack: directions turned into the BSDF's
+/// frame by glassBsdfDirection): reflection on the front (false, false) or back (true, true),
+/// transmission into the front of the light the back gathers (false, true) and into the back
+/// of the front's (true, false). Other models use (false, false) for either record.
+std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide, bool outputOnBack = false,
+                                bool gatherOnBack = false);
 
 }  // namespace pl

@@ -90,6 +90,16 @@ void adviseHugePages(void* data, size_t bytes) {
 #endif
 }
 
+/// Beer–Lambert attenuation exp(−σa t) of a gather segment of length t that ends on chart
+/// record c: a segment arriving at the back record of rough glass ran through the solid's
+/// inside (the front of a closed mesh is its outside), as followSpecular attenuates one
+/// arriving at the back of smooth glass. 1 for every other record.
+Rgb insideGlassAttenuation(const Scene& scene, const Chart& c, float t) {
+  const Bsdf& bsdf = scene.materials[c.material].bsdf;
+  if (!c.isBack || !isRoughGlassChart(c, bsdf)) return Rgb(1.0f);
+  return glm::exp(-std::get<DielectricBsdf>(bsdf).absorption * t);
+}
+
 }  // namespace
 
 uint32_t gatherGridSide(uint32_t gatherDirections) {
@@ -334,7 +344,8 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
         if (state.viaMirror || c.kind == ChartKind::Glossy) {
           entry.target |= VisibilityEntry::kHasExtra;
           const Vec2 st = directionToParaboloid(chartLocalDirection(c, -ray.direction));
-          extras.push_back({state.entry, VisibilityExtra{state.throughput, st, state.viaMirror ? 1u : 0u}});
+          extras.push_back({state.entry, VisibilityExtra{state.throughput * insideGlassAttenuation(scene, c, hit.t), st,
+                                                         state.viaMirror ? 1u : 0u}});
         }
       }
       std::swap(rays, nextRays);

@@ -20,8 +20,10 @@
 //   Diffuse   1 value per tixel: irradiance E (W·m⁻²). Outgoing radiance is
 //             Le + albedo(uv)·E/π, with the albedo texture applied at full resolution.
 //   Glossy    dirRes² values per tixel: exitant radiance Lo (W·sr⁻¹·m⁻², emission included).
-//   Specular  nothing: an ideal mirror's radiance is that of whatever the mirrored
-//             direction sees (a reordering), followed at render time.
+//             Rough glass (a DielectricBsdf with α ≥ kGgxMinAlpha, not thin) is a glossy
+//             chart too, always two-sided (see "Rough glass" below).
+//   Specular  nothing: an ideal mirror's or smooth glass's radiance is that of whatever the
+//             mirrored/refracted direction sees (a reordering), followed at render time.
 //
 // Sides (the light field's part of the sidedness rule; scatteringFrame in scene.h is the
 // path tracer's, emittedRadiance there the emitters'). A reflecting surface scatters on both
@@ -33,8 +35,15 @@
 // gathers over the back hemisphere and is what a ray arriving from behind sees (facingChart).
 // triangleChart maps triangles to the front record. Which charts get a back side is decided
 // by the parameterisation (parameterisation.h: charts on open surfaces); a chart with sides = 1
-// (the outside of a closed mesh, mirrors, glass) reflects nothing towards its back: a ray from
+// (the outside of a closed mesh, mirrors, smooth glass) reflects nothing towards its back: a ray from
 // behind sees only two-sided emission.
+//
+// Rough glass (isRoughGlassChart): both records, always present (closed surfaces too: the back
+// record of a glass ball is its inside), store the exitant radiance on their side, which is
+// the reflection of the light their own gather rays bring plus the transmission of the light
+// the other record's gather rays bring (propagation.cpp). The dielectric BSDF's frame is the
+// front record's (+z = the outside, the geometric front: bsdf.h), so a back record's local
+// directions are turned into it by negating z (glassBsdfDirection).
 #include "core/math.h"
 #include "scene/scene.h"
 
@@ -114,6 +123,21 @@ struct LightField {
 inline uint32_t facingChart(const Chart* charts, uint32_t chart, const Vec3& towardsViewer) {
   const Chart& c = charts[chart];
   return c.sides == 2 && !c.isBack && glm::dot(towardsViewer, c.normal) < 0.0f ? chart + 1 : chart;
+}
+
+/// Whether chart record c (of a material with BSDF bsdf) is rough glass: a glossy chart whose
+/// BSDF transmits (lightfield.h "Rough glass"; smooth and thin glass are Specular charts).
+inline bool isRoughGlassChart(const Chart& c, const Bsdf& bsdf) {
+  return c.kind == ChartKind::Glossy && hasTransmission(bsdf);
+}
+
+/// A direction in a record's local frame (z along its normal) in the frame of its material's
+/// transmissive BSDF, whose +z is the surface's geometric front: the same for a front record,
+/// z negated for a back record (backRecord = Chart::isBack; its normal is the negated front
+/// normal, its axes are the front's). Reflection-only BSDFs are evaluated in the record's own
+/// frame (the frame turned to the viewer's side, as the path tracer does) and need no turn.
+inline Vec3 glassBsdfDirection(bool backRecord, const Vec3& local) {
+  return backRecord ? Vec3(local.x, local.y, -local.z) : local;
 }
 
 /// Emitted radiance of chart record c's material towards a direction with cosine cosTheta

@@ -52,7 +52,9 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
   emitted = emittedRadiance(material, cosWoGeometric) * attenuation;
   if (step >= stepLimit) return false;
   Bsdf bsdf = bsdfAt(scene, surface);
-  if (auto* glass = std::get_if<DielectricBsdf>(&bsdf)) glass->alpha = 0.0f;  // rough glass followed as smooth
+  // Rough glass is a glossy chart and never comes here, except in a .plf baked before it was
+  // (where it was a specular chart): followed as smooth, as that bake followed it.
+  if (auto* glass = std::get_if<DielectricBsdf>(&bsdf)) glass->alpha = 0.0f;
   const ScatteringFrame scattering = scatteringFrame(surface, wo, bsdf);  // sidedness: scene.h
   if (!usableSide(wo, scattering.woLocal, scattering.geometricNormal, bsdf)) return false;
   // The one bounce (scene.h scatter), about the shading normal as in the path tracer.

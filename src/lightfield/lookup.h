@@ -131,8 +131,9 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv);
 ///    transmittance over its probability: 1 for reflection, t/η'² for refraction. The random
 ///    number is a hash of the arriving ray's bits (specularBranchU): deterministic, identical
 ///    in every stage that traces the same ray, and decorrelated between rays, so averages
-///    over pixels, samples or gather directions are unbiased. Rough glass is followed as if
-///    it were smooth (the light field has no transmitting glossy charts).
+///    over pixels, samples or gather directions are unbiased. Rough glass is a glossy chart
+///    (lightfield.h "Rough glass"), so chains end there; only a light field baked before
+///    that has it as a specular chart, and it is then followed as smooth, as that bake did.
 ///  * A segment that arrives on the inside (back) of glass ran through it: `weight` and
 ///    `emitted` include its Beer–Lambert attenuation exp(−σa t).
 ///  * From step kSpecularRouletteStep on, the chain survives with probability

@@ -18,7 +18,7 @@
 #include "camera/camera.h"
 #include "core/progress.h"
 #include "image/compare.h"
-#include "lightfield/bake.h"
+#include "bake/bake.h"
 #include "render/render.h"
 #include "scene/scene.h"
 #include "trace/trace.h"

@@ -395,20 +395,14 @@ TEST_F(RenderTest, TexturedBakeRoundTripsThroughThePlfWithTheImageFileNotItsPixe
   EXPECT_GT(brightest, 0.0f);  // the comparison is of a lit, textured quad
 }
 
-TEST_F(RenderTest, GlassSphereInTheFurnaceIsInvisible) {
-  // The white furnace (L = Le/(1 − a) = 2 everywhere) with a clear smooth glass sphere in it:
-  // the walls gather through the glass (bake) and the camera looks through it (render). Each
-  // glass chain ends on a wall of radiance L with weight 1 (reflection) or 1/η²·η² (in and
-  // out), so the sphere is invisible, except that chains longer than the depth limit end
-  // with nothing: near the silhouette a ray refracted in at grazing incidence meets the
-  // inside at the critical angle, where F ≈ 1, and circles inside for many steps. A hard cut
-  // at 8 lost 1.5 % of this image; with roulette from step 8 the limit still matters (these
-  // chains reflect with weight 1): −0.37 % at 64, −0.19 % at 128, −0.03 % at 256, the
-  // default (measured with the gather directions' earlier jitter; −0.06 % at 256 with the
-  // multi-jittered ones). The default settings are checked here.
+/// The white furnace (L = Le/(1 − a) = 2 everywhere, a = ½, Le = 1) with a clear glass sphere
+/// in it, baked (draft preset, converged) and rendered at 16 samples per pixel: the mean of
+/// the green channel and its brightest pixel over a 32 × 24 view of the sphere and the walls
+/// around it, each divided by the expected 2.
+void glassFurnace(const DielectricBsdf& glass, double& meanOverExpected, double& brightestOverExpected) {
   const float albedo = 0.5f, emission = 1.0f;
   Scene scene = makeFurnace(albedo, emission);
-  scene.materials.push_back(Material{"glass", DielectricBsdf{1.5f}, -1, Rgb(0.0f), false});
+  scene.materials.push_back(Material{"glass", glass, -1, Rgb(0.0f), false});
   Mesh sphere;
   sphere.name = "sphere";
   test_support::addSphere(sphere, Vec3(0.1f, -0.2f, 0.0f), 0.5f, 24, 48, 1);
@@ -426,17 +420,51 @@ TEST_F(RenderTest, GlassSphereInTheFurnaceIsInvisible) {
   RenderSettings render;
   render.samplesPerPixel = 16;
   const Image image = renderLightField(lf, accel, Camera(desc, 32, 24), render);
-  const float expected = emission / (1.0f - albedo);
-  double sum = 0.0;
+  const double expected = emission / (1.0f - albedo);
+  double sum = 0.0, brightest = 0.0;
   for (const Rgb& pixel : image.pixels) {
     sum += pixel.g;
-    EXPECT_LE(pixel.g, expected * 1.005f);  // never brighter: glass creates no energy
+    brightest = std::max(brightest, double(pixel.g));
   }
+  meanOverExpected = sum / double(image.pixels.size()) / expected;
+  brightestOverExpected = brightest / expected;
+}
+
+TEST_F(RenderTest, GlassSphereInTheFurnaceIsInvisible) {
+  // The walls gather through the smooth glass (bake) and the camera looks through it (render).
+  // Each glass chain ends on a wall of radiance L with weight 1 (reflection) or 1/η²·η² (in and
+  // out), so the sphere is invisible, except that chains longer than the depth limit end
+  // with nothing: near the silhouette a ray refracted in at grazing incidence meets the
+  // inside at the critical angle, where F ≈ 1, and circles inside for many steps. A hard cut
+  // at 8 lost 1.5 % of this image; with roulette from step 8 the limit still matters (these
+  // chains reflect with weight 1): −0.37 % at 64, −0.19 % at 128, −0.03 % at 256, the
+  // default (measured with the gather directions' earlier jitter; −0.06 % at 256 with the
+  // multi-jittered ones). The default settings are checked here.
+  double mean = 0.0, brightest = 0.0;
+  glassFurnace(DielectricBsdf{1.5f}, mean, brightest);
+  EXPECT_LE(brightest, 1.005);  // never brighter: glass creates no energy
   // 0.5 %: the light-field glass furnace criterion (measured error printed).
-  const double mean = sum / double(image.pixels.size());
-  std::printf("glass furnace in the light field: mean %.5f (expected %.1f, error %+.2e)\n", mean, expected,
-              mean / expected - 1.0);
-  EXPECT_NEAR(mean, expected, 0.005 * expected);
+  std::printf("glass furnace in the light field: mean error %+.2e\n", mean - 1.0);
+  EXPECT_NEAR(mean, 1.0, 0.005);
+}
+
+TEST_F(RenderTest, RoughGlassSphereInTheFurnaceIsNearlyInvisible) {
+  // The same with rough glass (α = 0.25), stored on both sides of every chart like a glossy
+  // surface: outside, Lo = R·L + T·(η²L) = L when the BSDF conserves energy (T carries the
+  // 1/η² of radiance leaving the dense side, the inside holds η²L). What is left is the
+  // discretisation: the operators' quadrature of the lobe over gather cells and output texels,
+  // the bilinear lookups, and the rough BSDF's own energy balance (the path tracer's rough
+  // glass furnace: within 0.3 %). Measured: mean −0.17 %, brightest pixel +0.15 %; checked
+  // at the 0.5 % furnace criterion.
+  DielectricBsdf glass;
+  glass.ior = 1.5f;
+  glass.alpha = 0.25f;
+  double mean = 0.0, brightest = 0.0;
+  glassFurnace(glass, mean, brightest);
+  std::printf("rough glass furnace in the light field: mean error %+.2e, brightest pixel %+.2e\n", mean - 1.0,
+              brightest - 1.0);
+  EXPECT_NEAR(mean, 1.0, 0.005);
+  EXPECT_LE(brightest, 1.005);
 }
 
 }  // namespace
