@@ -102,7 +102,12 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
   settings.seed = global.seed;
   settings.showProgress = options.frames == 1 && options.reference;
   Image image;
-  std::vector<double> frameMs;
+  std::vector<double> frameMs, primaryMs;
+  // With --stats, the fast renderer's first pass alone (FastRenderer::castPrimaryRays) is
+  // timed on every frame's camera after the last frame (interleaving it with the frames would
+  // evict their light-field data from the caches and slow them down).
+  const bool timePrimary = !options.statsPath.empty() && !options.reference;
+  std::vector<Camera> frameCameras;
   // One frame through the chosen renderer; frame time excludes writing files.
   auto renderFrame = [&](const Camera& frameCamera) {
     const auto start = SteadyClock::now();
@@ -112,6 +117,7 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
       fastRenderer.render(frameCamera, settings, image);
     }
     frameMs.push_back(1e3 * secondsSince(start));
+    if (timePrimary) frameCameras.push_back(frameCamera);
   };
   int frames = options.frames;
   if (!cameraPath) {
@@ -136,6 +142,12 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
     frames = result.frames;
   }
 
+  std::vector<float> depth;
+  for (const Camera& frameCamera : frameCameras) {
+    const auto start = SteadyClock::now();
+    fastRenderer.castPrimaryRays(frameCamera, settings, depth);
+    primaryMs.push_back(1e3 * secondsSince(start));
+  }
   const double medianMs = median(frameMs);
   const double fps = medianMs > 0.0 ? 1e3 / medianMs : 0.0;
   const int spp = options.samples > 0 ? options.samples : camera.isThinLens() ? RenderSettings::kThinLensSamples : 1;
@@ -157,6 +169,12 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
     json["ms_per_frame_min"] = *std::min_element(frameMs.begin(), frameMs.end());
     json["ms_per_frame_max"] = *std::max_element(frameMs.begin(), frameMs.end());
     json["fps"] = fps;
+    if (timePrimary) {
+      const double primary = median(primaryMs);
+      json["primary_ms_median"] = primary;
+      json["primary_ms_min"] = *std::min_element(primaryMs.begin(), primaryMs.end());
+      json["ratio_to_primary"] = primary > 0.0 ? medianMs / primary : 0.0;
+    }
     json["load_seconds"] = loadSeconds;
     json["accel_build_seconds"] = accelSeconds;
     json["file_bytes"] = std::filesystem::file_size(options.input);
@@ -195,7 +213,7 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--path", options->pathFile,
                       "Camera path JSON (keyframes; see README): render a walk-through to -o frames/%04d.png or -o walk.mp4");
   command->add_option("--stats", options->statsPath,
-                      "Write JSON: frames, ms_per_frame_median, fps, load and BVH times");
+                      "Write JSON: frames, ms_per_frame_median, fps, primary_ms_median (primary rays alone), load and BVH times");
   options->view.addCameraOptions(*command);
   options->view.addImageOptions(*command);
   command->callback([options, &global] { runRender(*options, global); });
