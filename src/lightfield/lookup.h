@@ -301,18 +301,20 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   const int frontSide = _mm_movemask_ps(_mm_cmpgt_ps(cosTheta, zero));  // bit k: cos θ_k > 0
   const int reflectingSide = _mm_movemask_ps(_mm_cmpge_ps(cosTheta, zero));  // bit k: cos θ_k ≥ 0
   const F4 emission = f4Load(shading.emission.v);
+  // exitantRadianceLanes' albedo / π, per lookup when textured (one branch for all four).
+  F4 albedoOverPi[4];
+  if (shading.texturedAlbedo)
+    for (int k = 0; k < 4; ++k) albedoOverPi[k] = f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv[k])), f4Splat(kInvPi));
+  else
+    albedoOverPi[0] = albedoOverPi[1] = albedoOverPi[2] = albedoOverPi[3] = f4Load(shading.albedoOverPi.v);
   for (int k = 0; k < 4; ++k) {
-    // exitantRadianceLanes' albedo / π for lookup k.
-    const F4 albedoOverPi = shading.texturedAlbedo
-                                ? f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv[k])), f4Splat(kInvPi))
-                                : f4Load(shading.albedoOverPi.v);
     // interpolateLanes' diffuse branch and exitantRadianceLanes' diffuse return, for lookup k.
     const uint64_t row0 = c.firstValue + uint64_t(v.i0[k]) * c.resU, row1 = c.firstValue + uint64_t(v.i1[k]) * c.resU;
     const F4 lower = f4Add(f4Mul(f4Splat(u.w0[k] * v.w0[k]), f4Load(values[row0 + u.i0[k]].v)),
                            f4Mul(f4Splat(u.w1[k] * v.w0[k]), f4Load(values[row0 + u.i1[k]].v)));
     const F4 upper = f4Add(f4Mul(f4Splat(u.w0[k] * v.w1[k]), f4Load(values[row1 + u.i0[k]].v)),
                            f4Mul(f4Splat(u.w1[k] * v.w1[k]), f4Load(values[row1 + u.i1[k]].v)));
-    const F4 reflected = f4Mul(albedoOverPi, f4Add(lower, upper));
+    const F4 reflected = f4Mul(albedoOverPi[k], f4Add(lower, upper));
     const bool front = ((frontSide >> k) & 1) != 0;
     // As exitantRadianceLanes: cos θ = 0 reflects but emits only if two-sided; NaN neither.
     const bool reflects = ((reflectingSide >> k) & 1) != 0;
