@@ -122,29 +122,6 @@ BakedScene& baked(const std::string& name) {
   return *slot;
 }
 
-/// Embree primary-ray casting alone: exactly the fast renderer's first pass (16×16 tiles in
-/// parallel, FastRenderer::tileCameraRays — 4×4-pixel blocks per 16-ray packet — then
-/// intersectCoherent); writes t to `depth` so nothing is optimised away.
-void castPrimaryRays(const pl::Accel& accel, const pl::Camera& camera, std::vector<float>& depth) {
-  const int width = camera.width(), height = camera.height(), tile = 16;
-  const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
-  depth.resize(size_t(width) * size_t(height));
-  pl::parallelForRange(uint64_t(tilesX * tilesY), 1, [&](uint64_t begin, uint64_t end) {
-    static thread_local std::vector<pl::Ray> rays(size_t(tile) * size_t(tile));
-    static thread_local std::vector<pl::RayHit> hits(size_t(tile) * size_t(tile));
-    static thread_local std::vector<float> weight(size_t(tile) * size_t(tile));
-    static thread_local std::vector<uint32_t> pixel(size_t(tile) * size_t(tile));
-    for (uint64_t t = begin; t < end; ++t) {
-      const int x0 = int(t % uint64_t(tilesX)) * tile, y0 = int(t / uint64_t(tilesX)) * tile;
-      const int x1 = std::min(x0 + tile, width), y1 = std::min(y0 + tile, height);
-      const size_t n =
-          pl::FastRenderer::tileCameraRays(camera, 1, 0, x0, y0, x1, y1, rays.data(), weight.data(), pixel.data());
-      accel.intersectCoherent(std::span<const pl::Ray>(rays.data(), n), std::span<pl::RayHit>(hits.data(), n));
-      for (size_t i = 0; i < n; ++i) depth[pixel[i]] = hits[i].t;
-    }
-  });
-}
-
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
@@ -186,7 +163,7 @@ void BM_Frame(benchmark::State& state, const std::string& name, int width, int h
     state.PauseTiming();
     cpu = processCpuMs();
     start = Clock::now();
-    castPrimaryRays(*scene.accel, camera, depth);
+    scene.renderer->castPrimaryRays(camera, settings, depth);  // the renderer's first pass alone
     primaryMs.push_back(msSince(start));
     primaryCpuMs += processCpuMs() - cpu;
     start = Clock::now();

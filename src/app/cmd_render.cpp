@@ -81,7 +81,7 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--path", options->pathFile,
                       "Camera path JSON (keyframes; see README): render a walk-through to -o frames/%04d.png or -o walk.mp4");
   command->add_option("--stats", options->statsPath,
-                      "Write JSON: frames, ms_per_frame_median, fps, load and BVH times");
+                      "Write JSON: frames, ms_per_frame_median, fps, primary_ms_median (primary rays alone), load and BVH times");
   options->view.addCameraOptions(*command);
   options->view.addImageOptions(*command);
   command->callback([options, &global] { runRender(*options, global); });

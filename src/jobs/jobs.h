@@ -211,6 +211,9 @@ struct RenderJobStats {
   int width = 0, height = 0, samplesPerPixel = 0, threads = 0, frames = 0;
   uint32_t mirrorDepth = 0;
   double msPerFrameMedian = 0, msPerFrameMin = 0, msPerFrameMax = 0, fps = 0;
+  /// The primary rays alone (FastRenderer::castPrimaryRays) on the same cameras, timed after
+  /// the frames when stats are written for the fast renderer; 0 = not timed.
+  double primaryMsMedian = 0, primaryMsMin = 0;
   double loadSeconds = 0, accelBuildSeconds = 0;
   uint64_t fileBytes = 0;
   std::string toJson() const;

@@ -17,6 +17,11 @@ Rgb backgroundRadiance(const Environment& environment, const Vec3& direction) {
 }
 
 Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv) {
+  // Lambert (every diffuse chart of an OBJ scene): bsdfAt's albedo, the model's albedo times
+  // the texel, without building the BSDF (the renderers call this per textured pixel).
+  const Material& m = scene.materials[material];
+  if (const auto* lambert = std::get_if<LambertBsdf>(&m.bsdf))
+    return m.albedoTexture < 0 ? lambert->albedo : lambert->albedo * scene.textures[size_t(m.albedoTexture)].sample(uv);
   SurfaceHit hit;
   hit.material = material;
   hit.uv = uv;

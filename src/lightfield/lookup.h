@@ -187,6 +187,10 @@ inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading&
   uv = Vec2(0.0f);
   lookup = towardsViewer;
   if (!shading.needsUv && !shading.normalMapped) return;
+  if (!shading.normalMapped) {  // surfaceAt's uv alone (no normals, no normal-map texel)
+    uv = uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics);
+    return;
+  }
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
   uv = surface.uv;
   if (shading.normalMapped) lookup = normalMappedLookupDirection(c, surface.shadingNormal, towardsViewer);
@@ -241,19 +245,19 @@ inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShadin
                            const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
   return f4Rgb(exitantRadianceLanes(scene, c, shading, load, worldPosition, worldDirectionTowardsViewer, uv));
 }
-/// Four light-field lookups on one diffuse chart without an albedo texture: the camera rays
-/// origin + t·direction (structure of arrays: x[k], y[k], z[k] for lookups k = 0…3), seen
-/// against their directions. result[k] = exitantRadianceLanes(…, origin_k + t_k·direction_k,
-/// −direction_k, …) to the bit — the same IEEE operations lane by lane, with the four lookups
-/// in the four SSE lanes for everything up to the value reads (the fast renderer's common case,
-/// where a dependent chain of ~40 scalar operations per pixel would otherwise dominate).
+/// Four light-field lookups on one diffuse chart: the camera rays origin + t·direction
+/// (structure of arrays: x[k], y[k], z[k] for lookups k = 0…3), seen against their directions,
+/// at surface uvs uv[k] (read only when the chart has an albedo texture, shading.needsUv).
+/// result[k] = exitantRadianceLanes(…, origin_k + t_k·direction_k, −direction_k, uv[k]) to the
+/// bit — the same IEEE operations lane by lane, with the four lookups in the four SSE lanes
+/// for everything up to the value reads (the fast renderer's common case, where a dependent
+/// chain of ~40 scalar operations per pixel would otherwise dominate).
 struct RaysSoA4 {
   alignas(16) float ox[4], oy[4], oz[4], dx[4], dy[4], dz[4], t[4];
 };
 inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const ChartShading& shading, const Lanes4* values,
-                                    const RaysSoA4& r, F4 result[4]) {
+                                    const RaysSoA4& r, const Vec2 uv[4], F4 result[4]) {
 #if defined(__SSE2__)
-  (void)scene;  // no albedo texture
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), half = _mm_set1_ps(0.5f);
   const __m128 t = _mm_load_ps(r.t), dx = _mm_load_ps(r.dx), dy = _mm_load_ps(r.dy), dz = _mm_load_ps(r.dz);
   // Position o + t·d, then d − chart origin (tixelGridCoordinates).
@@ -297,7 +301,13 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   const Taps u = taps(gridU, c.resU), v = taps(gridV, c.resV);
   const int frontSide = _mm_movemask_ps(_mm_cmpgt_ps(cosTheta, zero));  // bit k: cos θ_k > 0
   const int reflectingSide = _mm_movemask_ps(_mm_cmpge_ps(cosTheta, zero));  // bit k: cos θ_k ≥ 0
-  const F4 albedoOverPi = f4Load(shading.albedoOverPi.v), emission = f4Load(shading.emission.v);
+  const F4 emission = f4Load(shading.emission.v);
+  // exitantRadianceLanes' albedo / π, per lookup when textured (one branch for all four).
+  F4 albedoOverPi[4];
+  if (shading.texturedAlbedo)
+    for (int k = 0; k < 4; ++k) albedoOverPi[k] = f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv[k])), f4Splat(kInvPi));
+  else
+    albedoOverPi[0] = albedoOverPi[1] = albedoOverPi[2] = albedoOverPi[3] = f4Load(shading.albedoOverPi.v);
   for (int k = 0; k < 4; ++k) {
     // interpolateLanes' diffuse branch and exitantRadianceLanes' diffuse return, for lookup k.
     const uint64_t row0 = c.firstValue + uint64_t(v.i0[k]) * c.resU, row1 = c.firstValue + uint64_t(v.i1[k]) * c.resU;
@@ -305,7 +315,7 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
                            f4Mul(f4Splat(u.w1[k] * v.w0[k]), f4Load(values[row0 + u.i1[k]].v)));
     const F4 upper = f4Add(f4Mul(f4Splat(u.w0[k] * v.w1[k]), f4Load(values[row1 + u.i0[k]].v)),
                            f4Mul(f4Splat(u.w1[k] * v.w1[k]), f4Load(values[row1 + u.i1[k]].v)));
-    const F4 reflected = f4Mul(albedoOverPi, f4Add(lower, upper));
+    const F4 reflected = f4Mul(albedoOverPi[k], f4Add(lower, upper));
     const bool front = ((frontSide >> k) & 1) != 0;
     // As exitantRadianceLanes: cos θ = 0 reflects but emits only if two-sided; NaN neither.
     const bool reflects = ((reflectingSide >> k) & 1) != 0;
@@ -317,7 +327,7 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   for (int k = 0; k < 4; ++k) {
     const Vec3 d(r.dx[k], r.dy[k], r.dz[k]);
     result[k] = exitantRadianceLanes(scene, c, shading, PaddedValues{values}, Vec3(r.ox[k], r.oy[k], r.oz[k]) + r.t[k] * d, -d,
-                                     Vec2(0.0f));
+                                     uv[k]);
   }
 #endif
 }

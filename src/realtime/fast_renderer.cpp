@@ -42,6 +42,7 @@ FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel) : l
   for (const Chart& c : lightField.charts) {
     if (c.material >= scene.materials.size()) fail("fast renderer: chart material {} out of range", c.material);
     shading_.push_back(chartShading(scene, c));
+    anyTexturedChart_ = anyTexturedChart_ || shading_.back().needsUv;
   }
   if (lightField.triangleChart.size() != scene.meshes.size())
     fail("fast renderer: triangle → chart map has {} meshes, the scene {}", lightField.triangleChart.size(), scene.meshes.size());
@@ -111,6 +112,19 @@ size_t FastRenderer::tileCameraRays(const Camera& camera, int spp, uint64_t seed
   return n;
 }
 
+size_t FastRenderer::tilePrimaryHits(const Camera& camera, int spp, uint64_t seed, int x0, int y0, int x1, int y1,
+                                     Scratch& s) const {
+  const size_t pixels = size_t(x1 - x0) * size_t(y1 - y0);
+  const size_t samples = pixels * size_t(spp);
+  s.rays.resize(samples);
+  s.hits.resize(samples);
+  s.weight.resize(samples);
+  s.pixel.resize(pixels);
+  const size_t n = tileCameraRays(camera, spp, seed, x0, y0, x1, y1, s.rays.data(), s.weight.data(), s.pixel.data());
+  accel_.intersectCoherent(std::span<const Ray>(s.rays.data(), n), std::span<RayHit>(s.hits.data(), n));
+  return n;
+}
+
 void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDepth, uint64_t seed, int x0, int y0,
                               int x1, int y1, Scratch& s, Image& image) const {
   const Scene& scene = lightField_.scene;
@@ -118,21 +132,15 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   const ChartShading* shading = shading_.data();
   const PaddedValues values{paddedValues_.data()};
   const size_t pixels = size_t(x1 - x0) * size_t(y1 - y0);
-  const size_t samples = pixels * size_t(spp);
-  s.rays.resize(samples);
-  s.hits.resize(samples);
-  s.radiance.resize(samples);
-  s.weight.resize(samples);
-  s.pixel.resize(pixels);
+  s.radiance.resize(pixels * size_t(spp));
 
   // 1. Camera rays in 4×4-pixel blocks (see tileCameraRays).
-  const size_t n = tileCameraRays(camera, spp, seed, x0, y0, x1, y1, s.rays.data(), s.weight.data(), s.pixel.data());
-  accel_.intersectCoherent(std::span<const Ray>(s.rays.data(), n), std::span<RayHit>(s.hits.data(), n));
+  const size_t n = tilePrimaryHits(camera, spp, seed, x0, y0, x1, y1, s);
 
   // 2. Shade the camera hits; mirror hits start the reflection wavefront. With one sample
   // per pixel, a pixel that needs no reflection is written as soon as it is shaded, and four
-  // consecutive samples on the same plain diffuse chart (most of a frame) are looked up
-  // together (exitantRadianceDiffuse4: the same values as one at a time).
+  // consecutive samples on the same diffuse chart (most of a frame) are looked up together
+  // (exitantRadianceDiffuse4: the same values as one at a time).
   s.mirrorRays.clear();
   s.mirrorSlot.clear();
   s.mirrorThroughput.clear();
@@ -142,17 +150,29 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     const RayHit& hit = s.hits[i];
     return facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -s.rays[i].direction);
   };
-  // Whether samples i … i+3 all hit one diffuse chart record without an albedo texture (→ *chart).
+  // Texel reads miss the cache on textured scenes (a minified texture gives every pixel new
+  // cache lines): prefetch them for the whole tile first, so that they overlap. (Skipped
+  // without textures: the pass alone cost 10–15 % of the Cornell box's frame.)
+  for (size_t i = 0; anyTexturedChart_ && i < n; ++i) {
+    const RayHit& hit = s.hits[i];
+    if (!hit.hit()) continue;
+    const uint32_t chart = chartOf(i);
+    if (!shading[chart].needsUv) continue;
+    const int texture = scene.materials[charts[chart].material].albedoTexture;
+    scene.textures[size_t(texture)].prefetch(uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics));
+  }
+  // Whether samples i … i+3 all hit one diffuse chart record (→ *chart).
   auto sameDiffuseChart = [&](size_t i, uint32_t* chart) {
     for (size_t k = i; k < i + 4; ++k)
       if (!(s.weight[k] > 0.0f) || !s.hits[k].hit()) return false;
     *chart = chartOf(i);
-    if (charts[*chart].kind != ChartKind::Diffuse || shading[*chart].needsUv) return false;
+    if (charts[*chart].kind != ChartKind::Diffuse) return false;
     for (size_t k = i + 1; k < i + 4; ++k)
       if (chartOf(k) != *chart) return false;
     return true;
   };
   RaysSoA4 four;
+  Vec2 fourUv[4];
   F4 fourRadiance[4];
   for (size_t i = 0; i < n;) {
     uint32_t chart = 0;
@@ -163,7 +183,14 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         four.dx[k] = ray.direction.x, four.dy[k] = ray.direction.y, four.dz[k] = ray.direction.z;
         four.t[k] = s.hits[i + k].t;
       }
-      exitantRadianceDiffuse4(scene, charts[chart], shading[chart], paddedValues_.data(), four, fourRadiance);
+      // A separate loop: a call inside the one above keeps the compiler from merging its stores
+      // into vectors, and the lookup's 16-byte loads of them then stall (measured on Cornell).
+      if (shading[chart].needsUv)
+        for (int k = 0; k < 4; ++k) {
+          Vec3 unusedLookup;  // a diffuse lookup needs only the uv
+          lookupInputs(scene, charts[chart], shading[chart], s.hits[i + k], -s.rays[i + k].direction, fourUv[k], unusedLookup);
+        }
+      exitantRadianceDiffuse4(scene, charts[chart], shading[chart], paddedValues_.data(), four, fourUv, fourRadiance);
       for (int k = 0; k < 4; ++k) f4StoreRgb(out + s.pixel[i + k], f4Mul(f4Splat(s.weight[i + k]), fourRadiance[k]));
       i += 4;
       continue;
@@ -264,22 +291,45 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   }
 }
 
-void FastRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) const {
+namespace {
+/// The settings render() and castPrimaryRays() refuse, checked before anything is allocated.
+void checkSettings(const RenderSettings& settings) {
   if (settings.samplesPerPixel < 0) fail("render: samples per pixel must be ≥ 0, got {}", settings.samplesPerPixel);
   if (settings.tileSize < 1) fail("render: tile size must be ≥ 1, got {}", settings.tileSize);
-  const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
-  const uint32_t mirrorDepth = effectiveMirrorDepth(settings, lightField_.settings.mirrorDepth);
+}
+}  // namespace
+
+template <typename Tile>
+void FastRenderer::forEachTile(const Camera& camera, const RenderSettings& settings, Tile&& tile) const {
   const int width = camera.width(), height = camera.height();
-  if (image.width != width || image.height != height) image = Image(width, height);
-  const int tile = settings.tileSize;
-  const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+  const int size = settings.tileSize;
+  const int tilesX = (width + size - 1) / size, tilesY = (height + size - 1) / size;
   parallelForRange(uint64_t(tilesX) * uint64_t(tilesY), 1, [&](uint64_t begin, uint64_t end) {
     static thread_local Scratch scratch;
     for (uint64_t t = begin; t < end; ++t) {
-      const int x0 = int(t % uint64_t(tilesX)) * tile, y0 = int(t / uint64_t(tilesX)) * tile;
-      renderTile(camera, spp, mirrorDepth, settings.seed, x0, y0, std::min(x0 + tile, width), std::min(y0 + tile, height),
-                 scratch, image);
+      const int x0 = int(t % uint64_t(tilesX)) * size, y0 = int(t / uint64_t(tilesX)) * size;
+      tile(x0, y0, std::min(x0 + size, width), std::min(y0 + size, height), scratch);
     }
+  });
+}
+
+void FastRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) const {
+  checkSettings(settings);
+  const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
+  const uint32_t mirrorDepth = effectiveMirrorDepth(settings, lightField_.settings.mirrorDepth);
+  if (image.width != camera.width() || image.height != camera.height()) image = Image(camera.width(), camera.height());
+  forEachTile(camera, settings, [&](int x0, int y0, int x1, int y1, Scratch& scratch) {
+    renderTile(camera, spp, mirrorDepth, settings.seed, x0, y0, x1, y1, scratch, image);
+  });
+}
+
+void FastRenderer::castPrimaryRays(const Camera& camera, const RenderSettings& settings, std::vector<float>& depth) const {
+  checkSettings(settings);
+  const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
+  depth.resize(size_t(camera.width()) * size_t(camera.height()));
+  forEachTile(camera, settings, [&](int x0, int y0, int x1, int y1, Scratch& s) {
+    const size_t n = tilePrimaryHits(camera, spp, settings.seed, x0, y0, x1, y1, s);
+    for (size_t i = 0; i < n; ++i) depth[s.pixel[i / size_t(spp)]] = s.hits[i].t;
   });
 }
 

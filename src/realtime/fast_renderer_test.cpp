@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <variant>
+#include <vector>
 
 #include "accel/accel.h"
 #include "camera/camera.h"
@@ -132,6 +134,57 @@ TEST_F(FastRendererTest, MatchesReferenceOnBuiltInCornellBox) {
   expectSameAsReference(lf, desc, 64, 64, RenderSettings{}, 0.001f);
 }
 
+TEST_F(FastRendererTest, MatchesReferenceWithAlbedoTextures) {
+  // Every Lambertian material textured (8-bit values, so the texture is packed; the OBJ has no
+  // uvs, so uv = barycentrics): the four-at-a-time textured lookups and the texel prefetch.
+  Scene scene = loadScene(kMcGuire + "CornellBox-Glossy.obj");
+  Texture texture;
+  texture.path = "random-8-bit";
+  texture.image = Image(13, 9);
+  Pcg32 rng(8, 1);
+  for (Rgb& texel : texture.image.pixels)
+    texel = Rgb(float(rng.next() >> 24) / 255.0f, float(rng.next() >> 24) / 255.0f, float(rng.next() >> 24) / 255.0f);
+  scene.textures.push_back(texture);
+  int textured = 0;
+  for (Material& m : scene.materials)
+    if (std::holds_alternative<LambertBsdf>(m.bsdf)) m.albedoTexture = 0, ++textured;
+  ASSERT_GT(textured, 0);
+  const LightField lf = randomLightField(std::move(scene), 6);
+  ASSERT_FALSE(lf.scene.textures[0].packed.empty());
+  const CameraDesc desc = lf.scene.cameras.empty() ? lf.scene.automaticCamera() : lf.scene.cameras.front();
+  expectSameAsReference(lf, desc, 96, 72, RenderSettings{});
+}
+
+TEST_F(FastRendererTest, PrimaryRaysAloneFindTheRenderersHits) {
+  // castPrimaryRays (what `render --stats` times as primary rays alone): per pixel the hit
+  // distance of the ray through its centre, as one ray at a time finds it; ∞ for a miss.
+  const LightField lf = randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 7);
+  const Accel accel(lf.scene);
+  const FastRenderer fast(lf, accel);
+  CameraDesc desc = lf.scene.automaticCamera();
+  desc.fovYDegrees = 60.0f;  // wider than the box: some pixels miss
+  const Camera camera(desc, 37, 29);
+  std::vector<float> depth;
+  fast.castPrimaryRays(camera, RenderSettings{}, depth);
+  ASSERT_EQ(depth.size(), size_t(37 * 29));
+  int hits = 0, misses = 0;
+  for (int y = 0; y < 29; ++y)
+    for (int x = 0; x < 37; ++x) {
+      RayHit hit;
+      const bool found = accel.intersect(camera.generateRay(Vec2(float(x) + 0.5f, float(y) + 0.5f), Vec2(0.5f)).ray, hit);
+      const float t = depth[size_t(y) * 37 + size_t(x)];
+      if (found) {
+        EXPECT_NEAR(t, hit.t, 1e-4f * hit.t) << x << ", " << y;
+        ++hits;
+      } else {
+        EXPECT_EQ(t, kInfinity) << x << ", " << y;
+        ++misses;
+      }
+    }
+  EXPECT_GT(hits, 0);
+  EXPECT_GT(misses, 0);
+}
+
 TEST_F(FastRendererTest, ReusesTheImageAndRejectsBadSettings) {
   const LightField lf = randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 5);
   const Accel accel(lf.scene);
@@ -148,6 +201,9 @@ TEST_F(FastRendererTest, ReusesTheImageAndRejectsBadSettings) {
   bad = RenderSettings{};
   bad.tileSize = 0;
   EXPECT_THROW(fast.render(camera, bad, image), Error);
+  std::vector<float> depth;
+  EXPECT_THROW(fast.castPrimaryRays(camera, bad, depth), Error);
+  EXPECT_TRUE(depth.empty());  // refused before anything is written
 }
 
 }  // namespace

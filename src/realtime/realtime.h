@@ -6,14 +6,16 @@
 // Per tile:
 //   1. camera rays for all samples of the tile, ordered in 4×4-pixel blocks so that each
 //      16-ray Embree packet (Accel::intersectCoherent) covers a compact footprint;
+//   1b. on charts with an albedo texture (when there are any), a prefetch of the texels each hit will read
+//      (Texture::prefetch), so that their cache misses overlap across the tile;
 //   2. shading of every hit without building a SurfaceHit: the hit point is ray.origin +
 //      t·ray.direction, the chart comes from LightField::triangleChart, and the radiance from
 //      exitantRadianceLanes() of lightfield/lookup.h with the chart's ChartShading precomputed
-//      once (the one 16-neighbour formula the reference also runs, in four SSE lanes; only
-//      textured diffuse charts need the hit's uv and build the SurfaceHit). With one sample
-//      per pixel, four consecutive samples on one plain diffuse chart go through
-//      exitantRadianceDiffuse4 together (bit-identical), and a pixel is written from the
-//      lanes as soon as it is shaded;
+//      once (the one 16-neighbour formula the reference also runs, in four SSE lanes;
+//      textured diffuse charts interpolate the hit's uv alone, uvAt, and only normal-mapped
+//      glossy charts build the SurfaceHit). With one sample per pixel, four consecutive
+//      samples on one diffuse chart go through exitantRadianceDiffuse4 together
+//      (bit-identical), and a pixel is written from the lanes as soon as it is shaded;
 //   3. mirrors as a wavefront of reflection rays: all samples of the tile that hit an
 //      ideal-specular chart spawn their reflected ray (same steps as the reference: shading
 //      normal frame, the BSDF's delta sample with its Fresnel weight, offset origin), and
@@ -63,17 +65,34 @@ class FastRenderer {
   static size_t tileCameraRays(const Camera& camera, int spp, uint64_t seed, int x0, int y0, int x1, int y1, Ray* rays,
                                float* weight, uint32_t* pixel);
 
+  /// Primary rays alone: exactly render()'s first pass — the same tiles in parallel, the same
+  /// per-thread scratch, tileCameraRays and Accel::intersectCoherent — and no shading. Writes
+  /// the hit distance of each pixel's last sample (∞ for a miss) to depth[y·width + x] so that
+  /// nothing is optimised away. This is the floor of the design (the renderer casts these rays,
+  /// then looks the light field up): `render --stats` (primary_ms_median) and realtime_bench
+  /// time it next to render().
+  void castPrimaryRays(const Camera& camera, const RenderSettings& settings, std::vector<float>& depth) const;
+
   const LightField& lightField() const { return lightField_; }
   const Accel& accel() const { return accel_; }
 
  private:
   struct Scratch;
+  /// The camera rays of the tile's samples into scratch.rays/weight/pixel and their hits into
+  /// scratch.hits (buffers sized for the tile); returns the number of samples.
+  size_t tilePrimaryHits(const Camera& camera, int spp, uint64_t seed, int x0, int y0, int x1, int y1,
+                         Scratch& scratch) const;
+  /// render()'s tiling: tile(x0, y0, x1, y1, scratch) for every settings.tileSize tile of the
+  /// image, tiles in parallel, each thread with its own Scratch.
+  template <typename Tile>
+  void forEachTile(const Camera& camera, const RenderSettings& settings, Tile&& tile) const;
   void renderTile(const Camera& camera, int spp, uint32_t mirrorDepth, uint64_t seed, int x0, int y0, int x1, int y1,
                   Scratch& scratch, Image& image) const;
 
   const LightField& lightField_;
   const Accel& accel_;
   std::vector<ChartShading> shading_;  ///< per chart
+  bool anyTexturedChart_ = false;      ///< some chart's shading needsUv: renderTile prefetches texels
   /// The light field's values padded to 16 bytes (PaddedValues): one aligned load per tap.
   std::vector<Lanes4> paddedValues_;
   /// LightField::triangleChart flattened: chart of triangle t of mesh m at

@@ -138,6 +138,24 @@ TEST_F(RenderCliTest, RenderWritesTheLookedUpRadianceAndStats) {
   EXPECT_GE(median, double(json["ms_per_frame_min"]));
   EXPECT_LE(median, double(json["ms_per_frame_max"]));
   EXPECT_NEAR(double(json["fps"]), 1000.0 / median, 1e-9 * double(json["fps"]));
+  // Primary rays alone are timed for the fast renderer only (its first pass).
+  EXPECT_FALSE(json.contains("primary_ms_median"));
+}
+
+TEST_F(RenderCliTest, FastRenderStatsTimePrimaryRaysAlone) {
+  const std::string stats = path("fast.json");
+  std::string err;
+  ASSERT_EQ(run("render " + path("quad.plf") + " -o " + path("fast.png") +
+                    " --camera top --width 40 --height 30 --frames 3 --stats " + stats,
+                nullptr, &err),
+            0)
+      << err;
+  const auto json = nlohmann::json::parse(cli_test::readFileText(stats));
+  EXPECT_EQ(json["renderer"], "fast");
+  const double frame = json["ms_per_frame_median"], primary = json["primary_ms_median"];
+  EXPECT_GT(primary, 0.0);
+  EXPECT_LE(double(json["primary_ms_min"]), primary);
+  EXPECT_NEAR(double(json["ratio_to_primary"]), frame / primary, 1e-9 * frame / primary);
 }
 
 TEST_F(RenderCliTest, RenderWritesPng) {

@@ -4,6 +4,7 @@
 #include "core/error.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -60,27 +61,120 @@ void validateMaterial(const Material& material, const std::string& sourcePath) {
     fail("{}: material '{}': {}", sourcePath, material.name, problem);
 }
 
-Rgb Texture::sample(Vec2 uv) const {
-  if (image.empty()) return Rgb(1.0f);
+
+namespace {
+
+/// The blocks per row of a texture packed in 4×4-texel blocks, and the place of texel (x, y).
+int packedBlocksPerRow(int width) { return (width + 3) / 4; }
+template <typename Blocks>  // const or not
+auto& packedTexel(Blocks& blocks, int blocksPerRow, int x, int y) {
+  return blocks[size_t(y >> 2) * size_t(blocksPerRow) + size_t(x >> 2)].texels[(y & 3) * 4 + (x & 3)];
+}
+
+/// Texture::packed and palette for `image`, or false (nothing changed) when its channels take
+/// more than 256 distinct values. The distinct values go through a small open-addressing hash
+/// table keyed by their bits (−0 and +0 stay distinct, so the palette gives back every bit).
+bool packTexels(const Image& image, std::vector<Texture::PackedBlock>& packed, std::vector<float>& palette) {
+  constexpr uint32_t kSlots = 1024, kEmpty = 0xffffffffu;  // kEmpty: a NaN pattern, never a finite texel
+  std::vector<uint32_t> keys(kSlots, kEmpty);
+  std::vector<uint8_t> indices(kSlots, 0);
+  std::vector<float> values;
+  auto indexOf = [&](float v, uint32_t& index) {
+    const uint32_t bits = std::bit_cast<uint32_t>(v);
+    for (uint32_t slot = (bits * 2654435761u) >> 22;; slot = (slot + 1) & (kSlots - 1)) {
+      if (keys[slot] == bits) return index = indices[slot], true;
+      if (keys[slot] != kEmpty) continue;
+      if (values.size() == 256) return false;
+      keys[slot] = bits;
+      indices[slot] = uint8_t(values.size());
+      index = uint32_t(values.size());
+      values.push_back(v);
+      return true;
+    }
+  };
+  const int blocksPerRow = packedBlocksPerRow(image.width);
+  std::vector<Texture::PackedBlock> blocks(size_t(blocksPerRow) * size_t((image.height + 3) / 4), Texture::PackedBlock{});
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const Rgb& texel = image.at(x, y);
+      uint32_t r, g, b;
+      if (!indexOf(texel.r, r) || !indexOf(texel.g, g) || !indexOf(texel.b, b)) return false;
+      packedTexel(blocks, blocksPerRow, x, y) = r | g << 8 | b << 16;
+    }
+  packed = std::move(blocks);
+  palette = std::move(values);
+  return true;
+}
+
+}  // namespace
+
+namespace {
+
+/// The 2×2 texels sample(uv) blends and their weights, or false for a non-finite uv.
+struct BilinearFootprint {
+  int x0, x1, y0, y1;
+  float fx, fy;
+};
+bool bilinearFootprint(const Image& image, Vec2 uv, BilinearFootprint& f) {
   // Texel (x, y) has its centre at u = (x + 0.5)/W and v = 1 − (y + 0.5)/H (row 0 is the top
   // of the image, v = 0 its bottom). Continuous texel coordinates of uv:
   const float x = uv.x * float(image.width) - 0.5f;
   const float y = (1.0f - uv.y) * float(image.height) - 0.5f;
-  if (!std::isfinite(x) || !std::isfinite(y)) return average;
+  if (!std::isfinite(x) || !std::isfinite(y)) return false;
   const float x0f = std::floor(x), y0f = std::floor(y);
-  const float fx = x - x0f, fy = y - y0f;
-  // Wrap-around (repeat) with a non-negative modulo; fmod keeps huge coordinates in range.
+  f.fx = x - x0f;
+  f.fy = y - y0f;
+  // Wrap-around (repeat) with a non-negative modulo. i is a whole number; below 2^30 in
+  // magnitude the integer remainder is exactly fmod's (and much cheaper per pixel); fmod
+  // keeps huge coordinates in range.
   auto wrap = [](float i, int n) {
+    if (std::abs(i) < 0x1p30f) {
+      const int k = int(i) % n;
+      return k < 0 ? k + n : k;
+    }
     float m = std::fmod(i, float(n));
     if (m < 0.0f) m += float(n);
     int k = int(m);
     return k >= n ? 0 : k;
   };
-  const int x0 = wrap(x0f, image.width), x1 = wrap(x0f + 1.0f, image.width);
-  const int y0 = wrap(y0f, image.height), y1 = wrap(y0f + 1.0f, image.height);
-  const Rgb top = (1.0f - fx) * image.at(x0, y0) + fx * image.at(x1, y0);
-  const Rgb bottom = (1.0f - fx) * image.at(x0, y1) + fx * image.at(x1, y1);
-  return (1.0f - fy) * top + fy * bottom;
+  f.x0 = wrap(x0f, image.width), f.x1 = wrap(x0f + 1.0f, image.width);
+  f.y0 = wrap(y0f, image.height), f.y1 = wrap(y0f + 1.0f, image.height);
+  return true;
+}
+
+}  // namespace
+
+Rgb Texture::sample(Vec2 uv) const {
+  if (image.empty()) return Rgb(1.0f);
+  BilinearFootprint f;
+  if (!bilinearFootprint(image, uv, f)) return average;
+  auto bilinear = [&](auto&& texel) {
+    const Rgb top = (1.0f - f.fx) * texel(f.x0, f.y0) + f.fx * texel(f.x1, f.y0);
+    const Rgb bottom = (1.0f - f.fx) * texel(f.x0, f.y1) + f.fx * texel(f.x1, f.y1);
+    return (1.0f - f.fy) * top + f.fy * bottom;
+  };
+  if (packed.empty()) return bilinear([&](int tx, int ty) { return image.at(tx, ty); });
+  const int blocksPerRow = packedBlocksPerRow(image.width);
+  const float* values = palette.data();
+  return bilinear([&](int tx, int ty) {
+    const uint32_t p = packedTexel(packed, blocksPerRow, tx, ty);
+    return Rgb(values[p & 0xffu], values[(p >> 8) & 0xffu], values[(p >> 16) & 0xffu]);
+  });
+}
+
+void Texture::prefetch(Vec2 uv) const {
+  BilinearFootprint f;
+  if (image.empty() || !bilinearFootprint(image, uv, f)) return;
+  if (packed.empty()) {
+    __builtin_prefetch(&image.at(f.x0, f.y0));
+    __builtin_prefetch(&image.at(f.x1, f.y1));
+    return;
+  }
+  // Two opposite corners: all the blocks of a footprint that spans one or two (most of them),
+  // two of the four at a block corner.
+  const int blocksPerRow = packedBlocksPerRow(image.width);
+  __builtin_prefetch(&packedTexel(packed, blocksPerRow, f.x0, f.y0));
+  __builtin_prefetch(&packedTexel(packed, blocksPerRow, f.x1, f.y1));
 }
 
 void Texture::finish(const std::string& sceneSource) {
@@ -93,6 +187,9 @@ void Texture::finish(const std::string& sceneSource) {
     sum += texel;
   }
   average = sum / float(image.pixels.size());
+  packed.clear();
+  palette.clear();
+  packTexels(image, packed, palette);
 }
 
 Texture loadTextureFile(const std::string& path, ImageDecode decode) {
@@ -304,7 +401,7 @@ SurfaceHit surfaceAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, 
     }
   }
   // Without texture coordinates uv are the barycentrics, so a texture still maps somewhere.
-  hit.uv = mesh.uvs.empty() ? Vec2(b1, b2) : b0 * mesh.uvs[tri.x] + b1 * mesh.uvs[tri.y] + b2 * mesh.uvs[tri.z];
+  hit.uv = uvAt(mesh, triangle, barycentrics);
   const Material& material = scene.materials[hit.material];
   if (material.normalTexture >= 0 && !mesh.uvs.empty()) {
     const Vec3 p[3] = {p0, p1, p2};
@@ -342,12 +439,8 @@ float coverageAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, Vec2
   const Mesh& mesh = scene.meshes[meshIndex];
   const Material& material = scene.materials[mesh.materials[triangle]];
   if (material.alphaTexture < 0) return material.alphaFactor;
-  // Only uv is needed: interpolate it without the rest of surfaceAt (this runs per candidate
-  // hit inside Embree's traversal).
-  const UVec3 tri = mesh.triangles[triangle];
-  const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.0f - b1 - b2;
-  const Vec2 uv = mesh.uvs.empty() ? Vec2(b1, b2) : b0 * mesh.uvs[tri.x] + b1 * mesh.uvs[tri.y] + b2 * mesh.uvs[tri.z];
-  return material.alphaFactor * scene.textures[size_t(material.alphaTexture)].sample(uv).r;
+  // Only uv is needed (this runs per candidate hit inside Embree's traversal).
+  return material.alphaFactor * scene.textures[size_t(material.alphaTexture)].sample(uvAt(mesh, triangle, barycentrics)).r;
 }
 
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -617,6 +618,49 @@ TEST(Texture, BilinearWithRepeatAndBottomLeftOrigin) {
   // columns (which are neighbours across the wrap) half and half.
   EXPECT_VEC3_NEAR(t.sample(Vec2(-1.75f, 2.25f)), Rgb(0, 0, 1), kTight);
   EXPECT_VEC3_NEAR(t.sample(Vec2(0.0f, 0.75f)), Rgb(0.5f, 0.5f, 0.0f), kTight);
+}
+
+// finish() packs a texture of at most 256 distinct channel values (an 8-bit image) into 4×4
+// blocks of palette indices; sample() must give exactly (bit for bit) what the float image
+// gives, at texel centres, between texels, across the wrap on every side and across block
+// edges of a size that is not a multiple of 4. More than 256 values: not packed.
+TEST(Texture, PackedTexelsSampleBitForBitLikeTheFloatImage) {
+  Texture texture;
+  texture.path = "palette";
+  texture.image = Image(11, 6);
+  uint32_t state = 12345;
+  auto next = [&] { return (state = state * 1664525u + 1013904223u) >> 24; };  // 0 … 255
+  for (Rgb& texel : texture.image.pixels)
+    texel = Rgb(srgbToLinear(float(next()) / 255.0f), float(next()) / 255.0f, srgbToLinear(float(next()) / 255.0f));
+  texture.image.at(3, 2) = Rgb(-0.0f, 0.0f, 1.0f);  // −0 and +0: both kept exactly
+  texture.finish("test");
+  ASSERT_FALSE(texture.packed.empty());
+  ASSERT_LE(texture.palette.size(), 256u);
+  EXPECT_EQ(texture.packed.size(), 3u * 2u);  // ⌈11/4⌉ × ⌈6/4⌉ blocks
+  Texture plain = texture;
+  plain.packed.clear();
+  plain.palette.clear();
+  int compared = 0;
+  for (int j = -30; j <= 30; ++j)
+    for (int i = -40; i <= 40; ++i) {
+      const Vec2 uv(float(i) * 0.0371f, float(j) * 0.0533f);
+      const Rgb a = texture.sample(uv), b = plain.sample(uv);
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(std::bit_cast<uint32_t>(a[c]), std::bit_cast<uint32_t>(b[c])) << "uv " << uv.x << ", " << uv.y;
+      ++compared;
+    }
+  EXPECT_EQ(compared, 61 * 81);
+  // Texel centres give the texels themselves.
+  EXPECT_VEC3_NEAR(texture.sample(Vec2(3.5f / 11.0f, 1.0f - 2.5f / 6.0f)), Rgb(0.0f, 0.0f, 1.0f), kTight);
+
+  Texture wide;
+  wide.path = "wide";
+  wide.image = Image(300, 1);
+  for (int x = 0; x < 300; ++x) wide.image.at(x, 0) = Rgb(float(x) / 300.0f);
+  wide.finish("test");
+  EXPECT_TRUE(wide.packed.empty());
+  EXPECT_TRUE(wide.palette.empty());
+  EXPECT_VEC3_NEAR(wide.sample(Vec2((10.5f) / 300.0f, 0.5f)), Rgb(10.0f / 300.0f), kTight);
 }
 
 /// One triangle (0,0,0), (1,0,0), (0,1,0): counter-clockwise seen from +z.
