@@ -1,5 +1,6 @@
 // `plenoptic demo [--output-dir DIR]` (what `make demo` runs): the whole pipeline on the
-// built-in Cornell box, each step one function taking the options struct:
+// built-in Cornell box, each step one function taking the options struct and running one
+// library job (jobs/jobs.h), as the trace, bake and render commands do:
 //   1. path-traced reference (the ground truth),
 //   2. light-field bake (default preset) written as a .plf,
 //   3. the light field rendered from the same camera, compared with the reference
@@ -9,7 +10,6 @@
 // It ends by printing where every file is.
 #include <fmt/format.h>
 
-#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -18,14 +18,11 @@
 #include "accel/accel.h"
 #include "app/commands.h"
 #include "app/view_options.h"
-#include "camera/camera.h"
 #include "core/error.h"
 #include "image/compare.h"
-#include "bake/bake.h"
-#include "plf/plf_file.h"
+#include "jobs/jobs.h"
 #include "realtime/realtime.h"
 #include "scene/scene.h"
-#include "trace/trace.h"
 #include "viewer/viewer.h"
 
 namespace pl {
@@ -62,68 +59,67 @@ ViewOptions demoView(const DemoOptions& options) {
   return view;
 }
 
-/// Step 1: path-traces the Cornell box from its own camera; writes linear EXR and PNG.
-Image traceReference(const DemoOptions& options, const Scene& scene, const GlobalOptions& global,
-                     std::vector<DemoFile>& files) {
-  const Accel accel(scene);
-  const PathTracer tracer(scene, accel);
-  const ViewOptions view = demoView(options);
-  const Camera camera = view.makeCamera(scene);
-  TraceSettings settings;
-  settings.spp = options.traceSpp;
-  settings.seed = global.seed;
-  const TraceResult result = tracer.render(camera, settings);
-  if (result.stats.nanSamples > 0)
-    fmt::print(stderr, "plenoptic: warning: {} non-finite samples were left out of the demo render\n",
-               result.stats.nanSamples);
-
+/// Step 1: path-traces the Cornell box from its own camera (TraceJob); writes linear EXR and PNG.
+Image traceReference(const DemoOptions& options, const GlobalOptions& global, std::vector<DemoFile>& files) {
+  TraceJobOptions job;
+  job.sceneName = "cornell";
+  job.output = outputPath(options, "cornell_trace.exr");
+  job.trace.spp = options.traceSpp;
+  job.trace.seed = global.seed;
+  job.view = demoView(options);
+  job.threads = global.threads;
+  const TraceJobResult result = TraceJob(job).run(makeCornellBox());
+  const TraceStats& stats = result.stats.trace;
+  if (stats.nanSamples > 0)
+    fmt::print(stderr, "plenoptic: warning: {} non-finite samples were left out of the demo render\n", stats.nanSamples);
+  const std::string png = outputPath(options, "cornell_trace.png");
+  job.view.writeImage(png, result.radiance);
   const std::string what = fmt::format("path-traced reference, {}x{}, {} spp, {:.1f} s ({:.2f} M paths/s)",
-                                       view.width, view.height, settings.spp, result.stats.seconds,
-                                       result.stats.pathsPerSecond() * 1e-6);
-  for (const char* extension : {".exr", ".png"}) {
-    const std::string path = outputPath(options, std::string("cornell_trace") + extension);
-    view.writeImage(path, result.radiance);
-    files.push_back({what, path});
-  }
+                                       result.stats.width, result.stats.height, result.stats.spp, stats.seconds,
+                                       stats.pathsPerSecond() * 1e-6);
+  files.push_back({what, job.output});
+  files.push_back({what, png});
   return result.radiance;
 }
 
-/// Step 2: bakes the light field and writes it (with its visibility field beside it).
-LightField bakeLightField(const DemoOptions& options, std::vector<DemoFile>& files) {
-  BakeOptions bakeOptions;
-  bakeOptions.visibilityPath = outputPath(options, "cornell.plv");
-  bakeOptions.log = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
-  LightField lightField = bake(makeCornellBox(), bakePreset(options.preset), bakeOptions);
-  const std::string path = outputPath(options, "cornell.plf");
-  writeLightField(path, lightField);
-  const BakeStats& stats = lightField.stats;
+/// Step 2: bakes the light field (BakeJob) and writes it, with its visibility field beside it.
+LightField bakeLightField(const DemoOptions& options, const GlobalOptions& global, std::vector<DemoFile>& files) {
+  BakeJobOptions job;
+  job.sceneName = "cornell";
+  job.output = outputPath(options, "cornell.plf");
+  job.visibilityPath = outputPath(options, "cornell.plv");
+  job.preset = options.preset;
+  job.seed = global.seed;
+  job.threads = global.threads;
+  job.log = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
+  BakeJobResult result = BakeJob(job).run(makeCornellBox());
+  const BakeStats& stats = result.stats.bake;
   files.push_back({fmt::format("light field, preset {}: {} tixels, {} iterations (residual {:.1e}), {:.2f} s "
                                "(visibility {:.2f} s, propagation {:.2f} s)",
                                options.preset, stats.tixels, stats.iterations, stats.residual, stats.seconds,
                                stats.visibilitySeconds, stats.propagationSeconds),
-                   path});
-  return lightField;
+                   job.output});
+  return std::move(result.lightField);
 }
 
-/// Step 3: renders the light field from the reference's camera and compares the two.
-void renderAndCompare(const DemoOptions& options, const LightField& lightField, const Accel& accel,
+/// Step 3: renders the light field from the reference's camera (RenderJob, fast renderer)
+/// and compares the two.
+void renderAndCompare(const DemoOptions& options, const GlobalOptions& global, const LightField& lightField,
                       const Image& reference, std::vector<DemoFile>& files) {
-  const ViewOptions view = demoView(options);
-  const Camera camera = view.makeCamera(lightField.scene);
-  RenderSettings settings;
-  settings.samplesPerPixel = options.lightFieldSamples;
-  const FastRenderer renderer(lightField, accel);
-  const auto start = std::chrono::steady_clock::now();
-  const Image rendered = renderer.render(camera, settings);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-
-  const std::string what = fmt::format("light-field render, {}x{}, {} samples/pixel, {:.1f} ms", view.width,
-                                       view.height, settings.samplesPerPixel, ms);
-  for (const char* extension : {".exr", ".png"}) {
-    const std::string path = outputPath(options, std::string("cornell_lightfield") + extension);
-    view.writeImage(path, rendered);
-    files.push_back({what, path});
-  }
+  RenderJobOptions job;
+  job.inputName = outputPath(options, "cornell.plf");
+  job.output = outputPath(options, "cornell_lightfield.exr");
+  job.render.samplesPerPixel = options.lightFieldSamples;
+  job.view = demoView(options);
+  job.threads = global.threads;
+  const RenderJobResult result = RenderJob(job).run(lightField);
+  const Image& rendered = result.image;
+  const std::string png = outputPath(options, "cornell_lightfield.png");
+  job.view.writeImage(png, rendered);
+  const std::string what = fmt::format("light-field render, {}x{}, {} samples/pixel, {:.1f} ms", result.stats.width,
+                                       result.stats.height, result.stats.samplesPerPixel, result.stats.msPerFrameMedian);
+  files.push_back({what, job.output});
+  files.push_back({what, png});
 
   const ImageComparison comparison = compareImages(rendered, reference);
   double lumRendered = 0.0, lumReference = 0.0;
@@ -148,15 +144,14 @@ void runDemo(const DemoOptions& options, const GlobalOptions& global) {
     fail("--output-dir {}: cannot create the directory{}{}", options.outputDir, error ? ": " : "", error.message());
 
   std::vector<DemoFile> files;
-  const Scene scene = makeCornellBox();
-  const Image reference = traceReference(options, scene, global, files);
-  const LightField lightField = bakeLightField(options, files);
-  const Accel accel(lightField.scene);
-  renderAndCompare(options, lightField, accel, reference, files);
+  const Image reference = traceReference(options, global, files);
+  const LightField lightField = bakeLightField(options, global, files);
+  renderAndCompare(options, global, lightField, reference, files);
 
   std::vector<std::string> walkthrough;
   if (options.walkthrough) {
     const ViewOptions view = demoView(options);
+    const Accel accel(lightField.scene);
     walkthrough = runDemoWalkthrough(lightField, accel, view.resolveCamera(lightField.scene),
                                      view.metresPerUnit(lightField.scene),
                                      std::filesystem::absolute(options.outputDir).string());

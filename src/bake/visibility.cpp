@@ -185,15 +185,14 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
   }
   for (const Material& m : scene.materials) {
     h.value(uint8_t(chartKindOf(m.bsdf)));
-    if (const auto* mirror = std::get_if<MirrorBsdf>(&m.bsdf)) {
-      h.value(mirror->reflectance);
-      h.value(uint8_t(mirror->fresnel));
-    }
-    if (const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf)) {
-      h.value(glass->ior);
-      h.value(glass->transmittance);
-      h.value(uint8_t(glass->thin));
-      h.value(glass->absorption);
+    // Specular models bend and weight the chains folded into the field, and transmitting
+    // ones attenuate the gather rays inside them: all their parameters (the model's
+    // parameters() hook, bsdf.h). Other models' parameters (a roughness, an albedo) change
+    // only the propagation, so a field traced before such an edit is reused.
+    if (chartKindOf(m.bsdf) == ChartKind::Specular || describe(m.bsdf).transmits) {
+      h.value(uint32_t(m.bsdf.index()));
+      std::visit([&](const auto& b) { std::decay_t<decltype(b)>::parameters(b, [&](const auto& field) { h.value(field); }); },
+                 m.bsdf);
     }
     // An alpha mask changes what every ray sees; a normal map bends the specular chains
     // (followSpecular shades with surfaceAt's mapped normal), not the other charts' rays.
