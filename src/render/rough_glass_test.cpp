@@ -162,7 +162,9 @@ TEST_F(RoughGlassTest, LightFieldMatchesThePathTracer) {
 // 16², 0.989 at 24² and 32²; a ball so absorbing that only its reflection is seen, σa = 20, is
 // 0.988 at 32²). Hence a 16² map and tolerance 1e-4 here: ball 0.983, image mean 0.997 per
 // channel, relMSE 0.0032; the tolerances are about twice these. Applying the attenuation twice
-// (or not at all) moves the ball's ratio by a factor of about e^∓0.7, far outside them.
+// (or not at all) would scale the light that crossed the ball — about three quarters of its
+// pixels' luminance — by about e^∓2/3 (2/3: the mean chord of a ball of diameter 1), far
+// outside them.
 TEST_F(RoughGlassTest, AbsorbingBallMatchesThePathTracer) {
   BakeSettings settings = bakePreset("draft");
   settings.glossyDirRes = 16;
