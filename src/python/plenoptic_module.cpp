@@ -181,7 +181,8 @@ PYBIND11_MODULE(plenoptic, m) {
 
   // Errors: plenoptic.Error for every failure (the CLI's message, without 'plenoptic: error: '),
   // plenoptic.UsageError (also a ValueError) for a wrong request — what the CLI exits 2 for —
-  // and plenoptic.FileError (also an OSError) for a file that cannot be opened, read or written.
+  // and plenoptic.FileError (also an OSError, with `filename`) for a file that cannot be opened,
+  // read or written (pl::FileError).
   static py::exception<pl::Error> error(m, "Error", PyExc_RuntimeError);
   static py::handle usageError = [&] {
     py::object type = py::reinterpret_steal<py::object>(PyErr_NewExceptionWithDoc(
@@ -190,8 +191,6 @@ PYBIND11_MODULE(plenoptic, m) {
     m.attr("UsageError") = type;
     return type.release();
   }();
-  // plenoptic.FileError (also an OSError, with `filename`) for a file that cannot be opened,
-  // read or written (pl::FileError).
   static py::handle fileError = [&] {
     // Defined in Python for its __str__: the message alone, as for the other errors (OSError's
     // own str would print "[Errno None] None: 'filename'" once filename is set).
