@@ -274,6 +274,28 @@ TEST_F(AtomicWriteTest, CheckOutputPathRefusesWrongExtensionsDirectoriesAndMissi
   std::filesystem::permissions(path("readonly"), std::filesystem::perms::owner_all);
 }
 
+// A file that cannot be written or read is a FileError naming it (the Python module's
+// OSError); a wrong request is not.
+TEST_F(AtomicWriteTest, FileProblemsAreFileErrorsNamingTheFile) {
+  auto filePath = [](const std::function<void()>& call) {
+    try {
+      call();
+    } catch (const FileError& e) {
+      return e.path();
+    } catch (const Error&) {
+      return std::string("other error");
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(filePath([] { checkOutputPath("/no/such/dir/out.exr", {}, "-o"); }), "/no/such/dir/out.exr");
+  std::filesystem::create_directory(path("dir.plf"));
+  EXPECT_EQ(filePath([&] { checkOutputPath(path("dir.plf"), {".plf"}, "-o"); }), path("dir.plf"));
+  EXPECT_EQ(filePath([&] { writeFileAtomically(path("dir.plf"), std::string_view("x")); }), path("dir.plf"));
+  ASSERT_EQ(::mkfifo(path("pipe.exr").c_str(), 0600), 0);
+  EXPECT_EQ(filePath([&] { requireRegularFile(path("pipe.exr")); }), path("pipe.exr"));
+  EXPECT_EQ(filePath([&] { checkOutputPath(path("out.exr"), {".plf"}, "-o"); }), "other error");  // a usage error
+}
+
 TEST_F(AtomicWriteTest, CheckDistinctOutputsComparesResolvedPaths) {
   std::filesystem::create_directory(path("sub"));
   EXPECT_NO_THROW(checkDistinctOutputs({{"-o", path("a.plf")}, {"--visibility", path("a.plv")}, {"--stats", ""}}));

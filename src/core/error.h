@@ -7,6 +7,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace pl {
 
@@ -30,10 +31,29 @@ class UsageError : public Error {
   using Error::Error;
 };
 
+/// An Error opening, reading or writing a file (missing, not readable, directory not
+/// writable), as opposed to what a file contains or how the program was called. Same exit
+/// status as Error; the Python module raises it as an OSError carrying path() as its
+/// filename. The message still names the file itself, as every message does.
+class FileError : public Error {
+ public:
+  FileError(std::string path, const std::string& message) : Error(message), path_(std::move(path)) {}
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
 /// Throws pl::Error with a fmt-formatted message.
 template <typename... Args>
 [[noreturn]] void fail(fmt::format_string<Args...> format, Args&&... args) {
   throw Error(fmt::format(format, std::forward<Args>(args)...));
+}
+
+/// Throws pl::FileError about `path` with a fmt-formatted message.
+template <typename... Args>
+[[noreturn]] void failFile(const std::string& path, fmt::format_string<Args...> format, Args&&... args) {
+  throw FileError(path, fmt::format(format, std::forward<Args>(args)...));
 }
 
 /// Throws pl::UsageError with a fmt-formatted message.

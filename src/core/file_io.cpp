@@ -62,16 +62,16 @@ void checkOutputPath(const std::string& path, std::initializer_list<std::string_
   }
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
-  if (fs::is_directory(status)) fail("{} {}: is a directory", option, path);
-  if (fs::exists(status) && !fs::is_regular_file(status)) fail("{} {}: exists and is not a regular file", option, path);
+  if (fs::is_directory(status)) failFile(path, "{} {}: is a directory", option, path);
+  if (fs::exists(status) && !fs::is_regular_file(status)) failFile(path, "{} {}: exists and is not a regular file", option, path);
   const fs::path parentPath = fs::path(path).parent_path();
   const std::string parent = parentPath.empty() ? std::string(".") : parentPath.string();
   const fs::file_status parentStatus = fs::status(parent, ec);
-  if (!fs::exists(parentStatus)) fail("{} {}: directory '{}' does not exist", option, path, parent);
-  if (!fs::is_directory(parentStatus)) fail("{} {}: '{}' is not a directory", option, path, parent);
+  if (!fs::exists(parentStatus)) failFile(path, "{} {}: directory '{}' does not exist", option, path, parent);
+  if (!fs::is_directory(parentStatus)) failFile(path, "{} {}: '{}' is not a directory", option, path, parent);
   // access(2) also reports a read-only file system (EROFS), which permission bits do not show.
   if (::access(parent.c_str(), W_OK | X_OK) != 0)
-    fail("{} {}: cannot write in directory '{}': {}", option, path, parent, std::strerror(errno));
+    failFile(path, "{} {}: cannot write in directory '{}': {}", option, path, parent, std::strerror(errno));
 }
 
 void checkDistinctOutputs(std::initializer_list<OutputFlag> outputs) {
@@ -96,15 +96,15 @@ void requireRegularFile(const std::string& path) {
                      : S_ISBLK(info.st_mode)  ? "a block device"
                      : S_ISSOCK(info.st_mode) ? "a socket"
                                               : "not a file";
-  fail("{}: not a regular file ({})", path, kind);
+  failFile(path, "{}: not a regular file ({})", path, kind);
 }
 
 PendingFile::PendingFile(std::string target) : target_(std::move(target)) {
   const std::filesystem::path parent = std::filesystem::path(target_).parent_path();
   std::error_code ec;
   if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
-    fail("{}: cannot write: directory '{}' does not exist", target_, parent.string());
-  if (std::filesystem::is_directory(target_, ec)) fail("{}: cannot write: is a directory", target_);
+    failFile(target_, "{}: cannot write: directory '{}' does not exist", target_, parent.string());
+  if (std::filesystem::is_directory(target_, ec)) failFile(target_, "{}: cannot write: is a directory", target_);
   temporary_ = temporaryPathBeside(target_);
   interruptSlot_ = registerTemporaryFile(temporary_.c_str());
 }
@@ -130,7 +130,7 @@ void PendingFile::commit(FileSync sync) {
     std::filesystem::rename(temporary_, target_);
   } catch (const std::exception& e) {
     discard();
-    fail("{}: cannot write: {}", target_, e.what());
+    failFile(target_, "{}: cannot write: {}", target_, e.what());
   }
   open_ = false;
   if (sync == FileSync::durable) {
@@ -148,7 +148,7 @@ void writeFileAtomically(const std::string& path, const std::function<void(const
     write(file.temporaryPath());
   } catch (const std::exception& e) {
     file.discard();
-    fail("{}: cannot write: {}", path, e.what());
+    failFile(path, "{}: cannot write: {}", path, e.what());
   }
   file.commit(sync);
 }
@@ -172,7 +172,7 @@ void writeFileAtomically(const std::string& path, std::string_view bytes, FileSy
 MappedFile::MappedFile(const std::string& path) {
   requireRegularFile(path);
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) fail("{}: cannot open for reading: {}", path, std::strerror(errno));
+  if (fd < 0) failFile(path, "{}: cannot open for reading: {}", path, std::strerror(errno));
   struct stat info {};
   if (::fstat(fd, &info) != 0) {
     const int error = errno;

@@ -137,7 +137,7 @@ EnvImage loadEnvironment(const std::string& path) {
   }
   std::error_code ec;
   if (fs::is_directory(path, ec)) return facesToCube(facePathsInDirectory(path));
-  if (!fs::exists(path, ec)) fail("{}: no such file or directory", path);
+  if (!fs::exists(path, ec)) failFile(path, "{}: no such file or directory", path);
 
   Image image = readImage(path);
   if (image.width == 2 * image.height && image.height > 0) return LatLongMap{std::move(image)};

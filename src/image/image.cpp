@@ -39,14 +39,14 @@ bool isHdrExtension(const std::string& path) {
 namespace detail {
 std::vector<unsigned char> readFileBytes(const std::string& path) {
   std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) fail("{}: cannot open: {}", path, std::strerror(errno));
+  if (!file) failFile(path, "{}: cannot open: {}", path, std::strerror(errno));
   std::vector<unsigned char> bytes;
   unsigned char buffer[1 << 16];
   size_t n;
   while ((n = std::fread(buffer, 1, sizeof buffer, file)) > 0) bytes.insert(bytes.end(), buffer, buffer + n);
   const bool failed = std::ferror(file) != 0;
   std::fclose(file);
-  if (failed) fail("{}: read error", path);
+  if (failed) failFile(path, "{}: read error", path);
   return bytes;
 }
 
@@ -102,8 +102,8 @@ Image hdrAs(Image image, ImageDecode decode) {
 /// The path names an existing regular file (else pl::Error naming it).
 void requireImageFile(const std::string& path) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail("{}: no such file", path);
-  if (std::filesystem::is_directory(path, ec)) fail("{}: is a directory, not an image file", path);
+  if (!std::filesystem::exists(path, ec)) failFile(path, "{}: no such file", path);
+  if (std::filesystem::is_directory(path, ec)) failFile(path, "{}: is a directory, not an image file", path);
   requireRegularFile(path);
 }
 }  // namespace

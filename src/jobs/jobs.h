@@ -38,10 +38,13 @@ struct ViewSettings {
   // Image size in pixels.
   int width = 640;
   int height = 480;
-  // Camera: `camera` NAME, else the camera the scene file's settings name, else the scene's
+  // Camera: `cameraDesc`, else `camera` NAME, else the camera the scene file's settings name, else the scene's
   // first camera, else an automatic camera framing the scene. eye/target/up/fov/aperture/
   // focus distance, when given, override the chosen camera's values.
   std::string camera;
+  /// A camera given whole (the Python module's Camera): wins over `camera` and the scene's
+  /// cameras, lens included (fNumber 0 = pinhole); the overrides below still apply to it.
+  std::optional<CameraDesc> cameraDesc;
   std::vector<float> eye, target, up;  ///< 3 components each when given (scene units)
   float fovDegrees = 0.0f;             ///< vertical; 0 = keep the camera's own
   float fNumberLens = 0.0f;            ///< thin lens f-number (0 = pinhole/keep)

@@ -12,7 +12,9 @@ namespace pl {
 
 CameraDesc ViewSettings::resolveCamera(const Scene& scene) const {
   CameraDesc desc;
-  if (!camera.empty()) {
+  if (cameraDesc) {
+    desc = *cameraDesc;
+  } else if (!camera.empty()) {
     desc = scene.camera(camera);
   } else if (scene.settings.camera) {  // the scene file's suggestion ("settings": {"camera": ...})
     desc = scene.camera(*scene.settings.camera);

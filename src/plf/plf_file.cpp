@@ -729,7 +729,7 @@ class PlfReader {
   explicit PlfReader(const std::string& path) : path_(path) {
     requireRegularFile(path);  // before open(2), which would block on a FIFO
     file_.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (file_.fd < 0) fail("{}: cannot open light field: {}", path, errnoText());
+    if (file_.fd < 0) failFile(path, "{}: cannot open light field: {}", path, errnoText());
     struct stat st {};
     if (::fstat(file_.fd, &st) != 0) fail("{}: cannot stat: {}", path, errnoText());
     if (!S_ISREG(st.st_mode)) fail("{}: not a regular file", path);

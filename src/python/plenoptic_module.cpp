@@ -5,11 +5,14 @@
 // a trace, bake or render runs.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/eval.h>
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <memory>
+#include <tuple>
 #include <optional>
 #include <string>
 #include <utility>
@@ -17,11 +20,15 @@
 #include <vector>
 
 #include "core/error.h"
+#include "env/env.h"
+#include "env/ibl.h"
 #include "image/compare.h"
 #include "image/image.h"
 #include "jobs/jobs.h"
 #include "plf/compression.h"
 #include "plf/plf_file.h"
+#include "realtime/camera_path.h"
+#include "realtime/walkthrough.h"
 #include "scene/scene.h"
 
 namespace py = pybind11;
@@ -70,12 +77,90 @@ Rgb nonNegative(const Rgb& value, const char* what) {
   return value;
 }
 
-/// The camera and image-size arguments shared by trace and render.
-ViewSettings viewSettings(int width, int height, const std::optional<std::string>& camera) {
+Vec3 toVec3(const std::vector<float>& v, const char* what) {
+  if (v.size() != 3) throw UsageError(fmt::format("Camera: {} must be three numbers (x, y, z)", what));
+  return Vec3(v[0], v[1], v[2]);
+}
+
+/// A camera built in Python: pinhole (fstop 0) or thin lens, the scene's units. Checked here
+/// (UsageError) with the renderers' own camera checks, so a bad camera fails when it is made.
+CameraDesc makeCamera(const std::vector<float>& eye, const std::vector<float>& target, const std::vector<float>& up,
+                      float fov, float fstop, float focusDistance, const std::string& name) {
+  CameraDesc desc;
+  desc.name = name;
+  desc.eye = toVec3(eye, "eye");
+  desc.target = toVec3(target, "target");
+  desc.up = toVec3(up, "up");
+  desc.fovYDegrees = fov;
+  if (!(fstop >= 0.0f) || !std::isfinite(fstop))
+    throw UsageError(fmt::format("Camera: fstop {} must be positive (or 0 for a pinhole)", fstop));
+  if (!(focusDistance >= 0.0f) || !std::isfinite(focusDistance))
+    throw UsageError(fmt::format("Camera: focus_distance {} must be positive (or 0 for the distance to the target)",
+                                 focusDistance));
+  desc.fNumber = fstop;
+  desc.focusDistance = focusDistance;
+  try {
+    CameraDesc pinhole = desc;  // the lens needs the scene's unit, checked when rendering
+    pinhole.fNumber = 0.0f;
+    (void)Camera(pinhole, 1, 1, false, 1.0f);
+  } catch (const Error& e) {
+    throw UsageError(e.what());
+  }
+  return desc;
+}
+
+/// The camera and image-size arguments shared by trace and render. camera: None (the scene's
+/// default), a camera name of the scene (str) or a Camera.
+ViewSettings viewSettings(int width, int height, const py::object& camera) {
   ViewSettings view;
   view.width = width;
   view.height = height;
-  if (camera) view.camera = *camera;
+  if (camera.is_none()) return view;
+  if (py::isinstance<py::str>(camera)) view.camera = camera.cast<std::string>();
+  else if (py::isinstance<CameraDesc>(camera)) view.cameraDesc = camera.cast<CameraDesc>();
+  else throw py::value_error("camera: expected None, a camera name (str) or a plenoptic.Camera");
+  return view;
+}
+
+/// A lat-long environment array (height, 2·height, 3), float32, radiance; ValueError otherwise.
+LatLongMap envFromArray(const py::handle& object, const char* what) {
+  LatLongMap map;
+  map.image = fromArray(object, what);
+  if (map.image.width != 2 * map.image.height)
+    throw UsageError(fmt::format("{}: a lat-long environment must be twice as wide as high, got {}x{}", what,
+                                 map.image.width, map.image.height));
+  return map;
+}
+
+/// `value` within [low, high], else a UsageError naming `what` (the command line's ranges).
+int inRange(int value, int low, int high, const char* what) {
+  if (value < low || value > high) throw UsageError(fmt::format("{} {} is out of range ({}..{})", what, value, low, high));
+  return value;
+}
+
+/// The exposure and tone-mapping keywords of exposure_scale, tone_map and write_image, as the
+/// command line's --exposure/--fstop/--shutter/--iso/--tonemap/--key/--auto-key/--white.
+ViewSettings pictureSettings(std::optional<float> ev, std::optional<float> fstop, std::optional<float> shutter,
+                             std::optional<float> iso, const std::string& tonemap, std::optional<float> key, bool autoKey,
+                             std::optional<float> white) {
+  const int given = int(fstop.has_value()) + int(shutter.has_value()) + int(iso.has_value());
+  if (given != 0 && given != 3)
+    throw UsageError("fstop, shutter and iso: give all three (photographic exposure) or none");
+  ViewSettings view;
+  view.exposureEv = ev;
+  view.fstop = fstop;
+  view.shutterSeconds = shutter;
+  view.iso = iso;
+  view.tonemap = tonemap;
+  view.key = key;
+  view.autoKey = autoKey;
+  view.white = white;
+  try {
+    (void)view.exposureScale();
+    (void)view.toneMapSettings();
+  } catch (const Error& e) {
+    throw UsageError(e.what());
+  }
   return view;
 }
 
@@ -95,7 +180,9 @@ PYBIND11_MODULE(plenoptic, m) {
       "Images are float32 arrays (height, width, 3) of linear Rec.709 radiance in W/(sr m^2).";
 
   // Errors: plenoptic.Error for every failure (the CLI's message, without 'plenoptic: error: '),
-  // plenoptic.UsageError (also a ValueError) for a wrong request — what the CLI exits 2 for.
+  // plenoptic.UsageError (also a ValueError) for a wrong request — what the CLI exits 2 for —
+  // and plenoptic.FileError (also an OSError, with `filename`) for a file that cannot be opened,
+  // read or written (pl::FileError).
   static py::exception<pl::Error> error(m, "Error", PyExc_RuntimeError);
   static py::handle usageError = [&] {
     py::object type = py::reinterpret_steal<py::object>(PyErr_NewExceptionWithDoc(
@@ -104,15 +191,57 @@ PYBIND11_MODULE(plenoptic, m) {
     m.attr("UsageError") = type;
     return type.release();
   }();
+  static py::handle fileError = [&] {
+    // Defined in Python for its __str__: the message alone, as for the other errors (OSError's
+    // own str would print "[Errno None] None: 'filename'" once filename is set).
+    py::dict scope;
+    scope["__builtins__"] = py::module_::import("builtins");
+    scope["Error"] = error;
+    py::exec(R"(
+class FileError(Error, OSError):
+    """A file that cannot be opened, read or written; `filename` names it."""
+    __module__ = "plenoptic"
+    def __str__(self):
+        return str(self.args[0]) if self.args else ""
+)",
+             scope);
+    py::object type = scope["FileError"];
+    m.attr("FileError") = type;
+    return type.release();
+  }();
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
+    } catch (const pl::FileError& e) {
+      py::object exception = fileError(e.what());
+      exception.attr("filename") = e.path();
+      PyErr_SetObject(fileError.ptr(), exception.ptr());
     } catch (const pl::UsageError& e) {
       PyErr_SetString(usageError.ptr(), e.what());
     } catch (const pl::Error& e) {
       PyErr_SetString(error.ptr(), e.what());
     }
   });
+
+  py::class_<CameraDesc>(m, "Camera",
+                         "A camera: eye, target and up in scene units, vertical field of view in degrees, thin lens\n"
+                         "f-number fstop (0 = pinhole) focused at focus_distance (scene units; 0 = the distance to target).")
+      .def(py::init(&makeCamera), py::arg("eye"), py::arg("target"), py::arg("up") = std::vector<float>{0.0f, 1.0f, 0.0f},
+           py::arg("fov") = 40.0f, py::arg("fstop") = 0.0f, py::arg("focus_distance") = 0.0f, py::arg("name") = "python")
+      .def_property_readonly("name", [](const CameraDesc& c) { return c.name; })
+      .def_property_readonly("eye", [](const CameraDesc& c) { return std::vector<float>{c.eye.x, c.eye.y, c.eye.z}; })
+      .def_property_readonly("target",
+                             [](const CameraDesc& c) { return std::vector<float>{c.target.x, c.target.y, c.target.z}; })
+      .def_property_readonly("up", [](const CameraDesc& c) { return std::vector<float>{c.up.x, c.up.y, c.up.z}; })
+      .def_property_readonly("fov", [](const CameraDesc& c) { return c.fovYDegrees; }, "vertical, degrees")
+      .def_property_readonly("fstop", [](const CameraDesc& c) { return c.fNumber; }, "thin lens f-number (0 = pinhole)")
+      .def_property_readonly("focus_distance", [](const CameraDesc& c) { return c.focusDistance; }, "scene units")
+      .def("__repr__", [](const CameraDesc& c) {
+        return fmt::format("plenoptic.Camera(eye=[{}, {}, {}], target=[{}, {}, {}], up=[{}, {}, {}], fov={}, fstop={}, "
+                           "focus_distance={}, name='{}')",
+                           c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z,
+                           c.fovYDegrees, c.fNumber, c.focusDistance, c.name);
+      });
 
   py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene", "A loaded scene (units as in its file; the built-in Cornell box is in millimetres).")
       .def_property_readonly("source", [](const Scene& s) { return s.sourcePath; }, "'cornell' or the file it was loaded from")
@@ -131,6 +260,8 @@ PYBIND11_MODULE(plenoptic, m) {
                              })
       .def_property_readonly("light_count", [](const Scene& s) { return s.lights.size(); },
                              "point, spot and directional lights (emissive surfaces are materials)")
+      .def("camera", [](const Scene& s, const std::string& name) { return s.camera(name); }, py::arg("name"),
+           "The scene's camera `name` as a Camera")
       .def("emission",
            [](const Scene& s, const std::string& material) {
              for (const Material& mat : s.materials)
@@ -169,7 +300,7 @@ PYBIND11_MODULE(plenoptic, m) {
 
   m.def(
       "trace",
-      [](const Scene& scene, int width, int height, int spp, uint64_t seed, int threads, std::optional<std::string> camera,
+      [](const Scene& scene, int width, int height, int spp, uint64_t seed, int threads, const py::object& camera,
          int maxDepth, bool variance) {
         TraceJobOptions options;
         options.sceneName = scene.sourcePath;
@@ -192,7 +323,8 @@ PYBIND11_MODULE(plenoptic, m) {
       py::arg("threads") = 0, py::arg("camera") = py::none(), py::arg("max_depth") = -1, py::arg("variance") = false,
       "Path-traces `scene` (what `plenoptic trace` does): returns (radiance, stats), or (radiance, stats, variance of\n"
       "the mean) with variance=True. radiance: float32 (height, width, 3), W/(sr m^2); stats: the --stats JSON.\n"
-      "threads=0: all hardware threads. camera: a camera name of the scene (default: its first, else automatic).");
+      "threads=0: all hardware threads. camera: a Camera, or a camera name of the scene (default: its first, else\n"
+      "automatic).");
 
   py::class_<PyLightField>(m, "LightField", "A baked light field.")
       .def_readonly("stats", &PyLightField::stats, "The bake's --stats JSON as a dict (empty for a loaded file)")
@@ -206,7 +338,7 @@ PYBIND11_MODULE(plenoptic, m) {
           py::arg("path"), py::arg("compress") = "none", "Writes the .plf file (compress: none, lossless, bc1, hdr).")
       .def(
           "render",
-          [](const PyLightField& lf, int width, int height, int samples, std::optional<std::string> camera, uint64_t seed,
+          [](const PyLightField& lf, int width, int height, int samples, const py::object& camera, uint64_t seed,
              bool reference, int threads) {
             RenderJobOptions options;
             options.render.samplesPerPixel = samples;
@@ -225,7 +357,52 @@ PYBIND11_MODULE(plenoptic, m) {
           py::arg("width") = 640, py::arg("height") = 480, py::arg("samples") = 0, py::arg("camera") = py::none(),
           py::arg("seed") = 0, py::arg("reference") = false, py::arg("threads") = 0,
           "Renders the light field (what `plenoptic render` does): float32 (height, width, 3), W/(sr m^2).\n"
-          "samples=0: 1 per pixel for a pinhole camera, 16 for a thin lens. reference=True: the reference renderer.");
+          "samples=0: 1 per pixel for a pinhole camera, 16 for a thin lens. reference=True: the reference renderer.\n"
+          "camera: a Camera, or a camera name of the scene (default: its first, else automatic).")
+      .def(
+          "render_path",
+          [](const PyLightField& lf, const py::object& path, int width, int height, int samples,
+             const py::object& camera, uint64_t seed, bool reference, int threads) {
+            // The frames' cameras: a list of Cameras as they are, or a camera path file's frames
+            // (realtime/camera_path.h: frame k at t0 + k/fps) posed on `camera` (its lens, and
+            // its fov where the path has none).
+            std::vector<CameraDesc> cameras;
+            const ViewSettings base = viewSettings(width, height, camera);
+            if (py::isinstance<py::str>(path)) {
+              const CameraPath cameraPath = loadCameraPath(path.cast<std::string>());
+              const CameraDesc baseCamera = base.resolveCamera(lf.lightField->scene);
+              for (int frame = 0; frame < cameraPath.frameCount(); ++frame)
+                cameras.push_back(applyPose(baseCamera, cameraPath.at(cameraPath.frameTime(frame))));
+            } else {
+              for (const py::handle item : py::iter(path)) {
+                if (!py::isinstance<CameraDesc>(item))
+                  throw py::value_error("render_path: expected a camera path file name (str) or a list of plenoptic.Camera");
+                cameras.push_back(item.cast<CameraDesc>());
+              }
+              if (cameras.empty()) throw UsageError("render_path: the list of cameras is empty");
+            }
+            std::vector<Image> frames;
+            {
+              py::gil_scoped_release release;
+              for (const CameraDesc& frameCamera : cameras) {
+                RenderJobOptions options;
+                options.render.samplesPerPixel = samples;
+                options.render.seed = seed;
+                options.reference = reference;
+                options.view = base;
+                options.view.cameraDesc = frameCamera;
+                options.threads = threads;
+                frames.push_back(RenderJob(std::move(options)).run(*lf.lightField).image);
+              }
+            }
+            py::list arrays;
+            for (const Image& frame : frames) arrays.append(toArray(frame));
+            return arrays;
+          },
+          py::arg("path"), py::arg("width") = 640, py::arg("height") = 480, py::arg("samples") = 0,
+          py::arg("camera") = py::none(), py::arg("seed") = 0, py::arg("reference") = false, py::arg("threads") = 0,
+          "Renders a walk-through: path is a camera path JSON file (what `plenoptic render --path` renders, frame k at\n"
+          "t0 + k/fps, posed on `camera`) or a list of Cameras. Returns a list of float32 (height, width, 3) frames.");
 
   m.def(
       "bake",
@@ -271,9 +448,113 @@ PYBIND11_MODULE(plenoptic, m) {
 
   m.def("read_image", [](const std::string& path) { return toArray(readImage(path)); }, py::arg("path"),
         "Reads .exr, .hdr, .pfm (linear) or .png/.jpg (sRGB-decoded): float32 (height, width, 3).");
+  // The exposure and tone-mapping keywords shared by exposure_scale, tone_map and write_image.
+  const auto pictureArgs = [] {
+    return std::make_tuple(py::arg("ev") = py::none(), py::arg("fstop") = py::none(), py::arg("shutter") = py::none(),
+                           py::arg("iso") = py::none(), py::arg("tonemap") = "reinhard", py::arg("key") = py::none(),
+                           py::arg("auto_key") = false, py::arg("white") = py::none());
+  };
+  using OptFloat = std::optional<float>;
+  std::apply(
+      [&](auto... args) {
+        m.def(
+            "exposure_scale",
+            [](OptFloat ev, OptFloat fstop, OptFloat shutter, OptFloat iso, const std::string& tonemap, OptFloat key,
+               bool autoKey, OptFloat white) {
+              return pictureSettings(ev, fstop, shutter, iso, tonemap, key, autoKey, white).exposureScale();
+            },
+            args...,
+            "The factor from radiance to pixel value (camera/exposure.h): 1 with nothing given, 2^ev, or the ISO 12232\n"
+            "saturation-based exposure of fstop, shutter (seconds) and iso (all three), times 2^ev.");
+        m.def(
+            "tone_map",
+            [](const py::handle& image, OptFloat ev, OptFloat fstop, OptFloat shutter, OptFloat iso,
+               const std::string& tonemap, OptFloat key, bool autoKey, OptFloat white) {
+              const ViewSettings view = pictureSettings(ev, fstop, shutter, iso, tonemap, key, autoKey, white);
+              const Image radiance = fromArray(image, "tone_map");
+              const Image8 display = toneMap(exposedCopy(radiance, view.exposureScale()), view.toneMapSettings());
+              py::array_t<uint8_t, py::array::c_style> array(
+                  {py::ssize_t(display.height), py::ssize_t(display.width), py::ssize_t(3)});
+              std::memcpy(array.mutable_data(), display.rgb.data(), display.rgb.size());
+              return array;
+            },
+            py::arg("image"), args...,
+            "Exposure and tone mapping as the command line's PNG output: uint8 (height, width, 3) sRGB. tonemap:\n"
+            "reinhard (key: default 0.18 without an exposure, none with one; auto_key estimates it), linear, clamp;\n"
+            "white: the luminance mapped to 1.");
+        m.def(
+            "write_image",
+            [](const std::string& path, const py::handle& image, OptFloat ev, OptFloat fstop, OptFloat shutter,
+               OptFloat iso, const std::string& tonemap, OptFloat key, bool autoKey, OptFloat white) {
+              ViewSettings::checkImageOutput(path, "write_image");
+              const ViewSettings view = pictureSettings(ev, fstop, shutter, iso, tonemap, key, autoKey, white);
+              view.writeImage(path, fromArray(image, "write_image"));
+            },
+            py::arg("path"), py::arg("image"), args...,
+            "Writes a float32 (height, width, 3) radiance array (atomically): .exr, .hdr, .pfm get radiance times the\n"
+            "exposure; .png the exposure, tone mapping and sRGB encoding (tone_map).");
+      },
+      pictureArgs());
+  // Environment tools (env/ibl.h) on lat-long arrays (height, 2·height, 3), the layout of
+  // `plenoptic env` with --layout latlong; the command line's ranges.
+  constexpr int kMaxMapSize = 16384, kMaxSamples = 1 << 20;
   m.def(
-      "write_image", [](const std::string& path, const py::handle& image) { writeHdrImage(path, fromArray(image, "write_image")); },
-      py::arg("path"), py::arg("image"), "Writes a float32 (height, width, 3) array as .exr, .hdr or .pfm (atomically).");
+      "sh9",
+      [](const py::handle& env) {
+        const EnvImage map = envFromArray(env, "sh9");
+        Sh9 sh;
+        {
+          py::gil_scoped_release release;
+          sh = projectSh9(map);
+        }
+        py::array_t<double, py::array::c_style> array({py::ssize_t(9), py::ssize_t(3)});
+        for (int k = 0; k < 9; ++k)
+          for (int c = 0; c < 3; ++c) array.mutable_at(k, c) = sh.coefficients[size_t(k)][c];
+        return array;
+      },
+      py::arg("env"),
+      "The 9 radiance SH coefficients (bands 0-2, Ramamoorthi-Hanrahan 2001 basis order) of a lat-long environment\n"
+      "(height, 2*height, 3) float32 radiance: float64 (9, 3), W/m^2 per unit basis.");
+  m.def(
+      "irradiance",
+      [](const py::handle& env, int size, const std::string& method) {
+        if (method != "sh" && method != "brute") throw UsageError("irradiance: method must be 'sh' or 'brute'");
+        inRange(size, 1, 4096, "irradiance: size");
+        const EnvImage map = envFromArray(env, "irradiance");
+        EnvImage result;
+        {
+          py::gil_scoped_release release;
+          result = method == "sh" ? irradianceFromSh(projectSh9(map), false, size) : irradianceBruteForce(map, false, size);
+        }
+        return toArray(std::get<LatLongMap>(result).image);
+      },
+      py::arg("env"), py::arg("size") = 32, py::arg("method") = "sh",
+      "Irradiance E(n) = integral of L max(0, n.w) dw, W/m^2, at each texel direction of a lat-long map of height\n"
+      "`size`: float32 (size, 2*size, 3). method: 'sh' (from sh9) or 'brute' (sum over every texel of env).");
+  m.def(
+      "prefilter",
+      [](const py::handle& env, int levels, int height, int samples, const std::string& model) {
+        PrefilterOptions options;
+        if (model != "ggx" && model != "blinn-phong")
+          throw UsageError(fmt::format("prefilter: unknown model '{}' (expected ggx or blinn-phong)", model));
+        options.model = parseSpecularModel(model);
+        options.levels = inRange(levels, 1, 32, "prefilter: levels");
+        options.height = inRange(height, 4, kMaxMapSize, "prefilter: height");
+        options.samples = inRange(samples, 1, kMaxSamples, "prefilter: samples");
+        const EnvImage map = envFromArray(env, "prefilter");
+        std::vector<PrefilteredLevel> result;
+        {
+          py::gil_scoped_release release;
+          result = prefilter(map, options);
+        }
+        py::list out;
+        for (const PrefilteredLevel& level : result) out.append(py::make_tuple(level.roughness, toArray(level.map.image)));
+        return out;
+      },
+      py::arg("env"), py::arg("levels") = 6, py::arg("height") = 128, py::arg("samples") = 1024,
+      py::arg("model") = "ggx",
+      "Prefiltered specular maps (split sum, Karis 2013): a list of (roughness, float32 lat-long radiance) for\n"
+      "roughness k/(levels-1); level k has height `height` halved k times, not below 16. model: ggx, blinn-phong.");
   m.def(
       "compare",
       [](const py::handle& a, const py::handle& reference) {

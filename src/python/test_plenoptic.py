@@ -116,3 +116,183 @@ def test_errors_are_plenoptic_exceptions_with_the_cli_messages(cornell, tmp_path
         cornell.set_emission("light", [-1.0, 0.0, 0.0])
     with pytest.raises(plenoptic.Error, match="missing.plf: cannot open light field"):
         plenoptic.load_light_field(str(tmp_path / "missing.plf"))
+
+
+def test_file_errors_are_oserrors_naming_the_file_and_bad_arguments_are_valueerrors(cornell, tmp_path):
+    assert issubclass(plenoptic.FileError, plenoptic.Error) and issubclass(plenoptic.FileError, OSError)
+    assert not issubclass(plenoptic.FileError, ValueError)
+    missing = str(tmp_path / "missing")
+    cases = [(lambda: plenoptic.load_scene(missing + ".obj"), missing + ".obj"),
+             (lambda: plenoptic.load_light_field(missing + ".plf"), missing + ".plf"),
+             (lambda: plenoptic.read_image(missing + ".exr"), missing + ".exr"),
+             (lambda: plenoptic.write_image(missing + "/x.pfm", np.zeros((2, 2, 3), np.float32)), missing + "/x.pfm")]
+    for call, name in cases:
+        with pytest.raises(OSError) as raised:
+            call()
+        assert raised.value.filename == name and name in str(raised.value)
+        assert isinstance(raised.value, plenoptic.Error) and not isinstance(raised.value, ValueError)
+    lf = plenoptic.bake(cornell, preset="draft")
+    with pytest.raises(OSError) as raised:
+        lf.render_path(missing + ".json", width=4, height=4)
+    assert raised.value.filename == missing + ".json"
+    # What is wrong with the request, not with a file, stays a ValueError and no OSError.
+    with pytest.raises(ValueError) as raised:
+        cornell.set_emission("nothing", [1.0, 1.0, 1.0])
+    assert isinstance(raised.value, plenoptic.Error) and not isinstance(raised.value, OSError)
+    # A file that exists but holds garbage is an Error about its content, not an OSError.
+    garbage = tmp_path / "garbage.plf"
+    garbage.write_bytes(b"not a light field")
+    with pytest.raises(plenoptic.Error, match="garbage.plf") as raised:
+        plenoptic.load_light_field(str(garbage))
+    assert not isinstance(raised.value, OSError)
+
+
+def test_a_python_camera_equals_the_same_camera_given_on_the_command_line(cornell):
+    default = cornell.camera("default")
+    camera = plenoptic.Camera(eye=default.eye, target=default.target, up=default.up, fov=default.fov)
+    assert camera.fov == pytest.approx(default.fov) and camera.fstop == 0.0 and camera.eye == default.eye
+    by_name, _ = plenoptic.trace(cornell, width=16, height=12, spp=2, seed=3, camera="default")
+    by_camera, stats = plenoptic.trace(cornell, width=16, height=12, spp=2, seed=3, camera=camera)
+    assert stats["camera"] == "python"
+    assert np.array_equal(by_name, by_camera)
+    # A camera looking elsewhere gives another picture; a narrower fov another again.
+    moved = plenoptic.Camera(eye=[default.eye[0] + 100.0, default.eye[1], default.eye[2]], target=default.target,
+                             fov=default.fov)
+    assert not np.array_equal(plenoptic.trace(cornell, width=16, height=12, spp=2, seed=3, camera=moved)[0], by_name)
+
+
+@pytest.mark.skipif(not BINARY, reason="PLENOPTIC_BINARY not set")
+def test_a_python_thin_lens_camera_equals_the_command_line_flags(cornell, tmp_path):
+    camera = plenoptic.Camera([278.0, 273.0, -600.0], [278.0, 273.0, 0.0], fov=35.0, fstop=2.0, focus_distance=700.0)
+    out = tmp_path / "cli.pfm"
+    subprocess.run([BINARY, "trace", "cornell", "-o", str(out), "--width", "16", "--height", "12", "--spp", "4",
+                    "--eye", "278,273,-600", "--target", "278,273,0", "--up", "0,1,0", "--fov", "35",
+                    "--aperture", "2", "--focus-distance", "700", "--quiet"], check=True, capture_output=True)
+    image, _ = plenoptic.trace(cornell, width=16, height=12, spp=4, camera=camera)
+    assert np.array_equal(plenoptic.read_image(str(out)), image)
+
+
+def test_light_field_renders_with_a_python_camera_and_along_a_camera_path(cornell, tmp_path):
+    lf = plenoptic.bake(cornell, preset="draft")
+    default = cornell.camera("default")
+    camera = plenoptic.Camera(default.eye, default.target, default.up, default.fov)
+    frame = lf.render(width=24, height=16, camera=camera)
+    assert np.array_equal(frame, lf.render(width=24, height=16, camera="default"))
+    moved = plenoptic.Camera([default.eye[0] + 100.0, default.eye[1], default.eye[2]], default.target, fov=default.fov)
+    frames = lf.render_path([camera, moved], width=24, height=16)
+    assert len(frames) == 2 and frames[0].shape == (16, 24, 3) and frames[0].dtype == np.float32
+    assert np.array_equal(frames[0], frame) and np.array_equal(frames[1], lf.render(width=24, height=16, camera=moved))
+    # A path file of 0.1 s at 20 fps: 3 frames, the first on the first keyframe, the last on the last.
+    path = tmp_path / "walk.json"
+    path.write_text(json.dumps({"fps": 20, "keyframes": [
+        {"time": 0.0, "eye": default.eye, "target": default.target, "fov": default.fov},
+        {"time": 0.1, "eye": moved.eye, "target": default.target, "fov": default.fov}]}))
+    walked = lf.render_path(str(path), width=24, height=16)
+    assert len(walked) == 3
+    assert np.array_equal(walked[0], frame) and np.array_equal(walked[2], frames[1])
+    assert not np.array_equal(walked[1], walked[0]) and not np.array_equal(walked[1], walked[2])
+
+
+def test_bad_cameras_and_camera_paths_raise(cornell, tmp_path):
+    with pytest.raises(ValueError, match="coincide"):
+        plenoptic.Camera([0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match="field of view"):
+        plenoptic.Camera([0.0, 0.0, 1.0], [0.0, 0.0, 0.0], fov=180.0)
+    with pytest.raises(ValueError, match="fstop"):
+        plenoptic.Camera([0.0, 0.0, 1.0], [0.0, 0.0, 0.0], fstop=-1.0)
+    with pytest.raises(ValueError, match="three numbers"):
+        plenoptic.Camera([0.0, 1.0], [0.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match="camera"):
+        plenoptic.trace(cornell, width=4, height=4, spp=1, camera=3)
+    lf = plenoptic.bake(cornell, preset="draft")
+    with pytest.raises(ValueError, match="empty"):
+        lf.render_path([], width=4, height=4)
+    with pytest.raises(ValueError, match="list of plenoptic.Camera"):
+        lf.render_path(["default"], width=4, height=4)
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"keyframes": [{"time": 0, "eye": [0, 0], "target": [0, 0, 0]}]}')
+    with pytest.raises(plenoptic.Error, match="bad.json"):
+        lf.render_path(str(bad), width=4, height=4)
+
+
+def test_exposure_scale_follows_the_closed_forms():
+    assert plenoptic.exposure_scale() == 1.0
+    assert plenoptic.exposure_scale(ev=1.0) == pytest.approx(2.0)
+    assert plenoptic.exposure_scale(ev=-2.0) == pytest.approx(0.25)
+    # ISO 12232 saturation exposure: 1 / (1.2 * 2^EV100), EV100 = log2(N^2/t * 100/S).
+    ev100 = np.log2(16.0 ** 2 / 0.008 * 100.0 / 200.0)
+    assert plenoptic.exposure_scale(fstop=16.0, shutter=0.008, iso=200.0) == pytest.approx(1.0 / (1.2 * 2.0 ** ev100),
+                                                                                           rel=1e-5)
+    with pytest.raises(ValueError, match="all three"):
+        plenoptic.exposure_scale(fstop=16.0)
+    with pytest.raises(ValueError, match="tonemap|reinhard"):
+        plenoptic.exposure_scale(tonemap="filmic")
+
+
+def test_tone_map_encodes_srgb_and_write_image_png_equals_the_command_line(tmp_path):
+    # clamp keeps values in [0, 1]; the sRGB encoding of 0.5 is 0.7354 -> 188, of 0.0031308 -> 0.04045 -> 10.
+    flat = np.full((2, 3, 3), 0.5, dtype=np.float32)
+    flat[0, 0] = [0.0, 1.0, 0.0031308]
+    mapped = plenoptic.tone_map(flat, tonemap="clamp")
+    assert mapped.dtype == np.uint8 and mapped.shape == (2, 3, 3)
+    assert (mapped[1] == 188).all() and mapped[0, 0].tolist() == [0, 255, 10]
+    # Exposure scales before the curve: ev=1 on 0.25 is 0.5.
+    assert np.array_equal(plenoptic.tone_map(flat * 0.5, tonemap="clamp", ev=1.0)[1], mapped[1])
+    rng = np.random.default_rng(5)
+    hdr = (rng.random((6, 8, 3), dtype=np.float32) * 4.0).astype(np.float32)
+    png = str(tmp_path / "py.png")
+    plenoptic.write_image(png, hdr, ev=0.5, tonemap="reinhard", white=3.0)
+    decoded = plenoptic.read_image(png)  # sRGB-decoded back to linear
+    bytes_ = plenoptic.tone_map(hdr, ev=0.5, tonemap="reinhard", white=3.0).astype(np.float64) / 255.0
+    linear = np.where(bytes_ <= 0.04045, bytes_ / 12.92, ((bytes_ + 0.055) / 1.055) ** 2.4)
+    assert np.allclose(decoded, linear, atol=1e-5)
+    if BINARY:
+        exr = str(tmp_path / "in.pfm")
+        plenoptic.write_image(exr, hdr)
+        cli = str(tmp_path / "cli.png")
+        subprocess.run([BINARY, "tonemap", exr, "-o", cli, "--exposure", "0.5", "--tonemap", "reinhard", "--white", "3",
+                        "--quiet"], check=True, capture_output=True)
+        assert np.array_equal(plenoptic.read_image(cli), decoded)
+    with pytest.raises(ValueError, match="expected a"):
+        plenoptic.write_image(str(tmp_path / "x.tiff"), hdr)
+    assert not os.path.exists(str(tmp_path / "x.tiff"))
+
+
+def test_environment_tools_on_a_constant_environment_follow_the_closed_forms():
+    # L = 1 everywhere: L00 = 4*pi*Y00 = 2*sqrt(pi), the other coefficients 0; E(n) = pi; every
+    # prefiltered level is 1 (a normalised BRDF-weighted mean of a constant).
+    env = np.ones((16, 32, 3), dtype=np.float32)
+    sh = plenoptic.sh9(env)
+    assert sh.shape == (9, 3) and sh.dtype == np.float64
+    assert sh[0] == pytest.approx([2.0 * np.sqrt(np.pi)] * 3, rel=1e-3)
+    assert np.abs(sh[1:]).max() < 1e-3
+    for method in ("sh", "brute"):
+        irradiance = plenoptic.irradiance(env, size=8, method=method)
+        assert irradiance.shape == (8, 16, 3) and irradiance.dtype == np.float32
+        assert np.allclose(irradiance, np.pi, rtol=1e-2)
+    levels = plenoptic.prefilter(env, levels=3, height=16, samples=16)
+    assert [roughness for roughness, _ in levels] == pytest.approx([0.0, 0.5, 1.0])
+    assert levels[0][1].shape == (16, 32, 3) and levels[0][1].dtype == np.float32
+    for _, level in levels:
+        assert np.allclose(level, 1.0, rtol=1e-3)
+    # A sky brighter above than below: upward irradiance exceeds downward (row 0 is +y, up).
+    sky = np.ones((16, 32, 3), dtype=np.float32)
+    sky[8:] = 0.1
+    irradiance = plenoptic.irradiance(sky, size=8, method="brute")
+    assert irradiance[0].mean() > 2.0 * irradiance[-1].mean()
+
+
+def test_environment_tools_refuse_bad_arrays_and_arguments():
+    env = np.ones((16, 32, 3), dtype=np.float32)
+    with pytest.raises(ValueError, match="twice as wide"):
+        plenoptic.sh9(np.ones((16, 16, 3), dtype=np.float32))
+    with pytest.raises(ValueError, match="float32"):
+        plenoptic.sh9(env.astype(np.float64))
+    with pytest.raises(ValueError, match="method"):
+        plenoptic.irradiance(env, method="fast")
+    with pytest.raises(ValueError, match="out of range"):
+        plenoptic.irradiance(env, size=0)
+    with pytest.raises(ValueError, match="out of range"):
+        plenoptic.prefilter(env, levels=0)
+    with pytest.raises(ValueError, match="model"):
+        plenoptic.prefilter(env, model="phong")

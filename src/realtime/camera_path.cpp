@@ -189,7 +189,7 @@ CameraPath parseCameraPath(const std::string& text, const std::string& source) {
 CameraPath loadCameraPath(const std::string& path) {
   requireRegularFile(path);
   std::ifstream in(path, std::ios::binary);
-  if (!in) fail("{}: cannot open camera path file", path);
+  if (!in) failFile(path, "{}: cannot open camera path file", path);
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) fail("{}: read error", path);

@@ -14,7 +14,6 @@
 #include "realtime/frame_output.h"
 
 namespace pl {
-namespace {
 
 Image exposedCopy(const Image& radiance, float exposureScale) {
   Image exposed = radiance;
@@ -22,8 +21,6 @@ Image exposedCopy(const Image& radiance, float exposureScale) {
     for (Rgb& p : exposed.pixels) p *= exposureScale;
   return exposed;
 }
-
-}  // namespace
 
 void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap) {
   const bool hdr = isHdrExtension(path);

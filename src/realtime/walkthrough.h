@@ -48,6 +48,9 @@ WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& ba
 CameraPath orbitPath(const CameraDesc& camera, double seconds = 4.0, double fps = CameraPath::kDefaultFps,
                      float degrees = 25.0f);
 
+/// radiance × exposureScale (camera/exposure.h), the exposed image tone mapping starts from.
+Image exposedCopy(const Image& radiance, float exposureScale);
+
 /// Writes a frame of radiance, the one way every command writes an image (ViewSettings::
 /// writeImage in jobs/jobs.h calls this): .exr/.hdr/.pfm get radiance × exposureScale, .png
 /// additionally the tone mapping and sRGB encoding. Atomic.

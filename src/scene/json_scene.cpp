@@ -410,7 +410,7 @@ Scene parseScene(const JsonContext& ctx, const json& root) {
 
 Scene loadJsonScene(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) fail("{}: cannot open file", path);
+  if (!in) failFile(path, "{}: cannot open file", path);
   json root;
   try {
     root = json::parse(in);

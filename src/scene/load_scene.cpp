@@ -44,8 +44,8 @@ Scene loadScene(const std::string& pathOrName) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path path(pathOrName);
-  if (!fs::exists(path, ec)) fail("{}: no such file", pathOrName);
-  if (fs::is_directory(path, ec)) fail("{}: is a directory, not a scene file", pathOrName);
+  if (!fs::exists(path, ec)) failFile(pathOrName, "{}: no such file", pathOrName);
+  if (fs::is_directory(path, ec)) failFile(pathOrName, "{}: is a directory, not a scene file", pathOrName);
   requireRegularFile(pathOrName);
 
   std::string extension = path.extension().string();

@@ -79,7 +79,7 @@ bool parseInt(const std::string& text, long& value) {
 std::vector<std::string> readLines(const std::string& path) {
   requireRegularFile(path);
   std::ifstream in(path, std::ios::binary);
-  if (!in) fail("{}: cannot open file", path);
+  if (!in) failFile(path, "{}: cannot open file", path);
   std::vector<std::string> lines;
   std::string line;
   while (std::getline(in, line)) {
