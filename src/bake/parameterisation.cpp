@@ -257,7 +257,7 @@ bool buried(const Scene& scene, const Accel& accel, const Chart& c, const Vec3& 
     const Mesh& mesh = scene.meshes[hit.mesh];
     // Glass buries nothing: light passes through it, and a window or a glass table top seen
     // from below is the back of an open sheet, not the inside of a solid.
-    if (std::holds_alternative<DielectricBsdf>(scene.materials[mesh.materials[hit.triangle]].bsdf)) continue;
+    if (hasTransmission(scene.materials[mesh.materials[hit.triangle]].bsdf)) continue;
     const UVec3 tri = mesh.triangles[hit.triangle];
     const Vec3 n = glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]], mesh.positions[tri[2]] - mesh.positions[tri[0]]);
     if (glm::dot(n, d) > 0.0f) ++backHits;

@@ -189,7 +189,7 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
     // ones attenuate the gather rays inside them: all their parameters (the model's
     // parameters() hook, bsdf.h). Other models' parameters (a roughness, an albedo) change
     // only the propagation, so a field traced before such an edit is reused.
-    if (chartKindOf(m.bsdf) == ChartKind::Specular || describe(m.bsdf).transmits) {
+    if (chartKindOf(m.bsdf) == ChartKind::Specular || hasTransmission(m.bsdf)) {
       h.value(uint32_t(m.bsdf.index()));
       std::visit([&](const auto& b) { std::decay_t<decltype(b)>::parameters(b, [&](const auto& field) { h.value(field); }); },
                  m.bsdf);
