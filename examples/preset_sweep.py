@@ -31,7 +31,7 @@ def main():
         # 16 jittered samples per pixel: the path tracer averages over each pixel too.
         image = lf.render(width=args.size, height=args.size, samples=16, threads=args.threads)
         error = plenoptic.compare(image, reference)
-        rows.append((preset, bake_seconds, lf.stats["tixels"], error["rel_mse"], error["mean_luminance_ratio"]))
+        rows.append((preset, bake_seconds, lf.stats["tixels"], error["relmse"], error["mean_luminance_ratio"]))
 
     print(f"{'preset':8} {'bake s':>8} {'tixels':>8} {'relMSE':>10} {'mean ratio':>10}")
     for preset, seconds, tixels, rel_mse, ratio in rows:

@@ -32,9 +32,6 @@ Image readHdrInput(const std::string& path) {
   return readImage(path);
 }
 
-/// JSON has no infinity: an infinite or undefined figure is written as null.
-nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
 void runCompare(const CompareOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
   if (!options.heatmap.empty()) checkOutputPath(options.heatmap, {".png"}, "--heatmap");
@@ -46,23 +43,9 @@ void runCompare(const CompareOptions& options, const GlobalOptions& global) {
   const ImageComparison c = compareImages(a, b, options.peak);
 
   if (options.json) {
-    nlohmann::json j;
+    nlohmann::json j = nlohmann::json::parse(comparisonJson(c));
     j["a"] = options.test;
     j["b"] = options.reference;
-    j["width"] = c.width;
-    j["height"] = c.height;
-    j["rmse"] = number(c.rmse);
-    j["relmse"] = number(c.relMseAverage);
-    j["relmse_rgb"] = {number(c.relMse[0]), number(c.relMse[1]), number(c.relMse[2])};
-    j["mse_rgb"] = {number(c.mse[0]), number(c.mse[1]), number(c.mse[2])};
-    j["psnr"] = number(c.psnr);  // null when infinite (identical images)
-    j["psnr_peak"] = c.peak;
-    j["identical"] = c.rmse == 0.0 && c.nonFinitePixels == 0;
-    j["mean_ratio_rgb"] = {number(c.meanRatio[0]), number(c.meanRatio[1]), number(c.meanRatio[2])};
-    j["mean_luminance_ratio"] = number(c.meanLuminanceRatio);  // Rec.709 Y, mean A / mean B
-    j["max_abs_error"] = number(c.maxAbsError);
-    j["max_abs_error_pixel"] = {c.maxErrorX, c.maxErrorY};
-    j["nonfinite_pixels"] = c.nonFinitePixels;
     fmt::print("{}\n", j.dump(2));
   } else {
     fmt::print("A (test):      {}\nB (reference): {}\nsize:          {}x{}\n", options.test, options.reference, c.width,

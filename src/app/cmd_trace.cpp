@@ -18,9 +18,7 @@
 namespace pl {
 namespace {
 
-// Ranges of the options, declared once (image size: ViewSettings::kMaxImageSide).
-constexpr int kMaxSpp = 1 << 24;
-constexpr int kMaxDepth = 100000;
+// The options' ranges are declared once, in jobs.h (TraceJobOptions, ViewSettings).
 
 struct TraceOptions {
   std::string scene;        ///< `cornell`, .obj, .gltf/.glb, .json
@@ -95,13 +93,13 @@ void addTraceCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("-o,--output", options->output,
                       "Output image: .exr/.hdr/.pfm hold radiance (x exposure), .png is tone-mapped sRGB");
   command->add_option("--spp", options->spp, "Samples (paths) per pixel")
-      ->check(CLI::Range(1, kMaxSpp))
+      ->check(CLI::Range(1, TraceJobOptions::kMaxSpp))
       ->capture_default_str();
   command->add_option("--max-depth", options->maxDepth,
                       fmt::format("Maximum scattering events per path: {} = no cap (unbiased: Russian roulette "
                                   "alone ends paths; safety cap {}), 0 = emission seen directly, 1 = direct light, ...",
                                   kUnboundedDepth, kSafetyDepth))
-      ->check(CLI::Range(kUnboundedDepth, kMaxDepth))
+      ->check(CLI::Range(kUnboundedDepth, TraceJobOptions::kMaxDepth))
       ->capture_default_str();
   command->add_option("--strategy", options->strategy,
                       "Direct lighting: mis (default), nee (light sampling only) or bsdf (BSDF sampling only); "

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
@@ -14,12 +15,14 @@
 #include <thread>
 #include <vector>
 
+#include "core/cancel.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/hash.h"
 #include "core/interrupt.h"
 #include "core/math.h"
 #include "core/memory.h"
+#include "core/parallel.h"
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "core/timing.h"
@@ -326,6 +329,40 @@ TEST_F(AtomicWriteTest, ReadersRefuseNonRegularFilesWithoutOpeningThem) {
   EXPECT_NO_THROW(requireRegularFile(path("missing")));  // the reader's own open reports it
   writeFileAtomically(path("regular"), std::string_view("x"));
   EXPECT_NO_THROW(requireRegularFile(path("regular")));
+}
+
+// --- core/cancel.h ---
+
+TEST_F(AtomicWriteTest, CancellationStopsParallelLoopsAndRemovesUncommittedOutputs) {
+  // A loop whose ranges request cancellation once a quarter of the work is done: the rest is
+  // never started (a cancellation point opens every sub-range) and pl::Cancelled reaches the caller.
+  struct ClearAtExit {
+    ~ClearAtExit() { clearCancellation(); }  // whatever happens, later tests run uncancelled
+  } clearAtExit;
+  std::atomic<uint64_t> done{0};
+  const uint64_t count = 100000;
+  EXPECT_THROW(parallelForRange(count, 1,
+                                [&](uint64_t begin, uint64_t end) {
+                                  if (done.fetch_add(end - begin) + (end - begin) >= count / 4) requestCancellation();
+                                }),
+               Cancelled);
+  EXPECT_LT(done.load(), count);
+  // An atomic write cancelled from inside stays a cancellation (not "cannot write"), and the
+  // old file and no temporary remain.
+  writeFileAtomically(path("out.plv"), std::string_view("old"));
+  EXPECT_THROW(writeFileAtomically(path("out.plv"),
+                                   [&](const std::string& temporary) {
+                                     writeFileBytes(temporary, "half", 4);
+                                     throwIfCancelled();
+                                   }),
+               Cancelled);
+  EXPECT_EQ(contents(path("out.plv")), "old");
+  EXPECT_EQ(entries(), std::vector<std::string>{"out.plv"});
+  // Cleared, loops run to their end again.
+  clearCancellation();
+  done = 0;
+  parallelForRange(count, 1, [&](uint64_t begin, uint64_t end) { done += end - begin; });
+  EXPECT_EQ(done.load(), count);
 }
 
 // --- core/interrupt.h ---

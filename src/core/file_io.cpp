@@ -16,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "core/cancel.h"
 #include "core/error.h"
 #include "core/interrupt.h"
 
@@ -146,6 +147,8 @@ void writeFileAtomically(const std::string& path, const std::function<void(const
   PendingFile file(path);
   try {
     write(file.temporaryPath());
+  } catch (const Cancelled&) {
+    throw;  // stays a cancellation (core/cancel.h); the PendingFile removes the temporary
   } catch (const std::exception& e) {
     file.discard();
     failFile(path, "{}: cannot write: {}", path, e.what());

@@ -1,5 +1,7 @@
 #include "core/parallel.h"
 
+#include "core/cancel.h"
+
 #include <pmmintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -52,7 +54,10 @@ void parallelForRange(uint64_t count, uint64_t grain, const std::function<void(u
   if (count == 0) return;
   ensureDenormalObserver();
   tbb::parallel_for(tbb::blocked_range<uint64_t>(0, count, grain ? grain : 1),
-                    [&](const tbb::blocked_range<uint64_t>& r) { body(r.begin(), r.end()); });
+                    [&](const tbb::blocked_range<uint64_t>& r) {
+                      throwIfCancelled();  // TBB cancels the other sub-ranges and rethrows in the caller
+                      body(r.begin(), r.end());
+                    });
 }
 
 }  // namespace pl

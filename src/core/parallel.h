@@ -30,7 +30,9 @@ class ThreadPool {
 void enableFlushDenormals();
 
 /// Calls body(begin, end) on disjoint sub-ranges of [0, count), in parallel. grain is the
-/// smallest range handed to one task.
+/// smallest range handed to one task. Each sub-range starts with a cancellation point
+/// (core/cancel.h): once cancellation is requested, the loop stops and pl::Cancelled is thrown.
+/// An exception from body stops the loop too and is rethrown to the caller.
 void parallelForRange(uint64_t count, uint64_t grain, const std::function<void(uint64_t, uint64_t)>& body);
 
 /// Calls body(i) for every i in [0, count), in parallel.

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include <nlohmann/json.hpp>
+
 #include "core/error.h"
 
 namespace pl {
@@ -107,6 +109,26 @@ Image8 relativeErrorHeatmap(const Image& a, const Image& reference, float maxErr
     for (int c = 0; c < 3; ++c) dst[c] = uint8_t(std::lround(colour[c] * 255.0f));
   }
   return out;
+}
+
+std::string comparisonJson(const ImageComparison& c) {
+  // nlohmann::json writes NaN and ±∞ as null.
+  nlohmann::json j;
+  j["width"] = c.width;
+  j["height"] = c.height;
+  j["rmse"] = c.rmse;
+  j["relmse"] = c.relMseAverage;
+  j["relmse_rgb"] = c.relMse;
+  j["mse_rgb"] = c.mse;
+  j["psnr"] = c.psnr;
+  j["psnr_peak"] = c.peak;
+  j["identical"] = c.rmse == 0.0 && c.nonFinitePixels == 0;
+  j["mean_ratio_rgb"] = c.meanRatio;
+  j["mean_luminance_ratio"] = c.meanLuminanceRatio;  // Rec.709 Y, mean A / mean B
+  j["max_abs_error"] = c.maxAbsError;
+  j["max_abs_error_pixel"] = {c.maxErrorX, c.maxErrorY};
+  j["nonfinite_pixels"] = c.nonFinitePixels;
+  return j.dump();
 }
 
 }  // namespace pl

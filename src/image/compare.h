@@ -38,6 +38,14 @@ inline constexpr double kRelMseEpsilon = 0.01;
 /// (the caller prefixes file names).
 ImageComparison compareImages(const Image& a, const Image& reference, double peak = 1.0);
 
+/// The figures as the text of a JSON object — their one naming, which `plenoptic compare
+/// --json` prints (adding the file names "a" and "b") and the Python module's compare()
+/// returns as a dict: width, height, rmse, relmse, relmse_rgb, mse_rgb, psnr, psnr_peak,
+/// identical, mean_ratio_rgb, mean_luminance_ratio, max_abs_error, max_abs_error_pixel
+/// ([x, y]), nonfinite_pixels. JSON has no infinity: an infinite or undefined figure (the PSNR
+/// of identical images, a ratio against a black channel) is null.
+std::string comparisonJson(const ImageComparison& c);
+
 /// Per-pixel relative RMS error e = sqrt(mean over c of (a − b)²/(b² + 0.01)) as a false-colour
 /// image (Google "Turbo" colour map: dark blue = 0, green ≈ max/2, dark red = max; values at
 /// or above `maxError` saturate); pixels non-finite in either image are magenta.

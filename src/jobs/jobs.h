@@ -99,6 +99,8 @@ struct TraceJobOptions {
   std::string variancePath;  ///< per-pixel variance of the mean (.exr/.hdr/.pfm); empty = none
   std::string statsPath;     ///< the stats as JSON; empty = none
   TraceSettings trace;       ///< spp, max depth, strategy, sampler, seed
+  static constexpr int kMaxSpp = 1 << 24;     ///< the most samples per pixel a trace accepts
+  static constexpr int kMaxDepth = 100000;     ///< the largest --max-depth cap (or kUnboundedDepth)
   ViewSettings view;
   int threads = 0;  ///< worker threads (0 = all hardware threads)
   // Which values were given by the caller: the scene file's "settings" fill in the others.

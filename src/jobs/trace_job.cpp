@@ -10,10 +10,6 @@
 #include "jobs/jobs.h"
 
 namespace pl {
-namespace {
-constexpr int kMaxSpp = 1 << 24;  ///< the most samples per pixel a trace accepts
-}  // namespace
-
 std::string TraceJobStats::toJson() const {
   nlohmann::json json;
   json["command"] = "trace";
@@ -58,8 +54,11 @@ TraceSettings TraceJob::settingsFor(const Scene& scene, ViewSettings& view) cons
   if (!options_.cameraGiven && suggested.camera) view.camera = *suggested.camera;
   if (!options_.sppGiven && suggested.spp) settings.spp = *suggested.spp;
   view.checkImageSize(options_.sceneName + ": ");
-  if (settings.spp < 1 || settings.spp > kMaxSpp)
-    fail("{}: {} samples per pixel is out of range (1..{})", options_.sceneName, settings.spp, kMaxSpp);
+  if (settings.spp < 1 || settings.spp > TraceJobOptions::kMaxSpp)
+    fail("{}: {} samples per pixel is out of range (1..{})", options_.sceneName, settings.spp, TraceJobOptions::kMaxSpp);
+  if (settings.maxDepth != kUnboundedDepth && (settings.maxDepth < 0 || settings.maxDepth > TraceJobOptions::kMaxDepth))
+    failUsage("{}: maximum depth {} is out of range (0..{}, or {} for no cap)", options_.sceneName, settings.maxDepth,
+              TraceJobOptions::kMaxDepth, kUnboundedDepth);
   return settings;
 }
 

@@ -5,6 +5,7 @@
 // home for both rules.
 #include <cstdint>
 
+#include "core/error.h"
 #include "core/math.h"
 
 namespace pl {
@@ -26,6 +27,18 @@ struct RenderSettings {
   int tileSize = 16;  ///< square tiles rendered in parallel
   bool showProgress = false;  ///< progress bar (for single large renders, not timing loops)
 };
+
+/// What both renderers refuse before allocating anything: samples per pixel outside
+/// 0..kMaxSamplesPerPixel, a mirror depth outside −1..kMaxMirrorDepth, a tile size below 1
+/// (the commands' flag ranges, so a library caller gets the same bounds).
+inline void checkRenderSettings(const RenderSettings& settings) {
+  if (settings.samplesPerPixel < 0 || settings.samplesPerPixel > RenderSettings::kMaxSamplesPerPixel)
+    failUsage("render: {} samples per pixel is out of range (0..{})", settings.samplesPerPixel,
+         RenderSettings::kMaxSamplesPerPixel);
+  if (settings.mirrorDepth < -1 || settings.mirrorDepth > RenderSettings::kMaxMirrorDepth)
+    failUsage("render: mirror depth {} is out of range (-1..{})", settings.mirrorDepth, RenderSettings::kMaxMirrorDepth);
+  if (settings.tileSize < 1) failUsage("render: tile size must be ≥ 1, got {}", settings.tileSize);
+}
 
 /// The samples-per-pixel rule: settings.samplesPerPixel when > 0, else kThinLensSamples for a
 /// thin-lens camera and 1 (the pixel centre) for a pinhole.

@@ -1,24 +1,32 @@
 // The Python module `plenoptic` (pybind11): a second front end over the library jobs of
 // jobs/jobs.h, as the command line is the first. Images cross as NumPy float32 arrays of
 // shape (height, width, 3), linear Rec.709 radiance in W·sr⁻¹·m⁻², top row first; stats cross
-// as dicts holding exactly the --stats JSON of the matching command. The GIL is released while
-// a trace, bake or render runs.
+// as dicts holding exactly the --stats JSON of the matching command. Every call that does real
+// work (trace, bake, render, reading and writing light fields, the environment tools) runs it
+// through runInterruptible: the GIL is released meanwhile, and Ctrl-C raises KeyboardInterrupt.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/eval.h>
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
+#include <exception>
 #include <memory>
-#include <tuple>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
+#include <tuple>
+#include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
 
+#include "core/cancel.h"
 #include "core/error.h"
 #include "env/env.h"
 #include "env/ibl.h"
@@ -62,6 +70,61 @@ Image fromArray(const py::handle& object, const char* what) {
   Image image(int(array.shape(1)), int(array.shape(0)));
   std::memcpy(image.pixels.data(), array.data(), image.pixels.size() * sizeof(Rgb));
   return image;
+}
+
+/// Runs `work` — library code only, no Python objects — on a worker thread while this thread
+/// waits with the GIL released, taking it back every 50 ms to run Python's signal handlers
+/// (PyErr_CheckSignals: they only run on the main thread, which is why the work may not run
+/// here). When a handler raises — Ctrl-C's KeyboardInterrupt — cancellation is requested
+/// (core/cancel.h): the job stops at its next cancellation point and unwinds, removing the
+/// outputs it had not committed, and once the worker has stopped the handler's exception is
+/// raised here (also if the job happened to finish first). Otherwise work's result, or its
+/// exception, is passed on as if it had run on this thread.
+template <typename Work>
+auto runInterruptible(Work&& work) -> decltype(work()) {
+  using Result = decltype(work());
+  using Stored = std::conditional_t<std::is_void_v<Result>, bool, Result>;
+  std::optional<Stored> result;
+  std::exception_ptr failure;
+  std::mutex mutex;
+  std::condition_variable finished;
+  bool done = false;
+  std::thread worker([&] {
+    try {
+      if constexpr (std::is_void_v<Result>) {
+        work();
+        result.emplace(true);
+      } else {
+        result.emplace(work());
+      }
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    const std::lock_guard lock(mutex);
+    done = true;
+    finished.notify_one();
+  });
+  std::optional<py::error_already_set> interruption;
+  for (;;) {
+    bool stopped = false;
+    {
+      py::gil_scoped_release release;
+      std::unique_lock lock(mutex);
+      stopped = finished.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; });
+    }
+    if (stopped) break;
+    if (!interruption && PyErr_CheckSignals() != 0) {
+      interruption.emplace();  // takes the handler's exception off the interpreter
+      requestCancellation();
+    }
+  }
+  worker.join();
+  if (interruption) {
+    clearCancellation();
+    throw *interruption;
+  }
+  if (failure) std::rethrow_exception(failure);
+  if constexpr (!std::is_void_v<Result>) return std::move(*result);
 }
 
 py::dict statsDict(const std::string& json) { return py::module_::import("json").attr("loads")(json); }
@@ -295,7 +358,10 @@ class FileError(Error, OSError):
            py::arg("index"), py::arg("rgb"),
            "Sets light `index`'s intensity (point, spot: W/sr) or irradiance (directional: W/m^2)");
 
-  m.def("load_scene", [](const std::string& path) { return std::make_shared<Scene>(loadScene(path)); }, py::arg("path"),
+  m.def(
+      "load_scene",
+      [](const std::string& path) { return runInterruptible([&] { return std::make_shared<Scene>(loadScene(path)); }); },
+      py::arg("path"),
         "Loads 'cornell' (built in) or a .obj, .gltf, .glb or .json scene.");
 
   m.def(
@@ -309,12 +375,8 @@ class FileError(Error, OSError):
         options.trace.maxDepth = maxDepth;
         options.view = viewSettings(width, height, camera);
         options.threads = threads;
-        TraceJobResult result;
-        {
-          const TraceJob job(std::move(options));
-          py::gil_scoped_release release;
-          result = job.run(scene);
-        }
+        const TraceJob job(std::move(options));
+        const TraceJobResult result = runInterruptible([&] { return job.run(scene); });
         py::dict stats = statsDict(result.stats.toJson());
         if (variance) return py::make_tuple(toArray(result.radiance), stats, toArray(result.variance));
         return py::make_tuple(toArray(result.radiance), stats);
@@ -332,8 +394,7 @@ class FileError(Error, OSError):
           "save",
           [](const PyLightField& lf, const std::string& path, const std::string& compress) {
             const ValuesCodec codec = parseValuesCodec(compress);
-            py::gil_scoped_release release;
-            writeLightField(path, *lf.lightField, codec);
+            runInterruptible([&] { writeLightField(path, *lf.lightField, codec); });
           },
           py::arg("path"), py::arg("compress") = "none", "Writes the .plf file (compress: none, lossless, bc1, hdr).")
       .def(
@@ -346,13 +407,8 @@ class FileError(Error, OSError):
             options.reference = reference;
             options.view = viewSettings(width, height, camera);
             options.threads = threads;
-            RenderJobResult result;
-            {
-              const RenderJob job(std::move(options));
-              py::gil_scoped_release release;
-              result = job.run(*lf.lightField);
-            }
-            return toArray(result.image);
+            const RenderJob job(std::move(options));
+            return toArray(runInterruptible([&] { return job.run(*lf.lightField).image; }));
           },
           py::arg("width") = 640, py::arg("height") = 480, py::arg("samples") = 0, py::arg("camera") = py::none(),
           py::arg("seed") = 0, py::arg("reference") = false, py::arg("threads") = 0,
@@ -381,9 +437,8 @@ class FileError(Error, OSError):
               }
               if (cameras.empty()) throw UsageError("render_path: the list of cameras is empty");
             }
-            std::vector<Image> frames;
-            {
-              py::gil_scoped_release release;
+            const std::vector<Image> frames = runInterruptible([&] {
+              std::vector<Image> images;
               for (const CameraDesc& frameCamera : cameras) {
                 RenderJobOptions options;
                 options.render.samplesPerPixel = samples;
@@ -392,9 +447,10 @@ class FileError(Error, OSError):
                 options.view = base;
                 options.view.cameraDesc = frameCamera;
                 options.threads = threads;
-                frames.push_back(RenderJob(std::move(options)).run(*lf.lightField).image);
+                images.push_back(RenderJob(std::move(options)).run(*lf.lightField).image);
               }
-            }
+              return images;
+            });
             py::list arrays;
             for (const Image& frame : frames) arrays.append(toArray(frame));
             return arrays;
@@ -415,16 +471,14 @@ class FileError(Error, OSError):
         options.threads = threads;
         if (visibility) options.visibilityPath = *visibility;
         options.reuseVisibility = reuseVisibility;
-        BakeJobResult result;
-        {
-          const BakeJob job(std::move(options));
-          py::gil_scoped_release release;
+        const BakeJob job(std::move(options));
+        BakeJobResult result = runInterruptible([&] {
           // The bake keeps its scene (in the light field); a copy must be finalized again to
           // get the vertex padding Embree reads (scene.h), which also checks the edits.
           Scene copy = scene;
           copy.finalize();
-          result = job.run(std::move(copy));
-        }
+          return job.run(std::move(copy));
+        });
         PyLightField lf;
         lf.stats = statsDict(result.stats.toJson());
         lf.lightField = std::make_shared<const LightField>(std::move(result.lightField));
@@ -440,8 +494,7 @@ class FileError(Error, OSError):
       "load_light_field",
       [](const std::string& path) {
         PyLightField lf;
-        py::gil_scoped_release release;
-        lf.lightField = std::make_shared<const LightField>(readLightField(path));
+        lf.lightField = runInterruptible([&] { return std::make_shared<const LightField>(readLightField(path)); });
         return lf;
       },
       py::arg("path"), "Reads a .plf file.");
@@ -502,11 +555,7 @@ class FileError(Error, OSError):
       "sh9",
       [](const py::handle& env) {
         const EnvImage map = envFromArray(env, "sh9");
-        Sh9 sh;
-        {
-          py::gil_scoped_release release;
-          sh = projectSh9(map);
-        }
+        const Sh9 sh = runInterruptible([&] { return projectSh9(map); });
         py::array_t<double, py::array::c_style> array({py::ssize_t(9), py::ssize_t(3)});
         for (int k = 0; k < 9; ++k)
           for (int c = 0; c < 3; ++c) array.mutable_at(k, c) = sh.coefficients[size_t(k)][c];
@@ -521,11 +570,9 @@ class FileError(Error, OSError):
         if (method != "sh" && method != "brute") throw UsageError("irradiance: method must be 'sh' or 'brute'");
         inRange(size, 1, 4096, "irradiance: size");
         const EnvImage map = envFromArray(env, "irradiance");
-        EnvImage result;
-        {
-          py::gil_scoped_release release;
-          result = method == "sh" ? irradianceFromSh(projectSh9(map), false, size) : irradianceBruteForce(map, false, size);
-        }
+        const EnvImage result = runInterruptible([&] {
+          return method == "sh" ? irradianceFromSh(projectSh9(map), false, size) : irradianceBruteForce(map, false, size);
+        });
         return toArray(std::get<LatLongMap>(result).image);
       },
       py::arg("env"), py::arg("size") = 32, py::arg("method") = "sh",
@@ -542,11 +589,7 @@ class FileError(Error, OSError):
         options.height = inRange(height, 4, kMaxMapSize, "prefilter: height");
         options.samples = inRange(samples, 1, kMaxSamples, "prefilter: samples");
         const EnvImage map = envFromArray(env, "prefilter");
-        std::vector<PrefilteredLevel> result;
-        {
-          py::gil_scoped_release release;
-          result = prefilter(map, options);
-        }
+        const std::vector<PrefilteredLevel> result = runInterruptible([&] { return prefilter(map, options); });
         py::list out;
         for (const PrefilteredLevel& level : result) out.append(py::make_tuple(level.roughness, toArray(level.map.image)));
         return out;
@@ -559,17 +602,11 @@ class FileError(Error, OSError):
       "compare",
       [](const py::handle& a, const py::handle& reference) {
         const ImageComparison c = compareImages(fromArray(a, "compare: a"), fromArray(reference, "compare: reference"));
-        py::dict d;
-        d["rel_mse"] = c.relMseAverage;
-        d["rel_mse_rgb"] = c.relMse;
-        d["rmse"] = c.rmse;
-        d["psnr"] = c.psnr;
-        d["mean_ratio_rgb"] = c.meanRatio;
-        d["mean_luminance_ratio"] = c.meanLuminanceRatio;
-        d["non_finite_pixels"] = c.nonFinitePixels;
-        return d;
+        return statsDict(comparisonJson(c));
       },
       py::arg("a"), py::arg("reference"),
-      "Compares two images as `plenoptic compare` does: rel_mse (mean over channels of (a-b)^2/(b^2+0.01)), rmse,\n"
-      "psnr (peak 1), mean ratios a/b per channel and of luminance.");
+      "Compares two images as `plenoptic compare --json` does, with the same keys: relmse (mean over channels of\n"
+      "(a-b)^2/(b^2+0.01)), relmse_rgb, rmse, mse_rgb, psnr (peak 1; None when the images are identical), identical,\n"
+      "mean_ratio_rgb (mean a / mean b per channel), mean_luminance_ratio, max_abs_error, max_abs_error_pixel,\n"
+      "nonfinite_pixels, width, height.");
 }

@@ -3,6 +3,7 @@ and PLENOPTIC_BINARY naming the command-line program). Small sizes: every test r
 import json
 import os
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -61,6 +62,10 @@ def test_bake_save_load_and_render(cornell, tmp_path):
     # The light field against the path tracer: close in mean (the bake's draft preset).
     traced, _ = plenoptic.trace(cornell, width=32, height=24, spp=64)
     assert plenoptic.compare(reference, traced)["mean_luminance_ratio"] == pytest.approx(1.0, abs=0.1)
+    # The command line's --samples and --mirror-depth ranges hold for library callers too.
+    for renderer in (False, True):
+        with pytest.raises(plenoptic.UsageError, match="1000000000 samples per pixel is out of range"):
+            lf.render(width=32, height=24, samples=10**9, reference=renderer)
 
 
 def test_editing_emission_and_rebaking_with_the_reused_visibility_equals_a_full_bake(tmp_path):
@@ -83,7 +88,14 @@ def test_image_round_trip_and_compare(tmp_path):
     plenoptic.write_image(path, image)
     assert np.array_equal(plenoptic.read_image(path), image)
     same = plenoptic.compare(image, image)
-    assert same["rel_mse"] == 0.0 and same["mean_ratio_rgb"] == [1.0, 1.0, 1.0]
+    assert same["relmse"] == 0.0 and same["mean_ratio_rgb"] == [1.0, 1.0, 1.0]
+    assert same["identical"] is True and same["psnr"] is None  # infinite: null in JSON
+    # The same keys and values as `plenoptic compare --json` (which adds the file names).
+    if BINARY:
+        plenoptic.write_image(str(tmp_path / "b.pfm"), image * 1.5)
+        cli = json.loads(subprocess.run([BINARY, "compare", str(tmp_path / "b.pfm"), path, "--json"],
+                                        capture_output=True, text=True, check=True).stdout)
+        assert {k: v for k, v in cli.items() if k not in ("a", "b")} == plenoptic.compare(image * 1.5, image)
     assert plenoptic.compare(image * 2, image)["mean_luminance_ratio"] == pytest.approx(2.0)
 
 
@@ -108,6 +120,8 @@ def test_errors_are_plenoptic_exceptions_with_the_cli_messages(cornell, tmp_path
         plenoptic.bake(cornell, preset="best")
     with pytest.raises(plenoptic.Error, match="out of range"):
         plenoptic.trace(cornell, width=0, height=4, spp=1)
+    with pytest.raises(plenoptic.UsageError, match="maximum depth 1000000000 is out of range"):
+        plenoptic.trace(cornell, width=4, height=4, spp=1, max_depth=10**9)
     with pytest.raises(plenoptic.UsageError, match="no material"):
         cornell.set_emission("nothing", [1.0, 1.0, 1.0])
     with pytest.raises(plenoptic.UsageError, match="light 0 does not exist"):
@@ -296,3 +310,44 @@ def test_environment_tools_refuse_bad_arrays_and_arguments():
         plenoptic.prefilter(env, levels=0)
     with pytest.raises(ValueError, match="model"):
         plenoptic.prefilter(env, model="phong")
+
+
+# Ctrl-C: each case runs in its own interpreter (a KeyboardInterrupt that landed outside the
+# call would otherwise stop pytest itself), which sends itself SIGINT a second into a call that
+# would run for hours. The subprocess's timeout only guards against a call that is never
+# cancelled; a cancelled one returns within about a second.
+INTERRUPT_SCRIPT = r"""
+import os, signal, sys, threading
+import plenoptic
+scene = plenoptic.load_scene("cornell")
+threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+try:
+    {call}
+    print("not interrupted")
+except KeyboardInterrupt:
+    print("KeyboardInterrupt")
+# The flag is cleared: the next call runs to its end.
+image, _ = plenoptic.trace(scene, width=8, height=8, spp=1)
+print("next call", image.shape)
+"""
+
+
+def run_interrupted(call, tmp_path):
+    result = subprocess.run([sys.executable, "-c", INTERRUPT_SCRIPT.replace("{call}", call)], cwd=tmp_path,
+                            env=dict(os.environ), capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr
+    return result.stdout.split("\n")
+
+
+def test_ctrl_c_interrupts_a_trace(tmp_path):
+    lines = run_interrupted("plenoptic.trace(scene, width=1024, height=1024, spp=1000000)", tmp_path)
+    assert lines[:2] == ["KeyboardInterrupt", "next call (8, 8, 3)"]
+
+
+def test_ctrl_c_interrupts_a_bake_leaving_the_old_visibility_file_untouched(tmp_path):
+    plv = tmp_path / "field.plv"
+    plv.write_bytes(b"the previous file")
+    lines = run_interrupted("plenoptic.bake(scene, preset='high', visibility='field.plv')", tmp_path)
+    assert lines[:2] == ["KeyboardInterrupt", "next call (8, 8, 3)"]
+    assert plv.read_bytes() == b"the previous file"
+    assert sorted(os.listdir(tmp_path)) == ["field.plv"]  # no temporary left behind

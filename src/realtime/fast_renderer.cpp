@@ -291,13 +291,6 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   }
 }
 
-namespace {
-/// The settings render() and castPrimaryRays() refuse, checked before anything is allocated.
-void checkSettings(const RenderSettings& settings) {
-  if (settings.samplesPerPixel < 0) fail("render: samples per pixel must be ≥ 0, got {}", settings.samplesPerPixel);
-  if (settings.tileSize < 1) fail("render: tile size must be ≥ 1, got {}", settings.tileSize);
-}
-}  // namespace
 
 template <typename Tile>
 void FastRenderer::forEachTile(const Camera& camera, const RenderSettings& settings, Tile&& tile) const {
@@ -314,7 +307,7 @@ void FastRenderer::forEachTile(const Camera& camera, const RenderSettings& setti
 }
 
 void FastRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) const {
-  checkSettings(settings);
+  checkRenderSettings(settings);
   const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
   const uint32_t mirrorDepth = effectiveMirrorDepth(settings, lightField_.settings.mirrorDepth);
   if (image.width != camera.width() || image.height != camera.height()) image = Image(camera.width(), camera.height());
@@ -324,7 +317,7 @@ void FastRenderer::render(const Camera& camera, const RenderSettings& settings, 
 }
 
 void FastRenderer::castPrimaryRays(const Camera& camera, const RenderSettings& settings, std::vector<float>& depth) const {
-  checkSettings(settings);
+  checkRenderSettings(settings);
   const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
   depth.resize(size_t(camera.width()) * size_t(camera.height()));
   forEachTile(camera, settings, [&](int x0, int y0, int x1, int y1, Scratch& s) {

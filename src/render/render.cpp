@@ -50,8 +50,7 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hi
 }  // namespace
 
 Image renderLightField(const LightField& lf, const Accel& accel, const Camera& camera, const RenderSettings& settings) {
-  if (settings.samplesPerPixel < 0) fail("render: samples per pixel must be ≥ 0, got {}", settings.samplesPerPixel);
-  if (settings.tileSize < 1) fail("render: tile size must be ≥ 1, got {}", settings.tileSize);
+  checkRenderSettings(settings);
   const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
   const uint32_t mirrorDepth = effectiveMirrorDepth(settings, lf.settings.mirrorDepth);
   const int width = camera.width(), height = camera.height();

@@ -27,6 +27,7 @@
 #include "accel/accel.h"
 #include "bsdf/bsdf.h"
 #include "camera/camera.h"
+#include "core/cancel.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/progress.h"
@@ -270,6 +271,9 @@ void PathTracer::Impl::tracePixel(const Camera& camera, const ZSobolLayout& layo
                                   int x, int y, PixelAccumulator& acc, Counters& counters) const {
   const uint64_t pixelIndex = static_cast<uint64_t>(y) * static_cast<uint64_t>(camera.width()) + static_cast<uint64_t>(x);
   for (int i = 0; i < settings.spp; ++i) {
+    // A pixel may take minutes at millions of samples: a cancellation point per sample (one
+    // relaxed atomic load against a path's microseconds).
+    throwIfCancelled();
     Sampler sampler =
         Sampler::make(settings.sampler, layout, pixelIndex, x, y, static_cast<uint64_t>(i), settings.seed);
     sampler.setDimension(kFilmDimension);
