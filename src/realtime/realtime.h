@@ -45,9 +45,18 @@ class Camera;
 
 class FastRenderer {
  public:
-  /// Precomputes the per-chart shading table. `lightField` and `accel` (built over
-  /// lightField.scene) must outlive the renderer.
-  FastRenderer(const LightField& lightField, const Accel& accel);
+  /// Beyond this many bytes of values and chart records a light field's lookups miss the
+  /// caches (this machine's L2 is 1 MiB per core; the L3 is shared with everything else
+  /// running), and render() prefetches each tile's chart records and value rows before
+  /// shading it (renderTile).
+  static constexpr uint64_t kPrefetchLookupBytes = uint64_t(4) << 20;
+
+  /// Precomputes the per-chart shading table and asks for huge pages under the arrays the
+  /// lookups read (core/memory.h adviseHugePages). `lightField` and `accel` (built over
+  /// lightField.scene) must outlive the renderer. `prefetchLookupBytes`: the size from which
+  /// tiles prefetch their lookups (tests pass 0 to run that path on small scenes; the image
+  /// is the same either way).
+  FastRenderer(const LightField& lightField, const Accel& accel, uint64_t prefetchLookupBytes = kPrefetchLookupBytes);
 
   /// Renders camera.width() × camera.height() pixels of radiance (W·sr⁻¹·m⁻², camera weight
   /// included, no exposure) into `image`, which is resized only when its size differs.
@@ -93,6 +102,9 @@ class FastRenderer {
   const Accel& accel_;
   std::vector<ChartShading> shading_;  ///< per chart
   bool anyTexturedChart_ = false;      ///< some chart's shading needsUv: renderTile prefetches texels
+  /// Values and chart records take more than the constructor's prefetchLookupBytes:
+  /// renderTile prefetches each tile's chart records and value rows before shading it.
+  bool prefetchLookups_ = false;
   /// The light field's values padded to 16 bytes (PaddedValues): one aligned load per tap.
   std::vector<Lanes4> paddedValues_;
   /// LightField::triangleChart flattened: chart of triangle t of mesh m at
