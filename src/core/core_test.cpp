@@ -376,32 +376,6 @@ TEST(Memory, AvailableMemoryIsKnownAndTheGuardNamesEstimateAndFlags) {
   }
 }
 
-TEST(Memory, HugePageInteriorIsTheWholeAlignedPagesInside) {
-  const uint64_t page = kHugePageBytes;
-  EXPECT_EQ(hugePageInterior(3 * page, 2 * page).begin, 3 * page);
-  EXPECT_EQ(hugePageInterior(3 * page, 2 * page).end, 5 * page);
-  const AddressRange unaligned = hugePageInterior(3 * page + 100, 3 * page);
-  EXPECT_EQ(unaligned.begin, 4 * page);
-  EXPECT_EQ(unaligned.end, 6 * page);
-  // Less than one whole page inside: empty.
-  const AddressRange small = hugePageInterior(3 * page + 100, page);
-  EXPECT_EQ(small.begin, small.end);
-  EXPECT_EQ(hugePageInterior(page + 1, page - 2).begin, hugePageInterior(page + 1, page - 2).end);
-}
-
-TEST(Memory, AdvisingHugePagesKeepsTheContents) {
-  // 7 MiB: at least two whole huge pages lie inside wherever the allocation starts.
-  std::vector<uint32_t> data((uint64_t(7) << 20) / sizeof(uint32_t));
-  for (size_t i = 0; i < data.size(); ++i) data[i] = uint32_t(i * 2654435761u);
-  const uint64_t advised = adviseHugePages(data.data(), data.size() * sizeof(uint32_t));
-  const AddressRange inside = hugePageInterior(reinterpret_cast<uintptr_t>(data.data()), data.size() * sizeof(uint32_t));
-  EXPECT_GE(inside.end - inside.begin, 2 * kHugePageBytes);
-  // Either the kernel took the advice for exactly the interior, or (no THP) refused it.
-  EXPECT_TRUE(advised == 0 || advised == inside.end - inside.begin) << advised;
-  for (size_t i = 0; i < data.size(); ++i) ASSERT_EQ(data[i], uint32_t(i * 2654435761u)) << i;
-  EXPECT_EQ(adviseHugePages(data.data(), 4096), 0u);  // no whole huge page inside
-}
-
 // --- XXH64 (core/hash.h) ---------------------------------------------------------------------------------
 
 TEST(Xxh64, MatchesReferenceVectors) {

@@ -1,7 +1,6 @@
 // Memory figures of the process and the system (see memory.h).
 #include "core/memory.h"
 
-#include <sys/mman.h>
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -56,35 +55,6 @@ void requireMemory(uint64_t bytes, std::string_view what, std::string_view how) 
   const std::optional<uint64_t> available = availableMemoryBytes();
   if (available && bytes > *available)
     fail("{}: estimated memory {} exceeds the {} available; {}", what, gibibytes(bytes), gibibytes(*available), how);
-}
-
-AddressRange hugePageInterior(uint64_t address, uint64_t bytes) {
-  const uint64_t mask = kHugePageBytes - 1;
-  const uint64_t begin = (address + mask) & ~mask;
-  const uint64_t end = (address + bytes) & ~mask;
-  return begin < end ? AddressRange{begin, end} : AddressRange{begin, begin};
-}
-
-uint64_t adviseHugePages(const void* data, uint64_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  const AddressRange range = hugePageInterior(reinterpret_cast<uintptr_t>(data), bytes);
-  if (range.begin == range.end) return 0;
-  void* begin = reinterpret_cast<void*>(range.begin);
-  const size_t length = size_t(range.end - range.begin);
-  // madvise changes how pages are mapped, never their contents, so advising const data is fine.
-  if (::madvise(begin, length, MADV_HUGEPAGE) != 0) return 0;
-  // Pages touched before the advice stay 4 KiB until collapsed (khugepaged would take
-  // minutes): collapse them now. MADV_COLLAPSE is Linux 6.1's value 25 (glibc's headers may
-  // not name it yet); older kernels reject it with EINVAL, and memory too fragmented to
-  // collapse fails with EAGAIN: both harmless.
-  constexpr int kMadvCollapse = 25;
-  (void)::madvise(begin, length, kMadvCollapse);
-  return range.end - range.begin;
-#else
-  (void)data;
-  (void)bytes;
-  return 0;
-#endif
 }
 
 }  // namespace pl

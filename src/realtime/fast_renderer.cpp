@@ -8,7 +8,6 @@
 #include "bsdf/bsdf.h"
 #include "camera/camera.h"
 #include "core/error.h"
-#include "core/memory.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "realtime/realtime.h"
@@ -37,18 +36,6 @@ struct FastRenderer::Scratch {
 inline Rgb pixelValue(float weight, const Rgb& radiance) { return weight > 0.0f ? weight * radiance : Rgb(0.0f); }
 
 namespace {
-/// pl::adviseHugePages over a vector's elements.
-template <typename T>
-void adviseVectorHugePages(const std::vector<T>& v) {
-  adviseHugePages(v.data(), uint64_t(v.size()) * sizeof(T));
-}
-/// pl::adviseHugePages over a vector's whole allocation, called right after reserve() so that the
-/// pages fault in as huge pages when the vector is filled.
-template <typename T>
-void adviseVectorHugePagesReserved(const std::vector<T>& v) {
-  adviseHugePages(v.data(), uint64_t(v.capacity()) * sizeof(T));
-}
-
 /// Issues prefetches for the cache lines of [p, p + bytes) (bytes ≤ 128: at most 3 lines).
 inline void prefetchBytes(const void* p, size_t bytes) {
   const char* c = static_cast<const char*>(p);
@@ -62,10 +49,8 @@ FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel, uin
     : lightField_(lightField), accel_(accel) {
   const Scene& scene = lightField.scene;
   paddedValues_.reserve(lightField.values.size());
-  adviseVectorHugePagesReserved(paddedValues_);
   for (const Rgb& v : lightField.values) paddedValues_.push_back(lanes4(v));
   shading_.reserve(lightField.charts.size());
-  adviseVectorHugePagesReserved(shading_);
   for (const Chart& c : lightField.charts) {
     if (c.material >= scene.materials.size()) fail("fast renderer: chart material {} out of range", c.material);
     shading_.push_back(chartShading(scene, c));
@@ -82,15 +67,6 @@ FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel, uin
       if (chart >= lightField.charts.size()) fail("fast renderer: mesh {}: chart index {} out of range", m, chart);
       triangleChart_.push_back(chart);
     }
-  }
-  // The arrays a lookup reads at random (README "Sponza"): with 4 KiB pages nearly every
-  // lookup in a light field of tens of MB also misses the TLB. The chart records and texels
-  // already exist (they belong to the light field and its scene): their pages are collapsed.
-  adviseVectorHugePages(triangleChart_);
-  adviseVectorHugePages(lightField.charts);
-  for (const Texture& texture : scene.textures) {
-    adviseVectorHugePages(texture.packed);
-    adviseVectorHugePages(texture.image.pixels);
   }
   const uint64_t lookupBytes = uint64_t(paddedValues_.size()) * sizeof(Lanes4) +
                                uint64_t(lightField.charts.size()) * (sizeof(Chart) + sizeof(ChartShading));
@@ -226,8 +202,10 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
           __builtin_prefetch(paddedValues_.data() + c.firstValue + uint64_t(tv.i1) * c.resU + tu.i1);
         }
       }
-      if (!shading[chart].needsUv) continue;
+      // shading[chart].needsUv, from the (small, cached) material array: the shading record
+      // prefetched above is still on its way, and waiting for it here was a tenth of this loop.
       const int texture = scene.materials[c.material].albedoTexture;
+      if (c.kind != ChartKind::Diffuse || texture < 0) continue;
       scene.textures[size_t(texture)].prefetch(uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics));
     }
   }

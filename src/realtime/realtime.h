@@ -51,8 +51,7 @@ class FastRenderer {
   /// shading it (renderTile).
   static constexpr uint64_t kPrefetchLookupBytes = uint64_t(4) << 20;
 
-  /// Precomputes the per-chart shading table and asks for huge pages under the arrays the
-  /// lookups read (core/memory.h adviseHugePages). `lightField` and `accel` (built over
+  /// Precomputes the per-chart shading table. `lightField` and `accel` (built over
   /// lightField.scene) must outlive the renderer. `prefetchLookupBytes`: the size from which
   /// tiles prefetch their lookups (tests pass 0 to run that path on small scenes; the image
   /// is the same either way).
