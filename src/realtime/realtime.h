@@ -6,8 +6,10 @@
 // Per tile:
 //   1. camera rays for all samples of the tile, ordered in 4×4-pixel blocks so that each
 //      16-ray Embree packet (Accel::intersectCoherent) covers a compact footprint;
-//   1b. on charts with an albedo texture (when there are any), a prefetch of the texels each hit will read
-//      (Texture::prefetch), so that their cache misses overlap across the tile;
+//   1b. on light fields larger than kPrefetchLookupBytes and on textured ones, two passes over
+//      the tile's hits that only prefetch — chart records, then each hit's facing record (kept
+//      for step 2), its shading, the two value rows of a diffuse lookup and the texels it will
+//      read (Texture::prefetch) — so that their cache misses overlap across the tile;
 //   2. shading of every hit without building a SurfaceHit: the hit point is ray.origin +
 //      t·ray.direction, the chart comes from LightField::triangleChart, and the radiance from
 //      exitantRadianceLanes() of lightfield/lookup.h with the chart's ChartShading precomputed
