@@ -13,6 +13,10 @@
 //             (and the bake) stay those of the box, while primary visibility pays for a
 //             million-triangle BVH: it isolates what the design claims, a frame cost that
 //             does not depend on how complex the lighting or the light field is.
+//   plf       the light field in the .plf file named by the environment variable
+//             PLENOPTIC_BENCH_PLF (not baked; registered only when the variable is set), seen
+//             from its scene's first camera: e.g. a default bake of Sponza (issue 13's
+//             walk-through target), whose frames are too slow to bake inside a benchmark.
 // Counters: ms_median (fast renderer, radiance only), primary_ms_median (rays only),
 // ratio = ms_median / primary_ms_median, the same with minima (ms_min, primary_ms_min,
 // ratio_min), CPU milliseconds per frame summed over threads (cpu_ms, primary_cpu_ms,
@@ -25,6 +29,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -38,6 +43,7 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "bake/bake.h"
+#include "plf/plf_file.h"
 #include "realtime/display.h"
 #include "realtime/realtime.h"
 #include "scene/scene.h"
@@ -106,18 +112,22 @@ BakedScene& baked(const std::string& name) {
   if (!slot) {
     pl::Progress::setEnabled(false);
     const auto start = Clock::now();
-    pl::Scene scene = sceneNamed(name);
-    const bool cornellUnits = scene.sourcePath == "cornell";
     slot = std::make_unique<BakedScene>();
+    if (name == "plf") {
+      slot->lightField = pl::readLightField(std::getenv("PLENOPTIC_BENCH_PLF"));
+    } else {
+      pl::Scene scene = sceneNamed(name);
+      slot->lightField = pl::bake(std::move(scene), pl::bakePreset("default"));
+      slot->lightField.scene.finalize();
+    }
+    const pl::Scene& scene = slot->lightField.scene;
     slot->camera = scene.cameras.empty() ? scene.automaticCamera() : scene.cameras.front();
-    slot->metresPerUnit = cornellUnits ? 0.001f : 1.0f;
-    slot->lightField = pl::bake(std::move(scene), pl::bakePreset("default"));
-    slot->lightField.scene.finalize();
+    slot->metresPerUnit = scene.sourcePath == "cornell" ? 0.001f : 1.0f;
     slot->accel = std::make_unique<pl::Accel>(slot->lightField.scene);
     slot->renderer = std::make_unique<pl::FastRenderer>(slot->lightField, *slot->accel);
-    std::fprintf(stderr, "[setup] %s: %zu triangles, %zu charts, baked (default preset) in %.1f s\n", name.c_str(),
+    std::fprintf(stderr, "[setup] %s: %zu triangles, %zu charts, %s in %.1f s\n", name.c_str(),
                  slot->lightField.scene.triangleCount(), slot->lightField.charts.size(),
-                 std::chrono::duration<double>(Clock::now() - start).count());
+                 name == "plf" ? "read" : "baked (default preset)", std::chrono::duration<double>(Clock::now() - start).count());
   }
   return *slot;
 }
@@ -198,6 +208,11 @@ void registerAll() {
   for (const char* name : {"cornell", "glossy", "mirror", "million"})
     for (auto [w, h] : {std::pair{640, 480}, std::pair{1280, 720}})
       benchmark::RegisterBenchmark(fmt::format("frame/{}/{}x{}", name, w, h).c_str(), BM_Frame, name, w, h, 0.0f, 1)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+  if (std::getenv("PLENOPTIC_BENCH_PLF"))
+    for (auto [w, h] : {std::pair{640, 480}, std::pair{1280, 720}})
+      benchmark::RegisterBenchmark(fmt::format("frame/plf/{}x{}", w, h).c_str(), BM_Frame, std::string("plf"), w, h, 0.0f, 1)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
   // The lens model: a thin lens (f/1.4, focused at the target) with 4 and 16 aperture samples.

@@ -23,6 +23,7 @@ struct FastRenderer::Scratch {
   std::vector<Rgb> radiance;       ///< radiance along each camera ray
   std::vector<float> weight;       ///< camera weight (cos⁴θ or 1)
   std::vector<uint32_t> pixel;     ///< per pixel of the tile (spp samples each): y·width + x
+  std::vector<uint32_t> chart;     ///< per sample, after the prefetch pass: the chart record it sees
   // The mirror wavefront: reflected rays, their sample and accumulated reflectance.
   std::vector<Ray> mirrorRays, nextRays;
   std::vector<RayHit> mirrorHits;
@@ -34,7 +35,18 @@ struct FastRenderer::Scratch {
 /// A one-sample pixel: weight × radiance, or 0 for a sample of zero weight (as the reference).
 inline Rgb pixelValue(float weight, const Rgb& radiance) { return weight > 0.0f ? weight * radiance : Rgb(0.0f); }
 
-FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel) : lightField_(lightField), accel_(accel) {
+namespace {
+/// Issues prefetches for the cache lines of [p, p + bytes) (bytes ≤ 128: at most 3 lines).
+inline void prefetchBytes(const void* p, size_t bytes) {
+  const char* c = static_cast<const char*>(p);
+  __builtin_prefetch(c);
+  __builtin_prefetch(c + bytes - 1);
+  if (bytes > 64) __builtin_prefetch(c + 64);
+}
+}  // namespace
+
+FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel, uint64_t prefetchLookupBytes)
+    : lightField_(lightField), accel_(accel) {
   const Scene& scene = lightField.scene;
   paddedValues_.reserve(lightField.values.size());
   for (const Rgb& v : lightField.values) paddedValues_.push_back(lanes4(v));
@@ -56,6 +68,9 @@ FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel) : l
       triangleChart_.push_back(chart);
     }
   }
+  const uint64_t lookupBytes = uint64_t(paddedValues_.size()) * sizeof(Lanes4) +
+                               uint64_t(lightField.charts.size()) * (sizeof(Chart) + sizeof(ChartShading));
+  prefetchLookups_ = lookupBytes > prefetchLookupBytes;
 }
 
 size_t FastRenderer::tileCameraRays(const Camera& camera, int spp, uint64_t seed, int x0, int y0, int x1, int y1,
@@ -146,20 +161,53 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   s.mirrorThroughput.clear();
   Rgb* out = image.pixels.data();
   // The chart record sample i sees: its triangle's chart, turned to the side facing the camera.
-  auto chartOf = [&](size_t i) {
+  auto facingChartOf = [&](size_t i) {
     const RayHit& hit = s.hits[i];
     return facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -s.rays[i].direction);
   };
-  // Texel reads miss the cache on textured scenes (a minified texture gives every pixel new
-  // cache lines): prefetch them for the whole tile first, so that they overlap. (Skipped
-  // without textures: the pass alone cost 10–15 % of the Cornell box's frame.)
-  for (size_t i = 0; anyTexturedChart_ && i < n; ++i) {
-    const RayHit& hit = s.hits[i];
-    if (!hit.hit()) continue;
-    const uint32_t chart = chartOf(i);
-    if (!shading[chart].needsUv) continue;
-    const int texture = scene.materials[charts[chart].material].albedoTexture;
-    scene.textures[size_t(texture)].prefetch(uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics));
+  // A lookup is a chain of dependent loads — the hit's chart index, its chart record, the
+  // record's shading, two rows of values, texels — each a cache (and, on 4 KiB pages, TLB)
+  // miss once the light field outgrows the caches; one pixel at a time the processor can
+  // overlap only a few such chains. So on large light fields (prefetchLookups_) and textured
+  // ones the tile's lookups are first walked in two passes that only prefetch: (a) every
+  // hit's chart index, prefetching its record; (b) with the records arriving, the facing
+  // record (kept for the shading below), its shading, the two value rows the diffuse
+  // interpolation reads, and the texels (Texture::prefetch). (Without textures on a small
+  // light field everything is cached and the passes alone cost 10–15 % of the Cornell box's
+  // frame: skipped.)
+  const bool prefetched = prefetchLookups_ || anyTexturedChart_;
+  auto chartOf = [&](size_t i) { return prefetched ? s.chart[i] : facingChartOf(i); };
+  if (prefetched) {
+    s.chart.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const RayHit& hit = s.hits[i];
+      if (!hit.hit()) continue;
+      s.chart[i] = triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle];
+      if (prefetchLookups_) prefetchBytes(charts + s.chart[i], sizeof(Chart));
+    }
+    for (size_t i = 0; i < n; ++i) {
+      const RayHit& hit = s.hits[i];
+      if (!hit.hit()) continue;
+      const uint32_t chart = facingChart(charts, s.chart[i], -s.rays[i].direction);
+      s.chart[i] = chart;
+      const Chart& c = charts[chart];
+      if (prefetchLookups_) {
+        prefetchBytes(shading + chart, sizeof(ChartShading));
+        if (c.kind == ChartKind::Diffuse) {
+          // The rows interpolateLanes' diffuse branch reads (the grid from the chart's own
+          // tixel size; a prefetch need not round like the lookup).
+          const Vec2 grid = tixelGridCoordinates(c, s.rays[i].origin + hit.t * s.rays[i].direction);
+          const LinearTap tu = linearTap(grid.x, c.resU), tv = linearTap(grid.y, c.resV);
+          __builtin_prefetch(paddedValues_.data() + c.firstValue + uint64_t(tv.i0) * c.resU + tu.i0);
+          __builtin_prefetch(paddedValues_.data() + c.firstValue + uint64_t(tv.i1) * c.resU + tu.i1);
+        }
+      }
+      // shading[chart].needsUv, from the (small, cached) material array: the shading record
+      // prefetched above is still on its way (waiting for it here took 8 % of renderTile).
+      const int texture = scene.materials[c.material].albedoTexture;
+      if (c.kind != ChartKind::Diffuse || texture < 0) continue;
+      scene.textures[size_t(texture)].prefetch(uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics));
+    }
   }
   // Whether samples i … i+3 all hit one diffuse chart record (→ *chart).
   auto sameDiffuseChart = [&](size_t i, uint32_t* chart) {

@@ -6,8 +6,10 @@
 // Per tile:
 //   1. camera rays for all samples of the tile, ordered in 4×4-pixel blocks so that each
 //      16-ray Embree packet (Accel::intersectCoherent) covers a compact footprint;
-//   1b. on charts with an albedo texture (when there are any), a prefetch of the texels each hit will read
-//      (Texture::prefetch), so that their cache misses overlap across the tile;
+//   1b. on light fields larger than kPrefetchLookupBytes and on textured ones, two passes over
+//      the tile's hits that only prefetch — chart records, then each hit's facing record (kept
+//      for step 2), its shading, the two value rows of a diffuse lookup and the texels it will
+//      read (Texture::prefetch) — so that their cache misses overlap across the tile;
 //   2. shading of every hit without building a SurfaceHit: the hit point is ray.origin +
 //      t·ray.direction, the chart comes from LightField::triangleChart, and the radiance from
 //      exitantRadianceLanes() of lightfield/lookup.h with the chart's ChartShading precomputed
@@ -45,9 +47,17 @@ class Camera;
 
 class FastRenderer {
  public:
+  /// Beyond this many bytes of values and chart records a light field's lookups miss the
+  /// caches (this machine's L2 is 1 MiB per core; the L3 is shared with everything else
+  /// running), and render() prefetches each tile's chart records and value rows before
+  /// shading it (renderTile).
+  static constexpr uint64_t kPrefetchLookupBytes = uint64_t(4) << 20;
+
   /// Precomputes the per-chart shading table. `lightField` and `accel` (built over
-  /// lightField.scene) must outlive the renderer.
-  FastRenderer(const LightField& lightField, const Accel& accel);
+  /// lightField.scene) must outlive the renderer. `prefetchLookupBytes`: the size from which
+  /// tiles prefetch their lookups (tests pass 0 to run that path on small scenes; the image
+  /// is the same either way).
+  FastRenderer(const LightField& lightField, const Accel& accel, uint64_t prefetchLookupBytes = kPrefetchLookupBytes);
 
   /// Renders camera.width() × camera.height() pixels of radiance (W·sr⁻¹·m⁻², camera weight
   /// included, no exposure) into `image`, which is resized only when its size differs.
@@ -93,6 +103,9 @@ class FastRenderer {
   const Accel& accel_;
   std::vector<ChartShading> shading_;  ///< per chart
   bool anyTexturedChart_ = false;      ///< some chart's shading needsUv: renderTile prefetches texels
+  /// Values and chart records take more than the constructor's prefetchLookupBytes:
+  /// renderTile prefetches each tile's chart records and value rows before shading it.
+  bool prefetchLookups_ = false;
   /// The light field's values padded to 16 bytes (PaddedValues): one aligned load per tap.
   std::vector<Lanes4> paddedValues_;
   /// LightField::triangleChart flattened: chart of triangle t of mesh m at
