@@ -148,7 +148,8 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   // The chart record sample i sees: its triangle's chart, turned to the side facing the camera.
   auto chartOf = [&](size_t i) {
     const RayHit& hit = s.hits[i];
-    return facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -s.rays[i].direction);
+    return facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -s.rays[i].direction,
+                       scene.meshes[hit.mesh], hit.triangle);
   };
   // Texel reads miss the cache on textured scenes (a minified texture gives every pixel new
   // cache lines): prefetch them for the whole tile first, so that they overlap. (Skipped
@@ -252,7 +253,8 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         s.radiance[slot] += throughput * backgroundRadiance(scene.environment, ray.direction);
         continue;
       }
-      const uint32_t chart = facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -ray.direction);
+      const uint32_t chart = facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -ray.direction,
+                                         scene.meshes[hit.mesh], hit.triangle);
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv;
