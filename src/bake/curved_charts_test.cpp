@@ -62,8 +62,8 @@ TEST(CurvedCharts, SmoothCylinderIsAFewDistortionBoundedCharts) {
   const float cosBound = std::cos(2.0f * kCurvedChartConeDegrees * kPi / 180.0f);
   for (uint32_t ci = 0; ci < p.charts.size(); ++ci) {
     const Chart& c = p.charts[ci];
-    // Every chart is curved (the 5.6° steps between facets exceed the planar tolerance) and
-    // two-sided (an open surface).
+    // Every chart is curved (the 5.6° steps between facets exceed the planar tolerance, and a
+    // lone facet's vertex normals leave its plane) and two-sided (an open surface).
     EXPECT_TRUE(c.curved);
     EXPECT_EQ(c.sides, 2);
     if (!c.isBack) {
@@ -123,27 +123,60 @@ TEST(CurvedCharts, SmoothCylinderIsAFewDistortionBoundedCharts) {
     }
   }
   EXPECT_EQ(seen.size(), scene.triangleCount());
-  // A chart spans at most 2 × 35° of the 360°: at least 6 charts; the greedy growth leaves
-  // a few more, against the 64 flat strips the facets would give.
-  EXPECT_GE(fronts, 6u);
-  EXPECT_LE(fronts, 10u);
+  // A chart spans at most 2 × 20° of the 360°: at least 9 charts; the greedy growth leaves
+  // more (16), against the 64 flat strips the facets would give.
+  EXPECT_GE(fronts, 9u);
+  EXPECT_LE(fronts, 20u);
   std::printf("smooth cylinder: %zu charts (front records), %llu tixels\n", fronts, (unsigned long long)p.tixelCount);
 }
 
-TEST(CurvedCharts, FlatShadedAndCreasedMeshesStayPlanar) {
+TEST(CurvedCharts, FlatShadedMeshesGatherAroundFaceNormalsAndCreasesStop) {
   Progress::setEnabled(false);
   BakeSettings settings;
   settings.tixelsPerUnit = 16.0f;
-  // Without vertex normals no edge is smooth: one planar chart per strip of coplanar quads.
-  const Parameterisation faceted = buildParameterisation(makeCylinder(64, 4, false), settings);
-  size_t fronts = 0;
-  for (const Chart& c : faceted.charts) {
-    EXPECT_FALSE(c.curved);
+  // Without vertex normals, faces meeting at 5.6° (≤ 30°) join curved charts as the smooth
+  // cylinder's do, but each tixel gathers around the face normal of its triangle (the path
+  // tracer shades flat-shaded meshes with it).
+  const Scene cylinder = makeCylinder(64, 4, false);
+  const Parameterisation faceted = buildParameterisation(cylinder, settings);
+  size_t fronts = 0, curvedFronts = 0;
+  for (uint32_t ci = 0; ci < faceted.charts.size(); ++ci) {
+    const Chart& c = faceted.charts[ci];
     fronts += c.isBack ? 0 : 1;
+    curvedFronts += c.curved && !c.isBack;
+    if (!c.curved) continue;  // a lone strip left between two curved charts is planar
+    const float side = c.isBack ? -1.0f : 1.0f;
+    for (uint64_t g = c.firstTixel; g < c.firstTixel + c.tixelCount(); ++g) {
+      // Some face of the chart has exactly this normal (facets of the 64-gon are 5.6° apart).
+      float best = -1.0f;
+      for (const auto& [m, t] : faceted.chartTriangles[ci])
+        best = std::max(best, side * glm::dot(faceted.gatherNormal[g], triangleNormal(cylinder.meshes[m], t)));
+      EXPECT_GT(best, 1.0f - 1e-5f);
+    }
   }
-  EXPECT_EQ(fronts, 64u);
+  EXPECT_GE(fronts, 9u);
+  EXPECT_LE(fronts, 20u);
+  EXPECT_GE(curvedFronts, fronts / 2);
+  // A 24-gon without normals (15° steps, within the 20° cone and the 30° edge bound) joins
+  // too (fewer charts than faces; a lone face left between two charts is planar); an 8-gon's
+  // faces (45°) do not.
+  for (const uint32_t segments : {24u, 8u}) {
+    const Parameterisation p = buildParameterisation(makeCylinder(segments, 1, false), settings);
+    size_t curved = 0, faces = 0;
+    for (const Chart& c : p.charts) {
+      curved += c.curved && !c.isBack;
+      faces += !c.isBack;
+    }
+    if (segments == 24) {
+      EXPECT_GT(curved, 0u);
+      EXPECT_LT(faces, 24u);
+    } else {
+      EXPECT_EQ(curved, 0u);
+      EXPECT_EQ(faces, 8u);
+    }
+  }
   // Split normals along a crease: an octagonal prism whose every face has its own vertex
-  // normals (each face's vertices are separate, welded only by position).
+  // normals (each face's vertices are separate, welded only by position) stays planar.
   Scene prism;
   prism.sourcePath = "creased prism";
   prism.materials.push_back(Material{"grey", LambertBsdf{Rgb(0.6f)}});
@@ -200,8 +233,9 @@ TEST(CurvedCharts, CoarseSmoothCylinderShadesSmoothly) {
   BakeSettings settings = bakePreset("draft");
   settings.tixelsPerUnit = 24.0f;
   settings.tolerance = 1e-4f;
-  // 16 segments: the facets' normals are 22.5° apart, so a flat chart per facet is off the
-  // smooth cos φ by up to sin 11.25° · sin 50° ≈ 0.15 (in units of ρ/π) at its edges.
+  // 16 segments: the facets' normals are 22.5° apart, so flat shading (the faceted mesh's
+  // curved charts gather around face normals) is off the smooth cos φ by up to
+  // sin 11.25° · sin 50° ≈ 0.15 (in units of ρ/π) at facet edges.
   Scene smooth = makeCylinder(16, 2, true);
   smooth.lights.push_back(DirectionalLight{Vec3(-1.0f, 0.0f, 0.0f), Rgb(1.0f)});
   Scene faceted = makeCylinder(16, 2, false);
@@ -214,7 +248,7 @@ TEST(CurvedCharts, CoarseSmoothCylinderShadesSmoothly) {
   // Curved charts: bilinear interpolation of cos φ over 1/24-wide tixels, the gather points
   // lying on the facets (≤ 2 % inside the circle) and nlerp'd normals: within 2 %.
   EXPECT_LT(smoothError, 0.02);
-  EXPECT_GT(facetedError, 0.08) << "the control: flat per-facet charts are faceted";
+  EXPECT_GT(facetedError, 0.08) << "the control: a flat-shaded mesh stays faceted";
 
   // The curved flag survives the .plf, and the reloaded field looks up the same.
   const std::string path = (std::filesystem::temp_directory_path() / "curved_charts_test.plf").string();

@@ -285,11 +285,6 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
                                       triangleNormal(scene.meshes[t.mesh], t.triangle));
     return c.isBack ? -n : n;
   };
-  auto frameAt = [&](const Vec3& n) -> TixelFrame {
-    if (!c.curved) return {c.axisU, c.axisV, c.normal};
-    const Frame f = Frame::fromNormal(n);
-    return {f.s, f.t, f.n};
-  };
   for (uint32_t j = 0; j < c.resV; ++j)
     for (uint32_t i = 0; i < c.resU; ++i) {
       const uint32_t local = j * c.resU + i;
@@ -351,7 +346,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       }
       // A buried point gathers from the nearest footprint sub-sample that is not buried; a
       // tixel with none takes a neighbour's point below.
-      if (probe && !r.tris.empty() && buried(scene, accel, frameAt(normal), point)) {
+      if (probe && !r.tris.empty() && buried(scene, accel, tixelFrameAround(c, normal), point)) {
         std::sort(insideSamples.begin(), insideSamples.begin() + inside,
                   [](const auto& x, const auto& y) { return x.first < y.first; });
         isBuried[local] = 1;
@@ -359,7 +354,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
           const FootprintSample& sample = insideSamples[size_t(k)].second;
           const Vec3 q = pointOnTriangle(scene, r.tris[sample.tri], sample.bary);
           const Vec3 qNormal = normalAt(sample);
-          if (!buried(scene, accel, frameAt(qNormal), q)) {
+          if (!buried(scene, accel, tixelFrameAround(c, qNormal), q)) {
             point = q;
             normal = qNormal;
             isBuried[local] = 0;
@@ -468,12 +463,16 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
     curvedMaterial[m] = chartKindOf(scene.materials[m].bsdf) == ChartKind::Diffuse && !scene.materials[m].isEmissive();
   const float cosCone = std::cos(kCurvedChartConeDegrees * kPi / 180.0f);
   const float cosSmooth = std::cos(kSmoothEdgeToleranceDegrees * kPi / 180.0f);
-  // Whether the edge (welded ids a, b) between triangles g and h is smooth: at both ends the
-  // two triangles' vertex normals agree. Meshes without normals have no smooth edges.
+  const float cosFlatShaded = std::cos(kFlatShadedChartEdgeDegrees * kPi / 180.0f);
+  // Whether the edge (welded ids a, b) between triangles g and h may join a curved chart: at
+  // both ends the two triangles' vertex normals agree (a smooth edge); between two triangles
+  // of meshes without vertex normals (flat shading), when their faces meet at no more than
+  // kFlatShadedChartEdgeDegrees.
   auto smoothEdge = [&](uint32_t g, uint32_t h, uint32_t a, uint32_t b) {
     const Mesh& mg = scene.meshes[tris[g].mesh];
     const Mesh& mh = scene.meshes[tris[h].mesh];
-    if (mg.normals.empty() || mh.normals.empty()) return false;
+    if (mg.normals.empty() || mh.normals.empty())
+      return mg.normals.empty() && mh.normals.empty() && glm::dot(tris[g].normal, tris[h].normal) >= cosFlatShaded;
     for (const uint32_t w : {a, b}) {
       int kg = 0, kh = 0;
       while (kg < 3 && tris[g].welded[kg] != w) ++kg;
@@ -697,19 +696,27 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
     // front of the chart's plane, the back's radiance is exactly 0 — what a one-sided chart
     // shows from behind. (The walls of an open box, a floor, a ground plane under a black sky.)
     const float behindTolerance = 1e-4f * diagonal;
-    auto somethingBehind = [&](const Chart& c) {
-      // A curved chart does not lie in its plane: the test below does not apply to it.
-      if (!scene.environment.isBlack() || c.curved) return true;
-      const float d0 = glm::dot(c.normal, c.origin);
+    // Something behind the plane with unit normal n through point x.
+    auto somethingBehindPlane = [&](const Vec3& n, const Vec3& x) {
+      const float d0 = glm::dot(n, x);
       for (int k = 0; k < 8; ++k) {
         const Vec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
-        if (glm::dot(c.normal, corner) - d0 < -behindTolerance) return true;
+        if (glm::dot(n, corner) - d0 < -behindTolerance) return true;
       }
       for (const Light& light : scene.lights) {
         const PunctualLight l = PunctualLight::from(light);
-        if (l.kind == PunctualLight::Kind::Directional ? glm::dot(l.direction, c.normal) > 0.0f
-                                                        : glm::dot(c.normal, l.position) - d0 < 0.0f)
+        if (l.kind == PunctualLight::Kind::Directional ? glm::dot(l.direction, n) > 0.0f : glm::dot(n, l.position) - d0 < 0.0f)
           return true;
+      }
+      return false;
+    };
+    // A curved chart does not lie in one plane: behind any of its triangles' planes.
+    auto somethingBehind = [&](const Chart& c, uint32_t ci) {
+      if (!scene.environment.isBlack()) return true;
+      if (!c.curved) return somethingBehindPlane(c.normal, c.origin);
+      for (const auto& [m, t] : p.chartTriangles[ci]) {
+        const Vec3 n = triangleNormal(scene.meshes[m], t);
+        if (n != Vec3(0.0f) && somethingBehindPlane(n, scene.meshes[m].positions[scene.meshes[m].triangles[t][0]])) return true;
       }
       return false;
     };
@@ -717,7 +724,7 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
       const auto& [m, t] = p.chartTriangles[ci][0];  // a chart's triangles are connected: one surface
       Chart front = p.charts[ci];
       const bool twoSided = isRoughGlassChart(front, scene.materials[front.material].bsdf) ||
-                            (front.kind != ChartKind::Specular && openComponent[root(meshBase[m] + t)] != 0 && somethingBehind(front));
+                            (front.kind != ChartKind::Specular && openComponent[root(meshBase[m] + t)] != 0 && somethingBehind(front, ci));
       front.sides = twoSided ? 2 : 1;
       charts.push_back(front);
       chartTriangles.push_back(p.chartTriangles[ci]);

@@ -16,9 +16,10 @@
 // than the preset's wherever triangles are. So, for a Lambertian material that does not emit,
 // a triangle also joins a neighbour across a *smooth* edge — welded, with the shading normals
 // of both triangles equal (within kSmoothEdgeToleranceDegrees) at both ends of the edge, so a
-// modelled crease (split normals) or a flat-shaded mesh (no vertex normals) stops the chart —
-// when its winding normal is within kCurvedChartConeDegrees of the seed triangle's. The flattening is the projection along the chart
-// normal: every face normal lies within 2 × kCurvedChartConeDegrees (≤ 70°) of it, so the
+// modelled crease (split normals) stops the chart; on a flat-shaded mesh (no vertex normals,
+// Crytek Sponza's) any edge whose faces meet within kFlatShadedChartEdgeDegrees — when its
+// winding normal is within kCurvedChartConeDegrees of the seed triangle's. The flattening is the projection along the chart
+// normal: every face normal lies within 2 × kCurvedChartConeDegrees (≤ 40°) of it, so the
 // projection is locally one-to-one and linear on each triangle (lookups need no per-triangle
 // data). Its distortion is the foreshortening cos θ of a face tilted θ from the chart normal
 // (one direction shrinks by cos θ, the other is kept: area stretch cos θ, angle stretch
@@ -30,7 +31,9 @@
 // the planar charts of before, unchanged.
 // Glossy, specular, rough-glass and emissive charts stay planar. A curved chart's diffuse
 // tixels gather around the interpolated shading normal at their gather point (gatherNormal,
-// tixelFrame), so a smooth mesh gets smoothly varying irradiance.
+// tixelFrame), so a smooth mesh gets smoothly varying irradiance; on a flat-shaded mesh that
+// is the face normal of the triangle under the tixel, as the path tracer shades it (facets
+// stay facets, blended over one tixel at their edges, but are no longer a chart each).
 //
 // Tixel size (world units): 1 / tixelsPerUnit when that is set, otherwise the scene's room
 // scale (sceneScale) / tixelsAcrossScene, so a preset means the same density in a one-room
@@ -70,10 +73,13 @@ namespace pl {
 
 inline constexpr float kChartNormalToleranceDegrees = 2.0f;
 /// Curved charts: every face normal within this angle of the seed triangle's normal.
-inline constexpr float kCurvedChartConeDegrees = 35.0f;
+inline constexpr float kCurvedChartConeDegrees = 20.0f;
 /// Curved charts: an edge is smooth when both triangles' shading normals at each of its ends
 /// are within this angle.
 inline constexpr float kSmoothEdgeToleranceDegrees = 1.0f;
+/// Curved charts of flat-shaded meshes (no vertex normals): neighbouring faces join when their
+/// normals are within this angle.
+inline constexpr float kFlatShadedChartEdgeDegrees = 30.0f;
 inline constexpr float kChartPlaneTolerance = 0.005f;  ///< relative to the scene diagonal
 /// Glossy charts' tixels are this many times finer than diffuse ones (per side).
 inline constexpr float kGlossyTixelDensity = 2.0f;
@@ -112,10 +118,14 @@ struct TixelFrame {
   Vec3 toWorld(const Vec3& local) const { return local.x * u + local.y * v + local.z * n; }
   Vec3 toLocal(const Vec3& w) const { return {glm::dot(w, u), glm::dot(w, v), glm::dot(w, n)}; }
 };
-inline TixelFrame tixelFrame(const Parameterisation& p, const Chart& c, uint64_t tixel) {
+/// The frame of a point of chart c whose gather normal is `normal` (read only when curved).
+inline TixelFrame tixelFrameAround(const Chart& c, const Vec3& normal) {
   if (!c.curved) return {c.axisU, c.axisV, c.normal};
-  const Frame f = Frame::fromNormal(p.gatherNormal[tixel]);
+  const Frame f = Frame::fromNormal(normal);
   return {f.s, f.t, f.n};
+}
+inline TixelFrame tixelFrame(const Parameterisation& p, const Chart& c, uint64_t tixel) {
+  return tixelFrameAround(c, c.curved ? p.gatherNormal[tixel] : c.normal);
 }
 
 ChartKind chartKindOf(const Bsdf& bsdf);
