@@ -106,7 +106,8 @@ nlohmann::json toJson(const PlfInfo& info) {
             {"diffuse", info.diffuseCharts},
             {"glossy", info.glossyCharts},
             {"specular", info.specularCharts},
-            {"two_sided", info.twoSidedCharts}}},
+            {"two_sided", info.twoSidedCharts},
+            {"curved", info.curvedCharts}}},
           {"tixels", info.tixels},
           {"values", info.values},
           {"sections", sections},
@@ -159,8 +160,8 @@ void printHuman(const PlfInfo& info) {
     fmt::print(" + lat-long map {}×{} (scale {:.4g}, rotated {:.4g}° about +y)", info.environmentMapWidth,
                info.environmentMapHeight, info.environmentMapScale, info.environmentMapRotationDegrees);
   fmt::print("\n");
-  fmt::print("charts       {} ({} diffuse, {} glossy, {} specular; {} two-sided, counted twice)\n", info.charts,
-             info.diffuseCharts, info.glossyCharts, info.specularCharts, info.twoSidedCharts);
+  fmt::print("charts       {} ({} diffuse, {} glossy, {} specular; {} two-sided, counted twice; {} curved)\n", info.charts,
+             info.diffuseCharts, info.glossyCharts, info.specularCharts, info.twoSidedCharts, info.curvedCharts);
   fmt::print("tixels       {}\n", info.tixels);
   fmt::print("values       {} RGB (float32, {})\n", info.values, humanBytes(info.values * 12));
   const ValuesStorage storage = valuesStorage(info);

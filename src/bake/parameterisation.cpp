@@ -230,7 +230,7 @@ FootprintSample locate(const ChartRaster& r, uint32_t bin, Vec2 q) {
   return s;
 }
 
-// A candidate gather point x on a chart (unit normal n, tangent frame axisU/axisV) is buried
+// A candidate gather point x on a chart (frame f: unit normal n, tangents u, v) is buried
 // when it lies inside other geometry — the floor under a baseboard or a block standing on it,
 // the part of a wall behind a crossing wall: at least kBuriedMinHits of its kBuriedProbes
 // probe rays hit the back side of a surface. The probes leave the front hemisphere at 8
@@ -243,15 +243,15 @@ FootprintSample locate(const ChartRaster& r, uint32_t bin, Vec2 q) {
 constexpr int kBuriedProbes = 9;
 constexpr int kBuriedMinHits = 5;
 
-bool buried(const Scene& scene, const Accel& accel, const Chart& c, const Vec3& x) {
+bool buried(const Scene& scene, const Accel& accel, const TixelFrame& f, const Vec3& x) {
   int backHits = 0;
   for (int k = 0; k < kBuriedProbes; ++k) {
-    Vec3 d = c.normal;
+    Vec3 d = f.n;
     if (k > 0) {
       const float phi = 2.0f * kPi * float(k - 1) / float(kBuriedProbes - 1);
-      d = 0.8660254f * (std::cos(phi) * c.axisU + std::sin(phi) * c.axisV) + 0.5f * c.normal;
+      d = 0.8660254f * (std::cos(phi) * f.u + std::sin(phi) * f.v) + 0.5f * f.n;
     }
-    const Ray ray{offsetRayOrigin(x, c.normal, d), d, 0.0f, kInfinity};
+    const Ray ray{offsetRayOrigin(x, f.n, d), d, 0.0f, kInfinity};
     RayHit hit;
     if (!accel.intersect(ray, hit)) continue;
     const Mesh& mesh = scene.meshes[hit.mesh];
@@ -275,6 +275,16 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
   const Material& material = scene.materials[c.material];
   const bool textured = c.kind == ChartKind::Diffuse && material.albedoTexture >= 0;
   const Rgb constantAlbedo = c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, Vec2(0.0f)) : Rgb(0.0f);
+  // The normal a point of the chart gathers around: the chart's on a planar chart; on a curved
+  // one the interpolated shading normal there (no normal map: that is render-time detail),
+  // turned to the record's side.
+  auto normalAt = [&](const FootprintSample& s) {
+    if (!c.curved) return c.normal;
+    const ChartRaster::Tri2& t = r.tris[s.tri];
+    const Vec3 n = interpolatedNormal(scene.meshes[t.mesh], t.triangle, Vec2(s.bary[1], s.bary[2]),
+                                      triangleNormal(scene.meshes[t.mesh], t.triangle));
+    return c.isBack ? -n : n;
+  };
   for (uint32_t j = 0; j < c.resV; ++j)
     for (uint32_t i = 0; i < c.resU; ++i) {
       const uint32_t local = j * c.resU + i;
@@ -329,23 +339,31 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
         s.tri = bestTri;
         s.bary = barycentric2(tr, bestQ);
       }
-      if (!r.tris.empty()) point = pointOnTriangle(scene, r.tris[s.tri], s.bary);
+      Vec3 normal = c.normal;
+      if (!r.tris.empty()) {
+        point = pointOnTriangle(scene, r.tris[s.tri], s.bary);
+        normal = normalAt(s);
+      }
       // A buried point gathers from the nearest footprint sub-sample that is not buried; a
       // tixel with none takes a neighbour's point below.
-      if (probe && !r.tris.empty() && buried(scene, accel, c, point)) {
+      if (probe && !r.tris.empty() && buried(scene, accel, tixelFrameAround(c, normal), point)) {
         std::sort(insideSamples.begin(), insideSamples.begin() + inside,
                   [](const auto& x, const auto& y) { return x.first < y.first; });
         isBuried[local] = 1;
         for (int k = 0; k < inside; ++k) {
-          const Vec3 q = pointOnTriangle(scene, r.tris[insideSamples[size_t(k)].second.tri], insideSamples[size_t(k)].second.bary);
-          if (!buried(scene, accel, c, q)) {
+          const FootprintSample& sample = insideSamples[size_t(k)].second;
+          const Vec3 q = pointOnTriangle(scene, r.tris[sample.tri], sample.bary);
+          const Vec3 qNormal = normalAt(sample);
+          if (!buried(scene, accel, tixelFrameAround(c, qNormal), q)) {
             point = q;
+            normal = qNormal;
             isBuried[local] = 0;
             break;
           }
         }
       }
       p.gatherPoint[g] = point;
+      if (c.curved) p.gatherNormal[g] = normal;
 
       if (c.kind == ChartKind::Diffuse) {
         if (!textured) {
@@ -368,7 +386,10 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
     if (!isBuried[k]) source[k] = k;
   if (!fillFromNearestSeed(c, source)) return;  // the whole chart is buried: nothing visible to borrow from
   for (uint32_t k = 0; k < isBuried.size(); ++k)
-    if (isBuried[k]) p.gatherPoint[c.firstTixel + k] = p.gatherPoint[c.firstTixel + source[k]];
+    if (isBuried[k]) {
+      p.gatherPoint[c.firstTixel + k] = p.gatherPoint[c.firstTixel + source[k]];
+      if (c.curved) p.gatherNormal[c.firstTixel + k] = p.gatherNormal[c.firstTixel + source[k]];
+    }
 }
 
 }  // namespace
@@ -436,18 +457,50 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
     k = e;
   }
 
+  // Curved charts (parameterisation.h): materials that may grow them, and smooth edges.
+  std::vector<uint8_t> curvedMaterial(scene.materials.size(), 0);
+  for (size_t m = 0; m < scene.materials.size(); ++m)
+    curvedMaterial[m] = chartKindOf(scene.materials[m].bsdf) == ChartKind::Diffuse && !scene.materials[m].isEmissive();
+  const float cosCone = std::cos(kCurvedChartConeDegrees * kPi / 180.0f);
+  const float cosSmooth = std::cos(kSmoothEdgeToleranceDegrees * kPi / 180.0f);
+  const float cosFlatShaded = std::cos(kFlatShadedChartEdgeDegrees * kPi / 180.0f);
+  // Whether the edge (welded ids a, b) between triangles g and h may join a curved chart: at
+  // both ends the two triangles' vertex normals agree (a smooth edge); between two triangles
+  // of meshes without vertex normals (flat shading), when their faces meet at no more than
+  // kFlatShadedChartEdgeDegrees.
+  auto smoothEdge = [&](uint32_t g, uint32_t h, uint32_t a, uint32_t b) {
+    const Mesh& mg = scene.meshes[tris[g].mesh];
+    const Mesh& mh = scene.meshes[tris[h].mesh];
+    if (mg.normals.empty() || mh.normals.empty())
+      return mg.normals.empty() && mh.normals.empty() && glm::dot(tris[g].normal, tris[h].normal) >= cosFlatShaded;
+    for (const uint32_t w : {a, b}) {
+      int kg = 0, kh = 0;
+      while (kg < 3 && tris[g].welded[kg] != w) ++kg;
+      while (kh < 3 && tris[h].welded[kh] != w) ++kh;
+      if (kg == 3 || kh == 3) return false;
+      const Vec3 ng = mg.normals[mg.triangles[tris[g].triangle][kg]];
+      const Vec3 nh = mh.normals[mh.triangles[tris[h].triangle][kh]];
+      // Zero normals (no normal given) never match; unit ones within the tolerance do.
+      if (!(glm::dot(ng, nh) >= cosSmooth)) return false;
+    }
+    return true;
+  };
+
   Parameterisation p;
   p.triangleChart.resize(scene.meshes.size());
   for (uint32_t m = 0; m < scene.meshes.size(); ++m) p.triangleChart[m].assign(scene.meshes[m].triangles.size(), 0);
   std::vector<uint32_t> chartOf(tris.size(), UINT32_MAX);
+  std::vector<uint8_t> chartCurved;  // per chart: some triangle joined across a smooth, non-coplanar edge
   std::vector<uint32_t> stack;
   for (uint32_t seed = 0; seed < tris.size(); ++seed) {
     if (chartOf[seed] != UINT32_MAX) continue;
     const uint32_t chart = uint32_t(p.chartTriangles.size());
     p.chartTriangles.emplace_back();
+    chartCurved.push_back(0);
     const TriangleInfo& s = tris[seed];
     const Vec3 n0 = s.normal;
     const float d0 = glm::dot(n0, scene.meshes[s.mesh].positions[scene.meshes[s.mesh].triangles[s.triangle][0]]);
+    const bool mayCurve = curvedMaterial[s.material] != 0;
     chartOf[seed] = chart;
     stack.assign(1, seed);
     while (!stack.empty()) {
@@ -462,12 +515,15 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
           const uint32_t h = edges[k].second;
           if (chartOf[h] != UINT32_MAX) continue;
           const TriangleInfo& t = tris[h];
-          if (t.material != s.material || t.area == 0.0 || glm::dot(t.normal, n0) < cosTol) continue;
+          if (t.material != s.material || t.area == 0.0) continue;
           const Mesh& mesh = scene.meshes[t.mesh];
-          bool coplanar = true;
+          bool coplanar = glm::dot(t.normal, n0) >= cosTol;
           for (int v = 0; v < 3; ++v)
             coplanar = coplanar && std::abs(glm::dot(n0, mesh.positions[mesh.triangles[t.triangle][v]]) - d0) <= planeTol;
-          if (!coplanar) continue;
+          if (!coplanar) {
+            if (!mayCurve || glm::dot(t.normal, n0) < cosCone || !smoothEdge(g, h, a, b)) continue;
+            chartCurved[chart] = 1;
+          }
           chartOf[h] = chart;
           stack.push_back(h);
         }
@@ -521,6 +577,7 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
   const size_t chartCount = p.chartTriangles.size();
   p.charts.resize(chartCount);
   p.chartArea.assign(chartCount, 0.0);
+  p.chartMinCosine.assign(chartCount, 1.0f);
   parallelFor(chartCount, [&](uint64_t ci) {
     const auto& list = p.chartTriangles[ci];
     Chart& c = p.charts[ci];
@@ -546,6 +603,27 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
     const double nLen = glm::length(normalSum);
     const Vec3 n = nLen > 0.0 ? Vec3(normalSum / nLen) : Vec3(0.0f, 0.0f, 1.0f);
     c.normal = n;
+    // A curved chart: the projection along n foreshortens a face tilted θ by cos θ, so its
+    // tixels shrink by the smallest cos θ (parameterisation.h "Curved charts").
+    float minCosine = 1.0f;
+    c.curved = chartCurved[ci] != 0;
+    // A chart of a smooth mesh that did not grow past one plane (a lone facet between two
+    // curved charts) is curved too when its vertex normals leave the plane's normal: it
+    // then gathers around them like its neighbours instead of shading flat.
+    for (size_t k = 0; !c.curved && curvedMaterial[c.material] && k < list.size(); ++k) {
+      const Mesh& mesh = scene.meshes[list[k].first];
+      if (mesh.normals.empty()) break;
+      for (int v = 0; v < 3; ++v) {
+        const Vec3 vn = mesh.normals[mesh.triangles[list[k].second][v]];
+        c.curved = c.curved || (vn != Vec3(0.0f) && glm::dot(vn, n) < cosTol);
+      }
+    }
+    if (c.curved)
+      for (const auto& [m, t] : list) {
+        const Vec3 fn = triangleNormal(scene.meshes[m], t);
+        if (fn != Vec3(0.0f)) minCosine = std::min(minCosine, glm::dot(fn, n));
+      }
+    p.chartMinCosine[ci] = minCosine;
 
     // axisU: among the (longest 256) triangle edges projected into the plane, the one giving
     // the smallest bounding rectangle; ties keep the first.
@@ -588,7 +666,7 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
     c.axisU = bestU;
     c.axisV = glm::cross(n, bestU);
     const float width = bestHi.x - bestLo.x, height = bestHi.y - bestLo.y;
-    float size = chartTixelSize(scene, c.material, c.kind, baseSize);
+    float size = chartTixelSize(scene, c.material, c.kind, baseSize) * minCosine;
     // Only a chart wider than maxTixelsPerChartSide tixels (16 384 in every preset: kilometres
     // of floor at centimetre tixels) is coarsened; none is coarsened for being small.
     const uint32_t cap = std::max<uint32_t>(1, settings.maxTixelsPerChartSide);
@@ -609,6 +687,7 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
     std::vector<Chart> charts;
     std::vector<std::vector<std::pair<uint32_t, uint32_t>>> chartTriangles;
     std::vector<double> chartArea;
+    std::vector<float> chartMinCosine;
     charts.reserve(chartCount);
     std::vector<uint32_t> meshBase(scene.meshes.size() + 1, 0);  // index in `tris` of each mesh's triangle 0
     for (size_t m = 0; m < scene.meshes.size(); ++m) meshBase[m + 1] = meshBase[m] + uint32_t(scene.meshes[m].triangles.size());
@@ -617,18 +696,27 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
     // front of the chart's plane, the back's radiance is exactly 0 — what a one-sided chart
     // shows from behind. (The walls of an open box, a floor, a ground plane under a black sky.)
     const float behindTolerance = 1e-4f * diagonal;
-    auto somethingBehind = [&](const Chart& c) {
-      if (!scene.environment.isBlack()) return true;
-      const float d0 = glm::dot(c.normal, c.origin);
+    // Something behind the plane with unit normal n through point x.
+    auto somethingBehindPlane = [&](const Vec3& n, const Vec3& x) {
+      const float d0 = glm::dot(n, x);
       for (int k = 0; k < 8; ++k) {
         const Vec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
-        if (glm::dot(c.normal, corner) - d0 < -behindTolerance) return true;
+        if (glm::dot(n, corner) - d0 < -behindTolerance) return true;
       }
       for (const Light& light : scene.lights) {
         const PunctualLight l = PunctualLight::from(light);
-        if (l.kind == PunctualLight::Kind::Directional ? glm::dot(l.direction, c.normal) > 0.0f
-                                                        : glm::dot(c.normal, l.position) - d0 < 0.0f)
+        if (l.kind == PunctualLight::Kind::Directional ? glm::dot(l.direction, n) > 0.0f : glm::dot(n, l.position) - d0 < 0.0f)
           return true;
+      }
+      return false;
+    };
+    // A curved chart does not lie in one plane: behind any of its triangles' planes.
+    auto somethingBehind = [&](const Chart& c, uint32_t ci) {
+      if (!scene.environment.isBlack()) return true;
+      if (!c.curved) return somethingBehindPlane(c.normal, c.origin);
+      for (const auto& [m, t] : p.chartTriangles[ci]) {
+        const Vec3 n = triangleNormal(scene.meshes[m], t);
+        if (n != Vec3(0.0f) && somethingBehindPlane(n, scene.meshes[m].positions[scene.meshes[m].triangles[t][0]])) return true;
       }
       return false;
     };
@@ -636,11 +724,12 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
       const auto& [m, t] = p.chartTriangles[ci][0];  // a chart's triangles are connected: one surface
       Chart front = p.charts[ci];
       const bool twoSided = isRoughGlassChart(front, scene.materials[front.material].bsdf) ||
-                            (front.kind != ChartKind::Specular && openComponent[root(meshBase[m] + t)] != 0 && somethingBehind(front));
+                            (front.kind != ChartKind::Specular && openComponent[root(meshBase[m] + t)] != 0 && somethingBehind(front, ci));
       front.sides = twoSided ? 2 : 1;
       charts.push_back(front);
       chartTriangles.push_back(p.chartTriangles[ci]);
       chartArea.push_back(p.chartArea[ci]);
+      chartMinCosine.push_back(p.chartMinCosine[ci]);
       if (!twoSided) continue;
       Chart back = front;
       back.isBack = true;
@@ -648,10 +737,12 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
       charts.push_back(back);
       chartTriangles.push_back(p.chartTriangles[ci]);
       chartArea.push_back(p.chartArea[ci]);
+      chartMinCosine.push_back(p.chartMinCosine[ci]);
     }
     p.charts = std::move(charts);
     p.chartTriangles = std::move(chartTriangles);
     p.chartArea = std::move(chartArea);
+    p.chartMinCosine = std::move(chartMinCosine);
   }
   const size_t recordCount = p.charts.size();
   for (uint32_t ci = 0; ci < recordCount; ++ci) {
@@ -665,6 +756,7 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
   }
   p.tixelChart.resize(p.tixelCount);
   p.gatherPoint.resize(p.tixelCount);
+  p.gatherNormal.resize(p.tixelCount);
   p.coverage.resize(p.tixelCount);
   p.transportAlbedo.resize(p.tixelCount);
   for (uint32_t ci = 0; ci < recordCount; ++ci)

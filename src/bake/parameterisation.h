@@ -8,7 +8,32 @@
 // triangle's vertices lie within kChartPlaneTolerance × (scene diagonal) of the seed
 // triangle's plane. Each chart gets an orthonormal frame — normal = the area-weighted mean of
 // its triangles' winding normals (the emitting/front side), axisU along the polygon edge that
-// gives the smallest bounding rectangle — and a square tixel grid over that rectangle.
+// gives the smallest bounding rectangle of the triangles projected along the normal — and a
+// square tixel grid over that rectangle.
+//
+// Curved charts (Chart::curved). A smooth diffuse surface (banners, curtains, arches, a
+// sphere) would otherwise be one flat chart per triangle: faceted lookups and tixels smaller
+// than the preset's wherever triangles are. So, for a Lambertian material that does not emit,
+// a triangle also joins a neighbour across a *smooth* edge — welded, with the shading normals
+// of both triangles equal (within kSmoothEdgeToleranceDegrees) at both ends of the edge, so a
+// modelled crease (split normals) stops the chart; on a flat-shaded mesh (no vertex normals,
+// Crytek Sponza's) any edge whose faces meet within kFlatShadedChartEdgeDegrees — when its
+// winding normal is within kCurvedChartConeDegrees of the seed triangle's. The flattening is the projection along the chart
+// normal: every face normal lies within 2 × kCurvedChartConeDegrees (≤ 40°) of it, so the
+// projection is locally one-to-one and linear on each triangle (lookups need no per-triangle
+// data). Its distortion is the foreshortening cos θ of a face tilted θ from the chart normal
+// (one direction shrinks by cos θ, the other is kept: area stretch cos θ, angle stretch
+// 1/cos θ); the tixel size is multiplied by the chart's smallest cos θ (chartMinCosine),
+// so that even the most tilted triangle's tixels are no larger than the preset's on the
+// surface — no chart is coarser than the preset. A chart is curved when it grew across a
+// smooth edge that is not coplanar, or (a lone facet of a smooth mesh) when a vertex normal
+// of its triangles leaves kChartNormalToleranceDegrees of the chart normal; all others are
+// the planar charts of before, unchanged.
+// Glossy, specular, rough-glass and emissive charts stay planar. A curved chart's diffuse
+// tixels gather around the interpolated shading normal at their gather point (gatherNormal,
+// tixelFrame), so a smooth mesh gets smoothly varying irradiance; on a flat-shaded mesh that
+// is the face normal of the triangle under the tixel, as the path tracer shades it (facets
+// stay facets, blended over one tixel at their edges, but are no longer a chart each).
 //
 // Tixel size (world units): 1 / tixelsPerUnit when that is set, otherwise the scene's room
 // scale (sceneScale) / tixelsAcrossScene, so a preset means the same density in a one-room
@@ -47,6 +72,14 @@
 namespace pl {
 
 inline constexpr float kChartNormalToleranceDegrees = 2.0f;
+/// Curved charts: every face normal within this angle of the seed triangle's normal.
+inline constexpr float kCurvedChartConeDegrees = 20.0f;
+/// Curved charts: an edge is smooth when both triangles' shading normals at each of its ends
+/// are within this angle.
+inline constexpr float kSmoothEdgeToleranceDegrees = 1.0f;
+/// Curved charts of flat-shaded meshes (no vertex normals): neighbouring faces join when their
+/// normals are within this angle.
+inline constexpr float kFlatShadedChartEdgeDegrees = 30.0f;
 inline constexpr float kChartPlaneTolerance = 0.005f;  ///< relative to the scene diagonal
 /// Glossy charts' tixels are this many times finer than diffuse ones (per side).
 inline constexpr float kGlossyTixelDensity = 2.0f;
@@ -59,6 +92,9 @@ struct Parameterisation {
   std::vector<std::vector<uint32_t>> triangleChart;  ///< [mesh][triangle] → chart
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> chartTriangles;  ///< chart → (mesh, triangle)
   std::vector<double> chartArea;    ///< sum of the chart's triangle areas (scene units²)
+  /// Per chart record: the smallest cos θ between a face normal and the chart normal (the
+  /// projection's largest foreshortening; the tixel size was multiplied by it), 1 when planar.
+  std::vector<float> chartMinCosine;
   float sceneScale = 0.0f;          ///< sceneScale() (0 when settings.tixelsPerUnit fixed the size)
   float baseTixelSize = 0.0f;       ///< the preset's tixel size before the per-material factors
   uint64_t tixelCount = 0;
@@ -66,9 +102,31 @@ struct Parameterisation {
   // Per tixel, by global tixel index (Chart::firstTixel + i + j·resU):
   std::vector<uint32_t> tixelChart;   ///< owning chart
   std::vector<Vec3> gatherPoint;      ///< world point on the polygon the tixel gathers from
+  /// Curved charts only (else empty entries are never read): the unit interpolated shading
+  /// normal at gatherPoint, on the record's side (negated on a back record). See tixelFrame.
+  std::vector<Vec3> gatherNormal;
   std::vector<float> coverage;        ///< fraction of the tixel's square covered by the polygon
   std::vector<Rgb> transportAlbedo;   ///< diffuse charts: mean albedo over the tixel's footprint
 };
+
+/// The orthonormal frame a tixel gathers in (z along the normal it gathers around): its
+/// chart's frame (axisU, axisV, normal) on a planar chart, a frame around gatherNormal on a
+/// curved one. toWorld/toLocal are chartWorldDirection/chartLocalDirection's formulas, so a
+/// planar chart's rays are bit for bit those of its chart frame.
+struct TixelFrame {
+  Vec3 u, v, n;
+  Vec3 toWorld(const Vec3& local) const { return local.x * u + local.y * v + local.z * n; }
+  Vec3 toLocal(const Vec3& w) const { return {glm::dot(w, u), glm::dot(w, v), glm::dot(w, n)}; }
+};
+/// The frame of a point of chart c whose gather normal is `normal` (read only when curved).
+inline TixelFrame tixelFrameAround(const Chart& c, const Vec3& normal) {
+  if (!c.curved) return {c.axisU, c.axisV, c.normal};
+  const Frame f = Frame::fromNormal(normal);
+  return {f.s, f.t, f.n};
+}
+inline TixelFrame tixelFrame(const Parameterisation& p, const Chart& c, uint64_t tixel) {
+  return tixelFrameAround(c, c.curved ? p.gatherNormal[tixel] : c.normal);
+}
 
 ChartKind chartKindOf(const Bsdf& bsdf);
 /// Paraboloid map resolution for a material (1 diffuse, 0 specular, glossy from its lobe).

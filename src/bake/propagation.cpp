@@ -503,6 +503,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
       const Vec3 x = param.gatherPoint[g];
+      const Vec3 normal = tixelFrame(param, c, g).n;  // the chart's normal, or a curved chart's tixel normal
       // Rough glass takes light from both sides: reflected from its own, transmitted from
       // the other (|cos θ|; the BSDF chooses, see the Pending loop below).
       const bool bothSides = isRoughGlassChart(c, scene.materials[c.material].bsdf);
@@ -511,9 +512,9 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         float distance;
         Rgb incident;
         if (!light.incidentAt(x, wi, distance, incident)) continue;
-        const float cosTheta = bothSides ? std::abs(glm::dot(c.normal, wi)) : glm::dot(c.normal, wi);
+        const float cosTheta = bothSides ? std::abs(glm::dot(normal, wi)) : glm::dot(normal, wi);
         if (!(cosTheta > 0.0f) || isBlack(incident)) continue;
-        const Vec3 origin = offsetRayOrigin(x, c.normal, wi);
+        const Vec3 origin = offsetRayOrigin(x, normal, wi);
         const std::optional<Ray> ray = std::isfinite(distance) ? shadowRayTo(origin, light.position)
                                                                : std::optional<Ray>(Ray{origin, wi, 0.0f, kInfinity});
         if (!ray) continue;
@@ -528,8 +529,8 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       if (lightSamples == 0) continue;
       // Every accepted sample direction has cos θx > 0, so all of this tixel's shadow rays
       // start at the same offset origin (rough glass: one on each side).
-      const Vec3 origin = offsetRayOrigin(x, c.normal, c.normal);
-      const Vec3 originBehind = offsetRayOrigin(x, c.normal, -c.normal);
+      const Vec3 origin = offsetRayOrigin(x, normal, normal);
+      const Vec3 originBehind = offsetRayOrigin(x, normal, -normal);
       // The tixel's S samples are an Owen-scrambled Sobol (0,2)-net of its own (a scramble
       // keyed by the tixel): the emitter choice, stretched back onto [0, 1), and the second
       // coordinate are stratified jointly (before: stratified emitter choice, random second
@@ -544,7 +545,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         if (!(dist2 > 0.0f)) continue;
         const float dist = std::sqrt(dist2);
         const Vec3 wi = d * (1.0f / dist);
-        const float cosSigned = glm::dot(c.normal, wi);
+        const float cosSigned = glm::dot(normal, wi);
         const float cosX = bothSides ? std::abs(cosSigned) : cosSigned;
         float cosY = -glm::dot(em.normal, wi);
         if (!(cosX > 0.0f) || (cosY <= 0.0f && !em.twoSided)) continue;
@@ -633,6 +634,7 @@ void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t 
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
       uint64_t cursor = vis.extraOffset[g];
+      const TixelFrame frame = tixelFrame(param, c, g);  // the gather rays' frame (visibility.cpp)
       subCells.clear();  // this tixel's gather sub-cells, computed when first needed
       auto direction = [&](uint32_t k) {
         if (subCells.empty()) gatherSubCells(g, vis.gridSide, settings.seed, subCells);
@@ -655,7 +657,7 @@ void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t 
           // The environment in the direction the path left: the gather direction itself, or
           // after mirrors the final direction stored with the path.
           const Vec3 leaving = extra ? octahedralDecode(extra->st)
-                                     : chartWorldDirection(c, direction(k));
+                                     : frame.toWorld(direction(k));
           L = environment.radiance(leaving);
         } else {
           const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
@@ -667,8 +669,8 @@ void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t 
               // The same power heuristic as the shadow rays, evaluated for this gather ray
               // against the seen chart's plane (exact for a direct hit on a planar emitter).
               const Vec3 local = direction(k);
-              const Vec3 w = glm::normalize(chartWorldDirection(c, local));
-              const Vec3 o = offsetRayOrigin(param.gatherPoint[g], c.normal, w);
+              const Vec3 w = glm::normalize(frame.toWorld(local));
+              const Vec3 o = offsetRayOrigin(param.gatherPoint[g], frame.n, w);
               const float denom = glm::dot(w, seen.normal);
               const float t = denom != 0.0f ? glm::dot(seen.origin - o, seen.normal) / denom : 0.0f;
               const float cosY = std::abs(denom);

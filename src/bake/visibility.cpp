@@ -225,6 +225,11 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
     h.value(c.dirRes);
     h.value(c.sides);
     h.value(uint8_t(c.isBack));
+    // A curved chart's tixels gather around their own normals (planar charts hash as before).
+    if (c.curved) {
+      h.value(uint8_t(1));
+      h.bytes(param.gatherNormal.data() + c.firstTixel, c.tixelCount() * sizeof(Vec3));
+    }
   }
   h.bytes(param.gatherPoint.data(), param.gatherPoint.size() * sizeof(Vec3));
   h.value(gatherGridSide(settings.gatherDirections));
@@ -284,12 +289,13 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
       // Every gather direction is in the upper hemisphere, so all rays of a tixel share one
       // origin, offset off the surface along the normal. The frame is orthonormal and the
       // local directions are unit, so the world directions need no renormalisation.
-      const Vec3 origin = offsetRayOrigin(param.gatherPoint[g], c.normal, c.normal);
+      const TixelFrame frame = tixelFrame(param, c, g);
+      const Vec3 origin = offsetRayOrigin(param.gatherPoint[g], frame.n, frame.n);
       gatherSubCells(g, field.gridSide, settings.seed, jitters);
       for (uint32_t k = 0; k < n; ++k) {
         Ray ray;
         ray.origin = origin;
-        ray.direction = chartWorldDirection(c, directionTable[size_t(k) * kJitterCount + jitters[k]]);
+        ray.direction = frame.toWorld(directionTable[size_t(k) * kJitterCount + jitters[k]]);
         rays.push_back(ray);
         states.push_back({g * n + k, Rgb(1.0f), false});
       }
@@ -315,10 +321,12 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
         }
         // The side facing the ray (a two-sided chart's back record when it arrives from
         // behind); `back` is left only for one-sided charts seen from behind.
-        const uint32_t chartIndex = facingChart(param.charts.data(), param.triangleChart[hit.mesh][hit.triangle], -ray.direction);
+        const Mesh& hitMesh = scene.meshes[hit.mesh];
+        const uint32_t chartIndex =
+            facingChart(param.charts.data(), param.triangleChart[hit.mesh][hit.triangle], -ray.direction, hitMesh, hit.triangle);
         const Chart& c = param.charts[chartIndex];
         const Vec3 pos = ray.origin + hit.t * ray.direction;
-        const bool back = glm::dot(ray.direction, c.normal) > 0.0f;
+        const bool back = glm::dot(ray.direction, chartNormalAt(c, hitMesh, hit.triangle)) > 0.0f;
         if (c.kind == ChartKind::Specular) {
           // A mirror or glass: the step the renderers take too (followSpecular). Its own
           // emission is not gathered (as before glass: mirrors were never lamps here).

@@ -34,6 +34,8 @@ std::string BakeJobStats::toJson() const {
   json["charts"] = charts;  // chart records: a two-sided chart counts twice (front and back)
   json["two_sided_charts"] = twoSidedCharts;
   json["back_side_tixels"] = backSideTixels;
+  json["curved_charts"] = curvedCharts;  // chart records (a two-sided curved chart counts twice)
+  json["curved_tixels"] = curvedTixels;
   json["visibility_rays"] = bake.visibilityRays;
   json["visibility_rays_per_second"] =
       bake.visibilitySeconds > 0 ? double(bake.visibilityRays) / bake.visibilitySeconds : 0.0;
@@ -107,6 +109,8 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
   for (const Chart& c : lf.charts) {
     stats.twoSidedCharts += c.isBack ? 1 : 0;
     stats.backSideTixels += c.isBack ? c.tixelCount() : 0;
+    stats.curvedCharts += c.curved ? 1 : 0;
+    stats.curvedTixels += c.curved ? c.tixelCount() : 0;
   }
   if (!options_.statsPath.empty()) writeFileAtomically(options_.statsPath, stats.toJson());
   return result;

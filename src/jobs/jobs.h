@@ -167,7 +167,7 @@ struct BakeJobStats {
   int threads = 0;
   double seconds = 0.0;  ///< the whole job: loading (path overload), baking and writing
   BakeStats bake;
-  uint64_t charts = 0, twoSidedCharts = 0, backSideTixels = 0, fileBytes = 0;
+  uint64_t charts = 0, twoSidedCharts = 0, backSideTixels = 0, curvedCharts = 0, curvedTixels = 0, fileBytes = 0;
   std::string toJson() const;
 };
 

@@ -3,10 +3,15 @@
 // light-field seed (slides 9–17). This header is the data model shared by the bake (which
 // fills it), the .plf file (which stores it) and the renderers (which look it up).
 //
-// Position: every chart (a planar polygon: edge-connected coplanar triangles with one
-// material) has an orthonormal frame (origin, axisU, axisV, normal) and a uniform grid of
-// resU × resV tixels of side tixelSize (scene units) covering its bounding rectangle in the
-// plane: tixel (i, j) has centre origin + (i + ½)·tixelSize·axisU + (j + ½)·tixelSize·axisV.
+// Position: every chart (edge-connected triangles with one material) has an orthonormal frame
+// (origin, axisU, axisV, normal) and a uniform grid of resU × resV tixels of side tixelSize
+// (scene units) covering the bounding rectangle of its triangles projected along the normal
+// onto the plane: tixel (i, j) has centre origin + (i + ½)·tixelSize·axisU + (j + ½)·tixelSize·axisV.
+// A chart is planar (coplanar triangles) or, for diffuse materials, curved (`curved`: a smooth
+// surface whose face normals stay within a bounded cone around the chart normal, so the
+// projection along it is one-to-one; parameterisation.h "Curved charts"). A point on a curved
+// chart maps to the grid by the same projection; its tixel size is set so that the most
+// foreshortened triangle's tixels are still no larger than the preset's on the surface.
 // Every tixel holds valid values, including those whose centre lies outside the polygon, so
 // bilinear interpolation at polygon edges never reads garbage.
 //
@@ -67,6 +72,7 @@ struct Chart {
   uint64_t firstValue = 0;      ///< index of tixel (0, 0), direction texel (0, 0) in values
   uint8_t sides = 1;            ///< 2: a two-sided surface (both records have 2), see "Sides" above
   bool isBack = false;          ///< the back-side record of a two-sided surface (follows its front)
+  bool curved = false;          ///< a curved diffuse chart: sides are decided per triangle (chartNormalAt)
 
   uint64_t tixelCount() const { return uint64_t(resU) * resV; }
   uint64_t valuesPerTixel() const { return uint64_t(dirRes) * dirRes; }
@@ -114,15 +120,31 @@ struct LightField {
   BakeStats stats;
 };
 
-/// The chart record holding the side of record `chart` (as triangleChart gives it) that
-/// a viewer in world direction towardsViewer (from the surface; −ray direction) sees: its back
-/// record chart + 1 when the surface is two-sided and the viewer is behind the chart normal,
-/// otherwise `chart` itself. The one place the bake's gather rays and both renderers choose a
-/// side. (The chart normal, not the hit triangle's, decides: a chart's triangles are coplanar
-/// within kChartNormalToleranceDegrees.)
-inline uint32_t facingChart(const Chart* charts, uint32_t chart, const Vec3& towardsViewer) {
+/// The normal of chart record c at triangle `triangle` of `mesh` (one of its triangles): the
+/// chart normal for a planar chart (its triangles are coplanar within
+/// kChartNormalToleranceDegrees), the triangle's unit winding normal for a curved one (negated
+/// on a back record), since a curved chart's triangles may face up to its cone bound away from
+/// the chart normal. Not unit for a degenerate triangle of a curved chart (zero).
+inline Vec3 chartNormalAt(const Chart& c, const Mesh& mesh, uint32_t triangle) {
+  if (!c.curved) return c.normal;
+  const Vec3 n = triangleNormal(mesh, triangle);
+  return c.isBack ? -n : n;
+}
+
+/// The chart record holding the side of record `chart` (as triangleChart gives it) that a
+/// viewer in world direction towardsViewer (from the surface; −ray direction) sees at a point
+/// whose record normal (chartNormalAt) is `normalAtHit`: its back record chart + 1 when the
+/// surface is two-sided and the viewer is behind that normal, otherwise `chart` itself. The
+/// one place the bake's gather rays and both renderers choose a side.
+inline uint32_t facingChart(const Chart* charts, uint32_t chart, const Vec3& towardsViewer, const Vec3& normalAtHit) {
   const Chart& c = charts[chart];
-  return c.sides == 2 && !c.isBack && glm::dot(towardsViewer, c.normal) < 0.0f ? chart + 1 : chart;
+  return c.sides == 2 && !c.isBack && glm::dot(towardsViewer, normalAtHit) < 0.0f ? chart + 1 : chart;
+}
+/// facingChart at a ray's hit on triangle `triangle` of `mesh` (the triangle normal is only
+/// computed for a curved chart).
+inline uint32_t facingChart(const Chart* charts, uint32_t chart, const Vec3& towardsViewer, const Mesh& mesh,
+                            uint32_t triangle) {
+  return facingChart(charts, chart, towardsViewer, chartNormalAt(charts[chart], mesh, triangle));
 }
 
 /// Whether chart record c (of a material with BSDF bsdf) is rough glass: a glossy chart whose

@@ -105,7 +105,8 @@ Vec3 normalMappedLookupDirection(const Chart& c, const Vec3& shadingNormal, cons
 
 Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosition,
                     const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
-  chart = facingChart(lf.charts.data(), chart, worldDirectionTowardsViewer);
+  // No triangle here: the chart normal decides the side (exact for planar charts).
+  chart = facingChart(lf.charts.data(), chart, worldDirectionTowardsViewer, lf.charts[chart].normal);
   const Chart& c = lf.charts[chart];
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   return exitantRadiance(lf.scene, c, chartShading(lf.scene, c), lf.values.data(), worldPosition,
@@ -115,7 +116,8 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer) {
   // The chart facing the viewer (a two-sided surface's back record when seen from behind), then
   // the lookup direction the normal map reflects to on it. The shading is made once per call.
-  const uint32_t chart = facingChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], worldDirectionTowardsViewer);
+  const uint32_t chart = facingChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], worldDirectionTowardsViewer,
+                                     lf.scene.meshes[hit.mesh], hit.triangle);
   const Chart& c = lf.charts[chart];
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   const ChartShading shading = chartShading(lf.scene, c);

@@ -196,6 +196,13 @@ inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading&
   if (shading.normalMapped) lookup = normalMappedLookupDirection(c, surface.shadingNormal, towardsViewer);
 }
 
+/// The cos θ towards the viewer that the lookups use on a curved chart record. Its triangles
+/// face up to the cone bound away from the chart normal, so the chart normal cannot tell the
+/// side; facingChart has turned a two-sided surface to the record the viewer is in front of,
+/// and the record reflects. Known limit: a one-sided curved chart (the outside of a closed
+/// smooth mesh) seen from inside the mesh also reflects, where a planar one shows black.
+inline constexpr float kCurvedChartCosine = 1.0f;
+
 /// Exitant radiance (W·sr⁻¹·m⁻²) of chart `chart` at worldPosition towards the viewer:
 ///   diffuse chart:  Le + albedo(uv)·E/π with E bilinearly interpolated over the 2×2 nearest
 ///                   tixels and the albedo texture applied at full resolution at `uv`;
@@ -222,7 +229,10 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
   if (c.kind == ChartKind::Specular) return f4Zero();
   const Vec2 grid = tixelGridCoordinates(c, worldPosition, shading.inverseTixelSize);
   // cos θ towards the viewer (chartLocalDirection's z; a diffuse lookup needs no more of it).
-  const float cosTheta = glm::dot(worldDirectionTowardsViewer, c.normal);
+  // A curved chart (diffuse, never emissive: parameterisation.h) has no single normal: the
+  // caller's facingChart chose its side by the hit triangle's normal, and it reflects
+  // (cos θ taken as 1, see kCurvedChartCosine).
+  const float cosTheta = c.curved ? kCurvedChartCosine : glm::dot(worldDirectionTowardsViewer, c.normal);
   // chartEmittedRadiance (lightfield.h) on the precomputed emission of this record.
   const bool emits = cosTheta > 0.0f || shading.twoSidedEmission;
   // Behind a one-sided record: no reflected light (the caller turned two-sided ones with
@@ -299,8 +309,9 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
     return out;
   };
   const Taps u = taps(gridU, c.resU), v = taps(gridV, c.resV);
-  const int frontSide = _mm_movemask_ps(_mm_cmpgt_ps(cosTheta, zero));  // bit k: cos θ_k > 0
-  const int reflectingSide = _mm_movemask_ps(_mm_cmpge_ps(cosTheta, zero));  // bit k: cos θ_k ≥ 0
+  // bit k: cos θ_k > 0, and cos θ_k ≥ 0 (a curved chart: kCurvedChartCosine > 0 in every lane).
+  const int frontSide = c.curved ? 0xf : _mm_movemask_ps(_mm_cmpgt_ps(cosTheta, zero));
+  const int reflectingSide = c.curved ? 0xf : _mm_movemask_ps(_mm_cmpge_ps(cosTheta, zero));
   const F4 emission = f4Load(shading.emission.v);
   // exitantRadianceLanes' albedo / π, per lookup when textured (one branch for all four).
   F4 albedoOverPi[4];

@@ -469,17 +469,19 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
 // --- Charts ------------------------------------------------------------------------------
 
 constexpr uint64_t kChartRecordBytes = 4 + 1 + 4 * 12 + 4 + 3 * 4 + 2 * 8;
-// The kind byte: ChartKind in bits 0–5, and the sides (lightfield.h "Sides"): bit 7 = two-sided
+// The kind byte: ChartKind in bits 0–4, and the sides (lightfield.h "Sides"): bit 7 = two-sided
 // (on both records), bit 6 = the back record. Files written before two-sided charts have both
-// bits clear, so they read as one-sided charts, which is what they hold.
-constexpr uint8_t kChartTwoSidedBit = 0x80, kChartBackBit = 0x40, kChartKindMask = 0x3f;
+// bits clear, so they read as one-sided charts, which is what they hold. Bit 5 marks a curved
+// chart (lightfield.h: diffuse only); files written before curved charts have it clear.
+constexpr uint8_t kChartTwoSidedBit = 0x80, kChartBackBit = 0x40, kChartCurvedBit = 0x20, kChartKindMask = 0x1f;
 
 std::vector<unsigned char> encodeCharts(const std::vector<Chart>& charts) {
   ByteWriter w;
   w.put(uint64_t(charts.size()));
   for (const Chart& c : charts) {
     w.put(c.material);
-    w.put(uint8_t(uint8_t(c.kind) | (c.sides == 2 ? kChartTwoSidedBit : 0) | (c.isBack ? kChartBackBit : 0)));
+    w.put(uint8_t(uint8_t(c.kind) | (c.sides == 2 ? kChartTwoSidedBit : 0) | (c.isBack ? kChartBackBit : 0) |
+                  (c.curved ? kChartCurvedBit : 0)));
     w.put(c.origin);
     w.put(c.axisU);
     w.put(c.axisV);
@@ -507,6 +509,8 @@ std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std:
     c.kind = ChartKind(kind);
     c.sides = (kindByte & kChartTwoSidedBit) ? 2 : 1;
     c.isBack = (kindByte & kChartBackBit) != 0;
+    c.curved = (kindByte & kChartCurvedBit) != 0;
+    if (c.curved && c.kind != ChartKind::Diffuse) r.corrupt(fmt::format("chart {} of kind {} is marked curved", i, kind));
     c.origin = r.get<Vec3>();
     c.axisU = r.get<Vec3>();
     c.axisV = r.get<Vec3>();
@@ -530,7 +534,8 @@ std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std:
     if (c.isBack) {
       const Chart* front = i > 0 ? &charts[i - 1] : nullptr;
       if (c.sides != 2 || !front || front->sides != 2 || front->isBack || front->material != c.material ||
-          front->kind != c.kind || front->resU != c.resU || front->resV != c.resV || front->dirRes != c.dirRes)
+          front->kind != c.kind || front->resU != c.resU || front->resV != c.resV || front->dirRes != c.dirRes ||
+          front->curved != c.curved)
         r.corrupt(fmt::format("chart {} is a back side without a matching two-sided front chart before it", i));
     } else if (i > 0 && charts[i - 1].sides == 2 && !charts[i - 1].isBack) {
       r.corrupt(fmt::format("two-sided chart {} is not followed by its back side", i - 1));
@@ -1015,6 +1020,7 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
     info.glossyCharts += c.kind == ChartKind::Glossy;
     info.specularCharts += c.kind == ChartKind::Specular;
     info.twoSidedCharts += c.isBack;
+    info.curvedCharts += c.curved;
     info.tixels += c.tixelCount();
   }
   info.values = reader.entry(kValues).decodedSize / sizeof(Rgb);

@@ -271,8 +271,10 @@ void checkBakedSphere(float albedo, EnvKind kind, const std::string& mapPath = {
   const LightField lf = bake(std::move(scene), settings);
   const std::string what = std::string(envName(kind)) + ", albedo " + std::to_string(albedo);
 
-  // No two facets of the icosphere are coplanar: one chart each, all diffuse.
-  ASSERT_EQ(lf.charts.size(), triangles) << what;
+  // No two facets of the icosphere are coplanar, but neighbours meet at less than
+  // kFlatShadedChartEdgeDegrees: curved charts of several facets (parameterisation.h), each
+  // tixel gathering around its facet's normal; all diffuse.
+  ASSERT_LT(lf.charts.size(), triangles) << what;
   uint64_t tixels = 0;
   for (const Chart& c : lf.charts) {
     ASSERT_EQ(c.kind, ChartKind::Diffuse) << what;

@@ -163,7 +163,8 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   // The chart record sample i sees: its triangle's chart, turned to the side facing the camera.
   auto facingChartOf = [&](size_t i) {
     const RayHit& hit = s.hits[i];
-    return facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -s.rays[i].direction);
+    return facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -s.rays[i].direction,
+                       scene.meshes[hit.mesh], hit.triangle);
   };
   // A lookup is a chain of dependent loads — the hit's chart index, its chart record, the
   // record's shading, two rows of values, texels — each a cache (and, on 4 KiB pages, TLB)
@@ -300,7 +301,8 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         s.radiance[slot] += throughput * backgroundRadiance(scene.environment, ray.direction);
         continue;
       }
-      const uint32_t chart = facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -ray.direction);
+      const uint32_t chart = facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -ray.direction,
+                                         scene.meshes[hit.mesh], hit.triangle);
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv;

@@ -112,9 +112,9 @@ TEST_F(TwoSidedTest, OpenSurfacesGetABackRecordClosedOnesDoNot) {
 
   // The rule that picks a side: the back record only for a viewer behind a two-sided chart.
   const uint32_t sheet = p.triangleChart[1][0];
-  EXPECT_EQ(facingChart(p.charts.data(), sheet, Vec3(1, 0, 0)), sheet);
-  EXPECT_EQ(facingChart(p.charts.data(), sheet, Vec3(-1, 0, 0)), sheet + 1);
-  EXPECT_EQ(facingChart(p.charts.data(), sheet + 1, Vec3(1, 0, 0)), sheet + 1) << "a back record is never turned again";
+  EXPECT_EQ(facingChart(p.charts.data(), sheet, Vec3(1, 0, 0), p.charts[sheet].normal), sheet);
+  EXPECT_EQ(facingChart(p.charts.data(), sheet, Vec3(-1, 0, 0), p.charts[sheet].normal), sheet + 1);
+  EXPECT_EQ(facingChart(p.charts.data(), sheet + 1, Vec3(1, 0, 0), p.charts[sheet + 1].normal), sheet + 1) << "a back record is never turned again";
 }
 
 // A closed, consistently wound cube stays one-sided; flipping one face's winding, or removing

@@ -76,7 +76,7 @@ TEST_F(RenderCliTest, InfoPrintsContentsAndSizes) {
   std::string out, err;
   ASSERT_EQ(run("info " + path("quad.plf"), &out, &err), 0) << err;
   for (const char* fragment : {"format version 2", "all sections verified", "handmade-quad", "2 triangles",
-                               "lambert ×1", "cameras    2: side, top", "1 (1 diffuse, 0 glossy, 0 specular; 0 two-sided, counted twice)",
+                               "lambert ×1", "cameras    2: side, top", "1 (1 diffuse, 0 glossy, 0 specular; 0 two-sided, counted twice; 0 curved)",
                                "tixels       16", "values       16 RGB", "VALS", "preset handmade", "3 iterations"})
     EXPECT_NE(out.find(fragment), std::string::npos) << "'" << fragment << "' not in:\n" << out;
 }

@@ -378,6 +378,18 @@ CameraDesc Scene::automaticCamera() const {
   return camera;
 }
 
+Vec3 interpolatedNormal(const Mesh& mesh, uint32_t triangle, Vec2 barycentrics, const Vec3& geometricNormal) {
+  if (mesh.normals.empty()) return geometricNormal;
+  const UVec3 tri = mesh.triangles[triangle];
+  const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.0f - b1 - b2;
+  const Vec3 n = b0 * mesh.normals[tri.x] + b1 * mesh.normals[tri.y] + b2 * mesh.normals[tri.z];
+  const float length = glm::length(n);
+  // Opposing vertex normals can cancel; then the geometric normal is the only sensible one.
+  if (!(length > 1e-6f && std::isfinite(length))) return geometricNormal;
+  const Vec3 shading = n / length;
+  return glm::dot(shading, geometricNormal) < 0.0f ? -shading : shading;
+}
+
 SurfaceHit surfaceAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, Vec2 barycentrics) {
   const Mesh& mesh = scene.meshes[meshIndex];
   const UVec3 tri = mesh.triangles[triangle];
@@ -392,17 +404,7 @@ SurfaceHit surfaceAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, 
   // Counter-clockwise winding (p0, p1, p2) seen from the front ⇒ (p1−p0)×(p2−p0) points out
   // of the front side.
   hit.geometricNormal = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-  hit.shadingNormal = hit.geometricNormal;
-  if (!mesh.normals.empty()) {
-    const Vec3 n = b0 * mesh.normals[tri.x] + b1 * mesh.normals[tri.y] + b2 * mesh.normals[tri.z];
-    const float length = glm::length(n);
-    // Opposing vertex normals can cancel; then the geometric normal is the only sensible one.
-    if (length > 1e-6f && std::isfinite(length)) {
-      Vec3 shading = n / length;
-      if (glm::dot(shading, hit.geometricNormal) < 0.0f) shading = -shading;
-      hit.shadingNormal = shading;
-    }
-  }
+  hit.shadingNormal = interpolatedNormal(mesh, triangle, barycentrics, hit.geometricNormal);
   // Without texture coordinates uv are the barycentrics, so a texture still maps somewhere.
   hit.uv = uvAt(mesh, triangle, barycentrics);
   const Material& material = scene.materials[hit.material];

@@ -245,6 +245,20 @@ struct SurfaceHit {
 /// renderers all shade with it.
 SurfaceHit surfaceAt(const Scene& scene, uint32_t mesh, uint32_t triangle, Vec2 barycentrics);
 
+/// The unit winding normal (p1 − p0) × (p2 − p0) of triangle `triangle` (the front side),
+/// zero for a degenerate triangle.
+inline Vec3 triangleNormal(const Mesh& mesh, uint32_t triangle) {
+  const UVec3 t = mesh.triangles[triangle];
+  const Vec3 n = glm::cross(mesh.positions[t[1]] - mesh.positions[t[0]], mesh.positions[t[2]] - mesh.positions[t[0]]);
+  const float length = glm::length(n);
+  return length > 0.0f ? n / length : Vec3(0.0f);
+}
+
+/// The interpolated vertex normal of triangle `triangle` at barycentrics (b1, b2), unit and on
+/// the side of geometricNormal (the triangle's unit winding normal); geometricNormal itself when
+/// the mesh has no normals or they cancel. surfaceAt's shading normal before any normal map.
+Vec3 interpolatedNormal(const Mesh& mesh, uint32_t triangle, Vec2 barycentrics, const Vec3& geometricNormal);
+
 /// The shading normal n perturbed by a tangent-space normal-map texel t ∈ [0,1]³ (as sampled
 /// from an ImageDecode::Data texture): m = 2t − 1, m.xy × scale, n' = normalize(m.x T + m.y B
 /// + m.z n). The tangent frame comes from the triangle's uv derivatives (one per triangle,
