@@ -189,7 +189,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     for (size_t i = 0; i < n; ++i) {
       const RayHit& hit = s.hits[i];
       if (!hit.hit()) continue;
-      const uint32_t chart = facingChart(charts, s.chart[i], -s.rays[i].direction);
+      const uint32_t chart = facingChart(charts, s.chart[i], -s.rays[i].direction, scene.meshes[hit.mesh], hit.triangle);
       s.chart[i] = chart;
       const Chart& c = charts[chart];
       if (prefetchLookups_) {
