@@ -176,6 +176,9 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   distributed.visibilityRays = comm.allgather(rays);
   distributed.visibilitySeconds = gatherDoubles(visibilitySeconds);
   distributed.propagationSeconds = gatherDoubles(prop.seconds);
+  distributed.firstShotSeconds = gatherDoubles(prop.firstShotSeconds);
+  distributed.gatherSeconds = gatherDoubles(prop.gatherSeconds);
+  distributed.batches = plan.batches();
   distributed.exchangeBytes = prop.exchangeBytes;
   distributed.exchanges = comm.exchanges();
   distributed.exchangeSeconds = prop.exchangeSeconds;

@@ -33,6 +33,9 @@ struct DistributedBakeStats {
   std::vector<uint64_t> visibilityRays;  ///< per rank: rays it traced (0 when it reused its .plv)
   std::vector<double> visibilitySeconds; ///< per rank
   std::vector<double> propagationSeconds;  ///< per rank
+  std::vector<double> firstShotSeconds;    ///< per rank: of propagationSeconds, the first shot
+  std::vector<double> gatherSeconds;       ///< per rank: of propagationSeconds, in gatherIteration
+  uint64_t batches = 0;             ///< propagation batches (one exchange each per iteration)
   uint64_t exchangeBytes = 0;       ///< received by this rank over the propagation
   uint64_t exchanges = 0;           ///< allgatherv calls (one per batch per iteration, plus the first shot's)
   double exchangeSeconds = 0.0;     ///< this rank's time inside the exchanges (waits included)

@@ -971,7 +971,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
     for (size_t batch = 0; batch + 1 < batchStart.size(); ++batch) {
       const uint64_t begin = batchStart[batch], end = batchStart[batch + 1];
       const TixelRange mine = plan.part(batch, rank);
+      const auto gatherStart = std::chrono::steady_clock::now();
       gatherIteration(state, vis, mine.begin, mine.end, omega);
+      result.gatherSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - gatherStart).count();
       exchange(state.current, batch);
       updateTransport(state, begin, end);
       for (int r = 0; r < ranks; ++r) {

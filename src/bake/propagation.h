@@ -58,6 +58,9 @@ struct PropagationResult {
   // the time it spent in the exchanges (waiting for the slowest rank included).
   uint64_t exchangeBytes = 0;
   double exchangeSeconds = 0.0;
+  /// Of `seconds`: in gatherIteration (the part of an iteration that the ranks share; the rest
+  /// — transport refresh, change, power sums — every rank does for all tixels).
+  double gatherSeconds = 0.0;
 };
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,

@@ -25,6 +25,7 @@ namespace fs = std::filesystem;
 class DistributedBake : public cli_test::CliTest {
  protected:
   void SetUp() override {
+    CliTest::SetUp();
     if (!mpiAvailable()) GTEST_SKIP() << "this build has no MPI (install libopenmpi-dev, see scripts/bootstrap.sh)";
     if (std::system("command -v mpirun > /dev/null 2>&1") != 0)
       GTEST_SKIP() << "mpirun not found (install openmpi-bin, see scripts/bootstrap.sh)";

@@ -48,15 +48,16 @@ std::string BakeJobStats::toJson() const {
   // Distributed bake (README "Distributed bake"): per-rank figures in rank order; the
   // exchange is rank 0's (every rank receives about the same).
   json["ranks"] = distributed.ranks;
-  if (distributed.ranks > 1) {
-    json["rank_estimated_cost_share"] = distributed.estimatedCost;
-    json["rank_visibility_rays"] = distributed.visibilityRays;
-    json["rank_visibility_seconds"] = distributed.visibilitySeconds;
-    json["rank_propagation_seconds"] = distributed.propagationSeconds;
-    json["exchange_bytes"] = distributed.exchangeBytes;
-    json["exchanges"] = distributed.exchanges;
-    json["exchange_seconds"] = distributed.exchangeSeconds;
-  }
+  json["batches"] = distributed.batches;
+  json["rank_estimated_cost_share"] = distributed.estimatedCost;
+  json["rank_visibility_rays"] = distributed.visibilityRays;
+  json["rank_visibility_seconds"] = distributed.visibilitySeconds;
+  json["rank_propagation_seconds"] = distributed.propagationSeconds;
+  json["rank_first_shot_seconds"] = distributed.firstShotSeconds;
+  json["rank_gather_seconds"] = distributed.gatherSeconds;
+  json["exchange_bytes"] = distributed.exchangeBytes;
+  json["exchanges"] = distributed.exchanges;
+  json["exchange_seconds"] = distributed.exchangeSeconds;
   return json.dump(2) + "\n";
 }
 

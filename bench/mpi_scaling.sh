@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Strong scaling of the distributed bake on one machine (issue #16): the same bake as
+#   1 rank × 2 threads:   plenoptic bake SCENE --threads 2
+#   2 ranks × 1 thread:   mpirun -np 2 plenoptic bake SCENE --threads 1
+# (the same two cores either way: what the second costs over the first is the exchange and
+# the work every rank repeats), checks that both light fields render to the same bits, and
+# prints one row per scene: wall seconds of each, their ratio, the exchange (MB received per
+# rank, number of allgatherv calls, seconds inside them) and the per-rank visibility ray rates
+# and propagation split that bench/mpi_model.py turns into the modelled speed-up on 4, 16 and
+# 64 machines. The --stats JSON of every run stays in WORKDIR (NAME.1x2.json, NAME.2x1.json).
+#
+# Usage: bench/mpi_scaling.sh [PLENOPTIC] [WORKDIR]
+#   PLENOPTIC  the executable (default: build/plenoptic)
+#   WORKDIR    where every file goes (default: out/mpi)
+# Environment: RUNS, space-separated NAME=SCENE:PRESET items (default: the built-in Cornell
+# box at the high preset; add e.g. sponza=/work/shared/scenes/sponza/sponza.json:default).
+# Every run deletes its .plv files after it (a Sponza default field is ~4 GB).
+set -euo pipefail
+
+PLENOPTIC="${1:-build/plenoptic}"
+WORKDIR="${2:-out/mpi}"
+RUNS="${RUNS:-cornell=cornell:high}"
+mkdir -p "$WORKDIR"
+command -v mpirun >/dev/null || { echo "mpi_scaling: mpirun not found (scripts/bootstrap.sh installs openmpi-bin)" >&2; exit 1; }
+MPIRUN=(mpirun --oversubscribe --allow-run-as-root)
+
+json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2], {}, d))" "$@"; }
+
+printf '%-10s %-8s %9s %9s %6s %9s %6s %8s %s\n' scene preset "1x2 s" "2x1 s" ratio "exch MB" calls "exch s" "same bits"
+for item in $RUNS; do
+  name="${item%%=*}"; rest="${item#*=}"; scene="${rest%%:*}"; preset="${rest##*:}"
+  one="$WORKDIR/$name.1x2"; two="$WORKDIR/$name.2x1"
+  "$PLENOPTIC" bake "$scene" -o "$one.plf" --preset "$preset" --threads 2 --quiet --stats "$one.json" > "$one.log" 2>&1
+  rm -f "$one.plv"
+  "${MPIRUN[@]}" -np 2 "$PLENOPTIC" bake "$scene" -o "$two.plf" --preset "$preset" --threads 1 --quiet \
+    --stats "$two.json" > "$two.log" 2>&1
+  rm -f "$two".rank*-of-2.plv
+  # Same light field: the fast renderer's image of each, compared bit for bit.
+  "$PLENOPTIC" render "$one.plf" -o "$one.pfm" --quiet > /dev/null 2>&1
+  "$PLENOPTIC" render "$two.plf" -o "$two.pfm" --quiet > /dev/null 2>&1
+  same=$(cmp -s "$one.pfm" "$two.pfm" && echo yes || echo NO)
+  t1=$(json "$one.json" seconds); t2=$(json "$two.json" seconds)
+  printf '%-10s %-8s %9.2f %9.2f %6.3f %9.1f %6d %8.2f %s\n' "$name" "$preset" "$t1" "$t2" \
+    "$(python3 -c "print($t2/$t1)")" "$(json "$two.json" 'exchange_bytes/1e6')" "$(json "$two.json" exchanges)" \
+    "$(json "$two.json" exchange_seconds)" "$same"
+done
