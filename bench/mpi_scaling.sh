@@ -25,7 +25,9 @@ WORKDIR="${2:-out/mpi}"
 RUNS="${RUNS:-cornell=cornell:high}"
 mkdir -p "$WORKDIR"
 command -v mpirun >/dev/null || { echo "mpi_scaling: mpirun not found (scripts/bootstrap.sh installs openmpi-bin)" >&2; exit 1; }
-MPIRUN=(mpirun --oversubscribe --allow-run-as-root)
+# --bind-to none: Open MPI binds each of 2 ranks to a core by default, and a rank whose core
+# another program (a build, a test) holds cannot move; the 1-rank run is not bound either.
+MPIRUN=(mpirun --oversubscribe --allow-run-as-root --bind-to none)
 
 json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2], {}, d))" "$@"; }
 
