@@ -2,7 +2,6 @@
 #include "distributed/communicator.h"
 
 #include <algorithm>
-#include <bit>
 #include <cstdlib>
 
 #include "core/error.h"
@@ -12,12 +11,6 @@ namespace pl {
 #if PLENOPTIC_HAVE_MPI
 std::unique_ptr<Communicator> makeMpiCommunicator();  // mpi_communicator.cpp
 #endif
-
-double Communicator::sumInRankOrder(double value) {
-  double total = 0.0;
-  for (uint64_t bits : allgather(std::bit_cast<uint64_t>(value))) total += std::bit_cast<double>(bits);
-  return total;
-}
 
 uint64_t Communicator::sum(uint64_t value) {
   uint64_t total = 0;
@@ -36,8 +29,6 @@ int launcherWorldSize() {
   return 0;
 }
 }  // namespace
-
-bool launchedByMpiLauncher() { return launcherWorldSize() > 0; }
 
 bool mpiAvailable() { return PLENOPTIC_HAVE_MPI != 0; }
 

@@ -40,8 +40,7 @@ class Communicator {
   /// Calls to allgatherv so far (each is one collective: its latency is paid once per call).
   uint64_t exchanges() const { return exchanges_; }
 
-  /// Σ over ranks of `value`, added in rank order (the same bits on every rank).
-  double sumInRankOrder(double value);
+  /// Σ over ranks of `value` (integers: the same on every rank whatever the order).
   uint64_t sum(uint64_t value);
 
  protected:
@@ -61,14 +60,13 @@ class SingleProcess final : public Communicator {
   std::string name() const override { return "single process"; }
 };
 
-/// Whether this program was started by mpirun/mpiexec (Open MPI's or a PMI launcher's
-/// environment variables are set), so that a plain run never initialises MPI.
-bool launchedByMpiLauncher();
 /// Whether this build has the MPI implementation.
 bool mpiAvailable();
 
 /// The MPI communicator (MPI_COMM_WORLD; MPI is initialised here and finalised with the
-/// object) when the program was launched by mpirun and the build has MPI, otherwise
+/// object) when the program was launched by mpirun/mpiexec (Open MPI's or a PMI launcher's
+/// environment variables are set: a plain run never initialises MPI) and the build has MPI,
+/// otherwise
 /// SingleProcess. Throws pl::Error when launched by mpirun with more than one rank but built
 /// without MPI (each rank would otherwise bake the whole scene and write the same file).
 std::unique_ptr<Communicator> makeCommunicator();

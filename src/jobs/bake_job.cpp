@@ -13,8 +13,8 @@
 #include "jobs/jobs.h"
 #include "bake/bake.h"
 #include "bake/shard.h"
-#include "plf/compression.h"
 #include "distributed/communicator.h"
+#include "plf/compression.h"
 #include "plf/plf_file.h"
 
 namespace pl {
