@@ -10,6 +10,7 @@ packages=(
   libopenexr-dev libstb-dev libzstd-dev libsquish-dev libsdl2-dev libimgui-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libopenmpi-dev openmpi-bin
   xvfb xauth
   python3-dev pybind11-dev python3-numpy python3-pytest
 )

@@ -9,6 +9,8 @@
 
 #include "app/commands.h"
 #include "core/error.h"
+#include "core/progress.h"
+#include "distributed/communicator.h"
 #include "jobs/jobs.h"
 
 namespace pl {
@@ -29,8 +31,11 @@ struct BakeCommandOptions {
   std::string compress = "none";  ///< how the values are stored: none|lossless|bc1|hdr (compression.h)
 };
 
-void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
+void runBake(const BakeCommandOptions& options, const GlobalOptions& global, Communicator& comm) {
+  // Ranks other than 0 stay quiet (no bars, no notes): rank 0 speaks for the job.
+  const bool speaker = comm.rank() == 0;
   applyGlobalOptions(global);
+  if (!speaker) Progress::setEnabled(false);
   if (options.output.empty()) failUsage("bake: an output file is required (-o OUT.plf)");
   BakeJobOptions jobOptions;
   jobOptions.sceneName = options.scene;
@@ -47,15 +52,34 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global) {
   jobOptions.seed = global.seed;
   jobOptions.threads = global.threads;
   jobOptions.log = [&](const std::string& line) {
-    if (!global.quiet) fmt::print(stderr, "{}\n", line);
+    if (!global.quiet && speaker) fmt::print(stderr, "{}\n", line);
   };
+  jobOptions.communicator = &comm;
   const BakeJob job(std::move(jobOptions));  // checks every output before the scene is loaded
   const BakeJobResult result = job.run(options.scene);
   const BakeJobStats& stats = result.stats;
   const BakeStats& s = stats.bake;
+  if (!speaker) return;
   fmt::print("wrote {} ({} charts, {} tixels, {} values, {:.1f} MB; {} iterations, residual {:.2e}; {:.2f} s)\n",
              options.output, stats.charts, s.tixels, s.values, stats.fileBytes / 1e6, s.iterations, s.residual,
              stats.seconds);
+}
+
+/// `plenoptic bake` in one process, or as one rank of `mpirun -np N plenoptic bake ...`
+/// (distributed/communicator.h). A rank that fails ends the whole job: it reports its error
+/// and aborts every rank (mpirun then exits non-zero), so nothing is left waiting in an
+/// exchange and rank 0 writes no .plf.
+void runBakeCommand(const BakeCommandOptions& options, const GlobalOptions& global) {
+  std::unique_ptr<Communicator> comm = makeCommunicator();
+  if (comm->size() == 1) return runBake(options, global, *comm);
+  try {
+    runBake(options, global, *comm);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "plenoptic: error: rank {} of {}: {}\n", comm->rank(), comm->size(),
+               dynamic_cast<const Error*>(&e) ? e.what() : fmt::format("internal error: {}", e.what()));
+    std::fflush(stderr);
+    comm->abort(kExitFailure);
+  }
 }
 
 }  // namespace
@@ -91,7 +115,7 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--tolerance", options->tolerance,
                       "Override the preset: relative change of total power at which iteration stops")
       ->check(CLI::Range(1e-9f, 1.0f));
-  command->callback([options, &global] { runBake(*options, global); });
+  command->callback([options, &global] { runBakeCommand(*options, global); });
 }
 
 }  // namespace pl

@@ -1,6 +1,8 @@
 // The bake driver and its presets (see bake.h).
 #include "bake/bake.h"
 
+#include <algorithm>
+#include <bit>
 #include <chrono>
 #include <future>
 
@@ -10,7 +12,9 @@
 #include "core/parallel.h"
 #include "bake/parameterisation.h"
 #include "bake/propagation.h"
+#include "bake/shard.h"
 #include "bake/visibility.h"
+#include "distributed/communicator.h"
 
 namespace pl {
 
@@ -45,9 +49,10 @@ BakeSettings bakePreset(const std::string& name) {
   return s;
 }
 
-uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings) {
+uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings, uint64_t visibilityTixels) {
   const uint64_t directions = uint64_t(gatherGridSide(settings.gatherDirections)) * gatherGridSide(settings.gatherDirections);
-  const uint64_t visibility = tixels * (directions * sizeof(VisibilityEntry) + sizeof(uint64_t));
+  const uint64_t held = visibilityTixels > 0 ? visibilityTixels : tixels;
+  const uint64_t visibility = held * (directions * sizeof(VisibilityEntry) + sizeof(uint64_t));
   constexpr uint64_t kQuadBytes = 64, kChangeBytes = 4, kValueArrays = 3;
   // Writing the .plv compresses it a batch of blocks at a time beside the field.
   const uint64_t writeBuffers = visibilityWriteBufferBytes(gatherGridSide(settings.gatherDirections));
@@ -61,12 +66,28 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   auto note = [&](const std::string& text) {
     if (options.log) options.log(text);
   };
+  SingleProcess single;
+  Communicator& comm = options.communicator ? *options.communicator : single;
+  const int rank = comm.rank(), ranks = comm.size();
   LightField lf;
   lf.scene = std::move(scene);
   lf.settings = settings;
   const Accel accel(lf.scene);
   const Parameterisation param = buildParameterisation(lf.scene, accel, settings);
   const uint64_t hash = visibilityHash(lf.scene, param, settings);
+  if (ranks > 1) {
+    // Every rank must bake the same geometry, parameterisation and settings (the job compares
+    // the scene files first; this also covers the files they reference), or the exchanged
+    // values would mean different tixels: refused before any ray is traced.
+    const std::vector<uint64_t> hashes = comm.allgather(hash);
+    std::string differ;
+    for (int r = 1; r < ranks; ++r)
+      if (hashes[size_t(r)] != hashes[0]) differ += fmt::format("{}{}", differ.empty() ? "" : ", ", r);
+    if (!differ.empty())
+      fail("{}: rank(s) {} of {} have a different scene geometry, parameterisation or settings than rank 0 "
+           "(visibility hash {:016x}, rank 0 {:016x}); every rank must bake the same scene",
+           lf.scene.sourcePath, differ, ranks, hash, hashes[0]);
+  }
   {
     uint64_t byKind[3] = {0, 0, 0}, tixelsByKind[3] = {0, 0, 0};
     for (const Chart& c : param.charts) {
@@ -78,59 +99,113 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
                      param.charts.size(), byKind[0], byKind[1], byKind[2], param.tixelCount, tixelsByKind[0],
                      tixelsByKind[1], param.valueCount, param.sceneScale, param.baseTixelSize));
   }
-  if (options.checkMemory) options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings));
+  const ShardPlan plan = planShards(lf.scene, param, settings, ranks);
+  const std::vector<TixelRange> held = visibilityRanges(lf.scene, param, plan, rank);
+  uint64_t heldTixels = 0, ownTixels = 0;
+  for (const TixelRange& r : held) heldTixels += r.size();
+  for (const TixelRange& r : plan.owned(rank)) ownTixels += r.size();
+  double totalCost = 0.0;
+  for (double c : plan.rankCost) totalCost += c;
+  if (ranks > 1) {
+    double largest = 0.0;
+    for (double c : plan.rankCost) largest = std::max(largest, c);
+    note(fmt::format("distributed: {} ranks, {} batches split by estimated cost (largest share {:.1f} %, even {:.1f} %); "
+                     "rank {} updates {} tixels and holds the visibility of {}",
+                     ranks, plan.batches(), totalCost > 0 ? 100.0 * largest / totalCost : 0.0, 100.0 / ranks, rank,
+                     ownTixels, heldTixels));
+  }
+  if (options.checkMemory)
+    options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, heldTixels));
 
-  VisibilityField visibility;
+  const std::string visibilityPath = shardVisibilityPath(options.visibilityPath, rank, ranks);
+  const uint64_t shardHash = visibilityShardHash(hash, held, param.tixelCount);
+  VisibilityShard visibility;
   bool reused = false;
   auto computeAndSave = [&] {
-    visibility = computeVisibility(lf.scene, accel, param, settings);
-    note(fmt::format("visibility: {} rays in {:.2f} s ({:.1f} Mrays/s), {:.1f} MB", visibility.rays, visibility.seconds,
-                     visibility.seconds > 0 ? visibility.rays / visibility.seconds * 1e-6 : 0.0, visibility.bytes() / 1e6));
-    if (!options.visibilityPath.empty()) writeVisibility(options.visibilityPath, visibility);
+    visibility = computeVisibilityShard(lf.scene, accel, param, settings, held);
+    const VisibilityField& f = visibility.field;
+    note(fmt::format("visibility: {} rays in {:.2f} s ({:.1f} Mrays/s), {:.1f} MB", f.rays, f.seconds,
+                     f.seconds > 0 ? f.rays / f.seconds * 1e-6 : 0.0, f.bytes() / 1e6));
+    if (!visibilityPath.empty()) writeVisibility(visibilityPath, f);
   };
   PropagationResult prop;
-  if (options.reuseVisibility && !options.visibilityPath.empty()) {
+  if (options.reuseVisibility && !visibilityPath.empty()) {
     // The saved field is read on its own thread while propagation starts with the shadow rays
     // of the first shot, which do not need it; propagation waits for it after them.
     std::string why;
     double readSeconds = 0.0;
     std::future<bool> read = std::async(std::launch::async, [&] {
       const auto readStart = std::chrono::steady_clock::now();
-      const bool ok = readVisibility(options.visibilityPath, hash, visibility, &why);
+      VisibilityField field;
+      const bool ok = readVisibility(visibilityPath, shardHash, field, &why, param.tixelCount);
+      if (ok) visibility = VisibilityShard::of(std::move(field), held);
       readSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - readStart).count();
       return ok;
     });
-    prop = propagate(lf.scene, accel, param, [&]() -> const VisibilityField& {
+    prop = propagate(lf.scene, accel, param, [&]() -> const VisibilityShard& {
       reused = read.get();
       if (reused) {
         note(fmt::format("visibility: reusing {} ({} tixels × {} directions, read in {:.2f} s, overlapping the shadow rays)",
-                         options.visibilityPath, visibility.tixelCount, visibility.directionsPerTixel(), readSeconds));
+                         visibilityPath, visibility.field.tixelCount, visibility.field.directionsPerTixel(), readSeconds));
       } else {
         note(fmt::format("visibility: recomputing, because {}", why));
         computeAndSave();
       }
       return visibility;
-    }, settings);
+    }, settings, comm, plan);
   } else {
     computeAndSave();
-    prop = propagate(lf.scene, accel, param, visibility, settings);
+    prop = propagate(lf.scene, accel, param, [&]() -> const VisibilityShard& { return visibility; }, settings, comm, plan);
   }
   note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s (first shot {:.2f} s, {} shadow rays)",
                    prop.iterations, prop.residual, prop.seconds, prop.firstShotSeconds, prop.shadowRays));
 
+  // Every rank's figures, in rank order (collectives: every rank gets here).
+  const uint64_t rays = reused ? 0 : visibility.field.rays;
+  const double visibilitySeconds = reused ? 0.0 : visibility.field.seconds;
+  auto gatherDoubles = [&](double value) {
+    std::vector<double> out;
+    for (uint64_t bits : comm.allgather(std::bit_cast<uint64_t>(value))) out.push_back(std::bit_cast<double>(bits));
+    return out;
+  };
+  DistributedBakeStats distributed;
+  distributed.ranks = ranks;
+  distributed.ownTixels = ownTixels;
+  distributed.heldTixels = heldTixels;
+  for (double c : plan.rankCost) distributed.estimatedCost.push_back(totalCost > 0 ? c / totalCost : 0.0);
+  distributed.visibilityRays = comm.allgather(rays);
+  distributed.visibilitySeconds = gatherDoubles(visibilitySeconds);
+  distributed.propagationSeconds = gatherDoubles(prop.seconds);
+  distributed.firstShotSeconds = gatherDoubles(prop.firstShotSeconds);
+  distributed.gatherSeconds = gatherDoubles(prop.gatherSeconds);
+  distributed.batches = plan.batches();
+  distributed.exchangeBytes = prop.exchangeBytes;
+  distributed.exchanges = comm.exchanges();
+  distributed.exchangeSeconds = prop.exchangeSeconds;
+  if (ranks > 1)
+    note(fmt::format("distributed: rank {} received {:.1f} MB in {} exchanges, {:.2f} s inside them", rank,
+                     prop.exchangeBytes / 1e6, comm.exchanges(), prop.exchangeSeconds));
+
   lf.charts = param.charts;
   lf.triangleChart = param.triangleChart;
   lf.values = std::move(prop.values);
-  lf.stats.visibilitySeconds = reused ? 0.0 : visibility.seconds;
+  double slowestVisibility = 0.0;
+  uint64_t totalRays = 0;
+  for (int r = 0; r < ranks; ++r) {
+    slowestVisibility = std::max(slowestVisibility, distributed.visibilitySeconds[size_t(r)]);
+    totalRays += distributed.visibilityRays[size_t(r)];
+  }
+  lf.stats.visibilitySeconds = slowestVisibility;
   lf.stats.propagationSeconds = prop.seconds;
   lf.stats.iterations = prop.iterations;
   lf.stats.residual = prop.residual;
   lf.stats.tixels = param.tixelCount;
   lf.stats.values = param.valueCount;
-  lf.stats.visibilityRays = reused ? 0 : visibility.rays;
+  lf.stats.visibilityRays = totalRays;
   lf.stats.reusedVisibility = reused;
   lf.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   lf.stats.peakRssBytes = peakRssBytes();
+  if (options.distributedStats) *options.distributedStats = std::move(distributed);
   return lf;
 }
 

@@ -18,9 +18,28 @@
 
 namespace pl {
 
+class Communicator;
+
 /// The settings of a named preset; throws pl::Error listing the names for an unknown one.
 BakeSettings bakePreset(const std::string& name);
 std::vector<std::string> bakePresetNames();
+
+/// What a distributed bake measured (README "Distributed bake"); one process: ranks 1.
+struct DistributedBakeStats {
+  int ranks = 1;
+  uint64_t ownTixels = 0;           ///< tixels this rank updated (rank 0's in the job's stats)
+  uint64_t heldTixels = 0;          ///< tixels of its visibility shard (own + rough-glass twins)
+  std::vector<double> estimatedCost;     ///< per rank: its share of the estimated cost (sums to 1)
+  std::vector<uint64_t> visibilityRays;  ///< per rank: rays it traced (0 when it reused its .plv)
+  std::vector<double> visibilitySeconds; ///< per rank
+  std::vector<double> propagationSeconds;  ///< per rank
+  std::vector<double> firstShotSeconds;    ///< per rank: of propagationSeconds, the first shot
+  std::vector<double> gatherSeconds;       ///< per rank: of propagationSeconds, in gatherIteration
+  uint64_t batches = 0;             ///< propagation batches (one exchange each per iteration)
+  uint64_t exchangeBytes = 0;       ///< received by this rank over the propagation
+  uint64_t exchanges = 0;           ///< allgatherv calls (one per batch per iteration, plus the first shot's)
+  double exchangeSeconds = 0.0;     ///< this rank's time inside the exchanges (waits included)
+};
 
 struct BakeOptions {
   /// Where the visibility field is saved (and looked for with reuseVisibility); empty = not saved.
@@ -33,6 +52,13 @@ struct BakeOptions {
   /// are allocated, with bakeMemoryEstimate() of this bake; may throw to refuse it (the
   /// command line calls requireMemory, core/memory.h). May be empty.
   std::function<void(uint64_t bytes)> checkMemory;
+  /// The ranks of a distributed bake (distributed/communicator.h); null = one process. Every
+  /// rank calls bake() with the same scene and settings (refused otherwise, before any ray is
+  /// traced); each traces and saves its shard of the visibility field (visibilityPath becomes
+  /// shardVisibilityPath, shard.h) and every rank returns the whole light field.
+  Communicator* communicator = nullptr;
+  /// Receives what the distributed bake measured. May be null.
+  DistributedBakeStats* distributedStats = nullptr;
 };
 
 /// Bytes of the bake's large arrays for this parameterisation and these settings: the
@@ -42,7 +68,8 @@ struct BakeOptions {
 /// transport quad plus a 4-byte change per tixel. What the bake allocates after the check: the
 /// scene and the BVH, already resident then, are not in it (nor the field's rare extra
 /// records: mirror chains, glossy targets).
-uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings);
+/// visibilityTixels: the tixels of the field this process holds (a rank's shard); 0 = all.
+uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings, uint64_t visibilityTixels = 0);
 
 /// Bakes `scene` (moved into the result). Throws pl::Error on failures.
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options = {});

@@ -11,12 +11,14 @@
 #include <variant>
 
 #include "accel/accel.h"
+#include "bake/shard.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/sampler.h"
 #include "core/sampling.h"
 #include "core/simd4.h"
+#include "distributed/communicator.h"
 #include "light/light.h"
 #include "lightfield/lookup.h"
 #include "lightfield/paraboloid.h"
@@ -450,21 +452,24 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
 
   direct.assign(param.valueCount, Rgb(0.0f));
   change.assign(tixels, 0.0f);
-  // At least 2048 tixels per batch, and at most ~16000 batches.
-  const uint64_t kBatchTixels = std::max<uint64_t>(2048, tixels / 16000 + 1);
-  batchStart.assign(1, 0);
-  {
-    uint64_t count = 0;
-    for (size_t ci = 0; ci < param.charts.size(); ++ci) {
-      count += param.charts[ci].tixelCount();
-      if (count >= kBatchTixels) {
-        batchStart.push_back(param.charts[ci].firstTixel + param.charts[ci].tixelCount());
-        count = 0;
-      }
-    }
-    if (batchStart.back() != tixels) batchStart.push_back(tixels);
-  }
+  batchStart = propagationBatches(param);
+}
 
+std::vector<uint64_t> propagationBatches(const Parameterisation& param) {
+  // At least 2048 tixels per batch, and at most ~16000 batches.
+  const uint64_t tixels = param.tixelCount;
+  const uint64_t kBatchTixels = std::max<uint64_t>(2048, tixels / 16000 + 1);
+  std::vector<uint64_t> batchStart(1, 0);
+  uint64_t count = 0;
+  for (size_t ci = 0; ci < param.charts.size(); ++ci) {
+    count += param.charts[ci].tixelCount();
+    if (count >= kBatchTixels) {
+      batchStart.push_back(param.charts[ci].firstTixel + param.charts[ci].tixelCount());
+      count = 0;
+    }
+  }
+  if (batchStart.back() != tixels) batchStart.push_back(tixels);
+  return batchStart;
 }
 
 TransportState::~TransportState() = default;
@@ -596,7 +601,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
   });
 }
 
-void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t begin, uint64_t end) {
+void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t begin, uint64_t end) {
   const Scene& scene = state.scene;
   const Parameterisation& param = state.param;
   const BakeSettings& settings = state.settings;
@@ -606,9 +611,10 @@ void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t 
   const uint32_t lightSamples = state.ops->lightSamples, n = state.n;
   const uint64_t tixels = param.tixelCount;
   std::vector<Rgb>& direct = state.direct;
-  if (vis.tixelCount != param.tixelCount || vis.gridSide != state.gridSide)
-    fail("{}: visibility field has {} tixels × {}² directions, the parameterisation and settings {} × {}²", scene.sourcePath,
-         vis.tixelCount, vis.gridSide, param.tixelCount, state.gridSide);
+  if (!vis.holds(begin, end) || end > param.tixelCount || vis.field.gridSide != state.gridSide)
+    fail("{}: the visibility field (holding {} tixels × {}² directions) does not fit tixels [{}, {}) of the "
+         "parameterisation ({} tixels) and the settings ({}² directions)",
+         scene.sourcePath, vis.field.tixelCount, vis.field.gridSide, begin, end, param.tixelCount, state.gridSide);
 
   // Emission and environment arriving through the gather rays (constant over the iteration).
   const Environment& environment = scene.environment;
@@ -633,19 +639,21 @@ void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t 
     for (uint64_t g = t0; g < t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
-      uint64_t cursor = vis.extraOffset[g];
+      const VisibilityEntry* entries = vis.entries(g);
+      const VisibilityExtra* extras = vis.extras(g);
+      uint64_t cursor = 0;
       const TixelFrame frame = tixelFrame(param, c, g);  // the gather rays' frame (visibility.cpp)
       subCells.clear();  // this tixel's gather sub-cells, computed when first needed
       auto direction = [&](uint32_t k) {
-        if (subCells.empty()) gatherSubCells(g, vis.gridSide, settings.seed, subCells);
-        return gatherCellDirection(k, subCells[k], vis.gridSide, settings.seed);
+        if (subCells.empty()) gatherSubCells(g, state.gridSide, settings.seed, subCells);
+        return gatherCellDirection(k, subCells[k], state.gridSide, settings.seed);
       };
       const bool keepIncoming = c.kind == ChartKind::Glossy;
       bool any = false;
       Rgb sum(0.0f);  // Σ_k L_k in gather order
       for (uint32_t k = 0; k < n; ++k) {
-        const VisibilityEntry e = vis.entries[g * n + k];
-        const VisibilityExtra* extra = e.hasExtra() ? &vis.extras[cursor++] : nullptr;
+        const VisibilityEntry e = entries[k];
+        const VisibilityExtra* extra = e.hasExtra() ? &extras[cursor++] : nullptr;
         // Most entries see neither a lit sky nor an emitter: they add nothing (skipping them
         // leaves every sum the same; this pass reads every entry of the field).
         if (((tixelEmits[std::min<uint64_t>(e.tixel(), tixels)] >> (e.backSide() ? 1 : 0)) & 1) == 0) {
@@ -697,9 +705,12 @@ void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t 
   });
 }
 
-void beginIteration(TransportState& state) {
+void finishFirstShot(TransportState& state) {
   // Every range has gathered its first shot: each rough-glass record adds its twin's.
   state.ops->glassFirstShot->addTransmission(state.param, state.ops->glossy, state.direct);
+}
+
+void beginIteration(TransportState& state) {
   requireFiniteValues(state.scene, state.param, state.direct, "in the first shot (direct light)");
   state.current = state.direct;
   state.ops->quads.assign(state.param.tixelCount + 1, TransportQuad{});
@@ -737,7 +748,7 @@ void updateTransport(TransportState& state, uint64_t begin, uint64_t end) {
   });
 }
 
-void gatherIteration(TransportState& state, const VisibilityField& vis, uint64_t begin, uint64_t end, float omega) {
+void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t begin, uint64_t end, float omega) {
   const Parameterisation& param = state.param;
   const TransportState::Operators& ops = *state.ops;
   const std::vector<GlossyMaterial>& glossy = ops.glossy;
@@ -772,8 +783,8 @@ void gatherIteration(TransportState& state, const VisibilityField& vis, uint64_t
         }
         return L * extra->throughput;
       };
-      const VisibilityEntry* entries = vis.entries.data() + g * n;
-      const VisibilityExtra* extras = vis.extras.data() + vis.extraOffset[g];
+      const VisibilityEntry* entries = vis.entries(g);
+      const VisibilityExtra* extras = vis.extras(g);
       const F4 sum = c.kind == ChartKind::Glossy
                          ? gatherTixel<true>(entries, n, ops.quads.data(), ops.quads.size(), extras, incoming.data(), slowPath)
                          : gatherTixel<false>(entries, n, ops.quads.data(), ops.quads.size(), extras, nullptr, slowPath);
@@ -792,14 +803,26 @@ void gatherIteration(TransportState& state, const VisibilityField& vis, uint64_t
           // Rough glass: plus the transmission of what the twin record gathers now.
           const uint64_t twin = twinTixel(param, g);
           twinIncoming.resize(n);
-          const F4 twinSum = gatherTixel<true>(vis.entries.data() + twin * n, n, ops.quads.data(), ops.quads.size(),
-                                               vis.extras.data() + vis.extraOffset[twin], twinIncoming.data(), slowPath);
+          const F4 twinSum = gatherTixel<true>(vis.entries(twin), n, ops.quads.data(), ops.quads.size(), vis.extras(twin),
+                                               twinIncoming.data(), slowPath);
           gm.transmission[c.isBack ? 1 : 0].apply(twinIncoming.data(), twinSum, out);
         }
         const Rgb* before = previousValues.data() + vb;
         for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) out[t] = relax(before[t], out[t]);
         change[g] = exitanceChange(state, before, out, g, c);
       }
+    }
+  });
+}
+
+void recomputeChange(TransportState& state, const std::vector<Rgb>& before, uint64_t begin, uint64_t end) {
+  const Parameterisation& param = state.param;
+  parallelForRange(end - begin, 256, [&](uint64_t t0, uint64_t t1) {
+    for (uint64_t g = begin + t0; g < begin + t1; ++g) {
+      const Chart& c = param.charts[param.tixelChart[g]];
+      if (c.kind == ChartKind::Specular) continue;
+      const uint64_t vb = valueBase(g, c);
+      state.change[g] = exitanceChange(state, before.data() + vb, state.current.data() + vb, g, c);
     }
   });
 }
@@ -835,23 +858,62 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const std::function<const VisibilityField&()>& visibility, const BakeSettings& settings) {
+  SingleProcess single;
+  const ShardPlan plan = planShards(scene, param, settings, 1);
+  VisibilityShard shard;
+  return propagate(scene, accel, param, [&]() -> const VisibilityShard& {
+    shard = VisibilityShard::whole(visibility());
+    return shard;
+  }, settings, single, plan);
+}
+
+PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                            const std::function<const VisibilityShard&()>& visibility, const BakeSettings& settings,
+                            Communicator& comm, const ShardPlan& plan) {
   const auto start = std::chrono::steady_clock::now();
-  const uint64_t tixels = param.tixelCount;
   PropagationResult result;
   TransportState state(scene, accel, param, settings);
+  const int rank = comm.rank(), ranks = comm.size();
+  if (plan.ranks != ranks || plan.batchStart != state.batchStart)
+    fail("{}: the shard plan ({} ranks, {} batches) does not fit this propagation ({} ranks, {} batches)", scene.sourcePath,
+         plan.ranks, plan.batches(), ranks, state.batchStart.size() - 1);
+  const std::vector<TixelRange> own = plan.owned(rank);
+  uint64_t ownTixels = 0;
+  for (const TixelRange& r : own) ownTixels += r.size();
+
+  // The exchange: after a batch, every rank's part of its values is copied to every other rank
+  // (in place: values are in tixel order, so a part is one contiguous run of values).
+  std::vector<uint64_t> displacement(static_cast<size_t>(ranks)), count(static_cast<size_t>(ranks));
+  auto exchange = [&](std::vector<Rgb>& values, size_t batch) {
+    if (ranks == 1) return;
+    const auto exchangeStart = std::chrono::steady_clock::now();
+    for (int r = 0; r < ranks; ++r) {
+      const TixelRange part = plan.part(batch, r);
+      const uint64_t v0 = firstValueOf(param, part.begin), v1 = firstValueOf(param, part.end);
+      displacement[size_t(r)] = v0 * sizeof(Rgb);
+      count[size_t(r)] = (v1 - v0) * sizeof(Rgb);
+    }
+    comm.allgatherv(values.data(), displacement, count);
+    result.exchangeSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - exchangeStart).count();
+  };
+  const uint64_t bytesBefore = comm.bytesReceived();
 
   // ---- First shot ------------------------------------------------------------------------
   {
-    Progress progress("direct light", tixels);
-    shootShadowRays(state, 0, tixels, &progress);
+    Progress progress("direct light", ownTixels);
+    for (const TixelRange& r : own) shootShadowRays(state, r.begin, r.end, &progress);
   }
 
   // From here on the visibility field is needed. Time spent obtaining it (waiting for a read
   // that overlapped the shadow rays, or tracing it) is not propagation time.
   const auto waitStart = std::chrono::steady_clock::now();
-  const VisibilityField& vis = visibility();
+  const VisibilityShard& vis = visibility();
   const double waitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - waitStart).count();
-  gatherEmission(state, vis, 0, tixels);
+  // The rank's own tixels and the rough-glass twins it holds (whose gathered cells its own
+  // glass records transmit; their direct values are replaced by the exchange below).
+  for (const TixelRange& r : vis.ranges) gatherEmission(state, vis, r.begin, r.end);
+  finishFirstShot(state);
+  for (size_t b = 0; b < plan.batches(); ++b) exchange(state.direct, b);
 
   result.firstShotSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - waitSeconds;
 
@@ -873,6 +935,11 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   // iterations on the Cornell box, ω = 1.3 overshoots, ω ≥ 2 diverges. If the L1 change below
   // grows after the second iteration, the rest of the iteration falls back to ω = 1, which
   // converges for any ρ < 1.
+  //
+  // Distributed (shard.h): a rank updates its part of each batch, the parts are exchanged
+  // before the next batch, and the batch's transport is refreshed on every rank from the
+  // exchanged values, so each batch still sees this iteration's values of the batches before
+  // it. The stopping rule below then runs on every rank over the same values in the same order.
   //
   // Stopping. The residual is the relative change of the total outgoing power, |ΔP| / P, and
   // iteration stops once it is below the tolerance — and once, too, the error that remains is:
@@ -896,14 +963,25 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   const std::vector<Rgb>& current = state.current;
   auto totalPower = [&](const std::vector<Rgb>& values) { return transportPower(state, values); };
 
+  // The iteration's starting values are also what the change of the tixels other ranks
+  // updated is measured from (recomputeChange).
+  const bool keepPrevious = anyGlossy || ranks > 1;
   double previousPower = totalPower(current), previousL1Change = 0.0;
   Progress progress("propagation", settings.maxIterations);
   for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
-    if (anyGlossy) state.previousValues = current;
+    if (keepPrevious) state.previousValues = current;
     for (size_t batch = 0; batch + 1 < batchStart.size(); ++batch) {
       const uint64_t begin = batchStart[batch], end = batchStart[batch + 1];
-      gatherIteration(state, vis, begin, end, omega);
+      const TixelRange mine = plan.part(batch, rank);
+      const auto gatherStart = std::chrono::steady_clock::now();
+      gatherIteration(state, vis, mine.begin, mine.end, omega);
+      result.gatherSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - gatherStart).count();
+      exchange(state.current, batch);
       updateTransport(state, begin, end);
+      for (int r = 0; r < ranks; ++r) {
+        const TixelRange theirs = plan.part(batch, r);
+        if (r != rank) recomputeChange(state, state.previousValues, theirs.begin, theirs.end);
+      }
     }
     const double power = totalPower(current);
     if (!std::isfinite(power)) {
@@ -931,7 +1009,8 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
 
   finishTransport(state);
   result.values = std::move(state.current);
-  result.shadowRays = state.shadowRays.load();
+  result.shadowRays = comm.sum(state.shadowRays.load());
+  result.exchangeBytes = comm.bytesReceived() - bytesBefore;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - waitSeconds;
   return result;
 }

@@ -53,11 +53,21 @@ struct PropagationResult {
   double residual = 0.0;    ///< relative change of total outgoing power at the last iteration
   double seconds = 0.0;
   double firstShotSeconds = 0.0;  ///< of `seconds`: operators, shadow rays, constant gather part
-  uint64_t shadowRays = 0;
+  uint64_t shadowRays = 0;         ///< of every rank
+  // Distributed propagation (0 in one process): what this rank received from the others and
+  // the time it spent in the exchanges (waiting for the slowest rank included).
+  uint64_t exchangeBytes = 0;
+  double exchangeSeconds = 0.0;
+  /// Of `seconds`: in gatherIteration (the part of an iteration that the ranks share; the rest
+  /// — transport refresh, change, power sums — every rank does for all tixels).
+  double gatherSeconds = 0.0;
 };
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const VisibilityField& visibility, const BakeSettings& settings);
+
+class Communicator;
+struct ShardPlan;
 
 /// The same, with the visibility field supplied late: `visibility` is called once, after the
 /// shadow rays of the first shot (which do not need the field), so that reading a saved field
@@ -66,10 +76,25 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const std::function<const VisibilityField&()>& visibility, const BakeSettings& settings);
 
+/// One rank of a distributed propagation (shard.h): this rank (comm.rank() of plan.ranks)
+/// shoots the first shot of its own tixels, gathers through its shard of the field and updates
+/// its part of every batch; after each batch the parts are exchanged (comm.allgatherv of the
+/// values), so every rank holds all values, computes the stopping rule from them itself (the
+/// same sums in the same order: no reduction is needed) and returns the same values — the
+/// single-process result, bit for bit. `visibility` must hold visibilityRanges(plan, rank).
+/// Only rank 0 should show progress bars (Progress::setEnabled).
+PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                            const std::function<const VisibilityShard&()>& visibility, const BakeSettings& settings,
+                            Communicator& comm, const ShardPlan& plan);
+
+/// Batches of whole charts in tixel order, each ≥ 2048 tixels (and at most ~16000 of them):
+/// batch b is tixels [result[b], result[b + 1]).
+std::vector<uint64_t> propagationBatches(const Parameterisation& param);
+
 // ---- The stages, over an explicit transport state -------------------------------------------
 // propagate() above is: TransportState → shootShadowRays (all tixels) → [the visibility field]
-// → gatherEmission (all tixels) → beginIteration → per iteration, for each batch of
-// state.batchStart: gatherIteration + updateTransport → finishTransport. Every stage that
+// → gatherEmission (all tixels) → finishFirstShot → beginIteration → per iteration, for each
+// batch of state.batchStart: gatherIteration + updateTransport → finishTransport. Every stage that
 // works per tixel takes a range [begin, end) of tixel indices, so that a distributed bake can
 // shard the tixels: the results for a range depend only on the state, never on the other
 // ranges being run or on thread timing (the first shot is per tixel; an iteration update of
@@ -94,9 +119,7 @@ struct TransportState {
   std::vector<Rgb> previousValues;  ///< current as it was before this iteration (needed with glossy charts)
   std::vector<float> change;        ///< per tixel, |Δ exitance| of its last update (W·m⁻², luminance)
   std::atomic<uint64_t> shadowRays{0};
-  /// Batches of whole charts in tixel order, each ≥ 2048 tixels: batch b is tixels
-  /// [batchStart[b], batchStart[b + 1]).
-  std::vector<uint64_t> batchStart;
+  std::vector<uint64_t> batchStart;  ///< propagationBatches(param)
 
   struct Operators;  ///< glossy operators, lights, transport quads (propagation.cpp)
   std::unique_ptr<Operators> ops;
@@ -107,8 +130,12 @@ struct TransportState {
 /// `progress` (may be null) by the tixels done.
 void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progress* progress = nullptr);
 /// First shot, gather: emission and environment arriving along the gather rays of tixels
-/// [begin, end) are added to state.direct. Throws pl::Error when `vis` does not fit the state.
-void gatherEmission(TransportState& state, const VisibilityField& vis, uint64_t begin, uint64_t end);
+/// [begin, end) are added to state.direct. Throws pl::Error when `vis` does not hold the range
+/// or has another gather grid.
+void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t begin, uint64_t end);
+/// Ends the first shot once every range has gathered: each rough-glass record adds the
+/// transmission of what its twin gathered.
+void finishFirstShot(TransportState& state);
 /// Starts the iteration: checks direct is finite, current = direct, every tixel's transport.
 void beginIteration(TransportState& state);
 /// One update of tixels [begin, end): current ← max(0, current + ω·(direct + M·current −
@@ -116,7 +143,13 @@ void beginIteration(TransportState& state);
 /// overlapping the range are looked up at state.previousValues (Jacobi inside the range, so no
 /// value is read while it is written), the others at current (Gauss–Seidel between ranges).
 /// Diffuse charts are looked up through their transport, refreshed by updateTransport.
-void gatherIteration(TransportState& state, const VisibilityField& vis, uint64_t begin, uint64_t end, float omega);
+/// A range that is only part of a batch (a rank's part) gives its tixels the same values as
+/// the whole batch would: the batch's other glossy charts, not yet updated, still hold their
+/// previous values in current. `vis` must hold [begin, end) (and rough-glass twins).
+void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t begin, uint64_t end, float omega);
+/// state.change of tixels [begin, end) from `before` (the values at the start of the
+/// iteration) to current: what gatherIteration stores, for the tixels another rank updated.
+void recomputeChange(TransportState& state, const std::vector<Rgb>& before, uint64_t begin, uint64_t end);
 /// Refreshes the transport (the bilinear interpolants of ρ̄E/π) of tixels [begin, end) from current.
 void updateTransport(TransportState& state, uint64_t begin, uint64_t end);
 /// Σ area × exitance luminance of `values` (W): the total outgoing power the stopping rule watches.

@@ -239,31 +239,94 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
   return h.state;
 }
 
+VisibilityShard VisibilityShard::whole(const VisibilityField& field) {
+  return of(field, {TixelRange{0, field.tixelCount}});
+}
+
+VisibilityShard VisibilityShard::of(VisibilityField field, std::vector<TixelRange> ranges) {
+  VisibilityShard shard;
+  uint64_t total = 0;
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    if (ranges[i].end < ranges[i].begin || (i > 0 && ranges[i].begin < ranges[i - 1].end))
+      fail("visibility shard: tixel ranges not sorted and disjoint");
+    shard.localStart.push_back(total);
+    total += ranges[i].size();
+  }
+  if (total != field.tixelCount) fail("visibility shard: {} tixels in its ranges, {} in its field", total, field.tixelCount);
+  shard.field = std::move(field);
+  shard.ranges = std::move(ranges);
+  return shard;
+}
+
+bool VisibilityShard::holds(uint64_t begin, uint64_t end) const {
+  if (begin >= end) return true;
+  for (const TixelRange& r : ranges) {
+    if (r.end <= begin) continue;
+    if (r.begin > begin) return false;
+    if (r.end >= end) return true;
+    begin = r.end;
+  }
+  return false;
+}
+
+uint64_t visibilityShardHash(uint64_t fieldHash, const std::vector<TixelRange>& ranges, uint64_t tixelCount) {
+  if (ranges.size() == 1 && ranges[0] == TixelRange{0, tixelCount}) return fieldHash;
+  Fnv1a h;
+  h.value(fieldHash);
+  for (const TixelRange& r : ranges) {
+    h.value(r.begin);
+    h.value(r.end);
+  }
+  return h.state;
+}
+
 VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                   const BakeSettings& settings) {
+  return computeVisibilityShard(scene, accel, param, settings, {TixelRange{0, param.tixelCount}}).field;
+}
+
+VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges) {
   const auto start = std::chrono::steady_clock::now();
   VisibilityField field;
   field.gridSide = gatherGridSide(settings.gatherDirections);
-  field.tixelCount = param.tixelCount;
-  field.hash = visibilityHash(scene, param, settings);
+  uint64_t heldTixels = 0;
+  for (const TixelRange& r : ranges) heldTixels += r.size();
+  field.tixelCount = heldTixels;
+  field.hash = visibilityShardHash(visibilityHash(scene, param, settings), ranges, param.tixelCount);
   if (param.tixelCount > VisibilityEntry::kIndexMask)
     fail("{}: {} tixels exceed the visibility field's limit of {}", scene.sourcePath, param.tixelCount,
          VisibilityEntry::kIndexMask - 1);
   const uint32_t n = field.directionsPerTixel();
   std::vector<VisibilityEntry> entries;
-  entries.reserve(param.tixelCount * n);
-  adviseHugePages(entries.data(), param.tixelCount * n * sizeof(VisibilityEntry));
-  entries.resize(param.tixelCount * n);
+  entries.reserve(heldTixels * n);
+  adviseHugePages(entries.data(), heldTixels * n * sizeof(VisibilityEntry));
+  entries.resize(heldTixels * n);
   std::vector<Vec3> directionTable(size_t(n) * kJitterCount);  // [cell][sub-cell]
   for (uint32_t k = 0; k < n; ++k)
     for (uint32_t j = 0; j < kJitterCount; ++j) directionTable[size_t(k) * kJitterCount + j] = cellDirection(k, j, field.gridSide, settings.seed);
 
   // Blocks of tixels whose rays are traced as one Embree stream (~4096 rays).
+  // Blocks never straddle two ranges: block i is global tixels [t0, t1), stored from `local`.
   const uint64_t tixelsPerBlock = std::max<uint64_t>(1, 4096 / n);
-  const uint64_t blockCount = (param.tixelCount + tixelsPerBlock - 1) / tixelsPerBlock;
+  struct Block {
+    uint64_t t0, t1, local;
+  };
+  std::vector<Block> blockList;
+  {
+    uint64_t local = 0;
+    for (const TixelRange& r : ranges) {
+      for (uint64_t t = r.begin; t < r.end; t += tixelsPerBlock) {
+        const uint64_t t1 = std::min(r.end, t + tixelsPerBlock);
+        blockList.push_back({t, t1, local});
+        local += t1 - t;
+      }
+    }
+  }
+  const uint64_t blockCount = blockList.size();
   std::vector<std::vector<std::pair<uint64_t, VisibilityExtra>>> blockExtras(blockCount);
   std::atomic<uint64_t> rayCount{0};
-  Progress progress("visibility", param.tixelCount);
+  Progress progress("visibility", heldTixels);
 
   struct PathState {
     uint64_t entry;
@@ -271,7 +334,7 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
     bool viaMirror;
   };
   parallelFor(blockCount, [&](uint64_t block) {
-    const uint64_t t0 = block * tixelsPerBlock, t1 = std::min(param.tixelCount, t0 + tixelsPerBlock);
+    const uint64_t t0 = blockList[block].t0, t1 = blockList[block].t1, localBase = blockList[block].local;
     std::vector<Ray> rays, nextRays;
     std::vector<RayHit> hits;
     std::vector<PathState> states, nextStates;
@@ -297,7 +360,7 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
         ray.origin = origin;
         ray.direction = frame.toWorld(directionTable[size_t(k) * kJitterCount + jitters[k]]);
         rays.push_back(ray);
-        states.push_back({g * n + k, Rgb(1.0f), false});
+        states.push_back({(localBase + g - t0) * n + k, Rgb(1.0f), false});
       }
     }
     for (uint32_t depth = 0; !rays.empty(); ++depth) {
@@ -364,10 +427,10 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
   progress.finish();
 
   // Per-tixel offsets of the extra records, then the records in entry order.
-  std::vector<uint64_t> extraOffset(param.tixelCount + 1, 0);
+  std::vector<uint64_t> extraOffset(heldTixels + 1, 0);
   for (const auto& list : blockExtras)
     for (const auto& [entry, extra] : list) ++extraOffset[entry / n + 1];
-  for (uint64_t g = 0; g < param.tixelCount; ++g) extraOffset[g + 1] += extraOffset[g];
+  for (uint64_t g = 0; g < heldTixels; ++g) extraOffset[g + 1] += extraOffset[g];
   std::vector<VisibilityExtra> extras;
   extras.reserve(extraOffset.back());
   adviseHugePages(extras.data(), extras.capacity() * sizeof(VisibilityExtra));
@@ -380,7 +443,7 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
   field.extras = FieldArray<VisibilityExtra>(std::move(extras));
   field.rays = rayCount.load();
   field.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return field;
+  return VisibilityShard::of(std::move(field), ranges);
 }
 
 namespace {
@@ -495,7 +558,8 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
   });
 }
 
-bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why) {
+bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
+                    uint64_t targetTixels) {
   auto reason = [&](std::string text) {
     if (why) *why = std::move(text);
     return false;
@@ -600,7 +664,7 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
       uint64_t flagged = 0;
       for (uint64_t k = 0; k < n; ++k) {
         const VisibilityEntry e = entries[g * n + k];
-        if (!e.escaped() && e.tixel() >= tixelCount)
+        if (!e.escaped() && e.tixel() >= (targetTixels > 0 ? targetTixels : tixelCount))
           fail("{}: an entry of tixel {} points outside the field", path, g);
         flagged += e.hasExtra() ? 1 : 0;
       }

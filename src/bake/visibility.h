@@ -105,6 +105,48 @@ struct VisibilityField {
   }
 };
 
+/// Tixels [begin, end) (global tixel indices).
+struct TixelRange {
+  uint64_t begin = 0, end = 0;
+  uint64_t size() const { return end - begin; }
+  bool operator==(const TixelRange&) const = default;
+};
+
+/// The part of a visibility field one rank of a distributed bake holds (its shard): the
+/// tixels of `ranges` (sorted, disjoint), stored one range after another in `field`, whose
+/// tixelCount is their total (entries still name seen tixels by global index). A
+/// single-process bake holds one range, every tixel.
+struct VisibilityShard {
+  VisibilityField field;
+  std::vector<TixelRange> ranges;
+  std::vector<uint64_t> localStart;  ///< per range: field index of its first tixel
+
+  /// The whole field as a shard of one range (shares the storage).
+  static VisibilityShard whole(const VisibilityField& field);
+  /// `field` holding `ranges` (sorted, disjoint; their total must be field.tixelCount).
+  static VisibilityShard of(VisibilityField field, std::vector<TixelRange> ranges);
+  /// Whether every tixel of [begin, end) is held.
+  bool holds(uint64_t begin, uint64_t end) const;
+  /// Field index of held tixel g.
+  uint64_t local(uint64_t g) const {
+    if (ranges.size() == 1) return g - ranges[0].begin;
+    size_t lo = 0, hi = ranges.size();
+    while (hi - lo > 1) {
+      const size_t mid = (lo + hi) / 2;
+      if (ranges[mid].begin <= g) lo = mid; else hi = mid;
+    }
+    return localStart[lo] + (g - ranges[lo].begin);
+  }
+  /// Tixel g's N entries and its first extra record.
+  const VisibilityEntry* entries(uint64_t g) const { return field.entries.data() + local(g) * field.directionsPerTixel(); }
+  const VisibilityExtra* extras(uint64_t g) const { return field.extras.data() + field.extraOffset[local(g)]; }
+};
+
+/// The hash a shard's .plv carries: the whole field's (visibilityHash) for one range holding
+/// every tixel, else that hash combined with the ranges, so that a shard traced for another
+/// rank count or partition is not reused.
+uint64_t visibilityShardHash(uint64_t fieldHash, const std::vector<TixelRange>& ranges, uint64_t tixelCount);
+
 /// Octahedral map of unit vectors to [−1, 1]² and back (exact round trip up to float error).
 inline Vec2 octahedralEncode(const Vec3& d) {
   const Vec3 a = d / (std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
@@ -146,6 +188,11 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
 /// Traces the visibility field (parallel, with a progress bar).
 VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                   const BakeSettings& settings);
+/// Traces the tixels of `ranges` only (sorted, disjoint), stored one range after another: a
+/// rank's shard, whose hash is visibilityShardHash. Every tixel's entries are the same as in
+/// the whole field (a tixel's rays depend only on the tixel, the seed and the scene).
+VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges);
 
 /// Writes the field atomically (temp + rename), compressed: zstd frames of blocks of
 /// entries split into index and fraction planes (format: see visibility.cpp), with a progress bar.
@@ -160,6 +207,9 @@ uint64_t visibilityWriteBufferBytes(uint32_t gridSide);
 /// expectedHash (a stale field is not an error); throws pl::Error naming the file when it is
 /// present but corrupt or truncated (header, payload checksum, every frame and every index are
 /// checked before it returns).
-bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why);
+/// targetTixels: how many tixels the entries may point at (0: the file's own tixel count; a
+/// shard's entries point at any tixel of the scene).
+bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
+                    uint64_t targetTixels = 0);
 
 }  // namespace pl

@@ -6,11 +6,14 @@
 
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/hash.h"
 #include "core/memory.h"
 #include "core/parallel.h"
 #include "core/timing.h"
 #include "jobs/jobs.h"
 #include "bake/bake.h"
+#include "bake/shard.h"
+#include "distributed/communicator.h"
 #include "plf/compression.h"
 #include "plf/plf_file.h"
 
@@ -44,6 +47,19 @@ std::string BakeJobStats::toJson() const {
   json["peak_rss_bytes"] = bake.peakRssBytes;
   json["file_bytes"] = fileBytes;
   json["compression"] = compression;
+  // Distributed bake (README "Distributed bake"): per-rank figures in rank order; the
+  // exchange is rank 0's (every rank receives about the same).
+  json["ranks"] = distributed.ranks;
+  json["batches"] = distributed.batches;
+  json["rank_estimated_cost_share"] = distributed.estimatedCost;
+  json["rank_visibility_rays"] = distributed.visibilityRays;
+  json["rank_visibility_seconds"] = distributed.visibilitySeconds;
+  json["rank_propagation_seconds"] = distributed.propagationSeconds;
+  json["rank_first_shot_seconds"] = distributed.firstShotSeconds;
+  json["rank_gather_seconds"] = distributed.gatherSeconds;
+  json["exchange_bytes"] = distributed.exchangeBytes;
+  json["exchanges"] = distributed.exchanges;
+  json["exchange_seconds"] = distributed.exchangeSeconds;
   return json.dump(2) + "\n";
 }
 
@@ -75,8 +91,36 @@ BakeJobResult BakeJob::run(Scene scene) const { return runFrom(std::move(scene),
 
 BakeJobResult BakeJob::run(const std::string& scenePath) const {
   const auto start = SteadyClock::now();
+  checkSameJobOnEveryRank(scenePath);
   Scene scene = loadScene(scenePath);
   return runFrom(std::move(scene), secondsSince(start));
+}
+
+void BakeJob::checkSameJobOnEveryRank(const std::string& scenePath) const {
+  Communicator* comm = options_.communicator;
+  if (!comm || comm->size() <= 1) return;
+  // The scene file's bytes (the built-in scene's name) and everything that shapes the bake;
+  // files the scene refers to are covered later by bake()'s check of the geometry and
+  // parameterisation.
+  const BakeSettings s = settings();
+  uint64_t hash = xxh64(scenePath.data(), scenePath.size());
+  if (scenePath != "cornell") {
+    requireRegularFile(scenePath);
+    const MappedFile file(scenePath);
+    hash = xxh64(file.bytes().data(), file.bytes().size());
+  }
+  const std::string shape = fmt::format("{}|{}|{}|{}|{}|{}|{}|{}", options_.preset, s.tixelsAcrossScene, s.gatherDirections,
+                                        s.areaLightSamples, s.tolerance, s.seed, options_.compress,
+                                        options_.reuseVisibility);
+  hash = xxh64(shape.data(), shape.size(), hash);
+  const std::vector<uint64_t> hashes = comm->allgather(hash);
+  std::string differ;
+  for (size_t r = 1; r < hashes.size(); ++r)
+    if (hashes[r] != hashes[0]) differ += fmt::format("{}{}", differ.empty() ? "" : ", ", r);
+  if (!differ.empty())
+    fail("{}: refused: rank(s) {} of {} have a different scene file or bake settings than rank 0 (hash {:016x} here, "
+         "{:016x} on rank 0); every rank must bake the same scene with the same flags",
+         scenePath, differ, hashes.size(), hash, hashes[0]);
 }
 
 BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
@@ -90,10 +134,16 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
     requireMemory(bytes, "bake (visibility field and light-field values)",
                   "lower --preset, --tixels-across or --directions");
   };
+  bakeOptions.communicator = options_.communicator;
+  DistributedBakeStats distributed;
+  bakeOptions.distributedStats = &distributed;
   BakeJobResult result{bake(std::move(scene), settings(), bakeOptions), {}};
   const LightField& lf = result.lightField;
   BakeJobStats& stats = result.stats;
-  if (!options_.output.empty()) {
+  stats.distributed = distributed;
+  // Every rank holds the whole light field; rank 0 alone writes it (atomically) and the stats.
+  const bool writer = !options_.communicator || options_.communicator->rank() == 0;
+  if (writer && !options_.output.empty()) {
     writeLightField(options_.output, lf, parseValuesCodec(options_.compress));
     stats.fileBytes = std::filesystem::file_size(options_.output);
   }
@@ -101,7 +151,7 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
   stats.scene = options_.sceneName;
   stats.output = options_.output;
   stats.preset = options_.preset;
-  stats.visibilityFile = visibilityPath_;
+  stats.visibilityFile = options_.communicator ? shardVisibilityPath(visibilityPath_, options_.communicator->rank(), options_.communicator->size()) : visibilityPath_;
   stats.compression = options_.compress;
   stats.threads = pool.threads();
   stats.bake = lf.stats;
@@ -112,7 +162,7 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
     stats.curvedCharts += c.curved ? 1 : 0;
     stats.curvedTixels += c.curved ? c.tixelCount() : 0;
   }
-  if (!options_.statsPath.empty()) writeFileAtomically(options_.statsPath, stats.toJson());
+  if (writer && !options_.statsPath.empty()) writeFileAtomically(options_.statsPath, stats.toJson());
   return result;
 }
 

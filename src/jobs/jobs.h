@@ -18,6 +18,7 @@
 #include <string_view>
 #include <vector>
 
+#include "bake/bake.h"
 #include "camera/camera.h"
 #include "camera/exposure.h"
 #include "image/image.h"
@@ -29,6 +30,8 @@
 #include "trace/trace.h"
 
 namespace pl {
+
+class Communicator;
 
 /// How radiance becomes a picture, and from where: image size, camera choice and overrides,
 /// exposure, vignetting and tone mapping. Shared by trace, render and view.
@@ -159,6 +162,9 @@ struct BakeJobOptions {
   int threads = 0;  ///< 0 = all hardware threads
   /// One-line notes (reuse decisions, rates); empty = dropped.
   std::function<void(const std::string&)> log;
+  /// The ranks of a distributed bake (distributed/communicator.h); null = one process. Every
+  /// rank runs the job; only rank 0 writes the .plf and the stats.
+  Communicator* communicator = nullptr;
 };
 
 /// What `plenoptic bake --stats` writes.
@@ -168,6 +174,7 @@ struct BakeJobStats {
   double seconds = 0.0;  ///< the whole job: loading (path overload), baking and writing
   BakeStats bake;
   uint64_t charts = 0, twoSidedCharts = 0, backSideTixels = 0, curvedCharts = 0, curvedTixels = 0, fileBytes = 0;
+  DistributedBakeStats distributed;
   std::string toJson() const;
 };
 
@@ -189,6 +196,9 @@ class BakeJob {
 
  private:
   BakeJobResult runFrom(Scene scene, double startedSecondsAgo) const;
+  /// Distributed: every rank must name the same scene file (same bytes) and settings; throws
+  /// pl::Error on every rank otherwise, before the scene is loaded.
+  void checkSameJobOnEveryRank(const std::string& scenePath) const;
   BakeJobOptions options_;
   std::string visibilityPath_;
 };

@@ -1,0 +1,113 @@
+// The partition of the tixels between the ranks of a distributed bake (see shard.h).
+#include "bake/shard.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "bake/propagation.h"
+#include "core/error.h"
+
+namespace pl {
+
+namespace {
+// Cost of one BSDF evaluation or operator multiply-add relative to one traced ray (Embree
+// ~1 µs per incoherent ray per core on Sponza; an evaluation is a few tens of ns).
+constexpr double kGlossyEvalCost = 0.05;
+}  // namespace
+
+std::vector<TixelRange> ShardPlan::owned(int rank) const {
+  std::vector<TixelRange> out;
+  for (size_t b = 0; b < batches(); ++b) {
+    const TixelRange r = part(b, rank);
+    if (r.size() == 0) continue;
+    if (!out.empty() && out.back().end == r.begin)
+      out.back().end = r.end;
+    else
+      out.push_back(r);
+  }
+  return out;
+}
+
+double estimatedTixelCost(const Scene& scene, const Parameterisation& param, const BakeSettings& settings, uint64_t g) {
+  const Chart& c = param.charts[param.tixelChart[g]];
+  if (c.kind == ChartKind::Specular) return 0.0;
+  const double n = double(gatherGridSide(settings.gatherDirections)) * gatherGridSide(settings.gatherDirections);
+  const double lights = double(scene.lights.size()), samples = double(settings.areaLightSamples);
+  double cost = n + lights + samples;
+  if (c.kind == ChartKind::Glossy)
+    cost += kGlossyEvalCost * double(c.valuesPerTixel()) * (9.0 * lights + samples + n / 8.0);
+  return cost;
+}
+
+ShardPlan planShards(const Scene& scene, const Parameterisation& param, const BakeSettings& settings, int ranks) {
+  if (ranks < 1) fail("a distributed bake needs at least one rank, not {}", ranks);
+  ShardPlan plan;
+  plan.ranks = ranks;
+  plan.batchStart = propagationBatches(param);
+  plan.rankCost.assign(size_t(ranks), 0.0);
+  std::vector<double> prefix;
+  for (size_t b = 0; b < plan.batches(); ++b) {
+    const uint64_t begin = plan.batchStart[b], end = plan.batchStart[b + 1];
+    prefix.assign(1, 0.0);
+    for (uint64_t g = begin; g < end; ++g) prefix.push_back(prefix.back() + estimatedTixelCost(scene, param, settings, g));
+    const double total = prefix.back();
+    plan.split.push_back(begin);
+    for (int r = 1; r < ranks; ++r) {
+      // The first tixel at which the running cost reaches r/ranks of the batch's.
+      const double target = total * double(r) / double(ranks);
+      const uint64_t at = uint64_t(std::lower_bound(prefix.begin(), prefix.end(), target) - prefix.begin());
+      plan.split.push_back(std::max(plan.split.back(), std::min(end, begin + at)));
+    }
+    plan.split.push_back(end);
+    for (int r = 0; r < ranks; ++r) {
+      const TixelRange p = plan.part(b, r);
+      plan.rankCost[size_t(r)] += prefix[p.end - begin] - prefix[p.begin - begin];
+    }
+  }
+  return plan;
+}
+
+std::vector<TixelRange> visibilityRanges(const Scene& scene, const Parameterisation& param, const ShardPlan& plan, int rank) {
+  std::vector<TixelRange> ranges = plan.owned(rank);
+  const size_t ownCount = ranges.size();
+  for (size_t i = 0; i < ownCount; ++i) {
+    const TixelRange r = ranges[i];
+    for (uint32_t ci = param.tixelChart[r.begin]; ci < param.charts.size() && param.charts[ci].firstTixel < r.end; ++ci) {
+      const Chart& c = param.charts[ci];
+      if (!isRoughGlassChart(c, scene.materials[c.material].bsdf)) continue;
+      // The twin record has the same grid (the back follows the front).
+      const Chart& twin = param.charts[c.isBack ? ci - 1 : ci + 1];
+      const uint64_t a = std::max(r.begin, c.firstTixel) - c.firstTixel;
+      const uint64_t b = std::min(r.end, c.firstTixel + c.tixelCount()) - c.firstTixel;
+      ranges.push_back({twin.firstTixel + a, twin.firstTixel + b});
+    }
+  }
+  std::sort(ranges.begin(), ranges.end(), [](const TixelRange& x, const TixelRange& y) { return x.begin < y.begin; });
+  std::vector<TixelRange> merged;
+  for (const TixelRange& r : ranges) {
+    if (r.size() == 0) continue;
+    if (!merged.empty() && r.begin <= merged.back().end)
+      merged.back().end = std::max(merged.back().end, r.end);
+    else
+      merged.push_back(r);
+  }
+  return merged;
+}
+
+std::string shardVisibilityPath(const std::string& path, int rank, int ranks) {
+  if (ranks <= 1 || path.empty()) return path;
+  std::filesystem::path p(path);
+  const std::string extension = p.extension().string();
+  p.replace_extension();
+  return fmt::format("{}.rank{}-of-{}{}", p.string(), rank, ranks, extension);
+}
+
+uint64_t firstValueOf(const Parameterisation& param, uint64_t g) {
+  if (g >= param.tixelCount) return param.valueCount;
+  const Chart& c = param.charts[param.tixelChart[g]];
+  return c.firstValue + (g - c.firstTixel) * c.valuesPerTixel();
+}
+
+}  // namespace pl

@@ -1,0 +1,58 @@
+#pragma once
+// How the ranks of a distributed bake share the tixels (issue #16; README "Distributed bake").
+//
+// Propagation is block Gauss–Seidel over batches of whole charts (propagation.h): batch b is
+// updated after batches < b, its tixels all at once. A distributed bake keeps exactly that
+// order: every batch is split across all ranks, rank r updating the contiguous part
+// part(b, r), and the parts are exchanged before the next batch starts. So the result is the
+// single-process one bit for bit, whatever the rank count.
+//
+// The split balances an estimate of each tixel's cost, not the tixel count (see
+// estimatedTixelCost): a rank's part of every batch costs about 1/ranks of the batch, so its
+// share of visibility rays, first-shot shadow rays and gather work is balanced too (each of
+// those is per tixel, and every batch is split the same way).
+#include <string>
+#include <vector>
+
+#include "bake/visibility.h"
+
+namespace pl {
+
+struct ShardPlan {
+  int ranks = 1;
+  std::vector<uint64_t> batchStart;  ///< propagationBatches: batch b is [batchStart[b], batchStart[b + 1])
+  /// Per batch, ranks + 1 boundaries: rank r's part of batch b is
+  /// [split[b·(ranks+1) + r], split[b·(ranks+1) + r + 1]).
+  std::vector<uint64_t> split;
+  std::vector<double> rankCost;  ///< estimated cost of every rank's tixels (ray equivalents)
+
+  size_t batches() const { return batchStart.size() - 1; }
+  TixelRange part(size_t batch, int rank) const {
+    const size_t at = batch * size_t(ranks + 1) + size_t(rank);
+    return {split[at], split[at + 1]};
+  }
+  /// Rank r's parts of every batch, adjacent ones merged.
+  std::vector<TixelRange> owned(int rank) const;
+};
+
+/// Estimated cost of tixel g in ray equivalents: its gather rays (N, a mirror chain counted as
+/// one ray), its first-shot shadow rays (punctual lights + area-light samples) and, for a
+/// glossy tixel, its BSDF evaluations and operator products (dirRes² × (9 × lights +
+/// area-light samples + N/8) at kGlossyEvalCost rays each); mirror tixels cost nothing.
+double estimatedTixelCost(const Scene& scene, const Parameterisation& param, const BakeSettings& settings, uint64_t g);
+
+/// The split of every propagation batch into `ranks` parts of about equal estimated cost.
+/// Deterministic: every rank computes the same plan.
+ShardPlan planShards(const Scene& scene, const Parameterisation& param, const BakeSettings& settings, int ranks);
+
+/// The tixels whose visibility rank r traces and keeps: its own, plus the twin records of its
+/// rough-glass tixels (a rough-glass record's update gathers its twin's light too).
+std::vector<TixelRange> visibilityRanges(const Scene& scene, const Parameterisation& param, const ShardPlan& plan, int rank);
+
+/// Rank r's .plv: `path` itself for one rank, else STEM.rankR-of-N.plv beside it.
+std::string shardVisibilityPath(const std::string& path, int rank, int ranks);
+
+/// Index in LightField::values of tixel g's first value (valueCount for g = tixelCount).
+uint64_t firstValueOf(const Parameterisation& param, uint64_t g);
+
+}  // namespace pl
