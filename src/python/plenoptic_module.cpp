@@ -362,7 +362,7 @@ class FileError(Error, OSError):
       "load_scene",
       [](const std::string& path) { return runInterruptible([&] { return std::make_shared<Scene>(loadScene(path)); }); },
       py::arg("path"),
-        "Loads 'cornell' (built in) or a .obj, .gltf, .glb or .json scene.");
+      "Loads 'cornell' (built in) or a .obj, .gltf, .glb or .json scene.");
 
   m.def(
       "trace",
