@@ -158,19 +158,25 @@ TEST(Shards, PlanSplitsEveryBatchIntoContiguousPartsOfEqualCost) {
 }
 
 TEST(Shards, MirrorTixelsCostNothingAndGlossyOnesMore) {
-  const Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/CornellBox-Glossy.obj");
+  // CornellBox-Glossy has glossy charts, CornellBox-Mirror a mirror (specular charts).
   const BakeSettings settings = smallSettings(10, 64);
-  const Parameterisation param = buildParameterisation(scene, settings);
   double diffuse = 0.0, glossy = 0.0;
-  for (uint64_t g = 0; g < param.tixelCount; ++g) {
-    const Chart& c = param.charts[param.tixelChart[g]];
-    const double cost = estimatedTixelCost(scene, param, settings, g);
-    if (c.kind == ChartKind::Specular) {
-      EXPECT_EQ(cost, 0.0);
+  uint64_t specular = 0;
+  for (const char* file : {"CornellBox-Glossy.obj", "CornellBox-Mirror.obj"}) {
+    const Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/" + file);
+    const Parameterisation param = buildParameterisation(scene, settings);
+    for (uint64_t g = 0; g < param.tixelCount; ++g) {
+      const Chart& c = param.charts[param.tixelChart[g]];
+      const double cost = estimatedTixelCost(scene, param, settings, g);
+      if (c.kind == ChartKind::Specular) {
+        EXPECT_EQ(cost, 0.0);
+        ++specular;
+      }
+      if (c.kind == ChartKind::Diffuse) diffuse = cost;
+      if (c.kind == ChartKind::Glossy) glossy = std::max(glossy, cost);
     }
-    if (c.kind == ChartKind::Diffuse) diffuse = cost;
-    if (c.kind == ChartKind::Glossy) glossy = std::max(glossy, cost);
   }
+  EXPECT_GT(specular, 0u);   // the mirror was looked at
   EXPECT_GT(diffuse, 64.0);  // its gather rays and more
   EXPECT_GT(glossy, diffuse);
 }
