@@ -79,14 +79,12 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
     // Every rank must bake the same geometry, parameterisation and settings (the job compares
     // the scene files first; this also covers the files they reference), or the exchanged
     // values would mean different tixels: refused before any ray is traced.
-    const std::vector<uint64_t> hashes = comm.allgather(hash);
-    std::string differ;
-    for (int r = 1; r < ranks; ++r)
-      if (hashes[size_t(r)] != hashes[0]) differ += fmt::format("{}{}", differ.empty() ? "" : ", ", r);
+    uint64_t rank0Hash = 0;
+    const std::string differ = comm.ranksDiffering(hash, rank0Hash);
     if (!differ.empty())
       fail("{}: rank(s) {} of {} have a different scene geometry, parameterisation or settings than rank 0 "
            "(visibility hash {:016x}, rank 0 {:016x}); every rank must bake the same scene",
-           lf.scene.sourcePath, differ, ranks, hash, hashes[0]);
+           lf.scene.sourcePath, differ, ranks, hash, rank0Hash);
   }
   {
     uint64_t byKind[3] = {0, 0, 0}, tixelsByKind[3] = {0, 0, 0};
@@ -172,7 +170,8 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   distributed.ranks = ranks;
   distributed.ownTixels = ownTixels;
   distributed.heldTixels = heldTixels;
-  for (double c : plan.rankCost) distributed.estimatedCost.push_back(totalCost > 0 ? c / totalCost : 0.0);
+  // (One rank: no costs are estimated, its share is the whole.)
+  for (double c : plan.rankCost) distributed.estimatedCost.push_back(totalCost > 0 ? c / totalCost : 1.0 / ranks);
   distributed.visibilityRays = comm.allgather(rays);
   distributed.visibilitySeconds = gatherDoubles(visibilitySeconds);
   distributed.propagationSeconds = gatherDoubles(prop.seconds);

@@ -577,7 +577,6 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
   const size_t chartCount = p.chartTriangles.size();
   p.charts.resize(chartCount);
   p.chartArea.assign(chartCount, 0.0);
-  p.chartMinCosine.assign(chartCount, 1.0f);
   parallelFor(chartCount, [&](uint64_t ci) {
     const auto& list = p.chartTriangles[ci];
     Chart& c = p.charts[ci];
@@ -623,7 +622,6 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
         const Vec3 fn = triangleNormal(scene.meshes[m], t);
         if (fn != Vec3(0.0f)) minCosine = std::min(minCosine, glm::dot(fn, n));
       }
-    p.chartMinCosine[ci] = minCosine;
 
     // axisU: among the (longest 256) triangle edges projected into the plane, the one giving
     // the smallest bounding rectangle; ties keep the first.
@@ -687,7 +685,6 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
     std::vector<Chart> charts;
     std::vector<std::vector<std::pair<uint32_t, uint32_t>>> chartTriangles;
     std::vector<double> chartArea;
-    std::vector<float> chartMinCosine;
     charts.reserve(chartCount);
     std::vector<uint32_t> meshBase(scene.meshes.size() + 1, 0);  // index in `tris` of each mesh's triangle 0
     for (size_t m = 0; m < scene.meshes.size(); ++m) meshBase[m + 1] = meshBase[m] + uint32_t(scene.meshes[m].triangles.size());
@@ -729,7 +726,6 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
       charts.push_back(front);
       chartTriangles.push_back(p.chartTriangles[ci]);
       chartArea.push_back(p.chartArea[ci]);
-      chartMinCosine.push_back(p.chartMinCosine[ci]);
       if (!twoSided) continue;
       Chart back = front;
       back.isBack = true;
@@ -737,12 +733,10 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
       charts.push_back(back);
       chartTriangles.push_back(p.chartTriangles[ci]);
       chartArea.push_back(p.chartArea[ci]);
-      chartMinCosine.push_back(p.chartMinCosine[ci]);
     }
     p.charts = std::move(charts);
     p.chartTriangles = std::move(chartTriangles);
     p.chartArea = std::move(chartArea);
-    p.chartMinCosine = std::move(chartMinCosine);
   }
   const size_t recordCount = p.charts.size();
   for (uint32_t ci = 0; ci < recordCount; ++ci) {

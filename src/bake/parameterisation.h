@@ -23,7 +23,7 @@
 // projection is locally one-to-one and linear on each triangle (lookups need no per-triangle
 // data). Its distortion is the foreshortening cos θ of a face tilted θ from the chart normal
 // (one direction shrinks by cos θ, the other is kept: area stretch cos θ, angle stretch
-// 1/cos θ); the tixel size is multiplied by the chart's smallest cos θ (chartMinCosine),
+// 1/cos θ); the tixel size is multiplied by the chart's smallest cos θ,
 // so that even the most tilted triangle's tixels are no larger than the preset's on the
 // surface — no chart is coarser than the preset. A chart is curved when it grew across a
 // smooth edge that is not coplanar, or (a lone facet of a smooth mesh) when a vertex normal
@@ -92,9 +92,6 @@ struct Parameterisation {
   std::vector<std::vector<uint32_t>> triangleChart;  ///< [mesh][triangle] → chart
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> chartTriangles;  ///< chart → (mesh, triangle)
   std::vector<double> chartArea;    ///< sum of the chart's triangle areas (scene units²)
-  /// Per chart record: the smallest cos θ between a face normal and the chart normal (the
-  /// projection's largest foreshortening; the tixel size was multiplied by it), 1 when planar.
-  std::vector<float> chartMinCosine;
   float sceneScale = 0.0f;          ///< sceneScale() (0 when settings.tixelsPerUnit fixed the size)
   float baseTixelSize = 0.0f;       ///< the preset's tixel size before the per-material factors
   uint64_t tixelCount = 0;

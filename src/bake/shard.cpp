@@ -50,6 +50,10 @@ ShardPlan planShards(const Scene& scene, const Parameterisation& param, const Ba
   std::vector<double> prefix;
   for (size_t b = 0; b < plan.batches(); ++b) {
     const uint64_t begin = plan.batchStart[b], end = plan.batchStart[b + 1];
+    if (ranks == 1) {  // one process: the whole batch, no cost estimate needed
+      plan.split.insert(plan.split.end(), {begin, end});
+      continue;
+    }
     prefix.assign(1, 0.0);
     for (uint64_t g = begin; g < end; ++g) prefix.push_back(prefix.back() + estimatedTixelCost(scene, param, settings, g));
     const double total = prefix.back();

@@ -24,7 +24,7 @@ struct ShardPlan {
   /// Per batch, ranks + 1 boundaries: rank r's part of batch b is
   /// [split[b·(ranks+1) + r], split[b·(ranks+1) + r + 1]).
   std::vector<uint64_t> split;
-  std::vector<double> rankCost;  ///< estimated cost of every rank's tixels (ray equivalents)
+  std::vector<double> rankCost;  ///< estimated cost of every rank's tixels (ray equivalents); 0 for one rank (not estimated)
 
   size_t batches() const { return batchStart.size() - 1; }
   TixelRange part(size_t batch, int rank) const {

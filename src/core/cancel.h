@@ -13,6 +13,8 @@
 // ranges (Embree's BVH build, one codec call, loading a scene) runs to its end first.
 // The flag stays raised until clearCancellation(): a request stops every job running in the
 // process, and the caller that raised it clears it once its job has stopped.
+#include <atomic>
+
 #include "core/error.h"
 
 namespace pl {
@@ -23,13 +25,22 @@ class Cancelled : public Error {
   Cancelled() : Error("cancelled") {}
 };
 
-/// Raises the flag (async-signal-safe: one lock-free atomic store).
-void requestCancellation() noexcept;
-/// Lowers it (before starting a job again after a cancellation).
-void clearCancellation() noexcept;
-bool cancellationRequested() noexcept;
+namespace detail {
+inline std::atomic<bool> cancellationRequested{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+}  // namespace detail
 
-/// A cancellation point: throws pl::Cancelled when the flag is raised.
-void throwIfCancelled();
+/// Raises the flag (async-signal-safe: one lock-free atomic store).
+inline void requestCancellation() noexcept { detail::cancellationRequested.store(true, std::memory_order_relaxed); }
+/// Lowers it (before starting a job again after a cancellation).
+inline void clearCancellation() noexcept { detail::cancellationRequested.store(false, std::memory_order_relaxed); }
+inline bool cancellationRequested() noexcept { return detail::cancellationRequested.load(std::memory_order_relaxed); }
+
+/// A cancellation point: throws pl::Cancelled when the flag is raised. Inline, so that the
+/// path tracer's per-sample check is one relaxed load and a predicted branch, no call.
+inline void throwIfCancelled() {
+  if (cancellationRequested()) [[unlikely]]
+    throw Cancelled();
+}
 
 }  // namespace pl

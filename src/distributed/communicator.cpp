@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstdlib>
 
+#include <fmt/format.h>
+
 #include "core/error.h"
 
 namespace pl {
@@ -16,6 +18,15 @@ uint64_t Communicator::sum(uint64_t value) {
   uint64_t total = 0;
   for (uint64_t v : allgather(value)) total += v;
   return total;
+}
+
+std::string Communicator::ranksDiffering(uint64_t value, uint64_t& rank0Value) {
+  const std::vector<uint64_t> values = allgather(value);
+  rank0Value = values[0];
+  std::string differ;
+  for (size_t r = 1; r < values.size(); ++r)
+    if (values[r] != values[0]) differ += fmt::format("{}{}", differ.empty() ? "" : ", ", r);
+  return differ;
 }
 
 void SingleProcess::abort(int status) { std::exit(status); }

@@ -42,6 +42,9 @@ class Communicator {
 
   /// Σ over ranks of `value` (integers: the same on every rank whatever the order).
   uint64_t sum(uint64_t value);
+  /// The ranks whose `value` differs from rank 0's, as "1, 3" (empty when all agree), and
+  /// rank 0's value in `rank0Value`: how a job checks that every rank does the same work.
+  std::string ranksDiffering(uint64_t value, uint64_t& rank0Value);
 
  protected:
   uint64_t bytesReceived_ = 0;

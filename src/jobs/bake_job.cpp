@@ -105,22 +105,19 @@ void BakeJob::checkSameJobOnEveryRank(const std::string& scenePath) const {
   const BakeSettings s = settings();
   uint64_t hash = xxh64(scenePath.data(), scenePath.size());
   if (scenePath != "cornell") {
-    requireRegularFile(scenePath);
-    const MappedFile file(scenePath);
+    const MappedFile file(scenePath);  // (refuses a FIFO or directory: requireRegularFile)
     hash = xxh64(file.bytes().data(), file.bytes().size());
   }
   const std::string shape = fmt::format("{}|{}|{}|{}|{}|{}|{}|{}", options_.preset, s.tixelsAcrossScene, s.gatherDirections,
                                         s.areaLightSamples, s.tolerance, s.seed, options_.compress,
                                         options_.reuseVisibility);
   hash = xxh64(shape.data(), shape.size(), hash);
-  const std::vector<uint64_t> hashes = comm->allgather(hash);
-  std::string differ;
-  for (size_t r = 1; r < hashes.size(); ++r)
-    if (hashes[r] != hashes[0]) differ += fmt::format("{}{}", differ.empty() ? "" : ", ", r);
+  uint64_t rank0Hash = 0;
+  const std::string differ = comm->ranksDiffering(hash, rank0Hash);
   if (!differ.empty())
     fail("{}: refused: rank(s) {} of {} have a different scene file or bake settings than rank 0 (hash {:016x} here, "
          "{:016x} on rank 0); every rank must bake the same scene with the same flags",
-         scenePath, differ, hashes.size(), hash, hashes[0]);
+         scenePath, differ, comm->size(), hash, rank0Hash);
 }
 
 BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {

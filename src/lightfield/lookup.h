@@ -193,7 +193,7 @@ inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading&
   }
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
   uv = surface.uv;
-  if (shading.normalMapped) lookup = normalMappedLookupDirection(c, surface.shadingNormal, towardsViewer);
+  lookup = normalMappedLookupDirection(c, surface.shadingNormal, towardsViewer);
 }
 
 /// The cos θ towards the viewer that the lookups use on a curved chart record. Its triangles

@@ -236,8 +236,8 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       // into vectors, and the lookup's 16-byte loads of them then stall (measured on Cornell).
       if (shading[chart].needsUv)
         for (int k = 0; k < 4; ++k) {
-          Vec3 unusedLookup;  // a diffuse lookup needs only the uv
-          lookupInputs(scene, charts[chart], shading[chart], s.hits[i + k], -s.rays[i + k].direction, fourUv[k], unusedLookup);
+          const RayHit& hit = s.hits[i + k];  // a diffuse chart: the uv alone (lookupInputs' case)
+          fourUv[k] = uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics);
         }
       exitantRadianceDiffuse4(scene, charts[chart], shading[chart], paddedValues_.data(), four, fourUv, fourRadiance);
       for (int k = 0; k < 4; ++k) f4StoreRgb(out + s.pixel[i + k], f4Mul(f4Splat(s.weight[i + k]), fourRadiance[k]));
