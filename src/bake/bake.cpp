@@ -72,8 +72,13 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   LightField lf;
   lf.scene = std::move(scene);
   lf.settings = settings;
+  // Setup. The BVH and the charts are per scene: every rank builds them. The per-tixel part
+  // (footprints and buried-point probes, most of the time on a large scene) is divided
+  // between the ranks and exchanged (shard.h fillTixelsDistributed).
   const Accel accel(lf.scene);
-  const Parameterisation param = buildParameterisation(lf.scene, accel, settings);
+  Parameterisation param = buildCharts(lf.scene, accel, settings);
+  const double chartSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const TixelSetupTiming tixelSetup = fillTixelsDistributed(lf.scene, accel, param, comm);
   const uint64_t hash = visibilityHash(lf.scene, param, settings);
   if (ranks > 1) {
     // Every rank must bake the same geometry, parameterisation and settings (the job compares
@@ -93,9 +98,12 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
       tixelsByKind[size_t(c.kind)] += c.tixelCount();
     }
     note(fmt::format("parameterisation: {} charts ({} diffuse, {} glossy, {} specular), {} tixels ({} diffuse, {} glossy), "
-                     "{} values; room scale {:.4g}, tixel size {:.4g} (scene units)",
+                     "{} values; room scale {:.4g}, tixel size {:.4g} (scene units); BVH and charts {:.2f} s, "
+                     "tixels {:.2f} s{}",
                      param.charts.size(), byKind[0], byKind[1], byKind[2], param.tixelCount, tixelsByKind[0],
-                     tixelsByKind[1], param.valueCount, param.sceneScale, param.baseTixelSize));
+                     tixelsByKind[1], param.valueCount, param.sceneScale, param.baseTixelSize, chartSeconds,
+                     tixelSetup.seconds,
+                     ranks > 1 ? fmt::format(" (this rank's share; exchanged in {:.2f} s)", tixelSetup.exchangeSeconds) : ""));
   }
   const ShardPlan plan = planShards(lf.scene, param, settings, ranks);
   const std::vector<TixelRange> held = visibilityRanges(lf.scene, param, plan, rank);
@@ -172,6 +180,9 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   distributed.heldTixels = heldTixels;
   // (One rank: no costs are estimated, its share is the whole.)
   for (double c : plan.rankCost) distributed.estimatedCost.push_back(totalCost > 0 ? c / totalCost : 1.0 / ranks);
+  distributed.setupSeconds = chartSeconds;
+  distributed.tixelSetupSeconds = gatherDoubles(tixelSetup.seconds);
+  distributed.tixelSetupExchangeSeconds = tixelSetup.exchangeSeconds;
   distributed.visibilityRays = comm.allgather(rays);
   distributed.visibilitySeconds = gatherDoubles(visibilitySeconds);
   distributed.propagationSeconds = gatherDoubles(prop.seconds);

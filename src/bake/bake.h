@@ -30,6 +30,9 @@ struct DistributedBakeStats {
   uint64_t ownTixels = 0;           ///< tixels this rank updated (rank 0's in the job's stats)
   uint64_t heldTixels = 0;          ///< tixels of its visibility shard (own + rough-glass twins)
   std::vector<double> estimatedCost;     ///< per rank: its share of the estimated cost (sums to 1)
+  double setupSeconds = 0.0;        ///< BVH and charts (buildCharts): work every rank repeats (this rank's)
+  std::vector<double> tixelSetupSeconds;  ///< per rank: filling its share of the per-tixel setup (fillTixels)
+  double tixelSetupExchangeSeconds = 0.0;  ///< this rank's time in that setup's exchange (waits included)
   std::vector<uint64_t> visibilityRays;  ///< per rank: rays it traced (0 when it reused its .plv)
   std::vector<double> visibilitySeconds; ///< per rank
   std::vector<double> propagationSeconds;  ///< per rank

@@ -400,6 +400,21 @@ Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& s
 }
 
 Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, const BakeSettings& settings) {
+  Parameterisation p = buildCharts(scene, accel, settings);
+  fillTixels(scene, accel, p, 0, uint32_t(p.charts.size()));
+  return p;
+}
+
+void fillTixels(const Scene& scene, const Accel& accel, Parameterisation& p, uint32_t firstRecord, uint32_t endRecord) {
+  if (firstRecord > endRecord || endRecord > p.charts.size())
+    fail("fillTixels: records [{}, {}) are not within the {} chart records", firstRecord, endRecord, p.charts.size());
+  parallelFor(endRecord - firstRecord, [&](uint64_t k) {
+    const uint64_t ci = firstRecord + k;
+    fillChartTixels(scene, accel, p.charts[ci], p.chartTriangles[ci], p);
+  });
+}
+
+Parameterisation buildCharts(const Scene& scene, const Accel& accel, const BakeSettings& settings) {
   Vec3 lo, hi;
   scene.bounds(lo, hi);
   const float diagonal = glm::length(hi - lo);
@@ -755,7 +770,6 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
   p.transportAlbedo.resize(p.tixelCount);
   for (uint32_t ci = 0; ci < recordCount; ++ci)
     std::fill_n(p.tixelChart.begin() + int64_t(p.charts[ci].firstTixel), p.charts[ci].tixelCount(), ci);
-  parallelFor(recordCount, [&](uint64_t ci) { fillChartTixels(scene, accel, p.charts[ci], p.chartTriangles[ci], p); });
   return p;
 }
 

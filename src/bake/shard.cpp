@@ -2,12 +2,16 @@
 #include "bake/shard.h"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
+#include <type_traits>
 
 #include <fmt/format.h>
 
+#include "bake/parameterisation.h"
 #include "bake/propagation.h"
 #include "core/error.h"
+#include "distributed/communicator.h"
 
 namespace pl {
 
@@ -106,6 +110,55 @@ std::string shardVisibilityPath(const std::string& path, int rank, int ranks) {
   const std::string extension = p.extension().string();
   p.replace_extension();
   return fmt::format("{}.rank{}-of-{}{}", p.string(), rank, ranks, extension);
+}
+
+std::vector<uint32_t> tixelSetupSplit(const Parameterisation& param, int ranks) {
+  if (ranks < 1) fail("a distributed bake needs at least one rank, not {}", ranks);
+  const size_t records = param.charts.size();
+  std::vector<double> prefix(records + 1, 0.0);
+  for (size_t ci = 0; ci < records; ++ci) {
+    const Chart& c = param.charts[ci];
+    const double perTixel = c.kind == ChartKind::Specular ? 0.25 : 1.0;
+    prefix[ci + 1] = prefix[ci] + 1.0 + perTixel * double(c.tixelCount());
+  }
+  std::vector<uint32_t> split{0};
+  for (int r = 1; r < ranks; ++r) {
+    // The first record at which the running cost reaches r/ranks of the total.
+    const double target = prefix.back() * double(r) / double(ranks);
+    const size_t at = size_t(std::lower_bound(prefix.begin(), prefix.end(), target) - prefix.begin());
+    split.push_back(std::max(split.back(), uint32_t(std::min(at, records))));
+  }
+  split.push_back(uint32_t(records));
+  return split;
+}
+
+TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, Parameterisation& param, Communicator& comm) {
+  TixelSetupTiming timing;
+  const int rank = comm.rank(), ranks = comm.size();
+  const std::vector<uint32_t> split = tixelSetupSplit(param, ranks);
+  const auto start = std::chrono::steady_clock::now();
+  fillTixels(scene, accel, param, split[size_t(rank)], split[size_t(rank) + 1]);
+  const auto filled = std::chrono::steady_clock::now();
+  timing.seconds = std::chrono::duration<double>(filled - start).count();
+  if (ranks == 1) return timing;
+  // Rank r's records hold tixels [first tixel of split[r], first tixel of split[r + 1]).
+  auto firstTixelOf = [&](uint32_t record) { return record < param.charts.size() ? param.charts[record].firstTixel : param.tixelCount; };
+  auto exchange = [&](auto& array) {
+    using Element = typename std::decay_t<decltype(array)>::value_type;
+    std::vector<uint64_t> displacement(static_cast<size_t>(ranks)), count(static_cast<size_t>(ranks));
+    for (int r = 0; r < ranks; ++r) {
+      const uint64_t t0 = firstTixelOf(split[size_t(r)]), t1 = firstTixelOf(split[size_t(r) + 1]);
+      displacement[size_t(r)] = t0 * sizeof(Element);
+      count[size_t(r)] = (t1 - t0) * sizeof(Element);
+    }
+    comm.allgatherv(array.data(), displacement, count);
+  };
+  exchange(param.gatherPoint);
+  exchange(param.gatherNormal);
+  exchange(param.coverage);
+  exchange(param.transportAlbedo);
+  timing.exchangeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - filled).count();
+  return timing;
 }
 
 uint64_t firstValueOf(const Parameterisation& param, uint64_t g) {

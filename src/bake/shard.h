@@ -18,6 +18,9 @@
 
 namespace pl {
 
+class Accel;
+class Communicator;
+
 struct ShardPlan {
   int ranks = 1;
   std::vector<uint64_t> batchStart;  ///< propagationBatches: batch b is [batchStart[b], batchStart[b + 1])
@@ -48,6 +51,26 @@ ShardPlan planShards(const Scene& scene, const Parameterisation& param, const Ba
 /// The tixels whose visibility rank r traces and keeps: its own, plus the twin records of its
 /// rough-glass tixels (a rough-glass record's update gathers its twin's light too).
 std::vector<TixelRange> visibilityRanges(const Scene& scene, const Parameterisation& param, const ShardPlan& plan, int rank);
+
+/// The split of the parameterisation's per-tixel setup (fillTixels) between ranks: ranks + 1
+/// record boundaries, rank r filling chart records [result[r], result[r + 1]), contiguous runs
+/// of about equal estimated cost. A record costs its tixels (each takes 16 footprint
+/// sub-samples and, unless specular, a buried-point probe of 9 rays; a specular tixel counts
+/// 1/4) plus one. Deterministic: every rank computes the same split.
+std::vector<uint32_t> tixelSetupSplit(const Parameterisation& param, int ranks);
+
+/// What fillTixelsDistributed measured on this rank.
+struct TixelSetupTiming {
+  double seconds = 0.0;          ///< filling this rank's records (its share of the divisible work)
+  double exchangeSeconds = 0.0;  ///< in the exchange (waiting for the slowest rank included)
+};
+
+/// fillTixels over the ranks of `comm`: this rank fills its records of tixelSetupSplit, then
+/// each per-tixel array is exchanged (one in-place allgatherv per array: the records of a rank
+/// are one contiguous run of tixels), so every rank holds the whole parameterisation — the
+/// one-process buildParameterisation's bit for bit, since a record's tixels depend only on the
+/// record. One rank: fillTixels of every record, no exchange. `param` comes from buildCharts.
+TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, Parameterisation& param, Communicator& comm);
 
 /// Rank r's .plv: `path` itself for one rank, else STEM.rankR-of-N.plv beside it.
 std::string shardVisibilityPath(const std::string& path, int rank, int ranks);

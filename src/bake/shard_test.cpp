@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <barrier>
 #include <cstring>
 #include <filesystem>
@@ -223,6 +224,79 @@ TEST_F(ShardFiles, ShardFieldHoldsTheWholeFieldsEntriesAndRoundTrips) {
   ASSERT_EQ(read.entries.size(), shard.field.entries.size());
   EXPECT_EQ(std::memcmp(read.entries.data(), shard.field.entries.data(), read.entries.size() * sizeof(VisibilityEntry)), 0);
   EXPECT_FALSE(readVisibility(plv, whole.hash, read, &why, param.tixelCount));  // another partition's hash
+}
+
+template <typename T>
+size_t differingEntries(const std::vector<T>& a, const std::vector<T>& b) {
+  if (a.size() != b.size()) return std::max(a.size(), b.size());
+  size_t differing = 0;
+  for (size_t i = 0; i < a.size(); ++i) differing += std::memcmp(&a[i], &b[i], sizeof(T)) != 0;
+  return differing;
+}
+
+TEST(Shards, TixelSetupSplitCoversTheRecordsInContiguousRunsOfEqualCost) {
+  const Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/CornellBox-Sphere.obj");
+  const Parameterisation param = buildCharts(scene, Accel(scene), smallSettings(24, 16));
+  for (int ranks : {1, 2, 3, 7}) {
+    const std::vector<uint32_t> split = tixelSetupSplit(param, ranks);
+    ASSERT_EQ(split.size(), size_t(ranks) + 1);
+    EXPECT_EQ(split.front(), 0u);
+    EXPECT_EQ(split.back(), param.charts.size());
+    // The documented cost: 1 per record plus its tixels, a specular tixel counting 1/4.
+    auto cost = [&](uint32_t ci) {
+      const Chart& c = param.charts[ci];
+      return 1.0 + (c.kind == ChartKind::Specular ? 0.25 : 1.0) * double(c.tixelCount());
+    };
+    double total = 0.0, largestRecord = 0.0;
+    for (uint32_t ci = 0; ci < param.charts.size(); ++ci) {
+      total += cost(ci);
+      largestRecord = std::max(largestRecord, cost(ci));
+    }
+    double covered = 0.0;
+    for (int r = 0; r < ranks; ++r) {
+      ASSERT_LE(split[size_t(r)], split[size_t(r) + 1]);
+      double share = 0.0;
+      for (uint32_t ci = split[size_t(r)]; ci < split[size_t(r) + 1]; ++ci) share += cost(ci);
+      covered += share;
+      // Records are not divided: a share exceeds 1/ranks of the total by less than one record.
+      EXPECT_LT(share, total / ranks + largestRecord) << "rank " << r << " of " << ranks;
+    }
+    EXPECT_DOUBLE_EQ(covered, total);
+  }
+}
+
+TEST(Shards, RanksFillTheOneProcessParameterisationBitForBit) {
+  // The sphere box: curved charts (gather normals), buried tixels under the spheres, two-sided records.
+  const Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/CornellBox-Sphere.obj");
+  const BakeSettings settings = smallSettings(24, 16);
+  const Accel accel(scene);
+  const Parameterisation one = buildParameterisation(scene, accel, settings);
+  ASSERT_TRUE(std::any_of(one.charts.begin(), one.charts.end(), [](const Chart& c) { return c.curved; }));
+  for (int ranks : {2, 3}) {
+    std::vector<Parameterisation> results(static_cast<size_t>(ranks));
+    std::vector<TixelSetupTiming> timings(static_cast<size_t>(ranks));
+    ThreadRanks world(ranks);
+    world.run([&](Communicator& comm) {
+      Parameterisation p = buildCharts(scene, accel, settings);
+      timings[size_t(comm.rank())] = fillTixelsDistributed(scene, accel, p, comm);
+      results[size_t(comm.rank())] = std::move(p);
+    });
+    for (int r = 0; r < ranks; ++r) {
+      const Parameterisation& p = results[size_t(r)];
+      EXPECT_EQ(differingEntries(p.gatherPoint, one.gatherPoint), 0u) << "rank " << r << " of " << ranks;
+      EXPECT_EQ(differingEntries(p.gatherNormal, one.gatherNormal), 0u) << "rank " << r << " of " << ranks;
+      EXPECT_EQ(differingEntries(p.coverage, one.coverage), 0u) << "rank " << r << " of " << ranks;
+      EXPECT_EQ(differingEntries(p.transportAlbedo, one.transportAlbedo), 0u) << "rank " << r << " of " << ranks;
+      EXPECT_EQ(visibilityHash(scene, p, settings), visibilityHash(scene, one, settings));
+      EXPECT_GT(timings[size_t(r)].seconds, 0.0);
+    }
+  }
+  // A rank that filled only its own records (no exchange) holds zeros elsewhere: what the
+  // exchange above supplies, so the comparison could fail.
+  Parameterisation part = buildCharts(scene, accel, settings);
+  const std::vector<uint32_t> split = tixelSetupSplit(part, 2);
+  fillTixels(scene, accel, part, split[0], split[1]);
+  EXPECT_GT(differingEntries(part.gatherPoint, one.gatherPoint), 0u);
 }
 
 TEST(Shards, ShardFileNames) {

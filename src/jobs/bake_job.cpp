@@ -27,6 +27,7 @@ std::string BakeJobStats::toJson() const {
   json["preset"] = preset;
   json["threads"] = threads;
   json["seconds"] = seconds;
+  json["load_seconds"] = loadSeconds;
   json["bake_seconds"] = bake.seconds;
   json["visibility_seconds"] = bake.visibilitySeconds;
   json["propagation_seconds"] = bake.propagationSeconds;
@@ -52,6 +53,9 @@ std::string BakeJobStats::toJson() const {
   json["ranks"] = distributed.ranks;
   json["batches"] = distributed.batches;
   json["rank_estimated_cost_share"] = distributed.estimatedCost;
+  json["setup_seconds"] = distributed.setupSeconds;
+  json["rank_tixel_setup_seconds"] = distributed.tixelSetupSeconds;
+  json["tixel_setup_exchange_seconds"] = distributed.tixelSetupExchangeSeconds;
   json["rank_visibility_rays"] = distributed.visibilityRays;
   json["rank_visibility_seconds"] = distributed.visibilitySeconds;
   json["rank_propagation_seconds"] = distributed.propagationSeconds;
@@ -145,6 +149,7 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
     stats.fileBytes = std::filesystem::file_size(options_.output);
   }
   stats.seconds = loadSeconds + secondsSince(start);
+  stats.loadSeconds = loadSeconds;
   stats.scene = options_.sceneName;
   stats.output = options_.output;
   stats.preset = options_.preset;

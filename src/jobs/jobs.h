@@ -172,6 +172,7 @@ struct BakeJobStats {
   std::string scene, output, preset, visibilityFile, compression;
   int threads = 0;
   double seconds = 0.0;  ///< the whole job: loading (path overload), baking and writing
+  double loadSeconds = 0.0;  ///< of seconds: loading the scene (path overload; 0 for a given Scene)
   BakeStats bake;
   uint64_t charts = 0, twoSidedCharts = 0, backSideTixels = 0, curvedCharts = 0, curvedTixels = 0, fileBytes = 0;
   DistributedBakeStats distributed;
