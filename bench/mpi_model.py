@@ -12,7 +12,7 @@ thread (bench/mpi_scaling.sh writes NAME.1x2.json and NAME.2x1.json). From them:
                 ranks of rank_visibility_seconds and rank_gather_seconds; F = ranks × the
                 smallest rank_first_shot_seconds, which include the wait at the first exchange)
   R             per iteration, the work every rank repeats for all tixels (transport refresh,
-                change, power sums; rank 0's propagation − first shot − gather − exchange, / iterations)
+                change, power sums; rank 0's rank_repeated_seconds / iterations)
   X0            the setup every rank repeats: loading the scene (load_seconds) and the BVH and
                 charts (setup_seconds), both from the 2x1 run (1 thread: conservative, the BVH
                 build is multi-threaded)
@@ -72,8 +72,7 @@ def inputs(one, two):
                 for r in range(ranks)]
     imbalance = max(per_rank) / (sum(per_rank) / ranks)
     iterations = two["iterations"]
-    repeated = (two["rank_propagation_seconds"][0] - two["rank_first_shot_seconds"][0] - two["rank_gather_seconds"][0] -
-                two["exchange_seconds"]) / iterations
+    repeated = two["rank_repeated_seconds"][0] / iterations
     repeated_setup = two["load_seconds"] + two["setup_seconds"]
     rest = (one["seconds"] - one["load_seconds"] - one["setup_seconds"] - one["rank_tixel_setup_seconds"][0] -
             one["visibility_seconds"] - one["propagation_seconds"])

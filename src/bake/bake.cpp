@@ -188,6 +188,7 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   distributed.propagationSeconds = gatherDoubles(prop.seconds);
   distributed.firstShotSeconds = gatherDoubles(prop.firstShotSeconds);
   distributed.gatherSeconds = gatherDoubles(prop.gatherSeconds);
+  distributed.repeatedSeconds = gatherDoubles(prop.repeatedSeconds);
   distributed.batches = plan.batches();
   distributed.exchangeBytes = prop.exchangeBytes;
   distributed.exchanges = comm.exchanges();

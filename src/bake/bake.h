@@ -38,6 +38,7 @@ struct DistributedBakeStats {
   std::vector<double> propagationSeconds;  ///< per rank
   std::vector<double> firstShotSeconds;    ///< per rank: of propagationSeconds, the first shot
   std::vector<double> gatherSeconds;       ///< per rank: of propagationSeconds, in gatherIteration
+  std::vector<double> repeatedSeconds;     ///< per rank: of propagationSeconds, the per-iteration work on all tixels
   uint64_t batches = 0;             ///< propagation batches (one exchange each per iteration)
   uint64_t exchangeBytes = 0;       ///< received by this rank over the propagation
   uint64_t exchanges = 0;           ///< allgatherv calls (one per batch per iteration, plus the first shot's)

@@ -968,21 +968,29 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   const bool keepPrevious = anyGlossy || ranks > 1;
   double previousPower = totalPower(current), previousL1Change = 0.0;
   Progress progress("propagation", settings.maxIterations);
+  auto secondsSince = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
   for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
+    auto repeatedStart = std::chrono::steady_clock::now();
     if (keepPrevious) state.previousValues = current;
+    result.repeatedSeconds += secondsSince(repeatedStart);
     for (size_t batch = 0; batch + 1 < batchStart.size(); ++batch) {
       const uint64_t begin = batchStart[batch], end = batchStart[batch + 1];
       const TixelRange mine = plan.part(batch, rank);
       const auto gatherStart = std::chrono::steady_clock::now();
       gatherIteration(state, vis, mine.begin, mine.end, omega);
-      result.gatherSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - gatherStart).count();
+      result.gatherSeconds += secondsSince(gatherStart);
       exchange(state.current, batch);
+      repeatedStart = std::chrono::steady_clock::now();
       updateTransport(state, begin, end);
       for (int r = 0; r < ranks; ++r) {
         const TixelRange theirs = plan.part(batch, r);
         if (r != rank) recomputeChange(state, state.previousValues, theirs.begin, theirs.end);
       }
+      result.repeatedSeconds += secondsSince(repeatedStart);
     }
+    repeatedStart = std::chrono::steady_clock::now();
     const double power = totalPower(current);
     if (!std::isfinite(power)) {
       requireFiniteValues(scene, param, current, fmt::format("in iteration {}", iteration));
@@ -990,6 +998,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
            scene.sourcePath, iteration);
     }
     const double changed = transportChange(state);
+    result.repeatedSeconds += secondsSince(repeatedStart);
     const double l1Change = power > 0.0 ? changed / power : 0.0;
     if (iteration > 2 && l1Change > previousL1Change) omega = 1.0f;
     const double contraction = previousL1Change > 0.0 ? l1Change / previousL1Change : 1.0;

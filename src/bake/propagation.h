@@ -61,6 +61,10 @@ struct PropagationResult {
   /// Of `seconds`: in gatherIteration (the part of an iteration that the ranks share; the rest
   /// — transport refresh, change, power sums — every rank does for all tixels).
   double gatherSeconds = 0.0;
+  /// Of `seconds`: in the iteration, the work every rank does for all tixels whoever updated
+  /// them — the transport refresh, the change of the other ranks' tixels, the copy of the
+  /// starting values and the power sums of the stopping rule (measured, not derived).
+  double repeatedSeconds = 0.0;
 };
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,

@@ -61,6 +61,7 @@ std::string BakeJobStats::toJson() const {
   json["rank_propagation_seconds"] = distributed.propagationSeconds;
   json["rank_first_shot_seconds"] = distributed.firstShotSeconds;
   json["rank_gather_seconds"] = distributed.gatherSeconds;
+  json["rank_repeated_seconds"] = distributed.repeatedSeconds;
   json["exchange_bytes"] = distributed.exchangeBytes;
   json["exchanges"] = distributed.exchanges;
   json["exchange_seconds"] = distributed.exchangeSeconds;
