@@ -4,8 +4,11 @@
 // closed form where per-triangle charts are faceted.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <set>
 
 #include "accel/accel.h"
@@ -14,6 +17,7 @@
 #include "core/progress.h"
 #include "lightfield/lookup.h"
 #include "plf/plf_file.h"
+#include "support/glossy_spheres.h"
 
 namespace pl {
 namespace {
@@ -202,6 +206,76 @@ TEST(CurvedCharts, FlatShadedMeshesGatherAroundFaceNormalsAndCreasesStop) {
     fronts += c.isBack ? 0 : 1;
   }
   EXPECT_EQ(fronts, 8u);
+}
+
+// Curved glossy charts: the GGX and Blinn-Phong spheres of glossy_spheres.h (smooth meshes of
+// 1 088 faces each) are a few curved glossy charts each instead of one chart per triangle,
+// their tixels gather around the interpolated (≈ radial) normal and store their maps in a
+// frame around it; a rough-glass sphere stays one chart per triangle.
+TEST(CurvedCharts, SmoothGlossySpheresAreAFewCurvedGlossyCharts) {
+  Progress::setEnabled(false);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("plenoptic_curved_glossy_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const Scene scene = test_support::loadGlossySpheres(dir);
+  const Parameterisation p = buildParameterisation(scene, bakePreset("draft"));
+  for (const char* name : {"leftSphere", "rightSphere"}) {
+    uint32_t material = 0;
+    while (material < scene.materials.size() && scene.materials[material].name != name) ++material;
+    ASSERT_LT(material, scene.materials.size()) << name;
+    // The sphere's centre: the mean of its triangles' vertices (a latitude-longitude sphere).
+    size_t triangles = 0;
+    Vec3 centre(0.0f);
+    for (const Mesh& mesh : scene.meshes)
+      for (size_t t = 0; t < mesh.triangles.size(); ++t)
+        if (mesh.materials[t] == material) {
+          ++triangles;
+          for (int k = 0; k < 3; ++k) centre += mesh.positions[mesh.triangles[t][k]];
+        }
+    centre /= float(3 * triangles);
+    size_t records = 0, curved = 0;
+    float worstCosine = 1.0f;
+    for (const Chart& c : p.charts) {
+      if (c.material != material) continue;
+      ++records;
+      EXPECT_EQ(c.kind, ChartKind::Glossy);
+      EXPECT_EQ(c.sides, 1);  // a closed mesh
+      if (!c.curved) continue;
+      ++curved;
+      for (uint64_t g = c.firstTixel; g < c.firstTixel + c.tixelCount(); ++g) {
+        const Vec3 n = p.gatherNormal[g];
+        EXPECT_NEAR(glm::length(n), 1.0f, 1e-5f);
+        worstCosine = std::min(worstCosine, glm::dot(n, glm::normalize(p.gatherPoint[g] - centre)));
+        // The map's frame: orthonormal around the gather normal.
+        const TixelFrame f = tixelFrame(p, c, g);
+        EXPECT_EQ(f.n, n);
+        EXPECT_NEAR(glm::dot(f.u, n), 0.0f, 1e-5f);
+        EXPECT_NEAR(glm::dot(f.v, n), 0.0f, 1e-5f);
+        EXPECT_NEAR(glm::dot(f.u, f.v), 0.0f, 1e-5f);
+      }
+    }
+    std::printf("%s: %zu triangles, %zu chart records (%zu curved), gather normals within %.2f° of radial\n", name,
+                triangles, records, curved, std::acos(std::min(1.0f, worstCosine)) * 180.0f / kPi);
+    EXPECT_GT(triangles, 1000u);
+    EXPECT_LT(records, triangles / 10);  // planar glossy charts: one per triangle
+    EXPECT_GE(curved, records - records / 4);
+    EXPECT_GT(worstCosine, std::cos(3.0f * kPi / 180.0f));  // vertex normals of a fine sphere: ≈ radial
+  }
+  // Rough glass stays planar: one two-sided record pair per triangle of that sphere.
+  const std::filesystem::path json = dir / "rough.json";
+  std::ofstream(json) << R"({"meshes": [{"file": ")" << PLENOPTIC_TEST_DATA_DIR
+                      << R"(/cornell-mcguire/CornellBox-Sphere.obj"}], "materials": {"rightSphere": )"
+                      << R"({"type": "dielectric", "ior": 1.6, "roughness": 0.5}}})";
+  const Scene rough = loadScene(json.string());
+  std::filesystem::remove_all(dir);
+  const Parameterisation q = buildParameterisation(rough, bakePreset("draft"));
+  size_t glassRecords = 0;
+  for (const Chart& c : q.charts) {
+    if (!isRoughGlassChart(c, rough.materials[c.material].bsdf)) continue;
+    ++glassRecords;
+    EXPECT_FALSE(c.curved);
+  }
+  EXPECT_GT(glassRecords, 1000u);
 }
 
 // Light-field radiance at the cylinder's surface at angle φ (mid-height), seen from outside

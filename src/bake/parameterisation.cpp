@@ -24,6 +24,16 @@ ChartKind chartKindOf(const Bsdf& bsdf) {
   return ChartKind::Glossy;
 }
 
+bool mayGrowCurvedCharts(const Material& material) {
+  if (material.isEmissive()) return false;
+  switch (chartKindOf(material.bsdf)) {
+    case ChartKind::Diffuse: return true;
+    case ChartKind::Glossy: return !hasTransmission(material.bsdf);  // not rough glass
+    case ChartKind::Specular: return false;
+  }
+  return false;
+}
+
 uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings) {
   switch (chartKindOf(bsdf)) {
     case ChartKind::Diffuse: return 1;
@@ -275,15 +285,10 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
   const Material& material = scene.materials[c.material];
   const bool textured = c.kind == ChartKind::Diffuse && material.albedoTexture >= 0;
   const Rgb constantAlbedo = c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, Vec2(0.0f)) : Rgb(0.0f);
-  // The normal a point of the chart gathers around: the chart's on a planar chart; on a curved
-  // one the interpolated shading normal there (no normal map: that is render-time detail),
-  // turned to the record's side.
+  // The normal a point of the chart gathers around (chartShadingNormalAt, lightfield.h).
   auto normalAt = [&](const FootprintSample& s) {
-    if (!c.curved) return c.normal;
     const ChartRaster::Tri2& t = r.tris[s.tri];
-    const Vec3 n = interpolatedNormal(scene.meshes[t.mesh], t.triangle, Vec2(s.bary[1], s.bary[2]),
-                                      triangleNormal(scene.meshes[t.mesh], t.triangle));
-    return c.isBack ? -n : n;
+    return chartShadingNormalAt(c, scene.meshes[t.mesh], t.triangle, Vec2(s.bary[1], s.bary[2]));
   };
   for (uint32_t j = 0; j < c.resV; ++j)
     for (uint32_t i = 0; i < c.resU; ++i) {
@@ -475,7 +480,7 @@ Parameterisation buildCharts(const Scene& scene, const Accel& accel, const BakeS
   // Curved charts (parameterisation.h): materials that may grow them, and smooth edges.
   std::vector<uint8_t> curvedMaterial(scene.materials.size(), 0);
   for (size_t m = 0; m < scene.materials.size(); ++m)
-    curvedMaterial[m] = chartKindOf(scene.materials[m].bsdf) == ChartKind::Diffuse && !scene.materials[m].isEmissive();
+    curvedMaterial[m] = mayGrowCurvedCharts(scene.materials[m]);
   const float cosCone = std::cos(kCurvedChartConeDegrees * kPi / 180.0f);
   const float cosSmooth = std::cos(kSmoothEdgeToleranceDegrees * kPi / 180.0f);
   const float cosFlatShaded = std::cos(kFlatShadedChartEdgeDegrees * kPi / 180.0f);

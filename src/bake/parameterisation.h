@@ -11,10 +11,11 @@
 // gives the smallest bounding rectangle of the triangles projected along the normal — and a
 // square tixel grid over that rectangle.
 //
-// Curved charts (Chart::curved). A smooth diffuse surface (banners, curtains, arches, a
-// sphere) would otherwise be one flat chart per triangle: faceted lookups and tixels smaller
-// than the preset's wherever triangles are. So, for a Lambertian material that does not emit,
-// a triangle also joins a neighbour across a *smooth* edge — welded, with the shading normals
+// Curved charts (Chart::curved). A smooth diffuse or glossy surface (banners, curtains,
+// arches, a sphere, a sofa, a vase) would otherwise be one flat chart per triangle: faceted
+// lookups and tixels smaller than the preset's wherever triangles are. So, for a Lambertian or
+// glossy (Blinn-Phong, GGX) material that does not emit (mayGrowCurvedCharts; rough glass
+// stays planar: its two records are the two sides of one interface), a triangle also joins a neighbour across a *smooth* edge — welded, with the shading normals
 // of both triangles equal (within kSmoothEdgeToleranceDegrees) at both ends of the edge, so a
 // modelled crease (split normals) stops the chart; on a flat-shaded mesh (no vertex normals,
 // Crytek Sponza's) any edge whose faces meet within kFlatShadedChartEdgeDegrees — when its
@@ -29,11 +30,15 @@
 // smooth edge that is not coplanar, or (a lone facet of a smooth mesh) when a vertex normal
 // of its triangles leaves kChartNormalToleranceDegrees of the chart normal; all others are
 // the planar charts of before, unchanged.
-// Glossy, specular, rough-glass and emissive charts stay planar. A curved chart's diffuse
-// tixels gather around the interpolated shading normal at their gather point (gatherNormal,
-// tixelFrame), so a smooth mesh gets smoothly varying irradiance; on a flat-shaded mesh that
-// is the face normal of the triangle under the tixel, as the path tracer shades it (facets
-// stay facets, blended over one tixel at their edges, but are no longer a chart each).
+// Glossy charts grow within the same bounds as diffuse ones (the same cone, smooth-edge and
+// flat-shading angles). Specular, rough-glass and emissive charts stay planar. A curved
+// chart's tixels gather around the interpolated shading normal at their gather point
+// (gatherNormal, chartShadingNormalAt), so a smooth mesh gets smoothly varying values; on a
+// flat-shaded mesh that is the face normal of the triangle under the tixel, as the path
+// tracer shades it (facets stay facets, blended over one tixel at their edges, but are no
+// longer a chart each). A glossy tixel stores its paraboloid map in its frame (tixelFrame:
+// tixelFrameAround its gather normal, lightfield.h), and lookups read it in the frame around
+// the interpolated normal at the looked-up point, so highlights move smoothly over the mesh.
 //
 // Tixel size (world units): 1 / tixelsPerUnit when that is set, otherwise the scene's room
 // scale (sceneScale) / tixelsAcrossScene, so a preset means the same density in a one-room
@@ -106,26 +111,16 @@ struct Parameterisation {
   std::vector<Rgb> transportAlbedo;   ///< diffuse charts: mean albedo over the tixel's footprint
 };
 
-/// The orthonormal frame a tixel gathers in (z along the normal it gathers around): its
-/// chart's frame (axisU, axisV, normal) on a planar chart, a frame around gatherNormal on a
-/// curved one. toWorld/toLocal are chartWorldDirection/chartLocalDirection's formulas, so a
-/// planar chart's rays are bit for bit those of its chart frame.
-struct TixelFrame {
-  Vec3 u, v, n;
-  Vec3 toWorld(const Vec3& local) const { return local.x * u + local.y * v + local.z * n; }
-  Vec3 toLocal(const Vec3& w) const { return {glm::dot(w, u), glm::dot(w, v), glm::dot(w, n)}; }
-};
-/// The frame of a point of chart c whose gather normal is `normal` (read only when curved).
-inline TixelFrame tixelFrameAround(const Chart& c, const Vec3& normal) {
-  if (!c.curved) return {c.axisU, c.axisV, c.normal};
-  const Frame f = Frame::fromNormal(normal);
-  return {f.s, f.t, f.n};
-}
+/// The frame tixel `tixel` of chart c gathers in and stores its directional map in
+/// (tixelFrameAround, lightfield.h, of its gatherNormal on a curved chart).
 inline TixelFrame tixelFrame(const Parameterisation& p, const Chart& c, uint64_t tixel) {
   return tixelFrameAround(c, c.curved ? p.gatherNormal[tixel] : c.normal);
 }
 
 ChartKind chartKindOf(const Bsdf& bsdf);
+/// Whether charts of `material` may be curved ("Curved charts" above): Lambertian and glossy
+/// (Blinn-Phong, GGX) materials that do not emit; not rough glass, mirrors or smooth glass.
+bool mayGrowCurvedCharts(const Material& material);
 /// Paraboloid map resolution for a material (1 diffuse, 0 specular, glossy from its lobe).
 uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings);
 /// The scene's room scale (scene units): the side of the empty cube whose mean free path

@@ -587,7 +587,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         const GlossyMaterial& gm = glossy[c.material];
         const Bsdf& bsdf = scene.materials[c.material].bsdf;
         const Chart* glass = isRoughGlassChart(c, bsdf) ? &c : nullptr;
-        const Vec3 wiLocal = chartLocalDirection(c, p.wi);
+        const Vec3 wiLocal = tixelFrame(param, c, p.tixel).toLocal(p.wi);  // the map's frame (a curved chart's own)
         // Punctual lights: the BSDF averaged over each output texel (a delta light would
         // otherwise alias between texel centres). Area-light samples are many per tixel and
         // already spread over the emitter: the texel-centre value suffices and costs 9× less.

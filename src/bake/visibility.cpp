@@ -413,7 +413,10 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
         entry.fv = uint16_t(tv.f * 65535.0f + 0.5f);
         if (state.viaMirror || c.kind == ChartKind::Glossy) {
           entry.target |= VisibilityEntry::kHasExtra;
-          const Vec2 st = directionToParaboloid(chartLocalDirection(c, -ray.direction));
+          // In the frame of the glossy map at the hit (a curved chart's, around its
+          // interpolated normal there: the lookup every renderer makes, lookup.h).
+          const TixelFrame frame = tixelFrameAround(c, chartShadingNormalAt(c, hitMesh, hit.triangle, hit.barycentrics));
+          const Vec2 st = directionToParaboloid(frame.toLocal(-ray.direction));
           extras.push_back({state.entry, VisibilityExtra{state.throughput * insideGlassAttenuation(scene, c, hit.t), st,
                                                          state.viaMirror ? 1u : 0u}});
         }

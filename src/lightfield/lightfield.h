@@ -7,7 +7,8 @@
 // (origin, axisU, axisV, normal) and a uniform grid of resU × resV tixels of side tixelSize
 // (scene units) covering the bounding rectangle of its triangles projected along the normal
 // onto the plane: tixel (i, j) has centre origin + (i + ½)·tixelSize·axisU + (j + ½)·tixelSize·axisV.
-// A chart is planar (coplanar triangles) or, for diffuse materials, curved (`curved`: a smooth
+// A chart is planar (coplanar triangles) or, for diffuse and glossy materials that are not
+// rough glass and do not emit, curved (`curved`: a smooth
 // surface whose face normals stay within a bounded cone around the chart normal, so the
 // projection along it is one-to-one; parameterisation.h "Curved charts"). A point on a curved
 // chart maps to the grid by the same projection; its tixel size is set so that the most
@@ -15,8 +16,10 @@
 // Every tixel holds valid values, including those whose centre lies outside the polygon, so
 // bilinear interpolation at polygon edges never reads garbage.
 //
-// Direction: a tixel's hemisphere (around the chart normal) is a paraboloid map (seed slides
-// 16–17): a local unit direction d (z along the normal) maps to
+// Direction: a tixel's hemisphere (around the chart normal; on a curved chart around the
+// tixel's own normal, in the frame tixelFrameAround gives it, and a lookup at a point in the
+// frame around the interpolated normal there: chartShadingNormalAt) is a paraboloid map (seed
+// slides 16–17): a local unit direction d (z along the normal) maps to
 //     (s, t) = (d.x, d.y) / (1 + d.z)  ∈ unit disk ⊂ [−1, 1]²
 // and back by d = (2s, 2t, 1 − s² − t²) / (1 + s² + t²). The dirRes × dirRes texels cover
 // [−1, 1]²; texels outside the disk hold the value of the nearest horizon direction.
@@ -72,7 +75,7 @@ struct Chart {
   uint64_t firstValue = 0;      ///< index of tixel (0, 0), direction texel (0, 0) in values
   uint8_t sides = 1;            ///< 2: a two-sided surface (both records have 2), see "Sides" above
   bool isBack = false;          ///< the back-side record of a two-sided surface (follows its front)
-  bool curved = false;          ///< a curved diffuse chart: sides are decided per triangle (chartNormalAt)
+  bool curved = false;          ///< a curved (diffuse or glossy) chart: sides are decided per triangle (chartNormalAt)
 
   uint64_t tixelCount() const { return uint64_t(resU) * resV; }
   uint64_t valuesPerTixel() const { return uint64_t(dirRes) * dirRes; }
@@ -129,6 +132,58 @@ inline Vec3 chartNormalAt(const Chart& c, const Mesh& mesh, uint32_t triangle) {
   if (!c.curved) return c.normal;
   const Vec3 n = triangleNormal(mesh, triangle);
   return c.isBack ? -n : n;
+}
+
+/// The normal chart record c's values are taken around at barycentrics (b1, b2) of triangle
+/// `triangle` of `mesh` (one of its triangles): the chart normal on a planar chart; on a curved
+/// one the interpolated shading normal there (interpolatedNormal, scene.h: no normal map, that
+/// is render-time detail; the face normal on a flat-shaded mesh), turned to the record's side
+/// (negated on a back record). The bake's gather normals (Parameterisation::gatherNormal) are
+/// this at each tixel's gather point, and the lookups of glossy charts take their direction
+/// frame around it at the hit: continuous over the chart, and within a tixel of the gather
+/// normals of the tixels they interpolate.
+inline Vec3 chartShadingNormalAt(const Chart& c, const Mesh& mesh, uint32_t triangle, Vec2 barycentrics) {
+  if (!c.curved) return c.normal;
+  const Vec3 n = interpolatedNormal(mesh, triangle, barycentrics, triangleNormal(mesh, triangle));
+  return c.isBack ? -n : n;
+}
+
+/// An orthonormal frame (z along n). Directions of a chart record's values are expressed in it:
+/// a tixel's gather directions and, on a glossy chart, its paraboloid map. toWorld/toLocal are
+/// chartWorldDirection/chartLocalDirection's formulas (lookup.h), so on a planar chart (the
+/// chart frame) the results are bit for bit those of the chart frame.
+struct TixelFrame {
+  Vec3 u, v, n;
+  Vec3 toWorld(const Vec3& local) const { return local.x * u + local.y * v + local.z * n; }
+  Vec3 toLocal(const Vec3& w) const { return {glm::dot(w, u), glm::dot(w, v), glm::dot(w, n)}; }
+};
+/// The frame at a point of chart c whose unit normal (chartShadingNormalAt, or a tixel's
+/// gatherNormal) is `normal`: the chart's frame (axisU, axisV, normal) on a planar chart
+/// (`normal` unread); on a curved one a frame around `normal`. The one definition the bake
+/// (gather directions, glossy maps) and the lookups of every renderer share.
+///  * Curved diffuse charts: Frame::fromNormal(normal). Only the gather directions turn with
+///    it, and an irradiance sum does not care how they are turned about the normal.
+///  * Curved glossy charts: u = axisU made orthogonal to the normal (Gram–Schmidt), v = n × u.
+///    A directional map is read in the frame of the lookup point and interpolated between
+///    tixels stored in the frames of their gather points, so the frame must vary continuously
+///    over the chart. Frame::fromNormal does not: at n.z = 0 it turns by 180° about n
+///    (n = (1, 0, ±0) gives s = (0, 0, ∓1)), and a sphere's charts straddle that great
+///    circle. axisU is orthogonal to the chart normal and the chart's normals stay within
+///    about 2 × kCurvedChartConeDegrees of it (parameterisation.h), so axisU is ≥ ≈ 50° off
+///    any of them and the projection never vanishes (Frame::fromNormal is the fallback for a
+///    degenerate vertex normal that leaves that bound).
+inline TixelFrame tixelFrameAround(const Chart& c, const Vec3& normal) {
+  if (!c.curved) return {c.axisU, c.axisV, c.normal};
+  if (c.kind == ChartKind::Glossy) {
+    const Vec3 u = c.axisU - glm::dot(c.axisU, normal) * normal;
+    const float length = glm::length(u);
+    if (length > 1e-3f) {
+      const Vec3 unitU = u / length;
+      return {unitU, glm::cross(normal, unitU), normal};
+    }
+  }
+  const Frame f = Frame::fromNormal(normal);
+  return {f.s, f.t, f.n};
 }
 
 /// The chart record holding the side of record `chart` (as triangleChart gives it) that a

@@ -92,15 +92,16 @@ ChartShading chartShading(const Scene& scene, const Chart& c) {
     shading.albedoOverPi = lanes4(diffuseAlbedoAt(scene, c.material, Vec2(0.0f)) * kInvPi);
   shading.needsUv = c.kind == ChartKind::Diffuse && shading.texturedAlbedo;
   shading.normalMapped = c.kind == ChartKind::Glossy && material.normalTexture >= 0;
+  shading.curvedGlossy = c.kind == ChartKind::Glossy && c.curved;
   return shading;
 }
 
-Vec3 normalMappedLookupDirection(const Chart& c, const Vec3& shadingNormal, const Vec3& wo) {
+Vec3 normalMappedLookupDirection(const Vec3& mapNormal, const Vec3& shadingNormal, const Vec3& wo) {
   // The viewer's side: a back-side viewer (one-sided chart) sees the front, as without a map.
-  if (!(glm::dot(wo, c.normal) > 0.0f)) return wo;
+  if (!(glm::dot(wo, mapNormal) > 0.0f)) return wo;
   const Vec3 mirrored = 2.0f * glm::dot(wo, shadingNormal) * shadingNormal - wo;  // about n'
-  const Vec3 d = 2.0f * glm::dot(mirrored, c.normal) * c.normal - mirrored;       // about n
-  return glm::dot(d, c.normal) > 0.0f ? glm::normalize(d) : wo;
+  const Vec3 d = 2.0f * glm::dot(mirrored, mapNormal) * mapNormal - mirrored;     // about n
+  return glm::dot(d, mapNormal) > 0.0f ? glm::normalize(d) : wo;
 }
 
 Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosition,
@@ -110,7 +111,7 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
   const Chart& c = lf.charts[chart];
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   return exitantRadiance(lf.scene, c, chartShading(lf.scene, c), lf.values.data(), worldPosition,
-                         worldDirectionTowardsViewer, uv);
+                         worldDirectionTowardsViewer, c.normal, uv);
 }
 
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer) {
@@ -121,10 +122,11 @@ Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& wor
   const Chart& c = lf.charts[chart];
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   const ChartShading shading = chartShading(lf.scene, c);
+  const Vec3 lookupNormal = lookupNormalAt(lf.scene, c, shading, hit.mesh, hit.triangle, hit.barycentrics);
   const Vec3 lookupDirection = shading.normalMapped
-                                   ? normalMappedLookupDirection(c, hit.shadingNormal, worldDirectionTowardsViewer)
+                                   ? normalMappedLookupDirection(lookupNormal, hit.shadingNormal, worldDirectionTowardsViewer)
                                    : worldDirectionTowardsViewer;
-  return exitantRadiance(lf.scene, c, shading, lf.values.data(), hit.position, lookupDirection, hit.uv);
+  return exitantRadiance(lf.scene, c, shading, lf.values.data(), hit.position, lookupDirection, lookupNormal, hit.uv);
 }
 
 }  // namespace pl

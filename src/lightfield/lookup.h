@@ -168,24 +168,40 @@ struct ChartShading {
   bool texturedAlbedo = false;    ///< diffuse albedo varies with uv: diffuseAlbedoAt per point
   bool needsUv = false;           ///< a diffuse chart with an albedo texture: the lookup needs the hit's uv
   bool normalMapped = false;      ///< a glossy chart with a normal map: lookupDirection needs the hit's normal
+  /// A curved glossy chart: its map is read in the frame around the hit's interpolated normal
+  /// (chartShadingNormalAt), so the lookup needs the hit's triangle and barycentrics.
+  bool curvedGlossy = false;
 };
 ChartShading chartShading(const Scene& scene, const Chart& c);
 
-/// The direction to look glossy chart c up in, for a viewer towards wo (unit, world) at a
-/// point whose shading normal n' (normal-mapped, surfaceAt) differs from the chart's flat
-/// normal n. The value stored towards d is the glossy reflection of light arriving around
-/// d mirrored about n; the normal-mapped surface reflects light arriving around wo mirrored
-/// about n'. So d = mirror about n of (wo mirrored about n'), which moves the highlight as the
-/// normal map says. wo itself when d would fall behind the chart (grazing tilts).
-Vec3 normalMappedLookupDirection(const Chart& c, const Vec3& shadingNormal, const Vec3& wo);
+/// The direction to look a glossy chart up in, for a viewer towards wo (unit, world) at a
+/// point whose shading normal n' (normal-mapped, surfaceAt) differs from the normal n its map
+/// is stored around there (mapNormal: the chart normal, or on a curved chart the interpolated
+/// normal at the point, chartShadingNormalAt). The value stored towards d is the glossy
+/// reflection of light arriving around d mirrored about n; the normal-mapped surface reflects
+/// light arriving around wo mirrored about n'. So d = mirror about n of (wo mirrored about n'),
+/// which moves the highlight as the normal map says. wo itself when d would fall behind n
+/// (grazing tilts).
+Vec3 normalMappedLookupDirection(const Vec3& mapNormal, const Vec3& shadingNormal, const Vec3& wo);
+
+/// The unit normal chart c's glossy map is read around at barycentrics (b1, b2) of triangle
+/// `triangle` of mesh `mesh` (exitantRadianceLanes' lookupNormal): chartShadingNormalAt on a
+/// curved glossy chart, the chart normal otherwise (where it is not read).
+inline Vec3 lookupNormalAt(const Scene& scene, const Chart& c, const ChartShading& shading, uint32_t mesh,
+                           uint32_t triangle, Vec2 barycentrics) {
+  return shading.curvedGlossy ? chartShadingNormalAt(c, scene.meshes[mesh], triangle, barycentrics) : c.normal;
+}
 
 /// What exitantRadianceLanes needs of a ray's hit on chart c besides the position: the uv
-/// (for an albedo texture) and the lookup direction (towards the viewer; bent by a normal map
-/// on glossy charts). surfaceAt is evaluated only where the chart's shading needs it.
+/// (for an albedo texture), the lookup direction (towards the viewer; bent by a normal map
+/// on glossy charts) and the normal the glossy map is read around (the chart normal; on a
+/// curved glossy chart the interpolated normal at the hit, chartShadingNormalAt). surfaceAt
+/// is evaluated only where the chart's shading needs it.
 inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading& shading, const RayHit& hit,
-                         const Vec3& towardsViewer, Vec2& uv, Vec3& lookup) {
+                         const Vec3& towardsViewer, Vec2& uv, Vec3& lookup, Vec3& lookupNormal) {
   uv = Vec2(0.0f);
   lookup = towardsViewer;
+  lookupNormal = lookupNormalAt(scene, c, shading, hit.mesh, hit.triangle, hit.barycentrics);
   if (!shading.needsUv && !shading.normalMapped) return;
   if (!shading.normalMapped) {  // surfaceAt's uv alone (no normals, no normal-map texel)
     uv = uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics);
@@ -193,7 +209,7 @@ inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading&
   }
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
   uv = surface.uv;
-  lookup = normalMappedLookupDirection(c, surface.shadingNormal, towardsViewer);
+  lookup = normalMappedLookupDirection(lookupNormal, surface.shadingNormal, towardsViewer);
 }
 
 /// The cos θ towards the viewer that the lookups use on a curved chart record. Its triangles
@@ -206,7 +222,10 @@ inline constexpr float kCurvedChartCosine = 1.0f;
 /// Exitant radiance (W·sr⁻¹·m⁻²) of chart `chart` at worldPosition towards the viewer:
 ///   diffuse chart:  Le + albedo(uv)·E/π with E bilinearly interpolated over the 2×2 nearest
 ///                   tixels and the albedo texture applied at full resolution at `uv`;
-///   glossy chart:   the 16-neighbour interpolation of the stored exitant radiance;
+///   glossy chart:   the 16-neighbour interpolation of the stored exitant radiance (this
+///                   overload has no triangle: on a curved glossy chart it reads the maps in
+///                   the frame around the chart normal, an approximation — ray hits go through
+///                   the SurfaceHit overload, which uses the hit's interpolated normal);
 ///   specular chart: 0 — the caller follows the mirrored ray (reordering) and looks up what it
 ///                   sees.
 /// `chart` may be any record; a viewer behind a front record is turned to its back record
@@ -222,14 +241,17 @@ Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& wor
 /// exitantRadiance given the chart's precomputed shading and the values read through `load`
 /// (RgbValues over LightField::values, or PaddedValues): the one implementation every caller
 /// goes through, as four lanes (r, g, b, 0). Defined inline so that the fast renderer's
-/// per-pixel loop inlines it instead of calling across files.
+/// per-pixel loop inlines it instead of calling across files. lookupNormal: the unit normal
+/// the glossy map is read around at worldPosition (lookupInputs), read only on curved glossy
+/// charts.
 template <typename Load>
 inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
-                               const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
+                               const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer,
+                               const Vec3& lookupNormal, Vec2 uv) {
   if (c.kind == ChartKind::Specular) return f4Zero();
   const Vec2 grid = tixelGridCoordinates(c, worldPosition, shading.inverseTixelSize);
   // cos θ towards the viewer (chartLocalDirection's z; a diffuse lookup needs no more of it).
-  // A curved chart (diffuse, never emissive: parameterisation.h) has no single normal: the
+  // A curved chart (diffuse or glossy, never emissive: parameterisation.h) has no single normal: the
   // caller's facingChart chose its side by the hit triangle's normal, and it reflects
   // (cos θ taken as 1, see kCurvedChartCosine).
   const float cosTheta = c.curved ? kCurvedChartCosine : glm::dot(worldDirectionTowardsViewer, c.normal);
@@ -246,14 +268,21 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
     const F4 reflected = f4Mul(albedoOverPi, irradiance);
     return shading.emissive && emits ? f4Add(f4Load(shading.emission.v), reflected) : reflected;
   }
-  // Glossy: the stored values already include the record's emission.
-  const Vec3 local = chartLocalDirection(c, worldDirectionTowardsViewer);
+  // Glossy: the stored values already include the record's emission. The direction in the
+  // map's frame (tixelFrameAround: the chart frame, chartLocalDirection's formula, on a planar
+  // chart; on a curved one the frame around the interpolated normal here, which varies
+  // continuously over the chart and is within a tixel of each interpolated tixel's gather
+  // frame). A direction below that normal (a silhouette of a smooth mesh, where the shading
+  // normal turns away from a viewer the triangle still faces) reads the horizon texels.
+  const Vec3 local = tixelFrameAround(c, lookupNormal).toLocal(worldDirectionTowardsViewer);
   return interpolateLanes(load, c, grid, directionToParaboloid(local));
 }
 template <typename Load>
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
-                           const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
-  return f4Rgb(exitantRadianceLanes(scene, c, shading, load, worldPosition, worldDirectionTowardsViewer, uv));
+                           const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, const Vec3& lookupNormal,
+                           Vec2 uv) {
+  return f4Rgb(
+      exitantRadianceLanes(scene, c, shading, load, worldPosition, worldDirectionTowardsViewer, lookupNormal, uv));
 }
 /// Four light-field lookups on one diffuse chart: the camera rays origin + t·direction
 /// (structure of arrays: x[k], y[k], z[k] for lookups k = 0…3), seen against their directions,
@@ -338,14 +367,15 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   for (int k = 0; k < 4; ++k) {
     const Vec3 d(r.dx[k], r.dy[k], r.dz[k]);
     result[k] = exitantRadianceLanes(scene, c, shading, PaddedValues{values}, Vec3(r.ox[k], r.oy[k], r.oz[k]) + r.t[k] * d, -d,
-                                     uv[k]);
+                                     c.normal, uv[k]);
   }
 #endif
 }
 
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
-                           const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, Vec2 uv) {
-  return exitantRadiance(scene, c, shading, RgbValues{values}, worldPosition, worldDirectionTowardsViewer, uv);
+                           const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, const Vec3& lookupNormal,
+                           Vec2 uv) {
+  return exitantRadiance(scene, c, shading, RgbValues{values}, worldPosition, worldDirectionTowardsViewer, lookupNormal, uv);
 }
 
 }  // namespace pl

@@ -472,7 +472,9 @@ constexpr uint64_t kChartRecordBytes = 4 + 1 + 4 * 12 + 4 + 3 * 4 + 2 * 8;
 // The kind byte: ChartKind in bits 0–4, and the sides (lightfield.h "Sides"): bit 7 = two-sided
 // (on both records), bit 6 = the back record. Files written before two-sided charts have both
 // bits clear, so they read as one-sided charts, which is what they hold. Bit 5 marks a curved
-// chart (lightfield.h: diffuse only); files written before curved charts have it clear.
+// chart (lightfield.h: diffuse, or glossy but not rough glass); files written before curved
+// charts have it clear, and files written before curved glossy charts have it on diffuse
+// charts only, so both read unchanged.
 constexpr uint8_t kChartTwoSidedBit = 0x80, kChartBackBit = 0x40, kChartCurvedBit = 0x20, kChartKindMask = 0x1f;
 
 std::vector<unsigned char> encodeCharts(const std::vector<Chart>& charts) {
@@ -496,8 +498,11 @@ std::vector<unsigned char> encodeCharts(const std::vector<Chart>& charts) {
   return std::move(w.bytes());
 }
 
-/// Decodes CHRT; checks each chart's own fields and its material index.
-std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std::string& path, size_t materials) {
+/// Decodes CHRT; checks each chart's own fields and its material index (and, for a curved
+/// chart, that its material may be curved: not rough glass).
+std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std::string& path,
+                                const std::vector<Material>& sceneMaterials) {
+  const size_t materials = sceneMaterials.size();
   ByteReader r(bytes, path, kSectionNames[kCharts]);
   std::vector<Chart> charts(r.getCount(kChartRecordBytes, "charts"));
   for (size_t i = 0; i < charts.size(); ++i) {
@@ -510,7 +515,7 @@ std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std:
     c.sides = (kindByte & kChartTwoSidedBit) ? 2 : 1;
     c.isBack = (kindByte & kChartBackBit) != 0;
     c.curved = (kindByte & kChartCurvedBit) != 0;
-    if (c.curved && c.kind != ChartKind::Diffuse) r.corrupt(fmt::format("chart {} of kind {} is marked curved", i, kind));
+    if (c.curved && c.kind == ChartKind::Specular) r.corrupt(fmt::format("chart {} of kind {} is marked curved", i, kind));
     c.origin = r.get<Vec3>();
     c.axisU = r.get<Vec3>();
     c.axisV = r.get<Vec3>();
@@ -522,6 +527,8 @@ std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std:
     c.firstTixel = r.get<uint64_t>();
     c.firstValue = r.get<uint64_t>();
     if (c.material >= materials) r.corrupt(fmt::format("chart {} has material {} of {}", i, c.material, materials));
+    if (c.curved && isRoughGlassChart(c, sceneMaterials[c.material].bsdf))
+      r.corrupt(fmt::format("rough-glass chart {} is marked curved", i));
     if (!isFinite(c.origin) || !isFinite(c.axisU) || !isFinite(c.axisV) || !isFinite(c.normal) ||
         !(c.tixelSize > 0.0f) || !std::isfinite(c.tixelSize))
       r.corrupt(fmt::format("chart {} has a non-finite frame or tixel size", i));
@@ -964,7 +971,7 @@ LightField readLightField(const std::string& path) {
   const PlfReader reader(path);
   LightField lf;
   lf.scene = decodeScene(reader.read(kScene), path, reader.version());
-  lf.charts = decodeCharts(reader.read(kCharts), path, lf.scene.materials.size());
+  lf.charts = decodeCharts(reader.read(kCharts), path, lf.scene.materials);
   lf.triangleChart = decodeTriangleCharts(reader.read(kTriangleCharts), path, lf.scene, lf.charts);
   const SectionEntry& values = reader.entry(kValues);
   const uint64_t valueBytes = values.decodedSize;
@@ -1013,7 +1020,7 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
     info.environmentMapRotationDegrees = map->rotationDegrees();
   }
 
-  const std::vector<Chart> charts = decodeCharts(reader.read(kCharts), path, scene.materials.size());
+  const std::vector<Chart> charts = decodeCharts(reader.read(kCharts), path, scene.materials);
   info.charts = charts.size();
   for (const Chart& c : charts) {
     info.diffuseCharts += c.kind == ChartKind::Diffuse;

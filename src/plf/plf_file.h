@@ -99,7 +99,7 @@ struct PlfInfo {
   // Charts (decoded from CHRT).
   uint64_t charts = 0, diffuseCharts = 0, glossyCharts = 0, specularCharts = 0;  ///< chart records
   uint64_t twoSidedCharts = 0;  ///< back records (each two-sided chart has one; lightfield.h "Sides")
-  uint64_t curvedCharts = 0;    ///< curved chart records (lightfield.h; diffuse, counted in diffuseCharts)
+  uint64_t curvedCharts = 0;    ///< curved chart records (lightfield.h; diffuse or glossy, counted there too)
   uint64_t tixels = 0, values = 0;
   // Bake settings and statistics (from META).
   BakeSettings settings;

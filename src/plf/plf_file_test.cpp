@@ -748,6 +748,43 @@ TEST_F(PlfFileTest, TwoSidedChartsRoundTripAndBrokenPairsAreRefused) {
 
 // Alpha masks and normal maps travel in SCNE's optional surface-detail block: every field and
 // every texture's decoding come back; a value out of range in it is refused.
+// Curved charts (CHRT kind byte bit 5): kept on diffuse and glossy charts; a curved specular
+// chart or a curved rough-glass chart is corrupt (rough glass stays planar).
+TEST_F(PlfFileTest, CurvedGlossyChartsRoundTripAndCurvedSpecularOrRoughGlassAreRefused) {
+  LightField original = makeTestLightField();
+  ASSERT_EQ(original.charts[0].kind, ChartKind::Diffuse);
+  ASSERT_EQ(original.charts[1].kind, ChartKind::Specular);
+  ASSERT_EQ(original.charts[2].kind, ChartKind::Glossy);
+  original.charts[0].curved = true;
+  original.charts[2].curved = true;
+  const std::string path = file("curved.plf");
+  writeLightField(path, original);
+  const LightField copy = readLightField(path);
+  ASSERT_EQ(copy.charts.size(), original.charts.size());
+  for (size_t i = 0; i < copy.charts.size(); ++i) EXPECT_EQ(copy.charts[i].curved, original.charts[i].curved) << i;
+  EXPECT_EQ(copy.values, original.values);
+  EXPECT_EQ(readLightFieldInfo(path).curvedCharts, 2u);
+
+  const auto good = readBytes(path);
+  const auto table = sections(good);
+  const uint64_t chartRecord = 4 + 1 + 48 + 4 + 12 + 16;
+  const uint64_t recordsAt = table[1].offset + 8;  // record 0's material, then its kind byte
+  // The mirror chart marked curved.
+  auto bad = good;
+  bad[recordsAt + chartRecord + 4] |= 0x20;
+  resign(bad);
+  writeBytes(file("curvedmirror.plf"), bad);
+  expectRefused(file("curvedmirror.plf"), {"corrupt charts section", "chart 1 of kind 2 is marked curved"});
+  // The curved glossy chart given the rough-glass material (4: GGX α 0.04, not thin).
+  ASSERT_TRUE(hasTransmission(original.scene.materials[4].bsdf));
+  bad = good;
+  const uint32_t roughGlass = 4;
+  std::memcpy(bad.data() + recordsAt + 2 * chartRecord, &roughGlass, 4);
+  resign(bad);
+  writeBytes(file("curvedglass.plf"), bad);
+  expectRefused(file("curvedglass.plf"), {"corrupt charts section", "rough-glass chart 2 is marked curved"});
+}
+
 TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {
   LightField original = makeTestLightField();
   Scene& s = original.scene;

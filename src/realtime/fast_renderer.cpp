@@ -256,10 +256,10 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv;
-        Vec3 lookup;
-        lookupInputs(scene, c, shading[chart], hit, -ray.direction, uv, lookup);
-        const F4 lanes =
-            exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup, uv);
+        Vec3 lookup, lookupNormal;
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, uv, lookup, lookupNormal);
+        const F4 lanes = exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup,
+                                              lookupNormal, uv);
         if (spp == 1) {
           // The pixel, straight from the lanes (weight > 0 here): pixelValue's weight × radiance.
           f4StoreRgb(out + s.pixel[i], f4Mul(f4Splat(s.weight[i]), lanes));
@@ -306,10 +306,10 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv;
-        Vec3 lookup;
-        lookupInputs(scene, c, shading[chart], hit, -ray.direction, uv, lookup);
-        s.radiance[slot] +=
-            throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup, uv);
+        Vec3 lookup, lookupNormal;
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, uv, lookup, lookupNormal);
+        s.radiance[slot] += throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction,
+                                                         lookup, lookupNormal, uv);
         continue;
       }
       Rgb emitted;

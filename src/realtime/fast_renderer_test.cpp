@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -19,6 +22,7 @@
 #include "core/rng.h"
 #include "bake/parameterisation.h"
 #include "render/render.h"
+#include "support/glossy_spheres.h"
 
 namespace pl {
 namespace {
@@ -101,6 +105,24 @@ TEST_F(FastRendererTest, MatchesReferenceOnGlossyCornellBox) {
   inside.target = lo + Vec3(0.05f, 0.1f, 0.1f) * (hi - lo);
   inside.fovYDegrees = 70.0f;
   expectSameAsReference(lf, inside, 80, 60, RenderSettings{});
+}
+
+// Curved glossy charts (two glossy spheres): both renderers read the maps in the frame around
+// the hit's interpolated normal (lookupInputs / exitantRadiance's SurfaceHit overload).
+TEST_F(FastRendererTest, MatchesReferenceOnCurvedGlossyCharts) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("plenoptic_fast_curved_glossy_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const LightField lf = randomLightField(test_support::loadGlossySpheres(dir), 8);
+  std::filesystem::remove_all(dir);
+  ASSERT_GT(std::count_if(lf.charts.begin(), lf.charts.end(),
+                          [](const Chart& c) { return c.kind == ChartKind::Glossy && c.curved; }),
+            0);
+  CameraDesc desc;  // the spheres, close up (render/curved_glossy_test.cpp's view)
+  desc.eye = {0.0f, 0.9f, 2.2f};
+  desc.target = {0.0f, 0.35f, 0.0f};
+  desc.fovYDegrees = 40.0f;
+  expectSameAsReference(lf, desc, 96, 72, RenderSettings{});
 }
 
 TEST_F(FastRendererTest, MatchesReferenceThroughMirrors) {

@@ -15,7 +15,8 @@
 //      exitantRadianceLanes() of lightfield/lookup.h with the chart's ChartShading precomputed
 //      once (the one 16-neighbour formula the reference also runs, in four SSE lanes;
 //      textured diffuse charts interpolate the hit's uv alone, uvAt, and only normal-mapped
-//      glossy charts build the SurfaceHit). With one sample per pixel, four consecutive
+//      glossy charts build the SurfaceHit; curved glossy charts interpolate the hit's vertex
+//      normal alone, chartShadingNormalAt, to read their maps around it). With one sample per pixel, four consecutive
 //      samples on one diffuse chart go through exitantRadianceDiffuse4 together
 //      (bit-identical), and a pixel is written from the lanes as soon as it is shaded;
 //   3. mirrors as a wavefront of reflection rays: all samples of the tile that hit an

@@ -399,6 +399,7 @@ SurfaceHit surfaceAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, 
   SurfaceHit hit;
   hit.mesh = meshIndex;
   hit.triangle = triangle;
+  hit.barycentrics = barycentrics;
   hit.material = mesh.materials[triangle];
   hit.position = b0 * p0 + b1 * p1 + b2 * p2;
   // Counter-clockwise winding (p0, p1, p2) seen from the front ⇒ (p1−p0)×(p2−p0) points out

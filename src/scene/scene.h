@@ -236,6 +236,7 @@ struct SurfaceHit {
   Vec3 geometricNormal{0.0f, 0.0f, 1.0f};  ///< unit, from the triangle winding
   Vec3 shadingNormal{0.0f, 0.0f, 1.0f};    ///< unit, interpolated (or geometric), same side
   Vec2 uv{0.0f};
+  Vec2 barycentrics{0.0f};                 ///< (b1, b2) on the triangle, as surfaceAt was given them
   uint32_t mesh = 0, triangle = 0, material = 0;
 };
 
