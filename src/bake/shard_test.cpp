@@ -297,6 +297,10 @@ TEST(Shards, RanksFillTheOneProcessParameterisationBitForBit) {
   const std::vector<uint32_t> split = tixelSetupSplit(part, 2);
   fillTixels(scene, accel, part, split[0], split[1]);
   EXPECT_GT(differingEntries(part.gatherPoint, one.gatherPoint), 0u);
+  // Records outside the parameterisation are refused, not written past the arrays.
+  const uint32_t records = uint32_t(part.charts.size());
+  EXPECT_THROW(fillTixels(scene, accel, part, 0, records + 1), Error);
+  EXPECT_THROW(fillTixels(scene, accel, part, 2, 1), Error);
 }
 
 TEST(Shards, ShardFileNames) {
