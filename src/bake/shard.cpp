@@ -132,7 +132,8 @@ std::vector<uint32_t> tixelSetupSplit(const Parameterisation& param, int ranks) 
   return split;
 }
 
-TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, Parameterisation& param, Communicator& comm) {
+TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, Parameterisation& param, Communicator& comm,
+                                       uint64_t windowBytes) {
   TixelSetupTiming timing;
   const int rank = comm.rank(), ranks = comm.size();
   const std::vector<uint32_t> split = tixelSetupSplit(param, ranks);
@@ -143,15 +144,22 @@ TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, P
   if (ranks == 1) return timing;
   // Rank r's records hold tixels [first tixel of split[r], first tixel of split[r + 1]).
   auto firstTixelOf = [&](uint32_t record) { return record < param.charts.size() ? param.charts[record].firstTixel : param.tixelCount; };
+  // In windows of at most windowBytes of the array, so that no collective addresses more than
+  // an MPI int can (the communicator refuses layouts spanning over 2 GB).
   auto exchange = [&](auto& array) {
     using Element = typename std::decay_t<decltype(array)>::value_type;
+    const uint64_t window = std::max<uint64_t>(1, windowBytes / sizeof(Element));
     std::vector<uint64_t> displacement(static_cast<size_t>(ranks)), count(static_cast<size_t>(ranks));
-    for (int r = 0; r < ranks; ++r) {
-      const uint64_t t0 = firstTixelOf(split[size_t(r)]), t1 = firstTixelOf(split[size_t(r) + 1]);
-      displacement[size_t(r)] = t0 * sizeof(Element);
-      count[size_t(r)] = (t1 - t0) * sizeof(Element);
+    for (uint64_t w0 = 0; w0 < param.tixelCount; w0 += window) {
+      const uint64_t w1 = std::min(param.tixelCount, w0 + window);
+      for (int r = 0; r < ranks; ++r) {
+        const uint64_t t0 = std::clamp(firstTixelOf(split[size_t(r)]), w0, w1);
+        const uint64_t t1 = std::clamp(firstTixelOf(split[size_t(r) + 1]), w0, w1);
+        displacement[size_t(r)] = t0 * sizeof(Element);
+        count[size_t(r)] = (t1 - t0) * sizeof(Element);
+      }
+      comm.allgatherv(array.data(), displacement, count);
     }
-    comm.allgatherv(array.data(), displacement, count);
   };
   exchange(param.gatherPoint);
   exchange(param.gatherNormal);

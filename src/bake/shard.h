@@ -66,11 +66,13 @@ struct TixelSetupTiming {
 };
 
 /// fillTixels over the ranks of `comm`: this rank fills its records of tixelSetupSplit, then
-/// each per-tixel array is exchanged (one in-place allgatherv per array: the records of a rank
-/// are one contiguous run of tixels), so every rank holds the whole parameterisation — the
-/// one-process buildParameterisation's bit for bit, since a record's tixels depend only on the
-/// record. One rank: fillTixels of every record, no exchange. `param` comes from buildCharts.
-TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, Parameterisation& param, Communicator& comm);
+/// each per-tixel array is exchanged (in-place allgathervs, one per windowBytes of the array:
+/// the records of a rank are one contiguous run of tixels), so every rank holds the whole
+/// parameterisation — the one-process buildParameterisation's bit for bit, since a record's
+/// tixels depend only on the record. One rank: fillTixels of every record, no exchange.
+/// `param` comes from buildCharts.
+TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, Parameterisation& param, Communicator& comm,
+                                       uint64_t windowBytes = uint64_t(1) << 30);
 
 /// Rank r's .plv: `path` itself for one rank, else STEM.rankR-of-N.plv beside it.
 std::string shardVisibilityPath(const std::string& path, int rank, int ranks);

@@ -272,13 +272,16 @@ TEST(Shards, RanksFillTheOneProcessParameterisationBitForBit) {
   const Accel accel(scene);
   const Parameterisation one = buildParameterisation(scene, accel, settings);
   ASSERT_TRUE(std::any_of(one.charts.begin(), one.charts.end(), [](const Chart& c) { return c.curved; }));
-  for (int ranks : {2, 3}) {
+  // 2 and 3 ranks; with 3, also in windows of 1000 bytes (as a field over 1 GiB per array is
+  // exchanged), whose boundaries fall inside ranks' runs.
+  for (const auto& [ranks, windowBytes] : {std::pair{2, uint64_t(1) << 30}, std::pair{3, uint64_t(1) << 30},
+                                          std::pair{3, uint64_t(1000)}}) {
     std::vector<Parameterisation> results(static_cast<size_t>(ranks));
     std::vector<TixelSetupTiming> timings(static_cast<size_t>(ranks));
     ThreadRanks world(ranks);
     world.run([&](Communicator& comm) {
       Parameterisation p = buildCharts(scene, accel, settings);
-      timings[size_t(comm.rank())] = fillTixelsDistributed(scene, accel, p, comm);
+      timings[size_t(comm.rank())] = fillTixelsDistributed(scene, accel, p, comm, windowBytes);
       results[size_t(comm.rank())] = std::move(p);
     });
     for (int r = 0; r < ranks; ++r) {
