@@ -216,6 +216,36 @@ TEST_F(FastRendererTest, MatchesReferenceWithAlbedoTextures) {
   expectSameAsReference(lf, desc, 96, 72, RenderSettings{});
 }
 
+TEST_F(FastRendererTest, MatchesReferenceWithMinifiedAlbedoTexturesThroughMirrors) {
+  // A 256 × 192 texture (float values, so its mip levels and level 0 are float rows) on every
+  // Lambertian material of the mirror box, whose triangles (uv = barycentrics) each span the
+  // whole texture: minified several levels at 64 × 48, at the primary hits and behind the
+  // mirror (the cone grows with the chain's length). Texture LOD on at 1 and 4 samples per
+  // pixel (the cone 1/√spp of a pixel), and off.
+  Scene scene = loadScene(kMcGuire + "CornellBox-Mirror.obj");
+  Texture texture;
+  texture.path = "random-float";
+  texture.image = Image(256, 192);
+  Pcg32 rng(9, 2);
+  for (Rgb& texel : texture.image.pixels) texel = Rgb(rng.uniform(), rng.uniform(), rng.uniform());
+  scene.textures.push_back(texture);
+  for (Material& m : scene.materials)
+    if (std::holds_alternative<LambertBsdf>(m.bsdf)) m.albedoTexture = 0;
+  const LightField lf = randomLightField(std::move(scene), 10);
+  ASSERT_EQ(lf.scene.textures[0].mips.size(), 8u);  // 128×96 … 2×1, 1×1
+  const CameraDesc desc = lf.scene.cameras.empty() ? lf.scene.automaticCamera() : lf.scene.cameras.front();
+  RenderSettings four, off;
+  four.samplesPerPixel = 4;
+  off.textureLod = false;
+  for (const RenderSettings& settings : {RenderSettings{}, four, off}) expectSameAsReference(lf, desc, 64, 48, settings);
+  // The levels matter: the image with LOD is not the one without.
+  const Accel accel(lf.scene);
+  const Camera camera(desc, 64, 48);
+  const FastRenderer fast(lf, accel, 0);
+  const Image with = fast.render(camera, RenderSettings{}), without = fast.render(camera, off);
+  EXPECT_GT(compare(with, without).pixelsOverTolerance, 64 * 48 / 4);
+}
+
 TEST_F(FastRendererTest, PrimaryRaysAloneFindTheRenderersHits) {
   // castPrimaryRays (what `render --stats` times as primary rays alone): per pixel the hit
   // distance of the ray through its centre, as one ray at a time finds it; ∞ for a miss.
