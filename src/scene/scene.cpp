@@ -149,12 +149,29 @@ bool bilinearFootprint(const Image& image, Vec2 uv, BilinearFootprint& f) {
 
 namespace {
 
-/// Bilinear, repeat, in one level (its float image, and its packed texels when present); false
-/// for a non-finite uv.
+/// bilinearFootprint for a uv already reduced to [0, 1)² (Texture::sampleLod): the texel
+/// coordinate x = u·W − ½ lies in [−½, W − ½), so ⌊x⌋ ∈ [−1, W − 1] is the truncation of x + 1
+/// minus 1, and the wrap is one comparison per index — no floor, no division. Always true
+/// (a NaN uv was sent to sample() before).
+bool reducedFootprint(const Image& image, Vec2 uv, BilinearFootprint& f) {
+  auto axis = [](float x, int n, int& i0, int& i1, float& fraction) {
+    const int below = int(x + 1.0f) - 1;  // ⌊x⌋ for x ≥ −1
+    fraction = x - float(below);
+    i0 = below < 0 ? n - 1 : below;
+    i1 = below + 1 >= n ? 0 : below + 1;
+  };
+  axis(uv.x * float(image.width) - 0.5f, image.width, f.x0, f.x1, f.fx);
+  axis((1.0f - uv.y) * float(image.height) - 0.5f, image.height, f.y0, f.y1, f.fy);
+  return true;
+}
+
+/// Bilinear, repeat, in one level (its float image, and its packed texels when present), the
+/// footprint from `footprint` (bilinearFootprint or reducedFootprint); false for a non-finite uv.
+template <typename Footprint>
 bool sampleLevel(const Image& image, const std::vector<Texture::PackedBlock>& packed, const std::vector<float>& palette,
-                 Vec2 uv, Rgb& result) {
+                 Vec2 uv, Footprint&& footprint, Rgb& result) {
   BilinearFootprint f;
-  if (!bilinearFootprint(image, uv, f)) return false;
+  if (!footprint(image, uv, f)) return false;
   auto bilinear = [&](auto&& texel) {
     const Rgb top = (1.0f - f.fx) * texel(f.x0, f.y0) + f.fx * texel(f.x1, f.y0);
     const Rgb bottom = (1.0f - f.fx) * texel(f.x0, f.y1) + f.fx * texel(f.x1, f.y1);
@@ -173,9 +190,10 @@ bool sampleLevel(const Image& image, const std::vector<Texture::PackedBlock>& pa
   return true;
 }
 
-void prefetchLevel(const Image& image, const std::vector<Texture::PackedBlock>& packed, Vec2 uv) {
+template <typename Footprint>
+void prefetchLevel(const Image& image, const std::vector<Texture::PackedBlock>& packed, Vec2 uv, Footprint&& footprint) {
   BilinearFootprint f;
-  if (!bilinearFootprint(image, uv, f)) return;
+  if (!footprint(image, uv, f)) return;
   if (packed.empty()) {
     __builtin_prefetch(&image.at(f.x0, f.y0));
     __builtin_prefetch(&image.at(f.x1, f.y1));
@@ -230,21 +248,29 @@ Image downsampleBox(const Image& image) {
 Rgb Texture::sample(Vec2 uv) const {
   if (image.empty()) return Rgb(1.0f);
   Rgb result;
-  return sampleLevel(image, packed, palette, uv, result) ? result : average;
+  return sampleLevel(image, packed, palette, uv, bilinearFootprint, result) ? result : average;
 }
 
 Rgb Texture::sampleLod(Vec2 uv, float lod) const {
   if (!(lod > 0.0f) || mips.empty()) return sample(uv);  // also NaN
+  // uv reduced to [0, 1) once for both levels (repeat), so that each level's footprint is
+  // reducedFootprint's few integer operations (per pixel the renderers take four footprints:
+  // two levels, sampled and prefetched). Not bit-identical to sample() at level 0 (the
+  // rounding of u·W differs), which is why lod ≤ 0 goes through sample().
+  uv -= glm::floor(uv);
+  if (!(uv.x < 1.0f)) uv.x = 0.0f;  // u − ⌊u⌋ rounds up to 1 for tiny negative u
+  if (!(uv.y < 1.0f)) uv.y = 0.0f;
   const size_t coarsest = mips.size();                   // level index of mips.back()
   const float clamped = std::min(lod, float(coarsest));
   const size_t fine = size_t(clamped);  // ⌊lod⌋ ≥ 0
   const float f = clamped - float(fine);
   auto level = [&](size_t l, Rgb& out) {
-    return l == 0 ? sampleLevel(image, packed, palette, uv, out)
-                  : sampleLevel(mips[l - 1].image, mips[l - 1].packed, mips[l - 1].palette, uv, out);
+    return l == 0 ? sampleLevel(image, packed, palette, uv, reducedFootprint, out)
+                  : sampleLevel(mips[l - 1].image, mips[l - 1].packed, mips[l - 1].palette, uv, reducedFootprint, out);
   };
   Rgb a, b;
-  if (!level(fine, a)) return average;
+  if (!(uv.x >= 0.0f && uv.y >= 0.0f)) return average;  // a non-finite uv
+  level(fine, a);
   if (f == 0.0f) return a;
   level(fine + 1, b);  // fine < coarsest here (f > 0 needs clamped < coarsest)
   return (1.0f - f) * a + f * b;
@@ -252,14 +278,16 @@ Rgb Texture::sampleLod(Vec2 uv, float lod) const {
 
 void Texture::prefetch(Vec2 uv, float lod) const {
   if (image.empty()) return;
-  if (!(lod > 0.0f) || mips.empty()) return prefetchLevel(image, packed, uv);
+  if (!(lod > 0.0f) || mips.empty()) return prefetchLevel(image, packed, uv, bilinearFootprint);
+  uv -= glm::floor(uv);  // as sampleLod
+  if (!(uv.x >= 0.0f && uv.x < 1.0f && uv.y >= 0.0f && uv.y < 1.0f)) return;
+  // The finer level of the pair only: the coarser one has a quarter of its texels and is
+  // more often cached, and its footprint would cost as much again.
   const size_t fine = size_t(std::min(lod, float(mips.size())));
   if (fine == 0)
-    prefetchLevel(image, packed, uv);
+    prefetchLevel(image, packed, uv, reducedFootprint);
   else
-    prefetchLevel(mips[fine - 1].image, mips[fine - 1].packed, uv);
-  // The coarser level of the pair: a quarter of the size, more often cached; fetched too.
-  if (fine < mips.size()) prefetchLevel(mips[fine].image, mips[fine].packed, uv);
+    prefetchLevel(mips[fine - 1].image, mips[fine - 1].packed, uv, reducedFootprint);
 }
 
 void Texture::finish(const std::string& sceneSource) {
