@@ -347,7 +347,10 @@ std::optional<Scattered> scatter(const ScatteringFrame& f, const Bsdf& bsdf, Vec
 /// material of a scene with it.
 void validateMaterial(const Material& material, const std::string& sourcePath);
 
-/// The material's BSDF with its albedo texture applied at uv.
+/// The material's BSDF with its albedo texture applied at uv, at full resolution
+/// (Texture::sample): the path tracer integrates a pixel's footprint with its samples, and the
+/// bake averages over each tixel's footprint itself. Only the light-field renderers read mip
+/// levels (lookup.h albedoTextureLod).
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit);
 
 }  // namespace pl
