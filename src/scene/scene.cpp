@@ -243,18 +243,6 @@ Image downsampleBox(const Image& image) {
   return next;
 }
 
-/// The levels sampleLod reads for lod > 0 over `coarsest` + 1 levels: level `fine` = ⌊lod⌋
-/// (lod clamped to the coarsest) and fine + 1, weighted 1 − blend and blend, with the
-/// fraction φ = lod − ⌊lod⌋ narrowed to blend = clamp(2·(φ − ¼), 0, 1): the first quarter of
-/// each octave reads level ⌊lod⌋ alone, the last quarter level ⌊lod⌋ + 1 alone, the middle half
-/// blends linearly ("brilinear" filtering: half the lookups read one level instead of two,
-/// README *Texture level of detail*). blend = 1 only where fine + 1 ≤ coarsest.
-void levelBlend(float lod, size_t coarsest, size_t& fine, float& blend) {
-  const float clamped = std::min(lod, float(coarsest));
-  fine = size_t(clamped);  // ⌊lod⌋ ≥ 0
-  blend = std::clamp(2.0f * (clamped - float(fine) - 0.25f), 0.0f, 1.0f);
-}
-
 }  // namespace
 
 Rgb Texture::sample(Vec2 uv) const {
@@ -272,19 +260,19 @@ Rgb Texture::sampleLod(Vec2 uv, float lod) const {
   uv -= glm::floor(uv);
   if (!(uv.x < 1.0f)) uv.x = 0.0f;  // u − ⌊u⌋ rounds up to 1 for tiny negative u
   if (!(uv.y < 1.0f)) uv.y = 0.0f;
-  size_t fine;
-  float f;
-  levelBlend(lod, mips.size(), fine, f);  // mips.size(): the coarsest level's index
+  const size_t coarsest = mips.size();                   // level index of mips.back()
+  const float clamped = std::min(lod, float(coarsest));
+  const size_t fine = size_t(clamped);  // ⌊lod⌋ ≥ 0
+  const float f = clamped - float(fine);
   auto level = [&](size_t l, Rgb& out) {
     return l == 0 ? sampleLevel(image, packed, palette, uv, reducedFootprint, out)
                   : sampleLevel(mips[l - 1].image, mips[l - 1].packed, mips[l - 1].palette, uv, reducedFootprint, out);
   };
   Rgb a, b;
   if (!(uv.x >= 0.0f && uv.y >= 0.0f)) return average;  // a non-finite uv
-  if (f == 1.0f) return level(fine + 1, b), b;
   level(fine, a);
   if (f == 0.0f) return a;
-  level(fine + 1, b);  // fine < coarsest here (f > 0 needs lod < coarsest)
+  level(fine + 1, b);  // fine < coarsest here (f > 0 needs clamped < coarsest)
   return (1.0f - f) * a + f * b;
 }
 
@@ -293,16 +281,13 @@ void Texture::prefetch(Vec2 uv, float lod) const {
   if (!(lod > 0.0f) || mips.empty()) return prefetchLevel(image, packed, uv, bilinearFootprint);
   uv -= glm::floor(uv);  // as sampleLod
   if (!(uv.x >= 0.0f && uv.x < 1.0f && uv.y >= 0.0f && uv.y < 1.0f)) return;
-  // One level: the finer of a blended pair (the coarser has a quarter of its texels and is
-  // more often cached, and its footprint would cost as much again), or the one read alone.
-  size_t fine;
-  float f;
-  levelBlend(lod, mips.size(), fine, f);
-  const size_t l = f == 1.0f ? fine + 1 : fine;
-  if (l == 0)
+  // The finer level of the pair only: the coarser one has a quarter of its texels and is
+  // more often cached, and its footprint would cost as much again.
+  const size_t fine = size_t(std::min(lod, float(mips.size())));
+  if (fine == 0)
     prefetchLevel(image, packed, uv, reducedFootprint);
   else
-    prefetchLevel(mips[l - 1].image, mips[l - 1].packed, uv, reducedFootprint);
+    prefetchLevel(mips[fine - 1].image, mips[fine - 1].packed, uv, reducedFootprint);
 }
 
 void Texture::finish(const std::string& sceneSource) {

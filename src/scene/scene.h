@@ -41,13 +41,11 @@ struct Texture {
   /// into the albedo; the renderers count and report non-finite radiance where it arises. The
   /// path tracer, the bake and normal/alpha maps read textures here.
   Rgb sample(Vec2 uv) const;
-  /// Bilinear in mip levels ⌊lod⌋ and ⌊lod⌋ + 1 (`mips`), blended linearly over the middle
-  /// half of each octave and one level alone in its first and last quarters (trilinear with a
-  /// narrowed blend, "brilinear": scene.cpp levelBlend). lod ≤ 0 or NaN is exactly sample(uv)
-  /// (magnified or unfiltered: full resolution, the same bits); lod beyond the coarsest level
-  /// reads that level alone. Level l has the same uv convention as the image (texel centres at
-  /// (x + ½)/W_l), so levels line up. The light-field renderers' albedo (lookup.h
-  /// albedoTextureLod chooses lod).
+  /// Trilinear: bilinear in mip levels ⌊lod⌋ and ⌊lod⌋ + 1 (`levels`), blended by the
+  /// fraction of lod. lod ≤ 0 or NaN is exactly sample(uv) (magnified or unfiltered: full
+  /// resolution, the same bits); lod beyond the coarsest level reads that level alone. Level l
+  /// has the same uv convention as the image (texel centres at (x + ½)/W_l), so levels line up.
+  /// The light-field renderers' albedo (lookup.h albedoTextureLod chooses lod).
   Rgb sampleLod(Vec2 uv, float lod) const;
   /// Asks the processor to fetch the cache lines sampleLod(uv, lod) will read (the packed
   /// texels, or the float rows), without waiting for them. The fast renderer issues it for a
