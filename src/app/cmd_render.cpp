@@ -25,6 +25,7 @@ struct RenderOptions {
   int frames = 1;         ///< --frames N: render N times (timing); the last frame is written
   int samples = 0;        ///< --samples N: camera samples per pixel (0 = automatic, see render_settings.h)
   int mirrorDepth = -1;   ///< --mirror-depth N (-1 = the bake's)
+  bool textureLod = true;  ///< --texture-lod on|off
   bool reference = false;  ///< --reference: the straightforward renderer instead of the fast one
   std::string pathFile;    ///< --path PATH.json: render a walk-through, one output per frame
   ViewOptions view;
@@ -40,6 +41,7 @@ void runRender(const RenderOptions& options, const GlobalOptions& global) {
   jobOptions.frames = options.frames;
   jobOptions.render.samplesPerPixel = options.samples;
   jobOptions.render.mirrorDepth = options.mirrorDepth;
+  jobOptions.render.textureLod = options.textureLod;
   jobOptions.render.seed = global.seed;
   jobOptions.reference = options.reference;
   jobOptions.pathFile = options.pathFile;
@@ -76,6 +78,7 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
                       "Mirror reflections followed (-1 = the bake's own mirror depth)")
       ->check(CLI::Range(-1, RenderSettings::kMaxMirrorDepth))
       ->capture_default_str();
+  addTextureLodOption(*command, options->textureLod);
   command->add_flag("--reference", options->reference,
                     "Use the straightforward reference renderer (src/render) instead of the fast one (the default)");
   command->add_option("--path", options->pathFile,

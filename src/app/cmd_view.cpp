@@ -27,6 +27,7 @@ struct ViewCommandOptions {
   float speed = 0.0f;          ///< --speed: scene units per second (0 = quarter of the scene diagonal)
   int samples = 0;             ///< --samples N (0 = automatic, as render)
   int mirrorDepth = -1;        ///< --mirror-depth N (-1 = the bake's)
+  bool textureLod = true;      ///< --texture-lod on|off
   ViewOptions view;
 };
 
@@ -47,6 +48,7 @@ void runView(const ViewCommandOptions& options, const GlobalOptions& global) {
   viewer.toneMap = view.toneMapSettings();
   viewer.render.samplesPerPixel = options.samples;
   viewer.render.mirrorDepth = options.mirrorDepth;
+  viewer.render.textureLod = options.textureLod;
   viewer.render.seed = global.seed;
   viewer.frames = options.frames;
   viewer.screenshotPath = options.screenshot;
@@ -82,6 +84,7 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0, RenderSettings::kMaxSamplesPerPixel));
   command->add_option("--mirror-depth", options->mirrorDepth, "Mirror reflections followed (-1 = the bake's)")
       ->check(CLI::Range(-1, RenderSettings::kMaxMirrorDepth));
+  addTextureLodOption(*command, options->textureLod);
   options->view.width = 1024;
   options->view.height = 768;
   options->view.addCameraOptions(*command);

@@ -85,6 +85,15 @@ void ViewOptions::addExposureOptions(CLI::App& command) {
   });
 }
 
+void addTextureLodOption(CLI::App& command, bool& textureLod) {
+  command
+      .add_option_function<std::string>(
+          "--texture-lod", [&textureLod](const std::string& s) { textureLod = s == "on"; },
+          "Albedo textures at the mip level of each sample's ray cone (on, the default) or at full resolution (off)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->default_str("on");
+}
+
 void ViewOptions::addToneMapOptions(CLI::App& command) {
   command.add_option("--tonemap", tonemap, "Tone mapping for PNG output: reinhard, linear or clamp")
       ->check(CLI::IsMember({"reinhard", "linear", "clamp"}))

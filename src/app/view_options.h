@@ -22,4 +22,7 @@ struct ViewOptions : ViewSettings {
   void addToneMapOptions(CLI::App& command);
 };
 
+/// --texture-lod on|off for the light-field renderers (render, view): RenderSettings::textureLod.
+void addTextureLodOption(CLI::App& command, bool& textureLod);
+
 }  // namespace pl

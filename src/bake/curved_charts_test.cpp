@@ -295,7 +295,7 @@ double worstArcError(const LightField& lf) {
     const SurfaceHit s = surfaceAt(lf.scene, hit.mesh, hit.triangle, hit.barycentrics);
     const Vec3 radial = glm::normalize(Vec3(s.position.x, 0.0f, s.position.z));
     const double expected = rho * kInvPi * std::max(0.0f, radial.x);
-    const Rgb L = exitantRadiance(lf, s, -d);
+    const Rgb L = exitantRadiance(lf, s, -d, 0.0f);  // no texture: no cone
     worst = std::max(worst, std::abs(double(L.r) - expected) / (rho * kInvPi));
   }
   return worst;

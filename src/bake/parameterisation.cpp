@@ -284,7 +284,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
   std::vector<uint8_t> isBuried(c.tixelCount(), 0);
   const Material& material = scene.materials[c.material];
   const bool textured = c.kind == ChartKind::Diffuse && material.albedoTexture >= 0;
-  const Rgb constantAlbedo = c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, Vec2(0.0f)) : Rgb(0.0f);
+  const Rgb constantAlbedo = c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, Vec2(0.0f), kFullResolution) : Rgb(0.0f);
   // The normal a point of the chart gathers around (chartShadingNormalAt, lightfield.h).
   auto normalAt = [&](const FootprintSample& s) {
     const ChartRaster::Tri2& t = r.tris[s.tri];
@@ -308,7 +308,9 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
           ++inside;
           if (textured) {
             const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
-            albedoSum += diffuseAlbedoAt(scene, c.material, hit.uv);
+            // Full resolution: this average over the tixel's footprint samples is the filter
+            // (the renderers' mip levels would filter twice).
+            albedoSum += diffuseAlbedoAt(scene, c.material, hit.uv, kFullResolution);
           }
         }
       p.coverage[g] = float(inside) / float(kFootprintSamples * kFootprintSamples);
@@ -377,7 +379,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
           p.transportAlbedo[g] = albedoSum / float(inside);
         } else {
           const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
-          p.transportAlbedo[g] = diffuseAlbedoAt(scene, c.material, hit.uv);
+          p.transportAlbedo[g] = diffuseAlbedoAt(scene, c.material, hit.uv, kFullResolution);
         }
       } else {
         p.transportAlbedo[g] = Rgb(0.0f);

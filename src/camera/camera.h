@@ -77,6 +77,10 @@ class Camera {
   float apertureRadius() const { return apertureRadius_; }  ///< scene units (0 = pinhole)
   float focusDistance() const { return focusDistance_; }    ///< scene units
   bool vignetting() const { return vignetting_; }
+  /// The height of one pixel on the image plane at unit distance from the eye, 2·tan(fovY/2)
+  /// / height: the width of a pixel's ray cone per unit distance (render_settings.h
+  /// textureConeSpread).
+  float pixelSpread() const { return 2.0f * tanHalfFovY_ / float(height_); }
 
  private:
   CameraDesc desc_;

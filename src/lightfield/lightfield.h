@@ -26,7 +26,9 @@
 //
 // What is stored per chart kind:
 //   Diffuse   1 value per tixel: irradiance E (W·m⁻²). Outgoing radiance is
-//             Le + albedo(uv)·E/π, with the albedo texture applied at full resolution.
+//             Le + albedo(uv)·E/π, with the albedo texture read by the renderers at the mip
+//             level of the view ray's cone (lookup.h albedoTextureLod; the bake's transport
+//             albedo is a full-resolution average over each tixel's footprint).
 //   Glossy    dirRes² values per tixel: exitant radiance Lo (W·sr⁻¹·m⁻², emission included).
 //             Rough glass (a DielectricBsdf with α ≥ kGgxMinAlpha, not thin) is a glossy
 //             chart too, always two-sided (see "Rough glass" below).

@@ -16,18 +16,18 @@ Rgb backgroundRadiance(const Environment& environment, const Vec3& direction) {
   return environment.radiance(direction);
 }
 
-Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv) {
+Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float lod) {
   // Lambert (every diffuse chart of an OBJ scene): bsdfAt's albedo, the model's albedo times
   // the texel, without building the BSDF (the renderers call this per textured pixel).
   const Material& m = scene.materials[material];
-  if (const auto* lambert = std::get_if<LambertBsdf>(&m.bsdf))
-    return m.albedoTexture < 0 ? lambert->albedo : lambert->albedo * scene.textures[size_t(m.albedoTexture)].sample(uv);
-  SurfaceHit hit;
-  hit.material = material;
-  hit.uv = uv;
-  // The directional albedo at normal incidence: a Lambertian model's albedo, and for any other
-  // model a chart was classified diffuse for its hemispherical reflectance.
-  return albedo(bsdfAt(scene, hit), Vec3(0.0f, 0.0f, 1.0f));
+  const auto* lambert = std::get_if<LambertBsdf>(&m.bsdf);
+  if (m.albedoTexture < 0) return lambert ? lambert->albedo : albedo(m.bsdf, Vec3(0.0f, 0.0f, 1.0f));
+  const Rgb texel = scene.textures[size_t(m.albedoTexture)].sampleLod(uv, lod);
+  if (lambert) return lambert->albedo * texel;
+  // bsdfAt's texturing (the model's diffuse albedo times the texel), then the directional
+  // albedo at normal incidence: for a model other than Lambert, a chart was classified
+  // diffuse for its hemispherical reflectance.
+  return albedo(withDiffuseAlbedo(m.bsdf, diffuseAlbedo(m.bsdf) * texel), Vec3(0.0f, 0.0f, 1.0f));
 }
 
 namespace {
@@ -89,7 +89,7 @@ ChartShading chartShading(const Scene& scene, const Chart& c) {
   shading.twoSidedEmission = material.twoSidedEmission;
   shading.texturedAlbedo = material.albedoTexture >= 0;
   if (c.kind == ChartKind::Diffuse && !shading.texturedAlbedo)
-    shading.albedoOverPi = lanes4(diffuseAlbedoAt(scene, c.material, Vec2(0.0f)) * kInvPi);
+    shading.albedoOverPi = lanes4(diffuseAlbedoAt(scene, c.material, Vec2(0.0f), kFullResolution) * kInvPi);
   shading.needsUv = c.kind == ChartKind::Diffuse && shading.texturedAlbedo;
   shading.normalMapped = c.kind == ChartKind::Glossy && material.normalTexture >= 0;
   shading.curvedGlossy = c.kind == ChartKind::Glossy && c.curved;
@@ -111,10 +111,11 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
   const Chart& c = lf.charts[chart];
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   return exitantRadiance(lf.scene, c, chartShading(lf.scene, c), lf.values.data(), worldPosition,
-                         worldDirectionTowardsViewer, c.normal, uv);
+                         worldDirectionTowardsViewer, c.normal, uv, kFullResolution);
 }
 
-Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer) {
+Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer,
+                    float coneWidth) {
   // The chart facing the viewer (a two-sided surface's back record when seen from behind), then
   // the lookup direction the normal map reflects to on it. The shading is made once per call.
   const uint32_t chart = facingChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], worldDirectionTowardsViewer,
@@ -126,7 +127,10 @@ Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& wor
   const Vec3 lookupDirection = shading.normalMapped
                                    ? normalMappedLookupDirection(lookupNormal, hit.shadingNormal, worldDirectionTowardsViewer)
                                    : worldDirectionTowardsViewer;
-  return exitantRadiance(lf.scene, c, shading, lf.values.data(), hit.position, lookupDirection, lookupNormal, hit.uv);
+  const float lod = shading.needsUv ? albedoLodAt(lf.scene, c.material, hit.mesh, hit.triangle, -worldDirectionTowardsViewer,
+                                                  coneWidth)
+                                    : kFullResolution;
+  return exitantRadiance(lf.scene, c, shading, lf.values.data(), hit.position, lookupDirection, lookupNormal, hit.uv, lod);
 }
 
 }  // namespace pl

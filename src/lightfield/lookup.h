@@ -15,6 +15,9 @@
 #include "lightfield/paraboloid.h"
 #include "scene/scene.h"
 
+#include <bit>
+#include <cmath>
+#include <limits>
 #include <cstdint>
 
 namespace pl {
@@ -113,9 +116,62 @@ inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 
   return f4Rgb(interpolateLanes(RgbValues{values}, c, grid, st));
 }
 
+/// log2(x) for x > 0 within 0.0078 (exact at powers of two): the exponent of x plus
+/// t + 0.347·t·(1 − t) for its mantissa 1 + t (the quadratic through log2's ends with the
+/// least maximum error). +∞ for +∞; −∞ for 0, negative numbers and NaN. Monotonic.
+inline float approximateLog2(float x) {
+  if (!(x > 0.0f)) return -std::numeric_limits<float>::infinity();
+  const uint32_t bits = std::bit_cast<uint32_t>(x);
+  const float t = std::bit_cast<float>((bits & 0x007fffffu) | 0x3f800000u) - 1.0f;  // mantissa − 1, in [0, 1)
+  return float(int(bits >> 23) - 127) + t + 0.347f * t * (1.0f - t);
+}
+
 /// Diffuse albedo of `material` at surface uv: the Lambertian albedo times its albedo texture
-/// (if any) sampled at full resolution, exactly as the path tracer's bsdfAt does.
-Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv);
+/// (if any) read at mip level `lod` (Texture::sampleLod; lod ≤ 0 is full resolution, exactly
+/// the texel the path tracer's bsdfAt reads). The renderers pass albedoTextureLod's level; the
+/// bake passes kFullResolution (its transport albedo is already an average over each gather
+/// point's footprint, parameterisation.cpp).
+Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float lod);
+inline constexpr float kFullResolution = 0.0f;
+
+/// The mip level a light-field renderer reads an albedo texture at, by ray cones
+/// (Akenine-Möller et al., "Texture Level of Detail Strategies for Real-Time Ray Tracing",
+/// Ray Tracing Gems, ch. 20): a ray arriving along unit `direction` at triangle `triangle` of
+/// `mesh` with a cone of width w = coneWidth (scene units; RenderSettings' textureConeSpread
+/// × the distance travelled from the camera, summed over the mirror/glass chain) covers a
+/// footprint w / |cos θ| long on the surface (θ between the ray and the triangle's normal).
+/// The triangle maps world area P_a = ½|c|, c = (p1 − p0) × (p2 − p0), to texel area
+/// T_a = W·H·½|(uv1 − uv0) × (uv2 − uv0)| (W × H texels; uv = the barycentrics without uvs),
+/// so a world length ℓ spans ℓ·√(T_a / P_a) texels (isotropic). The level is log2 of the
+/// texels across the footprint:
+///   λ = log2(w · √(T_a / P_a) / |cos θ|),  |cos θ| = |d·c| / |c|
+///     = ½ · log2(W·H·|uv cross| · w² · |c| / (d·c)²)          (one log2, no square root).
+/// w = 0 (texture LOD off) gives −∞, degenerate uvs −∞ (level 0), a grazing ray +∞ (the
+/// coarsest level); a NaN reads level 0 (Texture::sampleLod). The log2 is approximateLog2
+/// (within 0.008 of a level; libm's log2f was 3 % of a Sponza frame).
+inline float albedoTextureLod(const Mesh& mesh, uint32_t triangle, const Texture& texture, const Vec3& direction,
+                              float coneWidth) {
+  const UVec3 tri = mesh.triangles[triangle];
+  const Vec3 c = glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]], mesh.positions[tri[2]] - mesh.positions[tri[0]]);
+  float uvCross = 1.0f;  // uvAt's barycentric uvs: (0,0), (1,0), (0,1)
+  if (!mesh.uvs.empty()) {
+    const Vec2 a = mesh.uvs[tri[1]] - mesh.uvs[tri[0]], b = mesh.uvs[tri[2]] - mesh.uvs[tri[0]];
+    uvCross = std::abs(a.x * b.y - a.y * b.x);
+  }
+  const float cosArea = glm::dot(direction, c);  // |c| cos θ
+  const float texelsSquared = float(texture.image.width) * float(texture.image.height) * uvCross *
+                              (coneWidth * coneWidth) * (glm::length(c) / (cosArea * cosArea));
+  return 0.5f * approximateLog2(texelsSquared);
+}
+
+/// albedoTextureLod for a hit on a diffuse chart of `material`: the level its albedo texture
+/// is read at, or kFullResolution for a material without one.
+inline float albedoLodAt(const Scene& scene, uint32_t material, uint32_t mesh, uint32_t triangle, const Vec3& direction,
+                         float coneWidth) {
+  const int texture = scene.materials[material].albedoTexture;
+  if (texture < 0) return kFullResolution;
+  return albedoTextureLod(scene.meshes[mesh], triangle, scene.textures[size_t(texture)], direction, coneWidth);
+}
 
 /// One step of an ideal-specular chain at `hit` (a specular chart: a mirror or glass) of
 /// `ray`, the step every light-field stage takes — gather rays in the visibility field, view
@@ -193,18 +249,22 @@ inline Vec3 lookupNormalAt(const Scene& scene, const Chart& c, const ChartShadin
 }
 
 /// What exitantRadianceLanes needs of a ray's hit on chart c besides the position: the uv
-/// (for an albedo texture), the lookup direction (towards the viewer; bent by a normal map
-/// on glossy charts) and the normal the glossy map is read around (the chart normal; on a
-/// curved glossy chart the interpolated normal at the hit, chartShadingNormalAt). surfaceAt
-/// is evaluated only where the chart's shading needs it.
+/// and mip level (for an albedo texture: albedoLodAt with the ray's cone width `coneWidth`
+/// at the hit), the lookup direction (towards the viewer; bent by a normal map on glossy
+/// charts) and the normal the glossy map is read around (the chart normal; on a curved
+/// glossy chart the interpolated normal at the hit, chartShadingNormalAt). surfaceAt is
+/// evaluated only where the chart's shading needs it.
 inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading& shading, const RayHit& hit,
-                         const Vec3& towardsViewer, Vec2& uv, Vec3& lookup, Vec3& lookupNormal) {
+                         const Vec3& towardsViewer, float coneWidth, Vec2& uv, float& lod, Vec3& lookup,
+                         Vec3& lookupNormal) {
   uv = Vec2(0.0f);
+  lod = kFullResolution;
   lookup = towardsViewer;
   lookupNormal = lookupNormalAt(scene, c, shading, hit.mesh, hit.triangle, hit.barycentrics);
   if (!shading.needsUv && !shading.normalMapped) return;
   if (!shading.normalMapped) {  // surfaceAt's uv alone (no normals, no normal-map texel)
     uv = uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics);
+    lod = albedoLodAt(scene, c.material, hit.mesh, hit.triangle, -towardsViewer, coneWidth);
     return;
   }
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
@@ -221,7 +281,8 @@ inline constexpr float kCurvedChartCosine = 1.0f;
 
 /// Exitant radiance (W·sr⁻¹·m⁻²) of chart `chart` at worldPosition towards the viewer:
 ///   diffuse chart:  Le + albedo(uv)·E/π with E bilinearly interpolated over the 2×2 nearest
-///                   tixels and the albedo texture applied at full resolution at `uv`;
+///                   tixels and the albedo texture read at `uv`, at full resolution (this
+///                   overload has no ray cone);
 ///   glossy chart:   the 16-neighbour interpolation of the stored exitant radiance (this
 ///                   overload has no triangle: on a curved glossy chart it reads the maps in
 ///                   the frame around the chart normal, an approximation — ray hits go through
@@ -235,19 +296,23 @@ inline constexpr float kCurvedChartCosine = 1.0f;
 Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosition,
                     const Vec3& worldDirectionTowardsViewer, Vec2 uv);
 
-/// The same for a ray hit (chart from lf.triangleChart and facingChart, uv from the hit).
-Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer);
+/// The same for a ray hit (chart from lf.triangleChart and facingChart, uv from the hit), the
+/// albedo texture read at the mip level of a ray cone `coneWidth` wide at the hit (scene
+/// units; albedoLodAt; 0 = full resolution).
+Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer,
+                    float coneWidth);
 
 /// exitantRadiance given the chart's precomputed shading and the values read through `load`
 /// (RgbValues over LightField::values, or PaddedValues): the one implementation every caller
 /// goes through, as four lanes (r, g, b, 0). Defined inline so that the fast renderer's
 /// per-pixel loop inlines it instead of calling across files. lookupNormal: the unit normal
 /// the glossy map is read around at worldPosition (lookupInputs), read only on curved glossy
-/// charts.
+/// charts. uv and lod: where and at which mip level a diffuse chart's albedo texture is read
+/// (lookupInputs).
 template <typename Load>
 inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
                                const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer,
-                               const Vec3& lookupNormal, Vec2 uv) {
+                               const Vec3& lookupNormal, Vec2 uv, float lod) {
   if (c.kind == ChartKind::Specular) return f4Zero();
   const Vec2 grid = tixelGridCoordinates(c, worldPosition, shading.inverseTixelSize);
   // cos θ towards the viewer (chartLocalDirection's z; a diffuse lookup needs no more of it).
@@ -263,7 +328,7 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
   if (c.kind == ChartKind::Diffuse) {
     // Le + (albedo/π) · E, lane by lane.
     const F4 irradiance = interpolateLanes(load, c, grid, Vec2(0.0f));
-    const F4 albedoOverPi = shading.texturedAlbedo ? f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv)), f4Splat(kInvPi))
+    const F4 albedoOverPi = shading.texturedAlbedo ? f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv, lod)), f4Splat(kInvPi))
                                                    : f4Load(shading.albedoOverPi.v);
     const F4 reflected = f4Mul(albedoOverPi, irradiance);
     return shading.emissive && emits ? f4Add(f4Load(shading.emission.v), reflected) : reflected;
@@ -280,14 +345,15 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
 template <typename Load>
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
                            const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, const Vec3& lookupNormal,
-                           Vec2 uv) {
+                           Vec2 uv, float lod) {
   return f4Rgb(
-      exitantRadianceLanes(scene, c, shading, load, worldPosition, worldDirectionTowardsViewer, lookupNormal, uv));
+      exitantRadianceLanes(scene, c, shading, load, worldPosition, worldDirectionTowardsViewer, lookupNormal, uv, lod));
 }
 /// Four light-field lookups on one diffuse chart: the camera rays origin + t·direction
 /// (structure of arrays: x[k], y[k], z[k] for lookups k = 0…3), seen against their directions,
-/// at surface uvs uv[k] (read only when the chart has an albedo texture, shading.needsUv).
-/// result[k] = exitantRadianceLanes(…, origin_k + t_k·direction_k, −direction_k, uv[k]) to the
+/// at surface uvs uv[k] and mip levels lod[k] (read only when the chart has an albedo texture,
+/// shading.needsUv).
+/// result[k] = exitantRadianceLanes(…, origin_k + t_k·direction_k, −direction_k, uv[k], lod[k]) to the
 /// bit — the same IEEE operations lane by lane, with the four lookups in the four SSE lanes
 /// for everything up to the value reads (the fast renderer's common case, where a dependent
 /// chain of ~40 scalar operations per pixel would otherwise dominate).
@@ -295,7 +361,7 @@ struct RaysSoA4 {
   alignas(16) float ox[4], oy[4], oz[4], dx[4], dy[4], dz[4], t[4];
 };
 inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const ChartShading& shading, const Lanes4* values,
-                                    const RaysSoA4& r, const Vec2 uv[4], F4 result[4]) {
+                                    const RaysSoA4& r, const Vec2 uv[4], const float lod[4], F4 result[4]) {
 #if defined(__SSE2__)
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), half = _mm_set1_ps(0.5f);
   const __m128 t = _mm_load_ps(r.t), dx = _mm_load_ps(r.dx), dy = _mm_load_ps(r.dy), dz = _mm_load_ps(r.dz);
@@ -345,7 +411,7 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   // exitantRadianceLanes' albedo / π, per lookup when textured (one branch for all four).
   F4 albedoOverPi[4];
   if (shading.texturedAlbedo)
-    for (int k = 0; k < 4; ++k) albedoOverPi[k] = f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv[k])), f4Splat(kInvPi));
+    for (int k = 0; k < 4; ++k) albedoOverPi[k] = f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv[k], lod[k])), f4Splat(kInvPi));
   else
     albedoOverPi[0] = albedoOverPi[1] = albedoOverPi[2] = albedoOverPi[3] = f4Load(shading.albedoOverPi.v);
   for (int k = 0; k < 4; ++k) {
@@ -367,15 +433,16 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   for (int k = 0; k < 4; ++k) {
     const Vec3 d(r.dx[k], r.dy[k], r.dz[k]);
     result[k] = exitantRadianceLanes(scene, c, shading, PaddedValues{values}, Vec3(r.ox[k], r.oy[k], r.oz[k]) + r.t[k] * d, -d,
-                                     c.normal, uv[k]);
+                                     c.normal, uv[k], lod[k]);
   }
 #endif
 }
 
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
                            const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, const Vec3& lookupNormal,
-                           Vec2 uv) {
-  return exitantRadiance(scene, c, shading, RgbValues{values}, worldPosition, worldDirectionTowardsViewer, lookupNormal, uv);
+                           Vec2 uv, float lod) {
+  return exitantRadiance(scene, c, shading, RgbValues{values}, worldPosition, worldDirectionTowardsViewer, lookupNormal, uv,
+                         lod);
 }
 
 }  // namespace pl

@@ -114,7 +114,8 @@ TEST(Lookup, DiffuseIsEmissionPlusAlbedoTimesInterpolatedIrradianceOverPi) {
 // The fast renderer's four-at-a-time diffuse lookup gives exactly (bit for bit) what one
 // lookup at a time gives, for rays landing inside the grid, outside it on every side (held
 // edges), in front of and behind the chart, on a one- and a two-sided emitter, and with an
-// albedo texture sampled at uvs inside and outside [0, 1] (repeat).
+// albedo texture sampled at uvs inside and outside [0, 1] (repeat) and at mip levels below 0,
+// between levels, beyond the coarsest and NaN.
 TEST(Lookup, FourAtATimeDiffuseLookupEqualsOneAtATimeBitForBit) {
   LightField lf = makeLightField(ChartKind::Diffuse, 1, [](uint32_t i, uint32_t j, uint32_t, uint32_t) {
     return linearField(float(i) * 1.37f, float(j) * 0.91f, 0.0f, 0.0f) * (1.0f + 0.1f * float((i * 7 + j * 3) % 5));
@@ -139,9 +140,10 @@ TEST(Lookup, FourAtATimeDiffuseLookupEqualsOneAtATimeBitForBit) {
       RaysSoA4 rays;
       Vec3 origin[4], direction[4];
       Vec2 uv[4];
-      float t[4];
+      float t[4], lod[4];
       for (int k = 0; k < 4; ++k) {
         uv[k] = Vec2(6.0f * rng.uniform() - 3.0f, 6.0f * rng.uniform() - 3.0f);
+        lod[k] = group % 50 == 7 ? std::nanf("") : 6.0f * rng.uniform() - 1.0f;  // 7×5: levels 0…2
         // A target point from 1.5 tixels outside the grid to 1.5 beyond it, seen from either side.
         const float gu = -2.0f + (float(c.resU) + 3.0f) * rng.uniform(), gv = -2.0f + (float(c.resV) + 3.0f) * rng.uniform();
         const Vec3 target = c.origin + (gu + 0.5f) * c.tixelSize * c.axisU + (gv + 0.5f) * c.tixelSize * c.axisV;
@@ -154,10 +156,10 @@ TEST(Lookup, FourAtATimeDiffuseLookupEqualsOneAtATimeBitForBit) {
         rays.t[k] = t[k];
       }
       F4 four[4];
-      exitantRadianceDiffuse4(lf.scene, c, shading, padded.data(), rays, uv, four);
+      exitantRadianceDiffuse4(lf.scene, c, shading, padded.data(), rays, uv, lod, four);
       for (int k = 0; k < 4; ++k) {
         const Rgb one = f4Rgb(exitantRadianceLanes(lf.scene, c, shading, PaddedValues{padded.data()},
-                                                   origin[k] + t[k] * direction[k], -direction[k], c.normal, uv[k]));
+                                                   origin[k] + t[k] * direction[k], -direction[k], c.normal, uv[k], lod[k]));
         const Rgb batch = f4Rgb(four[k]);
         for (int ch = 0; ch < 3; ++ch)
           ASSERT_EQ(std::bit_cast<uint32_t>(batch[ch]), std::bit_cast<uint32_t>(one[ch]))
@@ -167,6 +169,22 @@ TEST(Lookup, FourAtATimeDiffuseLookupEqualsOneAtATimeBitForBit) {
     }
   }
   EXPECT_EQ(compared, 6000);
+}
+
+// The texture LOD's log2 (albedoTextureLod): within 0.0078 of log2 over many octaves, exact at
+// powers of two, monotonic, and −∞ / +∞ at the ends (levels 0 and the coarsest).
+TEST(Lookup, ApproximateLog2IsCloseExactAtPowersOfTwoAndMonotonic) {
+  float previous = -std::numeric_limits<float>::infinity();
+  for (float x = 1e-6f; x < 1e6f; x *= 1.0007f) {
+    const float got = approximateLog2(x);
+    EXPECT_NEAR(got, std::log2(x), 0.0078f) << x;
+    EXPECT_GE(got, previous) << x;
+    previous = got;
+  }
+  for (int e = -20; e <= 20; ++e) EXPECT_EQ(approximateLog2(std::ldexp(1.0f, e)), float(e));
+  EXPECT_EQ(approximateLog2(0.0f), -std::numeric_limits<float>::infinity());
+  EXPECT_EQ(approximateLog2(std::nanf("")), -std::numeric_limits<float>::infinity());
+  EXPECT_EQ(approximateLog2(std::numeric_limits<float>::infinity()), 128.0f);
 }
 
 TEST(Lookup, SpecularChartsStoreNothingAndReturnZero) {

@@ -3,6 +3,7 @@
 // numbers: samples per pixel and mirror depth. Shared by the reference renderer (render/), the
 // fast renderer (realtime/), the viewer and the library jobs (jobs/), which must all agree: one
 // home for both rules.
+#include <cmath>
 #include <cstdint>
 
 #include "core/error.h"
@@ -26,6 +27,10 @@ struct RenderSettings {
   uint64_t seed = 0;
   int tileSize = 16;  ///< square tiles rendered in parallel
   bool showProgress = false;  ///< progress bar (for single large renders, not timing loops)
+  /// Texture level of detail: diffuse albedo textures are read at the mip level of each
+  /// sample's ray cone (lookup.h albedoTextureLod, textureConeSpread below) instead of at full
+  /// resolution. `render`/`view` --texture-lod on|off.
+  bool textureLod = true;
 };
 
 /// What both renderers refuse before allocating anything: samples per pixel outside
@@ -50,6 +55,19 @@ inline int effectiveSamplesPerPixel(const RenderSettings& settings, bool thinLen
 /// (bakeMirrorDepth = LightField::settings.mirrorDepth).
 inline uint32_t effectiveMirrorDepth(const RenderSettings& settings, uint32_t bakeMirrorDepth) {
   return settings.mirrorDepth >= 0 ? uint32_t(settings.mirrorDepth) : bakeMirrorDepth;
+}
+
+/// The ray-cone spread of a camera sample (Ray Tracing Gems ch. 20): the cone's width, in
+/// scene units, at distance t along the ray (summed over the segments of a mirror/glass chain)
+/// is textureConeSpread × t. pixelSpread is the camera's (Camera::pixelSpread: a pixel's height
+/// on the image plane at unit distance, 2·tan(fovY/2) / height — exactly a pixel's footprint at
+/// the image centre). spp samples per pixel share a pixel's area, so each cone is 1/√spp of the
+/// pixel wide (the samples integrate the rest of the footprint). Planar mirrors and glass
+/// keep the spread (the width grows with the total distance); the curvature of curved
+/// mirrors or glass, which would widen or narrow the cone, is not modelled. 0 with
+/// textureLod off: every level is then −∞, i.e. full resolution.
+inline float textureConeSpread(const RenderSettings& settings, float pixelSpread, int spp) {
+  return settings.textureLod ? pixelSpread / std::sqrt(float(spp)) : 0.0f;
 }
 
 /// Radiance from infinity towards −direction for a ray leaving the scene along `direction`.

@@ -24,11 +24,15 @@ struct FastRenderer::Scratch {
   std::vector<float> weight;       ///< camera weight (cos⁴θ or 1)
   std::vector<uint32_t> pixel;     ///< per pixel of the tile (spp samples each): y·width + x
   std::vector<uint32_t> chart;     ///< per sample, after the prefetch pass: the chart record it sees
+  // Per sample on a textured diffuse chart, after the prefetch pass: the hit's uv and albedo mip level.
+  std::vector<Vec2> uv;
+  std::vector<float> lod;
   // The mirror wavefront: reflected rays, their sample and accumulated reflectance.
   std::vector<Ray> mirrorRays, nextRays;
   std::vector<RayHit> mirrorHits;
   std::vector<uint32_t> mirrorSlot, nextSlot;
   std::vector<Rgb> mirrorThroughput, nextThroughput;
+  std::vector<float> mirrorDistance, nextDistance;  ///< length of the chain so far (scene units; ray cones)
   std::vector<uint32_t> reflectedSamples;  ///< camera samples that hit a mirror (one sample per pixel)
 };
 
@@ -140,8 +144,8 @@ size_t FastRenderer::tilePrimaryHits(const Camera& camera, int spp, uint64_t see
   return n;
 }
 
-void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDepth, uint64_t seed, int x0, int y0,
-                              int x1, int y1, Scratch& s, Image& image) const {
+void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDepth, float coneSpread, uint64_t seed, int x0,
+                              int y0, int x1, int y1, Scratch& s, Image& image) const {
   const Scene& scene = lightField_.scene;
   const Chart* charts = lightField_.charts.data();
   const ChartShading* shading = shading_.data();
@@ -159,6 +163,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   s.mirrorRays.clear();
   s.mirrorSlot.clear();
   s.mirrorThroughput.clear();
+  s.mirrorDistance.clear();
   Rgb* out = image.pixels.data();
   // The chart record sample i sees: its triangle's chart, turned to the side facing the camera.
   auto facingChartOf = [&](size_t i) {
@@ -173,13 +178,15 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   // ones the tile's lookups are first walked in two passes that only prefetch: (a) every
   // hit's chart index, prefetching its record; (b) with the records arriving, the facing
   // record (kept for the shading below), its shading, the two value rows the diffuse
-  // interpolation reads, and the texels (Texture::prefetch). (Without textures on a small
+  // interpolation reads, and the texels (Texture::prefetch; the uv and mip level are kept for
+  // the shading). (Without textures on a small
   // light field everything is cached and the passes alone cost 10–15 % of the Cornell box's
   // frame: skipped.)
   const bool prefetched = prefetchLookups_ || anyTexturedChart_;
   auto chartOf = [&](size_t i) { return prefetched ? s.chart[i] : facingChartOf(i); };
   if (prefetched) {
     s.chart.resize(n);
+    if (anyTexturedChart_) s.uv.resize(n), s.lod.resize(n);
     for (size_t i = 0; i < n; ++i) {
       const RayHit& hit = s.hits[i];
       if (!hit.hit()) continue;
@@ -207,7 +214,11 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       // prefetched above is still on its way (waiting for it here took 8 % of renderTile).
       const int texture = scene.materials[c.material].albedoTexture;
       if (c.kind != ChartKind::Diffuse || texture < 0) continue;
-      scene.textures[size_t(texture)].prefetch(uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics));
+      // lookupInputs' uv and level for this hit (the same functions: the same bits).
+      const Texture& albedo = scene.textures[size_t(texture)];
+      s.uv[i] = uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics);
+      s.lod[i] = albedoTextureLod(scene.meshes[hit.mesh], hit.triangle, albedo, s.rays[i].direction, coneSpread * hit.t);
+      albedo.prefetch(s.uv[i], s.lod[i]);
     }
   }
   // Whether samples i … i+3 all hit one diffuse chart record (→ *chart).
@@ -222,6 +233,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   };
   RaysSoA4 four;
   Vec2 fourUv[4];
+  float fourLod[4];
   F4 fourRadiance[4];
   for (size_t i = 0; i < n;) {
     uint32_t chart = 0;
@@ -234,12 +246,11 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       }
       // A separate loop: a call inside the one above keeps the compiler from merging its stores
       // into vectors, and the lookup's 16-byte loads of them then stall (measured on Cornell).
+      // A textured chart: the uvs and levels of the prefetch pass (anyTexturedChart_ ran it).
       if (shading[chart].needsUv)
-        for (int k = 0; k < 4; ++k) {
-          const RayHit& hit = s.hits[i + k];  // a diffuse chart: the uv alone (lookupInputs' case)
-          fourUv[k] = uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics);
-        }
-      exitantRadianceDiffuse4(scene, charts[chart], shading[chart], paddedValues_.data(), four, fourUv, fourRadiance);
+        for (int k = 0; k < 4; ++k) fourUv[k] = s.uv[i + k], fourLod[k] = s.lod[i + k];
+      exitantRadianceDiffuse4(scene, charts[chart], shading[chart], paddedValues_.data(), four, fourUv, fourLod,
+                              fourRadiance);
       for (int k = 0; k < 4; ++k) f4StoreRgb(out + s.pixel[i + k], f4Mul(f4Splat(s.weight[i + k]), fourRadiance[k]));
       i += 4;
       continue;
@@ -256,10 +267,11 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv;
+        float lod;
         Vec3 lookup, lookupNormal;
-        lookupInputs(scene, c, shading[chart], hit, -ray.direction, uv, lookup, lookupNormal);
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * hit.t, uv, lod, lookup, lookupNormal);
         const F4 lanes = exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup,
-                                              lookupNormal, uv);
+                                              lookupNormal, uv, lod);
         if (spp == 1) {
           // The pixel, straight from the lanes (weight > 0 here): pixelValue's weight × radiance.
           f4StoreRgb(out + s.pixel[i], f4Mul(f4Splat(s.weight[i]), lanes));
@@ -274,6 +286,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
           s.mirrorRays.push_back(reflected);
           s.mirrorSlot.push_back(uint32_t(i));
           s.mirrorThroughput.push_back(reflectance);
+          s.mirrorDistance.push_back(hit.t);
         }
       }
     }
@@ -292,11 +305,13 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     s.nextRays.clear();
     s.nextSlot.clear();
     s.nextThroughput.clear();
+    s.nextDistance.clear();
     for (size_t i = 0; i < active; ++i) {
       const Ray& ray = s.mirrorRays[i];
       const RayHit& hit = s.mirrorHits[i];
       const uint32_t slot = s.mirrorSlot[i];
       const Rgb throughput = s.mirrorThroughput[i];
+      const float distance = s.mirrorDistance[i] + hit.t;  // the reference's running sum (render.cpp)
       if (!hit.hit()) {
         s.radiance[slot] += throughput * backgroundRadiance(scene.environment, ray.direction);
         continue;
@@ -306,10 +321,11 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv;
+        float lod;
         Vec3 lookup, lookupNormal;
-        lookupInputs(scene, c, shading[chart], hit, -ray.direction, uv, lookup, lookupNormal);
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * distance, uv, lod, lookup, lookupNormal);
         s.radiance[slot] += throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction,
-                                                         lookup, lookupNormal, uv);
+                                                         lookup, lookupNormal, uv, lod);
         continue;
       }
       Rgb emitted;
@@ -321,11 +337,13 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         s.nextRays.push_back(reflected);
         s.nextSlot.push_back(slot);
         s.nextThroughput.push_back(throughput * reflectance);
+        s.nextDistance.push_back(distance);
       }
     }
     std::swap(s.mirrorRays, s.nextRays);
     std::swap(s.mirrorSlot, s.nextSlot);
     std::swap(s.mirrorThroughput, s.nextThroughput);
+    std::swap(s.mirrorDistance, s.nextDistance);
   }
 
   // Pixel = mean over its samples of weight × radiance (the reference's order of sums).
@@ -360,9 +378,10 @@ void FastRenderer::render(const Camera& camera, const RenderSettings& settings, 
   checkRenderSettings(settings);
   const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
   const uint32_t mirrorDepth = effectiveMirrorDepth(settings, lightField_.settings.mirrorDepth);
+  const float coneSpread = textureConeSpread(settings, camera.pixelSpread(), spp);
   if (image.width != camera.width() || image.height != camera.height()) image = Image(camera.width(), camera.height());
   forEachTile(camera, settings, [&](int x0, int y0, int x1, int y1, Scratch& scratch) {
-    renderTile(camera, spp, mirrorDepth, settings.seed, x0, y0, x1, y1, scratch, image);
+    renderTile(camera, spp, mirrorDepth, coneSpread, settings.seed, x0, y0, x1, y1, scratch, image);
   });
 }
 

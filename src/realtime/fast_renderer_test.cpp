@@ -195,25 +195,56 @@ TEST_F(FastRendererTest, MatchesReferenceOnBuiltInCornellBox) {
   expectSameAsReference(lf, desc, 64, 64, RenderSettings{}, 0.001f);
 }
 
-TEST_F(FastRendererTest, MatchesReferenceWithAlbedoTextures) {
-  // Every Lambertian material textured (8-bit values, so the texture is packed; the OBJ has no
-  // uvs, so uv = barycentrics): the four-at-a-time textured lookups and the texel prefetch.
-  Scene scene = loadScene(kMcGuire + "CornellBox-Glossy.obj");
+/// `scene` with a width × height texture of random texels (8-bit values when eightBit, else
+/// any floats in [0, 1)) multiplying every Lambertian material's albedo.
+Scene withRandomAlbedoTexture(Scene scene, int width, int height, bool eightBit, uint64_t seed) {
   Texture texture;
-  texture.path = "random-8-bit";
-  texture.image = Image(13, 9);
-  Pcg32 rng(8, 1);
-  for (Rgb& texel : texture.image.pixels)
-    texel = Rgb(float(rng.next() >> 24) / 255.0f, float(rng.next() >> 24) / 255.0f, float(rng.next() >> 24) / 255.0f);
+  texture.path = eightBit ? "random-8-bit" : "random-float";
+  texture.image = Image(width, height);
+  Pcg32 rng(seed, 1);
+  auto value = [&] { return eightBit ? float(rng.next() >> 24) / 255.0f : rng.uniform(); };
+  for (Rgb& texel : texture.image.pixels) {
+    const float r = value(), g = value(), b = value();
+    texel = Rgb(r, g, b);
+  }
   scene.textures.push_back(texture);
   int textured = 0;
   for (Material& m : scene.materials)
-    if (std::holds_alternative<LambertBsdf>(m.bsdf)) m.albedoTexture = 0, ++textured;
-  ASSERT_GT(textured, 0);
+    if (std::holds_alternative<LambertBsdf>(m.bsdf)) m.albedoTexture = int(scene.textures.size()) - 1, ++textured;
+  EXPECT_GT(textured, 0);
+  return scene;
+}
+
+TEST_F(FastRendererTest, MatchesReferenceWithAlbedoTextures) {
+  // Every Lambertian material textured (8-bit values, so the texture is packed; the OBJ has no
+  // uvs, so uv = barycentrics): the four-at-a-time textured lookups and the texel prefetch.
+  Scene scene = withRandomAlbedoTexture(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 13, 9, true, 8);
   const LightField lf = randomLightField(std::move(scene), 6);
   ASSERT_FALSE(lf.scene.textures[0].packed.empty());
   const CameraDesc desc = lf.scene.cameras.empty() ? lf.scene.automaticCamera() : lf.scene.cameras.front();
   expectSameAsReference(lf, desc, 96, 72, RenderSettings{});
+}
+
+TEST_F(FastRendererTest, MatchesReferenceWithMinifiedAlbedoTexturesThroughMirrors) {
+  // A 256 × 192 texture (float values, so its mip levels and level 0 are float rows) on every
+  // Lambertian material of the mirror box, whose triangles (uv = barycentrics) each span the
+  // whole texture: minified several levels at 64 × 48, at the primary hits and behind the
+  // mirror (the cone grows with the chain's length). Texture LOD on at 1 and 4 samples per
+  // pixel (the cone 1/√spp of a pixel), and off.
+  Scene scene = withRandomAlbedoTexture(loadScene(kMcGuire + "CornellBox-Mirror.obj"), 256, 192, false, 9);
+  const LightField lf = randomLightField(std::move(scene), 10);
+  ASSERT_EQ(lf.scene.textures[0].mips.size(), 8u);  // 128×96 … 2×1, 1×1
+  const CameraDesc desc = lf.scene.cameras.empty() ? lf.scene.automaticCamera() : lf.scene.cameras.front();
+  RenderSettings four, off;
+  four.samplesPerPixel = 4;
+  off.textureLod = false;
+  for (const RenderSettings& settings : {RenderSettings{}, four, off}) expectSameAsReference(lf, desc, 64, 48, settings);
+  // The levels matter: the image with LOD is not the one without.
+  const Accel accel(lf.scene);
+  const Camera camera(desc, 64, 48);
+  const FastRenderer fast(lf, accel, 0);
+  const Image with = fast.render(camera, RenderSettings{}), without = fast.render(camera, off);
+  EXPECT_GT(compare(with, without).pixelsOverTolerance, 64 * 48 / 4);
 }
 
 TEST_F(FastRendererTest, PrimaryRaysAloneFindTheRenderersHits) {

@@ -9,7 +9,7 @@
 //   1b. on light fields larger than kPrefetchLookupBytes and on textured ones, two passes over
 //      the tile's hits that only prefetch — chart records, then each hit's facing record (kept
 //      for step 2), its shading, the two value rows of a diffuse lookup and the texels it will
-//      read (Texture::prefetch) — so that their cache misses overlap across the tile;
+//      read (Texture::prefetch, at the mip level of the sample's ray cone) — so that their cache misses overlap across the tile;
 //   2. shading of every hit without building a SurfaceHit: the hit point is ray.origin +
 //      t·ray.direction, the chart comes from LightField::triangleChart, and the radiance from
 //      exitantRadianceLanes() of lightfield/lookup.h with the chart's ChartShading precomputed
@@ -97,8 +97,9 @@ class FastRenderer {
   /// image, tiles in parallel, each thread with its own Scratch.
   template <typename Tile>
   void forEachTile(const Camera& camera, const RenderSettings& settings, Tile&& tile) const;
-  void renderTile(const Camera& camera, int spp, uint32_t mirrorDepth, uint64_t seed, int x0, int y0, int x1, int y1,
-                  Scratch& scratch, Image& image) const;
+  /// coneSpread: textureConeSpread of the camera and settings (0 = albedo at full resolution).
+  void renderTile(const Camera& camera, int spp, uint32_t mirrorDepth, float coneSpread, uint64_t seed, int x0, int y0,
+                  int x1, int y1, Scratch& scratch, Image& image) const;
 
   const LightField& lightField_;
   const Accel& accel_;

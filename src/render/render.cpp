@@ -22,16 +22,21 @@ namespace {
 
 /// Radiance along `ray` whose closest hit is `hit` (hit.hit() false: it left the scene).
 /// Mirrors and glass are followed as a chain of reflections/refractions with the weights multiplied in
-/// (`throughput`); the first non-specular chart ends it with the light-field lookup.
-Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hit, uint32_t mirrorDepth) {
+/// (`throughput`); the first non-specular chart ends it with the light-field lookup, its
+/// albedo texture read at the level of the ray cone (coneSpread × the chain's length so far,
+/// textureConeSpread).
+Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hit, uint32_t mirrorDepth,
+                    float coneSpread) {
   const Scene& scene = lf.scene;
   Rgb throughput(1.0f), result(0.0f);
+  float distance = 0.0f;  // along the chain, scene units
   for (uint32_t reflections = 0;; ++reflections) {
     if (!hit.hit()) return result + throughput * backgroundRadiance(scene.environment, ray.direction);
+    distance += hit.t;
     const Chart& chart = lf.charts[lf.triangleChart[hit.mesh][hit.triangle]];
     if (chart.kind != ChartKind::Specular)
-      return result +
-             throughput * exitantRadiance(lf, surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics), -ray.direction);
+      return result + throughput * exitantRadiance(lf, surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics),
+                                                   -ray.direction, coneSpread * distance);
 
     // An ideal mirror or glass: its own emission (if any) plus the branch weight times what
     // the reflected or refracted direction sees.
@@ -53,6 +58,7 @@ Image renderLightField(const LightField& lf, const Accel& accel, const Camera& c
   checkRenderSettings(settings);
   const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
   const uint32_t mirrorDepth = effectiveMirrorDepth(settings, lf.settings.mirrorDepth);
+  const float coneSpread = textureConeSpread(settings, camera.pixelSpread(), spp);
   const int width = camera.width(), height = camera.height();
   const int tile = settings.tileSize;
   const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
@@ -92,7 +98,7 @@ Image renderLightField(const LightField& lf, const Accel& accel, const Camera& c
         for (int x = x0; x < x1; ++x) {
           Rgb sum(0.0f);
           for (int k = 0; k < spp; ++k, ++i)
-            if (weights[i] > 0.0f) sum += weights[i] * radianceFromHit(lf, accel, rays[i], hits[i], mirrorDepth);
+            if (weights[i] > 0.0f) sum += weights[i] * radianceFromHit(lf, accel, rays[i], hits[i], mirrorDepth, coneSpread);
           image.at(x, y) = sum / float(spp);
         }
       if (progress) progress->advance();

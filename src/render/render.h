@@ -4,7 +4,8 @@
 // Per camera sample: the primary hit (Embree, 16-wide packets per tile) → SurfaceHit → the
 // hit triangle's chart → exitantRadiance() of lightfield/lookup.h (the one 16-neighbour
 // lookup: bilinear in position × bilinear in paraboloid direction; diffuse charts get their
-// albedo texture at full resolution). Ideal-specular charts (mirrors, glass) store nothing:
+// albedo texture at the mip level of the sample's ray cone, lookup.h albedoTextureLod, or at
+// full resolution with RenderSettings::textureLod off). Ideal-specular charts (mirrors, glass) store nothing:
 // the view ray is reflected or refracted by followSpecular (lightfield/lookup.h: the
 // mirror's reflectance; for glass one Fresnel branch chosen stochastically with the right
 // weight), and followed, up to mirrorDepth steps; a chain longer than that contributes

@@ -200,6 +200,14 @@ TEST_F(RenderCliTest, RefusesBadInputWithoutWritingAnything) {
   EXPECT_NE(run("render " + path("quad.plf") + " -o " + path("d.exr") + " --camera nosuch", nullptr, &err), 0);
   EXPECT_NE(err.find("nosuch"), std::string::npos) << err;
   EXPECT_FALSE(fs::exists(path("d.exr")));
+
+  // --texture-lod takes on or off, nothing else; both render.
+  EXPECT_NE(run("render " + path("quad.plf") + " -o " + path("e.exr") + " --texture-lod maybe", nullptr, &err), 0);
+  EXPECT_NE(err.find("--texture-lod"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("e.exr")));
+  for (const char* value : {"on", "off"})
+    EXPECT_EQ(run("render " + path("quad.plf") + " -o " + path("f.exr") + " --texture-lod " + value, nullptr, &err), 0)
+        << err;
 }
 
 // tests/data/render/quad-v1.plf is makeQuadLightField() as written by the version-1 writer,

@@ -147,27 +147,53 @@ bool bilinearFootprint(const Image& image, Vec2 uv, BilinearFootprint& f) {
 
 }  // namespace
 
-Rgb Texture::sample(Vec2 uv) const {
-  if (image.empty()) return Rgb(1.0f);
+namespace {
+
+/// bilinearFootprint for a uv already reduced to [0, 1)² (Texture::sampleLod): the texel
+/// coordinate x = u·W − ½ lies in [−½, W − ½), so ⌊x⌋ ∈ [−1, W − 1] is the truncation of x + 1
+/// minus 1, and the wrap is one comparison per index — no floor, no division. Always true
+/// (a NaN uv was sent to sample() before).
+bool reducedFootprint(const Image& image, Vec2 uv, BilinearFootprint& f) {
+  auto axis = [](float x, int n, int& i0, int& i1, float& fraction) {
+    const int below = int(x + 1.0f) - 1;  // ⌊x⌋ for x ≥ −1
+    fraction = x - float(below);
+    i0 = below < 0 ? n - 1 : below;
+    i1 = below + 1 >= n ? 0 : below + 1;
+  };
+  axis(uv.x * float(image.width) - 0.5f, image.width, f.x0, f.x1, f.fx);
+  axis((1.0f - uv.y) * float(image.height) - 0.5f, image.height, f.y0, f.y1, f.fy);
+  return true;
+}
+
+/// Bilinear, repeat, in one level (its float image, and its packed texels when present), the
+/// footprint from `footprint` (bilinearFootprint or reducedFootprint); false for a non-finite uv.
+template <typename Footprint>
+bool sampleLevel(const Image& image, const std::vector<Texture::PackedBlock>& packed, const std::vector<float>& palette,
+                 Vec2 uv, Footprint&& footprint, Rgb& result) {
   BilinearFootprint f;
-  if (!bilinearFootprint(image, uv, f)) return average;
+  if (!footprint(image, uv, f)) return false;
   auto bilinear = [&](auto&& texel) {
     const Rgb top = (1.0f - f.fx) * texel(f.x0, f.y0) + f.fx * texel(f.x1, f.y0);
     const Rgb bottom = (1.0f - f.fx) * texel(f.x0, f.y1) + f.fx * texel(f.x1, f.y1);
     return (1.0f - f.fy) * top + f.fy * bottom;
   };
-  if (packed.empty()) return bilinear([&](int tx, int ty) { return image.at(tx, ty); });
+  if (packed.empty()) {
+    result = bilinear([&](int tx, int ty) { return image.at(tx, ty); });
+    return true;
+  }
   const int blocksPerRow = packedBlocksPerRow(image.width);
   const float* values = palette.data();
-  return bilinear([&](int tx, int ty) {
+  result = bilinear([&](int tx, int ty) {
     const uint32_t p = packedTexel(packed, blocksPerRow, tx, ty);
     return Rgb(values[p & 0xffu], values[(p >> 8) & 0xffu], values[(p >> 16) & 0xffu]);
   });
+  return true;
 }
 
-void Texture::prefetch(Vec2 uv) const {
+template <typename Footprint>
+void prefetchLevel(const Image& image, const std::vector<Texture::PackedBlock>& packed, Vec2 uv, Footprint&& footprint) {
   BilinearFootprint f;
-  if (image.empty() || !bilinearFootprint(image, uv, f)) return;
+  if (!footprint(image, uv, f)) return;
   if (packed.empty()) {
     __builtin_prefetch(&image.at(f.x0, f.y0));
     __builtin_prefetch(&image.at(f.x1, f.y1));
@@ -178,6 +204,90 @@ void Texture::prefetch(Vec2 uv) const {
   const int blocksPerRow = packedBlocksPerRow(image.width);
   __builtin_prefetch(&packedTexel(packed, blocksPerRow, f.x0, f.y0));
   __builtin_prefetch(&packedTexel(packed, blocksPerRow, f.x1, f.y1));
+}
+
+/// The source texels under each texel of one axis shrunk from n to m ≤ n texels, with their
+/// weights: target texel i covers source [i·n/m, (i+1)·n/m), and source texel j gets the
+/// length of [j, j+1) inside it divided by n/m (the weights of a target texel sum to 1).
+struct BoxTap {
+  int source;
+  double weight;
+};
+std::vector<std::vector<BoxTap>> boxTaps(int n, int m) {
+  std::vector<std::vector<BoxTap>> taps(size_t(m), std::vector<BoxTap>{});
+  const double scale = double(n) / double(m);
+  for (int i = 0; i < m; ++i) {
+    // Exact in doubles for the sizes of images: i·n and (i+1)·n are integers, divided once.
+    const double lo = double(i) * double(n) / double(m), hi = double(i + 1) * double(n) / double(m);
+    for (int j = int(std::floor(lo)); j < n && double(j) < hi; ++j) {
+      const double overlap = std::min(hi, double(j + 1)) - std::max(lo, double(j));
+      if (overlap > 0.0) taps[size_t(i)].push_back({j, overlap / scale});
+    }
+  }
+  return taps;
+}
+
+/// The next mip level of `image`: max(1, ⌊W/2⌋) × max(1, ⌊H/2⌋) exact box averages (Texture::mips).
+Image downsampleBox(const Image& image) {
+  const int width = std::max(1, image.width / 2), height = std::max(1, image.height / 2);
+  const auto tapsX = boxTaps(image.width, width), tapsY = boxTaps(image.height, height);
+  Image next(width, height);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      glm::dvec3 sum(0.0);
+      for (const BoxTap& ty : tapsY[size_t(y)])
+        for (const BoxTap& tx : tapsX[size_t(x)]) sum += (ty.weight * tx.weight) * glm::dvec3(image.at(tx.source, ty.source));
+      next.at(x, y) = Rgb(sum);
+    }
+  }
+  return next;
+}
+
+}  // namespace
+
+Rgb Texture::sample(Vec2 uv) const {
+  if (image.empty()) return Rgb(1.0f);
+  Rgb result;
+  return sampleLevel(image, packed, palette, uv, bilinearFootprint, result) ? result : average;
+}
+
+Rgb Texture::sampleLod(Vec2 uv, float lod) const {
+  if (!(lod > 0.0f) || mips.empty()) return sample(uv);  // also NaN
+  // uv reduced to [0, 1) once for both levels (repeat), so that each level's footprint is
+  // reducedFootprint's few integer operations (per pixel the renderers take four footprints:
+  // two levels, sampled and prefetched). Not bit-identical to sample() at level 0 (the
+  // rounding of u·W differs), which is why lod ≤ 0 goes through sample().
+  uv -= glm::floor(uv);
+  if (!(uv.x < 1.0f)) uv.x = 0.0f;  // u − ⌊u⌋ rounds up to 1 for tiny negative u
+  if (!(uv.y < 1.0f)) uv.y = 0.0f;
+  const size_t coarsest = mips.size();                   // level index of mips.back()
+  const float clamped = std::min(lod, float(coarsest));
+  const size_t fine = size_t(clamped);  // ⌊lod⌋ ≥ 0
+  const float f = clamped - float(fine);
+  auto level = [&](size_t l, Rgb& out) {
+    return l == 0 ? sampleLevel(image, packed, palette, uv, reducedFootprint, out)
+                  : sampleLevel(mips[l - 1].image, mips[l - 1].packed, mips[l - 1].palette, uv, reducedFootprint, out);
+  };
+  Rgb a, b;
+  if (!(uv.x >= 0.0f && uv.y >= 0.0f)) return average;  // a non-finite uv
+  level(fine, a);
+  if (f == 0.0f) return a;
+  level(fine + 1, b);  // fine < coarsest here (f > 0 needs clamped < coarsest)
+  return (1.0f - f) * a + f * b;
+}
+
+void Texture::prefetch(Vec2 uv, float lod) const {
+  if (image.empty()) return;
+  if (!(lod > 0.0f) || mips.empty()) return prefetchLevel(image, packed, uv, bilinearFootprint);
+  uv -= glm::floor(uv);  // as sampleLod
+  if (!(uv.x >= 0.0f && uv.x < 1.0f && uv.y >= 0.0f && uv.y < 1.0f)) return;
+  // The finer level of the pair only: the coarser one has a quarter of its texels and is
+  // more often cached, and its footprint would cost as much again.
+  const size_t fine = size_t(std::min(lod, float(mips.size())));
+  if (fine == 0)
+    prefetchLevel(image, packed, uv, reducedFootprint);
+  else
+    prefetchLevel(mips[fine - 1].image, mips[fine - 1].packed, uv, reducedFootprint);
 }
 
 void Texture::finish(const std::string& sceneSource) {
@@ -193,6 +303,14 @@ void Texture::finish(const std::string& sceneSource) {
   packed.clear();
   palette.clear();
   packTexels(image, packed, palette);
+  // The mip pyramid, each level from the one before (box averages of linear values).
+  mips.clear();
+  for (const Image* above = &image; above->width > 1 || above->height > 1; above = &mips.back().image) {
+    Level level;
+    level.image = downsampleBox(*above);
+    packTexels(level.image, level.packed, level.palette);
+    mips.push_back(std::move(level));
+  }
 }
 
 Texture loadTextureFile(const std::string& path, ImageDecode decode) {

@@ -36,15 +36,22 @@ struct Texture {
   /// `sceneSource` and the texture. Scene::finalize and the .plf reader call it.
   void finish(const std::string& sceneSource);
 
-  /// Bilinear, repeat. A non-finite uv (only possible from a NaN hit, since loaders reject
-  /// non-finite uvs) returns `average` rather than spreading the NaN into the albedo; the
-  /// renderers count and report non-finite radiance where it arises.
+  /// Bilinear at full resolution (level 0), repeat. A non-finite uv (only possible from a NaN
+  /// hit, since loaders reject non-finite uvs) returns `average` rather than spreading the NaN
+  /// into the albedo; the renderers count and report non-finite radiance where it arises. The
+  /// path tracer, the bake and normal/alpha maps read textures here.
   Rgb sample(Vec2 uv) const;
-  /// Asks the processor to fetch the cache lines sample(uv) will read (the packed texels, or
-  /// the float rows), without waiting for them. The fast renderer issues it for a whole tile
-  /// before shading it, so that the texel reads of many pixels overlap instead of missing the
-  /// cache one after another.
-  void prefetch(Vec2 uv) const;
+  /// Trilinear: bilinear in mip levels ⌊lod⌋ and ⌊lod⌋ + 1 (`levels`), blended by the
+  /// fraction of lod. lod ≤ 0 or NaN is exactly sample(uv) (magnified or unfiltered: full
+  /// resolution, the same bits); lod beyond the coarsest level reads that level alone. Level l
+  /// has the same uv convention as the image (texel centres at (x + ½)/W_l), so levels line up.
+  /// The light-field renderers' albedo (lookup.h albedoTextureLod chooses lod).
+  Rgb sampleLod(Vec2 uv, float lod) const;
+  /// Asks the processor to fetch the cache lines sampleLod(uv, lod) will read (the packed
+  /// texels, or the float rows), without waiting for them. The fast renderer issues it for a
+  /// whole tile before shading it, so that the texel reads of many pixels overlap instead of
+  /// missing the cache one after another.
+  void prefetch(Vec2 uv, float lod) const;
 
   /// The same texels as `image`, packed for sampling, when all their channel values are among
   /// at most 256 floats (every texture decoded from 8 bits): per texel one byte per channel,
@@ -59,6 +66,24 @@ struct Texture {
   };
   std::vector<PackedBlock> packed;
   std::vector<float> palette;
+
+  /// One mip level: its texels as floats, and packed like level 0 when their values allow.
+  struct Level {
+    Image image;
+    std::vector<PackedBlock> packed;  ///< empty unless ≤ 256 distinct values per channel
+    std::vector<float> palette;
+  };
+  /// Mip levels 1, 2, … down to 1×1 (mips[l − 1] is level l), built by finish() from the
+  /// linear texels: level l + 1 is W_{l+1} = max(1, ⌊W_l / 2⌋) by H_{l+1} = max(1, ⌊H_l / 2⌋)
+  /// texels, each the exact box average of the level-l texels under it (a texel of level l
+  /// covers [x, x+1) × [y, y+1); the one of level l+1 covers W_l/W_{l+1} × H_l/H_{l+1} of
+  /// them, partial texels weighted by the area they cover — so an even size gives plain 2×2
+  /// averages and an odd one 2.5- or 3-texel-wide boxes, and the average of every level is
+  /// the image's). Averages rarely keep ≤ 256 values per channel, so most levels stay float:
+  /// 12 bytes per texel, ≤ ⅓ of level 0's texel count in all, i.e. +4 bytes per level-0
+  /// texel beside its 12 (floats) + 4 (packed) bytes — +25 % for an 8-bit texture, +33 %
+  /// for a float-only one.
+  std::vector<Level> mips;
 };
 
 struct Material {
@@ -322,7 +347,10 @@ std::optional<Scattered> scatter(const ScatteringFrame& f, const Bsdf& bsdf, Vec
 /// material of a scene with it.
 void validateMaterial(const Material& material, const std::string& sourcePath);
 
-/// The material's BSDF with its albedo texture applied at uv.
+/// The material's BSDF with its albedo texture applied at uv, at full resolution
+/// (Texture::sample): the path tracer integrates a pixel's footprint with its samples, and the
+/// bake averages over each tixel's footprint itself. Only the light-field renderers read mip
+/// levels (lookup.h albedoTextureLod).
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit);
 
 }  // namespace pl

@@ -1,6 +1,7 @@
 // Tests of the scene module: the built-in Cornell box, every loader on real files, texture
 // sampling, per-hit surface data, the automatic camera, and one test per kind of bad input.
 #include "core/error.h"
+#include "core/rng.h"
 #include "scene/scene.h"
 
 #include <gtest/gtest.h>
@@ -661,6 +662,86 @@ TEST(Texture, PackedTexelsSampleBitForBitLikeTheFloatImage) {
   EXPECT_TRUE(wide.packed.empty());
   EXPECT_TRUE(wide.palette.empty());
   EXPECT_VEC3_NEAR(wide.sample(Vec2((10.5f) / 300.0f, 0.5f)), Rgb(10.0f / 300.0f), kTight);
+}
+
+// Mip levels are exact box averages of the level above: a 5×3 texture gives level 1 = 2×1
+// (each texel covers 2.5 × 3 texels of level 0: two whole columns and half of the middle one,
+// all three rows) and level 2 = 1×1 (the mean of level 1, which is the mean of the image);
+// an even 4×2 level gives plain 2×2 averages. Weights written out by hand, not by the code's
+// own overlap rule.
+TEST(Texture, MipLevelsAreExactBoxAverages) {
+  Texture texture;
+  texture.path = "odd";
+  texture.image = Image(5, 3);
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 5; ++x) texture.image.at(x, y) = Rgb(float(x + 5 * y), float(x * x), float(y == 1 ? 7 : 1));
+  texture.finish("test");
+  ASSERT_EQ(texture.mips.size(), 2u);
+  const Image& level1 = texture.mips[0].image;
+  ASSERT_EQ(level1.width, 2);
+  ASSERT_EQ(level1.height, 1);
+  auto column = [&](int x) {  // the mean of column x over the three rows
+    return (texture.image.at(x, 0) + texture.image.at(x, 1) + texture.image.at(x, 2)) / 3.0f;
+  };
+  const Rgb left = (column(0) + column(1) + 0.5f * column(2)) / 2.5f;
+  const Rgb right = (0.5f * column(2) + column(3) + column(4)) / 2.5f;
+  EXPECT_VEC3_NEAR(level1.at(0, 0), left, 1e-5f);
+  EXPECT_VEC3_NEAR(level1.at(1, 0), right, 1e-5f);
+  const Image& level2 = texture.mips[1].image;
+  ASSERT_EQ(level2.width, 1);
+  ASSERT_EQ(level2.height, 1);
+  EXPECT_VEC3_NEAR(level2.at(0, 0), 0.5f * (left + right), 1e-5f);
+  EXPECT_VEC3_NEAR(level2.at(0, 0), texture.average, 1e-5f);
+
+  Texture even;
+  even.path = "even";
+  even.image = Image(4, 2);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) even.image.at(x, y) = Rgb(float(x), float(10 * y), float(x * y));
+  even.finish("test");
+  ASSERT_EQ(even.mips.size(), 2u);  // 2×1, 1×1
+  for (int x = 0; x < 2; ++x) {
+    const Rgb box = (even.image.at(2 * x, 0) + even.image.at(2 * x + 1, 0) + even.image.at(2 * x, 1) +
+                     even.image.at(2 * x + 1, 1)) / 4.0f;
+    EXPECT_VEC3_NEAR(even.mips[0].image.at(x, 0), box, 1e-6f);
+  }
+}
+
+// sampleLod: level 0 (lod ≤ 0, NaN) is sample() to the bit; an integral lod reads that level
+// bilinearly (the same uv convention: the texel centres of a 2×1 level at u = ¼, ¾); a
+// fractional one blends the two levels linearly; beyond the coarsest it holds the 1×1 level.
+// A level whose values allow is packed like level 0.
+TEST(Texture, SampleLodIsTrilinearOverTheLevels) {
+  Texture texture;
+  texture.path = "levels";
+  texture.image = Image(8, 4);
+  Pcg32 rng(3, 9);
+  for (Rgb& texel : texture.image.pixels) texel = Rgb(rng.uniform(), rng.uniform(), rng.uniform());
+  texture.finish("test");
+  ASSERT_EQ(texture.mips.size(), 3u);  // 4×2, 2×1, 1×1
+  for (const Vec2 uv : {Vec2(0.1f, 0.2f), Vec2(0.6f, 0.9f), Vec2(-1.3f, 2.7f)}) {
+    const Rgb full = texture.sample(uv);
+    for (const float lod : {0.0f, -3.0f, std::nanf("")}) {
+      const Rgb got = texture.sampleLod(uv, lod);
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(std::bit_cast<uint32_t>(got[c]), std::bit_cast<uint32_t>(full[c]));
+    }
+    EXPECT_VEC3_NEAR(texture.sampleLod(uv, 5.0f), texture.mips[2].image.at(0, 0), 1e-6f);
+    EXPECT_VEC3_NEAR(texture.sampleLod(uv, 3.0f), texture.mips[2].image.at(0, 0), 1e-6f);
+  }
+  const Image& level2 = texture.mips[1].image;  // 2×1: centres at u = ¼ and ¾
+  EXPECT_VEC3_NEAR(texture.sampleLod(Vec2(0.25f, 0.5f), 2.0f), level2.at(0, 0), 1e-6f);
+  EXPECT_VEC3_NEAR(texture.sampleLod(Vec2(0.5f, 0.5f), 2.0f), 0.5f * (level2.at(0, 0) + level2.at(1, 0)), 1e-6f);
+  const Rgb level3 = texture.mips[2].image.at(0, 0);
+  EXPECT_VEC3_NEAR(texture.sampleLod(Vec2(0.25f, 0.5f), 2.25f), 0.75f * level2.at(0, 0) + 0.25f * level3, 1e-6f);
+
+  Texture flat;  // a constant 8-bit texture: every level keeps one value and is packed
+  flat.path = "flat";
+  flat.image = Image(6, 6);
+  for (Rgb& texel : flat.image.pixels) texel = Rgb(0.25f, 0.5f, 0.75f);
+  flat.finish("test");
+  ASSERT_EQ(flat.mips.size(), 2u);  // 3×3, 1×1
+  for (const Texture::Level& level : flat.mips) EXPECT_FALSE(level.packed.empty());
+  EXPECT_VEC3_NEAR(flat.sampleLod(Vec2(0.3f, 0.1f), 1.5f), Rgb(0.25f, 0.5f, 0.75f), 1e-7f);
 }
 
 /// One triangle (0,0,0), (1,0,0), (0,1,0): counter-clockwise seen from +z.

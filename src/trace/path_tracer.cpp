@@ -214,6 +214,8 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
     if (depth >= maxDepth) break;
 
     // The sidedness rule (scene.h): reflecting BSDFs two-sided, transmitting ones unturned.
+    // The albedo texture at full resolution (no mip level): the pixel's samples integrate its
+    // footprint, which is what the light-field renderers' texture LOD approximates.
     const Bsdf bsdf = bsdfAt(scene, surface);
     const ScatteringFrame scattering = scatteringFrame(surface, wo, bsdf);
     const auto& [geometricNormal, frame, woLocal] = scattering;
