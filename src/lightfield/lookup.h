@@ -138,14 +138,20 @@ inline constexpr float kFullResolution = 0.0f;
 /// (Akenine-Möller et al., "Texture Level of Detail Strategies for Real-Time Ray Tracing",
 /// Ray Tracing Gems, ch. 20): a ray arriving along unit `direction` at triangle `triangle` of
 /// `mesh` with a cone of width w = coneWidth (scene units; RenderSettings' textureConeSpread
-/// × the distance travelled from the camera, summed over the mirror/glass chain) covers a
-/// footprint w / |cos θ| long on the surface (θ between the ray and the triangle's normal).
-/// The triangle maps world area P_a = ½|c|, c = (p1 − p0) × (p2 − p0), to texel area
-/// T_a = W·H·½|(uv1 − uv0) × (uv2 − uv0)| (W × H texels; uv = the barycentrics without uvs),
-/// so a world length ℓ spans ℓ·√(T_a / P_a) texels (isotropic). The level is log2 of the
-/// texels across the footprint:
-///   λ = log2(w · √(T_a / P_a) / |cos θ|),  |cos θ| = |d·c| / |c|
-///     = ½ · log2(W·H·|uv cross| · w² · |c| / (d·c)²)          (one log2, no square root).
+/// × the distance travelled from the camera, summed over the mirror/glass chain) covers an
+/// elliptical footprint on the surface with axes w (across the view) and w / |cos θ| (along
+/// it; θ between the ray and the triangle's normal). The triangle maps world area
+/// P_a = ½|c|, c = (p1 − p0) × (p2 − p0), to texel area T_a = W·H·½|(uv1 − uv0) × (uv2 − uv0)|
+/// (W × H texels; uv = the barycentrics without uvs). One isotropic level must stand for that
+/// ellipse: it is taken with the footprint's area, i.e. the geometric mean w / √|cos θ| of its
+/// axes, so the level covers as many texels as the footprint does — not its long axis, as the
+/// paper's rule (and GPU trilinear filtering without anisotropy) does, which blurs grazing
+/// surfaces across the view by 1/|cos θ|. Measured on a Sponza frame at 1 sample per pixel
+/// against 256 samples at full resolution: relMSE 0.0057 with the area, 0.0066 with the long
+/// axis, 0.0089 at full resolution (README "Texture level of detail"). The level is log2 of
+/// the texels across that mean width:
+///   λ = log2(w · √(T_a / P_a) / √|cos θ|),  |cos θ| = |d·c| / |c|
+///     = ½ · log2(W·H·|uv cross| · w² / |d·c|)          (one log2, no square root or length).
 /// w = 0 (texture LOD off) gives −∞, degenerate uvs −∞ (level 0), a grazing ray +∞ (the
 /// coarsest level); a NaN reads level 0 (Texture::sampleLod). The log2 is approximateLog2
 /// (within 0.008 of a level; libm's log2f was 3 % of a Sponza frame).
@@ -158,9 +164,9 @@ inline float albedoTextureLod(const Mesh& mesh, uint32_t triangle, const Texture
     const Vec2 a = mesh.uvs[tri[1]] - mesh.uvs[tri[0]], b = mesh.uvs[tri[2]] - mesh.uvs[tri[0]];
     uvCross = std::abs(a.x * b.y - a.y * b.x);
   }
-  const float cosArea = glm::dot(direction, c);  // |c| cos θ
-  const float texelsSquared = float(texture.image.width) * float(texture.image.height) * uvCross *
-                              (coneWidth * coneWidth) * (glm::length(c) / (cosArea * cosArea));
+  const float cosArea = std::abs(glm::dot(direction, c));  // |c| |cos θ|
+  const float texelsSquared =
+      float(texture.image.width) * float(texture.image.height) * uvCross * (coneWidth * coneWidth) / cosArea;
   return 0.5f * approximateLog2(texelsSquared);
 }
 

@@ -223,7 +223,9 @@ TEST_F(RenderTest, SeveralSamplesAverageTheLookupAndAreReproducible) {
 // in its closed form: on a plane facing the camera at distance d the level is log2 of the
 // texels one pixel spans — measured here independently, from the uvs where the rays of two
 // neighbouring pixel centres land. Four times the distance is two levels more; a plane turned
-// by 60° about the horizontal (cos θ = ½) one level more than facing.
+// by 60° about the horizontal (cos θ = ½) half a level more than facing: its footprint is
+// twice as long along the view and as wide across it, twice the area (lookup.h: the level
+// follows the footprint's area).
 TEST_F(RenderTest, TextureLodOfAPlaneFacingTheCameraIsLog2OfTexelsPerPixel) {
   Scene scene;
   scene.materials = {Material{"plane", LambertBsdf{Rgb(1.0f)}, 0, Rgb(0.0f), false}};
@@ -263,7 +265,7 @@ TEST_F(RenderTest, TextureLodOfAPlaneFacingTheCameraIsLog2OfTexelsPerPixel) {
   EXPECT_NEAR(near, std::log2(nearTexels), 0.01f);
   EXPECT_NEAR(far, std::log2(farTexels), 0.01f);
   EXPECT_NEAR(far - near, 2.0f, 1e-4f);
-  EXPECT_NEAR(tilted - far, 1.0f, 1e-3f);
+  EXPECT_NEAR(tilted - far, 0.5f, 1e-3f);
   EXPECT_GT(far, 5.0f);  // 512 texels per unit, 0.15 units per pixel at d = 10: ≈ 78 texels
   // Off: no cone, full resolution.
   RenderSettings off;
