@@ -17,6 +17,7 @@
 #include "render/render.h"
 #include "scene/scene.h"
 #include "support/glossy_spheres.h"
+#include "support/light_field_vs_trace.h"
 #include "support/temp_dir_test.h"
 #include "trace/trace.h"
 
@@ -52,20 +53,10 @@ TEST_F(CurvedGlossyTest, GlossySpheresMatchThePathTracer) {
   const Scene scene = test_support::loadGlossySpheres(dir_);
   const Camera camera = spheresCamera();
   const Accel accel(scene);
-  const PathTracer tracer(scene, accel);
-  TraceSettings trace;
-  trace.spp = 512;
-  trace.showProgress = false;
-  const Image reference = tracer.render(camera, trace).radiance;
-
-  const LightField lf = bake(Scene(scene), bakePreset("draft"));
+  const auto [reference, lf, image] = test_support::lightFieldAndReference(scene, camera, 512, bakePreset("draft"), 4);
   uint64_t curvedGlossy = 0;
   for (const Chart& c : lf.charts) curvedGlossy += c.kind == ChartKind::Glossy && c.curved;
   EXPECT_GT(curvedGlossy, 0u);
-  const Accel lfAccel(lf.scene);
-  RenderSettings render;
-  render.samplesPerPixel = 4;
-  const Image image = renderLightField(lf, lfAccel, camera, render);
   const ImageComparison whole = compareImages(image, reference);
 
   // The spheres' pixels alone (every other pixel zero in both images).

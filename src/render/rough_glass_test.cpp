@@ -15,6 +15,7 @@
 #include "bake/parameterisation.h"
 #include "render/render.h"
 #include "scene/scene.h"
+#include "support/light_field_vs_trace.h"
 #include "support/sphere_mesh.h"
 #include "trace/trace.h"
 
@@ -106,16 +107,7 @@ struct Agreement {
 Agreement compareWithPathTracer(const Scene& scene, const BakeSettings& settings = bakePreset("draft")) {
   const Camera camera = testCamera();
   const Accel accel(scene);
-  const PathTracer tracer(scene, accel);
-  TraceSettings trace;
-  trace.spp = 512;
-  trace.showProgress = false;
-  const Image reference = tracer.render(camera, trace).radiance;
-  const LightField lf = bake(Scene(scene), settings);
-  const Accel lfAccel(lf.scene);
-  RenderSettings render;
-  render.samplesPerPixel = 16;
-  const Image image = renderLightField(lf, lfAccel, camera, render);
+  const auto [reference, lf, image] = test_support::lightFieldAndReference(scene, camera, 512, settings, 16);
 
   Agreement result;
   result.image = compareImages(image, reference);

@@ -1,0 +1,40 @@
+#pragma once
+// Test support (header-only; include as "support/light_field_vs_trace.h"): the light field of
+// a scene against the path tracer from one camera — what the accuracy tests of src/render
+// (rough glass, curved glossy charts) compare. The caller links pl_bake, pl_render, pl_trace.
+#include "accel/accel.h"
+#include "bake/bake.h"
+#include "camera/camera.h"
+#include "image/image.h"
+#include "render/render.h"
+#include "scene/scene.h"
+#include "trace/trace.h"
+
+namespace pl::test_support {
+
+struct LightFieldAndReference {
+  Image reference;        ///< path traced, referenceSpp samples per pixel
+  LightField lightField;  ///< baked with the given settings
+  Image image;            ///< the light field rendered by the reference renderer
+};
+
+inline LightFieldAndReference lightFieldAndReference(const Scene& scene, const Camera& camera, int referenceSpp,
+                                                     const BakeSettings& settings, int lightFieldSamples) {
+  LightFieldAndReference out;
+  {
+    const Accel accel(scene);
+    const PathTracer tracer(scene, accel);
+    TraceSettings trace;
+    trace.spp = referenceSpp;
+    trace.showProgress = false;
+    out.reference = tracer.render(camera, trace).radiance;
+  }
+  out.lightField = bake(Scene(scene), settings);
+  const Accel accel(out.lightField.scene);
+  RenderSettings render;
+  render.samplesPerPixel = lightFieldSamples;
+  out.image = renderLightField(out.lightField, accel, camera, render);
+  return out;
+}
+
+}  // namespace pl::test_support
