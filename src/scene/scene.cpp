@@ -303,8 +303,10 @@ void Texture::finish(const std::string& sceneSource) {
   packed.clear();
   palette.clear();
   packTexels(image, packed, palette);
-  // The mip pyramid, each level from the one before (box averages of linear values).
+  // The mip pyramid, each level from the one before (box averages of linear values); albedo
+  // textures only (the light-field renderers' LOD reads no other kind).
   mips.clear();
+  if (decode != ImageDecode::Colour) return;
   for (const Image* above = &image; above->width > 1 || above->height > 1; above = &mips.back().image) {
     Level level;
     level.image = downsampleBox(*above);

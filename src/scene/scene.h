@@ -82,7 +82,8 @@ struct Texture {
   /// the image's). Averages rarely keep ≤ 256 values per channel, so most levels stay float:
   /// 12 bytes per texel, ≤ ⅓ of level 0's texel count in all, i.e. +4 bytes per level-0
   /// texel beside its 12 (floats) + 4 (packed) bytes — +25 % for an 8-bit texture, +33 %
-  /// for a float-only one.
+  /// for a float-only one. Only colour textures (ImageDecode::Colour: albedo) get levels;
+  /// normal maps and alpha masks are read at full resolution everywhere, so theirs stay empty.
   std::vector<Level> mips;
 };
 

@@ -705,6 +705,14 @@ TEST(Texture, MipLevelsAreExactBoxAverages) {
                      even.image.at(2 * x + 1, 1)) / 4.0f;
     EXPECT_VEC3_NEAR(even.mips[0].image.at(x, 0), box, 1e-6f);
   }
+  // Normal maps and alpha masks are read at full resolution only: no levels.
+  for (const ImageDecode decode : {ImageDecode::Data, ImageDecode::Coverage}) {
+    Texture data = even;
+    data.decode = decode;
+    data.finish("test");
+    EXPECT_TRUE(data.mips.empty());
+    EXPECT_VEC3_NEAR(data.sampleLod(Vec2(0.3f, 0.6f), 1.0f), data.sample(Vec2(0.3f, 0.6f)), 0.0f);
+  }
 }
 
 // sampleLod: level 0 (lod ≤ 0, NaN) is sample() to the bit; an integral lod reads that level
