@@ -204,6 +204,21 @@ inline uint32_t facingChart(const Chart* charts, uint32_t chart, const Vec3& tow
   return facingChart(charts, chart, towardsViewer, chartNormalAt(charts[chart], mesh, triangle));
 }
 
+/// What a renderer's view ray sees: facingChart's record, or kNoChartRecord when the viewer is
+/// behind a one-sided *curved* record — the inside of a closed smooth mesh, which reflects
+/// nothing (the rule the bake's gather rays follow: `back` in visibility.cpp). Curved charts
+/// never emit (parameterisation.h), so nothing is seen there: radiance 0. A planar one-sided
+/// record seen from behind is returned as it is, and the lookup's cos θ < 0 against its one
+/// normal gives the same answer there, plus a two-sided emitter's emission.
+inline constexpr uint32_t kNoChartRecord = 0xffffffffu;
+inline uint32_t viewedChart(const Chart* charts, uint32_t chart, const Vec3& towardsViewer, const Mesh& mesh,
+                            uint32_t triangle) {
+  const Chart& c = charts[chart];
+  const Vec3 normal = chartNormalAt(c, mesh, triangle);
+  const uint32_t facing = facingChart(charts, chart, towardsViewer, normal);
+  return c.curved && c.sides == 1 && glm::dot(towardsViewer, normal) < 0.0f ? kNoChartRecord : facing;
+}
+
 /// Whether chart record c (of a material with BSDF bsdf) is rough glass: a glossy chart whose
 /// BSDF transmits (lightfield.h "Rough glass"; smooth and thin glass are Specular charts).
 inline bool isRoughGlassChart(const Chart& c, const Bsdf& bsdf) {

@@ -116,10 +116,12 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
 
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer,
                     float coneWidth) {
-  // The chart facing the viewer (a two-sided surface's back record when seen from behind), then
-  // the lookup direction the normal map reflects to on it. The shading is made once per call.
-  const uint32_t chart = facingChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], worldDirectionTowardsViewer,
+  // The chart facing the viewer (a two-sided surface's back record when seen from behind; none
+  // behind a one-sided curved one), then the lookup direction the normal map reflects to on
+  // it. The shading is made once per call.
+  const uint32_t chart = viewedChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], worldDirectionTowardsViewer,
                                      lf.scene.meshes[hit.mesh], hit.triangle);
+  if (chart == kNoChartRecord) return Rgb(0.0f);  // inside a closed smooth mesh
   const Chart& c = lf.charts[chart];
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   const ChartShading shading = chartShading(lf.scene, c);

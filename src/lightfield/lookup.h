@@ -280,9 +280,9 @@ inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading&
 
 /// The cos θ towards the viewer that the lookups use on a curved chart record. Its triangles
 /// face up to the cone bound away from the chart normal, so the chart normal cannot tell the
-/// side; facingChart has turned a two-sided surface to the record the viewer is in front of,
-/// and the record reflects. Known limit: a one-sided curved chart (the outside of a closed
-/// smooth mesh) seen from inside the mesh also reflects, where a planar one shows black.
+/// side; the caller's viewedChart has turned a two-sided surface to the record the viewer is
+/// in front of and left out a one-sided record seen from behind (by the hit triangle's
+/// normal), so the record reflects.
 inline constexpr float kCurvedChartCosine = 1.0f;
 
 /// Exitant radiance (W·sr⁻¹·m⁻²) of chart `chart` at worldPosition towards the viewer:
@@ -323,7 +323,7 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
   const Vec2 grid = tixelGridCoordinates(c, worldPosition, shading.inverseTixelSize);
   // cos θ towards the viewer (chartLocalDirection's z; a diffuse lookup needs no more of it).
   // A curved chart (diffuse or glossy, never emissive: parameterisation.h) has no single normal: the
-  // caller's facingChart chose its side by the hit triangle's normal, and it reflects
+  // caller's viewedChart chose its side by the hit triangle's normal, and it reflects
   // (cos θ taken as 1, see kCurvedChartCosine).
   const float cosTheta = c.curved ? kCurvedChartCosine : glm::dot(worldDirectionTowardsViewer, c.normal);
   // chartEmittedRadiance (lightfield.h) on the precomputed emission of this record.

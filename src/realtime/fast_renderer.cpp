@@ -165,10 +165,11 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   s.mirrorThroughput.clear();
   s.mirrorDistance.clear();
   Rgb* out = image.pixels.data();
-  // The chart record sample i sees: its triangle's chart, turned to the side facing the camera.
-  auto facingChartOf = [&](size_t i) {
+  // The chart record sample i sees: its triangle's chart, turned to the side facing the camera
+  // (kNoChartRecord behind a one-sided curved record: viewedChart).
+  auto viewedChartOf = [&](size_t i) {
     const RayHit& hit = s.hits[i];
-    return facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -s.rays[i].direction,
+    return viewedChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -s.rays[i].direction,
                        scene.meshes[hit.mesh], hit.triangle);
   };
   // A lookup is a chain of dependent loads — the hit's chart index, its chart record, the
@@ -183,7 +184,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   // light field everything is cached and the passes alone cost 10–15 % of the Cornell box's
   // frame: skipped.)
   const bool prefetched = prefetchLookups_ || anyTexturedChart_;
-  auto chartOf = [&](size_t i) { return prefetched ? s.chart[i] : facingChartOf(i); };
+  auto chartOf = [&](size_t i) { return prefetched ? s.chart[i] : viewedChartOf(i); };
   if (prefetched) {
     s.chart.resize(n);
     if (anyTexturedChart_) s.uv.resize(n), s.lod.resize(n);
@@ -196,8 +197,9 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     for (size_t i = 0; i < n; ++i) {
       const RayHit& hit = s.hits[i];
       if (!hit.hit()) continue;
-      const uint32_t chart = facingChart(charts, s.chart[i], -s.rays[i].direction, scene.meshes[hit.mesh], hit.triangle);
+      const uint32_t chart = viewedChart(charts, s.chart[i], -s.rays[i].direction, scene.meshes[hit.mesh], hit.triangle);
       s.chart[i] = chart;
+      if (chart == kNoChartRecord) continue;
       const Chart& c = charts[chart];
       if (prefetchLookups_) {
         prefetchBytes(shading + chart, sizeof(ChartShading));
@@ -226,7 +228,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     for (size_t k = i; k < i + 4; ++k)
       if (!(s.weight[k] > 0.0f) || !s.hits[k].hit()) return false;
     *chart = chartOf(i);
-    if (charts[*chart].kind != ChartKind::Diffuse) return false;
+    if (*chart == kNoChartRecord || charts[*chart].kind != ChartKind::Diffuse) return false;
     for (size_t k = i + 1; k < i + 4; ++k)
       if (chartOf(k) != *chart) return false;
     return true;
@@ -262,8 +264,9 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       // The reference skips samples of zero weight.
     } else if (!hit.hit()) {
       radiance = backgroundRadiance(scene.environment, ray.direction);
+    } else if (chart = chartOf(i); chart == kNoChartRecord) {
+      // Inside a closed smooth mesh: nothing reflected, nothing emitted (viewedChart).
     } else {
-      chart = chartOf(i);
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv;
@@ -316,8 +319,9 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         s.radiance[slot] += throughput * backgroundRadiance(scene.environment, ray.direction);
         continue;
       }
-      const uint32_t chart = facingChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -ray.direction,
+      const uint32_t chart = viewedChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -ray.direction,
                                          scene.meshes[hit.mesh], hit.triangle);
+      if (chart == kNoChartRecord) continue;  // inside a closed smooth mesh: nothing seen
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         Vec2 uv;

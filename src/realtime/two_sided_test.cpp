@@ -29,6 +29,7 @@
 #include "scene/scene.h"
 #include "trace/trace.h"
 #include "support/quad_mesh.h"
+#include "support/sphere_mesh.h"
 
 namespace pl {
 namespace {
@@ -226,6 +227,59 @@ TEST_F(TwoSidedTest, ThinSheetMatchesThePathTracerFromBothSides) {
   // The scene does what the comment says: the back is lit, but far less than the front.
   EXPECT_GT(luminance(sides[1]), 0.005f * luminance(sides[0]));
   EXPECT_LT(luminance(sides[1]), 0.2f * luminance(sides[0]));
+}
+
+// The one-sided rule on curved charts: a closed smooth sphere (flat-shaded faces within 30°,
+// so curved charts; closed, so one-sided) lit from outside. From inside it the path tracer
+// sees black (no light gets in), and so must both light-field renderers: the lookup's cos θ
+// on a curved record is taken as 1, so before viewedChart they reflected the outside's
+// irradiance there. From outside the same sphere is lit in all three.
+TEST_F(TwoSidedTest, InsideAClosedSmoothMeshIsBlackInEveryRenderer) {
+  Scene scene = makeSheetScene();
+  Material ball;
+  ball.name = "ball";
+  ball.bsdf = LambertBsdf{Rgb(0.7f)};
+  scene.materials.push_back(ball);
+  Mesh sphere;
+  test_support::addSphere(sphere, Vec3(0.0f, 1.0f, 1.5f), 0.4f, 16, 32, uint32_t(scene.materials.size() - 1));
+  scene.meshes.push_back(sphere);
+  scene.finalize();
+  const Accel traceAccel(scene);
+  const PathTracer tracer(scene, traceAccel);
+  BakeSettings settings = bakePreset("draft");
+  settings.gatherDirections = 64;
+  const LightField lf = bake(Scene(scene), settings);
+  uint32_t curvedOneSided = 0;
+  for (const Chart& c : lf.charts) curvedOneSided += c.material == scene.materials.size() - 1 && c.curved && c.sides == 1;
+  ASSERT_GT(curvedOneSided, 0u);
+  const Accel accel(lf.scene);
+  const FastRenderer fast(lf, accel);
+  RenderSettings rs;
+  rs.samplesPerPixel = 1;
+  TraceSettings ts;
+  ts.spp = 16;
+  ts.showProgress = false;
+  auto luminanceSum = [](const Image& image) {
+    double sum = 0.0;
+    for (const Rgb& p : image.pixels) sum += luminance(p);
+    return sum;
+  };
+  CameraDesc inside;
+  inside.eye = {0.0f, 1.0f, 1.5f};
+  inside.target = {1.0f, 1.2f, 1.5f};
+  inside.fovYDegrees = 60.0f;
+  const Camera in(inside, 32, 24);
+  EXPECT_EQ(luminanceSum(tracer.render(in, ts).radiance), 0.0);
+  EXPECT_EQ(luminanceSum(renderLightField(lf, accel, in, rs)), 0.0);
+  EXPECT_EQ(luminanceSum(fast.render(in, rs)), 0.0);
+  CameraDesc outside = inside;
+  outside.eye = {2.5f, 1.6f, 1.5f};
+  outside.target = {0.0f, 1.0f, 1.5f};
+  const Camera out(outside, 32, 24);
+  const double pt = luminanceSum(tracer.render(out, ts).radiance);
+  EXPECT_GT(pt, 0.0);
+  EXPECT_NEAR(luminanceSum(renderLightField(lf, accel, out, rs)), pt, 0.2 * pt);
+  EXPECT_NEAR(luminanceSum(fast.render(out, rs)), luminanceSum(renderLightField(lf, accel, out, rs)), 1e-4 * pt);
 }
 
 }  // namespace
