@@ -400,10 +400,11 @@ class FileError(Error, OSError):
       .def(
           "render",
           [](const PyLightField& lf, int width, int height, int samples, const py::object& camera, uint64_t seed,
-             bool reference, int threads) {
+             bool reference, int threads, bool textureLod) {
             RenderJobOptions options;
             options.render.samplesPerPixel = samples;
             options.render.seed = seed;
+            options.render.textureLod = textureLod;
             options.reference = reference;
             options.view = viewSettings(width, height, camera);
             options.threads = threads;
@@ -411,14 +412,15 @@ class FileError(Error, OSError):
             return toArray(runInterruptible([&] { return job.run(*lf.lightField).image; }));
           },
           py::arg("width") = 640, py::arg("height") = 480, py::arg("samples") = 0, py::arg("camera") = py::none(),
-          py::arg("seed") = 0, py::arg("reference") = false, py::arg("threads") = 0,
+          py::arg("seed") = 0, py::arg("reference") = false, py::arg("threads") = 0, py::arg("texture_lod") = true,
           "Renders the light field (what `plenoptic render` does): float32 (height, width, 3), W/(sr m^2).\n"
           "samples=0: 1 per pixel for a pinhole camera, 16 for a thin lens. reference=True: the reference renderer.\n"
+          "texture_lod=False: albedo textures at full resolution (`--texture-lod off`).\n"
           "camera: a Camera, or a camera name of the scene (default: its first, else automatic).")
       .def(
           "render_path",
           [](const PyLightField& lf, const py::object& path, int width, int height, int samples,
-             const py::object& camera, uint64_t seed, bool reference, int threads) {
+             const py::object& camera, uint64_t seed, bool reference, int threads, bool textureLod) {
             // The frames' cameras: a list of Cameras as they are, or a camera path file's frames
             // (realtime/camera_path.h: frame k at t0 + k/fps) posed on `camera` (its lens, and
             // its fov where the path has none).
@@ -443,6 +445,7 @@ class FileError(Error, OSError):
                 RenderJobOptions options;
                 options.render.samplesPerPixel = samples;
                 options.render.seed = seed;
+                options.render.textureLod = textureLod;
                 options.reference = reference;
                 options.view = base;
                 options.view.cameraDesc = frameCamera;
@@ -457,6 +460,7 @@ class FileError(Error, OSError):
           },
           py::arg("path"), py::arg("width") = 640, py::arg("height") = 480, py::arg("samples") = 0,
           py::arg("camera") = py::none(), py::arg("seed") = 0, py::arg("reference") = false, py::arg("threads") = 0,
+          py::arg("texture_lod") = true,
           "Renders a walk-through: path is a camera path JSON file (what `plenoptic render --path` renders, frame k at\n"
           "t0 + k/fps, posed on `camera`) or a list of Cameras. Returns a list of float32 (height, width, 3) frames.");
 

@@ -11,6 +11,7 @@ import pytest
 import plenoptic
 
 BINARY = os.environ.get("PLENOPTIC_BINARY", "")
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tests", "data")
 
 
 @pytest.fixture(scope="module")
@@ -66,6 +67,25 @@ def test_bake_save_load_and_render(cornell, tmp_path):
     for renderer in (False, True):
         with pytest.raises(plenoptic.UsageError, match="1000000000 samples per pixel is out of range"):
             lf.render(width=32, height=24, samples=10**9, reference=renderer)
+
+
+def test_texture_lod_is_a_render_option(tmp_path):
+    # A 2×2-texel checker quad under a white sky, seen from far enough that its texels are
+    # smaller than a pixel: with texture LOD (the default) the renderers read the minified
+    # level, with texture_lod=False the texels themselves, as `plenoptic render --texture-lod off`.
+    quad = os.path.join(DATA, "scene", "textured", "quad.obj")
+    (tmp_path / "lit.json").write_text(json.dumps({"meshes": [{"file": quad}], "environment": {"color": 1.0}}))
+    scene = plenoptic.load_scene(str(tmp_path / "lit.json"))
+    lf = plenoptic.bake(scene, preset="draft")
+    far = plenoptic.Camera(eye=[0.5, 0.5, 30.0], target=[0.5, 0.5, 0.0], fov=20.0)  # the quad: 1.5 pixels
+    for reference in (False, True):
+        lod = lf.render(width=16, height=16, camera=far, reference=reference)
+        assert np.array_equal(lod, lf.render(width=16, height=16, camera=far, reference=reference, texture_lod=True))
+        full = lf.render(width=16, height=16, camera=far, reference=reference, texture_lod=False)
+        assert lod.mean() > 0.0 and full.mean() > 0.0
+        assert not np.array_equal(lod, full)
+    frames = lf.render_path([far], width=16, height=16, texture_lod=False)
+    assert np.array_equal(frames[0], lf.render(width=16, height=16, camera=far, texture_lod=False))
 
 
 def test_editing_emission_and_rebaking_with_the_reused_visibility_equals_a_full_bake(tmp_path):
