@@ -117,22 +117,23 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
 Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer,
                     float coneWidth) {
   // The chart facing the viewer (a two-sided surface's back record when seen from behind; none
-  // behind a one-sided curved one), then the lookup direction the normal map reflects to on
-  // it. The shading is made once per call.
+  // behind a one-sided curved one), then what the lookup needs at the hit — the fast
+  // renderer's lookupInputs. The shading is made once per call.
   const uint32_t chart = viewedChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], worldDirectionTowardsViewer,
                                      lf.scene.meshes[hit.mesh], hit.triangle);
   if (chart == kNoChartRecord) return Rgb(0.0f);  // inside a closed smooth mesh
   const Chart& c = lf.charts[chart];
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   const ChartShading shading = chartShading(lf.scene, c);
-  const Vec3 lookupNormal = lookupNormalAt(lf.scene, c, shading, hit.mesh, hit.triangle, hit.barycentrics);
-  const Vec3 lookupDirection = shading.normalMapped
-                                   ? normalMappedLookupDirection(lookupNormal, hit.shadingNormal, worldDirectionTowardsViewer)
-                                   : worldDirectionTowardsViewer;
-  const float lod = shading.needsUv ? albedoLodAt(lf.scene, c.material, hit.mesh, hit.triangle, -worldDirectionTowardsViewer,
-                                                  coneWidth)
-                                    : kFullResolution;
-  return exitantRadiance(lf.scene, c, shading, lf.values.data(), hit.position, lookupDirection, lookupNormal, hit.uv, lod);
+  RayHit rayHit;
+  rayHit.mesh = hit.mesh;
+  rayHit.triangle = hit.triangle;
+  rayHit.barycentrics = hit.barycentrics;
+  Vec2 uv;
+  float lod;
+  Vec3 lookupDirection, lookupNormal;
+  lookupInputs(lf.scene, c, shading, rayHit, worldDirectionTowardsViewer, coneWidth, uv, lod, lookupDirection, lookupNormal);
+  return exitantRadiance(lf.scene, c, shading, lf.values.data(), hit.position, lookupDirection, lookupNormal, uv, lod);
 }
 
 }  // namespace pl

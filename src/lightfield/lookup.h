@@ -15,7 +15,6 @@
 #include "lightfield/paraboloid.h"
 #include "scene/scene.h"
 
-#include <bit>
 #include <cmath>
 #include <limits>
 #include <cstdint>
@@ -116,15 +115,6 @@ inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 
   return f4Rgb(interpolateLanes(RgbValues{values}, c, grid, st));
 }
 
-/// log2(x) for x > 0 within 0.0078 (exact at powers of two): the exponent of x plus
-/// t + 0.347·t·(1 − t) for its mantissa 1 + t (the quadratic through log2's ends with the
-/// least maximum error). +∞ for +∞; −∞ for 0, negative numbers and NaN. Monotonic.
-inline float approximateLog2(float x) {
-  if (!(x > 0.0f)) return -std::numeric_limits<float>::infinity();
-  const uint32_t bits = std::bit_cast<uint32_t>(x);
-  const float t = std::bit_cast<float>((bits & 0x007fffffu) | 0x3f800000u) - 1.0f;  // mantissa − 1, in [0, 1)
-  return float(int(bits >> 23) - 127) + t + 0.347f * t * (1.0f - t);
-}
 
 /// Diffuse albedo of `material` at surface uv: the Lambertian albedo times its albedo texture
 /// (if any) read at mip level `lod` (Texture::sampleLod; lod ≤ 0 is full resolution, exactly
@@ -152,9 +142,9 @@ inline constexpr float kFullResolution = 0.0f;
 /// the texels across that mean width:
 ///   λ = log2(w · √(T_a / P_a) / √|cos θ|),  |cos θ| = |d·c| / |c|
 ///     = ½ · log2(W·H·|uv cross| · w² / |d·c|)          (one log2, no square root or length).
-/// w = 0 (texture LOD off) gives −∞, degenerate uvs −∞ (level 0), a grazing ray +∞ (the
-/// coarsest level); a NaN reads level 0 (Texture::sampleLod). The log2 is approximateLog2
-/// (within 0.008 of a level; libm's log2f was 3 % of a Sponza frame).
+/// w = 0 (texture LOD off) gives −∞, degenerate uvs −∞ (level 0), a grazing ray a level
+/// beyond the coarsest (read as the coarsest); a NaN reads level 0 (Texture::sampleLod). The
+/// log2 is core/math.h approximateLog2 (within 0.008 of a level).
 inline float albedoTextureLod(const Mesh& mesh, uint32_t triangle, const Texture& texture, const Vec3& direction,
                               float coneWidth) {
   const UVec3 tri = mesh.triangles[triangle];

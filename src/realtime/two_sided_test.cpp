@@ -278,8 +278,12 @@ TEST_F(TwoSidedTest, InsideAClosedSmoothMeshIsBlackInEveryRenderer) {
   const Camera out(outside, 32, 24);
   const double pt = luminanceSum(tracer.render(out, ts).radiance);
   EXPECT_GT(pt, 0.0);
-  EXPECT_NEAR(luminanceSum(renderLightField(lf, accel, out, rs)), pt, 0.2 * pt);
-  EXPECT_NEAR(luminanceSum(fast.render(out, rs)), luminanceSum(renderLightField(lf, accel, out, rs)), 1e-4 * pt);
+  // Measured: the light field's sum 0.34 % above the path tracer's (16 spp), the fast
+  // renderer's within 1e-6 of the reference's. Bounds: 3 % (the draft bake's bias on the box
+  // scenes is 1–2 %), and the 1e-5 float rounding the two renderers are allowed elsewhere.
+  const double reference = luminanceSum(renderLightField(lf, accel, out, rs));
+  EXPECT_NEAR(reference, pt, 0.03 * pt);
+  EXPECT_NEAR(luminanceSum(fast.render(out, rs)), reference, 1e-5 * reference);
 }
 
 }  // namespace
