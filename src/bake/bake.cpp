@@ -77,7 +77,7 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   // between the ranks and exchanged (shard.h fillTixelsDistributed).
   const Accel accel(lf.scene);
   Parameterisation param = buildCharts(lf.scene, accel, settings);
-  const double chartSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double setupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const TixelSetupTiming tixelSetup = fillTixelsDistributed(lf.scene, accel, param, comm);
   const uint64_t hash = visibilityHash(lf.scene, param, settings);
   if (ranks > 1) {
@@ -101,7 +101,7 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
                      "{} values; room scale {:.4g}, tixel size {:.4g} (scene units); BVH and charts {:.2f} s, "
                      "tixels {:.2f} s{}",
                      param.charts.size(), byKind[0], byKind[1], byKind[2], param.tixelCount, tixelsByKind[0],
-                     tixelsByKind[1], param.valueCount, param.sceneScale, param.baseTixelSize, chartSeconds,
+                     tixelsByKind[1], param.valueCount, param.sceneScale, param.baseTixelSize, setupSeconds,
                      tixelSetup.seconds,
                      ranks > 1 ? fmt::format(" (this rank's share; exchanged in {:.2f} s)", tixelSetup.exchangeSeconds) : ""));
   }
@@ -180,7 +180,7 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   distributed.heldTixels = heldTixels;
   // (One rank: no costs are estimated, its share is the whole.)
   for (double c : plan.rankCost) distributed.estimatedCost.push_back(totalCost > 0 ? c / totalCost : 1.0 / ranks);
-  distributed.setupSeconds = chartSeconds;
+  distributed.setupSeconds = setupSeconds;
   distributed.tixelSetupSeconds = gatherDoubles(tixelSetup.seconds);
   distributed.tixelSetupExchangeSeconds = tixelSetup.exchangeSeconds;
   distributed.visibilityRays = comm.allgather(rays);

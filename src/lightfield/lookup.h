@@ -147,6 +147,7 @@ inline constexpr float kFullResolution = 0.0f;
 /// log2 is core/math.h approximateLog2 (within 0.008 of a level).
 inline float albedoTextureLod(const Mesh& mesh, uint32_t triangle, const Texture& texture, const Vec3& direction,
                               float coneWidth) {
+  if (!(coneWidth > 0.0f)) return kFullResolution;  // LOD off: the same level 0, without the triangle's loads
   const UVec3 tri = mesh.triangles[triangle];
   const Vec3 c = glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]], mesh.positions[tri[2]] - mesh.positions[tri[0]]);
   float uvCross = 1.0f;  // uvAt's barycentric uvs: (0,0), (1,0), (0,1)
