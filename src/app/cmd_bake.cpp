@@ -28,6 +28,7 @@ struct BakeCommandOptions {
   uint32_t gatherDirections = 0;
   uint32_t lightSamples = 0;
   float tolerance = 0.0f;
+  bool sunMasks = true;           ///< --sun-masks on|off
   std::string compress = "none";  ///< how the values are stored: none|lossless|bc1|hdr (compression.h)
 };
 
@@ -47,6 +48,7 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global, Com
   jobOptions.gatherDirections = options.gatherDirections;
   jobOptions.lightSamples = options.lightSamples;
   jobOptions.tolerance = options.tolerance;
+  jobOptions.sunMasks = options.sunMasks;
   jobOptions.reuseVisibility = options.reuseVisibility;
   jobOptions.compress = options.compress;
   jobOptions.seed = global.seed;
@@ -115,6 +117,12 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--tolerance", options->tolerance,
                       "Override the preset: relative change of total power at which iteration stops")
       ->check(CLI::Range(1e-9f, 1.0f));
+  command
+      ->add_option_function<std::string>(
+          "--sun-masks", [options](const std::string& s) { options->sunMasks = s == "on"; },
+          "Sub-tixel visibility masks for directional lights (sharp sun shadows; the README's \"Sun masks\"): on|off")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->default_str("on");
   command->callback([options, &global] { runBakeCommand(*options, global); });
 }
 

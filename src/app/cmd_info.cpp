@@ -1,6 +1,6 @@
 // `plenoptic info IN.plf [--json] [--no-verify]`: what a light-field file holds — format
-// version, the embedded scene, charts by kind, tixels, values, section sizes, and the bake's
-// settings and statistics — read without decoding the values (plf/plf_file.h).
+// version, the embedded scene, charts by kind, tixels, values, sun masks, section sizes, and
+// the bake's settings and statistics — read without decoding the values (plf/plf_file.h).
 #include <fmt/format.h>
 
 #include <map>
@@ -110,6 +110,7 @@ nlohmann::json toJson(const PlfInfo& info) {
             {"curved", info.curvedCharts}}},
           {"tixels", info.tixels},
           {"values", info.values},
+          {"sun_mask_lights", info.sunMaskLights},
           {"sections", sections},
           {"compression",
            {{"mode", std::string(storage.mode)},
@@ -127,7 +128,8 @@ nlohmann::json toJson(const PlfInfo& info) {
             {"max_iterations", bs.maxIterations},
             {"mirror_depth", bs.mirrorDepth},
             {"area_light_samples", bs.areaLightSamples},
-            {"seed", bs.seed}}},
+            {"seed", bs.seed},
+            {"sun_masks", bs.sunMasks}}},
           {"stats",
            {{"seconds", st.seconds},
             {"visibility_seconds", st.visibilitySeconds},
@@ -164,6 +166,12 @@ void printHuman(const PlfInfo& info) {
              info.diffuseCharts, info.glossyCharts, info.specularCharts, info.twoSidedCharts, info.curvedCharts);
   fmt::print("tixels       {}\n", info.tixels);
   fmt::print("values       {} RGB (float32, {})\n", info.values, humanBytes(info.values * 12));
+  if (info.sunMaskLights == 0)
+    fmt::print("sun masks    none\n");
+  else
+    fmt::print("sun masks    {} light{} ({} tixels × {} bytes, {})\n", info.sunMaskLights,
+               info.sunMaskLights == 1 ? "" : "s", info.tixels, 2 * info.sunMaskLights,
+               humanBytes(info.tixels * 2 * info.sunMaskLights));
   const ValuesStorage storage = valuesStorage(info);
   fmt::print("compression  {}: values {} stored as {} ({:.2f}:1)\n", storage.mode, humanBytes(storage.decodedBytes),
              humanBytes(storage.storedBytes), storage.ratio);

@@ -200,6 +200,13 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   lf.charts = param.charts;
   lf.triangleChart = param.triangleChart;
   lf.values = std::move(prop.values);
+  // Sun masks: the masked lights leave the stored irradiance and go with the masks
+  // (lightfield.h "Sun masks").
+  removeSunMaskedDirect(lf.scene, param, lf.values);
+  lf.sunMaskLightCount = uint32_t(param.sunMaskLights.size());
+  lf.sunMasks.reserve(param.tixelCount * lf.sunMaskLightCount);
+  for (uint64_t g = 0; g < param.tixelCount && lf.sunMaskLightCount > 0; ++g)
+    lf.sunMasks.insert(lf.sunMasks.end(), param.sunMask[g].begin(), param.sunMask[g].begin() + lf.sunMaskLightCount);
   double slowestVisibility = 0.0;
   uint64_t totalRays = 0;
   for (int r = 0; r < ranks; ++r) {

@@ -276,6 +276,100 @@ bool buried(const Scene& scene, const Accel& accel, const TixelFrame& f, const V
   return false;
 }
 
+/// The sun masks of tixel (i, j) (bin `bin` of chart raster r) for the lights `lights`
+/// (lightfield.h "Sun masks"). Each footprint sub-sample inside the polygon casts one ray
+/// towards each light from its point on the surface (lifted off it along its normal): lit when
+/// it escapes, shadowed when it meets anything (either side of a surface, as the path
+/// tracer's shadow rays) or faces away from the light. A shadowed sub-sample of a planar chart
+/// that a wall separates from the tixel's gather point (x, normal n: unburied by construction)
+/// is buried — the floor under a wall or a column's base, which nobody sees — and undecided:
+/// its bit, like those of sub-samples outside the polygon, is copied from the nearest decided
+/// sub-sample, so that the masks do not darken the visible surface next to a contact. A tixel
+/// with none decided takes, for all bits, whether the light reaches its gather point. The 16
+/// rays of a light leave neighbouring points in one direction: one coherent packet.
+SunMaskSlots tixelSunMasks(const Scene& scene, const Accel& accel, const Chart& c, const ChartRaster& r, uint32_t bin,
+                           uint32_t i, uint32_t j, const Vec3& x, const Vec3& n, const std::vector<uint32_t>& lights) {
+  constexpr int kSamples = kSunMaskSide * kSunMaskSide;
+  std::array<Vec3, kSamples> point, normal;
+  std::array<bool, kSamples> inside{};
+  for (int b = 0; b < kSunMaskSide; ++b)
+    for (int a = 0; a < kSunMaskSide; ++a) {
+      const int k = b * kSunMaskSide + a;
+      const Vec2 q(float(i) + (a + 0.5f) / kSunMaskSide, float(j) + (b + 0.5f) / kSunMaskSide);
+      const FootprintSample s = locate(r, bin, q);
+      if (!s.inside) continue;
+      inside[size_t(k)] = true;
+      point[size_t(k)] = pointOnTriangle(scene, r.tris[s.tri], s.bary);
+      const ChartRaster::Tri2& t = r.tris[s.tri];
+      normal[size_t(k)] = chartShadingNormalAt(c, scene.meshes[t.mesh], t.triangle, Vec2(s.bary[1], s.bary[2]));
+    }
+  SunMaskSlots masks;
+  masks.fill(SunMask(0xffffu));
+  std::array<Ray, kSamples> rays;
+  std::array<uint8_t, kSamples> blocked;
+  for (size_t slot = 0; slot < lights.size(); ++slot) {
+    const PunctualLight light = PunctualLight::from(scene.lights[lights[slot]]);
+    const Vec3 wi = -light.direction;  // towards the light
+    // 1 lit, 0 shadowed, −1 undecided.
+    std::array<int, kSamples> state;
+    state.fill(-1);
+    size_t count = 0;
+    std::array<int, kSamples> rayOf;
+    rayOf.fill(-1);
+    for (int k = 0; k < kSamples; ++k) {
+      if (!inside[size_t(k)]) continue;
+      if (!(glm::dot(normal[size_t(k)], wi) > 0.0f)) {
+        state[size_t(k)] = 0;  // faces away: no direct light from it on this side
+        continue;
+      }
+      rays[count] = Ray{offsetRayOrigin(point[size_t(k)], normal[size_t(k)], wi), wi, 0.0f, kInfinity};
+      rayOf[size_t(k)] = int(count++);
+    }
+    accel.occludedCoherent(std::span<const Ray>(rays.data(), count), std::span<uint8_t>(blocked.data(), count));
+    for (int k = 0; k < kSamples; ++k) {
+      if (rayOf[size_t(k)] < 0) continue;
+      if (!blocked[size_t(rayOf[size_t(k)])]) {
+        state[size_t(k)] = 1;
+        continue;
+      }
+      // Shadowed — unless the sub-sample lies beyond a wall from the gather point: under
+      // or behind something standing on the surface, where no viewer looks (its ray starts
+      // inside the occluder). On a planar chart the segment between the two points, lifted
+      // off the surface, then meets that wall; on a curved one it may cut through the
+      // surface itself, so there every hit counts.
+      state[size_t(k)] = 0;
+      if (c.curved) continue;
+      const Vec3 from = offsetRayOrigin(x, n, n), to = offsetRayOrigin(point[size_t(k)], n, n);
+      const float length = glm::length(to - from);
+      if (length > 0.0f && accel.occluded(Ray{from, (to - from) / length, 0.0f, length})) state[size_t(k)] = -1;
+    }
+    // Undecided bits from the nearest decided sub-sample (squared distance in sub-samples; ties
+    // to the lower index), or all from the gather point.
+    bool anyDecided = false;
+    for (int k = 0; k < kSamples; ++k) anyDecided = anyDecided || state[size_t(k)] >= 0;
+    int gatherPointLit = 1;
+    if (!anyDecided) {
+      const float cosTheta = glm::dot(n, wi);
+      gatherPointLit = cosTheta > 0.0f && !accel.occluded(Ray{offsetRayOrigin(x, n, wi), wi, 0.0f, kInfinity}) ? 1 : 0;
+    }
+    SunMask mask = 0;
+    for (int k = 0; k < kSamples; ++k) {
+      int lit = anyDecided ? state[size_t(k)] : gatherPointLit;
+      if (lit < 0) {
+        int best = 1 << 30;
+        for (int m = 0; m < kSamples; ++m) {
+          if (state[size_t(m)] < 0) continue;
+          const int du = m % kSunMaskSide - k % kSunMaskSide, dv = m / kSunMaskSide - k / kSunMaskSide;
+          if (du * du + dv * dv < best) best = du * du + dv * dv, lit = state[size_t(m)];
+        }
+      }
+      if (lit > 0) mask = SunMask(mask | (1u << k));
+    }
+    masks[slot] = mask;
+  }
+  return masks;
+}
+
 void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
                      const std::vector<std::pair<uint32_t, uint32_t>>& tris, Parameterisation& p) {
   const ChartRaster r = rasteriseChart(scene, c, tris);
@@ -371,6 +465,8 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       }
       p.gatherPoint[g] = point;
       if (c.curved) p.gatherNormal[g] = normal;
+      if (c.kind == ChartKind::Diffuse && !p.sunMaskLights.empty() && !r.tris.empty())
+        p.sunMask[g] = tixelSunMasks(scene, accel, c, r, local, i, j, point, normal, p.sunMaskLights);
 
       if (c.kind == ChartKind::Diffuse) {
         if (!textured) {
@@ -775,6 +871,10 @@ Parameterisation buildCharts(const Scene& scene, const Accel& accel, const BakeS
   p.gatherNormal.resize(p.tixelCount);
   p.coverage.resize(p.tixelCount);
   p.transportAlbedo.resize(p.tixelCount);
+  if (settings.sunMasks) p.sunMaskLights = sunMaskLights(scene);
+  SunMaskSlots allLit;
+  allLit.fill(SunMask(0xffffu));
+  p.sunMask.assign(p.tixelCount, allLit);
   for (uint32_t ci = 0; ci < recordCount; ++ci)
     std::fill_n(p.tixelChart.begin() + int64_t(p.charts[ci].firstTixel), p.charts[ci].tixelCount(), ci);
   return p;

@@ -72,6 +72,7 @@
 
 #include <cstdint>
 #include <utility>
+#include <array>
 #include <vector>
 
 namespace pl {
@@ -109,6 +110,11 @@ struct Parameterisation {
   std::vector<Vec3> gatherNormal;
   std::vector<float> coverage;        ///< fraction of the tixel's square covered by the polygon
   std::vector<Rgb> transportAlbedo;   ///< diffuse charts: mean albedo over the tixel's footprint
+  /// Sun masks (lightfield.h "Sun masks"): the scene lights masked (sunMaskLights, or none
+  /// when BakeSettings::sunMasks is off) and per tixel one mask per masked light (slots past
+  /// their count unused; every bit set on glossy and specular charts).
+  std::vector<uint32_t> sunMaskLights;
+  std::vector<std::array<SunMask, kMaxSunMaskLights>> sunMask;
 };
 
 /// The frame tixel `tixel` of chart c gathers in and stores its directional map in

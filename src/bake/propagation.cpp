@@ -474,6 +474,33 @@ std::vector<uint64_t> propagationBatches(const Parameterisation& param) {
 
 TransportState::~TransportState() = default;
 
+int sunMaskSlot(const Parameterisation& param, uint32_t light) {
+  const auto at = std::find(param.sunMaskLights.begin(), param.sunMaskLights.end(), light);
+  return at == param.sunMaskLights.end() ? -1 : int(at - param.sunMaskLights.begin());
+}
+
+Rgb sunMaskedIrradiance(const Parameterisation& param, const PunctualLight& light, uint64_t tixel, size_t slot) {
+  const Chart& c = param.charts[param.tixelChart[tixel]];
+  const float cosTheta = glm::dot(tixelFrame(param, c, tixel).n, -light.direction);
+  if (!(cosTheta > 0.0f)) return Rgb(0.0f);
+  return light.intensity * (cosTheta * sunMaskFraction(param.sunMask[tixel][slot]));
+}
+
+void removeSunMaskedDirect(const Scene& scene, const Parameterisation& param, std::vector<Rgb>& values) {
+  if (param.sunMaskLights.empty()) return;
+  std::vector<PunctualLight> lights;
+  for (uint32_t index : param.sunMaskLights) lights.push_back(PunctualLight::from(scene.lights[index]));
+  parallelForRange(param.tixelCount, 4096, [&](uint64_t begin, uint64_t end) {
+    for (uint64_t g = begin; g < end; ++g) {
+      const Chart& c = param.charts[param.tixelChart[g]];
+      if (c.kind != ChartKind::Diffuse) continue;
+      Rgb& value = values[valueBase(g, c)];
+      for (size_t slot = 0; slot < lights.size(); ++slot) value -= sunMaskedIrradiance(param, lights[slot], g, slot);
+      value = glm::max(value, Rgb(0.0f));  // what rounding leaves below the other terms
+    }
+  });
+}
+
 void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progress* progress) {
   const Scene& scene = state.scene;
   const Accel& accel = state.accel;
@@ -512,11 +539,18 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       // Rough glass takes light from both sides: reflected from its own, transmitted from
       // the other (|cos θ|; the BSDF chooses, see the Pending loop below).
       const bool bothSides = isRoughGlassChart(c, scene.materials[c.material].bsdf);
-      for (const PunctualLight& light : punctualLights) {
+      for (size_t li = 0; li < punctualLights.size(); ++li) {
+        const PunctualLight& light = punctualLights[li];
         Vec3 wi;
         float distance;
         Rgb incident;
         if (!light.incidentAt(x, wi, distance, incident)) continue;
+        // A masked light on a diffuse tixel: its footprint's mean visibility, no ray
+        // (lightfield.h "Sun masks"; sunMaskedIrradiance, which the bake takes back out).
+        if (const int slot = sunMaskSlot(param, uint32_t(li)); slot >= 0 && c.kind == ChartKind::Diffuse) {
+          direct[valueBase(g, c)] += sunMaskedIrradiance(param, light, g, size_t(slot));
+          continue;
+        }
         const float cosTheta = bothSides ? std::abs(glm::dot(normal, wi)) : glm::dot(normal, wi);
         if (!(cosTheta > 0.0f) || isBlack(incident)) continue;
         const Vec3 origin = offsetRayOrigin(x, normal, wi);

@@ -46,6 +46,7 @@ namespace pl {
 
 class Accel;
 class Progress;
+struct PunctualLight;
 
 struct PropagationResult {
   std::vector<Rgb> values;  ///< in LightField::values layout, emission included for glossy charts
@@ -133,6 +134,16 @@ struct TransportState {
 /// tixels [begin, end) are added to state.direct. Needs no visibility field. Advances
 /// `progress` (may be null) by the tixels done.
 void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progress* progress = nullptr);
+/// Sun masks (lightfield.h): the slot of scene light `light` among param.sunMaskLights, or −1.
+int sunMaskSlot(const Parameterisation& param, uint32_t light);
+/// What masked light `light` (slot `slot`) adds to diffuse tixel `tixel`'s irradiance in the
+/// first shot: its irradiance × max(0, cos θ) at the tixel's normal × the lit fraction of the
+/// tixel's mask (W·m⁻²).
+Rgb sunMaskedIrradiance(const Parameterisation& param, const PunctualLight& light, uint64_t tixel, size_t slot);
+/// Takes the masked lights' first shot (sunMaskedIrradiance) back out of every diffuse
+/// tixel's final irradiance: the light field stores the rest, and the renderers add those
+/// lights at each point through the masks (lightfield.h "Sun masks"). Clamped at 0.
+void removeSunMaskedDirect(const Scene& scene, const Parameterisation& param, std::vector<Rgb>& values);
 /// First shot, gather: emission and environment arriving along the gather rays of tixels
 /// [begin, end) are added to state.direct. Throws pl::Error when `vis` does not hold the range
 /// or has another gather grid.

@@ -165,6 +165,7 @@ TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, P
   exchange(param.gatherNormal);
   exchange(param.coverage);
   exchange(param.transportAlbedo);
+  exchange(param.sunMask);
   timing.exchangeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - filled).count();
   return timing;
 }

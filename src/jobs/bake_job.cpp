@@ -87,6 +87,7 @@ BakeSettings BakeJob::settings() const {
   if (options_.tixelsAcross > 0.0f) settings.tixelsAcrossScene = options_.tixelsAcross;
   if (options_.gatherDirections > 0) settings.gatherDirections = options_.gatherDirections;
   if (options_.lightSamples > 0) settings.areaLightSamples = options_.lightSamples;
+  settings.sunMasks = options_.sunMasks;
   if (options_.tolerance > 0.0f) settings.tolerance = options_.tolerance;
   settings.seed = options_.seed;
   return settings;

@@ -54,11 +54,30 @@
 // the other record's gather rays bring (propagation.cpp). The dielectric BSDF's frame is the
 // front record's (+z = the outside, the geometric front: bsdf.h), so a back record's local
 // directions are turned into it by negating z (glassBsdfDirection).
+//
+// Sun masks (refinement where the light changes fastest: the edges of sun shadows). A tixel
+// samples the light at its gather point, and bilinear interpolation between tixel centres
+// spreads a sun shadow's edge over a tixel (8 cm at Sponza's default density, where the path
+// tracer's edge is a step). So for directional lights the light field keeps their visibility
+// at 4 × 4 points per tixel: every tixel of a diffuse chart stores, per masked light
+// (sunMaskLights: the scene's first kMaxSunMaskLights directional lights; none in a scene with
+// thin glass, whose shadow rays carry a colour, not a bit), a 16-bit mask whose bit
+// (b·kSunMaskSide + a) says whether the light reaches the tixel's footprint sub-sample (a, b)
+// — the point at tixel coordinates (i + (a + ½)/4, j + (b + ½)/4) (a along axisU, b along
+// axisV), the same sub-samples the parameterisation's coverage and albedo use. A diffuse
+// tixel's stored irradiance E then *excludes* those lights' direct irradiance, and a lookup
+// adds it back at the point: E_l·max(0, n·ω_l)·V_l, with V_l bilinear between the four
+// nearest sub-sample bits (sunVisibility) — edges resolved to a quarter of a tixel. (The bake
+// adds the same lights to the tixel's first shot as E_l·max(0, n_g·ω_l)·(set bits / 16): the
+// footprint's mean instead of one ray from the gather point; removeSunMaskedDirect.)
 #include "core/math.h"
 #include "scene/scene.h"
 
+#include <array>
+#include <bit>
 #include <cstdint>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace pl {
@@ -103,6 +122,8 @@ struct BakeSettings {
   uint32_t mirrorDepth = 256;      ///< longest ideal-specular chain followed (roulette from step 8: lookup.h)
   uint32_t areaLightSamples = 32;  ///< shadow rays per tixel towards emissive surfaces (MIS with the gather); 0 = gather only
   uint64_t seed = 0;
+  /// Sun masks for directional lights (lightfield.h "Sun masks"); `bake --sun-masks off`.
+  bool sunMasks = true;
 };
 
 struct BakeStats {
@@ -116,14 +137,70 @@ struct BakeStats {
   bool reusedVisibility = false;
 };
 
+/// Sun masks (see the header comment): at most this many directional lights are masked, with
+/// kSunMaskSide² sub-samples per tixel.
+inline constexpr uint32_t kMaxSunMaskLights = 4;
+inline constexpr int kSunMaskSide = 4;
+using SunMask = uint16_t;
+/// One tixel's masks, one slot per masked light (the bake's per-tixel layout).
+using SunMaskSlots = std::array<SunMask, kMaxSunMaskLights>;
+static_assert(kSunMaskSide * kSunMaskSide == 16, "a sun mask is 16 bits");
+
+/// Indices into scene.lights of the lights that get sun masks: its first kMaxSunMaskLights
+/// directional lights, or none when a material is thin glass.
+inline std::vector<uint32_t> sunMaskLights(const Scene& scene) {
+  std::vector<uint32_t> lights;
+  for (const Material& m : scene.materials)
+    if (const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf); glass && glass->thin) return lights;
+  for (uint32_t i = 0; i < scene.lights.size() && lights.size() < kMaxSunMaskLights; ++i)
+    if (std::holds_alternative<DirectionalLight>(scene.lights[i])) lights.push_back(i);
+  return lights;
+}
+
 struct LightField {
   Scene scene;                                     ///< geometry, materials, textures, cameras, environment
   std::vector<Chart> charts;
   std::vector<std::vector<uint32_t>> triangleChart;  ///< [mesh][triangle] → chart index
   std::vector<Rgb> values;                         ///< see the header comment for units
+  /// Sun masks (header comment): sunMaskLightCount = sunMaskLights(scene).size() masks per
+  /// tixel, mask of light l of tixel g at [g·sunMaskLightCount + l] (all bits set on tixels
+  /// of glossy and specular charts, which keep those lights in their values). Count 0 and no
+  /// masks: a light field baked without them (`bake --sun-masks off`, or older files), whose
+  /// diffuse values include every light.
+  uint32_t sunMaskLightCount = 0;
+  std::vector<SunMask> sunMasks;
   BakeSettings settings;
   BakeStats stats;
 };
+
+/// The fraction of light l's sun mask that is lit at grid position `grid` of chart c (tixel
+/// coordinates with tixel (i, j)'s centre at (i, j), tixelGridCoordinates): bilinear between
+/// the four nearest sub-sample centres, clamped to the chart's grid. chartMasks points at the
+/// masks of the chart's tixel (0, 0) (sunMasks + firstTixel·lightCount).
+inline float sunVisibility(const SunMask* chartMasks, uint32_t lightCount, uint32_t light, const Chart& c, Vec2 grid) {
+  // Sub-sample coordinates: sub-sample s (along one axis) of the chart has its centre at
+  // grid (s + ½)/4 − ½, so s = 4·(grid + ½) − ½.
+  auto axis = [](float g, uint32_t res, uint32_t& s0, uint32_t& s1, float& f) {
+    const float last = float(res * kSunMaskSide - 1);
+    const float s = std::min(std::max(float(kSunMaskSide) * (g + 0.5f) - 0.5f, 0.0f), last);  // NaN → 0
+    s0 = uint32_t(s);
+    s1 = std::min(s0 + 1, res * kSunMaskSide - 1);
+    f = s - float(s0);
+  };
+  uint32_t u0, u1, v0, v1;
+  float fu, fv;
+  axis(grid.x, c.resU, u0, u1, fu);
+  axis(grid.y, c.resV, v0, v1, fv);
+  auto bit = [&](uint32_t su, uint32_t sv) {
+    const uint32_t tixel = (sv / kSunMaskSide) * c.resU + su / kSunMaskSide;
+    const uint32_t b = (sv % kSunMaskSide) * kSunMaskSide + su % kSunMaskSide;
+    return float((chartMasks[uint64_t(tixel) * lightCount + light] >> b) & 1u);
+  };
+  return (1.0f - fv) * ((1.0f - fu) * bit(u0, v0) + fu * bit(u1, v0)) + fv * ((1.0f - fu) * bit(u0, v1) + fu * bit(u1, v1));
+}
+
+/// The lit fraction of a sun mask (the bake's footprint mean).
+inline float sunMaskFraction(SunMask mask) { return float(std::popcount(mask)) / float(kSunMaskSide * kSunMaskSide); }
 
 /// The normal of chart record c at triangle `triangle` of `mesh` (one of its triangles): the
 /// chart normal for a planar chart (its triangles are coplanar within

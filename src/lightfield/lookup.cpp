@@ -78,7 +78,25 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
   return true;
 }
 
-ChartShading chartShading(const Scene& scene, const Chart& c) {
+SunLights sunLightsOf(const LightField& lf) {
+  SunLights sun;
+  if (lf.sunMaskLightCount == 0) return sun;
+  const std::vector<uint32_t> lights = sunMaskLights(lf.scene);
+  if (lights.size() != lf.sunMaskLightCount)
+    fail("{}: the light field has sun masks for {} light(s), its scene {} directional light(s) to mask", lf.scene.sourcePath,
+         lf.sunMaskLightCount, lights.size());
+  for (uint32_t l = 0; l < lf.sunMaskLightCount; ++l) {
+    const auto& light = std::get<DirectionalLight>(lf.scene.lights[lights[l]]);
+    sun.towardsLight[l] = -light.direction;
+    sun.irradiance[l] = light.irradiance;
+  }
+  sun.count = lf.sunMaskLightCount;
+  return sun;
+}
+
+ChartShading chartShading(const LightField& lf, uint32_t chart, const SunLights& sun) {
+  const Scene& scene = lf.scene;
+  const Chart& c = lf.charts[chart];
   const Material& material = scene.materials[c.material];
   ChartShading shading;
   // Emission towards the record's own front (a back record's is zero for one-sided emitters).
@@ -93,6 +111,11 @@ ChartShading chartShading(const Scene& scene, const Chart& c) {
   shading.needsUv = c.kind == ChartKind::Diffuse && shading.texturedAlbedo;
   shading.normalMapped = c.kind == ChartKind::Glossy && material.normalTexture >= 0;
   shading.curvedGlossy = c.kind == ChartKind::Glossy && c.curved;
+  if (c.kind == ChartKind::Diffuse && sun.count > 0 &&
+      (c.firstTixel + c.tixelCount()) * sun.count <= lf.sunMasks.size()) {
+    shading.sunMasks = lf.sunMasks.data() + c.firstTixel * sun.count;
+    shading.sun = &sun;
+  }
   return shading;
 }
 
@@ -110,7 +133,8 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
   chart = facingChart(lf.charts.data(), chart, worldDirectionTowardsViewer, lf.charts[chart].normal);
   const Chart& c = lf.charts[chart];
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
-  return exitantRadiance(lf.scene, c, chartShading(lf.scene, c), lf.values.data(), worldPosition,
+  const SunLights sun = sunLightsOf(lf);
+  return exitantRadiance(lf.scene, c, chartShading(lf, chart, sun), lf.values.data(), worldPosition,
                          worldDirectionTowardsViewer, c.normal, uv, kFullResolution);
 }
 
@@ -124,7 +148,8 @@ Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& wor
   if (chart == kNoChartRecord) return Rgb(0.0f);  // inside a closed smooth mesh
   const Chart& c = lf.charts[chart];
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
-  const ChartShading shading = chartShading(lf.scene, c);
+  const SunLights sun = sunLightsOf(lf);
+  const ChartShading shading = chartShading(lf, chart, sun);
   RayHit rayHit;
   rayHit.mesh = hit.mesh;
   rayHit.triangle = hit.triangle;

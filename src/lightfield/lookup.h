@@ -209,6 +209,8 @@ float specularBranchU(const Ray& ray);
 /// (other bits of the same hash as specularBranchU: independent of the branch).
 float specularRouletteU(const Ray& ray);
 
+struct SunLights;
+
 /// The per-chart constants of exitantRadiance (its material's emission and, when no texture
 /// varies it, its diffuse albedo). The fast renderer (src/realtime) precomputes one per chart;
 /// the plain exitantRadiance below builds it on the fly, so both run the same formula.
@@ -224,8 +226,49 @@ struct ChartShading {
   /// A curved glossy chart: its map is read in the frame around the hit's interpolated normal
   /// (chartShadingNormalAt), so the lookup needs the hit's triangle and barycentrics.
   bool curvedGlossy = false;
+  /// Sun masks (lightfield.h): on a diffuse chart of a light field that has them, the masks
+  /// of the chart's tixel (0, 0) and the masked lights; the lookup adds those lights'
+  /// irradiance through the masks (sunIrradianceLanes). Null otherwise.
+  const SunMask* sunMasks = nullptr;
+  const SunLights* sun = nullptr;
 };
-ChartShading chartShading(const Scene& scene, const Chart& c);
+
+/// The lights a light field's sun masks stand for (LightField::sunMaskLightCount of
+/// sunMaskLights(scene)): unit direction towards each and its irradiance (W·m⁻²) on a surface
+/// facing it.
+struct SunLights {
+  uint32_t count = 0;
+  std::array<Vec3, kMaxSunMaskLights> towardsLight{};
+  std::array<Rgb, kMaxSunMaskLights> irradiance{};
+};
+SunLights sunLightsOf(const LightField& lf);
+
+/// The lookup's precomputed shading of chart record `chart` of lf; `sun` (sunLightsOf(lf)) must
+/// outlive it.
+ChartShading chartShading(const LightField& lf, uint32_t chart, const SunLights& sun);
+
+/// Whether the lookup needs the hit's interpolated normal on chart c: curved glossy charts
+/// (their maps) and curved diffuse charts with sun masks (the masked lights' cos θ).
+inline bool needsInterpolatedNormal(const Chart& c, const ChartShading& shading) {
+  return shading.curvedGlossy || (c.curved && shading.sunMasks != nullptr);
+}
+
+/// The masked lights' irradiance (W·m⁻², lanes r, g, b, 0) at grid position `grid` of diffuse
+/// chart c (tixelGridCoordinates) on a surface with unit normal `normal` (the chart's, or on a
+/// curved chart the interpolated normal at the point): Σ_l E_l·max(0, n·ω_l)·V_l(grid), V_l the
+/// bilinear mask visibility (sunVisibility). Zero without masks.
+inline F4 sunIrradianceLanes(const Chart& c, const ChartShading& shading, Vec2 grid, const Vec3& normal) {
+  F4 sum = f4Zero();
+  if (shading.sunMasks == nullptr) return sum;
+  const SunLights& sun = *shading.sun;
+  for (uint32_t l = 0; l < sun.count; ++l) {
+    const float cosTheta = glm::dot(normal, sun.towardsLight[l]);
+    if (!(cosTheta > 0.0f)) continue;
+    const float lit = sunVisibility(shading.sunMasks, sun.count, l, c, grid);
+    if (lit > 0.0f) sum = f4Add(sum, f4Mul(f4FromRgb(sun.irradiance[l]), f4Splat(cosTheta * lit)));
+  }
+  return sum;
+}
 
 /// The direction to look a glossy chart up in, for a viewer towards wo (unit, world) at a
 /// point whose shading normal n' (normal-mapped, surfaceAt) differs from the normal n its map
@@ -237,12 +280,14 @@ ChartShading chartShading(const Scene& scene, const Chart& c);
 /// (grazing tilts).
 Vec3 normalMappedLookupDirection(const Vec3& mapNormal, const Vec3& shadingNormal, const Vec3& wo);
 
-/// The unit normal chart c's glossy map is read around at barycentrics (b1, b2) of triangle
-/// `triangle` of mesh `mesh` (exitantRadianceLanes' lookupNormal): chartShadingNormalAt on a
-/// curved glossy chart, the chart normal otherwise (where it is not read).
+/// The unit normal chart c's lookup takes at barycentrics (b1, b2) of triangle `triangle` of
+/// mesh `mesh` (exitantRadianceLanes' lookupNormal: a glossy map is read around it, the sun
+/// masks' lights shine on it): chartShadingNormalAt where needsInterpolatedNormal, the chart
+/// normal otherwise.
 inline Vec3 lookupNormalAt(const Scene& scene, const Chart& c, const ChartShading& shading, uint32_t mesh,
                            uint32_t triangle, Vec2 barycentrics) {
-  return shading.curvedGlossy ? chartShadingNormalAt(c, scene.meshes[mesh], triangle, barycentrics) : c.normal;
+  return needsInterpolatedNormal(c, shading) ? chartShadingNormalAt(c, scene.meshes[mesh], triangle, barycentrics)
+                                             : c.normal;
 }
 
 /// What exitantRadianceLanes needs of a ray's hit on chart c besides the position: the uv
@@ -323,8 +368,8 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
   // facingChart), only two-sided emission.
   if (!(cosTheta >= 0.0f)) return shading.emissive && emits ? f4Load(shading.emission.v) : f4Zero();
   if (c.kind == ChartKind::Diffuse) {
-    // Le + (albedo/π) · E, lane by lane.
-    const F4 irradiance = interpolateLanes(load, c, grid, Vec2(0.0f));
+    // Le + (albedo/π) · E, lane by lane; E = the stored irradiance plus the sun masks' lights.
+    const F4 irradiance = f4Add(interpolateLanes(load, c, grid, Vec2(0.0f)), sunIrradianceLanes(c, shading, grid, lookupNormal));
     const F4 albedoOverPi = shading.texturedAlbedo ? f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv, lod)), f4Splat(kInvPi))
                                                    : f4Load(shading.albedoOverPi.v);
     const F4 reflected = f4Mul(albedoOverPi, irradiance);
@@ -401,6 +446,15 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
     return out;
   };
   const Taps u = taps(gridU, c.resU), v = taps(gridV, c.resV);
+  // The sun masks' lights, lookup by lookup (the scalar sunIrradianceLanes on the same grid
+  // coordinates; planar charts only: the fast renderer sends curved ones with masks one by one).
+  F4 sunIrradiance[4] = {f4Zero(), f4Zero(), f4Zero(), f4Zero()};
+  if (shading.sunMasks != nullptr) {
+    alignas(16) float gu[4], gv[4];
+    _mm_store_ps(gu, gridU);
+    _mm_store_ps(gv, gridV);
+    for (int k = 0; k < 4; ++k) sunIrradiance[k] = sunIrradianceLanes(c, shading, Vec2(gu[k], gv[k]), c.normal);
+  }
   // bit k: cos θ_k > 0, and cos θ_k ≥ 0 (a curved chart: kCurvedChartCosine > 0 in every lane).
   const int frontSide = c.curved ? 0xf : _mm_movemask_ps(_mm_cmpgt_ps(cosTheta, zero));
   const int reflectingSide = c.curved ? 0xf : _mm_movemask_ps(_mm_cmpge_ps(cosTheta, zero));
@@ -418,7 +472,7 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
                            f4Mul(f4Splat(u.w1[k] * v.w0[k]), f4Load(values[row0 + u.i1[k]].v)));
     const F4 upper = f4Add(f4Mul(f4Splat(u.w0[k] * v.w1[k]), f4Load(values[row1 + u.i0[k]].v)),
                            f4Mul(f4Splat(u.w1[k] * v.w1[k]), f4Load(values[row1 + u.i1[k]].v)));
-    const F4 reflected = f4Mul(albedoOverPi[k], f4Add(lower, upper));
+    const F4 reflected = f4Mul(albedoOverPi[k], f4Add(f4Add(lower, upper), sunIrradiance[k]));
     const bool front = ((frontSide >> k) & 1) != 0;
     // As exitantRadianceLanes: cos θ = 0 reflects but emits only if two-sided; NaN neither.
     const bool reflects = ((reflectingSide >> k) & 1) != 0;

@@ -131,11 +131,20 @@ TEST(Lookup, FourAtATimeDiffuseLookupEqualsOneAtATimeBitForBit) {
   texture.finish("lookup_test");
   lf.scene.textures.push_back(texture);
   int compared = 0;
-  for (int variant = 0; variant < 3; ++variant) {
+  for (int variant = 0; variant < 4; ++variant) {
     lf.scene.materials[0].twoSidedEmission = variant == 1;
-    lf.scene.materials[0].albedoTexture = variant == 2 ? 0 : -1;
-    const ChartShading shading = chartShading(lf.scene, c);
-    ASSERT_EQ(shading.needsUv, variant == 2);
+    lf.scene.materials[0].albedoTexture = variant >= 2 ? 0 : -1;
+    if (variant == 3) {
+      // Sun masks (lightfield.h): a directional light at 60° from the normal and random
+      // masks, so that sunIrradianceLanes runs lane by lane too.
+      lf.scene.lights.push_back(DirectionalLight{glm::normalize(-c.normal + 1.7f * c.axisU), Rgb(3.0f, 2.0f, 1.0f)});
+      lf.sunMaskLightCount = 1;
+      for (uint64_t g = 0; g < c.tixelCount(); ++g) lf.sunMasks.push_back(SunMask(rng.next() & 0xffffu));
+    }
+    const SunLights sun = sunLightsOf(lf);
+    const ChartShading shading = chartShading(lf, 0, sun);
+    ASSERT_EQ(shading.needsUv, variant >= 2);
+    ASSERT_EQ(shading.sunMasks != nullptr, variant == 3);
     for (int group = 0; group < 500; ++group) {
       RaysSoA4 rays;
       Vec3 origin[4], direction[4];
@@ -168,7 +177,7 @@ TEST(Lookup, FourAtATimeDiffuseLookupEqualsOneAtATimeBitForBit) {
       }
     }
   }
-  EXPECT_EQ(compared, 6000);
+  EXPECT_EQ(compared, 8000);
 }
 
 // The texture LOD's log2 (albedoTextureLod): within 0.0078 of log2 over many octaves, exact at

@@ -37,10 +37,25 @@ constexpr uint32_t kMaxSections = 64;
 /// Longest string (names, paths) a reader accepts.
 constexpr uint32_t kMaxStringBytes = 1u << 20;
 
-enum SectionIndex { kScene = 0, kCharts, kTriangleCharts, kValues, kMeta, kSectionKinds };
-constexpr const char* kSectionIds[kSectionKinds] = {"SCNE", "CHRT", "TRCH", "VALS", "META"};
-constexpr const char* kSectionNames[kSectionKinds] = {"scene", "charts", "triangle charts", "values",
-                                                      "metadata"};
+// Kinds in the order the writer stores them (the reader accepts any order).
+enum SectionIndex { kScene = 0, kCharts, kTriangleCharts, kValues, kSunMasks, kMeta, kSectionKinds };
+constexpr const char* kSectionIds[kSectionKinds] = {"SCNE", "CHRT", "TRCH", "VALS", "SMSK", "META"};
+constexpr const char* kSectionNames[kSectionKinds] = {"scene",     "charts",    "triangle charts", "values",
+                                                      "sun masks", "metadata"};
+/// Whether a file must hold the section (the others are optional: at most once).
+constexpr bool isRequiredSection(int kind) { return kind != kSunMasks; }
+/// The first version that may hold the section (an older file with it is refused as holding
+/// an unknown section, which is what it was when that version was current).
+constexpr uint32_t firstVersionWith(int kind) { return kind == kSunMasks ? 3 : 1; }
+
+/// SMSK (plf_file.h): u32 light count, u32 reserved (0), u64 tixel count, then the masks.
+struct SunMaskHeader {
+  uint32_t lightCount;
+  uint32_t reserved;
+  uint64_t tixelCount;
+};
+static_assert(sizeof(SunMaskHeader) == 16 && std::is_trivially_copyable_v<SunMaskHeader>);
+static_assert(sizeof(SunMask) == 2, "SMSK stores 16-bit masks");
 
 uint64_t alignUp(uint64_t x) { return (x + kSectionAlignment - 1) / kSectionAlignment * kSectionAlignment; }
 
@@ -607,7 +622,8 @@ nlohmann::json settingsToJson(const BakeSettings& s) {
           {"max_iterations", s.maxIterations},
           {"mirror_depth", s.mirrorDepth},
           {"area_light_samples", s.areaLightSamples},
-          {"seed", s.seed}};
+          {"seed", s.seed},
+          {"sun_masks", s.sunMasks}};
 }
 
 nlohmann::json statsToJson(const BakeStats& s) {
@@ -653,6 +669,8 @@ void decodeMeta(std::span<const unsigned char> bytes, const std::string& path, B
     readKey(s, "mirror_depth", settings.mirrorDepth);
     readKey(s, "area_light_samples", settings.areaLightSamples);
     readKey(s, "seed", settings.seed);
+    settings.sunMasks = false;  // writers before sun masks (version ≤ 2) baked without them
+    readKey(s, "sun_masks", settings.sunMasks);
     const auto& t = meta.at("stats");
     readKey(t, "seconds", stats.seconds);
     readKey(t, "visibility_seconds", stats.visibilitySeconds);
@@ -734,8 +752,9 @@ uint64_t headerHash(const Header& header, const std::vector<SectionEntry>& table
 }
 
 /// An opened, structurally validated .plf file: header and section table checked, every
-/// section known, raw, inside the file, in order and without overlap. Section contents are
-/// read (and checksummed) on demand.
+/// section known (for the file's version), at most once, raw (VALS: a known codec), inside
+/// the file, in order and without overlap, and every required section present (all but
+/// SMSK). Section contents are read (and checksummed) on demand.
 class PlfReader {
  public:
   explicit PlfReader(const std::string& path) : path_(path) {
@@ -784,7 +803,8 @@ class PlfReader {
       const SectionEntry& e = table_[i];
       const std::string id(e.id, 4);
       const auto kind = std::find(std::begin(kSectionIds), std::end(kSectionIds), id) - std::begin(kSectionIds);
-      if (kind == kSectionKinds) fail("{}: unknown section '{}' in a version {} file", path, id, version_);
+      if (kind == kSectionKinds || version_ < firstVersionWith(int(kind)))
+        fail("{}: unknown section '{}' in a version {} file", path, id, version_);
       if (found[kind] >= 0) fail("{}: section {} appears twice", path, id);
       found[kind] = int(i);
       const bool compressedValues = kind == kValues && e.encoding != uint32_t(ValuesCodec::Raw);
@@ -803,7 +823,8 @@ class PlfReader {
       previousEnd = e.offset + e.storedSize;
     }
     for (int kind = 0; kind < kSectionKinds; ++kind)
-      if (found[kind] < 0) fail("{}: the {} section ({}) is missing", path, kSectionNames[kind], kSectionIds[kind]);
+      if (found[kind] < 0 && isRequiredSection(kind))
+        fail("{}: the {} section ({}) is missing", path, kSectionNames[kind], kSectionIds[kind]);
     std::copy(std::begin(found), std::end(found), std::begin(entryOf_));
 
     if (actualSize_ < fileSize_) {
@@ -821,6 +842,9 @@ class PlfReader {
     checkPadding(tableEnd);
   }
 
+  /// Whether the file holds the section (always, for a required one).
+  bool has(int kind) const { return entryOf_[kind] >= 0; }
+  /// The section's table entry; the section must be present (has).
   const SectionEntry& entry(int kind) const { return table_[size_t(entryOf_[kind])]; }
   uint32_t version() const { return version_; }
   uint64_t fileSize() const { return fileSize_; }
@@ -838,6 +862,24 @@ class PlfReader {
     const SectionEntry& e = entry(kind);
     readAt(file_.fd, e.offset, destination, e.storedSize, path_);
     checkHash(kind, xxh64(destination, e.storedSize));
+  }
+  /// Reads the section's bytes into `head` (headBytes) and then `rest` (storedSize − headBytes;
+  /// headBytes ≤ storedSize), checksum verified: one pass over a section whose header and
+  /// payload live in different places in memory.
+  void readInto(int kind, void* head, uint64_t headBytes, void* rest) const {
+    const SectionEntry& e = entry(kind);
+    readAt(file_.fd, e.offset, head, headBytes, path_);
+    readAt(file_.fd, e.offset + headBytes, rest, e.storedSize - headBytes, path_);
+    Xxh64Stream stream;
+    stream.update(head, headBytes);
+    if (e.storedSize > headBytes) stream.update(rest, e.storedSize - headBytes);  // (rest may be null when empty)
+    checkHash(kind, stream.digest());
+  }
+  /// The section's first `bytes` bytes (≤ storedSize) *without* verifying its checksum: for
+  /// checking a header's sizes before allocating; the caller reads the whole section (or
+  /// verifies it) before trusting anything else.
+  void peek(int kind, void* destination, uint64_t bytes) const {
+    readAt(file_.fd, entry(kind).offset, destination, bytes, path_);
   }
   /// Verifies a section's checksum reading it in bounded chunks.
   void verify(int kind) const {
@@ -894,6 +936,55 @@ std::vector<PlfSectionInfo> sectionInfos(const PlfReader& reader) {
   return infos;
 }
 
+/// The light field's tixel count: the sum of its charts' (saturating at 2^64 − 1, which only
+/// a corrupt file reaches).
+uint64_t chartTixelCount(const std::vector<Chart>& charts) {
+  constexpr uint64_t kMax = std::numeric_limits<uint64_t>::max();
+  uint64_t total = 0;
+  for (const Chart& c : charts) total = c.tixelCount() > kMax - total ? kMax : total + c.tixelCount();
+  return total;
+}
+
+/// Reads SMSK's header (without its checksum) and checks it against the section's size, the
+/// scene's masked lights (sunMaskLights) and the charts' tixels, so that nothing is allocated
+/// from an unchecked count. On a problem the section's checksum is verified first, so
+/// damaged bytes are reported as a checksum mismatch rather than as a bad field.
+SunMaskHeader checkSunMaskHeader(const PlfReader& reader, const std::string& path, const Scene& scene,
+                                 const std::vector<Chart>& charts) {
+  const SectionEntry& e = reader.entry(kSunMasks);
+  auto corrupt = [&](const std::string& problem) {
+    reader.verify(kSunMasks);
+    fail("{}: corrupt sun masks section (SMSK): {}", path, problem);
+  };
+  auto lights = [](uint64_t n) { return fmt::format("{} light{}", n, n == 1 ? "" : "s"); };
+  if (e.storedSize < sizeof(SunMaskHeader))
+    corrupt(fmt::format("{} bytes, fewer than its {}-byte header", e.storedSize, sizeof(SunMaskHeader)));
+  SunMaskHeader h{};
+  reader.peek(kSunMasks, &h, sizeof(h));
+  if (h.reserved != 0) corrupt(fmt::format("reserved field is {}, not 0", h.reserved));
+  if (h.lightCount < 1 || h.lightCount > kMaxSunMaskLights)
+    corrupt(fmt::format("light count {} (must be 1 to {})", h.lightCount, kMaxSunMaskLights));
+  const size_t maskedLights = sunMaskLights(scene).size();
+  if (h.lightCount != maskedLights)
+    corrupt(fmt::format("masks of {} per tixel, but the scene has {} masked light{} (its first {} directional "
+                        "lights, none when a material is thin glass)",
+                        lights(h.lightCount), maskedLights, maskedLights == 1 ? "" : "s", kMaxSunMaskLights));
+  const uint64_t payload = e.storedSize - sizeof(SunMaskHeader);
+  const uint64_t perTixel = uint64_t(h.lightCount) * sizeof(SunMask);
+  if (payload % perTixel != 0 || h.tixelCount != payload / perTixel) {
+    const bool fits = h.tixelCount <= (std::numeric_limits<uint64_t>::max() - sizeof(SunMaskHeader)) / perTixel;
+    corrupt(fmt::format("the section has {} bytes, but its {}-byte header and the masks of {} tixels × {} × {} bytes "
+                        "need {}",
+                        e.storedSize, sizeof(SunMaskHeader), h.tixelCount, lights(h.lightCount), sizeof(SunMask),
+                        fits ? std::to_string(sizeof(SunMaskHeader) + h.tixelCount * perTixel)
+                             : std::string("more than 2^64")));
+  }
+  const uint64_t tixels = chartTixelCount(charts);
+  if (h.tixelCount != tixels)
+    corrupt(fmt::format("masks for {} tixels, but the charts have {} tixels", h.tixelCount, tixels));
+  return h;
+}
+
 }  // namespace
 
 void writeLightField(const std::string& path, const LightField& lf, ValuesCodec valuesEncoding) {
@@ -902,8 +993,23 @@ void writeLightField(const std::string& path, const LightField& lf, ValuesCodec 
 
 void writeLightField(const std::string& path, const LightField& lf, ValuesCodec valuesEncoding,
                      const ValuesCodecOptions& codecOptions) {
-  // Encode the small sections; raw values are written straight from the LightField,
-  // compressed ones from their encoded stream (compression.h).
+  // Sun masks that a reader would refuse are a programming error: refused before anything is
+  // written (lightfield.h: count 0 and no masks, or sunMaskLights(scene) masks per tixel).
+  const uint64_t tixels = chartTixelCount(lf.charts);
+  const size_t maskedLights = sunMaskLights(lf.scene).size();
+  if (lf.sunMaskLightCount != 0 && lf.sunMaskLightCount != maskedLights)
+    fail("{}: cannot write the light field: it has sun masks of {} light{} per tixel, but its scene has {} masked "
+         "light{} (sunMaskLights)",
+         path, lf.sunMaskLightCount, lf.sunMaskLightCount == 1 ? "" : "s", maskedLights, maskedLights == 1 ? "" : "s");
+  if (lf.sunMaskLightCount == 0 ? !lf.sunMasks.empty()
+                                : lf.sunMasks.size() % lf.sunMaskLightCount != 0 ||
+                                      lf.sunMasks.size() / lf.sunMaskLightCount != tixels)
+    fail("{}: cannot write the light field: it holds {} sun masks, but {} masked light{} × {} tixels need {}", path,
+         lf.sunMasks.size(), lf.sunMaskLightCount, lf.sunMaskLightCount == 1 ? "" : "s", tixels,
+         uint64_t(lf.sunMaskLightCount) * tixels);
+
+  // Encode the small sections; raw values and sun masks are written straight from the
+  // LightField, compressed values from their encoded stream (compression.h).
   static_assert(sizeof(Rgb) == 12, "VALS stores float32 RGB triplets");
   const std::vector<unsigned char> scene = encodeScene(lf.scene);
   const std::vector<unsigned char> charts = encodeCharts(lf.charts);
@@ -917,24 +1023,47 @@ void writeLightField(const std::string& path, const LightField& lf, ValuesCodec 
   }
   const std::span<const unsigned char> rawValues{reinterpret_cast<const unsigned char*>(lf.values.data()),
                                                  lf.values.size() * sizeof(Rgb)};
-  const std::span<const unsigned char> sections[kSectionKinds] = {
-      scene, charts, triangleCharts,
-      valuesEncoding == ValuesCodec::Raw ? rawValues : std::span<const unsigned char>(compressedValues), meta};
+  const SunMaskHeader sunMaskHeader{lf.sunMaskLightCount, 0, tixels};
+  const std::span<const unsigned char> sunMasks{reinterpret_cast<const unsigned char*>(lf.sunMasks.data()),
+                                                lf.sunMasks.size() * sizeof(SunMask)};
+
+  // Each section's stored bytes: one or two parts (SMSK's header and its masks), in kind order;
+  // SMSK only when the light field has sun masks.
+  struct OutSection {
+    int kind;
+    std::span<const unsigned char> parts[2];
+    uint64_t size() const { return parts[0].size() + parts[1].size(); }
+  };
+  std::vector<OutSection> sections = {
+      {kScene, {scene, {}}},
+      {kCharts, {charts, {}}},
+      {kTriangleCharts, {triangleCharts, {}}},
+      {kValues,
+       {valuesEncoding == ValuesCodec::Raw ? rawValues : std::span<const unsigned char>(compressedValues), {}}}};
+  if (lf.sunMaskLightCount > 0)
+    sections.push_back(
+        {kSunMasks,
+         {{reinterpret_cast<const unsigned char*>(&sunMaskHeader), sizeof(sunMaskHeader)}, sunMasks}});
+  sections.push_back({kMeta, {meta, {}}});
 
   Header header{};
   std::memcpy(header.magic, kPlfMagic.data(), kPlfMagic.size());
   header.version = kPlfVersion;
-  header.sectionCount = kSectionKinds;
-  std::vector<SectionEntry> table(kSectionKinds);
+  header.sectionCount = uint32_t(sections.size());
+  std::vector<SectionEntry> table(sections.size());
   uint64_t offset = alignUp(sizeof(Header) + table.size() * sizeof(SectionEntry));
-  for (int kind = 0; kind < kSectionKinds; ++kind) {
-    SectionEntry& e = table[size_t(kind)];
-    std::memcpy(e.id, kSectionIds[kind], 4);
-    e.encoding = uint32_t(kind == kValues ? valuesEncoding : ValuesCodec::Raw);
+  for (size_t i = 0; i < sections.size(); ++i) {
+    const OutSection& section = sections[i];
+    SectionEntry& e = table[i];
+    std::memcpy(e.id, kSectionIds[section.kind], 4);
+    e.encoding = uint32_t(section.kind == kValues ? valuesEncoding : ValuesCodec::Raw);
     e.offset = offset;
-    e.storedSize = e.decodedSize = sections[kind].size();
-    if (kind == kValues) e.decodedSize = rawValues.size();
-    e.checksum = xxh64(sections[kind].data(), sections[kind].size());
+    e.storedSize = e.decodedSize = section.size();
+    if (section.kind == kValues) e.decodedSize = rawValues.size();
+    Xxh64Stream stream;
+    for (const auto& part : section.parts)
+      if (!part.empty()) stream.update(part.data(), part.size());
+    e.checksum = stream.digest();
     e.reserved = 0;
     offset = alignUp(offset + e.storedSize);
   }
@@ -955,10 +1084,10 @@ void writeLightField(const std::string& path, const LightField& lf, ValuesCodec 
         writeAll(file.fd, table.data(), table.size() * sizeof(SectionEntry), tempPath);
         uint64_t written = sizeof(header) + table.size() * sizeof(SectionEntry);
         const unsigned char zeros[kSectionAlignment] = {};
-        for (int kind = 0; kind < kSectionKinds; ++kind) {
-          writeAll(file.fd, zeros, table[size_t(kind)].offset - written, tempPath);
-          writeAll(file.fd, sections[kind].data(), sections[kind].size(), tempPath);
-          written = table[size_t(kind)].offset + sections[kind].size();
+        for (size_t i = 0; i < sections.size(); ++i) {
+          writeAll(file.fd, zeros, table[i].offset - written, tempPath);
+          for (const auto& part : sections[i].parts) writeAll(file.fd, part.data(), part.size(), tempPath);
+          written = table[i].offset + sections[i].size();
         }
         const int fd = file.fd;
         file.fd = -1;
@@ -988,6 +1117,16 @@ LightField readLightField(const std::string& path) {
                                          valuesCodecName(ValuesCodec(values.encoding))));
   }
   checkChartRanges(lf.charts, lf.values.size(), path);
+  if (reader.has(kSunMasks)) {
+    // Sizes checked against the section's (file-bounded) size before the masks are allocated.
+    const SunMaskHeader header = checkSunMaskHeader(reader, path, lf.scene, lf.charts);
+    lf.sunMasks.resize(header.tixelCount * header.lightCount);  // = (storedSize − 16) / 2
+    SunMaskHeader again{};
+    reader.readInto(kSunMasks, &again, sizeof(again), lf.sunMasks.data());
+    if (std::memcmp(&again, &header, sizeof(header)) != 0)
+      fail("{}: the sun masks section (SMSK) changed while being read", path);
+    lf.sunMaskLightCount = header.lightCount;
+  }  // else none: sunMaskLightCount 0, sunMasks empty (a file baked without them, or of version 1 or 2)
   decodeMeta(reader.read(kMeta), path, lf.settings, lf.stats);
   return lf;
 }
@@ -1031,10 +1170,12 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
     info.tixels += c.tixelCount();
   }
   info.values = reader.entry(kValues).decodedSize / sizeof(Rgb);
+  if (reader.has(kSunMasks)) info.sunMaskLights = checkSunMaskHeader(reader, path, scene, charts).lightCount;
   decodeMeta(reader.read(kMeta), path, info.settings, info.stats);
   if (verifyChecksums) {
     reader.verify(kTriangleCharts);
     reader.verify(kValues);
+    if (reader.has(kSunMasks)) reader.verify(kSunMasks);
     info.checksumsVerified = true;
   }
   return info;

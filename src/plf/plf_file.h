@@ -1,6 +1,6 @@
 #pragma once
 // The light-field file (.plf): a LightField — its embedded Scene, charts, triangle → chart
-// map, HDR values, bake settings and statistics — in one self-contained binary file.
+// map, HDR values, sun masks, bake settings and statistics — in one self-contained binary file.
 //
 // Layout (all integers and floats little-endian; offsets and sizes in bytes):
 //
@@ -24,7 +24,9 @@
 //              reserved     u64      0
 //   sections, each at its offset, in table order, zero padding between them (checked).
 //
-// Sections (each present exactly once):
+// Sections (SMSK optional, every other one present exactly once; the writer stores them in
+// this order, a reader accepts them in any order in the table; a section id the file's version does not have,
+// such as SMSK in a version 1 or 2 file, is refused as unknown):
 //   SCNE  the Scene: meshes, materials (every BSDF variant's parameters), textures, lights,
 //         cameras, the environment (constant and lat-long map with its scale and rotation)
 //         and the scene file's suggested settings. Everything a renderer needs. A texture
@@ -41,7 +43,19 @@
 //   TRCH  triangle → chart: u64 mesh count, then per mesh u64 triangle count + u32 indices.
 //   VALS  the values: float32 RGB triplets (12 bytes each), in LightField::values order.
 //         Compressed (encoding ≠ 0): a stream of plf/compression.h.
+//   SMSK  (version ≥ 3, optional) the sun masks (lightfield.h "Sun masks"), written only when
+//         LightField::sunMaskLightCount > 0; absent = no masks (count 0). Always raw:
+//           lightCount   u32   L, 1 to kMaxSunMaskLights; must equal sunMaskLights(scene).size()
+//           reserved     u32   0
+//           tixelCount   u64   T, must equal the charts' tixel count (Σ resU·resV)
+//           masks        T × L u16, in LightField::sunMasks order (tixel-major: light l of
+//                        tixel g at g·L + l; bit b·4 + a = sub-sample (a, b) lit)
+//         so the section is exactly 16 + 2·T·L bytes.
 //   META  UTF-8 JSON: {"settings": BakeSettings, "stats": BakeStats}.
+//
+// Versions: 1 textures as float pixels; 2 textures as their image file's bytes; 3 an optional
+// SMSK section (sun masks). A file without sun masks differs from version 2 only in the
+// version field (and so the header hash).
 //
 // The version is checked right after the magic, before anything else is interpreted, so a
 // future layout can change everything after it (versions 1 to kPlfVersion are read). Reading never trusts the file: the magic,
@@ -61,8 +75,9 @@
 namespace pl {
 
 /// The version written. 2: textures store their image file's bytes (PNG/JPEG/…) instead of
-/// float pixels. Readers also read version 1 (the same but for the texture records).
-inline constexpr uint32_t kPlfVersion = 2;
+/// float pixels. 3: an optional SMSK section (sun masks). Readers also read versions 1 (the
+/// same as 2 but for the texture records) and 2 (as 3, never with SMSK).
+inline constexpr uint32_t kPlfVersion = 3;
 inline constexpr uint32_t kPlfOldestReadableVersion = 1;
 inline constexpr size_t kPlfHeaderSize = 32;
 inline constexpr size_t kPlfSectionEntrySize = 48;
@@ -75,13 +90,13 @@ inline constexpr std::array<char, 8> kPlfMagic = {'P', 'L', 'F', '\0', '\r', '\n
 
 /// One entry of the section table, as stored.
 struct PlfSectionInfo {
-  std::string id;  ///< "SCNE", "CHRT", "TRCH", "VALS", "META"
+  std::string id;  ///< "SCNE", "CHRT", "TRCH", "VALS", "SMSK" (optional), "META"
   uint32_t encoding = 0;
   uint64_t offset = 0, storedSize = 0, decodedSize = 0, checksum = 0;
 };
 
-/// What `plenoptic info` shows, read without decoding the big sections (VALS, TRCH are only
-/// checksummed, in chunks).
+/// What `plenoptic info` shows, read without decoding the big sections (VALS, TRCH and SMSK
+/// are only checksummed, in chunks; SMSK's 16-byte header is read and checked).
 struct PlfInfo {
   std::string path;
   uint32_t version = 0;
@@ -101,6 +116,7 @@ struct PlfInfo {
   uint64_t twoSidedCharts = 0;  ///< back records (each two-sided chart has one; lightfield.h "Sides")
   uint64_t curvedCharts = 0;    ///< curved chart records (lightfield.h; diffuse or glossy, counted there too)
   uint64_t tixels = 0, values = 0;
+  uint32_t sunMaskLights = 0;  ///< masks per tixel (SMSK's light count); 0 = no SMSK section
   // Bake settings and statistics (from META).
   BakeSettings settings;
   BakeStats stats;

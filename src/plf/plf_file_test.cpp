@@ -13,6 +13,7 @@
 #include <functional>
 #include <iterator>
 #include <memory>
+#include <random>
 
 #include "core/error.h"
 #include "core/hash.h"
@@ -843,6 +844,271 @@ TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {
   resign(bad);
   writeBytes(file("decode.plf"), bad);
   expectRefused(file("decode.plf"), {"scene section", "unknown decoding 9"});
+}
+
+// --- Sun masks (SMSK, version 3) -----------------------------------------------------------
+
+// makeTestLightField's scene has one directional light (lights[2]) and no thin glass, so
+// sunMaskLights gives {2}; `extraSuns` more directional lights give that many more masks per
+// tixel. The masks are random bits (38 tixels × L).
+LightField makeSunMaskedLightField(int extraSuns = 0) {
+  LightField lf = makeTestLightField();
+  for (int i = 0; i < extraSuns; ++i)
+    lf.scene.lights.push_back(DirectionalLight{{0.0f, -1.0f, 0.1f * float(i)}, {1.0f, 0.5f, 0.25f}});
+  lf.sunMaskLightCount = uint32_t(sunMaskLights(lf.scene).size());
+  uint64_t tixels = 0;
+  for (const Chart& c : lf.charts) tixels += c.tixelCount();
+  std::mt19937 rng(1234);
+  lf.sunMasks.resize(tixels * lf.sunMaskLightCount);
+  for (SunMask& m : lf.sunMasks) m = SunMask(rng());
+  return lf;
+}
+
+/// Index of the section table entry with this id (−1: none).
+int sectionIndex(const std::vector<unsigned char>& bytes, const std::string& id) {
+  uint32_t count;
+  std::memcpy(&count, bytes.data() + 12, 4);
+  for (uint32_t i = 0; i < count; ++i)
+    if (std::memcmp(bytes.data() + kPlfHeaderSize + i * kPlfSectionEntrySize, id.data(), 4) == 0) return int(i);
+  return -1;
+}
+
+TEST_F(PlfFileTest, SunMasksRoundTripWithEveryValuesEncoding) {
+  for (int extraSuns : {0, 1}) {
+    const LightField original = makeSunMaskedLightField(extraSuns);
+    const uint32_t lights = uint32_t(1 + extraSuns);
+    ASSERT_EQ(original.sunMaskLightCount, lights);
+    ASSERT_EQ(original.sunMasks.size(), 38u * lights);
+    // Every values codec: `plenoptic compress` rewrites a read LightField with another codec,
+    // and the masks must come through unchanged.
+    for (ValuesCodec codec : {ValuesCodec::Raw, ValuesCodec::Lossless, ValuesCodec::Hdr}) {
+      SCOPED_TRACE(fmt::format("{} lights, codec {}", lights, uint32_t(codec)));
+      const std::string path = file("masks.plf");
+      writeLightField(path, original, codec);
+      const LightField copy = readLightField(path);
+      EXPECT_EQ(copy.sunMaskLightCount, lights);
+      EXPECT_EQ(copy.sunMasks, original.sunMasks);
+      const LightField recompressed = [&] {
+        writeLightField(file("again.plf"), copy, ValuesCodec::Lossless);
+        return readLightField(file("again.plf"));
+      }();
+      EXPECT_EQ(recompressed.sunMaskLightCount, lights);
+      EXPECT_EQ(recompressed.sunMasks, original.sunMasks);
+
+      // SMSK sits between VALS and META: 16 header bytes and 2 bytes per mask.
+      const PlfInfo info = readLightFieldInfo(path);
+      EXPECT_EQ(info.version, 3u);
+      EXPECT_EQ(info.sunMaskLights, lights);
+      EXPECT_TRUE(info.checksumsVerified);
+      ASSERT_EQ(info.sections.size(), 6u);
+      EXPECT_EQ(info.sections[3].id, "VALS");
+      EXPECT_EQ(info.sections[4].id, "SMSK");
+      EXPECT_EQ(info.sections[5].id, "META");
+      EXPECT_EQ(info.sections[4].encoding, 0u);
+      EXPECT_EQ(info.sections[4].storedSize, 16u + 38u * lights * 2u);
+      EXPECT_EQ(info.sections[4].decodedSize, info.sections[4].storedSize);
+      EXPECT_EQ(info.sections[5].offset + info.sections[5].storedSize, info.fileBytes);
+
+      // The section's bytes: L, reserved 0, T, then the masks as they are in memory.
+      const auto bytes = readBytes(path);
+      const Section smsk = sections(bytes)[4];
+      uint32_t storedLights = 0, reserved = 7;
+      uint64_t storedTixels = 0;
+      std::memcpy(&storedLights, bytes.data() + smsk.offset, 4);
+      std::memcpy(&reserved, bytes.data() + smsk.offset + 4, 4);
+      std::memcpy(&storedTixels, bytes.data() + smsk.offset + 8, 8);
+      EXPECT_EQ(storedLights, lights);
+      EXPECT_EQ(reserved, 0u);
+      EXPECT_EQ(storedTixels, 38u);
+      EXPECT_EQ(
+          std::memcmp(bytes.data() + smsk.offset + 16, original.sunMasks.data(), original.sunMasks.size() * 2), 0);
+    }
+  }
+}
+
+TEST_F(PlfFileTest, LightFieldWithoutSunMasksHasNoSunMaskSection) {
+  const LightField original = makeTestLightField();
+  ASSERT_EQ(sunMaskLights(original.scene).size(), 1u);  // it could have masks, but has none
+  ASSERT_EQ(original.sunMaskLightCount, 0u);
+  const std::string path = file("nomasks.plf");
+  writeLightField(path, original);
+  const auto bytes = readBytes(path);
+  EXPECT_EQ(sectionIndex(bytes, "SMSK"), -1);
+  EXPECT_EQ(sections(bytes).size(), 5u);
+  const LightField copy = readLightField(path);
+  EXPECT_EQ(copy.sunMaskLightCount, 0u);
+  EXPECT_TRUE(copy.sunMasks.empty());
+  const PlfInfo info = readLightFieldInfo(path);
+  EXPECT_EQ(info.version, kPlfVersion);
+  EXPECT_EQ(info.sunMaskLights, 0u);
+}
+
+TEST_F(PlfFileTest, WriterRefusesSunMasksThatDoNotMatchTheLightField) {
+  auto expectWriteRefused = [&](const LightField& lf, const std::vector<std::string>& fragments) {
+    const std::string path = file("refused.plf");
+    try {
+      writeLightField(path, lf);
+      ADD_FAILURE() << "written: " << fragments.front();
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(path), std::string::npos) << message;
+      for (const std::string& fragment : fragments)
+        EXPECT_NE(message.find(fragment), std::string::npos) << "'" << fragment << "' not in: " << message;
+    }
+    EXPECT_EQ(fileCount(), 0u) << "nothing may be written";
+  };
+  LightField lf = makeSunMaskedLightField();
+  lf.sunMasks.pop_back();  // one tixel short
+  expectWriteRefused(lf, {"holds 37 sun masks", "1 masked light × 38 tixels need 38"});
+  lf = makeSunMaskedLightField();
+  lf.sunMaskLightCount = 0;  // masks without a count
+  expectWriteRefused(lf, {"holds 38 sun masks", "0 masked lights × 38 tixels need 0"});
+  lf = makeSunMaskedLightField();
+  lf.sunMaskLightCount = 2;  // more lights than the scene masks
+  lf.sunMasks.resize(76);
+  expectWriteRefused(lf, {"sun masks of 2 lights per tixel", "its scene has 1 masked light"});
+}
+
+TEST_F(PlfFileTest, RefusesBadSunMaskSectionsNamingTheFileAndSection) {
+  const std::string path = file("good.plf");
+  writeLightField(path, makeSunMaskedLightField());
+  const auto good = readBytes(path);
+  const int entry = sectionIndex(good, "SMSK");
+  ASSERT_EQ(entry, 4);
+  const Section smsk = sections(good)[size_t(entry)];
+  ASSERT_EQ(smsk.size, 16u + 38u * 2u);
+  const std::string section = "corrupt sun masks section (SMSK)";
+  auto put32 = [](std::vector<unsigned char>& bytes, uint64_t at, uint32_t value) {
+    std::memcpy(bytes.data() + at, &value, 4);
+  };
+  auto put64 = [](std::vector<unsigned char>& bytes, uint64_t at, uint64_t value) {
+    std::memcpy(bytes.data() + at, &value, 8);
+  };
+  auto check = [&](std::vector<unsigned char> bad, const std::string& name, const std::vector<std::string>& fragments) {
+    SCOPED_TRACE(name);
+    writeBytes(file(name), bad);
+    expectRefused(file(name), fragments);
+  };
+  const uint64_t entryAt = kPlfHeaderSize + uint64_t(entry) * kPlfSectionEntrySize;
+
+  // The section one mask short (its last two bytes zeroed, so they read as padding).
+  {
+    auto bad = good;
+    bad[smsk.offset + smsk.size - 1] = bad[smsk.offset + smsk.size - 2] = 0;
+    put64(bad, entryAt + 16, smsk.size - 2);  // stored size
+    put64(bad, entryAt + 24, smsk.size - 2);  // decoded size
+    resign(bad);
+    check(bad, "short.plf", {section, "the section has 90 bytes", "38 tixels × 1 light × 2 bytes need 92"});
+  }
+  // Shorter than its header.
+  {
+    auto bad = good;
+    std::fill(bad.begin() + long(smsk.offset + 8), bad.begin() + long(smsk.offset + smsk.size), 0);
+    put64(bad, entryAt + 16, 8);
+    put64(bad, entryAt + 24, 8);
+    resign(bad);
+    check(bad, "header.plf", {section, "8 bytes, fewer than its 16-byte header"});
+  }
+  // A tixel count that does not match the section's size.
+  {
+    auto bad = good;
+    put64(bad, smsk.offset + 8, 39);
+    resign(bad);
+    check(bad, "tixels.plf", {section, "the section has 92 bytes", "39 tixels × 1 light × 2 bytes need 94"});
+  }
+  // Two lights' masks (the size still matching: 19 tixels × 2), but the scene masks one.
+  {
+    auto bad = good;
+    put32(bad, smsk.offset, 2);
+    put64(bad, smsk.offset + 8, 19);
+    resign(bad);
+    check(bad, "lights.plf", {section, "masks of 2 lights per tixel", "the scene has 1 masked light"});
+  }
+  // Light counts outside 1..kMaxSunMaskLights.
+  for (const uint32_t lights : {0u, kMaxSunMaskLights + 1}) {
+    auto bad = good;
+    put32(bad, smsk.offset, lights);
+    resign(bad);
+    check(bad, fmt::format("count{}.plf", lights),
+          {section, fmt::format("light count {} (must be 1 to {})", lights, kMaxSunMaskLights)});
+  }
+  // The reserved field set.
+  {
+    auto bad = good;
+    put32(bad, smsk.offset + 4, 1);
+    resign(bad);
+    check(bad, "reserved.plf", {section, "reserved field is 1, not 0"});
+  }
+  // The charts grown under the masks: the mirror chart (record 1) made 4×5 tixels instead of
+  // 4×4 (specular: no values, so only the tixel count changes), 42 tixels for 38 masks.
+  {
+    auto bad = good;
+    const uint64_t chartRecord = 4 + 1 + 48 + 4 + 12 + 16;
+    const uint64_t resVAt = sections(good)[1].offset + 8 + chartRecord + 4 + 1 + 48 + 4 + 4;
+    uint32_t resV = 0;
+    std::memcpy(&resV, bad.data() + resVAt, 4);
+    ASSERT_EQ(resV, 4u);
+    put32(bad, resVAt, 5);
+    resign(bad);
+    check(bad, "chrt.plf", {section, "masks for 38 tixels, but the charts have 42 tixels"});
+  }
+  // A second SMSK entry (META's entry renamed: found while the table is read).
+  {
+    auto bad = good;
+    const int meta = sectionIndex(good, "META");
+    ASSERT_EQ(meta, 5);
+    std::memcpy(bad.data() + kPlfHeaderSize + uint64_t(meta) * kPlfSectionEntrySize, "SMSK", 4);
+    resign(bad);
+    check(bad, "twice.plf", {"section SMSK appears twice"});
+  }
+  // SMSK in a file whose header says version 2 or 1: those versions have no such section.
+  for (const uint32_t version : {2u, 1u}) {
+    auto bad = good;
+    put32(bad, 8, version);
+    resign(bad);
+    check(bad, fmt::format("v{}.plf", version), {fmt::format("unknown section 'SMSK' in a version {} file", version)});
+  }
+  // Damaged bytes (not re-signed) are a checksum mismatch, in the header fields too (the
+  // header is checked before the masks are read, but the checksum decides the diagnosis).
+  for (const uint64_t at : {smsk.offset, smsk.offset + 9, smsk.offset + smsk.size / 2, smsk.offset + smsk.size - 1}) {
+    auto bad = good;
+    bad[at] ^= 0x04;
+    check(bad, fmt::format("flip{}.plf", at), {"checksum mismatch in the sun masks section (SMSK)"});
+  }
+  // And the untouched file still reads (the edits above were all that was wrong).
+  EXPECT_EQ(readLightField(path).sunMasks, makeSunMaskedLightField().sunMasks);
+}
+
+TEST_F(PlfFileTest, VersionOneAndTwoFilesStillReadWithoutSunMasks) {
+  // Files written by the version-1 and version-2 writers (tests/data/render, the quad of
+  // render_cli_test.cpp; render_cli_test checks the rest of their contents).
+  for (const uint32_t version : {1u, 2u}) {
+    const std::string fixture = fmt::format("{}/render/quad-v{}.plf", PLENOPTIC_TEST_DATA_DIR, version);
+    SCOPED_TRACE(fixture);
+    const LightField lf = readLightField(fixture);
+    EXPECT_EQ(lf.charts.size(), 1u);
+    EXPECT_EQ(lf.sunMaskLightCount, 0u);
+    EXPECT_TRUE(lf.sunMasks.empty());
+    const PlfInfo info = readLightFieldInfo(fixture);
+    EXPECT_EQ(info.version, version);
+    EXPECT_EQ(info.sunMaskLights, 0u);
+  }
+  // A mask-free file is a version-2 file but for the version field: so labelled, it reads the
+  // same (textures included, which version 1 stored differently).
+  const LightField original = makeTestLightField();
+  const std::string path = file("v2.plf");
+  writeLightField(path, original);
+  auto bytes = readBytes(path);
+  const uint32_t two = 2;
+  std::memcpy(bytes.data() + 8, &two, 4);
+  resign(bytes);
+  writeBytes(path, bytes);
+  const LightField copy = readLightField(path);
+  EXPECT_EQ(copy.values, original.values);
+  EXPECT_EQ(copy.scene.textures.size(), original.scene.textures.size());
+  EXPECT_EQ(copy.sunMaskLightCount, 0u);
+  EXPECT_TRUE(copy.sunMasks.empty());
+  EXPECT_EQ(readLightFieldInfo(path).version, 2u);
 }
 
 }  // namespace

@@ -50,14 +50,14 @@ inline void prefetchBytes(const void* p, size_t bytes) {
 }  // namespace
 
 FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel, uint64_t prefetchLookupBytes)
-    : lightField_(lightField), accel_(accel) {
+    : lightField_(lightField), accel_(accel), sun_(sunLightsOf(lightField)) {
   const Scene& scene = lightField.scene;
   paddedValues_.reserve(lightField.values.size());
   for (const Rgb& v : lightField.values) paddedValues_.push_back(lanes4(v));
   shading_.reserve(lightField.charts.size());
   for (const Chart& c : lightField.charts) {
     if (c.material >= scene.materials.size()) fail("fast renderer: chart material {} out of range", c.material);
-    shading_.push_back(chartShading(scene, c));
+    shading_.push_back(chartShading(lightField, uint32_t(shading_.size()), sun_));
     anyTexturedChart_ = anyTexturedChart_ || shading_.back().needsUv;
   }
   if (lightField.triangleChart.size() != scene.meshes.size())
@@ -228,7 +228,10 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     for (size_t k = i; k < i + 4; ++k)
       if (!(s.weight[k] > 0.0f) || !s.hits[k].hit()) return false;
     *chart = chartOf(i);
-    if (*chart == kNoChartRecord || charts[*chart].kind != ChartKind::Diffuse) return false;
+    // (A curved chart with sun masks needs each hit's interpolated normal: one by one.)
+    if (*chart == kNoChartRecord || charts[*chart].kind != ChartKind::Diffuse ||
+        (charts[*chart].curved && shading[*chart].sunMasks != nullptr))
+      return false;
     for (size_t k = i + 1; k < i + 4; ++k)
       if (chartOf(k) != *chart) return false;
     return true;
