@@ -266,12 +266,16 @@ TEST(Shards, TixelSetupSplitCoversTheRecordsInContiguousRunsOfEqualCost) {
 }
 
 TEST(Shards, RanksFillTheOneProcessParameterisationBitForBit) {
-  // The sphere box: curved charts (gather normals), buried tixels under the spheres, two-sided records.
-  const Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/CornellBox-Sphere.obj");
+  // The sphere box: curved charts (gather normals), buried tixels under the spheres, two-sided
+  // records; and a sun, so that sun masks are made (the spheres' shadow edges: partial masks).
+  Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/CornellBox-Sphere.obj");
+  scene.lights.push_back(DirectionalLight{glm::normalize(Vec3(-0.3f, -0.5f, -1.0f)), Rgb(2.0f)});  // in through the open front
   const BakeSettings settings = smallSettings(24, 16);
   const Accel accel(scene);
   const Parameterisation one = buildParameterisation(scene, accel, settings);
   ASSERT_TRUE(std::any_of(one.charts.begin(), one.charts.end(), [](const Chart& c) { return c.curved; }));
+  ASSERT_EQ(one.sunMaskLights.size(), 1u);
+  ASSERT_TRUE(std::any_of(one.sunMask.begin(), one.sunMask.end(), [](const SunMaskSlots& m) { return m[0] != 0 && m[0] != 0xffff; }));
   // 2 and 3 ranks; with 3, also in windows of 1000 bytes (as a field over 1 GiB per array is
   // exchanged), whose boundaries fall inside ranks' runs.
   for (const auto& [ranks, windowBytes] : {std::pair{2, uint64_t(1) << 30}, std::pair{3, uint64_t(1) << 30},
@@ -290,6 +294,7 @@ TEST(Shards, RanksFillTheOneProcessParameterisationBitForBit) {
       EXPECT_EQ(differingEntries(p.gatherNormal, one.gatherNormal), 0u) << "rank " << r << " of " << ranks;
       EXPECT_EQ(differingEntries(p.coverage, one.coverage), 0u) << "rank " << r << " of " << ranks;
       EXPECT_EQ(differingEntries(p.transportAlbedo, one.transportAlbedo), 0u) << "rank " << r << " of " << ranks;
+      EXPECT_EQ(differingEntries(p.sunMask, one.sunMask), 0u) << "rank " << r << " of " << ranks;
       EXPECT_EQ(visibilityHash(scene, p, settings), visibilityHash(scene, one, settings));
       EXPECT_GT(timings[size_t(r)].seconds, 0.0);
     }

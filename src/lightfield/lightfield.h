@@ -191,6 +191,12 @@ inline float sunVisibility(const SunMask* chartMasks, uint32_t lightCount, uint3
   float fu, fv;
   axis(grid.x, c.resU, u0, u1, fu);
   axis(grid.y, c.resV, v0, v1, fv);
+  // Most lookups read four sub-samples of one tixel that is wholly lit or wholly shadowed.
+  if (u0 / kSunMaskSide == u1 / kSunMaskSide && v0 / kSunMaskSide == v1 / kSunMaskSide) {
+    const SunMask mask = chartMasks[uint64_t((v0 / kSunMaskSide) * c.resU + u0 / kSunMaskSide) * lightCount + light];
+    if (mask == 0xffffu) return 1.0f;
+    if (mask == 0) return 0.0f;
+  }
   auto bit = [&](uint32_t su, uint32_t sv) {
     const uint32_t tixel = (sv / kSunMaskSide) * c.resU + su / kSunMaskSide;
     const uint32_t b = (sv % kSunMaskSide) * kSunMaskSide + su % kSunMaskSide;

@@ -394,7 +394,8 @@ inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShadin
 /// Four light-field lookups on one diffuse chart: the camera rays origin + t·direction
 /// (structure of arrays: x[k], y[k], z[k] for lookups k = 0…3), seen against their directions,
 /// at surface uvs uv[k] and mip levels lod[k] (read only when the chart has an albedo texture,
-/// shading.needsUv).
+/// shading.needsUv), and — on a curved chart with sun masks, where the masked lights shine on
+/// the interpolated normal — at lookupNormals[k] (lookupNormalAt; null: the chart normal).
 /// result[k] = exitantRadianceLanes(…, origin_k + t_k·direction_k, −direction_k, uv[k], lod[k]) to the
 /// bit — the same IEEE operations lane by lane, with the four lookups in the four SSE lanes
 /// for everything up to the value reads (the fast renderer's common case, where a dependent
@@ -403,7 +404,8 @@ struct RaysSoA4 {
   alignas(16) float ox[4], oy[4], oz[4], dx[4], dy[4], dz[4], t[4];
 };
 inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const ChartShading& shading, const Lanes4* values,
-                                    const RaysSoA4& r, const Vec2 uv[4], const float lod[4], F4 result[4]) {
+                                    const RaysSoA4& r, const Vec2 uv[4], const float lod[4], F4 result[4],
+                                    const Vec3* lookupNormals = nullptr) {
 #if defined(__SSE2__)
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), half = _mm_set1_ps(0.5f);
   const __m128 t = _mm_load_ps(r.t), dx = _mm_load_ps(r.dx), dy = _mm_load_ps(r.dy), dz = _mm_load_ps(r.dz);
@@ -447,13 +449,14 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   };
   const Taps u = taps(gridU, c.resU), v = taps(gridV, c.resV);
   // The sun masks' lights, lookup by lookup (the scalar sunIrradianceLanes on the same grid
-  // coordinates; planar charts only: the fast renderer sends curved ones with masks one by one).
+  // coordinates and the same normals: lookupNormalAt's, which a curved chart's caller passes).
   F4 sunIrradiance[4] = {f4Zero(), f4Zero(), f4Zero(), f4Zero()};
   if (shading.sunMasks != nullptr) {
     alignas(16) float gu[4], gv[4];
     _mm_store_ps(gu, gridU);
     _mm_store_ps(gv, gridV);
-    for (int k = 0; k < 4; ++k) sunIrradiance[k] = sunIrradianceLanes(c, shading, Vec2(gu[k], gv[k]), c.normal);
+    for (int k = 0; k < 4; ++k)
+      sunIrradiance[k] = sunIrradianceLanes(c, shading, Vec2(gu[k], gv[k]), lookupNormals ? lookupNormals[k] : c.normal);
   }
   // bit k: cos θ_k > 0, and cos θ_k ≥ 0 (a curved chart: kCurvedChartCosine > 0 in every lane).
   const int frontSide = c.curved ? 0xf : _mm_movemask_ps(_mm_cmpgt_ps(cosTheta, zero));
@@ -484,7 +487,7 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   for (int k = 0; k < 4; ++k) {
     const Vec3 d(r.dx[k], r.dy[k], r.dz[k]);
     result[k] = exitantRadianceLanes(scene, c, shading, PaddedValues{values}, Vec3(r.ox[k], r.oy[k], r.oz[k]) + r.t[k] * d, -d,
-                                     c.normal, uv[k], lod[k]);
+                                     lookupNormals ? lookupNormals[k] : c.normal, uv[k], lod[k]);
   }
 #endif
 }

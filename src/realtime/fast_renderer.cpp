@@ -210,6 +210,10 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
           const LinearTap tu = linearTap(grid.x, c.resU), tv = linearTap(grid.y, c.resV);
           __builtin_prefetch(paddedValues_.data() + c.firstValue + uint64_t(tv.i0) * c.resU + tu.i0);
           __builtin_prefetch(paddedValues_.data() + c.firstValue + uint64_t(tv.i1) * c.resU + tu.i1);
+          // The sun masks the lookup reads (sunVisibility: the tixel's and, across a tixel
+          // edge, a neighbour's; the first is the common case).
+          if (sun_.count > 0)
+            __builtin_prefetch(lightField_.sunMasks.data() + (c.firstTixel + uint64_t(tv.i0) * c.resU + tu.i0) * sun_.count);
         }
       }
       // shading[chart].needsUv, from the (small, cached) material array: the shading record
@@ -228,10 +232,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     for (size_t k = i; k < i + 4; ++k)
       if (!(s.weight[k] > 0.0f) || !s.hits[k].hit()) return false;
     *chart = chartOf(i);
-    // (A curved chart with sun masks needs each hit's interpolated normal: one by one.)
-    if (*chart == kNoChartRecord || charts[*chart].kind != ChartKind::Diffuse ||
-        (charts[*chart].curved && shading[*chart].sunMasks != nullptr))
-      return false;
+    if (*chart == kNoChartRecord || charts[*chart].kind != ChartKind::Diffuse) return false;
     for (size_t k = i + 1; k < i + 4; ++k)
       if (chartOf(k) != *chart) return false;
     return true;
@@ -239,6 +240,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   RaysSoA4 four;
   Vec2 fourUv[4];
   float fourLod[4];
+  Vec3 fourNormal[4];
   F4 fourRadiance[4];
   for (size_t i = 0; i < n;) {
     uint32_t chart = 0;
@@ -254,8 +256,14 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       // A textured chart: the uvs and levels of the prefetch pass (anyTexturedChart_ ran it).
       if (shading[chart].needsUv)
         for (int k = 0; k < 4; ++k) fourUv[k] = s.uv[i + k], fourLod[k] = s.lod[i + k];
+      // A curved chart with sun masks: the normals the masked lights shine on (lookupInputs').
+      const bool normals = needsInterpolatedNormal(charts[chart], shading[chart]);
+      if (normals)
+        for (int k = 0; k < 4; ++k)
+          fourNormal[k] = lookupNormalAt(scene, charts[chart], shading[chart], s.hits[i + k].mesh, s.hits[i + k].triangle,
+                                         s.hits[i + k].barycentrics);
       exitantRadianceDiffuse4(scene, charts[chart], shading[chart], paddedValues_.data(), four, fourUv, fourLod,
-                              fourRadiance);
+                              fourRadiance, normals ? fourNormal : nullptr);
       for (int k = 0; k < 4; ++k) f4StoreRgb(out + s.pixel[i + k], f4Mul(f4Splat(s.weight[i + k]), fourRadiance[k]));
       i += 4;
       continue;
