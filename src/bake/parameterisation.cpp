@@ -465,7 +465,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       }
       p.gatherPoint[g] = point;
       if (c.curved) p.gatherNormal[g] = normal;
-      if (c.kind == ChartKind::Diffuse && !p.sunMaskLights.empty() && !r.tris.empty())
+      if (c.kind == ChartKind::Diffuse && !p.sunMaskLights.empty())
         p.sunMask[g] = tixelSunMasks(scene, accel, c, r, local, i, j, point, normal, p.sunMaskLights);
 
       if (c.kind == ChartKind::Diffuse) {
@@ -482,8 +482,8 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       }
     }
   // Buried tixels (wholly under other geometry) gather from the nearest unburied tixel's
-  // point (4-neighbour breadth-first order), so bilinear lookups next to a contact read the
-  // light of the visible side, not the dark inside of the occluder.
+  // point (4-neighbour breadth-first order), and take its sun masks, so bilinear lookups next
+  // to a contact read the light of the visible side, not the dark inside of the occluder.
   std::vector<uint32_t> source(isBuried.size(), UINT32_MAX);
   for (uint32_t k = 0; k < isBuried.size(); ++k)
     if (!isBuried[k]) source[k] = k;
@@ -492,6 +492,9 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
     if (isBuried[k]) {
       p.gatherPoint[c.firstTixel + k] = p.gatherPoint[c.firstTixel + source[k]];
       if (c.curved) p.gatherNormal[c.firstTixel + k] = p.gatherNormal[c.firstTixel + source[k]];
+      // Its sun masks too: its own sub-samples are all inside the occluder (shadowed), and
+      // the visible surface next to it reads them through the bilinear mask lookup.
+      p.sunMask[c.firstTixel + k] = p.sunMask[c.firstTixel + source[k]];
     }
 }
 

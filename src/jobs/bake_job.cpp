@@ -38,6 +38,7 @@ std::string BakeJobStats::toJson() const {
   json["charts"] = charts;  // chart records: a two-sided chart counts twice (front and back)
   json["two_sided_charts"] = twoSidedCharts;
   json["back_side_tixels"] = backSideTixels;
+  json["sun_mask_lights"] = sunMaskLights;
   json["curved_charts"] = curvedCharts;  // chart records (a two-sided curved chart counts twice)
   json["curved_tixels"] = curvedTixels;
   json["visibility_rays"] = bake.visibilityRays;
@@ -166,6 +167,7 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
     stats.curvedCharts += c.curved ? 1 : 0;
     stats.curvedTixels += c.curved ? c.tixelCount() : 0;
   }
+  stats.sunMaskLights = lf.sunMaskLightCount;
   if (writer && !options_.statsPath.empty()) writeFileAtomically(options_.statsPath, stats.toJson());
   return result;
 }

@@ -176,6 +176,7 @@ struct BakeJobStats {
   double loadSeconds = 0.0;  ///< of seconds: loading the scene (path overload; 0 for a given Scene)
   BakeStats bake;
   uint64_t charts = 0, twoSidedCharts = 0, backSideTixels = 0, curvedCharts = 0, curvedTixels = 0, fileBytes = 0;
+  uint32_t sunMaskLights = 0;  ///< directional lights with sun masks (LightField::sunMaskLightCount)
   DistributedBakeStats distributed;
   std::string toJson() const;
 };

@@ -182,7 +182,8 @@ inline float sunVisibility(const SunMask* chartMasks, uint32_t lightCount, uint3
   // grid (s + ½)/4 − ½, so s = 4·(grid + ½) − ½.
   auto axis = [](float g, uint32_t res, uint32_t& s0, uint32_t& s1, float& f) {
     const float last = float(res * kSunMaskSide - 1);
-    const float s = std::min(std::max(float(kSunMaskSide) * (g + 0.5f) - 0.5f, 0.0f), last);  // NaN → 0
+    const float unclamped = float(kSunMaskSide) * (g + 0.5f) - 0.5f;
+    const float s = unclamped > 0.0f ? std::min(unclamped, last) : 0.0f;  // NaN → 0
     s0 = uint32_t(s);
     s1 = std::min(s0 + 1, res * kSunMaskSide - 1);
     f = s - float(s0);

@@ -88,6 +88,25 @@ def test_texture_lod_is_a_render_option(tmp_path):
     assert np.array_equal(frames[0], lf.render(width=16, height=16, camera=far, texture_lod=False))
 
 
+def test_sun_masks_are_a_bake_option(tmp_path):
+    # A quad in the sun: with sun masks (the default) the directional light is stored as masks
+    # and added back at render time, with sun_masks=False it stays in the values, as
+    # `plenoptic bake --sun-masks off`; a wholly lit quad looks the same either way.
+    quad = os.path.join(DATA, "scene", "textured", "quad.obj")
+    (tmp_path / "sun.json").write_text(json.dumps({
+        "meshes": [{"file": quad}],
+        "lights": [{"type": "directional", "direction": [0.3, 0.2, -1.0], "irradiance": [2.0, 2.0, 2.0]}]}))
+    scene = plenoptic.load_scene(str(tmp_path / "sun.json"))
+    masked = plenoptic.bake(scene, preset="draft")
+    plain = plenoptic.bake(scene, preset="draft", sun_masks=False)
+    assert masked.stats["sun_mask_lights"] == 1 and plain.stats["sun_mask_lights"] == 0
+    camera = plenoptic.Camera(eye=[0.5, 0.5, 2.0], target=[0.5, 0.5, 0.0], fov=30.0)
+    a = masked.render(width=16, height=16, camera=camera)
+    b = plain.render(width=16, height=16, camera=camera)
+    assert a.mean() > 0.0
+    assert np.allclose(a, b, rtol=1e-4, atol=1e-6)
+
+
 def test_editing_emission_and_rebaking_with_the_reused_visibility_equals_a_full_bake(tmp_path):
     scene = plenoptic.load_scene("cornell")
     visibility = str(tmp_path / "cornell.plv")
