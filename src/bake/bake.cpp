@@ -56,7 +56,9 @@ uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings
   constexpr uint64_t kQuadBytes = 64, kChangeBytes = 4, kValueArrays = 3;
   // Writing the .plv compresses it a batch of blocks at a time beside the field.
   const uint64_t writeBuffers = visibilityWriteBufferBytes(gatherGridSide(settings.gatherDirections));
-  return visibility + writeBuffers + values * kValueArrays * sizeof(Rgb) + tixels * (kQuadBytes + kChangeBytes);
+  // Sun masks: every slot in the parameterisation, then the light field's copy (at most as many).
+  const uint64_t sunMasks = settings.sunMasks ? sizeof(SunMaskSlots) * 2 : 0;
+  return visibility + writeBuffers + values * kValueArrays * sizeof(Rgb) + tixels * (kQuadBytes + kChangeBytes + sunMasks);
 }
 
 std::vector<std::string> bakePresetNames() { return {"draft", "default", "high"}; }
