@@ -25,7 +25,8 @@
 // [−1, 1]²; texels outside the disk hold the value of the nearest horizon direction.
 //
 // What is stored per chart kind:
-//   Diffuse   1 value per tixel: irradiance E (W·m⁻²). Outgoing radiance is
+//   Diffuse   1 value per tixel: irradiance E (W·m⁻²; without the sun-masked directional
+//             lights, which the lookup adds through the masks: "Sun masks" below). Outgoing radiance is
 //             Le + albedo(uv)·E/π, with the albedo texture read by the renderers at the mip
 //             level of the view ray's cone (lookup.h albedoTextureLod; the bake's transport
 //             albedo is a full-resolution average over each tixel's footprint).
