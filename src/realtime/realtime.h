@@ -8,7 +8,7 @@
 //      16-ray Embree packet (Accel::intersectCoherent) covers a compact footprint;
 //   1b. on light fields larger than kPrefetchLookupBytes and on textured ones, two passes over
 //      the tile's hits that only prefetch — chart records, then each hit's facing record (kept
-//      for step 2), its shading, the two value rows of a diffuse lookup and the texels it will
+//      for step 2), its shading, the two value rows and the sun mask of a diffuse lookup and the texels it will
 //      read (Texture::prefetch, at the mip level of the sample's ray cone) — so that their cache misses overlap across the tile;
 //   2. shading of every hit without building a SurfaceHit: the hit point is ray.origin +
 //      t·ray.direction, the chart comes from LightField::triangleChart, and the radiance from
