@@ -292,10 +292,10 @@ double worstArcError(const LightField& lf) {
     const Vec3 d = glm::normalize(Vec3(0.0f, 1.0f, 0.0f) - eye);
     RayHit hit;
     EXPECT_TRUE(accel.intersect(Ray{eye, d, 0.0f, kInfinity}, hit));
-    const SurfaceHit s = surfaceAt(lf.scene, hit.mesh, hit.triangle, hit.barycentrics);
-    const Vec3 radial = glm::normalize(Vec3(s.position.x, 0.0f, s.position.z));
+    const Vec3 position = positionAt(lf.scene.meshes[hit.mesh], hit.triangle, hit.barycentrics);
+    const Vec3 radial = glm::normalize(Vec3(position.x, 0.0f, position.z));
     const double expected = rho * kInvPi * std::max(0.0f, radial.x);
-    const Rgb L = exitantRadiance(lf, s, -d, 0.0f);  // no texture: no cone
+    const Rgb L = exitantRadiance(lf, hit, position, -d, 0.0f);  // no texture: no cone
     worst = std::max(worst, std::abs(double(L.r) - expected) / (rho * kInvPi));
   }
   return worst;

@@ -31,10 +31,8 @@ std::optional<Ray> shadowRayTo(const Vec3& origin, const Vec3& target) {
   return Ray{origin, toTarget / distance, 0.0f, distance};
 }
 
-ShadowRays::ShadowRays(const Scene& scene, const Accel& accel) : scene_(scene), accel_(accel) {
-  for (const Material& m : scene.materials)
-    if (const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf); glass && glass->thin) hasThinGlass_ = true;
-}
+ShadowRays::ShadowRays(const Scene& scene, const Accel& accel)
+    : scene_(scene), accel_(accel), hasThinGlass_(scene.hasThinGlass()) {}
 
 Rgb ShadowRays::transmittance(Ray ray, uint64_t& rays) const {
   ++rays;

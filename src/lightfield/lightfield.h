@@ -151,8 +151,7 @@ static_assert(kSunMaskSide * kSunMaskSide == 16, "a sun mask is 16 bits");
 /// directional lights, or none when a material is thin glass.
 inline std::vector<uint32_t> sunMaskLights(const Scene& scene) {
   std::vector<uint32_t> lights;
-  for (const Material& m : scene.materials)
-    if (const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf); glass && glass->thin) return lights;
+  if (scene.hasThinGlass()) return lights;
   for (uint32_t i = 0; i < scene.lights.size() && lights.size() < kMaxSunMaskLights; ++i)
     if (std::holds_alternative<DirectionalLight>(scene.lights[i])) lights.push_back(i);
   return lights;

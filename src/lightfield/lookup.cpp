@@ -79,18 +79,19 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
 }
 
 SunLights sunLightsOf(const LightField& lf) {
+  // sunMaskLights' lights, the scene's first directional ones, taken without its allocation
+  // and material scan (the reference lookup calls this per sample): a light field has masks
+  // only when its scene has no thin glass (the bake and the .plf reader make sure).
   SunLights sun;
-  if (lf.sunMaskLightCount == 0) return sun;
-  const std::vector<uint32_t> lights = sunMaskLights(lf.scene);
-  if (lights.size() != lf.sunMaskLightCount)
-    fail("{}: the light field has sun masks for {} light(s), its scene {} directional light(s) to mask", lf.scene.sourcePath,
-         lf.sunMaskLightCount, lights.size());
-  for (uint32_t l = 0; l < lf.sunMaskLightCount; ++l) {
-    const auto& light = std::get<DirectionalLight>(lf.scene.lights[lights[l]]);
-    sun.towardsLight[l] = -light.direction;
-    sun.irradiance[l] = light.irradiance;
-  }
-  sun.count = lf.sunMaskLightCount;
+  for (size_t i = 0; i < lf.scene.lights.size() && sun.count < lf.sunMaskLightCount; ++i)
+    if (const auto* light = std::get_if<DirectionalLight>(&lf.scene.lights[i])) {
+      sun.towardsLight[sun.count] = -light->direction;
+      sun.irradiance[sun.count] = light->irradiance;
+      ++sun.count;
+    }
+  if (sun.count != lf.sunMaskLightCount)
+    fail("{}: the light field has sun masks for {} light(s), its scene {} directional light(s)", lf.scene.sourcePath,
+         lf.sunMaskLightCount, sun.count);
   return sun;
 }
 
@@ -138,8 +139,8 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
                          worldDirectionTowardsViewer, c.normal, uv, kFullResolution);
 }
 
-Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer,
-                    float coneWidth) {
+Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPosition,
+                    const Vec3& worldDirectionTowardsViewer, float coneWidth) {
   // The chart facing the viewer (a two-sided surface's back record when seen from behind; none
   // behind a one-sided curved one), then what the lookup needs at the hit — the fast
   // renderer's lookupInputs. The shading is made once per call.
@@ -150,15 +151,11 @@ Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& wor
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   const SunLights sun = sunLightsOf(lf);
   const ChartShading shading = chartShading(lf, chart, sun);
-  RayHit rayHit;
-  rayHit.mesh = hit.mesh;
-  rayHit.triangle = hit.triangle;
-  rayHit.barycentrics = hit.barycentrics;
   Vec2 uv;
   float lod;
   Vec3 lookupDirection, lookupNormal;
-  lookupInputs(lf.scene, c, shading, rayHit, worldDirectionTowardsViewer, coneWidth, uv, lod, lookupDirection, lookupNormal);
-  return exitantRadiance(lf.scene, c, shading, lf.values.data(), hit.position, lookupDirection, lookupNormal, uv, lod);
+  lookupInputs(lf.scene, c, shading, hit, worldDirectionTowardsViewer, coneWidth, uv, lod, lookupDirection, lookupNormal);
+  return exitantRadiance(lf.scene, c, shading, lf.values.data(), worldPosition, lookupDirection, lookupNormal, uv, lod);
 }
 
 }  // namespace pl

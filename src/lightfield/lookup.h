@@ -338,18 +338,19 @@ inline constexpr float kCurvedChartCosine = 1.0f;
 Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosition,
                     const Vec3& worldDirectionTowardsViewer, Vec2 uv);
 
-/// The same for a ray hit (chart from lf.triangleChart and facingChart, uv from the hit), the
+/// The same for a ray hit at worldPosition (chart from lf.triangleChart and viewedChart; uv,
+/// mip level and normals from lookupInputs: surfaceAt only where the chart needs it), the
 /// albedo texture read at the mip level of a ray cone `coneWidth` wide at the hit (scene
 /// units; albedoLodAt; 0 = full resolution).
-Rgb exitantRadiance(const LightField& lf, const SurfaceHit& hit, const Vec3& worldDirectionTowardsViewer,
-                    float coneWidth);
+Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPosition,
+                    const Vec3& worldDirectionTowardsViewer, float coneWidth);
 
 /// exitantRadiance given the chart's precomputed shading and the values read through `load`
 /// (RgbValues over LightField::values, or PaddedValues): the one implementation every caller
 /// goes through, as four lanes (r, g, b, 0). Defined inline so that the fast renderer's
-/// per-pixel loop inlines it instead of calling across files. lookupNormal: the unit normal
-/// the glossy map is read around at worldPosition (lookupInputs), read only on curved glossy
-/// charts. uv and lod: where and at which mip level a diffuse chart's albedo texture is read
+/// per-pixel loop inlines it instead of calling across files. lookupNormal: lookupNormalAt's
+/// normal at worldPosition (lookupInputs): a curved glossy chart's map is read around it, a
+/// curved diffuse chart's sun-masked lights shine on it. uv and lod: where and at which mip level a diffuse chart's albedo texture is read
 /// (lookupInputs).
 template <typename Load>
 inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,

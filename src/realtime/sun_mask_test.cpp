@@ -78,7 +78,7 @@ std::vector<float> floorProfile(const LightField& lf, const std::vector<float>& 
     // From between the floor and the slab, straight down.
     EXPECT_TRUE(accel.intersect(Ray{Vec3(x, 0.5f, 0.3f), Vec3(0.0f, -1.0f, 0.0f), 0.0f, kInfinity}, hit));
     EXPECT_EQ(hit.mesh, 0u);
-    profile.push_back(luminance(exitantRadiance(lf, surfaceAt(lf.scene, hit.mesh, hit.triangle, hit.barycentrics),
+    profile.push_back(luminance(exitantRadiance(lf, hit, positionAt(lf.scene.meshes[hit.mesh], hit.triangle, hit.barycentrics),
                                                 Vec3(0.0f, 1.0f, 0.0f), 0.0f)));
   }
   return profile;

@@ -35,7 +35,7 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hi
     distance += hit.t;
     const Chart& chart = lf.charts[lf.triangleChart[hit.mesh][hit.triangle]];
     if (chart.kind != ChartKind::Specular)
-      return result + throughput * exitantRadiance(lf, surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics),
+      return result + throughput * exitantRadiance(lf, hit, positionAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics),
                                                    -ray.direction, coneSpread * distance);
 
     // An ideal mirror or glass: its own emission (if any) plus the branch weight times what

@@ -463,6 +463,13 @@ void Scene::finalize() {
     fail("{}: the environment colour {} is invalid", src, vecString(environment.constant));
 }
 
+bool Scene::hasThinGlass() const {
+  return std::any_of(materials.begin(), materials.end(), [](const Material& m) {
+    const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf);
+    return glass && glass->thin;
+  });
+}
+
 size_t Scene::triangleCount() const {
   size_t count = 0;
   for (const Mesh& mesh : meshes) count += mesh.triangles.size();
@@ -523,7 +530,6 @@ Vec3 interpolatedNormal(const Mesh& mesh, uint32_t triangle, Vec2 barycentrics, 
 SurfaceHit surfaceAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, Vec2 barycentrics) {
   const Mesh& mesh = scene.meshes[meshIndex];
   const UVec3 tri = mesh.triangles[triangle];
-  const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.0f - b1 - b2;
   const Vec3 &p0 = mesh.positions[tri.x], &p1 = mesh.positions[tri.y], &p2 = mesh.positions[tri.z];
 
   SurfaceHit hit;
@@ -531,7 +537,7 @@ SurfaceHit surfaceAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, 
   hit.triangle = triangle;
   hit.barycentrics = barycentrics;
   hit.material = mesh.materials[triangle];
-  hit.position = b0 * p0 + b1 * p1 + b2 * p2;
+  hit.position = positionAt(mesh, triangle, barycentrics);
   // Counter-clockwise winding (p0, p1, p2) seen from the front ⇒ (p1−p0)×(p2−p0) points out
   // of the front side.
   hit.geometricNormal = glm::normalize(glm::cross(p1 - p0, p2 - p0));

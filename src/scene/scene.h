@@ -230,6 +230,10 @@ struct Scene {
   void finalize();
 
   size_t triangleCount() const;
+  /// Whether some material is thin glass (a DielectricBsdf sheet), which shadow rays pass with
+  /// a coloured transmittance (light/light.h ShadowRays) and which rules out sun masks
+  /// (lightfield.h sunMaskLights).
+  bool hasThinGlass() const;
   /// Axis-aligned bounds of all vertices.
   void bounds(Vec3& lo, Vec3& hi) const;
   /// The camera called `name`; throws pl::Error listing the available ones if missing.
@@ -296,6 +300,13 @@ Vec3 interpolatedNormal(const Mesh& mesh, uint32_t triangle, Vec2 barycentrics, 
 /// the shading normal on the geometric normal's side.
 Vec3 normalMapped(const Vec3& shadingNormal, const Vec3& geometricNormal, const Vec3 (&p)[3], const Vec2 (&uv)[3],
                   Rgb texel, float scale);
+
+/// The point at barycentrics (b1, b2) of a triangle, exactly surfaceAt's position.
+inline Vec3 positionAt(const Mesh& mesh, uint32_t triangle, Vec2 barycentrics) {
+  const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.0f - b1 - b2;
+  const UVec3 tri = mesh.triangles[triangle];
+  return b0 * mesh.positions[tri.x] + b1 * mesh.positions[tri.y] + b2 * mesh.positions[tri.z];
+}
 
 /// The texture coordinates at barycentrics (b1, b2) of a triangle, exactly surfaceAt's uv
 /// (the barycentrics themselves for a mesh without uvs), without the rest of surfaceAt: the
