@@ -104,7 +104,9 @@ def test_sun_masks_are_a_bake_option(tmp_path):
     a = masked.render(width=16, height=16, camera=camera)
     b = plain.render(width=16, height=16, camera=camera)
     assert a.mean() > 0.0
-    assert np.allclose(a, b, rtol=1e-4, atol=1e-6)
+    # Only the rounding of taking the sun out of the stored irradiance and adding it back
+    # (measured: 2 ulps).
+    assert np.allclose(a, b, rtol=1e-6, atol=0.0)
 
 
 def test_editing_emission_and_rebaking_with_the_reused_visibility_equals_a_full_bake(tmp_path):

@@ -118,19 +118,27 @@ TEST_F(SunMaskTest, TheSunsShadowEdgeIsPlacedAndSharpToAQuarterTixel) {
   const Edge sharp = edgeOf(xs, withMasks), blurred = edgeOf(xs, without);
   std::printf("shadow edge at x = %.4f: with masks half height at %.4f, 10-90 %% width %.3f tixel; without: %.4f, %.3f tixel\n",
               kEdgeX, sharp.halfHeight, sharp.width / kTixel, blurred.halfHeight, blurred.width / kTixel);
+  // Measured: half height 0.0004 from the edge, width 0.20 tixel (the masks' quarter-tixel
+  // sub-samples, bilinear); bounds at the resolution the masks promise, a quarter tixel.
   EXPECT_NEAR(sharp.halfHeight, kEdgeX, 0.25f * kTixel);
   EXPECT_LT(sharp.width, 0.4f * kTixel);
-  // Without masks the step is spread over the tixel the edge falls in (the test can fail).
+  // Without masks the step is spread over the tixel the edge falls in (measured 0.80 tixel,
+  // its half height on the tixel boundary): the test can fail.
   EXPECT_GT(blurred.width, 0.6f * kTixel);
 
   // In the sun, a tixel and more away from the edge, both light fields hold the same light:
-  // the masked light goes out of the stored irradiance and back in through the masks. (In the
-  // shadow only interreflected light arrives, and it differs by ~10 %: the first shot of the
-  // tixels the edge crosses is their footprint's mean with masks, one ray's 0 or 1 without.)
+  // the masked light goes out of the stored irradiance and back in through the masks. They
+  // differ only by the interreflected part (measured 0.13 %; bound 1 %), which moves because
+  // the first shot of the tixels the edge crosses is their footprint's mean with masks, one
+  // ray's 0 or 1 without. (In the shadow, where only interreflected light arrives, that is
+  // ~10 %.)
   const std::vector<float> far = {0.3f, 0.6f, 1.0f, 1.5f};
   const std::vector<float> farMasked = floorProfile(masked, far), farPlain = floorProfile(plain, far);
+  float largest = 0.0f;
+  for (size_t i = 0; i < far.size(); ++i) largest = std::max(largest, std::abs(farMasked[i] / farPlain[i] - 1.0f));
+  std::printf("in the sun, masked / unmasked differ by at most %.2g\n", largest);
   for (size_t i = 0; i < far.size(); ++i)
-    EXPECT_NEAR(farMasked[i], farPlain[i], 0.02f * farPlain[i] + 1e-4f) << "x = " << far[i];
+    EXPECT_NEAR(farMasked[i], farPlain[i], 0.01f * farPlain[i]) << "x = " << far[i];
 }
 
 // The rendered floor against the path tracer, seen from the lit side under the slab: the
@@ -172,10 +180,12 @@ TEST_F(SunMaskTest, MaskedLightFieldIsCloserToThePathTracerAtTheEdge) {
     if (sunMasks) {
       const Image fast = FastRenderer(lf, accel).render(camera, settings);
       for (size_t i = 0; i < image.pixels.size(); ++i)
+        // Float rounding only: the hit point from the ray, not the barycentrics (realtime.h).
         ASSERT_NEAR(luminance(fast.pixels[i]), luminance(image.pixels[i]), 1e-4f * luminance(image.pixels[i]) + 1e-6f) << i;
     }
   }
   std::printf("relMSE against the path tracer: %.3g with masks, %.3g without\n", errors[1], errors[0]);
+  // Measured 0.0084 against 0.0256 (the 256-spp trace's own noise is part of both).
   EXPECT_LT(errors[1], 0.5 * errors[0]) << "relMSE with masks " << errors[1] << ", without " << errors[0];
 }
 

@@ -28,6 +28,7 @@
 #include "render/render.h"
 #include "scene/scene.h"
 #include "trace/trace.h"
+#include "support/light_field_vs_trace.h"
 #include "support/quad_mesh.h"
 #include "support/sphere_mesh.h"
 
@@ -73,13 +74,12 @@ CameraDesc sheetCamera(float side) {
 Rgb meanOverSheet(const Image& image, const Camera& camera, const Accel& accel, int* count) {
   Rgb sum(0.0f);
   *count = 0;
-  for (int y = 0; y < camera.height(); ++y)
-    for (int x = 0; x < camera.width(); ++x) {
-      RayHit hit;
-      if (!accel.intersect(camera.generateRay(Vec2(x + 0.5f, y + 0.5f), Vec2(0.5f)).ray, hit) || hit.mesh != 1) continue;
-      sum += image.at(x, y);
-      ++*count;
-    }
+  const std::vector<RayHit> hits = test_support::pixelCentreHits(accel, camera);
+  for (size_t i = 0; i < hits.size(); ++i) {
+    if (!hits[i].hit() || hits[i].mesh != 1) continue;
+    sum += image.pixels[i];
+    ++*count;
+  }
   return *count > 0 ? sum / float(*count) : sum;
 }
 

@@ -62,18 +62,16 @@ TEST_F(CurvedGlossyTest, GlossySpheresMatchThePathTracer) {
   // The spheres' pixels alone (every other pixel zero in both images).
   Image lfSpheres = image, ptSpheres = reference;
   int spherePixels = 0;
-  for (int y = 0; y < camera.height(); ++y)
-    for (int x = 0; x < camera.width(); ++x) {
-      const Ray ray = camera.generateRay(Vec2(float(x) + 0.5f, float(y) + 0.5f), Vec2(0.5f)).ray;
-      RayHit hit;
-      accel.intersect(ray, hit);
-      const bool sphere = hit.hit() && scene.materials[scene.meshes[hit.mesh].materials[hit.triangle]].name.find("Sphere") !=
-                                           std::string::npos;
-      spherePixels += sphere;
-      if (sphere) continue;
-      lfSpheres.at(x, y) = Rgb(0.0f);
-      ptSpheres.at(x, y) = Rgb(0.0f);
-    }
+  const std::vector<RayHit> hits = test_support::pixelCentreHits(accel, camera);
+  for (size_t i = 0; i < hits.size(); ++i) {
+    const RayHit& hit = hits[i];
+    const bool sphere = hit.hit() && scene.materials[scene.meshes[hit.mesh].materials[hit.triangle]].name.find("Sphere") !=
+                                         std::string::npos;
+    spherePixels += sphere;
+    if (sphere) continue;
+    lfSpheres.pixels[i] = Rgb(0.0f);
+    ptSpheres.pixels[i] = Rgb(0.0f);
+  }
   const ImageComparison spheres = compareImages(lfSpheres, ptSpheres);
   // relMSE over the sphere pixels only (compareImages averages over all pixels, zeros included).
   const double sphereRelMse = spheres.relMseAverage * double(image.pixels.size()) / double(std::max(spherePixels, 1));

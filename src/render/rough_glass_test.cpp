@@ -113,16 +113,13 @@ Agreement compareWithPathTracer(const Scene& scene, const BakeSettings& settings
   result.image = compareImages(image, reference);
   double lfSum = 0.0, ptSum = 0.0;
   int count = 0;
-  for (int y = 0; y < camera.height(); ++y)
-    for (int x = 0; x < camera.width(); ++x) {
-      const Ray ray = camera.generateRay(Vec2(float(x) + 0.5f, float(y) + 0.5f), Vec2(0.5f)).ray;
-      RayHit hit;
-      accel.intersect(ray, hit);
-      if (!hit.hit() || hit.mesh != 1) continue;
-      lfSum += luminance(image.at(x, y));
-      ptSum += luminance(reference.at(x, y));
-      ++count;
-    }
+  const std::vector<RayHit> hits = test_support::pixelCentreHits(accel, camera);
+  for (size_t i = 0; i < hits.size(); ++i) {
+    if (!hits[i].hit() || hits[i].mesh != 1) continue;
+    lfSum += luminance(image.pixels[i]);
+    ptSum += luminance(reference.pixels[i]);
+    ++count;
+  }
   EXPECT_GT(count, 50);
   result.ball = ptSum > 0.0 ? lfSum / ptSum : 0.0;
   const ImageComparison& c = result.image;

@@ -10,6 +10,8 @@
 #include "scene/scene.h"
 #include "trace/trace.h"
 
+#include <vector>
+
 namespace pl::test_support {
 
 struct LightFieldAndReference {
@@ -35,6 +37,17 @@ inline LightFieldAndReference lightFieldAndReference(const Scene& scene, const C
   render.samplesPerPixel = lightFieldSamples;
   out.image = renderLightField(out.lightField, accel, camera, render);
   return out;
+}
+
+/// Per pixel (y·width + x), what the ray through its centre hits: the pixels a comparison
+/// keeps to one surface (a ball, the spheres, a sheet).
+inline std::vector<RayHit> pixelCentreHits(const Accel& accel, const Camera& camera) {
+  std::vector<RayHit> hits(size_t(camera.width()) * size_t(camera.height()));
+  for (int y = 0; y < camera.height(); ++y)
+    for (int x = 0; x < camera.width(); ++x)
+      accel.intersect(camera.generateRay(Vec2(float(x) + 0.5f, float(y) + 0.5f), Vec2(0.5f)).ray,
+                      hits[size_t(y) * size_t(camera.width()) + size_t(x)]);
+  return hits;
 }
 
 }  // namespace pl::test_support
