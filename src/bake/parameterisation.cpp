@@ -308,8 +308,7 @@ SunMaskSlots tixelSunMasks(const Scene& scene, const Accel& accel, const Chart& 
   std::array<Ray, kSamples> rays;
   std::array<uint8_t, kSamples> blocked;
   for (size_t slot = 0; slot < lights.size(); ++slot) {
-    const PunctualLight light = PunctualLight::from(scene.lights[lights[slot]]);
-    const Vec3 wi = -light.direction;  // towards the light
+    const Vec3 wi = -std::get<DirectionalLight>(scene.lights[lights[slot]]).direction;  // towards the light
     // 1 lit, 0 shadowed, −1 undecided.
     std::array<int, kSamples> state;
     state.fill(-1);

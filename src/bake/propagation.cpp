@@ -512,6 +512,9 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
   const uint32_t lightSamples = ops.lightSamples, n = state.n;
   const std::vector<PunctualLight>& punctualLights = ops.punctualLights;
   const ShadowRays& shadows = *ops.shadows;
+  // Per punctual light (scene.lights order): its sun-mask slot, or −1.
+  std::vector<int> maskSlot(punctualLights.size());
+  for (size_t li = 0; li < punctualLights.size(); ++li) maskSlot[li] = sunMaskSlot(param, uint32_t(li));
   std::vector<Rgb>& direct = state.direct;
   std::atomic<uint64_t>& shadowRays = state.shadowRays;
   const uint64_t tixelsPerBlock = 64;
@@ -541,16 +544,16 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       const bool bothSides = isRoughGlassChart(c, scene.materials[c.material].bsdf);
       for (size_t li = 0; li < punctualLights.size(); ++li) {
         const PunctualLight& light = punctualLights[li];
+        // A masked light on a diffuse tixel: its footprint's mean visibility, no ray
+        // (lightfield.h "Sun masks"; sunMaskedIrradiance, which the bake takes back out).
+        if (maskSlot[li] >= 0 && c.kind == ChartKind::Diffuse) {
+          direct[valueBase(g, c)] += sunMaskedIrradiance(param, light, g, size_t(maskSlot[li]));
+          continue;
+        }
         Vec3 wi;
         float distance;
         Rgb incident;
         if (!light.incidentAt(x, wi, distance, incident)) continue;
-        // A masked light on a diffuse tixel: its footprint's mean visibility, no ray
-        // (lightfield.h "Sun masks"; sunMaskedIrradiance, which the bake takes back out).
-        if (const int slot = sunMaskSlot(param, uint32_t(li)); slot >= 0 && c.kind == ChartKind::Diffuse) {
-          direct[valueBase(g, c)] += sunMaskedIrradiance(param, light, g, size_t(slot));
-          continue;
-        }
         const float cosTheta = bothSides ? std::abs(glm::dot(normal, wi)) : glm::dot(normal, wi);
         if (!(cosTheta > 0.0f) || isBlack(incident)) continue;
         const Vec3 origin = offsetRayOrigin(x, normal, wi);

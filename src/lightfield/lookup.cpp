@@ -86,7 +86,7 @@ SunLights sunLightsOf(const LightField& lf) {
   for (size_t i = 0; i < lf.scene.lights.size() && sun.count < lf.sunMaskLightCount; ++i)
     if (const auto* light = std::get_if<DirectionalLight>(&lf.scene.lights[i])) {
       sun.towardsLight[sun.count] = -light->direction;
-      sun.irradiance[sun.count] = light->irradiance;
+      sun.irradiance[sun.count] = lanes4(light->irradiance);
       ++sun.count;
     }
   if (sun.count != lf.sunMaskLightCount)

@@ -239,7 +239,7 @@ struct ChartShading {
 struct SunLights {
   uint32_t count = 0;
   std::array<Vec3, kMaxSunMaskLights> towardsLight{};
-  std::array<Rgb, kMaxSunMaskLights> irradiance{};
+  std::array<Lanes4, kMaxSunMaskLights> irradiance{};  ///< r, g, b, 0 (one load per lookup)
 };
 SunLights sunLightsOf(const LightField& lf);
 
@@ -265,7 +265,7 @@ inline F4 sunIrradianceLanes(const Chart& c, const ChartShading& shading, Vec2 g
     const float cosTheta = glm::dot(normal, sun.towardsLight[l]);
     if (!(cosTheta > 0.0f)) continue;
     const float lit = sunVisibility(shading.sunMasks, sun.count, l, c, grid);
-    if (lit > 0.0f) sum = f4Add(sum, f4Mul(f4FromRgb(sun.irradiance[l]), f4Splat(cosTheta * lit)));
+    if (lit > 0.0f) sum = f4Add(sum, f4Mul(f4Load(sun.irradiance[l].v), f4Splat(cosTheta * lit)));
   }
   return sum;
 }
