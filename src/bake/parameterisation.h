@@ -150,12 +150,14 @@ float chartTixelSize(const Scene& scene, uint32_t material, ChartKind kind, floa
 /// It is buildCharts followed by fillTixels of every record.
 Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, const BakeSettings& settings);
 /// The first part: charts, their frames, grids, sides and tixel/value indices (charts,
-/// triangleChart, chartTriangles, chartArea, the counts, tixelChart); the per-tixel arrays
-/// (gatherPoint, gatherNormal, coverage, transportAlbedo) are allocated, zero.
+/// triangleChart, chartTriangles, chartArea, the counts, tixelChart, sunMaskLights); the
+/// per-tixel arrays (gatherPoint, gatherNormal, coverage, transportAlbedo: zero; sunMask: all
+/// bits set) are allocated.
 Parameterisation buildCharts(const Scene& scene, const Accel& accel, const BakeSettings& settings);
 /// The second part, for chart records [firstRecord, endRecord): the per-tixel arrays of their
-/// tixels, from footprint sub-samples and the buried-point probes (9 rays per gather point
-/// candidate) — most of the parameterisation's time on a large scene. A record's tixels depend
+/// tixels, from footprint sub-samples, the buried-point probes (9 rays per gather point
+/// candidate) and the sun masks' rays (16 per diffuse tixel and masked light) — most of the
+/// parameterisation's time on a large scene. A record's tixels depend
 /// only on the record, so ranks can fill disjoint records and exchange them (shard.h).
 void fillTixels(const Scene& scene, const Accel& accel, Parameterisation& p, uint32_t firstRecord, uint32_t endRecord);
 /// The same, building its own Accel for the scene scale.
