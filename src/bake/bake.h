@@ -1,6 +1,6 @@
 #pragma once
 // The light-field bake: parameterisation → visibility field → propagation → LightField
-// (DESIGN.md "Light-field pipeline"). The .plf file is written by plf_file.h.
+// (docs/design.md, The bake). The .plf file is written by plf_file.h.
 //
 // Presets (densities are relative to the scene's largest extent, so a scene in millimetres and
 // one in metres get the same grids):
@@ -24,7 +24,7 @@ class Communicator;
 BakeSettings bakePreset(const std::string& name);
 std::vector<std::string> bakePresetNames();
 
-/// What a distributed bake measured (README "Distributed bake"); one process: ranks 1.
+/// What a distributed bake measured (docs/design.md, Distributed bake); one process: ranks 1.
 struct DistributedBakeStats {
   int ranks = 1;
   uint64_t ownTixels = 0;           ///< tixels this rank updated (rank 0's in the job's stats)

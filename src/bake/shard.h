@@ -1,5 +1,5 @@
 #pragma once
-// How the ranks of a distributed bake share the tixels (issue #16; README "Distributed bake").
+// How the ranks of a distributed bake share the tixels (docs/design.md, Distributed bake).
 //
 // Propagation is block Gauss–Seidel over batches of whole charts (propagation.h): batch b is
 // updated after batches < b, its tixels all at once. A distributed bake keeps exactly that

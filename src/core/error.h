@@ -2,7 +2,7 @@
 // Errors that reach the user. Every message says what was wrong and where (file, line,
 // element), e.g. "scene.obj:12: face index 40 out of range (30 vertices)". The command-line
 // front end prints "plenoptic: error: " + what() to stderr and exits with one of the
-// statuses below (the same for every command; README "Commands").
+// statuses below (the same for every command; docs/user-guide.md, Errors and exit statuses).
 #include <fmt/format.h>
 
 #include <stdexcept>

@@ -49,7 +49,7 @@ std::string BakeJobStats::toJson() const {
   json["peak_rss_bytes"] = bake.peakRssBytes;
   json["file_bytes"] = fileBytes;
   json["compression"] = compression;
-  // Distributed bake (README "Distributed bake"): per-rank figures in rank order; the
+  // Distributed bake (docs/user-guide.md, bake --stats): per-rank figures in rank order; the
   // exchange is rank 0's (every rank receives about the same).
   json["ranks"] = distributed.ranks;
   json["batches"] = distributed.batches;

@@ -3,7 +3,7 @@
 // have to copy — which camera and settings win (command line over scene file over defaults),
 // exposure, tone mapping and image writing, the output checks made before any work, the
 // thread count, and the statistics each job reports (toJson gives exactly the --stats JSON the
-// README documents). The command line (app/) and the Python module (src/python/) are thin front
+// docs/user-guide.md documents). The command line (app/) and the Python module (src/python/) are thin front
 // ends over these: parse their arguments into the options below → run the job → print.
 //
 // Every job checks its options and its outputs when constructed (pl::UsageError for a wrong

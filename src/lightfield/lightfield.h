@@ -108,7 +108,7 @@ struct Chart {
   }
 };
 
-/// Quality preset parameters (see presets in bake.cpp and the README). The member defaults are
+/// Quality preset parameters (see presets in bake.cpp and docs/user-guide.md). The member defaults are
 /// those of the "default" preset, so a default-constructed BakeSettings equals
 /// bakePreset("default") (a test checks it).
 struct BakeSettings {

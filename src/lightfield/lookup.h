@@ -138,7 +138,7 @@ inline constexpr float kFullResolution = 0.0f;
 /// paper's rule (and GPU trilinear filtering without anisotropy) does, which blurs grazing
 /// surfaces across the view by 1/|cos θ|. Measured on a Sponza frame at 1 sample per pixel
 /// against 256 samples at full resolution: relMSE 0.0057 with the area, 0.0066 with the long
-/// axis, 0.0089 at full resolution (README "Texture level of detail"). The level is log2 of
+/// axis, 0.0089 at full resolution (docs/benchmarks.md, Texture level of detail). The level is log2 of
 /// the texels across that mean width:
 ///   λ = log2(w · √(T_a / P_a) / √|cos θ|),  |cos θ| = |d·c| / |c|
 ///     = ½ · log2(W·H·|uv cross| · w² / |d·c|)          (one log2, no square root or length).

@@ -60,7 +60,8 @@ struct Texture {
   /// and a texture takes a third of the cache. The palette holds the exact floats, so
   /// sample() gives the same values bit for bit. Built by finish(); empty for other textures
   /// (16-bit and HDR images), which sample() reads from `image`. Measured on Sponza's
-  /// walk-through, where texel reads missing the cache were a quarter of the frame: README.
+  /// walk-through, where texel reads missing the cache were a quarter of the frame: docs/benchmarks.md,
+  /// Walk-through speed.
   struct alignas(64) PackedBlock {
     uint32_t texels[16];  ///< texel (x, y) of the block at [4·y + x]: palette indices r | g << 8 | b << 16
   };
@@ -253,7 +254,7 @@ Texture loadTextureFile(const std::string& path, ImageDecode decode = ImageDecod
 Texture textureFromEncoded(std::string path, std::vector<unsigned char> bytes, const std::string& label,
                            ImageDecode decode = ImageDecode::Colour);
 
-/// Loads `cornell`, .obj, .gltf/.glb or .json (see README for the JSON schema).
+/// Loads `cornell`, .obj, .gltf/.glb or .json (see docs/scenes.md for the JSON schema).
 /// Throws pl::Error with the file name and the problem for any malformed input.
 Scene loadScene(const std::string& pathOrName);
 
