@@ -106,7 +106,7 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::IsMember({"none", "lossless", "bc1", "hdr"}))
       ->capture_default_str();
   command->add_option("--tixels-across", options->tixelsAcross,
-                      "Override the preset: tixels across the scene's room scale (see the README)")
+                      "Override the preset: tixels across the scene's room scale (see docs/user-guide.md)")
       ->check(CLI::Range(1.0f, 4096.0f));
   command->add_option("--directions", options->gatherDirections,
                       "Override the preset: gather directions per tixel (rounded to a square)")
@@ -120,7 +120,7 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
   command
       ->add_option_function<std::string>(
           "--sun-masks", [options](const std::string& s) { options->sunMasks = s == "on"; },
-          "Sub-tixel visibility masks for directional lights (sharp sun shadows; the README's \"Sun masks\"): on|off")
+          "Sub-tixel visibility masks for directional lights (sharp sun shadows; see docs/user-guide.md): on|off")
       ->check(CLI::IsMember({"on", "off"}))
       ->default_str("on");
   command->callback([options, &global] { runBakeCommand(*options, global); });

@@ -82,7 +82,7 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--reference", options->reference,
                     "Use the straightforward reference renderer (src/render) instead of the fast one (the default)");
   command->add_option("--path", options->pathFile,
-                      "Camera path JSON (keyframes; see README): render a walk-through to -o frames/%04d.png or -o walk.mp4");
+                      "Camera path JSON (keyframes; see docs/user-guide.md): render a walk-through to -o frames/%04d.png or -o walk.mp4");
   command->add_option("--stats", options->statsPath,
                       "Write JSON: frames, ms_per_frame_median, fps, primary_ms_median (primary rays alone), load and BVH times");
   options->view.addCameraOptions(*command);
