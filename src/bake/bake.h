@@ -2,12 +2,12 @@
 // The light-field bake: parameterisation → visibility field → propagation → LightField
 // (docs/design.md, The bake). The .plf file is written by plf_file.h.
 //
-// Presets (densities are relative to the scene's largest extent, so a scene in millimetres and
-// one in metres get the same grids):
-//   preset   tixels across   max per side   gather dirs   glossy map ≤   area-light rays   tolerance
-//   draft          32              32        144 (12²)         8              16             5e-3
-//   default        64              64        256 (16²)        16              32             1e-3
-//   high           96             128        576 (24²)        24              64             2e-4
+// Presets (densities are relative to the scene's room scale, so a scene in millimetres and one
+// in metres get the same grids; every preset allows 16384 tixels per chart side):
+//   preset   tixels across   gather dirs   glossy map ≤   area-light rays   tolerance
+//   draft          20         144 (12²)         8              16             5e-3
+//   default        40         256 (16²)        16              32             1e-3
+//   high           60         576 (24²)        24              64             2e-4
 // "tolerance" is the relative change of total outgoing power at which iteration stops, once
 // the remaining error estimated from the rate of convergence is below it too (propagation.h).
 #include "lightfield/lightfield.h"
