@@ -19,7 +19,8 @@
 #   default, high: |ratio − 1| ≤ 0.02 and LF error ≤ 0.01
 #   draft:         |ratio − 1| ≤ 0.05
 # A case whose bake, render or trace fails (a bake the memory guard refuses, a scene the loader
-# rejects) is a row saying so (ERROR and the command's message), and the run goes on.
+# rejects) is a row saying so (ERROR and the command's message), and the run goes on. Stopped by
+# SIGINT or SIGTERM, the run finishes the command at hand and prints the table of what is done.
 #
 # Usage: bench/conformance.sh [PLENOPTIC] [WORKDIR]
 #   PLENOPTIC  the executable (default: build/plenoptic)
@@ -70,17 +71,24 @@ run() {
   return 1
 }
 
+# SIGINT/SIGTERM: stop after the current command and print the table of what is done (the rest
+# "not run").
+interrupted=
+trap 'interrupted=1' INT TERM
+for name in "${cases[@]}"; do  # no stale results of an earlier run in the table
+  rm -f "$workdir/$name".*.failed "$workdir/$name".*.compare.json "$workdir/$name".*.bake.json
+done
 start=$SECONDS
 for name in "${cases[@]}"; do
+  [[ -n "$interrupted" ]] && break
   scene="$workdir/scenes/$name.json"
   out="$workdir/$name"
-  rm -f "$out".*.failed "$out.ref.failed"
   echo "== $name: reference ($ref_spp spp, ${size}x$size)" >&2
   run "$out.ref.failed" "$plenoptic" "${global[@]}" trace "$scene" -o "$out.ref.pfm" --variance "$out.refvar.pfm" \
     --spp "$ref_spp" "${size_flags[@]}" --stats "$out.trace.json" && rm -f "$out.ref.failed"
   for preset in $presets; do
+    [[ -n "$interrupted" ]] && break
     o="$out.$preset"
-    rm -f "$o.bake.json" "$o.compare.json"
     echo "== $name: bake ($preset), render ($lf_samples samples per pixel), compare" >&2
     run "$o.failed" "$plenoptic" "${global[@]}" bake "$scene" -o "$o.plf" --preset "$preset" --stats "$o.bake.json" &&
       run "$o.failed" "$plenoptic" "${global[@]}" render "$o.plf" -o "$o.lf.pfm" --samples "$lf_samples" "${size_flags[@]}" &&
@@ -119,7 +127,7 @@ lines = [
     "| case | preset | mean Y ratio | relMSE | ref noise | LF error | ref mean Y | bake s | result |",
     "|---|---|---|---|---|---|---|---|---|",
 ]
-passed = failed = errors = 0
+passed = failed = errors = not_run = 0
 noise_cache = {}
 for name, varies in cases:
     out = os.path.join(workdir, name)
@@ -133,9 +141,13 @@ for name, varies in cases:
         bake_s = "–"
         if os.path.exists(o + ".bake.json"):
             bake_s = f"{json.load(open(o + '.bake.json'))['seconds']:.2f}"
+        if not failure and not os.path.exists(o + ".compare.json"):
+            failure = "not run (interrupted)"
         if failure:
-            errors += 1
-            lines.append(f"| {name} | {preset} | | | | | | {bake_s} | ERROR: {failure} |")
+            not_run += failure.startswith("not run")
+            errors += not failure.startswith("not run")
+            label = failure if failure.startswith("not run") else "ERROR: " + failure
+            lines.append(f"| {name} | {preset} | | | | | | {bake_s} | {label} |")
             continue
         cmp = json.load(open(o + ".compare.json"))
         if name not in noise_cache:
@@ -158,7 +170,8 @@ for name, varies in cases:
         failed += bool(why)
         lines.append(f"| {name} | {preset} | {ratio:.4f} | {relmse:.2e} | {noise:.1e} | {lf_error:.2e} | "
                      f"{mean_y:.3f} | {bake_s} | {result} |")
-lines += ["", f"{passed} passed, {failed} failed, {errors} errors; {int(elapsed) // 60} min {int(elapsed) % 60} s "
+lines += ["", f"{passed} passed, {failed} failed, {errors} errors" + (f", {not_run} not run" if not_run else "") + "; "
+          f"{int(elapsed) // 60} min {int(elapsed) % 60} s "
           f"for the whole run (bakes, renders, references).", "",
           "| case | what it varies |", "|---|---|"]
 lines += [f"| {name} | {varies} |" for name, varies in cases]
