@@ -376,8 +376,15 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
   const bool probe = c.kind != ChartKind::Specular;
   std::vector<uint8_t> isBuried(c.tixelCount(), 0);
   const Material& material = scene.materials[c.material];
-  const bool textured = c.kind == ChartKind::Diffuse && material.albedoTexture >= 0;
-  const Rgb constantAlbedo = c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, Vec2(0.0f), kFullResolution) : Rgb(0.0f);
+  // The transport albedo: a diffuse chart's albedo, or a glossy chart's diffuse part's
+  // (Chart::diffuseValue), averaged over each tixel's footprint when a texture varies it.
+  const bool hasAlbedo = c.kind == ChartKind::Diffuse || c.diffuseValue;
+  const bool textured = hasAlbedo && material.albedoTexture >= 0;
+  auto albedoAt = [&](Vec2 uv) {
+    return c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, uv, kFullResolution)
+                                        : glossyDiffuseAlbedoAt(scene, c.material, uv, kFullResolution);
+  };
+  const Rgb constantAlbedo = hasAlbedo ? albedoAt(Vec2(0.0f)) : Rgb(0.0f);
   // The normal a point of the chart gathers around (chartShadingNormalAt, lightfield.h).
   auto normalAt = [&](const FootprintSample& s) {
     const ChartRaster::Tri2& t = r.tris[s.tri];
@@ -403,7 +410,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
             const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
             // Full resolution: this average over the tixel's footprint samples is the filter
             // (the renderers' mip levels would filter twice).
-            albedoSum += diffuseAlbedoAt(scene, c.material, hit.uv, kFullResolution);
+            albedoSum += albedoAt(hit.uv);
           }
         }
       p.coverage[g] = float(inside) / float(kFootprintSamples * kFootprintSamples);
@@ -467,14 +474,14 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       if (c.kind == ChartKind::Diffuse && !p.sunMaskLights.empty())
         p.sunMask[g] = tixelSunMasks(scene, accel, c, r, local, i, j, point, normal, p.sunMaskLights);
 
-      if (c.kind == ChartKind::Diffuse) {
+      if (hasAlbedo) {
         if (!textured) {
           p.transportAlbedo[g] = constantAlbedo;
         } else if (inside > 0) {
           p.transportAlbedo[g] = albedoSum / float(inside);
         } else {
           const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
-          p.transportAlbedo[g] = diffuseAlbedoAt(scene, c.material, hit.uv, kFullResolution);
+          p.transportAlbedo[g] = albedoAt(hit.uv);
         }
       } else {
         p.transportAlbedo[g] = Rgb(0.0f);
@@ -719,6 +726,8 @@ Parameterisation buildCharts(const Scene& scene, const Accel& accel, const BakeS
     const Bsdf& bsdf = scene.materials[firstMaterial].bsdf;
     c.kind = chartKindOf(bsdf);
     c.dirRes = directionalResolution(bsdf, settings);
+    // A glossy model with a diffuse part keeps that part's irradiance per tixel (lightfield.h).
+    c.diffuseValue = c.kind == ChartKind::Glossy && !isBlack(diffuseAlbedo(bsdf));
     const double nLen = glm::length(normalSum);
     const Vec3 n = nLen > 0.0 ? Vec3(normalSum / nLen) : Vec3(0.0f, 0.0f, 1.0f);
     c.normal = n;

@@ -109,7 +109,7 @@ struct Parameterisation {
   /// normal at gatherPoint, on the record's side (negated on a back record). See tixelFrame.
   std::vector<Vec3> gatherNormal;
   std::vector<float> coverage;        ///< fraction of the tixel's square covered by the polygon
-  std::vector<Rgb> transportAlbedo;   ///< diffuse charts: mean albedo over the tixel's footprint
+  std::vector<Rgb> transportAlbedo;   ///< diffuse charts, and glossy diffuseValue ones' diffuse part: mean albedo over the tixel's footprint
   /// Sun masks (lightfield.h "Sun masks"): the scene lights masked (sunMaskLights, or none
   /// when BakeSettings::sunMasks is off) and per tixel one mask per masked light (slots past
   /// their count unused; every bit set on glossy and specular charts).

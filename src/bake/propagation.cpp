@@ -140,6 +140,21 @@ struct GlossyMaterial {
   std::vector<std::vector<Vec3>> outputs;     ///< per output texel, its sub-sample directions
   std::vector<Vec3> centres;                  ///< per output texel, its representative direction
   std::vector<float> projectedSolidAngle;     ///< per output texel, ≈ Ω·cos θ (for the power sum)
+  // The diffuse part of a model that has one (Chart::diffuseValue, lightfield.h): op above is
+  // then the model without it (`specular`), and each tixel keeps Ẽ = Σ_k w_k L_k after its
+  // map, w_k = ∫_cell k(μ) cos θ dω (diffuseDirectionalFactor). Its radiant exitance per unit
+  // area is ρ·Ẽ·diffuseExitance, diffuseExitance = (1/π) Σ_k w_k = (1/π) ∫ k(μ) cos θ dω.
+  bool diffuse = false;
+  Bsdf specular;
+  std::vector<Lanes4> diffuseWeight;  ///< w_k per gather cell
+  Rgb diffuseExitance{0.0f};
+  /// out[directionTexels] += Σ_k w_k L_k (a chart with a diffuse value; nothing otherwise).
+  void addDiffuse(const Chart& c, const Lanes4* incoming, Rgb* out) const {
+    if (!diffuse) return;
+    F4 sum = f4Zero();
+    for (size_t k = 0; k < diffuseWeight.size(); ++k) sum = f4Add(sum, f4Mul(f4Load(diffuseWeight[k].v), f4Load(incoming[k].v)));
+    out[c.directionTexels()] += f4Rgb(sum);
+  }
 };
 
 // ---- Rough glass (lightfield.h "Rough glass") -------------------------------------------------
@@ -315,10 +330,12 @@ void requireFiniteValues(const Scene& scene, const Parameterisation& param, cons
 
 }  // namespace
 
-std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide, bool outputOnBack, bool gatherOnBack) {
-  const uint32_t n = gridSide * gridSide, texels = dirRes * dirRes;
-  std::vector<Rgb> op(size_t(texels) * n);
-  // Incident sub-sample directions of every cell (same for every output texel).
+namespace {
+
+/// The incident sub-sample directions of every gather cell, kCellSubsamples² per cell in cell
+/// order: cosine-distributed, so a mean over a cell's directions times π/N is ∫_cell … cos θ dω.
+std::vector<Vec3> gatherCellSubsampleDirections(uint32_t gridSide) {
+  const uint32_t n = gridSide * gridSide;
   std::vector<Vec3> cellDirs(size_t(n) * kCellSubsamples * kCellSubsamples);
   for (uint32_t k = 0; k < n; ++k) {
     const float a = float(k % gridSide), b = float(k / gridSide);
@@ -328,6 +345,35 @@ std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t grid
         cellDirs[(size_t(k) * kCellSubsamples + y) * kCellSubsamples + x] = sampleCosineHemisphere(u);
       }
   }
+  return cellDirs;
+}
+
+/// GlossyMaterial's diffuse part of model `bsdf` (which has one): the model without it, and
+/// per gather cell w_k = (π/N) · mean over the cell's sub-sample directions of k(μ).
+void addDiffusePart(GlossyMaterial& g, const Bsdf& bsdf, uint32_t gridSide) {
+  const uint32_t n = gridSide * gridSide, perCell = kCellSubsamples * kCellSubsamples;
+  const std::vector<Vec3> cellDirs = gatherCellSubsampleDirections(gridSide);
+  g.diffuse = true;
+  g.specular = withDiffuseAlbedo(bsdf, Rgb(0.0f));
+  g.diffuseWeight.resize(n);
+  Rgb total(0.0f);
+  for (uint32_t k = 0; k < n; ++k) {
+    Rgb sum(0.0f);
+    for (uint32_t s = 0; s < perCell; ++s) sum += diffuseDirectionalFactor(bsdf, cellDirs[size_t(k) * perCell + s].z);
+    const Rgb w = sum * (kPi / float(n * perCell));
+    g.diffuseWeight[k] = lanes4(w);
+    total += w;
+  }
+  g.diffuseExitance = total * kInvPi;
+}
+
+}  // namespace
+
+std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide, bool outputOnBack, bool gatherOnBack) {
+  const uint32_t n = gridSide * gridSide, texels = dirRes * dirRes;
+  std::vector<Rgb> op(size_t(texels) * n);
+  // Incident sub-sample directions of every cell (same for every output texel).
+  const std::vector<Vec3> cellDirs = gatherCellSubsampleDirections(gridSide);
   // ∫_cell f cos θ dω = (π/N)·E[f] over cosine-distributed directions in the cell.
   const float cellWeight = kPi / float(n);
   parallelFor(texels, [&](uint64_t c) {
@@ -394,7 +440,9 @@ double exitance(const TransportState& state, const Rgb* values, uint64_t g, cons
   if (c.kind == ChartKind::Diffuse) return double(luminance(state.param.transportAlbedo[g] * values[0]));
   double sum = 0.0;
   const GlossyMaterial& gm = state.ops->glossy[c.material];
-  for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) sum += double(luminance(values[t])) * gm.projectedSolidAngle[t];
+  for (uint32_t t = 0; t < c.directionTexels(); ++t) sum += double(luminance(values[t])) * gm.projectedSolidAngle[t];
+  if (c.diffuseValue)
+    sum += double(luminance(state.param.transportAlbedo[g] * values[c.directionTexels()] * gm.diffuseExitance));
   return sum;
 }
 // |change| of that exitance from `before` to `after`, texel by texel (so that changes of
@@ -403,10 +451,25 @@ float exitanceChange(const TransportState& state, const Rgb* before, const Rgb* 
   if (c.kind == ChartKind::Diffuse) return std::abs(luminance(state.param.transportAlbedo[g] * (after[0] - before[0])));
   float sum = 0.0f;
   const GlossyMaterial& gm = state.ops->glossy[c.material];
-  for (uint32_t t = 0; t < c.valuesPerTixel(); ++t) sum += std::abs(luminance(after[t] - before[t])) * gm.projectedSolidAngle[t];
+  for (uint32_t t = 0; t < c.directionTexels(); ++t) sum += std::abs(luminance(after[t] - before[t])) * gm.projectedSolidAngle[t];
+  if (c.diffuseValue) {
+    const uint64_t d = c.directionTexels();
+    sum += std::abs(luminance(state.param.transportAlbedo[g] * (after[d] - before[d]) * gm.diffuseExitance));
+  }
   return sum;
 }
 
+/// The diffuse part of a glossy diffuseValue chart c's exitant radiance towards paraboloid
+/// direction st at grid position `grid`: k(μo)/π · the bilinear interpolation of ρ̄·Ẽ over the
+/// tixels (ρ̄ the transport albedo; as the diffuse quads interpolate ρ̄·E).
+Rgb glossyDiffuseRadiance(const TransportState& state, const Rgb* values, const Chart& c, Vec2 grid, Vec2 st) {
+  const std::vector<Rgb>& albedo = state.param.transportAlbedo;
+  const F4 e = bilinearOverTixels(c, grid, [&](uint32_t i, uint32_t j) {
+    return f4FromRgb(albedo[c.firstTixel + uint64_t(j) * c.resU + i] * values[c.diffuseValueIndex(i, j)]);
+  });
+  const Bsdf& bsdf = state.scene.materials[c.material].bsdf;
+  return f4Rgb(e) * kInvPi * diffuseDirectionalFactor(bsdf, paraboloidToDirection(st).z);
+}
 
 }  // namespace
 
@@ -425,8 +488,9 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
     if (c.kind != ChartKind::Glossy || glossy[c.material].dirRes != 0) continue;
     GlossyMaterial& g = glossy[c.material];
     g.dirRes = c.dirRes;
-    g.op = SparseOperator::fromDense(glossyOperator(scene.materials[c.material].bsdf, c.dirRes, gridSide),
-                                     c.dirRes * c.dirRes, n);
+    const Bsdf& bsdf = scene.materials[c.material].bsdf;
+    if (c.diffuseValue) addDiffusePart(g, bsdf, gridSide);
+    g.op = SparseOperator::fromDense(glossyOperator(g.diffuse ? g.specular : bsdf, c.dirRes, gridSide), c.dirRes * c.dirRes, n);
     if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) addGlassOperators(g, scene.materials[c.material].bsdf, gridSide);
     const std::vector<float>& omega = paraboloidTexelSolidAngles(c.dirRes);
     for (uint32_t t = 0; t < c.dirRes * c.dirRes; ++t) {
@@ -628,10 +692,13 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         // Punctual lights: the BSDF averaged over each output texel (a delta light would
         // otherwise alias between texel centres). Area-light samples are many per tixel and
         // already spread over the emitter: the texel-centre value suffices and costs 9× less.
-        for (uint32_t t = 0; t < c.valuesPerTixel(); ++t)
-          direct[vb + t] += (p.areaSample ? recordEval(bsdf, glass, gm.centres[t], wiLocal)
-                                          : texelAverageBsdf(bsdf, gm.outputs[t], wiLocal, glass)) *
+        // The maps get the model without its diffuse part when the tixel keeps that part's Ẽ.
+        const Bsdf& mapped = gm.diffuse ? gm.specular : bsdf;
+        for (uint32_t t = 0; t < c.directionTexels(); ++t)
+          direct[vb + t] += (p.areaSample ? recordEval(mapped, glass, gm.centres[t], wiLocal)
+                                          : texelAverageBsdf(mapped, gm.outputs[t], wiLocal, glass)) *
                             p.irradiance;
+        if (gm.diffuse) direct[vb + c.directionTexels()] += diffuseDirectionalFactor(bsdf, wiLocal.z) * p.irradiance;
       }
     }
     if (progress) progress->advance(t1 - t0);
@@ -736,8 +803,10 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
       const uint64_t vb = valueBase(g, c);
       if (c.kind == ChartKind::Diffuse)
         direct[vb] += sum * (kPi / float(n));
-      else
+      else {
         glossy[c.material].reflection(c).apply(incoming.data(), f4FromRgb(sum), direct.data() + vb);
+        glossy[c.material].addDiffuse(c, incoming.data(), direct.data() + vb);
+      }
     }
   });
 }
@@ -816,7 +885,9 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
           const float fu = float(e.fu) * (1.0f / 65535.0f), fv = float(e.fv) * (1.0f / 65535.0f);
           const uint64_t local = base - seen.firstTixel;
           const Vec2 grid(float(local % seen.resU) + fu, float(local / seen.resU) + fv);
-          L = interpolateValues(sameBatch ? previousValues.data() : current.data(), seen, grid, extra->st);
+          const Rgb* values = sameBatch ? previousValues.data() : current.data();
+          L = interpolateValues(values, seen, grid, extra->st);
+          if (seen.diffuseValue) L += glossyDiffuseRadiance(state, values, seen, grid, extra->st);
         }
         return L * extra->throughput;
       };
@@ -836,6 +907,7 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
         std::copy_n(direct.data() + vb, c.valuesPerTixel(), out);
         const GlossyMaterial& gm = glossy[c.material];
         gm.reflection(c).apply(incoming.data(), sum, out);
+        gm.addDiffuse(c, incoming.data(), out);
         if (gm.glass) {
           // Rough glass: plus the transmission of what the twin record gathers now.
           const uint64_t twin = twinTixel(param, g);
@@ -883,7 +955,8 @@ void finishTransport(TransportState& state) {
     if (c.kind != ChartKind::Glossy) continue;
     const Rgb le = chartEmittedRadiance(scene.materials[c.material], c, 1.0f);
     if (isBlack(le)) continue;
-    for (uint64_t v = 0; v < c.tixelCount() * c.valuesPerTixel(); ++v) current[c.firstValue + v] += le;
+    for (uint64_t local = 0; local < c.tixelCount(); ++local)  // the maps, not a diffuse value
+      for (uint64_t t = 0; t < c.directionTexels(); ++t) current[c.firstValue + local * c.valuesPerTixel() + t] += le;
   }
   requireFiniteValues(scene, param, current, "when adding the glossy charts' emission");
 }

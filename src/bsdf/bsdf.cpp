@@ -885,6 +885,12 @@ Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo) {
                     bsdf);
 }
 
+Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta) {
+  if (!(cosTheta > 0.0f)) return Rgb(0.0f);
+  const auto* ggx = std::get_if<GgxBsdf>(&bsdf);
+  return ggx ? ggxDiffuseFactor(*ggx, std::min(cosTheta, 1.0f)) : Rgb(1.0f);
+}
+
 const char* modelName(const Bsdf& bsdf) {
   return std::visit(Overloaded{
                         [](const LambertBsdf&) { return "lambert"; },

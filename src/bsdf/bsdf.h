@@ -257,6 +257,15 @@ Rgb albedo(const Bsdf& bsdf, const Vec3& wo);
 /// The model with its diffuse albedo replaced (texture lookups at a hit point). Models with
 /// no diffuse part are returned unchanged.
 Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo);
+/// The directional factor k(μ) of the model's diffuse part: every model's diffuse term is
+///   f_diffuse(wo, wi) = diffuseAlbedo(bsdf)/π · k(μo) · k(μi)        (μ = cos θ, per channel)
+/// — k = 1 for Lambert and Blinn-Phong (a plain Lambertian term); for GGX
+/// k(μ) = (1 − E(μ)) / √(1 − Ē), E the specular lobe's directional albedo and Ē its cosine-
+/// weighted mean (the energy-conserving base above). Zero for μ ≤ 0. The light field stores a
+/// glossy chart's diffuse part as one irradiance-like value per tixel, Ẽ = ∫ L k(μi) cos θi dωi,
+/// and evaluates ρ(uv)/π · k(μo) · Ẽ where it is seen, so that textures modulate it
+/// (lightfield.h "What is stored per chart kind").
+Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta);
 /// A short name for messages and `info`: "lambert", "mirror", "blinn-phong", "ggx",
 /// "dielectric" (smooth), "rough-dielectric", "thin-dielectric".
 const char* modelName(const Bsdf& bsdf);

@@ -31,6 +31,14 @@
 //             level of the view ray's cone (lookup.h albedoTextureLod; the bake's transport
 //             albedo is a full-resolution average over each tixel's footprint).
 //   Glossy    dirRes² values per tixel: exitant radiance Lo (W·sr⁻¹·m⁻², emission included).
+//             When the material has a diffuse part (diffuseValue: Blinn-Phong's or GGX's base
+//             with a non-black diffuse albedo) the maps hold only the rest (the specular lobe
+//             and emission), and one more value follows each tixel's map: the diffuse part's
+//             irradiance Ẽ = ∫ L k(μi) cos θi dωi (W·m⁻²; k the model's diffuseDirectionalFactor,
+//             1 for Blinn-Phong). The renderers add albedo(uv)/π · k(μo) · Ẽ, Ẽ bilinear over
+//             the 2×2 nearest tixels and the albedo texture read as on a diffuse chart, so a
+//             textured glossy material shows its texture (the bake's transport albedo of such
+//             a tixel is, as on diffuse charts, the footprint mean of diffuse albedo × texel).
 //             Rough glass (a DielectricBsdf with α ≥ kGgxMinAlpha, not thin) is a glossy
 //             chart too, always two-sided (see "Rough glass" below).
 //   Specular  nothing: an ideal mirror's or smooth glass's radiance is that of whatever the
@@ -98,14 +106,20 @@ struct Chart {
   uint8_t sides = 1;            ///< 2: a two-sided surface (both records have 2), see "Sides" above
   bool isBack = false;          ///< the back-side record of a two-sided surface (follows its front)
   bool curved = false;          ///< a curved (diffuse or glossy) chart: sides are decided per triangle (chartNormalAt)
+  /// A glossy chart whose material has a diffuse part: each tixel's map is followed by its
+  /// diffuse irradiance Ẽ (see "What is stored per chart kind" above).
+  bool diffuseValue = false;
 
   uint64_t tixelCount() const { return uint64_t(resU) * resV; }
-  uint64_t valuesPerTixel() const { return uint64_t(dirRes) * dirRes; }
+  uint64_t directionTexels() const { return uint64_t(dirRes) * dirRes; }
+  uint64_t valuesPerTixel() const { return directionTexels() + (diffuseValue ? 1 : 0); }
   /// Values are tixel-major: all direction texels of one tixel are contiguous, direction
-  /// texel (s, t) at s + t·dirRes, tixels row by row (i + j·resU).
+  /// texel (s, t) at s + t·dirRes, then (diffuseValue) the tixel's Ẽ; tixels row by row (i + j·resU).
   uint64_t valueIndex(uint32_t i, uint32_t j, uint32_t s = 0, uint32_t t = 0) const {
     return firstValue + (uint64_t(j) * resU + i) * valuesPerTixel() + uint64_t(t) * dirRes + s;
   }
+  /// The index of tixel (i, j)'s diffuse irradiance Ẽ (diffuseValue charts only).
+  uint64_t diffuseValueIndex(uint32_t i, uint32_t j) const { return valueIndex(i, j) + directionTexels(); }
 };
 
 /// Quality preset parameters (see presets in bake.cpp and docs/user-guide.md). The member defaults are

@@ -30,6 +30,12 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float lod) {
   return albedo(withDiffuseAlbedo(m.bsdf, diffuseAlbedo(m.bsdf) * texel), Vec3(0.0f, 0.0f, 1.0f));
 }
 
+Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float lod) {
+  const Material& m = scene.materials[material];
+  const Rgb rho = diffuseAlbedo(m.bsdf);
+  return m.albedoTexture < 0 ? rho : rho * scene.textures[size_t(m.albedoTexture)].sampleLod(uv, lod);
+}
+
 namespace {
 
 /// A 64-bit hash of the ray's bits (origin and direction): the source of followSpecular's
@@ -109,7 +115,9 @@ ChartShading chartShading(const LightField& lf, uint32_t chart, const SunLights&
   shading.texturedAlbedo = material.albedoTexture >= 0;
   if (c.kind == ChartKind::Diffuse && !shading.texturedAlbedo)
     shading.albedoOverPi = lanes4(diffuseAlbedoAt(scene, c.material, Vec2(0.0f), kFullResolution) * kInvPi);
-  shading.needsUv = c.kind == ChartKind::Diffuse && shading.texturedAlbedo;
+  if (c.diffuseValue && !shading.texturedAlbedo)
+    shading.albedoOverPi = lanes4(glossyDiffuseAlbedoAt(scene, c.material, Vec2(0.0f), kFullResolution) * kInvPi);
+  shading.needsUv = (c.kind == ChartKind::Diffuse || c.diffuseValue) && shading.texturedAlbedo;
   shading.normalMapped = c.kind == ChartKind::Glossy && material.normalTexture >= 0;
   shading.curvedGlossy = c.kind == ChartKind::Glossy && c.curved;
   if (c.kind == ChartKind::Diffuse && sun.count > 0 &&

@@ -110,6 +110,21 @@ inline F4 interpolateLanes(const Load& load, const Chart& c, Vec2 grid, Vec2 st)
   return sum;
 }
 
+/// Bilinear interpolation over the 2×2 tixels of chart c nearest grid position `grid`
+/// (tixelGridCoordinates) of perTixel(i, j) (four lanes), clamped to the grid like
+/// interpolateLanes: the glossy charts' diffuse irradiance Ẽ (lightfield.h) is read this way by
+/// the renderers and, weighted by each tixel's transport albedo, by the bake.
+template <typename PerTixel>
+inline F4 bilinearOverTixels(const Chart& c, Vec2 grid, const PerTixel& perTixel) {
+  const LinearTap tu = linearTap(grid.x, c.resU);
+  const LinearTap tv = linearTap(grid.y, c.resV);
+  const F4 lower = f4Add(f4Mul(f4Splat((1.0f - tu.f) * (1.0f - tv.f)), perTixel(tu.i0, tv.i0)),
+                         f4Mul(f4Splat(tu.f * (1.0f - tv.f)), perTixel(tu.i1, tv.i0)));
+  const F4 upper = f4Add(f4Mul(f4Splat((1.0f - tu.f) * tv.f), perTixel(tu.i0, tv.i1)),
+                         f4Mul(f4Splat(tu.f * tv.f), perTixel(tu.i1, tv.i1)));
+  return f4Add(lower, upper);
+}
+
 /// interpolateLanes over a raw Rgb value array (the bake uses it on its working arrays).
 inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 st) {
   return f4Rgb(interpolateLanes(RgbValues{values}, c, grid, st));
@@ -123,6 +138,10 @@ inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 
 /// point's footprint, parameterisation.cpp).
 Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float lod);
 inline constexpr float kFullResolution = 0.0f;
+/// The albedo ρ of a glossy chart's diffuse part (Chart::diffuseValue) at surface uv: the
+/// model's diffuse albedo times its albedo texture (if any) read at mip level `lod` — the
+/// path tracer's texturing (bsdfAt), whose diffuse term is ρ/π · k(μo) · k(μi).
+Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float lod);
 
 /// The mip level a light-field renderer reads an albedo texture at, by ray cones
 /// (Akenine-Möller et al., "Texture Level of Detail Strategies for Real-Time Ray Tracing",
@@ -216,12 +235,12 @@ struct SunLights;
 /// the plain exitantRadiance below builds it on the fly, so both run the same formula.
 struct ChartShading {
   Lanes4 emission;                ///< Le of the chart's material (W·sr⁻¹·m⁻²), as lanes r, g, b, 0
-  Lanes4 albedoOverPi;            ///< diffuse albedo / π when !texturedAlbedo (diffuse charts only)
+  Lanes4 albedoOverPi;            ///< diffuse albedo / π when !texturedAlbedo (diffuse charts, glossy diffuseValue ones)
   float inverseTixelSize = 1.0f;  ///< 1 / chart.tixelSize (tixelGridCoordinates)
   bool emissive = false;          ///< emission is not black
   bool twoSidedEmission = false;
   bool texturedAlbedo = false;    ///< diffuse albedo varies with uv: diffuseAlbedoAt per point
-  bool needsUv = false;           ///< a diffuse chart with an albedo texture: the lookup needs the hit's uv
+  bool needsUv = false;           ///< a diffuse (or diffuseValue glossy) chart with an albedo texture: the lookup needs the hit's uv
   bool normalMapped = false;      ///< a glossy chart with a normal map: lookupDirection needs the hit's normal
   /// A curved glossy chart: its map is read in the frame around the hit's interpolated normal
   /// (chartShadingNormalAt), so the lookup needs the hit's triangle and barycentrics.
@@ -383,7 +402,15 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
   // frame). A direction below that normal (a silhouette of a smooth mesh, where the shading
   // normal turns away from a viewer the triangle still faces) reads the horizon texels.
   const Vec3 local = tixelFrameAround(c, lookupNormal).toLocal(worldDirectionTowardsViewer);
-  return interpolateLanes(load, c, grid, directionToParaboloid(local));
+  const F4 mapped = interpolateLanes(load, c, grid, directionToParaboloid(local));
+  if (!c.diffuseValue) return mapped;
+  // Plus the diffuse part, ρ(uv)/π · k(μo) · Ẽ (lightfield.h), with Ẽ bilinear over the tixels.
+  const F4 irradiance = bilinearOverTixels(c, grid, [&](uint32_t i, uint32_t j) { return load(c.diffuseValueIndex(i, j)); });
+  const F4 albedoOverPi = shading.texturedAlbedo
+                              ? f4Mul(f4FromRgb(glossyDiffuseAlbedoAt(scene, c.material, uv, lod)), f4Splat(kInvPi))
+                              : f4Load(shading.albedoOverPi.v);
+  const F4 factor = f4FromRgb(diffuseDirectionalFactor(scene.materials[c.material].bsdf, local.z));
+  return f4Add(mapped, f4Mul(f4Mul(albedoOverPi, factor), irradiance));
 }
 template <typename Load>
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,

@@ -56,9 +56,12 @@ std::vector<Grid> buildLayout(const std::vector<Chart>& charts, uint64_t valueCo
       // Diffuse: the tixel grid (value (i, j) at firstValue + i + j·resU).
       images.push_back({c.firstValue, 1, c.resU, c.resU, c.resV});
     } else {
-      // Glossy: every tixel's dirRes × dirRes paraboloid texture (texel (s, t) at s + t·dirRes).
+      // Glossy: every tixel's dirRes × dirRes paraboloid texture (texel (s, t) at s + t·dirRes),
+      // then (diffuseValue) the tixels' diffuse irradiance as one more tixel-grid image.
       for (uint64_t tixel = 0; tixel < tixels; ++tixel)
         images.push_back({c.firstValue + tixel * perTixel, 1, c.dirRes, c.dirRes, c.dirRes});
+      if (c.diffuseValue)
+        images.push_back({c.firstValue + c.directionTexels(), perTixel, perTixel * c.resU, c.resU, c.resV});
     }
   }
   std::sort(covered.begin(), covered.end());

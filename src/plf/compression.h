@@ -34,7 +34,8 @@
 // Layout ("images"): the values are visited as 2-D images so that neighbours in an image
 // are neighbours on a surface or on the hemisphere. A diffuse chart is one resU × resV image
 // (one irradiance per tixel); a glossy chart is one dirRes × dirRes image per tixel, its
-// paraboloid texture. Values that no chart covers form 1-pixel-high images. BC1 pads
+// paraboloid texture, plus (Chart::diffuseValue) one resU × resV image of its tixels'
+// diffuse irradiance. Values that no chart covers form 1-pixel-high images. BC1 pads
 // images to whole 4 × 4 blocks (padding texels are masked out of the endpoint fit).
 // Chosen by measurement on CornellBox-Glossy (533 mostly small glossy charts, dirRes 12)
 // against the alternative of dirRes² images of resU × resV (one per direction texel, i.e.

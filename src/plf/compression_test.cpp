@@ -29,7 +29,7 @@ namespace fs = std::filesystem;
 
 /// Charts exercising every layout case: a diffuse grid whose sides are not multiples of 4,
 /// a glossy chart with dirRes 8 (whole BC1 blocks per direction), a glossy chart with
-/// dirRes 3, a specular chart (no values) and values that no chart covers (a gap and a tail).
+/// dirRes 3 and a diffuse value after each tixel's map (Chart::diffuseValue), a specular chart (no values) and values that no chart covers (a gap and a tail).
 std::vector<Chart> makeCharts(uint64_t& valueCount) {
   Chart diffuse;
   diffuse.kind = ChartKind::Diffuse;
@@ -50,8 +50,9 @@ std::vector<Chart> makeCharts(uint64_t& valueCount) {
   glossy3.resU = 2;
   glossy3.resV = 9;
   glossy3.dirRes = 3;
+  glossy3.diffuseValue = true;  // 9 + 1 values per tixel
   glossy3.firstValue = glossy8.firstValue + 5 * 6 * 64;
-  valueCount = glossy3.firstValue + 2 * 9 * 9 + 11;  // an uncovered tail of 11
+  valueCount = glossy3.firstValue + 2 * 9 * 10 + 11;  // an uncovered tail of 11
   return {diffuse, glossy8, specular, glossy3};
 }
 
@@ -75,6 +76,10 @@ std::vector<Rgb> makeSmoothValues(const std::vector<Chart>& charts, uint64_t val
             values[c.valueIndex(i, j, s, t)] =
                 Rgb(float(base * 0.9 * n()), float(base * 0.7 * n()), float(base * 0.4 * n()));
           }
+    if (c.diffuseValue)
+      for (uint32_t j = 0; j < c.resV; ++j)
+        for (uint32_t i = 0; i < c.resU; ++i)
+          values[c.diffuseValueIndex(i, j)] = Rgb(float(2.0 + 0.1 * i), float(1.5 + 0.1 * j), 1.0f);
   }
   values[3] = Rgb(0.0f);  // exact zeros must stay zero in every codec
   return values;

@@ -490,7 +490,11 @@ constexpr uint64_t kChartRecordBytes = 4 + 1 + 4 * 12 + 4 + 3 * 4 + 2 * 8;
 // chart (lightfield.h: diffuse, or glossy but not rough glass); files written before curved
 // charts have it clear, and files written before curved glossy charts have it on diffuse
 // charts only, so both read unchanged.
-constexpr uint8_t kChartTwoSidedBit = 0x80, kChartBackBit = 0x40, kChartCurvedBit = 0x20, kChartKindMask = 0x1f;
+// Bit 4 (version 4 on) marks a glossy chart with a diffuse value after each tixel's map
+// (Chart::diffuseValue); older files have it clear, and their glossy maps hold the whole
+// exitant radiance, which is what a chart without the bit means.
+constexpr uint8_t kChartTwoSidedBit = 0x80, kChartBackBit = 0x40, kChartCurvedBit = 0x20, kChartDiffuseValueBit = 0x10,
+                  kChartKindMask = 0x0f;
 
 std::vector<unsigned char> encodeCharts(const std::vector<Chart>& charts) {
   ByteWriter w;
@@ -498,7 +502,7 @@ std::vector<unsigned char> encodeCharts(const std::vector<Chart>& charts) {
   for (const Chart& c : charts) {
     w.put(c.material);
     w.put(uint8_t(uint8_t(c.kind) | (c.sides == 2 ? kChartTwoSidedBit : 0) | (c.isBack ? kChartBackBit : 0) |
-                  (c.curved ? kChartCurvedBit : 0)));
+                  (c.curved ? kChartCurvedBit : 0) | (c.diffuseValue ? kChartDiffuseValueBit : 0)));
     w.put(c.origin);
     w.put(c.axisU);
     w.put(c.axisV);
@@ -530,7 +534,10 @@ std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std:
     c.sides = (kindByte & kChartTwoSidedBit) ? 2 : 1;
     c.isBack = (kindByte & kChartBackBit) != 0;
     c.curved = (kindByte & kChartCurvedBit) != 0;
+    c.diffuseValue = (kindByte & kChartDiffuseValueBit) != 0;
     if (c.curved && c.kind == ChartKind::Specular) r.corrupt(fmt::format("chart {} of kind {} is marked curved", i, kind));
+    if (c.diffuseValue && c.kind != ChartKind::Glossy)
+      r.corrupt(fmt::format("chart {} of kind {} is marked as having a diffuse value", i, kind));
     c.origin = r.get<Vec3>();
     c.axisU = r.get<Vec3>();
     c.axisV = r.get<Vec3>();

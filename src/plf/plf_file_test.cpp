@@ -786,6 +786,38 @@ TEST_F(PlfFileTest, CurvedGlossyChartsRoundTripAndCurvedSpecularOrRoughGlassAreR
   expectRefused(file("curvedglass.plf"), {"corrupt charts section", "rough-glass chart 2 is marked curved"});
 }
 
+// Glossy charts that keep a diffuse value per tixel after their map (Chart::diffuseValue,
+// CHRT bit 4, version 4): the flag and the longer value layout round-trip with every values
+// encoding; the bit on a chart of another kind is refused.
+TEST_F(PlfFileTest, GlossyDiffuseValuesRoundTripAndTheBitOnOtherKindsIsRefused) {
+  LightField original = makeTestLightField();
+  ASSERT_EQ(original.charts[2].kind, ChartKind::Glossy);
+  original.charts[2].diffuseValue = true;  // 16 + 1 values per tixel
+  original.values.resize(16 + 2 * 3 * 17);
+  for (size_t i = 0; i < original.values.size(); ++i) original.values[i] = Rgb(float(i), 0.25f * float(i), 3.0f);
+  for (const ValuesCodec codec : {ValuesCodec::Raw, ValuesCodec::Lossless}) {
+    const std::string path = file("diffuse-value.plf");
+    writeLightField(path, original, codec);
+    const LightField copy = readLightField(path);
+    ASSERT_EQ(copy.charts.size(), original.charts.size());
+    for (size_t i = 0; i < copy.charts.size(); ++i) EXPECT_EQ(copy.charts[i].diffuseValue, original.charts[i].diffuseValue) << i;
+    EXPECT_EQ(copy.values, original.values);
+    EXPECT_EQ(readLightFieldInfo(path).version, kPlfVersion);
+  }
+  const std::string path = file("diffuse-value.plf");
+  writeLightField(path, original);
+  const auto good = readBytes(path);
+  const auto table = sections(good);
+  const uint64_t chartRecord = 4 + 1 + 48 + 4 + 12 + 16;
+  const uint64_t recordsAt = table[1].offset + 8;  // record 0's material, then its kind byte
+  auto bad = good;
+  bad[recordsAt + 4] |= 0x10;  // the diffuse chart marked as having a diffuse value
+  resign(bad);
+  writeBytes(file("diffuse-bit.plf"), bad);
+  expectRefused(file("diffuse-bit.plf"), {"corrupt charts section", "chart 0 of kind 0 is marked as having a diffuse value"});
+  EXPECT_EQ(chartRecord, 85u);
+}
+
 TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {
   LightField original = makeTestLightField();
   Scene& s = original.scene;
@@ -897,7 +929,7 @@ TEST_F(PlfFileTest, SunMasksRoundTripWithEveryValuesEncoding) {
 
       // SMSK sits between VALS and META: 16 header bytes and 2 bytes per mask.
       const PlfInfo info = readLightFieldInfo(path);
-      EXPECT_EQ(info.version, 3u);
+      EXPECT_EQ(info.version, kPlfVersion);  // SMSK since version 3
       EXPECT_EQ(info.sunMaskLights, lights);
       EXPECT_TRUE(info.checksumsVerified);
       ASSERT_EQ(info.sections.size(), 6u);
