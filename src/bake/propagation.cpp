@@ -515,6 +515,11 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   ops->glassFirstShot.emplace(scene, param, n);
 
   direct.assign(param.valueCount, Rgb(0.0f));
+  const bool glossyReflector = std::any_of(param.charts.begin(), param.charts.end(), [&](const Chart& c) {
+    return c.kind == ChartKind::Glossy && !isRoughGlassChart(c, scene.materials[c.material].bsdf);
+  });
+  if (settings.punctualHighlights && !scene.lights.empty() && glossyReflector)
+    punctualGlossy.assign(param.valueCount, Rgb(0.0f));
   change.assign(tixels, 0.0f);
   batchStart = propagationBatches(param);
 }
@@ -580,6 +585,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
   std::vector<int> maskSlot(punctualLights.size());
   for (size_t li = 0; li < punctualLights.size(); ++li) maskSlot[li] = sunMaskSlot(param, uint32_t(li));
   std::vector<Rgb>& direct = state.direct;
+  std::vector<Rgb>& punctualGlossy = state.punctualGlossy;
   std::atomic<uint64_t>& shadowRays = state.shadowRays;
   const uint64_t tixelsPerBlock = 64;
   const uint64_t blocks = (end - begin + tixelsPerBlock - 1) / tixelsPerBlock;
@@ -694,10 +700,16 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         // already spread over the emitter: the texel-centre value suffices and costs 9× less.
         // The maps get the model without its diffuse part when the tixel keeps that part's Ẽ.
         const Bsdf& mapped = gm.diffuse ? gm.specular : bsdf;
-        for (uint32_t t = 0; t < c.directionTexels(); ++t)
-          direct[vb + t] += (p.areaSample ? recordEval(mapped, glass, gm.centres[t], wiLocal)
-                                          : texelAverageBsdf(mapped, gm.outputs[t], wiLocal, glass)) *
-                            p.irradiance;
+        // A punctual light's highlight on a reflecting glossy chart is also noted apart, to be
+        // taken out of the stored maps at the end (punctualGlossy).
+        const bool highlight = !p.areaSample && !glass && !punctualGlossy.empty();
+        for (uint32_t t = 0; t < c.directionTexels(); ++t) {
+          const Rgb reflected = (p.areaSample ? recordEval(mapped, glass, gm.centres[t], wiLocal)
+                                              : texelAverageBsdf(mapped, gm.outputs[t], wiLocal, glass)) *
+                                p.irradiance;
+          direct[vb + t] += reflected;
+          if (highlight) punctualGlossy[vb + t] += reflected;
+        }
         if (gm.diffuse) direct[vb + c.directionTexels()] += diffuseDirectionalFactor(bsdf, wiLocal.z) * p.irradiance;
       }
     }
@@ -949,6 +961,10 @@ void finishTransport(TransportState& state) {
   const Scene& scene = state.scene;
   const Parameterisation& param = state.param;
   std::vector<Rgb>& current = state.current;
+  // The punctual lights' direct highlights leave the stored maps (lightfield.h "Punctual
+  // highlights"): the renderers evaluate them per pixel.
+  if (!state.punctualGlossy.empty())
+    for (uint64_t v = 0; v < current.size(); ++v) current[v] = glm::max(Rgb(0.0f), current[v] - state.punctualGlossy[v]);
   // Glossy values carry their emission (towards the record's own side) from here on; diffuse
   // ones stay irradiance.
   for (const Chart& c : param.charts) {
@@ -1024,6 +1040,8 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   for (const TixelRange& r : vis.ranges) gatherEmission(state, vis, r.begin, r.end);
   finishFirstShot(state);
   for (size_t b = 0; b < plan.batches(); ++b) exchange(state.direct, b);
+  if (!state.punctualGlossy.empty())
+    for (size_t b = 0; b < plan.batches(); ++b) exchange(state.punctualGlossy, b);
 
   result.firstShotSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - waitSeconds;
 

@@ -120,6 +120,11 @@ struct TransportState {
   const BakeSettings settings;
   uint32_t gridSide = 0, n = 0;    ///< gather grid side, gather directions per tixel (n = side²)
   std::vector<Rgb> direct;          ///< the first shot, constant over the iteration (glossy: no emission)
+  /// The part of `direct` that punctual lights reflect directly off glossy charts other than
+  /// rough glass (BakeSettings::punctualHighlights; empty when there is none): transported like
+  /// the rest, then taken out of the stored maps by finishTransport (lightfield.h "Punctual
+  /// highlights"). Exchanged between ranks like `direct`.
+  std::vector<Rgb> punctualGlossy;
   std::vector<Rgb> current;         ///< the iterate (from beginIteration on)
   std::vector<Rgb> previousValues;  ///< current as it was before this iteration (needed with glossy charts)
   std::vector<float> change;        ///< per tixel, |Δ exitance| of its last update (W·m⁻², luminance)

@@ -79,6 +79,16 @@
 // nearest sub-sample bits (sunVisibility) — edges resolved to a quarter of a tixel. (The bake
 // adds the same lights to the tixel's first shot as E_l·max(0, n_g·ω_l)·(set bits / 16): the
 // footprint's mean instead of one ray from the gather point; removeSunMaskedDirect.)
+//
+// Punctual highlights. A point, spot or directional light reflected by a glossy surface is a
+// highlight as sharp as the lobe, which a map of dirRes² texels per tixel smears into a fan (a
+// point light's reflection on a GGX r 0.2 ceiling: radiance ≈ 50 in the path tracer, ≈ 1.2 in
+// the map). So the bake leaves their direct reflection out of the glossy maps it stores (it
+// keeps it while propagating, so the light they reflect onwards is transported, and takes it
+// out at the end), and the renderers add it where a glossy surface is seen: the model (without
+// its diffuse part, which Ẽ holds) against each light at the hit, with the shading normal and
+// a shadow ray, as the path tracer's next-event estimation does (PunctualHighlights in
+// lookup.h). Rough glass keeps them in its maps.
 #include "core/math.h"
 #include "scene/scene.h"
 
@@ -139,6 +149,10 @@ struct BakeSettings {
   uint64_t seed = 0;
   /// Sun masks for directional lights (lightfield.h "Sun masks"); `bake --sun-masks off`.
   bool sunMasks = true;
+  /// Punctual highlights (lightfield.h "Punctual highlights"): the glossy maps leave out the
+  /// direct reflection of point, spot and directional lights, which the renderers evaluate per
+  /// pixel. False in files written before them, whose maps hold it.
+  bool punctualHighlights = true;
 };
 
 struct BakeStats {

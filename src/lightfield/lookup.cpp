@@ -166,4 +166,45 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
   return exitantRadiance(lf.scene, c, shading, lf.values.data(), worldPosition, lookupDirection, lookupNormal, uv, lod);
 }
 
+PunctualHighlights::PunctualHighlights(const LightField& lf, const Accel& accel) : lf_(lf) {
+  if (!lf.settings.punctualHighlights) return;
+  for (const Light& light : lf.scene.lights) lights_.push_back(PunctualLight::from(light));
+  if (lights_.empty()) return;
+  shadows_.emplace(lf.scene, accel);
+  for (const Material& m : lf.scene.materials) withoutDiffuse_.push_back(withDiffuseAlbedo(m.bsdf, Rgb(0.0f)));
+}
+
+Rgb PunctualHighlights::radiance(uint32_t chart, const RayHit& hit, const Vec3& towardsViewer, uint64_t& shadowRays) const {
+  const Chart& c = lf_.charts[chart];
+  if (lights_.empty() || c.kind != ChartKind::Glossy) return Rgb(0.0f);
+  const Scene& scene = lf_.scene;
+  const Bsdf& model = scene.materials[c.material].bsdf;
+  if (isRoughGlassChart(c, model)) return Rgb(0.0f);  // rough glass keeps them in its maps
+  // The model the maps hold (the bake's first shot: without the diffuse part when Ẽ keeps it).
+  const Bsdf& bsdf = c.diffuseValue ? withoutDiffuse_[c.material] : model;
+  const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+  const ScatteringFrame scattering = scatteringFrame(surface, towardsViewer, bsdf);  // the sidedness rule (scene.h)
+  const auto& [geometricNormal, frame, woLocal] = scattering;
+  if (!usableSide(towardsViewer, woLocal, geometricNormal, bsdf)) return Rgb(0.0f);
+  Rgb sum(0.0f);
+  for (const PunctualLight& light : lights_) {
+    Vec3 wi;
+    float distance;
+    Rgb incident;
+    if (!light.incidentAt(surface.position, wi, distance, incident)) continue;
+    const Vec3 wiLocal = frame.toLocal(wi);
+    if (!usableSide(wi, wiLocal, geometricNormal, bsdf)) continue;
+    const Rgb f = eval(bsdf, woLocal, wiLocal);
+    const float cosIn = std::abs(wiLocal.z);
+    if (isBlack(f) || !(cosIn > 0.0f) || isBlack(incident)) continue;
+    const Vec3 origin = offsetRayOrigin(surface.position, geometricNormal, wi);
+    const std::optional<Ray> shadow =
+        std::isfinite(distance) ? shadowRayTo(origin, light.position) : std::optional<Ray>(Ray{origin, wi, 0.0f, kInfinity});
+    if (!shadow) continue;
+    const Rgb visible = shadows_->transmittance(*shadow, shadowRays);
+    if (!isBlack(visible)) sum += visible * f * cosIn * incident;
+  }
+  return sum;
+}
+
 }  // namespace pl

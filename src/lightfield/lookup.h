@@ -12,12 +12,16 @@
 #include "core/math.h"
 #include "core/simd4.h"
 #include "lightfield/lightfield.h"
+#include "light/emitters.h"
+#include "light/light.h"
 #include "lightfield/paraboloid.h"
 #include "scene/scene.h"
 
 #include <cmath>
 #include <limits>
 #include <cstdint>
+#include <optional>
+#include <vector>
 
 namespace pl {
 
@@ -519,6 +523,35 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   }
 #endif
 }
+
+/// The punctual lights' direct glossy reflection that a light field baked with punctual
+/// highlights (BakeSettings::punctualHighlights) keeps out of its glossy maps, evaluated where
+/// a glossy surface is seen (lightfield.h "Punctual highlights"): at a hit on a reflecting
+/// glossy chart record,
+///   Σ_l f(wo, wi_l) · E_l · |cos θ_l| · T_l
+/// with f the chart's model without its diffuse part when the chart keeps Ẽ (Chart::
+/// diffuseValue; the model the maps hold otherwise), in the scattering frame of the shading
+/// normal at the hit (normal map included), E_l the light's irradiance normal to wi_l and T_l
+/// its shadow ray's transmittance (ShadowRays) — the path tracer's next-event estimation of
+/// that light, term for term. Both renderers add it to their lookups.
+class PunctualHighlights {
+ public:
+  /// lf and accel must outlive it.
+  PunctualHighlights(const LightField& lf, const Accel& accel);
+  /// Whether there is anything to add: the light field was baked with punctual highlights and
+  /// its scene has punctual lights.
+  bool active() const { return !lights_.empty(); }
+  /// The highlights on chart record `chart` (the record the viewer sees: viewedChart) at ray
+  /// hit `hit`, towards the unit direction `towardsViewer`; 0 on other kinds and rough glass.
+  /// `shadowRays` is increased by the rays traced.
+  Rgb radiance(uint32_t chart, const RayHit& hit, const Vec3& towardsViewer, uint64_t& shadowRays) const;
+
+ private:
+  const LightField& lf_;
+  std::vector<PunctualLight> lights_;
+  std::optional<ShadowRays> shadows_;
+  std::vector<Bsdf> withoutDiffuse_;  ///< per material
+};
 
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
                            const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, const Vec3& lookupNormal,

@@ -630,7 +630,8 @@ nlohmann::json settingsToJson(const BakeSettings& s) {
           {"mirror_depth", s.mirrorDepth},
           {"area_light_samples", s.areaLightSamples},
           {"seed", s.seed},
-          {"sun_masks", s.sunMasks}};
+          {"sun_masks", s.sunMasks},
+          {"punctual_highlights", s.punctualHighlights}};
 }
 
 nlohmann::json statsToJson(const BakeStats& s) {
@@ -678,6 +679,8 @@ void decodeMeta(std::span<const unsigned char> bytes, const std::string& path, B
     readKey(s, "seed", settings.seed);
     settings.sunMasks = false;  // writers before sun masks (version ≤ 2) baked without them
     readKey(s, "sun_masks", settings.sunMasks);
+    settings.punctualHighlights = false;  // writers before punctual highlights kept them in the glossy maps
+    readKey(s, "punctual_highlights", settings.punctualHighlights);
     const auto& t = meta.at("stats");
     readKey(t, "seconds", stats.seconds);
     readKey(t, "visibility_seconds", stats.visibilitySeconds);

@@ -34,6 +34,7 @@ struct FastRenderer::Scratch {
   std::vector<Rgb> mirrorThroughput, nextThroughput;
   std::vector<float> mirrorDistance, nextDistance;  ///< length of the chain so far (scene units; ray cones)
   std::vector<uint32_t> reflectedSamples;  ///< camera samples that hit a mirror (one sample per pixel)
+  uint64_t shadowRays = 0;  ///< the punctual highlights' shadow rays (PunctualHighlights)
 };
 
 /// A one-sample pixel: weight × radiance, or 0 for a sample of zero weight (as the reference).
@@ -50,7 +51,7 @@ inline void prefetchBytes(const void* p, size_t bytes) {
 }  // namespace
 
 FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel, uint64_t prefetchLookupBytes)
-    : lightField_(lightField), accel_(accel), sun_(sunLightsOf(lightField)) {
+    : lightField_(lightField), accel_(accel), sun_(sunLightsOf(lightField)), highlights_(lightField, accel) {
   const Scene& scene = lightField.scene;
   paddedValues_.reserve(lightField.values.size());
   for (const Rgb& v : lightField.values) paddedValues_.push_back(lanes4(v));
@@ -284,8 +285,10 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         float lod;
         Vec3 lookup, lookupNormal;
         lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * hit.t, uv, lod, lookup, lookupNormal);
-        const F4 lanes = exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup,
-                                              lookupNormal, uv, lod);
+        F4 lanes = exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup,
+                                        lookupNormal, uv, lod);
+        if (c.kind == ChartKind::Glossy && highlights_.active())  // lightfield.h "Punctual highlights"
+          lanes = f4Add(lanes, f4FromRgb(highlights_.radiance(chart, hit, -ray.direction, s.shadowRays)));
         if (spp == 1) {
           // The pixel, straight from the lanes (weight > 0 here): pixelValue's weight × radiance.
           f4StoreRgb(out + s.pixel[i], f4Mul(f4Splat(s.weight[i]), lanes));
@@ -341,6 +344,8 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * distance, uv, lod, lookup, lookupNormal);
         s.radiance[slot] += throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction,
                                                          lookup, lookupNormal, uv, lod);
+        if (c.kind == ChartKind::Glossy && highlights_.active())
+          s.radiance[slot] += throughput * highlights_.radiance(chart, hit, -ray.direction, s.shadowRays);
         continue;
       }
       Rgb emitted;

@@ -25,8 +25,8 @@ namespace {
 /// (`throughput`); the first non-specular chart ends it with the light-field lookup, its
 /// albedo texture read at the level of the ray cone (coneSpread × the chain's length so far,
 /// textureConeSpread).
-Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hit, uint32_t mirrorDepth,
-                    float coneSpread) {
+Rgb radianceFromHit(const LightField& lf, const Accel& accel, const PunctualHighlights& highlights, Ray ray, RayHit hit,
+                    uint32_t mirrorDepth, float coneSpread) {
   const Scene& scene = lf.scene;
   Rgb throughput(1.0f), result(0.0f);
   float distance = 0.0f;  // along the chain, scene units
@@ -34,9 +34,18 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, Ray ray, RayHit hi
     if (!hit.hit()) return result + throughput * backgroundRadiance(scene.environment, ray.direction);
     distance += hit.t;
     const Chart& chart = lf.charts[lf.triangleChart[hit.mesh][hit.triangle]];
-    if (chart.kind != ChartKind::Specular)
-      return result + throughput * exitantRadiance(lf, hit, positionAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics),
-                                                   -ray.direction, coneSpread * distance);
+    if (chart.kind != ChartKind::Specular) {
+      Rgb seen = exitantRadiance(lf, hit, positionAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics), -ray.direction,
+                                 coneSpread * distance);
+      if (highlights.active() && chart.kind == ChartKind::Glossy) {
+        // The punctual lights' highlights the maps leave out (lightfield.h "Punctual highlights").
+        const uint32_t viewed = viewedChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], -ray.direction,
+                                            scene.meshes[hit.mesh], hit.triangle);
+        uint64_t shadowRays = 0;
+        if (viewed != kNoChartRecord) seen += highlights.radiance(viewed, hit, -ray.direction, shadowRays);
+      }
+      return result + throughput * seen;
+    }
 
     // An ideal mirror or glass: its own emission (if any) plus the branch weight times what
     // the reflected or refracted direction sees.
@@ -63,6 +72,7 @@ Image renderLightField(const LightField& lf, const Accel& accel, const Camera& c
   const int tile = settings.tileSize;
   const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
   Image image(width, height);
+  const PunctualHighlights highlights(lf, accel);
 
   std::unique_ptr<Progress> progress;
   if (settings.showProgress) progress = std::make_unique<Progress>("rendering", uint64_t(tilesX) * uint64_t(tilesY));
@@ -98,7 +108,7 @@ Image renderLightField(const LightField& lf, const Accel& accel, const Camera& c
         for (int x = x0; x < x1; ++x) {
           Rgb sum(0.0f);
           for (int k = 0; k < spp; ++k, ++i)
-            if (weights[i] > 0.0f) sum += weights[i] * radianceFromHit(lf, accel, rays[i], hits[i], mirrorDepth, coneSpread);
+            if (weights[i] > 0.0f) sum += weights[i] * radianceFromHit(lf, accel, highlights, rays[i], hits[i], mirrorDepth, coneSpread);
           image.at(x, y) = sum / float(spp);
         }
       if (progress) progress->advance();
