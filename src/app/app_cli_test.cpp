@@ -101,10 +101,10 @@ TEST_F(AppCli, HelpAndVersionGoToStdoutWithStatus0) {
 // --- Conventions of the command line (cli_support.h) ----------------------------------------------
 
 /// Every command and command group, as typed after `plenoptic`.
-const std::vector<std::string> kCommands = {"",        "demo",    "trace", "bake",           "info",
-                                            "render",  "view",    "compare", "tonemap",      "env",
-                                            "env convert", "env sh", "env irradiance", "env prefilter",
-                                            "env splitsum-error", "compress"};
+const std::vector<std::string> kCommands = {
+    "",        "demo",        "trace",  "bake",           "info",          "render",
+    "view",    "compare",     "tonemap", "env",           "env convert",   "env sh",
+    "env irradiance", "env prefilter", "env splitsum-error", "compress"};
 
 TEST_F(AppCli, NoArgumentsPrintsTheCommandListWithStatus0) {
   std::string out, err;
@@ -160,7 +160,28 @@ TEST_F(AppCli, RequiredFlagsAreMarkedInTheHelp) {
   }
 }
 
+/// The commands a --help output lists under "Commands:".
+std::vector<std::string> listedCommands(const std::string& help) {
+  std::vector<std::string> names;
+  const size_t at = help.find("\nCommands:\n");
+  if (at == std::string::npos) return names;
+  std::istringstream lines(help.substr(at + 11));
+  for (std::string line; std::getline(lines, line) && line.rfind("  ", 0) == 0;)
+    names.push_back(line.substr(2, line.find(' ', 2) - 2));
+  return names;
+}
+
 TEST_F(AppCli, EveryHelpIsFreeOfFormattingArtefacts) {
+  // kCommands holds every command the program lists (so a new one is checked here too).
+  for (const std::string& command : kCommands) {
+    std::string out;
+    ASSERT_EQ(run(command + " --help", &out), 0) << command;
+    for (const std::string& sub : listedCommands(out)) {
+      const std::string full = command.empty() ? sub : command + " " + sub;
+      EXPECT_NE(std::find(kCommands.begin(), kCommands.end(), full), kCommands.end()) << full << " is not in kCommands";
+    }
+  }
+  EXPECT_EQ(listedCommands([&] { std::string out; run("--help", &out); return out; }()).size(), 10u);
   for (const std::string& command : kCommands) {
     std::string out, err;
     ASSERT_EQ(run(command + " --help", &out, &err), 0) << command << "\n" << err;
