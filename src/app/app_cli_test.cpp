@@ -53,9 +53,23 @@ class AppCli : public cli_test::CliTest {
 
 TEST_F(AppCli, FlagErrorsExitWithStatus2InTheOneErrorForm) {
   const std::string trace = "trace cornell -o " + q("t.png") + " --width 8 --height 8 --spp 1";
-  expectError("", 2, "A subcommand is required");  // (run adds --quiet: a global flag alone is no command)
+  // (run adds --quiet: a global option alone is no command)
+  expectError("", 2, "a command is required: demo, trace, bake, info, render, view, compare, tonemap, env or compress "
+                     "(see 'plenoptic --help')");
+  expectError("env --quiet", 2, "a command is required: convert, sh, irradiance, prefilter or splitsum-error");
   expectError(trace + " --no-such-flag", 2, "--no-such-flag");
   expectError(trace + " --spp", 2, "--spp");
+  // A flag's value missing at the end of the line (run() would add --quiet after it).
+  for (const auto& [arguments, expected] :
+       {std::pair<std::string, std::string>{trace + " --spp", "--spp: missing its value (INT in [1, 16777216]) "
+                                                             "(see 'plenoptic trace --help')\n"},
+        {trace + " --strategy", "--strategy: missing its value ({mis,nee,bsdf}) (see 'plenoptic trace --help')\n"}}) {
+    std::string out, err;
+    EXPECT_EQ(cli_test::runPlenoptic(arguments, dir_, &out, &err), 2) << arguments;
+    EXPECT_EQ(err, "plenoptic: error: " + expected) << arguments;
+  }
+  expectError(trace + " --pixel 3", 2, "--pixel: expected 2 values, got 1");
+  expectError("info a.plf b.plf", 2, "unexpected argument 'b.plf' (see 'plenoptic info --help')");
   expectError(trace + " --spp abc", 2, "--spp");
   expectError(trace + " --spp 0", 2, "--spp");
   expectError(trace + " --strategy fast", 2, "--strategy");
@@ -63,6 +77,7 @@ TEST_F(AppCli, FlagErrorsExitWithStatus2InTheOneErrorForm) {
   expectError("trace cornell --spp 1", 2, "an output image is required");
   expectError("render " + q("a.plf") + " -o " + q("f%03d.png"), 2, "needs a camera path");
   expectError("frobnicate", 2, "unknown command 'frobnicate' (see 'plenoptic --help')");
+  expectError("demo --preset fast --output-dir " + q("demo"), 2, "--preset: fast not in {draft,default,high}");
   EXPECT_TRUE(outputs().empty());
 }
 

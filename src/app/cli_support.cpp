@@ -197,6 +197,38 @@ std::optional<std::string> unknownArgumentMessage(const CLI::App& app) {
   return fmt::format("unknown command '{}'{}", typed, match ? fmt::format("; did you mean '{}'?", *match) : "");
 }
 
+std::string parseErrorMessage(const std::string& message) {
+  static const std::regex missingOne(R"(^(\S+): 1 required (\S+(?: .*)?) missing$)");
+  static const std::regex missingMany(R"(^(\S+): (\d+) required (\S+(?: .*)?) missing$)");
+  static const std::regex tooFew(R"(^(\S+): At least (\d+) required but received (\d+)$)");
+  static const std::regex unexpected(R"(^The following arguments? (?:was|were) not expected: (.*)$)");
+  const auto typeText = [](const std::string& typeName) {
+    const auto [type, constraint] = typeAndConstraint(typeName);
+    return constraint.empty() ? type : type + " " + constraint;
+  };
+  std::smatch m;
+  if (std::regex_match(message, m, missingOne)) return m[1].str() + ": missing its value (" + typeText(m[2]) + ")";
+  if (std::regex_match(message, m, missingMany))
+    return m[1].str() + ": missing its " + m[2].str() + " values (" + typeText(m[3]) + ")";
+  if (std::regex_match(message, m, tooFew))
+    return m[1].str() + ": expected " + m[2].str() + " values, got " + m[3].str();
+  if (std::regex_match(message, m, unexpected)) {
+    const std::string words = m[1];
+    return words.find(' ') == std::string::npos ? "unexpected argument '" + words + "'" : "unexpected arguments: " + words;
+  }
+  return message;
+}
+
+std::optional<std::string> missingCommandMessage(const CLI::App& app) {
+  const CLI::App* command = selectedLeaf(app);
+  const std::vector<const CLI::App*> subs = visibleSubcommands(*command);
+  if (command->get_require_subcommand_min() == 0 || subs.empty()) return std::nullopt;
+  std::string names;
+  for (size_t i = 0; i < subs.size(); ++i)
+    names += (i == 0 ? "" : i + 1 == subs.size() ? " or " : ", ") + subs[i]->get_name();
+  return "a command is required: " + names;
+}
+
 const CLI::App* commandListRequested(const CLI::App& app, const std::vector<std::string>& args) {
   const CLI::App* current = &app;
   for (const std::string& arg : args) {

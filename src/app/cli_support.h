@@ -45,6 +45,16 @@ std::optional<std::string> nearest(const std::string& typed, const std::vector<s
 /// or nothing when the error is of another kind (missing value, out of range, ...).
 std::optional<std::string> unknownArgumentMessage(const CLI::App& app);
 
+/// After a CLI11 parse error of `app`: "a command is required: demo, trace, ... or compress"
+/// when the command selected last needs a subcommand and none was given; nothing otherwise.
+std::optional<std::string> missingCommandMessage(const CLI::App& app);
+
+/// CLI11's parse-error text in the program's words: "--spp: missing its value (INT in
+/// [1, 16777216])" rather than "--spp: 1 required INT:INT in [1 - 16777216] missing",
+/// "unexpected argument 'b'" rather than "The following argument was not expected: b".
+/// Any other text is returned as it is.
+std::string parseErrorMessage(const std::string& message);
+
 /// When `args` (argv without the program name) are only command names ending at a command
 /// that needs a subcommand ("", "env"), that command: its help is what the user is after.
 const CLI::App* commandListRequested(const CLI::App& app, const std::vector<std::string>& args);
