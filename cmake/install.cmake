@@ -35,9 +35,13 @@ foreach(notice LICENSE LICENSE.md LICENSE.txt COPYING NOTICE NOTICE.md CHANGELOG
 endforeach()
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/docs/" DESTINATION "${CMAKE_INSTALL_DOCDIR}/docs" COMPONENT cli)
 
-# install_test: installs into a fresh prefix under the build tree and checks the result
-# (cmake/install_test.cmake).
+# install_test installs into a fresh prefix under the build tree and checks the result
+# (cmake/install_test.cmake); version_test runs cmake/version.cmake outside git and in a
+# clean, a modified and a tagged checkout (cmake/version_test.cmake).
 if(BUILD_TESTING)
+  add_test(NAME version_test
+    COMMAND "${CMAKE_COMMAND}" -DSCRATCH=${CMAKE_BINARY_DIR}/version_test_scratch
+            -DSCRIPT=${PROJECT_SOURCE_DIR}/cmake/version.cmake -P "${PROJECT_SOURCE_DIR}/cmake/version_test.cmake")
   add_test(NAME install_test
     COMMAND "${CMAKE_COMMAND}" -DBUILD_DIR=${CMAKE_BINARY_DIR} -DPREFIX=${CMAKE_BINARY_DIR}/install_test_prefix
             -DPROJECT_VERSION=${PROJECT_VERSION} -P "${CMAKE_SOURCE_DIR}/cmake/install_test.cmake")
