@@ -259,6 +259,10 @@ TEST_F(AppCli, BashCompletionComesFromTheCommandLineDefinition) {
   std::ofstream(path("scene.obj")) << "";
   EXPECT_EQ(complete(script, {"plenoptic", "trace", path("scene.o")}), path("scene.obj"));
   EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "-o", path("scene.o")}), path("scene.obj"));
+  EXPECT_EQ(complete(script, {"plenoptic", "bake", "cornell", "--stats", path("scene.o")}), path("scene.obj"));
+  // Values that are no file names: nothing offered.
+  EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--eye", path("scene.o")}), "");
+  EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--spp", ""}), "");
 }
 
 TEST_F(AppCli, ManPageComesFromTheCommandLineDefinition) {

@@ -266,9 +266,15 @@ std::vector<std::string> choicesOf(const CLI::Option* option) {
 /// Whether an option takes a value (a flag takes none).
 bool takesValue(const CLI::Option* option) { return option->get_items_expected_max() > 0; }
 
-/// Whether an option's value is a file name (text that is not a fixed choice).
+/// Whether an option's value is a file or directory name: text that is not a fixed choice and
+/// whose description speaks of one (a file type, "file", "image", "directory", "JSON", an
+/// output), so that --eye X,Y,Z or --fstop N are not offered file names.
 bool takesFile(const CLI::Option* option) {
-  return takesValue(option) && option->get_type_name().rfind("TEXT", 0) == 0 && choicesOf(option).empty();
+  static const std::regex fileWords(
+      R"(\.(plf|plv|exr|hdr|pfm|png|json|obj|gltf|glb|mp4)\b|\b(file|image|directory|JSON|PNG|path)\b|^Output|^Write|^Where)",
+      std::regex::icase);
+  return takesValue(option) && option->get_type_name().rfind("TEXT", 0) == 0 && choicesOf(option).empty() &&
+         std::regex_search(option->get_description(), fileWords);
 }
 
 void addCompletionCases(const CLI::App& command, const std::string& path, std::string& specCases,
