@@ -495,7 +495,8 @@ std::string manPage(const CLI::App& app, const std::string& version) {
       "memory, an internal error.\n"
       ".TP\n.B {}\nThe command line is wrong: an unknown command or option, a missing or malformed value, a value out "
       "of range, a bad combination.\n"
-      ".TP\n.B 130, 143\nInterrupted by SIGINT or SIGTERM (128 + the signal number).\n"
+      ".TP\n.B 129, 130, 143\nInterrupted by SIGHUP, SIGINT (Ctrl-C) or SIGTERM (128 + the signal number); the "
+      "temporary files of unfinished outputs are removed.\n"
       ".PP\nEvery error is one line on standard error: \\fB{}: error:\\fR followed by what was wrong.\n",
       int(kExitSuccess), int(kExitFailure), int(kExitUsage), name);
   out += fmt::format(
