@@ -57,6 +57,7 @@ TEST_F(AppCli, FlagErrorsExitWithStatus2InTheOneErrorForm) {
   expectError("", 2, "a command is required: demo, trace, bake, info, render, view, compare, tonemap, env or compress "
                      "(see 'plenoptic --help')");
   expectError("env --quiet", 2, "a command is required: convert, sh, irradiance, prefilter or splitsum-error");
+  expectError("--threads 99999", 2, "--threads: Value 99999 not in range 0 to 4096");  // not "a command is required"
   expectError(trace + " --no-such-flag", 2, "--no-such-flag");
   expectError(trace + " --spp", 2, "--spp");
   // A flag's value missing at the end of the line (run() would add --quiet after it).

@@ -219,7 +219,10 @@ std::string parseErrorMessage(const std::string& message) {
   return message;
 }
 
-std::optional<std::string> missingCommandMessage(const CLI::App& app) {
+std::optional<std::string> missingCommandMessage(const CLI::App& app, const CLI::ParseError& error) {
+  if (dynamic_cast<const CLI::RequiredError*>(&error) == nullptr ||
+      std::string(error.what()).find("ubcommand") == std::string::npos)
+    return std::nullopt;
   const CLI::App* command = selectedLeaf(app);
   const std::vector<const CLI::App*> subs = visibleSubcommands(*command);
   if (command->get_require_subcommand_min() == 0 || subs.empty()) return std::nullopt;

@@ -45,9 +45,10 @@ std::optional<std::string> nearest(const std::string& typed, const std::vector<s
 /// or nothing when the error is of another kind (missing value, out of range, ...).
 std::optional<std::string> unknownArgumentMessage(const CLI::App& app);
 
-/// After a CLI11 parse error of `app`: "a command is required: demo, trace, ... or compress"
-/// when the command selected last needs a subcommand and none was given; nothing otherwise.
-std::optional<std::string> missingCommandMessage(const CLI::App& app);
+/// After CLI11's parse error `error` of `app`: "a command is required: demo, trace, ... or
+/// compress" when it is CLI11's "A subcommand is required" (the command selected last needs
+/// a subcommand and none was given); nothing for any other error.
+std::optional<std::string> missingCommandMessage(const CLI::App& app, const CLI::ParseError& error);
 
 /// CLI11's parse-error text in the program's words: "--spp: missing its value (INT in
 /// [1, 16777216])" rather than "--spp: 1 required INT:INT in [1 - 16777216] missing",

@@ -115,7 +115,7 @@ int main(int argc, char** argv) {
     // An unknown command or option: name the nearest known one ("did you mean 'trace'?").
     if (const auto unknown = pl::cli::unknownArgumentMessage(app))
       return report(fmt::format("{} (see '{} --help')", *unknown, selectedCommand(app)), pl::kExitUsage);
-    if (const auto missing = pl::cli::missingCommandMessage(app))
+    if (const auto missing = pl::cli::missingCommandMessage(app, e))
       return report(fmt::format("{} (see '{} --help')", *missing, selectedCommand(app)), pl::kExitUsage);
     return report(fmt::format("{} (see '{} --help')", pl::cli::parseErrorMessage(e.what()), selectedCommand(app)),
                   pl::kExitUsage);
