@@ -114,18 +114,27 @@ int editDistance(const std::string& a, const std::string& b) {
   return d[n][m];
 }
 
+namespace {
+
+/// "spp" for "--spp": a name without its leading dashes.
+std::string withoutDashes(const std::string& name) {
+  const size_t start = name.find_first_not_of('-');
+  return start == std::string::npos ? std::string() : name.substr(start);
+}
+
+}  // namespace
+
 std::optional<std::string> nearest(const std::string& typed, const std::vector<std::string>& candidates) {
   // Near enough: a third of the typed length in edits (at least 1, at most 3), or the one
   // candidate the typed text starts; nothing for a single letter.
-  const auto bare = [](const std::string& s) { return s.substr(s.find_first_not_of('-') == std::string::npos ? s.size() : s.find_first_not_of('-')); };
-  const std::string word = bare(typed);
+  const std::string word = withoutDashes(typed);
   if (word.size() < 2) return std::nullopt;  // one letter: any guess is a guess
   const int allowed = std::clamp(int(word.size()) / 3, 1, 3);
   std::optional<std::string> best;
   int bestDistance = allowed + 1;
   std::vector<std::string> prefixed;
   for (const std::string& candidate : candidates) {
-    const std::string name = bare(candidate);
+    const std::string name = withoutDashes(candidate);
     if (name.size() > word.size() && name.compare(0, word.size(), word) == 0)
       prefixed.push_back(candidate);
     const int distance = editDistance(word, name);
