@@ -11,7 +11,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
-  xvfb xauth
+  xvfb xauth bash-completion
   python3-dev pybind11-dev python3-numpy python3-pytest
 )
 if [ "${1:-}" = "--fuzz" ]; then

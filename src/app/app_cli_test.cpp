@@ -223,13 +223,15 @@ TEST_F(AppCli, EveryHelpIsFreeOfFormattingArtefacts) {
   EXPECT_NE(out.find("\nArguments:\n  scene TEXT REQUIRED "), std::string::npos) << out;
 }
 
-/// What the bash completion proposes for the words of `line` (the last one being completed,
-/// "" for a new word), with the script `plenoptic completion bash` prints.
-std::string complete(const std::string& script, const std::vector<std::string>& words) {
+/// What the bash completion proposes for `words` (the last one being completed, "" for a new
+/// word) with `script` (what `plenoptic completion bash` prints), after running `setup` (e.g.
+/// sourcing the bash-completion package, whose _init_completion the script then uses).
+std::string complete(const std::string& script, const std::vector<std::string>& words, const std::string& setup = "") {
   std::string array;
   for (const std::string& word : words) array += " '" + word + "'";
-  const std::string command = "bash --norc --noprofile -c 'source \"$0\" && COMP_WORDS=(\"$@\") && "
-                              "COMP_CWORD=$((${#COMP_WORDS[@]} - 1)) && _plenoptic && echo \"${COMPREPLY[*]}\"' " +
+  const std::string command = "bash --norc --noprofile -c '" + setup +
+                              " source \"$0\" && COMP_WORDS=(\"$@\") && COMP_CWORD=$((${#COMP_WORDS[@]} - 1)) && "
+                              "COMP_LINE=\"$*\" && COMP_POINT=${#COMP_LINE} && _plenoptic && echo \"${COMPREPLY[*]}\"' " +
                               script + array;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (!pipe) return "(popen failed)";
@@ -248,22 +250,29 @@ TEST_F(AppCli, BashCompletionComesFromTheCommandLineDefinition) {
   EXPECT_NE(out.find("subs=\"demo trace bake info render view compare tonemap env compress\""), std::string::npos) << out;
   ASSERT_EQ(run("completion bash -o " + q("plenoptic.bash"), &out, &err), 0) << err;
   const std::string script = path("plenoptic.bash");
-  EXPECT_EQ(complete(script, {"plenoptic", "tr"}), "trace");
-  EXPECT_EQ(complete(script, {"plenoptic", "--threads", "4", "b"}), "bake");
-  EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--sp"}), "--spp");
-  EXPECT_EQ(complete(script, {"plenoptic", "trace", "--strategy", ""}), "mis nee bsdf");
-  EXPECT_EQ(complete(script, {"plenoptic", "env", "c"}), "convert");
-  EXPECT_EQ(complete(script, {"plenoptic", "env", "prefilter", "--mo"}), "--model");
-  EXPECT_EQ(complete(script, {"plenoptic", "demo", "--no-w"}), "--no-walkthrough");
-  EXPECT_EQ(complete(script, {"plenoptic", "bake", "--thr"}), "--threads");  // global flags after the command
-  // File arguments complete file names.
   std::ofstream(path("scene.obj")) << "";
-  EXPECT_EQ(complete(script, {"plenoptic", "trace", path("scene.o")}), path("scene.obj"));
-  EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "-o", path("scene.o")}), path("scene.obj"));
-  EXPECT_EQ(complete(script, {"plenoptic", "bake", "cornell", "--stats", path("scene.o")}), path("scene.obj"));
-  // Values that are no file names: nothing offered.
-  EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--eye", path("scene.o")}), "");
-  EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--spp", ""}), "");
+  // Plain bash, and bash with the bash-completion package loaded when it is installed.
+  std::vector<std::string> setups = {""};
+  if (fs::exists("/usr/share/bash-completion/bash_completion"))
+    setups.push_back("source /usr/share/bash-completion/bash_completion &&");
+  for (const std::string& setup : setups) {
+    SCOPED_TRACE(setup.empty() ? "plain bash" : "with bash-completion");
+    EXPECT_EQ(complete(script, {"plenoptic", "tr"}, setup), "trace");
+    EXPECT_EQ(complete(script, {"plenoptic", "--threads", "4", "b"}, setup), "bake");
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--sp"}, setup), "--spp");
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", "--strategy", ""}, setup), "mis nee bsdf");
+    EXPECT_EQ(complete(script, {"plenoptic", "env", "c"}, setup), "convert");
+    EXPECT_EQ(complete(script, {"plenoptic", "env", "prefilter", "--mo"}, setup), "--model");
+    EXPECT_EQ(complete(script, {"plenoptic", "demo", "--no-w"}, setup), "--no-walkthrough");
+    EXPECT_EQ(complete(script, {"plenoptic", "bake", "--thr"}, setup), "--threads");  // global flags after the command
+    // File arguments complete file names.
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", path("scene.o")}, setup), path("scene.obj"));
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "-o", path("scene.o")}, setup), path("scene.obj"));
+    EXPECT_EQ(complete(script, {"plenoptic", "bake", "cornell", "--stats", path("scene.o")}, setup), path("scene.obj"));
+    // Values that are no file names: nothing offered.
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--eye", path("scene.o")}, setup), "");
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--spp", ""}, setup), "");
+  }
 }
 
 TEST_F(AppCli, ManPageComesFromTheCommandLineDefinition) {

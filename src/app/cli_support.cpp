@@ -343,7 +343,8 @@ _{0}() {{
   local cur prev cword i w path="" subs opts valued files choices
   local -a words
   if declare -F _init_completion >/dev/null 2>&1; then
-    _init_completion || return
+    local split
+    _init_completion -s || return  # -s: --flag=value completes the value
   else
     words=("${{COMP_WORDS[@]}}")
     cword=$COMP_CWORD
