@@ -44,5 +44,5 @@ if(BUILD_TESTING)
             -DSCRIPT=${PROJECT_SOURCE_DIR}/cmake/version.cmake -P "${PROJECT_SOURCE_DIR}/cmake/version_test.cmake")
   add_test(NAME install_test
     COMMAND "${CMAKE_COMMAND}" -DBUILD_DIR=${CMAKE_BINARY_DIR} -DPREFIX=${CMAKE_BINARY_DIR}/install_test_prefix
-            -DPROJECT_VERSION=${PROJECT_VERSION} -P "${CMAKE_SOURCE_DIR}/cmake/install_test.cmake")
+            -DPROJECT_VERSION=${PROJECT_VERSION} -P "${PROJECT_SOURCE_DIR}/cmake/install_test.cmake")
 endif()
