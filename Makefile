@@ -4,11 +4,12 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
+PREFIX ?= /usr/local
 FUZZ_BUILD_DIR ?= build-fuzz
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS ?= obj gltf json_scene camera_path hdr exr plf plf_fixed plv plv_fixed
 
-.PHONY: all bootstrap configure build python test demo bench fuzz clean
+.PHONY: all bootstrap configure build python test demo bench fuzz install clean
 
 all: build
 
@@ -27,6 +28,11 @@ python: configure
 
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+# The program, its bash completion and man page, and the documentation under $(PREFIX)
+# (cmake/install.cmake); e.g. `make install PREFIX=~/.local`.
+install: build
+	@cmake --install $(BUILD_DIR) --prefix $(PREFIX)
 
 demo: build
 	@$(BUILD_DIR)/plenoptic demo --output-dir out/demo

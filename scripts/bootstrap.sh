@@ -7,11 +7,11 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config ccache git
   libembree-dev libtbb-dev libglm-dev libtinyobjloader-dev libtinygltf-dev
-  libopenexr-dev libstb-dev libzstd-dev libsquish-dev libsdl2-dev libimgui-dev
+  libopenexr-dev libstb-dev libzstd-dev libsquish-dev libsdl2-dev libxxhash-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
-  xvfb xauth
+  xvfb xauth bash-completion
   python3-dev pybind11-dev python3-numpy python3-pytest
 )
 if [ "${1:-}" = "--fuzz" ]; then

@@ -12,6 +12,8 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <regex>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -51,16 +53,32 @@ class AppCli : public cli_test::CliTest {
 
 TEST_F(AppCli, FlagErrorsExitWithStatus2InTheOneErrorForm) {
   const std::string trace = "trace cornell -o " + q("t.png") + " --width 8 --height 8 --spp 1";
-  expectError("", 2, "A subcommand is required");
+  // (run adds --quiet: a global option alone is no command)
+  expectError("", 2, "a command is required: demo, trace, bake, info, render, view, compare, tonemap, env or compress "
+                     "(see 'plenoptic --help')");
+  expectError("env --quiet", 2, "a command is required: convert, sh, irradiance, prefilter or splitsum-error");
+  expectError("--threads 99999", 2, "--threads: Value 99999 not in range 0 to 4096");  // not "a command is required"
   expectError(trace + " --no-such-flag", 2, "--no-such-flag");
   expectError(trace + " --spp", 2, "--spp");
+  // A flag's value missing at the end of the line (run() would add --quiet after it).
+  for (const auto& [arguments, expected] :
+       {std::pair<std::string, std::string>{trace + " --spp", "--spp: missing its value (INT in [1, 16777216]) "
+                                                             "(see 'plenoptic trace --help')\n"},
+        {trace + " --strategy", "--strategy: missing its value ({mis,nee,bsdf}) (see 'plenoptic trace --help')\n"}}) {
+    std::string out, err;
+    EXPECT_EQ(cli_test::runPlenoptic(arguments, dir_, &out, &err), 2) << arguments;
+    EXPECT_EQ(err, "plenoptic: error: " + expected) << arguments;
+  }
+  expectError(trace + " --pixel 3", 2, "--pixel: expected 2 values, got 1");
+  expectError("info a.plf b.plf", 2, "unexpected argument 'b.plf' (see 'plenoptic info --help')");
   expectError(trace + " --spp abc", 2, "--spp");
   expectError(trace + " --spp 0", 2, "--spp");
   expectError(trace + " --strategy fast", 2, "--strategy");
   expectError(trace + " --fstop 8", 2, "--fstop/--shutter/--iso");
   expectError("trace cornell --spp 1", 2, "an output image is required");
   expectError("render " + q("a.plf") + " -o " + q("f%03d.png"), 2, "needs a camera path");
-  expectError("frobnicate", 2, "A subcommand is required");
+  expectError("frobnicate", 2, "unknown command 'frobnicate' (see 'plenoptic --help')");
+  expectError("demo --preset fast --output-dir " + q("demo"), 2, "--preset: fast not in {draft,default,high}");
   EXPECT_TRUE(outputs().empty());
 }
 
@@ -90,9 +108,186 @@ TEST_F(AppCli, HelpAndVersionGoToStdoutWithStatus0) {
     EXPECT_FALSE(out.empty()) << flags;
     EXPECT_EQ(err, "") << flags;
   }
+  // The CMake project version, then `git describe` of the checkout it was built from.
   std::string out;
   run("--version", &out);
-  EXPECT_EQ(out, "plenoptic 0.1.0\n");
+  EXPECT_TRUE(std::regex_match(out, std::regex(R"(plenoptic \d+\.\d+\.\d+( \([A-Za-z0-9._+-]+\))?\n)"))) << out;
+}
+
+// --- Conventions of the command line (cli_support.h) ----------------------------------------------
+
+/// Every command and command group, as typed after `plenoptic`.
+const std::vector<std::string> kCommands = {
+    "",        "demo",        "trace",  "bake",           "info",          "render",
+    "view",    "compare",     "tonemap", "env",           "env convert",   "env sh",
+    "env irradiance", "env prefilter", "env splitsum-error", "compress"};
+
+TEST_F(AppCli, NoArgumentsPrintsTheCommandListWithStatus0) {
+  std::string out, err;
+  EXPECT_EQ(cli_test::runPlenoptic("", dir_, &out, &err), 0) << err;
+  EXPECT_EQ(err, "");
+  EXPECT_EQ(out.rfind("plenoptic: physically based global illumination", 0), 0u) << out;
+  for (const char* command : {"demo", "trace", "bake", "info", "render", "view", "compare", "tonemap", "env", "compress"})
+    EXPECT_TRUE(std::regex_search(out, std::regex(std::string("\n  ") + command + " +\\S"))) << command << "\n" << out;
+  EXPECT_EQ(out.find("completion"), std::string::npos) << "hidden commands listed:\n" << out;
+  EXPECT_EQ(out.find("manpage"), std::string::npos) << out;
+  // A command group alone: its own list.
+  EXPECT_EQ(cli_test::runPlenoptic("env", dir_, &out, &err), 0) << err;
+  EXPECT_EQ(err, "");
+  EXPECT_NE(out.find("Usage: plenoptic env [OPTIONS] COMMAND"), std::string::npos) << out;
+  for (const char* command : {"convert", "sh", "irradiance", "prefilter", "splitsum-error"})
+    EXPECT_NE(out.find(std::string("  ") + command + " "), std::string::npos) << command << "\n" << out;
+}
+
+TEST_F(AppCli, AnUnknownCommandOrFlagSuggestsTheNearest) {
+  const std::string trace = "trace cornell -o " + q("t.png") + " --width 8 --height 8 --spp 1";
+  expectError("trac", 2, "unknown command 'trac'; did you mean 'trace'? (see 'plenoptic --help')");
+  expectError("tarce cornell", 2, "unknown command 'tarce'; did you mean 'trace'?");
+  expectError("rendr a.plf", 2, "unknown command 'rendr'; did you mean 'render'?");
+  expectError("env convrt x.exr", 2, "unknown command 'convrt'; did you mean 'convert'? (see 'plenoptic env --help')");
+  expectError(trace + " --spq 4", 2, "unknown option '--spq'; did you mean '--spp'? (see 'plenoptic trace --help')");
+  expectError(trace + " --widht=8", 2, "unknown option '--widht'; did you mean '--width'?");
+  expectError("--treads 2 " + trace, 2, "unknown option '--treads'; did you mean '--threads'?");
+  expectError(trace + " --thread 2", 2, "did you mean '--threads'?");  // a global option after the command
+  expectError("bake cornell -o " + q("b.plf") + " --prest draft", 2, "did you mean '--preset'?");
+  // Nothing near: no guess.
+  expectError(trace + " --zzzzzz", 2, "unknown option '--zzzzzz' (see 'plenoptic trace --help')");
+  expectError("xyzzy", 2, "unknown command 'xyzzy' (see 'plenoptic --help')");
+  EXPECT_TRUE(outputs().empty());
+}
+
+/// The help line of option `name` ("-o,--output") in `help`, or "" when there is none.
+std::string helpLine(const std::string& help, const std::string& name) {
+  std::istringstream lines(help);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("  " + name + " ", 0) == 0) return line;
+  return "";
+}
+
+TEST_F(AppCli, RequiredFlagsAreMarkedInTheHelp) {
+  std::string out;
+  ASSERT_EQ(run("trace --help", &out), 0);
+  EXPECT_NE(helpLine(out, "-o,--output").find(" REQUIRED"), std::string::npos) << out;  // unless --pixel: says so
+  EXPECT_NE(helpLine(out, "-o,--output").find("not needed with --pixel"), std::string::npos) << out;
+  EXPECT_EQ(helpLine(out, "--spp").find("REQUIRED"), std::string::npos) << out;
+  for (const char* command : {"bake", "render", "tonemap", "compress", "env convert"}) {
+    ASSERT_EQ(run(std::string(command) + " --help", &out), 0) << command;
+    EXPECT_NE(helpLine(out, "-o,--output").find(" REQUIRED"), std::string::npos) << command << "\n" << out;
+  }
+}
+
+/// The commands a --help output lists under "Commands:".
+std::vector<std::string> listedCommands(const std::string& help) {
+  std::vector<std::string> names;
+  const size_t at = help.find("\nCommands:\n");
+  if (at == std::string::npos) return names;
+  std::istringstream lines(help.substr(at + 11));
+  for (std::string line; std::getline(lines, line) && line.rfind("  ", 0) == 0;)
+    names.push_back(line.substr(2, line.find(' ', 2) - 2));
+  return names;
+}
+
+TEST_F(AppCli, EveryHelpIsFreeOfFormattingArtefacts) {
+  // kCommands holds every command the program lists (so a new one is checked here too).
+  for (const std::string& command : kCommands) {
+    std::string out;
+    ASSERT_EQ(run(command + " --help", &out), 0) << command;
+    for (const std::string& sub : listedCommands(out)) {
+      const std::string full = command.empty() ? sub : command + " " + sub;
+      EXPECT_NE(std::find(kCommands.begin(), kCommands.end(), full), kCommands.end()) << full << " is not in kCommands";
+    }
+  }
+  EXPECT_EQ(listedCommands([&] { std::string out; run("--help", &out); return out; }()).size(), 10u);
+  for (const std::string& command : kCommands) {
+    std::string out, err;
+    ASSERT_EQ(run(command + " --help", &out, &err), 0) << command << "\n" << err;
+    EXPECT_EQ(err, "") << command;
+    EXPECT_EQ(out.find("{false}"), std::string::npos) << command << "\n" << out;
+    EXPECT_EQ(out.find("{true}"), std::string::npos) << command << "\n" << out;
+    // The program's name, not the path it was run by.
+    EXPECT_NE(out.find("Usage: plenoptic" + (command.empty() ? "" : " " + command) + " "), std::string::npos)
+        << command << "\n" << out;
+    EXPECT_EQ(out.find(PLENOPTIC_BINARY), std::string::npos) << command << "\n" << out;
+  }
+  std::string out;
+  ASSERT_EQ(run("demo --help", &out), 0);
+  EXPECT_NE(helpLine(out, "--no-walkthrough"), "") << out;
+  // A value's type and its check, each once: not "INT:INT in [1 - 16384]=640".
+  ASSERT_EQ(run("trace --help", &out), 0);
+  EXPECT_EQ(out.find("INT:INT"), std::string::npos) << out;
+  EXPECT_EQ(out.find("FLOAT:"), std::string::npos) << out;
+  EXPECT_EQ(out.find("TEXT:{"), std::string::npos) << out;
+  EXPECT_EQ(helpLine(out, "--width").rfind("  --width INT=640 in [1, 16384]", 0), 0u) << out;
+  EXPECT_EQ(helpLine(out, "--strategy").rfind("  --strategy {mis,nee,bsdf}=mis", 0), 0u) << out;
+  EXPECT_EQ(helpLine(out, "--scene-unit").rfind("  --scene-unit FLOAT > 0", 0), 0u) << out;
+  EXPECT_NE(out.find("\nArguments:\n  scene TEXT REQUIRED "), std::string::npos) << out;
+}
+
+/// What the bash completion proposes for `words` (the last one being completed, "" for a new
+/// word) with `script` (what `plenoptic completion bash` prints), after running `setup` (e.g.
+/// sourcing the bash-completion package, whose _init_completion the script then uses).
+std::string complete(const std::string& script, const std::vector<std::string>& words, const std::string& setup = "") {
+  std::string array;
+  for (const std::string& word : words) array += " '" + word + "'";
+  const std::string command = "bash --norc --noprofile -c '" + setup +
+                              " source \"$0\" && COMP_WORDS=(\"$@\") && COMP_CWORD=$((${#COMP_WORDS[@]} - 1)) && "
+                              "COMP_LINE=\"$*\" && COMP_POINT=${#COMP_LINE} && _plenoptic && echo \"${COMPREPLY[*]}\"' " +
+                              script + array;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return "(popen failed)";
+  std::string out;
+  char buffer[4096];
+  for (size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;) out.append(buffer, n);
+  ::pclose(pipe);
+  if (!out.empty() && out.back() == '\n') out.pop_back();
+  return out;
+}
+
+TEST_F(AppCli, BashCompletionComesFromTheCommandLineDefinition) {
+  std::string out, err;
+  ASSERT_EQ(run("completion bash", &out, &err), 0) << err;
+  EXPECT_NE(out.find("complete -F _plenoptic plenoptic"), std::string::npos);
+  EXPECT_NE(out.find("subs=\"demo trace bake info render view compare tonemap env compress\""), std::string::npos) << out;
+  ASSERT_EQ(run("completion bash -o " + q("plenoptic.bash"), &out, &err), 0) << err;
+  const std::string script = path("plenoptic.bash");
+  std::ofstream(path("scene.obj")) << "";
+  // Plain bash, and bash with the bash-completion package loaded when it is installed.
+  std::vector<std::string> setups = {""};
+  if (fs::exists("/usr/share/bash-completion/bash_completion"))
+    setups.push_back("source /usr/share/bash-completion/bash_completion &&");
+  for (const std::string& setup : setups) {
+    SCOPED_TRACE(setup.empty() ? "plain bash" : "with bash-completion");
+    EXPECT_EQ(complete(script, {"plenoptic", "tr"}, setup), "trace");
+    EXPECT_EQ(complete(script, {"plenoptic", "--threads", "4", "b"}, setup), "bake");
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--sp"}, setup), "--spp");
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", "--strategy", ""}, setup), "mis nee bsdf");
+    EXPECT_EQ(complete(script, {"plenoptic", "env", "c"}, setup), "convert");
+    EXPECT_EQ(complete(script, {"plenoptic", "env", "prefilter", "--mo"}, setup), "--model");
+    EXPECT_EQ(complete(script, {"plenoptic", "demo", "--no-w"}, setup), "--no-walkthrough");
+    EXPECT_EQ(complete(script, {"plenoptic", "bake", "--thr"}, setup), "--threads");  // global flags after the command
+    // File arguments complete file names.
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", path("scene.o")}, setup), path("scene.obj"));
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "-o", path("scene.o")}, setup), path("scene.obj"));
+    EXPECT_EQ(complete(script, {"plenoptic", "bake", "cornell", "--stats", path("scene.o")}, setup), path("scene.obj"));
+    // Values that are no file names: nothing offered.
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--eye", path("scene.o")}, setup), "");
+    EXPECT_EQ(complete(script, {"plenoptic", "trace", "cornell", "--spp", ""}, setup), "");
+  }
+}
+
+TEST_F(AppCli, ManPageComesFromTheCommandLineDefinition) {
+  std::string out, err;
+  ASSERT_EQ(run("manpage", &out, &err), 0) << err;
+  EXPECT_NE(out.find("\n.TH PLENOPTIC 1 "), std::string::npos) << out;
+  EXPECT_NE(out.find(".SH NAME\nplenoptic \\- physically based global illumination"), std::string::npos) << out;
+  for (const std::string& command : kCommands)
+    if (!command.empty()) {
+      EXPECT_NE(out.find(".SS \"plenoptic " + command + "\""), std::string::npos) << command;
+    }
+  EXPECT_NE(out.find("\\fB\\-\\-spp\\fR"), std::string::npos);
+  EXPECT_NE(out.find("\\fB\\-\\-no\\-walkthrough\\fR\n"), std::string::npos);
+  EXPECT_EQ(out.find("{false}"), std::string::npos);
+  EXPECT_NE(out.find(".SH EXIT STATUS"), std::string::npos);
 }
 
 TEST_F(AppCli, ProblemsFoundByACommandExitWithStatus1) {

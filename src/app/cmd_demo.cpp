@@ -177,7 +177,9 @@ void addDemoCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--spp", options->traceSpp, "Samples per pixel of the path-traced reference")
       ->check(CLI::Range(1, 1 << 20))
       ->capture_default_str();
-  command->add_option("--preset", options->preset, "Bake preset: draft, default or high")->capture_default_str();
+  command->add_option("--preset", options->preset, "Bake preset (as bake --preset)")
+      ->check(CLI::IsMember({"draft", "default", "high"}))  // checked before the reference is traced
+      ->capture_default_str();
   command->add_flag("!--no-walkthrough", options->walkthrough, "Skip the viewer / rendered walk-through");
   command->callback([options, &global] { runDemo(*options, global); });
 }

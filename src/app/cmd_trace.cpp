@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "app/cli_support.h"
 #include "app/commands.h"
 #include "app/view_options.h"
 #include "core/error.h"
@@ -91,7 +92,9 @@ void addTraceCommand(CLI::App& app, const GlobalOptions& global) {
       "trace", "Render a scene with the reference path tracer (NEE + BSDF sampling, MIS, Russian roulette)");
   command->add_option("scene", options->scene, "cornell, or a scene file (.obj, .gltf, .glb, .json)")->required();
   command->add_option("-o,--output", options->output,
-                      "Output image: .exr/.hdr/.pfm hold radiance (x exposure), .png is tone-mapped sRGB");
+                      "Output image: .exr/.hdr/.pfm hold radiance (x exposure), .png is tone-mapped sRGB "
+                      "(not needed with --pixel)")
+      ->option_text(cli::kRequiredText);  // required unless --pixel: checked by runTrace
   command->add_option("--spp", options->spp, "Samples (paths) per pixel")
       ->check(CLI::Range(1, TraceJobOptions::kMaxSpp))
       ->capture_default_str();

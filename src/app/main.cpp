@@ -5,13 +5,17 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <iostream>
 #include <limits>
 #include <new>
 #include <string>
+#include <vector>
 
+#include "app/cli_support.h"
 #include "app/commands.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "plenoptic_version.h"  // generated at build time (cmake/version.cmake)
 
 namespace {
 
@@ -62,10 +66,12 @@ int main(int argc, char** argv) {
   pl::installInterruptHandlers();
 
   CLI::App app{"plenoptic: physically based global illumination, precomputed as a light field over the "
-               "scene's surfaces and rendered in real time"};
+               "scene's surfaces and rendered in real time",
+               "plenoptic"};
+  app.formatter(std::make_shared<pl::cli::HelpFormatter>());  // before the subcommands: they share it
   app.require_subcommand(1);
   app.fallthrough();  // global options may follow the subcommand name
-  app.set_version_flag("--version", "plenoptic 0.1.0");
+  app.set_version_flag("--version", "plenoptic " PLENOPTIC_VERSION_STRING);
 
   pl::GlobalOptions global;
   app.add_option("--threads", global.threads, "Worker threads (0 = all hardware threads)")
@@ -86,7 +92,18 @@ int main(int argc, char** argv) {
   pl::addTonemapCommand(app, global);
   pl::addEnvCommand(app, global);
   pl::addCompressCommand(app, global);
+  pl::cli::addGeneratorCommands(app, PLENOPTIC_VERSION_STRING);  // hidden: completion bash, manpage
   requireFiniteFloats(app);
+  pl::cli::groupCommands(app);
+
+  // No arguments (or only a command that needs a subcommand, as `env`): the command list.
+  if (const CLI::App* command = pl::cli::commandListRequested(app, std::vector<std::string>(argv + 1, argv + argc))) {
+    std::string parents;
+    for (const CLI::App* parent = command->get_parent(); parent != nullptr; parent = parent->get_parent())
+      parents = parent->get_name() + (parents.empty() ? "" : " " + parents);
+    std::cout << command->help(parents) << std::flush;
+    return pl::kExitSuccess;
+  }
 
   // One error form for every failure: "plenoptic: error: ..." on stderr and the exit
   // statuses of core/error.h (1 the command failed, 2 the command line is wrong; 130/143
@@ -95,7 +112,13 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    return report(fmt::format("{} (see '{} --help')", e.what(), selectedCommand(app)), pl::kExitUsage);
+    // An unknown command or option: name the nearest known one ("did you mean 'trace'?").
+    if (const auto unknown = pl::cli::unknownArgumentMessage(app))
+      return report(fmt::format("{} (see '{} --help')", *unknown, selectedCommand(app)), pl::kExitUsage);
+    if (const auto missing = pl::cli::missingCommandMessage(app, e))
+      return report(fmt::format("{} (see '{} --help')", *missing, selectedCommand(app)), pl::kExitUsage);
+    return report(fmt::format("{} (see '{} --help')", pl::cli::parseErrorMessage(e.what()), selectedCommand(app)),
+                  pl::kExitUsage);
   } catch (const pl::UsageError& e) {
     return report(e.what(), pl::kExitUsage);
   } catch (const pl::Error& e) {

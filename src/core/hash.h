@@ -1,6 +1,6 @@
 #pragma once
-// XXH64, Yann Collet's 64-bit xxHash: the checksum of .plf sections and headers and of the .plv
-// payload (~10 GB/s, so verifying a file costs far less than reading it).
+// XXH64, Yann Collet's 64-bit xxHash (Debian's libxxhash): the checksum of .plf sections and
+// headers and of the .plv payload (~10 GB/s, so verifying a file costs far less than reading it).
 #include <cstddef>
 #include <cstdint>
 
@@ -10,6 +10,7 @@ namespace pl {
 uint64_t xxh64(const void* data, size_t size, uint64_t seed = 0);
 
 /// Incremental XXH64 for data that arrives in pieces; equals xxh64() of the concatenation.
+/// Copyable: a copy continues independently from the same point.
 class Xxh64Stream {
  public:
   explicit Xxh64Stream(uint64_t seed = 0);
@@ -17,11 +18,9 @@ class Xxh64Stream {
   uint64_t digest() const;
 
  private:
-  uint64_t lanes_[4];
-  uint64_t seed_;
-  uint64_t totalLength_ = 0;
-  unsigned char buffer_[32];
-  size_t buffered_ = 0;
+  // libxxhash's XXH64_state_t, held by value so that this header does not include xxhash.h
+  // (hash.cpp checks that it fits). A plain struct: copying its bytes copies the state.
+  alignas(8) unsigned char state_[96];
 };
 
 }  // namespace pl

@@ -1,0 +1,66 @@
+# ctest version_test: cmake/version.cmake on scratch trees: outside git the bare version; in a
+# checkout without tags "g<hash>", then "-dirty" once a tracked file changes; on a tag its name.
+# cmake -DSCRATCH=... -DSCRIPT=.../version.cmake -P version_test.cmake
+function(fail)
+  string(JOIN "" text ${ARGN})
+  message(FATAL_ERROR "version_test: ${text}")
+endfunction()
+
+# VERSION_STRING of the header version.cmake writes for source directory `dir`.
+function(version_of dir out)
+  execute_process(COMMAND "${CMAKE_COMMAND}" -DSOURCE_DIR=${dir} -DOUTPUT=${SCRATCH}/version.h -DVERSION=1.2.3
+                          -P "${SCRIPT}" RESULT_VARIABLE status)
+  if(NOT status EQUAL 0)
+    fail("version.cmake failed on ${dir}")
+  endif()
+  file(STRINGS "${SCRATCH}/version.h" line REGEX "PLENOPTIC_VERSION_STRING")
+  string(REGEX REPLACE "^#define PLENOPTIC_VERSION_STRING \"(.*)\"$" "\\1" string "${line}")
+  set(${out} "${string}" PARENT_SCOPE)
+endfunction()
+
+function(git)
+  execute_process(COMMAND "${GIT_EXECUTABLE}" -C "${SCRATCH}/repo" -c user.name=test -c user.email=test@example.com
+                          -c commit.gpgsign=false -c tag.gpgsign=false ${ARGN}
+                  RESULT_VARIABLE status OUTPUT_QUIET ERROR_VARIABLE err)
+  if(NOT status EQUAL 0)
+    fail("git ${ARGN}: ${err}")
+  endif()
+endfunction()
+
+file(REMOVE_RECURSE "${SCRATCH}")
+file(MAKE_DIRECTORY "${SCRATCH}/plain")
+version_of("${SCRATCH}/plain" v)
+if(NOT v STREQUAL "1.2.3")
+  fail("outside git: '${v}', expected '1.2.3'")
+endif()
+
+find_program(GIT_EXECUTABLE git)
+if(GIT_EXECUTABLE)
+  file(MAKE_DIRECTORY "${SCRATCH}/repo")
+  file(WRITE "${SCRATCH}/repo/a.txt" "a\n")
+  git(init -q)
+  git(add a.txt)
+  git(commit -q -m first)
+  version_of("${SCRATCH}/repo" v)
+  if(NOT v MATCHES "^1\\.2\\.3 \\(g[0-9a-f]+\\)$")
+    fail("clean checkout without tags: '${v}'")
+  endif()
+  file(WRITE "${SCRATCH}/repo/a.txt" "b\n")
+  version_of("${SCRATCH}/repo" v)
+  if(NOT v MATCHES "^1\\.2\\.3 \\(g[0-9a-f]+-dirty\\)$")
+    fail("modified checkout: '${v}'")
+  endif()
+  git(checkout -q -- a.txt)
+  git(tag -a v1.2.3 -m release)
+  version_of("${SCRATCH}/repo" v)
+  if(NOT v STREQUAL "1.2.3 (v1.2.3)")
+    fail("on a tag: '${v}'")
+  endif()
+  # A directory inside a checkout is not the checkout: the bare version.
+  file(MAKE_DIRECTORY "${SCRATCH}/repo/sub")
+  version_of("${SCRATCH}/repo/sub" v)
+  if(NOT v STREQUAL "1.2.3")
+    fail("a directory inside another checkout: '${v}'")
+  endif()
+endif()
+file(REMOVE_RECURSE "${SCRATCH}")
