@@ -23,7 +23,6 @@ Every case has one camera, "main" (the built-in box's: eye (278, 273, -800) look
 39.3077 degrees vertical fov), moved by the case's transform like the meshes.
 """
 import json
-import math
 import os
 import re
 import sys
@@ -107,7 +106,7 @@ class Obj:
         self.faces.append((material, refs))
 
     def write(self, path, mtl="room.mtl"):
-        lines = [f"# written by bench/conformance/make_scenes.py", f"mtllib {mtl}"]
+        lines = ["# written by bench/conformance/make_scenes.py", f"mtllib {mtl}"]
         lines += [f"v {p[0]:.6g} {p[1]:.6g} {p[2]:.6g}" for p in self.v]
         lines += [f"vt {t[0]:.6g} {t[1]:.6g}" for t in self.vt]
         current = None
