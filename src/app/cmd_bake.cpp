@@ -29,6 +29,7 @@ struct BakeCommandOptions {
   uint32_t lightSamples = 0;
   float tolerance = 0.0f;
   bool sunMasks = true;           ///< --sun-masks on|off
+  bool punctualHighlights = true; ///< --punctual-highlights on|off
   std::string compress = "none";  ///< how the values are stored: none|lossless|bc1|hdr (compression.h)
 };
 
@@ -49,6 +50,7 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global, Com
   jobOptions.lightSamples = options.lightSamples;
   jobOptions.tolerance = options.tolerance;
   jobOptions.sunMasks = options.sunMasks;
+  jobOptions.punctualHighlights = options.punctualHighlights;
   jobOptions.reuseVisibility = options.reuseVisibility;
   jobOptions.compress = options.compress;
   jobOptions.seed = global.seed;
@@ -121,6 +123,13 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
       ->add_option_function<std::string>(
           "--sun-masks", [options](const std::string& s) { options->sunMasks = s == "on"; },
           "Sub-tixel visibility masks for directional lights (sharp sun shadows; see docs/user-guide.md): on|off")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->default_str("on");
+  command
+      ->add_option_function<std::string>(
+          "--punctual-highlights", [options](const std::string& s) { options->punctualHighlights = s == "on"; },
+          "Point, spot and directional lights' highlights on glossy surfaces evaluated per pixel by the renderers "
+          "(off: kept in the glossy maps; see docs/user-guide.md): on|off")
       ->check(CLI::IsMember({"on", "off"}))
       ->default_str("on");
   command->callback([options, &global] { runBakeCommand(*options, global); });

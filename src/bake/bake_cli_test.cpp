@@ -57,6 +57,20 @@ TEST_F(BakeCli, BakesWritesStatsAndReusesVisibility) {
   EXPECT_NE(err.find("recomputing"), std::string::npos) << err;
 }
 
+// --punctual-highlights on|off is recorded in the light field's bake settings (what the
+// renderers go by: lightfield.h "Punctual highlights"); on by default; other values refused.
+TEST_F(BakeCli, PunctualHighlightsAreABakeOption) {
+  std::string out, err;
+  const std::string common = "bake cornell --preset draft --tixels-across 8 --directions 16 --quiet -o \"";
+  ASSERT_EQ(run(common + path("on.plf") + "\"", &out, &err), 0) << err;
+  EXPECT_TRUE(readLightField(path("on.plf")).settings.punctualHighlights);
+  ASSERT_EQ(run(common + path("off.plf") + "\" --punctual-highlights off", &out, &err), 0) << err;
+  EXPECT_FALSE(readLightField(path("off.plf")).settings.punctualHighlights);
+  EXPECT_EQ(run(common + path("x.plf") + "\" --punctual-highlights maybe", &out, &err), 2);
+  EXPECT_NE(err.find("--punctual-highlights"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("x.plf")));
+}
+
 TEST_F(BakeCli, RefusesBadInput) {
   std::string out, err;
   EXPECT_NE(run("bake \"" + path("missing.obj") + "\" -o \"" + path("x.plf") + "\"", &out, &err), 0);

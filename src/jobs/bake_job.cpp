@@ -89,6 +89,7 @@ BakeSettings BakeJob::settings() const {
   if (options_.gatherDirections > 0) settings.gatherDirections = options_.gatherDirections;
   if (options_.lightSamples > 0) settings.areaLightSamples = options_.lightSamples;
   settings.sunMasks = options_.sunMasks;
+  settings.punctualHighlights = options_.punctualHighlights;
   if (options_.tolerance > 0.0f) settings.tolerance = options_.tolerance;
   settings.seed = options_.seed;
   return settings;

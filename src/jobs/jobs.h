@@ -157,6 +157,7 @@ struct BakeJobOptions {
   uint32_t lightSamples = 0;
   float tolerance = 0.0f;
   bool sunMasks = true;  ///< BakeSettings::sunMasks (`--sun-masks`)
+  bool punctualHighlights = true;  ///< BakeSettings::punctualHighlights (`--punctual-highlights`)
   bool reuseVisibility = false;
   std::string compress = "none";  ///< none | lossless | bc1 | hdr (plf/compression.h)
   uint64_t seed = 0;

@@ -467,9 +467,10 @@ class FileError(Error, OSError):
   m.def(
       "bake",
       [](const Scene& scene, const std::string& preset, uint64_t seed, int threads, std::optional<std::string> visibility,
-         bool reuseVisibility, bool sunMasks) {
+         bool reuseVisibility, bool sunMasks, bool punctualHighlights) {
         BakeJobOptions options;
         options.sunMasks = sunMasks;
+        options.punctualHighlights = punctualHighlights;
         options.sceneName = scene.sourcePath;
         options.preset = preset;
         options.seed = seed;
@@ -491,9 +492,11 @@ class FileError(Error, OSError):
       },
       py::arg("scene"), py::arg("preset") = "default", py::arg("seed") = 0, py::arg("threads") = 0,
       py::arg("visibility") = py::none(), py::arg("reuse_visibility") = false, py::arg("sun_masks") = true,
+      py::arg("punctual_highlights") = true,
       "Bakes `scene`'s light field (what `plenoptic bake` does). visibility: a .plv path where the visibility field\n"
       "is saved; with reuse_visibility=True it is read back when the geometry and settings match (so a bake after\n"
-      "editing only lights or emission re-runs the propagation alone). sun_masks=False: `--sun-masks off`.");
+      "editing only lights or emission re-runs the propagation alone). sun_masks=False: `--sun-masks off`;\n"
+      "punctual_highlights=False: `--punctual-highlights off`.");
 
   m.def(
       "load_light_field",

@@ -109,6 +109,29 @@ def test_sun_masks_are_a_bake_option(tmp_path):
     assert np.allclose(a, b, rtol=1e-6, atol=0.0)
 
 
+def test_punctual_highlights_are_a_bake_option(tmp_path):
+    # A glossy quad under a point light, seen from above: with punctual highlights (the
+    # default) the renderers evaluate the light's reflection per pixel, with
+    # punctual_highlights=False it stays in the glossy maps, smeared over a map texel. Against
+    # the path tracer (measured at 32x32, 16 samples vs 256 spp: relMSE 0.00023 with them,
+    # 0.052 without).
+    quad = os.path.join(DATA, "scene", "textured", "quad.obj")
+    (tmp_path / "lamp.json").write_text(json.dumps({
+        "meshes": [{"file": quad, "material": "shiny"}],
+        "materials": {"shiny": {"type": "ggx", "diffuse": 0.2, "f0": 0.04, "roughness": 0.1}},
+        "lights": [{"type": "point", "position": [0.5, 0.5, 1.0], "intensity": [1.0, 1.0, 1.0]}]}))
+    scene = plenoptic.load_scene(str(tmp_path / "lamp.json"))
+    camera = plenoptic.Camera(eye=[0.5, 0.5, 2.0], target=[0.5, 0.5, 0.0], fov=30.0)
+    reference, _ = plenoptic.trace(scene, width=32, height=32, spp=256, camera=camera)
+    errors = []
+    for highlights in (True, False):
+        lf = plenoptic.bake(scene, preset="draft", punctual_highlights=highlights)
+        image = lf.render(width=32, height=32, samples=16, camera=camera)
+        errors.append(plenoptic.compare(image, reference)["relmse"])
+    print("relMSE with and without punctual highlights:", errors)
+    assert errors[0] < 0.005 and errors[1] > 10.0 * errors[0]
+
+
 def test_editing_emission_and_rebaking_with_the_reused_visibility_equals_a_full_bake(tmp_path):
     scene = plenoptic.load_scene("cornell")
     visibility = str(tmp_path / "cornell.plv")
