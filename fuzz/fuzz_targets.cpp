@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "bake/visibility.h"
+#include "camera/camera_path.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/hash.h"
 #include "image/image.h"
 #include "plf/plf_file.h"
-#include "bake/visibility.h"
-#include "realtime/camera_path.h"
 #include "scene/scene.h"
 
 namespace pl::fuzz {

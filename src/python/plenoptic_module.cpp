@@ -26,6 +26,7 @@
 #include <variant>
 #include <vector>
 
+#include "camera/camera_path.h"
 #include "core/cancel.h"
 #include "core/error.h"
 #include "env/env.h"
@@ -35,7 +36,6 @@
 #include "jobs/jobs.h"
 #include "plf/compression.h"
 #include "plf/plf_file.h"
-#include "realtime/camera_path.h"
 #include "realtime/walkthrough.h"
 #include "scene/scene.h"
 
@@ -422,7 +422,7 @@ class FileError(Error, OSError):
           [](const PyLightField& lf, const py::object& path, int width, int height, int samples,
              const py::object& camera, uint64_t seed, bool reference, int threads, bool textureLod) {
             // The frames' cameras: a list of Cameras as they are, or a camera path file's frames
-            // (realtime/camera_path.h: frame k at t0 + k/fps) posed on `camera` (its lens, and
+            // (camera/camera_path.h: frame k at t0 + k/fps) posed on `camera` (its lens, and
             // its fov where the path has none).
             std::vector<CameraDesc> cameras;
             const ViewSettings base = viewSettings(width, height, camera);

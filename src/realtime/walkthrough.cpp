@@ -85,21 +85,4 @@ WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& ba
                            [&](const Camera& camera, Image& image) { renderer.render(camera, settings, image); });
 }
 
-CameraPath orbitPath(const CameraDesc& camera, double seconds, double fps, float degrees) {
-  if (!(seconds > 0.0) || !(fps > 0.0)) fail("orbit path: duration and fps must be positive");
-  const Vec3 up = glm::normalize(camera.up);
-  const Vec3 offset = camera.eye - camera.target;
-  CameraPath path;
-  path.fps = fps;
-  // Angles of the 5 keyframes: 0, +a, 0, −a, 0 (a smooth swing with Catmull–Rom).
-  const float angles[5] = {0.0f, degrees, 0.0f, -degrees, 0.0f};
-  for (int k = 0; k < 5; ++k) {
-    const float a = angles[k] * kPi / 180.0f;
-    // Rodrigues' rotation of the eye offset about the up axis through the target.
-    const Vec3 rotated = offset * std::cos(a) + glm::cross(up, offset) * std::sin(a) + up * glm::dot(up, offset) * (1.0f - std::cos(a));
-    path.keyframes.push_back(CameraKeyframe{seconds * double(k) / 4.0, camera.target + rotated, camera.target, up, camera.fovYDegrees});
-  }
-  return path;
-}
-
 }  // namespace pl

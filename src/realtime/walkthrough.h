@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "camera/camera_path.h"
 #include "image/image.h"
 #include "image/tonemap.h"
-#include "realtime/camera_path.h"
-#include "realtime/realtime.h"
 #include "lightfield/render_settings.h"
+#include "realtime/realtime.h"
 
 namespace pl {
 
@@ -42,11 +42,6 @@ WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& ba
 /// The same with the fast renderer and `settings`.
 WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& baseCamera, const WalkthroughOptions& options,
                                     const FastRenderer& renderer, const RenderSettings& settings);
-
-/// A path for demos: the eye swings around the camera's target by ±degrees about its up axis
-/// and back (5 keyframes over `seconds`), at the camera's own fov.
-CameraPath orbitPath(const CameraDesc& camera, double seconds = 4.0, double fps = CameraPath::kDefaultFps,
-                     float degrees = 25.0f);
 
 /// radiance × exposureScale (camera/exposure.h), the exposed image tone mapping starts from.
 Image exposedCopy(const Image& radiance, float exposureScale);
