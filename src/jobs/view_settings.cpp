@@ -5,8 +5,8 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/memory.h"
+#include "image/frame_output.h"
 #include "jobs/jobs.h"
-#include "realtime/walkthrough.h"
 
 namespace pl {
 

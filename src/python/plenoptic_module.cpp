@@ -32,11 +32,11 @@
 #include "env/env.h"
 #include "env/ibl.h"
 #include "image/compare.h"
+#include "image/frame_output.h"
 #include "image/image.h"
 #include "jobs/jobs.h"
 #include "plf/compression.h"
 #include "plf/plf_file.h"
-#include "realtime/walkthrough.h"
 #include "scene/scene.h"
 
 namespace py = pybind11;

@@ -11,29 +11,9 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "core/timing.h"
-#include "realtime/frame_output.h"
+#include "image/frame_output.h"
 
 namespace pl {
-
-Image exposedCopy(const Image& radiance, float exposureScale) {
-  Image exposed = radiance;
-  if (exposureScale != 1.0f)
-    for (Rgb& p : exposed.pixels) p *= exposureScale;
-  return exposed;
-}
-
-void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap) {
-  const bool hdr = isHdrExtension(path);
-  if (!hdr && fileExtensionLower(path) != ".png")
-    fail("{}: unknown output type '{}' (use .exr, .hdr, .pfm or .png)", path, fileExtensionLower(path));
-  if (hdr && exposureScale == 1.0f) {
-    writeHdrImage(path, radiance);  // radiance as it is: no exposed copy (half the memory)
-  } else if (hdr) {
-    writeHdrImage(path, exposedCopy(radiance, exposureScale));
-  } else {
-    writePng(path, pl::toneMap(exposedCopy(radiance, exposureScale), toneMap));
-  }
-}
 
 WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& baseCamera, const WalkthroughOptions& options,
                                     const std::function<void(const Camera&, Image&)>& renderFrame) {

@@ -2,7 +2,8 @@
 // Rendering a camera path to files: the loop behind `plenoptic render --path` and the
 // non-interactive `make demo`. Frame k shows the path's pose at t₀ + k/fps on the base camera
 // (which keeps its lens and, when the path has no fov, its fov); each frame is written as
-// `plenoptic render` writes a single image (writeFrame), or piped into an MP4 (frame_output.h).
+// `plenoptic render` writes a single image (image/frame_output.h writeFrame), or piped into an
+// MP4 (VideoWriter, the same file).
 #include <functional>
 #include <string>
 #include <vector>
@@ -42,13 +43,5 @@ WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& ba
 /// The same with the fast renderer and `settings`.
 WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& baseCamera, const WalkthroughOptions& options,
                                     const FastRenderer& renderer, const RenderSettings& settings);
-
-/// radiance × exposureScale (camera/exposure.h), the exposed image tone mapping starts from.
-Image exposedCopy(const Image& radiance, float exposureScale);
-
-/// Writes a frame of radiance, the one way every command writes an image (ViewSettings::
-/// writeImage in jobs/jobs.h calls this): .exr/.hdr/.pfm get radiance × exposureScale, .png
-/// additionally the tone mapping and sRGB encoding. Atomic.
-void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap);
 
 }  // namespace pl
