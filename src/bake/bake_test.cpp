@@ -688,6 +688,13 @@ TEST_F(BakeTest, PresetsAndUnknownPreset) {
   EXPECT_LT(bakePreset("draft").tixelsAcrossScene, bakePreset("default").tixelsAcrossScene);
   EXPECT_LT(bakePreset("default").tixelsAcrossScene, bakePreset("high").tixelsAcrossScene);
   EXPECT_THROW(bakePreset("ultra"), Error);
+  // The names come from kBakePresets, and the error lists them all.
+  EXPECT_EQ(bakePresetNames(), (std::vector<std::string>{"draft", "default", "high"}));
+  try {
+    bakePreset("ultra");
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("(choose draft, default or high)"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
