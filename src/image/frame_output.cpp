@@ -58,7 +58,7 @@ Image exposedCopy(const Image& radiance, float exposureScale) {
 void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap) {
   const bool hdr = isHdrExtension(path);
   if (!hdr && fileExtensionLower(path) != ".png")
-    fail("{}: unknown output type '{}' (use .exr, .hdr, .pfm or .png)", path, fileExtensionLower(path));
+    fail("{}: unknown output type '{}' (use {})", path, fileExtensionLower(path), alternatives(kWrittenImageExtensions));
   if (hdr && exposureScale == 1.0f) {
     writeHdrImage(path, radiance);  // radiance as it is: no exposed copy (half the memory)
   } else if (hdr) {

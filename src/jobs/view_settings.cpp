@@ -66,7 +66,7 @@ ToneMapSettings ViewSettings::toneMapSettings() const {
 }
 
 void ViewSettings::checkImageOutput(const std::string& path, std::string_view option) {
-  checkOutputPath(path, {".exr", ".hdr", ".pfm", ".png"}, option);
+  checkOutputPath(path, kWrittenImageExtensions, option);
 }
 
 void ViewSettings::requireImageMemory(int frameBuffers, std::string_view what) const {

@@ -24,7 +24,7 @@ WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& ba
   if (!video) {
     const std::string ext = fileExtensionLower(options.output);
     if (!isHdrExtension(options.output) && ext != ".png")
-      fail("-o {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", options.output, ext);
+      fail("-o {}: unknown image type '{}' (expected {})", options.output, ext, alternatives(kWrittenImageExtensions));
   }
   const std::filesystem::path parent = std::filesystem::path(options.output).parent_path();
   if (!parent.empty()) {
