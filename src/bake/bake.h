@@ -1,6 +1,7 @@
 #pragma once
-// The light-field bake: parameterisation → visibility field → propagation → LightField
-// (parameterisation.h, visibility.h, propagation.h). The .plf file is written by plf_file.h.
+// The light-field bake, in three steps: 1. parameterisation (parameterisation.h), 2. visibility
+// field (visibility.h), 3. propagation (propagation.h) → LightField. The .plf file is written
+// by plf_file.h.
 // The quality presets are kBakePresets below.
 #include "lightfield/lightfield.h"
 

@@ -1,6 +1,6 @@
 #pragma once
-// Parameterisation of a scene's surfaces for the light-field bake (DESIGN.md "Light-field
-// pipeline" step 1; seed slides 9–17).
+// Parameterisation of a scene's surfaces for the light-field bake (step 1 of the bake,
+// bake.h; seed slides 9–17).
 //
 // Charts: maximal sets of edge-connected triangles that share a material and a plane. Two
 // triangles sharing an edge (vertices welded by position, so split vertices still connect)

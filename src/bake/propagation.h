@@ -1,5 +1,5 @@
 #pragma once
-// Propagation (DESIGN.md "Light-field pipeline" step 3; seed slides 8, 18–27): solves
+// Propagation (step 3 of the bake, bake.h; seed slides 8, 18–27): solves
 // L = Le + M L over the parameterised surfaces by a Neumann series, with the transport operator
 // M split into gathering through the visibility field and a local BRDF operator per tixel.
 //

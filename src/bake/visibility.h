@@ -1,5 +1,5 @@
 #pragma once
-// The visibility field (seed slide 21; DESIGN.md "Light-field pipeline" step 2): for every
+// The visibility field (seed slide 21; step 2 of the bake, bake.h): for every
 // tixel and each of its gather directions, what is seen — a point on a non-specular chart
 // (after following ideal-specular chains), or the environment. Computed once with Embree,
 // saved beside the light field (.plv) and reused while geometry and parameterisation are
