@@ -154,24 +154,18 @@ TEST(CameraPath, StandingStillStaysStill) {
   for (double t = 0.0; t <= 1.0; t += 0.1) EXPECT_EQ(path.at(t).eye, Vec3(0.0f));
 }
 
-CameraDesc orbitBaseCamera() {
-  CameraDesc d;
-  d.eye = {0, 0, 5};
-  d.target = {0, 0, 0};
-  d.fovYDegrees = 30.0f;
-  return d;
-}
-
 TEST(CameraPath, OrbitKeepsDistanceAndReturnsToTheStart) {
-  const CameraPath path = orbitPath(orbitBaseCamera(), 2.0, 10.0, 30.0f);
+  CameraDesc camera;  // looking at the origin from (0, 0, 5)
+  camera.eye = {0, 0, 5};
+  const CameraPath path = orbitPath(camera, 2.0, 10.0, 30.0f);
   ASSERT_EQ(path.keyframes.size(), 5u);
   EXPECT_EQ(path.frameCount(), 21);
   // 1e-5: float rounding of the rotation (sin, cos and products) on coordinates of size 5.
   for (const CameraKeyframe& k : path.keyframes) EXPECT_NEAR(glm::length(k.eye - k.target), 5.0f, 1e-5f);
   // Keyframe 1 is rotated by +30° about +y: x = 5·sin 30° = 2.5 (right-handed, counter-clockwise from above).
   EXPECT_NEAR(path.keyframes[1].eye.x, 2.5f, 1e-5f);
-  EXPECT_NEAR(glm::length(path.keyframes[4].eye - orbitBaseCamera().eye), 0.0f, 1e-5f);
-  EXPECT_THROW(orbitPath(orbitBaseCamera(), 0.0), Error);
+  EXPECT_NEAR(glm::length(path.keyframes[4].eye - camera.eye), 0.0f, 1e-5f);
+  EXPECT_THROW(orbitPath(camera, 0.0), Error);
 }
 
 /// Path files go into a fresh directory per test.

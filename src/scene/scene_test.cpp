@@ -15,6 +15,8 @@
 #include <string>
 #include <tuple>
 
+#include "support/expect_vec3.h"
+
 namespace pl {
 namespace {
 
@@ -28,14 +30,6 @@ const std::string kFuzzCorpus = std::string(PLENOPTIC_TEST_DATA_DIR) + "/fuzz/";
 // Float tolerance for values that went through a few float operations (products, sums of
 // magnitude ≲ 10): a few ulps of float (6e-8 relative) at that scale.
 constexpr float kTight = 1e-5f;
-
-#define EXPECT_VEC3_NEAR(a, b, tol)                                                                    \
-  do {                                                                                                 \
-    const Vec3 va_ = (a), vb_ = (b);                                                                   \
-    EXPECT_NEAR(va_.x, vb_.x, tol);                                                                    \
-    EXPECT_NEAR(va_.y, vb_.y, tol);                                                                    \
-    EXPECT_NEAR(va_.z, vb_.z, tol);                                                                    \
-  } while (0)
 
 /// Runs `load`, expects a pl::Error whose message contains every string of `needles`.
 void expectError(const std::function<void()>& load, std::initializer_list<std::string> needles) {
