@@ -38,13 +38,13 @@
 #include <vector>
 
 #include "accel/accel.h"
+#include "bake/bake.h"
 #include "camera/camera.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/progress.h"
-#include "bake/bake.h"
+#include "image/display.h"
 #include "plf/plf_file.h"
-#include "realtime/display.h"
 #include "realtime/realtime.h"
 #include "scene/scene.h"
 

@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "camera/camera_path.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/hash.h"
 #include "image/image.h"
 #include "plf/plf_file.h"
-#include "bake/visibility.h"
-#include "realtime/camera_path.h"
+#include "plf/plv_file.h"
 #include "scene/scene.h"
 
 namespace pl::fuzz {
@@ -145,7 +145,7 @@ void runPlfFixed(std::span<const uint8_t> input) {
   runPlf(bytes);
 }
 
-// .plv header (visibility.cpp): magic 8, version 4, gridSide 4, hash 8 at 16, tixelCount,
+// .plv header (plf/plv_file.h): magic 8, version 4, gridSide 4, hash 8 at 16, tixelCount,
 // entryCount, extraCount, payloadHash 8 at 48; payload from 56.
 constexpr size_t kPlvHashOffset = 16, kPlvPayloadHashOffset = 48, kPlvHeaderBytes = 56;
 

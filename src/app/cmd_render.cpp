@@ -1,7 +1,7 @@
 // `plenoptic render IN.plf -o OUT.exr|png`: the fast light-field renderer (src/realtime, the
 // default) or, with --reference, the straightforward one (src/render/render.h), through the
 // shared camera, exposure and tone-mapping flags. With --path PATH.json it renders a
-// walk-through (realtime/camera_path.h) to an image sequence (-o frames/%04d.png) or an MP4
+// walk-through (camera/camera_path.h) to an image sequence (-o frames/%04d.png) or an MP4
 // video (-o walk.mp4, through ffmpeg). The work is RenderJob's (src/jobs/jobs.h): flags → job →
 // printed summary.
 #include <fmt/format.h>

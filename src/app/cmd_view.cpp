@@ -8,9 +8,9 @@
 #include "accel/accel.h"
 #include "app/commands.h"
 #include "app/view_options.h"
+#include "camera/camera_path.h"
 #include "core/error.h"
 #include "plf/plf_file.h"
-#include "realtime/camera_path.h"
 #include "viewer/viewer.h"
 
 namespace pl {

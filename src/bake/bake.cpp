@@ -19,30 +19,18 @@
 namespace pl {
 
 BakeSettings bakePreset(const std::string& name) {
+  const BakePresetValues* preset = nullptr;
+  for (const BakePresetValues& p : kBakePresets)
+    if (name == p.name) preset = &p;
+  if (!preset) fail("unknown bake preset '{}' (choose {})", name, alternatives(bakePresetNames()));
   BakeSettings s;
   s.preset = name;
   s.tixelsPerUnit = 0.0f;  // density from the scene's room scale (sceneScale)
-  if (name == "draft") {
-    s.tixelsAcrossScene = 20;
-    s.gatherDirections = 144;
-    s.glossyDirRes = 8;
-    s.areaLightSamples = 16;
-    s.tolerance = 5e-3f;
-  } else if (name == "default") {
-    s.tixelsAcrossScene = 40;
-    s.gatherDirections = 256;
-    s.glossyDirRes = 16;
-    s.areaLightSamples = 32;
-    s.tolerance = 1e-3f;
-  } else if (name == "high") {
-    s.tixelsAcrossScene = 60;
-    s.gatherDirections = 576;
-    s.glossyDirRes = 24;
-    s.areaLightSamples = 64;
-    s.tolerance = 2e-4f;
-  } else {
-    fail("unknown bake preset '{}' (choose draft, default or high)", name);
-  }
+  s.tixelsAcrossScene = preset->tixelsAcrossScene;
+  s.gatherDirections = preset->gatherDirections;
+  s.glossyDirRes = preset->glossyDirRes;
+  s.areaLightSamples = preset->areaLightSamples;
+  s.tolerance = preset->tolerance;
   s.maxTixelsPerChartSide = 16384;
   s.maxIterations = 200;
   s.mirrorDepth = 256;
@@ -61,7 +49,11 @@ uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings
   return visibility + writeBuffers + values * kValueArrays * sizeof(Rgb) + tixels * (kQuadBytes + kChangeBytes + sunMasks);
 }
 
-std::vector<std::string> bakePresetNames() { return {"draft", "default", "high"}; }
+std::vector<std::string> bakePresetNames() {
+  std::vector<std::string> names;
+  for (const BakePresetValues& p : kBakePresets) names.emplace_back(p.name);
+  return names;
+}
 
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options) {
   const auto start = std::chrono::steady_clock::now();

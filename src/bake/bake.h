@@ -1,17 +1,10 @@
 #pragma once
-// The light-field bake: parameterisation → visibility field → propagation → LightField
-// (docs/design.md, The bake). The .plf file is written by plf_file.h.
-//
-// Presets (densities are relative to the scene's room scale, so a scene in millimetres and one
-// in metres get the same grids; every preset allows 16384 tixels per chart side):
-//   preset   tixels across   gather dirs   glossy map ≤   area-light rays   tolerance
-//   draft          20         144 (12²)         8              16             5e-3
-//   default        40         256 (16²)        16              32             1e-3
-//   high           60         576 (24²)        24              64             2e-4
-// "tolerance" is the relative change of total outgoing power at which iteration stops, once
-// the remaining error estimated from the rate of convergence is below it too (propagation.h).
+// The light-field bake, in three steps: 1. parameterisation (parameterisation.h), 2. visibility
+// field (visibility.h), 3. propagation (propagation.h) → LightField (docs/design.md, The
+// bake). The .plf file is written by plf_file.h. The quality presets are kBakePresets below.
 #include "lightfield/lightfield.h"
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -20,8 +13,32 @@ namespace pl {
 
 class Communicator;
 
+/// A named quality preset. Densities are relative to the scene's room scale (sceneScale,
+/// parameterisation.h), so a scene in millimetres and one in metres get the same grids; the
+/// other BakeSettings (chart size limit, iteration cap, mirror depth, seed, sun masks) are the
+/// same for every preset.
+struct BakePresetValues {
+  const char* name;
+  float tixelsAcrossScene;    ///< tixels across the room scale
+  uint32_t gatherDirections;  ///< gather rays per tixel (a square: 12², 16², 24²)
+  uint32_t glossyDirRes;      ///< cap on the side of a glossy chart's paraboloid map
+  uint32_t areaLightSamples;  ///< shadow rays per tixel towards emissive surfaces
+  /// Relative change of total outgoing power at which iteration stops, once the remaining
+  /// error estimated from the rate of convergence is below it too (propagation.h).
+  float tolerance;
+};
+/// The presets: the one list of their names and values (bakePreset, bakePresetNames, and
+/// through them the jobs, the command line and Python; docs/user-guide.md's table shows it).
+inline constexpr BakePresetValues kBakePresets[] = {
+    // name     across  gather  glossy  area rays  tolerance
+    {"draft",    20.0f,  144,    8,      16,        5e-3f},
+    {"default",  40.0f,  256,    16,     32,        1e-3f},
+    {"high",     60.0f,  576,    24,     64,        2e-4f},
+};
+
 /// The settings of a named preset; throws pl::Error listing the names for an unknown one.
 BakeSettings bakePreset(const std::string& name);
+/// The names of kBakePresets, in order (draft, default, high).
 std::vector<std::string> bakePresetNames();
 
 /// What a distributed bake measured (docs/design.md, Distributed bake); one process: ranks 1.

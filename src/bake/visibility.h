@@ -13,97 +13,20 @@
 // as a multi-jittered pattern (gatherSubCells): stratified per cell and, more finely, along
 // each axis, and decorrelated between neighbouring tixels.
 //
-// Entries (8 bytes in memory, tixel-major: entry k of tixel g at g·N + k; compressed on disk):
-//   target  bits 0–29: global index of the tixel at the lower-left of the 2×2 bilinear
-//                      footprint of the seen point (kEscape: nothing was hit)
-//           bit 30:    the seen chart was hit from behind (its back side)
-//           bit 31:    the entry has an extra record (see below)
-//   fu, fv  bilinear fractions towards tixel (i+1, j) and (i, j+1), × 65535
-// Extra records (rare: glossy targets and paths through mirrors), in entry order per tixel,
-// starting at extraOffset[g]:
-//   throughput  product of the mirror reflectances along the chain (1 without mirrors)
-//   st          paraboloid coordinates, in the seen chart's frame, of the direction in which
-//               the seen point sends light back along the path (glossy targets); for a path
-//               that leaves the scene after mirrors, the octahedral encoding of its final
-//               world direction (to look the environment up)
-//   viaMirror   whether the path went through at least one mirror
-#include "core/math.h"
-#include "bake/parameterisation.h"
-
+// The field's data types (VisibilityEntry, VisibilityExtra, VisibilityField: what each entry
+// means) and its .plv file are plf/plv_file.h's.
 #include <cmath>
 #include <cstdint>
-#include <memory>
 #include <string>
 #include <vector>
+
+#include "bake/parameterisation.h"
+#include "core/math.h"
+#include "plf/plv_file.h"
 
 namespace pl {
 
 class Accel;
-
-struct VisibilityEntry {
-  static constexpr uint32_t kIndexMask = 0x3fffffffu;
-  static constexpr uint32_t kEscape = kIndexMask;
-  static constexpr uint32_t kBackSide = 1u << 30;
-  static constexpr uint32_t kHasExtra = 1u << 31;
-  uint32_t target = kEscape;
-  uint16_t fu = 0, fv = 0;
-
-  uint32_t tixel() const { return target & kIndexMask; }
-  bool escaped() const { return tixel() == kEscape; }
-  bool backSide() const { return (target & kBackSide) != 0; }
-  bool hasExtra() const { return (target & kHasExtra) != 0; }
-};
-static_assert(sizeof(VisibilityEntry) == 8);
-
-struct VisibilityExtra {
-  Rgb throughput{1.0f};
-  Vec2 st{0.0f};
-  uint32_t viaMirror = 0;
-};
-static_assert(sizeof(VisibilityExtra) == 24);
-
-/// Read-only elements of a visibility field (a field just traced, or decoded from its .plv).
-/// Copies share the storage.
-template <typename T>
-class FieldArray {
- public:
-  FieldArray() = default;
-  explicit FieldArray(std::vector<T> owned) {
-    auto storage = std::make_shared<const std::vector<T>>(std::move(owned));
-    data_ = storage->data();
-    size_ = storage->size();
-    keepAlive_ = std::move(storage);
-  }
-
-  const T* data() const { return data_; }
-  size_t size() const { return size_; }
-  bool empty() const { return size_ == 0; }
-  const T& operator[](size_t i) const { return data_[i]; }
-  const T* begin() const { return data_; }
-  const T* end() const { return data_ + size_; }
-
- private:
-  std::shared_ptr<const void> keepAlive_;
-  const T* data_ = nullptr;
-  size_t size_ = 0;
-};
-
-struct VisibilityField {
-  uint32_t gridSide = 0;          ///< m: N = m² gather directions per tixel
-  uint64_t tixelCount = 0;
-  uint64_t hash = 0;              ///< of geometry + parameterisation + settings (visibilityHash)
-  FieldArray<VisibilityEntry> entries;    ///< tixelCount × N
-  FieldArray<uint64_t> extraOffset;       ///< tixelCount + 1
-  FieldArray<VisibilityExtra> extras;
-  uint64_t rays = 0;              ///< rays traced to build it (gather + mirror continuations)
-  double seconds = 0.0;
-
-  uint32_t directionsPerTixel() const { return gridSide * gridSide; }
-  uint64_t bytes() const {
-    return entries.size() * sizeof(VisibilityEntry) + extraOffset.size() * sizeof(uint64_t) +
-           extras.size() * sizeof(VisibilityExtra);
-  }
-};
 
 /// Tixels [begin, end) (global tixel indices).
 struct TixelRange {
@@ -193,23 +116,5 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 /// the whole field (a tixel's rays depend only on the tixel, the seed and the scene).
 VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                        const BakeSettings& settings, const std::vector<TixelRange>& ranges);
-
-/// Writes the field atomically (temp + rename), compressed: zstd frames of blocks of
-/// entries split into index and fraction planes (format: see visibility.cpp), with a progress bar.
-void writeVisibility(const std::string& path, const VisibilityField& field);
-
-/// Bytes writeVisibility holds besides the field itself (one batch of blocks and frames).
-uint64_t visibilityWriteBufferBytes(uint32_t gridSide);
-
-/// Reads and decodes a field into memory (the in-memory layout above: the bytes the bake's
-/// memory estimate counts, checked with requireMemory before allocating). Returns false and
-/// sets *why when the file is absent, of an older format version, or its hash differs from
-/// expectedHash (a stale field is not an error); throws pl::Error naming the file when it is
-/// present but corrupt or truncated (header, payload checksum, every frame and every index are
-/// checked before it returns).
-/// targetTixels: how many tixels the entries may point at (0: the file's own tixel count; a
-/// shard's entries point at any tixel of the scene).
-bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
-                    uint64_t targetTixels = 0);
 
 }  // namespace pl

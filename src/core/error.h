@@ -5,8 +5,10 @@
 // statuses below (the same for every command; docs/user-guide.md, Errors and exit statuses).
 #include <fmt/format.h>
 
+#include <iterator>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 
 namespace pl {
@@ -60,6 +62,21 @@ template <typename... Args>
 template <typename... Args>
 [[noreturn]] void failUsage(fmt::format_string<Args...> format, Args&&... args) {
   throw UsageError(fmt::format(format, std::forward<Args>(args)...));
+}
+
+/// The choices of a message as "a, b or c" ("a" alone, "a or b"), in the order given: how
+/// every message lists what it would have accepted (presets, file extensions).
+template <typename Range>
+std::string alternatives(const Range& choices) {
+  std::string list;
+  const size_t count = size_t(std::size(choices));
+  size_t i = 0;
+  for (const auto& choice : choices) {
+    list += i == 0 ? "" : i + 1 == count ? " or " : ", ";
+    list += std::string_view(choice);
+    ++i;
+  }
+  return list;
 }
 
 }  // namespace pl

@@ -50,17 +50,12 @@ std::string fileExtensionLower(const std::string& path) {
   return ext;
 }
 
-void checkOutputPath(const std::string& path, std::initializer_list<std::string_view> extensions,
-                     std::string_view option) {
+void checkOutputPath(const std::string& path, std::span<const std::string_view> extensions, std::string_view option) {
   namespace fs = std::filesystem;
   const std::string ext = fileExtensionLower(path);
-  if (extensions.size() > 0 && std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) {
-    std::string list;
-    size_t i = 0;
-    for (const std::string_view e : extensions)
-      list += fmt::format("{}{}", i++ == 0 ? "" : i == extensions.size() ? " or " : ", ", e);
-    failUsage("{} {}: expected a {} file name, not '{}'", option, path, list, ext.empty() ? "no extension" : ext);
-  }
+  if (!extensions.empty() && std::find(extensions.begin(), extensions.end(), ext) == extensions.end())
+    failUsage("{} {}: expected a {} file name, not '{}'", option, path, alternatives(extensions),
+              ext.empty() ? "no extension" : ext);
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (fs::is_directory(status)) failFile(path, "{} {}: is a directory", option, path);

@@ -34,8 +34,11 @@ std::string fileExtensionLower(const std::string& path);
 ///   * pl::Error when the path is a directory or another non-regular file (FIFO, device),
 ///     or its directory does not exist, is not a directory or is not writable.
 /// The target itself may exist: it is replaced by renaming a temporary over it.
-void checkOutputPath(const std::string& path, std::initializer_list<std::string_view> extensions,
-                     std::string_view option);
+void checkOutputPath(const std::string& path, std::span<const std::string_view> extensions, std::string_view option);
+inline void checkOutputPath(const std::string& path, std::initializer_list<std::string_view> extensions,
+                            std::string_view option) {
+  checkOutputPath(path, std::span<const std::string_view>(extensions.begin(), extensions.size()), option);
+}
 
 /// An output path and the flag it came from.
 struct OutputFlag {

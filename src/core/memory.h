@@ -3,6 +3,7 @@
 // before its large allocations (framebuffers, visibility field, light-field values): a run
 // that would not fit is refused up front with its estimate and the flag that lowers it,
 // instead of being killed by the system part-way (or slowing it down by swapping).
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -23,5 +24,10 @@ std::optional<uint64_t> availableMemoryBytes();
 /// lower the estimate, e.g. "lower --width/--height". Does nothing when the available memory
 /// is unknown.
 void requireMemory(uint64_t bytes, std::string_view what, std::string_view how);
+
+/// Asks Linux for transparent huge pages (2 MiB) on a large, not yet touched allocation: the
+/// tens to hundreds of MB of a visibility field then take a few hundred page faults to fill
+/// instead of tens of thousands. A hint only (THP may be off); a no-op elsewhere.
+void adviseHugePages(void* data, size_t bytes);
 
 }  // namespace pl

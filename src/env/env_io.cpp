@@ -22,7 +22,6 @@ EnvLayout parseEnvLayout(const std::string& name) {
 
 namespace {
 
-constexpr std::array<const char*, 5> kImageExtensions = {".hdr", ".exr", ".pfm", ".png", ".jpg"};
 constexpr const char* kFacePlaceholder = "{face}";
 
 std::string replaceFace(const std::string& pattern, const char* face) {
@@ -71,17 +70,20 @@ CubeMap facesToCube(const std::array<std::string, 6>& paths) {
 std::array<std::string, 6> facePathsInDirectory(const std::string& dir) {
   std::array<std::string, 6> paths;
   for (int f = 0; f < 6; ++f) {
-    for (const char* ext : kImageExtensions) {
-      const fs::path candidate = fs::path(dir) / (std::string(kCubeFaceNames[size_t(f)]) + ext);
+    // Every readable image type (image.h), HDR first: the first that exists is the face.
+    std::string tried;
+    auto look = [&](std::string_view ext) {
+      tried += tried.empty() ? std::string(ext) : "/" + std::string(ext);
+      if (!paths[size_t(f)].empty()) return;
+      const fs::path candidate = fs::path(dir) / (std::string(kCubeFaceNames[size_t(f)]) + std::string(ext));
       std::error_code ec;
-      if (fs::exists(candidate, ec)) {
-        paths[size_t(f)] = candidate.string();
-        break;
-      }
-    }
+      if (fs::exists(candidate, ec)) paths[size_t(f)] = candidate.string();
+    };
+    for (std::string_view ext : kHdrImageExtensions) look(ext);
+    for (std::string_view ext : kLdrImageExtensions) look(ext);
     if (paths[size_t(f)].empty())
-      fail("{}: cube face '{}' missing (looked for {}.hdr/.exr/.pfm/.png/.jpg)", dir, kCubeFaceNames[size_t(f)],
-           kCubeFaceNames[size_t(f)]);
+      fail("{}: cube face '{}' missing (looked for {}{})", dir, kCubeFaceNames[size_t(f)], kCubeFaceNames[size_t(f)],
+           tried);
   }
   return paths;
 }

@@ -1,6 +1,8 @@
 // Image basics: the sRGB transfer function, dispatch on the file extension, atomic writes.
 #include "image/image.h"
 
+#include <fmt/ranges.h>
+
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -31,10 +33,14 @@ float linearToSrgb(float linear) {
   return 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
 }
 
-bool isHdrExtension(const std::string& path) {
-  const std::string ext = fileExtensionLower(path);
-  return ext == ".exr" || ext == ".hdr" || ext == ".pfm";
+namespace {
+template <size_t N>
+bool contains(const std::array<std::string_view, N>& list, const std::string& extension) {
+  return std::find(list.begin(), list.end(), extension) != list.end();
 }
+}  // namespace
+
+bool isHdrExtension(const std::string& path) { return contains(kHdrImageExtensions, fileExtensionLower(path)); }
 
 namespace detail {
 std::vector<unsigned char> readFileBytes(const std::string& path) {
@@ -115,13 +121,11 @@ Image readImage(const std::string& path, ImageDecode decode) {
   if (ext == ".hdr") return hdrAs(detail::readRadianceHdr(path), decode);
   if (ext == ".pfm") return hdrAs(detail::readPfm(path), decode);
   if (isLdrImageExtension(ext)) return detail::decodeLdr(detail::readFileBytes(path), path, ext == ".png", decode);
-  fail("{}: unknown image extension '{}' (readable: .exr .hdr .pfm .png .jpg .jpeg .tga .bmp)", path, ext);
+  fail("{}: unknown image extension '{}' (readable: {} {})", path, ext, fmt::join(kHdrImageExtensions, " "),
+       fmt::join(kLdrImageExtensions, " "));
 }
 
-bool isLdrImageExtension(const std::string& extension) {
-  return extension == ".png" || extension == ".jpg" || extension == ".jpeg" || extension == ".tga" ||
-         extension == ".bmp";
-}
+bool isLdrImageExtension(const std::string& extension) { return contains(kLdrImageExtensions, extension); }
 
 ImageFile readImageFile(const std::string& path, ImageDecode decode) {
   const std::string ext = fileExtensionLower(path);
@@ -144,8 +148,8 @@ bool ldrImageHasAlphaChannel(std::span<const unsigned char> bytes) {
 
 void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOptions& options) {
   const std::string ext = fileExtensionLower(path);
-  if (ext != ".exr" && ext != ".hdr" && ext != ".pfm")
-    fail("{}: cannot write HDR image with extension '{}' (use .exr, .hdr or .pfm)", path, ext);
+  if (!isHdrExtension(path))
+    fail("{}: cannot write HDR image with extension '{}' (use {})", path, ext, alternatives(kHdrImageExtensions));
   if (image.pixels.size() != size_t(image.width) * size_t(image.height))
     fail("{}: cannot write: pixel buffer holds {} pixels, expected {}x{}", path, image.pixels.size(), image.width,
          image.height);

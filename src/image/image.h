@@ -18,9 +18,11 @@
 #include "core/file_io.h"  // fileExtensionLower
 #include "core/math.h"
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace pl {
@@ -63,6 +65,17 @@ enum class ImageDecode : uint8_t {
                  ///< first channel, value / maximum, repeated in R, G and B (alpha masks)
 };
 
+/// The image file types by extension (lower case, with the dot; the table at the top): the one
+/// list readImage, writeHdrImage, writeFrame (frame_output.h), the commands' output checks and
+/// the cube-face search of env/ follow. HDR formats hold linear floats and are read and
+/// written as they are; 8-bit formats are read (decoded as ImageDecode says), and of them
+/// only PNG is written (tone-mapped).
+inline constexpr std::array<std::string_view, 3> kHdrImageExtensions = {".exr", ".hdr", ".pfm"};
+inline constexpr std::array<std::string_view, 5> kLdrImageExtensions = {".png", ".jpg", ".jpeg", ".tga", ".bmp"};
+/// What a rendered image may be written as (writeFrame): the HDR formats and PNG.
+inline constexpr std::array<std::string_view, 4> kWrittenImageExtensions = {
+    kHdrImageExtensions[0], kHdrImageExtensions[1], kHdrImageExtensions[2], kLdrImageExtensions[0]};
+
 /// Reads an HDR image (.exr, .hdr, .pfm) or an 8-bit one (.png, .jpg, .tga, .bmp: decoded as
 /// `decode` says; grey images repeat their channel). HDR files are linear already: Colour and
 /// Data read them as they are, Coverage takes their red channel. Throws pl::Error naming the
@@ -75,8 +88,7 @@ Image readImage(const std::string& path, ImageDecode decode = ImageDecode::Colou
 /// says. The one conversion every 8/16-bit image reader (stb, glTF buffers) uses.
 Image decodeTexels(const void* texels, int bitsPerChannel, int width, int height, int channels, ImageDecode decode);
 
-/// True for the extensions (lower case, with the dot) of the 8-bit formats: .png .jpg .jpeg
-/// .tga .bmp.
+/// True for the extensions (lower case, with the dot) of the 8-bit formats (kLdrImageExtensions).
 bool isLdrImageExtension(const std::string& extension);
 
 /// An image file as a texture keeps it: the decoded pixels (as readImage gives them) and, for
@@ -111,7 +123,7 @@ struct HdrWriteOptions {
 void writeHdrImage(const std::string& path, const Image& image, const HdrWriteOptions& options = {});
 /// Writes an already tone-mapped 8-bit image as PNG (atomic).
 void writePng(const std::string& path, const Image8& image);
-/// True for the extensions writeHdrImage accepts (.exr, .hdr, .pfm; case-insensitive).
+/// True for the extensions writeHdrImage accepts (kHdrImageExtensions; case-insensitive).
 bool isHdrExtension(const std::string& path);
 
 }  // namespace pl

@@ -42,6 +42,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/byte_reader.h"
 #include "core/error.h"
 #include "image/image_io.h"
 
@@ -116,34 +117,13 @@ void writePngFile(const std::string& path, const Image8& image) {
 
 namespace {
 
-class ByteReader {
- public:
-  ByteReader(const std::string& path, const std::vector<unsigned char>& bytes) : path_(path), bytes_(bytes) {}
-  size_t offset() const { return at_; }
-  unsigned char next() {
-    if (at_ >= bytes_.size()) fail("{}: truncated Radiance HDR file (pixel data ends at byte {})", path_, bytes_.size());
-    return bytes_[at_++];
-  }
-  /// A header line without its '\n'; fails if the file ends first or the line is absurdly long.
-  std::string line() {
-    std::string s;
-    while (true) {
-      const unsigned char c = next();
-      if (c == '\n') return s;
-      if (s.size() > 4096) fail("{}: corrupt Radiance HDR header (line longer than 4096 bytes)", path_);
-      s.push_back(char(c));
-    }
-  }
-
- private:
-  const std::string& path_;
-  const std::vector<unsigned char>& bytes_;
-  size_t at_ = 0;
-};
+/// Longest Radiance header line accepted (the header is a few short lines; anything longer is
+/// a corrupt file, not a header to keep reading).
+constexpr size_t kMaxHeaderLineBytes = 4096;
 
 /// Reads one scan line of `width` RGBE pixels (new adaptive RLE, old RLE or flat).
 void readScanline(ByteReader& in, const std::string& path, int y, int width, unsigned char* rgbe) {
-  const unsigned char b0 = in.next(), b1 = in.next(), b2 = in.next(), b3 = in.next();
+  const unsigned char b0 = in.get<unsigned char>(), b1 = in.get<unsigned char>(), b2 = in.get<unsigned char>(), b3 = in.get<unsigned char>();
   const bool newRle = width >= 8 && width < 0x8000 && b0 == 2 && b1 == 2 && !(b2 & 0x80);
   if (newRle) {
     if ((int(b2) << 8 | int(b3)) != width)
@@ -152,17 +132,17 @@ void readScanline(ByteReader& in, const std::string& path, int y, int width, uns
     for (int channel = 0; channel < 4; ++channel) {
       int x = 0;
       while (x < width) {
-        int count = in.next();
+        int count = in.get<unsigned char>();
         const bool run = count > 128;
         if (run) count -= 128;
         if (count == 0 || x + count > width)
           fail("{}: corrupt Radiance HDR file (bad run length {} in scan line {} at byte {})", path, count, y,
                in.offset());
         if (run) {
-          const unsigned char value = in.next();
+          const unsigned char value = in.get<unsigned char>();
           for (int i = 0; i < count; ++i) rgbe[4 * (x++) + channel] = value;
         } else {
-          for (int i = 0; i < count; ++i) rgbe[4 * (x++) + channel] = in.next();
+          for (int i = 0; i < count; ++i) rgbe[4 * (x++) + channel] = in.get<unsigned char>();
         }
       }
     }
@@ -185,7 +165,7 @@ void readScanline(ByteReader& in, const std::string& path, int y, int width, uns
       shift = 0;
     }
     if (x >= width) return;
-    for (unsigned char& b : pixel) b = in.next();
+    for (unsigned char& b : pixel) b = in.get<unsigned char>();
   }
 }
 
@@ -193,15 +173,15 @@ void readScanline(ByteReader& in, const std::string& path, int y, int width, uns
 
 Image readRadianceHdr(const std::string& path) {
   const std::vector<unsigned char> bytes = readFileBytes(path);
-  ByteReader in(path, bytes);
+  ByteReader in(bytes, path, "or truncated Radiance HDR file");
   if (bytes.size() < 2 || bytes[0] != '#' || bytes[1] != '?')
     fail("{}: not a Radiance HDR file (does not start with '#?')", path);
-  in.line();
+  in.getLine(kMaxHeaderLineBytes);
   // Header: VARIABLE=value lines up to an empty line. EXPOSURE multiplies (cumulatively) the
   // values that were stored, so radiance = stored / exposure.
   double exposure = 1.0;
   while (true) {
-    const std::string line = in.line();
+    const std::string line = in.getLine(kMaxHeaderLineBytes);
     if (line.empty()) break;
     if (line.rfind("FORMAT=", 0) == 0 && line != "FORMAT=32-bit_rle_rgbe")
       fail("{}: unsupported Radiance format '{}' (only 32-bit_rle_rgbe)", path, line.substr(7));
@@ -211,7 +191,7 @@ Image readRadianceHdr(const std::string& path) {
       exposure *= e;
     }
   }
-  const std::string resolution = in.line();
+  const std::string resolution = in.getLine(kMaxHeaderLineBytes);
   char ySign = 0, xSign = 0, yAxis = 0, xAxis = 0;
   long long height = 0, width = 0;
   if (std::sscanf(resolution.c_str(), "%c%c %lld %c%c %lld", &ySign, &yAxis, &height, &xSign, &xAxis, &width) != 6 ||

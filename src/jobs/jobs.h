@@ -20,12 +20,12 @@
 
 #include "bake/bake.h"
 #include "camera/camera.h"
+#include "camera/camera_path.h"
 #include "camera/exposure.h"
 #include "image/image.h"
 #include "image/tonemap.h"
 #include "lightfield/lightfield.h"
 #include "lightfield/render_settings.h"
-#include "realtime/camera_path.h"
 #include "scene/scene.h"
 #include "trace/trace.h"
 

@@ -38,7 +38,7 @@ std::string TraceJobStats::toJson() const {
 TraceJob::TraceJob(TraceJobOptions options) : options_(std::move(options)) {
   // Every output is checked before the scene is even loaded (core/file_io.h).
   if (!options_.output.empty()) ViewSettings::checkImageOutput(options_.output, "-o");
-  if (!options_.variancePath.empty()) checkOutputPath(options_.variancePath, {".exr", ".hdr", ".pfm"}, "--variance");
+  if (!options_.variancePath.empty()) checkOutputPath(options_.variancePath, kHdrImageExtensions, "--variance");
   if (!options_.statsPath.empty()) checkOutputPath(options_.statsPath, {}, "--stats");
   checkDistinctOutputs(
       {{"-o", options_.output}, {"--variance", options_.variancePath}, {"--stats", options_.statsPath}});

@@ -5,8 +5,8 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/memory.h"
+#include "image/frame_output.h"
 #include "jobs/jobs.h"
-#include "realtime/walkthrough.h"
 
 namespace pl {
 
@@ -66,7 +66,7 @@ ToneMapSettings ViewSettings::toneMapSettings() const {
 }
 
 void ViewSettings::checkImageOutput(const std::string& path, std::string_view option) {
-  checkOutputPath(path, {".exr", ".hdr", ".pfm", ".png"}, option);
+  checkOutputPath(path, kWrittenImageExtensions, option);
 }
 
 void ViewSettings::requireImageMemory(int frameBuffers, std::string_view what) const {

@@ -1,6 +1,6 @@
 #pragma once
 // Private to the light-field module: the two third-party codecs used by compression.cpp (and
-// zstd by the .plv file, visibility.cpp), each behind one .cpp file (codec_zstd.cpp: libzstd; codec_bc1.cpp: libsquish).
+// zstd by the .plv file, plv_file.cpp), each behind one .cpp file (codec_zstd.cpp: libzstd; codec_bc1.cpp: libsquish).
 #include <cstddef>
 #include <cstdint>
 #include <span>

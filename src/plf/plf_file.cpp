@@ -15,6 +15,7 @@
 #include <span>
 #include <type_traits>
 
+#include "core/byte_reader.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/hash.h"
@@ -34,8 +35,6 @@ namespace {
 constexpr size_t kSectionAlignment = 64;
 /// No file of this version has more sections than this; a larger count is corruption.
 constexpr uint32_t kMaxSections = 64;
-/// Longest string (names, paths) a reader accepts.
-constexpr uint32_t kMaxStringBytes = 1u << 20;
 
 // Kinds in the order the writer stores them (the reader accepts any order).
 enum SectionIndex { kScene = 0, kCharts, kTriangleCharts, kValues, kSunMasks, kMeta, kSectionKinds };
@@ -83,66 +82,6 @@ class ByteWriter {
 
  private:
   std::vector<unsigned char> bytes_;
-};
-
-/// Reads fields back, checking every size against the bytes that remain, so a corrupt count
-/// is reported instead of allocating or reading past the end.
-class ByteReader {
- public:
-  ByteReader(std::span<const unsigned char> bytes, const std::string& path, const char* section)
-      : bytes_(bytes), path_(path), section_(section) {}
-
-  template <typename T>
-  T get() {
-    static_assert(std::is_trivially_copyable_v<T>);
-    need(sizeof(T), "a field");
-    T value;
-    std::memcpy(&value, bytes_.data() + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    return value;
-  }
-  std::string getString() {
-    const uint32_t length = get<uint32_t>();
-    if (length > kMaxStringBytes) corrupt(fmt::format("a string of {} bytes", length));
-    need(length, "a string");
-    std::string s(reinterpret_cast<const char*>(bytes_.data() + pos_), length);
-    pos_ += length;
-    return s;
-  }
-  /// A u64 element count whose elements (elementBytes each) must fit in what remains.
-  uint64_t getCount(uint64_t elementBytes, const char* what) {
-    const uint64_t count = get<uint64_t>();
-    if (elementBytes > 0 && count > remaining() / elementBytes)
-      corrupt(fmt::format("{} {} of {} bytes each, but only {} bytes remain", count, what, elementBytes,
-                          remaining()));
-    return count;
-  }
-  template <typename T>
-  std::vector<T> getArray(const char* what) {
-    const uint64_t count = getCount(sizeof(T), what);
-    std::vector<T> v(count);
-    if (count > 0) std::memcpy(v.data(), bytes_.data() + pos_, count * sizeof(T));  // (an empty v's data() may be null)
-    pos_ += count * sizeof(T);
-    return v;
-  }
-  uint64_t remaining() const { return bytes_.size() - pos_; }
-  void expectEnd() {
-    if (pos_ != bytes_.size()) corrupt(fmt::format("{} unexpected bytes after the last field", remaining()));
-  }
-  [[noreturn]] void corrupt(const std::string& problem) const {
-    fail("{}: corrupt {} section at byte {}: {}", path_, section_, pos_, problem);
-  }
-
- private:
-  void need(uint64_t bytes, const char* what) {
-    if (bytes > remaining())
-      corrupt(fmt::format("{} of {} bytes, but only {} bytes remain", what, bytes, remaining()));
-  }
-
-  std::span<const unsigned char> bytes_;
-  const std::string& path_;
-  const char* section_;
-  uint64_t pos_ = 0;
 };
 
 // --- Scene -------------------------------------------------------------------------------
@@ -338,7 +277,7 @@ enum class TextureDecoding { Decode, Skip };
 /// TextureDecoding::Skip, encoded textures have no pixels: for summaries only).
 Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path, uint32_t version,
                   TextureDecoding textures = TextureDecoding::Decode) {
-  ByteReader r(bytes, path, kSectionNames[kScene]);
+  ByteReader r(bytes, path, std::string(kSectionNames[kScene]) + " section");
   Scene scene;
   scene.sourcePath = r.getString();
   scene.meshes.resize(r.getCount(kMinMeshBytes, "meshes"));
@@ -522,7 +461,7 @@ std::vector<unsigned char> encodeCharts(const std::vector<Chart>& charts) {
 std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std::string& path,
                                 const std::vector<Material>& sceneMaterials) {
   const size_t materials = sceneMaterials.size();
-  ByteReader r(bytes, path, kSectionNames[kCharts]);
+  ByteReader r(bytes, path, std::string(kSectionNames[kCharts]) + " section");
   std::vector<Chart> charts(r.getCount(kChartRecordBytes, "charts"));
   for (size_t i = 0; i < charts.size(); ++i) {
     Chart& c = charts[i];
@@ -598,7 +537,7 @@ std::vector<unsigned char> encodeTriangleCharts(const std::vector<std::vector<ui
 
 std::vector<std::vector<uint32_t>> decodeTriangleCharts(std::span<const unsigned char> bytes, const std::string& path,
                                                         const Scene& scene, const std::vector<Chart>& charts) {
-  ByteReader r(bytes, path, kSectionNames[kTriangleCharts]);
+  ByteReader r(bytes, path, std::string(kSectionNames[kTriangleCharts]) + " section");
   std::vector<std::vector<uint32_t>> triangleChart(r.getCount(8, "meshes"));
   if (triangleChart.size() != scene.meshes.size())
     r.corrupt(fmt::format("{} meshes, but the scene has {}", triangleChart.size(), scene.meshes.size()));

@@ -26,17 +26,17 @@
 #include <variant>
 #include <vector>
 
+#include "camera/camera_path.h"
 #include "core/cancel.h"
 #include "core/error.h"
 #include "env/env.h"
 #include "env/ibl.h"
 #include "image/compare.h"
+#include "image/frame_output.h"
 #include "image/image.h"
 #include "jobs/jobs.h"
 #include "plf/compression.h"
 #include "plf/plf_file.h"
-#include "realtime/camera_path.h"
-#include "realtime/walkthrough.h"
 #include "scene/scene.h"
 
 namespace py = pybind11;
@@ -422,7 +422,7 @@ class FileError(Error, OSError):
           [](const PyLightField& lf, const py::object& path, int width, int height, int samples,
              const py::object& camera, uint64_t seed, bool reference, int threads, bool textureLod) {
             // The frames' cameras: a list of Cameras as they are, or a camera path file's frames
-            // (realtime/camera_path.h: frame k at t0 + k/fps) posed on `camera` (its lens, and
+            // (camera/camera_path.h: frame k at t0 + k/fps) posed on `camera` (its lens, and
             // its fov where the path has none).
             std::vector<CameraDesc> cameras;
             const ViewSettings base = viewSettings(width, height, camera);

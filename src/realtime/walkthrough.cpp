@@ -11,29 +11,9 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "core/timing.h"
-#include "realtime/frame_output.h"
+#include "image/frame_output.h"
 
 namespace pl {
-
-Image exposedCopy(const Image& radiance, float exposureScale) {
-  Image exposed = radiance;
-  if (exposureScale != 1.0f)
-    for (Rgb& p : exposed.pixels) p *= exposureScale;
-  return exposed;
-}
-
-void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap) {
-  const bool hdr = isHdrExtension(path);
-  if (!hdr && fileExtensionLower(path) != ".png")
-    fail("{}: unknown output type '{}' (use .exr, .hdr, .pfm or .png)", path, fileExtensionLower(path));
-  if (hdr && exposureScale == 1.0f) {
-    writeHdrImage(path, radiance);  // radiance as it is: no exposed copy (half the memory)
-  } else if (hdr) {
-    writeHdrImage(path, exposedCopy(radiance, exposureScale));
-  } else {
-    writePng(path, pl::toneMap(exposedCopy(radiance, exposureScale), toneMap));
-  }
-}
 
 WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& baseCamera, const WalkthroughOptions& options,
                                     const std::function<void(const Camera&, Image&)>& renderFrame) {
@@ -44,7 +24,7 @@ WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& ba
   if (!video) {
     const std::string ext = fileExtensionLower(options.output);
     if (!isHdrExtension(options.output) && ext != ".png")
-      fail("-o {}: unknown image type '{}' (expected .exr, .hdr, .pfm or .png)", options.output, ext);
+      fail("-o {}: unknown image type '{}' (expected {})", options.output, ext, alternatives(kWrittenImageExtensions));
   }
   const std::filesystem::path parent = std::filesystem::path(options.output).parent_path();
   if (!parent.empty()) {
@@ -83,23 +63,6 @@ WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& ba
                                     const FastRenderer& renderer, const RenderSettings& settings) {
   return renderWalkthrough(path, baseCamera, options,
                            [&](const Camera& camera, Image& image) { renderer.render(camera, settings, image); });
-}
-
-CameraPath orbitPath(const CameraDesc& camera, double seconds, double fps, float degrees) {
-  if (!(seconds > 0.0) || !(fps > 0.0)) fail("orbit path: duration and fps must be positive");
-  const Vec3 up = glm::normalize(camera.up);
-  const Vec3 offset = camera.eye - camera.target;
-  CameraPath path;
-  path.fps = fps;
-  // Angles of the 5 keyframes: 0, +a, 0, −a, 0 (a smooth swing with Catmull–Rom).
-  const float angles[5] = {0.0f, degrees, 0.0f, -degrees, 0.0f};
-  for (int k = 0; k < 5; ++k) {
-    const float a = angles[k] * kPi / 180.0f;
-    // Rodrigues' rotation of the eye offset about the up axis through the target.
-    const Vec3 rotated = offset * std::cos(a) + glm::cross(up, offset) * std::sin(a) + up * glm::dot(up, offset) * (1.0f - std::cos(a));
-    path.keyframes.push_back(CameraKeyframe{seconds * double(k) / 4.0, camera.target + rotated, camera.target, up, camera.fovYDegrees});
-  }
-  return path;
 }
 
 }  // namespace pl

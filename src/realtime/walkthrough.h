@@ -2,16 +2,17 @@
 // Rendering a camera path to files: the loop behind `plenoptic render --path` and the
 // non-interactive `make demo`. Frame k shows the path's pose at t₀ + k/fps on the base camera
 // (which keeps its lens and, when the path has no fov, its fov); each frame is written as
-// `plenoptic render` writes a single image (writeFrame), or piped into an MP4 (frame_output.h).
+// `plenoptic render` writes a single image (image/frame_output.h writeFrame), or piped into an
+// MP4 (VideoWriter, the same file).
 #include <functional>
 #include <string>
 #include <vector>
 
+#include "camera/camera_path.h"
 #include "image/image.h"
 #include "image/tonemap.h"
-#include "realtime/camera_path.h"
-#include "realtime/realtime.h"
 #include "lightfield/render_settings.h"
+#include "realtime/realtime.h"
 
 namespace pl {
 
@@ -42,18 +43,5 @@ WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& ba
 /// The same with the fast renderer and `settings`.
 WalkthroughResult renderWalkthrough(const CameraPath& path, const CameraDesc& baseCamera, const WalkthroughOptions& options,
                                     const FastRenderer& renderer, const RenderSettings& settings);
-
-/// A path for demos: the eye swings around the camera's target by ±degrees about its up axis
-/// and back (5 keyframes over `seconds`), at the camera's own fov.
-CameraPath orbitPath(const CameraDesc& camera, double seconds = 4.0, double fps = CameraPath::kDefaultFps,
-                     float degrees = 25.0f);
-
-/// radiance × exposureScale (camera/exposure.h), the exposed image tone mapping starts from.
-Image exposedCopy(const Image& radiance, float exposureScale);
-
-/// Writes a frame of radiance, the one way every command writes an image (ViewSettings::
-/// writeImage in jobs/jobs.h calls this): .exr/.hdr/.pfm get radiance × exposureScale, .png
-/// additionally the tone mapping and sRGB encoding. Atomic.
-void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap);
 
 }  // namespace pl

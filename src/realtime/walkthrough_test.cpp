@@ -21,18 +21,6 @@ CameraDesc baseCamera() {
   return d;
 }
 
-TEST(Walkthrough, OrbitKeepsDistanceAndReturnsToTheStart) {
-  const CameraPath path = orbitPath(baseCamera(), 2.0, 10.0, 30.0f);
-  ASSERT_EQ(path.keyframes.size(), 5u);
-  EXPECT_EQ(path.frameCount(), 21);
-  // 1e-5: float rounding of the rotation (sin, cos and products) on coordinates of size 5.
-  for (const CameraKeyframe& k : path.keyframes) EXPECT_NEAR(glm::length(k.eye - k.target), 5.0f, 1e-5f);
-  // Keyframe 1 is rotated by +30° about +y: x = 5·sin 30° = 2.5 (right-handed, counter-clockwise from above).
-  EXPECT_NEAR(path.keyframes[1].eye.x, 2.5f, 1e-5f);
-  EXPECT_NEAR(glm::length(path.keyframes[4].eye - baseCamera().eye), 0.0f, 1e-5f);
-  EXPECT_THROW(orbitPath(baseCamera(), 0.0), Error);
-}
-
 /// Frames go into a fresh directory per test.
 class WalkthroughFiles : public test_support::TempDirTest {};
 

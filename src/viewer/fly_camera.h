@@ -6,8 +6,8 @@
 // to the left (counter-clockwise seen from above, about +up); pitch grows upwards and is
 // kept within ±kMaxPitchDegrees so the view never flips over the pole. The target stays at
 // the initial eye–target distance in front of the eye (a thin lens stays focused there).
+#include "camera/camera_path.h"
 #include "core/math.h"
-#include "realtime/camera_path.h"
 #include "scene/scene.h"
 
 namespace pl {
@@ -43,7 +43,7 @@ class FlyCamera {
   bool moved_ = false;
 };
 
-/// Records a flown camera into a camera path (realtime/camera_path.h): a keyframe at the start,
+/// Records a flown camera into a camera path (camera/camera_path.h): a keyframe at the start,
 /// then at most one every `interval` seconds, and one at the end; times are seconds since
 /// the start of the recording. The viewer toggles it with P (or R).
 class PathRecorder {

@@ -15,9 +15,9 @@
 #include "camera/camera.h"
 #include "core/error.h"
 #include "core/timing.h"
+#include "image/display.h"
+#include "image/frame_output.h"
 #include "image/image.h"
-#include "realtime/display.h"
-#include "realtime/frame_output.h"
 #include "realtime/realtime.h"
 #include "viewer/fly_camera.h"
 #include "viewer/hud_text.h"
@@ -118,92 +118,69 @@ bool displayAvailable() {
   return ok;
 }
 
-ViewerResult runViewer(const LightField& lightField, const Accel& accel, const ViewerOptions& options) {
+namespace {
+
+/// Refuses options the loop cannot honour, before the window opens.
+void checkViewerOptions(const ViewerOptions& options) {
   if (options.width < 1 || options.height < 1) fail("view: window size {}x{} is invalid", options.width, options.height);
   if (options.frames < 0) fail("view: --frames must be ≥ 0, got {}", options.frames);
   if (!options.screenshotPath.empty() && options.frames == 0 && !options.path)
     fail("view: --screenshot needs --frames N or --path (it is written after the last frame)");
   isFramePattern(options.screenshotPattern, "screenshot pattern");  // validates it
+}
 
+/// Scene units per second: the option, or a quarter of the scene's diagonal.
+float flySpeed(const Scene& scene, const ViewerOptions& options) {
+  if (options.speed > 0.0f) return options.speed;
   Vec3 lo, hi;
-  lightField.scene.bounds(lo, hi);
-  const float speed = options.speed > 0.0f ? options.speed : 0.25f * std::max(glm::length(hi - lo), 1e-6f);
-  FlyCamera fly(options.camera, speed);
-  const FastRenderer renderer(lightField, accel);
-  DisplayEncoder display;
-  Window window(options.title, options.width, options.height);
+  scene.bounds(lo, hi);
+  return 0.25f * std::max(glm::length(hi - lo), 1e-6f);
+}
 
-  float exposureEv = 0.0f;  // the +/− offset on top of options.exposureScale
-  ToneMapSettings toneMap = options.toneMap;
-  const int totalFrames = options.frames > 0 ? options.frames : options.path ? options.path->frameCount() : 0;
-  Image radiance;
-  std::vector<double> frameMs, renderMs;
-  std::vector<double> recentMs;
-  int screenshots = 0;
-  bool dragging = false, quit = false;
-  PathRecorder recorder(options.recordInterval);
-  const Clock::time_point sessionStart = Clock::now();
-  auto secondsAt = [&](Clock::time_point t) { return std::chrono::duration<double>(t - sessionStart).count(); };
-  std::string message;  // a transient HUD line (saved files)
-  Clock::time_point messageUntil;
-  auto stopRecording = [&](Clock::time_point now) {
-    const CameraPath path = recorder.stop(secondsAt(now), fly.desc());
-    saveCameraPath(options.recordPath, path);
-    message = fmt::format("saved {} keyframes to {}", path.keyframes.size(), options.recordPath);
-    fmt::print("{}\n", message);
-    messageUntil = Clock::now() + std::chrono::seconds(3);
-  };
+/// One viewer session: what the walk-through loop carries from frame to frame, and the steps
+/// of a frame — input, camera, render and display, HUD — in the order runViewer calls them.
+class ViewerSession {
+ public:
+  ViewerSession(const LightField& lightField, const Accel& accel, const ViewerOptions& options)
+      : options_(options),
+        speed_(flySpeed(lightField.scene, options)),
+        fly_(options.camera, speed_),
+        renderer_(lightField, accel),
+        window_(options.title, options.width, options.height),
+        toneMap_(options.toneMap),
+        recorder_(options.recordInterval),
+        start_(Clock::now()) {}
 
-  Clock::time_point previous = Clock::now();
-  for (int frame = 0; !quit && (totalFrames == 0 || frame < totalFrames); ++frame) {
-    const Clock::time_point frameStart = Clock::now();
-    const float dt = std::min(float(std::chrono::duration<double>(frameStart - previous).count()), 0.25f);
-    previous = frameStart;
+  bool quit() const { return quit_; }
 
+  /// SDL's queued events: quit, mouse look, exposure, tone mapping, screenshots, recording.
+  void handleEvents(Clock::time_point frameStart) {
     SDL_Event event;
     while (SDL_PollEvent(&event)) {
       switch (event.type) {
-        case SDL_QUIT: quit = true; break;
+        case SDL_QUIT: quit_ = true; break;
         case SDL_MOUSEBUTTONDOWN:
-          if (event.button.button == SDL_BUTTON_LEFT) dragging = true;
+          if (event.button.button == SDL_BUTTON_LEFT) dragging_ = true;
           break;
         case SDL_MOUSEBUTTONUP:
-          if (event.button.button == SDL_BUTTON_LEFT) dragging = false;
+          if (event.button.button == SDL_BUTTON_LEFT) dragging_ = false;
           break;
         case SDL_MOUSEMOTION:
-          if (dragging && !options.path)
-            fly.turn(-float(event.motion.xrel) * kRadiansPerPixel, -float(event.motion.yrel) * kRadiansPerPixel);
+          if (dragging_ && !options_.path)
+            fly_.turn(-float(event.motion.xrel) * kRadiansPerPixel, -float(event.motion.yrel) * kRadiansPerPixel);
           break;
-        case SDL_KEYDOWN: {
-          const SDL_Keycode key = event.key.keysym.sym;
-          if (key == SDLK_ESCAPE) quit = true;
-          if (key == SDLK_PLUS || key == SDLK_EQUALS || key == SDLK_KP_PLUS) exposureEv += kExposureStepEv;
-          if (key == SDLK_MINUS || key == SDLK_KP_MINUS) exposureEv -= kExposureStepEv;
-          if (key == SDLK_t) toneMap.op = nextOperator(toneMap.op);
-          if (key == SDLK_F12 && !radiance.empty()) {
-            const std::string path = formatFramePath(options.screenshotPattern, screenshots++);
-            writeFrame(path, radiance, options.exposureScale * std::exp2(exposureEv), toneMap);
-            message = "wrote " + path;
-            fmt::print("{}\n", message);
-            messageUntil = Clock::now() + std::chrono::seconds(3);
-          }
-          if ((key == SDLK_p || key == SDLK_r) && event.key.repeat == 0) {
-            if (recorder.recording()) {
-              stopRecording(frameStart);
-            } else {
-              recorder.start(secondsAt(frameStart), fly.desc());
-            }
-          }
-          break;
-        }
+        case SDL_KEYDOWN: handleKey(event.key, frameStart); break;
         default: break;
       }
     }
+  }
 
-    // Camera: the scripted path, or keys (held state) for movement.
-    if (options.path) {
-      const CameraPose pose = options.path->at(options.path->frameTime(frame));
-      fly = FlyCamera(applyPose(options.camera, pose), speed);
+  /// The camera of frame `frame`: the scripted path's pose, or the held movement keys over dt
+  /// seconds; the recorder (when recording) samples it.
+  void moveCamera(int frame, float dt, Clock::time_point frameStart) {
+    if (options_.path) {
+      const CameraPose pose = options_.path->at(options_.path->frameTime(frame));
+      fly_ = FlyCamera(applyPose(options_.camera, pose), speed_);
     } else {
       const Uint8* keys = SDL_GetKeyboardState(nullptr);
       const Vec3 direction(float(keys[SDL_SCANCODE_D]) - float(keys[SDL_SCANCODE_A]),
@@ -212,41 +189,108 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
       if (direction != Vec3(0.0f)) {
         const SDL_Keymod mod = SDL_GetModState();
         const float factor = (mod & KMOD_SHIFT) ? kFastFactor : (mod & KMOD_CTRL) ? kSlowFactor : 1.0f;
-        fly.move(direction, dt, factor);
+        fly_.move(direction, dt, factor);
       }
     }
-    recorder.sample(secondsAt(frameStart), fly.desc());
+    recorder_.sample(secondsAt(frameStart), fly_.desc());
+  }
 
+  /// Renders the frame at the window's size, encodes it into the window's texture with the
+  /// HUD on top, and presents it.
+  void renderAndPresent(Clock::time_point frameStart) {
     int width = 0, height = 0;
-    window.outputSize(width, height);
-    const Camera camera(fly.desc(), width, height, options.vignetting, options.metresPerUnit);
+    window_.outputSize(width, height);
+    const Camera camera(fly_.desc(), width, height, options_.vignetting, options_.metresPerUnit);
     const Clock::time_point renderStart = Clock::now();
-    renderer.render(camera, options.render, radiance);
-    renderMs.push_back(std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
+    renderer_.render(camera, options_.render, radiance_);
+    renderMs_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
 
-    SDL_Texture* texture = window.texture(width, height);
+    SDL_Texture* texture = window_.texture(width, height);
     void* locked = nullptr;
     int pitch = 0;
     if (SDL_LockTexture(texture, nullptr, &locked, &pitch) != 0) fail("view: cannot lock the texture: {}", SDL_GetError());
     uint32_t* pixels = static_cast<uint32_t*>(locked);
-    const float exposureScale = options.exposureScale * std::exp2(exposureEv);
-    display.encode(radiance, exposureScale, toneMap, pixels, pitch);
+    display_.encode(radiance_, exposureScale(), toneMap_, pixels, pitch);
+    drawHud(pixels, pitch, width, height, frameStart);
+    SDL_UnlockTexture(texture);
+    window_.present();
+  }
 
-    // HUD: fps over the last frames, frame time, camera, exposure, tone mapping.
-    const double meanMs = recentMs.empty() ? 0.0 : [&] {
+  /// Counts the frame's time (the HUD's fps averages the last kTimingWindow frames).
+  void endFrame(Clock::time_point frameStart) {
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
+    frameMs_.push_back(ms);
+    recentMs_.push_back(ms);
+    if (recentMs_.size() > kTimingWindow) recentMs_.erase(recentMs_.begin());
+  }
+
+  /// Saves a recording still running and the requested screenshot; the session's timings.
+  ViewerResult finish() {
+    if (recorder_.recording()) stopRecording(Clock::now());
+    if (!options_.screenshotPath.empty() && !radiance_.empty())
+      writeFrame(options_.screenshotPath, radiance_, exposureScale(), toneMap_);
+    ViewerResult result;
+    result.frames = int(frameMs_.size());
+    result.msPerFrameMedian = median(frameMs_);
+    result.renderMsMedian = median(renderMs_);
+    return result;
+  }
+
+ private:
+  double secondsAt(Clock::time_point t) const { return std::chrono::duration<double>(t - start_).count(); }
+  /// The starting exposure with the +/− offset.
+  float exposureScale() const { return options_.exposureScale * std::exp2(exposureEv_); }
+
+  void handleKey(const SDL_KeyboardEvent& key, Clock::time_point frameStart) {
+    const SDL_Keycode code = key.keysym.sym;
+    if (code == SDLK_ESCAPE) quit_ = true;
+    if (code == SDLK_PLUS || code == SDLK_EQUALS || code == SDLK_KP_PLUS) exposureEv_ += kExposureStepEv;
+    if (code == SDLK_MINUS || code == SDLK_KP_MINUS) exposureEv_ -= kExposureStepEv;
+    if (code == SDLK_t) toneMap_.op = nextOperator(toneMap_.op);
+    if (code == SDLK_F12 && !radiance_.empty()) {
+      const std::string path = formatFramePath(options_.screenshotPattern, screenshots_++);
+      writeFrame(path, radiance_, exposureScale(), toneMap_);
+      showMessage("wrote " + path);
+    }
+    if ((code == SDLK_p || code == SDLK_r) && key.repeat == 0) {
+      if (recorder_.recording()) {
+        stopRecording(frameStart);
+      } else {
+        recorder_.start(secondsAt(frameStart), fly_.desc());
+      }
+    }
+  }
+
+  void stopRecording(Clock::time_point now) {
+    const CameraPath path = recorder_.stop(secondsAt(now), fly_.desc());
+    saveCameraPath(options_.recordPath, path);
+    showMessage(fmt::format("saved {} keyframes to {}", path.keyframes.size(), options_.recordPath));
+  }
+
+  /// Prints `text` and shows it on the HUD for 3 seconds.
+  void showMessage(std::string text) {
+    message_ = std::move(text);
+    fmt::print("{}\n", message_);
+    messageUntil_ = Clock::now() + std::chrono::seconds(3);
+  }
+
+  /// The HUD: fps over the last frames, frame time, camera, exposure, tone mapping and the
+  /// transient message, on a darkened box at the top left.
+  void drawHud(uint32_t* pixels, int pitch, int width, int height, Clock::time_point frameStart) const {
+    const double meanMs = recentMs_.empty() ? 0.0 : [&] {
       double sum = 0.0;
-      for (double ms : recentMs) sum += ms;
-      return sum / double(recentMs.size());
+      for (double ms : recentMs_) sum += ms;
+      return sum / double(recentMs_.size());
     }();
-    const Vec3 eye = fly.eye();
+    const Vec3 eye = fly_.eye();
     std::vector<std::string> lines = {
         fmt::format("{:.1f} FPS  {:.2f} MS/FRAME  (RENDER {:.2f} MS)  {}X{}", meanMs > 0 ? 1e3 / meanMs : 0.0, meanMs,
-                    renderMs.back(), width, height),
+                    renderMs_.back(), width, height),
         fmt::format("EYE {:.3g} {:.3g} {:.3g}", eye.x, eye.y, eye.z),
-        fmt::format("EXPOSURE {:+.1f} EV  TONEMAP {}{}", exposureEv, toneMapOperatorName(toneMap.op),
-                    recorder.recording() ? "  [REC]" : ""),
+        fmt::format("EXPOSURE {:+.1f} EV  TONEMAP {}{}", exposureEv_, toneMapOperatorName(toneMap_.op),
+                    recorder_.recording() ? "  [REC]" : ""),
     };
-    if (!message.empty() && frameStart < messageUntil) lines.push_back(message);
+    if (!message_.empty() && frameStart < messageUntil_) lines.push_back(message_);
     int hudWidth = 0;
     for (const std::string& line : lines) hudWidth = std::max(hudWidth, hudTextWidth(line, kHudScale));
     const int hudHeight = int(lines.size()) * kLineAdvance * kHudScale + 6;
@@ -254,23 +298,43 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
     for (size_t i = 0; i < lines.size(); ++i)
       drawHudText(pixels, pitch, width, height, 6, 4 + int(i) * kLineAdvance * kHudScale, lines[i], kHudScale,
                   0xFFFFFFFFu);
-    SDL_UnlockTexture(texture);
-    window.present();
-
-    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
-    frameMs.push_back(ms);
-    recentMs.push_back(ms);
-    if (recentMs.size() > kTimingWindow) recentMs.erase(recentMs.begin());
   }
-  if (recorder.recording()) stopRecording(Clock::now());
-  if (!options.screenshotPath.empty() && !radiance.empty())
-    writeFrame(options.screenshotPath, radiance, options.exposureScale * std::exp2(exposureEv), toneMap);
 
-  ViewerResult result;
-  result.frames = int(frameMs.size());
-  result.msPerFrameMedian = median(frameMs);
-  result.renderMsMedian = median(renderMs);
-  return result;
+  const ViewerOptions& options_;
+  const float speed_;
+  FlyCamera fly_;
+  const FastRenderer renderer_;
+  DisplayEncoder display_;
+  Window window_;
+  float exposureEv_ = 0.0f;  ///< the +/− offset on top of options.exposureScale
+  ToneMapSettings toneMap_;
+  Image radiance_;  ///< the last frame
+  std::vector<double> frameMs_, renderMs_, recentMs_;
+  int screenshots_ = 0;
+  bool dragging_ = false, quit_ = false;
+  PathRecorder recorder_;
+  const Clock::time_point start_;
+  std::string message_;  ///< a transient HUD line (saved files)
+  Clock::time_point messageUntil_;
+};
+
+}  // namespace
+
+ViewerResult runViewer(const LightField& lightField, const Accel& accel, const ViewerOptions& options) {
+  checkViewerOptions(options);
+  ViewerSession session(lightField, accel, options);
+  const int totalFrames = options.frames > 0 ? options.frames : options.path ? options.path->frameCount() : 0;
+  Clock::time_point previous = Clock::now();
+  for (int frame = 0; !session.quit() && (totalFrames == 0 || frame < totalFrames); ++frame) {
+    const Clock::time_point frameStart = Clock::now();
+    const float dt = std::min(float(std::chrono::duration<double>(frameStart - previous).count()), 0.25f);
+    previous = frameStart;
+    session.handleEvents(frameStart);
+    session.moveCamera(frame, dt, frameStart);
+    session.renderAndPresent(frameStart);
+    session.endFrame(frameStart);
+  }
+  return session.finish();
 }
 
 std::vector<std::string> runDemoWalkthrough(const LightField& lightField, const Accel& accel, const CameraDesc& camera,

@@ -22,11 +22,11 @@
 #include <string>
 #include <vector>
 
+#include "camera/camera_path.h"
 #include "camera/exposure.h"
 #include "image/tonemap.h"
 #include "lightfield/lightfield.h"
 #include "lightfield/render_settings.h"
-#include "realtime/camera_path.h"
 #include "realtime/walkthrough.h"
 
 namespace pl {

@@ -11,14 +11,14 @@
 #include <sstream>
 #include <string>
 
-#include "core/rng.h"
-#include "image/image.h"
-#include "bake/parameterisation.h"
 #include "accel/accel.h"
+#include "bake/parameterisation.h"
 #include "core/parallel.h"
 #include "core/progress.h"
+#include "core/rng.h"
+#include "image/frame_output.h"
+#include "image/image.h"
 #include "plf/plf_file.h"
-#include "realtime/frame_output.h"
 #include "support/cli_test_support.h"
 #include "viewer/viewer.h"
 

@@ -1,5 +1,5 @@
 // The per-frame display encoder against the exact file path (toneMap + encodeSrgb8).
-#include "realtime/display.h"
+#include "image/display.h"
 
 #include <gtest/gtest.h>
 

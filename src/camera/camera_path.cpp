@@ -1,5 +1,5 @@
 // Camera paths (see camera_path.h).
-#include "realtime/camera_path.h"
+#include "camera/camera_path.h"
 
 #include <nlohmann/json.hpp>
 
@@ -226,6 +226,23 @@ CameraDesc applyPose(CameraDesc base, const CameraPose& pose) {
     base.focalLengthMm = 0.0f;  // a new fov implies the focal length that gives it
   }
   return base;
+}
+
+CameraPath orbitPath(const CameraDesc& camera, double seconds, double fps, float degrees) {
+  if (!(seconds > 0.0) || !(fps > 0.0)) fail("orbit path: duration and fps must be positive");
+  const Vec3 up = glm::normalize(camera.up);
+  const Vec3 offset = camera.eye - camera.target;
+  CameraPath path;
+  path.fps = fps;
+  // Angles of the 5 keyframes: 0, +a, 0, −a, 0 (a smooth swing with Catmull–Rom).
+  const float angles[5] = {0.0f, degrees, 0.0f, -degrees, 0.0f};
+  for (int k = 0; k < 5; ++k) {
+    const float a = angles[k] * kPi / 180.0f;
+    // Rodrigues' rotation of the eye offset about the up axis through the target.
+    const Vec3 rotated = offset * std::cos(a) + glm::cross(up, offset) * std::sin(a) + up * glm::dot(up, offset) * (1.0f - std::cos(a));
+    path.keyframes.push_back(CameraKeyframe{seconds * double(k) / 4.0, camera.target + rotated, camera.target, up, camera.fovYDegrees});
+  }
+  return path;
 }
 
 }  // namespace pl

@@ -1,6 +1,7 @@
 #pragma once
-// Where the frames of a walk-through go: an image sequence named by a printf-style frame
-// pattern ("frames/%04d.png"), or an MP4 video encoded by the ffmpeg program.
+// Picture output: how a frame of radiance becomes a file — the exposed copy, one image
+// (writeFrame: the one way every command writes an image), an image sequence named by a
+// printf-style frame pattern ("frames/%04d.png"), or an MP4 video encoded by the ffmpeg program.
 //
 // Frame patterns contain exactly one conversion %d or %0Nd (N = 1…9): frame k of the path
 // replaces it by k (0-based). "%%" stands for a literal '%'.
@@ -15,8 +16,17 @@
 
 #include "core/file_io.h"
 #include "image/image.h"
+#include "image/tonemap.h"
 
 namespace pl {
+
+/// radiance × exposureScale (camera/exposure.h), the exposed image tone mapping starts from.
+Image exposedCopy(const Image& radiance, float exposureScale);
+
+/// Writes a frame of radiance, the one way every command writes an image (ViewSettings::
+/// writeImage in jobs/jobs.h calls this): .exr/.hdr/.pfm get radiance × exposureScale, .png
+/// additionally the tone mapping and sRGB encoding. Atomic.
+void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap);
 
 /// True when `pattern` contains a frame conversion (%d or %0Nd). Throws pl::Error naming
 /// the option for malformed patterns (two conversions, "%x", width out of range).

@@ -1,5 +1,5 @@
 // Frame patterns and MP4 output.
-#include "realtime/frame_output.h"
+#include "image/frame_output.h"
 
 #include <gtest/gtest.h>
 

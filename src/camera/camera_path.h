@@ -78,4 +78,9 @@ void saveCameraPath(const std::string& path, const CameraPath& cameraPath);
 /// `base` with the pose's eye, target, up and (if set) fov; the lens settings stay.
 CameraDesc applyPose(CameraDesc base, const CameraPose& pose);
 
+/// A path for demos: the eye swings around the camera's target by ±degrees about its up axis
+/// and back (5 keyframes over `seconds`), at the camera's own fov.
+CameraPath orbitPath(const CameraDesc& camera, double seconds = 4.0, double fps = CameraPath::kDefaultFps,
+                     float degrees = 25.0f);
+
 }  // namespace pl

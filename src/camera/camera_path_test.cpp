@@ -1,6 +1,6 @@
 // Camera paths: parsing, errors that name the file and the problem, interpolation
 // properties (through the keyframes, smooth, straight lines stay straight), round trip.
-#include "realtime/camera_path.h"
+#include "camera/camera_path.h"
 
 #include <gtest/gtest.h>
 
@@ -152,6 +152,20 @@ TEST(CameraPath, StandingStillStaysStill) {
       {"time": 2, "eye": [5, 0, 0], "target": [5, 0, -1]}]})",
                                           "still");
   for (double t = 0.0; t <= 1.0; t += 0.1) EXPECT_EQ(path.at(t).eye, Vec3(0.0f));
+}
+
+TEST(CameraPath, OrbitKeepsDistanceAndReturnsToTheStart) {
+  CameraDesc camera;  // looking at the origin from (0, 0, 5)
+  camera.eye = {0, 0, 5};
+  const CameraPath path = orbitPath(camera, 2.0, 10.0, 30.0f);
+  ASSERT_EQ(path.keyframes.size(), 5u);
+  EXPECT_EQ(path.frameCount(), 21);
+  // 1e-5: float rounding of the rotation (sin, cos and products) on coordinates of size 5.
+  for (const CameraKeyframe& k : path.keyframes) EXPECT_NEAR(glm::length(k.eye - k.target), 5.0f, 1e-5f);
+  // Keyframe 1 is rotated by +30° about +y: x = 5·sin 30° = 2.5 (right-handed, counter-clockwise from above).
+  EXPECT_NEAR(path.keyframes[1].eye.x, 2.5f, 1e-5f);
+  EXPECT_NEAR(glm::length(path.keyframes[4].eye - camera.eye), 0.0f, 1e-5f);
+  EXPECT_THROW(orbitPath(camera, 0.0), Error);
 }
 
 /// Path files go into a fresh directory per test.

@@ -1,5 +1,5 @@
 // Image sequences and MP4 output (see frame_output.h).
-#include "realtime/frame_output.h"
+#include "image/frame_output.h"
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -8,6 +8,7 @@
 #include <cstdlib>
 
 #include "core/error.h"
+#include "image/tonemap.h"
 
 namespace pl {
 namespace {
@@ -46,6 +47,26 @@ Conversion findConversion(const std::string& pattern, const std::string& option)
 }
 
 }  // namespace
+
+Image exposedCopy(const Image& radiance, float exposureScale) {
+  Image exposed = radiance;
+  if (exposureScale != 1.0f)
+    for (Rgb& p : exposed.pixels) p *= exposureScale;
+  return exposed;
+}
+
+void writeFrame(const std::string& path, const Image& radiance, float exposureScale, const ToneMapSettings& toneMap) {
+  const bool hdr = isHdrExtension(path);
+  if (!hdr && fileExtensionLower(path) != ".png")
+    fail("{}: unknown output type '{}' (use {})", path, fileExtensionLower(path), alternatives(kWrittenImageExtensions));
+  if (hdr && exposureScale == 1.0f) {
+    writeHdrImage(path, radiance);  // radiance as it is: no exposed copy (half the memory)
+  } else if (hdr) {
+    writeHdrImage(path, exposedCopy(radiance, exposureScale));
+  } else {
+    writePng(path, pl::toneMap(exposedCopy(radiance, exposureScale), toneMap));
+  }
+}
 
 bool isFramePattern(const std::string& pattern, const std::string& option) {
   return findConversion(pattern, option).begin != std::string::npos;

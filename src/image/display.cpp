@@ -1,5 +1,5 @@
 // Per-frame display encoding (see display.h).
-#include "realtime/display.h"
+#include "image/display.h"
 
 #include <algorithm>
 #include <cmath>
