@@ -37,10 +37,6 @@ struct Fnv1a {
   }
 };
 
-}  // namespace
-
-namespace {
-
 /// Beer–Lambert attenuation exp(−σa t) of a gather segment of length t that ends on chart
 /// record c: a segment arriving at the back record of rough glass ran through the solid's
 /// inside (the front of a closed mesh is its outside), as followSpecular attenuates one

@@ -14,7 +14,9 @@
 // Writes are atomic: a temporary file beside the target is renamed over it on success, so a
 // failed write never leaves a half-written file.
 //
-// Tone mapping (Image → Image8) is in image/tonemap.h, error metrics in image/compare.h.
+// Tone mapping (Image → Image8) is in image/tonemap.h, error metrics in image/compare.h, and
+// picture output (a rendered frame to a file, image sequences, MP4 video, the per-frame display
+// encoding) in image/frame_output.h and image/display.h.
 #include "core/file_io.h"  // fileExtensionLower
 #include "core/math.h"
 
