@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "app/commands.h"
+#include "bake/bake.h"
 #include "core/error.h"
 #include "core/progress.h"
 #include "distributed/communicator.h"
@@ -95,7 +96,7 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("scene", options->scene, "cornell, or a scene file (.obj, .gltf, .glb, .json)")->required();
   command->add_option("-o,--output", options->output, "Output light field (.plf)")->required();
   command->add_option("--preset", options->preset, "Quality preset")
-      ->check(CLI::IsMember({"draft", "default", "high"}))
+      ->check(CLI::IsMember(bakePresetNames()))
       ->capture_default_str();
   command->add_flag("--reuse-visibility", options->reuseVisibility,
                     "Reuse the saved visibility field if geometry, parameterisation and settings are unchanged "

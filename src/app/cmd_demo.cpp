@@ -17,6 +17,7 @@
 
 #include "accel/accel.h"
 #include "app/commands.h"
+#include "bake/bake.h"
 #include "app/view_options.h"
 #include "core/error.h"
 #include "image/compare.h"
@@ -178,7 +179,7 @@ void addDemoCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(1, 1 << 20))
       ->capture_default_str();
   command->add_option("--preset", options->preset, "Bake preset (as bake --preset)")
-      ->check(CLI::IsMember({"draft", "default", "high"}))  // checked before the reference is traced
+      ->check(CLI::IsMember(bakePresetNames()))  // checked before the reference is traced
       ->capture_default_str();
   command->add_flag("!--no-walkthrough", options->walkthrough, "Skip the viewer / rendered walk-through");
   command->callback([options, &global] { runDemo(*options, global); });
