@@ -15,6 +15,7 @@
 #include "core/timing.h"
 #include "env/env.h"
 #include "env/ibl.h"
+#include "image/image.h"
 
 namespace pl {
 namespace {
@@ -94,7 +95,7 @@ void checkEnvOutput(const std::string& path, EnvLayout layout) {
     if (!isHdrExtension(path)) failUsage("-o {}: expected an .exr, .hdr or .pfm file name", path);
     return;
   }
-  checkOutputPath(path, {".exr", ".hdr", ".pfm"}, "-o");
+  checkOutputPath(path, kHdrImageExtensions, "-o");
 }
 
 void runConvert(const ConvertOptions& o, const GlobalOptions& global) {
