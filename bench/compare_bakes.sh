@@ -10,7 +10,8 @@ trap 'rm -rf "$D"' EXIT
 "$NEW" bake "$SCENE" -o "$D/new.plf" --preset "$PRESET" --seed 5 --quiet >/dev/null
 "$OLD" bake "$SCENE" -o "$D/old.plf" --preset "$PRESET" --seed 5 --quiet >/dev/null
 sums() {
-  "$OLD" info "$1" --json | python3 -c \
+  # The new build reads both files (it also reads the older build's format version).
+  "$NEW" info "$1" --json | python3 -c \
     "import json,sys; print([(s['id'], s['checksum_xxh64']) for s in json.load(sys.stdin)['sections'] if s['id'] != 'META'])"
 }
 a=$(sums "$D/new.plf"); b=$(sums "$D/old.plf")
