@@ -35,6 +35,7 @@
 #include "image/frame_output.h"
 #include "image/image.h"
 #include "jobs/jobs.h"
+#include "plenoptic_version.h"  // generated at build time (cmake/version.cmake)
 #include "plf/compression.h"
 #include "plf/plf_file.h"
 #include "scene/scene.h"
@@ -241,6 +242,9 @@ PYBIND11_MODULE(plenoptic, m) {
   m.doc() =
       "plenoptic: physically based global illumination precomputed as a light field.\n"
       "Images are float32 arrays (height, width, 3) of linear Rec.709 radiance in W/(sr m^2).";
+  // The version `plenoptic --version` prints: the project version, and the git revision built.
+  m.attr("__version__") = PLENOPTIC_VERSION;
+  m.attr("build") = PLENOPTIC_VERSION_STRING;
 
   // Errors: plenoptic.Error for every failure (the CLI's message, without 'plenoptic: error: '),
   // plenoptic.UsageError (also a ValueError) for a wrong request — what the CLI exits 2 for —

@@ -28,6 +28,17 @@ def test_scene_is_readable(cornell):
     assert cornell.emission("light") == pytest.approx([18.387, 13.9873, 6.75357], rel=1e-4)
 
 
+def test_version_is_the_programs():
+    # __version__ is the project version (PEP 440 "X.Y.Z"); build adds the git revision, as
+    # `plenoptic --version` prints it.
+    parts = plenoptic.__version__.split(".")
+    assert len(parts) == 3 and all(p.isdigit() for p in parts)
+    assert plenoptic.build.startswith(plenoptic.__version__)
+    if BINARY:
+        printed = subprocess.run([BINARY, "--version"], capture_output=True, text=True, check=True).stdout.strip()
+        assert printed == "plenoptic " + plenoptic.build
+
+
 def test_trace_returns_float32_radiance_and_the_stats_of_the_cli(cornell):
     image, stats = plenoptic.trace(cornell, width=24, height=16, spp=4, seed=1, threads=2)
     assert image.shape == (16, 24, 3) and image.dtype == np.float32
