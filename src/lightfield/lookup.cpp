@@ -174,7 +174,7 @@ PunctualHighlights::PunctualHighlights(const LightField& lf, const Accel& accel)
   for (const Material& m : lf.scene.materials) withoutDiffuse_.push_back(withDiffuseAlbedo(m.bsdf, Rgb(0.0f)));
 }
 
-Rgb PunctualHighlights::radiance(uint32_t chart, const RayHit& hit, const Vec3& towardsViewer, uint64_t& shadowRays) const {
+Rgb PunctualHighlights::radiance(uint32_t chart, const RayHit& hit, const Vec3& towardsViewer) const {
   const Chart& c = lf_.charts[chart];
   if (lights_.empty() || c.kind != ChartKind::Glossy) return Rgb(0.0f);
   const Scene& scene = lf_.scene;
@@ -187,6 +187,7 @@ Rgb PunctualHighlights::radiance(uint32_t chart, const RayHit& hit, const Vec3& 
   const auto& [geometricNormal, frame, woLocal] = scattering;
   if (!usableSide(towardsViewer, woLocal, geometricNormal, bsdf)) return Rgb(0.0f);
   Rgb sum(0.0f);
+  uint64_t shadowRays = 0;  // ShadowRays counts them; no renderer reports them
   for (const PunctualLight& light : lights_) {
     Vec3 wi;
     float distance;

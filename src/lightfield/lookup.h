@@ -543,8 +543,7 @@ class PunctualHighlights {
   bool active() const { return !lights_.empty(); }
   /// The highlights on chart record `chart` (the record the viewer sees: viewedChart) at ray
   /// hit `hit`, towards the unit direction `towardsViewer`; 0 on other kinds and rough glass.
-  /// `shadowRays` is increased by the rays traced.
-  Rgb radiance(uint32_t chart, const RayHit& hit, const Vec3& towardsViewer, uint64_t& shadowRays) const;
+  Rgb radiance(uint32_t chart, const RayHit& hit, const Vec3& towardsViewer) const;
 
  private:
   const LightField& lf_;

@@ -34,7 +34,6 @@ struct FastRenderer::Scratch {
   std::vector<Rgb> mirrorThroughput, nextThroughput;
   std::vector<float> mirrorDistance, nextDistance;  ///< length of the chain so far (scene units; ray cones)
   std::vector<uint32_t> reflectedSamples;  ///< camera samples that hit a mirror (one sample per pixel)
-  uint64_t shadowRays = 0;  ///< the punctual highlights' shadow rays (PunctualHighlights)
 };
 
 /// A one-sample pixel: weight × radiance, or 0 for a sample of zero weight (as the reference).
@@ -288,7 +287,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         F4 lanes = exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup,
                                         lookupNormal, uv, lod);
         if (c.kind == ChartKind::Glossy && highlights_.active())  // lightfield.h "Punctual highlights"
-          lanes = f4Add(lanes, f4FromRgb(highlights_.radiance(chart, hit, -ray.direction, s.shadowRays)));
+          lanes = f4Add(lanes, f4FromRgb(highlights_.radiance(chart, hit, -ray.direction)));
         if (spp == 1) {
           // The pixel, straight from the lanes (weight > 0 here): pixelValue's weight × radiance.
           f4StoreRgb(out + s.pixel[i], f4Mul(f4Splat(s.weight[i]), lanes));
@@ -345,7 +344,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         s.radiance[slot] += throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction,
                                                          lookup, lookupNormal, uv, lod);
         if (c.kind == ChartKind::Glossy && highlights_.active())
-          s.radiance[slot] += throughput * highlights_.radiance(chart, hit, -ray.direction, s.shadowRays);
+          s.radiance[slot] += throughput * highlights_.radiance(chart, hit, -ray.direction);
         continue;
       }
       Rgb emitted;

@@ -65,7 +65,10 @@ TEST_F(PunctualHighlightTest, PointLightHighlightsOnGlossyWallsMatchThePathTrace
   EXPECT_LT(with.relMseAverage, 0.05);
   EXPECT_LT(with.relMseAverage, without.relMseAverage / 3.0);
 
-  // The fast renderer adds the same highlights (one and four samples per pixel).
+  // The fast renderer adds the same highlights (one and four samples per pixel): the same
+  // functions on the same hits, so only the hit point's rounding differs (measured: relMSE
+  // 3.8e-13 and 1.2e-13, mean ratio 1 to 7 digits); a missing or doubled highlight would be
+  // above 1e-2. Bounds: relMSE 1e-6, ratio 1e-4.
   const Accel accel(lf.scene);
   const FastRenderer fast(lf, accel);
   for (int spp : {1, 4}) {
@@ -73,6 +76,8 @@ TEST_F(PunctualHighlightTest, PointLightHighlightsOnGlossyWallsMatchThePathTrace
     render.samplesPerPixel = spp;
     render.showProgress = false;
     const ImageComparison same = compareImages(fast.render(camera, render), renderLightField(lf, accel, camera, render));
+    std::printf("fast vs reference renderer, %d spp: relMSE %.3g, mean ratio %.7f\n", spp, same.relMseAverage,
+                same.meanLuminanceRatio);
     EXPECT_LT(same.relMseAverage, 1e-6) << spp;
     EXPECT_NEAR(same.meanLuminanceRatio, 1.0, 1e-4) << spp;
   }

@@ -41,8 +41,7 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, const PunctualHigh
         // The punctual lights' highlights the maps leave out (lightfield.h "Punctual highlights").
         const uint32_t viewed = viewedChart(lf.charts.data(), lf.triangleChart[hit.mesh][hit.triangle], -ray.direction,
                                             scene.meshes[hit.mesh], hit.triangle);
-        uint64_t shadowRays = 0;
-        if (viewed != kNoChartRecord) seen += highlights.radiance(viewed, hit, -ray.direction, shadowRays);
+        if (viewed != kNoChartRecord) seen += highlights.radiance(viewed, hit, -ray.direction);
       }
       return result + throughput * seen;
     }
