@@ -76,8 +76,6 @@ nlohmann::json toJson(const PlfInfo& info) {
                         {"stored_bytes", s.storedSize},
                         {"decoded_bytes", s.decodedSize},
                         {"checksum_xxh64", fmt::format("{:016x}", s.checksum)}});
-  const BakeSettings& bs = info.settings;
-  const BakeStats& st = info.stats;
   const ValuesStorage storage = valuesStorage(info);
   return {{"file", info.path},
           {"format_version", info.version},
@@ -117,31 +115,8 @@ nlohmann::json toJson(const PlfInfo& info) {
             {"values_stored_bytes", storage.storedBytes},
             {"values_decoded_bytes", storage.decodedBytes},
             {"ratio", storage.ratio}}},
-          {"settings",
-           {{"preset", bs.preset},
-            {"tixels_per_unit", bs.tixelsPerUnit},
-            {"tixels_across_scene", bs.tixelsAcrossScene},
-            {"max_tixels_per_chart_side", bs.maxTixelsPerChartSide},
-            {"gather_directions", bs.gatherDirections},
-            {"glossy_dir_res", bs.glossyDirRes},
-            {"tolerance", bs.tolerance},
-            {"max_iterations", bs.maxIterations},
-            {"mirror_depth", bs.mirrorDepth},
-            {"area_light_samples", bs.areaLightSamples},
-            {"seed", bs.seed},
-            {"sun_masks", bs.sunMasks},
-            {"punctual_highlights", bs.punctualHighlights}}},
-          {"stats",
-           {{"seconds", st.seconds},
-            {"visibility_seconds", st.visibilitySeconds},
-            {"propagation_seconds", st.propagationSeconds},
-            {"iterations", st.iterations},
-            {"residual", st.residual},
-            {"tixels", st.tixels},
-            {"values", st.values},
-            {"visibility_rays", st.visibilityRays},
-            {"peak_rss_bytes", st.peakRssBytes},
-            {"reused_visibility", st.reusedVisibility}}}};
+          {"settings", toJson(info.settings)},
+          {"stats", toJson(info.stats)}};
 }
 
 void printHuman(const PlfInfo& info) {

@@ -20,33 +20,26 @@
 namespace pl {
 
 std::string BakeJobStats::toJson() const {
-  nlohmann::json json;
+  // The bake's own statistics under the keys of the .plf's META (lightfield.h toJson), but
+  // `seconds` is the whole job's here and the bake's is `bake_seconds`.
+  nlohmann::json json = pl::toJson(bake);
+  json["bake_seconds"] = bake.seconds;
+  json["seconds"] = seconds;
   json["command"] = "bake";
   json["scene"] = scene;
   json["output"] = output;
   json["preset"] = preset;
   json["threads"] = threads;
-  json["seconds"] = seconds;
   json["load_seconds"] = loadSeconds;
-  json["bake_seconds"] = bake.seconds;
-  json["visibility_seconds"] = bake.visibilitySeconds;
-  json["propagation_seconds"] = bake.propagationSeconds;
-  json["iterations"] = bake.iterations;
-  json["residual"] = bake.residual;
-  json["tixels"] = bake.tixels;
-  json["values"] = bake.values;
   json["charts"] = charts;  // chart records: a two-sided chart counts twice (front and back)
   json["two_sided_charts"] = twoSidedCharts;
   json["back_side_tixels"] = backSideTixels;
   json["sun_mask_lights"] = sunMaskLights;
   json["curved_charts"] = curvedCharts;  // chart records (a two-sided curved chart counts twice)
   json["curved_tixels"] = curvedTixels;
-  json["visibility_rays"] = bake.visibilityRays;
   json["visibility_rays_per_second"] =
       bake.visibilitySeconds > 0 ? double(bake.visibilityRays) / bake.visibilitySeconds : 0.0;
-  json["reused_visibility"] = bake.reusedVisibility;
   json["visibility_file"] = visibilityFile;
-  json["peak_rss_bytes"] = bake.peakRssBytes;
   json["file_bytes"] = fileBytes;
   json["compression"] = compression;
   // Distributed bake (docs/user-guide.md, bake --stats): per-rank figures in rank order; the

@@ -92,6 +92,8 @@
 #include "core/math.h"
 #include "scene/scene.h"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -132,7 +134,7 @@ struct Chart {
   uint64_t diffuseValueIndex(uint32_t i, uint32_t j) const { return valueIndex(i, j) + directionTexels(); }
 };
 
-/// Quality preset parameters (see presets in bake.cpp and docs/user-guide.md). The member defaults are
+/// Quality preset parameters (kBakePresets in bake/bake.h, docs/user-guide.md). The member defaults are
 /// those of the "default" preset, so a default-constructed BakeSettings equals
 /// bakePreset("default") (a test checks it).
 struct BakeSettings {
@@ -165,6 +167,18 @@ struct BakeStats {
   uint64_t peakRssBytes = 0;
   bool reusedVisibility = false;
 };
+
+// The one JSON schema of the bake's settings and statistics (lightfield.cpp): the .plf's META
+// section, `plenoptic info --json` ("settings", "stats") and `bake --stats` (the statistics'
+// keys, docs/user-guide.md) all write these, and the .plf reader reads them back.
+nlohmann::json toJson(const BakeSettings& settings);
+nlohmann::json toJson(const BakeStats& stats);
+/// The fields `json` holds; a key it lacks leaves its field as it is (a newer writer may add
+/// keys, which are ignored), except sun_masks and punctual_highlights, whose absence means a
+/// writer from before them, which baked without them (false). Throws nlohmann::json::exception
+/// for a value of the wrong type.
+void fromJson(const nlohmann::json& json, BakeSettings& settings);
+void fromJson(const nlohmann::json& json, BakeStats& stats);
 
 /// Sun masks (see the header comment): at most this many directional lights are masked, with
 /// kSunMaskSide² sub-samples per tixel.

@@ -368,10 +368,6 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
       m.alphaCutoff = r.get<float>();
       m.normalTexture = r.get<int32_t>();
       m.normalScale = r.get<float>();
-      if (!(m.alphaFactor >= 0.0f && m.alphaFactor <= 1.0f && m.alphaCutoff >= 0.0f && m.alphaCutoff <= 1.0f) ||
-          !std::isfinite(m.normalScale))
-        r.corrupt(fmt::format("material '{}' has alpha {}, cutoff {}, normal scale {}", m.name, m.alphaFactor,
-                              m.alphaCutoff, m.normalScale));
     }
     for (Texture& t : scene.textures) {
       const uint8_t decode = r.get<uint8_t>();
@@ -389,34 +385,16 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
       t.finish(path);
     }
 
-  // Cross-references. The writer only ever stores a finalized scene, so any violation means
-  // the file was produced by something else or damaged in a way the checksum missed.
-  for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
-    Mesh& m = scene.meshes[mi];
-    const size_t vertices = m.positions.size();
-    if ((!m.normals.empty() && m.normals.size() != vertices) || (!m.uvs.empty() && m.uvs.size() != vertices))
-      r.corrupt(fmt::format("mesh {} has {} positions but {} normals and {} uvs", mi, vertices, m.normals.size(),
-                            m.uvs.size()));
-    if (m.materials.size() != m.triangles.size())
-      r.corrupt(fmt::format("mesh {} has {} triangles but {} triangle materials", mi, m.triangles.size(),
-                            m.materials.size()));
-    for (const Vec3& p : m.positions)
-      if (!isFinite(p)) r.corrupt(fmt::format("mesh {} has a non-finite vertex", mi));
-    for (size_t t = 0; t < m.triangles.size(); ++t) {
-      const UVec3& tri = m.triangles[t];
-      if (tri.x >= vertices || tri.y >= vertices || tri.z >= vertices)
-        r.corrupt(fmt::format("mesh {} triangle {} indexes a vertex beyond its {} vertices", mi, t, vertices));
-      if (m.materials[t] >= scene.materials.size())
-        r.corrupt(fmt::format("mesh {} triangle {} has material {} of {}", mi, t, m.materials[t],
-                              scene.materials.size()));
-    }
-    // Embree reads 16 bytes at the last vertex: keep one element of padding (see scene.h).
-    m.positions.reserve(vertices + 1);
+  // The writer only ever stores a finalized scene, so a scene that fails the scene checker
+  // (every index, number, material model and light) was produced by something else or damaged
+  // in a way the checksum missed.
+  try {
+    checkScene(scene);
+  } catch (const Error& e) {
+    fail("{}: the {} section holds an invalid scene: {}", path, kSectionNames[kScene], e.what());
   }
-  for (const Material& m : scene.materials)
-    for (const int texture : {m.albedoTexture, m.alphaTexture, m.normalTexture})
-      if (texture < -1 || texture >= int64_t(scene.textures.size()))
-        r.corrupt(fmt::format("material '{}' uses texture {} of {}", m.name, texture, scene.textures.size()));
+  // Embree reads 16 bytes at the last vertex: keep one element of padding (see scene.h).
+  for (Mesh& m : scene.meshes) m.positions.reserve(m.positions.size() + 1);
   return scene;
 }
 
@@ -557,80 +535,20 @@ std::vector<std::vector<uint32_t>> decodeTriangleCharts(std::span<const unsigned
 
 // --- Metadata ----------------------------------------------------------------------------
 
-nlohmann::json settingsToJson(const BakeSettings& s) {
-  return {{"preset", s.preset},
-          {"tixels_per_unit", s.tixelsPerUnit},
-          {"max_tixels_per_chart_side", s.maxTixelsPerChartSide},
-          {"tixels_across_scene", s.tixelsAcrossScene},
-          {"gather_directions", s.gatherDirections},
-          {"glossy_dir_res", s.glossyDirRes},
-          {"tolerance", s.tolerance},
-          {"max_iterations", s.maxIterations},
-          {"mirror_depth", s.mirrorDepth},
-          {"area_light_samples", s.areaLightSamples},
-          {"seed", s.seed},
-          {"sun_masks", s.sunMasks},
-          {"punctual_highlights", s.punctualHighlights}};
-}
-
-nlohmann::json statsToJson(const BakeStats& s) {
-  return {{"seconds", s.seconds},
-          {"visibility_seconds", s.visibilitySeconds},
-          {"propagation_seconds", s.propagationSeconds},
-          {"iterations", s.iterations},
-          {"residual", s.residual},
-          {"tixels", s.tixels},
-          {"values", s.values},
-          {"visibility_rays", s.visibilityRays},
-          {"peak_rss_bytes", s.peakRssBytes},
-          {"reused_visibility", s.reusedVisibility}};
-}
-
 std::vector<unsigned char> encodeMeta(const LightField& lf) {
   const nlohmann::json meta = {{"writer", "plenoptic"},
-                               {"settings", settingsToJson(lf.settings)},
-                               {"stats", statsToJson(lf.stats)}};
+                               {"settings", toJson(lf.settings)},
+                               {"stats", toJson(lf.stats)}};
   const std::string text = meta.dump(2);
   return {text.begin(), text.end()};
-}
-
-/// Keys a newer writer may add are ignored; keys it dropped keep their defaults.
-template <typename T>
-void readKey(const nlohmann::json& object, const char* key, T& field) {
-  if (auto it = object.find(key); it != object.end()) field = it->get<T>();
 }
 
 void decodeMeta(std::span<const unsigned char> bytes, const std::string& path, BakeSettings& settings,
                 BakeStats& stats) {
   try {
     const auto meta = nlohmann::json::parse(bytes.begin(), bytes.end());
-    const auto& s = meta.at("settings");
-    readKey(s, "preset", settings.preset);
-    readKey(s, "tixels_per_unit", settings.tixelsPerUnit);
-    readKey(s, "max_tixels_per_chart_side", settings.maxTixelsPerChartSide);
-    readKey(s, "tixels_across_scene", settings.tixelsAcrossScene);
-    readKey(s, "gather_directions", settings.gatherDirections);
-    readKey(s, "glossy_dir_res", settings.glossyDirRes);
-    readKey(s, "tolerance", settings.tolerance);
-    readKey(s, "max_iterations", settings.maxIterations);
-    readKey(s, "mirror_depth", settings.mirrorDepth);
-    readKey(s, "area_light_samples", settings.areaLightSamples);
-    readKey(s, "seed", settings.seed);
-    settings.sunMasks = false;  // writers before sun masks (version ≤ 2) baked without them
-    readKey(s, "sun_masks", settings.sunMasks);
-    settings.punctualHighlights = false;  // writers before punctual highlights kept them in the glossy maps
-    readKey(s, "punctual_highlights", settings.punctualHighlights);
-    const auto& t = meta.at("stats");
-    readKey(t, "seconds", stats.seconds);
-    readKey(t, "visibility_seconds", stats.visibilitySeconds);
-    readKey(t, "propagation_seconds", stats.propagationSeconds);
-    readKey(t, "iterations", stats.iterations);
-    readKey(t, "residual", stats.residual);
-    readKey(t, "tixels", stats.tixels);
-    readKey(t, "values", stats.values);
-    readKey(t, "visibility_rays", stats.visibilityRays);
-    readKey(t, "peak_rss_bytes", stats.peakRssBytes);
-    readKey(t, "reused_visibility", stats.reusedVisibility);
+    fromJson(meta.at("settings"), settings);
+    fromJson(meta.at("stats"), stats);
   } catch (const nlohmann::json::exception& e) {
     fail("{}: corrupt metadata section: {}", path, e.what());
   }

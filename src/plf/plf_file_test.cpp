@@ -12,6 +12,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <random>
 
@@ -1141,6 +1142,26 @@ TEST_F(PlfFileTest, VersionOneAndTwoFilesStillReadWithoutSunMasks) {
   EXPECT_EQ(copy.sunMaskLightCount, 0u);
   EXPECT_TRUE(copy.sunMasks.empty());
   EXPECT_EQ(readLightFieldInfo(path).version, 2u);
+}
+
+// A file whose checksums are right but whose scene breaks the scene checker (checkScene, the
+// one Scene::finalize runs): an energy-creating material or a broken light is refused with a
+// message naming the file, the section and the problem, by the full and the info reader.
+TEST_F(PlfFileTest, RefusesAnInvalidMaterialOrLightInTheScene) {
+  LightField bright = makeTestLightField();
+  std::get<LambertBsdf>(bright.scene.materials[0].bsdf).albedo = Rgb(1.5f, 0.5f, 0.5f);  // reflects more than it receives
+  writeLightField(file("albedo.plf"), bright);  // the writer stores what it is given
+  expectRefused(file("albedo.plf"), {"scene section holds an invalid scene", "material 'white'", "Lambert albedo"});
+
+  LightField spot = makeTestLightField();
+  std::get<SpotLight>(spot.scene.lights[1]).innerAngle = 1.0f;  // wider than its outer angle 0.4
+  writeLightField(file("spot.plf"), spot);
+  expectRefused(file("spot.plf"), {"scene section holds an invalid scene", "spot light 1", "inner angle"});
+
+  LightField nan = makeTestLightField();
+  std::get<PointLight>(nan.scene.lights[0]).intensity.g = std::numeric_limits<float>::quiet_NaN();
+  writeLightField(file("nan.plf"), nan);
+  expectRefused(file("nan.plf"), {"scene section holds an invalid scene", "point light 0", "non-finite"});
 }
 
 }  // namespace

@@ -61,12 +61,11 @@ void validateMaterial(const Material& material, const std::string& sourcePath) {
 }
 
 
-void Scene::finalize() {
-  const std::string& src = sourcePath;
-  if (materials.empty()) fail("{}: the scene has no materials", src);
+void checkScene(const Scene& scene) {
+  const std::string& src = scene.sourcePath;
+  if (scene.materials.empty()) fail("{}: the scene has no materials", src);
 
-  for (size_t m = 0; m < materials.size(); ++m) {
-    const Material& material = materials[m];
+  for (const Material& material : scene.materials) {
     if (!isFinite(material.emission) || material.emission.r < 0.0f || material.emission.g < 0.0f ||
         material.emission.b < 0.0f)
       fail("{}: material '{}' has an invalid emission {}", src, material.name, vecString(material.emission));
@@ -78,11 +77,11 @@ void Scene::finalize() {
     if (maxComponent(material.emission) > kMaxEmission)
       fail("{}: material '{}' has an emission {} above {:g} W/(sr m^2), too large to compute with", src,
            material.name, vecString(material.emission), kMaxEmission);
-    validateMaterial(material, sourcePath);
+    validateMaterial(material, src);
     for (const int texture : {material.albedoTexture, material.alphaTexture, material.normalTexture})
-      if (texture < -1 || texture >= int(textures.size()))
+      if (texture < -1 || texture >= int64_t(scene.textures.size()))
         fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name, texture,
-             textures.size());
+             scene.textures.size());
     if (!(material.alphaFactor >= 0.0f && material.alphaFactor <= 1.0f) ||
         !(material.alphaCutoff >= 0.0f && material.alphaCutoff <= 1.0f))
       fail("{}: material '{}' has alpha {} and alpha cutoff {}; both must be in [0, 1]", src, material.name,
@@ -90,10 +89,9 @@ void Scene::finalize() {
     if (!std::isfinite(material.normalScale))
       fail("{}: material '{}' has a non-finite normal-map scale", src, material.name);
   }
-  for (Texture& texture : textures) texture.finish(src);
 
-  size_t totalBefore = 0, dropped = 0;
-  for (Mesh& mesh : meshes) {
+  size_t triangles = 0;
+  for (const Mesh& mesh : scene.meshes) {
     const size_t vertexCount = mesh.positions.size();
     if (!mesh.normals.empty() && mesh.normals.size() != vertexCount)
       fail("{}: mesh '{}' has {} normals for {} vertices", src, mesh.name, mesh.normals.size(), vertexCount);
@@ -106,56 +104,28 @@ void Scene::finalize() {
     for (size_t v = 0; v < vertexCount; ++v)
       if (!isFinite(mesh.positions[v]))
         fail("{}: mesh '{}': vertex {} is not finite {}", src, mesh.name, v, vecString(mesh.positions[v]));
-    for (size_t v = 0; v < mesh.normals.size(); ++v) {
-      Vec3& n = mesh.normals[v];
-      if (!isFinite(n)) fail("{}: mesh '{}': normal {} is not finite {}", src, mesh.name, v, vecString(n));
-      // Zero normals stay zero: surfaceAt() falls back to the geometric normal there.
-      const float length = glm::length(n);
-      if (length > 0.0f) n /= length;
-    }
+    for (size_t v = 0; v < mesh.normals.size(); ++v)
+      if (!isFinite(mesh.normals[v]))
+        fail("{}: mesh '{}': normal {} is not finite {}", src, mesh.name, v, vecString(mesh.normals[v]));
     for (size_t v = 0; v < mesh.uvs.size(); ++v)
       if (!isFinite2(mesh.uvs[v]))
         fail("{}: mesh '{}': texture coordinate {} is not finite", src, mesh.name, v);
-
-    totalBefore += mesh.triangles.size();
-    size_t kept = 0;
     for (size_t t = 0; t < mesh.triangles.size(); ++t) {
       const UVec3 tri = mesh.triangles[t];
       for (int k = 0; k < 3; ++k)
         if (tri[k] >= vertexCount)
           fail("{}: mesh '{}': triangle {} refers to vertex {} but the mesh has {} vertices", src, mesh.name, t,
                tri[k], vertexCount);
-      if (mesh.materials[t] >= materials.size())
+      if (mesh.materials[t] >= scene.materials.size())
         fail("{}: mesh '{}': triangle {} uses material {} but the scene has {}", src, mesh.name, t,
-             mesh.materials[t], materials.size());
-      if (isDegenerate(mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z])) continue;
-      mesh.triangles[kept] = tri;
-      mesh.materials[kept] = mesh.materials[t];
-      ++kept;
+             mesh.materials[t], scene.materials.size());
     }
-    dropped += mesh.triangles.size() - kept;
-    mesh.triangles.resize(kept);
-    mesh.materials.resize(kept);
+    triangles += mesh.triangles.size();
   }
-  std::erase_if(meshes, [](const Mesh& mesh) { return mesh.triangles.empty(); });
-  if (meshes.empty()) {
-    if (totalBefore == 0) fail("{}: the scene has no triangles", src);
-    fail("{}: all {} triangles are degenerate (zero area)", src, totalBefore);
-  }
-  if (dropped > 0)
-    spdlog::warn("{}: dropped {} degenerate (zero-area) triangle(s) of {}", src, dropped, totalBefore);
+  if (triangles == 0) fail("{}: the scene has no triangles", src);
 
-  // Embree reads vertex buffers with 16-byte loads, so the last Vec3 needs 4 readable bytes
-  // past it: one element of spare capacity (a copy of the Scene does not keep it, so the
-  // renderers build their Accel from the Scene object that was finalized or moved).
-  for (Mesh& mesh : meshes) mesh.positions.reserve(mesh.positions.size() + 1);
-
-  validateLights(*this);
-  for (Light& light : lights) {
-    if (auto* spot = std::get_if<SpotLight>(&light)) spot->direction = glm::normalize(spot->direction);
-    if (auto* sun = std::get_if<DirectionalLight>(&light)) sun->direction = glm::normalize(sun->direction);
-  }
-  for (const CameraDesc& camera : cameras) {
+  validateLights(scene);
+  for (const CameraDesc& camera : scene.cameras) {
     if (!isFinite(camera.eye) || !isFinite(camera.target) || !isFinite(camera.up))
       fail("{}: camera '{}' has non-finite eye, target or up", src, camera.name);
     if (camera.eye == camera.target) fail("{}: camera '{}' has eye == target", src, camera.name);
@@ -169,13 +139,56 @@ void Scene::finalize() {
     if (camera.aspectRatio && !(*camera.aspectRatio > 0.0f && std::isfinite(*camera.aspectRatio)))
       fail("{}: camera '{}' has an invalid aspect ratio", src, camera.name);
   }
+  const SceneSettings& settings = scene.settings;
   if ((settings.width && *settings.width <= 0) || (settings.height && *settings.height <= 0) ||
       (settings.spp && *settings.spp <= 0))
     fail("{}: settings: width, height and spp must be positive", src);
-  if (settings.camera) (void)camera(*settings.camera);  // throws, listing the cameras, if unknown
+  if (settings.camera) (void)scene.camera(*settings.camera);  // throws, listing the cameras, if unknown
+  const Environment& environment = scene.environment;
   if (!isFinite(environment.constant) || environment.constant.r < 0.0f || environment.constant.g < 0.0f ||
       environment.constant.b < 0.0f)
     fail("{}: the environment colour {} is invalid", src, vecString(environment.constant));
+}
+
+void Scene::finalize() {
+  const std::string& src = sourcePath;
+  checkScene(*this);
+  for (Texture& texture : textures) texture.finish(src);
+
+  size_t totalBefore = 0, dropped = 0;
+  for (Mesh& mesh : meshes) {
+    // Zero normals stay zero: surfaceAt() falls back to the geometric normal there.
+    for (Vec3& n : mesh.normals) {
+      const float length = glm::length(n);
+      if (length > 0.0f) n /= length;
+    }
+    totalBefore += mesh.triangles.size();
+    size_t kept = 0;
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const UVec3 tri = mesh.triangles[t];
+      if (isDegenerate(mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z])) continue;
+      mesh.triangles[kept] = tri;
+      mesh.materials[kept] = mesh.materials[t];
+      ++kept;
+    }
+    dropped += mesh.triangles.size() - kept;
+    mesh.triangles.resize(kept);
+    mesh.materials.resize(kept);
+  }
+  std::erase_if(meshes, [](const Mesh& mesh) { return mesh.triangles.empty(); });
+  if (meshes.empty()) fail("{}: all {} triangles are degenerate (zero area)", src, totalBefore);
+  if (dropped > 0)
+    spdlog::warn("{}: dropped {} degenerate (zero-area) triangle(s) of {}", src, dropped, totalBefore);
+
+  // Embree reads vertex buffers with 16-byte loads, so the last Vec3 needs 4 readable bytes
+  // past it: one element of spare capacity (a copy of the Scene does not keep it, so the
+  // renderers build their Accel from the Scene object that was finalized or moved).
+  for (Mesh& mesh : meshes) mesh.positions.reserve(mesh.positions.size() + 1);
+
+  for (Light& light : lights) {
+    if (auto* spot = std::get_if<SpotLight>(&light)) spot->direction = glm::normalize(spot->direction);
+    if (auto* sun = std::get_if<DirectionalLight>(&light)) sun->direction = glm::normalize(sun->direction);
+  }
 }
 
 bool Scene::hasThinGlass() const {

@@ -151,10 +151,9 @@ struct Scene {
   Environment environment;
   SceneSettings settings;
 
-  /// Checks every index and number (throws pl::Error naming sourcePath and the problem:
-  /// NaN vertices, out-of-range indices, no triangles), drops degenerate triangles (with a
-  /// warning), normalises normals and light directions, and pads the vertex buffers for
-  /// sharing with Embree. Loaders call it last. The padding is spare *capacity*: a moved
+  /// Checks the scene (checkScene below), prepares its textures (Texture::finish), drops
+  /// degenerate triangles (with a warning; throws when none is left), normalises normals and
+  /// light directions, and pads the vertex buffers for sharing with Embree. Loaders call it last. The padding is spare *capacity*: a moved
   /// Scene keeps it, a copied one does not (build the Accel on the loaded object, or call
   /// finalize() again on a copy).
   void finalize();
@@ -173,6 +172,16 @@ struct Scene {
   /// sphere fits its 40° vertical field of view (and any image at least as wide as high).
   CameraDesc automaticCamera() const;
 };
+
+/// The one checker of a scene's consistency, for scenes from any source: Scene::finalize runs
+/// it on every loaded scene and the .plf reader on the scene a file holds. Throws pl::Error
+/// naming scene.sourcePath and the first problem: no materials or no triangles; a material's
+/// emission (negative, not finite, above 1e12 W·sr⁻¹·m⁻²), model (validateMaterial), texture
+/// indices, alpha or normal-map scale; a mesh's array sizes, non-finite vertices, normals or
+/// uvs, or out-of-range vertex and material indices; a light (position, direction, intensity,
+/// cone angles); a camera; the settings (positive sizes and spp, a camera that exists); the
+/// environment colour. It changes nothing, so it also accepts a finalized scene.
+void checkScene(const Scene& scene);
 
 /// Loads `cornell`, .obj, .gltf/.glb or .json (see docs/scenes.md for the JSON schema).
 /// Throws pl::Error with the file name and the problem for any malformed input.
