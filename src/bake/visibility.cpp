@@ -1,4 +1,4 @@
-// The visibility field: gather directions, tracing and hashing. Its .plv file: plf/plv_file.cpp.
+// The visibility field: gather directions, tracing and hashing (FNV-1a, core/hash.h). Its .plv file: plf/plv_file.cpp.
 #include "bake/visibility.h"
 
 #include <algorithm>
@@ -19,23 +19,6 @@
 namespace pl {
 
 namespace {
-
-// FNV-1a, 64 bit: a change detector over bytes (not a cryptographic hash).
-struct Fnv1a {
-  uint64_t state = 0xcbf29ce484222325ULL;
-  void bytes(const void* data, size_t size) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < size; ++i) {
-      state ^= p[i];
-      state *= 0x100000001b3ULL;
-    }
-  }
-  template <typename T>
-  void value(const T& v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    bytes(&v, sizeof(T));
-  }
-};
 
 /// Beer–Lambert attenuation exp(−σa t) of a gather segment of length t that ends on chart
 /// record c: a segment arriving at the back record of rough glass ran through the solid's
@@ -119,7 +102,7 @@ Vec3 gatherCellDirection(uint32_t k, uint32_t subCell, uint32_t gridSide, uint64
 }
 
 uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings) {
-  Fnv1a h;
+  Fnv1a64 h;
   h.value(kPlvVersion);
   h.value(uint64_t(scene.meshes.size()));
   for (const Mesh& mesh : scene.meshes) {
@@ -127,7 +110,7 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
     for (const UVec3& t : mesh.triangles) {
       for (int k = 0; k < 3; ++k) h.value(mesh.positions[t[k]]);
     }
-    h.bytes(mesh.materials.data(), mesh.materials.size() * sizeof(uint32_t));
+    h.update(mesh.materials.data(), mesh.materials.size() * sizeof(uint32_t));
   }
   for (const Material& m : scene.materials) {
     h.value(uint8_t(chartKindOf(m.bsdf)));
@@ -146,7 +129,7 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
       const Image& image = scene.textures[size_t(index)].image;
       h.value(image.width);
       h.value(image.height);
-      h.bytes(image.pixels.data(), image.pixels.size() * sizeof(Rgb));
+      h.update(image.pixels.data(), image.pixels.size() * sizeof(Rgb));
     };
     if (m.isMasked()) {
       h.value(m.alphaFactor);
@@ -174,15 +157,15 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
     // A curved chart's tixels gather around their own normals (planar charts hash as before).
     if (c.curved) {
       h.value(uint8_t(1));
-      h.bytes(param.gatherNormal.data() + c.firstTixel, c.tixelCount() * sizeof(Vec3));
+      h.update(param.gatherNormal.data() + c.firstTixel, c.tixelCount() * sizeof(Vec3));
     }
   }
-  h.bytes(param.gatherPoint.data(), param.gatherPoint.size() * sizeof(Vec3));
+  h.update(param.gatherPoint.data(), param.gatherPoint.size() * sizeof(Vec3));
   h.value(gatherGridSide(settings.gatherDirections));
   h.value(settings.mirrorDepth);
   h.value(kSpecularRouletteStep);  // chains end differently with another roulette start
   h.value(settings.seed);
-  return h.state;
+  return h.digest();
 }
 
 VisibilityShard VisibilityShard::whole(const VisibilityField& field) {
@@ -217,13 +200,13 @@ bool VisibilityShard::holds(uint64_t begin, uint64_t end) const {
 
 uint64_t visibilityShardHash(uint64_t fieldHash, const std::vector<TixelRange>& ranges, uint64_t tixelCount) {
   if (ranges.size() == 1 && ranges[0] == TixelRange{0, tixelCount}) return fieldHash;
-  Fnv1a h;
+  Fnv1a64 h;
   h.value(fieldHash);
   for (const TixelRange& r : ranges) {
     h.value(r.begin);
     h.value(r.end);
   }
-  return h.state;
+  return h.digest();
 }
 
 VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const Parameterisation& param,

@@ -106,6 +106,7 @@ Vec3 gatherCellDirection(uint32_t k, uint32_t subCell, uint32_t gridSide, uint64
 /// materials' *transport class* (chart kind, and mirror parameters, which the field's
 /// throughputs contain — not diffuse albedo or emission), the parameterisation (charts,
 /// gather points) and the settings that shape it (gather directions, mirror depth, seed).
+/// FNV-1a (core/hash.h Fnv1a64): the value is stored in every .plv header.
 uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings);
 
 /// Traces the visibility field (parallel, with a progress bar).

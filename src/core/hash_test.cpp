@@ -104,5 +104,23 @@ TEST(Xxh64KnownDigests, DigestIsRepeatableAndACopyContinuesIndependently) {
   EXPECT_EQ(stream.digest(), known(64, 1));
 }
 
+// FNV-1a 64 (the .plv header's visibility hash): the published test vectors of Fowler, Noll
+// and Vo, so that every saved .plv keeps its hash.
+TEST(Fnv1a64KnownDigests, MatchesThePublishedVectors) {
+  auto digest = [](const char* text, size_t size) {
+    Fnv1a64 h;
+    h.update(text, size);
+    return h.digest();
+  };
+  EXPECT_EQ(digest("", 0), 0xcbf29ce484222325ull);
+  EXPECT_EQ(digest("a", 1), 0xaf63dc4c8601ec8cull);
+  EXPECT_EQ(digest("foobar", 6), 0x85944171f73967e8ull);
+  Fnv1a64 pieces;  // value() feeds a value's bytes, in pieces as the whole
+  pieces.value('f');
+  pieces.update("oob", 3);
+  pieces.value(uint16_t('a' | 'r' << 8));  // little-endian: 'a' then 'r'
+  EXPECT_EQ(pieces.digest(), 0x85944171f73967e8ull);
+}
+
 }  // namespace
 }  // namespace pl
