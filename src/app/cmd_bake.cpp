@@ -17,43 +17,13 @@
 namespace pl {
 namespace {
 
-struct BakeCommandOptions {
-  std::string scene;            ///< `cornell`, .obj, .gltf/.glb, .json
-  std::string output;           ///< .plf
-  std::string preset = "default";
-  bool reuseVisibility = false;
-  std::string visibilityPath;   ///< default: OUT with extension .plv
-  std::string statsPath;
-  // Overrides of single preset values (0 / negative = keep the preset's).
-  float tixelsAcross = 0.0f;
-  uint32_t gatherDirections = 0;
-  uint32_t lightSamples = 0;
-  float tolerance = 0.0f;
-  bool sunMasks = true;           ///< --sun-masks on|off
-  bool punctualHighlights = true; ///< --punctual-highlights on|off
-  std::string compress = "none";  ///< how the values are stored: none|lossless|bc1|hdr (compression.h)
-};
-
-void runBake(const BakeCommandOptions& options, const GlobalOptions& global, Communicator& comm) {
+void runBake(const BakeJobOptions& options, const GlobalOptions& global, Communicator& comm) {
   // Ranks other than 0 stay quiet (no bars, no notes): rank 0 speaks for the job.
   const bool speaker = comm.rank() == 0;
   applyGlobalOptions(global);
   if (!speaker) Progress::setEnabled(false);
   if (options.output.empty()) failUsage("bake: an output file is required (-o OUT.plf)");
-  BakeJobOptions jobOptions;
-  jobOptions.sceneName = options.scene;
-  jobOptions.output = options.output;
-  jobOptions.visibilityPath = options.visibilityPath;
-  jobOptions.statsPath = options.statsPath;
-  jobOptions.preset = options.preset;
-  jobOptions.tixelsAcross = options.tixelsAcross;
-  jobOptions.gatherDirections = options.gatherDirections;
-  jobOptions.lightSamples = options.lightSamples;
-  jobOptions.tolerance = options.tolerance;
-  jobOptions.sunMasks = options.sunMasks;
-  jobOptions.punctualHighlights = options.punctualHighlights;
-  jobOptions.reuseVisibility = options.reuseVisibility;
-  jobOptions.compress = options.compress;
+  BakeJobOptions jobOptions = options;
   jobOptions.seed = global.seed;
   jobOptions.threads = global.threads;
   jobOptions.log = [&](const std::string& line) {
@@ -61,7 +31,7 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global, Com
   };
   jobOptions.communicator = &comm;
   const BakeJob job(std::move(jobOptions));  // checks every output before the scene is loaded
-  const BakeJobResult result = job.run(options.scene);
+  const BakeJobResult result = job.run(options.sceneName);
   const BakeJobStats& stats = result.stats;
   const BakeStats& s = stats.bake;
   if (!speaker) return;
@@ -74,7 +44,7 @@ void runBake(const BakeCommandOptions& options, const GlobalOptions& global, Com
 /// (distributed/communicator.h). A rank that fails ends the whole job: it reports its error
 /// and aborts every rank (mpirun then exits non-zero), so nothing is left waiting in an
 /// exchange and rank 0 writes no .plf.
-void runBakeCommand(const BakeCommandOptions& options, const GlobalOptions& global) {
+void runBakeCommand(const BakeJobOptions& options, const GlobalOptions& global) {
   std::unique_ptr<Communicator> comm = makeCommunicator();
   if (comm->size() == 1) return runBake(options, global, *comm);
   try {
@@ -90,10 +60,11 @@ void runBakeCommand(const BakeCommandOptions& options, const GlobalOptions& glob
 }  // namespace
 
 void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
-  auto options = std::make_shared<BakeCommandOptions>();
+  // The flags are bound to the job's options; sceneName is the scene loaded.
+  auto options = std::make_shared<BakeJobOptions>();
   CLI::App* command = app.add_subcommand(
       "bake", "Precompute the scene's light field (charts, visibility field, propagation) into a .plf file");
-  command->add_option("scene", options->scene, "cornell, or a scene file (.obj, .gltf, .glb, .json)")->required();
+  command->add_option("scene", options->sceneName, "cornell, or a scene file (.obj, .gltf, .glb, .json)")->required();
   command->add_option("-o,--output", options->output, "Output light field (.plf)")->required();
   command->add_option("--preset", options->preset, "Quality preset")
       ->check(CLI::IsMember(bakePresetNames()))

@@ -18,7 +18,6 @@
 #include "accel/accel.h"
 #include "app/commands.h"
 #include "bake/bake.h"
-#include "app/view_options.h"
 #include "core/error.h"
 #include "image/compare.h"
 #include "jobs/jobs.h"
@@ -53,8 +52,8 @@ std::string outputPath(const DemoOptions& options, const std::string& name) {
   return (std::filesystem::path(options.outputDir) / name).string();
 }
 
-ViewOptions demoView(const DemoOptions& options) {
-  ViewOptions view;  // scene camera, exposure 1 (EXR = radiance), Reinhard for the PNGs
+ViewSettings demoView(const DemoOptions& options) {
+  ViewSettings view;  // scene camera, exposure 1 (EXR = radiance), Reinhard for the PNGs
   view.width = options.imageSize;
   view.height = options.imageSize;
   return view;
@@ -118,7 +117,7 @@ void renderAndCompare(const DemoOptions& options, const GlobalOptions& global, c
   const std::string png = outputPath(options, "cornell_lightfield.png");
   job.view.writeImage(png, rendered);
   const std::string what = fmt::format("light-field render, {}x{}, {} samples/pixel, {:.1f} ms", result.stats.width,
-                                       result.stats.height, result.stats.samplesPerPixel, result.stats.msPerFrameMedian);
+                                       result.stats.height, result.stats.spp, result.stats.msPerFrameMedian);
   files.push_back({what, job.output});
   files.push_back({what, png});
 
@@ -151,7 +150,7 @@ void runDemo(const DemoOptions& options, const GlobalOptions& global) {
 
   std::vector<std::string> walkthrough;
   if (options.walkthrough) {
-    const ViewOptions view = demoView(options);
+    const ViewSettings view = demoView(options);
     const Accel accel(lightField.scene);
     walkthrough = runDemoWalkthrough(lightField, accel, view.resolveCamera(lightField.scene),
                                      view.metresPerUnit(lightField.scene),

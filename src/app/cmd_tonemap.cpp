@@ -16,12 +16,12 @@ namespace {
 struct TonemapOptions {
   std::string input;   ///< any readable image (.exr, .hdr, .pfm; .png is decoded to linear)
   std::string output;  ///< .png (tone-mapped sRGB) or .exr/.hdr/.pfm (input × exposure)
-  ViewOptions view;    ///< only its exposure and tone-mapping flags are used
+  ViewSettings view;   ///< only its exposure and tone-mapping flags are used
 };
 
 void runTonemap(const TonemapOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
-  ViewOptions::checkImageOutput(options.output, "-o");
+  ViewSettings::checkImageOutput(options.output, "-o");
   const std::string ext = fileExtensionLower(options.output);
   const Image image = readImage(options.input);
   options.view.writeImage(options.output, image);
@@ -40,8 +40,8 @@ void addTonemapCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("input", options->input, "Input image (.exr, .hdr, .pfm, or .png decoded to linear)")->required();
   command->add_option("-o,--output", options->output, "Output: .png tone-mapped sRGB, or .exr/.hdr/.pfm exposed")
       ->required();
-  options->view.addExposureOptions(*command);
-  options->view.addToneMapOptions(*command);
+  addExposureOptions(*command, options->view);
+  addToneMapOptions(*command, options->view);
   command->callback([options, &global] { runTonemap(*options, global); });
 }
 

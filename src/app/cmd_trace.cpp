@@ -22,42 +22,20 @@ namespace {
 // The options' ranges are declared once, in jobs.h (TraceJobOptions, ViewSettings).
 
 struct TraceOptions {
-  std::string scene;        ///< `cornell`, .obj, .gltf/.glb, .json
-  std::string output;       ///< .exr/.hdr/.pfm (radiance × exposure) or .png (tone-mapped)
-  int spp = 64;
-  int maxDepth = TraceSettings{}.maxDepth;
-  std::string strategy = "mis";
-  std::string sampler = samplerName(TraceSettings{}.sampler);
-  std::string statsPath;     ///< --stats: JSON with timings
-  std::string variancePath;  ///< --variance: per-pixel variance of the mean (HDR file)
-  std::vector<int> pixel;    ///< --pixel X,Y: replay one pixel, print it, write no image
-  ViewOptions view;
-  // Which flags were given: a scene file's "settings" fill in only the ones that were not.
-  bool sppGiven = false, widthGiven = false, heightGiven = false, cameraGiven = false;
+  TraceJobOptions job;     ///< the flags are bound to its fields; sceneName is the scene loaded
+  std::vector<int> pixel;  ///< --pixel X,Y: replay one pixel, print it, write no image
 };
 
 void runTrace(const TraceOptions& options, const GlobalOptions& global) {
   applyGlobalOptions(global);
   const bool replay = !options.pixel.empty();
-  if (!replay && options.output.empty()) failUsage("trace: an output image is required (-o OUT.exr|png)");
-  TraceJobOptions jobOptions;
-  jobOptions.sceneName = options.scene;
-  jobOptions.output = replay ? std::string() : options.output;
-  jobOptions.variancePath = options.variancePath;
-  jobOptions.statsPath = options.statsPath;
-  jobOptions.trace.spp = options.spp;
-  jobOptions.trace.maxDepth = options.maxDepth;
+  if (!replay && options.job.output.empty()) failUsage("trace: an output image is required (-o OUT.exr|png)");
+  TraceJobOptions jobOptions = options.job;
+  if (replay) jobOptions.output.clear();
   jobOptions.trace.seed = global.seed;
-  jobOptions.trace.strategy = parseStrategy(options.strategy);
-  jobOptions.trace.sampler = parseSampler(options.sampler);
-  jobOptions.view = options.view;
   jobOptions.threads = global.threads;
-  jobOptions.sppGiven = options.sppGiven;
-  jobOptions.widthGiven = options.widthGiven;
-  jobOptions.heightGiven = options.heightGiven;
-  jobOptions.cameraGiven = options.cameraGiven;
   const TraceJob job(std::move(jobOptions));  // checks every output before the scene is loaded
-  const Scene scene = loadScene(options.scene);
+  const Scene scene = loadScene(options.job.sceneName);
 
   if (replay) {
     const int x = options.pixel[0], y = options.pixel[1];
@@ -80,7 +58,7 @@ void runTrace(const TraceOptions& options, const GlobalOptions& global) {
                "plenoptic: warning: {} of {} samples had a non-finite radiance and were left out "
                "(first at pixel {},{} sample {}; replay with --pixel {},{})\n",
                t.nanSamples, t.paths, t.firstNanX, t.firstNanY, t.firstNanSample, t.firstNanX, t.firstNanY);
-  fmt::print("wrote {} ({}x{}, {} spp, {:.2f} s, {:.3f} M paths/s, {:.2f} M rays/s)\n", options.output, stats.width,
+  fmt::print("wrote {} ({}x{}, {} spp, {:.2f} s, {:.3f} M paths/s, {:.2f} M rays/s)\n", stats.output, stats.width,
              stats.height, stats.spp, t.seconds, t.pathsPerSecond() * 1e-6, t.raysPerSecond() * 1e-6);
 }
 
@@ -88,45 +66,53 @@ void runTrace(const TraceOptions& options, const GlobalOptions& global) {
 
 void addTraceCommand(CLI::App& app, const GlobalOptions& global) {
   auto options = std::make_shared<TraceOptions>();
+  TraceJobOptions& job = options->job;
   CLI::App* command = app.add_subcommand(
       "trace", "Render a scene with the reference path tracer (NEE + BSDF sampling, MIS, Russian roulette)");
-  command->add_option("scene", options->scene, "cornell, or a scene file (.obj, .gltf, .glb, .json)")->required();
-  command->add_option("-o,--output", options->output,
+  command->add_option("scene", job.sceneName, "cornell, or a scene file (.obj, .gltf, .glb, .json)")->required();
+  command->add_option("-o,--output", job.output,
                       "Output image: .exr/.hdr/.pfm hold radiance (x exposure), .png is tone-mapped sRGB "
                       "(not needed with --pixel)")
       ->option_text(cli::kRequiredText);  // required unless --pixel: checked by runTrace
-  command->add_option("--spp", options->spp, "Samples (paths) per pixel")
+  // --samples: the name render and view use, accepted here too.
+  command->add_option("--spp,--samples", job.trace.spp, "Samples (paths) per pixel")
       ->check(CLI::Range(1, TraceJobOptions::kMaxSpp))
       ->capture_default_str();
-  command->add_option("--max-depth", options->maxDepth,
+  command->add_option("--max-depth", job.trace.maxDepth,
                       fmt::format("Maximum scattering events per path: {} = no cap (unbiased: Russian roulette "
                                   "alone ends paths; safety cap {}), 0 = emission seen directly, 1 = direct light, ...",
                                   kUnboundedDepth, kSafetyDepth))
       ->check(CLI::Range(kUnboundedDepth, TraceJobOptions::kMaxDepth))
       ->capture_default_str();
-  command->add_option("--strategy", options->strategy,
-                      "Direct lighting: mis (default), nee (light sampling only) or bsdf (BSDF sampling only); "
-                      "the last two are for testing")
+  command
+      ->add_option_function<std::string>(
+          "--strategy", [&job](const std::string& s) { job.trace.strategy = parseStrategy(s); },
+          "Direct lighting: mis (default), nee (light sampling only) or bsdf (BSDF sampling only); "
+          "the last two are for testing")
       ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
-      ->capture_default_str();
-  command->add_option("--sampler", options->sampler,
-                      "Sample numbers: sobol (default; Owen-scrambled ZSobol, stratified per pixel) or independent "
-                      "(PCG32 streams; exact per-pixel variance estimates)")
+      ->default_str(strategyName(job.trace.strategy));
+  command
+      ->add_option_function<std::string>(
+          "--sampler", [&job](const std::string& s) { job.trace.sampler = parseSampler(s); },
+          "Sample numbers: sobol (default; Owen-scrambled ZSobol, stratified per pixel) or independent "
+          "(PCG32 streams; exact per-pixel variance estimates)")
       ->check(CLI::IsMember({"independent", "sobol"}))
-      ->capture_default_str();
-  command->add_option("--stats", options->statsPath, "Write timings and counts as JSON");
-  command->add_option("--variance", options->variancePath,
+      ->default_str(samplerName(job.trace.sampler));
+  command->add_option("--stats", job.statsPath, "Write timings and counts as JSON");
+  command->add_option("--variance", job.variancePath,
                       "Also write the per-pixel variance of the mean (.exr/.hdr/.pfm; radiance², no exposure)");
   command->add_option("--pixel", options->pixel, "Replay one pixel X,Y and print its value (writes no image)")
       ->expected(2)
       ->delimiter(',');
-  options->view.addCameraOptions(*command);
-  options->view.addImageOptions(*command);
+  addCameraOptions(*command, job.view);
+  addImageOptions(*command, job.view);
   command->callback([options, command, &global] {
-    options->sppGiven = command->count("--spp") > 0;
-    options->widthGiven = command->count("--width") > 0;
-    options->heightGiven = command->count("--height") > 0;
-    options->cameraGiven = command->count("--camera") > 0;
+    // A scene file's "settings" fill in only what was not given.
+    TraceJobOptions& given = options->job;
+    given.sppGiven = command->count("--spp") > 0;
+    given.widthGiven = command->count("--width") > 0;
+    given.heightGiven = command->count("--height") > 0;
+    given.cameraGiven = command->count("--camera") > 0;
     runTrace(*options, global);
   });
 }

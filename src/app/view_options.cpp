@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "camera/exposure.h"
+#include "core/error.h"
+
 namespace pl {
 namespace {
 
@@ -44,79 +47,93 @@ float parsePositive(const std::string& flag, const std::string& text, bool allow
 
 }  // namespace
 
-void ViewOptions::addCameraOptions(CLI::App& command) {
-  command.add_option("--width", width, "Image width in pixels")->check(CLI::Range(1, kMaxImageSide))->capture_default_str();
-  command.add_option("--height", height, "Image height in pixels")->check(CLI::Range(1, kMaxImageSide))->capture_default_str();
-  command.add_option("--camera", camera, "Camera NAME from the scene (default: the scene's first camera, else automatic)");
-  command.add_option_function<std::string>("--eye", [this](const std::string& s) { eye = parseVec3("--eye", s); },
+void addCameraOptions(CLI::App& command, ViewSettings& view) {
+  constexpr int kMaxSide = ViewSettings::kMaxImageSide;
+  command.add_option("--width", view.width, "Image width in pixels")->check(CLI::Range(1, kMaxSide))->capture_default_str();
+  command.add_option("--height", view.height, "Image height in pixels")->check(CLI::Range(1, kMaxSide))->capture_default_str();
+  command.add_option("--camera", view.camera, "Camera NAME from the scene (default: the scene's first camera, else automatic)");
+  command.add_option_function<std::string>("--eye", [&view](const std::string& s) { view.eye = parseVec3("--eye", s); },
                                            "Camera position X,Y,Z (scene units)");
-  command.add_option_function<std::string>("--target", [this](const std::string& s) { target = parseVec3("--target", s); },
-                                           "Point the camera looks at, X,Y,Z");
-  command.add_option_function<std::string>("--up", [this](const std::string& s) { up = parseVec3("--up", s); },
+  command.add_option_function<std::string>(
+      "--target", [&view](const std::string& s) { view.target = parseVec3("--target", s); },
+      "Point the camera looks at, X,Y,Z");
+  command.add_option_function<std::string>("--up", [&view](const std::string& s) { view.up = parseVec3("--up", s); },
                                            "Camera up direction X,Y,Z");
-  command.add_option("--fov", fovDegrees, "Vertical field of view in degrees (0 < fov < 180)")
+  command.add_option("--fov", view.fovDegrees, "Vertical field of view in degrees (0 < fov < 180)")
       ->check(CLI::Range(1e-3f, 179.9f));
-  command.add_option("--aperture", fNumberLens,
+  command.add_option("--aperture", view.fNumberLens,
                      "Thin-lens f-number N for depth of field (aperture diameter = focal length / N); "
                      "exposure is set separately with --fstop")
       ->check(CLI::Range(0.1f, 1e4f));
-  command.add_option("--focus-distance", focusDistance, "Distance in focus, scene units (default: eye to target)")
+  command.add_option("--focus-distance", view.focusDistance, "Distance in focus, scene units (default: eye to target)")
       ->check(CLI::PositiveNumber);
-  command.add_option("--scene-unit", sceneUnitMetres,
+  command.add_option("--scene-unit", view.sceneUnitMetres,
                      "Metres per scene unit, sizes the lens (default: 0.001 for cornell, 1 otherwise)")
       ->check(CLI::PositiveNumber);
 }
 
-void ViewOptions::addExposureOptions(CLI::App& command) {
-  command.add_option("--exposure", exposureEv, "Exposure compensation in EV: pixel = radiance · 2^EV")
+void addExposureOptions(CLI::App& command, ViewSettings& view) {
+  command.add_option("--exposure", view.exposureEv, "Exposure compensation in EV: pixel = radiance · 2^EV")
       ->check(CLI::Range(-64.0f, 64.0f));
-  command.add_option_function<std::string>("--fstop", [this](const std::string& s) { fstop = parsePositive("--fstop", s, false); },
-                                           "Photographic exposure: f-number N (with --shutter and --iso)");
   command.add_option_function<std::string>(
-      "--shutter", [this](const std::string& s) { shutterSeconds = parsePositive("--shutter", s, true); },
+      "--fstop", [&view](const std::string& s) { view.fstop = parsePositive("--fstop", s, false); },
+      "Photographic exposure: f-number N (with --shutter and --iso)");
+  command.add_option_function<std::string>(
+      "--shutter", [&view](const std::string& s) { view.shutterSeconds = parsePositive("--shutter", s, true); },
       "Photographic exposure: shutter time in seconds, e.g. 0.008 or 1/125 (with --fstop and --iso)");
-  command.add_option_function<std::string>("--iso", [this](const std::string& s) { iso = parsePositive("--iso", s, false); },
-                                           "Photographic exposure: ISO speed S (with --fstop and --shutter)");
+  command.add_option_function<std::string>(
+      "--iso", [&view](const std::string& s) { view.iso = parsePositive("--iso", s, false); },
+      "Photographic exposure: ISO speed S (with --fstop and --shutter)");
   // Refuse an incomplete set as soon as the command line is parsed, before any rendering.
-  command.parse_complete_callback([this] {
-    const int given = int(fstop.has_value()) + int(shutterSeconds.has_value()) + int(iso.has_value());
-    if (given != 0 && given != 3)
-      throw CLI::ValidationError("--fstop/--shutter/--iso", "give all three (photographic exposure) or none");
+  command.parse_complete_callback([&view] {
+    try {
+      (void)photographicExposure(view.fstop, view.shutterSeconds, view.iso, "--fstop/--shutter/--iso");
+    } catch (const UsageError& e) {
+      throw CLI::ValidationError(e.what());
+    }
   });
 }
 
-void addTextureLodOption(CLI::App& command, bool& textureLod) {
+void addRenderSettingsOptions(CLI::App& command, RenderSettings& render) {
+  // --samples: the name these commands used first, still accepted.
+  command.add_option("--spp,--samples", render.samplesPerPixel,
+                     "Camera samples per pixel (0 = 1 at the pixel centre for a pinhole, 16 for a thin lens)")
+      ->check(CLI::Range(0, RenderSettings::kMaxSamplesPerPixel))
+      ->capture_default_str();
+  command.add_option("--mirror-depth", render.mirrorDepth, "Mirror reflections followed (-1 = the bake's own mirror depth)")
+      ->check(CLI::Range(-1, RenderSettings::kMaxMirrorDepth))
+      ->capture_default_str();
   command
       .add_option_function<std::string>(
-          "--texture-lod", [&textureLod](const std::string& s) { textureLod = s == "on"; },
+          "--texture-lod", [&render](const std::string& s) { render.textureLod = s == "on"; },
           "Albedo textures at the mip level of each sample's ray cone (on, the default) or at full resolution (off)")
       ->check(CLI::IsMember({"on", "off"}))
       ->default_str("on");
 }
 
-void ViewOptions::addToneMapOptions(CLI::App& command) {
-  command.add_option("--tonemap", tonemap, "Tone mapping for PNG output: reinhard, linear or clamp")
+void addToneMapOptions(CLI::App& command, ViewSettings& view) {
+  command.add_option("--tonemap", view.tonemap, "Tone mapping for PNG output: reinhard, linear or clamp")
       ->check(CLI::IsMember({"reinhard", "linear", "clamp"}))
       ->capture_default_str();
   command.add_option_function<std::string>(
       "--key",
-      [this](const std::string& s) {
+      [&view](const std::string& s) {
         if (s == "auto") {
-          autoKey = true;
+          view.autoKey = true;
         } else {
-          key = parsePositive("--key", s, false);
+          view.key = parsePositive("--key", s, false);
         }
       },
       "Reinhard key (log-average luminance maps to it; default 0.18 unless an exposure is given), or 'auto'");
   command.add_option_function<std::string>(
-      "--white", [this](const std::string& s) { white = parsePositive("--white", s, false); },
+      "--white", [&view](const std::string& s) { view.white = parsePositive("--white", s, false); },
       "White point: the (exposed) luminance mapped to 1 (reinhard, linear)");
 }
 
-void ViewOptions::addImageOptions(CLI::App& command) {
-  addExposureOptions(command);
-  command.add_flag("--vignetting", vignetting, "Natural vignetting: weight each pixel by cos⁴ of its angle off the axis");
-  addToneMapOptions(command);
+void addImageOptions(CLI::App& command, ViewSettings& view) {
+  addExposureOptions(command, view);
+  command.add_flag("--vignetting", view.vignetting, "Natural vignetting: weight each pixel by cos⁴ of its angle off the axis");
+  addToneMapOptions(command, view);
 }
 
 }  // namespace pl

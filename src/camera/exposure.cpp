@@ -16,6 +16,15 @@ double ev100(const PhotographicExposure& s) {
   return std::log2(n * n / double(s.shutterSeconds) * 100.0 / double(s.iso));
 }
 
+std::optional<PhotographicExposure> photographicExposure(std::optional<float> fNumber,
+                                                         std::optional<float> shutterSeconds,
+                                                         std::optional<float> iso, std::string_view names) {
+  const int given = int(fNumber.has_value()) + int(shutterSeconds.has_value()) + int(iso.has_value());
+  if (given == 0) return std::nullopt;
+  if (given != 3) failUsage("{}: give all three (photographic exposure) or none", names);
+  return PhotographicExposure{*fNumber, *shutterSeconds, *iso};
+}
+
 double saturationExposure(double ev100Value) { return 1.0 / (1.2 * std::exp2(ev100Value)); }
 
 float exposureScale(const ExposureSettings& settings) {

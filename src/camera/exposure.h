@@ -18,6 +18,7 @@
 //     factor), as real-time engines do.
 //   * both: H · 2^EV (the compensation applies on top of the photographic exposure).
 #include <optional>
+#include <string_view>
 
 namespace pl {
 
@@ -36,6 +37,14 @@ struct ExposureSettings {
   std::optional<float> compensationEv;              ///< --exposure EV
   std::optional<PhotographicExposure> photographic;  ///< --fstop/--shutter/--iso
 };
+
+/// The photographic exposure of an f-number, a shutter time and an ISO speed given all three;
+/// none when none is given. One or two of them throw pl::UsageError "<names>: give all three
+/// (photographic exposure) or none": the one home of that rule, where the command line, the
+/// jobs and the Python module each name their own flags or keywords in `names`.
+std::optional<PhotographicExposure> photographicExposure(std::optional<float> fNumber,
+                                                         std::optional<float> shutterSeconds,
+                                                         std::optional<float> iso, std::string_view names);
 
 /// The multiplier from radiance to pixel value described above (1 when nothing is set).
 float exposureScale(const ExposureSettings& settings);

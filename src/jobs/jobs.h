@@ -73,7 +73,8 @@ struct ViewSettings {
   float metresPerUnit(const Scene& scene) const;
   /// Camera(resolveCamera(scene), width, height, vignetting, metresPerUnit(scene)).
   Camera makeCamera(const Scene& scene) const;
-  /// The exposure as settings; throws pl::Error unless fstop/shutter/iso come all three or none.
+  /// The exposure as settings; throws pl::UsageError unless fstop/shutter/iso come all three
+  /// or none (photographicExposure, camera/exposure.h).
   ExposureSettings exposureSettings() const;
   /// Multiplier from scene radiance to pixel value (1 when no exposure is given).
   float exposureScale() const;
@@ -227,7 +228,7 @@ struct RenderJobOptions {
 /// What `plenoptic render --stats` writes.
 struct RenderJobStats {
   std::string input, output, camera, renderer, path;
-  int width = 0, height = 0, samplesPerPixel = 0, threads = 0, frames = 0;
+  int width = 0, height = 0, spp = 0, threads = 0, frames = 0;  ///< spp: camera samples per pixel used
   uint32_t mirrorDepth = 0;
   double msPerFrameMedian = 0, msPerFrameMin = 0, msPerFrameMax = 0, fps = 0;
   /// The primary rays alone (FastRenderer::castPrimaryRays) on the same cameras, timed after

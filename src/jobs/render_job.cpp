@@ -27,7 +27,8 @@ std::string RenderJobStats::toJson() const {
   json["camera"] = camera;
   json["width"] = width;
   json["height"] = height;
-  json["samples_per_pixel"] = samplesPerPixel;
+  json["spp"] = spp;
+  json["samples_per_pixel"] = spp;  // the former name of "spp", still written for one release (CHANGELOG.md)
   json["mirror_depth"] = mirrorDepth;
   json["threads"] = threads;
   json["renderer"] = renderer;
@@ -162,7 +163,7 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   stats.camera = cameraDesc.name;
   stats.width = view.width;
   stats.height = view.height;
-  stats.samplesPerPixel = effectiveSamplesPerPixel(settings, camera.isThinLens());
+  stats.spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
   stats.mirrorDepth = effectiveMirrorDepth(settings, lightField.settings.mirrorDepth);
   stats.threads = pool.threads();
   stats.renderer = o.reference ? "reference" : "fast";

@@ -47,9 +47,7 @@ Camera ViewSettings::makeCamera(const Scene& scene) const {
 ExposureSettings ViewSettings::exposureSettings() const {
   ExposureSettings settings;
   settings.compensationEv = exposureEv;
-  const int given = int(fstop.has_value()) + int(shutterSeconds.has_value()) + int(iso.has_value());
-  if (given != 0 && given != 3) fail("--fstop, --shutter and --iso: give all three (photographic exposure) or none");
-  if (given == 3) settings.photographic = PhotographicExposure{*fstop, *shutterSeconds, *iso};
+  settings.photographic = photographicExposure(fstop, shutterSeconds, iso, "--fstop, --shutter and --iso");
   return settings;
 }
 

@@ -207,9 +207,7 @@ int inRange(int value, int low, int high, const char* what) {
 ViewSettings pictureSettings(std::optional<float> ev, std::optional<float> fstop, std::optional<float> shutter,
                              std::optional<float> iso, const std::string& tonemap, std::optional<float> key, bool autoKey,
                              std::optional<float> white) {
-  const int given = int(fstop.has_value()) + int(shutter.has_value()) + int(iso.has_value());
-  if (given != 0 && given != 3)
-    throw UsageError("fstop, shutter and iso: give all three (photographic exposure) or none");
+  (void)photographicExposure(fstop, shutter, iso, "fstop, shutter and iso");  // all three or none
   ViewSettings view;
   view.exposureEv = ev;
   view.fstop = fstop;
@@ -226,6 +224,13 @@ ViewSettings pictureSettings(std::optional<float> ev, std::optional<float> fstop
     throw UsageError(e.what());
   }
   return view;
+}
+
+/// Camera samples per pixel from the `spp` keyword or its former name `samples` (still
+/// accepted); 0 = automatic when neither is given.
+int sppKeyword(std::optional<int> spp, std::optional<int> samples) {
+  if (spp && samples) throw UsageError("spp and samples are the same setting (samples is its former name): give one");
+  return spp ? *spp : samples.value_or(0);
 }
 
 /// A baked or loaded light field, shared by the Python objects that refer to it.
@@ -403,10 +408,10 @@ class FileError(Error, OSError):
           py::arg("path"), py::arg("compress") = "none", "Writes the .plf file (compress: none, lossless, bc1, hdr).")
       .def(
           "render",
-          [](const PyLightField& lf, int width, int height, int samples, const py::object& camera, uint64_t seed,
-             bool reference, int threads, bool textureLod) {
+          [](const PyLightField& lf, int width, int height, std::optional<int> spp, const py::object& camera,
+             uint64_t seed, bool reference, int threads, bool textureLod, std::optional<int> samples) {
             RenderJobOptions options;
-            options.render.samplesPerPixel = samples;
+            options.render.samplesPerPixel = sppKeyword(spp, samples);
             options.render.seed = seed;
             options.render.textureLod = textureLod;
             options.reference = reference;
@@ -415,19 +420,23 @@ class FileError(Error, OSError):
             const RenderJob job(std::move(options));
             return toArray(runInterruptible([&] { return job.run(*lf.lightField).image; }));
           },
-          py::arg("width") = 640, py::arg("height") = 480, py::arg("samples") = 0, py::arg("camera") = py::none(),
+          py::arg("width") = 640, py::arg("height") = 480, py::arg("spp") = py::none(), py::arg("camera") = py::none(),
           py::arg("seed") = 0, py::arg("reference") = false, py::arg("threads") = 0, py::arg("texture_lod") = true,
+          py::kw_only(), py::arg("samples") = py::none(),
           "Renders the light field (what `plenoptic render` does): float32 (height, width, 3), W/(sr m^2).\n"
-          "samples=0: 1 per pixel for a pinhole camera, 16 for a thin lens. reference=True: the reference renderer.\n"
+          "spp (or its former name samples): camera samples per pixel; none or 0: 1 for a pinhole camera, 16 for a\n"
+          "thin lens. reference=True: the reference renderer.\n"
           "texture_lod=False: albedo textures at full resolution (`--texture-lod off`).\n"
           "camera: a Camera, or a camera name of the scene (default: its first, else automatic).")
       .def(
           "render_path",
-          [](const PyLightField& lf, const py::object& path, int width, int height, int samples,
-             const py::object& camera, uint64_t seed, bool reference, int threads, bool textureLod) {
+          [](const PyLightField& lf, const py::object& path, int width, int height, std::optional<int> spp,
+             const py::object& camera, uint64_t seed, bool reference, int threads, bool textureLod,
+             std::optional<int> samples) {
             // The frames' cameras: a list of Cameras as they are, or a camera path file's frames
             // (camera/camera_path.h: frame k at t0 + k/fps) posed on `camera` (its lens, and
             // its fov where the path has none).
+            const int samplesPerPixel = sppKeyword(spp, samples);
             std::vector<CameraDesc> cameras;
             const ViewSettings base = viewSettings(width, height, camera);
             if (py::isinstance<py::str>(path)) {
@@ -447,7 +456,7 @@ class FileError(Error, OSError):
               std::vector<Image> images;
               for (const CameraDesc& frameCamera : cameras) {
                 RenderJobOptions options;
-                options.render.samplesPerPixel = samples;
+                options.render.samplesPerPixel = samplesPerPixel;
                 options.render.seed = seed;
                 options.render.textureLod = textureLod;
                 options.reference = reference;
@@ -462,9 +471,9 @@ class FileError(Error, OSError):
             for (const Image& frame : frames) arrays.append(toArray(frame));
             return arrays;
           },
-          py::arg("path"), py::arg("width") = 640, py::arg("height") = 480, py::arg("samples") = 0,
+          py::arg("path"), py::arg("width") = 640, py::arg("height") = 480, py::arg("spp") = py::none(),
           py::arg("camera") = py::none(), py::arg("seed") = 0, py::arg("reference") = false, py::arg("threads") = 0,
-          py::arg("texture_lod") = true,
+          py::arg("texture_lod") = true, py::kw_only(), py::arg("samples") = py::none(),
           "Renders a walk-through: path is a camera path JSON file (what `plenoptic render --path` renders, frame k at\n"
           "t0 + k/fps, posed on `camera`) or a list of Cameras. Returns a list of float32 (height, width, 3) frames.");
 

@@ -69,12 +69,16 @@ def test_bake_save_load_and_render(cornell, tmp_path):
     lf.save(str(path), compress="lossless")
     loaded = plenoptic.load_light_field(str(path))
     assert np.array_equal(loaded.render(width=32, height=24), frame)
-    reference = lf.render(width=32, height=24, samples=4, reference=True)
+    reference = lf.render(width=32, height=24, spp=4, reference=True)
     assert reference.shape == (24, 32, 3)
+    # samples, the former name of spp, is still accepted; both at once are refused.
+    assert np.array_equal(lf.render(width=32, height=24, samples=4, reference=True), reference)
+    with pytest.raises(plenoptic.UsageError, match="spp and samples"):
+        lf.render(width=32, height=24, spp=4, samples=4)
     # The light field against the path tracer: close in mean (the bake's draft preset).
     traced, _ = plenoptic.trace(cornell, width=32, height=24, spp=64)
     assert plenoptic.compare(reference, traced)["mean_luminance_ratio"] == pytest.approx(1.0, abs=0.1)
-    # The command line's --samples and --mirror-depth ranges hold for library callers too.
+    # The command line's --spp and --mirror-depth ranges hold for library callers too.
     for renderer in (False, True):
         with pytest.raises(plenoptic.UsageError, match="1000000000 samples per pixel is out of range"):
             lf.render(width=32, height=24, samples=10**9, reference=renderer)
@@ -137,7 +141,7 @@ def test_punctual_highlights_are_a_bake_option(tmp_path):
     errors = []
     for highlights in (True, False):
         lf = plenoptic.bake(scene, preset="draft", punctual_highlights=highlights)
-        image = lf.render(width=32, height=32, samples=16, camera=camera)
+        image = lf.render(width=32, height=32, spp=16, camera=camera)
         errors.append(plenoptic.compare(image, reference)["relmse"])
     print("relMSE with and without punctual highlights:", errors)
     assert errors[0] < 0.005 and errors[1] > 10.0 * errors[0]

@@ -14,7 +14,7 @@
 //
 // Pixel value = mean over the pixel's samples of (camera weight × radiance), in
 // W·sr⁻¹·m⁻² (camera weight = cos⁴θ with vignetting, else 1). No exposure or tone mapping
-// here: the caller writes the image through app/view_options (ViewOptions::writeImage), as
+// here: the caller writes the image through ViewSettings::writeImage (jobs/jobs.h), as
 // `trace` does, so both renderers' files are directly comparable.
 //
 // Sampling: with one sample per pixel the ray goes through the pixel centre (and the lens

@@ -132,7 +132,8 @@ TEST_F(RenderCliTest, RenderWritesTheLookedUpRadianceAndStats) {
   EXPECT_EQ(json["renderer"], "reference");
   EXPECT_EQ(json["frames"], 3);
   EXPECT_EQ(json["camera"], "top");
-  EXPECT_EQ(json["samples_per_pixel"], 1);
+  EXPECT_EQ(json["spp"], 1);
+  EXPECT_EQ(json["samples_per_pixel"], 1);  // the former name, still written for one release
   const double median = json["ms_per_frame_median"];
   EXPECT_GT(median, 0.0);
   EXPECT_GE(median, double(json["ms_per_frame_min"]));
@@ -156,6 +157,30 @@ TEST_F(RenderCliTest, FastRenderStatsTimePrimaryRaysAlone) {
   EXPECT_GT(primary, 0.0);
   EXPECT_LE(double(json["primary_ms_min"]), primary);
   EXPECT_NEAR(double(json["ratio_to_primary"]), frame / primary, 1e-9 * frame / primary);
+}
+
+// --spp is the name of samples per pixel in every command and stats file; --samples, the
+// name render used first, is still accepted and means the same.
+TEST_F(RenderCliTest, SamplesPerPixelIsSppAndSamplesStillWorks) {
+  for (const std::string flag : {"--spp", "--samples"}) {
+    SCOPED_TRACE(flag);
+    const std::string stats = path("spp.json"), out = path("spp" + flag + ".exr");
+    std::string err;
+    ASSERT_EQ(run("render " + path("quad.plf") + " -o " + out + " --width 12 --height 8 " + flag + " 3 --stats " + stats,
+                  nullptr, &err),
+              0)
+        << err;
+    const auto json = nlohmann::json::parse(cli_test::readFileText(stats));
+    EXPECT_EQ(json["spp"], 3);
+    EXPECT_EQ(json["samples_per_pixel"], 3);
+  }
+  EXPECT_EQ(readImage(path("spp--spp.exr")).pixels, readImage(path("spp--samples.exr")).pixels);
+  std::string err;
+  ASSERT_EQ(run("trace cornell -o " + path("t.pfm") + " --width 4 --height 4 --samples 2 --stats " + path("t.json"), nullptr,
+                &err),
+            0)
+      << err;
+  EXPECT_EQ(nlohmann::json::parse(cli_test::readFileText(path("t.json")))["spp"], 2);
 }
 
 TEST_F(RenderCliTest, RenderWritesPng) {

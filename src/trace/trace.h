@@ -8,7 +8,7 @@
 // Conventions:
 //  * A pixel value is the mean over the pixel's area (box filter) of camera weight × radiance
 //    (W·sr⁻¹·m⁻², linear Rec.709), where the camera weight is cos⁴θ with vignetting on, else 1.
-//    No exposure is applied here (the caller's ViewOptions do that when writing files).
+//    No exposure is applied here (the caller's ViewSettings do that when writing files).
 //  * Every sample's numbers come from a Sampler (core/sampler.h) of (pixel, sample index,
 //    seed) — Owen-scrambled ZSobol by default, or the independent PCG32 stream
 //    Pcg32::forKey(pixel index, sample index, seed) — so an image depends on the seed only,
