@@ -4,12 +4,14 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <functional>
 #include <future>
 
 #include "accel/accel.h"
 #include "core/error.h"
 #include "core/memory.h"
 #include "core/parallel.h"
+#include "core/timing.h"
 #include "bake/parameterisation.h"
 #include "bake/propagation.h"
 #include "bake/shard.h"
@@ -55,114 +57,128 @@ std::vector<std::string> bakePresetNames() {
   return names;
 }
 
-LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  auto note = [&](const std::string& text) {
-    if (options.log) options.log(text);
-  };
-  SingleProcess single;
-  Communicator& comm = options.communicator ? *options.communicator : single;
-  const int rank = comm.rank(), ranks = comm.size();
-  LightField lf;
-  lf.scene = std::move(scene);
-  lf.settings = settings;
-  // Setup. The BVH and the charts are per scene: every rank builds them. The per-tixel part
-  // (footprints and buried-point probes, most of the time on a large scene) is divided
-  // between the ranks and exchanged (shard.h fillTixelsDistributed).
-  const Accel accel(lf.scene);
-  Parameterisation param = buildCharts(lf.scene, accel, settings);
-  const double setupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const TixelSetupTiming tixelSetup = fillTixelsDistributed(lf.scene, accel, param, comm);
-  const uint64_t hash = visibilityHash(lf.scene, param, settings);
-  if (ranks > 1) {
-    // Every rank must bake the same geometry, parameterisation and settings (the job compares
-    // the scene files first; this also covers the files they reference), or the exchanged
-    // values would mean different tixels: refused before any ray is traced.
-    uint64_t rank0Hash = 0;
-    const std::string differ = comm.ranksDiffering(hash, rank0Hash);
-    if (!differ.empty())
-      fail("{}: rank(s) {} of {} have a different scene geometry, parameterisation or settings than rank 0 "
-           "(visibility hash {:016x}, rank 0 {:016x}); every rank must bake the same scene",
-           lf.scene.sourcePath, differ, ranks, hash, rank0Hash);
+namespace {
+
+using Note = std::function<void(const std::string&)>;
+
+/// Every rank must bake the same geometry, parameterisation and settings (the job compares the
+/// scene files first; this also covers the files they reference), or the exchanged values
+/// would mean different tixels: refused before any ray is traced.
+void requireSameBakeOnEveryRank(Communicator& comm, uint64_t hash, const Scene& scene) {
+  if (comm.size() <= 1) return;
+  uint64_t rank0Hash = 0;
+  const std::string differ = comm.ranksDiffering(hash, rank0Hash);
+  if (!differ.empty())
+    fail("{}: rank(s) {} of {} have a different scene geometry, parameterisation or settings than rank 0 "
+         "(visibility hash {:016x}, rank 0 {:016x}); every rank must bake the same scene",
+         scene.sourcePath, differ, comm.size(), hash, rank0Hash);
+}
+
+void noteParameterisation(const Note& note, const Parameterisation& param, double setupSeconds,
+                          const TixelSetupTiming& tixelSetup, int ranks) {
+  uint64_t byKind[3] = {0, 0, 0}, tixelsByKind[3] = {0, 0, 0};
+  for (const Chart& c : param.charts) {
+    ++byKind[size_t(c.kind)];
+    tixelsByKind[size_t(c.kind)] += c.tixelCount();
   }
-  {
-    uint64_t byKind[3] = {0, 0, 0}, tixelsByKind[3] = {0, 0, 0};
-    for (const Chart& c : param.charts) {
-      ++byKind[size_t(c.kind)];
-      tixelsByKind[size_t(c.kind)] += c.tixelCount();
-    }
-    note(fmt::format("parameterisation: {} charts ({} diffuse, {} glossy, {} specular), {} tixels ({} diffuse, {} glossy), "
-                     "{} values; room scale {:.4g}, tixel size {:.4g} (scene units); BVH and charts {:.2f} s, "
-                     "tixels {:.2f} s{}",
-                     param.charts.size(), byKind[0], byKind[1], byKind[2], param.tixelCount, tixelsByKind[0],
-                     tixelsByKind[1], param.valueCount, param.sceneScale, param.baseTixelSize, setupSeconds,
-                     tixelSetup.seconds,
-                     ranks > 1 ? fmt::format(" (this rank's share; exchanged in {:.2f} s)", tixelSetup.exchangeSeconds) : ""));
-  }
-  const ShardPlan plan = planShards(lf.scene, param, settings, ranks);
-  const std::vector<TixelRange> held = visibilityRanges(lf.scene, param, plan, rank);
+  note(fmt::format("parameterisation: {} charts ({} diffuse, {} glossy, {} specular), {} tixels ({} diffuse, {} glossy), "
+                   "{} values; room scale {:.4g}, tixel size {:.4g} (scene units); BVH and charts {:.2f} s, "
+                   "tixels {:.2f} s{}",
+                   param.charts.size(), byKind[0], byKind[1], byKind[2], param.tixelCount, tixelsByKind[0],
+                   tixelsByKind[1], param.valueCount, param.sceneScale, param.baseTixelSize, setupSeconds,
+                   tixelSetup.seconds,
+                   ranks > 1 ? fmt::format(" (this rank's share; exchanged in {:.2f} s)", tixelSetup.exchangeSeconds) : ""));
+}
+
+/// This rank's share of the bake (shard.h): the tixels whose visibility it holds and those it updates.
+struct RankShare {
+  std::vector<TixelRange> held;  ///< visibilityRanges: its own tixels and the rough-glass twins they need
   uint64_t heldTixels = 0, ownTixels = 0;
-  for (const TixelRange& r : held) heldTixels += r.size();
-  for (const TixelRange& r : plan.owned(rank)) ownTixels += r.size();
-  double totalCost = 0.0;
-  for (double c : plan.rankCost) totalCost += c;
-  if (ranks > 1) {
+  double totalCost = 0.0;  ///< Σ plan.rankCost (0 for one rank: not estimated)
+};
+
+RankShare rankShare(const Scene& scene, const Parameterisation& param, const ShardPlan& plan, int rank, const Note& note) {
+  RankShare share;
+  share.held = visibilityRanges(scene, param, plan, rank);
+  for (const TixelRange& r : share.held) share.heldTixels += r.size();
+  for (const TixelRange& r : plan.owned(rank)) share.ownTixels += r.size();
+  for (double c : plan.rankCost) share.totalCost += c;
+  if (plan.ranks > 1) {
     double largest = 0.0;
     for (double c : plan.rankCost) largest = std::max(largest, c);
     note(fmt::format("distributed: {} ranks, {} batches split by estimated cost (largest share {:.1f} %, even {:.1f} %); "
                      "rank {} updates {} tixels and holds the visibility of {}",
-                     ranks, plan.batches(), totalCost > 0 ? 100.0 * largest / totalCost : 0.0, 100.0 / ranks, rank,
-                     ownTixels, heldTixels));
+                     plan.ranks, plan.batches(), share.totalCost > 0 ? 100.0 * largest / share.totalCost : 0.0,
+                     100.0 / plan.ranks, rank, share.ownTixels, share.heldTixels));
   }
-  if (options.checkMemory)
-    options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, heldTixels));
+  return share;
+}
 
-  const std::string visibilityPath = shardVisibilityPath(options.visibilityPath, rank, ranks);
-  const uint64_t shardHash = visibilityShardHash(hash, held, param.tixelCount);
+/// The visibility field (this rank's shard) and the propagation through it.
+struct Transport {
   VisibilityShard visibility;
-  bool reused = false;
+  bool reused = false;  ///< the field was read from options.visibilityPath, not traced
+  PropagationResult propagation;
+};
+
+/// Reads the saved field when asked to and it matches `hash`, else traces (and saves) it; and
+/// propagates. A saved field is read on its own thread while propagation starts with the
+/// shadow rays of the first shot, which do not need it; propagation waits for it after them.
+Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                            const BakeSettings& settings, const BakeOptions& options, Communicator& comm,
+                            const ShardPlan& plan, const std::vector<TixelRange>& held, uint64_t hash, const Note& note) {
+  const std::string visibilityPath = shardVisibilityPath(options.visibilityPath, comm.rank(), comm.size());
+  const uint64_t shardHash = visibilityShardHash(hash, held, param.tixelCount);
+  Transport t;
   auto computeAndSave = [&] {
-    visibility = computeVisibilityShard(lf.scene, accel, param, settings, held);
-    const VisibilityField& f = visibility.field;
+    t.visibility = computeVisibilityShard(scene, accel, param, settings, held);
+    const VisibilityField& f = t.visibility.field;
     note(fmt::format("visibility: {} rays in {:.2f} s ({:.1f} Mrays/s), {:.1f} MB", f.rays, f.seconds,
                      f.seconds > 0 ? f.rays / f.seconds * 1e-6 : 0.0, f.bytes() / 1e6));
     if (!visibilityPath.empty()) writeVisibility(visibilityPath, f);
   };
-  PropagationResult prop;
   if (options.reuseVisibility && !visibilityPath.empty()) {
-    // The saved field is read on its own thread while propagation starts with the shadow rays
-    // of the first shot, which do not need it; propagation waits for it after them.
     std::string why;
     double readSeconds = 0.0;
     std::future<bool> read = std::async(std::launch::async, [&] {
       const auto readStart = std::chrono::steady_clock::now();
       VisibilityField field;
       const bool ok = readVisibility(visibilityPath, shardHash, field, &why, param.tixelCount);
-      if (ok) visibility = VisibilityShard::of(std::move(field), held);
-      readSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - readStart).count();
+      if (ok) t.visibility = VisibilityShard::of(std::move(field), held);
+      readSeconds = secondsSince(readStart);
       return ok;
     });
-    prop = propagate(lf.scene, accel, param, [&]() -> const VisibilityShard& {
-      reused = read.get();
-      if (reused) {
+    t.propagation = propagate(scene, accel, param, [&]() -> const VisibilityShard& {
+      t.reused = read.get();
+      if (t.reused) {
         note(fmt::format("visibility: reusing {} ({} tixels × {} directions, read in {:.2f} s, overlapping the shadow rays)",
-                         visibilityPath, visibility.field.tixelCount, visibility.field.directionsPerTixel(), readSeconds));
+                         visibilityPath, t.visibility.field.tixelCount, t.visibility.field.directionsPerTixel(),
+                         readSeconds));
       } else {
         note(fmt::format("visibility: recomputing, because {}", why));
         computeAndSave();
       }
-      return visibility;
+      return t.visibility;
     }, settings, comm, plan);
   } else {
     computeAndSave();
-    prop = propagate(lf.scene, accel, param, [&]() -> const VisibilityShard& { return visibility; }, settings, comm, plan);
+    t.propagation = propagate(scene, accel, param, [&]() -> const VisibilityShard& { return t.visibility; }, settings,
+                              comm, plan);
   }
+  const PropagationResult& prop = t.propagation;
   note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s (first shot {:.2f} s, {} shadow rays)",
                    prop.iterations, prop.residual, prop.seconds, prop.firstShotSeconds, prop.shadowRays));
+  return t;
+}
 
-  // Every rank's figures, in rank order (collectives: every rank gets here).
-  const uint64_t rays = reused ? 0 : visibility.field.rays;
-  const double visibilitySeconds = reused ? 0.0 : visibility.field.seconds;
+/// Every rank's figures, in rank order: collectives, so every rank calls it, in the same order.
+DistributedBakeStats gatherDistributedStats(Communicator& comm, const ShardPlan& plan, const RankShare& share,
+                                            double setupSeconds, const TixelSetupTiming& tixelSetup,
+                                            const Transport& t, const Note& note) {
+  const int ranks = comm.size();
+  const PropagationResult& prop = t.propagation;
+  const uint64_t rays = t.reused ? 0 : t.visibility.field.rays;
+  const double visibilitySeconds = t.reused ? 0.0 : t.visibility.field.seconds;
   auto gatherDoubles = [&](double value) {
     std::vector<double> out;
     for (uint64_t bits : comm.allgather(std::bit_cast<uint64_t>(value))) out.push_back(std::bit_cast<double>(bits));
@@ -170,10 +186,11 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   };
   DistributedBakeStats distributed;
   distributed.ranks = ranks;
-  distributed.ownTixels = ownTixels;
-  distributed.heldTixels = heldTixels;
+  distributed.ownTixels = share.ownTixels;
+  distributed.heldTixels = share.heldTixels;
   // (One rank: no costs are estimated, its share is the whole.)
-  for (double c : plan.rankCost) distributed.estimatedCost.push_back(totalCost > 0 ? c / totalCost : 1.0 / ranks);
+  for (double c : plan.rankCost)
+    distributed.estimatedCost.push_back(share.totalCost > 0 ? c / share.totalCost : 1.0 / ranks);
   distributed.setupSeconds = setupSeconds;
   distributed.tixelSetupSeconds = gatherDoubles(tixelSetup.seconds);
   distributed.tixelSetupExchangeSeconds = tixelSetup.exchangeSeconds;
@@ -188,34 +205,81 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   distributed.exchanges = comm.exchanges();
   distributed.exchangeSeconds = prop.exchangeSeconds;
   if (ranks > 1)
-    note(fmt::format("distributed: rank {} received {:.1f} MB in {} exchanges, {:.2f} s inside them", rank,
+    note(fmt::format("distributed: rank {} received {:.1f} MB in {} exchanges, {:.2f} s inside them", comm.rank(),
                      prop.exchangeBytes / 1e6, comm.exchanges(), prop.exchangeSeconds));
+  return distributed;
+}
 
+/// The charts, values and sun masks of the light field from the parameterisation and the
+/// propagated values (moved out of `values`): the masked lights leave the stored irradiance
+/// and go with the masks (lightfield.h "Sun masks").
+void storeLightField(LightField& lf, const Parameterisation& param, std::vector<Rgb>&& values) {
   lf.charts = param.charts;
   lf.triangleChart = param.triangleChart;
-  lf.values = std::move(prop.values);
-  // Sun masks: the masked lights leave the stored irradiance and go with the masks
-  // (lightfield.h "Sun masks").
+  lf.values = std::move(values);
   removeSunMaskedDirect(lf.scene, param, lf.values);
   lf.sunMaskLightCount = uint32_t(param.sunMaskLights.size());
   lf.sunMasks.reserve(param.tixelCount * lf.sunMaskLightCount);
   for (uint64_t g = 0; g < param.tixelCount && lf.sunMaskLightCount > 0; ++g)
     lf.sunMasks.insert(lf.sunMasks.end(), param.sunMask[g].begin(), param.sunMask[g].begin() + lf.sunMaskLightCount);
+}
+
+/// The bake's statistics (lightfield.h BakeStats) but its total time and peak memory, which
+/// the caller adds last: visibility time is the slowest rank's, rays are every rank's.
+BakeStats bakeStats(const Parameterisation& param, const Transport& t, const DistributedBakeStats& distributed) {
   double slowestVisibility = 0.0;
   uint64_t totalRays = 0;
-  for (int r = 0; r < ranks; ++r) {
+  for (int r = 0; r < distributed.ranks; ++r) {
     slowestVisibility = std::max(slowestVisibility, distributed.visibilitySeconds[size_t(r)]);
     totalRays += distributed.visibilityRays[size_t(r)];
   }
-  lf.stats.visibilitySeconds = slowestVisibility;
-  lf.stats.propagationSeconds = prop.seconds;
-  lf.stats.iterations = prop.iterations;
-  lf.stats.residual = prop.residual;
-  lf.stats.tixels = param.tixelCount;
-  lf.stats.values = param.valueCount;
-  lf.stats.visibilityRays = totalRays;
-  lf.stats.reusedVisibility = reused;
-  lf.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  BakeStats stats;
+  stats.visibilitySeconds = slowestVisibility;
+  stats.propagationSeconds = t.propagation.seconds;
+  stats.iterations = t.propagation.iterations;
+  stats.residual = t.propagation.residual;
+  stats.tixels = param.tixelCount;
+  stats.values = param.valueCount;
+  stats.visibilityRays = totalRays;
+  stats.reusedVisibility = t.reused;
+  return stats;
+}
+
+}  // namespace
+
+LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const Note note = [&](const std::string& text) {
+    if (options.log) options.log(text);
+  };
+  SingleProcess single;
+  Communicator& comm = options.communicator ? *options.communicator : single;
+  LightField lf;
+  lf.scene = std::move(scene);
+  lf.settings = settings;
+  // 1. Parameterisation. The BVH and the charts are per scene: every rank builds them. The
+  // per-tixel part (footprints and buried-point probes, most of the time on a large scene) is
+  // divided between the ranks and exchanged (shard.h fillTixelsDistributed).
+  const Accel accel(lf.scene);
+  Parameterisation param = buildCharts(lf.scene, accel, settings);
+  const double setupSeconds = secondsSince(start);
+  const TixelSetupTiming tixelSetup = fillTixelsDistributed(lf.scene, accel, param, comm);
+  const uint64_t hash = visibilityHash(lf.scene, param, settings);
+  requireSameBakeOnEveryRank(comm, hash, lf.scene);
+  noteParameterisation(note, param, setupSeconds, tixelSetup, comm.size());
+  const ShardPlan plan = planShards(lf.scene, param, settings, comm.size());
+  const RankShare share = rankShare(lf.scene, param, plan, comm.rank(), note);
+  if (options.checkMemory)
+    options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels));
+
+  // 2. Visibility field and 3. propagation.
+  Transport transport = traceAndPropagate(lf.scene, accel, param, settings, options, comm, plan, share.held, hash, note);
+  DistributedBakeStats distributed =
+      gatherDistributedStats(comm, plan, share, setupSeconds, tixelSetup, transport, note);
+
+  storeLightField(lf, param, std::move(transport.propagation.values));
+  lf.stats = bakeStats(param, transport, distributed);
+  lf.stats.seconds = secondsSince(start);
   lf.stats.peakRssBytes = peakRssBytes();
   if (options.distributedStats) *options.distributedStats = std::move(distributed);
   return lf;

@@ -14,6 +14,7 @@
 #include "bake/shard.h"
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/timing.h"
 #include "core/progress.h"
 #include "core/sampler.h"
 #include "core/sampling.h"
@@ -993,6 +994,195 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   }, settings, single, plan);
 }
 
+namespace {
+
+/// The exchange step of a distributed propagation: after a batch, every rank's part of its
+/// values is copied to every other rank (in place: values are in tixel order, so a part is one
+/// contiguous run of values). Nothing to do for one rank.
+class ValueExchange {
+ public:
+  ValueExchange(const Parameterisation& param, const ShardPlan& plan, Communicator& comm)
+      : param_(param), plan_(plan), comm_(comm), displacement_(size_t(comm.size())), count_(size_t(comm.size())) {}
+
+  /// Exchanges every rank's part of batch `batch` of `values`.
+  void batch(std::vector<Rgb>& values, size_t batch) {
+    const int ranks = comm_.size();
+    if (ranks == 1) return;
+    const auto start = std::chrono::steady_clock::now();
+    for (int r = 0; r < ranks; ++r) {
+      const TixelRange part = plan_.part(batch, r);
+      const uint64_t v0 = firstValueOf(param_, part.begin), v1 = firstValueOf(param_, part.end);
+      displacement_[size_t(r)] = v0 * sizeof(Rgb);
+      count_[size_t(r)] = (v1 - v0) * sizeof(Rgb);
+    }
+    comm_.allgatherv(values.data(), displacement_, count_);
+    seconds_ += secondsSince(start);
+  }
+  /// Exchanges every batch of `values`.
+  void all(std::vector<Rgb>& values) {
+    for (size_t b = 0; b < plan_.batches(); ++b) batch(values, b);
+  }
+  /// Time spent inside the exchanges (waiting for the slowest rank included).
+  double seconds() const { return seconds_; }
+
+ private:
+  const Parameterisation& param_;
+  const ShardPlan& plan_;
+  Communicator& comm_;
+  std::vector<uint64_t> displacement_, count_;
+  double seconds_ = 0.0;
+};
+
+/// The first shot of this rank's tixels: shadow rays, then (the visibility field obtained,
+/// its time returned in waitSeconds) the gathered emission, then the exchange of the direct
+/// values. Returns the visibility field.
+const VisibilityShard& shootFirstShot(TransportState& state, const ShardPlan& plan, int rank,
+                                      const std::function<const VisibilityShard&()>& visibility,
+                                      ValueExchange& exchange, double& waitSeconds) {
+  const std::vector<TixelRange> own = plan.owned(rank);
+  uint64_t ownTixels = 0;
+  for (const TixelRange& r : own) ownTixels += r.size();
+  {
+    Progress progress("direct light", ownTixels);
+    for (const TixelRange& r : own) shootShadowRays(state, r.begin, r.end, &progress);
+  }
+  // From here on the visibility field is needed. Time spent obtaining it (waiting for a read
+  // that overlapped the shadow rays, or tracing it) is not propagation time.
+  const auto waitStart = std::chrono::steady_clock::now();
+  const VisibilityShard& vis = visibility();
+  waitSeconds = secondsSince(waitStart);
+  // The rank's own tixels and the rough-glass twins it holds (whose gathered cells its own
+  // glass records transmit; their direct values are replaced by the exchange below).
+  for (const TixelRange& r : vis.ranges) gatherEmission(state, vis, r.begin, r.end);
+  finishFirstShot(state);
+  exchange.all(state.direct);
+  if (!state.punctualGlossy.empty()) exchange.all(state.punctualGlossy);
+  return vis;
+}
+
+// The iteration is Gauss–Seidel by batches of whole charts: batches are updated one after
+// another, so a batch already sees this iteration's values of the batches before it (about
+// half the iterations of Jacobi). Inside a batch, tixels are updated in parallel and read the
+// previous iteration's values of their own batch, so no value is read while it is written
+// and the result does not depend on thread timing.
+//
+// Over-relaxed (SOR): a tixel's new values are old + ω·(update − old), clamped at 0. Plain
+// Gauss–Seidel (ω = 1) from the first shot only ever adds light, so it approaches the
+// solution from below, each iteration closing a fixed fraction (1 − ρ) of the gap; stepping
+// past the update by ω − 1 closes more of it. ω = 1.2 took the fewest iterations on the
+// Cornell boxes (docs/benchmarks.md, Propagation); much larger values overshoot, and ω ≥ 2
+// diverges. If the L1 change grows after the second iteration, the rest of the iteration
+// falls back to ω = 1, which converges for any ρ < 1.
+//
+// Distributed (shard.h): a rank updates its part of each batch, the parts are exchanged
+// before the next batch, and the batch's transport is refreshed on every rank from the
+// exchanged values, so each batch still sees this iteration's values of the batches before
+// it. The stopping rule then runs on every rank over the same values in the same order.
+constexpr float kOverRelaxation = 1.2f;
+
+/// When to stop. The residual is the relative change of the total outgoing power, |ΔP| / P,
+/// and iteration stops once it is below the tolerance — and once, too, the error that remains is:
+///   * with over-relaxation, changes of opposite sign in different tixels could cancel in ΔP
+///     while the values still swing, so the L1 change δ = Σ area·|Δ exitance| / P is tracked
+///     (for plain Gauss–Seidel every change is ≥ 0 and δ = |ΔP|/P);
+///   * the error left after a change δ is the rest of a geometric series, δ·ρ̂/(1 − ρ̂), with
+///     ρ̂ = δ_k / δ_{k−1} the measured contraction: below δ while ρ̂ < ½, but 9·δ for a bright
+///     closed scene converging at ρ̂ = 0.9, where the last change alone would stop too early.
+/// Both |ΔP|/P and δ·ρ̂/(1 − ρ̂) must be below the tolerance. It also owns ω, which falls back to
+/// 1 when δ grows after the second iteration.
+class StoppingRule {
+ public:
+  StoppingRule(double startPower, float tolerance) : previousPower_(startPower), tolerance_(tolerance) {}
+
+  /// After iteration `iteration` (from 1) with total power `power` and L1 change `changed`
+  /// (transportPower, transportChange): sets result.iterations and result.residual, and
+  /// whether to stop.
+  bool converged(uint32_t iteration, double power, double changed, PropagationResult& result) {
+    const double l1Change = power > 0.0 ? changed / power : 0.0;
+    if (iteration > 2 && l1Change > previousL1Change_) omega_ = 1.0f;
+    const double contraction = previousL1Change_ > 0.0 ? l1Change / previousL1Change_ : 1.0;
+    const double remainingError = l1Change == 0.0 ? 0.0 : (contraction < 1.0 ? l1Change * contraction / (1.0 - contraction) : kInfinity);
+    result.iterations = iteration;
+    result.residual = power > 0.0 ? std::abs(power - previousPower_) / power : 0.0;
+    previousPower_ = power;
+    previousL1Change_ = l1Change;
+    return result.residual < tolerance_ && remainingError < tolerance_;
+  }
+  /// The over-relaxation of the next iteration.
+  float omega() const { return omega_; }
+
+ private:
+  double previousPower_, previousL1Change_ = 0.0;
+  float tolerance_;
+  float omega_ = kOverRelaxation;
+};
+
+/// One iteration: every batch in order, this rank's part gathered (gatherIteration), the
+/// parts exchanged, the batch's transport refreshed and the change of the other ranks'
+/// tixels measured from the iteration's starting values. Adds its times to `result`.
+void iterateOnce(TransportState& state, const VisibilityShard& vis, const ShardPlan& plan, int rank, float omega,
+                 ValueExchange& exchange, bool keepPrevious, PropagationResult& result) {
+  const std::vector<uint64_t>& batchStart = state.batchStart;
+  auto repeatedStart = std::chrono::steady_clock::now();
+  // The iteration's starting values are also what the change of the tixels other ranks
+  // updated is measured from (recomputeChange).
+  if (keepPrevious) state.previousValues = state.current;
+  result.repeatedSeconds += secondsSince(repeatedStart);
+  for (size_t batch = 0; batch + 1 < batchStart.size(); ++batch) {
+    const uint64_t begin = batchStart[batch], end = batchStart[batch + 1];
+    const TixelRange mine = plan.part(batch, rank);
+    const auto gatherStart = std::chrono::steady_clock::now();
+    gatherIteration(state, vis, mine.begin, mine.end, omega);
+    result.gatherSeconds += secondsSince(gatherStart);
+    exchange.batch(state.current, batch);
+    repeatedStart = std::chrono::steady_clock::now();
+    updateTransport(state, begin, end);
+    for (int r = 0; r < plan.ranks; ++r) {
+      const TixelRange theirs = plan.part(batch, r);
+      if (r != rank) recomputeChange(state, state.previousValues, theirs.begin, theirs.end);
+    }
+    result.repeatedSeconds += secondsSince(repeatedStart);
+  }
+}
+
+/// The iteration, from the first shot to convergence (StoppingRule) or maxIterations.
+void iterate(TransportState& state, const VisibilityShard& vis, const ShardPlan& plan, int rank, ValueExchange& exchange,
+             PropagationResult& result) {
+  const Scene& scene = state.scene;
+  const Parameterisation& param = state.param;
+  const BakeSettings& settings = state.settings;
+  beginIteration(state);
+  // The previous iteration's values are needed only by lookups in glossy charts of the batch
+  // being updated (diffuse lookups read the quads, which lag by a batch), and by the change of
+  // the tixels other ranks updated.
+  const bool anyGlossy = std::any_of(param.charts.begin(), param.charts.end(),
+                                     [](const Chart& c) { return c.kind == ChartKind::Glossy; });
+  const bool keepPrevious = anyGlossy || plan.ranks > 1;
+  StoppingRule stopping(transportPower(state, state.current), settings.tolerance);
+  Progress progress("propagation", settings.maxIterations);
+  for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
+    iterateOnce(state, vis, plan, rank, stopping.omega(), exchange, keepPrevious, result);
+    const auto repeatedStart = std::chrono::steady_clock::now();
+    const double power = transportPower(state, state.current);
+    if (!std::isfinite(power)) {
+      requireFiniteValues(scene, param, state.current, fmt::format("in iteration {}", iteration));
+      fail("{}: light propagation overflowed in iteration {}: the total power is not finite; scale the emission down",
+           scene.sourcePath, iteration);
+    }
+    const double changed = transportChange(state);
+    result.repeatedSeconds += secondsSince(repeatedStart);
+    progress.advance(1);
+    if (stopping.converged(iteration, power, changed, result)) {
+      // Converged: the iterations left are not needed, so the bar completes.
+      progress.advance(settings.maxIterations - iteration);
+      break;
+    }
+  }
+  progress.finish();
+}
+
+}  // namespace
+
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const std::function<const VisibilityShard&()>& visibility, const BakeSettings& settings,
                             Communicator& comm, const ShardPlan& plan) {
@@ -1003,152 +1193,20 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   if (plan.ranks != ranks || plan.batchStart != state.batchStart)
     fail("{}: the shard plan ({} ranks, {} batches) does not fit this propagation ({} ranks, {} batches)", scene.sourcePath,
          plan.ranks, plan.batches(), ranks, state.batchStart.size() - 1);
-  const std::vector<TixelRange> own = plan.owned(rank);
-  uint64_t ownTixels = 0;
-  for (const TixelRange& r : own) ownTixels += r.size();
-
-  // The exchange: after a batch, every rank's part of its values is copied to every other rank
-  // (in place: values are in tixel order, so a part is one contiguous run of values).
-  std::vector<uint64_t> displacement(static_cast<size_t>(ranks)), count(static_cast<size_t>(ranks));
-  auto exchange = [&](std::vector<Rgb>& values, size_t batch) {
-    if (ranks == 1) return;
-    const auto exchangeStart = std::chrono::steady_clock::now();
-    for (int r = 0; r < ranks; ++r) {
-      const TixelRange part = plan.part(batch, r);
-      const uint64_t v0 = firstValueOf(param, part.begin), v1 = firstValueOf(param, part.end);
-      displacement[size_t(r)] = v0 * sizeof(Rgb);
-      count[size_t(r)] = (v1 - v0) * sizeof(Rgb);
-    }
-    comm.allgatherv(values.data(), displacement, count);
-    result.exchangeSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - exchangeStart).count();
-  };
+  ValueExchange exchange(param, plan, comm);
   const uint64_t bytesBefore = comm.bytesReceived();
 
-  // ---- First shot ------------------------------------------------------------------------
-  {
-    Progress progress("direct light", ownTixels);
-    for (const TixelRange& r : own) shootShadowRays(state, r.begin, r.end, &progress);
-  }
-
-  // From here on the visibility field is needed. Time spent obtaining it (waiting for a read
-  // that overlapped the shadow rays, or tracing it) is not propagation time.
-  const auto waitStart = std::chrono::steady_clock::now();
-  const VisibilityShard& vis = visibility();
-  const double waitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - waitStart).count();
-  // The rank's own tixels and the rough-glass twins it holds (whose gathered cells its own
-  // glass records transmit; their direct values are replaced by the exchange below).
-  for (const TixelRange& r : vis.ranges) gatherEmission(state, vis, r.begin, r.end);
-  finishFirstShot(state);
-  for (size_t b = 0; b < plan.batches(); ++b) exchange(state.direct, b);
-  if (!state.punctualGlossy.empty())
-    for (size_t b = 0; b < plan.batches(); ++b) exchange(state.punctualGlossy, b);
-
-  result.firstShotSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - waitSeconds;
-
-  // ---- Iteration ---------------------------------------------------------------------------
-  beginIteration(state);
-  // Gauss–Seidel by batches of whole charts: batches are updated one after another, so a
-  // batch already sees this iteration's values of the batches before it (about half the
-  // iterations of Jacobi). Inside a batch, tixels are updated in parallel and read the
-  // previous iteration's values of their own batch, so no value is read while it is written
-  // and the result does not depend on thread timing.
-  //
-  // Over-relaxed (SOR): a tixel's new values are old + ω·(update − old), clamped at 0. Plain
-  // Gauss–Seidel (ω = 1) from the first shot only ever adds light, so it approaches the
-  // solution from below, each iteration closing a fixed fraction (1 − ρ) of the gap; stepping
-  // past the update by ω − 1 closes more of it. Measured with the default preset (iterations
-  // to the 1e-3 tolerance, ω = 1 → 1.2): built-in Cornell box 8 → 4, CornellBox-Glossy 8 → 4,
-  // CornellBox-Mirror 6 → 5, each ending closer to the converged solution than before;
-  // white furnace a = 0.9 (gather only, tolerance 1e-7) 107 → 90. ω = 1.15 and 1.25 take more
-  // iterations on the Cornell box, ω = 1.3 overshoots, ω ≥ 2 diverges. If the L1 change below
-  // grows after the second iteration, the rest of the iteration falls back to ω = 1, which
-  // converges for any ρ < 1.
-  //
-  // Distributed (shard.h): a rank updates its part of each batch, the parts are exchanged
-  // before the next batch, and the batch's transport is refreshed on every rank from the
-  // exchanged values, so each batch still sees this iteration's values of the batches before
-  // it. The stopping rule below then runs on every rank over the same values in the same order.
-  //
-  // Stopping. The residual is the relative change of the total outgoing power, |ΔP| / P, and
-  // iteration stops once it is below the tolerance — and once, too, the error that remains is:
-  //   * with over-relaxation, changes of opposite sign in different tixels could cancel in ΔP
-  //     while the values still swing, so the L1 change δ = Σ area·|Δ exitance| / P is tracked
-  //     (for plain Gauss–Seidel every change is ≥ 0 and δ = |ΔP|/P);
-  //   * the error left after a change δ is the rest of a geometric series, δ·ρ̂/(1 − ρ̂), with
-  //     ρ̂ = δ_k / δ_{k−1} the measured contraction: below δ while ρ̂ < ½, but 9·δ for a bright
-  //     closed scene converging at ρ̂ = 0.9, where the last change alone would stop too early.
-  // Both |ΔP|/P and δ·ρ̂/(1 − ρ̂) must be below the tolerance. Measured at the default preset
-  // (residual, δ at the stop): built-in Cornell box 4 iterations (7.4e-4, 2.4e-3, ρ̂ 0.15; its
-  // render then within relMSE 9e-8 of the converged one, Gauss–Seidel's 8 iterations 1.7e-7),
-  // CornellBox-Glossy 4, CornellBox-Mirror 5, CornellBox-Sphere 4.
-  constexpr float kOverRelaxation = 1.2f;
-  float omega = kOverRelaxation;
-  // The previous iteration's values are needed only by lookups in glossy charts of the batch
-  // being updated (diffuse lookups read the quads, which lag by a batch; see above).
-  const bool anyGlossy = std::any_of(param.charts.begin(), param.charts.end(),
-                                     [](const Chart& c) { return c.kind == ChartKind::Glossy; });
-  const std::vector<uint64_t>& batchStart = state.batchStart;
-  const std::vector<Rgb>& current = state.current;
-  auto totalPower = [&](const std::vector<Rgb>& values) { return transportPower(state, values); };
-
-  // The iteration's starting values are also what the change of the tixels other ranks
-  // updated is measured from (recomputeChange).
-  const bool keepPrevious = anyGlossy || ranks > 1;
-  double previousPower = totalPower(current), previousL1Change = 0.0;
-  Progress progress("propagation", settings.maxIterations);
-  auto secondsSince = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-  };
-  for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
-    auto repeatedStart = std::chrono::steady_clock::now();
-    if (keepPrevious) state.previousValues = current;
-    result.repeatedSeconds += secondsSince(repeatedStart);
-    for (size_t batch = 0; batch + 1 < batchStart.size(); ++batch) {
-      const uint64_t begin = batchStart[batch], end = batchStart[batch + 1];
-      const TixelRange mine = plan.part(batch, rank);
-      const auto gatherStart = std::chrono::steady_clock::now();
-      gatherIteration(state, vis, mine.begin, mine.end, omega);
-      result.gatherSeconds += secondsSince(gatherStart);
-      exchange(state.current, batch);
-      repeatedStart = std::chrono::steady_clock::now();
-      updateTransport(state, begin, end);
-      for (int r = 0; r < ranks; ++r) {
-        const TixelRange theirs = plan.part(batch, r);
-        if (r != rank) recomputeChange(state, state.previousValues, theirs.begin, theirs.end);
-      }
-      result.repeatedSeconds += secondsSince(repeatedStart);
-    }
-    repeatedStart = std::chrono::steady_clock::now();
-    const double power = totalPower(current);
-    if (!std::isfinite(power)) {
-      requireFiniteValues(scene, param, current, fmt::format("in iteration {}", iteration));
-      fail("{}: light propagation overflowed in iteration {}: the total power is not finite; scale the emission down",
-           scene.sourcePath, iteration);
-    }
-    const double changed = transportChange(state);
-    result.repeatedSeconds += secondsSince(repeatedStart);
-    const double l1Change = power > 0.0 ? changed / power : 0.0;
-    if (iteration > 2 && l1Change > previousL1Change) omega = 1.0f;
-    const double contraction = previousL1Change > 0.0 ? l1Change / previousL1Change : 1.0;
-    const double remainingError = l1Change == 0.0 ? 0.0 : (contraction < 1.0 ? l1Change * contraction / (1.0 - contraction) : kInfinity);
-    result.iterations = iteration;
-    result.residual = power > 0.0 ? std::abs(power - previousPower) / power : 0.0;
-    previousPower = power;
-    previousL1Change = l1Change;
-    progress.advance(1);
-    if (result.residual < settings.tolerance && remainingError < settings.tolerance) {
-      // Converged: the iterations left are not needed, so the bar completes.
-      progress.advance(settings.maxIterations - iteration);
-      break;
-    }
-  }
-  progress.finish();
-
+  double waitSeconds = 0.0;
+  const VisibilityShard& vis = shootFirstShot(state, plan, rank, visibility, exchange, waitSeconds);
+  result.firstShotSeconds = secondsSince(start) - waitSeconds;
+  iterate(state, vis, plan, rank, exchange, result);
   finishTransport(state);
+
   result.values = std::move(state.current);
   result.shadowRays = comm.sum(state.shadowRays.load());
   result.exchangeBytes = comm.bytesReceived() - bytesBefore;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - waitSeconds;
+  result.exchangeSeconds = exchange.seconds();
+  result.seconds = secondsSince(start) - waitSeconds;
   return result;
 }
 
