@@ -5,7 +5,7 @@
 # For the built-in Cornell box and McGuire's CornellBox-Glossy and CornellBox-Mirror, at the
 # default bake preset:
 #   1. plenoptic bake SCENE -o NAME.plf --stats NAME.bake.json
-#   2. plenoptic render NAME.plf --samples 16 (SIZE×SIZE) -o NAME.lf.pfm      light field
+#   2. plenoptic render NAME.plf --spp 16 (SIZE×SIZE) -o NAME.lf.pfm           light field
 #   3. plenoptic trace SCENE --spp REF_SPP (SIZE×SIZE) -o NAME.ref.pfm         reference,
 #      with --variance NAME.refvar.pfm (the reference's own squared standard error per pixel)
 #   4. plenoptic compare NAME.lf.pfm NAME.ref.pfm --json --heatmap NAME.heat.png
@@ -79,7 +79,7 @@ for i in ${names[@]+"${!names[@]}"}; do
   echo "== $name: bake (default preset)" >&2
   "$plenoptic" --quiet bake "$scene" -o "$out.plf" --stats "$out.bake.json" >&2
   echo "== $name: light-field render ($lf_samples samples per pixel)" >&2
-  "$plenoptic" --quiet render "$out.plf" -o "$out.lf.pfm" --samples "$lf_samples" "${size_flags[@]}" >&2
+  "$plenoptic" --quiet render "$out.plf" -o "$out.lf.pfm" --spp "$lf_samples" "${size_flags[@]}" >&2
   echo "== $name: reference ($ref_spp spp)" >&2
   "$plenoptic" --quiet trace "$scene" -o "$out.ref.pfm" --variance "$out.refvar.pfm" --spp "$ref_spp" \
     "${size_flags[@]}" --stats "$out.trace.json" >&2
@@ -110,7 +110,7 @@ reuse="$workdir/reuse"
 "$plenoptic" --quiet bake "$workdir/light_recoloured.json" -o "$reuse.full.plf" --visibility "$reuse.full.plv" \
   --stats "$reuse.full.json" >&2
 for kind in reused full original; do
-  "$plenoptic" --quiet render "$reuse.$kind.plf" -o "$reuse.$kind.exr" --samples "$lf_samples" "${size_flags[@]}" >&2
+  "$plenoptic" --quiet render "$reuse.$kind.plf" -o "$reuse.$kind.exr" --spp "$lf_samples" "${size_flags[@]}" >&2
 done
 "$plenoptic" --quiet compare "$reuse.reused.exr" "$reuse.full.exr" --json >"$reuse.compare.json"
 "$plenoptic" --quiet compare "$reuse.original.exr" "$reuse.full.exr" --json >"$reuse.changed.json"
@@ -141,7 +141,7 @@ for name in names:
                  cmp["relmse"], noise, normalised, normalised_noise, trace["seconds"], out + ".heat.png"))
 
 if rows:
-    print(f"light field (render --samples {lf_samples}) vs path-traced reference ({ref_spp} spp), {size}x{size}, default preset")
+    print(f"light field (render --spp {lf_samples}) vs path-traced reference ({ref_spp} spp), {size}x{size}, default preset")
     header = ("scene", "bake s", "tixels", ".plf bytes", "mean Y ratio", "relMSE", "ref noise", "LF error", "relMSE@0.18", "noise@0.18", "ref s", "heat map")
     print(f"{header[0]:<8} {header[1]:>7} {header[2]:>8} {header[3]:>11} {header[4]:>12} {header[5]:>9} {header[6]:>9} {header[7]:>9} {header[8]:>11} {header[9]:>10} {header[10]:>7}  {header[11]}")
     for r in rows:

@@ -5,7 +5,7 @@
 #
 # For each case and each preset:
 #   1. plenoptic bake CASE.json -o CASE.PRESET.plf --preset PRESET --stats CASE.PRESET.bake.json
-#   2. plenoptic render CASE.PRESET.plf --samples LF_SAMPLES (SIZE×SIZE) -o CASE.PRESET.lf.pfm
+#   2. plenoptic render CASE.PRESET.plf --spp LF_SAMPLES (SIZE×SIZE) -o CASE.PRESET.lf.pfm
 #   3. plenoptic trace CASE.json --spp REF_SPP --variance CASE.refvar.pfm (SIZE×SIZE)
 #      -o CASE.ref.pfm      (once per case, shared by the presets)
 #   4. plenoptic compare CASE.PRESET.lf.pfm CASE.ref.pfm --json --heatmap CASE.PRESET.heat.png
@@ -91,7 +91,7 @@ for name in "${cases[@]}"; do
     o="$out.$preset"
     echo "== $name: bake ($preset), render ($lf_samples samples per pixel), compare" >&2
     run "$o.failed" "$plenoptic" "${global[@]}" bake "$scene" -o "$o.plf" --preset "$preset" --stats "$o.bake.json" &&
-      run "$o.failed" "$plenoptic" "${global[@]}" render "$o.plf" -o "$o.lf.pfm" --samples "$lf_samples" "${size_flags[@]}" &&
+      run "$o.failed" "$plenoptic" "${global[@]}" render "$o.plf" -o "$o.lf.pfm" --spp "$lf_samples" "${size_flags[@]}" &&
       [[ ! -e "$out.ref.failed" ]] &&
       { "$plenoptic" "${global[@]}" compare "$o.lf.pfm" "$out.ref.pfm" --json --heatmap "$o.heat.png" \
           >"$o.compare.json" 2>"$o.failed.log" ||
@@ -120,7 +120,7 @@ def text(path):
 
 
 lines = [
-    f"Light field (`render --samples {lf_samples}`) against the path tracer (`trace --spp {ref_spp} --variance`), "
+    f"Light field (`render --spp {lf_samples}`) against the path tracer (`trace --spp {ref_spp} --variance`), "
     f"{size}×{size}; targets: draft |ratio − 1| ≤ 0.05; default and high |ratio − 1| ≤ 0.02 and LF error "
     f"(relMSE − ref noise) ≤ 0.01.",
     "",

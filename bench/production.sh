@@ -5,7 +5,7 @@
 # Per scene and preset:
 #   1. plenoptic bake SCENE -o NAME.plf --preset P --stats NAME.bake.json  (bake time, peak RSS,
 #      .plf and .plv sizes from the stats and the files)
-#   2. plenoptic render NAME.plf --samples LF_SAMPLES (WIDTH×HEIGHT) -o NAME.lf.pfm   light field
+#   2. plenoptic render NAME.plf --spp LF_SAMPLES (WIDTH×HEIGHT) -o NAME.lf.pfm   light field
 #   3. plenoptic compare NAME.lf.pfm SCENE.ref.pfm --json --heatmap FIGURES/production-NAME-heat.png
 #      against one converged path trace of the same view per scene
 #      (plenoptic trace SCENE --spp REF_SPP --variance ..., traced once, reused by every preset)
@@ -98,7 +98,7 @@ for i in "${!names[@]}"; do
       continue
     fi
     echo "== $name, $preset: light field ($lf_samples samples per pixel) against the path trace" >&2
-    run render "$out.plf" -o "$out.lf.pfm" --samples "$lf_samples" "${size_flags[@]}"
+    run render "$out.plf" -o "$out.lf.pfm" --spp "$lf_samples" "${size_flags[@]}"
     heat=()
     [[ -n "$figures" ]] && heat=(--heatmap "$figures/production-$name-$preset-heat.png")
     "$plenoptic" --quiet compare "$out.lf.pfm" "$ref.pfm" --json "${heat[@]}" >"$out.compare.json"

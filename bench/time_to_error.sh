@@ -56,7 +56,7 @@ fi
 
 for s in $lf_samples; do
   echo "== light-field render, $s sample(s) per pixel, $frames frames" >&2
-  "$plenoptic" --quiet render "$w/cornell.plf" -o "$w/lf_s$s.exr" --samples "$s" --frames "$frames" \
+  "$plenoptic" --quiet render "$w/cornell.plf" -o "$w/lf_s$s.exr" --spp "$s" --frames "$frames" \
     "${size_flags[@]}" --stats "$w/lf_s$s.json" >&2
   "$plenoptic" --quiet compare "$w/lf_s$s.exr" "$w/ref.pfm" --json >"$w/lf_s$s.compare.json"
 done

@@ -646,9 +646,8 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       const Vec3 originBehind = offsetRayOrigin(x, normal, -normal);
       // The tixel's S samples are an Owen-scrambled Sobol (0,2)-net of its own (a scramble
       // keyed by the tixel): the emitter choice, stretched back onto [0, 1), and the second
-      // coordinate are stratified jointly (before: stratified emitter choice, random second
-      // coordinate). Together with the gather's multi-jitter this took the median per-tixel
-      // noise of the default Cornell box from 1.63 % to 1.40 %.
+      // coordinate are stratified jointly, which (with the gather's multi-jitter) lowers the
+      // noise between neighbouring tixels (docs/benchmarks.md, Per-tixel noise).
       const ZSobolLayout layout = ZSobolLayout::forKey(g, int(lightSamples), settings.seed ^ 0x4e4545ULL);
       for (uint32_t s = 0; s < lightSamples; ++s) {
         const EmitterPoint sample = lights.sampleEmitterPoint(Sampler::sobol(layout, 0, 0, s).get2D());
@@ -667,10 +666,9 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         // Power heuristic (β = 2) between this strategy (S samples, solid-angle pdf
         // pl = areaPdf·r²/cos θy) and the N cosine-distributed gather rays (pdf pg = cos θx/π):
         //   Le·cos θx/(S·pl) · (S·pl)²/((S·pl)² + (N·pg)²).
-        // (The balance heuristic, S·pl/(S·pl + N·pg), left a fifth of the weight to the few
-        // gather rays that hit a small light from afar, whose count varies from tixel to
-        // tixel: the power heuristic took the median per-tixel noise of the default Cornell
-        // box from 1.40 % to 0.80 %.)
+        // (The balance heuristic, S·pl/(S·pl + N·pg), would leave much of the weight to the
+        // few gather rays that hit a small light from afar, whose count varies from tixel to
+        // tixel: noise between neighbours; docs/benchmarks.md, Per-tixel noise.)
         const float sPl = float(lightSamples) * sample.areaPdf * dist2 / cosY;
         const float nPg = float(n) * kInvPi * cosX;
         const std::optional<Ray> ray =

@@ -37,7 +37,7 @@ common=(--quiet --threads 1)
 size_flags=(--width "$size" --height "$size")
 # shellcheck disable=SC2086  # EXTRA_BAKE_FLAGS is a list of flags
 "$plenoptic" "${common[@]}" bake "$scene" -o "$work/lf.plf" --preset "$preset" ${EXTRA_BAKE_FLAGS:-}
-"$plenoptic" "${common[@]}" render "$work/lf.plf" -o "$work/lf.pfm" --samples "$lf_samples" "${size_flags[@]}"
+"$plenoptic" "${common[@]}" render "$work/lf.plf" -o "$work/lf.pfm" --spp "$lf_samples" "${size_flags[@]}"
 "$plenoptic" "${common[@]}" trace "$scene" -o "$work/ref.pfm" --variance "$work/refvar.pfm" --spp "$ref_spp" \
   "${size_flags[@]}"
 "$plenoptic" --quiet compare "$work/lf.pfm" "$work/ref.pfm" --json >"$work/compare.json"
