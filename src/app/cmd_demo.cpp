@@ -30,8 +30,8 @@ namespace {
 
 struct DemoOptions {
   std::string outputDir = "out/demo";
-  // Path-traced reference. 512² × 256 spp ≈ 67 M paths: the tracer does ≈ 1.5 M paths per
-  // CPU-second on this machine, so ≈ 20–25 s on 2 idle cores; nearly noise-free.
+  // Path-traced reference. 512² × 256 spp ≈ 67 M paths: nearly noise-free, in well under a
+  // minute on two cores (the time `make demo` prints; README.md's tour shows one run).
   int imageSize = 512;
   int traceSpp = 256;
   std::string preset = "default";
