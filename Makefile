@@ -22,7 +22,7 @@ configure: bootstrap
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
-# The Python module alone (build/python/plenoptic*.so; `build` makes it too).
+# The Python package alone (build/python/plenoptic/; `build` makes it too). To install it: docs/python.md.
 python: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS) --target plenoptic_python
 
