@@ -109,7 +109,10 @@ void bindPictures(py::module_& m) {
               if (pictures.empty()) throw UsageError("write_video: no frames");
               runInterruptible([&] {
                 VideoWriter writer(path, pictures.front().width, pictures.front().height, fps);
-                for (const Image8& picture : pictures) writer.write(picture);
+                for (const Image8& picture : pictures) {
+                  throwIfCancelled();  // Ctrl-C: the writer removes the partial video
+                  writer.write(picture);
+                }
                 writer.finish();
               });
             },
