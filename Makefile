@@ -9,7 +9,7 @@ FUZZ_BUILD_DIR ?= build-fuzz
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS ?= obj gltf json_scene camera_path hdr exr plf plf_fixed plv plv_fixed
 
-.PHONY: all bootstrap configure build python test demo bench fuzz install clean
+.PHONY: all bootstrap configure build python examples scenes test demo bench fuzz install clean
 
 all: build
 
@@ -22,9 +22,20 @@ configure: bootstrap
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
-# The Python module alone (build/python/plenoptic*.so; `build` makes it too).
+# The Python package alone (build/python/plenoptic/; `build` makes it too). To install it: docs/python.md.
 python: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS) --target plenoptic_python
+
+# The worked Python examples (examples/, with matplotlib for their plots), written to out/examples/.
+examples: python
+	@bash scripts/bootstrap.sh --examples
+	@for example in trace_vs_bake relight_sweep camera_path_video; do \
+	  PYTHONPATH=$(BUILD_DIR)/python /usr/bin/python3 examples/$$example.py --out out/examples || exit 1; done
+
+# The scenes the documentation uses, from their public sources into scenes/ (needs a network;
+# scripts/get-scenes.sh --help).
+scenes:
+	@bash scripts/get-scenes.sh
 
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)

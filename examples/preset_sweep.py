@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """Sweeps the bake presets on the built-in Cornell box against a path-traced reference and
-shows light-field error against bake time: a plot (examples/preset_sweep.png) when matplotlib
-is installed (Debian: python3-matplotlib), a table always.
+shows light-field error against bake time: a plot (OUT/preset_sweep.png) when matplotlib is
+installed (Debian: python3-matplotlib), a table always.
 
-    PYTHONPATH=build/python python3 examples/preset_sweep.py [--size 128] [--spp 256] [--threads 0]
+    python3 examples/preset_sweep.py [--size 128] [--spp 256] [--threads 0] [--out out/examples]
 """
 import argparse
+import os
 import time
 
 import plenoptic
@@ -16,7 +17,7 @@ def main():
     parser.add_argument("--size", type=int, default=128, help="image width and height in pixels")
     parser.add_argument("--spp", type=int, default=256, help="samples per pixel of the path-traced reference")
     parser.add_argument("--threads", type=int, default=0, help="worker threads (0 = all)")
-    parser.add_argument("--plot", default="examples/preset_sweep.png", help="where the plot goes (with matplotlib)")
+    parser.add_argument("--out", default=os.path.join("out", "examples"), help="output directory (the plot)")
     args = parser.parse_args()
 
     scene = plenoptic.load_scene("cornell")
@@ -52,8 +53,10 @@ def main():
     ax.set_ylabel("relMSE vs path tracer")
     ax.set_title("Cornell box: light-field error against bake time")
     fig.tight_layout()
-    fig.savefig(args.plot, dpi=120)
-    print(f"wrote {args.plot}")
+    os.makedirs(args.out, exist_ok=True)
+    plot = os.path.join(args.out, "preset_sweep.png")
+    fig.savefig(plot, dpi=120)
+    print(f"wrote {plot}")
 
 
 if __name__ == "__main__":

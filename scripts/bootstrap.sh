@@ -2,6 +2,7 @@
 # Installs the Debian 12 packages plenoptic needs to build, test and run its demo.
 # Idempotent and quiet when everything is already present; run as root (or with sudo).
 # --fuzz: also clang and its runtime libraries (libclang_rt.fuzzer, ASan, UBSan) for `make fuzz`.
+# --examples: also matplotlib, which the Python examples plot with (examples/; not the tests).
 set -euo pipefail
 
 packages=(
@@ -13,10 +14,12 @@ packages=(
   libopenmpi-dev openmpi-bin
   xvfb xauth bash-completion
   python3-dev pybind11-dev python3-numpy python3-pytest
+  python3-pip python3-venv python3-setuptools python3-wheel
 )
-if [ "${1:-}" = "--fuzz" ]; then
-  packages+=(clang libclang-rt-14-dev)
-fi
+case "${1:-}" in
+  --fuzz) packages+=(clang libclang-rt-14-dev) ;;
+  --examples) packages+=(python3-matplotlib) ;;
+esac
 # Optional: ffmpeg turns rendered walk-throughs into MP4. Installed when it is available.
 optional_packages=(ffmpeg)
 

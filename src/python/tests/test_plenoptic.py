@@ -1,7 +1,16 @@
-"""pytest suite of the Python module (run by ctest as `python_tests`, with PYTHONPATH=build/python
-and PLENOPTIC_BINARY naming the command-line program). Small sizes: every test runs in seconds."""
+"""pytest suite of the Python package `plenoptic`. ctest runs it twice: as `python_tests` on the
+build tree's package (PYTHONPATH=build/python) and as part of `python_package` on the package
+`pip install`ed into a fresh venv, from a directory outside the source and build trees.
+Environment: PLENOPTIC_BINARY names the command-line program (the tests that compare with it
+are skipped without it), PLENOPTIC_TEST_DATA the repository's tests/data (default: found from
+this file's place in the repository), PLENOPTIC_EXPECT_PACKAGE_IN a directory the imported
+package must lie in. Small sizes: every test runs in seconds."""
+import ast
 import json
 import os
+import pty
+import re
+import shutil
 import subprocess
 import sys
 
@@ -11,7 +20,8 @@ import pytest
 import plenoptic
 
 BINARY = os.environ.get("PLENOPTIC_BINARY", "")
-DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tests", "data")
+DATA = os.environ.get("PLENOPTIC_TEST_DATA") or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                                             "..", "tests", "data")
 
 
 @pytest.fixture(scope="module")
@@ -178,14 +188,53 @@ def test_image_round_trip_and_compare(tmp_path):
     assert plenoptic.compare(image * 2, image)["mean_luminance_ratio"] == pytest.approx(2.0)
 
 
-def test_arrays_of_the_wrong_shape_or_dtype_are_refused(tmp_path):
+def test_arrays_of_any_float_dtype_and_layout_are_converted(tmp_path):
+    # The same pixels as float32 C order, float64, float16, Fortran order, strided views: every
+    # call sees the float32 values NumPy's cast gives.
+    rng = np.random.default_rng(11)
+    base = (rng.random((6, 8, 3)) * 4.0).astype(np.float16).astype(np.float32)  # exact in float16 too
+    variants = {
+        "float64": base.astype(np.float64),
+        "float16": base.astype(np.float16),
+        "fortran": np.asfortranarray(base),
+        "strided": np.repeat(base, 2, axis=1)[:, ::2, :],
+        "channel-last view": np.moveaxis(np.ascontiguousarray(np.moveaxis(base, 2, 0)), 0, 2),
+    }
+    assert not variants["fortran"].flags.c_contiguous and not variants["strided"].flags.c_contiguous
+    assert not variants["channel-last view"].flags.c_contiguous
+    reference = plenoptic.tone_map(base)
+    for name, array in variants.items():
+        assert np.array_equal(plenoptic.tone_map(array), reference), name
+        assert plenoptic.compare(array, base)["identical"], name
+        path = str(tmp_path / "x.pfm")
+        plenoptic.write_image(path, array)
+        assert np.array_equal(plenoptic.read_image(path), base), name
+    # Negative strides: a flipped view is read in its own (flipped) order.
+    assert np.array_equal(plenoptic.tone_map(base[::-1, ::-1]), reference[::-1, ::-1])
+    # float64 values are rounded to the nearest float32.
+    fine = np.full((2, 2, 3), 1.0 + 2.0 ** -30, dtype=np.float64)
+    plenoptic.write_image(str(tmp_path / "fine.pfm"), fine)
+    assert (plenoptic.read_image(str(tmp_path / "fine.pfm")) == np.float32(1.0)).all()
+    env = np.ones((16, 32, 3), dtype=np.float64)
+    assert np.allclose(plenoptic.sh9(np.asfortranarray(env)), plenoptic.sh9(env.astype(np.float32)), rtol=0, atol=0)
+    # The input is not modified (a converted copy is read, never written).
+    before = variants["float64"].copy()
+    plenoptic.compare(variants["float64"], base)
+    assert np.array_equal(before, variants["float64"])
+
+
+def test_arrays_of_the_wrong_shape_or_kind_are_refused(tmp_path):
     path = str(tmp_path / "x.pfm")
-    with pytest.raises(ValueError, match="float32"):
-        plenoptic.write_image(path, np.zeros((4, 4, 3), dtype=np.float64))
+    # An integer array is most likely an 8-bit picture, not radiance: refused, not converted.
+    for dtype in (np.uint8, np.int32, np.bool_, np.complex64):
+        with pytest.raises(ValueError, match="floating-point"):
+            plenoptic.write_image(path, np.zeros((4, 4, 3), dtype=dtype))
     with pytest.raises(ValueError, match="shape"):
         plenoptic.write_image(path, np.zeros((4, 4), dtype=np.float32))
     with pytest.raises(ValueError, match="shape"):
         plenoptic.compare(np.zeros((4, 4, 4), dtype=np.float32), np.zeros((4, 4, 3), dtype=np.float32))
+    with pytest.raises(ValueError, match="empty"):
+        plenoptic.tone_map(np.zeros((0, 4, 3), dtype=np.float64))
     with pytest.raises(ValueError, match="NumPy"):
         plenoptic.write_image(path, [[1.0, 2.0, 3.0]])
     assert not os.path.exists(path)
@@ -382,8 +431,8 @@ def test_environment_tools_refuse_bad_arrays_and_arguments():
     env = np.ones((16, 32, 3), dtype=np.float32)
     with pytest.raises(ValueError, match="twice as wide"):
         plenoptic.sh9(np.ones((16, 16, 3), dtype=np.float32))
-    with pytest.raises(ValueError, match="float32"):
-        plenoptic.sh9(env.astype(np.float64))
+    with pytest.raises(ValueError, match="floating-point"):
+        plenoptic.sh9(env.astype(np.uint8))
     with pytest.raises(ValueError, match="method"):
         plenoptic.irradiance(env, method="fast")
     with pytest.raises(ValueError, match="out of range"):
@@ -392,6 +441,214 @@ def test_environment_tools_refuse_bad_arrays_and_arguments():
         plenoptic.prefilter(env, levels=0)
     with pytest.raises(ValueError, match="model"):
         plenoptic.prefilter(env, model="phong")
+
+
+def test_the_package_has_its_stubs_and_is_the_expected_one():
+    # PEP 561: the stubs and the py.typed marker lie beside __init__.py, wherever the package is.
+    package = os.path.dirname(os.path.abspath(plenoptic.__file__))
+    for name in ("__init__.py", "__init__.pyi", "py.typed"):
+        assert os.path.isfile(os.path.join(package, name)), name
+    assert os.path.dirname(plenoptic._plenoptic.__file__) == package
+    where = os.environ.get("PLENOPTIC_EXPECT_PACKAGE_IN")
+    if where:  # the installed package, not the build or source tree
+        assert os.path.realpath(package).startswith(os.path.realpath(where) + os.sep), package
+
+
+def signature_parameters(function):
+    """The parameter names of a pybind11 function, from the signature its docstring starts with
+    ("name(a: int, b: List[float] = [0.0, 1.0]) -> None"), without self."""
+    line = function.__doc__.split("\n", 1)[0]
+    text = line[line.index("(") + 1:]
+    parameters, depth, current = [], 0, ""
+    for char in text:
+        if char in "([{":
+            depth += 1
+        elif char in ")]}":
+            if depth == 0:
+                break
+            depth -= 1
+        if char == "," and depth == 0:
+            parameters.append(current)
+            current = ""
+        else:
+            current += char
+    parameters.append(current)
+    names = [p.split(":")[0].split("=")[0].strip() for p in parameters if p.strip()]
+    return [name for name in names if name != "self"]
+
+
+def stub_parameters(node):
+    """The parameter names of a stub, keyword-only ones after a "*" as pybind11 writes them."""
+    names = [a.arg for a in node.args.args if a.arg != "self"]
+    if node.args.kwonlyargs:
+        names += ["*"] + [a.arg for a in node.args.kwonlyargs]
+    return names
+
+
+def stub_members(body):
+    members = {}
+    for node in body:
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+            members[node.name] = node
+        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+            members[node.target.id] = node
+        elif isinstance(node, ast.Assign):
+            members.update((target.id, node) for target in node.targets if isinstance(target, ast.Name))
+    return members
+
+
+def test_the_stubs_name_every_function_class_and_parameter():
+    # __init__.pyi against the module itself, so that the two cannot drift apart: the same
+    # public names, the same members of each class, and every function's and method's
+    # parameter names in the same order.
+    path = os.path.join(os.path.dirname(plenoptic.__file__), "__init__.pyi")
+    with open(path) as stub_file:
+        stub = stub_members(ast.parse(stub_file.read()).body)
+    public = {name for name in stub if not name.startswith("_")}
+    assert public == set(plenoptic.__all__)
+    assert public == {name for name in dir(plenoptic) if not name.startswith("_")}
+    assert "__version__" in stub
+    for name in sorted(public):
+        runtime, node = getattr(plenoptic, name), stub[name]
+        if isinstance(node, ast.FunctionDef):
+            assert callable(runtime), name
+            assert stub_parameters(node) == signature_parameters(runtime), name
+        elif isinstance(node, ast.ClassDef):
+            assert isinstance(runtime, type), name
+            assert [b.id for b in node.bases if isinstance(b, ast.Name)] == [
+                b.__name__ for b in runtime.__bases__ if b.__name__ != "pybind11_object"], name
+            if issubclass(runtime, BaseException):
+                continue
+            members = stub_members(node.body)
+            # (A class made in Python only has pybind11's constructor that raises "No constructor
+            # defined", whose docstring has no signature.)
+            defined = {m for m in vars(runtime) if not m.startswith("_") or m == "__repr__"}
+            if (vars(runtime)["__init__"].__doc__ or "").startswith("__init__("):
+                defined.add("__init__")
+            assert set(members) == defined, name
+            for member, member_node in members.items():
+                attribute = vars(runtime)[member]
+                if isinstance(attribute, property):
+                    assert any(isinstance(d, ast.Name) and d.id == "property" for d in member_node.decorator_list), \
+                        f"{name}.{member}"
+                elif isinstance(member_node, ast.FunctionDef):
+                    assert stub_parameters(member_node) == signature_parameters(attribute), f"{name}.{member}"
+        else:
+            assert not callable(runtime), name
+
+
+def test_every_class_has_a_repr_that_names_the_package(cornell):
+    classes = [getattr(plenoptic, n) for n in plenoptic.__all__ if isinstance(getattr(plenoptic, n), type)]
+    for cls in classes:
+        assert cls.__module__ == "plenoptic", cls
+        if not issubclass(cls, BaseException):
+            assert "__repr__" in vars(cls), cls
+    assert plenoptic.trace.__module__ == "plenoptic"
+    assert repr(cornell) == "<plenoptic.Scene 'cornell': 32 triangles, 4 materials, 2 cameras, 0 lights>"
+    camera = cornell.camera("default")
+    assert repr(camera).startswith("plenoptic.Camera(eye=[278, 273, -800], target=[278, 273, 0], up=[0, 1, 0], fov=")
+    # A Camera's repr is the call that makes it again.
+    again = eval(repr(camera), {"plenoptic": plenoptic})
+    assert (again.eye, again.target, again.up, again.fov, again.name) == (camera.eye, camera.target, camera.up,
+                                                                          camera.fov, camera.name)
+    lf = plenoptic.bake(cornell, preset="draft")
+    assert re.fullmatch(r"<plenoptic\.LightField of 'cornell': \d+ charts, %d tixels, 0 sun-mask lights>"
+                        % lf.stats["tixels"], repr(lf)), repr(lf)
+    assert repr(plenoptic.UsageError("x")) == "UsageError('x')"
+
+
+# Progress bars: only on a terminal unless set_progress says otherwise, and never a carriage
+# return in captured output.
+PROGRESS_SCRIPT = r"""
+import contextlib, io, sys
+import plenoptic
+setting = {setting}
+if setting != "default":
+    plenoptic.set_progress(setting)
+scene = plenoptic.load_scene("cornell")
+if {redirect}:
+    with contextlib.redirect_stderr(io.StringIO()):
+        plenoptic.trace(scene, width=32, height=32, spp=4)
+else:
+    plenoptic.trace(scene, width=32, height=32, spp=4)
+"""
+
+
+def run_with_terminal_stderr(setting, redirect=False):
+    """What a script writes to its stderr when that is a terminal (a pseudo-terminal here)."""
+    master, slave = pty.openpty()
+    code = PROGRESS_SCRIPT.replace("{setting}", setting).replace("{redirect}", str(redirect))
+    process = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                               stderr=slave)
+    os.close(slave)
+    output = b""
+    while True:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:  # EIO: the child closed the terminal
+            break
+        if not chunk:
+            break
+        output += chunk
+    os.close(master)
+    assert process.wait(timeout=120) == 0, output
+    return output.decode()
+
+
+def test_progress_bars_only_on_a_terminal_by_default():
+    assert plenoptic.get_progress() is None
+    on_terminal = run_with_terminal_stderr('"default"')
+    assert "tracing" in on_terminal and "\r" in on_terminal  # the bar redraws its line
+    assert "tracing" not in run_with_terminal_stderr("False")
+    # sys.stderr replaced (as pytest's capsys, Jupyter or redirect_stderr do): no bar either.
+    assert "tracing" not in run_with_terminal_stderr('"default"', redirect=True)
+
+
+def test_captured_output_holds_no_progress_and_never_a_carriage_return(cornell, capfd):
+    try:
+        plenoptic.trace(cornell, width=32, height=32, spp=4)
+        assert capfd.readouterr().err == ""  # not a terminal: nothing by default
+        plenoptic.set_progress(True)
+        assert plenoptic.get_progress() is True
+        plenoptic.trace(cornell, width=32, height=32, spp=4)
+        err = capfd.readouterr().err
+        assert "tracing" in err and "100.0%" in err and "\r" not in err  # one line per 10 %
+        plenoptic.set_progress(False)
+        plenoptic.trace(cornell, width=32, height=32, spp=4)
+        assert capfd.readouterr().err == ""
+    finally:
+        plenoptic.set_progress(None)
+
+
+def test_write_video_encodes_the_tone_mapped_frames(tmp_path):
+    # Three flat frames of radiance 0.05, 0.2, 0.8 (clamp: sRGB 63, 124, 231): decoded back by
+    # ffmpeg, each frame's pixels are within H.264's rounding of those bytes.
+    levels = [0.05, 0.2, 0.8]
+    frames = [np.full((16, 32, 3), level, dtype=np.float64) for level in levels]
+    video = str(tmp_path / "walk.mp4")
+    with pytest.raises(ValueError, match="mp4"):
+        plenoptic.write_video(str(tmp_path / "walk.avi"), frames)
+    with pytest.raises(ValueError, match="frame 1 is"):
+        plenoptic.write_video(video, [frames[0], np.zeros((8, 8, 3))])
+    with pytest.raises(ValueError, match="no frames"):
+        plenoptic.write_video(video, [])
+    if shutil.which("ffmpeg") is None:
+        with pytest.raises(plenoptic.Error, match="ffmpeg"):
+            plenoptic.write_video(video, frames)
+        assert not os.path.exists(video)
+        return
+    with pytest.raises(plenoptic.Error, match="even width and height"):
+        plenoptic.write_video(video, [np.zeros((15, 32, 3))])
+    assert os.listdir(tmp_path) == []  # nothing half-written
+    plenoptic.write_video(video, frames, fps=10, tonemap="clamp")
+    decoded = subprocess.run(["ffmpeg", "-loglevel", "error", "-i", video, "-f", "rawvideo", "-pix_fmt", "rgb24", "-"],
+                             check=True, capture_output=True).stdout
+    pictures = np.frombuffer(decoded, dtype=np.uint8).reshape(-1, 16, 32, 3)
+    assert len(pictures) == 3
+    expected = [plenoptic.tone_map(frame, tonemap="clamp")[0, 0, 0] for frame in frames]
+    assert [int(e) for e in expected] == [63, 124, 231]
+    for picture, value in zip(pictures, expected):
+        assert np.abs(picture.astype(int) - int(value)).max() <= 3
 
 
 # Ctrl-C: each case runs in its own interpreter (a KeyboardInterrupt that landed outside the

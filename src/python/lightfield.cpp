@@ -1,0 +1,168 @@
+// bake, plenoptic.LightField (save, render, render_path) and load_light_field (bindings.h).
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "camera/camera_path.h"
+#include "core/error.h"
+#include "plf/compression.h"
+#include "plf/plf_file.h"
+
+namespace pl::python {
+namespace {
+
+/// A baked or loaded light field, shared by the Python objects that refer to it.
+struct PyLightField {
+  std::shared_ptr<const LightField> lightField;
+  py::dict stats;  ///< the bake's --stats JSON (empty for a loaded file)
+};
+
+/// Camera samples per pixel from the `spp` keyword or its former name `samples` (still
+/// accepted); 0 = automatic when neither is given.
+int sppKeyword(std::optional<int> spp, std::optional<int> samples) {
+  if (spp && samples) throw UsageError("spp and samples are the same setting (samples is its former name): give one");
+  return spp ? *spp : samples.value_or(0);
+}
+
+/// The options of one light-field render (`plenoptic render`'s flags).
+RenderJobOptions renderOptions(const ViewSettings& view, int samples, uint64_t seed, bool reference, int threads,
+                               bool textureLod) {
+  RenderJobOptions options;
+  options.render.samplesPerPixel = samples;
+  options.render.seed = seed;
+  options.render.textureLod = textureLod;
+  options.reference = reference;
+  options.view = view;
+  options.threads = threads;
+  return options;
+}
+
+/// The frames' cameras of render_path: a list of Cameras as they are, or a camera path file's
+/// frames (camera/camera_path.h: frame k at t0 + k/fps) posed on the base camera of `view`
+/// (its lens, and its fov where the path has none).
+std::vector<CameraDesc> pathCameras(const py::object& path, const ViewSettings& view, const Scene& scene) {
+  std::vector<CameraDesc> cameras;
+  if (py::isinstance<py::str>(path)) {
+    const CameraPath cameraPath = loadCameraPath(path.cast<std::string>());
+    const CameraDesc baseCamera = view.resolveCamera(scene);
+    for (int frame = 0; frame < cameraPath.frameCount(); ++frame)
+      cameras.push_back(applyPose(baseCamera, cameraPath.at(cameraPath.frameTime(frame))));
+    return cameras;
+  }
+  for (const py::handle item : py::iter(path)) {
+    if (!py::isinstance<CameraDesc>(item))
+      throw py::value_error("render_path: expected a camera path file name (str) or a list of plenoptic.Camera");
+    cameras.push_back(item.cast<CameraDesc>());
+  }
+  if (cameras.empty()) throw UsageError("render_path: the list of cameras is empty");
+  return cameras;
+}
+
+}  // namespace
+
+void bindLightField(py::module_& m) {
+  py::class_<PyLightField>(m, "LightField", "A baked light field.")
+      .def_readonly("stats", &PyLightField::stats, "The bake's --stats JSON as a dict (empty for a loaded file)")
+      .def(
+          "save",
+          [](const PyLightField& lf, const std::string& path, const std::string& compress) {
+            const ValuesCodec codec = parseValuesCodec(compress);
+            runInterruptible([&] { writeLightField(path, *lf.lightField, codec); });
+          },
+          py::arg("path"), py::arg("compress") = "none", "Writes the .plf file (compress: none, lossless, bc1, hdr).")
+      .def(
+          "render",
+          [](const PyLightField& lf, int width, int height, std::optional<int> spp, const py::object& camera,
+             uint64_t seed, bool reference, int threads, bool textureLod, std::optional<int> samples) {
+            const RenderJob job(renderOptions(viewSettings(width, height, camera), sppKeyword(spp, samples), seed,
+                                              reference, threads, textureLod));
+            return toArray(runInterruptible([&] { return job.run(*lf.lightField).image; }));
+          },
+          py::arg("width") = 640, py::arg("height") = 480, py::arg("spp") = py::none(), py::arg("camera") = py::none(),
+          py::arg("seed") = 0, py::arg("reference") = false, py::arg("threads") = 0, py::arg("texture_lod") = true,
+          py::kw_only(), py::arg("samples") = py::none(),
+          "Renders the light field (what `plenoptic render` does): float32 (height, width, 3), W/(sr m^2).\n"
+          "spp (or its former name samples): camera samples per pixel; none or 0: 1 for a pinhole camera, 16 for a\n"
+          "thin lens. reference=True: the reference renderer.\n"
+          "texture_lod=False: albedo textures at full resolution (`--texture-lod off`).\n"
+          "camera: a Camera, or a camera name of the scene (default: its first, else automatic).")
+      .def(
+          "render_path",
+          [](const PyLightField& lf, const py::object& path, int width, int height, std::optional<int> spp,
+             const py::object& camera, uint64_t seed, bool reference, int threads, bool textureLod,
+             std::optional<int> samples) {
+            const int samplesPerPixel = sppKeyword(spp, samples);
+            const ViewSettings base = viewSettings(width, height, camera);
+            const std::vector<CameraDesc> cameras = pathCameras(path, base, lf.lightField->scene);
+            const std::vector<Image> frames = runInterruptible([&] {
+              std::vector<Image> images;
+              for (const CameraDesc& frameCamera : cameras) {
+                RenderJobOptions options = renderOptions(base, samplesPerPixel, seed, reference, threads, textureLod);
+                options.view.cameraDesc = frameCamera;
+                images.push_back(RenderJob(std::move(options)).run(*lf.lightField).image);
+              }
+              return images;
+            });
+            py::list arrays;
+            for (const Image& frame : frames) arrays.append(toArray(frame));
+            return arrays;
+          },
+          py::arg("path"), py::arg("width") = 640, py::arg("height") = 480, py::arg("spp") = py::none(),
+          py::arg("camera") = py::none(), py::arg("seed") = 0, py::arg("reference") = false, py::arg("threads") = 0,
+          py::arg("texture_lod") = true, py::kw_only(), py::arg("samples") = py::none(),
+          "Renders a walk-through: path is a camera path JSON file (what `plenoptic render --path` renders, frame k at\n"
+          "t0 + k/fps, posed on `camera`) or a list of Cameras. Returns a list of float32 (height, width, 3) frames.")
+      .def("__repr__", [](const PyLightField& lf) {
+        const LightField& field = *lf.lightField;
+        return fmt::format("<plenoptic.LightField of '{}': {} charts, {} tixels, {} sun-mask lights>",
+                           field.scene.sourcePath, field.charts.size(), field.values.size(), field.sunMaskLightCount);
+      });
+
+  m.def(
+      "bake",
+      [](const Scene& scene, const std::string& preset, uint64_t seed, int threads, std::optional<std::string> visibility,
+         bool reuseVisibility, bool sunMasks, bool punctualHighlights) {
+        BakeJobOptions options;
+        options.sunMasks = sunMasks;
+        options.punctualHighlights = punctualHighlights;
+        options.sceneName = scene.sourcePath;
+        options.preset = preset;
+        options.seed = seed;
+        options.threads = threads;
+        if (visibility) options.visibilityPath = *visibility;
+        options.reuseVisibility = reuseVisibility;
+        const BakeJob job(std::move(options));
+        BakeJobResult result = runInterruptible([&] {
+          // The bake keeps its scene (in the light field); a copy must be finalized again to
+          // get the vertex padding Embree reads (scene.h), which also checks the edits.
+          Scene copy = scene;
+          copy.finalize();
+          return job.run(std::move(copy));
+        });
+        PyLightField lf;
+        lf.stats = statsDict(result.stats.toJson());
+        lf.lightField = std::make_shared<const LightField>(std::move(result.lightField));
+        return lf;
+      },
+      py::arg("scene"), py::arg("preset") = "default", py::arg("seed") = 0, py::arg("threads") = 0,
+      py::arg("visibility") = py::none(), py::arg("reuse_visibility") = false, py::arg("sun_masks") = true,
+      py::arg("punctual_highlights") = true,
+      "Bakes `scene`'s light field (what `plenoptic bake` does). visibility: a .plv path where the visibility field\n"
+      "is saved; with reuse_visibility=True it is read back when the geometry and settings match (so a bake after\n"
+      "editing only lights or emission re-runs the propagation alone). sun_masks=False: `--sun-masks off`;\n"
+      "punctual_highlights=False: `--punctual-highlights off`.");
+
+  m.def(
+      "load_light_field",
+      [](const std::string& path) {
+        PyLightField lf;
+        lf.lightField = runInterruptible([&] { return std::make_shared<const LightField>(readLightField(path)); });
+        return lf;
+      },
+      py::arg("path"), "Reads a .plf file.");
+}
+
+}  // namespace pl::python
