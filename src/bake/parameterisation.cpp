@@ -308,7 +308,7 @@ SunMaskSlots tixelSunMasks(const Scene& scene, const Accel& accel, const Chart& 
   std::array<Ray, kSamples> rays;
   std::array<uint8_t, kSamples> blocked;
   for (size_t slot = 0; slot < lights.size(); ++slot) {
-    const Vec3 wi = -std::get<DirectionalLight>(scene.lights[lights[slot]]).direction;  // towards the light
+    const Vec3 wi = parallelLight(scene.lights[lights[slot]])->towardsLight;  // a sun-masked light: parallel
     // 1 lit, 0 shadowed, −1 undecided.
     std::array<int, kSamples> state;
     state.fill(-1);
@@ -829,11 +829,8 @@ Parameterisation buildCharts(const Scene& scene, const Accel& accel, const BakeS
         const Vec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
         if (glm::dot(n, corner) - d0 < -behindTolerance) return true;
       }
-      for (const Light& light : scene.lights) {
-        const PunctualLight l = PunctualLight::from(light);
-        if (l.kind == PunctualLight::Kind::Directional ? glm::dot(l.direction, n) > 0.0f : glm::dot(n, l.position) - d0 < 0.0f)
-          return true;
-      }
+      for (const Light& light : scene.lights)
+        if (shinesBehindPlane(light, n, d0)) return true;
       return false;
     };
     // A curved chart does not lie in one plane: behind any of its triangles' planes.

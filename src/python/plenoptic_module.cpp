@@ -326,7 +326,7 @@ class FileError(Error, OSError):
                                return names;
                              })
       .def_property_readonly("light_count", [](const Scene& s) { return s.lights.size(); },
-                             "point, spot and directional lights (emissive surfaces are materials)")
+                             "point, spot, directional, … lights (emissive surfaces are materials)")
       .def("camera", [](const Scene& s, const std::string& name) { return s.camera(name); }, py::arg("name"),
            "The scene's camera `name` as a Camera")
       .def("emission",
@@ -350,17 +350,10 @@ class FileError(Error, OSError):
            [](Scene& s, size_t index, const std::vector<float>& rgb) {
              if (index >= s.lights.size())
                throw UsageError(fmt::format("{}: light {} does not exist ({} lights)", s.sourcePath, index, s.lights.size()));
-             const Rgb value = nonNegative(toRgb(rgb, "set_light_color"), "set_light_color");
-             std::visit(
-                 [&](auto& light) {
-                   using T = std::decay_t<decltype(light)>;
-                   if constexpr (std::is_same_v<T, DirectionalLight>) light.irradiance = value;
-                   else light.intensity = value;
-                 },
-                 s.lights[index]);
+             setLightEmission(s.lights[index], nonNegative(toRgb(rgb, "set_light_color"), "set_light_color"));
            },
            py::arg("index"), py::arg("rgb"),
-           "Sets light `index`'s intensity (point, spot: W/sr) or irradiance (directional: W/m^2)");
+           "Sets light `index`'s intensity (W/sr) or, for a directional light, its irradiance (W/m^2)");
 
   m.def(
       "load_scene",

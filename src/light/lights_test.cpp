@@ -1,0 +1,200 @@
+// The light types (lights.h): every type created from its parameter map, through the JSON
+// scene format and moved by a transform, the messages for bad parameter maps, and each type's
+// sampling against its closed form.
+#include "light/lights.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
+#include <fstream>
+#include <vector>
+
+#include "core/error.h"
+#include "scene/scene.h"
+#include "support/temp_dir_test.h"
+
+namespace pl {
+namespace {
+
+/// Every parameter of a light as floats, in hook order (a Vec3 as three).
+std::vector<float> parameterFloats(const Light& light) {
+  std::vector<float> values;
+  visitLightParameters(light, [&](const char*, LightParameterKind, const auto& field) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, Vec3>) values.insert(values.end(), {field.x, field.y, field.z});
+    else values.push_back(field);
+  });
+  return values;
+}
+
+/// A parameter map giving every parameter of type `index` a value of its own, all positive and
+/// increasing in hook order (so that a spot's inner angle stays below its outer one, and every
+/// type's values are in range); angles are in degrees when `degrees`.
+LightParameters distinctParameters(size_t index, bool degrees) {
+  LightParameters parameters;
+  float next = 0.1f;
+  const Light light = *lightOfIndex(index);
+  visitLightParameters(light, [&](const char* name, LightParameterKind kind, const auto& field) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, Vec3>) {
+      parameters[name] = Vec3(next, next + 0.1f, next + 0.2f);
+      next += 0.3f;
+    } else {
+      parameters[name] = kind == LightParameterKind::Angle && degrees ? 10.0f * next : next;
+      next += 0.1f;
+    }
+  });
+  return parameters;
+}
+
+// Every type: createLight sets each parameter from the map (the JSON keys are the hook's
+// names), the type is known by its name, and its index is the .plf light number.
+TEST(Lights, EveryTypeIsCreatedFromItsParameterMap) {
+  for (size_t index = 0; index < std::variant_size_v<Light>; ++index) {
+    const std::string type = lightTypeName(*lightOfIndex(index));
+    SCOPED_TRACE(type);
+    const LightParameters parameters = distinctParameters(index, false);
+    const Light light = createLight(type, parameters, "test");
+    EXPECT_EQ(light.index(), index);
+    visitLightParameters(light, [&](const char* name, LightParameterKind, const auto& field) {
+      const LightParameterValue& given = parameters.at(name);
+      if constexpr (std::is_same_v<std::decay_t<decltype(field)>, Vec3>) EXPECT_EQ(field, std::get<Vec3>(given)) << name;
+      else EXPECT_EQ(field, std::get<float>(given)) << name;
+    });
+    EXPECT_EQ(lightProblem(light), "");
+    int emissions = 0;
+    visitLightParameters(light, [&](const char*, LightParameterKind kind, const auto&) { emissions += kind == LightParameterKind::Emission; });
+    EXPECT_EQ(emissions, 1);
+    EXPECT_NE(lightTypeNames().find(type), std::string::npos);
+  }
+  EXPECT_FALSE(lightOfIndex(std::variant_size_v<Light>).has_value());
+}
+
+// Bad maps are refused with the place, the key and what was expected.
+TEST(Lights, BadParameterMapsNameTheProblem) {
+  auto message = [](auto&& create) {
+    try {
+      create();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message([] { createLight("laser", {}, "s.json: lights[0]"); }),
+            "s.json: lights[0]: unknown light type 'laser' (" + lightTypeNames() + ")");
+  EXPECT_EQ(message([] { createLight("point", {{"radius", 1.0f}}, "s.json: lights[1]"); }),
+            "s.json: lights[1]: unknown key 'radius' for a point light (position, intensity)");
+  EXPECT_EQ(message([] { createLight("point", {{"position", 1.0f}}, "w"); }), "w.position: expected [x, y, z], got one number");
+  EXPECT_EQ(message([] { createLight("spot", {{"inner_angle", Vec3(1.0f)}}, "w"); }), "w.inner_angle: expected a number, got three");
+  // Unknown names pass when asked to (a glTF node gives every light its whole pose).
+  EXPECT_NO_THROW(createLight("point", {{"direction", Vec3(1.0f)}}, "w", {.ignoreUnknown = true}));
+  // A colour may be one number (grey).
+  EXPECT_EQ(lightEmission(createLight("point", {{"intensity", 2.0f}}, "w")), Rgb(2.0f));
+}
+
+// The JSON scene format is the parameter map: one light of every type, angles in degrees,
+// comes out as createLight makes it (with its directions made unit by Scene::finalize).
+class LightsJson : public test_support::TempDirTest {};
+TEST_F(LightsJson, EveryTypeLoadsFromAJsonScene) {
+  std::string lights;
+  std::vector<Light> expected;
+  for (size_t index = 0; index < std::variant_size_v<Light>; ++index) {
+    const std::string type = lightTypeName(*lightOfIndex(index));
+    const LightParameters parameters = distinctParameters(index, true);
+    std::string entry = "{\"type\": \"" + type + "\"";
+    for (const auto& [name, value] : parameters) {
+      if (const Vec3* v = std::get_if<Vec3>(&value)) entry += fmt::format(", \"{}\": [{}, {}, {}]", name, v->x, v->y, v->z);
+      else entry += fmt::format(", \"{}\": {}", name, std::get<float>(value));
+    }
+    lights += (lights.empty() ? "" : ", ") + entry + "}";
+    Light light = createLight(type, parameters, "test", {.anglesInDegrees = true});
+    normaliseLightDirections(light);
+    expected.push_back(light);
+  }
+  std::ofstream(path("lights.json")) << "{\"include_cornell\": true, \"lights\": [" << lights << "]}";
+  const Scene scene = loadScene(path("lights.json"));
+  ASSERT_EQ(scene.lights.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(scene.lights[i].index(), expected[i].index());
+    EXPECT_EQ(parameterFloats(scene.lights[i]), parameterFloats(expected[i])) << lightTypeName(expected[i]);
+  }
+}
+
+// A transform moves positions, turns directions and scales lengths, by the kind of each
+// parameter.
+TEST(Lights, TransformsMoveEachParameterByItsKind) {
+  const Mat4 m = glm::translate(glm::scale(Mat4(1.0f), Vec3(2.0f)), Vec3(1.0f, 0.0f, 0.0f));  // x ↦ 2x + (2, 0, 0)
+  for (size_t index = 0; index < std::variant_size_v<Light>; ++index) {
+    const Light before = createLight(lightTypeName(*lightOfIndex(index)), distinctParameters(index, false), "test");
+    Light after = before;
+    transformLight(after, m);
+    std::vector<Vec3> vectorsBefore, vectorsAfter;
+    std::vector<float> numbersBefore, numbersAfter;
+    std::vector<LightParameterKind> kinds;
+    auto collect = [&](std::vector<Vec3>& vectors, std::vector<float>& numbers) {
+      return [&](const char*, LightParameterKind kind, const auto& field) {
+        kinds.push_back(kind);
+        if constexpr (std::is_same_v<std::decay_t<decltype(field)>, Vec3>) vectors.push_back(field);
+        else numbers.push_back(field);
+      };
+    };
+    visitLightParameters(before, collect(vectorsBefore, numbersBefore));
+    kinds.clear();
+    visitLightParameters(after, collect(vectorsAfter, numbersAfter));
+    size_t v = 0, n = 0;
+    for (const LightParameterKind kind : kinds) {
+      switch (kind) {
+        case LightParameterKind::Position: EXPECT_EQ(vectorsAfter[v], 2.0f * vectorsBefore[v] + Vec3(2.0f, 0.0f, 0.0f)); ++v; break;
+        case LightParameterKind::Direction: EXPECT_EQ(vectorsAfter[v], 2.0f * vectorsBefore[v]); ++v; break;
+        case LightParameterKind::Emission: EXPECT_EQ(vectorsAfter[v], vectorsBefore[v]); ++v; break;
+        case LightParameterKind::Angle: EXPECT_EQ(numbersAfter[n], numbersBefore[n]); ++n; break;
+        case LightParameterKind::Length: EXPECT_NEAR(numbersAfter[n], 2.0f * numbersBefore[n], 1e-6f); ++n; break;
+      }
+    }
+  }
+}
+
+// The delta lights against their closed forms: a point light gives I/d² along the line to it,
+// a spot the same inside its inner cone and nothing outside its outer one, a directional light
+// its irradiance from −direction everywhere (the sun masks' direction and irradiance).
+TEST(Lights, DeltaLightsGiveTheirClosedForms) {
+  const Light point = createLight("point", {{"position", Vec3(0.0f, 2.0f, 0.0f)}, {"intensity", Rgb(8.0f)}}, "test");
+  const std::optional<IncidentLight> p = sampleLight(point, Vec3(0.0f), Vec2(0.3f));
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->wi, Vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_EQ(p->incident, Rgb(2.0f));
+  EXPECT_EQ(p->pdf, 1.0f);
+  EXPECT_EQ(p->target, Vec3(0.0f, 2.0f, 0.0f));
+  EXPECT_FALSE(sampleLight(point, Vec3(0.0f, 2.0f, 0.0f), Vec2(0.3f)));  // at the light
+  EXPECT_TRUE(isDeltaLight(point));
+  EXPECT_FALSE(isAtInfinity(point));
+  EXPECT_FALSE(parallelLight(point));
+  EXPECT_FLOAT_EQ(lightPower(point, 1.0f), 4.0f * kPi * 8.0f);
+
+  const Light spot = createLight("spot",
+                                 {{"position", Vec3(0.0f, 2.0f, 0.0f)}, {"direction", Vec3(0.0f, -3.0f, 0.0f)}, {"intensity", Rgb(8.0f)},
+                                  {"inner_angle", 0.2f}, {"outer_angle", 0.4f}},
+                                 "test");
+  EXPECT_EQ(sampleLight(spot, Vec3(0.0f), Vec2(0.5f))->incident, Rgb(2.0f));
+  EXPECT_FALSE(sampleLight(spot, Vec3(2.0f * std::tan(0.41f), 0.0f, 0.0f), Vec2(0.5f)));
+  const float half = sampleLight(spot, Vec3(2.0f * std::tan(0.3f), 0.0f, 0.0f), Vec2(0.5f))->incident.r;
+  EXPECT_GT(half, 0.0f);
+  EXPECT_LT(half, 2.0f);
+
+  const Light sun = createLight("directional", {{"direction", Vec3(0.0f, -1.0f, 0.0f)}, {"irradiance", Rgb(3.0f)}}, "test");
+  for (const Vec3& x : {Vec3(0.0f), Vec3(1e4f, -5.0f, 3.0f)}) {
+    const std::optional<IncidentLight> s = sampleLight(sun, x, Vec2(0.5f));
+    EXPECT_EQ(s->wi, Vec3(0.0f, 1.0f, 0.0f));
+    EXPECT_EQ(s->incident, Rgb(3.0f));
+    EXPECT_TRUE(std::isinf(s->distance));
+  }
+  EXPECT_TRUE(isAtInfinity(sun));
+  EXPECT_EQ(parallelLight(sun)->towardsLight, Vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_EQ(parallelLight(sun)->irradiance, Rgb(3.0f));
+  EXPECT_TRUE(shinesBehindPlane(sun, Vec3(0.0f, -1.0f, 0.0f), 0.0f));  // from above onto a plane facing down
+  EXPECT_FALSE(shinesBehindPlane(sun, Vec3(0.0f, 1.0f, 0.0f), 0.0f));
+  EXPECT_TRUE(shinesBehindPlane(point, Vec3(0.0f, -1.0f, 0.0f), 0.0f));
+  EXPECT_FALSE(shinesBehindPlane(point, Vec3(0.0f, 1.0f, 0.0f), 0.0f));
+}
+
+}  // namespace
+}  // namespace pl
