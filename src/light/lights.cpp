@@ -89,6 +89,56 @@ std::optional<IncidentLight> DirectionalLight::sample(const Vec3&, Vec2) const {
   return in;
 }
 
+// ---- Sphere ------------------------------------------------------------------------------
+
+std::string SphereLight::problem() const {
+  if (!isFinite(position) || !isFinite(intensity) || !(intensity.r >= 0.0f && intensity.g >= 0.0f && intensity.b >= 0.0f))
+    return "has a non-finite position or a negative or non-finite intensity";
+  if (!(radius > 0.0f && std::isfinite(radius))) return fmt::format("needs a finite radius > 0 (got {})", radius);
+  return "";
+}
+
+float SphereLight::power(float) const { return 4.0f * kPi * luminance(intensity); }
+
+namespace {
+/// The cone a sphere of radius² r2 at distance² d2 > r2 subtends: 1 − cos α, from
+/// sin²α = r2/d2 as sin²α/(1 + cos α), which keeps its digits when the sphere is small or far.
+float oneMinusCosCone(float r2, float d2) {
+  const float sin2 = r2 / d2;
+  return sin2 / (1.0f + std::sqrt(std::max(0.0f, 1.0f - sin2)));
+}
+}  // namespace
+
+std::optional<IncidentLight> SphereLight::sample(const Vec3& x, Vec2 u) const {
+  const Vec3 toCentre = position - x;
+  const float d2 = glm::dot(toCentre, toCentre), r2 = radius * radius;
+  if (!(d2 > r2)) return std::nullopt;
+  const float d = std::sqrt(d2);
+  const float coneWidth = oneMinusCosCone(r2, d2);
+  // Uniform over the cone: 1 − cos θ = u.x·(1 − cos α), φ = 2π·u.y about the axis to the centre.
+  const float oneMinusCos = u.x * coneWidth;
+  const float cosTheta = 1.0f - oneMinusCos;
+  const float sin2Theta = std::max(0.0f, oneMinusCos * (2.0f - oneMinusCos));
+  const float sinTheta = std::sqrt(sin2Theta), phi = kTwoPi * u.y;
+  IncidentLight in;
+  in.wi = glm::normalize(Frame::fromNormal(toCentre / d).toWorld(Vec3(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta)));
+  // The near point where wi meets the sphere: t = d·cos θ − √(r² − d²·sin²θ).
+  in.distance = std::max(0.0f, d * cosTheta - std::sqrt(std::max(0.0f, r2 - d2 * sin2Theta)));
+  in.target = x + in.distance * in.wi;
+  in.incident = intensity / (kPi * r2);
+  in.pdf = 1.0f / (kTwoPi * coneWidth);
+  return in;
+}
+
+float SphereLight::pdf(const Vec3& x, const Vec3& wi) const {
+  const Vec3 toCentre = position - x;
+  const float d2 = glm::dot(toCentre, toCentre), r2 = radius * radius;
+  if (!(d2 > r2)) return 0.0f;
+  const float coneWidth = oneMinusCosCone(r2, d2);
+  const float cosTheta = glm::dot(wi, toCentre) / std::sqrt(d2);
+  return cosTheta >= 1.0f - coneWidth ? 1.0f / (kTwoPi * coneWidth) : 0.0f;
+}
+
 // ---- Creating lights ---------------------------------------------------------------------
 
 namespace {

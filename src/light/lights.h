@@ -159,9 +159,39 @@ struct DirectionalLight {
   Vec3 travel() const { return glm::normalize(direction); }
 };
 
+/// A sphere of radius r around `position` whose surface emits uniformly and diffusely,
+/// outwards: radiance L = I/(π r²), so that from outside it has intensity I (W·sr⁻¹) in every
+/// direction, as a point light of intensity I at its centre has, and the same flux 4π·I. A
+/// receiver at distance d > r with the whole sphere above its tangent plane (d·cos θc ≥ r, θc
+/// the angle to the centre) gets exactly that point light's irradiance I·cos θc/d² (Lambert:
+/// E = L·π sin²α·cos θc with sin α = r/d, α the half-angle the sphere subtends); nearer the
+/// horizon its light fades out smoothly, and its shadows are soft. Sampled uniformly over
+/// that cone (pdf 1/(2π(1 − cos α))). A receiver inside the sphere gets nothing. Like every
+/// light here it is no geometry: the camera and mirrors do not see the sphere itself.
+struct SphereLight {
+  static constexpr const char* kType = "sphere";
+  static constexpr bool kDelta = false, kAtInfinity = false;
+  Vec3 position{0.0f};
+  float radius = 0.0f;  ///< scene units, > 0: no default, a scene must give it
+  Rgb intensity{1.0f};
+
+  template <class Self, class F>
+  static void parameters(Self& l, F&& f) {
+    f("position", LightParameterKind::Position, l.position);
+    f("radius", LightParameterKind::Length, l.radius);
+    f("intensity", LightParameterKind::Emission, l.intensity);
+  }
+  std::string problem() const;
+  /// 4π·Y(I), the point light's.
+  float power(float sceneRadius) const;
+  std::optional<IncidentLight> sample(const Vec3& x, Vec2 u) const;
+  float pdf(const Vec3& x, const Vec3& wi) const;
+  bool shinesBehindPlane(const Vec3& n, float d0) const { return glm::dot(n, position) - d0 < radius; }
+};
+
 /// The closed set of light types. Adding one: its struct above and an entry here, at the end
 /// (the index is the .plf light number).
-using Light = std::variant<PointLight, SpotLight, DirectionalLight>;
+using Light = std::variant<PointLight, SpotLight, DirectionalLight, SphereLight>;
 
 // ---- Creating lights ---------------------------------------------------------------------
 
@@ -179,7 +209,7 @@ struct LightCreation {
 /// wrong shape. Ranges are checked by lightProblem (Scene::finalize).
 Light createLight(std::string_view type, const LightParameters& parameters, const std::string& where,
                   LightCreation options = {});
-/// The type names, in variant order: "point, spot, directional".
+/// The type names, in variant order: "point, spot, directional, sphere".
 std::string lightTypeNames();
 /// A default light of variant index `index` (the .plf light number), for filling through
 /// visitLightParameters; nullopt for an index no type has.
@@ -221,7 +251,7 @@ bool isAtInfinity(const Light& light);
 std::optional<ParallelLight> parallelLight(const Light& light);
 float lightPower(const Light& light, float sceneRadius);
 /// The light arriving at x for the 2-D sample u (unused by delta lights); nullopt when none
-/// does (x at a point light, outside a spot's cone).
+/// does (x at a point light, outside a spot's cone, inside a sphere light).
 std::optional<IncidentLight> sampleLight(const Light& light, const Vec3& x, Vec2 u);
 /// The solid-angle density sampleLight has for wi at x; 0 for delta lights.
 float lightPdf(const Light& light, const Vec3& x, const Vec3& wi);

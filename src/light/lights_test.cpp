@@ -196,5 +196,126 @@ TEST(Lights, DeltaLightsGiveTheirClosedForms) {
   EXPECT_FALSE(shinesBehindPlane(point, Vec3(0.0f, 1.0f, 0.0f), 0.0f));
 }
 
+// ---- The sphere light ---------------------------------------------------------------------
+
+/// Σ incident·max(0, n·wi)/pdf over an n × n stratified grid of samples, divided by n²: the
+/// sampler's estimate of the irradiance at x on a surface of normal `normal`.
+double stratifiedIrradiance(const Light& light, const Vec3& x, const Vec3& normal, int n = 128) {
+  double sum = 0.0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const std::optional<IncidentLight> in = sampleLight(light, x, Vec2((i + 0.5f) / n, (j + 0.5f) / n));
+      if (in) sum += double(in->incident.g) * std::max(0.0f, glm::dot(normal, in->wi)) / in->pdf;
+    }
+  return sum / (double(n) * n);
+}
+
+/// The same irradiance by quadrature over the sphere's surface: Σ L·cos θx·cos θy/ρ²·dA over
+/// the points that face x (cos θy > 0), on an n × 2n grid in (cos θ, φ) (equal areas).
+double surfaceIrradiance(const SphereLight& sphere, const Vec3& x, const Vec3& normal, int n = 1000) {
+  const double radiance = double(sphere.intensity.g) / (kPiD * double(sphere.radius) * sphere.radius);
+  const double dA = 4.0 * kPiD * double(sphere.radius) * sphere.radius / (2.0 * n * n);
+  double sum = 0.0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < 2 * n; ++i) {
+      const double z = 1.0 - 2.0 * (j + 0.5) / n, r = std::sqrt(1.0 - z * z), phi = kPiD * (i + 0.5) / n;
+      const DVec3 outward(r * std::cos(phi), r * std::sin(phi), z);
+      const DVec3 toPoint = DVec3(sphere.position) + double(sphere.radius) * outward - DVec3(x);
+      const double distance2 = glm::dot(toPoint, toPoint), distance = std::sqrt(distance2);
+      const double cosY = -glm::dot(outward, toPoint) / distance, cosX = glm::dot(DVec3(normal), toPoint) / distance;
+      if (cosY > 0.0 && cosX > 0.0) sum += radiance * cosX * cosY / distance2 * dA;
+    }
+  return sum;
+}
+
+// Lambert's (and Newton's) closed form: where the whole sphere is above the receiver's tangent
+// plane, its irradiance is the point light's at its centre, I·cos θc/d², whatever the radius —
+// near (d = 1.5 r), tilted, and a tiny sphere far away. The stratified cone samples integrate a
+// smooth function over the cone: 128² of them come within 1e-4.
+TEST(SphereLight, IrradianceIsThePointLightsAboveTheHorizon) {
+  const float radius = 0.5f, intensity = 6.0f;
+  const Light sphere = createLight("sphere", {{"position", Vec3(0.0f, 2.0f, 0.0f)}, {"radius", radius}, {"intensity", intensity}}, "test");
+  const Light point = createLight("point", {{"position", Vec3(0.0f, 2.0f, 0.0f)}, {"intensity", intensity}}, "test");
+  EXPECT_FALSE(isDeltaLight(sphere));
+  EXPECT_FALSE(isAtInfinity(sphere));
+  EXPECT_FALSE(parallelLight(sphere));
+  EXPECT_EQ(lightPower(sphere, 1.0f), lightPower(point, 1.0f));
+  struct Receiver {
+    Vec3 x, normal;
+  };
+  for (const Receiver& r : {Receiver{{0.0f, 1.25f, 0.0f}, {0.0f, 1.0f, 0.0f}},               // d = 1.5 r
+                            Receiver{{0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}},                // d = 4 r
+                            Receiver{{1.0f, 0.0f, 0.5f}, glm::normalize(Vec3(0.2f, 1.0f, 0.1f))},  // tilted
+                            Receiver{{0.0f, 0.0f, 0.0f}, glm::normalize(Vec3(1.0f, 0.5f, 0.0f))}}) {
+    const Vec3 toCentre = Vec3(0.0f, 2.0f, 0.0f) - r.x;
+    const double d = glm::length(toCentre), cosCentre = glm::dot(r.normal, toCentre) / d;
+    ASSERT_GE(d * cosCentre, radius);  // the whole sphere above the tangent plane
+    const double expected = intensity * cosCentre / (d * d);
+    EXPECT_NEAR(stratifiedIrradiance(sphere, r.x, r.normal), expected, 1e-4 * expected) << "x " << r.x.x << " " << r.x.y;
+    EXPECT_NEAR(sampleLight(point, r.x, Vec2(0.5f))->incident.g * cosCentre, expected, 1e-5 * expected);
+  }
+  const Light tiny = createLight("sphere", {{"position", Vec3(0.0f, 2.0f, 0.0f)}, {"radius", 1e-3f}, {"intensity", intensity}}, "test");
+  EXPECT_NEAR(stratifiedIrradiance(tiny, Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 16), intensity / 4.0, 1e-4 * intensity / 4.0);
+}
+
+// Where the sphere dips below the horizon, the cone samples agree with a quadrature over its
+// surface (the two share nothing but the definition L = I/(π r²)).
+TEST(SphereLight, IrradianceNearTheHorizonMatchesTheSurfaceIntegral) {
+  const Light light = createLight("sphere", {{"position", Vec3(0.0f, 0.3f, 0.0f)}, {"radius", 0.5f}, {"intensity", 6.0f}}, "test");
+  const SphereLight& sphere = std::get<SphereLight>(light);
+  for (const Vec3& x : {Vec3(1.0f, 0.0f, 0.0f), Vec3(0.7f, 0.0f, 0.3f), Vec3(2.0f, 0.0f, 0.0f)}) {
+    const Vec3 up(0.0f, 1.0f, 0.0f);
+    const double expected = surfaceIrradiance(sphere, x, up);
+    EXPECT_GT(expected, 0.0);
+    EXPECT_NEAR(stratifiedIrradiance(light, x, up, 256), expected, 2e-3 * expected) << "x " << x.x << " " << x.z;
+  }
+  EXPECT_TRUE(shinesBehindPlane(light, Vec3(0.0f, 1.0f, 0.0f), 0.0f));  // it pokes 0.2 below y = 0
+  EXPECT_FALSE(shinesBehindPlane(light, Vec3(0.0f, 1.0f, 0.0f), -0.3f));
+}
+
+// Every sample: its density is lightPdf's for its direction, the shadow ray's target is the
+// near point where that direction meets the sphere, and the radiance is I/(π r²). Directions
+// off the cone have density 0; a receiver inside the sphere gets nothing.
+TEST(SphereLight, SamplesLandOnTheNearSideWithTheirDensity) {
+  const Vec3 centre(0.5f, 3.0f, -1.0f);
+  const float radius = 0.8f;
+  const Light light = createLight("sphere", {{"position", centre}, {"radius", radius}, {"intensity", Rgb(2.0f, 4.0f, 8.0f)}}, "test");
+  const Vec3 x(0.0f, 0.0f, 0.0f);
+  for (int j = 0; j < 16; ++j)
+    for (int i = 0; i < 16; ++i) {
+      const std::optional<IncidentLight> in = sampleLight(light, x, Vec2((i + 0.5f) / 16, (j + 0.5f) / 16));
+      ASSERT_TRUE(in);
+      EXPECT_NEAR(glm::length(in->wi), 1.0f, 1e-6f);
+      EXPECT_FLOAT_EQ(lightPdf(light, x, in->wi), in->pdf);
+      EXPECT_NEAR(glm::length(in->target - centre), radius, 1e-5f);
+      EXPECT_LE(glm::dot(in->target - centre, in->wi), 1e-5f);  // the side facing x
+      EXPECT_NEAR(glm::length(in->target - x), in->distance, 1e-5f);
+      EXPECT_EQ(in->incident, Rgb(2.0f, 4.0f, 8.0f) / (kPi * radius * radius));
+    }
+  EXPECT_EQ(lightPdf(light, x, glm::normalize(Vec3(1.0f, 0.0f, 0.0f))), 0.0f);
+  EXPECT_FALSE(sampleLight(light, centre + Vec3(0.1f), Vec2(0.5f)));
+  EXPECT_EQ(lightPdf(light, centre, Vec3(0.0f, 1.0f, 0.0f)), 0.0f);
+}
+
+// A sphere light needs a radius; the JSON scene format takes it like any other light.
+class SphereLightJson : public test_support::TempDirTest {};
+TEST_F(SphereLightJson, TheRadiusIsRequiredAndPositive) {
+  std::ofstream(path("ok.json")) << R"({"include_cornell": true, "lights": [{"type": "sphere", "position": [278, 400, 280], "radius": 20, "intensity": [1, 2, 3]}]})";
+  const Scene scene = loadScene(path("ok.json"));
+  ASSERT_EQ(scene.lights.size(), 1u);
+  const SphereLight& sphere = std::get<SphereLight>(scene.lights[0]);
+  EXPECT_EQ(sphere.radius, 20.0f);
+  EXPECT_EQ(sphere.intensity, Rgb(1.0f, 2.0f, 3.0f));
+  for (const char* radius : {"", ", \"radius\": 0", ", \"radius\": -1"}) {
+    std::ofstream(path("bad.json")) << R"({"include_cornell": true, "lights": [{"type": "sphere", "position": [0, 1, 0])" << radius << "}]}";
+    try {
+      loadScene(path("bad.json"));
+      ADD_FAILURE() << "accepted a sphere light with radius '" << radius << "'";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.json: sphere light 0 needs a finite radius > 0"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pl

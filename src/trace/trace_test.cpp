@@ -481,6 +481,40 @@ TEST_F(TraceTest, PointLightAboveLambertianPlane) {
   }
 }
 
+// A sphere light (light/lights.h) of intensity I, its whole sphere above the plane (radius
+// 0.5 < height 2), lights it exactly as the point light of intensity I at its centre does
+// (Lambert): ρ·I·cos θ/(π D²) in expectation, for every strategy (no BSDF-sampled ray finds
+// it: BsdfOnly keeps next-event estimation for it). Its cone samples make it noisy: within
+// 4 standard errors of 1024 samples.
+TEST_F(TraceTest, SphereLightAboveLambertianPlaneIsThePointLightAtItsCentre) {
+  const Rgb albedo(0.6f, 0.4f, 0.2f);
+  const Rgb intensity(10.0f, 20.0f, 30.0f);
+  const float d = 2.0f;
+  const Scene scene = planeWith(
+      createLight("sphere", {{"position", Vec3(0.0f, d, 0.0f)}, {"radius", 0.5f}, {"intensity", intensity}}, "test"), albedo);
+  const Accel accel(scene);
+  const PathTracer tracer(scene, accel);
+  for (TraceStrategy strategy : {TraceStrategy::Mis, TraceStrategy::NeeOnly, TraceStrategy::BsdfOnly}) {
+    for (float x : {0.0f, 1.0f, 2.0f, 4.0f}) {
+      const float distance = std::sqrt(x * x + d * d);
+      const Rgb expected = albedo * intensity * (d / distance) / (kPi * distance * distance);
+      const Vec3 target(x, 0.0f, 0.0f);
+      Ray ray;
+      ray.origin = target + Vec3(0.3f, 5.0f, -0.2f);
+      ray.direction = glm::normalize(target - ray.origin);
+      TraceSettings settings;
+      settings.spp = 1024;
+      settings.strategy = strategy;
+      const RadianceEstimate e = tracer.estimateRadiance(ray, settings, 7);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_GT(e.varianceOfMean[c], 0.0f);
+        EXPECT_NEAR(e.mean[c], expected[c], 4.0f * std::sqrt(e.varianceOfMean[c]) + 1e-5f * expected[c])
+            << strategyName(strategy) << " x=" << x;
+      }
+    }
+  }
+}
+
 // A spot light is a point light inside its inner cone and dark outside its outer cone.
 TEST_F(TraceTest, SpotLightConesAboveLambertianPlane) {
   const Rgb albedo(0.5f);
