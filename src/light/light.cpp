@@ -170,7 +170,7 @@ std::optional<LightSample> LightSampler::sampleEntry(const Entry& entry, float s
       s.pdf = selectProbability * in->pdf;  // a delta light's pdf is 1: the selection alone
       s.delta = isDeltaLight(light);
       s.nextEventOnly = true;
-      s.infinite = !std::isfinite(in->distance);
+      s.infinite = isAtInfinity(light);
       s.target = in->target;
       break;
     }

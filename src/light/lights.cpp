@@ -92,7 +92,7 @@ std::optional<IncidentLight> DirectionalLight::sample(const Vec3&, Vec2) const {
 // ---- Sphere ------------------------------------------------------------------------------
 
 std::string SphereLight::problem() const {
-  if (!isFinite(position) || !isFinite(intensity) || !(intensity.r >= 0.0f && intensity.g >= 0.0f && intensity.b >= 0.0f))
+  if (!isFinite(position) || !isFinite(intensity) || !(std::min({intensity.r, intensity.g, intensity.b}) >= 0.0f))
     return "has a non-finite position or a negative or non-finite intensity";
   if (!(radius > 0.0f && std::isfinite(radius))) return fmt::format("needs a finite radius > 0 (got {})", radius);
   return "";
@@ -121,7 +121,8 @@ std::optional<IncidentLight> SphereLight::sample(const Vec3& x, Vec2 u) const {
   const float sin2Theta = std::max(0.0f, oneMinusCos * (2.0f - oneMinusCos));
   const float sinTheta = std::sqrt(sin2Theta), phi = kTwoPi * u.y;
   IncidentLight in;
-  in.wi = glm::normalize(Frame::fromNormal(toCentre / d).toWorld(Vec3(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta)));
+  const Vec3 local(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta);
+  in.wi = glm::normalize(Frame::fromNormal(toCentre / d).toWorld(local));
   // The near point where wi meets the sphere: t = d·cos θ − √(r² − d²·sin²θ).
   in.distance = std::max(0.0f, d * cosTheta - std::sqrt(std::max(0.0f, r2 - d2 * sin2Theta)));
   in.target = x + in.distance * in.wi;

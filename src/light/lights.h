@@ -5,8 +5,8 @@
 //
 //  * Each type is one struct: its parameters, listed by its parameters() hook, and what every
 //    renderer asks of it. Nothing outside light/ switches on the type: loaders, the .plf file,
-//    transforms, validation and the Python module go through the hook (createLight below),
-//    the samplers and the renderers through the functions at the end of this file.
+//    transforms, validation and the Python module go through the hook (createLight and the
+//    functions after it), the samplers and the renderers through those at the end of this file.
 //  * Units: positions and lengths in scene units; intensity I in W·sr⁻¹, irradiance E in
 //    W·m⁻², radiance L in W·sr⁻¹·m⁻². A `direction` is the way the light travels.
 //  * sample(x, u) gives the light arriving at a receiver at x (IncidentLight). A delta light
@@ -16,9 +16,8 @@
 //    Either way incident·max(0, n·wi)/pdf, times the shadow ray's transmittance, estimates the
 //    irradiance on a surface of normal n (exactly, for a delta light).
 //  * None of these lights is geometry: camera rays and BSDF-sampled rays never hit them. Only
-//    shadow rays find them, so
-//    the path tracer counts them by next-event estimation alone, with no MIS weight, and the
-//    light field holds their light where it lands on surfaces.
+//    shadow rays find them, so the path tracer counts them by next-event estimation alone,
+//    with no MIS weight, and the light field holds their light where it lands on surfaces.
 //  * power(R) is the selection weight of the light samplers (light/light.h): an estimate of
 //    the emitted flux's luminance, R the radius of the scene's bounding sphere (for lights at
 //    infinity).
@@ -202,9 +201,9 @@ struct LightCreation {
                                  ///< every light a position and a direction)
 };
 
-/// The one step every loader, the .plf reader and the Python module create lights through:
-/// a light of type `type` (its kType, e.g. "point") with `parameters` set, the others at the
-/// type's defaults, prepared. Throws pl::Error, its message starting with `where` (e.g.
+/// The one step the scene loaders (JSON, glTF) create lights through: a light of type `type`
+/// (its kType, e.g. "point") with `parameters` set, the others at the type's defaults,
+/// prepared. (The .plf reader fills a lightOfIndex through the same parameters() hook.) Throws pl::Error, its message starting with `where` (e.g.
 /// "scene.json: lights[2]"), for an unknown type, an unknown parameter name or a value of the
 /// wrong shape. Ranges are checked by lightProblem (Scene::finalize).
 Light createLight(std::string_view type, const LightParameters& parameters, const std::string& where,

@@ -12,36 +12,22 @@
 
 #include "core/error.h"
 #include "scene/scene.h"
+#include "support/light_parameters.h"
 #include "support/temp_dir_test.h"
 
 namespace pl {
 namespace {
 
-/// Every parameter of a light as floats, in hook order (a Vec3 as three).
-std::vector<float> parameterFloats(const Light& light) {
-  std::vector<float> values;
-  visitLightParameters(light, [&](const char*, LightParameterKind, const auto& field) {
-    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, Vec3>) values.insert(values.end(), {field.x, field.y, field.z});
-    else values.push_back(field);
-  });
-  return values;
-}
+using test_support::lightParameterFloats;
 
-/// A parameter map giving every parameter of type `index` a value of its own, all positive and
-/// increasing in hook order (so that a spot's inner angle stays below its outer one, and every
-/// type's values are in range); angles are in degrees when `degrees`.
+/// The parameters of lightWithDistinctParameters(index) as a parameter map, its angles ×100
+/// in degrees when `degrees` (0.4 → 40°).
 LightParameters distinctParameters(size_t index, bool degrees) {
   LightParameters parameters;
-  float next = 0.1f;
-  const Light light = *lightOfIndex(index);
+  const Light light = test_support::lightWithDistinctParameters(index);
   visitLightParameters(light, [&](const char* name, LightParameterKind kind, const auto& field) {
-    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, Vec3>) {
-      parameters[name] = Vec3(next, next + 0.1f, next + 0.2f);
-      next += 0.3f;
-    } else {
-      parameters[name] = kind == LightParameterKind::Angle && degrees ? 10.0f * next : next;
-      next += 0.1f;
-    }
+    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, Vec3>) parameters[name] = field;
+    else parameters[name] = kind == LightParameterKind::Angle && degrees ? 100.0f * field : field;
   });
   return parameters;
 }
@@ -62,7 +48,9 @@ TEST(Lights, EveryTypeIsCreatedFromItsParameterMap) {
     });
     EXPECT_EQ(lightProblem(light), "");
     int emissions = 0;
-    visitLightParameters(light, [&](const char*, LightParameterKind kind, const auto&) { emissions += kind == LightParameterKind::Emission; });
+    visitLightParameters(light, [&](const char*, LightParameterKind kind, const auto&) {
+      emissions += kind == LightParameterKind::Emission;
+    });
     EXPECT_EQ(emissions, 1);
     EXPECT_NE(lightTypeNames().find(type), std::string::npos);
   }
@@ -83,8 +71,10 @@ TEST(Lights, BadParameterMapsNameTheProblem) {
             "s.json: lights[0]: unknown light type 'laser' (" + lightTypeNames() + ")");
   EXPECT_EQ(message([] { createLight("point", {{"radius", 1.0f}}, "s.json: lights[1]"); }),
             "s.json: lights[1]: unknown key 'radius' for a point light (position, intensity)");
-  EXPECT_EQ(message([] { createLight("point", {{"position", 1.0f}}, "w"); }), "w.position: expected [x, y, z], got one number");
-  EXPECT_EQ(message([] { createLight("spot", {{"inner_angle", Vec3(1.0f)}}, "w"); }), "w.inner_angle: expected a number, got three");
+  EXPECT_EQ(message([] { createLight("point", {{"position", 1.0f}}, "w"); }),
+            "w.position: expected [x, y, z], got one number");
+  EXPECT_EQ(message([] { createLight("spot", {{"inner_angle", Vec3(1.0f)}}, "w"); }),
+            "w.inner_angle: expected a number, got three");
   // Unknown names pass when asked to (a glTF node gives every light its whole pose).
   EXPECT_NO_THROW(createLight("point", {{"direction", Vec3(1.0f)}}, "w", {.ignoreUnknown = true}));
   // A colour may be one number (grey).
@@ -115,7 +105,7 @@ TEST_F(LightsJson, EveryTypeLoadsFromAJsonScene) {
   ASSERT_EQ(scene.lights.size(), expected.size());
   for (size_t i = 0; i < expected.size(); ++i) {
     EXPECT_EQ(scene.lights[i].index(), expected[i].index());
-    EXPECT_EQ(parameterFloats(scene.lights[i]), parameterFloats(expected[i])) << lightTypeName(expected[i]);
+    EXPECT_EQ(lightParameterFloats(scene.lights[i]), lightParameterFloats(expected[i])) << lightTypeName(expected[i]);
   }
 }
 
@@ -143,7 +133,10 @@ TEST(Lights, TransformsMoveEachParameterByItsKind) {
     size_t v = 0, n = 0;
     for (const LightParameterKind kind : kinds) {
       switch (kind) {
-        case LightParameterKind::Position: EXPECT_EQ(vectorsAfter[v], 2.0f * vectorsBefore[v] + Vec3(2.0f, 0.0f, 0.0f)); ++v; break;
+        case LightParameterKind::Position:
+          EXPECT_EQ(vectorsAfter[v], 2.0f * vectorsBefore[v] + Vec3(2.0f, 0.0f, 0.0f));
+          ++v;
+          break;
         case LightParameterKind::Direction: EXPECT_EQ(vectorsAfter[v], 2.0f * vectorsBefore[v]); ++v; break;
         case LightParameterKind::Emission: EXPECT_EQ(vectorsAfter[v], vectorsBefore[v]); ++v; break;
         case LightParameterKind::Angle: EXPECT_EQ(numbersAfter[n], numbersBefore[n]); ++n; break;
@@ -171,8 +164,11 @@ TEST(Lights, DeltaLightsGiveTheirClosedForms) {
   EXPECT_FLOAT_EQ(lightPower(point, 1.0f), 4.0f * kPi * 8.0f);
 
   const Light spot = createLight("spot",
-                                 {{"position", Vec3(0.0f, 2.0f, 0.0f)}, {"direction", Vec3(0.0f, -3.0f, 0.0f)}, {"intensity", Rgb(8.0f)},
-                                  {"inner_angle", 0.2f}, {"outer_angle", 0.4f}},
+                                 {{"position", Vec3(0.0f, 2.0f, 0.0f)},
+                                  {"direction", Vec3(0.0f, -3.0f, 0.0f)},
+                                  {"intensity", Rgb(8.0f)},
+                                  {"inner_angle", 0.2f},
+                                  {"outer_angle", 0.4f}},
                                  "test");
   EXPECT_EQ(sampleLight(spot, Vec3(0.0f), Vec2(0.5f))->incident, Rgb(2.0f));
   EXPECT_FALSE(sampleLight(spot, Vec3(2.0f * std::tan(0.41f), 0.0f, 0.0f), Vec2(0.5f)));
@@ -234,7 +230,8 @@ double surfaceIrradiance(const SphereLight& sphere, const Vec3& x, const Vec3& n
 // smooth function over the cone: 128² of them come within 1e-4.
 TEST(SphereLight, IrradianceIsThePointLightsAboveTheHorizon) {
   const float radius = 0.5f, intensity = 6.0f;
-  const Light sphere = createLight("sphere", {{"position", Vec3(0.0f, 2.0f, 0.0f)}, {"radius", radius}, {"intensity", intensity}}, "test");
+  const Vec3 centre(0.0f, 2.0f, 0.0f);
+  const Light sphere = createLight("sphere", {{"position", centre}, {"radius", radius}, {"intensity", intensity}}, "test");
   const Light point = createLight("point", {{"position", Vec3(0.0f, 2.0f, 0.0f)}, {"intensity", intensity}}, "test");
   EXPECT_FALSE(isDeltaLight(sphere));
   EXPECT_FALSE(isAtInfinity(sphere));
@@ -247,21 +244,22 @@ TEST(SphereLight, IrradianceIsThePointLightsAboveTheHorizon) {
                             Receiver{{0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}},                // d = 4 r
                             Receiver{{1.0f, 0.0f, 0.5f}, glm::normalize(Vec3(0.2f, 1.0f, 0.1f))},  // tilted
                             Receiver{{0.0f, 0.0f, 0.0f}, glm::normalize(Vec3(1.0f, 0.5f, 0.0f))}}) {
-    const Vec3 toCentre = Vec3(0.0f, 2.0f, 0.0f) - r.x;
+    const Vec3 toCentre = centre - r.x;
     const double d = glm::length(toCentre), cosCentre = glm::dot(r.normal, toCentre) / d;
     ASSERT_GE(d * cosCentre, radius);  // the whole sphere above the tangent plane
     const double expected = intensity * cosCentre / (d * d);
     EXPECT_NEAR(stratifiedIrradiance(sphere, r.x, r.normal), expected, 1e-4 * expected) << "x " << r.x.x << " " << r.x.y;
     EXPECT_NEAR(sampleLight(point, r.x, Vec2(0.5f))->incident.g * cosCentre, expected, 1e-5 * expected);
   }
-  const Light tiny = createLight("sphere", {{"position", Vec3(0.0f, 2.0f, 0.0f)}, {"radius", 1e-3f}, {"intensity", intensity}}, "test");
+  const Light tiny = createLight("sphere", {{"position", centre}, {"radius", 1e-3f}, {"intensity", intensity}}, "test");
   EXPECT_NEAR(stratifiedIrradiance(tiny, Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 16), intensity / 4.0, 1e-4 * intensity / 4.0);
 }
 
 // Where the sphere dips below the horizon, the cone samples agree with a quadrature over its
 // surface (the two share nothing but the definition L = I/(π r²)).
 TEST(SphereLight, IrradianceNearTheHorizonMatchesTheSurfaceIntegral) {
-  const Light light = createLight("sphere", {{"position", Vec3(0.0f, 0.3f, 0.0f)}, {"radius", 0.5f}, {"intensity", 6.0f}}, "test");
+  const Light light =
+      createLight("sphere", {{"position", Vec3(0.0f, 0.3f, 0.0f)}, {"radius", 0.5f}, {"intensity", 6.0f}}, "test");
   const SphereLight& sphere = std::get<SphereLight>(light);
   for (const Vec3& x : {Vec3(1.0f, 0.0f, 0.0f), Vec3(0.7f, 0.0f, 0.3f), Vec3(2.0f, 0.0f, 0.0f)}) {
     const Vec3 up(0.0f, 1.0f, 0.0f);
@@ -279,7 +277,8 @@ TEST(SphereLight, IrradianceNearTheHorizonMatchesTheSurfaceIntegral) {
 TEST(SphereLight, SamplesLandOnTheNearSideWithTheirDensity) {
   const Vec3 centre(0.5f, 3.0f, -1.0f);
   const float radius = 0.8f;
-  const Light light = createLight("sphere", {{"position", centre}, {"radius", radius}, {"intensity", Rgb(2.0f, 4.0f, 8.0f)}}, "test");
+  const Light light =
+      createLight("sphere", {{"position", centre}, {"radius", radius}, {"intensity", Rgb(2.0f, 4.0f, 8.0f)}}, "test");
   const Vec3 x(0.0f, 0.0f, 0.0f);
   for (int j = 0; j < 16; ++j)
     for (int i = 0; i < 16; ++i) {
@@ -300,19 +299,22 @@ TEST(SphereLight, SamplesLandOnTheNearSideWithTheirDensity) {
 // A sphere light needs a radius; the JSON scene format takes it like any other light.
 class SphereLightJson : public test_support::TempDirTest {};
 TEST_F(SphereLightJson, TheRadiusIsRequiredAndPositive) {
-  std::ofstream(path("ok.json")) << R"({"include_cornell": true, "lights": [{"type": "sphere", "position": [278, 400, 280], "radius": 20, "intensity": [1, 2, 3]}]})";
+  std::ofstream(path("ok.json")) << R"({"include_cornell": true, "lights": [)"
+                                  << R"({"type": "sphere", "position": [278, 400, 280], "radius": 20, "intensity": [1, 2, 3]}]})";
   const Scene scene = loadScene(path("ok.json"));
   ASSERT_EQ(scene.lights.size(), 1u);
   const SphereLight& sphere = std::get<SphereLight>(scene.lights[0]);
   EXPECT_EQ(sphere.radius, 20.0f);
   EXPECT_EQ(sphere.intensity, Rgb(1.0f, 2.0f, 3.0f));
   for (const char* radius : {"", ", \"radius\": 0", ", \"radius\": -1"}) {
-    std::ofstream(path("bad.json")) << R"({"include_cornell": true, "lights": [{"type": "sphere", "position": [0, 1, 0])" << radius << "}]}";
+    std::ofstream(path("bad.json")) << R"({"include_cornell": true, "lights": [{"type": "sphere", "position": [0, 1, 0])"
+                                    << radius << "}]}";
     try {
       loadScene(path("bad.json"));
       ADD_FAILURE() << "accepted a sphere light with radius '" << radius << "'";
     } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("bad.json: sphere light 0 needs a finite radius > 0"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("bad.json: sphere light 0 needs a finite radius > 0"), std::string::npos)
+          << e.what();
     }
   }
 }

@@ -133,7 +133,8 @@ Light getLight(ByteReader& r) {
   const uint32_t type = r.get<uint32_t>();
   std::optional<Light> light = lightOfIndex(type);
   if (!light) r.corrupt(fmt::format("unknown light type {}", type));
-  visitLightParameters(*light, [&](const char*, LightParameterKind, auto& field) { field = r.get<std::decay_t<decltype(field)>>(); });
+  visitLightParameters(*light,
+                       [&](const char*, LightParameterKind, auto& field) { field = r.get<std::decay_t<decltype(field)>>(); });
   if (const std::string problem = lightProblem(*light); !problem.empty())
     r.corrupt(fmt::format("{} light {}", lightTypeName(*light), problem));
   prepareLight(*light);

@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "core/hash.h"
 #include "scene/scene.h"
+#include "support/light_parameters.h"
 #include "support/temp_dir_test.h"
 
 namespace pl {
@@ -214,15 +215,7 @@ class PlfFileTest : public test_support::TempDirTest {
   fs::path dir_;
 };
 
-/// Every parameter of a light as floats, in the order of its parameters() hook.
-std::vector<float> lightParameterFloats(const Light& light) {
-  std::vector<float> values;
-  visitLightParameters(light, [&](const char*, LightParameterKind, const auto& field) {
-    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, Vec3>) values.insert(values.end(), {field.x, field.y, field.z});
-    else values.push_back(field);
-  });
-  return values;
-}
+using test_support::lightParameterFloats;
 
 void expectSameRgb(const Rgb& a, const Rgb& b) {
   EXPECT_EQ(a.r, b.r);
@@ -237,15 +230,8 @@ TEST_F(PlfFileTest, EveryLightTypeRoundTrips) {
   original.scene.lights.clear();
   original.sunMaskLightCount = 0;
   original.sunMasks.clear();
-  for (size_t index = 0; index < std::variant_size_v<Light>; ++index) {
-    Light light = *lightOfIndex(index);
-    float next = 0.1f;  // positive and increasing in hook order: in range for every type
-    visitLightParameters(light, [&](const char*, LightParameterKind, auto& field) {
-      if constexpr (std::is_same_v<std::decay_t<decltype(field)>, Vec3>) field = Vec3(next, next + 0.1f, next + 0.2f), next += 0.3f;
-      else field = next, next += 0.1f;
-    });
-    original.scene.lights.push_back(light);
-  }
+  for (size_t index = 0; index < std::variant_size_v<Light>; ++index)
+    original.scene.lights.push_back(test_support::lightWithDistinctParameters(index));
   const std::string path = file("lights.plf");
   writeLightField(path, original);
   const LightField copy = readLightField(path);

@@ -442,17 +442,22 @@ Scene planeWith(const Light& light, const Rgb& albedo, bool blocker = false) {
   return finished(std::move(s));
 }
 
-/// Radiance leaving the plane at (x, 0, z) towards a viewer above it, estimated with one
-/// deterministic sample per strategy (direct light from one punctual light has no noise).
-Rgb planeRadianceAt(const PathTracer& tracer, float x, TraceStrategy strategy, float z = 0.0f) {
+/// A ray from a viewer above the plane to its point (x, 0, z).
+Ray rayToPlaneAt(float x, float z = 0.0f) {
   const Vec3 target(x, 0.0f, z);
   Ray ray;
   ray.origin = target + Vec3(0.3f, 5.0f, -0.2f);
   ray.direction = glm::normalize(target - ray.origin);
+  return ray;
+}
+
+/// Radiance leaving the plane at (x, 0, z) towards a viewer above it, estimated with one
+/// deterministic sample per strategy (direct light from one punctual light has no noise).
+Rgb planeRadianceAt(const PathTracer& tracer, float x, TraceStrategy strategy, float z = 0.0f) {
   TraceSettings settings;
   settings.spp = 4;
   settings.strategy = strategy;
-  const RadianceEstimate e = tracer.estimateRadiance(ray, settings, 1);
+  const RadianceEstimate e = tracer.estimateRadiance(rayToPlaneAt(x, z), settings, 1);
   EXPECT_EQ(e.samples, 4u);
   EXPECT_EQ(e.varianceOfMean, Rgb(0.0f));  // deterministic: nothing else lights the plane
   return e.mean;
@@ -498,14 +503,10 @@ TEST_F(TraceTest, SphereLightAboveLambertianPlaneIsThePointLightAtItsCentre) {
     for (float x : {0.0f, 1.0f, 2.0f, 4.0f}) {
       const float distance = std::sqrt(x * x + d * d);
       const Rgb expected = albedo * intensity * (d / distance) / (kPi * distance * distance);
-      const Vec3 target(x, 0.0f, 0.0f);
-      Ray ray;
-      ray.origin = target + Vec3(0.3f, 5.0f, -0.2f);
-      ray.direction = glm::normalize(target - ray.origin);
       TraceSettings settings;
       settings.spp = 1024;
       settings.strategy = strategy;
-      const RadianceEstimate e = tracer.estimateRadiance(ray, settings, 7);
+      const RadianceEstimate e = tracer.estimateRadiance(rayToPlaneAt(x), settings, 7);
       for (int c = 0; c < 3; ++c) {
         EXPECT_GT(e.varianceOfMean[c], 0.0f);
         EXPECT_NEAR(e.mean[c], expected[c], 4.0f * std::sqrt(e.varianceOfMean[c]) + 1e-5f * expected[c])
