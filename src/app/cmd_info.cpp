@@ -128,7 +128,7 @@ void printHuman(const PlfInfo& info) {
   fmt::print("  geometry   {} triangles, {} vertices in {} meshes\n", info.triangles, info.vertices, info.meshes);
   fmt::print("  materials  {} ({})\n", info.materials, modelCounts(info.materialModels));
   fmt::print("  textures   {}\n", info.textures);
-  fmt::print("  lights     {} point/spot/directional (plus emissive surfaces)\n", info.lights);
+  fmt::print("  lights     {} (plus emissive surfaces)\n", info.lights);
   std::string cameras;
   for (const std::string& c : info.cameraNames) cameras += (cameras.empty() ? "" : ", ") + (c.empty() ? "(unnamed)" : c);
   fmt::print("  cameras    {}{}\n", info.cameraNames.size(), cameras.empty() ? "" : ": " + cameras);

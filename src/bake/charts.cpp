@@ -376,11 +376,8 @@ void addBackSides(const Scene& scene, const std::vector<uint8_t>& openTriangle, 
       const Vec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
       if (glm::dot(n, corner) - d0 < -behindTolerance) return true;
     }
-    for (const Light& light : scene.lights) {
-      const PunctualLight l = PunctualLight::from(light);
-      if (l.kind == PunctualLight::Kind::Directional ? glm::dot(l.direction, n) > 0.0f : glm::dot(n, l.position) - d0 < 0.0f)
-        return true;
-    }
+    for (const Light& light : scene.lights)
+      if (shinesBehindPlane(light, n, d0)) return true;
     return false;
   };
   // A curved chart does not lie in one plane: behind any of its triangles' planes.

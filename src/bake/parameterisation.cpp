@@ -301,7 +301,7 @@ SunMaskSlots tixelSunMasks(const Scene& scene, const Accel& accel, const Chart& 
   std::array<Ray, kSamples> rays;
   std::array<uint8_t, kSamples> blocked;
   for (size_t slot = 0; slot < lights.size(); ++slot) {
-    const Vec3 wi = -std::get<DirectionalLight>(scene.lights[lights[slot]]).direction;  // towards the light
+    const Vec3 wi = parallelLight(scene.lights[lights[slot]])->towardsLight;  // a sun-masked light: parallel
     // 1 lit, 0 shadowed, −1 undecided.
     std::array<int, kSamples> state;
     state.fill(-1);

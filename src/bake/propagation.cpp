@@ -297,15 +297,10 @@ std::string brightestEmitter(const Scene& scene) {
     name = fmt::format("{} ({} {:.3g} {:.3g} {:.3g})", what, quantity, value.r, value.g, value.b);
   };
   for (const Material& m : scene.materials) consider(m.emission, fmt::format("material '{}'", m.name), "emission");
-  for (size_t i = 0; i < scene.lights.size(); ++i)
-    std::visit(
-        [&](const auto& light) {
-          using T = std::decay_t<decltype(light)>;
-          if constexpr (std::is_same_v<T, PointLight>) consider(light.intensity, fmt::format("point light {}", i), "intensity");
-          else if constexpr (std::is_same_v<T, SpotLight>) consider(light.intensity, fmt::format("spot light {}", i), "intensity");
-          else consider(light.irradiance, fmt::format("directional light {}", i), "irradiance");
-        },
-        scene.lights[i]);
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& light = scene.lights[i];
+    consider(lightEmission(light), fmt::format("{} light {}", lightTypeName(light), i), lightEmissionName(light));
+  }
   return name;
 }
 
@@ -401,7 +396,7 @@ struct TransportState::Operators {
   LightSampler lights;
   std::vector<float> areaPdf;          ///< per material: the emitter area density
   uint32_t lightSamples = 0;           ///< area-light shadow rays per tixel (0 without emitters)
-  std::vector<PunctualLight> punctualLights;
+  uint32_t sceneLightSamples = 1;      ///< shadow rays per tixel towards each non-delta scene light
   std::optional<ShadowRays> shadows;
   /// The first-shot gather of rough-glass tixels, kept until every range has gathered, when
   /// each record adds the transmission of its twin's (beginIteration).
@@ -507,9 +502,11 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   ops->areaPdf.assign(scene.materials.size(), 0.0f);
   for (uint32_t m = 0; m < scene.materials.size(); ++m) ops->areaPdf[m] = ops->lights.emitterAreaPdf(m);
   ops->lightSamples = ops->lights.emissiveTriangleCount() == 0 ? 0 : settings.areaLightSamples;
-  for (const Light& light : scene.lights) ops->punctualLights.push_back(PunctualLight::from(light));
-  // Point, spot and directional lights pass thin glass (windows) as in the path tracer. Area
-  // lights' shadow rays stop at all glass: emitters behind glass reach the tixel along the
+  // The gather never finds the scene's lights (they are no geometry): a non-delta one gets
+  // shadow rays even when the preset gives emissive surfaces none.
+  ops->sceneLightSamples = std::max(1u, settings.areaLightSamples);
+  // The scene's lights pass thin glass (windows) as in the path tracer. Emissive surfaces'
+  // shadow rays stop at all glass: emitters behind glass reach the tixel along the
   // gather chains, which count them with full weight (viaMirror), so crossing glass here too
   // would count them twice.
   ops->shadows.emplace(scene, accel);
@@ -519,7 +516,7 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   const bool glossyReflector = std::any_of(param.charts.begin(), param.charts.end(), [&](const Chart& c) {
     return c.kind == ChartKind::Glossy && !isRoughGlassChart(c, scene.materials[c.material].bsdf);
   });
-  if (settings.punctualHighlights && !scene.lights.empty() && glossyReflector)
+  if (settings.punctualHighlights && std::any_of(scene.lights.begin(), scene.lights.end(), isDeltaLight) && glossyReflector)
     punctualGlossy.assign(param.valueCount, Rgb(0.0f));
   change.assign(tixels, 0.0f);
   batchStart = propagationBatches(param);
@@ -549,17 +546,20 @@ int sunMaskSlot(const Parameterisation& param, uint32_t light) {
   return at == param.sunMaskLights.end() ? -1 : int(at - param.sunMaskLights.begin());
 }
 
-Rgb sunMaskedIrradiance(const Parameterisation& param, const PunctualLight& light, uint64_t tixel, size_t slot) {
+Rgb sunMaskedIrradiance(const Parameterisation& param, const Light& light, uint64_t tixel, size_t slot) {
   const Chart& c = param.charts[param.tixelChart[tixel]];
-  const float cosTheta = glm::dot(tixelFrame(param, c, tixel).n, -light.direction);
+  // A masked light is a delta light at infinity: the same wi and irradiance everywhere.
+  const std::optional<IncidentLight> in = sampleLight(light, param.gatherPoint[tixel], Vec2(0.5f));
+  if (!in) return Rgb(0.0f);
+  const float cosTheta = glm::dot(tixelFrame(param, c, tixel).n, in->wi);
   if (!(cosTheta > 0.0f)) return Rgb(0.0f);
-  return light.intensity * (cosTheta * sunMaskFraction(param.sunMask[tixel][slot]));
+  return in->incident * (cosTheta * sunMaskFraction(param.sunMask[tixel][slot]));
 }
 
 void removeSunMaskedDirect(const Scene& scene, const Parameterisation& param, std::vector<Rgb>& values) {
   if (param.sunMaskLights.empty()) return;
-  std::vector<PunctualLight> lights;
-  for (uint32_t index : param.sunMaskLights) lights.push_back(PunctualLight::from(scene.lights[index]));
+  std::vector<Light> lights;
+  for (uint32_t index : param.sunMaskLights) lights.push_back(scene.lights[index]);
   parallelForRange(param.tixelCount, 4096, [&](uint64_t begin, uint64_t end) {
     for (uint64_t g = begin; g < end; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
@@ -580,11 +580,11 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
   const std::vector<GlossyMaterial>& glossy = ops.glossy;
   const LightSampler& lights = ops.lights;
   const uint32_t lightSamples = ops.lightSamples, n = state.n;
-  const std::vector<PunctualLight>& punctualLights = ops.punctualLights;
+  const std::vector<Light>& sceneLights = scene.lights;
   const ShadowRays& shadows = *ops.shadows;
-  // Per punctual light (scene.lights order): its sun-mask slot, or −1.
-  std::vector<int> maskSlot(punctualLights.size());
-  for (size_t li = 0; li < punctualLights.size(); ++li) maskSlot[li] = sunMaskSlot(param, uint32_t(li));
+  // Per scene light: its sun-mask slot, or −1.
+  std::vector<int> maskSlot(sceneLights.size());
+  for (size_t li = 0; li < sceneLights.size(); ++li) maskSlot[li] = sunMaskSlot(param, uint32_t(li));
   std::vector<Rgb>& direct = state.direct;
   std::vector<Rgb>& punctualGlossy = state.punctualGlossy;
   std::atomic<uint64_t>& shadowRays = state.shadowRays;
@@ -594,7 +594,9 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
     uint64_t tixel;
     Vec3 wi;
     Rgb irradiance;  ///< already multiplied by cos θ at the receiver (and MIS-weighted)
-    bool areaSample;  ///< a sample of an emissive surface (glossy: texel-centre BSDF value)
+    /// A sample of an area light — an emissive surface or a non-delta scene light: a glossy map
+    /// takes the texel-centre BSDF value, and it is no punctual highlight.
+    bool areaSample;
   };
   parallelFor(blocks, [&](uint64_t block) {
     const uint64_t t0 = begin + block * tixelsPerBlock, t1 = std::min(end, t0 + tixelsPerBlock);
@@ -602,7 +604,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
     std::vector<Pending> pending;  // one per ray, waiting for the batched occlusion test
     std::vector<Pending> seen;     // visibility already known (shadow rays through thin glass)
     uint64_t glassRays = 0;
-    // At most one ray per punctual light and area-light sample per tixel.
+    // At most one ray per delta light and area-light sample per tixel.
     rays.reserve((t1 - t0) * (scene.lights.size() + lightSamples));
     pending.reserve(rays.capacity());
     for (uint64_t g = t0; g < t1; ++g) {
@@ -613,31 +615,37 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       // Rough glass takes light from both sides: reflected from its own, transmitted from
       // the other (|cos θ|; the BSDF chooses, see the Pending loop below).
       const bool bothSides = isRoughGlassChart(c, scene.materials[c.material].bsdf);
-      for (size_t li = 0; li < punctualLights.size(); ++li) {
-        const PunctualLight& light = punctualLights[li];
+      for (size_t li = 0; li < sceneLights.size(); ++li) {
+        const Light& light = sceneLights[li];
         // A masked light on a diffuse tixel: its footprint's mean visibility, no ray
         // (lightfield.h "Sun masks"; sunMaskedIrradiance, which the bake takes back out).
         if (maskSlot[li] >= 0 && c.kind == ChartKind::Diffuse) {
           direct[valueBase(g, c)] += sunMaskedIrradiance(param, light, g, size_t(maskSlot[li]));
           continue;
         }
-        Vec3 wi;
-        float distance;
-        Rgb incident;
-        if (!light.incidentAt(x, wi, distance, incident)) continue;
-        const float cosTheta = bothSides ? std::abs(glm::dot(normal, wi)) : glm::dot(normal, wi);
-        if (!(cosTheta > 0.0f) || isBlack(incident)) continue;
-        const Vec3 origin = offsetRayOrigin(x, normal, wi);
-        const std::optional<Ray> ray = std::isfinite(distance) ? shadowRayTo(origin, light.position)
-                                                               : std::optional<Ray>(Ray{origin, wi, 0.0f, kInfinity});
-        if (!ray) continue;
-        if (shadows.passesThinGlass()) {
-          const Rgb transmittance = shadows.transmittance(*ray, glassRays);
-          if (!isBlack(transmittance)) seen.push_back({g, wi, incident * cosTheta * transmittance, false});
-          continue;
+        // One ray towards a delta light; sceneLightSamples towards any other, the tixel's own
+        // (0,2)-net per light (as the area-light samples below), each weighted 1/(count·pdf).
+        const bool delta = isDeltaLight(light);
+        const uint32_t count = delta ? 1 : ops.sceneLightSamples;
+        const ZSobolLayout layout =
+            delta ? ZSobolLayout() : ZSobolLayout::forKey(g, int(count), settings.seed ^ 0x4c49474854ULL ^ (uint64_t(li) << 32));
+        for (uint32_t s = 0; s < count; ++s) {
+          const Vec2 u = delta ? Vec2(0.5f) : Sampler::sobol(layout, 0, 0, s).get2D();
+          const std::optional<IncidentLight> in = sampleLight(light, x, u);
+          if (!in) continue;
+          const float cosTheta = bothSides ? std::abs(glm::dot(normal, in->wi)) : glm::dot(normal, in->wi);
+          if (!(cosTheta > 0.0f) || isBlack(in->incident)) continue;
+          const std::optional<Ray> ray = shadowRayTowards(offsetRayOrigin(x, normal, in->wi), *in);
+          if (!ray) continue;
+          const Rgb irradiance = in->incident * (cosTheta / (in->pdf * float(count)));
+          if (shadows.passesThinGlass()) {
+            const Rgb transmittance = shadows.transmittance(*ray, glassRays);
+            if (!isBlack(transmittance)) seen.push_back({g, in->wi, irradiance * transmittance, !delta});
+            continue;
+          }
+          rays.push_back(*ray);
+          pending.push_back({g, in->wi, irradiance, !delta});
         }
-        rays.push_back(*ray);
-        pending.push_back({g, wi, incident * cosTheta, false});
       }
       if (lightSamples == 0) continue;
       // Every accepted sample direction has cos θx > 0, so all of this tixel's shadow rays
@@ -694,12 +702,12 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         const Bsdf& bsdf = scene.materials[c.material].bsdf;
         const Chart* glass = isRoughGlassChart(c, bsdf) ? &c : nullptr;
         const Vec3 wiLocal = tixelFrame(param, c, p.tixel).toLocal(p.wi);  // the map's frame (a curved chart's own)
-        // Punctual lights: the BSDF averaged over each output texel (a delta light would
+        // Delta lights: the BSDF averaged over each output texel (a delta light would
         // otherwise alias between texel centres). Area-light samples are many per tixel and
         // already spread over the emitter: the texel-centre value suffices and costs 9× less.
         // The maps get the model without its diffuse part when the tixel keeps that part's Ẽ.
         const Bsdf& mapped = gm.diffuse ? gm.specular : bsdf;
-        // A punctual light's highlight on a reflecting glossy chart is also noted apart, to be
+        // A delta light's highlight on a reflecting glossy chart is also noted apart, to be
         // taken out of the stored maps at the end (punctualGlossy).
         const bool highlight = !p.areaSample && !glass && !punctualGlossy.empty();
         for (uint32_t t = 0; t < c.directionTexels(); ++t) {

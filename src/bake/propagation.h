@@ -9,7 +9,8 @@
 //            (emission is added when the values are written out).
 //
 // First shot (constant over the iteration, "direct"):
-//   * point, spot and directional lights: shadow rays from every tixel's gather point;
+//   * the scene's lights (light/lights.h): shadow rays from every tixel's gather point, one
+//     towards a delta light, max(1, areaLightSamples) sampled ones towards any other;
 //   * emissive surfaces: areaLightSamples shadow rays per tixel towards emissive triangles
 //     (chosen ∝ area·luminance(Le)) combined by the power heuristic with the gather rays
 //     that hit emitters directly (emitters seen through mirrors come through the gather only);
@@ -46,7 +47,6 @@ namespace pl {
 
 class Accel;
 class Progress;
-struct PunctualLight;
 
 struct PropagationResult {
   std::vector<Rgb> values;  ///< in LightField::values layout, emission included for glossy charts
@@ -135,7 +135,7 @@ struct TransportState {
   std::unique_ptr<Operators> ops;
 };
 
-/// First shot, shadow rays: point, spot and directional lights and emissive surfaces seen from
+/// First shot, shadow rays: the scene's lights and emissive surfaces seen from
 /// tixels [begin, end) are added to state.direct. Needs no visibility field. Advances
 /// `progress` (may be null) by the tixels done.
 void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progress* progress = nullptr);
@@ -144,7 +144,7 @@ int sunMaskSlot(const Parameterisation& param, uint32_t light);
 /// What masked light `light` (slot `slot`) adds to diffuse tixel `tixel`'s irradiance in the
 /// first shot: its irradiance × max(0, cos θ) at the tixel's normal × the lit fraction of the
 /// tixel's mask (W·m⁻²).
-Rgb sunMaskedIrradiance(const Parameterisation& param, const PunctualLight& light, uint64_t tixel, size_t slot);
+Rgb sunMaskedIrradiance(const Parameterisation& param, const Light& light, uint64_t tixel, size_t slot);
 /// Takes the masked lights' first shot (sunMaskedIrradiance) back out of every diffuse
 /// tixel's final irradiance: the light field stores the rest, and the renderers add those
 /// lights at each point through the masks (lightfield.h "Sun masks"). Clamped at 0.

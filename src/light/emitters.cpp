@@ -1,9 +1,8 @@
-// Emitters (see emitters.h): emissive triangles, punctual lights and the environment light.
+// Emitters (see emitters.h): emissive triangles and the environment light.
 #include "light/emitters.h"
 
 #include <algorithm>
 #include <cmath>
-#include <variant>
 
 #include "core/error.h"
 #include "core/sampling.h"
@@ -13,55 +12,6 @@ namespace pl {
 Vec3 EmissiveTriangle::pointAt(Vec2 u) const {
   const Vec2 b = sampleUniformTriangle(u);
   return p0 + b.x * edge1 + b.y * edge2;
-}
-
-PunctualLight PunctualLight::from(const Light& light) {
-  PunctualLight p;
-  if (const auto* point = std::get_if<PointLight>(&light)) {
-    p.kind = Kind::Point;
-    p.position = point->position;
-    p.intensity = point->intensity;
-  } else if (const auto* spot = std::get_if<SpotLight>(&light)) {
-    p.kind = Kind::Spot;
-    p.position = spot->position;
-    p.direction = glm::normalize(spot->direction);
-    p.intensity = spot->intensity;
-    p.cosInner = std::cos(spot->innerAngle);
-    p.cosOuter = std::cos(spot->outerAngle);
-  } else {
-    const auto& directional = std::get<DirectionalLight>(light);
-    p.kind = Kind::Directional;
-    p.direction = glm::normalize(directional.direction);
-    p.intensity = directional.irradiance;
-  }
-  return p;
-}
-
-bool PunctualLight::incidentAt(const Vec3& x, Vec3& wi, float& distance, Rgb& irradiance) const {
-  if (kind == Kind::Directional) {
-    wi = -direction;
-    distance = kInfinity;
-    irradiance = intensity;
-    return true;
-  }
-  const Vec3 toLight = position - x;
-  const float distanceSquared = glm::dot(toLight, toLight);
-  if (!(distanceSquared > 0.0f)) return false;
-  distance = std::sqrt(distanceSquared);
-  wi = toLight / distance;
-  float falloff = 1.0f;
-  if (kind == Kind::Spot) {
-    const float c = glm::dot(direction, -wi);
-    if (cosInner <= cosOuter) {
-      falloff = c >= cosInner ? 1.0f : 0.0f;
-    } else {
-      const float t = std::clamp((c - cosOuter) / (cosInner - cosOuter), 0.0f, 1.0f);
-      falloff = t * t * (3.0f - 2.0f * t);
-    }
-  }
-  if (!(falloff > 0.0f)) return false;
-  irradiance = intensity * (falloff / distanceSquared);
-  return true;
 }
 
 std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene) {
@@ -90,15 +40,6 @@ std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene) {
     }
   }
   return list;
-}
-
-float PunctualLight::power(float sceneRadius) const {
-  switch (kind) {
-    case Kind::Point: return 4.0f * kPi * luminance(intensity);
-    case Kind::Spot: return 2.0f * kPi * (1.0f - 0.5f * (cosInner + cosOuter)) * luminance(intensity);
-    case Kind::Directional: return kPi * sceneRadius * sceneRadius * luminance(intensity);
-  }
-  return 0.0f;
 }
 
 EnvironmentLight::EnvironmentLight(const Rgb& constant, std::shared_ptr<const EnvironmentMap> map)

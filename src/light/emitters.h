@@ -1,11 +1,9 @@
 #pragma once
-// Emitters: every kind of light source, prepared for sampling — emissive triangles, point,
-// spot and directional lights, and the environment. Each gives its emitted radiance (or
-// intensity), a way to sample it, the density of that sampling and an estimate of its power
-// (the light sampler's selection weight, light.h). The scene description the loaders fill in
-// (scene.h: Material emission, Light, Environment) stays in scene/; this is where it becomes
-// something that can be sampled. Adding a kind of light: its struct here, its entry in
-// LightSampler (light.h/.cpp).
+// Emitters besides the scene's lights (lights.h): emissive triangles and the environment,
+// prepared for sampling. Each gives its emitted radiance, a way to sample it, the density of
+// that sampling and an estimate of its power (the light sampler's selection weight, light.h).
+// The scene description the loaders fill in (scene.h: Material emission, Environment) stays
+// in scene/; this is where it becomes something that can be sampled.
 //
 // Units: radiance Le in W·sr⁻¹·m⁻², intensity I in W·sr⁻¹, irradiance E in W·m⁻²; "power" is
 // a luminance-weighted flux estimate (Y of the RGB), used only to choose between lights.
@@ -40,33 +38,6 @@ struct EmissiveTriangle {
 
 /// Every non-degenerate triangle of an emissive material, mesh by mesh in triangle order.
 std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene);
-
-/// A point, spot or directional light prepared for evaluation at many points (axis
-/// normalised, cone cosines computed once). The one place the path tracer and the bake
-/// evaluate these lights. Delta lights: sampling one is evaluating it (incidentAt), its
-/// density is the selection probability alone.
-struct PunctualLight {
-  enum class Kind : uint8_t { Point, Spot, Directional };
-  Kind kind = Kind::Point;
-  Vec3 position{0.0f};
-  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< spot axis / directional travel direction (unit)
-  Rgb intensity{0.0f};                ///< W·sr⁻¹ (point, spot) or irradiance W·m⁻² (directional)
-  float cosInner = 1.0f, cosOuter = 1.0f;
-
-  static PunctualLight from(const Light& light);
-
-  /// The light arriving at x: wi (unit, towards the light), the shadow-ray length
-  /// (∞ for directional) and the irradiance on a surface normal to wi (W·m⁻²): I·falloff/d²
-  /// for point and spot lights — the spot's falloff a smoothstep in cos between the outer and
-  /// inner cone (a step when they coincide) — the light's irradiance for directional ones.
-  /// False when nothing arrives (x at the light's position, outside a spot's cone).
-  bool incidentAt(const Vec3& x, Vec3& wi, float& distance, Rgb& irradiance) const;
-
-  /// Emitted power estimate: point 4π·Y(I); spot 2π·(1 − (cos θinner + cos θouter)/2)·Y(I)
-  /// (pbrt's estimate); directional π R²·Y(E), the flux through the disk of the scene's
-  /// bounding sphere of radius `sceneRadius`.
-  float power(float sceneRadius) const;
-};
 
 /// Everything that arrives from infinity as one light: a constant radiance plus an optional
 /// map (exactly what scene.h's Environment holds). radiance(dir) = constant + map(dir).

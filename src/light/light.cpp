@@ -31,6 +31,11 @@ std::optional<Ray> shadowRayTo(const Vec3& origin, const Vec3& target) {
   return Ray{origin, toTarget / distance, 0.0f, distance};
 }
 
+std::optional<Ray> shadowRayTowards(const Vec3& origin, const IncidentLight& light) {
+  return std::isfinite(light.distance) ? shadowRayTo(origin, light.target)
+                                       : std::optional<Ray>(Ray{origin, light.wi, 0.0f, kInfinity});
+}
+
 ShadowRays::ShadowRays(const Scene& scene, const Accel& accel)
     : scene_(scene), accel_(accel), hasThinGlass_(scene.hasThinGlass()) {}
 
@@ -67,7 +72,7 @@ LightSampler::LightSampler(const Scene& scene) {
   scene.bounds(lo, hi);
   const float sceneRadius = std::max(0.5f * glm::length(hi - lo), 1e-6f);
 
-  std::vector<float> weights, triangleWeights, punctualWeights;
+  std::vector<float> weights, triangleWeights, sceneLightWeights;
   uint32_t base = 0;
   for (const Mesh& mesh : scene.meshes) {
     meshTriangleBase_.push_back(base);
@@ -85,13 +90,12 @@ LightSampler::LightSampler(const Scene& scene) {
   }
 
   for (const Light& light : scene.lights) {
-    const PunctualLight p = PunctualLight::from(light);
-    const float power = p.power(sceneRadius);
+    const float power = lightPower(light, sceneRadius);
     if (!(power > 0.0f)) continue;
-    entries_.push_back({Kind::Punctual, static_cast<uint32_t>(punctual_.size())});
-    punctual_.push_back(p);
+    entries_.push_back({Kind::SceneLight, static_cast<uint32_t>(sceneLights_.size())});
+    sceneLights_.push_back(light);
     weights.push_back(selectionWeight(power));
-    punctualWeights.push_back(selectionWeight(power));
+    sceneLightWeights.push_back(selectionWeight(power));
   }
 
   if (!environment_.isBlack()) {
@@ -103,7 +107,7 @@ LightSampler::LightSampler(const Scene& scene) {
     }
   }
   if (!weights.empty()) all_ = Distribution1D(weights);
-  if (!punctualWeights.empty()) punctualDistribution_ = Distribution1D(punctualWeights);
+  if (!sceneLightWeights.empty()) sceneLightDistribution_ = Distribution1D(sceneLightWeights);
   if (!triangleWeights.empty()) triangleDistribution_ = Distribution1D(triangleWeights);
 
   // Area density of sampleEmitterPoint: P(triangle)/A = (π·A·Y·s/Σ)/A = π·Y·s/Σ, the same for
@@ -117,14 +121,14 @@ LightSampler::LightSampler(const Scene& scene) {
     }
 }
 
-std::optional<LightSample> LightSampler::sample(const Vec3& position, Vec2 u, bool punctualOnly) const {
-  const Distribution1D& distribution = punctualOnly ? punctualDistribution_ : all_;
+std::optional<LightSample> LightSampler::sample(const Vec3& position, Vec2 u, bool nextEventOnly) const {
+  const Distribution1D& distribution = nextEventOnly ? sceneLightDistribution_ : all_;
   if (distribution.size() == 0) return std::nullopt;
   float remapped = 0.0f;
   const size_t chosen = distribution.sample(u.x, &remapped);
   const float selectProbability = distribution.probability(chosen);
   if (!(selectProbability > 0.0f)) return std::nullopt;
-  const Entry entry = punctualOnly ? Entry{Kind::Punctual, static_cast<uint32_t>(chosen)} : entries_[chosen];
+  const Entry entry = nextEventOnly ? Entry{Kind::SceneLight, static_cast<uint32_t>(chosen)} : entries_[chosen];
   return sampleEntry(entry, selectProbability, position, Vec2(remapped, u.y));
 }
 
@@ -157,14 +161,17 @@ std::optional<LightSample> LightSampler::sampleEntry(const Entry& entry, float s
       s.infinite = true;
       break;
     }
-    case Kind::Punctual: {
-      const PunctualLight& p = punctual_[entry.index];
-      s.delta = true;
-      s.pdf = selectProbability;  // a discrete choice; the direction is fixed
-      float distance;
-      if (!p.incidentAt(position, s.wi, distance, s.incident)) return std::nullopt;
-      s.infinite = p.kind == PunctualLight::Kind::Directional;
-      s.target = p.position;
+    case Kind::SceneLight: {
+      const Light& light = sceneLights_[entry.index];
+      const std::optional<IncidentLight> in = sampleLight(light, position, u);
+      if (!in) return std::nullopt;
+      s.wi = in->wi;
+      s.incident = in->incident;
+      s.pdf = selectProbability * in->pdf;  // a delta light's pdf is 1: the selection alone
+      s.delta = isDeltaLight(light);
+      s.nextEventOnly = true;
+      s.infinite = isAtInfinity(light);
+      s.target = in->target;
       break;
     }
   }

@@ -3,15 +3,14 @@
 // and by the bake's first shot, and the one definition of a shadow ray (where it ends, and how
 // much light passes along it).
 //
-// Emitters (emitters.h) are the scene's emissive triangles (EmissiveTriangle), point, spot and
-// directional lights (PunctualLight) and the environment (EnvironmentLight).
+// Emitters are the scene's emissive triangles (EmissiveTriangle, emitters.h), its lights
+// (scene.lights: the Light types of lights.h) and the environment (EnvironmentLight).
 //
 // Light selection: one discrete distribution over every emitter, proportional to an estimate
 // of its emitted power (luminance), each emitter's power() in emitters.h:
 //   emissive triangle  π · A · Y(Le)            (×2 when two-sided)
-//   point light        4π · Y(I)
-//   spot light         2π · (1 − (cos θinner + cos θouter)/2) · Y(I)
-//   directional light  π R² · Y(E)
+//   scene light        its power(R) (lights.h: 4π·Y(I) for a point light, π R²·Y(E) for a
+//                      directional one, …)
 //   environment        π R² · ∫ Y(Le) dω
 // where R is the radius of the scene's bounding sphere. Any positive weights give an
 // unbiased estimator; these make the variance small when emitters differ a lot. The bake,
@@ -46,6 +45,9 @@ Vec3 emitterShadowTarget(const Vec3& point, const Vec3& normal, const Vec3& wi);
 /// The shadow ray from `origin` (already offset off the receiver) to `target`: unit direction,
 /// tMin 0, tMax the distance. Nullopt when the two points coincide.
 std::optional<Ray> shadowRayTo(const Vec3& origin, const Vec3& target);
+/// The shadow ray from `origin` towards a scene light's sample (lights.h IncidentLight):
+/// unbounded along wi for a light at infinity, else shadowRayTo its target.
+std::optional<Ray> shadowRayTowards(const Vec3& origin, const IncidentLight& light);
 
 /// Light travelling along shadow rays: the one place that decides what blocks them.
 class ShadowRays {
@@ -80,8 +82,11 @@ struct LightSample {
                        ///< irradiance on a surface normal to wi (W·m⁻²)
   float pdf = 0.0f;    ///< solid-angle density of wi including the light's selection
                        ///< probability; for delta lights the selection probability alone
-  bool delta = false;     ///< point, spot or directional: reachable by next-event estimation only
-  bool infinite = false;  ///< directional or environment: the shadow ray is unbounded
+  bool delta = false;  ///< a delta light (lights.h isDeltaLight): wi is its only direction
+  /// A scene light (lights.h): no BSDF-sampled ray can find it, so next-event estimation
+  /// counts it with full weight (no MIS).
+  bool nextEventOnly = false;
+  bool infinite = false;  ///< a light at infinity or the environment: the shadow ray is unbounded
   Vec3 target{0.0f};      ///< finite lights: the point the shadow ray ends at
 };
 
@@ -97,19 +102,19 @@ class LightSampler {
   LightSampler() = default;
   explicit LightSampler(const Scene& scene);
 
-  /// Emitters with positive power: emissive triangles + punctual lights + environment.
+  /// Emitters with positive power: emissive triangles + scene lights + environment.
   size_t lightCount() const { return entries_.size(); }
   size_t emissiveTriangleCount() const { return triangles_.size(); }
   const EnvironmentLight& environment() const { return environment_; }
   /// Whether the environment is one of the lights (it is lit).
   bool hasEnvironment() const { return environmentEntry_ >= 0; }
 
-  /// Chooses a light with probability ∝ its power (only among point, spot and directional
-  /// lights when punctualOnly) and a point or direction on it, for a receiver at `position`:
-  /// u.x chooses the light (stretched, see the top of this file), the rest the point.
-  /// Nullopt when nothing is sampled (no lights, the back of a one-sided emitter, outside a
-  /// spot's cone, a zero density).
-  std::optional<LightSample> sample(const Vec3& position, Vec2 u, bool punctualOnly = false) const;
+  /// Chooses a light with probability ∝ its power (only among the scene lights when
+  /// nextEventOnly: the lights BSDF sampling cannot find) and a point or direction on it, for a
+  /// receiver at `position`: u.x chooses the light (stretched, see the top of this file), the
+  /// rest the point. Nullopt when nothing is sampled (no lights, the back of a one-sided
+  /// emitter, outside a spot's cone, a zero density).
+  std::optional<LightSample> sample(const Vec3& position, Vec2 u, bool nextEventOnly = false) const;
 
   /// The density sample() has for reaching emissive triangle `triangle` of mesh `mesh` from a
   /// receiver at `distance`, arriving at the emitter with |cos θlight| = cosLight (solid angle
@@ -126,20 +131,20 @@ class LightSampler {
   float emitterAreaPdf(uint32_t material) const;
 
  private:
-  enum class Kind : uint8_t { Triangle, Punctual, Environment };
+  enum class Kind : uint8_t { Triangle, SceneLight, Environment };
   struct Entry {
     Kind kind;
-    uint32_t index;  ///< into triangles_ or punctual_
+    uint32_t index;  ///< into triangles_ or sceneLights_
   };
   std::optional<LightSample> sampleEntry(const Entry& entry, float selectProbability, const Vec3& position,
                                          Vec2 u) const;
 
   EnvironmentLight environment_;
   std::vector<EmissiveTriangle> triangles_;
-  std::vector<PunctualLight> punctual_;
+  std::vector<Light> sceneLights_;  ///< those of scene.lights with positive power
   std::vector<Entry> entries_;
   Distribution1D all_;        ///< over entries_
-  Distribution1D punctualDistribution_;  ///< over punctual_
+  Distribution1D sceneLightDistribution_;  ///< over sceneLights_
   Distribution1D triangleDistribution_;  ///< over triangles_
   std::vector<uint32_t> meshTriangleBase_;  ///< first global triangle index of each mesh
   std::vector<int32_t> entryOfTriangle_;    ///< entry of each global triangle, or −1

@@ -80,15 +80,17 @@
 // adds the same lights to the tixel's first shot as E_l·max(0, n_g·ω_l)·(set bits / 16): the
 // footprint's mean instead of one ray from the gather point; removeSunMaskedDirect.)
 //
-// Punctual highlights. A point, spot or directional light reflected by a glossy surface is a
-// highlight as sharp as the lobe, which a map of dirRes² texels per tixel smears into a fan (a
-// point light's reflection on a GGX r 0.2 ceiling: radiance ≈ 50 in the path tracer, ≈ 1.2 in
-// the map). So the bake leaves their direct reflection out of the glossy maps it stores (it
+// Punctual highlights. A delta light (light/lights.h: point, spot, directional) reflected by a
+// glossy surface is a highlight as sharp as the lobe, which a map of dirRes² texels per tixel
+// smears into a fan (a point light's reflection on a GGX r 0.2 ceiling: radiance ≈ 50 in the
+// path tracer, ≈ 1.2 in the map). So the bake leaves their direct reflection out of the glossy maps it stores (it
 // keeps it while propagating, so the light they reflect onwards is transported, and takes it
 // out at the end), and the renderers add it where a glossy surface is seen: the model (without
 // its diffuse part, which Ẽ holds) against each light at the hit, with the shading normal and
 // a shadow ray, as the path tracer's next-event estimation does (PunctualHighlights in
-// lookup.h). Rough glass keeps them in its maps.
+// lookup.h). Rough glass keeps them in its maps. The reflection of every other light — the
+// non-delta scene lights and emissive surfaces, whose highlights are as wide as the light —
+// stays in the maps.
 #include "core/math.h"
 #include "scene/scene.h"
 
@@ -190,12 +192,13 @@ using SunMaskSlots = std::array<SunMask, kMaxSunMaskLights>;
 static_assert(kSunMaskSide * kSunMaskSide == 16, "a sun mask is 16 bits");
 
 /// Indices into scene.lights of the lights that get sun masks: its first kMaxSunMaskLights
-/// directional lights, or none when a material is thin glass.
+/// delta lights at infinity (directional lights: light/lights.h parallelLight), or none when
+/// a material is thin glass.
 inline std::vector<uint32_t> sunMaskLights(const Scene& scene) {
   std::vector<uint32_t> lights;
   if (scene.hasThinGlass()) return lights;
   for (uint32_t i = 0; i < scene.lights.size() && lights.size() < kMaxSunMaskLights; ++i)
-    if (std::holds_alternative<DirectionalLight>(scene.lights[i])) lights.push_back(i);
+    if (parallelLight(scene.lights[i])) lights.push_back(i);
   return lights;
 }
 

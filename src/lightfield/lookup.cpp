@@ -90,8 +90,8 @@ SunLights sunLightsOf(const LightField& lf) {
   // only when its scene has no thin glass (the bake and the .plf reader make sure).
   SunLights sun;
   for (size_t i = 0; i < lf.scene.lights.size() && sun.count < lf.sunMaskLightCount; ++i)
-    if (const auto* light = std::get_if<DirectionalLight>(&lf.scene.lights[i])) {
-      sun.towardsLight[sun.count] = -light->direction;
+    if (const std::optional<ParallelLight> light = parallelLight(lf.scene.lights[i])) {
+      sun.towardsLight[sun.count] = light->towardsLight;
       sun.irradiance[sun.count] = lanes4(light->irradiance);
       ++sun.count;
     }
@@ -168,7 +168,8 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
 
 PunctualHighlights::PunctualHighlights(const LightField& lf, const Accel& accel) : lf_(lf) {
   if (!lf.settings.punctualHighlights) return;
-  for (const Light& light : lf.scene.lights) lights_.push_back(PunctualLight::from(light));
+  for (const Light& light : lf.scene.lights)
+    if (isDeltaLight(light)) lights_.push_back(light);  // the others are in the maps
   if (lights_.empty()) return;
   shadows_.emplace(lf.scene, accel);
   for (const Material& m : lf.scene.materials) withoutDiffuse_.push_back(withDiffuseAlbedo(m.bsdf, Rgb(0.0f)));
@@ -188,19 +189,17 @@ Rgb PunctualHighlights::radiance(uint32_t chart, const RayHit& hit, const Vec3& 
   if (!usableSide(towardsViewer, woLocal, geometricNormal, bsdf)) return Rgb(0.0f);
   Rgb sum(0.0f);
   uint64_t shadowRays = 0;  // ShadowRays counts them; no renderer reports them
-  for (const PunctualLight& light : lights_) {
-    Vec3 wi;
-    float distance;
-    Rgb incident;
-    if (!light.incidentAt(surface.position, wi, distance, incident)) continue;
+  for (const Light& light : lights_) {
+    const std::optional<IncidentLight> in = sampleLight(light, surface.position, Vec2(0.5f));
+    if (!in) continue;
+    const Vec3& wi = in->wi;
+    const Rgb& incident = in->incident;
     const Vec3 wiLocal = frame.toLocal(wi);
     if (!usableSide(wi, wiLocal, geometricNormal, bsdf)) continue;
     const Rgb f = eval(bsdf, woLocal, wiLocal);
     const float cosIn = std::abs(wiLocal.z);
     if (isBlack(f) || !(cosIn > 0.0f) || isBlack(incident)) continue;
-    const Vec3 origin = offsetRayOrigin(surface.position, geometricNormal, wi);
-    const std::optional<Ray> shadow =
-        std::isfinite(distance) ? shadowRayTo(origin, light.position) : std::optional<Ray>(Ray{origin, wi, 0.0f, kInfinity});
+    const std::optional<Ray> shadow = shadowRayTowards(offsetRayOrigin(surface.position, geometricNormal, wi), *in);
     if (!shadow) continue;
     const Rgb visible = shadows_->transmittance(*shadow, shadowRays);
     if (!isBlack(visible)) sum += visible * f * cosIn * incident;

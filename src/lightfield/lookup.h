@@ -524,10 +524,10 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
 #endif
 }
 
-/// The punctual lights' direct glossy reflection that a light field baked with punctual
-/// highlights (BakeSettings::punctualHighlights) keeps out of its glossy maps, evaluated where
-/// a glossy surface is seen (lightfield.h "Punctual highlights"): at a hit on a reflecting
-/// glossy chart record,
+/// The direct glossy reflection of the delta lights (light/lights.h isDeltaLight) that a
+/// light field baked with punctual highlights (BakeSettings::punctualHighlights) keeps out of
+/// its glossy maps, evaluated where a glossy surface is seen (lightfield.h "Punctual
+/// highlights"): at a hit on a reflecting glossy chart record,
 ///   Σ_l f(wo, wi_l) · E_l · |cos θ_l| · T_l
 /// with f the chart's model without its diffuse part when the chart keeps Ẽ (Chart::
 /// diffuseValue; the model the maps hold otherwise), in the scattering frame of the shading
@@ -539,7 +539,7 @@ class PunctualHighlights {
   /// lf and accel must outlive it.
   PunctualHighlights(const LightField& lf, const Accel& accel);
   /// Whether there is anything to add: the light field was baked with punctual highlights and
-  /// its scene has punctual lights.
+  /// its scene has delta lights.
   bool active() const { return !lights_.empty(); }
   /// The highlights on chart record `chart` (the record the viewer sees: viewedChart) at ray
   /// hit `hit`, towards the unit direction `towardsViewer`; 0 on other kinds and rough glass.
@@ -547,7 +547,7 @@ class PunctualHighlights {
 
  private:
   const LightField& lf_;
-  std::vector<PunctualLight> lights_;
+  std::vector<Light> lights_;  ///< the scene's delta lights
   std::optional<ShadowRays> shadows_;
   std::vector<Bsdf> withoutDiffuse_;  ///< per material
 };

@@ -119,57 +119,26 @@ Bsdf getBsdf(ByteReader& r) {
   return *bsdf;
 }
 
+// A light likewise: its variant index (uint32; 0 point, 1 spot, 2 directional, … in the order
+// of light/lights.h's Light, the file's light numbers) followed by its parameters in the order
+// of the type's parameters() hook, each a Vec3 (three floats) or a float. A new type at the end
+// of the variant needs no new version: older files never contain it, and an older build
+// reading a newer file refuses it as "unknown light type N".
 void putLight(ByteWriter& w, const Light& light) {
   w.put(uint32_t(light.index()));
-  std::visit(
-      [&](const auto& l) {
-        using T = std::decay_t<decltype(l)>;
-        if constexpr (std::is_same_v<T, PointLight>) {
-          w.put(l.position);
-          w.put(l.intensity);
-        } else if constexpr (std::is_same_v<T, SpotLight>) {
-          w.put(l.position);
-          w.put(l.direction);
-          w.put(l.intensity);
-          w.put(l.innerAngle);
-          w.put(l.outerAngle);
-        } else {
-          static_assert(std::is_same_v<T, DirectionalLight>, "a new light type needs its .plf encoding");
-          w.put(l.direction);
-          w.put(l.irradiance);
-        }
-      },
-      light);
+  visitLightParameters(light, [&](const char*, LightParameterKind, const auto& field) { w.put(field); });
 }
 
 Light getLight(ByteReader& r) {
   const uint32_t type = r.get<uint32_t>();
-  switch (type) {
-    case 0: {
-      PointLight l;
-      l.position = r.get<Vec3>();
-      l.intensity = r.get<Rgb>();
-      return l;
-    }
-    case 1: {
-      SpotLight l;
-      l.position = r.get<Vec3>();
-      l.direction = r.get<Vec3>();
-      l.intensity = r.get<Rgb>();
-      l.innerAngle = r.get<float>();
-      l.outerAngle = r.get<float>();
-      return l;
-    }
-    case 2: {
-      DirectionalLight l;
-      l.direction = r.get<Vec3>();
-      l.irradiance = r.get<Rgb>();
-      return l;
-    }
-    default: r.corrupt(fmt::format("unknown light type {}", type));
-  }
+  std::optional<Light> light = lightOfIndex(type);
+  if (!light) r.corrupt(fmt::format("unknown light type {}", type));
+  visitLightParameters(*light,
+                       [&](const char*, LightParameterKind, auto& field) { field = r.get<std::decay_t<decltype(field)>>(); });
+  // Its values are checked with the rest of the scene (checkScene, after the section is read).
+  prepareLight(*light);
+  return *light;
 }
-static_assert(std::variant_size_v<Light> == 3, "getLight must decode every light type");
 
 /// How a texture record stores its image (the byte after its path).
 constexpr uint8_t kTexturePixels = 0;       ///< i32 width, i32 height, u64 count, float32 RGB texels

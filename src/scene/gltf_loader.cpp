@@ -425,21 +425,17 @@ void addLight(GltfContext& ctx, int lightIndex, const Mat4& world, const std::st
   const Rgb radiometric = color * float(light.intensity / kLumensPerWatt);
   const Vec3 position(world * Vec4(0.0f, 0.0f, 0.0f, 1.0f));
   const Vec3 direction = glm::normalize(Mat3(world) * Vec3(0.0f, 0.0f, -1.0f));
-  if (light.type == "point") {
-    ctx.scene.lights.push_back(PointLight{position, radiometric});
-  } else if (light.type == "spot") {
-    SpotLight spot;
-    spot.position = position;
-    spot.direction = direction;
-    spot.intensity = radiometric;
-    spot.innerAngle = float(light.spot.innerConeAngle);
-    spot.outerAngle = float(light.spot.outerConeAngle);
-    ctx.scene.lights.push_back(spot);
-  } else if (light.type == "directional") {
-    ctx.scene.lights.push_back(DirectionalLight{direction, radiometric});
-  } else {
+  // KHR_lights_punctual's types are plenoptic's of the same names (light/lights.h). Each takes
+  // what it has of the node's pose and the cone, and glTF's intensity as its Emission.
+  if (light.type != "point" && light.type != "spot" && light.type != "directional")
     fail("{}: light {} has unknown type '{}' (point, spot, directional)", ctx.path, lightIndex, light.type);
-  }
+  LightParameters parameters = {{"position", position},
+                                {"direction", direction},
+                                {"inner_angle", float(light.spot.innerConeAngle)},
+                                {"outer_angle", float(light.spot.outerConeAngle)}};
+  Light created = createLight(light.type, parameters, fmt::format("{}: light {}", ctx.path, lightIndex), {.ignoreUnknown = true});
+  setLightEmission(created, radiometric);
+  ctx.scene.lights.push_back(created);
 }
 
 void addCamera(GltfContext& ctx, int cameraIndex, const Mat4& world, const std::string& nodeName) {

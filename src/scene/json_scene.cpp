@@ -28,10 +28,11 @@
 //        "tixel_density": 1 (light-field tixels per length relative to the bake preset, > 0))
 //     A material whose name equals a material of a loaded file replaces it there.
 //   },
-//   "lights": [ {"type": "point", "position": [..], "intensity": [r,g,b] | I}      // W·sr⁻¹
-//             | {"type": "spot", "position": [..], "direction": [..], "intensity": ..,
-//                "inner_angle": deg, "outer_angle": deg}                           // W·sr⁻¹
-//             | {"type": "directional", "direction": [..], "irradiance": [r,g,b] | E} ],  // W·m⁻²
+//   "lights": [ {"type": "point", "position": [..], "intensity": [r,g,b] | I}, … ]
+//       "type" names a light type of light/lights.h (point, spot, directional, …), the other
+//       keys are its parameters, named and in the units of its parameters() hook
+//       (docs/scenes.md lists them): a number or [x, y, z] (a colour: one number for grey);
+//       angles in degrees.
 //   "cameras": [ {"name": "main", "eye": [..], "target": [..], "up": [0,1,0],
 //                 "fov": 40 (vertical, degrees), "fstop": 0 (0 = pinhole),
 //                 "focus_distance": d, "focal_length": mm, "aspect": w/h} ],
@@ -239,11 +240,7 @@ void transformScene(Scene& part, const Mat4& m) {
     if (mirrored)
       for (UVec3& t : mesh.triangles) std::swap(t.y, t.z);
   }
-  for (Light& light : part.lights) {
-    if (auto* p = std::get_if<PointLight>(&light)) p->position = point(p->position);
-    if (auto* s = std::get_if<SpotLight>(&light)) s->position = point(s->position), s->direction = linear * s->direction;
-    if (auto* d = std::get_if<DirectionalLight>(&light)) d->direction = linear * d->direction;
-  }
+  for (Light& light : part.lights) transformLight(light, m);
   for (CameraDesc& camera : part.cameras) {
     camera.eye = point(camera.eye);
     camera.target = point(camera.target);
@@ -325,26 +322,17 @@ Scene parseScene(const JsonContext& ctx, const json& root) {
       const std::string where = fmt::format("lights[{}]", i);
       if (!entry.is_object() || !find(entry, "type")) fail("{}: {}: expected an object with a \"type\"", ctx.path, where);
       const std::string type = stringOf(ctx, entry["type"], where + ".type");
-      if (type == "point") {
-        checkKeys(ctx, entry, {"type", "position", "intensity"}, where);
-        scene.lights.push_back(PointLight{vec3Or(ctx, entry, "position", Vec3(0.0f), where),
-                                          colourOr(ctx, entry, "intensity", Rgb(1.0f), where)});
-      } else if (type == "spot") {
-        checkKeys(ctx, entry, {"type", "position", "direction", "intensity", "inner_angle", "outer_angle"}, where);
-        SpotLight spot;
-        spot.position = vec3Or(ctx, entry, "position", spot.position, where);
-        spot.direction = vec3Or(ctx, entry, "direction", spot.direction, where);
-        spot.intensity = colourOr(ctx, entry, "intensity", spot.intensity, where);
-        spot.innerAngle = glm::radians(numberOr(ctx, entry, "inner_angle", glm::degrees(spot.innerAngle), where));
-        spot.outerAngle = glm::radians(numberOr(ctx, entry, "outer_angle", glm::degrees(spot.outerAngle), where));
-        scene.lights.push_back(spot);
-      } else if (type == "directional") {
-        checkKeys(ctx, entry, {"type", "direction", "irradiance"}, where);
-        scene.lights.push_back(DirectionalLight{vec3Or(ctx, entry, "direction", Vec3(0.0f, -1.0f, 0.0f), where),
-                                                colourOr(ctx, entry, "irradiance", Rgb(1.0f), where)});
-      } else {
-        fail("{}: {}.type: unknown light type '{}' (point, spot, directional)", ctx.path, where, type);
+      // Every other key is a parameter of the type (light/lights.h createLight): a number or
+      // [x, y, z], angles in degrees.
+      LightParameters parameters;
+      for (auto it = entry.begin(); it != entry.end(); ++it) {
+        if (it.key() == "type") continue;
+        const std::string key = where + "." + it.key();
+        if (it->is_number()) parameters[it.key()] = number(ctx, *it, key);
+        else if (it->is_array() && it->size() == 3) parameters[it.key()] = vec3(ctx, *it, key);
+        else fail("{}: {}: expected a number or [x, y, z], got {}", ctx.path, key, it->dump());
       }
+      scene.lights.push_back(createLight(type, parameters, fmt::format("{}: {}", ctx.path, where), {.anglesInDegrees = true}));
     }
   }
 

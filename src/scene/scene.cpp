@@ -29,27 +29,9 @@ bool isDegenerate(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
 std::string vecString(const Vec3& v) { return fmt::format("({}, {}, {})", v.x, v.y, v.z); }
 
 void validateLights(const Scene& scene) {
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    std::visit(
-        [&](const auto& light) {
-          using T = std::decay_t<decltype(light)>;
-          if constexpr (std::is_same_v<T, PointLight>) {
-            if (!isFinite(light.position) || !isFinite(light.intensity))
-              fail("{}: point light {} has a non-finite position or intensity", scene.sourcePath, i);
-          } else if constexpr (std::is_same_v<T, SpotLight>) {
-            if (!isFinite(light.position) || !isFinite(light.intensity) || !isFinite(light.direction) ||
-                glm::length(light.direction) == 0.0f)
-              fail("{}: spot light {} has a non-finite position/intensity or no direction", scene.sourcePath, i);
-            if (!(light.innerAngle >= 0.0f && light.innerAngle <= light.outerAngle && light.outerAngle <= kPi))
-              fail("{}: spot light {} needs 0 <= inner angle ({}) <= outer angle ({}) <= pi", scene.sourcePath,
-                   i, light.innerAngle, light.outerAngle);
-          } else {
-            if (!isFinite(light.direction) || !isFinite(light.irradiance) || glm::length(light.direction) == 0.0f)
-              fail("{}: directional light {} has a non-finite irradiance or no direction", scene.sourcePath, i);
-          }
-        },
-        scene.lights[i]);
-  }
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    if (const std::string problem = lightProblem(scene.lights[i]); !problem.empty())
+      fail("{}: {} light {} {}", scene.sourcePath, lightTypeName(scene.lights[i]), i, problem);
 }
 
 }  // namespace
@@ -185,10 +167,7 @@ void Scene::finalize() {
   // renderers build their Accel from the Scene object that was finalized or moved).
   for (Mesh& mesh : meshes) mesh.positions.reserve(mesh.positions.size() + 1);
 
-  for (Light& light : lights) {
-    if (auto* spot = std::get_if<SpotLight>(&light)) spot->direction = glm::normalize(spot->direction);
-    if (auto* sun = std::get_if<DirectionalLight>(&light)) sun->direction = glm::normalize(sun->direction);
-  }
+  for (Light& light : lights) normaliseLightDirections(light);
 }
 
 bool Scene::hasThinGlass() const {

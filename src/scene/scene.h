@@ -6,6 +6,7 @@
 #include "core/math.h"
 #include "env/env.h"
 #include "image/image.h"
+#include "light/lights.h"
 #include "scene/texture.h"
 
 #include <cstdint>
@@ -80,29 +81,6 @@ struct Mesh {
   std::vector<uint32_t> materials;  ///< one per triangle, index into Scene::materials
 };
 
-/// Isotropic point light: intensity I in W·sr⁻¹ (irradiance at distance d is I cos θ / d²).
-struct PointLight {
-  Vec3 position{0.0f};
-  Rgb intensity{1.0f};
-};
-
-/// Spot light: intensity I (W·sr⁻¹) on its axis, full inside innerAngle, falling smoothly
-/// (smoothstep in cos) to zero at outerAngle; angles in radians from the axis.
-struct SpotLight {
-  Vec3 position{0.0f};
-  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< unit, the way the light shines
-  Rgb intensity{1.0f};
-  float innerAngle = 0.3f;
-  float outerAngle = 0.5f;
-};
-
-/// Directional light at infinity: irradiance E in W·m⁻² on a surface facing it.
-struct DirectionalLight {
-  Vec3 direction{0.0f, -1.0f, 0.0f};  ///< unit, the way the light travels
-  Rgb irradiance{1.0f};
-};
-
-using Light = std::variant<PointLight, SpotLight, DirectionalLight>;
 
 /// A camera as a scene file describes it. The camera module turns it into rays.
 struct CameraDesc {
@@ -146,14 +124,15 @@ struct Scene {
   std::vector<Mesh> meshes;
   std::vector<Material> materials;
   std::vector<Texture> textures;
-  std::vector<Light> lights;
+  std::vector<Light> lights;  ///< light sources besides emissive materials and the environment (light/lights.h)
   std::vector<CameraDesc> cameras;
   Environment environment;
   SceneSettings settings;
 
   /// Checks the scene (checkScene below), prepares its textures (Texture::finish), drops
   /// degenerate triangles (with a warning; throws when none is left), normalises normals and
-  /// light directions, and pads the vertex buffers for sharing with Embree. Loaders call it last. The padding is spare *capacity*: a moved
+  /// light directions (and prepares the lights: light/lights.h), and pads the vertex buffers
+  /// for sharing with Embree. Loaders call it last. The padding is spare *capacity*: a moved
   /// Scene keeps it, a copied one does not (build the Accel on the loaded object, or call
   /// finalize() again on a copy).
   void finalize();

@@ -7,10 +7,10 @@
 // + β_k · f · cos θi · Le / p_light        next-event estimation at x_k, weighted by
 //                                         w_light = p_light² / (p_bsdf² + p_light²)
 // (Veach's power heuristic, β = 2). Both pdfs are solid-angle densities at x_k of the same
-// direction: p_light includes the probability of selecting that light. Delta lights (point,
-// spot, directional) can only be reached by NEE (weight 1); delta BSDF bounces (mirrors) can
-// only be followed by BSDF sampling, so emission seen right after one counts fully, as does
-// emission seen by the camera ray.
+// direction: p_light includes the probability of selecting that light. The scene's lights
+// (light/lights.h: point, spot, …) are no geometry and can only be reached by NEE (weight 1);
+// delta BSDF bounces (mirrors) can only be followed by BSDF sampling, so emission seen right
+// after one counts fully, as does emission seen by the camera ray.
 //
 // Light selection, the points sampled on lights, their densities and what blocks a shadow ray
 // are light/light.h's (LightSampler, ShadowRays): the bake's first shot uses the same ones.
@@ -134,7 +134,7 @@ Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNor
   sampler.setDimension(bounceDimension(depth, kLightSample));
   const Vec2 u = sampler.get2D();
   const std::optional<LightSample> light =
-      lights.sample(position, u, /*punctualOnly=*/settings.strategy == TraceStrategy::BsdfOnly);
+      lights.sample(position, u, /*nextEventOnly=*/settings.strategy == TraceStrategy::BsdfOnly);
   if (!light) return Rgb(0.0f);
   const Vec3& wi = light->wi;  // towards the light, world space
 
@@ -155,7 +155,7 @@ Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNor
   if (isBlack(visible)) return Rgb(0.0f);
 
   const Rgb unweighted = visible * f * cosIn * light->incident / light->pdf;
-  if (light->delta || settings.strategy != TraceStrategy::Mis) return unweighted;
+  if (light->nextEventOnly || settings.strategy != TraceStrategy::Mis) return unweighted;
   return unweighted * powerHeuristic(light->pdf, pdf(bsdf, woLocal, wiLocal));
 }
 

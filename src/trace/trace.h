@@ -1,6 +1,6 @@
 #pragma once
 // The reference path tracer: unidirectional path tracing with next-event estimation (NEE)
-// on emissive triangles, punctual lights and the environment, combined with BSDF sampling by
+// on emissive triangles, the scene's lights and the environment, combined with BSDF sampling by
 // multiple importance sampling (power heuristic), and Russian roulette. It is the ground
 // truth every other renderer in plenoptic (the light-field bake in particular) is checked
 // against, so it favours being obviously right over being clever.
@@ -42,8 +42,9 @@ enum class TraceStrategy {
   Mis,   ///< NEE + BSDF sampling, weighted by the power heuristic
   NeeOnly,   ///< light sampling only; emission found by BSDF sampling counts only after a
              ///< delta bounce (or on the camera ray)
-  BsdfOnly,  ///< BSDF sampling only for emissive surfaces and the environment. Punctual lights
-             ///< cannot be hit by a ray, so they are still sampled by NEE in this mode.
+  BsdfOnly,  ///< BSDF sampling only for emissive surfaces and the environment. The scene's
+             ///< lights (light/lights.h) cannot be hit by a ray, so they are still sampled by
+             ///< NEE in this mode.
 };
 
 /// "mis", "nee", "bsdf".
@@ -135,7 +136,7 @@ class PathTracer {
   RadianceEstimate estimateRadiance(const Ray& ray, const TraceSettings& settings, uint64_t key) const;
 
   size_t emissiveTriangleCount() const;
-  /// Number of light-selection entries (emissive triangles + punctual lights + environment).
+  /// Number of light-selection entries (emissive triangles + scene lights + environment).
   size_t lightCount() const;
 
  private:
