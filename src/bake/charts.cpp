@@ -255,6 +255,8 @@ Chart frameChart(const Scene& scene, const TriangleList& list, bool grewCurved, 
   c.dirRes = directionalResolution(bsdf, settings);
   // A glossy model with a diffuse part keeps that part's irradiance per tixel (lightfield.h).
   c.diffuseValue = c.kind == ChartKind::Glossy && !isBlack(diffuseAlbedo(bsdf));
+  // A normal-mapped diffuse material keeps irradiances about tilted normals (lightfield.h).
+  c.directionalIrradiance = c.kind == ChartKind::Diffuse && scene.materials[c.material].normalTexture >= 0;
   const double nLen = glm::length(normalSum);
   const Vec3 n = nLen > 0.0 ? Vec3(normalSum / nLen) : Vec3(0.0f, 0.0f, 1.0f);
   c.normal = n;
@@ -430,6 +432,8 @@ void layOutTixels(const Scene& scene, const BakeSettings& settings, Parameterisa
   p.tixelChart.resize(p.tixelCount);
   p.gatherPoint.resize(p.tixelCount);
   p.gatherNormal.resize(p.tixelCount);
+  if (std::any_of(p.charts.begin(), p.charts.end(), [](const Chart& c) { return c.directionalIrradiance; }))
+    p.transportTiltWeights.resize(p.tixelCount);
   p.coverage.resize(p.tixelCount);
   p.transportAlbedo.resize(p.tixelCount);
   if (settings.sunMasks) p.sunMaskLights = sunMaskLights(scene);

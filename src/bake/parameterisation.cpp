@@ -362,6 +362,27 @@ SunMaskSlots tixelSunMasks(const Scene& scene, const Accel& accel, const Chart& 
   return masks;
 }
 
+/// The weights (lightfield.h tiltWeights) of a directionalIrradiance tixel's E and tilted
+/// irradiances in the light it sends on: the mean over its footprint samples' mapped normals
+/// n' (world; `count` of them; none: the flat surface) of the irradiance about n' times the
+/// share (1 + n'·n)/2 of the cosine-weighted hemisphere above n that n' reflects into (the
+/// path tracer's Lambertian lobe reflects only above n', lightfield.h). `normal`: the tixel's
+/// gather normal.
+TiltWeights transportTiltWeights(const Chart& c, const Vec3& normal, const Vec3* mappedNormals, int count) {
+  if (count == 0) return TiltWeights{};
+  const TixelFrame frame = tiltFrameAround(c, normal);
+  TiltWeights mean;
+  mean.irradiance = 0.0f;
+  for (int s = 0; s < count; ++s) {
+    const Vec3 local = frame.toLocal(mappedNormals[s]);
+    const TiltWeights w = tiltWeights(local);
+    const float share = 0.5f * (1.0f + local.z) / float(count);
+    mean.irradiance += w.irradiance * share;
+    for (uint32_t k = 0; k < kTiltedNormals; ++k) mean.tilted[k] += w.tilted[k] * share;
+  }
+  return mean;
+}
+
 void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
                      const std::vector<std::pair<uint32_t, uint32_t>>& tris, Parameterisation& p) {
   const ChartRaster r = rasteriseChart(scene, c, tris);
@@ -390,6 +411,8 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       // Footprint: coverage and mean albedo over the sub-samples inside the polygon.
       int inside = 0;
       Rgb albedoSum(0.0f);
+      // directionalIrradiance: the mapped normals (world, the record's side) at the samples.
+      std::array<Vec3, kFootprintSamples * kFootprintSamples> mappedNormals;
       std::array<std::pair<float, FootprintSample>, kFootprintSamples * kFootprintSamples> insideSamples;
       for (int b = 0; b < kFootprintSamples; ++b)
         for (int a = 0; a < kFootprintSamples; ++a) {
@@ -399,11 +422,12 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
           const Vec2 fromCentre = q - Vec2(float(i) + 0.5f, float(j) + 0.5f);
           insideSamples[size_t(inside)] = {glm::dot(fromCentre, fromCentre), s};
           ++inside;
-          if (textured) {
+          if (textured || c.directionalIrradiance) {
             const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
             // Full resolution: this average over the tixel's footprint samples is the filter
             // (the renderers' mip levels would filter twice).
-            albedoSum += albedoAt(hit.uv);
+            if (textured) albedoSum += albedoAt(hit.uv);
+            mappedNormals[size_t(inside - 1)] = c.isBack ? -hit.shadingNormal : hit.shadingNormal;
           }
         }
       p.coverage[g] = float(inside) / float(kFootprintSamples * kFootprintSamples);
@@ -464,6 +488,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       }
       p.gatherPoint[g] = point;
       if (c.curved) p.gatherNormal[g] = normal;
+      if (c.directionalIrradiance) p.transportTiltWeights[g] = transportTiltWeights(c, normal, mappedNormals.data(), inside);
       if (c.kind == ChartKind::Diffuse && !p.sunMaskLights.empty())
         p.sunMask[g] = tixelSunMasks(scene, accel, c, r, local, i, j, point, normal, p.sunMaskLights);
 
@@ -491,6 +516,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
     if (isBuried[k]) {
       p.gatherPoint[c.firstTixel + k] = p.gatherPoint[c.firstTixel + source[k]];
       if (c.curved) p.gatherNormal[c.firstTixel + k] = p.gatherNormal[c.firstTixel + source[k]];
+      if (c.directionalIrradiance) p.transportTiltWeights[c.firstTixel + k] = p.transportTiltWeights[c.firstTixel + source[k]];
       // Its sun masks too: its own sub-samples are all inside the occluder (shadowed), and
       // the visible surface next to it reads them through the bilinear mask lookup.
       p.sunMask[c.firstTixel + k] = p.sunMask[c.firstTixel + source[k]];

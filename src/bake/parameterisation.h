@@ -108,6 +108,11 @@ struct Parameterisation {
   /// Curved charts only (else empty entries are never read): the unit interpolated shading
   /// normal at gatherPoint, on the record's side (negated on a back record). See tixelFrame.
   std::vector<Vec3> gatherNormal;
+  /// directionalIrradiance charts only (empty when there is none; other entries are never
+  /// read): the weights of the tixel's E and tilted irradiances in the irradiance its
+  /// transport sends on — the mean over its footprint's mapped normals (lightfield.h
+  /// "Normal-mapped diffuse charts"; transportTiltWeights in parameterisation.cpp).
+  std::vector<TiltWeights> transportTiltWeights;
   std::vector<float> coverage;        ///< fraction of the tixel's square covered by the polygon
   std::vector<Rgb> transportAlbedo;   ///< diffuse charts, and glossy diffuseValue ones' diffuse part: mean albedo over the tixel's footprint
   /// Sun masks (lightfield.h "Sun masks"): the scene lights masked (sunMaskLights, or none
@@ -121,6 +126,12 @@ struct Parameterisation {
 /// (tixelFrameAround, lightfield.h, of its gatherNormal on a curved chart).
 inline TixelFrame tixelFrame(const Parameterisation& p, const Chart& c, uint64_t tixel) {
   return tixelFrameAround(c, c.curved ? p.gatherNormal[tixel] : c.normal);
+}
+
+/// The frame tixel `tixel` of a directionalIrradiance chart c takes its tilted normals in
+/// (tiltFrameAround, lightfield.h, of its gatherNormal on a curved chart).
+inline TixelFrame tiltFrame(const Parameterisation& p, const Chart& c, uint64_t tixel) {
+  return tiltFrameAround(c, c.curved ? p.gatherNormal[tixel] : c.normal);
 }
 
 ChartKind chartKindOf(const Bsdf& bsdf);

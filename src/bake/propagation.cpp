@@ -404,6 +404,10 @@ struct TransportState::Operators {
   /// The quads (TransportQuad) of every tixel, plus one, all zero, for the entries that
   /// escaped (see gatherTixel).
   std::vector<TransportQuad> quads;
+  /// Normal-mapped diffuse charts (lightfield.h): per gather direction — cell k with jitter
+  /// sub-cell j at [k·kGatherJitterSide² + j] — its share of each tilted irradiance in the
+  /// gather frame, π/n · max(0, b_i·ω)/cos θ. Empty without such charts.
+  std::vector<std::array<float, kTiltedNormals>> tiltShares;
 };
 
 namespace {
@@ -467,6 +471,67 @@ Rgb glossyDiffuseRadiance(const TransportState& state, const Rgb* values, const 
   return f4Rgb(e) * kInvPi * diffuseDirectionalFactor(bsdf, paraboloidToDirection(st).z);
 }
 
+/// The tilted irradiances (lightfield.h "Normal-mapped diffuse charts") that light of
+/// irradiance `irradiance` (W·m⁻², already × cos θ at the tixel's normal) arriving from world
+/// direction wi adds to directionalIrradiance tixel g of chart c: irradiance ·
+/// max(0, b_k·wi) / cos θ for each tilted normal b_k, added to tilted[0 … kTiltedNormals − 1].
+void addTiltedIrradiance(const Parameterisation& param, const Chart& c, uint64_t g, const Vec3& wi, const Rgb& irradiance,
+                         Rgb* tilted) {
+  const Vec3 local = tiltFrame(param, c, g).toLocal(wi);
+  if (!(local.z > 0.0f)) return;
+  for (uint32_t k = 0; k < kTiltedNormals; ++k)
+    tilted[k] += irradiance * (std::max(0.0f, glm::dot(local, tiltedNormal(k))) / local.z);
+}
+
+/// The same for the radiances incoming[k] (W·sr⁻¹·m⁻²) of tixel g's n gather rays
+/// (cosine-distributed, so each stands for π/n · L / cos θ of irradiance): the gather's
+/// estimate of ∫ L max(0, b_k·ω) dω. subCells: gatherSubCells' scratch for the tixel.
+/// The shares are tabulated in the gather frame (tiltShares); on a curved chart, whose gather
+/// frame (tixelFrameAround) turns about the normal against its tilt frame, the values are
+/// moved into the tilt frame through the model of lightfield.h: their mean Ē does not depend
+/// on the frame, and E_k = Ē + sin β·g·t_k with g = 2/(3 sin β)·Σ_k E_k·t_k turned between the
+/// frames.
+void addTiltedGather(const TransportState& state, const Chart& c, uint64_t g, const Lanes4* incoming,
+                     std::vector<uint8_t>& subCells, Rgb* tilted) {
+  const Parameterisation& param = state.param;
+  const auto& shares = state.ops->tiltShares;
+  gatherSubCells(g, state.gridSide, state.settings.seed, subCells);
+  Rgb sum[kTiltedNormals] = {Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
+  for (uint32_t k = 0; k < state.n; ++k) {
+    const Rgb L(incoming[k].v[0], incoming[k].v[1], incoming[k].v[2]);
+    const std::array<float, kTiltedNormals>& share = shares[size_t(k) * kGatherJitterSide * kGatherJitterSide + subCells[k]];
+    for (uint32_t t = 0; t < kTiltedNormals; ++t) sum[t] += L * share[t];
+  }
+  if (c.curved) {
+    const TixelFrame from = tixelFrame(param, c, g), to = tiltFrame(param, c, g);
+    const float sinBeta = std::sin(glm::radians(kNormalTiltDegrees));
+    Rgb mean(0.0f), gx(0.0f), gy(0.0f);  // Ē and g in the gather frame
+    for (uint32_t t = 0; t < kTiltedNormals; ++t) {
+      const Vec3 b = tiltedNormal(t);
+      mean += sum[t] / float(kTiltedNormals);
+      gx += sum[t] * (2.0f / (3.0f * sinBeta) * b.x / sinBeta);
+      gy += sum[t] * (2.0f / (3.0f * sinBeta) * b.y / sinBeta);
+    }
+    // g's components along the tilt frame's axes.
+    const Rgb tx = gx * glm::dot(from.u, to.u) + gy * glm::dot(from.v, to.u);
+    const Rgb ty = gx * glm::dot(from.u, to.v) + gy * glm::dot(from.v, to.v);
+    for (uint32_t t = 0; t < kTiltedNormals; ++t) {
+      const Vec3 b = tiltedNormal(t);  // sin β·t_k
+      sum[t] = glm::max(Rgb(0.0f), mean + tx * b.x + ty * b.y);
+    }
+  }
+  for (uint32_t t = 0; t < kTiltedNormals; ++t) tilted[t] += sum[t];
+}
+
+/// The irradiance directionalIrradiance tixel g sends on (Parameterisation::
+/// transportTiltWeights applied to its E and tilted irradiances `values`), clamped at 0.
+Rgb transportIrradiance(const Parameterisation& param, uint64_t g, const Rgb* values) {
+  const TiltWeights& w = param.transportTiltWeights[g];
+  Rgb e = values[0] * w.irradiance;
+  for (uint32_t k = 0; k < kTiltedNormals; ++k) e += values[1 + k] * w.tilted[k];
+  return glm::max(e, Rgb(0.0f));
+}
+
 }  // namespace
 
 TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const Parameterisation& paramIn,
@@ -520,6 +585,17 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
     punctualGlossy.assign(param.valueCount, Rgb(0.0f));
   change.assign(tixels, 0.0f);
   batchStart = propagationBatches(param);
+  if (std::any_of(param.charts.begin(), param.charts.end(), [](const Chart& c) { return c.directionalIrradiance; })) {
+    constexpr uint32_t kJitters = kGatherJitterSide * kGatherJitterSide;
+    ops->tiltShares.resize(size_t(n) * kJitters);
+    for (uint32_t k = 0; k < n; ++k)
+      for (uint32_t j = 0; j < kJitters; ++j) {
+        const Vec3 w = gatherCellDirection(k, j, gridSide, settings.seed);
+        for (uint32_t t = 0; t < kTiltedNormals; ++t)
+          ops->tiltShares[size_t(k) * kJitters + j][t] =
+              w.z > 0.0f ? kPi / float(n) * std::max(0.0f, glm::dot(w, tiltedNormal(t))) / w.z : 0.0f;
+      }
+  }
 }
 
 std::vector<uint64_t> propagationBatches(const Parameterisation& param) {
@@ -564,9 +640,17 @@ void removeSunMaskedDirect(const Scene& scene, const Parameterisation& param, st
     for (uint64_t g = begin; g < end; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind != ChartKind::Diffuse) continue;
-      Rgb& value = values[valueBase(g, c)];
-      for (size_t slot = 0; slot < lights.size(); ++slot) value -= sunMaskedIrradiance(param, lights[slot], g, slot);
-      value = glm::max(value, Rgb(0.0f));  // what rounding leaves below the other terms
+      Rgb* value = &values[valueBase(g, c)];
+      for (size_t slot = 0; slot < lights.size(); ++slot) {
+        const Rgb masked = sunMaskedIrradiance(param, lights[slot], g, slot);
+        value[0] -= masked;
+        if (!c.directionalIrradiance) continue;
+        Rgb tilted[kTiltedNormals] = {Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};  // what the first shot added
+        addTiltedIrradiance(param, c, g, parallelLight(lights[slot])->towardsLight, masked, tilted);
+        for (uint32_t k = 0; k < kTiltedNormals; ++k) value[1 + k] -= tilted[k];
+      }
+      for (uint64_t v = 0; v < c.valuesPerTixel(); ++v)
+        value[v] = glm::max(value[v], Rgb(0.0f));  // what rounding leaves below the other terms
     }
   });
 }
@@ -620,7 +704,10 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         // A masked light on a diffuse tixel: its footprint's mean visibility, no ray
         // (lightfield.h "Sun masks"; sunMaskedIrradiance, which the bake takes back out).
         if (maskSlot[li] >= 0 && c.kind == ChartKind::Diffuse) {
-          direct[valueBase(g, c)] += sunMaskedIrradiance(param, light, g, size_t(maskSlot[li]));
+          const Rgb masked = sunMaskedIrradiance(param, light, g, size_t(maskSlot[li]));
+          direct[valueBase(g, c)] += masked;
+          if (c.directionalIrradiance) addTiltedIrradiance(param, c, g, parallelLight(light)->towardsLight, masked,
+                                                          &direct[valueBase(g, c) + 1]);
           continue;
         }
         // One ray towards a delta light; sceneLightSamples towards any other, the tixel's own
@@ -697,6 +784,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       const uint64_t vb = valueBase(p.tixel, c);
       if (c.kind == ChartKind::Diffuse) {
         direct[vb] += p.irradiance;
+        if (c.directionalIrradiance) addTiltedIrradiance(param, c, p.tixel, p.wi, p.irradiance, &direct[vb + 1]);
       } else {
         const GlossyMaterial& gm = glossy[c.material];
         const Bsdf& bsdf = scene.materials[c.material].bsdf;
@@ -771,7 +859,7 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
         if (subCells.empty()) gatherSubCells(g, state.gridSide, settings.seed, subCells);
         return gatherCellDirection(k, subCells[k], state.gridSide, settings.seed);
       };
-      const bool keepIncoming = c.kind == ChartKind::Glossy;
+      const bool keepIncoming = c.kind == ChartKind::Glossy || c.directionalIrradiance;
       bool any = false;
       Rgb sum(0.0f);  // Σ_k L_k in gather order
       for (uint32_t k = 0; k < n; ++k) {
@@ -820,9 +908,10 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
       if (Lanes4* glassCells = glassFirstShot.cells(param, g)) std::copy_n(incoming.data(), n, glassCells);
       if (!any) continue;
       const uint64_t vb = valueBase(g, c);
-      if (c.kind == ChartKind::Diffuse)
+      if (c.kind == ChartKind::Diffuse) {
         direct[vb] += sum * (kPi / float(n));
-      else {
+        if (c.directionalIrradiance) addTiltedGather(state, c, g, incoming.data(), subCells, &direct[vb + 1]);
+      } else {
         glossy[c.material].reflection(c).apply(incoming.data(), f4FromRgb(sum), direct.data() + vb);
         glossy[c.material].addDiffuse(c, incoming.data(), direct.data() + vb);
       }
@@ -858,7 +947,10 @@ void updateTransport(TransportState& state, uint64_t begin, uint64_t end) {
       const uint64_t local = g - c.firstTixel;
       const uint32_t i = uint32_t(local % c.resU), j = uint32_t(local / c.resU);
       auto transport = [&](uint64_t tixel) {
-        return param.transportAlbedo[tixel] * current[c.firstValue + (tixel - c.firstTixel)] * kInvPi;
+        const Rgb* values = &current[valueBase(tixel, c)];
+        // A normal-mapped chart sends on its irradiance about the footprint's mapped normals.
+        return param.transportAlbedo[tixel] * (c.directionalIrradiance ? transportIrradiance(param, tixel, values) : values[0]) *
+               kInvPi;
       };
       const bool right = i + 1 < c.resU, up = j + 1 < c.resV;
       const Rgb t00 = transport(g), t10 = right ? transport(g + 1) : Rgb(0.0f),
@@ -873,6 +965,37 @@ void updateTransport(TransportState& state, uint64_t begin, uint64_t end) {
   });
 }
 
+namespace {
+
+/// The radiance a gather entry with an extra record, or one that hit a back side, brings
+/// (gatherTixel's slow path) while tixels [begin, end) are being updated: a glossy chart
+/// overlapping that range is read at its previous values, every other chart at current.
+Rgb slowPathRadiance(const TransportState& state, VisibilityEntry e, const VisibilityExtra* extra, uint64_t begin,
+                     uint64_t end) {
+  // Back-side hits see the inside of a closed solid (a two-sided chart's back is its
+  // own record): no reflected light. Emission from behind is in the constant part.
+  if (!extra || e.escaped() || e.backSide()) return Rgb(0.0f);
+  const Parameterisation& param = state.param;
+  const uint32_t base = e.tixel();
+  const uint32_t seenChart = param.tixelChart[base];
+  const Chart& seen = param.charts[seenChart];
+  Rgb L(0.0f);
+  if (seen.kind == ChartKind::Diffuse) {
+    L = f4Rgb(lookupQuad(state.ops->quads[base], e));
+  } else if (seen.kind == ChartKind::Glossy) {
+    const bool sameBatch = seen.firstTixel < end && seen.firstTixel + seen.tixelCount() > begin;
+    const float fu = float(e.fu) * (1.0f / 65535.0f), fv = float(e.fv) * (1.0f / 65535.0f);
+    const uint64_t local = base - seen.firstTixel;
+    const Vec2 grid(float(local % seen.resU) + fu, float(local / seen.resU) + fv);
+    const Rgb* values = sameBatch ? state.previousValues.data() : state.current.data();
+    L = interpolateValues(values, seen, grid, extra->st);
+    if (seen.diffuseValue) L += glossyDiffuseRadiance(state, values, seen, grid, extra->st);
+  }
+  return L * extra->throughput;
+}
+
+}  // namespace
+
 void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t begin, uint64_t end, float omega) {
   const Parameterisation& param = state.param;
   const TransportState::Operators& ops = *state.ops;
@@ -884,35 +1007,16 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
   std::vector<float>& change = state.change;
   parallelForRange(end - begin, 16, [&](uint64_t t0, uint64_t t1) {
     std::vector<Lanes4> incoming(n), twinIncoming;
+    std::vector<uint8_t> subCells;
     for (uint64_t g = begin + t0; g < begin + t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
-      // Entries with an extra record, or that hit a back side.
       auto slowPath = [&](VisibilityEntry e, const VisibilityExtra* extra) {
-        // Back-side hits see the inside of a closed solid (a two-sided chart's back is its
-        // own record): no reflected light. Emission from behind is in the constant part.
-        if (!extra || e.escaped() || e.backSide()) return Rgb(0.0f);
-        const uint32_t base = e.tixel();
-        const uint32_t seenChart = param.tixelChart[base];
-        const Chart& seen = param.charts[seenChart];
-        Rgb L(0.0f);
-        if (seen.kind == ChartKind::Diffuse) {
-          L = f4Rgb(lookupQuad(ops.quads[base], e));
-        } else if (seen.kind == ChartKind::Glossy) {
-          // A chart overlapping the range being updated is read at its previous values.
-            const bool sameBatch = seen.firstTixel < end && seen.firstTixel + seen.tixelCount() > begin;
-          const float fu = float(e.fu) * (1.0f / 65535.0f), fv = float(e.fv) * (1.0f / 65535.0f);
-          const uint64_t local = base - seen.firstTixel;
-          const Vec2 grid(float(local % seen.resU) + fu, float(local / seen.resU) + fv);
-          const Rgb* values = sameBatch ? previousValues.data() : current.data();
-          L = interpolateValues(values, seen, grid, extra->st);
-          if (seen.diffuseValue) L += glossyDiffuseRadiance(state, values, seen, grid, extra->st);
-        }
-        return L * extra->throughput;
+        return slowPathRadiance(state, e, extra, begin, end);
       };
       const VisibilityEntry* entries = vis.entries(g);
       const VisibilityExtra* extras = vis.extras(g);
-      const F4 sum = c.kind == ChartKind::Glossy
+      const F4 sum = c.kind == ChartKind::Glossy || c.directionalIrradiance
                          ? gatherTixel<true>(entries, n, ops.quads.data(), ops.quads.size(), extras, incoming.data(), slowPath)
                          : gatherTixel<false>(entries, n, ops.quads.data(), ops.quads.size(), extras, nullptr, slowPath);
       const uint64_t vb = valueBase(g, c);
@@ -920,6 +1024,11 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
       if (c.kind == ChartKind::Diffuse) {
         const Rgb before = current[vb];
         current[vb] = relax(before, direct[vb] + f4Rgb(sum) * (kPi / float(n)));
+        if (c.directionalIrradiance) {
+          Rgb tilted[kTiltedNormals] = {direct[vb + 1], direct[vb + 2], direct[vb + 3]};
+          addTiltedGather(state, c, g, incoming.data(), subCells, tilted);
+          for (uint32_t k = 0; k < kTiltedNormals; ++k) current[vb + 1 + k] = relax(current[vb + 1 + k], tilted[k]);
+        }
         change[g] = exitanceChange(state, &before, &current[vb], g, c);
       } else {
         Rgb* out = current.data() + vb;

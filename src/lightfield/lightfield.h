@@ -44,6 +44,27 @@
 //   Specular  nothing: an ideal mirror's or smooth glass's radiance is that of whatever the
 //             mirrored/refracted direction sees (a reordering), followed at render time.
 //
+// Normal-mapped diffuse charts (directionalIrradiance). A normal map makes a Lambertian
+// surface reflect ρ/π·E(n') with E(n') = ∫ L(ω) max(0, n'·ω) dω the irradiance about the
+// mapped normal n' of each point (light from below the geometric surface never arrives), which
+// varies within a tixel; one irradiance about the chart's normal n shows the surface flat, and
+// too bright where n' turns away from the light. So such a chart's tixels keep, after E = E(n),
+// the irradiances E_k = E(b_k) about kTiltedNormals normals tilted by β = kNormalTiltDegrees
+// from n at azimuths φ_k = 0°, 120°, 240° (tiltedNormal: b_k = cos β·n + sin β·t_k in the
+// tixel's tilt frame, tiltFrameAround). E(n') is taken as the model
+//     E(n') ≈ E + a·(1 − n'_z) + g·n'_t        (n'_z along n, n'_t across it)
+// fitted exactly to the four values: Ē = mean E_k gives a = (Ē − E)/(1 − cos β), and
+// g = 2/(3 sin β)·Σ_k E_k·t_k (three unit vectors 120° apart: Σ_k (g·t_k)·t_k = 3/2·g).
+// It is exact for light from one direction above every tilted horizon (a = −E, g = its
+// tangential irradiance: E(n') = L·(n'·ω)) and for uniform light over the hemisphere (where
+// E(n') = E·(1 + n'_z)/2: a = −E/2, g = 0), so both a lamp's shading of the bumps and the
+// dimming of sky light on tilted facets come out right. tiltWeights gives the weights of E and
+// the E_k for a normal. All four values are irradiances, never negative, so every value codec
+// stores them. The renderers evaluate the model at each pixel's mapped normal (the sun-masked
+// lights, below, directly at n'); the bake's transport at each tixel's footprint-mean mapped
+// normal (the model is linear in n', so this is the footprint mean of E(n')), since a bumpy
+// surface sends on less light than a flat one.
+//
 // Sides (the light field's part of the sidedness rule; scatteringFrame in scene.h is the
 // path tracer's, emittedRadiance there the emitters'). A reflecting surface scatters on both
 // sides (scene.h), so a surface that can be seen and lit from behind stores its back side too:
@@ -123,18 +144,60 @@ struct Chart {
   /// A glossy chart whose material has a diffuse part: each tixel's map is followed by its
   /// diffuse irradiance Ẽ (see "What is stored per chart kind" above).
   bool diffuseValue = false;
+  /// A diffuse chart of a normal-mapped material: each tixel's irradiance E is followed by its
+  /// kTiltedNormals tilted irradiances E_k (see "Normal-mapped diffuse charts" above).
+  bool directionalIrradiance = false;
 
   uint64_t tixelCount() const { return uint64_t(resU) * resV; }
   uint64_t directionTexels() const { return uint64_t(dirRes) * dirRes; }
-  uint64_t valuesPerTixel() const { return directionTexels() + (diffuseValue ? 1 : 0); }
+  uint64_t valuesPerTixel() const;
   /// Values are tixel-major: all direction texels of one tixel are contiguous, direction
-  /// texel (s, t) at s + t·dirRes, then (diffuseValue) the tixel's Ẽ; tixels row by row (i + j·resU).
+  /// texel (s, t) at s + t·dirRes, then (diffuseValue) the tixel's Ẽ, or (directionalIrradiance)
+  /// its tilted irradiances E_0 … E_2; tixels row by row (i + j·resU).
   uint64_t valueIndex(uint32_t i, uint32_t j, uint32_t s = 0, uint32_t t = 0) const {
     return firstValue + (uint64_t(j) * resU + i) * valuesPerTixel() + uint64_t(t) * dirRes + s;
   }
   /// The index of tixel (i, j)'s diffuse irradiance Ẽ (diffuseValue charts only).
   uint64_t diffuseValueIndex(uint32_t i, uint32_t j) const { return valueIndex(i, j) + directionTexels(); }
+  /// The index of tixel (i, j)'s irradiance about tilted normal k (directionalIrradiance charts).
+  uint64_t tiltedIrradianceIndex(uint32_t i, uint32_t j, uint32_t k) const { return valueIndex(i, j) + 1 + k; }
 };
+
+/// Normal-mapped diffuse charts (see above): the tilted normals, their tilt β from the
+/// chart's normal and their number.
+inline constexpr uint32_t kTiltedNormals = 3;
+inline constexpr float kNormalTiltDegrees = 45.0f;
+
+inline uint64_t Chart::valuesPerTixel() const {
+  return directionTexels() + (diffuseValue ? 1 : 0) + (directionalIrradiance ? kTiltedNormals : 0);
+}
+
+/// Tilted normal k (0 … kTiltedNormals − 1) in the tilt frame's local coordinates (z along
+/// the chart's normal): (sin β cos φ_k, sin β sin φ_k, cos β), φ_k = k·120°.
+inline Vec3 tiltedNormal(uint32_t k) {
+  const float beta = glm::radians(kNormalTiltDegrees), phi = glm::radians(120.0f * float(k));
+  return {std::sin(beta) * std::cos(phi), std::sin(beta) * std::sin(phi), std::cos(beta)};
+}
+
+/// The weights of the model above: E(n') ≈ irradiance·E + Σ_k tilted[k]·E_k for a normal n'
+/// in the tilt frame's local coordinates (unit, or a mean of unit normals).
+struct TiltWeights {
+  float irradiance = 1.0f;
+  float tilted[kTiltedNormals] = {};
+};
+inline TiltWeights tiltWeights(const Vec3& localNormal) {
+  const float beta = glm::radians(kNormalTiltDegrees);
+  // E + a(1 − n'_z) with a = (Ē − E)/(1 − cos β): the isotropic part's share s of Ē − E.
+  const float share = (1.0f - localNormal.z) / (1.0f - std::cos(beta));
+  TiltWeights w;
+  w.irradiance = 1.0f - share;
+  for (uint32_t k = 0; k < kTiltedNormals; ++k) {
+    const Vec3 b = tiltedNormal(k);  // t_k = (b.x, b.y) / sin β
+    const float across = (b.x * localNormal.x + b.y * localNormal.y) / std::sin(beta);
+    w.tilted[k] = share / float(kTiltedNormals) + 2.0f / (3.0f * std::sin(beta)) * across;
+  }
+  return w;
+}
 
 /// Quality preset parameters (kBakePresets in bake/bake.h, docs/user-guide.md). The member defaults are
 /// those of the "default" preset, so a default-constructed BakeSettings equals
@@ -288,34 +351,46 @@ struct TixelFrame {
   Vec3 toWorld(const Vec3& local) const { return local.x * u + local.y * v + local.z * n; }
   Vec3 toLocal(const Vec3& w) const { return {glm::dot(w, u), glm::dot(w, v), glm::dot(w, n)}; }
 };
+/// A frame around unit `normal` at a point of chart c that turns continuously over the chart:
+/// the chart's frame (axisU, axisV, normal) on a planar chart (`normal` unread); on a curved
+/// one u = axisU made orthogonal to the normal (Gram–Schmidt), v = n × u. Directional data
+/// read in the frame of a lookup point and interpolated between tixels stored in the frames of
+/// their gather points (glossy maps, tilted irradiances) needs such a frame. Frame::fromNormal
+/// is not one: at n.z = 0 it turns by 180° about n (n = (1, 0, ±0) gives s = (0, 0, ∓1)), and a
+/// sphere's charts straddle that great circle. axisU is orthogonal to the chart normal and the
+/// chart's normals stay within about 2 × kCurvedChartConeDegrees of it (parameterisation.h),
+/// so axisU is ≥ ≈ 50° off any of them and the projection never vanishes (Frame::fromNormal is
+/// the fallback for a degenerate vertex normal that leaves that bound).
+inline TixelFrame continuousFrameAround(const Chart& c, const Vec3& normal) {
+  if (!c.curved) return {c.axisU, c.axisV, c.normal};
+  const Vec3 u = c.axisU - glm::dot(c.axisU, normal) * normal;
+  const float length = glm::length(u);
+  if (length > 1e-3f) {
+    const Vec3 unitU = u / length;
+    return {unitU, glm::cross(normal, unitU), normal};
+  }
+  const Frame f = Frame::fromNormal(normal);
+  return {f.s, f.t, f.n};
+}
 /// The frame at a point of chart c whose unit normal (chartShadingNormalAt, or a tixel's
 /// gatherNormal) is `normal`: the chart's frame (axisU, axisV, normal) on a planar chart
 /// (`normal` unread); on a curved one a frame around `normal`. The one definition the bake
 /// (gather directions, glossy maps) and the lookups of every renderer share.
 ///  * Curved diffuse charts: Frame::fromNormal(normal). Only the gather directions turn with
 ///    it, and an irradiance sum does not care how they are turned about the normal.
-///  * Curved glossy charts: u = axisU made orthogonal to the normal (Gram–Schmidt), v = n × u.
-///    A directional map is read in the frame of the lookup point and interpolated between
-///    tixels stored in the frames of their gather points, so the frame must vary continuously
-///    over the chart. Frame::fromNormal does not: at n.z = 0 it turns by 180° about n
-///    (n = (1, 0, ±0) gives s = (0, 0, ∓1)), and a sphere's charts straddle that great
-///    circle. axisU is orthogonal to the chart normal and the chart's normals stay within
-///    about 2 × kCurvedChartConeDegrees of it (parameterisation.h), so axisU is ≥ ≈ 50° off
-///    any of them and the projection never vanishes (Frame::fromNormal is the fallback for a
-///    degenerate vertex normal that leaves that bound).
+///  * Curved glossy charts: continuousFrameAround, since a directional map is read in the
+///    frame of the lookup point and interpolated between tixels stored in the frames of their
+///    gather points.
 inline TixelFrame tixelFrameAround(const Chart& c, const Vec3& normal) {
+  if (c.kind == ChartKind::Glossy) return continuousFrameAround(c, normal);
   if (!c.curved) return {c.axisU, c.axisV, c.normal};
-  if (c.kind == ChartKind::Glossy) {
-    const Vec3 u = c.axisU - glm::dot(c.axisU, normal) * normal;
-    const float length = glm::length(u);
-    if (length > 1e-3f) {
-      const Vec3 unitU = u / length;
-      return {unitU, glm::cross(normal, unitU), normal};
-    }
-  }
   const Frame f = Frame::fromNormal(normal);
   return {f.s, f.t, f.n};
 }
+/// The frame the tilted normals of a directionalIrradiance chart's tixel (tiltedNormal) are
+/// taken in, at a point whose unit normal is `normal`: continuousFrameAround, so that the
+/// renderers can interpolate tilted irradiances between tixels.
+inline TixelFrame tiltFrameAround(const Chart& c, const Vec3& normal) { return continuousFrameAround(c, normal); }
 
 /// The chart record holding the side of record `chart` (as triangleChart gives it) that a
 /// viewer in world direction towardsViewer (from the surface; −ray direction) sees at a point

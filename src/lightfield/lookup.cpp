@@ -118,7 +118,7 @@ ChartShading chartShading(const LightField& lf, uint32_t chart, const SunLights&
   if (c.diffuseValue && !shading.texturedAlbedo)
     shading.albedoOverPi = lanes4(glossyDiffuseAlbedoAt(scene, c.material, Vec2(0.0f), kFullResolution) * kInvPi);
   shading.needsUv = (c.kind == ChartKind::Diffuse || c.diffuseValue) && shading.texturedAlbedo;
-  shading.normalMapped = c.kind == ChartKind::Glossy && material.normalTexture >= 0;
+  shading.normalMapped = (c.kind == ChartKind::Glossy || c.directionalIrradiance) && material.normalTexture >= 0;
   shading.curvedGlossy = c.kind == ChartKind::Glossy && c.curved;
   if (c.kind == ChartKind::Diffuse && sun.count > 0 &&
       (c.firstTixel + c.tixelCount()) * sun.count <= lf.sunMasks.size()) {
@@ -144,7 +144,7 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   const SunLights sun = sunLightsOf(lf);
   return exitantRadiance(lf.scene, c, chartShading(lf, chart, sun), lf.values.data(), worldPosition,
-                         worldDirectionTowardsViewer, c.normal, uv, kFullResolution);
+                         worldDirectionTowardsViewer, c.normal, c.normal, uv, kFullResolution);
 }
 
 Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPosition,
@@ -161,9 +161,11 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
   const ChartShading shading = chartShading(lf, chart, sun);
   Vec2 uv;
   float lod;
-  Vec3 lookupDirection, lookupNormal;
-  lookupInputs(lf.scene, c, shading, hit, worldDirectionTowardsViewer, coneWidth, uv, lod, lookupDirection, lookupNormal);
-  return exitantRadiance(lf.scene, c, shading, lf.values.data(), worldPosition, lookupDirection, lookupNormal, uv, lod);
+  Vec3 lookupDirection, lookupNormal, mappedNormal;
+  lookupInputs(lf.scene, c, shading, hit, worldDirectionTowardsViewer, coneWidth, uv, lod, lookupDirection, lookupNormal,
+               mappedNormal);
+  return exitantRadiance(lf.scene, c, shading, lf.values.data(), worldPosition, lookupDirection, lookupNormal,
+                         mappedNormal, uv, lod);
 }
 
 PunctualHighlights::PunctualHighlights(const LightField& lf, const Accel& accel) : lf_(lf) {

@@ -90,11 +90,15 @@ inline F4 interpolateLanes(const Load& load, const Chart& c, Vec2 grid, Vec2 st)
   const float wu[2] = {1.0f - tu.f, tu.f}, wv[2] = {1.0f - tv.f, tv.f};
   F4 sum = f4Zero();
   if (c.dirRes == 1) {
-    // c.valueIndex(i, j) with one value per tixel; the rows summed separately, then together
-    // (a shorter chain of dependent additions than one running sum).
-    const uint64_t row0 = c.firstValue + uint64_t(js[0]) * c.resU, row1 = c.firstValue + uint64_t(js[1]) * c.resU;
-    const F4 lower = f4Add(f4Mul(f4Splat(wu[0] * wv[0]), load(row0 + is[0])), f4Mul(f4Splat(wu[1] * wv[0]), load(row0 + is[1])));
-    const F4 upper = f4Add(f4Mul(f4Splat(wu[0] * wv[1]), load(row1 + is[0])), f4Mul(f4Splat(wu[1] * wv[1]), load(row1 + is[1])));
+    // c.valueIndex(i, j) (one value per tixel, or a directionalIrradiance chart's E among its
+    // four); the rows summed separately, then together (a shorter chain of dependent
+    // additions than one running sum).
+    const uint64_t stride = c.valuesPerTixel();
+    const uint64_t row0 = c.firstValue + uint64_t(js[0]) * c.resU * stride, row1 = c.firstValue + uint64_t(js[1]) * c.resU * stride;
+    const F4 lower = f4Add(f4Mul(f4Splat(wu[0] * wv[0]), load(row0 + is[0] * stride)),
+                           f4Mul(f4Splat(wu[1] * wv[0]), load(row0 + is[1] * stride)));
+    const F4 upper = f4Add(f4Mul(f4Splat(wu[0] * wv[1]), load(row1 + is[0] * stride)),
+                           f4Mul(f4Splat(wu[1] * wv[1]), load(row1 + is[1] * stride)));
     return f4Add(lower, upper);
   }
   const LinearTap ta = linearTap(paraboloidTexelCoordinate(st.x, c.dirRes), c.dirRes);
@@ -127,6 +131,22 @@ inline F4 bilinearOverTixels(const Chart& c, Vec2 grid, const PerTixel& perTixel
   const F4 upper = f4Add(f4Mul(f4Splat((1.0f - tu.f) * tv.f), perTixel(tu.i0, tv.i1)),
                          f4Mul(f4Splat(tu.f * tv.f), perTixel(tu.i1, tv.i1)));
   return f4Add(lower, upper);
+}
+
+/// The irradiance about mapped normal n' (lanes r, g, b, 0; W·m⁻²) at grid position `grid` of
+/// a directionalIrradiance chart c (lightfield.h "Normal-mapped diffuse charts") whose
+/// interpolated irradiance about its normal is `irradiance`: the model of tiltWeights with the
+/// tilted irradiances bilinear over the tixels like E, clamped at 0. localMappedNormal: n' in
+/// the tilt frame at the point (tiltFrameAround).
+template <typename Load>
+inline F4 mappedNormalIrradiance(const Load& load, const Chart& c, Vec2 grid, F4 irradiance, const Vec3& localMappedNormal) {
+  const TiltWeights w = tiltWeights(localMappedNormal);
+  F4 total = f4Mul(f4Splat(w.irradiance), irradiance);
+  for (uint32_t k = 0; k < kTiltedNormals; ++k) {
+    const F4 tilted = bilinearOverTixels(c, grid, [&](uint32_t i, uint32_t j) { return load(c.tiltedIrradianceIndex(i, j, k)); });
+    total = f4Add(total, f4Mul(f4Splat(w.tilted[k]), tilted));
+  }
+  return f4Max(total, f4Zero());
 }
 
 /// interpolateLanes over a raw Rgb value array (the bake uses it on its working arrays).
@@ -245,7 +265,10 @@ struct ChartShading {
   bool twoSidedEmission = false;
   bool texturedAlbedo = false;    ///< diffuse albedo varies with uv: diffuseAlbedoAt per point
   bool needsUv = false;           ///< a diffuse (or diffuseValue glossy) chart with an albedo texture: the lookup needs the hit's uv
-  bool normalMapped = false;      ///< a glossy chart with a normal map: lookupDirection needs the hit's normal
+  /// A normal-mapped glossy chart (lookupDirection bends the lookup by the hit's mapped normal)
+  /// or directionalIrradiance diffuse chart (the irradiance is taken about it): lookupInputs
+  /// needs surfaceAt's shading normal.
+  bool normalMapped = false;
   /// A curved glossy chart: its map is read in the frame around the hit's interpolated normal
   /// (chartShadingNormalAt), so the lookup needs the hit's triangle and barycentrics.
   bool curvedGlossy = false;
@@ -271,21 +294,26 @@ SunLights sunLightsOf(const LightField& lf);
 ChartShading chartShading(const LightField& lf, uint32_t chart, const SunLights& sun);
 
 /// Whether the lookup needs the hit's interpolated normal on chart c: curved glossy charts
-/// (their maps) and curved diffuse charts with sun masks (the masked lights' cos θ).
+/// (their maps), curved diffuse charts with sun masks (the masked lights' cos θ) or tilted
+/// irradiances (their frame).
 inline bool needsInterpolatedNormal(const Chart& c, const ChartShading& shading) {
-  return shading.curvedGlossy || (c.curved && shading.sunMasks != nullptr);
+  return shading.curvedGlossy || (c.curved && (shading.sunMasks != nullptr || c.directionalIrradiance));
 }
 
 /// The masked lights' irradiance (W·m⁻², lanes r, g, b, 0) at grid position `grid` of diffuse
 /// chart c (tixelGridCoordinates) on a surface with unit normal `normal` (the chart's, or on a
 /// curved chart the interpolated normal at the point): Σ_l E_l·max(0, n·ω_l)·V_l(grid), V_l the
-/// bilinear mask visibility (sunVisibility). Zero without masks.
-inline F4 sunIrradianceLanes(const Chart& c, const ChartShading& shading, Vec2 grid, const Vec3& normal) {
+/// bilinear mask visibility (sunVisibility). Zero without masks. With a mapped normal n'
+/// (a directionalIrradiance chart) the cosine is max(0, n'·ω_l), for lights above the
+/// surface's normal n only, as the path tracer's sidedness rule has it.
+inline F4 sunIrradianceLanes(const Chart& c, const ChartShading& shading, Vec2 grid, const Vec3& normal,
+                             const Vec3& mappedNormal) {
   F4 sum = f4Zero();
   if (shading.sunMasks == nullptr) return sum;
   const SunLights& sun = *shading.sun;
   for (uint32_t l = 0; l < sun.count; ++l) {
-    const float cosTheta = glm::dot(normal, sun.towardsLight[l]);
+    if (!(glm::dot(normal, sun.towardsLight[l]) > 0.0f)) continue;
+    const float cosTheta = glm::dot(mappedNormal, sun.towardsLight[l]);
     if (!(cosTheta > 0.0f)) continue;
     const float lit = sunVisibility(shading.sunMasks, sun.count, l, c, grid);
     if (lit > 0.0f) sum = f4Add(sum, f4Mul(f4Load(sun.irradiance[l].v), f4Splat(cosTheta * lit)));
@@ -316,16 +344,19 @@ inline Vec3 lookupNormalAt(const Scene& scene, const Chart& c, const ChartShadin
 /// What exitantRadianceLanes needs of a ray's hit on chart c besides the position: the uv
 /// and mip level (for an albedo texture: albedoLodAt with the ray's cone width `coneWidth`
 /// at the hit), the lookup direction (towards the viewer; bent by a normal map on glossy
-/// charts) and the normal the glossy map is read around (the chart normal; on a curved
-/// glossy chart the interpolated normal at the hit, chartShadingNormalAt). surfaceAt is
-/// evaluated only where the chart's shading needs it.
+/// charts), the normal the glossy map is read around (the chart normal; on a curved
+/// glossy chart the interpolated normal at the hit, chartShadingNormalAt) and the mapped
+/// normal a directionalIrradiance chart's irradiance is taken about (surfaceAt's shading
+/// normal, turned to the record's side; lookupNormal elsewhere). surfaceAt is evaluated only
+/// where the chart's shading needs it.
 inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading& shading, const RayHit& hit,
                          const Vec3& towardsViewer, float coneWidth, Vec2& uv, float& lod, Vec3& lookup,
-                         Vec3& lookupNormal) {
+                         Vec3& lookupNormal, Vec3& mappedNormal) {
   uv = Vec2(0.0f);
   lod = kFullResolution;
   lookup = towardsViewer;
   lookupNormal = lookupNormalAt(scene, c, shading, hit.mesh, hit.triangle, hit.barycentrics);
+  mappedNormal = lookupNormal;
   if (!shading.needsUv && !shading.normalMapped) return;
   if (!shading.normalMapped) {  // surfaceAt's uv alone (no normals, no normal-map texel)
     uv = uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics);
@@ -334,7 +365,13 @@ inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading&
   }
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
   uv = surface.uv;
-  lookup = normalMappedLookupDirection(lookupNormal, surface.shadingNormal, towardsViewer);
+  if (c.kind == ChartKind::Glossy) {
+    lookup = normalMappedLookupDirection(lookupNormal, surface.shadingNormal, towardsViewer);
+    return;
+  }
+  // A directionalIrradiance chart: the albedo texture's level as on any diffuse chart.
+  if (shading.needsUv) lod = albedoLodAt(scene, c.material, hit.mesh, hit.triangle, -towardsViewer, coneWidth);
+  mappedNormal = c.isBack ? -surface.shadingNormal : surface.shadingNormal;
 }
 
 /// The cos θ towards the viewer that the lookups use on a curved chart record. Its triangles
@@ -373,12 +410,13 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
 /// goes through, as four lanes (r, g, b, 0). Defined inline so that the fast renderer's
 /// per-pixel loop inlines it instead of calling across files. lookupNormal: lookupNormalAt's
 /// normal at worldPosition (lookupInputs): a curved glossy chart's map is read around it, a
-/// curved diffuse chart's sun-masked lights shine on it. uv and lod: where and at which mip level a diffuse chart's albedo texture is read
-/// (lookupInputs).
+/// curved diffuse chart's sun-masked lights shine on it. mappedNormal: a directionalIrradiance
+/// chart's mapped normal (lookupInputs; lookupNormal on other charts). uv and lod: where and at
+/// which mip level a diffuse chart's albedo texture is read (lookupInputs).
 template <typename Load>
 inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
                                const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer,
-                               const Vec3& lookupNormal, Vec2 uv, float lod) {
+                               const Vec3& lookupNormal, const Vec3& mappedNormal, Vec2 uv, float lod) {
   if (c.kind == ChartKind::Specular) return f4Zero();
   const Vec2 grid = tixelGridCoordinates(c, worldPosition, shading.inverseTixelSize);
   // cos θ towards the viewer (chartLocalDirection's z; a diffuse lookup needs no more of it).
@@ -392,8 +430,17 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
   // facingChart), only two-sided emission.
   if (!(cosTheta >= 0.0f)) return shading.emissive && emits ? f4Load(shading.emission.v) : f4Zero();
   if (c.kind == ChartKind::Diffuse) {
-    // Le + (albedo/π) · E, lane by lane; E = the stored irradiance plus the sun masks' lights.
-    const F4 irradiance = f4Add(interpolateLanes(load, c, grid, Vec2(0.0f)), sunIrradianceLanes(c, shading, grid, lookupNormal));
+    // Le + (albedo/π) · E, lane by lane; E = the stored irradiance plus the sun masks' lights,
+    // about the mapped normal on a directionalIrradiance chart.
+    F4 stored = interpolateLanes(load, c, grid, Vec2(0.0f));
+    if (c.directionalIrradiance) {
+      // The path tracer's Lambertian lobe reflects only towards viewers above the mapped
+      // normal (bsdf.cpp sameHemisphereUp in the shading frame).
+      if (!(glm::dot(worldDirectionTowardsViewer, mappedNormal) > 0.0f))
+        return shading.emissive && emits ? f4Load(shading.emission.v) : f4Zero();
+      stored = mappedNormalIrradiance(load, c, grid, stored, tiltFrameAround(c, lookupNormal).toLocal(mappedNormal));
+    }
+    const F4 irradiance = f4Add(stored, sunIrradianceLanes(c, shading, grid, lookupNormal, mappedNormal));
     const F4 albedoOverPi = shading.texturedAlbedo ? f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv, lod)), f4Splat(kInvPi))
                                                    : f4Load(shading.albedoOverPi.v);
     const F4 reflected = f4Mul(albedoOverPi, irradiance);
@@ -419,11 +466,12 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
 template <typename Load>
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
                            const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, const Vec3& lookupNormal,
-                           Vec2 uv, float lod) {
-  return f4Rgb(
-      exitantRadianceLanes(scene, c, shading, load, worldPosition, worldDirectionTowardsViewer, lookupNormal, uv, lod));
+                           const Vec3& mappedNormal, Vec2 uv, float lod) {
+  return f4Rgb(exitantRadianceLanes(scene, c, shading, load, worldPosition, worldDirectionTowardsViewer, lookupNormal,
+                                    mappedNormal, uv, lod));
 }
-/// Four light-field lookups on one diffuse chart: the camera rays origin + t·direction
+/// Four light-field lookups on one diffuse chart that is not directionalIrradiance (one value
+/// per tixel; callers send those through exitantRadianceLanes): the camera rays origin + t·direction
 /// (structure of arrays: x[k], y[k], z[k] for lookups k = 0…3), seen against their directions,
 /// at surface uvs uv[k] and mip levels lod[k] (read only when the chart has an albedo texture,
 /// shading.needsUv), and — on a curved chart with sun masks, where the masked lights shine on
@@ -488,7 +536,8 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
     _mm_store_ps(gu, gridU);
     _mm_store_ps(gv, gridV);
     for (int k = 0; k < 4; ++k)
-      sunIrradiance[k] = sunIrradianceLanes(c, shading, Vec2(gu[k], gv[k]), lookupNormals ? lookupNormals[k] : c.normal);
+      sunIrradiance[k] = sunIrradianceLanes(c, shading, Vec2(gu[k], gv[k]), lookupNormals ? lookupNormals[k] : c.normal,
+                                            lookupNormals ? lookupNormals[k] : c.normal);
   }
   // bit k: cos θ_k > 0, and cos θ_k ≥ 0 (a curved chart: kCurvedChartCosine > 0 in every lane).
   const int frontSide = c.curved ? 0xf : _mm_movemask_ps(_mm_cmpgt_ps(cosTheta, zero));
@@ -518,8 +567,9 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
 #else
   for (int k = 0; k < 4; ++k) {
     const Vec3 d(r.dx[k], r.dy[k], r.dz[k]);
+    const Vec3 normal = lookupNormals ? lookupNormals[k] : c.normal;
     result[k] = exitantRadianceLanes(scene, c, shading, PaddedValues{values}, Vec3(r.ox[k], r.oy[k], r.oz[k]) + r.t[k] * d, -d,
-                                     lookupNormals ? lookupNormals[k] : c.normal, uv[k], lod[k]);
+                                     normal, normal, uv[k], lod[k]);
   }
 #endif
 }
@@ -554,9 +604,9 @@ class PunctualHighlights {
 
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
                            const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, const Vec3& lookupNormal,
-                           Vec2 uv, float lod) {
-  return exitantRadiance(scene, c, shading, RgbValues{values}, worldPosition, worldDirectionTowardsViewer, lookupNormal, uv,
-                         lod);
+                           const Vec3& mappedNormal, Vec2 uv, float lod) {
+  return exitantRadiance(scene, c, shading, RgbValues{values}, worldPosition, worldDirectionTowardsViewer, lookupNormal,
+                         mappedNormal, uv, lod);
 }
 
 }  // namespace pl

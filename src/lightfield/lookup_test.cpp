@@ -168,7 +168,7 @@ TEST(Lookup, FourAtATimeDiffuseLookupEqualsOneAtATimeBitForBit) {
       exitantRadianceDiffuse4(lf.scene, c, shading, padded.data(), rays, uv, lod, four);
       for (int k = 0; k < 4; ++k) {
         const Rgb one = f4Rgb(exitantRadianceLanes(lf.scene, c, shading, PaddedValues{padded.data()},
-                                                   origin[k] + t[k] * direction[k], -direction[k], c.normal, uv[k], lod[k]));
+                                                   origin[k] + t[k] * direction[k], -direction[k], c.normal, c.normal, uv[k], lod[k]));
         const Rgb batch = f4Rgb(four[k]);
         for (int ch = 0; ch < 3; ++ch)
           ASSERT_EQ(std::bit_cast<uint32_t>(batch[ch]), std::bit_cast<uint32_t>(one[ch]))

@@ -53,8 +53,9 @@ std::vector<Grid> buildLayout(const std::vector<Chart>& charts, uint64_t valueCo
            c.firstValue, tixels, perTixel, valueCount);
     covered.emplace_back(c.firstValue, c.firstValue + tixels * perTixel);
     if (c.dirRes == 1) {
-      // Diffuse: the tixel grid (value (i, j) at firstValue + i + j·resU).
-      images.push_back({c.firstValue, 1, c.resU, c.resU, c.resV});
+      // Diffuse: the tixel grid (value (i, j) at firstValue + (i + j·resU)·perTixel), then
+      // (directionalIrradiance) one tixel-grid image per tilted irradiance.
+      for (uint64_t k = 0; k < perTixel; ++k) images.push_back({c.firstValue + k, perTixel, perTixel * c.resU, c.resU, c.resV});
     } else {
       // Glossy: every tixel's dirRes × dirRes paraboloid texture (texel (s, t) at s + t·dirRes),
       // then (diffuseValue) the tixels' diffuse irradiance as one more tixel-grid image.

@@ -33,7 +33,8 @@
 //
 // Layout ("images"): the values are visited as 2-D images so that neighbours in an image
 // are neighbours on a surface or on the hemisphere. A diffuse chart is one resU × resV image
-// (one irradiance per tixel); a glossy chart is one dirRes × dirRes image per tixel, its
+// (one irradiance per tixel; a directionalIrradiance chart one more per tilted irradiance,
+// Chart::directionalIrradiance); a glossy chart is one dirRes × dirRes image per tixel, its
 // paraboloid texture, plus (Chart::diffuseValue) one resU × resV image of its tixels'
 // diffuse irradiance. Values that no chart covers form 1-pixel-high images. BC1 pads
 // images to whole 4 × 4 blocks (padding texels are masked out of the endpoint fit).

@@ -370,7 +370,7 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
 // --- Charts ------------------------------------------------------------------------------
 
 constexpr uint64_t kChartRecordBytes = 4 + 1 + 4 * 12 + 4 + 3 * 4 + 2 * 8;
-// The kind byte: ChartKind in bits 0–4, and the sides (lightfield.h "Sides"): bit 7 = two-sided
+// The kind byte: ChartKind in bits 0–2, and the sides (lightfield.h "Sides"): bit 7 = two-sided
 // (on both records), bit 6 = the back record. Files written before two-sided charts have both
 // bits clear, so they read as one-sided charts, which is what they hold. Bit 5 marks a curved
 // chart (lightfield.h: diffuse, or glossy but not rough glass); files written before curved
@@ -379,8 +379,11 @@ constexpr uint64_t kChartRecordBytes = 4 + 1 + 4 * 12 + 4 + 3 * 4 + 2 * 8;
 // Bit 4 (version 4 on) marks a glossy chart with a diffuse value after each tixel's map
 // (Chart::diffuseValue); older files have it clear, and their glossy maps hold the whole
 // exitant radiance, which is what a chart without the bit means.
+// Bit 3 (version 5 on) marks a diffuse chart with tilted irradiances after each tixel's
+// irradiance (Chart::directionalIrradiance); older files have it clear, and their normal-mapped
+// diffuse charts keep one irradiance, shown flat, which is what a chart without the bit means.
 constexpr uint8_t kChartTwoSidedBit = 0x80, kChartBackBit = 0x40, kChartCurvedBit = 0x20, kChartDiffuseValueBit = 0x10,
-                  kChartKindMask = 0x0f;
+                  kChartDirectionalBit = 0x08, kChartKindMask = 0x07;
 
 std::vector<unsigned char> encodeCharts(const std::vector<Chart>& charts) {
   ByteWriter w;
@@ -388,7 +391,8 @@ std::vector<unsigned char> encodeCharts(const std::vector<Chart>& charts) {
   for (const Chart& c : charts) {
     w.put(c.material);
     w.put(uint8_t(uint8_t(c.kind) | (c.sides == 2 ? kChartTwoSidedBit : 0) | (c.isBack ? kChartBackBit : 0) |
-                  (c.curved ? kChartCurvedBit : 0) | (c.diffuseValue ? kChartDiffuseValueBit : 0)));
+                  (c.curved ? kChartCurvedBit : 0) | (c.diffuseValue ? kChartDiffuseValueBit : 0) |
+                  (c.directionalIrradiance ? kChartDirectionalBit : 0)));
     w.put(c.origin);
     w.put(c.axisU);
     w.put(c.axisV);
@@ -421,9 +425,12 @@ std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std:
     c.isBack = (kindByte & kChartBackBit) != 0;
     c.curved = (kindByte & kChartCurvedBit) != 0;
     c.diffuseValue = (kindByte & kChartDiffuseValueBit) != 0;
+    c.directionalIrradiance = (kindByte & kChartDirectionalBit) != 0;
     if (c.curved && c.kind == ChartKind::Specular) r.corrupt(fmt::format("chart {} of kind {} is marked curved", i, kind));
     if (c.diffuseValue && c.kind != ChartKind::Glossy)
       r.corrupt(fmt::format("chart {} of kind {} is marked as having a diffuse value", i, kind));
+    if (c.directionalIrradiance && c.kind != ChartKind::Diffuse)
+      r.corrupt(fmt::format("chart {} of kind {} is marked as having tilted irradiances", i, kind));
     c.origin = r.get<Vec3>();
     c.axisU = r.get<Vec3>();
     c.axisV = r.get<Vec3>();
@@ -450,7 +457,8 @@ std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std:
       const Chart* front = i > 0 ? &charts[i - 1] : nullptr;
       if (c.sides != 2 || !front || front->sides != 2 || front->isBack || front->material != c.material ||
           front->kind != c.kind || front->resU != c.resU || front->resV != c.resV || front->dirRes != c.dirRes ||
-          front->curved != c.curved)
+          front->curved != c.curved || front->diffuseValue != c.diffuseValue ||
+          front->directionalIrradiance != c.directionalIrradiance)
         r.corrupt(fmt::format("chart {} is a back side without a matching two-sided front chart before it", i));
     } else if (i > 0 && charts[i - 1].sides == 2 && !charts[i - 1].isBack) {
       r.corrupt(fmt::format("two-sided chart {} is not followed by its back side", i - 1));

@@ -41,7 +41,9 @@
 //         or normal map and textures are colour.
 //   CHRT  the charts: u64 count, then fixed 85-byte records (see encodeCharts in plf_file.cpp).
 //         The kind byte's bit 4 (version ≥ 4) marks a glossy chart whose tixels keep their
-//         diffuse irradiance after their map (Chart::diffuseValue, lightfield.h).
+//         diffuse irradiance after their map (Chart::diffuseValue, lightfield.h); bit 3
+//         (version ≥ 5) a diffuse chart whose tixels keep tilted irradiances after their
+//         irradiance (Chart::directionalIrradiance).
 //   TRCH  triangle → chart: u64 mesh count, then per mesh u64 triangle count + u32 indices.
 //   VALS  the values: float32 RGB triplets (12 bytes each), in LightField::values order.
 //         Compressed (encoding ≠ 0): a stream of plf/compression.h.
@@ -56,9 +58,10 @@
 //   META  UTF-8 JSON: {"settings": BakeSettings, "stats": BakeStats}.
 //
 // Versions: 1 textures as float pixels; 2 textures as their image file's bytes; 3 an optional
-// SMSK section (sun masks); 4 glossy charts with a diffuse value per tixel (CHRT bit 4). A
-// file without sun masks differs from version 2 only in the version field (and so the header
-// hash); a version 3 file from version 4 only there when no chart has the bit.
+// SMSK section (sun masks); 4 glossy charts with a diffuse value per tixel (CHRT bit 4); 5
+// normal-mapped diffuse charts with tilted irradiances (CHRT bit 3). A file without sun masks
+// differs from version 2 only in the version field (and so the header hash); a version 3 file
+// from version 4, and a version 4 file from version 5, only there when no chart has the bit.
 //
 // The version is checked right after the magic, before anything else is interpreted, so a
 // future layout can change everything after it (versions 1 to kPlfVersion are read). Reading never trusts the file: the magic,
@@ -80,9 +83,11 @@ namespace pl {
 /// The version written. 2: textures store their image file's bytes (PNG/JPEG/…) instead of
 /// float pixels. 3: an optional SMSK section (sun masks). 4: glossy charts may keep a diffuse
 /// value per tixel (the textured-glossy fix; older files' glossy maps hold all of Lo, which
-/// is what a chart without it means). Readers also read versions 1 (the same as 2 but for the
-/// texture records), 2 (as 3, never with SMSK) and 3 (as 4, never with the chart bit).
-inline constexpr uint32_t kPlfVersion = 4;
+/// is what a chart without it means). 5: normal-mapped diffuse charts may keep tilted
+/// irradiances per tixel (older files' show such charts flat, which is what a chart without
+/// them means). Readers also read versions 1 (the same as 2 but for the texture records), 2
+/// (as 3, never with SMSK), 3 (as 4, never with the chart bit) and 4 (as 5, never with bit 3).
+inline constexpr uint32_t kPlfVersion = 5;
 inline constexpr uint32_t kPlfOldestReadableVersion = 1;
 inline constexpr size_t kPlfHeaderSize = 32;
 inline constexpr size_t kPlfSectionEntrySize = 48;

@@ -208,8 +208,8 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
           // tixel size; a prefetch need not round like the lookup).
           const Vec2 grid = tixelGridCoordinates(c, s.rays[i].origin + hit.t * s.rays[i].direction);
           const LinearTap tu = linearTap(grid.x, c.resU), tv = linearTap(grid.y, c.resV);
-          __builtin_prefetch(paddedValues_.data() + c.firstValue + uint64_t(tv.i0) * c.resU + tu.i0);
-          __builtin_prefetch(paddedValues_.data() + c.firstValue + uint64_t(tv.i1) * c.resU + tu.i1);
+          __builtin_prefetch(paddedValues_.data() + c.valueIndex(tu.i0, tv.i0));
+          __builtin_prefetch(paddedValues_.data() + c.valueIndex(tu.i1, tv.i1));
           // The sun masks the lookup reads (sunVisibility: the tixel's and, across a tixel
           // edge, a neighbour's; the first is the common case).
           if (sun_.count > 0)
@@ -232,7 +232,8 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     for (size_t k = i; k < i + 4; ++k)
       if (!(s.weight[k] > 0.0f) || !s.hits[k].hit()) return false;
     *chart = chartOf(i);
-    if (*chart == kNoChartRecord || charts[*chart].kind != ChartKind::Diffuse) return false;
+    if (*chart == kNoChartRecord || charts[*chart].kind != ChartKind::Diffuse || charts[*chart].directionalIrradiance)
+      return false;
     for (size_t k = i + 1; k < i + 4; ++k)
       if (chartOf(k) != *chart) return false;
     return true;
@@ -282,10 +283,11 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       if (c.kind != ChartKind::Specular) {
         Vec2 uv;
         float lod;
-        Vec3 lookup, lookupNormal;
-        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * hit.t, uv, lod, lookup, lookupNormal);
+        Vec3 lookup, lookupNormal, mappedNormal;
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * hit.t, uv, lod, lookup, lookupNormal,
+                     mappedNormal);
         F4 lanes = exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup,
-                                        lookupNormal, uv, lod);
+                                        lookupNormal, mappedNormal, uv, lod);
         if (c.kind == ChartKind::Glossy && highlights_.active())  // lightfield.h "Punctual highlights"
           lanes = f4Add(lanes, f4FromRgb(highlights_.radiance(chart, hit, -ray.direction)));
         if (spp == 1) {
@@ -339,10 +341,11 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       if (c.kind != ChartKind::Specular) {
         Vec2 uv;
         float lod;
-        Vec3 lookup, lookupNormal;
-        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * distance, uv, lod, lookup, lookupNormal);
+        Vec3 lookup, lookupNormal, mappedNormal;
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * distance, uv, lod, lookup, lookupNormal,
+                     mappedNormal);
         s.radiance[slot] += throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction,
-                                                         lookup, lookupNormal, uv, lod);
+                                                         lookup, lookupNormal, mappedNormal, uv, lod);
         if (c.kind == ChartKind::Glossy && highlights_.active())
           s.radiance[slot] += throughput * highlights_.radiance(chart, hit, -ray.direction);
         continue;
