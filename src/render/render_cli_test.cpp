@@ -75,7 +75,7 @@ class RenderCliTest : public cli_test::CliTest {
 TEST_F(RenderCliTest, InfoPrintsContentsAndSizes) {
   std::string out, err;
   ASSERT_EQ(run("info " + path("quad.plf"), &out, &err), 0) << err;
-  for (const char* fragment : {"format version 4", "all sections verified", "handmade-quad", "2 triangles",
+  for (const char* fragment : {"format version 5", "all sections verified", "handmade-quad", "2 triangles",
                                "lambert ×1", "cameras    2: side, top", "1 (1 diffuse, 0 glossy, 0 specular; 0 two-sided, counted twice; 0 curved)",
                                "tixels       16", "values       16 RGB", "VALS", "preset handmade", "3 iterations"})
     EXPECT_NE(out.find(fragment), std::string::npos) << "'" << fragment << "' not in:\n" << out;
@@ -214,15 +214,16 @@ TEST_F(RenderCliTest, RefusesBadInputWithoutWritingAnything) {
 // quad-v2.plf the same by the version-2 writer (which changed only texture records; the quad
 // has none), quad-v3.plf by the version-3 writer (an optional sun-mask section, which the quad
 // without lights does not get, and "sun_masks" among the settings), quad-v4.plf by the
-// version-4 writer (a chart bit for glossy charts' diffuse values; the quad is diffuse). They pin the format: a change of the byte layout without a new version number
+// version-4 writer (a chart bit for glossy charts' diffuse values; the quad is diffuse), quad-v5.plf by
+// the version-5 writer (SCNE's texturing block, which the untextured quad does not get). They pin the format: a change of the byte layout without a new version number
 // fails here, and files of the older version must still read. Regenerate the current one
 // deliberately (after bumping kPlfVersion and keeping a reader for old files) with
 //   PLENOPTIC_REGENERATE_FIXTURES=1 ./render_cli_test --gtest_filter='*Fixture*'
 TEST_F(RenderCliTest, OlderAndCurrentFixturesReadAndRewriteByteForByte) {
-  const std::string current = std::string(PLENOPTIC_TEST_DATA_DIR) + "/render/quad-v4.plf";
+  const std::string current = std::string(PLENOPTIC_TEST_DATA_DIR) + "/render/quad-v5.plf";
   if (std::getenv("PLENOPTIC_REGENERATE_FIXTURES")) writeLightField(current, makeQuadLightField());
   const LightField expected = makeQuadLightField();
-  for (const std::string name : {"quad-v1.plf", "quad-v2.plf", "quad-v3.plf", "quad-v4.plf"}) {
+  for (const std::string name : {"quad-v1.plf", "quad-v2.plf", "quad-v3.plf", "quad-v4.plf", "quad-v5.plf"}) {
     const std::string fixture = std::string(PLENOPTIC_TEST_DATA_DIR) + "/render/" + name;
     const LightField lf = readLightField(fixture);
     EXPECT_EQ(lf.scene.sourcePath, expected.scene.sourcePath);

@@ -49,12 +49,15 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <spdlog/spdlog.h>
 #include <tiny_gltf.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <set>
+#include <tuple>
 
 namespace pl::detail {
 
@@ -63,6 +66,35 @@ namespace {
 /// Photometric efficacy used to turn lumens into watts (see the header comment).
 constexpr double kLumensPerWatt = 683.0;
 
+/// The extensions this loader reads (docs/scenes.md): a file that requires another is refused.
+/// KHR_draco_mesh_compression and EXT_meshopt_compression join them where the build has their
+/// decoders (gltf_compression.h).
+const std::set<std::string>& supportedExtensions() {
+  static const std::set<std::string> kSupported = [] {
+    std::set<std::string> names = {"KHR_lights_punctual",        "KHR_materials_emissive_strength",
+                                   "KHR_materials_ior",          "KHR_materials_transmission",
+                                   "KHR_materials_volume",       "KHR_texture_transform"};
+    return names;
+  }();
+  return kSupported;
+}
+
+/// Refuses a file that requires an extension we do not read (naming it), and warns once,
+/// listing them, about extensions it uses that we ignore (what they add is then missing).
+void checkExtensions(const std::string& path, const tinygltf::Model& model) {
+  const std::set<std::string>& supported = supportedExtensions();
+  for (const std::string& name : model.extensionsRequired)
+    if (!supported.contains(name))
+      fail("{}: the file requires the glTF extension '{}', which plenoptic does not support (supported: {})", path,
+           name, fmt::join(supported, ", "));
+  std::vector<std::string> ignored;
+  for (const std::string& name : model.extensionsUsed)
+    if (!supported.contains(name) && std::find(ignored.begin(), ignored.end(), name) == ignored.end())
+      ignored.push_back(name);
+  if (!ignored.empty())
+    spdlog::warn("{}: ignoring glTF extension(s) the file uses but does not require: {}", path, fmt::join(ignored, ", "));
+}
+
 struct GltfContext {
   const std::string& path;
   const tinygltf::Model& model;
@@ -70,7 +102,8 @@ struct GltfContext {
   /// Each glTF image's encoded bytes (PNG/JPEG as in its file, data URI or buffer view), kept by
   /// keepEncodedImage instead of tinygltf's decoding; decoded by us when a material uses it.
   const std::vector<std::vector<unsigned char>>& encodedImages;
-  std::map<std::pair<int, ImageDecode>, int> textureOfImage;  ///< scene texture per (glTF image, decoding)
+  /// Scene texture per (glTF image, decoding, samplingKey of its sampler).
+  std::map<std::tuple<int, ImageDecode, int>, int> textureOfImage;
   int defaultMaterial = -1;
   int unnamedCameras = 0;
 };
@@ -224,20 +257,126 @@ bool textureHasAlpha(GltfContext& ctx, int textureIndex) {
   return std::any_of(alpha.pixels.begin(), alpha.pixels.end(), [](const Rgb& a) { return a.r < 1.0f; });
 }
 
+/// One sampler wrap mode (glTF's GL enum values) as ours.
+TextureWrap wrapMode(const GltfContext& ctx, int samplerIndex, int mode, const char* axis) {
+  switch (mode) {
+    case TINYGLTF_TEXTURE_WRAP_REPEAT: return TextureWrap::Repeat;
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return TextureWrap::ClampToEdge;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return TextureWrap::MirroredRepeat;
+    default:
+      fail("{}: sampler {}: {} {} is not a wrap mode (10497 REPEAT, 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT)",
+           ctx.path, samplerIndex, axis, mode);
+  }
+}
+
+/// The sampling of glTF texture `textureIndex` (its sampler; the defaults without one): wrapS
+/// → u, wrapT → v (the v flip maps each mode onto itself), magFilter NEAREST → nearest,
+/// minFilter NEAREST or LINEAR → no mip levels (texture.h TextureSampling).
+TextureSampling samplingOf(const GltfContext& ctx, int textureIndex) {
+  TextureSampling sampling;
+  const int samplerIndex = ctx.model.textures[size_t(textureIndex)].sampler;
+  if (samplerIndex < 0) return sampling;
+  if (size_t(samplerIndex) >= ctx.model.samplers.size())
+    fail("{}: texture {} uses sampler {} but the file has {}", ctx.path, textureIndex, samplerIndex,
+         ctx.model.samplers.size());
+  const tinygltf::Sampler& sampler = ctx.model.samplers[size_t(samplerIndex)];
+  sampling.wrapU = wrapMode(ctx, samplerIndex, sampler.wrapS, "wrapS");
+  sampling.wrapV = wrapMode(ctx, samplerIndex, sampler.wrapT, "wrapT");
+  sampling.nearest = sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
+  sampling.mipmaps = !(sampler.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST || sampler.minFilter == TINYGLTF_TEXTURE_FILTER_LINEAR);
+  return sampling;
+}
+
 /// The scene texture for glTF texture `textureIndex` decoded as `decode` (image.h): sRGB
-/// colour for baseColorTexture (glTF spec 3.9.2), raw values for normalTexture, the alpha
-/// channel for alpha masks. One scene texture per (image, decoding); it keeps the image's
-/// encoded bytes for the .plf.
+/// colour for baseColorTexture (glTF spec 3.9.2), raw values for normalTexture and
+/// metallicRoughnessTexture, the alpha channel for alpha masks, sampled as its sampler says.
+/// One scene texture per (image, decoding, sampling); it keeps the image's encoded bytes for
+/// the .plf.
 int textureFor(GltfContext& ctx, int textureIndex, ImageDecode decode = ImageDecode::Colour) {
   int source = 0;
   std::string label;
   const std::vector<unsigned char>& bytes = textureImageBytes(ctx, textureIndex, source, label);
-  if (auto it = ctx.textureOfImage.find({source, decode}); it != ctx.textureOfImage.end()) return it->second;
+  const TextureSampling sampling = samplingOf(ctx, textureIndex);
+  const int samplingKey = int(sampling.wrapU) | int(sampling.wrapV) << 2 | int(sampling.nearest) << 4 |
+                          int(sampling.mipmaps) << 5;
+  if (auto it = ctx.textureOfImage.find({source, decode, samplingKey}); it != ctx.textureOfImage.end()) return it->second;
   Texture texture = textureFromEncoded(label, bytes, fmt::format("{}: texture image '{}'", ctx.path, label), decode);
+  texture.sampling = sampling;
   const int ours = int(ctx.scene.textures.size());
   ctx.scene.textures.push_back(std::move(texture));
-  ctx.textureOfImage[{source, decode}] = ours;
+  ctx.textureOfImage[{source, decode, samplingKey}] = ours;
   return ours;
+}
+
+/// Fails unless texture `index` of material slot `slot` exists, naming the material.
+void checkTextureIndex(const GltfContext& ctx, const char* slot, int index, const std::string& material) {
+  if (index < 0 || size_t(index) >= ctx.model.textures.size())
+    fail("{}: material '{}': {} refers to texture {} but the file has {}", ctx.path, material, slot, index,
+         ctx.model.textures.size());
+}
+
+/// A texture slot of a material as the file gives it: the texture index, its texCoord and
+/// extensions (KHR_texture_transform).
+struct TextureSlotRef {
+  const char* slot;  ///< "baseColorTexture", … (for messages)
+  int index;
+  int texCoord;
+  const tinygltf::ExtensionMap& extensions;
+};
+
+/// The slot's TextureMapping, checked: the texture exists, the uv set is TEXCOORD_0 or
+/// TEXCOORD_1 (after KHR_texture_transform's own texCoord, which overrides the slot's).
+///
+/// KHR_texture_transform gives, in glTF's uv convention ((0,0) = the image's top left),
+///   uv' = T(offset) · R(rotation) · S(scale) · uv,   R = [cos r, sin r; −sin r, cos r]
+/// (rows; the extension's matrix, a rotation by −r). Ours has v flipped, uv_ours = F(uv) with
+/// F(u, v) = (u, 1 − v) = D·uv + e (D = diag(1, −1), e = (0, 1)), so in our convention the
+/// mapping is F ∘ (A·, + b) ∘ F with A = R·S, b = offset:
+///   linear = D·A·D,  offset = D·(A·e + b) + e.
+TextureMapping mappingOf(const GltfContext& ctx, const TextureSlotRef& slot, const std::string& material) {
+  checkTextureIndex(ctx, slot.slot, slot.index, material);
+  TextureMapping mapping;
+  int texCoord = slot.texCoord;
+  if (auto it = slot.extensions.find("KHR_texture_transform"); it != slot.extensions.end()) {
+    const tinygltf::Value& v = it->second;
+    auto pair = [&](const char* key, Vec2 fallback) {
+      if (!v.Has(key)) return fallback;
+      const tinygltf::Value& array = v.Get(key);
+      if (!array.IsArray() || array.ArrayLen() != 2 || !array.Get(0).IsNumber() || !array.Get(1).IsNumber())
+        fail("{}: material '{}': {} KHR_texture_transform.{} must be two numbers", ctx.path, material, slot.slot, key);
+      return Vec2(float(array.Get(0).GetNumberAsDouble()), float(array.Get(1).GetNumberAsDouble()));
+    };
+    const Vec2 offset = pair("offset", Vec2(0.0f)), scale = pair("scale", Vec2(1.0f));
+    float rotation = 0.0f;
+    if (v.Has("rotation")) {
+      if (!v.Get("rotation").IsNumber())
+        fail("{}: material '{}': {} KHR_texture_transform.rotation must be a number", ctx.path, material, slot.slot);
+      rotation = float(v.Get("rotation").GetNumberAsDouble());
+    }
+    if (v.Has("texCoord")) {
+      if (!v.Get("texCoord").IsInt())
+        fail("{}: material '{}': {} KHR_texture_transform.texCoord must be an integer", ctx.path, material, slot.slot);
+      texCoord = v.Get("texCoord").GetNumberAsInt();
+    }
+    const float c = std::cos(rotation), s = std::sin(rotation);
+    const Mat2 a(Vec2(c * scale.x, -s * scale.x), Vec2(s * scale.y, c * scale.y));  // columns of R·S
+    const Mat2 d(Vec2(1.0f, 0.0f), Vec2(0.0f, -1.0f));
+    const Vec2 e(0.0f, 1.0f);
+    mapping.linear = d * a * d;
+    mapping.offset = d * (a * e + offset) + e;
+    if (!std::isfinite(mapping.offset.x) || !std::isfinite(mapping.offset.y) || !isFinite(Vec3(mapping.linear[0], 0.0f)) ||
+        !isFinite(Vec3(mapping.linear[1], 0.0f)))
+      fail("{}: material '{}': {} KHR_texture_transform is not finite", ctx.path, material, slot.slot);
+  }
+  if (texCoord < 0 || texCoord > 1)
+    fail("{}: material '{}': {} reads TEXCOORD_{}; only TEXCOORD_0 and TEXCOORD_1 are supported", ctx.path, material,
+         slot.slot, texCoord);
+  mapping.uvSet = uint8_t(texCoord);
+  return mapping;
+}
+
+TextureSlotRef slotRef(const char* slot, const tinygltf::TextureInfo& info) {
+  return {slot, info.index, info.texCoord, info.extensions};
 }
 
 /// alphaMode MASK / BLEND → an alpha mask; normalTexture → a normal map (see the header).
@@ -251,15 +390,16 @@ void applyAlphaAndNormals(GltfContext& ctx, const tinygltf::Material& gltf, Mate
     if (!(material.alphaCutoff >= 0.0f && material.alphaCutoff <= 1.0f))
       fail("{}: material '{}': alphaCutoff {} must be in [0, 1]", ctx.path, material.name, gltf.alphaCutoff);
     material.alphaFactor = pbr.baseColorFactor.size() >= 4 ? std::clamp(float(pbr.baseColorFactor[3]), 0.0f, 1.0f) : 1.0f;
-    if (pbr.baseColorTexture.index >= 0 && textureHasAlpha(ctx, pbr.baseColorTexture.index))
+    if (pbr.baseColorTexture.index >= 0 && textureHasAlpha(ctx, pbr.baseColorTexture.index)) {
+      material.alphaMapping = mappingOf(ctx, slotRef("baseColorTexture", pbr.baseColorTexture), material.name);
       material.alphaTexture = textureFor(ctx, pbr.baseColorTexture.index, ImageDecode::Coverage);
+    }
   } else if (!gltf.alphaMode.empty() && gltf.alphaMode != "OPAQUE") {
     fail("{}: material '{}': unknown alphaMode '{}' (OPAQUE, MASK or BLEND)", ctx.path, material.name, gltf.alphaMode);
   }
   if (gltf.normalTexture.index >= 0) {
-    if (gltf.normalTexture.texCoord != 0)
-      spdlog::warn("{}: material '{}': normalTexture uses TEXCOORD_{}, only TEXCOORD_0 is read", ctx.path,
-                   material.name, gltf.normalTexture.texCoord);
+    const tinygltf::NormalTextureInfo& info = gltf.normalTexture;
+    material.normalMapping = mappingOf(ctx, {"normalTexture", info.index, info.texCoord, info.extensions}, material.name);
     material.normalTexture = textureFor(ctx, gltf.normalTexture.index, ImageDecode::Data);
     material.normalScale = float(gltf.normalTexture.scale);
   }
@@ -310,6 +450,12 @@ void applyTransmission(GltfContext& ctx, const tinygltf::Material& gltf, Materia
   if (material.albedoTexture >= 0) {
     spdlog::warn("{}: material '{}': baseColorTexture is ignored on a transmissive material", ctx.path, material.name);
     material.albedoTexture = -1;
+    material.albedoMapping = {};
+  }
+  if (material.metallicRoughness.texture >= 0) {
+    spdlog::warn("{}: material '{}': metallicRoughnessTexture is ignored on a transmissive material", ctx.path,
+                 material.name);
+    material.metallicRoughness = {};
   }
   material.bsdf = glass;
 }
@@ -327,11 +473,22 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
   material.name = gltf.name.empty() ? fmt::format("material{}", index) : gltf.name;
   material.bsdf = ggxFromMetallicRoughness(baseColor, metallic, roughness);
   if (pbr.baseColorTexture.index >= 0) {
-    if (pbr.baseColorTexture.texCoord != 0)
-      spdlog::warn("{}: material '{}': baseColorTexture uses TEXCOORD_{}, only TEXCOORD_0 is read", ctx.path,
-                   material.name, pbr.baseColorTexture.texCoord);
+    material.albedoMapping = mappingOf(ctx, slotRef("baseColorTexture", pbr.baseColorTexture), material.name);
     material.albedoTexture = textureFor(ctx, pbr.baseColorTexture.index);
   }
+  if (pbr.metallicRoughnessTexture.index >= 0) {
+    // B = metalness, G = roughness, linear (spec 3.9.2), times the factors at each point.
+    MetallicRoughnessMap& mr = material.metallicRoughness;
+    mr.mapping = mappingOf(ctx, slotRef("metallicRoughnessTexture", pbr.metallicRoughnessTexture), material.name);
+    mr.texture = textureFor(ctx, pbr.metallicRoughnessTexture.index, ImageDecode::Data);
+    mr.baseColor = baseColor;
+    mr.metallic = metallic;
+    mr.roughness = roughness;
+  }
+  // Occlusion is read (its texture must exist) and not used: the bake and the path tracer
+  // compute occlusion themselves (docs/scenes.md).
+  if (gltf.occlusionTexture.index >= 0)
+    checkTextureIndex(ctx, "occlusionTexture", gltf.occlusionTexture.index, material.name);
   applyTransmission(ctx, gltf, material, baseColor, roughness);
   applyAlphaAndNormals(ctx, gltf, material);
   if (gltf.emissiveFactor.size() >= 3) {
@@ -342,9 +499,11 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
     material.emission = strength * Rgb(float(gltf.emissiveFactor[0]), float(gltf.emissiveFactor[1]),
                                        float(gltf.emissiveFactor[2]));
   }
-  if (gltf.emissiveTexture.index >= 0)
+  if (gltf.emissiveTexture.index >= 0) {
+    checkTextureIndex(ctx, "emissiveTexture", gltf.emissiveTexture.index, material.name);
     spdlog::warn("{}: material '{}': emissiveTexture is not supported; emissiveFactor used alone", ctx.path,
                  material.name);
+  }
   material.twoSidedEmission = gltf.doubleSided;
   return material;
 }
@@ -376,10 +535,54 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
     for (size_t v = 0; v < vertexCount; ++v)
       mesh.normals.push_back(normalMatrix * Vec3(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]));
   }
-  if (const int uvAccessor = attribute("TEXCOORD_0"); uvAccessor >= 0) {
-    const std::vector<float> uvs = readFloats(ctx, uvAccessor, 2, "TEXCOORD_0");
-    if (uvs.size() / 2 != vertexCount) fail("{}: mesh '{}': TEXCOORD_0 and POSITION counts differ", ctx.path, name);
-    for (size_t v = 0; v < vertexCount; ++v) mesh.uvs.push_back(Vec2(uvs[2 * v], 1.0f - uvs[2 * v + 1]));
+  // The material first: which uv sets its textures read (a set they read must be there).
+  if (primitive.material >= 0 && size_t(primitive.material) >= ctx.model.materials.size())
+    fail("{}: mesh '{}' uses material {} but the file has {}", ctx.path, name, primitive.material,
+         ctx.model.materials.size());
+  bool readsSet[2] = {false, false};
+  if (primitive.material >= 0) {
+    const Material& m = ctx.scene.materials[size_t(primitive.material)];
+    const std::pair<int, const TextureMapping*> slots[] = {{m.albedoTexture, &m.albedoMapping},
+                                                          {m.alphaTexture, &m.alphaMapping},
+                                                          {m.normalTexture, &m.normalMapping},
+                                                          {m.metallicRoughness.texture, &m.metallicRoughness.mapping}};
+    for (const auto& [texture, mapping] : slots)
+      if (texture >= 0) readsSet[mapping->uvSet] = true;
+    for (int set = 0; set < 2; ++set)
+      if (readsSet[set] && attribute(set == 0 ? "TEXCOORD_0" : "TEXCOORD_1") < 0)
+        fail("{}: mesh '{}': its material '{}' reads TEXCOORD_{}, which the primitive does not have", ctx.path, name,
+             m.name, set);
+  }
+  // TEXCOORD_0 always (the barycentrics stand in without it); TEXCOORD_1 only where read.
+  for (int set = 0; set < 2; ++set) {
+    const char* key = set == 0 ? "TEXCOORD_0" : "TEXCOORD_1";
+    const int uvAccessor = attribute(key);
+    if (uvAccessor < 0 || (set == 1 && !readsSet[1])) continue;
+    const std::vector<float> uvs = readFloats(ctx, uvAccessor, 2, key);
+    if (uvs.size() / 2 != vertexCount) fail("{}: mesh '{}': {} and POSITION counts differ", ctx.path, name, key);
+    std::vector<Vec2>& target = set == 0 ? mesh.uvs : mesh.uvs1;
+    for (size_t v = 0; v < vertexCount; ++v) target.push_back(Vec2(uvs[2 * v], 1.0f - uvs[2 * v + 1]));
+  }
+  // COLOR_0 (RGB or RGBA, linear; alpha not read) multiplies the base colour. All white is
+  // the same as none, which keeps the material's albedo constant (exporters often write it).
+  if (const int colorAccessor = attribute("COLOR_0"); colorAccessor >= 0) {
+    const int components =
+        size_t(colorAccessor) < ctx.model.accessors.size() && ctx.model.accessors[size_t(colorAccessor)].type == TINYGLTF_TYPE_VEC4
+            ? 4 : 3;
+    const std::vector<float> colors = readFloats(ctx, colorAccessor, components, "COLOR_0");
+    if (colors.size() / size_t(components) != vertexCount)
+      fail("{}: mesh '{}': COLOR_0 and POSITION counts differ", ctx.path, name);
+    bool clamped = false, white = true;
+    for (size_t v = 0; v < vertexCount; ++v) {
+      const Rgb c(colors[size_t(components) * v], colors[size_t(components) * v + 1], colors[size_t(components) * v + 2]);
+      const Rgb kept = glm::clamp(c, 0.0f, 1.0f);
+      if (!isFinite(c)) fail("{}: mesh '{}': COLOR_0 {} is not finite", ctx.path, name, v);
+      clamped = clamped || kept != c;
+      white = white && kept == Rgb(1.0f);
+      mesh.colors.push_back(kept);
+    }
+    if (clamped) spdlog::warn("{}: mesh '{}': COLOR_0 values outside [0, 1] clamped", ctx.path, name);
+    if (white) mesh.colors.clear();
   }
 
   std::vector<uint32_t> indices;
@@ -393,9 +596,6 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
 
   uint32_t material;
   if (primitive.material >= 0) {
-    if (size_t(primitive.material) >= ctx.model.materials.size())
-      fail("{}: mesh '{}' uses material {} but the file has {}", ctx.path, name, primitive.material,
-           ctx.model.materials.size());
     material = uint32_t(primitive.material);
   } else {
     if (ctx.defaultMaterial < 0) {
@@ -542,6 +742,7 @@ Scene loadGltf(const std::string& path) {
     while (!error.empty() && (error.back() == '\n' || error.back() == '\r')) error.pop_back();
     fail("{}: not a valid glTF file: {}", path, error.empty() ? "unknown error" : error);
   }
+  checkExtensions(path, model);
 
   Scene scene;
   scene.sourcePath = path;
