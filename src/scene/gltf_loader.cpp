@@ -42,12 +42,14 @@
 //    `range` is ignored (physically lights have no cut-off).
 #include "core/error.h"
 #include "core/file_io.h"
+#include "scene/gltf_compression.h"
 #include "scene/loaders.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 #include <fmt/ranges.h>
 
@@ -55,8 +57,11 @@
 #include <cctype>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
+#include <optional>
 #include <set>
+#include <span>
 #include <tuple>
 
 namespace pl::detail {
@@ -66,14 +71,22 @@ namespace {
 /// Photometric efficacy used to turn lumens into watts (see the header comment).
 constexpr double kLumensPerWatt = 683.0;
 
+constexpr const char* kDraco = "KHR_draco_mesh_compression";
+constexpr const char* kMeshopt = "EXT_meshopt_compression";
+
 /// The extensions this loader reads (docs/scenes.md): a file that requires another is refused.
 /// KHR_draco_mesh_compression and EXT_meshopt_compression join them where the build has their
-/// decoders (gltf_compression.h).
+/// decoders (gltf_compression.h); a build without one refuses a file that requires it with the
+/// decoder's "built without … support", and reads the uncompressed fallback of one that only
+/// uses it.
 const std::set<std::string>& supportedExtensions() {
   static const std::set<std::string> kSupported = [] {
-    std::set<std::string> names = {"KHR_lights_punctual",        "KHR_materials_emissive_strength",
-                                   "KHR_materials_ior",          "KHR_materials_transmission",
-                                   "KHR_materials_volume",       "KHR_texture_transform"};
+    std::set<std::string> names = {"KHR_lights_punctual",  "KHR_materials_emissive_strength",
+                                   "KHR_materials_ior",    "KHR_materials_transmission",
+                                   "KHR_materials_volume", "KHR_mesh_quantization",
+                                   "KHR_texture_transform"};
+    if (dracoSupported()) names.insert(kDraco);
+    if (meshoptSupported()) names.insert(kMeshopt);
     return names;
   }();
   return kSupported;
@@ -84,7 +97,7 @@ const std::set<std::string>& supportedExtensions() {
 void checkExtensions(const std::string& path, const tinygltf::Model& model) {
   const std::set<std::string>& supported = supportedExtensions();
   for (const std::string& name : model.extensionsRequired)
-    if (!supported.contains(name))
+    if (!supported.contains(name) && name != kDraco && name != kMeshopt)
       fail("{}: the file requires the glTF extension '{}', which plenoptic does not support (supported: {})", path,
            name, fmt::join(supported, ", "));
   std::vector<std::string> ignored;
@@ -106,11 +119,16 @@ struct GltfContext {
   std::map<std::tuple<int, ImageDecode, int>, int> textureOfImage;
   int defaultMaterial = -1;
   int unnamedCameras = 0;
+  bool dracoRequired = false;  ///< the file lists KHR_draco_mesh_compression in extensionsRequired
 };
 
 /// Reads accessor `index` as `components` floats per element (float or normalised integers).
 std::vector<float> readFloats(const GltfContext& ctx, int index, int components, const char* what) {
   const tinygltf::Model& model = ctx.model;
+  // Unsigned integers read as normalised whatever the flag says, as before KHR_mesh_quantization
+  // (the core spec allows them only normalised); files using the extension get the flag's word.
+  const bool quantized = std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), "KHR_mesh_quantization") !=
+                         model.extensionsUsed.end();
   if (index < 0 || size_t(index) >= model.accessors.size())
     fail("{}: {} accessor {} does not exist", ctx.path, what, index);
   const tinygltf::Accessor& accessor = model.accessors[size_t(index)];
@@ -144,13 +162,28 @@ std::vector<float> readFloats(const GltfContext& ctx, int index, int components,
     for (int c = 0; c < components; ++c) {
       const unsigned char* p = element + size_t(c) * size_t(componentSize);
       float value;
+      // Integers: normalised ones (the core spec's TEXCOORD/COLOR types, and
+      // KHR_mesh_quantization's) as the spec maps them, c/max for unsigned and max(c/max, −1)
+      // for signed; others (KHR_mesh_quantization) as their value.
       switch (accessor.componentType) {
         case TINYGLTF_COMPONENT_TYPE_FLOAT: std::memcpy(&value, p, 4); break;
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: value = float(*p) / 255.0f; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: value = accessor.normalized || !quantized ? float(*p) / 255.0f : float(*p); break;
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
           uint16_t v;
           std::memcpy(&v, p, 2);
-          value = float(v) / 65535.0f;
+          value = accessor.normalized || !quantized ? float(v) / 65535.0f : float(v);
+          break;
+        }
+        case TINYGLTF_COMPONENT_TYPE_BYTE: {
+          int8_t v;
+          std::memcpy(&v, p, 1);
+          value = accessor.normalized ? std::max(float(v) / 127.0f, -1.0f) : float(v);
+          break;
+        }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: {
+          int16_t v;
+          std::memcpy(&v, p, 2);
+          value = accessor.normalized ? std::max(float(v) / 32767.0f, -1.0f) : float(v);
           break;
         }
         default: fail("{}: {} accessor {} has an unsupported component type {}", ctx.path, what, index,
@@ -460,6 +493,29 @@ void applyTransmission(GltfContext& ctx, const tinygltf::Material& gltf, Materia
   material.bsdf = glass;
 }
 
+/// The one model a material with a metallic-roughness texture keeps (Material::bsdf) for what
+/// takes one model per material — the bake's glossy lobe and chart classification, the
+/// renderers' punctual highlights: the texture's mean over its texels of each GGX parameter,
+///   α = mean of ggxAlpha(roughness·G),  F0 = mean of mix(0.04, baseColor, metallic·B),
+///   diffuse = baseColor · (1 − mean of metallic·B)
+/// (the path tracer and the per-point diffuse albedo read the texel itself, materialModelAt).
+GgxBsdf meanMetallicRoughnessModel(const Image& texels, const MetallicRoughnessMap& mr) {
+  double alpha = 0.0, metalness = 0.0;
+  glm::dvec3 f0(0.0);
+  for (const Rgb& t : texels.pixels) {
+    const GgxBsdf at = ggxFromMetallicRoughness(mr.baseColor, mr.metallic * t.b, mr.roughness * t.g);
+    alpha += at.alpha;
+    f0 += glm::dvec3(at.f0);
+    metalness += std::clamp(mr.metallic * t.b, 0.0f, 1.0f);
+  }
+  const double n = double(std::max<size_t>(1, texels.pixels.size()));
+  GgxBsdf mean;
+  mean.alpha = float(alpha / n);
+  mean.f0 = Rgb(f0 / n);
+  mean.diffuse = mr.baseColor * float(1.0 - metalness / n);
+  return mean;
+}
+
 Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int index) {
   const auto& pbr = gltf.pbrMetallicRoughness;
   Rgb baseColor(1.0f);
@@ -484,6 +540,7 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
     mr.baseColor = baseColor;
     mr.metallic = metallic;
     mr.roughness = roughness;
+    material.bsdf = meanMetallicRoughnessModel(ctx.scene.textures[size_t(mr.texture)].image, mr);
   }
   // Occlusion is read (its texture must exist) and not used: the bake and the path tracer
   // compute occlusion themselves (docs/scenes.md).
@@ -508,6 +565,85 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
   return material;
 }
 
+/// The bytes of buffer view `viewIndex`, checked against its buffer; `what` names it in messages.
+std::span<const unsigned char> bufferViewBytes(const tinygltf::Model& model, const std::string& path, int viewIndex,
+                                               const std::string& what) {
+  if (viewIndex < 0 || size_t(viewIndex) >= model.bufferViews.size())
+    fail("{}: {} refers to buffer view {} but the file has {}", path, what, viewIndex, model.bufferViews.size());
+  const tinygltf::BufferView& view = model.bufferViews[size_t(viewIndex)];
+  if (view.buffer < 0 || size_t(view.buffer) >= model.buffers.size())
+    fail("{}: buffer view {} refers to a missing buffer", path, viewIndex);
+  const std::vector<unsigned char>& data = model.buffers[size_t(view.buffer)].data;
+  if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset)
+    fail("{}: {}: buffer view {} runs past the end of its buffer", path, what, viewIndex);
+  return {data.data() + view.byteOffset, view.byteLength};
+}
+
+/// A KHR_draco_mesh_compression primitive decoded (gltf_compression.h): the extension object
+/// `extension` names the buffer view and each attribute's Draco id; `components` says which
+/// glTF attributes to read and with how many components (others are not read).
+DracoPrimitive decodeDracoPrimitive(const GltfContext& ctx, const tinygltf::Value& extension,
+                                    const tinygltf::Primitive& primitive, const std::map<std::string, int>& components,
+                                    const std::string& name) {
+  const std::string label = fmt::format("{}: mesh '{}'", ctx.path, name);
+  if (!extension.Has("bufferView") || !extension.Get("bufferView").IsInt() || !extension.Has("attributes") ||
+      !extension.Get("attributes").IsObject())
+    fail("{}: {} needs a bufferView and attributes", label, kDraco);
+  const std::span<const unsigned char> bytes =
+      bufferViewBytes(ctx.model, ctx.path, extension.Get("bufferView").GetNumberAsInt(), fmt::format("mesh '{}' ({})", name, kDraco));
+  std::map<std::string, int> ids;
+  const tinygltf::Value& attributes = extension.Get("attributes");
+  for (const std::string& key : attributes.Keys()) {
+    if (!components.contains(key) || !primitive.attributes.contains(key)) continue;
+    if (!attributes.Get(key).IsInt()) fail("{}: {} attribute {} is not an integer id", label, kDraco, key);
+    ids[key] = attributes.Get(key).GetNumberAsInt();
+  }
+  DracoPrimitive decoded = decodeDraco(bytes, ids, components, label);
+  if (decoded.indices.size() % 3 != 0 || decoded.vertexCount == 0)
+    fail("{}: the Draco buffer decodes to no triangles", label);
+  return decoded;
+}
+
+/// Decodes every EXT_meshopt_compression buffer view into a buffer of its own and points the
+/// view at it, so that the accessors read plain data (gltf_compression.h). Without meshopt in
+/// the build the views keep their uncompressed fallback, unless the file requires the
+/// extension (then decodeMeshopt refuses).
+void decodeMeshoptViews(const std::string& path, tinygltf::Model& model) {
+  const bool required = std::find(model.extensionsRequired.begin(), model.extensionsRequired.end(), kMeshopt) !=
+                        model.extensionsRequired.end();
+  for (size_t v = 0; v < model.bufferViews.size(); ++v) {
+    auto it = model.bufferViews[v].extensions.find(kMeshopt);
+    if (it == model.bufferViews[v].extensions.end() || !(meshoptSupported() || required)) continue;
+    const tinygltf::Value& e = it->second;
+    const std::string label = fmt::format("{}: buffer view {} ({})", path, v, kMeshopt);
+    auto integer = [&](const char* key, bool needed) -> size_t {
+      if (!e.Has(key)) {
+        if (needed) fail("{} lacks {}", label, key);
+        return 0;
+      }
+      if (!e.Get(key).IsInt() || e.Get(key).GetNumberAsInt() < 0) fail("{}: {} must be a non-negative integer", label, key);
+      return size_t(e.Get(key).GetNumberAsInt());
+    };
+    const size_t buffer = integer("buffer", true), offset = integer("byteOffset", false), length = integer("byteLength", true);
+    MeshoptView view;
+    view.byteStride = integer("byteStride", true);
+    view.count = integer("count", true);
+    view.mode = e.Has("mode") && e.Get("mode").IsString() ? e.Get("mode").Get<std::string>() : "";
+    view.filter = e.Has("filter") && e.Get("filter").IsString() ? e.Get("filter").Get<std::string>() : "NONE";
+    if (buffer >= model.buffers.size() || offset > model.buffers[buffer].data.size() ||
+        length > model.buffers[buffer].data.size() - offset)
+      fail("{}: its data lies outside buffer {}", label, buffer);
+    const unsigned char* source = model.buffers[buffer].data.data() + offset;
+    tinygltf::Buffer decoded;
+    decoded.data = decodeMeshopt({source, length}, view, label);
+    tinygltf::BufferView& target = model.bufferViews[v];
+    if (target.byteLength > decoded.data.size()) fail("{}: decodes to fewer bytes than the view's byteLength", label);
+    target.buffer = int(model.buffers.size());
+    target.byteOffset = 0;
+    model.buffers.push_back(std::move(decoded));
+  }
+}
+
 void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const Mat4& world, const std::string& name) {
   const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
   if (mode != TINYGLTF_MODE_TRIANGLES) {
@@ -520,17 +656,36 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
   };
   const int positionAccessor = attribute("POSITION");
   if (positionAccessor < 0) fail("{}: mesh '{}' has a primitive without POSITION", ctx.path, name);
+  auto componentsOf = [&](int accessor) {
+    return size_t(accessor) < ctx.model.accessors.size() && ctx.model.accessors[size_t(accessor)].type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+  };
+  // A Draco-compressed primitive: its attributes and indices from the decoded mesh (the
+  // accessors then give only counts and types); without Draco in the build and the extension
+  // not required, the accessors' uncompressed fallback.
+  std::optional<DracoPrimitive> draco;
+  if (auto it = primitive.extensions.find(kDraco); it != primitive.extensions.end() && (dracoSupported() || ctx.dracoRequired))
+    draco = decodeDracoPrimitive(ctx, it->second, primitive,
+                                 {{"POSITION", 3}, {"NORMAL", 3}, {"TEXCOORD_0", 2}, {"TEXCOORD_1", 2},
+                                  {"COLOR_0", componentsOf(attribute("COLOR_0"))}},
+                                 name);
+  auto floatsOf = [&](int accessor, int components, const char* key) {
+    if (draco) {
+      auto found = draco->attributes.find(key);
+      if (found != draco->attributes.end()) return found->second;
+    }
+    return readFloats(ctx, accessor, components, key);
+  };
 
   Mesh mesh;
   mesh.name = name;
-  const std::vector<float> positions = readFloats(ctx, positionAccessor, 3, "POSITION");
+  const std::vector<float> positions = floatsOf(positionAccessor, 3, "POSITION");
   const size_t vertexCount = positions.size() / 3;
   const Mat3 linear(world);
   const Mat3 normalMatrix = glm::transpose(glm::inverse(linear));
   for (size_t v = 0; v < vertexCount; ++v)
     mesh.positions.push_back(Vec3(world * Vec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0f)));
   if (const int normalAccessor = attribute("NORMAL"); normalAccessor >= 0) {
-    const std::vector<float> normals = readFloats(ctx, normalAccessor, 3, "NORMAL");
+    const std::vector<float> normals = floatsOf(normalAccessor, 3, "NORMAL");
     if (normals.size() != positions.size()) fail("{}: mesh '{}': NORMAL and POSITION counts differ", ctx.path, name);
     for (size_t v = 0; v < vertexCount; ++v)
       mesh.normals.push_back(normalMatrix * Vec3(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]));
@@ -558,7 +713,7 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
     const char* key = set == 0 ? "TEXCOORD_0" : "TEXCOORD_1";
     const int uvAccessor = attribute(key);
     if (uvAccessor < 0 || (set == 1 && !readsSet[1])) continue;
-    const std::vector<float> uvs = readFloats(ctx, uvAccessor, 2, key);
+    const std::vector<float> uvs = floatsOf(uvAccessor, 2, key);
     if (uvs.size() / 2 != vertexCount) fail("{}: mesh '{}': {} and POSITION counts differ", ctx.path, name, key);
     std::vector<Vec2>& target = set == 0 ? mesh.uvs : mesh.uvs1;
     for (size_t v = 0; v < vertexCount; ++v) target.push_back(Vec2(uvs[2 * v], 1.0f - uvs[2 * v + 1]));
@@ -566,10 +721,8 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
   // COLOR_0 (RGB or RGBA, linear; alpha not read) multiplies the base colour. All white is
   // the same as none, which keeps the material's albedo constant (exporters often write it).
   if (const int colorAccessor = attribute("COLOR_0"); colorAccessor >= 0) {
-    const int components =
-        size_t(colorAccessor) < ctx.model.accessors.size() && ctx.model.accessors[size_t(colorAccessor)].type == TINYGLTF_TYPE_VEC4
-            ? 4 : 3;
-    const std::vector<float> colors = readFloats(ctx, colorAccessor, components, "COLOR_0");
+    const int components = componentsOf(colorAccessor);
+    const std::vector<float> colors = floatsOf(colorAccessor, components, "COLOR_0");
     if (colors.size() / size_t(components) != vertexCount)
       fail("{}: mesh '{}': COLOR_0 and POSITION counts differ", ctx.path, name);
     bool clamped = false, white = true;
@@ -586,7 +739,8 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
   }
 
   std::vector<uint32_t> indices;
-  if (primitive.indices >= 0) indices = readIndices(ctx, primitive.indices);
+  if (draco) indices = std::move(draco->indices);
+  else if (primitive.indices >= 0) indices = readIndices(ctx, primitive.indices);
   else {
     indices.resize(vertexCount);
     for (size_t i = 0; i < vertexCount; ++i) indices[i] = uint32_t(i);
@@ -716,6 +870,57 @@ bool keepEncodedImage(tinygltf::Image* image, const int imageIndex, std::string*
   return true;
 }
 
+/// tinygltf refuses an index accessor without a buffer view, which is what an exporter writes
+/// for a KHR_draco_mesh_compression primitive (its indices are in the Draco stream). So when a
+/// file mentions the extension, such accessors get their primitive's Draco buffer view before
+/// tinygltf parses the JSON; their data is never read (decodeDracoPrimitive replaces it). Returns
+/// the file's bytes so patched (a .glb with its JSON chunk rebuilt), or "" when nothing needs it
+/// (then tinygltf reads the file itself, and reports whatever is wrong with it).
+std::string dracoPatchedFile(const std::string& path, bool binary) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.find(kDraco) == std::string::npos) return "";
+  std::string text = bytes, rest;
+  uint32_t jsonLength = 0;
+  if (binary) {
+    if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0 || bytes.compare(16, 4, "JSON") != 0) return "";
+    std::memcpy(&jsonLength, bytes.data() + 12, 4);
+    if (jsonLength > bytes.size() - 20) return "";
+    text = bytes.substr(20, jsonLength);
+    rest = bytes.substr(20 + size_t(jsonLength));
+  }
+  nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array() || !doc.contains("accessors") ||
+      !doc["accessors"].is_array())
+    return "";
+  nlohmann::json& accessors = doc["accessors"];
+  bool patched = false;
+  for (nlohmann::json& mesh : doc["meshes"]) {
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    for (nlohmann::json& primitive : mesh["primitives"]) {
+      if (!primitive.is_object() || !primitive.contains("indices") || !primitive["indices"].is_number_unsigned()) continue;
+      const auto extensions = primitive.find("extensions");
+      if (extensions == primitive.end() || !extensions->is_object() || !extensions->contains(kDraco)) continue;
+      const nlohmann::json& draco = (*extensions)[kDraco];
+      if (!draco.is_object() || !draco.contains("bufferView") || !draco["bufferView"].is_number_unsigned()) continue;
+      const size_t index = primitive["indices"].get<size_t>();
+      if (index >= accessors.size() || !accessors[index].is_object() || accessors[index].contains("bufferView")) continue;
+      accessors[index]["bufferView"] = draco["bufferView"];
+      patched = true;
+    }
+  }
+  if (!patched) return "";
+  std::string json = doc.dump();
+  if (!binary) return json;
+  while (json.size() % 4 != 0) json += ' ';  // GLB chunks are 4-byte aligned
+  std::string glb = bytes.substr(0, 12);
+  const uint32_t total = uint32_t(20 + json.size() + rest.size()), length = uint32_t(json.size());
+  std::memcpy(glb.data() + 8, &total, 4);
+  glb.append(reinterpret_cast<const char*>(&length), 4);
+  glb += "JSON";
+  return glb + json + rest;
+}
+
 }  // namespace
 
 Scene loadGltf(const std::string& path) {
@@ -729,8 +934,16 @@ Scene loadGltf(const std::string& path) {
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   bool ok = false;
   try {
-    ok = extension == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                             : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+    const bool binary = extension == ".glb";
+    if (const std::string patched = dracoPatchedFile(path, binary); !patched.empty()) {
+      const std::string baseDir = std::filesystem::path(path).parent_path().string();
+      ok = binary ? loader.LoadBinaryFromMemory(&model, &error, &warning, reinterpret_cast<const unsigned char*>(patched.data()),
+                                                unsigned(patched.size()), baseDir)
+                  : loader.LoadASCIIFromString(&model, &error, &warning, patched.data(), unsigned(patched.size()), baseDir);
+    } else {
+      ok = binary ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
+                  : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+    }
   } catch (const std::exception& e) {
     // tinygltf mostly reports through `error`, but some malformed files make it (or the JSON
     // library inside it) throw, e.g. std::out_of_range on a GLB whose chunk lengths lie.
@@ -743,10 +956,13 @@ Scene loadGltf(const std::string& path) {
     fail("{}: not a valid glTF file: {}", path, error.empty() ? "unknown error" : error);
   }
   checkExtensions(path, model);
+  decodeMeshoptViews(path, model);
 
   Scene scene;
   scene.sourcePath = path;
   GltfContext ctx{path, model, scene, encodedImages.bytes, {}};
+  ctx.dracoRequired = std::find(model.extensionsRequired.begin(), model.extensionsRequired.end(), kDraco) !=
+                      model.extensionsRequired.end();
   for (size_t m = 0; m < model.materials.size(); ++m)
     scene.materials.push_back(convertMaterial(ctx, model.materials[m], int(m)));
 
