@@ -277,11 +277,13 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
   }
   w.put(uint8_t(scene.settings.camera.has_value()));
   w.putString(scene.settings.camera.value_or(""));
-  // Surface detail (plf_file.h): only when some material has an alpha mask or a normal map,
-  // so files without them keep the original layout byte for byte.
-  const bool detail = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) {
-    return m.isMasked() || m.normalTexture >= 0;
-  });
+  // Surface detail (plf_file.h): only when some material has an alpha mask or a normal map, or
+  // a texture is not colour (a metallic-roughness texture: data), so files without them keep
+  // the original layout byte for byte.
+  const bool detail = std::any_of(scene.materials.begin(), scene.materials.end(),
+                                  [](const Material& m) { return m.isMasked() || m.normalTexture >= 0; }) ||
+                      std::any_of(scene.textures.begin(), scene.textures.end(),
+                                  [](const Texture& t) { return t.decode != ImageDecode::Colour; });
   if (detail) {
     w.put(kSurfaceDetailTag);
     for (const Material& m : scene.materials) {

@@ -35,7 +35,7 @@
 //         ImageDecode says: the pixels the scene loader had) or (0) float32 RGB pixels
 //         (textures from HDR files); see encodeScene in plf_file.cpp. Optionally followed by
 //         a surface-detail block, written only when a material has an alpha mask or a normal
-//         map: u32 tag "SDTL", then per material i32 alphaTexture, f32 alphaFactor,
+//         map or a texture is not colour (version ≥ 5: a metallic-roughness texture): u32 tag "SDTL", then per material i32 alphaTexture, f32 alphaFactor,
 //         f32 alphaCutoff, i32 normalTexture, f32 normalScale, then per texture u8 ImageDecode
 //         (image.h: 0 colour, 1 data, 2 coverage). Without the block materials have no mask
 //         or normal map and textures are colour. Then (version ≥ 5), only when the scene has a

@@ -898,6 +898,9 @@ TEST_F(PlfFileTest, RoundTripKeepsTexturing) {
   ggx.normalMapping.offset = Vec2(0.5f, 0.5f);
   ggx.metallicRoughness = {1, ggx.albedoMapping, Rgb(0.9f, 0.8f, 0.7f), 0.6f, 0.3f};
   s.textures[1].sampling = {TextureWrap::MirroredRepeat, TextureWrap::ClampToEdge, true, false};
+  // A data texture without alpha masks or normal maps: its decoding must come back too.
+  s.textures[1].decode = ImageDecode::Data;
+  s.textures[1].image = decodeLdrImage(*s.textures[1].encoded, "png", ImageDecode::Data);
   const std::string path = file("texturing.plf");
   writeLightField(path, original);
   const LightField copy = readLightField(path);
@@ -916,6 +919,8 @@ TEST_F(PlfFileTest, RoundTripKeepsTexturing) {
   EXPECT_EQ(back.metallicRoughness.roughness, 0.3f);
   EXPECT_TRUE(copy.scene.textures[1].sampling == s.textures[1].sampling);
   EXPECT_TRUE(copy.scene.textures[0].sampling.isDefault());
+  EXPECT_EQ(copy.scene.textures[1].decode, ImageDecode::Data);
+  EXPECT_EQ(copy.scene.textures[1].image.pixels, s.textures[1].image.pixels);
 
   // The block ends SCNE with 4 sampling bytes per texture: texture 1's wrapU set to 3 is refused.
   const auto good = readBytes(path);

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "support/expect_error.h"
 #include "support/expect_vec3.h"
 
 namespace pl {
@@ -41,15 +42,7 @@ void writeBytes(const fs::path& path, const std::vector<unsigned char>& bytes) {
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
 }
 
-void expectError(const std::function<void()>& load, std::initializer_list<std::string> needles) {
-  try {
-    load();
-    ADD_FAILURE() << "no pl::Error thrown";
-  } catch (const Error& e) {
-    for (const std::string& needle : needles)
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what() << " lacks " << needle;
-  }
-}
+using test_support::expectError;
 
 /// The loaded quad: two triangles of total area 2 inside the quad's bounds, uv = position / (2, 1).
 void expectQuad(const Scene& scene) {

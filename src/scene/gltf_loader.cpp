@@ -5,18 +5,28 @@
 //    local transform is its `matrix` or T·R·S. Positions go through the world matrix M,
 //    normals through the inverse transpose of its upper 3×3, and a mirroring transform
 //    (det < 0) swaps the winding so the front side stays the front side.
-//  * Triangle primitives (mode 4) with POSITION, optional NORMAL and TEXCOORD_0 (float, or
-//    normalised unsigned byte/short), indexed or not. Other modes: warning, skipped.
+//  * Triangle primitives (mode 4) with POSITION, optional NORMAL, TEXCOORD_0, TEXCOORD_1
+//    (kept only where a material reads it) and COLOR_0 (float, or normalised unsigned
+//    byte/short; with KHR_mesh_quantization also signed and unnormalised integers), indexed or
+//    not, KHR_draco_mesh_compression- or EXT_meshopt_compression-compressed or plain
+//    (gltf_compression.h). Other modes: warning, skipped. A texture slot reading a TEXCOORD set
+//    the primitive lacks is an error naming the mesh and the material.
 //  * Metallic-roughness materials → GgxBsdf:
 //        diffuse = baseColor · (1 − metallic)
 //        f0      = mix(0.04, baseColor, metallic)        (0.04: dielectric F0 of the spec)
 //        alpha   = max(roughness², 1e-3)                 (GGX α; the floor keeps the
 //                                                         microfacet distribution finite)
-//    baseColor = baseColorFactor.rgb; baseColorTexture → albedo texture
-//    multiplying `diffuse` (so it tints dielectrics; a metal's f0 keeps the factor only), its
-//    sRGB 8/16-bit texels decoded to linear; v is flipped to our bottom-left convention
-//    (uv_ours = (u, 1 − v)) since glTF's (0,0) is the image's top-left. A primitive without a
+//    baseColor = baseColorFactor.rgb; baseColorTexture → albedo texture and COLOR_0 → vertex
+//    colours, both multiplying `diffuse` (so they tint dielectrics; a metal's f0 keeps the
+//    factor only), texels sRGB 8/16-bit decoded to linear; v is flipped to our bottom-left
+//    convention (uv_ours = (u, 1 − v)) since glTF's (0,0) is the image's top-left. A
+//    metallicRoughnessTexture makes the whole model per point instead (scene.h
+//    MetallicRoughnessMap; Material::bsdf keeps its mean, meanMetallicRoughnessModel). Every
+//    texture slot has its texCoord and KHR_texture_transform (mappingOf), every texture its
+//    sampler (samplingOf). occlusionTexture is checked and ignored. A primitive without a
 //    material gets the spec's default material (baseColor 1, metallic 1, roughness 1).
+//  * Extensions: those of supportedExtensions; one required but not supported is refused,
+//    naming it; those used but not supported are warned about once (checkExtensions).
 //  * KHR_materials_transmission (transmissionFactor > 0) → DielectricBsdf: index from
 //    KHR_materials_ior (default 1.5), transmittance = baseColor · transmissionFactor (a factor
 //    below 1 is absorbed rather than mixed with a diffuse base: warning), α = roughness²
@@ -496,14 +506,20 @@ void applyTransmission(GltfContext& ctx, const tinygltf::Material& gltf, Materia
 /// The one model a material with a metallic-roughness texture keeps (Material::bsdf) for what
 /// takes one model per material — the bake's glossy lobe and chart classification, the
 /// renderers' punctual highlights: the texture's mean over its texels of each GGX parameter,
-///   α = mean of ggxAlpha(roughness·G),  F0 = mean of mix(0.04, baseColor, metallic·B),
-///   diffuse = baseColor · (1 − mean of metallic·B)
-/// (the path tracer and the per-point diffuse albedo read the texel itself, materialModelAt).
-GgxBsdf meanMetallicRoughnessModel(const Image& texels, const MetallicRoughnessMap& mr) {
+///   α = mean of ggxAlpha(roughness·G),  F0 = mean of mix(0.04, baseColor·ā, metallic·B),
+///   diffuse = baseColor·ā · (1 − mean of metallic·B)
+/// with ā the mean of the base colour texture (`albedo`, null without one: 1). The path
+/// tracer and the per-point diffuse albedo read the texels themselves (materialModelAt).
+GgxBsdf meanMetallicRoughnessModel(const Image& texels, const MetallicRoughnessMap& mr, const Image* albedo) {
+  glm::dvec3 albedoSum(0.0);
+  if (albedo)
+    for (const Rgb& a : albedo->pixels) albedoSum += glm::dvec3(a);
+  const Rgb base = albedo && !albedo->pixels.empty() ? mr.baseColor * Rgb(albedoSum / double(albedo->pixels.size()))
+                                                     : mr.baseColor;
   double alpha = 0.0, metalness = 0.0;
   glm::dvec3 f0(0.0);
   for (const Rgb& t : texels.pixels) {
-    const GgxBsdf at = ggxFromMetallicRoughness(mr.baseColor, mr.metallic * t.b, mr.roughness * t.g);
+    const GgxBsdf at = ggxFromMetallicRoughness(base, mr.metallic * t.b, mr.roughness * t.g);
     alpha += at.alpha;
     f0 += glm::dvec3(at.f0);
     metalness += std::clamp(mr.metallic * t.b, 0.0f, 1.0f);
@@ -512,7 +528,7 @@ GgxBsdf meanMetallicRoughnessModel(const Image& texels, const MetallicRoughnessM
   GgxBsdf mean;
   mean.alpha = float(alpha / n);
   mean.f0 = Rgb(f0 / n);
-  mean.diffuse = mr.baseColor * float(1.0 - metalness / n);
+  mean.diffuse = base * float(1.0 - metalness / n);
   return mean;
 }
 
@@ -540,7 +556,9 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
     mr.baseColor = baseColor;
     mr.metallic = metallic;
     mr.roughness = roughness;
-    material.bsdf = meanMetallicRoughnessModel(ctx.scene.textures[size_t(mr.texture)].image, mr);
+    material.bsdf = meanMetallicRoughnessModel(
+        ctx.scene.textures[size_t(mr.texture)].image, mr,
+        material.albedoTexture >= 0 ? &ctx.scene.textures[size_t(material.albedoTexture)].image : nullptr);
   }
   // Occlusion is read (its texture must exist) and not used: the bake and the path tracer
   // compute occlusion themselves (docs/scenes.md).

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "support/expect_error.h"
 #include "support/expect_vec3.h"
 
 namespace pl {
@@ -105,15 +106,7 @@ AlbedoPoint pointAt(const Scene& scene, float x, float y) {
   return x >= y ? albedoPointAt(scene, 0, 0, Vec2(x - y, y)) : albedoPointAt(scene, 0, 1, Vec2(x, y - x));
 }
 
-void expectError(const std::function<void()>& load, std::initializer_list<std::string> needles) {
-  try {
-    load();
-    ADD_FAILURE() << "no pl::Error thrown";
-  } catch (const Error& e) {
-    for (const std::string& needle : needles)
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what() << " lacks " << needle;
-  }
-}
+using test_support::expectError;
 
 /// What the loader logs while `run` runs.
 std::string logOf(const std::function<void()>& run) {
