@@ -83,11 +83,15 @@ std::vector<unsigned char> dracoQuad(int& positionId, int& uvId) {
   return {buffer.data(), buffer.data() + buffer.size()};
 }
 
-std::string dracoGltf(const fs::path& dir, const std::vector<unsigned char>& bytes, int positionId, int uvId) {
+/// The Draco quad as draco.gltf (the stream in draco.bin), or with `binary` as draco.glb (the
+/// stream in its binary chunk). Its index accessor has no buffer view, as exporters write it.
+std::string dracoGltf(const fs::path& dir, const std::vector<unsigned char>& bytes, int positionId, int uvId,
+                      bool binary = false) {
   writeBytes(dir / "draco.bin", bytes);
-  const std::string text = R"({"asset": {"version": "2.0"},
+  const std::string uri = binary ? "" : R"(, "uri": "draco.bin")";
+  std::string text = R"({"asset": {"version": "2.0"},
     "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"],
-    "buffers": [{"byteLength": )" + std::to_string(bytes.size()) + R"(, "uri": "draco.bin"}],
+    "buffers": [{"byteLength": )" + std::to_string(bytes.size()) + uri + R"(}],
     "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": )" + std::to_string(bytes.size()) + R"(}],
     "accessors": [{"componentType": 5126, "count": 4, "type": "VEC3", "min": [0,0,0], "max": [2,1,0]},
                   {"componentType": 5126, "count": 4, "type": "VEC2"},
@@ -96,8 +100,27 @@ std::string dracoGltf(const fs::path& dir, const std::vector<unsigned char>& byt
       "extensions": {"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": )" +
                            std::to_string(positionId) + R"(, "TEXCOORD_0": )" + std::to_string(uvId) + R"(}}}}]}],
     "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]})";
-  std::ofstream(dir / "draco.gltf", std::ios::binary) << text;
-  return (dir / "draco.gltf").string();
+  if (!binary) {
+    std::ofstream(dir / "draco.gltf", std::ios::binary) << text;
+    return (dir / "draco.gltf").string();
+  }
+  // GLB: header, JSON chunk, BIN chunk, each chunk padded to 4 bytes.
+  while (text.size() % 4 != 0) text += ' ';
+  std::vector<unsigned char> bin = bytes;
+  while (bin.size() % 4 != 0) bin.push_back(0);
+  std::vector<unsigned char> glb;
+  auto u32 = [&](uint32_t v) { glb.insert(glb.end(), reinterpret_cast<unsigned char*>(&v), reinterpret_cast<unsigned char*>(&v) + 4); };
+  glb.insert(glb.end(), {'g', 'l', 'T', 'F'});
+  u32(2);
+  u32(uint32_t(12 + 8 + text.size() + 8 + bin.size()));
+  u32(uint32_t(text.size()));
+  glb.insert(glb.end(), {'J', 'S', 'O', 'N'});
+  glb.insert(glb.end(), text.begin(), text.end());
+  u32(uint32_t(bin.size()));
+  glb.insert(glb.end(), {'B', 'I', 'N', '\0'});
+  glb.insert(glb.end(), bin.begin(), bin.end());
+  writeBytes(dir / "draco.glb", glb);
+  return (dir / "draco.glb").string();
 }
 
 TEST(GltfCompression, DracoQuadLoadsAndADamagedBufferIsRefused) {
@@ -105,6 +128,7 @@ TEST(GltfCompression, DracoQuadLoadsAndADamagedBufferIsRefused) {
   int positionId = 0, uvId = 0;
   const std::vector<unsigned char> bytes = dracoQuad(positionId, uvId);
   expectQuad(loadScene(dracoGltf(dir, bytes, positionId, uvId)));
+  expectQuad(loadScene(dracoGltf(dir, bytes, positionId, uvId, /*binary=*/true)));
   // Truncated, and with its header overwritten: refused, naming the file and the mesh.
   const std::vector<unsigned char> truncated(bytes.begin(), bytes.begin() + std::ptrdiff_t(bytes.size() / 2));
   expectError([&] { loadScene(dracoGltf(dir, truncated, positionId, uvId)); }, {"draco.gltf", "mesh 'squashed'", "Draco"});

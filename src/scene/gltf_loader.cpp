@@ -895,18 +895,22 @@ bool keepEncodedImage(tinygltf::Image* image, const int imageIndex, std::string*
 /// the file's bytes so patched (a .glb with its JSON chunk rebuilt), or "" when nothing needs it
 /// (then tinygltf reads the file itself, and reports whatever is wrong with it).
 std::string dracoPatchedFile(const std::string& path, bool binary) {
+  // The JSON alone first (a .glb's first chunk): the binary chunk is read only when patching.
   std::ifstream in(path, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (bytes.find(kDraco) == std::string::npos) return "";
-  std::string text = bytes, rest;
+  std::string header(binary ? 20 : 0, '\0'), text;
   uint32_t jsonLength = 0;
   if (binary) {
-    if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0 || bytes.compare(16, 4, "JSON") != 0) return "";
-    std::memcpy(&jsonLength, bytes.data() + 12, 4);
-    if (jsonLength > bytes.size() - 20) return "";
-    text = bytes.substr(20, jsonLength);
-    rest = bytes.substr(20 + size_t(jsonLength));
+    if (!in.read(header.data(), 20) || header.compare(0, 4, "glTF") != 0 || header.compare(16, 4, "JSON") != 0) return "";
+    std::memcpy(&jsonLength, header.data() + 12, 4);
+    std::error_code ec;
+    const uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec || jsonLength > size - 20) return "";  // a lying length: tinygltf reports the file
+    text.resize(jsonLength);
+    if (!in.read(text.data(), std::streamsize(jsonLength))) return "";
+  } else {
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
+  if (text.find(kDraco) == std::string::npos) return "";
   nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array() || !doc.contains("accessors") ||
       !doc["accessors"].is_array())
@@ -930,8 +934,9 @@ std::string dracoPatchedFile(const std::string& path, bool binary) {
   if (!patched) return "";
   std::string json = doc.dump();
   if (!binary) return json;
+  const std::string rest((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   while (json.size() % 4 != 0) json += ' ';  // GLB chunks are 4-byte aligned
-  std::string glb = bytes.substr(0, 12);
+  std::string glb = header.substr(0, 12);
   const uint32_t total = uint32_t(20 + json.size() + rest.size()), length = uint32_t(json.size());
   std::memcpy(glb.data() + 8, &total, 4);
   glb.append(reinterpret_cast<const char*>(&length), 4);
