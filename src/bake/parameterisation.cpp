@@ -379,7 +379,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
   // The transport albedo: a diffuse chart's albedo, or a glossy chart's diffuse part's
   // (Chart::diffuseValue), averaged over each tixel's footprint when a texture varies it.
   const bool hasAlbedo = c.kind == ChartKind::Diffuse || c.diffuseValue;
-  const bool textured = hasAlbedo && (material.albedoVaries() || material.metallicRoughness.texture >= 0);
+  const bool textured = hasAlbedo && material.modelVaries();
   auto albedoAt = [&](const AlbedoPoint& point) {
     return c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, point)
                                         : glossyDiffuseAlbedoAt(scene, c.material, point);

@@ -21,7 +21,7 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, const AlbedoPoint& p)
   // the modulation, without building the BSDF (the renderers call this per textured pixel).
   const Material& m = scene.materials[material];
   const auto* lambert = std::get_if<LambertBsdf>(&m.bsdf);
-  if (!m.albedoVaries() && m.metallicRoughness.texture < 0)
+  if (!m.modelVaries())
     return lambert ? lambert->albedo : albedo(m.bsdf, Vec3(0.0f, 0.0f, 1.0f));
   if (m.metallicRoughness.texture >= 0) return albedo(materialModelAt(scene, m, p), Vec3(0.0f, 0.0f, 1.0f));
   const Rgb modulation = albedoModulation(scene, m, p);
@@ -117,7 +117,7 @@ ChartShading chartShading(const LightField& lf, uint32_t chart, const SunLights&
   shading.emissive = !isBlack(emission);
   shading.inverseTixelSize = 1.0f / c.tixelSize;
   shading.twoSidedEmission = material.twoSidedEmission;
-  shading.texturedAlbedo = material.albedoVaries() || material.metallicRoughness.texture >= 0;
+  shading.texturedAlbedo = material.modelVaries();
   if (c.kind == ChartKind::Diffuse && !shading.texturedAlbedo)
     shading.albedoOverPi = lanes4(diffuseAlbedoAt(scene, c.material, AlbedoPoint{}) * kInvPi);
   if (c.diffuseValue && !shading.texturedAlbedo)

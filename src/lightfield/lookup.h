@@ -249,7 +249,7 @@ struct ChartShading {
   float inverseTixelSize = 1.0f;  ///< 1 / chart.tixelSize (tixelGridCoordinates)
   bool emissive = false;          ///< emission is not black
   bool twoSidedEmission = false;
-  bool texturedAlbedo = false;    ///< diffuse albedo varies over the surface (Material::albedoVaries, or a metallic-roughness texture): diffuseAlbedoAt per point
+  bool texturedAlbedo = false;    ///< diffuse albedo varies over the surface (Material::modelVaries): diffuseAlbedoAt per point
   bool needsUv = false;           ///< a diffuse (or diffuseValue glossy) chart whose albedo varies: the lookup needs the hit's AlbedoPoint
   bool normalMapped = false;      ///< a glossy chart with a normal map: lookupDirection needs the hit's normal
   /// A curved glossy chart: its map is read in the frame around the hit's interpolated normal

@@ -364,7 +364,7 @@ Rgb albedoModulation(const Scene& scene, const Material& material, const AlbedoP
 
 Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p) {
   const MetallicRoughnessMap& mr = material.metallicRoughness;
-  if (!material.albedoVaries() && mr.texture < 0) return material.bsdf;
+  if (!material.modelVaries()) return material.bsdf;
   const Rgb modulation = albedoModulation(scene, material, p);
   if (mr.texture >= 0) {
     const Rgb texel = scene.textures[size_t(mr.texture)].sample(p.metallicRoughnessUv);
@@ -375,7 +375,7 @@ Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoP
 
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit) {
   const Material& material = scene.materials[hit.material];
-  if (!material.albedoVaries() && material.metallicRoughness.texture < 0) return material.bsdf;
+  if (!material.modelVaries()) return material.bsdf;
   return materialModelAt(scene, material, albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics));
 }
 

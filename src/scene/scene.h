@@ -80,6 +80,9 @@ struct Material {
   /// Whether the diffuse albedo varies over the surface (a texture or vertex colours): the
   /// renderers then read it per pixel (albedoModulation) instead of once per chart.
   bool albedoVaries() const { return albedoTexture >= 0 || vertexColored; }
+  /// Whether the model varies over the surface at all (its albedo, or a metallic-roughness
+  /// texture): materialModelAt is then needed per point.
+  bool modelVaries() const { return albedoVaries() || metallicRoughness.texture >= 0; }
   /// Whether some of the surface may be cut away (the Accel filters hits on it).
   bool isMasked() const { return alphaTexture >= 0 || alphaFactor < alphaCutoff; }
 };
