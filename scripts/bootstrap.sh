@@ -7,7 +7,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config ccache git
-  libembree-dev libtbb-dev libglm-dev libtinyobjloader-dev libtinygltf-dev
+  libembree-dev libtbb-dev libglm-dev libtinyobjloader-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev
   libopenexr-dev libstb-dev libzstd-dev libsquish-dev libsdl2-dev libxxhash-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev

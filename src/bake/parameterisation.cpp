@@ -393,12 +393,17 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
   // The transport albedo: a diffuse chart's albedo, or a glossy chart's diffuse part's
   // (Chart::diffuseValue), averaged over each tixel's footprint when a texture varies it.
   const bool hasAlbedo = c.kind == ChartKind::Diffuse || c.diffuseValue;
-  const bool textured = hasAlbedo && material.albedoTexture >= 0;
-  auto albedoAt = [&](Vec2 uv) {
-    return c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, uv, kFullResolution)
-                                        : glossyDiffuseAlbedoAt(scene, c.material, uv, kFullResolution);
+  const bool textured = hasAlbedo && material.modelVaries();
+  auto albedoAt = [&](const AlbedoPoint& point) {
+    return c.kind == ChartKind::Diffuse ? diffuseAlbedoAt(scene, c.material, point)
+                                        : glossyDiffuseAlbedoAt(scene, c.material, point);
   };
-  const Rgb constantAlbedo = hasAlbedo ? albedoAt(Vec2(0.0f)) : Rgb(0.0f);
+  // Full resolution (AlbedoPoint's lod 0): the average over the tixel's footprint samples is
+  // the filter (the renderers' mip levels would filter twice).
+  auto albedoOn = [&](uint32_t tri, const std::array<float, 3>& bary) {
+    return albedoAt(albedoPointAt(scene, r.tris[tri].mesh, r.tris[tri].triangle, Vec2(bary[1], bary[2])));
+  };
+  const Rgb constantAlbedo = hasAlbedo ? albedoAt(AlbedoPoint{}) : Rgb(0.0f);
   // The normal a point of the chart gathers around (chartShadingNormalAt, lightfield.h).
   auto normalAt = [&](const FootprintSample& s) {
     const ChartRaster::Tri2& t = r.tris[s.tri];
@@ -422,11 +427,9 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
           const Vec2 fromCentre = q - Vec2(float(i) + 0.5f, float(j) + 0.5f);
           insideSamples[size_t(inside)] = {glm::dot(fromCentre, fromCentre), s};
           ++inside;
-          if (textured || c.directionalIrradiance) {
+          if (textured) albedoSum += albedoOn(s.tri, s.bary);
+          if (c.directionalIrradiance) {
             const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
-            // Full resolution: this average over the tixel's footprint samples is the filter
-            // (the renderers' mip levels would filter twice).
-            if (textured) albedoSum += albedoAt(hit.uv);
             mappedNormals[size_t(inside - 1)] = c.isBack ? -hit.shadingNormal : hit.shadingNormal;
           }
         }
@@ -498,8 +501,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
         } else if (inside > 0) {
           p.transportAlbedo[g] = albedoSum / float(inside);
         } else {
-          const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
-          p.transportAlbedo[g] = albedoAt(hit.uv);
+          p.transportAlbedo[g] = albedoOn(s.tri, s.bary);
         }
       } else {
         p.transportAlbedo[g] = Rgb(0.0f);

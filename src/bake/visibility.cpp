@@ -125,20 +125,30 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
     }
     // An alpha mask changes what every ray sees; a normal map bends the specular chains
     // (followSpecular shades with surfaceAt's mapped normal), not the other charts' rays.
-    auto texture = [&](int index) {
-      const Image& image = scene.textures[size_t(index)].image;
-      h.value(image.width);
-      h.value(image.height);
-      h.update(image.pixels.data(), image.pixels.size() * sizeof(Rgb));
+    // How they are read counts too (glTF texture mappings and samplers); the defaults hash
+    // nothing, so fields traced before mappings existed stay valid.
+    auto texture = [&](int index, const TextureMapping& mapping) {
+      const Texture& t = scene.textures[size_t(index)];
+      h.value(t.image.width);
+      h.value(t.image.height);
+      h.update(t.image.pixels.data(), t.image.pixels.size() * sizeof(Rgb));
+      if (!mapping.isDefault()) {
+        h.value(mapping.uvSet);
+        h.value(mapping.linear[0]);
+        h.value(mapping.linear[1]);
+        h.value(mapping.offset);
+      }
+      if (!t.sampling.isDefault())
+        h.value(uint32_t(t.sampling.wrapU) | uint32_t(t.sampling.wrapV) << 8 | uint32_t(t.sampling.nearest) << 16);
     };
     if (m.isMasked()) {
       h.value(m.alphaFactor);
       h.value(m.alphaCutoff);
-      if (m.alphaTexture >= 0) texture(m.alphaTexture);
+      if (m.alphaTexture >= 0) texture(m.alphaTexture, m.alphaMapping);
     }
     if (m.normalTexture >= 0 && chartKindOf(m.bsdf) == ChartKind::Specular) {
       h.value(m.normalScale);
-      texture(m.normalTexture);
+      texture(m.normalTexture, m.normalMapping);
     }
   }
   for (const Chart& c : param.charts) {

@@ -21,6 +21,7 @@ using Vec2 = glm::vec2;
 using Vec3 = glm::vec3;
 using Vec4 = glm::vec4;
 using DVec3 = glm::dvec3;
+using Mat2 = glm::mat2;
 using Mat3 = glm::mat3;
 using Mat4 = glm::mat4;
 using UVec3 = glm::uvec3;

@@ -16,24 +16,29 @@ Rgb backgroundRadiance(const Environment& environment, const Vec3& direction) {
   return environment.radiance(direction);
 }
 
-Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float lod) {
+Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, const AlbedoPoint& p) {
   // Lambert (every diffuse chart of an OBJ scene): bsdfAt's albedo, the model's albedo times
-  // the texel, without building the BSDF (the renderers call this per textured pixel).
+  // the modulation, without building the BSDF (the renderers call this per textured pixel).
   const Material& m = scene.materials[material];
   const auto* lambert = std::get_if<LambertBsdf>(&m.bsdf);
-  if (m.albedoTexture < 0) return lambert ? lambert->albedo : albedo(m.bsdf, Vec3(0.0f, 0.0f, 1.0f));
-  const Rgb texel = scene.textures[size_t(m.albedoTexture)].sampleLod(uv, lod);
-  if (lambert) return lambert->albedo * texel;
-  // bsdfAt's texturing (the model's diffuse albedo times the texel), then the directional
+  if (!m.modelVaries())
+    return lambert ? lambert->albedo : albedo(m.bsdf, Vec3(0.0f, 0.0f, 1.0f));
+  if (m.metallicRoughness.texture >= 0) return albedo(materialModelAt(scene, m, p), Vec3(0.0f, 0.0f, 1.0f));
+  const Rgb modulation = albedoModulation(scene, m, p);
+  if (lambert) return lambert->albedo * modulation;
+  // bsdfAt's texturing (the model's diffuse albedo times the modulation), then the directional
   // albedo at normal incidence: for a model other than Lambert, a chart was classified
   // diffuse for its hemispherical reflectance.
-  return albedo(withDiffuseAlbedo(m.bsdf, diffuseAlbedo(m.bsdf) * texel), Vec3(0.0f, 0.0f, 1.0f));
+  return albedo(withDiffuseAlbedo(m.bsdf, diffuseAlbedo(m.bsdf) * modulation), Vec3(0.0f, 0.0f, 1.0f));
 }
 
-Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float lod) {
+Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, const AlbedoPoint& p) {
   const Material& m = scene.materials[material];
+  // With a metallic-roughness texture: the point's model's diffuse albedo (its k(μ) stays the
+  // material model's, which the stored Ẽ was gathered with).
+  if (m.metallicRoughness.texture >= 0) return diffuseAlbedo(materialModelAt(scene, m, p));
   const Rgb rho = diffuseAlbedo(m.bsdf);
-  return m.albedoTexture < 0 ? rho : rho * scene.textures[size_t(m.albedoTexture)].sampleLod(uv, lod);
+  return m.albedoVaries() ? rho * albedoModulation(scene, m, p) : rho;
 }
 
 namespace {
@@ -112,11 +117,11 @@ ChartShading chartShading(const LightField& lf, uint32_t chart, const SunLights&
   shading.emissive = !isBlack(emission);
   shading.inverseTixelSize = 1.0f / c.tixelSize;
   shading.twoSidedEmission = material.twoSidedEmission;
-  shading.texturedAlbedo = material.albedoTexture >= 0;
+  shading.texturedAlbedo = material.modelVaries();
   if (c.kind == ChartKind::Diffuse && !shading.texturedAlbedo)
-    shading.albedoOverPi = lanes4(diffuseAlbedoAt(scene, c.material, Vec2(0.0f), kFullResolution) * kInvPi);
+    shading.albedoOverPi = lanes4(diffuseAlbedoAt(scene, c.material, AlbedoPoint{}) * kInvPi);
   if (c.diffuseValue && !shading.texturedAlbedo)
-    shading.albedoOverPi = lanes4(glossyDiffuseAlbedoAt(scene, c.material, Vec2(0.0f), kFullResolution) * kInvPi);
+    shading.albedoOverPi = lanes4(glossyDiffuseAlbedoAt(scene, c.material, AlbedoPoint{}) * kInvPi);
   shading.needsUv = (c.kind == ChartKind::Diffuse || c.diffuseValue) && shading.texturedAlbedo;
   shading.normalMapped = (c.kind == ChartKind::Glossy || c.directionalIrradiance) && material.normalTexture >= 0;
   shading.curvedGlossy = c.kind == ChartKind::Glossy && c.curved;
@@ -144,7 +149,7 @@ Rgb exitantRadiance(const LightField& lf, uint32_t chart, const Vec3& worldPosit
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   const SunLights sun = sunLightsOf(lf);
   return exitantRadiance(lf.scene, c, chartShading(lf, chart, sun), lf.values.data(), worldPosition,
-                         worldDirectionTowardsViewer, c.normal, c.normal, uv, kFullResolution);
+                         worldDirectionTowardsViewer, c.normal, c.normal, AlbedoPoint{uv, kFullResolution, Rgb(1.0f)});
 }
 
 Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPosition,
@@ -159,13 +164,12 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
   if (c.kind == ChartKind::Specular) return Rgb(0.0f);
   const SunLights sun = sunLightsOf(lf);
   const ChartShading shading = chartShading(lf, chart, sun);
-  Vec2 uv;
-  float lod;
+  AlbedoPoint albedo;
   Vec3 lookupDirection, lookupNormal, mappedNormal;
-  lookupInputs(lf.scene, c, shading, hit, worldDirectionTowardsViewer, coneWidth, uv, lod, lookupDirection, lookupNormal,
+  lookupInputs(lf.scene, c, shading, hit, worldDirectionTowardsViewer, coneWidth, albedo, lookupDirection, lookupNormal,
                mappedNormal);
   return exitantRadiance(lf.scene, c, shading, lf.values.data(), worldPosition, lookupDirection, lookupNormal,
-                         mappedNormal, uv, lod);
+                         mappedNormal, albedo);
 }
 
 PunctualHighlights::PunctualHighlights(const LightField& lf, const Accel& accel) : lf_(lf) {

@@ -155,17 +155,19 @@ inline Rgb interpolateValues(const Rgb* values, const Chart& c, Vec2 grid, Vec2 
 }
 
 
-/// Diffuse albedo of `material` at surface uv: the Lambertian albedo times its albedo texture
-/// (if any) read at mip level `lod` (Texture::sampleLod; lod ≤ 0 is full resolution, exactly
-/// the texel the path tracer's bsdfAt reads). The renderers pass albedoTextureLod's level; the
-/// bake passes kFullResolution (its transport albedo is already an average over each gather
-/// point's footprint, parameterisation.cpp).
-Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float lod);
+/// Diffuse albedo of `material` at albedo point p (scene.h: the albedo slot's uv, the mip level
+/// and the vertex colour): the Lambertian albedo times albedoModulation(p) — the albedo
+/// texture read at mip level p.lod (Texture::sampleLod; lod ≤ 0 is full resolution, exactly the
+/// texel the path tracer's bsdfAt reads) times the vertex colour. The renderers pass
+/// albedoTextureLod's level; the bake kFullResolution (its transport albedo is already an
+/// average over each gather point's footprint, parameterisation.cpp).
+Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, const AlbedoPoint& p);
 inline constexpr float kFullResolution = 0.0f;
-/// The albedo ρ of a glossy chart's diffuse part (Chart::diffuseValue) at surface uv: the
-/// model's diffuse albedo times its albedo texture (if any) read at mip level `lod` — the
-/// path tracer's texturing (bsdfAt), whose diffuse term is ρ/π · k(μo) · k(μi).
-Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float lod);
+/// The albedo ρ of a glossy chart's diffuse part (Chart::diffuseValue) at albedo point p: the
+/// model's diffuse albedo times albedoModulation(p) — the path tracer's texturing (bsdfAt),
+/// whose diffuse term is ρ/π · k(μo) · k(μi). With a metallic-roughness texture the diffuse
+/// albedo is baseColor × modulation × (1 − metalness) at the point (MetallicRoughnessMap).
+Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, const AlbedoPoint& p);
 
 /// The mip level a light-field renderer reads an albedo texture at, by ray cones
 /// (Akenine-Möller et al., "Texture Level of Detail Strategies for Real-Time Ray Tracing",
@@ -175,7 +177,8 @@ Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float 
 /// elliptical footprint on the surface with axes w (across the view) and w / |cos θ| (along
 /// it; θ between the ray and the triangle's normal). The triangle maps world area
 /// P_a = ½|c|, c = (p1 − p0) × (p2 − p0), to texel area T_a = W·H·½|(uv1 − uv0) × (uv2 − uv0)|
-/// (W × H texels; uv = the barycentrics without uvs). One isotropic level must stand for that
+/// (W × H texels; uv = the slot's uv set with its transform `mapping` applied, so T_a scales
+/// with |det| of its linear part; the barycentrics without uvs). One isotropic level must stand for that
 /// ellipse: it is taken with the footprint's area, i.e. the geometric mean w / √|cos θ| of its
 /// axes, so the level covers as many texels as the footprint does — not its long axis, as the
 /// paper's rule (and GPU trilinear filtering without anisotropy) does, which blurs grazing
@@ -188,16 +191,18 @@ Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, Vec2 uv, float 
 /// w = 0 (texture LOD off) gives −∞, degenerate uvs −∞ (level 0), a grazing ray a level
 /// beyond the coarsest (read as the coarsest); a NaN reads level 0 (Texture::sampleLod). The
 /// log2 is core/math.h approximateLog2 (within 0.008 of a level).
-inline float albedoTextureLod(const Mesh& mesh, uint32_t triangle, const Texture& texture, const Vec3& direction,
-                              float coneWidth) {
+inline float albedoTextureLod(const Mesh& mesh, uint32_t triangle, const Texture& texture, const TextureMapping& mapping,
+                              const Vec3& direction, float coneWidth) {
   if (!(coneWidth > 0.0f)) return kFullResolution;  // LOD off: the same level 0, without the triangle's loads
   const UVec3 tri = mesh.triangles[triangle];
   const Vec3 c = glm::cross(mesh.positions[tri[1]] - mesh.positions[tri[0]], mesh.positions[tri[2]] - mesh.positions[tri[0]]);
   float uvCross = 1.0f;  // uvAt's barycentric uvs: (0,0), (1,0), (0,1)
-  if (!mesh.uvs.empty()) {
-    const Vec2 a = mesh.uvs[tri[1]] - mesh.uvs[tri[0]], b = mesh.uvs[tri[2]] - mesh.uvs[tri[0]];
+  const std::vector<Vec2>& uvs = mapping.uvSet == 1 ? mesh.uvs1 : mesh.uvs;
+  if (!uvs.empty()) {
+    const Vec2 a = uvs[tri[1]] - uvs[tri[0]], b = uvs[tri[2]] - uvs[tri[0]];
     uvCross = std::abs(a.x * b.y - a.y * b.x);
   }
+  if (!mapping.isDefault()) uvCross *= std::abs(glm::determinant(mapping.linear));
   const float cosArea = std::abs(glm::dot(direction, c));  // |c| |cos θ|
   const float texelsSquared =
       float(texture.image.width) * float(texture.image.height) * uvCross * (coneWidth * coneWidth) / cosArea;
@@ -208,9 +213,10 @@ inline float albedoTextureLod(const Mesh& mesh, uint32_t triangle, const Texture
 /// is read at, or kFullResolution for a material without one.
 inline float albedoLodAt(const Scene& scene, uint32_t material, uint32_t mesh, uint32_t triangle, const Vec3& direction,
                          float coneWidth) {
-  const int texture = scene.materials[material].albedoTexture;
-  if (texture < 0) return kFullResolution;
-  return albedoTextureLod(scene.meshes[mesh], triangle, scene.textures[size_t(texture)], direction, coneWidth);
+  const Material& m = scene.materials[material];
+  if (m.albedoTexture < 0) return kFullResolution;
+  return albedoTextureLod(scene.meshes[mesh], triangle, scene.textures[size_t(m.albedoTexture)], m.albedoMapping, direction,
+                          coneWidth);
 }
 
 /// One step of an ideal-specular chain at `hit` (a specular chart: a mirror or glass) of
@@ -263,8 +269,8 @@ struct ChartShading {
   float inverseTixelSize = 1.0f;  ///< 1 / chart.tixelSize (tixelGridCoordinates)
   bool emissive = false;          ///< emission is not black
   bool twoSidedEmission = false;
-  bool texturedAlbedo = false;    ///< diffuse albedo varies with uv: diffuseAlbedoAt per point
-  bool needsUv = false;           ///< a diffuse (or diffuseValue glossy) chart with an albedo texture: the lookup needs the hit's uv
+  bool texturedAlbedo = false;    ///< diffuse albedo varies over the surface (Material::modelVaries): diffuseAlbedoAt per point
+  bool needsUv = false;           ///< a diffuse (or diffuseValue glossy) chart whose albedo varies: the lookup needs the hit's AlbedoPoint
   /// A normal-mapped glossy chart (lookupDirection bends the lookup by the hit's mapped normal)
   /// or directionalIrradiance diffuse chart (the irradiance is taken about it): lookupInputs
   /// needs surfaceAt's shading normal.
@@ -350,27 +356,25 @@ inline Vec3 lookupNormalAt(const Scene& scene, const Chart& c, const ChartShadin
 /// normal, turned to the record's side; lookupNormal elsewhere). surfaceAt is evaluated only
 /// where the chart's shading needs it.
 inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading& shading, const RayHit& hit,
-                         const Vec3& towardsViewer, float coneWidth, Vec2& uv, float& lod, Vec3& lookup,
+                         const Vec3& towardsViewer, float coneWidth, AlbedoPoint& albedo, Vec3& lookup,
                          Vec3& lookupNormal, Vec3& mappedNormal) {
-  uv = Vec2(0.0f);
-  lod = kFullResolution;
+  albedo = AlbedoPoint{};
   lookup = towardsViewer;
   lookupNormal = lookupNormalAt(scene, c, shading, hit.mesh, hit.triangle, hit.barycentrics);
   mappedNormal = lookupNormal;
-  if (!shading.needsUv && !shading.normalMapped) return;
-  if (!shading.normalMapped) {  // surfaceAt's uv alone (no normals, no normal-map texel)
-    uv = uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics);
-    lod = albedoLodAt(scene, c.material, hit.mesh, hit.triangle, -towardsViewer, coneWidth);
-    return;
+  const bool glossyMapped = shading.normalMapped && c.kind == ChartKind::Glossy;
+  if (shading.needsUv) {
+    albedo = albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+    // A normal-mapped glossy chart reads its albedo at full resolution (its surfaceAt below).
+    if (!glossyMapped) albedo.lod = albedoLodAt(scene, c.material, hit.mesh, hit.triangle, -towardsViewer, coneWidth);
   }
+  if (!shading.normalMapped) return;
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
-  uv = surface.uv;
-  if (c.kind == ChartKind::Glossy) {
+  if (glossyMapped) {
     lookup = normalMappedLookupDirection(lookupNormal, surface.shadingNormal, towardsViewer);
     return;
   }
-  // A directionalIrradiance chart: the albedo texture's level as on any diffuse chart.
-  if (shading.needsUv) lod = albedoLodAt(scene, c.material, hit.mesh, hit.triangle, -towardsViewer, coneWidth);
+  // A directionalIrradiance chart: the irradiance is taken about the mapped normal.
   mappedNormal = c.isBack ? -surface.shadingNormal : surface.shadingNormal;
 }
 
@@ -411,12 +415,12 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
 /// per-pixel loop inlines it instead of calling across files. lookupNormal: lookupNormalAt's
 /// normal at worldPosition (lookupInputs): a curved glossy chart's map is read around it, a
 /// curved diffuse chart's sun-masked lights shine on it. mappedNormal: a directionalIrradiance
-/// chart's mapped normal (lookupInputs; lookupNormal on other charts). uv and lod: where and at
-/// which mip level a diffuse chart's albedo texture is read (lookupInputs).
+/// chart's mapped normal (lookupInputs; lookupNormal on other charts). albedo: where, at which
+/// mip level and with which vertex colour a diffuse chart's albedo is read (lookupInputs).
 template <typename Load>
 inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
                                const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer,
-                               const Vec3& lookupNormal, const Vec3& mappedNormal, Vec2 uv, float lod) {
+                               const Vec3& lookupNormal, const Vec3& mappedNormal, const AlbedoPoint& albedo) {
   if (c.kind == ChartKind::Specular) return f4Zero();
   const Vec2 grid = tixelGridCoordinates(c, worldPosition, shading.inverseTixelSize);
   // cos θ towards the viewer (chartLocalDirection's z; a diffuse lookup needs no more of it).
@@ -441,7 +445,7 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
       stored = mappedNormalIrradiance(load, c, grid, stored, tiltFrameAround(c, lookupNormal).toLocal(mappedNormal));
     }
     const F4 irradiance = f4Add(stored, sunIrradianceLanes(c, shading, grid, lookupNormal, mappedNormal));
-    const F4 albedoOverPi = shading.texturedAlbedo ? f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv, lod)), f4Splat(kInvPi))
+    const F4 albedoOverPi = shading.texturedAlbedo ? f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, albedo)), f4Splat(kInvPi))
                                                    : f4Load(shading.albedoOverPi.v);
     const F4 reflected = f4Mul(albedoOverPi, irradiance);
     return shading.emissive && emits ? f4Add(f4Load(shading.emission.v), reflected) : reflected;
@@ -458,7 +462,7 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
   // Plus the diffuse part, ρ(uv)/π · k(μo) · Ẽ (lightfield.h), with Ẽ bilinear over the tixels.
   const F4 irradiance = bilinearOverTixels(c, grid, [&](uint32_t i, uint32_t j) { return load(c.diffuseValueIndex(i, j)); });
   const F4 albedoOverPi = shading.texturedAlbedo
-                              ? f4Mul(f4FromRgb(glossyDiffuseAlbedoAt(scene, c.material, uv, lod)), f4Splat(kInvPi))
+                              ? f4Mul(f4FromRgb(glossyDiffuseAlbedoAt(scene, c.material, albedo)), f4Splat(kInvPi))
                               : f4Load(shading.albedoOverPi.v);
   const F4 factor = f4FromRgb(diffuseDirectionalFactor(scene.materials[c.material].bsdf, local.z));
   return f4Add(mapped, f4Mul(f4Mul(albedoOverPi, factor), irradiance));
@@ -466,17 +470,17 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
 template <typename Load>
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
                            const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, const Vec3& lookupNormal,
-                           const Vec3& mappedNormal, Vec2 uv, float lod) {
+                           const Vec3& mappedNormal, const AlbedoPoint& albedo) {
   return f4Rgb(exitantRadianceLanes(scene, c, shading, load, worldPosition, worldDirectionTowardsViewer, lookupNormal,
-                                    mappedNormal, uv, lod));
+                                    mappedNormal, albedo));
 }
 /// Four light-field lookups on one diffuse chart that is not directionalIrradiance (one value
 /// per tixel; callers send those through exitantRadianceLanes): the camera rays origin + t·direction
 /// (structure of arrays: x[k], y[k], z[k] for lookups k = 0…3), seen against their directions,
-/// at surface uvs uv[k] and mip levels lod[k] (read only when the chart has an albedo texture,
-/// shading.needsUv), and — on a curved chart with sun masks, where the masked lights shine on
+/// at albedo points albedo[k] (uv, mip level, vertex colour; read only when the chart's albedo
+/// varies, shading.needsUv), and — on a curved chart with sun masks, where the masked lights shine on
 /// the interpolated normal — at lookupNormals[k] (lookupNormalAt; null: the chart normal).
-/// result[k] = exitantRadianceLanes(…, origin_k + t_k·direction_k, −direction_k, uv[k], lod[k]) to the
+/// result[k] = exitantRadianceLanes(…, origin_k + t_k·direction_k, −direction_k, albedo[k]) to the
 /// bit — the same IEEE operations lane by lane, with the four lookups in the four SSE lanes
 /// for everything up to the value reads (the fast renderer's common case, where a dependent
 /// chain of ~40 scalar operations per pixel would otherwise dominate).
@@ -484,7 +488,7 @@ struct RaysSoA4 {
   alignas(16) float ox[4], oy[4], oz[4], dx[4], dy[4], dz[4], t[4];
 };
 inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const ChartShading& shading, const Lanes4* values,
-                                    const RaysSoA4& r, const Vec2 uv[4], const float lod[4], F4 result[4],
+                                    const RaysSoA4& r, const AlbedoPoint albedo[4], F4 result[4],
                                     const Vec3* lookupNormals = nullptr) {
 #if defined(__SSE2__)
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), half = _mm_set1_ps(0.5f);
@@ -546,7 +550,7 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
   // exitantRadianceLanes' albedo / π, per lookup when textured (one branch for all four).
   F4 albedoOverPi[4];
   if (shading.texturedAlbedo)
-    for (int k = 0; k < 4; ++k) albedoOverPi[k] = f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, uv[k], lod[k])), f4Splat(kInvPi));
+    for (int k = 0; k < 4; ++k) albedoOverPi[k] = f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, albedo[k])), f4Splat(kInvPi));
   else
     albedoOverPi[0] = albedoOverPi[1] = albedoOverPi[2] = albedoOverPi[3] = f4Load(shading.albedoOverPi.v);
   for (int k = 0; k < 4; ++k) {
@@ -569,7 +573,7 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
     const Vec3 d(r.dx[k], r.dy[k], r.dz[k]);
     const Vec3 normal = lookupNormals ? lookupNormals[k] : c.normal;
     result[k] = exitantRadianceLanes(scene, c, shading, PaddedValues{values}, Vec3(r.ox[k], r.oy[k], r.oz[k]) + r.t[k] * d, -d,
-                                     normal, normal, uv[k], lod[k]);
+                                     normal, normal, albedo[k]);
   }
 #endif
 }
@@ -604,9 +608,9 @@ class PunctualHighlights {
 
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,
                            const Vec3& worldPosition, const Vec3& worldDirectionTowardsViewer, const Vec3& lookupNormal,
-                           const Vec3& mappedNormal, Vec2 uv, float lod) {
+                           const Vec3& mappedNormal, const AlbedoPoint& albedo) {
   return exitantRadiance(scene, c, shading, RgbValues{values}, worldPosition, worldDirectionTowardsViewer, lookupNormal,
-                         mappedNormal, uv, lod);
+                         mappedNormal, albedo);
 }
 
 }  // namespace pl

@@ -148,11 +148,11 @@ TEST(Lookup, FourAtATimeDiffuseLookupEqualsOneAtATimeBitForBit) {
     for (int group = 0; group < 500; ++group) {
       RaysSoA4 rays;
       Vec3 origin[4], direction[4];
-      Vec2 uv[4];
-      float t[4], lod[4];
+      AlbedoPoint albedo[4];
+      float t[4];
       for (int k = 0; k < 4; ++k) {
-        uv[k] = Vec2(6.0f * rng.uniform() - 3.0f, 6.0f * rng.uniform() - 3.0f);
-        lod[k] = group % 50 == 7 ? std::nanf("") : 6.0f * rng.uniform() - 1.0f;  // 7×5: levels 0…2
+        albedo[k].uv = Vec2(6.0f * rng.uniform() - 3.0f, 6.0f * rng.uniform() - 3.0f);
+        albedo[k].lod = group % 50 == 7 ? std::nanf("") : 6.0f * rng.uniform() - 1.0f;  // 7×5: levels 0…2
         // A target point from 1.5 tixels outside the grid to 1.5 beyond it, seen from either side.
         const float gu = -2.0f + (float(c.resU) + 3.0f) * rng.uniform(), gv = -2.0f + (float(c.resV) + 3.0f) * rng.uniform();
         const Vec3 target = c.origin + (gu + 0.5f) * c.tixelSize * c.axisU + (gv + 0.5f) * c.tixelSize * c.axisV;
@@ -165,10 +165,10 @@ TEST(Lookup, FourAtATimeDiffuseLookupEqualsOneAtATimeBitForBit) {
         rays.t[k] = t[k];
       }
       F4 four[4];
-      exitantRadianceDiffuse4(lf.scene, c, shading, padded.data(), rays, uv, lod, four);
+      exitantRadianceDiffuse4(lf.scene, c, shading, padded.data(), rays, albedo, four);
       for (int k = 0; k < 4; ++k) {
         const Rgb one = f4Rgb(exitantRadianceLanes(lf.scene, c, shading, PaddedValues{padded.data()},
-                                                   origin[k] + t[k] * direction[k], -direction[k], c.normal, c.normal, uv[k], lod[k]));
+                                                   origin[k] + t[k] * direction[k], -direction[k], c.normal, c.normal, albedo[k]));
         const Rgb batch = f4Rgb(four[k]);
         for (int ch = 0; ch < 3; ++ch)
           ASSERT_EQ(std::bit_cast<uint32_t>(batch[ch]), std::bit_cast<uint32_t>(one[ch]))

@@ -145,6 +145,39 @@ constexpr uint8_t kTexturePixels = 0;       ///< i32 width, i32 height, u64 coun
 constexpr uint8_t kTextureEncodedFile = 1;  ///< u64 count, the image file's bytes (PNG/JPEG/TGA/BMP)
 /// Opens SCNE's optional surface-detail block ("SDTL" read as a little-endian u32).
 constexpr uint32_t kSurfaceDetailTag = 0x4c544453u;
+/// Opens SCNE's optional texturing block ("TXMP", version ≥ 5; plf_file.h).
+constexpr uint32_t kTexturingTag = 0x504d5854u;
+
+/// Whether a scene needs the texturing block: a second uv set, vertex colours, a texture
+/// mapping other than TEXCOORD_0 as it is, a metallic-roughness texture or a sampling other
+/// than repeat/bilinear/mip-mapped. Scenes without any keep the version-4 layout of SCNE.
+bool needsTexturingBlock(const Scene& scene) {
+  for (const Mesh& m : scene.meshes)
+    if (!m.uvs1.empty() || !m.colors.empty()) return true;
+  for (const Material& m : scene.materials)
+    if (!m.albedoMapping.isDefault() || !m.alphaMapping.isDefault() || !m.normalMapping.isDefault() ||
+        m.metallicRoughness.texture >= 0)
+      return true;
+  for (const Texture& t : scene.textures)
+    if (!t.sampling.isDefault()) return true;
+  return false;
+}
+
+void putMapping(ByteWriter& w, const TextureMapping& mapping) {
+  w.put(mapping.uvSet);
+  w.put(mapping.linear[0]);
+  w.put(mapping.linear[1]);
+  w.put(mapping.offset);
+}
+
+TextureMapping getMapping(ByteReader& r) {
+  TextureMapping mapping;
+  mapping.uvSet = r.get<uint8_t>();
+  mapping.linear[0] = r.get<Vec2>();
+  mapping.linear[1] = r.get<Vec2>();
+  mapping.offset = r.get<Vec2>();
+  return mapping;
+}
 
 std::vector<unsigned char> encodeScene(const Scene& scene) {
   ByteWriter w;
@@ -213,11 +246,13 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
   }
   w.put(uint8_t(scene.settings.camera.has_value()));
   w.putString(scene.settings.camera.value_or(""));
-  // Surface detail (plf_file.h): only when some material has an alpha mask or a normal map,
-  // so files without them keep the original layout byte for byte.
-  const bool detail = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) {
-    return m.isMasked() || m.normalTexture >= 0;
-  });
+  // Surface detail (plf_file.h): only when some material has an alpha mask or a normal map, or
+  // a texture is not colour (a metallic-roughness texture: data), so files without them keep
+  // the original layout byte for byte.
+  const bool detail = std::any_of(scene.materials.begin(), scene.materials.end(),
+                                  [](const Material& m) { return m.isMasked() || m.normalTexture >= 0; }) ||
+                      std::any_of(scene.textures.begin(), scene.textures.end(),
+                                  [](const Texture& t) { return t.decode != ImageDecode::Colour; });
   if (detail) {
     w.put(kSurfaceDetailTag);
     for (const Material& m : scene.materials) {
@@ -228,6 +263,28 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
       w.put(m.normalScale);
     }
     for (const Texture& t : scene.textures) w.put(uint8_t(t.decode));
+  }
+  if (needsTexturingBlock(scene)) {
+    w.put(kTexturingTag);
+    for (const Mesh& m : scene.meshes) {
+      w.putArray(m.uvs1);
+      w.putArray(m.colors);
+    }
+    for (const Material& m : scene.materials) {
+      for (const TextureMapping* mapping : {&m.albedoMapping, &m.alphaMapping, &m.normalMapping}) putMapping(w, *mapping);
+      const MetallicRoughnessMap& mr = m.metallicRoughness;
+      w.put(int32_t(mr.texture));
+      putMapping(w, mr.mapping);
+      w.put(mr.baseColor);
+      w.put(mr.metallic);
+      w.put(mr.roughness);
+    }
+    for (const Texture& t : scene.textures) {
+      w.put(uint8_t(t.sampling.wrapU));
+      w.put(uint8_t(t.sampling.wrapV));
+      w.put(uint8_t(t.sampling.nearest));
+      w.put(uint8_t(t.sampling.mipmaps));
+    }
   }
   return std::move(w.bytes());
 }
@@ -329,8 +386,11 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
   const bool hasCamera = r.get<uint8_t>() != 0;
   std::string camera = r.getString();
   if (hasCamera) scene.settings.camera = std::move(camera);
-  if (r.remaining() > 0) {
-    if (r.get<uint32_t>() != kSurfaceDetailTag) r.corrupt("unexpected bytes after the scene's settings");
+  uint32_t tag = r.remaining() > 0 ? r.get<uint32_t>() : 0;
+  if (tag != 0 && tag != kSurfaceDetailTag && !(tag == kTexturingTag && version >= 5))
+    r.corrupt("unexpected bytes after the scene's settings");
+  if (tag == kSurfaceDetailTag) {
+    tag = 0;
     for (Material& m : scene.materials) {
       m.alphaTexture = r.get<int32_t>();
       m.alphaFactor = r.get<float>();
@@ -343,6 +403,34 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
       if (decode > uint8_t(ImageDecode::Coverage))
         r.corrupt(fmt::format("texture '{}' has unknown decoding {}", t.path, decode));
       t.decode = ImageDecode(decode);
+    }
+    if (r.remaining() > 0) {
+      tag = r.get<uint32_t>();
+      if (!(tag == kTexturingTag && version >= 5)) r.corrupt("unexpected bytes after the surface-detail block");
+    }
+  }
+  if (tag == kTexturingTag) {
+    for (Mesh& m : scene.meshes) {
+      m.uvs1 = r.getArray<Vec2>("second uvs");
+      m.colors = r.getArray<Rgb>("vertex colours");
+    }
+    for (Material& m : scene.materials) {
+      for (TextureMapping* mapping : {&m.albedoMapping, &m.alphaMapping, &m.normalMapping}) *mapping = getMapping(r);
+      MetallicRoughnessMap& mr = m.metallicRoughness;
+      mr.texture = r.get<int32_t>();
+      mr.mapping = getMapping(r);
+      mr.baseColor = r.get<Rgb>();
+      mr.metallic = r.get<float>();
+      mr.roughness = r.get<float>();
+      if (const std::string problem = mappingProblem(m); !problem.empty())
+        r.corrupt(fmt::format("material '{}': {}", m.name, problem));
+    }
+    for (Texture& t : scene.textures) {
+      const uint8_t wrapU = r.get<uint8_t>(), wrapV = r.get<uint8_t>(), nearest = r.get<uint8_t>(), mipmaps = r.get<uint8_t>();
+      if (wrapU > uint8_t(TextureWrap::MirroredRepeat) || wrapV > uint8_t(TextureWrap::MirroredRepeat) || nearest > 1 ||
+          mipmaps > 1)
+        r.corrupt(fmt::format("texture '{}' has unknown sampling {} {} {} {}", t.path, wrapU, wrapV, nearest, mipmaps));
+      t.sampling = TextureSampling{TextureWrap(wrapU), TextureWrap(wrapV), nearest != 0, mipmaps != 0};
     }
   }
   r.expectEnd();
@@ -364,6 +452,7 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
   }
   // Embree reads 16 bytes at the last vertex: keep one element of padding (see scene.h).
   for (Mesh& m : scene.meshes) m.positions.reserve(m.positions.size() + 1);
+  markVertexColoredMaterials(scene);
   return scene;
 }
 

@@ -35,10 +35,18 @@
 //         ImageDecode says: the pixels the scene loader had) or (0) float32 RGB pixels
 //         (textures from HDR files); see encodeScene in plf_file.cpp. Optionally followed by
 //         a surface-detail block, written only when a material has an alpha mask or a normal
-//         map: u32 tag "SDTL", then per material i32 alphaTexture, f32 alphaFactor,
+//         map or a texture is not colour (version ≥ 5: a metallic-roughness texture): u32 tag "SDTL", then per material i32 alphaTexture, f32 alphaFactor,
 //         f32 alphaCutoff, i32 normalTexture, f32 normalScale, then per texture u8 ImageDecode
 //         (image.h: 0 colour, 1 data, 2 coverage). Without the block materials have no mask
-//         or normal map and textures are colour.
+//         or normal map and textures are colour. Then (version ≥ 5), only when the scene has a
+//         second uv set, vertex colours, a texture mapping other than TEXCOORD_0 as it is, a
+//         metallic-roughness texture or a texture sampling other than repeat/bilinear/mip-mapped
+//         (encodeScene's needsTexturingBlock), a texturing block: u32 tag "TXMP"; per mesh
+//         u64 count + Vec2 second uvs, u64 count + Rgb vertex colours; per material the albedo,
+//         alpha and normal mappings (TextureMapping: u8 uv set, 4 f32 linear part column by
+//         column, 2 f32 offset), i32 metallic-roughness texture, its mapping, Rgb base colour,
+//         f32 metallic, f32 roughness; per texture u8 wrapU, u8 wrapV (TextureWrap), u8 nearest,
+//         u8 mipmaps. Without it every mapping, map and sampling is the default.
 //   CHRT  the charts: u64 count, then fixed 85-byte records (see encodeCharts in plf_file.cpp).
 //         The kind byte's bit 4 (version ≥ 4) marks a glossy chart whose tixels keep their
 //         diffuse irradiance after their map (Chart::diffuseValue, lightfield.h); bit 3
@@ -58,10 +66,11 @@
 //   META  UTF-8 JSON: {"settings": BakeSettings, "stats": BakeStats}.
 //
 // Versions: 1 textures as float pixels; 2 textures as their image file's bytes; 3 an optional
-// SMSK section (sun masks); 4 glossy charts with a diffuse value per tixel (CHRT bit 4); 5
-// normal-mapped diffuse charts with tilted irradiances (CHRT bit 3). A file without sun masks
-// differs from version 2 only in the version field (and so the header hash); a version 3 file
-// from version 4, and a version 4 file from version 5, only there when no chart has the bit.
+// SMSK section (sun masks); 4 glossy charts with a diffuse value per tixel (CHRT bit 4); 5 the
+// SCNE texturing block and normal-mapped diffuse charts with tilted irradiances (CHRT bit 3). A
+// file without sun masks differs from version 2 only in the version field (and so the header
+// hash); a version 3 file from version 4 only there when no chart has the bit; a version 4 file
+// from version 5 only there when the scene has no texturing block and no chart has bit 3.
 //
 // The version is checked right after the magic, before anything else is interpreted, so a
 // future layout can change everything after it (versions 1 to kPlfVersion are read). Reading never trusts the file: the magic,
@@ -83,10 +92,12 @@ namespace pl {
 /// The version written. 2: textures store their image file's bytes (PNG/JPEG/…) instead of
 /// float pixels. 3: an optional SMSK section (sun masks). 4: glossy charts may keep a diffuse
 /// value per tixel (the textured-glossy fix; older files' glossy maps hold all of Lo, which
-/// is what a chart without it means). 5: normal-mapped diffuse charts may keep tilted
-/// irradiances per tixel (older files' show such charts flat, which is what a chart without
-/// them means). Readers also read versions 1 (the same as 2 but for the texture records), 2
-/// (as 3, never with SMSK), 3 (as 4, never with the chart bit) and 4 (as 5, never with bit 3).
+/// is what a chart without it means). 5: SCNE may end with a texturing block (glTF texture
+/// mappings, second uv sets, vertex colours, metallic-roughness textures, samplers), and
+/// normal-mapped diffuse charts may keep tilted irradiances per tixel (older files show such
+/// charts flat, which is what a chart without them means). Readers also read versions 1 (the
+/// same as 2 but for the texture records), 2 (as 3, never with SMSK), 3 (as 4, never with the
+/// chart bit) and 4 (as 5, never with the texturing block or CHRT bit 3).
 inline constexpr uint32_t kPlfVersion = 5;
 inline constexpr uint32_t kPlfOldestReadableVersion = 1;
 inline constexpr size_t kPlfHeaderSize = 32;

@@ -893,6 +893,61 @@ TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {
   expectRefused(file("decode.plf"), {"scene section", "unknown decoding 9"});
 }
 
+// The texturing block (version 5): second uv sets, vertex colours, texture mappings, a
+// metallic-roughness map and samplings round-trip; a wrap mode out of range is refused; a scene
+// without any of them has no block (its SCNE is the version-4 one).
+TEST_F(PlfFileTest, RoundTripKeepsTexturing) {
+  LightField original = makeTestLightField();
+  Scene& s = original.scene;
+  const std::string plainPath = file("plain.plf");
+  writeLightField(plainPath, original);
+  const uint64_t plainScene = sections(readBytes(plainPath))[0].size;
+  Mesh& quad = s.meshes[0];
+  quad.uvs1 = {{0.5f, 0}, {1, 0.25f}, {1, 1}, {0, 0.5f}};
+  quad.colors = {{1, 0.5f, 0.25f}, {0, 1, 1}, {0.5f, 0.5f, 0.5f}, {1, 1, 1}};
+  Material& ggx = s.materials[3];
+  ggx.albedoTexture = 1;
+  ggx.albedoMapping.uvSet = 1;
+  ggx.albedoMapping.linear = Mat2(Vec2(0.5f, 0.25f), Vec2(-0.25f, 2.0f));
+  ggx.albedoMapping.offset = Vec2(0.1f, -3.0f);
+  ggx.normalMapping.offset = Vec2(0.5f, 0.5f);
+  ggx.metallicRoughness = {1, ggx.albedoMapping, Rgb(0.9f, 0.8f, 0.7f), 0.6f, 0.3f};
+  s.textures[1].sampling = {TextureWrap::MirroredRepeat, TextureWrap::ClampToEdge, true, false};
+  // A data texture without alpha masks or normal maps: its decoding must come back too.
+  s.textures[1].decode = ImageDecode::Data;
+  s.textures[1].image = decodeLdrImage(*s.textures[1].encoded, "png", ImageDecode::Data);
+  const std::string path = file("texturing.plf");
+  writeLightField(path, original);
+  const LightField copy = readLightField(path);
+  EXPECT_EQ(copy.scene.meshes[0].uvs1, quad.uvs1);
+  EXPECT_EQ(copy.scene.meshes[0].colors, quad.colors);
+  EXPECT_TRUE(copy.scene.materials[0].vertexColored);  // derived on load
+  const Material& back = copy.scene.materials[3];
+  EXPECT_EQ(back.albedoMapping.uvSet, 1);
+  EXPECT_EQ(back.albedoMapping.linear, ggx.albedoMapping.linear);
+  EXPECT_EQ(back.albedoMapping.offset, ggx.albedoMapping.offset);
+  EXPECT_EQ(back.normalMapping.offset, ggx.normalMapping.offset);
+  EXPECT_EQ(back.metallicRoughness.texture, 1);
+  EXPECT_EQ(back.metallicRoughness.mapping.linear, ggx.albedoMapping.linear);
+  EXPECT_EQ(back.metallicRoughness.baseColor, ggx.metallicRoughness.baseColor);
+  EXPECT_EQ(back.metallicRoughness.metallic, 0.6f);
+  EXPECT_EQ(back.metallicRoughness.roughness, 0.3f);
+  EXPECT_TRUE(copy.scene.textures[1].sampling == s.textures[1].sampling);
+  EXPECT_TRUE(copy.scene.textures[0].sampling.isDefault());
+  EXPECT_EQ(copy.scene.textures[1].decode, ImageDecode::Data);
+  EXPECT_EQ(copy.scene.textures[1].image.pixels, s.textures[1].image.pixels);
+
+  // The block ends SCNE with 4 sampling bytes per texture: texture 1's wrapU set to 3 is refused.
+  const auto good = readBytes(path);
+  const auto table = sections(good);
+  EXPECT_GT(table[0].size, plainScene);
+  auto bad = good;
+  bad[table[0].offset + table[0].size - 4] = 3;
+  resign(bad);
+  writeBytes(file("wrap.plf"), bad);
+  expectRefused(file("wrap.plf"), {"scene section", "unknown sampling 3"});
+}
+
 // --- Sun masks (SMSK, version 3) -----------------------------------------------------------
 
 // makeTestLightField's scene has one directional light (lights[2]) and no thin glass, so

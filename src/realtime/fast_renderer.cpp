@@ -25,8 +25,7 @@ struct FastRenderer::Scratch {
   std::vector<uint32_t> pixel;     ///< per pixel of the tile (spp samples each): y·width + x
   std::vector<uint32_t> chart;     ///< per sample, after the prefetch pass: the chart record it sees
   // Per sample on a textured diffuse chart, after the prefetch pass: the hit's uv and albedo mip level.
-  std::vector<Vec2> uv;
-  std::vector<float> lod;
+  std::vector<AlbedoPoint> albedo;
   // The mirror wavefront: reflected rays, their sample and accumulated reflectance.
   std::vector<Ray> mirrorRays, nextRays;
   std::vector<RayHit> mirrorHits;
@@ -187,7 +186,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   auto chartOf = [&](size_t i) { return prefetched ? s.chart[i] : viewedChartOf(i); };
   if (prefetched) {
     s.chart.resize(n);
-    if (anyTexturedChart_) s.uv.resize(n), s.lod.resize(n);
+    if (anyTexturedChart_) s.albedo.resize(n);
     for (size_t i = 0; i < n; ++i) {
       const RayHit& hit = s.hits[i];
       if (!hit.hit()) continue;
@@ -218,13 +217,15 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       }
       // shading[chart].needsUv, from the (small, cached) material array: the shading record
       // prefetched above is still on its way (waiting for it here took 8 % of renderTile).
-      const int texture = scene.materials[c.material].albedoTexture;
-      if (c.kind != ChartKind::Diffuse || texture < 0) continue;
-      // lookupInputs' uv and level for this hit (the same functions: the same bits).
-      const Texture& albedo = scene.textures[size_t(texture)];
-      s.uv[i] = uvAt(scene.meshes[hit.mesh], hit.triangle, hit.barycentrics);
-      s.lod[i] = albedoTextureLod(scene.meshes[hit.mesh], hit.triangle, albedo, s.rays[i].direction, coneSpread * hit.t);
-      albedo.prefetch(s.uv[i], s.lod[i]);
+      const Material& material = scene.materials[c.material];
+      if (c.kind != ChartKind::Diffuse || !material.modelVaries()) continue;
+      // lookupInputs' albedo point for this hit (the same functions: the same bits).
+      s.albedo[i] = albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+      if (material.albedoTexture < 0) continue;
+      const Texture& albedo = scene.textures[size_t(material.albedoTexture)];
+      s.albedo[i].lod = albedoTextureLod(scene.meshes[hit.mesh], hit.triangle, albedo, material.albedoMapping,
+                                         s.rays[i].direction, coneSpread * hit.t);
+      albedo.prefetch(s.albedo[i].uv, s.albedo[i].lod);
     }
   }
   // Whether samples i … i+3 all hit one diffuse chart record (→ *chart).
@@ -239,8 +240,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     return true;
   };
   RaysSoA4 four;
-  Vec2 fourUv[4];
-  float fourLod[4];
+  AlbedoPoint fourAlbedo[4];
   Vec3 fourNormal[4];
   F4 fourRadiance[4];
   for (size_t i = 0; i < n;) {
@@ -256,14 +256,14 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       // into vectors, and the lookup's 16-byte loads of them then stall (measured on Cornell).
       // A textured chart: the uvs and levels of the prefetch pass (anyTexturedChart_ ran it).
       if (shading[chart].needsUv)
-        for (int k = 0; k < 4; ++k) fourUv[k] = s.uv[i + k], fourLod[k] = s.lod[i + k];
+        for (int k = 0; k < 4; ++k) fourAlbedo[k] = s.albedo[i + k];
       // A curved chart with sun masks: the normals the masked lights shine on (lookupInputs').
       const bool normals = needsInterpolatedNormal(charts[chart], shading[chart]);
       if (normals)
         for (int k = 0; k < 4; ++k)
           fourNormal[k] = lookupNormalAt(scene, charts[chart], shading[chart], s.hits[i + k].mesh, s.hits[i + k].triangle,
                                          s.hits[i + k].barycentrics);
-      exitantRadianceDiffuse4(scene, charts[chart], shading[chart], paddedValues_.data(), four, fourUv, fourLod,
+      exitantRadianceDiffuse4(scene, charts[chart], shading[chart], paddedValues_.data(), four, fourAlbedo,
                               fourRadiance, normals ? fourNormal : nullptr);
       for (int k = 0; k < 4; ++k) f4StoreRgb(out + s.pixel[i + k], f4Mul(f4Splat(s.weight[i + k]), fourRadiance[k]));
       i += 4;
@@ -281,13 +281,12 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     } else {
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
-        Vec2 uv;
-        float lod;
+        AlbedoPoint albedo;
         Vec3 lookup, lookupNormal, mappedNormal;
-        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * hit.t, uv, lod, lookup, lookupNormal,
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * hit.t, albedo, lookup, lookupNormal,
                      mappedNormal);
         F4 lanes = exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup,
-                                        lookupNormal, mappedNormal, uv, lod);
+                                        lookupNormal, mappedNormal, albedo);
         if (c.kind == ChartKind::Glossy && highlights_.active())  // lightfield.h "Punctual highlights"
           lanes = f4Add(lanes, f4FromRgb(highlights_.radiance(chart, hit, -ray.direction)));
         if (spp == 1) {
@@ -339,13 +338,12 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       if (chart == kNoChartRecord) continue;  // inside a closed smooth mesh: nothing seen
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
-        Vec2 uv;
-        float lod;
+        AlbedoPoint albedo;
         Vec3 lookup, lookupNormal, mappedNormal;
-        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * distance, uv, lod, lookup, lookupNormal,
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * distance, albedo, lookup, lookupNormal,
                      mappedNormal);
         s.radiance[slot] += throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction,
-                                                         lookup, lookupNormal, mappedNormal, uv, lod);
+                                                         lookup, lookupNormal, mappedNormal, albedo);
         if (c.kind == ChartKind::Glossy && highlights_.active())
           s.radiance[slot] += throughput * highlights_.radiance(chart, hit, -ray.direction);
         continue;

@@ -14,7 +14,7 @@
 //      t·ray.direction, the chart comes from LightField::triangleChart, and the radiance from
 //      exitantRadianceLanes() of lightfield/lookup.h with the chart's ChartShading precomputed
 //      once (the one 16-neighbour formula the reference also runs, in four SSE lanes;
-//      textured diffuse charts interpolate the hit's uv alone, uvAt, and only normal-mapped
+//      diffuse charts whose albedo varies interpolate the hit's albedo point alone, albedoPointAt, and only normal-mapped
 //      glossy charts build the SurfaceHit; curved glossy charts interpolate the hit's vertex
 //      normal alone, chartShadingNormalAt, to read their maps around it). With one sample per pixel, four consecutive
 //      samples on one diffuse chart go through exitantRadianceDiffuse4 together

@@ -241,8 +241,9 @@ TEST_F(RenderCliTest, RefusesBadInputWithoutWritingAnything) {
 // has none), quad-v3.plf by the version-3 writer (an optional sun-mask section, which the quad
 // without lights does not get, and "sun_masks" among the settings), quad-v4.plf by the
 // version-4 writer (a chart bit for glossy charts' diffuse values; the quad is diffuse),
-// quad-v5.plf by the version-5 writer (a chart bit for normal-mapped diffuse charts' tilted
-// irradiances; the quad has no normal map). They pin the format: a change of the byte layout without a new version number
+// quad-v5.plf by the version-5 writer (SCNE's texturing block, which the untextured quad does
+// not get, and a chart bit for normal-mapped diffuse charts, which it has not either). They
+// pin the format: a change of the byte layout without a new version number
 // fails here, and files of the older version must still read. Regenerate the current one
 // deliberately (after bumping kPlfVersion and keeping a reader for old files) with
 //   PLENOPTIC_REGENERATE_FIXTURES=1 ./render_cli_test --gtest_filter='*Fixture*'

@@ -5,18 +5,28 @@
 //    local transform is its `matrix` or T·R·S. Positions go through the world matrix M,
 //    normals through the inverse transpose of its upper 3×3, and a mirroring transform
 //    (det < 0) swaps the winding so the front side stays the front side.
-//  * Triangle primitives (mode 4) with POSITION, optional NORMAL and TEXCOORD_0 (float, or
-//    normalised unsigned byte/short), indexed or not. Other modes: warning, skipped.
+//  * Triangle primitives (mode 4) with POSITION, optional NORMAL, TEXCOORD_0, TEXCOORD_1
+//    (kept only where a material reads it) and COLOR_0 (float, or normalised unsigned
+//    byte/short; with KHR_mesh_quantization also signed and unnormalised integers), indexed or
+//    not, KHR_draco_mesh_compression- or EXT_meshopt_compression-compressed or plain
+//    (gltf_compression.h). Other modes: warning, skipped. A texture slot reading a TEXCOORD set
+//    the primitive lacks is an error naming the mesh and the material.
 //  * Metallic-roughness materials → GgxBsdf:
 //        diffuse = baseColor · (1 − metallic)
 //        f0      = mix(0.04, baseColor, metallic)        (0.04: dielectric F0 of the spec)
 //        alpha   = max(roughness², 1e-3)                 (GGX α; the floor keeps the
 //                                                         microfacet distribution finite)
-//    baseColor = baseColorFactor.rgb; baseColorTexture → albedo texture
-//    multiplying `diffuse` (so it tints dielectrics; a metal's f0 keeps the factor only), its
-//    sRGB 8/16-bit texels decoded to linear; v is flipped to our bottom-left convention
-//    (uv_ours = (u, 1 − v)) since glTF's (0,0) is the image's top-left. A primitive without a
+//    baseColor = baseColorFactor.rgb; baseColorTexture → albedo texture and COLOR_0 → vertex
+//    colours, both multiplying `diffuse` (so they tint dielectrics; a metal's f0 keeps the
+//    factor only), texels sRGB 8/16-bit decoded to linear; v is flipped to our bottom-left
+//    convention (uv_ours = (u, 1 − v)) since glTF's (0,0) is the image's top-left. A
+//    metallicRoughnessTexture makes the whole model per point instead (scene.h
+//    MetallicRoughnessMap; Material::bsdf keeps its mean, meanMetallicRoughnessModel). Every
+//    texture slot has its texCoord and KHR_texture_transform (mappingOf), every texture its
+//    sampler (samplingOf). occlusionTexture is checked and ignored. A primitive without a
 //    material gets the spec's default material (baseColor 1, metallic 1, roughness 1).
+//  * Extensions: those of supportedExtensions; one required but not supported is refused,
+//    naming it; those used but not supported are warned about once (checkExtensions).
 //  * KHR_materials_transmission (transmissionFactor > 0) → DielectricBsdf: index from
 //    KHR_materials_ior (default 1.5), transmittance = baseColor · transmissionFactor (a factor
 //    below 1 is absorbed rather than mixed with a diffuse base: warning), α = roughness²
@@ -42,19 +52,27 @@
 //    `range` is ignored (physically lights have no cut-off).
 #include "core/error.h"
 #include "core/file_io.h"
+#include "scene/gltf_compression.h"
 #include "scene/loaders.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
+#include <optional>
+#include <set>
+#include <span>
+#include <tuple>
 
 namespace pl::detail {
 
@@ -63,6 +81,43 @@ namespace {
 /// Photometric efficacy used to turn lumens into watts (see the header comment).
 constexpr double kLumensPerWatt = 683.0;
 
+constexpr const char* kDraco = "KHR_draco_mesh_compression";
+constexpr const char* kMeshopt = "EXT_meshopt_compression";
+
+/// The extensions this loader reads (docs/scenes.md): a file that requires another is refused.
+/// KHR_draco_mesh_compression and EXT_meshopt_compression join them where the build has their
+/// decoders (gltf_compression.h); a build without one refuses a file that requires it with the
+/// decoder's "built without … support", and reads the uncompressed fallback of one that only
+/// uses it.
+const std::set<std::string>& supportedExtensions() {
+  static const std::set<std::string> kSupported = [] {
+    std::set<std::string> names = {"KHR_lights_punctual",  "KHR_materials_emissive_strength",
+                                   "KHR_materials_ior",    "KHR_materials_transmission",
+                                   "KHR_materials_volume", "KHR_mesh_quantization",
+                                   "KHR_texture_transform"};
+    if (dracoSupported()) names.insert(kDraco);
+    if (meshoptSupported()) names.insert(kMeshopt);
+    return names;
+  }();
+  return kSupported;
+}
+
+/// Refuses a file that requires an extension we do not read (naming it), and warns once,
+/// listing them, about extensions it uses that we ignore (what they add is then missing).
+void checkExtensions(const std::string& path, const tinygltf::Model& model) {
+  const std::set<std::string>& supported = supportedExtensions();
+  for (const std::string& name : model.extensionsRequired)
+    if (!supported.contains(name) && name != kDraco && name != kMeshopt)
+      fail("{}: the file requires the glTF extension '{}', which plenoptic does not support (supported: {})", path,
+           name, fmt::join(supported, ", "));
+  std::vector<std::string> ignored;
+  for (const std::string& name : model.extensionsUsed)
+    if (!supported.contains(name) && std::find(ignored.begin(), ignored.end(), name) == ignored.end())
+      ignored.push_back(name);
+  if (!ignored.empty())
+    spdlog::warn("{}: ignoring glTF extension(s) the file uses but does not require: {}", path, fmt::join(ignored, ", "));
+}
+
 struct GltfContext {
   const std::string& path;
   const tinygltf::Model& model;
@@ -70,14 +125,20 @@ struct GltfContext {
   /// Each glTF image's encoded bytes (PNG/JPEG as in its file, data URI or buffer view), kept by
   /// keepEncodedImage instead of tinygltf's decoding; decoded by us when a material uses it.
   const std::vector<std::vector<unsigned char>>& encodedImages;
-  std::map<std::pair<int, ImageDecode>, int> textureOfImage;  ///< scene texture per (glTF image, decoding)
+  /// Scene texture per (glTF image, decoding, samplingKey of its sampler).
+  std::map<std::tuple<int, ImageDecode, int>, int> textureOfImage;
   int defaultMaterial = -1;
   int unnamedCameras = 0;
+  bool dracoRequired = false;  ///< the file lists KHR_draco_mesh_compression in extensionsRequired
 };
 
 /// Reads accessor `index` as `components` floats per element (float or normalised integers).
 std::vector<float> readFloats(const GltfContext& ctx, int index, int components, const char* what) {
   const tinygltf::Model& model = ctx.model;
+  // Unsigned integers read as normalised whatever the flag says, as before KHR_mesh_quantization
+  // (the core spec allows them only normalised); files using the extension get the flag's word.
+  const bool quantized = std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), "KHR_mesh_quantization") !=
+                         model.extensionsUsed.end();
   if (index < 0 || size_t(index) >= model.accessors.size())
     fail("{}: {} accessor {} does not exist", ctx.path, what, index);
   const tinygltf::Accessor& accessor = model.accessors[size_t(index)];
@@ -111,13 +172,28 @@ std::vector<float> readFloats(const GltfContext& ctx, int index, int components,
     for (int c = 0; c < components; ++c) {
       const unsigned char* p = element + size_t(c) * size_t(componentSize);
       float value;
+      // Integers: normalised ones (the core spec's TEXCOORD/COLOR types, and
+      // KHR_mesh_quantization's) as the spec maps them, c/max for unsigned and max(c/max, −1)
+      // for signed; others (KHR_mesh_quantization) as their value.
       switch (accessor.componentType) {
         case TINYGLTF_COMPONENT_TYPE_FLOAT: std::memcpy(&value, p, 4); break;
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: value = float(*p) / 255.0f; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: value = accessor.normalized || !quantized ? float(*p) / 255.0f : float(*p); break;
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
           uint16_t v;
           std::memcpy(&v, p, 2);
-          value = float(v) / 65535.0f;
+          value = accessor.normalized || !quantized ? float(v) / 65535.0f : float(v);
+          break;
+        }
+        case TINYGLTF_COMPONENT_TYPE_BYTE: {
+          int8_t v;
+          std::memcpy(&v, p, 1);
+          value = accessor.normalized ? std::max(float(v) / 127.0f, -1.0f) : float(v);
+          break;
+        }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: {
+          int16_t v;
+          std::memcpy(&v, p, 2);
+          value = accessor.normalized ? std::max(float(v) / 32767.0f, -1.0f) : float(v);
           break;
         }
         default: fail("{}: {} accessor {} has an unsupported component type {}", ctx.path, what, index,
@@ -224,20 +300,126 @@ bool textureHasAlpha(GltfContext& ctx, int textureIndex) {
   return std::any_of(alpha.pixels.begin(), alpha.pixels.end(), [](const Rgb& a) { return a.r < 1.0f; });
 }
 
+/// One sampler wrap mode (glTF's GL enum values) as ours.
+TextureWrap wrapMode(const GltfContext& ctx, int samplerIndex, int mode, const char* axis) {
+  switch (mode) {
+    case TINYGLTF_TEXTURE_WRAP_REPEAT: return TextureWrap::Repeat;
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return TextureWrap::ClampToEdge;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return TextureWrap::MirroredRepeat;
+    default:
+      fail("{}: sampler {}: {} {} is not a wrap mode (10497 REPEAT, 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT)",
+           ctx.path, samplerIndex, axis, mode);
+  }
+}
+
+/// The sampling of glTF texture `textureIndex` (its sampler; the defaults without one): wrapS
+/// → u, wrapT → v (the v flip maps each mode onto itself), magFilter NEAREST → nearest,
+/// minFilter NEAREST or LINEAR → no mip levels (texture.h TextureSampling).
+TextureSampling samplingOf(const GltfContext& ctx, int textureIndex) {
+  TextureSampling sampling;
+  const int samplerIndex = ctx.model.textures[size_t(textureIndex)].sampler;
+  if (samplerIndex < 0) return sampling;
+  if (size_t(samplerIndex) >= ctx.model.samplers.size())
+    fail("{}: texture {} uses sampler {} but the file has {}", ctx.path, textureIndex, samplerIndex,
+         ctx.model.samplers.size());
+  const tinygltf::Sampler& sampler = ctx.model.samplers[size_t(samplerIndex)];
+  sampling.wrapU = wrapMode(ctx, samplerIndex, sampler.wrapS, "wrapS");
+  sampling.wrapV = wrapMode(ctx, samplerIndex, sampler.wrapT, "wrapT");
+  sampling.nearest = sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
+  sampling.mipmaps = !(sampler.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST || sampler.minFilter == TINYGLTF_TEXTURE_FILTER_LINEAR);
+  return sampling;
+}
+
 /// The scene texture for glTF texture `textureIndex` decoded as `decode` (image.h): sRGB
-/// colour for baseColorTexture (glTF spec 3.9.2), raw values for normalTexture, the alpha
-/// channel for alpha masks. One scene texture per (image, decoding); it keeps the image's
-/// encoded bytes for the .plf.
+/// colour for baseColorTexture (glTF spec 3.9.2), raw values for normalTexture and
+/// metallicRoughnessTexture, the alpha channel for alpha masks, sampled as its sampler says.
+/// One scene texture per (image, decoding, sampling); it keeps the image's encoded bytes for
+/// the .plf.
 int textureFor(GltfContext& ctx, int textureIndex, ImageDecode decode = ImageDecode::Colour) {
   int source = 0;
   std::string label;
   const std::vector<unsigned char>& bytes = textureImageBytes(ctx, textureIndex, source, label);
-  if (auto it = ctx.textureOfImage.find({source, decode}); it != ctx.textureOfImage.end()) return it->second;
+  const TextureSampling sampling = samplingOf(ctx, textureIndex);
+  const int samplingKey = int(sampling.wrapU) | int(sampling.wrapV) << 2 | int(sampling.nearest) << 4 |
+                          int(sampling.mipmaps) << 5;
+  if (auto it = ctx.textureOfImage.find({source, decode, samplingKey}); it != ctx.textureOfImage.end()) return it->second;
   Texture texture = textureFromEncoded(label, bytes, fmt::format("{}: texture image '{}'", ctx.path, label), decode);
+  texture.sampling = sampling;
   const int ours = int(ctx.scene.textures.size());
   ctx.scene.textures.push_back(std::move(texture));
-  ctx.textureOfImage[{source, decode}] = ours;
+  ctx.textureOfImage[{source, decode, samplingKey}] = ours;
   return ours;
+}
+
+/// Fails unless texture `index` of material slot `slot` exists, naming the material.
+void checkTextureIndex(const GltfContext& ctx, const char* slot, int index, const std::string& material) {
+  if (index < 0 || size_t(index) >= ctx.model.textures.size())
+    fail("{}: material '{}': {} refers to texture {} but the file has {}", ctx.path, material, slot, index,
+         ctx.model.textures.size());
+}
+
+/// A texture slot of a material as the file gives it: the texture index, its texCoord and
+/// extensions (KHR_texture_transform).
+struct TextureSlotRef {
+  const char* slot;  ///< "baseColorTexture", … (for messages)
+  int index;
+  int texCoord;
+  const tinygltf::ExtensionMap& extensions;
+};
+
+/// The slot's TextureMapping, checked: the texture exists, the uv set is TEXCOORD_0 or
+/// TEXCOORD_1 (after KHR_texture_transform's own texCoord, which overrides the slot's).
+///
+/// KHR_texture_transform gives, in glTF's uv convention ((0,0) = the image's top left),
+///   uv' = T(offset) · R(rotation) · S(scale) · uv,   R = [cos r, sin r; −sin r, cos r]
+/// (rows; the extension's matrix, a rotation by −r). Ours has v flipped, uv_ours = F(uv) with
+/// F(u, v) = (u, 1 − v) = D·uv + e (D = diag(1, −1), e = (0, 1)), so in our convention the
+/// mapping is F ∘ (A·, + b) ∘ F with A = R·S, b = offset:
+///   linear = D·A·D,  offset = D·(A·e + b) + e.
+TextureMapping mappingOf(const GltfContext& ctx, const TextureSlotRef& slot, const std::string& material) {
+  checkTextureIndex(ctx, slot.slot, slot.index, material);
+  TextureMapping mapping;
+  int texCoord = slot.texCoord;
+  if (auto it = slot.extensions.find("KHR_texture_transform"); it != slot.extensions.end()) {
+    const tinygltf::Value& v = it->second;
+    auto pair = [&](const char* key, Vec2 fallback) {
+      if (!v.Has(key)) return fallback;
+      const tinygltf::Value& array = v.Get(key);
+      if (!array.IsArray() || array.ArrayLen() != 2 || !array.Get(0).IsNumber() || !array.Get(1).IsNumber())
+        fail("{}: material '{}': {} KHR_texture_transform.{} must be two numbers", ctx.path, material, slot.slot, key);
+      return Vec2(float(array.Get(0).GetNumberAsDouble()), float(array.Get(1).GetNumberAsDouble()));
+    };
+    const Vec2 offset = pair("offset", Vec2(0.0f)), scale = pair("scale", Vec2(1.0f));
+    float rotation = 0.0f;
+    if (v.Has("rotation")) {
+      if (!v.Get("rotation").IsNumber())
+        fail("{}: material '{}': {} KHR_texture_transform.rotation must be a number", ctx.path, material, slot.slot);
+      rotation = float(v.Get("rotation").GetNumberAsDouble());
+    }
+    if (v.Has("texCoord")) {
+      if (!v.Get("texCoord").IsInt())
+        fail("{}: material '{}': {} KHR_texture_transform.texCoord must be an integer", ctx.path, material, slot.slot);
+      texCoord = v.Get("texCoord").GetNumberAsInt();
+    }
+    const float c = std::cos(rotation), s = std::sin(rotation);
+    const Mat2 a(Vec2(c * scale.x, -s * scale.x), Vec2(s * scale.y, c * scale.y));  // columns of R·S
+    const Mat2 d(Vec2(1.0f, 0.0f), Vec2(0.0f, -1.0f));
+    const Vec2 e(0.0f, 1.0f);
+    mapping.linear = d * a * d;
+    mapping.offset = d * (a * e + offset) + e;
+    if (!std::isfinite(mapping.offset.x) || !std::isfinite(mapping.offset.y) || !isFinite(Vec3(mapping.linear[0], 0.0f)) ||
+        !isFinite(Vec3(mapping.linear[1], 0.0f)))
+      fail("{}: material '{}': {} KHR_texture_transform is not finite", ctx.path, material, slot.slot);
+  }
+  if (texCoord < 0 || texCoord > 1)
+    fail("{}: material '{}': {} reads TEXCOORD_{}; only TEXCOORD_0 and TEXCOORD_1 are supported", ctx.path, material,
+         slot.slot, texCoord);
+  mapping.uvSet = uint8_t(texCoord);
+  return mapping;
+}
+
+TextureSlotRef slotRef(const char* slot, const tinygltf::TextureInfo& info) {
+  return {slot, info.index, info.texCoord, info.extensions};
 }
 
 /// alphaMode MASK / BLEND → an alpha mask; normalTexture → a normal map (see the header).
@@ -251,15 +433,16 @@ void applyAlphaAndNormals(GltfContext& ctx, const tinygltf::Material& gltf, Mate
     if (!(material.alphaCutoff >= 0.0f && material.alphaCutoff <= 1.0f))
       fail("{}: material '{}': alphaCutoff {} must be in [0, 1]", ctx.path, material.name, gltf.alphaCutoff);
     material.alphaFactor = pbr.baseColorFactor.size() >= 4 ? std::clamp(float(pbr.baseColorFactor[3]), 0.0f, 1.0f) : 1.0f;
-    if (pbr.baseColorTexture.index >= 0 && textureHasAlpha(ctx, pbr.baseColorTexture.index))
+    if (pbr.baseColorTexture.index >= 0 && textureHasAlpha(ctx, pbr.baseColorTexture.index)) {
+      material.alphaMapping = mappingOf(ctx, slotRef("baseColorTexture", pbr.baseColorTexture), material.name);
       material.alphaTexture = textureFor(ctx, pbr.baseColorTexture.index, ImageDecode::Coverage);
+    }
   } else if (!gltf.alphaMode.empty() && gltf.alphaMode != "OPAQUE") {
     fail("{}: material '{}': unknown alphaMode '{}' (OPAQUE, MASK or BLEND)", ctx.path, material.name, gltf.alphaMode);
   }
   if (gltf.normalTexture.index >= 0) {
-    if (gltf.normalTexture.texCoord != 0)
-      spdlog::warn("{}: material '{}': normalTexture uses TEXCOORD_{}, only TEXCOORD_0 is read", ctx.path,
-                   material.name, gltf.normalTexture.texCoord);
+    const tinygltf::NormalTextureInfo& info = gltf.normalTexture;
+    material.normalMapping = mappingOf(ctx, {"normalTexture", info.index, info.texCoord, info.extensions}, material.name);
     material.normalTexture = textureFor(ctx, gltf.normalTexture.index, ImageDecode::Data);
     material.normalScale = float(gltf.normalTexture.scale);
   }
@@ -310,8 +493,43 @@ void applyTransmission(GltfContext& ctx, const tinygltf::Material& gltf, Materia
   if (material.albedoTexture >= 0) {
     spdlog::warn("{}: material '{}': baseColorTexture is ignored on a transmissive material", ctx.path, material.name);
     material.albedoTexture = -1;
+    material.albedoMapping = {};
+  }
+  if (material.metallicRoughness.texture >= 0) {
+    spdlog::warn("{}: material '{}': metallicRoughnessTexture is ignored on a transmissive material", ctx.path,
+                 material.name);
+    material.metallicRoughness = {};
   }
   material.bsdf = glass;
+}
+
+/// The one model a material with a metallic-roughness texture keeps (Material::bsdf) for what
+/// takes one model per material — the bake's glossy lobe and chart classification, the
+/// renderers' punctual highlights: the texture's mean over its texels of each GGX parameter,
+///   α = mean of ggxAlpha(roughness·G),  F0 = mean of mix(0.04, baseColor·ā, metallic·B),
+///   diffuse = baseColor·ā · (1 − mean of metallic·B)
+/// with ā the mean of the base colour texture (`albedo`, null without one: 1). The path
+/// tracer and the per-point diffuse albedo read the texels themselves (materialModelAt).
+GgxBsdf meanMetallicRoughnessModel(const Image& texels, const MetallicRoughnessMap& mr, const Image* albedo) {
+  glm::dvec3 albedoSum(0.0);
+  if (albedo)
+    for (const Rgb& a : albedo->pixels) albedoSum += glm::dvec3(a);
+  const Rgb base = albedo && !albedo->pixels.empty() ? mr.baseColor * Rgb(albedoSum / double(albedo->pixels.size()))
+                                                     : mr.baseColor;
+  double alpha = 0.0, metalness = 0.0;
+  glm::dvec3 f0(0.0);
+  for (const Rgb& t : texels.pixels) {
+    const GgxBsdf at = ggxFromMetallicRoughness(base, mr.metallic * t.b, mr.roughness * t.g);
+    alpha += at.alpha;
+    f0 += glm::dvec3(at.f0);
+    metalness += std::clamp(mr.metallic * t.b, 0.0f, 1.0f);
+  }
+  const double n = double(std::max<size_t>(1, texels.pixels.size()));
+  GgxBsdf mean;
+  mean.alpha = float(alpha / n);
+  mean.f0 = Rgb(f0 / n);
+  mean.diffuse = base * float(1.0 - metalness / n);
+  return mean;
 }
 
 Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int index) {
@@ -327,11 +545,25 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
   material.name = gltf.name.empty() ? fmt::format("material{}", index) : gltf.name;
   material.bsdf = ggxFromMetallicRoughness(baseColor, metallic, roughness);
   if (pbr.baseColorTexture.index >= 0) {
-    if (pbr.baseColorTexture.texCoord != 0)
-      spdlog::warn("{}: material '{}': baseColorTexture uses TEXCOORD_{}, only TEXCOORD_0 is read", ctx.path,
-                   material.name, pbr.baseColorTexture.texCoord);
+    material.albedoMapping = mappingOf(ctx, slotRef("baseColorTexture", pbr.baseColorTexture), material.name);
     material.albedoTexture = textureFor(ctx, pbr.baseColorTexture.index);
   }
+  if (pbr.metallicRoughnessTexture.index >= 0) {
+    // B = metalness, G = roughness, linear (spec 3.9.2), times the factors at each point.
+    MetallicRoughnessMap& mr = material.metallicRoughness;
+    mr.mapping = mappingOf(ctx, slotRef("metallicRoughnessTexture", pbr.metallicRoughnessTexture), material.name);
+    mr.texture = textureFor(ctx, pbr.metallicRoughnessTexture.index, ImageDecode::Data);
+    mr.baseColor = baseColor;
+    mr.metallic = metallic;
+    mr.roughness = roughness;
+    material.bsdf = meanMetallicRoughnessModel(
+        ctx.scene.textures[size_t(mr.texture)].image, mr,
+        material.albedoTexture >= 0 ? &ctx.scene.textures[size_t(material.albedoTexture)].image : nullptr);
+  }
+  // Occlusion is read (its texture must exist) and not used: the bake and the path tracer
+  // compute occlusion themselves (docs/scenes.md).
+  if (gltf.occlusionTexture.index >= 0)
+    checkTextureIndex(ctx, "occlusionTexture", gltf.occlusionTexture.index, material.name);
   applyTransmission(ctx, gltf, material, baseColor, roughness);
   applyAlphaAndNormals(ctx, gltf, material);
   if (gltf.emissiveFactor.size() >= 3) {
@@ -342,11 +574,92 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
     material.emission = strength * Rgb(float(gltf.emissiveFactor[0]), float(gltf.emissiveFactor[1]),
                                        float(gltf.emissiveFactor[2]));
   }
-  if (gltf.emissiveTexture.index >= 0)
+  if (gltf.emissiveTexture.index >= 0) {
+    checkTextureIndex(ctx, "emissiveTexture", gltf.emissiveTexture.index, material.name);
     spdlog::warn("{}: material '{}': emissiveTexture is not supported; emissiveFactor used alone", ctx.path,
                  material.name);
+  }
   material.twoSidedEmission = gltf.doubleSided;
   return material;
+}
+
+/// The bytes of buffer view `viewIndex`, checked against its buffer; `what` names it in messages.
+std::span<const unsigned char> bufferViewBytes(const tinygltf::Model& model, const std::string& path, int viewIndex,
+                                               const std::string& what) {
+  if (viewIndex < 0 || size_t(viewIndex) >= model.bufferViews.size())
+    fail("{}: {} refers to buffer view {} but the file has {}", path, what, viewIndex, model.bufferViews.size());
+  const tinygltf::BufferView& view = model.bufferViews[size_t(viewIndex)];
+  if (view.buffer < 0 || size_t(view.buffer) >= model.buffers.size())
+    fail("{}: buffer view {} refers to a missing buffer", path, viewIndex);
+  const std::vector<unsigned char>& data = model.buffers[size_t(view.buffer)].data;
+  if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset)
+    fail("{}: {}: buffer view {} runs past the end of its buffer", path, what, viewIndex);
+  return {data.data() + view.byteOffset, view.byteLength};
+}
+
+/// A KHR_draco_mesh_compression primitive decoded (gltf_compression.h): the extension object
+/// `extension` names the buffer view and each attribute's Draco id; `components` says which
+/// glTF attributes to read and with how many components (others are not read).
+DracoPrimitive decodeDracoPrimitive(const GltfContext& ctx, const tinygltf::Value& extension,
+                                    const tinygltf::Primitive& primitive, const std::map<std::string, int>& components,
+                                    const std::string& name) {
+  const std::string label = fmt::format("{}: mesh '{}'", ctx.path, name);
+  if (!extension.Has("bufferView") || !extension.Get("bufferView").IsInt() || !extension.Has("attributes") ||
+      !extension.Get("attributes").IsObject())
+    fail("{}: {} needs a bufferView and attributes", label, kDraco);
+  const std::span<const unsigned char> bytes =
+      bufferViewBytes(ctx.model, ctx.path, extension.Get("bufferView").GetNumberAsInt(), fmt::format("mesh '{}' ({})", name, kDraco));
+  std::map<std::string, int> ids;
+  const tinygltf::Value& attributes = extension.Get("attributes");
+  for (const std::string& key : attributes.Keys()) {
+    if (!components.contains(key) || !primitive.attributes.contains(key)) continue;
+    if (!attributes.Get(key).IsInt()) fail("{}: {} attribute {} is not an integer id", label, kDraco, key);
+    ids[key] = attributes.Get(key).GetNumberAsInt();
+  }
+  DracoPrimitive decoded = decodeDraco(bytes, ids, components, label);
+  if (decoded.indices.size() % 3 != 0 || decoded.vertexCount == 0)
+    fail("{}: the Draco buffer decodes to no triangles", label);
+  return decoded;
+}
+
+/// Decodes every EXT_meshopt_compression buffer view into a buffer of its own and points the
+/// view at it, so that the accessors read plain data (gltf_compression.h). Without meshopt in
+/// the build the views keep their uncompressed fallback, unless the file requires the
+/// extension (then decodeMeshopt refuses).
+void decodeMeshoptViews(const std::string& path, tinygltf::Model& model) {
+  const bool required = std::find(model.extensionsRequired.begin(), model.extensionsRequired.end(), kMeshopt) !=
+                        model.extensionsRequired.end();
+  for (size_t v = 0; v < model.bufferViews.size(); ++v) {
+    auto it = model.bufferViews[v].extensions.find(kMeshopt);
+    if (it == model.bufferViews[v].extensions.end() || !(meshoptSupported() || required)) continue;
+    const tinygltf::Value& e = it->second;
+    const std::string label = fmt::format("{}: buffer view {} ({})", path, v, kMeshopt);
+    auto integer = [&](const char* key, bool needed) -> size_t {
+      if (!e.Has(key)) {
+        if (needed) fail("{} lacks {}", label, key);
+        return 0;
+      }
+      if (!e.Get(key).IsInt() || e.Get(key).GetNumberAsInt() < 0) fail("{}: {} must be a non-negative integer", label, key);
+      return size_t(e.Get(key).GetNumberAsInt());
+    };
+    const size_t buffer = integer("buffer", true), offset = integer("byteOffset", false), length = integer("byteLength", true);
+    MeshoptView view;
+    view.byteStride = integer("byteStride", true);
+    view.count = integer("count", true);
+    view.mode = e.Has("mode") && e.Get("mode").IsString() ? e.Get("mode").Get<std::string>() : "";
+    view.filter = e.Has("filter") && e.Get("filter").IsString() ? e.Get("filter").Get<std::string>() : "NONE";
+    if (buffer >= model.buffers.size() || offset > model.buffers[buffer].data.size() ||
+        length > model.buffers[buffer].data.size() - offset)
+      fail("{}: its data lies outside buffer {}", label, buffer);
+    const unsigned char* source = model.buffers[buffer].data.data() + offset;
+    tinygltf::Buffer decoded;
+    decoded.data = decodeMeshopt({source, length}, view, label);
+    tinygltf::BufferView& target = model.bufferViews[v];
+    if (target.byteLength > decoded.data.size()) fail("{}: decodes to fewer bytes than the view's byteLength", label);
+    target.buffer = int(model.buffers.size());
+    target.byteOffset = 0;
+    model.buffers.push_back(std::move(decoded));
+  }
 }
 
 void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const Mat4& world, const std::string& name) {
@@ -361,29 +674,91 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
   };
   const int positionAccessor = attribute("POSITION");
   if (positionAccessor < 0) fail("{}: mesh '{}' has a primitive without POSITION", ctx.path, name);
+  auto componentsOf = [&](int accessor) {
+    return size_t(accessor) < ctx.model.accessors.size() && ctx.model.accessors[size_t(accessor)].type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+  };
+  // A Draco-compressed primitive: its attributes and indices from the decoded mesh (the
+  // accessors then give only counts and types); without Draco in the build and the extension
+  // not required, the accessors' uncompressed fallback.
+  std::optional<DracoPrimitive> draco;
+  if (auto it = primitive.extensions.find(kDraco); it != primitive.extensions.end() && (dracoSupported() || ctx.dracoRequired))
+    draco = decodeDracoPrimitive(ctx, it->second, primitive,
+                                 {{"POSITION", 3}, {"NORMAL", 3}, {"TEXCOORD_0", 2}, {"TEXCOORD_1", 2},
+                                  {"COLOR_0", componentsOf(attribute("COLOR_0"))}},
+                                 name);
+  auto floatsOf = [&](int accessor, int components, const char* key) {
+    if (draco) {
+      auto found = draco->attributes.find(key);
+      if (found != draco->attributes.end()) return found->second;
+    }
+    return readFloats(ctx, accessor, components, key);
+  };
 
   Mesh mesh;
   mesh.name = name;
-  const std::vector<float> positions = readFloats(ctx, positionAccessor, 3, "POSITION");
+  const std::vector<float> positions = floatsOf(positionAccessor, 3, "POSITION");
   const size_t vertexCount = positions.size() / 3;
   const Mat3 linear(world);
   const Mat3 normalMatrix = glm::transpose(glm::inverse(linear));
   for (size_t v = 0; v < vertexCount; ++v)
     mesh.positions.push_back(Vec3(world * Vec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0f)));
   if (const int normalAccessor = attribute("NORMAL"); normalAccessor >= 0) {
-    const std::vector<float> normals = readFloats(ctx, normalAccessor, 3, "NORMAL");
+    const std::vector<float> normals = floatsOf(normalAccessor, 3, "NORMAL");
     if (normals.size() != positions.size()) fail("{}: mesh '{}': NORMAL and POSITION counts differ", ctx.path, name);
     for (size_t v = 0; v < vertexCount; ++v)
       mesh.normals.push_back(normalMatrix * Vec3(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]));
   }
-  if (const int uvAccessor = attribute("TEXCOORD_0"); uvAccessor >= 0) {
-    const std::vector<float> uvs = readFloats(ctx, uvAccessor, 2, "TEXCOORD_0");
-    if (uvs.size() / 2 != vertexCount) fail("{}: mesh '{}': TEXCOORD_0 and POSITION counts differ", ctx.path, name);
-    for (size_t v = 0; v < vertexCount; ++v) mesh.uvs.push_back(Vec2(uvs[2 * v], 1.0f - uvs[2 * v + 1]));
+  // The material first: which uv sets its textures read (a set they read must be there).
+  if (primitive.material >= 0 && size_t(primitive.material) >= ctx.model.materials.size())
+    fail("{}: mesh '{}' uses material {} but the file has {}", ctx.path, name, primitive.material,
+         ctx.model.materials.size());
+  bool readsSet[2] = {false, false};
+  if (primitive.material >= 0) {
+    const Material& m = ctx.scene.materials[size_t(primitive.material)];
+    const std::pair<int, const TextureMapping*> slots[] = {{m.albedoTexture, &m.albedoMapping},
+                                                          {m.alphaTexture, &m.alphaMapping},
+                                                          {m.normalTexture, &m.normalMapping},
+                                                          {m.metallicRoughness.texture, &m.metallicRoughness.mapping}};
+    for (const auto& [texture, mapping] : slots)
+      if (texture >= 0) readsSet[mapping->uvSet] = true;
+    for (int set = 0; set < 2; ++set)
+      if (readsSet[set] && attribute(set == 0 ? "TEXCOORD_0" : "TEXCOORD_1") < 0)
+        fail("{}: mesh '{}': its material '{}' reads TEXCOORD_{}, which the primitive does not have", ctx.path, name,
+             m.name, set);
+  }
+  // TEXCOORD_0 always (the barycentrics stand in without it); TEXCOORD_1 only where read.
+  for (int set = 0; set < 2; ++set) {
+    const char* key = set == 0 ? "TEXCOORD_0" : "TEXCOORD_1";
+    const int uvAccessor = attribute(key);
+    if (uvAccessor < 0 || (set == 1 && !readsSet[1])) continue;
+    const std::vector<float> uvs = floatsOf(uvAccessor, 2, key);
+    if (uvs.size() / 2 != vertexCount) fail("{}: mesh '{}': {} and POSITION counts differ", ctx.path, name, key);
+    std::vector<Vec2>& target = set == 0 ? mesh.uvs : mesh.uvs1;
+    for (size_t v = 0; v < vertexCount; ++v) target.push_back(Vec2(uvs[2 * v], 1.0f - uvs[2 * v + 1]));
+  }
+  // COLOR_0 (RGB or RGBA, linear; alpha not read) multiplies the base colour. All white is
+  // the same as none, which keeps the material's albedo constant (exporters often write it).
+  if (const int colorAccessor = attribute("COLOR_0"); colorAccessor >= 0) {
+    const int components = componentsOf(colorAccessor);
+    const std::vector<float> colors = floatsOf(colorAccessor, components, "COLOR_0");
+    if (colors.size() / size_t(components) != vertexCount)
+      fail("{}: mesh '{}': COLOR_0 and POSITION counts differ", ctx.path, name);
+    bool clamped = false, white = true;
+    for (size_t v = 0; v < vertexCount; ++v) {
+      const Rgb c(colors[size_t(components) * v], colors[size_t(components) * v + 1], colors[size_t(components) * v + 2]);
+      const Rgb kept = glm::clamp(c, 0.0f, 1.0f);
+      if (!isFinite(c)) fail("{}: mesh '{}': COLOR_0 {} is not finite", ctx.path, name, v);
+      clamped = clamped || kept != c;
+      white = white && kept == Rgb(1.0f);
+      mesh.colors.push_back(kept);
+    }
+    if (clamped) spdlog::warn("{}: mesh '{}': COLOR_0 values outside [0, 1] clamped", ctx.path, name);
+    if (white) mesh.colors.clear();
   }
 
   std::vector<uint32_t> indices;
-  if (primitive.indices >= 0) indices = readIndices(ctx, primitive.indices);
+  if (draco) indices = std::move(draco->indices);
+  else if (primitive.indices >= 0) indices = readIndices(ctx, primitive.indices);
   else {
     indices.resize(vertexCount);
     for (size_t i = 0; i < vertexCount; ++i) indices[i] = uint32_t(i);
@@ -393,9 +768,6 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
 
   uint32_t material;
   if (primitive.material >= 0) {
-    if (size_t(primitive.material) >= ctx.model.materials.size())
-      fail("{}: mesh '{}' uses material {} but the file has {}", ctx.path, name, primitive.material,
-           ctx.model.materials.size());
     material = uint32_t(primitive.material);
   } else {
     if (ctx.defaultMaterial < 0) {
@@ -512,6 +884,62 @@ bool keepEncodedImage(tinygltf::Image* image, const int imageIndex, std::string*
   return true;
 }
 
+/// tinygltf refuses an index accessor without a buffer view, which is what an exporter writes
+/// for a KHR_draco_mesh_compression primitive (its indices are in the Draco stream). So when a
+/// file mentions the extension, such accessors get their primitive's Draco buffer view before
+/// tinygltf parses the JSON; their data is never read (decodeDracoPrimitive replaces it). Returns
+/// the file's bytes so patched (a .glb with its JSON chunk rebuilt), or "" when nothing needs it
+/// (then tinygltf reads the file itself, and reports whatever is wrong with it).
+std::string dracoPatchedFile(const std::string& path, bool binary) {
+  // The JSON alone first (a .glb's first chunk): the binary chunk is read only when patching.
+  std::ifstream in(path, std::ios::binary);
+  std::string header(binary ? 20 : 0, '\0'), text;
+  uint32_t jsonLength = 0;
+  if (binary) {
+    if (!in.read(header.data(), 20) || header.compare(0, 4, "glTF") != 0 || header.compare(16, 4, "JSON") != 0) return "";
+    std::memcpy(&jsonLength, header.data() + 12, 4);
+    std::error_code ec;
+    const uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec || jsonLength > size - 20) return "";  // a lying length: tinygltf reports the file
+    text.resize(jsonLength);
+    if (!in.read(text.data(), std::streamsize(jsonLength))) return "";
+  } else {
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  if (text.find(kDraco) == std::string::npos) return "";
+  nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array() || !doc.contains("accessors") ||
+      !doc["accessors"].is_array())
+    return "";
+  nlohmann::json& accessors = doc["accessors"];
+  bool patched = false;
+  for (nlohmann::json& mesh : doc["meshes"]) {
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    for (nlohmann::json& primitive : mesh["primitives"]) {
+      if (!primitive.is_object() || !primitive.contains("indices") || !primitive["indices"].is_number_unsigned()) continue;
+      const auto extensions = primitive.find("extensions");
+      if (extensions == primitive.end() || !extensions->is_object() || !extensions->contains(kDraco)) continue;
+      const nlohmann::json& draco = (*extensions)[kDraco];
+      if (!draco.is_object() || !draco.contains("bufferView") || !draco["bufferView"].is_number_unsigned()) continue;
+      const size_t index = primitive["indices"].get<size_t>();
+      if (index >= accessors.size() || !accessors[index].is_object() || accessors[index].contains("bufferView")) continue;
+      accessors[index]["bufferView"] = draco["bufferView"];
+      patched = true;
+    }
+  }
+  if (!patched) return "";
+  std::string json = doc.dump();
+  if (!binary) return json;
+  const std::string rest((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  while (json.size() % 4 != 0) json += ' ';  // GLB chunks are 4-byte aligned
+  std::string glb = header.substr(0, 12);
+  const uint32_t total = uint32_t(20 + json.size() + rest.size()), length = uint32_t(json.size());
+  std::memcpy(glb.data() + 8, &total, 4);
+  glb.append(reinterpret_cast<const char*>(&length), 4);
+  glb += "JSON";
+  return glb + json + rest;
+}
+
 }  // namespace
 
 Scene loadGltf(const std::string& path) {
@@ -525,8 +953,16 @@ Scene loadGltf(const std::string& path) {
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   bool ok = false;
   try {
-    ok = extension == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                             : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+    const bool binary = extension == ".glb";
+    if (const std::string patched = dracoPatchedFile(path, binary); !patched.empty()) {
+      const std::string baseDir = std::filesystem::path(path).parent_path().string();
+      ok = binary ? loader.LoadBinaryFromMemory(&model, &error, &warning, reinterpret_cast<const unsigned char*>(patched.data()),
+                                                unsigned(patched.size()), baseDir)
+                  : loader.LoadASCIIFromString(&model, &error, &warning, patched.data(), unsigned(patched.size()), baseDir);
+    } else {
+      ok = binary ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
+                  : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+    }
   } catch (const std::exception& e) {
     // tinygltf mostly reports through `error`, but some malformed files make it (or the JSON
     // library inside it) throw, e.g. std::out_of_range on a GLB whose chunk lengths lie.
@@ -538,10 +974,14 @@ Scene loadGltf(const std::string& path) {
     while (!error.empty() && (error.back() == '\n' || error.back() == '\r')) error.pop_back();
     fail("{}: not a valid glTF file: {}", path, error.empty() ? "unknown error" : error);
   }
+  checkExtensions(path, model);
+  decodeMeshoptViews(path, model);
 
   Scene scene;
   scene.sourcePath = path;
   GltfContext ctx{path, model, scene, encodedImages.bytes, {}};
+  ctx.dracoRequired = std::find(model.extensionsRequired.begin(), model.extensionsRequired.end(), kDraco) !=
+                      model.extensionsRequired.end();
   for (size_t m = 0; m < model.materials.size(); ++m)
     scene.materials.push_back(convertMaterial(ctx, model.materials[m], int(m)));
 

@@ -23,7 +23,8 @@ void appendScene(Scene& scene, Scene&& part) {
   const auto materialOffset = uint32_t(scene.materials.size());
   const auto textureOffset = int(scene.textures.size());
   for (Material& material : part.materials) {
-    for (int* texture : {&material.albedoTexture, &material.alphaTexture, &material.normalTexture})
+    for (int* texture :
+         {&material.albedoTexture, &material.alphaTexture, &material.normalTexture, &material.metallicRoughness.texture})
       if (*texture >= 0) *texture += textureOffset;
     scene.materials.push_back(std::move(material));
   }

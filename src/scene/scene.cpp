@@ -36,6 +36,31 @@ void validateLights(const Scene& scene) {
 
 }  // namespace
 
+std::string mappingProblem(const Material& material) {
+  const std::pair<const char*, const TextureMapping*> slots[] = {{"albedo", &material.albedoMapping},
+                                                                 {"alpha", &material.alphaMapping},
+                                                                 {"normal", &material.normalMapping},
+                                                                 {"metallic-roughness", &material.metallicRoughness.mapping}};
+  for (const auto& [slot, mapping] : slots) {
+    if (mapping->uvSet > 1) return fmt::format("the {} texture reads uv set {} (0 or 1)", slot, mapping->uvSet);
+    if (!isFinite2(mapping->offset) || !isFinite2(mapping->linear[0]) || !isFinite2(mapping->linear[1]))
+      return fmt::format("the {} texture's uv transform is not finite", slot);
+  }
+  const MetallicRoughnessMap& mr = material.metallicRoughness;
+  if (mr.texture >= 0 && !(std::holds_alternative<GgxBsdf>(material.bsdf) && isFinite(mr.baseColor) &&
+                           mr.metallic >= 0.0f && mr.metallic <= 1.0f && mr.roughness >= 0.0f && mr.roughness <= 1.0f))
+    return "a metallic-roughness texture needs a GGX model and factors in [0, 1]";
+  return "";
+}
+
+void markVertexColoredMaterials(Scene& scene) {
+  for (Material& material : scene.materials) material.vertexColored = false;
+  for (const Mesh& mesh : scene.meshes)
+    if (!mesh.colors.empty())
+      for (const uint32_t material : mesh.materials)
+        if (material < scene.materials.size()) scene.materials[material].vertexColored = true;
+}
+
 /// The model's own validation (bsdf.h bsdfProblem), prefixed with the file and material.
 void validateMaterial(const Material& material, const std::string& sourcePath) {
   if (const std::string problem = bsdfProblem(material.bsdf); !problem.empty())
@@ -60,10 +85,13 @@ void checkScene(const Scene& scene) {
       fail("{}: material '{}' has an emission {} above {:g} W/(sr m^2), too large to compute with", src,
            material.name, vecString(material.emission), kMaxEmission);
     validateMaterial(material, src);
-    for (const int texture : {material.albedoTexture, material.alphaTexture, material.normalTexture})
+    for (const int texture :
+         {material.albedoTexture, material.alphaTexture, material.normalTexture, material.metallicRoughness.texture})
       if (texture < -1 || texture >= int64_t(scene.textures.size()))
         fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name, texture,
              scene.textures.size());
+    if (const std::string problem = mappingProblem(material); !problem.empty())
+      fail("{}: material '{}': {}", src, material.name, problem);
     if (!(material.alphaFactor >= 0.0f && material.alphaFactor <= 1.0f) ||
         !(material.alphaCutoff >= 0.0f && material.alphaCutoff <= 1.0f))
       fail("{}: material '{}' has alpha {} and alpha cutoff {}; both must be in [0, 1]", src, material.name,
@@ -80,6 +108,17 @@ void checkScene(const Scene& scene) {
     if (!mesh.uvs.empty() && mesh.uvs.size() != vertexCount)
       fail("{}: mesh '{}' has {} texture coordinates for {} vertices", src, mesh.name, mesh.uvs.size(),
            vertexCount);
+    if (!mesh.uvs1.empty() && mesh.uvs1.size() != vertexCount)
+      fail("{}: mesh '{}' has {} second texture coordinates for {} vertices", src, mesh.name, mesh.uvs1.size(),
+           vertexCount);
+    if (!mesh.colors.empty() && mesh.colors.size() != vertexCount)
+      fail("{}: mesh '{}' has {} vertex colours for {} vertices", src, mesh.name, mesh.colors.size(), vertexCount);
+    for (size_t v = 0; v < mesh.uvs1.size(); ++v)
+      if (!isFinite2(mesh.uvs1[v])) fail("{}: mesh '{}': second texture coordinate {} is not finite", src, mesh.name, v);
+    for (size_t v = 0; v < mesh.colors.size(); ++v)
+      if (!isFinite(mesh.colors[v]) || glm::any(glm::lessThan(mesh.colors[v], Rgb(0.0f))) ||
+          maxComponent(mesh.colors[v]) > 1.0f)
+        fail("{}: mesh '{}': vertex colour {} is {}, outside [0, 1]", src, mesh.name, v, vecString(mesh.colors[v]));
     if (mesh.materials.size() != mesh.triangles.size())
       fail("{}: mesh '{}' has {} material indices for {} triangles", src, mesh.name, mesh.materials.size(),
            mesh.triangles.size());
@@ -159,6 +198,7 @@ void Scene::finalize() {
   }
   std::erase_if(meshes, [](const Mesh& mesh) { return mesh.triangles.empty(); });
   if (meshes.empty()) fail("{}: all {} triangles are degenerate (zero area)", src, totalBefore);
+  markVertexColoredMaterials(*this);
   if (dropped > 0)
     spdlog::warn("{}: dropped {} degenerate (zero-area) triangle(s) of {}", src, dropped, totalBefore);
 
@@ -252,11 +292,16 @@ SurfaceHit surfaceAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, 
   // Without texture coordinates uv are the barycentrics, so a texture still maps somewhere.
   hit.uv = uvAt(mesh, triangle, barycentrics);
   const Material& material = scene.materials[hit.material];
-  if (material.normalTexture >= 0 && !mesh.uvs.empty()) {
+  const TextureMapping& normalMapping = material.normalMapping;
+  const std::vector<Vec2>& normalUvs = normalMapping.uvSet == 1 ? mesh.uvs1 : mesh.uvs;
+  if (material.normalTexture >= 0 && !normalUvs.empty()) {
     const Vec3 p[3] = {p0, p1, p2};
-    const Vec2 uv[3] = {mesh.uvs[tri.x], mesh.uvs[tri.y], mesh.uvs[tri.z]};
+    // The frame from the uvs the map is read with (an affine transform keeps the derivation).
+    const Vec2 uv[3] = {normalMapping.apply(normalUvs[tri.x]), normalMapping.apply(normalUvs[tri.y]),
+                        normalMapping.apply(normalUvs[tri.z])};
+    const Vec2 at = normalMapping.isDefault() ? hit.uv : uvAt(mesh, triangle, barycentrics, normalMapping);
     hit.shadingNormal = normalMapped(hit.shadingNormal, hit.geometricNormal, p, uv,
-                                     scene.textures[size_t(material.normalTexture)].sample(hit.uv), material.normalScale);
+                                     scene.textures[size_t(material.normalTexture)].sample(at), material.normalScale);
   }
   return hit;
 }
@@ -289,14 +334,41 @@ float coverageAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, Vec2
   const Material& material = scene.materials[mesh.materials[triangle]];
   if (material.alphaTexture < 0) return material.alphaFactor;
   // Only uv is needed (this runs per candidate hit inside Embree's traversal).
-  return material.alphaFactor * scene.textures[size_t(material.alphaTexture)].sample(uvAt(mesh, triangle, barycentrics)).r;
+  return material.alphaFactor *
+         scene.textures[size_t(material.alphaTexture)].sample(uvAt(mesh, triangle, barycentrics, material.alphaMapping)).r;
+}
+
+AlbedoPoint albedoPointAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, Vec2 barycentrics) {
+  const Mesh& mesh = scene.meshes[meshIndex];
+  const Material& material = scene.materials[mesh.materials[triangle]];
+  AlbedoPoint p;
+  p.uv = uvAt(mesh, triangle, barycentrics, material.albedoMapping);
+  p.vertexColor = vertexColorAt(mesh, triangle, barycentrics);
+  if (material.metallicRoughness.texture >= 0)
+    p.metallicRoughnessUv = uvAt(mesh, triangle, barycentrics, material.metallicRoughness.mapping);
+  return p;
+}
+
+Rgb albedoModulation(const Scene& scene, const Material& material, const AlbedoPoint& p) {
+  if (material.albedoTexture < 0) return p.vertexColor;
+  return scene.textures[size_t(material.albedoTexture)].sampleLod(p.uv, p.lod) * p.vertexColor;
+}
+
+Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p) {
+  const MetallicRoughnessMap& mr = material.metallicRoughness;
+  if (!material.modelVaries()) return material.bsdf;
+  const Rgb modulation = albedoModulation(scene, material, p);
+  if (mr.texture >= 0) {
+    const Rgb texel = scene.textures[size_t(mr.texture)].sample(p.metallicRoughnessUv);
+    return ggxFromMetallicRoughness(mr.baseColor * modulation, mr.metallic * texel.b, mr.roughness * texel.g);
+  }
+  return withDiffuseAlbedo(material.bsdf, diffuseAlbedo(material.bsdf) * modulation);
 }
 
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit) {
   const Material& material = scene.materials[hit.material];
-  if (material.albedoTexture < 0) return material.bsdf;
-  const Rgb texel = scene.textures[size_t(material.albedoTexture)].sample(hit.uv);
-  return withDiffuseAlbedo(material.bsdf, diffuseAlbedo(material.bsdf) * texel);
+  if (!material.modelVaries()) return material.bsdf;
+  return materialModelAt(scene, material, albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics));
 }
 
 ScatteringFrame scatteringFrame(const SurfaceHit& surface, const Vec3& wo, const Bsdf& bsdf) {

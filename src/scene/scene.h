@@ -18,6 +18,31 @@
 
 namespace pl {
 
+/// How a material slot maps a surface point to its texture: which of the mesh's uv sets it
+/// reads (0 = Mesh::uvs, 1 = Mesh::uvs1; glTF `texCoord`) and an affine transform applied
+/// to it (glTF KHR_texture_transform), uv' = linear · uv + offset, in our bottom-left uv
+/// convention (the glTF loader converts the extension's top-left one). The default is
+/// TEXCOORD_0 as it is.
+struct TextureMapping {
+  uint8_t uvSet = 0;
+  Mat2 linear{1.0f};
+  Vec2 offset{0.0f};
+  Vec2 apply(Vec2 uv) const { return linear * uv + offset; }
+  bool isDefault() const { return uvSet == 0 && linear == Mat2(1.0f) && offset == Vec2(0.0f); }
+};
+
+/// A metallic-roughness texture (glTF pbrMetallicRoughness.metallicRoughnessTexture) on a
+/// GgxBsdf material: at each point the model is ggxFromMetallicRoughness(baseColor ×
+/// albedo modulation (albedoModulation), metallic × B, roughness × G), B and G the texel's
+/// blue and green channels (raw values), the factors the material's own. `texture` is an
+/// index into Scene::textures (ImageDecode::Data) or −1 (none: the material's bsdf as it is).
+struct MetallicRoughnessMap {
+  int texture = -1;
+  TextureMapping mapping;
+  Rgb baseColor{1.0f};
+  float metallic = 1.0f, roughness = 1.0f;
+};
+
 struct Material {
   std::string name;
   Bsdf bsdf = LambertBsdf{};
@@ -42,8 +67,23 @@ struct Material {
   /// Light-field tixel density relative to the bake preset's (2 = tixels half as wide); a
   /// JSON scene's "tixel_density". Only the bake's parameterisation reads it.
   float tixelDensity = 1.0f;
+  /// The uv set and transform each texture slot reads (TextureMapping; all default outside
+  /// glTF). The alpha mask's is the albedo texture's in glTF (both are baseColorTexture).
+  TextureMapping albedoMapping, alphaMapping, normalMapping;
+  /// Per-point metalness and roughness (glTF only); see MetallicRoughnessMap.
+  MetallicRoughnessMap metallicRoughness;
+  /// Derived, not stored: whether a mesh with vertex colours (Mesh::colors) uses the material,
+  /// so that its albedo varies over a surface even without a texture. Scene::finalize and the
+  /// .plf reader set it (markVertexColoredMaterials).
+  bool vertexColored = false;
 
   bool isEmissive() const { return !isBlack(emission); }
+  /// Whether the diffuse albedo varies over the surface (a texture or vertex colours): the
+  /// renderers then read it per pixel (albedoModulation) instead of once per chart.
+  bool albedoVaries() const { return albedoTexture >= 0 || vertexColored; }
+  /// Whether the model varies over the surface at all (its albedo, or a metallic-roughness
+  /// texture): materialModelAt is then needed per point.
+  bool modelVaries() const { return albedoVaries() || metallicRoughness.texture >= 0; }
   /// Whether some of the surface may be cut away (the Accel filters hits on it).
   bool isMasked() const { return alphaTexture >= 0 || alphaFactor < alphaCutoff; }
 };
@@ -77,6 +117,12 @@ struct Mesh {
   std::vector<Vec3> positions;
   std::vector<Vec3> normals;  ///< empty, or one per vertex (unit length)
   std::vector<Vec2> uvs;      ///< empty, or one per vertex
+  /// A second uv set (glTF TEXCOORD_1), empty or one per vertex: read by the texture slots
+  /// whose TextureMapping::uvSet is 1.
+  std::vector<Vec2> uvs1;
+  /// Linear RGB vertex colours (glTF COLOR_0), empty or one per vertex in [0, 1]: they
+  /// multiply the diffuse albedo (albedoModulation), interpolated over each triangle.
+  std::vector<Rgb> colors;
   std::vector<UVec3> triangles;
   std::vector<uint32_t> materials;  ///< one per triangle, index into Scene::materials
 };
@@ -227,6 +273,60 @@ inline Vec2 uvAt(const Mesh& mesh, uint32_t triangle, Vec2 barycentrics) {
   return b0 * mesh.uvs[tri.x] + b1 * mesh.uvs[tri.y] + b2 * mesh.uvs[tri.z];
 }
 
+/// The texture coordinates a slot with `mapping` reads at barycentrics (b1, b2): its uv set
+/// interpolated (uvAt's rule: the barycentrics for a mesh without that set), then its transform.
+inline Vec2 uvAt(const Mesh& mesh, uint32_t triangle, Vec2 barycentrics, const TextureMapping& mapping) {
+  if (mapping.isDefault()) return uvAt(mesh, triangle, barycentrics);
+  const std::vector<Vec2>& uvs = mapping.uvSet == 1 ? mesh.uvs1 : mesh.uvs;
+  Vec2 uv(barycentrics);
+  if (!uvs.empty()) {
+    const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.0f - b1 - b2;
+    const UVec3 tri = mesh.triangles[triangle];
+    uv = b0 * uvs[tri.x] + b1 * uvs[tri.y] + b2 * uvs[tri.z];
+  }
+  return mapping.apply(uv);
+}
+
+/// The interpolated vertex colour at barycentrics (b1, b2) of a triangle (1 for a mesh without).
+inline Rgb vertexColorAt(const Mesh& mesh, uint32_t triangle, Vec2 barycentrics) {
+  if (mesh.colors.empty()) return Rgb(1.0f);
+  const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.0f - b1 - b2;
+  const UVec3 tri = mesh.triangles[triangle];
+  return b0 * mesh.colors[tri.x] + b1 * mesh.colors[tri.y] + b2 * mesh.colors[tri.z];
+}
+
+/// Where a material's albedo is read at a surface point: the albedo texture's uv (its slot's
+/// uv set and transform applied), the mip level (0 = full resolution, Texture::sampleLod) and
+/// the interpolated vertex colour. albedoPointAt makes one at full resolution; the
+/// light-field renderers set `lod` from their ray cones (lookup.h albedoLodAt).
+struct AlbedoPoint {
+  Vec2 uv{0.0f};
+  float lod = 0.0f;
+  Rgb vertexColor{1.0f};
+  Vec2 metallicRoughnessUv{0.0f};  ///< where a metallic-roughness texture is read (its own slot)
+};
+AlbedoPoint albedoPointAt(const Scene& scene, uint32_t mesh, uint32_t triangle, Vec2 barycentrics);
+
+/// The albedo rule, written once for the path tracer (bsdfAt), the bake's transport albedo and
+/// both renderers (lookup.h diffuseAlbedoAt): what multiplies the material's diffuse albedo at
+/// `p` — its albedo texture at p.uv and mip level p.lod (1 without one) × p.vertexColor.
+Rgb albedoModulation(const Scene& scene, const Material& material, const AlbedoPoint& p);
+
+/// What is wrong with a material's texture mappings and metallic-roughness map ("" if nothing):
+/// a uv set other than 0 and 1, a non-finite transform, a metallic-roughness texture on a
+/// model other than GGX or with factors outside [0, 1]. Scene::finalize and the .plf reader.
+std::string mappingProblem(const Material& material);
+
+/// The material's model at albedo point p, the one rule bsdfAt and the renderers' albedos
+/// (lookup.h diffuseAlbedoAt, glossyDiffuseAlbedoAt) apply: the model as it is when nothing
+/// varies; with a metallic-roughness texture ggxFromMetallicRoughness(baseColor × modulation,
+/// metallic × B, roughness × G) of the texel at p.metallicRoughnessUv (full resolution);
+/// otherwise the model with its diffuse albedo × albedoModulation(p).
+Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p);
+
+/// Sets Material::vertexColored from the meshes (Scene::finalize and the .plf reader call it).
+void markVertexColoredMaterials(Scene& scene);
+
 /// The alpha mask's coverage at barycentrics (b1, b2) of a triangle: alphaFactor × texture
 /// coverage at the interpolated uv (1 for unmasked materials). The Accel's hit filter.
 float coverageAt(const Scene& scene, uint32_t mesh, uint32_t triangle, Vec2 barycentrics);
@@ -268,10 +368,11 @@ std::optional<Scattered> scatter(const ScatteringFrame& f, const Bsdf& bsdf, Vec
 /// material of a scene with it.
 void validateMaterial(const Material& material, const std::string& sourcePath);
 
-/// The material's BSDF with its albedo texture applied at uv, at full resolution
-/// (Texture::sample): the path tracer integrates a pixel's footprint with its samples, and the
-/// bake averages over each tixel's footprint itself. Only the light-field renderers read mip
-/// levels (lookup.h albedoTextureLod).
+/// The material's BSDF at a hit: its diffuse albedo times albedoModulation at full resolution
+/// (Texture::sample) — the path tracer integrates a pixel's footprint with its samples, and
+/// the bake averages over each tixel's footprint itself; only the light-field renderers read
+/// mip levels (lookup.h albedoTextureLod) — and with a metallic-roughness texture the GGX
+/// parameters at the hit (MetallicRoughnessMap).
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit);
 
 }  // namespace pl

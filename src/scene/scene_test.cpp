@@ -15,6 +15,7 @@
 #include <string>
 #include <tuple>
 
+#include "support/expect_error.h"
 #include "support/expect_vec3.h"
 
 namespace pl {
@@ -31,17 +32,7 @@ const std::string kFuzzCorpus = std::string(PLENOPTIC_TEST_DATA_DIR) + "/fuzz/";
 // magnitude ≲ 10): a few ulps of float (6e-8 relative) at that scale.
 constexpr float kTight = 1e-5f;
 
-/// Runs `load`, expects a pl::Error whose message contains every string of `needles`.
-void expectError(const std::function<void()>& load, std::initializer_list<std::string> needles) {
-  try {
-    load();
-    ADD_FAILURE() << "no pl::Error thrown";
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    for (const std::string& needle : needles)
-      EXPECT_NE(message.find(needle), std::string::npos) << "message '" << message << "' lacks '" << needle << "'";
-  }
-}
+using test_support::expectError;
 
 /// A fresh directory for files written by one test.
 fs::path scratchDir(const std::string& name) {

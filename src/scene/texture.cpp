@@ -62,6 +62,23 @@ struct BilinearFootprint {
   int x0, x1, y0, y1;
   float fx, fy;
 };
+/// Wrap-around (repeat) of texel index i (a whole number) with a non-negative modulo. Below
+/// 2^30 in magnitude the integer remainder is exactly fmod's (and much cheaper per pixel);
+/// fmod keeps huge coordinates in range.
+int repeatIndex(float i, int n) {
+  // Most lookups are inside the image (uv in [0, 1)): no division at all (an integer
+  // remainder costs tens of cycles, four per footprint).
+  if (i >= 0.0f && i < float(n)) return int(i);
+  if (std::abs(i) < 0x1p30f) {
+    const int k = int(i) % n;
+    return k < 0 ? k + n : k;
+  }
+  float m = std::fmod(i, float(n));
+  if (m < 0.0f) m += float(n);
+  int k = int(m);
+  return k >= n ? 0 : k;
+}
+
 bool bilinearFootprint(const Image& image, Vec2 uv, BilinearFootprint& f) {
   // Texel (x, y) has its centre at u = (x + 0.5)/W and v = 1 − (y + 0.5)/H (row 0 is the top
   // of the image, v = 0 its bottom). Continuous texel coordinates of uv:
@@ -71,24 +88,40 @@ bool bilinearFootprint(const Image& image, Vec2 uv, BilinearFootprint& f) {
   const float x0f = std::floor(x), y0f = std::floor(y);
   f.fx = x - x0f;
   f.fy = y - y0f;
-  // Wrap-around (repeat) with a non-negative modulo. i is a whole number; below 2^30 in
-  // magnitude the integer remainder is exactly fmod's (and much cheaper per pixel); fmod
-  // keeps huge coordinates in range.
-  auto wrap = [](float i, int n) {
-    // Most lookups are inside the image (uv in [0, 1)): no division at all (an integer
-    // remainder costs tens of cycles, four per footprint).
-    if (i >= 0.0f && i < float(n)) return int(i);
-    if (std::abs(i) < 0x1p30f) {
-      const int k = int(i) % n;
-      return k < 0 ? k + n : k;
+  f.x0 = repeatIndex(x0f, image.width), f.x1 = repeatIndex(x0f + 1.0f, image.width);
+  f.y0 = repeatIndex(y0f, image.height), f.y1 = repeatIndex(y0f + 1.0f, image.height);
+  return true;
+}
+
+/// Texel index i (a whole number) of an axis of n texels wrapped as `wrap` says (TextureWrap).
+int wrapIndex(float i, int n, TextureWrap wrap) {
+  switch (wrap) {
+    case TextureWrap::ClampToEdge: return i <= 0.0f ? 0 : i >= float(n - 1) ? n - 1 : int(i);
+    case TextureWrap::MirroredRepeat: {
+      const int m = repeatIndex(i, 2 * n);
+      return m < n ? m : 2 * n - 1 - m;
     }
-    float m = std::fmod(i, float(n));
-    if (m < 0.0f) m += float(n);
-    int k = int(m);
-    return k >= n ? 0 : k;
-  };
-  f.x0 = wrap(x0f, image.width), f.x1 = wrap(x0f + 1.0f, image.width);
-  f.y0 = wrap(y0f, image.height), f.y1 = wrap(y0f + 1.0f, image.height);
+    case TextureWrap::Repeat: break;
+  }
+  return repeatIndex(i, n);
+}
+
+/// bilinearFootprint under a texture's own sampling (TextureSampling): its wrap modes, and
+/// with `nearest` the one texel the uv falls in (weights 0, both indices equal, so the bilinear
+/// blend returns that texel exactly). False for a non-finite uv.
+bool sampledFootprint(const Image& image, Vec2 uv, TextureWrap wrapU, TextureWrap wrapV, bool nearest,
+                      BilinearFootprint& f) {
+  // As bilinearFootprint; nearest: the texel [x, x + 1) × [y, y + 1) holding the point.
+  const float half = nearest ? 0.0f : 0.5f;
+  const float x = uv.x * float(image.width) - half;
+  const float y = (1.0f - uv.y) * float(image.height) - half;
+  if (!std::isfinite(x) || !std::isfinite(y)) return false;
+  const float x0f = std::floor(x), y0f = std::floor(y);
+  f.fx = nearest ? 0.0f : x - x0f;
+  f.fy = nearest ? 0.0f : y - y0f;
+  const float step = nearest ? 0.0f : 1.0f;
+  f.x0 = wrapIndex(x0f, image.width, wrapU), f.x1 = wrapIndex(x0f + step, image.width, wrapU);
+  f.y0 = wrapIndex(y0f, image.height, wrapV), f.y1 = wrapIndex(y0f + step, image.height, wrapV);
   return true;
 }
 
@@ -205,11 +238,36 @@ Image downsampleBox(const Image& image) {
 Rgb Texture::sample(Vec2 uv) const {
   if (image.empty()) return Rgb(1.0f);
   Rgb result;
+  if (!sampling.isDefault()) {
+    const auto footprint = [&](const Image& level, Vec2 at, BilinearFootprint& f) {
+      return sampledFootprint(level, at, sampling.wrapU, sampling.wrapV, sampling.nearest, f);
+    };
+    return sampleLevel(image, packed, palette, uv, footprint, result) ? result : average;
+  }
   return sampleLevel(image, packed, palette, uv, kBilinearFootprint, result) ? result : average;
 }
 
 Rgb Texture::sampleLod(Vec2 uv, float lod) const {
-  if (!(lod > 0.0f) || mips.empty()) return sample(uv);  // also NaN
+  if (!(lod > 0.0f) || mips.empty() || !sampling.mipmaps) return sample(uv);  // also NaN
+  if (!sampling.isDefault()) {
+    // Wrapped per level, bilinear in each (`nearest` is the magnification filter: level 0 read
+    // alone, by sample()); the same blend of two levels as below.
+    const auto footprint = [&](const Image& level, Vec2 at, BilinearFootprint& f) {
+      return sampledFootprint(level, at, sampling.wrapU, sampling.wrapV, false, f);
+    };
+    const float clamped = std::min(lod, float(mips.size()));
+    const size_t fine = size_t(clamped);
+    const float f = clamped - float(fine);
+    auto level = [&](size_t l, Rgb& out) {
+      return l == 0 ? sampleLevel(image, packed, palette, uv, footprint, out)
+                    : sampleLevel(mips[l - 1].image, mips[l - 1].packed, mips[l - 1].palette, uv, footprint, out);
+    };
+    Rgb a, b;
+    if (!level(fine, a)) return average;
+    if (f == 0.0f) return a;
+    level(fine + 1, b);
+    return (1.0f - f) * a + f * b;
+  }
   // uv reduced to [0, 1) once for both levels (repeat), so that each level's footprint is
   // reducedFootprint's few integer operations (per pixel the renderers take four footprints:
   // two levels, sampled and prefetched). Not bit-identical to sample() at level 0 (the
@@ -234,7 +292,7 @@ Rgb Texture::sampleLod(Vec2 uv, float lod) const {
 }
 
 void Texture::prefetch(Vec2 uv, float lod) const {
-  if (image.empty()) return;
+  if (image.empty() || !sampling.isDefault()) return;  // a hint only: other samplings go without
   if (!(lod > 0.0f) || mips.empty()) return prefetchLevel(image, packed, uv, kBilinearFootprint);
   uv -= glm::floor(uv);  // as sampleLod
   if (!(uv.x >= 0.0f && uv.x < 1.0f && uv.y >= 0.0f && uv.y < 1.0f)) return;

@@ -11,7 +11,28 @@
 
 namespace pl {
 
-/// A linear RGB texture, sampled bilinearly with wrap-around (repeat).
+/// What a texture coordinate outside [0, 1] reads, per axis (glTF sampler wrapS / wrapT):
+/// Repeat the image, hold its edge texels (ClampToEdge), or repeat it mirrored every other
+/// time (MirroredRepeat: texel index i of the infinite plane reads i mod 2W when below W,
+/// else 2W − 1 − (i mod 2W), as OpenGL defines it). The numbers are the .plf's.
+enum class TextureWrap : uint8_t { Repeat = 0, ClampToEdge = 1, MirroredRepeat = 2 };
+
+/// How a texture is filtered (a glTF sampler; OBJ and JSON textures keep the defaults):
+/// `nearest` (magFilter NEAREST): level-0 reads take the texel the uv falls in instead of the
+/// bilinear blend — what the path tracer and the bake always read, and the renderers where
+/// a texture is magnified. `mipmaps` false (minFilter NEAREST or LINEAR, which name no mip
+/// levels): the renderers read level 0 at every distance; otherwise they blend mip levels
+/// trilinearly whatever the *_MIPMAP_* variant asks.
+struct TextureSampling {
+  TextureWrap wrapU = TextureWrap::Repeat, wrapV = TextureWrap::Repeat;
+  bool nearest = false;
+  bool mipmaps = true;
+  bool isDefault() const { return *this == TextureSampling{}; }
+  bool operator==(const TextureSampling&) const = default;
+};
+
+/// A linear RGB texture, sampled bilinearly with wrap-around (repeat) unless its `sampling`
+/// says otherwise.
 /// uv = (0,0) is the *bottom-left* of the image (OBJ/OpenGL convention); glTF loaders flip v.
 /// `decode` says what the file's channels became (image.h): sRGB-decoded colour for albedo
 /// textures, raw values for normal maps, the alpha channel (coverage in [0, 1], in all three
@@ -26,12 +47,13 @@ struct Texture {
   /// and decodes them on load. Shared, so that copying a Scene does not copy them.
   std::shared_ptr<const std::vector<unsigned char>> encoded;
   Rgb average{0.0f};  ///< mean over all texels (used where one albedo per region is needed)
+  TextureSampling sampling;  ///< wrap modes and filters (default: repeat, bilinear, mip-mapped)
 
   /// Checks the pixels (present, finite) and computes `average`; throws pl::Error naming
   /// `sceneSource` and the texture. Scene::finalize and the .plf reader call it.
   void finish(const std::string& sceneSource);
 
-  /// Bilinear at full resolution (level 0), repeat. A non-finite uv (only possible from a NaN
+  /// Bilinear at full resolution (level 0), wrapped as `sampling` says. A non-finite uv (only possible from a NaN
   /// hit, since loaders reject non-finite uvs) returns `average` rather than spreading the NaN
   /// into the albedo; the renderers count and report non-finite radiance where it arises. The
   /// path tracer, the bake and normal/alpha maps read textures here.
