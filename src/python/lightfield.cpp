@@ -117,8 +117,10 @@ void bindLightField(py::module_& m) {
           "t0 + k/fps, posed on `camera`) or a list of Cameras. Returns a list of float32 (height, width, 3) frames.")
       .def("__repr__", [](const PyLightField& lf) {
         const LightField& field = *lf.lightField;
+        uint64_t tixels = 0;
+        for (const Chart& c : field.charts) tixels += c.tixelCount();
         return fmt::format("<plenoptic.LightField of '{}': {} charts, {} tixels, {} sun-mask lights>",
-                           field.scene.sourcePath, field.charts.size(), field.values.size(), field.sunMaskLightCount);
+                           field.scene.sourcePath, field.charts.size(), tixels, field.sunMaskLightCount);
       });
 
   m.def(
