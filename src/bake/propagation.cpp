@@ -504,20 +504,19 @@ void addTiltedGather(const TransportState& state, const Chart& c, uint64_t g, co
   }
   if (c.curved) {
     const TixelFrame from = tixelFrame(param, c, g), to = tiltFrame(param, c, g);
-    const float sinBeta = std::sin(glm::radians(kNormalTiltDegrees));
+    constexpr float kGradient = 2.0f / (3.0f * kNormalTiltSine);
     Rgb mean(0.0f), gx(0.0f), gy(0.0f);  // Ē and g in the gather frame
     for (uint32_t t = 0; t < kTiltedNormals; ++t) {
-      const Vec3 b = tiltedNormal(t);
       mean += sum[t] / float(kTiltedNormals);
-      gx += sum[t] * (2.0f / (3.0f * sinBeta) * b.x / sinBeta);
-      gy += sum[t] * (2.0f / (3.0f * sinBeta) * b.y / sinBeta);
+      gx += sum[t] * (kGradient * kTiltAcross[t][0]);
+      gy += sum[t] * (kGradient * kTiltAcross[t][1]);
     }
     // g's components along the tilt frame's axes.
     const Rgb tx = gx * glm::dot(from.u, to.u) + gy * glm::dot(from.v, to.u);
     const Rgb ty = gx * glm::dot(from.u, to.v) + gy * glm::dot(from.v, to.v);
     for (uint32_t t = 0; t < kTiltedNormals; ++t) {
-      const Vec3 b = tiltedNormal(t);  // sin β·t_k
-      sum[t] = glm::max(Rgb(0.0f), mean + tx * b.x + ty * b.y);
+      // E_k = Ē + sin β·g·t_k.
+      sum[t] = glm::max(Rgb(0.0f), mean + (tx * kTiltAcross[t][0] + ty * kTiltAcross[t][1]) * kNormalTiltSine);
     }
   }
   for (uint32_t t = 0; t < kTiltedNormals; ++t) tilted[t] += sum[t];

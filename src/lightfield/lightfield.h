@@ -163,20 +163,22 @@ struct Chart {
   uint64_t tiltedIrradianceIndex(uint32_t i, uint32_t j, uint32_t k) const { return valueIndex(i, j) + 1 + k; }
 };
 
-/// Normal-mapped diffuse charts (see above): the tilted normals, their tilt β from the
-/// chart's normal and their number.
+/// Normal-mapped diffuse charts (see above): the number of tilted normals, their tilt β = 45°
+/// from the chart's normal (cos β = sin β = √½) and their directions across it,
+/// t_k = (cos φ_k, sin φ_k), φ_k = k·120°. Constants, since the renderers use them per pixel.
 inline constexpr uint32_t kTiltedNormals = 3;
 inline constexpr float kNormalTiltDegrees = 45.0f;
+inline constexpr float kNormalTiltCosine = 0.70710678f, kNormalTiltSine = 0.70710678f;
+inline constexpr float kTiltAcross[kTiltedNormals][2] = {{1.0f, 0.0f}, {-0.5f, 0.86602540f}, {-0.5f, -0.86602540f}};
 
 inline uint64_t Chart::valuesPerTixel() const {
   return directionTexels() + (diffuseValue ? 1 : 0) + (directionalIrradiance ? kTiltedNormals : 0);
 }
 
 /// Tilted normal k (0 … kTiltedNormals − 1) in the tilt frame's local coordinates (z along
-/// the chart's normal): (sin β cos φ_k, sin β sin φ_k, cos β), φ_k = k·120°.
+/// the chart's normal): b_k = (sin β·t_k, cos β).
 inline Vec3 tiltedNormal(uint32_t k) {
-  const float beta = glm::radians(kNormalTiltDegrees), phi = glm::radians(120.0f * float(k));
-  return {std::sin(beta) * std::cos(phi), std::sin(beta) * std::sin(phi), std::cos(beta)};
+  return {kNormalTiltSine * kTiltAcross[k][0], kNormalTiltSine * kTiltAcross[k][1], kNormalTiltCosine};
 }
 
 /// The weights of the model above: E(n') ≈ irradiance·E + Σ_k tilted[k]·E_k for a normal n'
@@ -186,16 +188,15 @@ struct TiltWeights {
   float tilted[kTiltedNormals] = {};
 };
 inline TiltWeights tiltWeights(const Vec3& localNormal) {
-  const float beta = glm::radians(kNormalTiltDegrees);
-  // E + a(1 − n'_z) with a = (Ē − E)/(1 − cos β): the isotropic part's share s of Ē − E.
-  const float share = (1.0f - localNormal.z) / (1.0f - std::cos(beta));
+  // E + a(1 − n'_z) with a = (Ē − E)/(1 − cos β): the isotropic part's share s of Ē − E; and
+  // g·n'_t with g = 2/(3 sin β)·Σ_k E_k·t_k.
+  const float share = (1.0f - localNormal.z) * (1.0f / (1.0f - kNormalTiltCosine));
+  constexpr float kGradient = 2.0f / (3.0f * kNormalTiltSine);
   TiltWeights w;
   w.irradiance = 1.0f - share;
-  for (uint32_t k = 0; k < kTiltedNormals; ++k) {
-    const Vec3 b = tiltedNormal(k);  // t_k = (b.x, b.y) / sin β
-    const float across = (b.x * localNormal.x + b.y * localNormal.y) / std::sin(beta);
-    w.tilted[k] = share / float(kTiltedNormals) + 2.0f / (3.0f * std::sin(beta)) * across;
-  }
+  for (uint32_t k = 0; k < kTiltedNormals; ++k)
+    w.tilted[k] = share * (1.0f / float(kTiltedNormals)) +
+                  kGradient * (kTiltAcross[k][0] * localNormal.x + kTiltAcross[k][1] * localNormal.y);
   return w;
 }
 

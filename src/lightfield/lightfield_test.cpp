@@ -2,6 +2,8 @@
 #include "lightfield/lightfield.h"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
@@ -48,6 +50,45 @@ TEST(BakeJsonSchema, SettingsAndStatsRoundTripAndOldFilesMeanNoSunMasksOrHighlig
   EXPECT_EQ(toJson(statsBack), toJson(stats));
   EXPECT_EQ(statsBack.visibilityRays, uint64_t(1) << 40);
   EXPECT_THROW(fromJson(nlohmann::json{{"iterations", "seven"}}, statsBack), nlohmann::json::exception);
+}
+
+}  // namespace
+}  // namespace pl
+
+namespace pl {
+namespace {
+
+// Normal-mapped diffuse charts (lightfield.h): the tilt constants are 45° and 120° apart, and
+// the model E(n') ≈ tiltWeights(n')·(E, E_0, E_1, E_2) is exact where the header says it is —
+// light from one direction above every tilted horizon, and uniform light over the hemisphere
+// (E(n') = E·(1 + n'·n)/2, each E_k = E·(1 + cos β)/2).
+TEST(TiltedIrradiance, ConstantsAndTheModelsExactCases) {
+  const float beta = glm::radians(kNormalTiltDegrees);
+  EXPECT_NEAR(kNormalTiltCosine, std::cos(beta), 1e-7f);
+  EXPECT_NEAR(kNormalTiltSine, std::sin(beta), 1e-7f);
+  for (uint32_t k = 0; k < kTiltedNormals; ++k) {
+    const float phi = glm::radians(120.0f * float(k));
+    EXPECT_NEAR(kTiltAcross[k][0], std::cos(phi), 1e-7f);
+    EXPECT_NEAR(kTiltAcross[k][1], std::sin(phi), 1e-7f);
+    EXPECT_NEAR(glm::length(tiltedNormal(k)), 1.0f, 1e-6f);
+  }
+  auto model = [](const Vec3& n, float e, const float (&tilted)[kTiltedNormals]) {
+    const TiltWeights w = tiltWeights(n);
+    float sum = w.irradiance * e;
+    for (uint32_t k = 0; k < kTiltedNormals; ++k) sum += w.tilted[k] * tilted[k];
+    return sum;
+  };
+  const Vec3 normals[] = {Vec3(0, 0, 1), glm::normalize(Vec3(0.3f, -0.2f, 1.0f)), glm::normalize(Vec3(-0.6f, 0.4f, 0.7f))};
+  // One direction ω, 30° from the normal (within 90° of every b_k): E_k = ω·b_k (all positive), E(n') = ω·n'.
+  const Vec3 omega = glm::normalize(Vec3(std::sin(glm::radians(30.0f)) * Vec3(0.6f, 0.8f, 0.0f)) +
+                                    Vec3(0.0f, 0.0f, std::cos(glm::radians(30.0f))));
+  float directional[kTiltedNormals];
+  for (uint32_t k = 0; k < kTiltedNormals; ++k) directional[k] = glm::dot(omega, tiltedNormal(k));
+  for (const Vec3& n : normals) EXPECT_NEAR(model(n, omega.z, directional), glm::dot(omega, n), 1e-5f);
+  // Uniform radiance L = 1/π over the hemisphere: E = 1.
+  const float uniform[kTiltedNormals] = {0.5f * (1.0f + kNormalTiltCosine), 0.5f * (1.0f + kNormalTiltCosine),
+                                         0.5f * (1.0f + kNormalTiltCosine)};
+  for (const Vec3& n : normals) EXPECT_NEAR(model(n, 1.0f, uniform), 0.5f * (1.0f + n.z), 1e-5f);
 }
 
 }  // namespace
