@@ -168,7 +168,6 @@ std::optional<LightSample> LightSampler::sampleEntry(const Entry& entry, float s
       s.wi = in->wi;
       s.incident = in->incident;
       s.pdf = selectProbability * in->pdf;  // a delta light's pdf is 1: the selection alone
-      s.delta = isDeltaLight(light);
       s.nextEventOnly = true;
       s.infinite = isAtInfinity(light);
       s.target = in->target;

@@ -82,7 +82,6 @@ struct LightSample {
                        ///< irradiance on a surface normal to wi (W·m⁻²)
   float pdf = 0.0f;    ///< solid-angle density of wi including the light's selection
                        ///< probability; for delta lights the selection probability alone
-  bool delta = false;  ///< a delta light (lights.h isDeltaLight): wi is its only direction
   /// A scene light (lights.h): no BSDF-sampled ray can find it, so next-event estimation
   /// counts it with full weight (no MIS).
   bool nextEventOnly = false;

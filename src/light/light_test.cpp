@@ -79,7 +79,7 @@ TEST(LightSampler, SampleDensitiesMatchTheLookedUpDensities) {
     const std::optional<LightSample> s = lights.sample(receiver, Vec2(rng.uniform(), rng.uniform()));
     if (!s) continue;  // the back of a one-sided emitter cannot be: none faces away here
     ASSERT_GT(s->pdf, 0.0f);
-    if (s->delta) {
+    if (s->nextEventOnly) {  // the point light, the one scene light here
       ++delta;
       continue;
     }
