@@ -38,10 +38,17 @@ double estimatedTixelCost(const Scene& scene, const Parameterisation& param, con
   const Chart& c = param.charts[param.tixelChart[g]];
   if (c.kind == ChartKind::Specular) return 0.0;
   const double n = double(gatherGridSide(settings.gatherDirections)) * gatherGridSide(settings.gatherDirections);
-  const double lights = double(scene.lights.size()), samples = double(settings.areaLightSamples);
-  double cost = n + lights + samples;
+  const double samples = double(settings.areaLightSamples);
+  // The first shot's shadow rays: one per delta light (its glossy record averaged over 9
+  // directions per texel), max(1, area-light samples) per other scene light (propagation.cpp).
+  double deltaLights = 0.0, sampledLightRays = 0.0;
+  for (const Light& light : scene.lights) {
+    if (isDeltaLight(light)) deltaLights += 1.0;
+    else sampledLightRays += std::max(1.0, samples);
+  }
+  double cost = n + deltaLights + sampledLightRays + samples;
   if (c.kind == ChartKind::Glossy)
-    cost += kGlossyEvalCost * double(c.valuesPerTixel()) * (9.0 * lights + samples + n / 8.0);
+    cost += kGlossyEvalCost * double(c.valuesPerTixel()) * (9.0 * deltaLights + sampledLightRays + samples + n / 8.0);
   return cost;
 }
 
