@@ -6,11 +6,12 @@
 # (the render call's wall time).
 import math
 import os
-import struct
 import sys
-import time
 
 import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cycles_common import configure_cycles, render_to_pfm, uniform_world  # noqa: E402
 
 obj_path, out_path, spp, seed, size, threads = sys.argv[sys.argv.index("--") + 1:][:6]
 spp, seed, size, threads = int(spp), int(seed), int(size), int(threads)
@@ -90,11 +91,7 @@ for material in bpy.data.materials:
         raise SystemExit(f"material {material.name} is not in the .mtl")
     build_material(material, mtls[material.name])
 
-world = bpy.data.worlds.new("black")
-world.use_nodes = True
-world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-scene.world = world
+uniform_world(scene)
 
 camera_data = bpy.data.cameras.new("camera")
 camera_data.sensor_fit = "VERTICAL"
@@ -105,53 +102,5 @@ camera.rotation_euler = (math.radians(90.0), 0.0, 0.0)  # looks along +y_blender
 scene.collection.objects.link(camera)
 scene.camera = camera
 
-render = scene.render
-render.engine = "CYCLES"
-render.resolution_x = render.resolution_y = size
-render.resolution_percentage = 100
-render.threads_mode = "FIXED"
-render.threads = threads
-render.use_persistent_data = False
-render.film_transparent = False
-render.image_settings.file_format = "OPEN_EXR"
-render.image_settings.color_depth = "32"
-render.image_settings.color_mode = "RGBA"
-render.filepath = out_path
-scene.view_settings.view_transform = "Standard"
-scene.view_settings.look = "None"
-scene.view_settings.exposure = 0.0
-scene.view_settings.gamma = 1.0
-
-cycles = scene.cycles
-cycles.device = "CPU"
-cycles.samples = spp
-cycles.seed = seed
-cycles.use_animated_seed = False
-cycles.use_adaptive_sampling = False
-cycles.use_denoising = False
-cycles.use_preview_denoising = False
-cycles.pixel_filter_type = "BOX"
-cycles.filter_width = 1.0
-cycles.sample_clamp_direct = 0.0
-cycles.sample_clamp_indirect = 0.0
-cycles.blur_glossy = 0.0
-cycles.caustics_reflective = True
-cycles.caustics_refractive = True
-for bounces in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces", "volume_bounces",
-                "transparent_max_bounces"):
-    setattr(cycles, bounces, 1024)
-cycles.min_light_bounces = 0
-cycles.min_transparent_bounces = 0
-
-start = time.perf_counter()
-bpy.ops.render.render(write_still=True)
-seconds = time.perf_counter() - start
-print(f"CYCLES_SECONDS {seconds:.4f}")
-
-# The same pixels as PFM (both are stored bottom row first).
-image = bpy.data.images.load(out_path)
-pixels = image.pixels[:]
-rgb = [pixels[i + c] for i in range(0, len(pixels), 4) for c in range(3)]
-with open(os.path.splitext(out_path)[0] + ".pfm", "wb") as f:
-    f.write(f"PF\n{image.size[0]} {image.size[1]}\n-1.0\n".encode())
-    f.write(struct.pack(f"<{len(rgb)}f", *rgb))
+configure_cycles(scene, out_path, spp, seed, size, size, threads)
+render_to_pfm(out_path)

@@ -13,75 +13,13 @@ A 4 x 3 x 4 room (y up, open nowhere), lit by an emissive 1 x 1 ceiling panel (2
           green gradient along the walls' x and blue-grey at the top;
   ceiling grey (0.7, roughness 1); camera "main" at the front looking in.
 """
-import base64
 import json
 import math
 import os
-import struct
-import zlib
 
+from gltf_writer import MIRRORED_REPEAT, CLAMP_TO_EDGE, Buffer, data_uri, png
 
-def png(width, height, rgb):
-    """An 8-bit RGB PNG of rows top to bottom."""
-    raw = b"".join(b"\0" + bytes(rgb[y * width * 3:(y + 1) * width * 3]) for y in range(height))
-    def chunk(kind, data):
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff)
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
-            + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
-
-
-def data_uri(mime, data):
-    return "data:%s;base64,%s" % (mime, base64.b64encode(data).decode())
-
-
-buffer = bytearray()
-views, accessors = [], []
-
-
-def add(values, fmt, ctype, count, kind, target=None, minmax=False):
-    while len(buffer) % 4:
-        buffer.append(0)
-    offset = len(buffer)
-    for v in values:
-        buffer.extend(struct.pack("<" + fmt, *v) if isinstance(v, tuple) else struct.pack("<" + fmt, v))
-    views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(buffer) - offset})
-    accessor = {"bufferView": len(views) - 1, "componentType": ctype, "count": count, "type": kind}
-    if minmax:
-        accessor["min"] = [min(v[i] for v in values) for i in range(3)]
-        accessor["max"] = [max(v[i] for v in values) for i in range(3)]
-    accessors.append(accessor)
-    return len(accessors) - 1
-
-
-def quad(corners, normal, uv1=None, colors=None, n=1):
-    """A quad split into n x n cells (so that vertex colours vary), corners counter-clockwise
-    seen from the front: p0 + s (p1 - p0) + t (p3 - p0)."""
-    p0, p1, _, p3 = corners
-    pos, uvs, uv1s, cols, idx = [], [], [], [], []
-    for j in range(n + 1):
-        for i in range(n + 1):
-            s, t = i / n, j / n
-            p = tuple(p0[k] + s * (p1[k] - p0[k]) + t * (p3[k] - p0[k]) for k in range(3))
-            pos.append(p)
-            uvs.append((s, 1 - t))
-            if uv1:
-                uv1s.append(uv1(p))
-            if colors:
-                cols.append(colors(p))
-    for j in range(n):
-        for i in range(n):
-            a = j * (n + 1) + i
-            idx += [a, a + 1, a + n + 2, a, a + n + 2, a + n + 1]
-    attributes = {"POSITION": add(pos, "3f", 5126, len(pos), "VEC3", minmax=True),
-                  "NORMAL": add([normal] * len(pos), "3f", 5126, len(pos), "VEC3"),
-                  "TEXCOORD_0": add(uvs, "2f", 5126, len(uvs), "VEC2")}
-    if uv1:
-        attributes["TEXCOORD_1"] = add(uv1s, "2f", 5126, len(uv1s), "VEC2")
-    if colors:
-        attributes["COLOR_0"] = add(cols, "3f", 5126, len(cols), "VEC3")
-    return attributes, add(idx, "H", 5123, len(idx), "SCALAR")
-
-
+buf = Buffer()
 W, H, D = 4.0, 3.0, 4.0
 meshes = []
 
@@ -98,14 +36,14 @@ def wall_colour(p):
             round(0.15 * (1 - top) + 0.7 * top, 4))
 
 
-mesh("floor", 0, quad([(0, 0, D), (W, 0, D), (W, 0, 0), (0, 0, 0)], (0, 1, 0), uv1=lambda p: (p[0] / W, 0.5)))
-mesh("ceiling", 2, quad([(0, H, 0), (W, H, 0), (W, H, D), (0, H, D)], (0, -1, 0)))
-mesh("back", 1, quad([(0, 0, 0), (W, 0, 0), (W, H, 0), (0, H, 0)], (0, 0, 1), colors=wall_colour, n=6))
-mesh("left", 1, quad([(0, 0, D), (0, 0, 0), (0, H, 0), (0, H, D)], (1, 0, 0), colors=wall_colour, n=6))
-mesh("right", 1, quad([(W, 0, 0), (W, 0, D), (W, H, D), (W, H, 0)], (-1, 0, 0), colors=wall_colour, n=6))
-mesh("front", 1, quad([(W, 0, D), (0, 0, D), (0, H, D), (W, H, D)], (0, 0, -1), colors=wall_colour, n=6))
+mesh("floor", 0, buf.quad([(0, 0, D), (W, 0, D), (W, 0, 0), (0, 0, 0)], (0, 1, 0), uv1=lambda p: (p[0] / W, 0.5)))
+mesh("ceiling", 2, buf.quad([(0, H, 0), (W, H, 0), (W, H, D), (0, H, D)], (0, -1, 0)))
+mesh("back", 1, buf.quad([(0, 0, 0), (W, 0, 0), (W, H, 0), (0, H, 0)], (0, 0, 1), colors=wall_colour, n=6))
+mesh("left", 1, buf.quad([(0, 0, D), (0, 0, 0), (0, H, 0), (0, H, D)], (1, 0, 0), colors=wall_colour, n=6))
+mesh("right", 1, buf.quad([(W, 0, 0), (W, 0, D), (W, H, D), (W, H, 0)], (-1, 0, 0), colors=wall_colour, n=6))
+mesh("front", 1, buf.quad([(W, 0, D), (0, 0, D), (0, H, D), (W, H, D)], (0, 0, -1), colors=wall_colour, n=6))
 c = 0.5
-mesh("lamp", 3, quad([(W / 2 - c, H - 0.001, D / 2 - c), (W / 2 + c, H - 0.001, D / 2 - c),
+mesh("lamp", 3, buf.quad([(W / 2 - c, H - 0.001, D / 2 - c), (W / 2 + c, H - 0.001, D / 2 - c),
                       (W / 2 + c, H - 0.001, D / 2 + c), (W / 2 - c, H - 0.001, D / 2 + c)], (0, -1, 0)))
 
 checker = []
@@ -120,9 +58,9 @@ gltf = {
     "asset": {"version": "2.0", "generator": "bench/scenes/make_gltf_materials.py"},
     "extensionsUsed": ["KHR_texture_transform"],
     "buffers": [],
-    "bufferViews": views, "accessors": accessors,
+    "bufferViews": buf.views, "accessors": buf.accessors,
     "images": [{"uri": data_uri("image/png", png(8, 8, checker))}, {"uri": data_uri("image/png", png(16, 1, ramp))}],
-    "samplers": [{"wrapS": 33648, "wrapT": 33648}, {"wrapS": 33071, "wrapT": 33071}],
+    "samplers": [{"wrapS": MIRRORED_REPEAT, "wrapT": MIRRORED_REPEAT}, {"wrapS": CLAMP_TO_EDGE, "wrapT": CLAMP_TO_EDGE}],
     "textures": [{"source": 0, "sampler": 0}, {"source": 1, "sampler": 1}],
     "materials": [
         {"name": "floor", "pbrMetallicRoughness": {
@@ -145,7 +83,7 @@ gltf = {
     "scenes": [{"nodes": list(range(len(meshes) + 1))}],
 }
 gltf["extensionsUsed"].append("KHR_materials_emissive_strength")
-gltf["buffers"].append({"byteLength": len(buffer), "uri": data_uri("application/octet-stream", bytes(buffer))})
+gltf["buffers"].append(buf.gltf_buffer())
 path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "gltf-materials.gltf")
 with open(path, "w") as f:
     json.dump(gltf, f, separators=(",", ":"))
