@@ -26,6 +26,7 @@ void fields(Settings& s, Visit&& visit) {
   visit("seed", s.seed);
   visit("sun_masks", s.sunMasks);
   visit("punctual_highlights", s.punctualHighlights);
+  visit("caustic_photons", s.causticPhotons);
 }
 
 template <typename Stats, typename Visit>
@@ -41,6 +42,9 @@ void fields(Stats& s, Visit&& visit) {
   visit("visibility_rays", s.visibilityRays);
   visit("peak_rss_bytes", s.peakRssBytes);
   visit("reused_visibility", s.reusedVisibility);
+  visit("caustic_photons", s.causticPhotons);
+  visit("caustic_photons_landed", s.causticPhotonsLanded);
+  visit("caustic_seconds", s.causticSeconds);
 }
 
 template <typename T>
