@@ -572,8 +572,8 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   ops->sceneLightSamples = std::max(1u, settings.areaLightSamples);
   // The scene's lights pass thin glass (windows) as in the path tracer. Emissive surfaces'
   // shadow rays stop at all glass: emitters behind glass reach the tixel along the
-  // gather chains, which count them with full weight (viaMirror), so crossing glass here too
-  // would count them twice.
+  // gather chains, which count them with full weight (viaMirror), or on diffuse tixels by the
+  // caustic pass (caustics.h), so crossing glass here too would count them twice.
   ops->shadows.emplace(scene, accel);
   ops->glassFirstShot.emplace(scene, param, n);
   caustics = shootsCaustics(param, ops->lights, settings);

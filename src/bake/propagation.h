@@ -13,7 +13,8 @@
 //     towards a delta light, max(1, areaLightSamples) sampled ones towards any other;
 //   * emissive surfaces: areaLightSamples shadow rays per tixel towards emissive triangles
 //     (chosen ∝ area·luminance(Le)) combined by the power heuristic with the gather rays
-//     that hit emitters directly (emitters seen through mirrors come through the gather only);
+//     that hit emitters directly (emitters seen through mirrors and glass come through the
+//     gather only, or on diffuse tixels through the caustic pass below);
 //   * the environment (Environment::radiance of the leaving direction) through gather rays
 //     that escape, directly or after mirrors;
 //   * caustics (caustics.h): photons from the emissive surfaces through mirrors and glass,

@@ -69,6 +69,7 @@ nlohmann::json toJson(const BakeStats& stats) { return write(stats); }
 void fromJson(const nlohmann::json& json, BakeSettings& settings) {
   settings.sunMasks = false;            // writers before sun masks (.plf version ≤ 2) baked without them
   settings.punctualHighlights = false;  // writers before punctual highlights kept them in the glossy maps
+  settings.causticPhotons = 0;          // writers before the caustic pass left caustics to the gather
   read(json, settings);
 }
 

@@ -247,8 +247,8 @@ struct BakeStats {
 nlohmann::json toJson(const BakeSettings& settings);
 nlohmann::json toJson(const BakeStats& stats);
 /// The fields `json` holds; a key it lacks leaves its field as it is (a newer writer may add
-/// keys, which are ignored), except sun_masks and punctual_highlights, whose absence means a
-/// writer from before them, which baked without them (false). Throws nlohmann::json::exception
+/// keys, which are ignored), except sun_masks, punctual_highlights and caustic_photons, whose
+/// absence means a writer from before them, which baked without them (false, false, 0). Throws nlohmann::json::exception
 /// for a value of the wrong type.
 void fromJson(const nlohmann::json& json, BakeSettings& settings);
 void fromJson(const nlohmann::json& json, BakeStats& stats);
