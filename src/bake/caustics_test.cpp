@@ -10,24 +10,19 @@
 #include "core/progress.h"
 #include "lightfield/lookup.h"
 #include "scene/scene.h"
+#include "support/quad_mesh.h"
 
 namespace pl {
 namespace {
 
 /// A horizontal square of half-size h centred at (cx, y, cz), facing up (+y) or down.
 void addSquare(Mesh& mesh, float cx, float y, float cz, float h, bool up, uint32_t material) {
-  const auto base = static_cast<uint32_t>(mesh.positions.size());
-  for (const Vec3& p : {Vec3(cx - h, y, cz - h), Vec3(cx - h, y, cz + h), Vec3(cx + h, y, cz + h), Vec3(cx + h, y, cz - h)})
-    mesh.positions.push_back(p);
+  const Vec3 a(cx - h, y, cz - h), b(cx - h, y, cz + h), c(cx + h, y, cz + h), d(cx + h, y, cz - h);
   if (up) {
-    mesh.triangles.push_back(UVec3(base, base + 1, base + 2));
-    mesh.triangles.push_back(UVec3(base, base + 2, base + 3));
+    test_support::addQuad(mesh, a, b, c, d, material);  // a → b → c winds about +y
   } else {
-    mesh.triangles.push_back(UVec3(base, base + 2, base + 1));
-    mesh.triangles.push_back(UVec3(base, base + 3, base + 2));
+    test_support::addQuad(mesh, a, d, c, b, material);
   }
-  mesh.materials.push_back(material);
-  mesh.materials.push_back(material);
 }
 
 constexpr float kAlbedo = 0.8f;
