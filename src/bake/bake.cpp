@@ -33,6 +33,7 @@ BakeSettings bakePreset(const std::string& name) {
   s.glossyDirRes = preset->glossyDirRes;
   s.areaLightSamples = preset->areaLightSamples;
   s.tolerance = preset->tolerance;
+  s.causticPhotons = preset->causticPhotons;
   s.maxTixelsPerChartSide = 16384;
   s.maxIterations = 200;
   s.mirrorDepth = 256;
@@ -168,6 +169,9 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
   const PropagationResult& prop = t.propagation;
   note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s (first shot {:.2f} s, {} shadow rays)",
                    prop.iterations, prop.residual, prop.seconds, prop.firstShotSeconds, prop.shadowRays));
+  if (prop.causticPhotons > 0)
+    note(fmt::format("caustics: {} photons, {} reached a diffuse surface through mirrors or glass, {:.2f} s (of the first shot)",
+                     prop.causticPhotons, prop.causticPhotonsLanded, prop.causticSeconds));
   return t;
 }
 
@@ -242,6 +246,9 @@ BakeStats bakeStats(const Parameterisation& param, const Transport& t, const Dis
   stats.values = param.valueCount;
   stats.visibilityRays = totalRays;
   stats.reusedVisibility = t.reused;
+  stats.causticPhotons = t.propagation.causticPhotons;
+  stats.causticPhotonsLanded = t.propagation.causticPhotonsLanded;
+  stats.causticSeconds = t.propagation.causticSeconds;
   return stats;
 }
 

@@ -26,14 +26,17 @@ struct BakePresetValues {
   /// Relative change of total outgoing power at which iteration stops, once the remaining
   /// error estimated from the rate of convergence is below it too (propagation.h).
   float tolerance;
+  /// Photons of the caustic pass (caustics.h), shot only when the scene has an emissive
+  /// surface and a mirror or smooth glass.
+  uint64_t causticPhotons;
 };
 /// The presets: the one list of their names and values (bakePreset, bakePresetNames, and
 /// through them the jobs, the command line and Python; docs/user-guide.md's table shows it).
 inline constexpr BakePresetValues kBakePresets[] = {
-    // name     across  gather  glossy  area rays  tolerance
-    {"draft",    20.0f,  144,    8,      16,        5e-3f},
-    {"default",  40.0f,  256,    16,     32,        1e-3f},
-    {"high",     60.0f,  576,    24,     64,        2e-4f},
+    // name     across  gather  glossy  area rays  tolerance  caustic photons
+    {"draft",    20.0f,  144,    8,      16,        5e-3f,     uint64_t(1) << 20},
+    {"default",  40.0f,  256,    16,     32,        1e-3f,     uint64_t(1) << 22},
+    {"high",     60.0f,  576,    24,     64,        2e-4f,     uint64_t(1) << 24},
 };
 
 /// The settings of a named preset; throws pl::Error listing the names for an unknown one.

@@ -71,6 +71,25 @@ TEST_F(BakeCli, PunctualHighlightsAreABakeOption) {
   EXPECT_FALSE(fs::exists(path("x.plf")));
 }
 
+// --caustic-photons N is recorded in the bake settings (the preset's count by default); the
+// built-in box has no mirror or glass, so no photon is shot whatever N; a negative count is refused.
+TEST_F(BakeCli, CausticPhotonsAreABakeOption) {
+  std::string out, err;
+  const std::string common = "bake cornell --preset draft --tixels-across 8 --directions 16 --quiet -o \"";
+  ASSERT_EQ(run(common + path("preset.plf") + "\"", &out, &err), 0) << err;
+  EXPECT_EQ(readLightField(path("preset.plf")).settings.causticPhotons, uint64_t(1) << 20);
+  ASSERT_EQ(run(common + path("n.plf") + "\" --caustic-photons 1000 --stats \"" + path("n.json") + "\"", &out, &err), 0)
+      << err;
+  const LightField lf = readLightField(path("n.plf"));
+  EXPECT_EQ(lf.settings.causticPhotons, 1000u);
+  EXPECT_EQ(lf.stats.causticPhotons, 0u);
+  std::ifstream in(path("n.json"));
+  EXPECT_EQ(nlohmann::json::parse(in)["caustic_photons"].get<uint64_t>(), 0u);
+  EXPECT_EQ(run(common + path("x.plf") + "\" --caustic-photons -1", &out, &err), 2);
+  EXPECT_NE(err.find("--caustic-photons"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("x.plf")));
+}
+
 TEST_F(BakeCli, RefusesBadInput) {
   std::string out, err;
   EXPECT_NE(run("bake \"" + path("missing.obj") + "\" -o \"" + path("x.plf") + "\"", &out, &err), 0);

@@ -11,6 +11,7 @@
 #include <variant>
 
 #include "accel/accel.h"
+#include "bake/caustics.h"
 #include "bake/shard.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -571,10 +572,11 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   ops->sceneLightSamples = std::max(1u, settings.areaLightSamples);
   // The scene's lights pass thin glass (windows) as in the path tracer. Emissive surfaces'
   // shadow rays stop at all glass: emitters behind glass reach the tixel along the
-  // gather chains, which count them with full weight (viaMirror), so crossing glass here too
-  // would count them twice.
+  // gather chains, which count them with full weight (viaMirror), or on diffuse tixels by the
+  // caustic pass (caustics.h), so crossing glass here too would count them twice.
   ops->shadows.emplace(scene, accel);
   ops->glassFirstShot.emplace(scene, param, n);
+  caustics = shootsCaustics(param, ops->lights, settings);
 
   direct.assign(param.valueCount, Rgb(0.0f));
   const bool glossyReflector = std::any_of(param.charts.begin(), param.charts.end(), [&](const Chart& c) {
@@ -859,6 +861,8 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
         return gatherCellDirection(k, subCells[k], state.gridSide, settings.seed);
       };
       const bool keepIncoming = c.kind == ChartKind::Glossy || c.directionalIrradiance;
+      // Emitters seen through mirrors and glass are the caustic pass's on diffuse tixels.
+      const bool emittersViaMirror = !(state.caustics && c.kind == ChartKind::Diffuse);
       bool any = false;
       Rgb sum(0.0f);  // Σ_k L_k in gather order
       for (uint32_t k = 0; k < n; ++k) {
@@ -881,7 +885,7 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
           const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
           const Material& material = scene.materials[seen.material];
           const Rgb emitted = chartEmittedRadiance(material, seen, e.backSide() ? -1.0f : 1.0f);
-          if (!isBlack(emitted)) {
+          if (!isBlack(emitted) && (emittersViaMirror || !(extra && extra->viaMirror))) {
             float weight = 1.0f;
             if (lightSamples > 0 && !(extra && extra->viaMirror) && areaPdf[seen.material] > 0.0f) {
               // The same power heuristic as the shadow rays, evaluated for this gather ray
@@ -916,6 +920,23 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
       }
     }
   });
+}
+
+void shootCaustics(TransportState& state, Progress* progress) {
+  if (!state.caustics) return;
+  const Parameterisation& param = state.param;
+  const CausticPhotons photons =
+      traceCausticPhotons(state.scene, state.accel, param, state.ops->lights, state.settings, progress);
+  // In photon order, one tixel at a time: the sums do not depend on the thread count.
+  for (const CausticDeposit& d : photons.deposits) {
+    const Chart& c = param.charts[param.tixelChart[d.tixel]];
+    Rgb* values = &state.direct[valueBase(d.tixel, c)];
+    values[0] += d.irradiance;
+    if (c.directionalIrradiance) addTiltedIrradiance(param, c, d.tixel, d.wi, d.irradiance, values + 1);
+  }
+  state.causticPhotons = photons.photons;
+  state.causticPhotonsLanded = photons.landed;
+  state.causticSeconds = photons.seconds;
 }
 
 void finishFirstShot(TransportState& state) {
@@ -1168,6 +1189,10 @@ const VisibilityShard& shootFirstShot(TransportState& state, const ShardPlan& pl
   // The rank's own tixels and the rough-glass twins it holds (whose gathered cells its own
   // glass records transmit; their direct values are replaced by the exchange below).
   for (const TixelRange& r : vis.ranges) gatherEmission(state, vis, r.begin, r.end);
+  if (state.caustics) {
+    Progress progress("caustics", state.settings.causticPhotons);
+    shootCaustics(state, &progress);
+  }
   finishFirstShot(state);
   exchange.all(state.direct);
   if (!state.punctualGlossy.empty()) exchange.all(state.punctualGlossy);
@@ -1318,6 +1343,9 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
 
   result.values = std::move(state.current);
   result.shadowRays = comm.sum(state.shadowRays.load());
+  result.causticPhotons = state.causticPhotons;
+  result.causticPhotonsLanded = state.causticPhotonsLanded;
+  result.causticSeconds = state.causticSeconds;
   result.exchangeBytes = comm.bytesReceived() - bytesBefore;
   result.exchangeSeconds = exchange.seconds();
   result.seconds = secondsSince(start) - waitSeconds;

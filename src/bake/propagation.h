@@ -13,9 +13,13 @@
 //     towards a delta light, max(1, areaLightSamples) sampled ones towards any other;
 //   * emissive surfaces: areaLightSamples shadow rays per tixel towards emissive triangles
 //     (chosen ∝ area·luminance(Le)) combined by the power heuristic with the gather rays
-//     that hit emitters directly (emitters seen through mirrors come through the gather only);
+//     that hit emitters directly (emitters seen through mirrors and glass come through the
+//     gather only, or on diffuse tixels through the caustic pass below);
 //   * the environment (Environment::radiance of the leaving direction) through gather rays
-//     that escape, directly or after mirrors.
+//     that escape, directly or after mirrors;
+//   * caustics (caustics.h): photons from the emissive surfaces through mirrors and glass,
+//     deposited as irradiance on diffuse tixels, whose gather then leaves out the emission its
+//     mirror and glass chains reach (the partition is in caustics.h).
 // Iteration (block Gauss–Seidel over batches of whole charts, over-relaxed with ω = 1.2,
 // deterministic; see the .cpp):
 // R ← direct + M R, where M gathers the transport radiance of the seen
@@ -66,6 +70,8 @@ struct PropagationResult {
   /// them — the transport refresh, the change of the other ranks' tixels, the copy of the
   /// starting values and the power sums of the stopping rule (measured, not derived).
   double repeatedSeconds = 0.0;
+  uint64_t causticPhotons = 0, causticPhotonsLanded = 0;  ///< the caustic pass's (caustics.h)
+  double causticSeconds = 0.0;                            ///< of firstShotSeconds
 };
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
@@ -98,7 +104,7 @@ std::vector<uint64_t> propagationBatches(const Parameterisation& param);
 
 // ---- The stages, over an explicit transport state -------------------------------------------
 // propagate() above is: TransportState → shootShadowRays (all tixels) → [the visibility field]
-// → gatherEmission (all tixels) → finishFirstShot → beginIteration → per iteration, for each
+// → gatherEmission (all tixels) → shootCaustics → finishFirstShot → beginIteration → per iteration, for each
 // batch of state.batchStart: gatherIteration + updateTransport → finishTransport. Every stage that
 // works per tixel takes a range [begin, end) of tixel indices, so that a distributed bake can
 // shard the tixels: the results for a range depend only on the state, never on the other
@@ -129,6 +135,11 @@ struct TransportState {
   std::vector<Rgb> previousValues;  ///< current as it was before this iteration (needed with glossy charts)
   std::vector<float> change;        ///< per tixel, |Δ exitance| of its last update (W·m⁻², luminance)
   std::atomic<uint64_t> shadowRays{0};
+  /// Whether the caustic pass runs (caustics.h shootsCaustics): diffuse tixels' gather then
+  /// leaves out emission reached through mirrors and glass.
+  bool caustics = false;
+  uint64_t causticPhotons = 0, causticPhotonsLanded = 0;  ///< shootCaustics's
+  double causticSeconds = 0.0;
   std::vector<uint64_t> batchStart;  ///< propagationBatches(param)
 
   struct Operators;  ///< glossy operators, lights, transport quads (propagation.cpp)
@@ -153,6 +164,12 @@ void removeSunMaskedDirect(const Scene& scene, const Parameterisation& param, st
 /// [begin, end) are added to state.direct. Throws pl::Error when `vis` does not hold the range
 /// or has another gather grid.
 void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t begin, uint64_t end);
+/// First shot, caustics (caustics.h): traces the photons and adds their irradiance to the
+/// diffuse tixels they land on in state.direct (and to their tilted irradiances on
+/// directionalIrradiance charts). The photons land anywhere, so every rank of a distributed
+/// bake shoots all of them (the same ones) and adds them to every tixel. Nothing unless
+/// state.caustics. Advances `progress` (may be null) by photons.
+void shootCaustics(TransportState& state, Progress* progress = nullptr);
 /// Ends the first shot once every range has gathered: each rough-glass record adds the
 /// transmission of what its twin gathered.
 void finishFirstShot(TransportState& state);

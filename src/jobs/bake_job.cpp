@@ -83,6 +83,7 @@ BakeSettings BakeJob::settings() const {
   if (options_.lightSamples > 0) settings.areaLightSamples = options_.lightSamples;
   settings.sunMasks = options_.sunMasks;
   settings.punctualHighlights = options_.punctualHighlights;
+  if (options_.causticPhotons >= 0) settings.causticPhotons = uint64_t(options_.causticPhotons);
   if (options_.tolerance > 0.0f) settings.tolerance = options_.tolerance;
   settings.seed = options_.seed;
   return settings;
@@ -109,9 +110,9 @@ void BakeJob::checkSameJobOnEveryRank(const std::string& scenePath) const {
     const MappedFile file(scenePath);  // (refuses a FIFO or directory: requireRegularFile)
     hash = xxh64(file.bytes().data(), file.bytes().size());
   }
-  const std::string shape = fmt::format("{}|{}|{}|{}|{}|{}|{}|{}", options_.preset, s.tixelsAcrossScene, s.gatherDirections,
-                                        s.areaLightSamples, s.tolerance, s.seed, options_.compress,
-                                        options_.reuseVisibility);
+  const std::string shape = fmt::format("{}|{}|{}|{}|{}|{}|{}|{}|{}", options_.preset, s.tixelsAcrossScene,
+                                        s.gatherDirections, s.areaLightSamples, s.tolerance, s.seed, options_.compress,
+                                        options_.reuseVisibility, s.causticPhotons);
   hash = xxh64(shape.data(), shape.size(), hash);
   uint64_t rank0Hash = 0;
   const std::string differ = comm->ranksDiffering(hash, rank0Hash);

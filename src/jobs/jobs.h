@@ -159,6 +159,7 @@ struct BakeJobOptions {
   float tolerance = 0.0f;
   bool sunMasks = true;  ///< BakeSettings::sunMasks (`--sun-masks`)
   bool punctualHighlights = true;  ///< BakeSettings::punctualHighlights (`--punctual-highlights`)
+  int64_t causticPhotons = -1;  ///< BakeSettings::causticPhotons (`--caustic-photons`); −1 = the preset's, 0 = no caustic pass
   bool reuseVisibility = false;
   std::string compress = "none";  ///< none | lossless | bc1 | hdr (plf/compression.h)
   uint64_t seed = 0;

@@ -26,6 +26,7 @@ void fields(Settings& s, Visit&& visit) {
   visit("seed", s.seed);
   visit("sun_masks", s.sunMasks);
   visit("punctual_highlights", s.punctualHighlights);
+  visit("caustic_photons", s.causticPhotons);
 }
 
 template <typename Stats, typename Visit>
@@ -41,6 +42,9 @@ void fields(Stats& s, Visit&& visit) {
   visit("visibility_rays", s.visibilityRays);
   visit("peak_rss_bytes", s.peakRssBytes);
   visit("reused_visibility", s.reusedVisibility);
+  visit("caustic_photons", s.causticPhotons);
+  visit("caustic_photons_landed", s.causticPhotonsLanded);
+  visit("caustic_seconds", s.causticSeconds);
 }
 
 template <typename T>
@@ -65,6 +69,7 @@ nlohmann::json toJson(const BakeStats& stats) { return write(stats); }
 void fromJson(const nlohmann::json& json, BakeSettings& settings) {
   settings.sunMasks = false;            // writers before sun masks (.plf version ≤ 2) baked without them
   settings.punctualHighlights = false;  // writers before punctual highlights kept them in the glossy maps
+  settings.causticPhotons = 0;          // writers before the caustic pass left caustics to the gather
   read(json, settings);
 }
 

@@ -221,6 +221,10 @@ struct BakeSettings {
   /// direct reflection of point, spot and directional lights, which the renderers evaluate per
   /// pixel. False in files written before them, whose maps hold it.
   bool punctualHighlights = true;
+  /// Caustics (docs/design.md "Caustics"): photons shot from the emissive surfaces through
+  /// mirrors and glass onto diffuse tixels, whose gather then leaves that light out; 0 = none
+  /// (the gather finds it, as in files written before them). `bake --caustic-photons N`.
+  uint64_t causticPhotons = 0;
 };
 
 struct BakeStats {
@@ -232,6 +236,9 @@ struct BakeStats {
   uint64_t visibilityRays = 0;
   uint64_t peakRssBytes = 0;
   bool reusedVisibility = false;
+  uint64_t causticPhotons = 0;       ///< photons shot by the caustic pass (0: none)
+  uint64_t causticPhotonsLanded = 0; ///< of those, the ones that reached a diffuse tixel through mirrors or glass
+  double causticSeconds = 0;         ///< of propagationSeconds, in the caustic pass
 };
 
 // The one JSON schema of the bake's settings and statistics (lightfield.cpp): the .plf's META
@@ -240,8 +247,8 @@ struct BakeStats {
 nlohmann::json toJson(const BakeSettings& settings);
 nlohmann::json toJson(const BakeStats& stats);
 /// The fields `json` holds; a key it lacks leaves its field as it is (a newer writer may add
-/// keys, which are ignored), except sun_masks and punctual_highlights, whose absence means a
-/// writer from before them, which baked without them (false). Throws nlohmann::json::exception
+/// keys, which are ignored), except sun_masks, punctual_highlights and caustic_photons, whose
+/// absence means a writer from before them, which baked without them (false, false, 0). Throws nlohmann::json::exception
 /// for a value of the wrong type.
 void fromJson(const nlohmann::json& json, BakeSettings& settings);
 void fromJson(const nlohmann::json& json, BakeStats& stats);

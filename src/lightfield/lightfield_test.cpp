@@ -22,6 +22,7 @@ TEST(BakeJsonSchema, SettingsAndStatsRoundTripAndOldFilesMeanNoSunMasksOrHighlig
   const nlohmann::json json = toJson(settings);
   EXPECT_EQ(json.at("gather_directions"), 576);
   EXPECT_EQ(json.at("tixels_per_unit"), 3.5f);
+  EXPECT_EQ(json.at("caustic_photons"), uint64_t(1) << 24);
   BakeSettings back;
   fromJson(json, back);
   EXPECT_EQ(toJson(back), json);
@@ -31,6 +32,7 @@ TEST(BakeJsonSchema, SettingsAndStatsRoundTripAndOldFilesMeanNoSunMasksOrHighlig
   nlohmann::json old = json;
   old.erase("sun_masks");
   old.erase("punctual_highlights");
+  old.erase("caustic_photons");
   old.erase("seed");
   old["a_key_from_a_newer_writer"] = 1;
   BakeSettings fromOld;
@@ -38,6 +40,7 @@ TEST(BakeJsonSchema, SettingsAndStatsRoundTripAndOldFilesMeanNoSunMasksOrHighlig
   fromJson(old, fromOld);
   EXPECT_FALSE(fromOld.sunMasks);
   EXPECT_FALSE(fromOld.punctualHighlights);
+  EXPECT_EQ(fromOld.causticPhotons, 0u);  // caustics gathered
   EXPECT_EQ(fromOld.seed, 5u);
 
   BakeStats stats;
@@ -45,10 +48,14 @@ TEST(BakeJsonSchema, SettingsAndStatsRoundTripAndOldFilesMeanNoSunMasksOrHighlig
   stats.iterations = 7;
   stats.visibilityRays = uint64_t(1) << 40;
   stats.reusedVisibility = true;
+  stats.causticPhotons = 1000;
+  stats.causticPhotonsLanded = 300;
+  stats.causticSeconds = 0.5;
   BakeStats statsBack;
   fromJson(toJson(stats), statsBack);
   EXPECT_EQ(toJson(statsBack), toJson(stats));
   EXPECT_EQ(statsBack.visibilityRays, uint64_t(1) << 40);
+  EXPECT_EQ(statsBack.causticPhotonsLanded, 300u);
   EXPECT_THROW(fromJson(nlohmann::json{{"iterations", "seven"}}, statsBack), nlohmann::json::exception);
 }
 

@@ -126,10 +126,15 @@ void bindLightField(py::module_& m) {
   m.def(
       "bake",
       [](const Scene& scene, const std::string& preset, uint64_t seed, int threads, std::optional<std::string> visibility,
-         bool reuseVisibility, bool sunMasks, bool punctualHighlights) {
+         bool reuseVisibility, bool sunMasks, bool punctualHighlights, std::optional<int64_t> causticPhotons) {
         BakeJobOptions options;
         options.sunMasks = sunMasks;
         options.punctualHighlights = punctualHighlights;
+        if (causticPhotons) {
+          if (*causticPhotons < 0 || *causticPhotons > (int64_t(1) << 32))
+            throw py::value_error(fmt::format("caustic_photons must be in [0, 2^32] (got {})", *causticPhotons));
+          options.causticPhotons = *causticPhotons;
+        }
         options.sceneName = scene.sourcePath;
         options.preset = preset;
         options.seed = seed;
@@ -151,11 +156,12 @@ void bindLightField(py::module_& m) {
       },
       py::arg("scene"), py::arg("preset") = "default", py::arg("seed") = 0, py::arg("threads") = 0,
       py::arg("visibility") = py::none(), py::arg("reuse_visibility") = false, py::arg("sun_masks") = true,
-      py::arg("punctual_highlights") = true,
+      py::arg("punctual_highlights") = true, py::arg("caustic_photons") = py::none(),
       "Bakes `scene`'s light field (what `plenoptic bake` does). visibility: a .plv path where the visibility field\n"
       "is saved; with reuse_visibility=True it is read back when the geometry and settings match (so a bake after\n"
       "editing only lights or emission re-runs the propagation alone). sun_masks=False: `--sun-masks off`;\n"
-      "punctual_highlights=False: `--punctual-highlights off`.");
+      "punctual_highlights=False: `--punctual-highlights off`; caustic_photons=N: `--caustic-photons N` (None:\n"
+      "the preset's).");
 
   m.def(
       "load_light_field",

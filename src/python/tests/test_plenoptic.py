@@ -157,6 +157,18 @@ def test_punctual_highlights_are_a_bake_option(tmp_path):
     assert errors[0] < 0.005 and errors[1] > 10.0 * errors[0]
 
 
+def test_caustic_photons_is_a_bake_option():
+    # McGuire's mirror box: its lamp's light through the mirrors is shot as photons (the
+    # count is in the stats), or left to the gather with caustic_photons=0.
+    scene = plenoptic.load_scene(os.path.join(DATA, "cornell-mcguire", "CornellBox-Mirror.obj"))
+    shot = plenoptic.bake(scene, preset="draft", caustic_photons=1 << 14)
+    assert shot.stats["caustic_photons"] == 1 << 14
+    assert 0 < shot.stats["caustic_photons_landed"] < 1 << 14
+    assert plenoptic.bake(scene, preset="draft", caustic_photons=0).stats["caustic_photons"] == 0
+    with pytest.raises(ValueError, match="caustic_photons"):
+        plenoptic.bake(scene, preset="draft", caustic_photons=-1)
+
+
 def test_editing_emission_and_rebaking_with_the_reused_visibility_equals_a_full_bake(tmp_path):
     scene = plenoptic.load_scene("cornell")
     visibility = str(tmp_path / "cornell.plv")
