@@ -833,6 +833,49 @@ TEST_F(PlfFileTest, GlossyDiffuseValuesRoundTripAndTheBitOnOtherKindsIsRefused) 
   EXPECT_EQ(chartRecord, 85u);
 }
 
+// Normal-mapped glossy charts keep tilted irradiances after their diffuse value (CHRT bit 3,
+// as on diffuse charts; lightfield.h "Normal-mapped diffuse charts"): the flags and the longer
+// value layout round-trip with every values encoding; the bit on a glossy chart without a
+// diffuse value, or on a specular chart, is refused.
+TEST_F(PlfFileTest, GlossyTiltedIrradiancesRoundTripAndTheBitWithoutADiffuseValueIsRefused) {
+  LightField original = makeTestLightField();
+  ASSERT_EQ(original.charts[2].kind, ChartKind::Glossy);
+  original.charts[2].diffuseValue = true;
+  original.charts[2].directionalIrradiance = true;  // 16 + 1 + 3 values per tixel
+  original.values.resize(16 + 2 * 3 * 20);
+  for (size_t i = 0; i < original.values.size(); ++i) original.values[i] = Rgb(float(i), 0.25f * float(i), 3.0f);
+  EXPECT_EQ(original.charts[2].tiltedIrradianceIndex(1, 0, 2), original.charts[2].firstValue + 20 + 16 + 1 + 2);
+  for (const ValuesCodec codec : {ValuesCodec::Raw, ValuesCodec::Lossless}) {
+    const std::string path = file("glossy-tilted.plf");
+    writeLightField(path, original, codec);
+    const LightField copy = readLightField(path);
+    ASSERT_EQ(copy.charts.size(), original.charts.size());
+    for (size_t i = 0; i < copy.charts.size(); ++i) {
+      EXPECT_EQ(copy.charts[i].diffuseValue, original.charts[i].diffuseValue) << i;
+      EXPECT_EQ(copy.charts[i].directionalIrradiance, original.charts[i].directionalIrradiance) << i;
+    }
+    EXPECT_EQ(copy.values, original.values);
+  }
+  const std::string path = file("glossy-tilted.plf");
+  writeLightField(path, original);
+  const auto good = readBytes(path);
+  const auto table = sections(good);
+  const uint64_t chartRecord = 4 + 1 + 48 + 4 + 12 + 16;
+  const uint64_t recordsAt = table[1].offset + 8;  // record 0's material, then its kind byte
+  auto bad = good;
+  bad[recordsAt + 2 * chartRecord + 4] &= uint8_t(~0x10);  // the glossy chart without its diffuse value
+  resign(bad);
+  writeBytes(file("glossy-tilted-bit.plf"), bad);
+  expectRefused(file("glossy-tilted-bit.plf"),
+                {"corrupt charts section", "chart 2 of kind 1 without a diffuse value is marked as having tilted irradiances"});
+  bad = good;
+  bad[recordsAt + chartRecord + 4] |= 0x08;  // the mirror chart
+  resign(bad);
+  writeBytes(file("mirror-tilted-bit.plf"), bad);
+  expectRefused(file("mirror-tilted-bit.plf"),
+                {"corrupt charts section", "chart 1 of kind 2 without a diffuse value is marked as having tilted irradiances"});
+}
+
 TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {
   LightField original = makeTestLightField();
   Scene& s = original.scene;
