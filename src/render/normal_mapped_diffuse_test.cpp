@@ -194,7 +194,9 @@ TEST_F(NormalMappedDiffuseTest, GlossyTiltedIrradiancesRoundTripThroughThePlf) {
     for (const Rgb& v : decoded) {
       ASSERT_TRUE(v.r >= 0.0f && v.g >= 0.0f && v.b >= 0.0f) << valuesCodecName(codec);
     }
-    if (codec == ValuesCodec::Hdr) EXPECT_LT(measureValuesError(lf.values, decoded).relativeRmse, 0.05);
+    if (codec == ValuesCodec::Hdr) {
+      EXPECT_LT(measureValuesError(lf.values, decoded).relativeRmse, 0.05);
+    }
   }
 }
 
