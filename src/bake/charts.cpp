@@ -255,8 +255,10 @@ Chart frameChart(const Scene& scene, const TriangleList& list, bool grewCurved, 
   c.dirRes = directionalResolution(bsdf, settings);
   // A glossy model with a diffuse part keeps that part's irradiance per tixel (lightfield.h).
   c.diffuseValue = c.kind == ChartKind::Glossy && !isBlack(diffuseAlbedo(bsdf));
-  // A normal-mapped diffuse material keeps irradiances about tilted normals (lightfield.h).
-  c.directionalIrradiance = c.kind == ChartKind::Diffuse && scene.materials[c.material].normalTexture >= 0;
+  // A normal-mapped diffuse material, or glossy one with a diffuse part, keeps irradiances
+  // about tilted normals (lightfield.h "Normal-mapped diffuse charts").
+  c.directionalIrradiance =
+      (c.kind == ChartKind::Diffuse || c.diffuseValue) && scene.materials[c.material].normalTexture >= 0;
   const double nLen = glm::length(normalSum);
   const Vec3 n = nLen > 0.0 ? Vec3(normalSum / nLen) : Vec3(0.0f, 0.0f, 1.0f);
   c.normal = n;

@@ -405,10 +405,11 @@ struct TransportState::Operators {
   /// The quads (TransportQuad) of every tixel, plus one, all zero, for the entries that
   /// escaped (see gatherTixel).
   std::vector<TransportQuad> quads;
-  /// Normal-mapped diffuse charts (lightfield.h): per gather direction — cell k with jitter
-  /// sub-cell j at [k·kGatherJitterSide² + j] — its share of each tilted irradiance in the
-  /// gather frame, π/n · max(0, b_i·ω)/cos θ. Empty without such charts.
-  std::vector<std::array<float, kTiltedNormals>> tiltShares;
+  /// Normal-mapped charts (lightfield.h "Normal-mapped diffuse charts"), per material of a
+  /// directionalIrradiance chart (empty for the others): per gather direction — cell k with
+  /// jitter sub-cell j at [k·kGatherJitterSide² + j] — its share of each tilted irradiance in
+  /// the gather frame, π/n · max(0, b_i·ω)/cos θ · tiltFactor.
+  std::vector<std::vector<std::array<Rgb, kTiltedNormals>>> tiltShares;
 };
 
 namespace {
@@ -460,28 +461,53 @@ float exitanceChange(const TransportState& state, const Rgb* before, const Rgb* 
   return sum;
 }
 
+/// The irradiance tixel g of chart c sends on, from its irradiance values[0] (a diffuse
+/// chart's E, a glossy chart's Ẽ): values[0] itself, or on a directionalIrradiance chart
+/// Parameterisation::transportTiltWeights applied to it and the tilted irradiances after it,
+/// clamped at 0 (a normal-mapped surface sends on its irradiance about the footprint's mapped
+/// normals).
+Rgb transportIrradiance(const Parameterisation& param, const Chart& c, uint64_t g, const Rgb* values) {
+  if (!c.directionalIrradiance) return values[0];
+  const TiltWeights& w = param.transportTiltWeights[g];
+  Rgb e = values[0] * w.irradiance;
+  for (uint32_t k = 0; k < kTiltedNormals; ++k) e += values[1 + k] * w.tilted[k];
+  return glm::max(e, Rgb(0.0f));
+}
+
 /// The diffuse part of a glossy diffuseValue chart c's exitant radiance towards paraboloid
 /// direction st at grid position `grid`: k(μo)/π · the bilinear interpolation of ρ̄·Ẽ over the
-/// tixels (ρ̄ the transport albedo; as the diffuse quads interpolate ρ̄·E).
+/// tixels (ρ̄ the transport albedo, Ẽ transportIrradiance's; as the diffuse quads interpolate ρ̄·E).
 Rgb glossyDiffuseRadiance(const TransportState& state, const Rgb* values, const Chart& c, Vec2 grid, Vec2 st) {
   const std::vector<Rgb>& albedo = state.param.transportAlbedo;
   const F4 e = bilinearOverTixels(c, grid, [&](uint32_t i, uint32_t j) {
-    return f4FromRgb(albedo[c.firstTixel + uint64_t(j) * c.resU + i] * values[c.diffuseValueIndex(i, j)]);
+    const uint64_t tixel = c.firstTixel + uint64_t(j) * c.resU + i;
+    return f4FromRgb(albedo[tixel] * transportIrradiance(state.param, c, tixel, &values[c.diffuseValueIndex(i, j)]));
   });
   const Bsdf& bsdf = state.scene.materials[c.material].bsdf;
   return f4Rgb(e) * kInvPi * diffuseDirectionalFactor(bsdf, paraboloidToDirection(st).z);
 }
 
+/// The weight of light arriving at cos θ = `cosine` to tilted normal b_k in chart c's tilted
+/// irradiances, beyond the cosine: 1 on a diffuse chart, the diffuse part's k(b_k·ω) on a
+/// glossy one (its Ẽ_k weigh the light as Ẽ does, lightfield.h).
+Rgb tiltFactor(const Chart& c, const Bsdf& bsdf, float cosine) {
+  return c.kind == ChartKind::Glossy ? diffuseDirectionalFactor(bsdf, cosine) : Rgb(1.0f);
+}
+
 /// The tilted irradiances (lightfield.h "Normal-mapped diffuse charts") that light of
 /// irradiance `irradiance` (W·m⁻², already × cos θ at the tixel's normal) arriving from world
 /// direction wi adds to directionalIrradiance tixel g of chart c: irradiance ·
-/// max(0, b_k·wi) / cos θ for each tilted normal b_k, added to tilted[0 … kTiltedNormals − 1].
-void addTiltedIrradiance(const Parameterisation& param, const Chart& c, uint64_t g, const Vec3& wi, const Rgb& irradiance,
-                         Rgb* tilted) {
+/// max(0, b_k·wi) / cos θ · tiltFactor for each tilted normal b_k, added to
+/// tilted[0 … kTiltedNormals − 1].
+void addTiltedIrradiance(const Scene& scene, const Parameterisation& param, const Chart& c, uint64_t g, const Vec3& wi,
+                         const Rgb& irradiance, Rgb* tilted) {
   const Vec3 local = tiltFrame(param, c, g).toLocal(wi);
   if (!(local.z > 0.0f)) return;
-  for (uint32_t k = 0; k < kTiltedNormals; ++k)
-    tilted[k] += irradiance * (std::max(0.0f, glm::dot(local, tiltedNormal(k))) / local.z);
+  const Bsdf& bsdf = scene.materials[c.material].bsdf;
+  for (uint32_t k = 0; k < kTiltedNormals; ++k) {
+    const float cosine = glm::dot(local, tiltedNormal(k));
+    tilted[k] += irradiance * (std::max(0.0f, cosine) / local.z) * tiltFactor(c, bsdf, cosine);
+  }
 }
 
 /// The same for the radiances incoming[k] (W·sr⁻¹·m⁻²) of tixel g's n gather rays
@@ -495,12 +521,12 @@ void addTiltedIrradiance(const Parameterisation& param, const Chart& c, uint64_t
 void addTiltedGather(const TransportState& state, const Chart& c, uint64_t g, const Lanes4* incoming,
                      std::vector<uint8_t>& subCells, Rgb* tilted) {
   const Parameterisation& param = state.param;
-  const auto& shares = state.ops->tiltShares;
+  const auto& shares = state.ops->tiltShares[c.material];
   gatherSubCells(g, state.gridSide, state.settings.seed, subCells);
   Rgb sum[kTiltedNormals] = {Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
   for (uint32_t k = 0; k < state.n; ++k) {
     const Rgb L(incoming[k].v[0], incoming[k].v[1], incoming[k].v[2]);
-    const std::array<float, kTiltedNormals>& share = shares[size_t(k) * kGatherJitterSide * kGatherJitterSide + subCells[k]];
+    const std::array<Rgb, kTiltedNormals>& share = shares[size_t(k) * kGatherJitterSide * kGatherJitterSide + subCells[k]];
     for (uint32_t t = 0; t < kTiltedNormals; ++t) sum[t] += L * share[t];
   }
   if (c.curved) {
@@ -521,15 +547,6 @@ void addTiltedGather(const TransportState& state, const Chart& c, uint64_t g, co
     }
   }
   for (uint32_t t = 0; t < kTiltedNormals; ++t) tilted[t] += sum[t];
-}
-
-/// The irradiance directionalIrradiance tixel g sends on (Parameterisation::
-/// transportTiltWeights applied to its E and tilted irradiances `values`), clamped at 0.
-Rgb transportIrradiance(const Parameterisation& param, uint64_t g, const Rgb* values) {
-  const TiltWeights& w = param.transportTiltWeights[g];
-  Rgb e = values[0] * w.irradiance;
-  for (uint32_t k = 0; k < kTiltedNormals; ++k) e += values[1 + k] * w.tilted[k];
-  return glm::max(e, Rgb(0.0f));
 }
 
 }  // namespace
@@ -586,15 +603,21 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
     punctualGlossy.assign(param.valueCount, Rgb(0.0f));
   change.assign(tixels, 0.0f);
   batchStart = propagationBatches(param);
-  if (std::any_of(param.charts.begin(), param.charts.end(), [](const Chart& c) { return c.directionalIrradiance; })) {
+  ops->tiltShares.resize(scene.materials.size());
+  for (const Chart& c : param.charts) {
+    std::vector<std::array<Rgb, kTiltedNormals>>& shares = ops->tiltShares[c.material];
+    if (!c.directionalIrradiance || !shares.empty()) continue;
+    const Bsdf& bsdf = scene.materials[c.material].bsdf;
     constexpr uint32_t kJitters = kGatherJitterSide * kGatherJitterSide;
-    ops->tiltShares.resize(size_t(n) * kJitters);
+    shares.resize(size_t(n) * kJitters);
     for (uint32_t k = 0; k < n; ++k)
       for (uint32_t j = 0; j < kJitters; ++j) {
         const Vec3 w = gatherCellDirection(k, j, gridSide, settings.seed);
-        for (uint32_t t = 0; t < kTiltedNormals; ++t)
-          ops->tiltShares[size_t(k) * kJitters + j][t] =
-              w.z > 0.0f ? kPi / float(n) * std::max(0.0f, glm::dot(w, tiltedNormal(t))) / w.z : 0.0f;
+        for (uint32_t t = 0; t < kTiltedNormals; ++t) {
+          const float cosine = glm::dot(w, tiltedNormal(t));
+          shares[size_t(k) * kJitters + j][t] =
+              w.z > 0.0f ? Rgb(kPi / float(n) * std::max(0.0f, cosine) / w.z) * tiltFactor(c, bsdf, cosine) : Rgb(0.0f);
+        }
       }
   }
 }
@@ -647,7 +670,7 @@ void removeSunMaskedDirect(const Scene& scene, const Parameterisation& param, st
         value[0] -= masked;
         if (!c.directionalIrradiance) continue;
         Rgb tilted[kTiltedNormals] = {Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};  // what the first shot added
-        addTiltedIrradiance(param, c, g, parallelLight(lights[slot])->towardsLight, masked, tilted);
+        addTiltedIrradiance(scene, param, c, g, parallelLight(lights[slot])->towardsLight, masked, tilted);
         for (uint32_t k = 0; k < kTiltedNormals; ++k) value[1 + k] -= tilted[k];
       }
       for (uint64_t v = 0; v < c.valuesPerTixel(); ++v)
@@ -707,8 +730,8 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         if (maskSlot[li] >= 0 && c.kind == ChartKind::Diffuse) {
           const Rgb masked = sunMaskedIrradiance(param, light, g, size_t(maskSlot[li]));
           direct[valueBase(g, c)] += masked;
-          if (c.directionalIrradiance) addTiltedIrradiance(param, c, g, parallelLight(light)->towardsLight, masked,
-                                                          &direct[valueBase(g, c) + 1]);
+          if (c.directionalIrradiance)
+            addTiltedIrradiance(scene, param, c, g, parallelLight(light)->towardsLight, masked, &direct[valueBase(g, c) + 1]);
           continue;
         }
         // One ray towards a delta light; sceneLightSamples towards any other, the tixel's own
@@ -785,7 +808,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       const uint64_t vb = valueBase(p.tixel, c);
       if (c.kind == ChartKind::Diffuse) {
         direct[vb] += p.irradiance;
-        if (c.directionalIrradiance) addTiltedIrradiance(param, c, p.tixel, p.wi, p.irradiance, &direct[vb + 1]);
+        if (c.directionalIrradiance) addTiltedIrradiance(scene, param, c, p.tixel, p.wi, p.irradiance, &direct[vb + 1]);
       } else {
         const GlossyMaterial& gm = glossy[c.material];
         const Bsdf& bsdf = scene.materials[c.material].bsdf;
@@ -807,6 +830,8 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
           if (highlight) punctualGlossy[vb + t] += reflected;
         }
         if (gm.diffuse) direct[vb + c.directionTexels()] += diffuseDirectionalFactor(bsdf, wiLocal.z) * p.irradiance;
+        if (c.directionalIrradiance)
+          addTiltedIrradiance(scene, param, c, p.tixel, p.wi, p.irradiance, &direct[vb + c.directionTexels() + 1]);
       }
     }
     if (progress) progress->advance(t1 - t0);
@@ -917,6 +942,8 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
       } else {
         glossy[c.material].reflection(c).apply(incoming.data(), f4FromRgb(sum), direct.data() + vb);
         glossy[c.material].addDiffuse(c, incoming.data(), direct.data() + vb);
+        if (c.directionalIrradiance)
+          addTiltedGather(state, c, g, incoming.data(), subCells, direct.data() + vb + c.directionTexels() + 1);
       }
     }
   });
@@ -968,9 +995,7 @@ void updateTransport(TransportState& state, uint64_t begin, uint64_t end) {
       const uint32_t i = uint32_t(local % c.resU), j = uint32_t(local / c.resU);
       auto transport = [&](uint64_t tixel) {
         const Rgb* values = &current[valueBase(tixel, c)];
-        // A normal-mapped chart sends on its irradiance about the footprint's mapped normals.
-        return param.transportAlbedo[tixel] * (c.directionalIrradiance ? transportIrradiance(param, tixel, values) : values[0]) *
-               kInvPi;
+        return param.transportAlbedo[tixel] * transportIrradiance(param, c, tixel, values) * kInvPi;
       };
       const bool right = i + 1 < c.resU, up = j + 1 < c.resV;
       const Rgb t00 = transport(g), t10 = right ? transport(g + 1) : Rgb(0.0f),
@@ -1056,6 +1081,7 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
         const GlossyMaterial& gm = glossy[c.material];
         gm.reflection(c).apply(incoming.data(), sum, out);
         gm.addDiffuse(c, incoming.data(), out);
+        if (c.directionalIrradiance) addTiltedGather(state, c, g, incoming.data(), subCells, out + c.directionTexels() + 1);
         if (gm.glass) {
           // Rough glass: plus the transmission of what the twin record gathers now.
           const uint64_t twin = twinTixel(param, g);

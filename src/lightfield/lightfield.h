@@ -64,6 +64,12 @@
 // lights, below, directly at n'); the bake's transport at each tixel's footprint-mean mapped
 // normal (the model is linear in n', so this is the footprint mean of E(n')), since a bumpy
 // surface sends on less light than a flat one.
+// A normal-mapped glossy chart with a diffuse part (diffuseValue) keeps its Ẽ the same way:
+// Ẽ about n, then Ẽ_k = ∫ L k(b_k·ω) max(0, b_k·ω) dω about the tilted normals (k the
+// model's diffuseDirectionalFactor, as in Ẽ), and the renderers take the diffuse part's
+// irradiance from the same model at the mapped normal. (With k ≠ 1 the model is a fit, no
+// longer exact for one direction, since k varies with the angle.) The glossy map stays as it
+// is: its lookups follow the normal map (normalMappedLookupDirection, lookup.h).
 //
 // Sides (the light field's part of the sidedness rule; scatteringFrame in scene.h is the
 // path tracer's, emittedRadiance there the emitters'). A reflecting surface scatters on both
@@ -144,23 +150,27 @@ struct Chart {
   /// A glossy chart whose material has a diffuse part: each tixel's map is followed by its
   /// diffuse irradiance Ẽ (see "What is stored per chart kind" above).
   bool diffuseValue = false;
-  /// A diffuse chart of a normal-mapped material: each tixel's irradiance E is followed by its
-  /// kTiltedNormals tilted irradiances E_k (see "Normal-mapped diffuse charts" above).
+  /// A diffuse chart, or a diffuseValue glossy chart, of a normal-mapped material: each
+  /// tixel's irradiance E (a glossy chart's Ẽ) is followed by its kTiltedNormals tilted
+  /// irradiances E_k (see "Normal-mapped diffuse charts" above).
   bool directionalIrradiance = false;
 
   uint64_t tixelCount() const { return uint64_t(resU) * resV; }
   uint64_t directionTexels() const { return uint64_t(dirRes) * dirRes; }
   uint64_t valuesPerTixel() const;
   /// Values are tixel-major: all direction texels of one tixel are contiguous, direction
-  /// texel (s, t) at s + t·dirRes, then (diffuseValue) the tixel's Ẽ, or (directionalIrradiance)
+  /// texel (s, t) at s + t·dirRes, then (diffuseValue) the tixel's Ẽ, then (directionalIrradiance)
   /// its tilted irradiances E_0 … E_2; tixels row by row (i + j·resU).
   uint64_t valueIndex(uint32_t i, uint32_t j, uint32_t s = 0, uint32_t t = 0) const {
     return firstValue + (uint64_t(j) * resU + i) * valuesPerTixel() + uint64_t(t) * dirRes + s;
   }
   /// The index of tixel (i, j)'s diffuse irradiance Ẽ (diffuseValue charts only).
   uint64_t diffuseValueIndex(uint32_t i, uint32_t j) const { return valueIndex(i, j) + directionTexels(); }
-  /// The index of tixel (i, j)'s irradiance about tilted normal k (directionalIrradiance charts).
-  uint64_t tiltedIrradianceIndex(uint32_t i, uint32_t j, uint32_t k) const { return valueIndex(i, j) + 1 + k; }
+  /// The index of tixel (i, j)'s irradiance about tilted normal k (directionalIrradiance
+  /// charts): after its irradiance E (diffuse) or its map and Ẽ (glossy).
+  uint64_t tiltedIrradianceIndex(uint32_t i, uint32_t j, uint32_t k) const {
+    return valueIndex(i, j) + directionTexels() + (diffuseValue ? 1 : 0) + k;
+  }
 };
 
 /// Normal-mapped diffuse charts (see above): the number of tilted normals, their tilt β = 45°

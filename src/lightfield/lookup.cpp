@@ -165,10 +165,9 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
   const SunLights sun = sunLightsOf(lf);
   const ChartShading shading = chartShading(lf, chart, sun);
   AlbedoPoint albedo;
-  Vec3 lookupDirection, lookupNormal, mappedNormal;
-  lookupInputs(lf.scene, c, shading, hit, worldDirectionTowardsViewer, coneWidth, albedo, lookupDirection, lookupNormal,
-               mappedNormal);
-  return exitantRadiance(lf.scene, c, shading, lf.values.data(), worldPosition, lookupDirection, lookupNormal,
+  Vec3 lookupNormal, mappedNormal;
+  lookupInputs(lf.scene, c, shading, hit, worldDirectionTowardsViewer, coneWidth, albedo, lookupNormal, mappedNormal);
+  return exitantRadiance(lf.scene, c, shading, lf.values.data(), worldPosition, worldDirectionTowardsViewer, lookupNormal,
                          mappedNormal, albedo);
 }
 

@@ -349,17 +349,15 @@ inline Vec3 lookupNormalAt(const Scene& scene, const Chart& c, const ChartShadin
 
 /// What exitantRadianceLanes needs of a ray's hit on chart c besides the position: the uv
 /// and mip level (for an albedo texture: albedoLodAt with the ray's cone width `coneWidth`
-/// at the hit), the lookup direction (towards the viewer; bent by a normal map on glossy
-/// charts), the normal the glossy map is read around (the chart normal; on a curved
+/// at the hit), the normal the glossy map is read around (the chart normal; on a curved
 /// glossy chart the interpolated normal at the hit, chartShadingNormalAt) and the mapped
-/// normal a directionalIrradiance chart's irradiance is taken about (surfaceAt's shading
-/// normal, turned to the record's side; lookupNormal elsewhere). surfaceAt is evaluated only
-/// where the chart's shading needs it.
+/// normal (surfaceAt's shading normal, turned to the record's side, on a normal-mapped chart:
+/// ChartShading::normalMapped; lookupNormal elsewhere). surfaceAt is evaluated only where the
+/// chart's shading needs it.
 inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading& shading, const RayHit& hit,
-                         const Vec3& towardsViewer, float coneWidth, AlbedoPoint& albedo, Vec3& lookup,
-                         Vec3& lookupNormal, Vec3& mappedNormal) {
+                         const Vec3& towardsViewer, float coneWidth, AlbedoPoint& albedo, Vec3& lookupNormal,
+                         Vec3& mappedNormal) {
   albedo = AlbedoPoint{};
-  lookup = towardsViewer;
   lookupNormal = lookupNormalAt(scene, c, shading, hit.mesh, hit.triangle, hit.barycentrics);
   mappedNormal = lookupNormal;
   const bool glossyMapped = shading.normalMapped && c.kind == ChartKind::Glossy;
@@ -370,11 +368,6 @@ inline void lookupInputs(const Scene& scene, const Chart& c, const ChartShading&
   }
   if (!shading.normalMapped) return;
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
-  if (glossyMapped) {
-    lookup = normalMappedLookupDirection(lookupNormal, surface.shadingNormal, towardsViewer);
-    return;
-  }
-  // A directionalIrradiance chart: the irradiance is taken about the mapped normal.
   mappedNormal = c.isBack ? -surface.shadingNormal : surface.shadingNormal;
 }
 
@@ -414,8 +407,9 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
 /// goes through, as four lanes (r, g, b, 0). Defined inline so that the fast renderer's
 /// per-pixel loop inlines it instead of calling across files. lookupNormal: lookupNormalAt's
 /// normal at worldPosition (lookupInputs): a curved glossy chart's map is read around it, a
-/// curved diffuse chart's sun-masked lights shine on it. mappedNormal: a directionalIrradiance
-/// chart's mapped normal (lookupInputs; lookupNormal on other charts). albedo: where, at which
+/// curved diffuse chart's sun-masked lights shine on it. mappedNormal: a normal-mapped chart's
+/// mapped normal (lookupInputs; lookupNormal on other charts). worldDirectionTowardsViewer: the
+/// unit direction towards the viewer (a normal-mapped glossy chart bends its lookup itself). albedo: where, at which
 /// mip level and with which vertex colour a diffuse chart's albedo is read (lookupInputs).
 template <typename Load>
 inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartShading& shading, const Load& load,
@@ -450,21 +444,36 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
     const F4 reflected = f4Mul(albedoOverPi, irradiance);
     return shading.emissive && emits ? f4Add(f4Load(shading.emission.v), reflected) : reflected;
   }
-  // Glossy: the stored values already include the record's emission. The direction in the
-  // map's frame (tixelFrameAround: the chart frame, chartLocalDirection's formula, on a planar
-  // chart; on a curved one the frame around the interpolated normal here, which varies
-  // continuously over the chart and is within a tixel of each interpolated tixel's gather
-  // frame). A direction below that normal (a silhouette of a smooth mesh, where the shading
-  // normal turns away from a viewer the triangle still faces) reads the horizon texels.
-  const Vec3 local = tixelFrameAround(c, lookupNormal).toLocal(worldDirectionTowardsViewer);
+  // Glossy: the stored values already include the record's emission. On a normal-mapped
+  // chart the path tracer's model reflects only towards viewers above the mapped normal
+  // (bsdf.cpp sameHemisphereUp in the shading frame), and the map is read in the direction
+  // bent by the normal map (normalMappedLookupDirection).
+  Vec3 lookup = worldDirectionTowardsViewer;
+  if (shading.normalMapped) {
+    if (!(glm::dot(worldDirectionTowardsViewer, mappedNormal) > 0.0f))
+      return shading.emissive && emits ? f4Load(shading.emission.v) : f4Zero();
+    lookup = normalMappedLookupDirection(lookupNormal, mappedNormal, worldDirectionTowardsViewer);
+  }
+  // The direction in the map's frame (tixelFrameAround: the chart frame, chartLocalDirection's
+  // formula, on a planar chart; on a curved one the frame around the interpolated normal here,
+  // which varies continuously over the chart and is within a tixel of each interpolated
+  // tixel's gather frame). A direction below that normal (a silhouette of a smooth mesh, where
+  // the shading normal turns away from a viewer the triangle still faces) reads the horizon
+  // texels.
+  const Vec3 local = tixelFrameAround(c, lookupNormal).toLocal(lookup);
   const F4 mapped = interpolateLanes(load, c, grid, directionToParaboloid(local));
   if (!c.diffuseValue) return mapped;
-  // Plus the diffuse part, ρ(uv)/π · k(μo) · Ẽ (lightfield.h), with Ẽ bilinear over the tixels.
-  const F4 irradiance = bilinearOverTixels(c, grid, [&](uint32_t i, uint32_t j) { return load(c.diffuseValueIndex(i, j)); });
+  // Plus the diffuse part, ρ(uv)/π · k(μo) · Ẽ (lightfield.h), with Ẽ bilinear over the tixels
+  // (on a directionalIrradiance chart: about the mapped normal).
+  F4 irradiance = bilinearOverTixels(c, grid, [&](uint32_t i, uint32_t j) { return load(c.diffuseValueIndex(i, j)); });
+  if (c.directionalIrradiance)
+    irradiance = mappedNormalIrradiance(load, c, grid, irradiance, tiltFrameAround(c, lookupNormal).toLocal(mappedNormal));
   const F4 albedoOverPi = shading.texturedAlbedo
                               ? f4Mul(f4FromRgb(glossyDiffuseAlbedoAt(scene, c.material, albedo)), f4Splat(kInvPi))
                               : f4Load(shading.albedoOverPi.v);
-  const F4 factor = f4FromRgb(diffuseDirectionalFactor(scene.materials[c.material].bsdf, local.z));
+  // k(μo), μo against the mapped normal on a normal-mapped chart (the path tracer's shading frame).
+  const float cosViewer = shading.normalMapped ? glm::dot(worldDirectionTowardsViewer, mappedNormal) : local.z;
+  const F4 factor = f4FromRgb(diffuseDirectionalFactor(scene.materials[c.material].bsdf, cosViewer));
   return f4Add(mapped, f4Mul(f4Mul(albedoOverPi, factor), irradiance));
 }
 template <typename Load>

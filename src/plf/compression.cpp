@@ -58,11 +58,12 @@ std::vector<Grid> buildLayout(const std::vector<Chart>& charts, uint64_t valueCo
       for (uint64_t k = 0; k < perTixel; ++k) images.push_back({c.firstValue + k, perTixel, perTixel * c.resU, c.resU, c.resV});
     } else {
       // Glossy: every tixel's dirRes × dirRes paraboloid texture (texel (s, t) at s + t·dirRes),
-      // then (diffuseValue) the tixels' diffuse irradiance as one more tixel-grid image.
+      // then (diffuseValue) the tixels' diffuse irradiance as one more tixel-grid image, and
+      // (directionalIrradiance) one per tilted irradiance.
       for (uint64_t tixel = 0; tixel < tixels; ++tixel)
         images.push_back({c.firstValue + tixel * perTixel, 1, c.dirRes, c.dirRes, c.dirRes});
-      if (c.diffuseValue)
-        images.push_back({c.firstValue + c.directionTexels(), perTixel, perTixel * c.resU, c.resU, c.resV});
+      for (uint64_t k = c.directionTexels(); k < perTixel; ++k)
+        images.push_back({c.firstValue + k, perTixel, perTixel * c.resU, c.resU, c.resV});
     }
   }
   std::sort(covered.begin(), covered.end());

@@ -36,7 +36,7 @@
 // (one irradiance per tixel; a directionalIrradiance chart one more per tilted irradiance,
 // Chart::directionalIrradiance); a glossy chart is one dirRes × dirRes image per tixel, its
 // paraboloid texture, plus (Chart::diffuseValue) one resU × resV image of its tixels'
-// diffuse irradiance. Values that no chart covers form 1-pixel-high images. BC1 pads
+// diffuse irradiance (and of each tilted irradiance, Chart::directionalIrradiance). Values that no chart covers form 1-pixel-high images. BC1 pads
 // images to whole 4 × 4 blocks (padding texels are masked out of the endpoint fit).
 // Chosen by measurement on CornellBox-Glossy (533 mostly small glossy charts, dirRes 12)
 // against the alternative of dirRes² images of resU × resV (one per direction texel, i.e.

@@ -471,6 +471,10 @@ constexpr uint64_t kChartRecordBytes = 4 + 1 + 4 * 12 + 4 + 3 * 4 + 2 * 8;
 // Bit 3 (version 5 on) marks a diffuse chart with tilted irradiances after each tixel's
 // irradiance (Chart::directionalIrradiance); older files have it clear, and their normal-mapped
 // diffuse charts keep one irradiance, shown flat, which is what a chart without the bit means.
+// A glossy chart with a diffuse value may have bit 3 too (its Ẽ followed by tilted
+// irradiances), without a version bump: older files never have it there (their normal-mapped
+// glossy charts' Ẽ is shown flat), and an older build reading a newer file refuses the chart
+// as marked with tilted irradiances.
 constexpr uint8_t kChartTwoSidedBit = 0x80, kChartBackBit = 0x40, kChartCurvedBit = 0x20, kChartDiffuseValueBit = 0x10,
                   kChartDirectionalBit = 0x08, kChartKindMask = 0x07;
 
@@ -518,8 +522,8 @@ std::vector<Chart> decodeCharts(std::span<const unsigned char> bytes, const std:
     if (c.curved && c.kind == ChartKind::Specular) r.corrupt(fmt::format("chart {} of kind {} is marked curved", i, kind));
     if (c.diffuseValue && c.kind != ChartKind::Glossy)
       r.corrupt(fmt::format("chart {} of kind {} is marked as having a diffuse value", i, kind));
-    if (c.directionalIrradiance && c.kind != ChartKind::Diffuse)
-      r.corrupt(fmt::format("chart {} of kind {} is marked as having tilted irradiances", i, kind));
+    if (c.directionalIrradiance && c.kind != ChartKind::Diffuse && !c.diffuseValue)
+      r.corrupt(fmt::format("chart {} of kind {} without a diffuse value is marked as having tilted irradiances", i, kind));
     c.origin = r.get<Vec3>();
     c.axisU = r.get<Vec3>();
     c.axisV = r.get<Vec3>();

@@ -51,6 +51,7 @@
 //         The kind byte's bit 4 (version ≥ 4) marks a glossy chart whose tixels keep their
 //         diffuse irradiance after their map (Chart::diffuseValue, lightfield.h); bit 3
 //         (version ≥ 5) a diffuse chart whose tixels keep tilted irradiances after their
+//         irradiance, or a glossy chart with bit 4 whose tixels keep them after their diffuse
 //         irradiance (Chart::directionalIrradiance).
 //   TRCH  triangle → chart: u64 mesh count, then per mesh u64 triangle count + u32 indices.
 //   VALS  the values: float32 RGB triplets (12 bytes each), in LightField::values order.

@@ -212,6 +212,20 @@ class PlfFileTest : public test_support::TempDirTest {
     const uint64_t hash = stream.digest();
     std::memcpy(bytes.data() + 24, &hash, 8);
   }
+  /// Writes to `badName` the file at `goodPath` with chart record `chart`'s CHRT kind byte
+  /// given bits `set` and cleared of bits `clear` (re-signed), and expects it refused with
+  /// `fragments`.
+  void expectKindByteRefused(const std::string& goodPath, uint64_t chart, uint8_t set, uint8_t clear,
+                             const std::string& badName, const std::vector<std::string>& fragments) const {
+    auto bytes = readBytes(goodPath);
+    constexpr uint64_t kChartRecord = 4 + 1 + 48 + 4 + 12 + 16;
+    static_assert(kChartRecord == 85, "the CHRT record size");
+    const uint64_t kindAt = sections(bytes)[1].offset + 8 + chart * kChartRecord + 4;  // after the count and material
+    bytes[kindAt] = uint8_t((bytes[kindAt] | set) & ~clear);
+    resign(bytes);
+    writeBytes(file(badName), bytes);
+    expectRefused(file(badName), fragments);
+  }
 
   fs::path dir_;
 };
@@ -821,16 +835,41 @@ TEST_F(PlfFileTest, GlossyDiffuseValuesRoundTripAndTheBitOnOtherKindsIsRefused) 
   }
   const std::string path = file("diffuse-value.plf");
   writeLightField(path, original);
-  const auto good = readBytes(path);
-  const auto table = sections(good);
-  const uint64_t chartRecord = 4 + 1 + 48 + 4 + 12 + 16;
-  const uint64_t recordsAt = table[1].offset + 8;  // record 0's material, then its kind byte
-  auto bad = good;
-  bad[recordsAt + 4] |= 0x10;  // the diffuse chart marked as having a diffuse value
-  resign(bad);
-  writeBytes(file("diffuse-bit.plf"), bad);
-  expectRefused(file("diffuse-bit.plf"), {"corrupt charts section", "chart 0 of kind 0 is marked as having a diffuse value"});
-  EXPECT_EQ(chartRecord, 85u);
+  // The diffuse chart marked as having a diffuse value.
+  expectKindByteRefused(path, 0, 0x10, 0, "diffuse-bit.plf",
+                        {"corrupt charts section", "chart 0 of kind 0 is marked as having a diffuse value"});
+}
+
+// Normal-mapped glossy charts keep tilted irradiances after their diffuse value (CHRT bit 3,
+// as on diffuse charts; lightfield.h "Normal-mapped diffuse charts"): the flags and the longer
+// value layout round-trip with every values encoding; the bit on a glossy chart without a
+// diffuse value, or on a specular chart, is refused.
+TEST_F(PlfFileTest, GlossyTiltedIrradiancesRoundTripAndTheBitWithoutADiffuseValueIsRefused) {
+  LightField original = makeTestLightField();
+  ASSERT_EQ(original.charts[2].kind, ChartKind::Glossy);
+  original.charts[2].diffuseValue = true;
+  original.charts[2].directionalIrradiance = true;  // 16 + 1 + 3 values per tixel
+  original.values.resize(16 + 2 * 3 * 20);
+  for (size_t i = 0; i < original.values.size(); ++i) original.values[i] = Rgb(float(i), 0.25f * float(i), 3.0f);
+  EXPECT_EQ(original.charts[2].tiltedIrradianceIndex(1, 0, 2), original.charts[2].firstValue + 20 + 16 + 1 + 2);
+  for (const ValuesCodec codec : {ValuesCodec::Raw, ValuesCodec::Lossless}) {
+    const std::string path = file("glossy-tilted.plf");
+    writeLightField(path, original, codec);
+    const LightField copy = readLightField(path);
+    ASSERT_EQ(copy.charts.size(), original.charts.size());
+    for (size_t i = 0; i < copy.charts.size(); ++i) {
+      EXPECT_EQ(copy.charts[i].diffuseValue, original.charts[i].diffuseValue) << i;
+      EXPECT_EQ(copy.charts[i].directionalIrradiance, original.charts[i].directionalIrradiance) << i;
+    }
+    EXPECT_EQ(copy.values, original.values);
+  }
+  const std::string path = file("glossy-tilted.plf");
+  writeLightField(path, original);
+  // The glossy chart without its diffuse value; the mirror chart with the bit.
+  expectKindByteRefused(path, 2, 0, 0x10, "glossy-tilted-bit.plf",
+                        {"corrupt charts section", "chart 2 of kind 1 without a diffuse value is marked as having tilted irradiances"});
+  expectKindByteRefused(path, 1, 0x08, 0, "mirror-tilted-bit.plf",
+                        {"corrupt charts section", "chart 1 of kind 2 without a diffuse value is marked as having tilted irradiances"});
 }
 
 TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {

@@ -282,10 +282,9 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         AlbedoPoint albedo;
-        Vec3 lookup, lookupNormal, mappedNormal;
-        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * hit.t, albedo, lookup, lookupNormal,
-                     mappedNormal);
-        F4 lanes = exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, lookup,
+        Vec3 lookupNormal, mappedNormal;
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * hit.t, albedo, lookupNormal, mappedNormal);
+        F4 lanes = exitantRadianceLanes(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction, -ray.direction,
                                         lookupNormal, mappedNormal, albedo);
         if (c.kind == ChartKind::Glossy && highlights_.active())  // lightfield.h "Punctual highlights"
           lanes = f4Add(lanes, f4FromRgb(highlights_.radiance(chart, hit, -ray.direction)));
@@ -339,11 +338,11 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const Chart& c = charts[chart];
       if (c.kind != ChartKind::Specular) {
         AlbedoPoint albedo;
-        Vec3 lookup, lookupNormal, mappedNormal;
-        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * distance, albedo, lookup, lookupNormal,
+        Vec3 lookupNormal, mappedNormal;
+        lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * distance, albedo, lookupNormal,
                      mappedNormal);
         s.radiance[slot] += throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction,
-                                                         lookup, lookupNormal, mappedNormal, albedo);
+                                                         -ray.direction, lookupNormal, mappedNormal, albedo);
         if (c.kind == ChartKind::Glossy && highlights_.active())
           s.radiance[slot] += throughput * highlights_.radiance(chart, hit, -ray.direction);
         continue;

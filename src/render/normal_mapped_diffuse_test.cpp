@@ -3,7 +3,8 @@
 // 35° towards +u and −u). A diffuse chart of a normal-mapped material keeps, beside its
 // irradiance, irradiances about three tilted normals, from which the renderers take the
 // irradiance about the mapped normal at each pixel (lightfield.h "Normal-mapped diffuse
-// charts"); before that the chart kept one irradiance and showed the surface flat.
+// charts"); before that the chart kept one irradiance and showed the surface flat. A glossy
+// chart's diffuse part (GGX with a Lambertian base) keeps its irradiance the same way.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +15,7 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "image/compare.h"
+#include "plf/compression.h"
 #include "plf/plf_file.h"
 #include "scene/scene.h"
 #include "support/light_field_vs_trace.h"
@@ -31,9 +33,19 @@ constexpr float kTiltDegrees = 40.0f;
 
 /// The built-in box (every quad has vertices of its own) with planar uvs — the two coordinates
 /// across each quad's normal, over the box's 550 mm — and, withNormalMap, a normal map of 4
-/// columns on every white surface, tilted by ±kTiltDegrees along u.
-Scene stripedCornellBox(bool withNormalMap) {
+/// columns on every white surface, tilted by ±kTiltDegrees along u. glossyWhite: the white
+/// material is a GGX dielectric of roughness 0.3 over its Lambertian albedo (a glossy chart
+/// with a diffuse part, lightfield.h).
+Scene stripedCornellBox(bool withNormalMap, bool glossyWhite = false) {
   Scene scene = makeCornellBox();
+  if (glossyWhite)
+    for (Material& m : scene.materials)
+      if (m.name == "white") {
+        GgxBsdf ggx;
+        ggx.diffuse = std::get<LambertBsdf>(m.bsdf).albedo;
+        ggx.alpha = ggxAlphaFromRoughness(0.3f);
+        m.bsdf = ggx;
+      }
   for (Mesh& mesh : scene.meshes) {
     mesh.uvs.assign(mesh.positions.size(), Vec2(0.0f));
     for (const UVec3& tri : mesh.triangles) {
@@ -109,6 +121,32 @@ TEST_F(NormalMappedDiffuseTest, StripesShowAndTheBrightnessMatchesThePathTracer)
   EXPECT_LT(cmp.relMseAverage, 0.016);
 }
 
+// The same box with its white surfaces GGX roughness 0.3 over their white albedo: the glossy
+// charts' diffuse part keeps tilted irradiances too and is shaded at the mapped normal. Measured
+// (48 × 48, draft, 16 samples per pixel vs 256 spp): LF/PT 1.023, relMSE 0.0160, the normal
+// map's effect reproduced with a relative squared error of 0.25 (the same box without the
+// map: 0.991, 0.0066); with the glossy charts' diffuse part shaded flat, as before tilted
+// irradiances on glossy charts: 1.073, 0.032, effect error 0.81.
+TEST_F(NormalMappedDiffuseTest, GlossyStripesShowAndTheBrightnessMatchesThePathTracer) {
+  const Scene striped = stripedCornellBox(true, true), flat = stripedCornellBox(false, true);
+  const Camera camera(striped.cameras.front(), 48, 48);
+  const auto withMap = test_support::lightFieldAndReference(striped, camera, 256, bakePreset("draft"), 16);
+  const auto without = test_support::lightFieldAndReference(flat, camera, 256, bakePreset("draft"), 16);
+  uint64_t glossyDirectional = 0;
+  for (const Chart& c : withMap.lightField.charts) glossyDirectional += c.diffuseValue && c.directionalIrradiance;
+  EXPECT_GT(glossyDirectional, 0u);
+  const ImageComparison cmp = compareImages(withMap.image, withMap.reference);
+  const double effectError = relativeSquaredError(luminanceChange(withMap.image, without.image),
+                                                  luminanceChange(withMap.reference, without.reference));
+  const ImageComparison flatCmp = compareImages(without.image, without.reference);
+  std::printf("glossy striped normal map: LF/PT %.4f relMSE %.5f; its effect: relative squared error %.4f; flat LF/PT %.4f "
+              "relMSE %.5f\n",
+              cmp.meanLuminanceRatio, cmp.relMseAverage, effectError, flatCmp.meanLuminanceRatio, flatCmp.relMseAverage);
+  EXPECT_LT(effectError, 0.4);
+  EXPECT_NEAR(cmp.meanLuminanceRatio, 1.0, 0.04);
+  EXPECT_LT(cmp.relMseAverage, 0.022);
+}
+
 // The tilted irradiances survive the file and every value codec (they are irradiances, ≥ 0).
 TEST_F(NormalMappedDiffuseTest, TiltedIrradiancesRoundTripThroughThePlf) {
   const Scene scene = stripedCornellBox(true);
@@ -123,6 +161,43 @@ TEST_F(NormalMappedDiffuseTest, TiltedIrradiancesRoundTripThroughThePlf) {
   for (size_t i = 0; i < lf.charts.size(); ++i)
     EXPECT_EQ(back.charts[i].directionalIrradiance, lf.charts[i].directionalIrradiance) << "chart " << i;
   EXPECT_EQ(back.values, lf.values);
+}
+
+// A glossy chart's tilted irradiances (after its map and Ẽ) too: the chart flags and the
+// values round-trip raw and lossless, and the lossy codecs keep them non-negative (hdr within
+// its usual error; compression.h lays each out as a tixel-grid image).
+TEST_F(NormalMappedDiffuseTest, GlossyTiltedIrradiancesRoundTripThroughThePlf) {
+  const Scene scene = stripedCornellBox(true, true);
+  BakeSettings settings = bakePreset("draft");
+  settings.gatherDirections = 64;
+  settings.glossyDirRes = 4;
+  const LightField lf = bake(Scene(scene), settings);
+  uint64_t glossyDirectional = 0;
+  for (const Chart& c : lf.charts) glossyDirectional += c.kind == ChartKind::Glossy && c.directionalIrradiance;
+  EXPECT_GT(glossyDirectional, 0u);
+  for (const Rgb& v : lf.values) EXPECT_TRUE(v.r >= 0.0f && v.g >= 0.0f && v.b >= 0.0f);
+  const std::string path = ::testing::TempDir() + "/striped_glossy.plf";
+  writeLightField(path, lf);
+  const LightField back = readLightField(path);
+  ASSERT_EQ(back.charts.size(), lf.charts.size());
+  for (size_t i = 0; i < lf.charts.size(); ++i) {
+    EXPECT_EQ(back.charts[i].directionalIrradiance, lf.charts[i].directionalIrradiance) << "chart " << i;
+    EXPECT_EQ(back.charts[i].diffuseValue, lf.charts[i].diffuseValue) << "chart " << i;
+  }
+  EXPECT_EQ(back.values, lf.values);
+  for (const ValuesCodec codec : {ValuesCodec::Lossless, ValuesCodec::Bc1, ValuesCodec::Hdr}) {
+    const std::vector<Rgb> decoded =
+        decodeValues(codec, lf.charts, lf.values.size(), encodeValues(codec, lf.charts, lf.values), "test");
+    if (codec == ValuesCodec::Lossless) {
+      EXPECT_EQ(decoded, lf.values);
+    }
+    for (const Rgb& v : decoded) {
+      ASSERT_TRUE(v.r >= 0.0f && v.g >= 0.0f && v.b >= 0.0f) << valuesCodecName(codec);
+    }
+    if (codec == ValuesCodec::Hdr) {
+      EXPECT_LT(measureValuesError(lf.values, decoded).relativeRmse, 0.05);
+    }
+  }
 }
 
 }  // namespace
