@@ -959,7 +959,7 @@ void shootCaustics(TransportState& state, Progress* progress) {
     const Chart& c = param.charts[param.tixelChart[d.tixel]];
     Rgb* values = &state.direct[valueBase(d.tixel, c)];
     values[0] += d.irradiance;
-    if (c.directionalIrradiance) addTiltedIrradiance(param, c, d.tixel, d.wi, d.irradiance, values + 1);
+    if (c.directionalIrradiance) addTiltedIrradiance(state.scene, param, c, d.tixel, d.wi, d.irradiance, values + 1);
   }
   state.causticPhotons = photons.photons;
   state.causticPhotonsLanded = photons.landed;
