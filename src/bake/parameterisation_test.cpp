@@ -334,7 +334,7 @@ TEST(Parameterisation, MapResolutionFollowsTheLobeWidth) {
   // GGX α: the reflected FWHM is 4·atan(α·√(√2 − 1)).
   const float alpha = 0.09f;
   BakeSettings settings;
-  settings.glossyDirRes = 64;
+  settings.glossyDirRes = 128;
   const uint32_t expected = uint32_t(std::ceil(16.0f / (4.0f * std::atan(alpha * std::sqrt(std::sqrt(2.0f) - 1.0f)))));
   EXPECT_EQ(directionalResolution(GgxBsdf{Rgb(0.2f), Rgb(0.04f), alpha}, settings), expected);
 }

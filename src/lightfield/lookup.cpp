@@ -180,11 +180,21 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
                          mappedNormal, albedo);
 }
 
+namespace {
+
+/// A specular chart record of a glossy model: a mirror-like lobe (bake/parameterisation.h
+/// isMirrorLike), not a mirror or glass.
+bool isMirrorLikeRecord(const Chart& c, const Bsdf& model) {
+  return c.kind == ChartKind::Specular && !isDelta(model) && !hasTransmission(model);
+}
+
+}  // namespace
+
 PunctualHighlights::PunctualHighlights(const LightField& lf, const Accel& accel)
     : lf_(lf), glossyCharts_(lf.settings.punctualHighlights) {
   // Mirror-like charts have no maps to keep them in: theirs are always evaluated here.
   const bool mirrorLike = std::any_of(lf.charts.begin(), lf.charts.end(), [&](const Chart& c) {
-    return c.kind == ChartKind::Specular && !isDelta(lf.scene.materials[c.material].bsdf);
+    return isMirrorLikeRecord(c, lf.scene.materials[c.material].bsdf);
   });
   if (!glossyCharts_ && !mirrorLike) return;
   for (const Light& light : lf.scene.lights)
@@ -199,7 +209,8 @@ Rgb PunctualHighlights::radiance(uint32_t chart, const RayHit& hit, const Vec3& 
   if (lights_.empty() || c.kind == ChartKind::Diffuse) return Rgb(0.0f);
   const Scene& scene = lf_.scene;
   const Bsdf& model = scene.materials[c.material].bsdf;
-  if (c.kind == ChartKind::Specular ? isDelta(model) : !glossyCharts_) return Rgb(0.0f);  // a mirror's are 0
+  // A specular chart's only when mirror-like (a mirror's are 0).
+  if (c.kind == ChartKind::Specular ? !isMirrorLikeRecord(c, model) : !glossyCharts_) return Rgb(0.0f);
   if (isRoughGlassChart(c, model)) return Rgb(0.0f);  // rough glass keeps them in its maps
   // The model the maps hold (the bake's first shot: without the diffuse part when Ẽ keeps it).
   const Bsdf& bsdf = c.diffuseValue ? withoutDiffuse_[c.material] : model;
