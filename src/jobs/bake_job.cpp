@@ -110,8 +110,8 @@ void BakeJob::checkSameJobOnEveryRank(const std::string& scenePath) const {
     const MappedFile file(scenePath);  // (refuses a FIFO or directory: requireRegularFile)
     hash = xxh64(file.bytes().data(), file.bytes().size());
   }
-  const std::string shape = fmt::format("{}|{}|{}|{}|{}|{}|{}|{}|{}", options_.preset, s.tixelsAcrossScene, s.gatherDirections, s.glossyDirRes,
-                                        s.areaLightSamples, s.tolerance, s.seed, options_.compress,
+  const std::string shape = fmt::format("{}|{}|{}|{}|{}|{}|{}|{}|{}", options_.preset, s.tixelsAcrossScene, s.gatherDirections,
+                                        s.glossyDirRes, s.areaLightSamples, s.tolerance, s.seed, options_.compress,
                                         options_.reuseVisibility);
   hash = xxh64(shape.data(), shape.size(), hash);
   uint64_t rank0Hash = 0;
