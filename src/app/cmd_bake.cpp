@@ -85,6 +85,9 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--directions", options->gatherDirections,
                       "Override the preset: gather directions per tixel (rounded to a square)")
       ->check(CLI::Range(1u, 65536u));
+  command->add_option("--glossy-res", options->glossyDirRes,
+                      "Override the preset: the largest paraboloid map (texels across) of a glossy chart")
+      ->check(CLI::Range(2u, 256u));
   command->add_option("--light-samples", options->lightSamples,
                       "Override the preset: shadow rays per tixel towards emissive surfaces")
       ->check(CLI::Range(1u, 65536u));

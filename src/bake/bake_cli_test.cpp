@@ -90,6 +90,20 @@ TEST_F(BakeCli, CausticPhotonsAreABakeOption) {
   EXPECT_FALSE(fs::exists(path("x.plf")));
 }
 
+// --glossy-res N caps the glossy maps at N² texels instead of the preset's (recorded in the
+// bake settings); values outside [2, 256] are refused before anything is written.
+TEST_F(BakeCli, GlossyResOverridesThePresetsCap) {
+  std::string out, err;
+  const std::string common = "bake cornell --preset draft --tixels-across 8 --directions 16 --quiet -o \"";
+  ASSERT_EQ(run(common + path("g.plf") + "\" --glossy-res 12", &out, &err), 0) << err;
+  EXPECT_EQ(readLightField(path("g.plf")).settings.glossyDirRes, 12u);
+  ASSERT_EQ(run(common + path("d.plf") + "\"", &out, &err), 0) << err;
+  EXPECT_EQ(readLightField(path("d.plf")).settings.glossyDirRes, 8u);
+  EXPECT_EQ(run(common + path("x.plf") + "\" --glossy-res 1", &out, &err), 2);
+  EXPECT_NE(err.find("--glossy-res"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("x.plf")));
+}
+
 TEST_F(BakeCli, RefusesBadInput) {
   std::string out, err;
   EXPECT_NE(run("bake \"" + path("missing.obj") + "\" -o \"" + path("x.plf") + "\"", &out, &err), 0);

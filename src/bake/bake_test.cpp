@@ -327,6 +327,34 @@ TEST_F(BakeTest, GlossyOperatorRowsIntegrateTheBsdf) {
   }
 }
 
+TEST_F(BakeTest, NarrowLobeOperatorRowsIntegrateTheBsdf) {
+  // A lobe narrower than the cell sub-samples (GGX α = 0.0025, FWHM 0.4°; the sub-samples of a
+  // 16² grid lie ≈ 1.8° apart): the operator samples the lobe, so each row still sums to the
+  // directional albedo (16 sub-samples per cell would mostly miss the lobe), every row's
+  // weight lies in the cells around the mirror direction, and the cell-constant BSDF (×N/π)
+  // integrates to the same albedo.
+  const uint32_t res = 12, m = 16;
+  for (const Bsdf& bsdf : {Bsdf(GgxBsdf{Rgb(0.0f), Rgb(0.9f), 0.0025f}), Bsdf(BlinnPhongBsdf{Rgb(0.0f), Rgb(0.5f), 1e6f})}) {
+    ASSERT_TRUE(isNarrowLobe(bsdf, m));
+    const std::vector<Rgb> op = glossyOperator(bsdf, res, m);
+    for (uint32_t c : {65u, 66u, 77u, 78u, 40u, 100u}) {
+      Rgb sum(0.0f);
+      for (uint32_t k = 0; k < m * m; ++k) sum += op[c * m * m + k];
+      const Vec3 wo = paraboloidTexelDirection(c % res, c / res, res);
+      const Rgb expected = albedo(bsdf, wo);
+      EXPECT_NEAR(sum.g, expected.g, 0.02f * expected.g) << modelName(bsdf) << " texel " << c;
+      // The mirror direction's cell holds the largest weight.
+      const uint32_t mirrorCell = gatherCellOf(Vec3(-wo.x, -wo.y, wo.z), m);
+      uint32_t largest = 0;
+      for (uint32_t k = 1; k < m * m; ++k)
+        if (op[c * m * m + k].g > op[c * m * m + largest].g) largest = k;
+      const int da = int(largest % m) - int(mirrorCell % m), db = int(largest / m) - int(mirrorCell / m);
+      EXPECT_LE(std::abs(da) + std::abs(db), 2) << modelName(bsdf) << " texel " << c;
+    }
+  }
+  EXPECT_FALSE(isNarrowLobe(GgxBsdf{Rgb(0.0f), Rgb(0.9f), 0.09f}, m));  // roughness 0.3: sub-sampled
+}
+
 TEST_F(BakeTest, RoughGlassOperatorsIntegrateTheBsdfOnBothSides) {
   // Rough glass (propagation.h): on side s the output is R_s·(own gather) + T_s·(the twin's).
   // Row sums, for the texels around the normal (as above): R_s + T_s = the BSDF's directional

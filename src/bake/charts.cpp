@@ -93,9 +93,9 @@ EdgeAdjacency edgeAdjacency(const std::vector<TriangleInfo>& tris) {
 }
 
 /// Per material: whether its charts may grow curved (mayGrowCurvedCharts).
-std::vector<uint8_t> curvedMaterials(const Scene& scene) {
+std::vector<uint8_t> curvedMaterials(const Scene& scene, const BakeSettings& settings) {
   std::vector<uint8_t> curved(scene.materials.size(), 0);
-  for (size_t m = 0; m < scene.materials.size(); ++m) curved[m] = mayGrowCurvedCharts(scene.materials[m]);
+  for (size_t m = 0; m < scene.materials.size(); ++m) curved[m] = mayGrowCurvedCharts(scene.materials[m], settings);
   return curved;
 }
 
@@ -251,7 +251,7 @@ Chart frameChart(const Scene& scene, const TriangleList& list, bool grewCurved, 
   const uint32_t firstMaterial = scene.meshes[list[0].first].materials[list[0].second];
   c.material = firstMaterial;
   const Bsdf& bsdf = scene.materials[firstMaterial].bsdf;
-  c.kind = chartKindOf(bsdf);
+  c.kind = chartKindOf(bsdf, settings);
   c.dirRes = directionalResolution(bsdf, settings);
   // A glossy model with a diffuse part keeps that part's irradiance per tixel (lightfield.h).
   c.diffuseValue = c.kind == ChartKind::Glossy && !isBlack(diffuseAlbedo(bsdf));
@@ -455,7 +455,7 @@ Parameterisation buildCharts(const Scene& scene, const Accel& accel, const BakeS
   // 1e-5 of the diagonal keeps the welded (quantised) coordinates within 21 bits per axis.
   const std::vector<TriangleInfo> tris = weldTriangles(scene, lo, 1e-5f * diagonal);
   const EdgeAdjacency adjacency = edgeAdjacency(tris);
-  const std::vector<uint8_t> curvedMaterial = curvedMaterials(scene);
+  const std::vector<uint8_t> curvedMaterial = curvedMaterials(scene, settings);
   const float cosTol = std::cos(kChartNormalToleranceDegrees * kPi / 180.0f);
   Parameterisation p;
   const std::vector<uint8_t> chartCurved = growCharts(scene, tris, adjacency, curvedMaterial, SmoothEdgeRule(scene, tris),

@@ -16,17 +16,48 @@
 
 namespace pl {
 
-ChartKind chartKindOf(const Bsdf& bsdf) {
-  // Mirrors and smooth glass are followed through (followSpecular); rough glass stores its
-  // exitant radiance on both sides like a glossy chart (isRoughGlassChart).
-  if (isDelta(bsdf)) return ChartKind::Specular;
+namespace {
+
+/// θh, the half width at half maximum of the half-vector lobe (bsdf.h lobeHalfWidth). The
+/// reflected lobe is about twice as wide as the half-vector lobe, so its full width at half
+/// maximum is ≈ 4θh (radians).
+float reflectedLobeWidth(const Bsdf& bsdf) { return std::max(4.0f * lobeHalfWidth(bsdf), 1e-4f); }
+
+}  // namespace
+
+uint32_t lobeMapResolution(float lobeWidth) {
+  // Near the map centre s = tan(θ/2), so a texel 2/R wide in s spans ≈ 4/R radians; four
+  // texels across the lobe's FWHM needs R ≈ 16 / FWHM. (Two are not enough: the directional
+  // albedo of a normalised lobe already falls by ~8 % within 20° of the normal, and bilinear
+  // interpolation between texels 20° apart misses that.)
+  const float wanted = std::ceil(16.0f / std::max(lobeWidth, 1e-4f));
+  return uint32_t(std::clamp(wanted, 2.0f, 65536.0f));
+}
+
+bool isMirrorLike(const Bsdf& bsdf, const BakeSettings& settings) {
+  // Only a model that is all lobe: a diffuse part would need a stored irradiance beside the
+  // traced lobe, and rough glass is a glossy chart on both sides.
+  if (isDelta(bsdf) || isDiffuse(bsdf) || hasTransmission(bsdf) || !isBlack(diffuseAlbedo(bsdf))) return false;
+  // Narrower than a quarter texel of the largest map the preset allows (a texel spans ≈ 4/R
+  // radians): such a map would hold the lobe's reflection as the bilinear tent of texels four
+  // or more lobe widths apart, the reflection of a lamp a smear around a wrong core, while
+  // the traced lobe, this narrow, adds little noise.
+  const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
+  return lobeMapResolution(reflectedLobeWidth(bsdf)) > kMirrorLikeTexels * cap;
+}
+
+ChartKind chartKindOf(const Bsdf& bsdf, const BakeSettings& settings) {
+  // Mirrors and smooth glass are followed through (followSpecular), as are lobes too narrow
+  // for the preset's maps (isMirrorLike); rough glass stores its exitant radiance on both
+  // sides like a glossy chart (isRoughGlassChart).
+  if (isDelta(bsdf) || isMirrorLike(bsdf, settings)) return ChartKind::Specular;
   if (isDiffuse(bsdf)) return ChartKind::Diffuse;
   return ChartKind::Glossy;
 }
 
-bool mayGrowCurvedCharts(const Material& material) {
+bool mayGrowCurvedCharts(const Material& material, const BakeSettings& settings) {
   if (material.isEmissive()) return false;
-  switch (chartKindOf(material.bsdf)) {
+  switch (chartKindOf(material.bsdf, settings)) {
     case ChartKind::Diffuse: return true;
     case ChartKind::Glossy: return !hasTransmission(material.bsdf);  // not rough glass
     case ChartKind::Specular: return false;
@@ -35,22 +66,13 @@ bool mayGrowCurvedCharts(const Material& material) {
 }
 
 uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings) {
-  switch (chartKindOf(bsdf)) {
+  switch (chartKindOf(bsdf, settings)) {
     case ChartKind::Diffuse: return 1;
     case ChartKind::Specular: return 0;
     case ChartKind::Glossy: break;
   }
-  // θh, the half width at half maximum of the half-vector lobe (bsdf.h lobeHalfWidth).
-  // The reflected lobe is about twice as wide as the half-vector lobe, so its full width at
-  // half maximum is ≈ 4θh. Near the map centre s = tan(θ/2), so a texel 2/R wide in s spans
-  // ≈ 4/R radians; four texels across the lobe's FWHM needs R ≈ 16 / FWHM. (Two are not
-  // enough: the directional albedo of a normalised lobe already falls by ~8 % within 20° of
-  // the normal, and bilinear interpolation between texels 20° apart misses that.)
-  const float thetaH = lobeHalfWidth(bsdf);
-  const float fwhm = std::max(4.0f * thetaH, 1e-4f);
-  const float wanted = std::ceil(16.0f / fwhm);
   const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
-  return uint32_t(std::clamp(wanted, 2.0f, float(cap)));
+  return std::min(lobeMapResolution(reflectedLobeWidth(bsdf)), cap);
 }
 
 float sceneScale(const Scene& scene, const Accel& accel) {

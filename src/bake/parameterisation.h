@@ -52,7 +52,9 @@
 // Directional resolution by material (chartKindOf / directionalResolution):
 //   Lambertian → Diffuse, dirRes 1 (irradiance);
 //   ideal mirror, smooth or thin glass → Specular, dirRes 0 (a reordering, nothing stored);
-//   Blinn-Phong / GGX / rough glass → Glossy, dirRes from the lobe width (see the .cpp),
+//   Blinn-Phong / GGX without a diffuse part whose lobe is narrower than one texel of the
+//   largest map (isMirrorLike) → Specular too: followed through by sampling the lobe;
+//   Blinn-Phong / GGX / rough glass → Glossy, dirRes from the lobe width (lobeMapResolution),
 //   capped by glossyDirRes.
 //
 // Sides (lightfield.h "Sides"): the diffuse and glossy charts of an open surface — a connected
@@ -134,11 +136,25 @@ inline TixelFrame tiltFrame(const Parameterisation& p, const Chart& c, uint64_t 
   return tiltFrameAround(c, c.curved ? p.gatherNormal[tixel] : c.normal);
 }
 
-ChartKind chartKindOf(const Bsdf& bsdf);
+ChartKind chartKindOf(const Bsdf& bsdf, const BakeSettings& settings);
+/// The paraboloid map resolution (texels across) that puts four texels across a reflected
+/// lobe `lobeWidth` radians wide at half maximum (≈ 16 / lobeWidth), at least 2.
+uint32_t lobeMapResolution(float lobeWidth);
+/// A glossy lobe counts as mirror-like when lobeMapResolution asks for more than this many
+/// times the preset's cap (settings.glossyDirRes): the lobe is narrower than a quarter of a
+/// texel of the largest map (docs/design.md, "Glossy lobes and the map size", has the
+/// measurements that place the boundary there).
+inline constexpr uint32_t kMirrorLikeTexels = 16;
+/// Whether `bsdf` is a glossy model without a diffuse part (a metal) whose lobe is narrower
+/// than a quarter texel of the preset's largest map: its charts are Specular, and every lookup
+/// continues the ray by sampling the lobe (lightfield/lookup.h followSpecular).
+bool isMirrorLike(const Bsdf& bsdf, const BakeSettings& settings);
 /// Whether charts of `material` may be curved ("Curved charts" above): Lambertian and glossy
-/// (Blinn-Phong, GGX) materials that do not emit; not rough glass, mirrors or smooth glass.
-bool mayGrowCurvedCharts(const Material& material);
-/// Paraboloid map resolution for a material (1 diffuse, 0 specular, glossy from its lobe).
+/// (Blinn-Phong, GGX) materials that do not emit; not rough glass, mirrors, smooth glass or
+/// mirror-like lobes.
+bool mayGrowCurvedCharts(const Material& material, const BakeSettings& settings);
+/// Paraboloid map resolution for a material (1 diffuse, 0 specular, glossy: lobeMapResolution
+/// of its lobe, capped by settings.glossyDirRes).
 uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings);
 /// The scene's room scale (scene units): the side of the empty cube whose mean free path
 /// equals the scene's. For a closed cavity of volume V and surface area S, the mean length of

@@ -5,6 +5,7 @@
 
 #include <set>
 
+#include "bake/bake.h"
 #include "core/progress.h"
 #include "lightfield/lookup.h"
 
@@ -322,6 +323,58 @@ TEST(Parameterisation, DirectionalResolutionByMaterial) {
   EXPECT_EQ(directionalResolution(BlinnPhongBsdf{Rgb(0.3f), Rgb(0.3f), 100000.0f}, settings), 16u);  // capped
   EXPECT_LT(directionalResolution(GgxBsdf{Rgb(0.2f), Rgb(0.04f), 0.5f}, settings),
             directionalResolution(GgxBsdf{Rgb(0.2f), Rgb(0.04f), 0.1f}, settings));
+}
+
+TEST(Parameterisation, MapResolutionFollowsTheLobeWidth) {
+  // Four texels across the reflected lobe's FWHM, a texel spanning ≈ 4/R radians: R = 16/FWHM.
+  EXPECT_EQ(lobeMapResolution(1.0f), 16u);
+  EXPECT_EQ(lobeMapResolution(0.5f), 32u);
+  EXPECT_EQ(lobeMapResolution(0.1f), 160u);
+  EXPECT_EQ(lobeMapResolution(100.0f), 2u);  // at least 2
+  // GGX α: the reflected FWHM is 4·atan(α·√(√2 − 1)).
+  const float alpha = 0.09f;
+  BakeSettings settings;
+  settings.glossyDirRes = 128;
+  const uint32_t expected = uint32_t(std::ceil(16.0f / (4.0f * std::atan(alpha * std::sqrt(std::sqrt(2.0f) - 1.0f)))));
+  EXPECT_EQ(directionalResolution(GgxBsdf{Rgb(0.2f), Rgb(0.04f), alpha}, settings), expected);
+}
+
+TEST(Parameterisation, MetalLobesNarrowerThanAQuarterTexelAtTheCapAreMirrorLike) {
+  for (const char* preset : {"draft", "default", "high"}) {
+    const BakeSettings settings = bakePreset(preset);
+    SCOPED_TRACE(preset);
+    // A near-mirror metal (roughness 0.05, α = 0.0025): followed through, nothing stored.
+    const GgxBsdf metal{Rgb(0.0f), Rgb(0.9f), 0.0025f};
+    EXPECT_TRUE(isMirrorLike(metal, settings));
+    EXPECT_EQ(chartKindOf(metal, settings), ChartKind::Specular);
+    EXPECT_EQ(directionalResolution(metal, settings), 0u);
+    // The same lobe over a diffuse part keeps its map (a traced lobe has no stored diffuse part).
+    const GgxBsdf dielectric{Rgb(0.8f), Rgb(0.04f), 0.0025f};
+    EXPECT_FALSE(isMirrorLike(dielectric, settings));
+    EXPECT_EQ(chartKindOf(dielectric, settings), ChartKind::Glossy);
+    EXPECT_EQ(directionalResolution(dielectric, settings), settings.glossyDirRes);
+    // A rough metal (roughness 0.6) is resolved by every preset's map.
+    const GgxBsdf rough{Rgb(0.0f), Rgb(0.9f), 0.36f};
+    EXPECT_FALSE(isMirrorLike(rough, settings));
+    EXPECT_EQ(chartKindOf(rough, settings), ChartKind::Glossy);
+    // GGX metal roughness 0.3 (FWHM 13°) keeps its map at every preset.
+    EXPECT_FALSE(isMirrorLike(GgxBsdf{Rgb(0.0f), Rgb(0.9f), 0.09f}, settings));
+    // Rough glass and mirrors keep their kinds.
+    EXPECT_FALSE(isMirrorLike(DielectricBsdf{1.5f, Rgb(1.0f), 0.0025f}, settings));
+    EXPECT_FALSE(isMirrorLike(MirrorBsdf{}, settings));
+    // The rule: mirror-like exactly when the lobe asks for more than kMirrorLikeTexels × the cap.
+    for (float a = 0.001f; a < 0.5f; a *= 1.1f) {
+      const GgxBsdf m{Rgb(0.0f), Rgb(0.9f), a};
+      const float fwhm = 4.0f * lobeHalfWidth(m);
+      EXPECT_EQ(isMirrorLike(m, settings), lobeMapResolution(fwhm) > kMirrorLikeTexels * settings.glossyDirRes) << a;
+    }
+  }
+  // Mirror-like charts are planar (never grown curved).
+  Material m;
+  m.bsdf = GgxBsdf{Rgb(0.0f), Rgb(0.9f), 0.0025f};
+  EXPECT_FALSE(mayGrowCurvedCharts(m, bakePreset("default")));
+  m.bsdf = GgxBsdf{Rgb(0.0f), Rgb(0.9f), 0.36f};
+  EXPECT_TRUE(mayGrowCurvedCharts(m, bakePreset("default")));
 }
 
 }  // namespace

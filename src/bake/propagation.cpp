@@ -139,6 +139,12 @@ struct GlossyMaterial {
   SparseOperator backReflection;
   SparseOperator transmission[2];
   const SparseOperator& reflection(const Chart& c) const { return glass && c.isBack ? backReflection : op; }
+  // A narrow lobe (isNarrowLobe): per output texel and gather cell, the BSDF as the operator
+  // sees it, constant over the cell: W[c][k] / ∫_cell k cos θ dω = W[c][k]·N/π. The first
+  // shot's light samples use it, so that both strategies of its MIS estimate the same
+  // cell-constant f, where f at the sample direction itself would be a spike or nothing.
+  std::vector<Rgb> cellBsdf;
+  uint32_t gridSide = 0;
   std::vector<std::vector<Vec3>> outputs;     ///< per output texel, its sub-sample directions
   std::vector<Vec3> centres;                  ///< per output texel, its representative direction
   std::vector<float> projectedSolidAngle;     ///< per output texel, ≈ Ω·cos θ (for the power sum)
@@ -366,7 +372,44 @@ void addDiffusePart(GlossyMaterial& g, const Bsdf& bsdf, uint32_t gridSide) {
 
 }  // namespace
 
+bool isNarrowLobe(const Bsdf& bsdf, uint32_t gridSide) {
+  if (hasTransmission(bsdf) || isDelta(bsdf) || isDiffuse(bsdf)) return false;
+  // The cell sub-samples lie ≈ 2/(gridSide·kCellSubsamples) radians apart near the normal
+  // (the concentric disk's diameter 2 over gridSide·kCellSubsamples of them).
+  const float spacing = 2.0f / float(gridSide * kCellSubsamples);
+  return 4.0f * lobeHalfWidth(bsdf) < kNarrowLobeSubsamples * spacing;
+}
+
+namespace {
+
+/// glossyOperator for a narrow lobe (isNarrowLobe): per output sub-direction wo, kLobeSamples²
+/// stratified directions importance-sampled from the lobe, each adding f·cos θ/pdf to the cell
+/// it falls in (gatherCellOf). Unbiased for any lobe width, and each row sums to the model's
+/// directional albedo up to the sampling error, where fixed sub-samples would miss the lobe.
+std::vector<Rgb> sampledGlossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide) {
+  constexpr int kLobeSamples = 32;
+  const uint32_t n = gridSide * gridSide, texels = dirRes * dirRes;
+  std::vector<Rgb> op(size_t(texels) * n);
+  parallelFor(texels, [&](uint64_t c) {
+    const std::vector<Vec3> outputs = outputTexelDirections(uint32_t(c % dirRes), uint32_t(c / dirRes), dirRes);
+    const float norm = 1.0f / float(outputs.size() * kLobeSamples * kLobeSamples);
+    Rgb* row = op.data() + c * n;
+    for (const Vec3& wo : outputs)
+      for (int y = 0; y < kLobeSamples; ++y)
+        for (int x = 0; x < kLobeSamples; ++x) {
+          const Vec2 u((float(x) + 0.5f) / kLobeSamples, (float(y) + 0.5f) / kLobeSamples);
+          const std::optional<BsdfSample> bs = sample(bsdf, wo, u);
+          if (!bs || !(bs->wi.z > 0.0f)) continue;
+          row[gatherCellOf(bs->wi, gridSide)] += bs->weight * norm;
+        }
+  });
+  return op;
+}
+
+}  // namespace
+
 std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide, bool outputOnBack, bool gatherOnBack) {
+  if (isNarrowLobe(bsdf, gridSide)) return sampledGlossyOperator(bsdf, dirRes, gridSide);
   const uint32_t n = gridSide * gridSide, texels = dirRes * dirRes;
   std::vector<Rgb> op(size_t(texels) * n);
   // Incident sub-sample directions of every cell (same for every output texel).
@@ -568,7 +611,14 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
     g.dirRes = c.dirRes;
     const Bsdf& bsdf = scene.materials[c.material].bsdf;
     if (c.diffuseValue) addDiffusePart(g, bsdf, gridSide);
-    g.op = SparseOperator::fromDense(glossyOperator(g.diffuse ? g.specular : bsdf, c.dirRes, gridSide), c.dirRes * c.dirRes, n);
+    const Bsdf& mapped = g.diffuse ? g.specular : bsdf;
+    std::vector<Rgb> dense = glossyOperator(mapped, c.dirRes, gridSide);
+    g.op = SparseOperator::fromDense(dense, c.dirRes * c.dirRes, n);
+    if (isNarrowLobe(mapped, gridSide)) {
+      for (Rgb& w : dense) w *= float(n) * kInvPi;
+      g.cellBsdf = std::move(dense);
+      g.gridSide = gridSide;
+    }
     if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) addGlassOperators(g, scene.materials[c.material].bsdf, gridSide);
     const std::vector<float>& omega = paraboloidTexelSolidAngles(c.dirRes);
     for (uint32_t t = 0; t < c.dirRes * c.dirRes; ++t) {
@@ -822,9 +872,12 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         // A delta light's highlight on a reflecting glossy chart is also noted apart, to be
         // taken out of the stored maps at the end (punctualGlossy).
         const bool highlight = !p.areaSample && !glass && !punctualGlossy.empty();
+        const Rgb* cellBsdf =
+            gm.cellBsdf.empty() || !(wiLocal.z > 0.0f) ? nullptr : gm.cellBsdf.data() + gatherCellOf(wiLocal, gm.gridSide);
         for (uint32_t t = 0; t < c.directionTexels(); ++t) {
-          const Rgb reflected = (p.areaSample ? recordEval(mapped, glass, gm.centres[t], wiLocal)
-                                              : texelAverageBsdf(mapped, gm.outputs[t], wiLocal, glass)) *
+          const Rgb reflected = (cellBsdf                ? cellBsdf[size_t(t) * gm.gridSide * gm.gridSide]
+                                 : p.areaSample ? recordEval(mapped, glass, gm.centres[t], wiLocal)
+                                                : texelAverageBsdf(mapped, gm.outputs[t], wiLocal, glass)) *
                                 p.irradiance;
           direct[vb + t] += reflected;
           if (highlight) punctualGlossy[vb + t] += reflected;

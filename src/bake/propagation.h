@@ -196,6 +196,12 @@ double transportChange(const TransportState& state);
 /// Ends the propagation: glossy values get their emission. state.current is then the result.
 void finishTransport(TransportState& state);
 
+/// A reflected lobe (Blinn-Phong, GGX) whose full width at half maximum spans fewer than
+/// kNarrowLobeSubsamples of glossyOperator's cell sub-samples: its operator is built by
+/// sampling the lobe, and the first shot's light samples read the BSDF from it per cell.
+inline constexpr float kNarrowLobeSubsamples = 2.0f;
+bool isNarrowLobe(const Bsdf& bsdf, uint32_t gridSide);
+
 /// The glossy operator W of one material for an R-texel output map and an m × m gather grid:
 /// R² × m² RGB weights, row c (output texel a + b·R) times column k (gather cell).
 /// For rough glass (lightfield.h "Rough glass") the output map and the gather grid may each
@@ -203,6 +209,9 @@ void finishTransport(TransportState& state);
 /// frame by glassBsdfDirection): reflection on the front (false, false) or back (true, true),
 /// transmission into the front of the light the back gathers (false, true) and into the back
 /// of the front's (true, false). Other models use (false, false) for either record.
+/// A lobe narrower than the sub-samples that glossyOperator integrates each cell with
+/// (reflected FWHM below kNarrowLobeSubsamples of their spacing) is integrated by
+/// importance-sampling the lobe instead (isNarrowLobe): reflecting models only.
 std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t gridSide, bool outputOnBack = false,
                                 bool gatherOnBack = false);
 

@@ -101,6 +101,13 @@ Vec3 gatherCellDirection(uint32_t k, uint32_t subCell, uint32_t gridSide, uint64
   return cellDirection(k, subCell, gridSide, seed);
 }
 
+uint32_t gatherCellOf(const Vec3& local, uint32_t gridSide) {
+  const Vec2 u = inverseConcentricDisk(Vec2(local.x, local.y));
+  const uint32_t a = std::min(uint32_t(u.x * float(gridSide)), gridSide - 1);
+  const uint32_t b = std::min(uint32_t(u.y * float(gridSide)), gridSide - 1);
+  return a + b * gridSide;
+}
+
 uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings) {
   Fnv1a64 h;
   h.value(kPlvVersion);
@@ -113,12 +120,12 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
     h.update(mesh.materials.data(), mesh.materials.size() * sizeof(uint32_t));
   }
   for (const Material& m : scene.materials) {
-    h.value(uint8_t(chartKindOf(m.bsdf)));
+    h.value(uint8_t(chartKindOf(m.bsdf, settings)));
     // Specular models bend and weight the chains folded into the field, and transmitting
     // ones attenuate the gather rays inside them: all their parameters (the model's
     // parameters() hook, bsdf.h). Other models' parameters (a roughness, an albedo) change
     // only the propagation, so a field traced before such an edit is reused.
-    if (chartKindOf(m.bsdf) == ChartKind::Specular || hasTransmission(m.bsdf)) {
+    if (chartKindOf(m.bsdf, settings) == ChartKind::Specular || hasTransmission(m.bsdf)) {
       h.value(uint32_t(m.bsdf.index()));
       std::visit([&](const auto& b) { std::decay_t<decltype(b)>::parameters(b, [&](const auto& field) { h.value(field); }); },
                  m.bsdf);
@@ -146,7 +153,7 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
       h.value(m.alphaCutoff);
       if (m.alphaTexture >= 0) texture(m.alphaTexture, m.alphaMapping);
     }
-    if (m.normalTexture >= 0 && chartKindOf(m.bsdf) == ChartKind::Specular) {
+    if (m.normalTexture >= 0 && chartKindOf(m.bsdf, settings) == ChartKind::Specular) {
       h.value(m.normalScale);
       texture(m.normalTexture, m.normalMapping);
     }

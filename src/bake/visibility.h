@@ -100,6 +100,9 @@ inline constexpr uint32_t kGatherJitterSide = 4;
 void gatherSubCells(uint64_t tixel, uint32_t gridSide, uint64_t seed, std::vector<uint8_t>& out);
 /// Gather direction of cell k through sub-cell `subCell`, in the chart's local frame.
 Vec3 gatherCellDirection(uint32_t k, uint32_t subCell, uint32_t gridSide, uint64_t seed);
+/// The gather cell (a + b·gridSide) whose directions contain the local direction `local`
+/// (z ≥ 0, in the tixel's gather frame): the inverse of the cosine-weighted cell map.
+uint32_t gatherCellOf(const Vec3& local, uint32_t gridSide);
 
 
 /// Hash of everything the visibility field depends on: vertex positions, triangles and their

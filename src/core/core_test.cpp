@@ -74,6 +74,17 @@ TEST(Pcg32, UniformMeanAndRange) {
   EXPECT_NEAR(sum / n, 0.5, 5 * std::sqrt(1.0 / 12.0 / n));
 }
 
+TEST(Sampling, InverseConcentricDiskUndoesTheConcentricMap) {
+  Pcg32 rng(11, 3);
+  for (int i = 0; i < 10000; ++i) {
+    const Vec2 u(rng.uniform(), rng.uniform());
+    const Vec2 back = inverseConcentricDisk(sampleConcentricDisk(u));
+    EXPECT_NEAR(back.x, u.x, 2e-5f) << u.x << "," << u.y;
+    EXPECT_NEAR(back.y, u.y, 2e-5f) << u.x << "," << u.y;
+  }
+  EXPECT_NEAR(inverseConcentricDisk(Vec2(0.0f)).x, 0.5f, 1e-6f);
+}
+
 TEST(Sampling, CosineHemisphereHasTheCosineDensity) {
   // cos θ / cosineHemispherePdf(cos θ) = π holds by algebra for any direction, so it cannot
   // test the sampler. Test the distribution instead: under pdf = cos θ/π,

@@ -25,6 +25,29 @@ inline Vec2 sampleConcentricDisk(Vec2 u) {
   return r * Vec2(std::cos(theta), std::sin(theta));
 }
 
+/// The inverse of sampleConcentricDisk: the u ∈ [0,1]² that maps to disk point d (|d| ≤ 1),
+/// so the inverse of sampleCosineHemisphere too for a direction's (x, y).
+inline Vec2 inverseConcentricDisk(Vec2 d) {
+  const float r = std::sqrt(d.x * d.x + d.y * d.y);
+  float phi = std::atan2(d.y, d.x);
+  if (phi < -kPi / 4.0f) phi += 2.0f * kPi;  // phi in [−π/4, 7π/4)
+  float a, b;
+  if (phi < kPi / 4.0f) {  // the right wedge: r = a > 0
+    a = r;
+    b = phi * a / (kPi / 4.0f);
+  } else if (phi < 3.0f * kPi / 4.0f) {  // top: r = b > 0
+    b = r;
+    a = -(phi - kPi / 2.0f) * b / (kPi / 4.0f);
+  } else if (phi < 5.0f * kPi / 4.0f) {  // left: a = −r
+    a = -r;
+    b = (phi - kPi) * a / (kPi / 4.0f);
+  } else {  // bottom: b = −r
+    b = -r;
+    a = -(phi - 3.0f * kPi / 2.0f) * b / (kPi / 4.0f);
+  }
+  return Vec2(std::clamp(0.5f * (a + 1.0f), 0.0f, 1.0f), std::clamp(0.5f * (b + 1.0f), 0.0f, 1.0f));
+}
+
 /// Cosine-weighted hemisphere around +z; pdf = cos θ / π.
 inline Vec3 sampleCosineHemisphere(Vec2 u) {
   const Vec2 d = sampleConcentricDisk(u);

@@ -80,6 +80,7 @@ BakeSettings BakeJob::settings() const {
   BakeSettings settings = bakePreset(options_.preset);
   if (options_.tixelsAcross > 0.0f) settings.tixelsAcrossScene = options_.tixelsAcross;
   if (options_.gatherDirections > 0) settings.gatherDirections = options_.gatherDirections;
+  if (options_.glossyDirRes > 0) settings.glossyDirRes = options_.glossyDirRes;
   if (options_.lightSamples > 0) settings.areaLightSamples = options_.lightSamples;
   settings.sunMasks = options_.sunMasks;
   settings.punctualHighlights = options_.punctualHighlights;
@@ -110,9 +111,9 @@ void BakeJob::checkSameJobOnEveryRank(const std::string& scenePath) const {
     const MappedFile file(scenePath);  // (refuses a FIFO or directory: requireRegularFile)
     hash = xxh64(file.bytes().data(), file.bytes().size());
   }
-  const std::string shape = fmt::format("{}|{}|{}|{}|{}|{}|{}|{}|{}", options_.preset, s.tixelsAcrossScene,
-                                        s.gatherDirections, s.areaLightSamples, s.tolerance, s.seed, options_.compress,
-                                        options_.reuseVisibility, s.causticPhotons);
+  const std::string shape = fmt::format("{}|{}|{}|{}|{}|{}|{}|{}|{}|{}", options_.preset, s.tixelsAcrossScene,
+                                        s.gatherDirections, s.glossyDirRes, s.areaLightSamples, s.tolerance, s.seed,
+                                        options_.compress, options_.reuseVisibility, s.causticPhotons);
   hash = xxh64(shape.data(), shape.size(), hash);
   uint64_t rank0Hash = 0;
   const std::string differ = comm->ranksDiffering(hash, rank0Hash);

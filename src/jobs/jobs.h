@@ -155,6 +155,7 @@ struct BakeJobOptions {
   // Overrides of single preset values (0 = keep the preset's).
   float tixelsAcross = 0.0f;
   uint32_t gatherDirections = 0;
+  uint32_t glossyDirRes = 0;  ///< cap on the glossy maps' resolution (BakeSettings::glossyDirRes)
   uint32_t lightSamples = 0;
   float tolerance = 0.0f;
   bool sunMasks = true;  ///< BakeSettings::sunMasks (`--sun-masks`)

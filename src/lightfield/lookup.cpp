@@ -58,6 +58,11 @@ float specularBranchU(const Ray& ray) { return float(specularRayHash(ray) >> 40)
 
 float specularRouletteU(const Ray& ray) { return float((specularRayHash(ray) >> 16) & 0xffffffULL) * 0x1p-24f; }
 
+Vec2 specularLobeU(const Ray& ray) {
+  const uint64_t h = hashCombine(specularRayHash(ray), 0x4c4f4245ULL);
+  return Vec2(float(h >> 40) * 0x1p-24f, float((h >> 16) & 0xffffffULL) * 0x1p-24f);
+}
+
 bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint32_t step, uint32_t stepLimit,
                     Rgb& emitted, Ray& next, Rgb& weight) {
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
@@ -73,9 +78,12 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
   if (auto* glass = std::get_if<DielectricBsdf>(&bsdf)) glass->alpha = 0.0f;
   const ScatteringFrame scattering = scatteringFrame(surface, wo, bsdf);  // sidedness: scene.h
   if (!usableSide(wo, scattering.woLocal, scattering.geometricNormal, bsdf)) return false;
-  // The one bounce (scene.h scatter), about the shading normal as in the path tracer.
-  const std::optional<Scattered> bs = scatter(scattering, bsdf, Vec2(specularBranchU(ray), 0.5f));
-  if (!bs || !bs->sample.delta) return false;
+  // The one bounce (scene.h scatter), about the shading normal as in the path tracer: a
+  // delta lobe's branch, or (a mirror-like lobe, bake/parameterisation.h isMirrorLike) a
+  // direction importance-sampled from the lobe, weighted f·cos θ/pdf.
+  const bool lobe = !isDelta(bsdf);
+  const std::optional<Scattered> bs = scatter(scattering, bsdf, lobe ? specularLobeU(ray) : Vec2(specularBranchU(ray), 0.5f));
+  if (!bs || (!lobe && !bs->sample.delta)) return false;
   next = Ray{offsetRayOrigin(surface.position, scattering.geometricNormal, bs->wi), bs->wi, 0.0f, kInfinity};
   weight = bs->sample.weight * attenuation;
   if (step >= kSpecularRouletteStep) {
@@ -171,8 +179,23 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
                          mappedNormal, albedo);
 }
 
-PunctualHighlights::PunctualHighlights(const LightField& lf, const Accel& accel) : lf_(lf) {
-  if (!lf.settings.punctualHighlights) return;
+namespace {
+
+/// A specular chart record of a glossy model: a mirror-like lobe (bake/parameterisation.h
+/// isMirrorLike), not a mirror or glass.
+bool isMirrorLikeRecord(const Chart& c, const Bsdf& model) {
+  return c.kind == ChartKind::Specular && !isDelta(model) && !hasTransmission(model);
+}
+
+}  // namespace
+
+PunctualHighlights::PunctualHighlights(const LightField& lf, const Accel& accel)
+    : lf_(lf), glossyCharts_(lf.settings.punctualHighlights) {
+  // Mirror-like charts have no maps to keep them in: theirs are always evaluated here.
+  const bool mirrorLike = std::any_of(lf.charts.begin(), lf.charts.end(), [&](const Chart& c) {
+    return isMirrorLikeRecord(c, lf.scene.materials[c.material].bsdf);
+  });
+  if (!glossyCharts_ && !mirrorLike) return;
   for (const Light& light : lf.scene.lights)
     if (isDeltaLight(light)) lights_.push_back(light);  // the others are in the maps
   if (lights_.empty()) return;
@@ -182,9 +205,11 @@ PunctualHighlights::PunctualHighlights(const LightField& lf, const Accel& accel)
 
 Rgb PunctualHighlights::radiance(uint32_t chart, const RayHit& hit, const Vec3& towardsViewer) const {
   const Chart& c = lf_.charts[chart];
-  if (lights_.empty() || c.kind != ChartKind::Glossy) return Rgb(0.0f);
+  if (lights_.empty() || c.kind == ChartKind::Diffuse) return Rgb(0.0f);
   const Scene& scene = lf_.scene;
   const Bsdf& model = scene.materials[c.material].bsdf;
+  // A specular chart's only when mirror-like (a mirror's are 0).
+  if (c.kind == ChartKind::Specular ? !isMirrorLikeRecord(c, model) : !glossyCharts_) return Rgb(0.0f);
   if (isRoughGlassChart(c, model)) return Rgb(0.0f);  // rough glass keeps them in its maps
   // The model the maps hold (the bake's first shot: without the diffuse part when Ẽ keeps it).
   const Bsdf& bsdf = c.diffuseValue ? withoutDiffuse_[c.material] : model;

@@ -227,6 +227,10 @@ inline float albedoLodAt(const Scene& scene, uint32_t material, uint32_t mesh, u
 /// refracted ray (offset off the surface) and `weight` its throughput.
 ///  * Mirrors: the BSDF's delta sample (Schlick Fresnel when the material asks for it), with
 ///    the frame facing the arriving ray (two-sided, as in the path tracer).
+///  * Mirror-like lobes (a Blinn-Phong or GGX model without a diffuse part whose lobe is too
+///    narrow for a map, bake/parameterisation.h isMirrorLike): a direction importance-sampled
+///    from the lobe with the two numbers specularLobeU, weight f·cos θ/pdf — one sample per
+///    ray, so, like glass's branches, unbiased over pixels, samples or gather directions.
 ///  * Glass (DielectricBsdf, frame unflipped: +z outside): reflection or refraction is chosen
 ///    stochastically with the BSDF's own probabilities (Fresnel F for solid glass, R'/(R'+T')
 ///    by luminance for thin sheets), so the weight is the branch's reflectance or radiance
@@ -253,6 +257,10 @@ inline constexpr uint32_t kSpecularRouletteStep = 8;
 
 /// The uniform number in [0, 1) that followSpecular draws its branch with for `ray`.
 float specularBranchU(const Ray& ray);
+
+/// The two uniform numbers in [0, 1) with which followSpecular samples a mirror-like lobe for
+/// `ray` (a second hash of its bits: independent of the branch and the roulette).
+Vec2 specularLobeU(const Ray& ray);
 
 /// The uniform number in [0, 1) that followSpecular plays its roulette with for `ray`
 /// (other bits of the same hash as specularBranchU: independent of the branch).
@@ -596,20 +604,23 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
 /// diffuseValue; the model the maps hold otherwise), in the scattering frame of the shading
 /// normal at the hit (normal map included), E_l the light's irradiance normal to wi_l and T_l
 /// its shadow ray's transmittance (ShadowRays) — the path tracer's next-event estimation of
-/// that light, term for term. Both renderers add it to their lookups.
+/// that light, term for term. Both renderers add it to their lookups. Mirror-like charts
+/// (Specular records of a glossy model, bake/parameterisation.h isMirrorLike), which no
+/// sampled ray can take a delta light's light to, get theirs too, whatever the setting.
 class PunctualHighlights {
  public:
   /// lf and accel must outlive it.
   PunctualHighlights(const LightField& lf, const Accel& accel);
-  /// Whether there is anything to add: the light field was baked with punctual highlights and
-  /// its scene has delta lights.
+  /// Whether there is anything to add: the light field was baked with punctual highlights or
+  /// has mirror-like charts, and its scene has delta lights.
   bool active() const { return !lights_.empty(); }
   /// The highlights on chart record `chart` (the record the viewer sees: viewedChart) at ray
-  /// hit `hit`, towards the unit direction `towardsViewer`; 0 on other kinds and rough glass.
+  /// hit `hit`, towards the unit direction `towardsViewer`; 0 on other kinds, mirrors, glass.
   Rgb radiance(uint32_t chart, const RayHit& hit, const Vec3& towardsViewer) const;
 
  private:
   const LightField& lf_;
+  bool glossyCharts_ = false;  ///< the glossy charts' highlights too (BakeSettings::punctualHighlights)
   std::vector<Light> lights_;  ///< the scene's delta lights
   std::optional<ShadowRays> shadows_;
   std::vector<Bsdf> withoutDiffuse_;  ///< per material

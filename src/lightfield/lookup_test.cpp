@@ -10,6 +10,7 @@
 
 #include "core/rng.h"
 #include "lightfield/paraboloid.h"
+#include "support/quad_mesh.h"
 
 namespace pl {
 namespace {
@@ -200,6 +201,47 @@ TEST(Lookup, SpecularChartsStoreNothingAndReturnZero) {
   LightField lf = makeLightField(ChartKind::Specular, 0, [](uint32_t, uint32_t, uint32_t, uint32_t) { return Rgb(1.0f); });
   EXPECT_TRUE(lf.values.empty());
   EXPECT_EQ(exitantRadiance(lf, 0, lf.charts[0].origin, lf.charts[0].normal, Vec2(0.0f)), Rgb(0.0f));
+}
+
+TEST(FollowSpecular, SamplesAMirrorLikeLobeWithoutBias) {
+  // A GGX metal too sharp for a map (bake/parameterisation.h isMirrorLike) is followed by one
+  // lobe sample per ray: the mean weight over many rays is the lobe's directional albedo, and
+  // the sampled directions gather around the mirror direction.
+  Scene scene;
+  Material metal;
+  metal.name = "metal";
+  const GgxBsdf ggx{Rgb(0.0f), Rgb(0.9f, 0.6f, 0.3f), 0.01f};
+  metal.bsdf = ggx;
+  scene.materials.push_back(metal);
+  Mesh mesh;
+  test_support::addQuad(mesh, Vec3(-1.0f, -1.0f, 0.0f), Vec3(1.0f, -1.0f, 0.0f), Vec3(1.0f, 1.0f, 0.0f), Vec3(-1.0f, 1.0f, 0.0f), 0);
+  scene.meshes.push_back(mesh);
+  const Vec3 wo = glm::normalize(Vec3(0.3f, 0.2f, 1.0f));  // towards the viewer
+  const Vec3 mirror(-wo.x, -wo.y, wo.z);
+  RayHit hit;
+  hit.mesh = 0;
+  hit.triangle = 0;
+  hit.barycentrics = Vec2(0.3f, 0.2f);
+  hit.t = 2.0f;
+  const Vec3 p = positionAt(scene.meshes[0], 0, hit.barycentrics);
+  Pcg32 rng(7, 1);
+  constexpr int kRays = 20000;
+  Rgb sum(0.0f);
+  Vec3 meanDirection(0.0f);
+  for (int i = 0; i < kRays; ++i) {
+    // Rays that differ in their last bits: each its own hash, the same wo to 1e-4.
+    const Vec3 d = -glm::normalize(wo + 1e-4f * Vec3(rng.uniform(), rng.uniform(), rng.uniform()));
+    const Ray ray{p - 2.0f * d, d, 0.0f, kInfinity};
+    Rgb emitted, weight;
+    Ray next;
+    if (!followSpecular(scene, ray, hit, 0, 8, emitted, next, weight)) continue;
+    EXPECT_GT(next.direction.z, 0.0f);
+    sum += weight;
+    meanDirection += next.direction;
+  }
+  const Rgb expected = albedo(ggx, wo);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(sum[k] / kRays, expected[k], 0.01f * expected[k]) << k;
+  EXPECT_GT(glm::dot(glm::normalize(meanDirection), mirror), 0.9999f);
 }
 
 TEST(Lookup, LinearTapClampsAndInterpolates) {

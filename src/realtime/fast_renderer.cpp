@@ -298,7 +298,9 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       } else {
         Ray reflected;
         Rgb reflectance;
-        if (followSpecular(scene, ray, hit, 0, mirrorDepth, radiance, reflected, reflectance)) {
+        const bool more = followSpecular(scene, ray, hit, 0, mirrorDepth, radiance, reflected, reflectance);
+        if (highlights_.active()) radiance += highlights_.radiance(chart, hit, -ray.direction);  // mirror-like lobes
+        if (more) {
           s.mirrorRays.push_back(reflected);
           s.mirrorSlot.push_back(uint32_t(i));
           s.mirrorThroughput.push_back(reflectance);
@@ -352,6 +354,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       Rgb reflectance;
       const bool more = followSpecular(scene, ray, hit, reflections, mirrorDepth, emitted, reflected, reflectance);
       s.radiance[slot] += throughput * emitted;
+      if (highlights_.active()) s.radiance[slot] += throughput * highlights_.radiance(chart, hit, -ray.direction);
       if (more) {
         s.nextRays.push_back(reflected);
         s.nextSlot.push_back(slot);

@@ -52,6 +52,8 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, const PunctualHigh
     Ray reflected;
     const bool more = followSpecular(scene, ray, hit, reflections, mirrorDepth, emitted, reflected, reflectance);
     result += throughput * emitted;
+    if (highlights.active())  // a mirror-like lobe's (lightfield/lookup.h PunctualHighlights)
+      result += throughput * highlights.radiance(lf.triangleChart[hit.mesh][hit.triangle], hit, -ray.direction);
     if (!more) return result;
     throughput *= reflectance;
     ray = reflected;

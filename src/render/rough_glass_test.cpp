@@ -92,9 +92,9 @@ TEST_F(RoughGlassTest, RoughGlassChartsAreTwoSidedGlossy) {
   }
   EXPECT_GT(glassFronts, 0u);
   // Smooth glass stays a specular chart; thin glass too.
-  EXPECT_EQ(chartKindOf(DielectricBsdf{1.5f}), ChartKind::Specular);
-  EXPECT_EQ(chartKindOf(DielectricBsdf{1.5f, Rgb(1.0f), kAlpha, true}), ChartKind::Specular);
-  EXPECT_EQ(chartKindOf(DielectricBsdf{1.5f, Rgb(1.0f), kAlpha}), ChartKind::Glossy);
+  EXPECT_EQ(chartKindOf(DielectricBsdf{1.5f}, bakePreset("draft")), ChartKind::Specular);
+  EXPECT_EQ(chartKindOf(DielectricBsdf{1.5f, Rgb(1.0f), kAlpha, true}, bakePreset("draft")), ChartKind::Specular);
+  EXPECT_EQ(chartKindOf(DielectricBsdf{1.5f, Rgb(1.0f), kAlpha}, bakePreset("draft")), ChartKind::Glossy);
 }
 
 /// The light field (baked with `settings`, 16 samples per pixel) against a path trace of the
