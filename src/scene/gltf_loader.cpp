@@ -555,6 +555,7 @@ void applyLayers(GltfContext& ctx, const tinygltf::Material& gltf, Material& mat
     return c;
   };
   PbrLayerMaps& layers = material.layers;
+  layers.layered = true;
   GltfPbrInputs& in = layers.factors;
   in.baseColor = baseColor;
   in.metallic = metallic;
@@ -600,6 +601,7 @@ void applyLayers(GltfContext& ctx, const tinygltf::Material& gltf, Material& mat
     layers.texture[s.slot] = texture;
     layers.mapping[s.slot] = mapping;
     const Rgb m = meanTexel(ctx.scene.textures[size_t(texture)].image);
+    layers.meanTexel[s.slot] = m;
     switch (s.slot) {
       case PbrLayerMaps::kSpecular: mean.specular *= m.r; break;
       case PbrLayerMaps::kSpecularColor: mean.specularColor *= m; break;
@@ -633,11 +635,7 @@ void applyLayers(GltfContext& ctx, const tinygltf::Material& gltf, Material& mat
 /// with ā the mean of the base colour texture (`albedo`, null without one: 1). The path
 /// tracer and the per-point diffuse albedo read the texels themselves (materialModelAt).
 GgxBsdf meanMetallicRoughnessModel(const Image& texels, const MetallicRoughnessMap& mr, const Image* albedo) {
-  glm::dvec3 albedoSum(0.0);
-  if (albedo)
-    for (const Rgb& a : albedo->pixels) albedoSum += glm::dvec3(a);
-  const Rgb base = albedo && !albedo->pixels.empty() ? mr.baseColor * Rgb(albedoSum / double(albedo->pixels.size()))
-                                                     : mr.baseColor;
+  const Rgb base = albedo && !albedo->pixels.empty() ? mr.baseColor * meanTexel(*albedo) : mr.baseColor;
   double alpha = 0.0, metalness = 0.0;
   glm::dvec3 f0(0.0);
   for (const Rgb& t : texels.pixels) {

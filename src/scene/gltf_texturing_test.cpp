@@ -322,6 +322,17 @@ TEST(GltfTexturing, LayerExtensionsFactorsAndTexturesPerHit) {
     EXPECT_NEAR(at.clearcoatAlpha, want.clearcoatAlpha, kTight);
     EXPECT_VEC3_NEAR(at.sheenColor, want.sheenColor, kTight);
   }
+  // A metallic-roughness texture on a layered material keeps the layers at every hit.
+  const Scene withMr = loadScene(writeQuad(dir, R"({"pbrMetallicRoughness": {"metallicFactor": 0.5, "roughnessFactor": 0.8,
+      "metallicRoughnessTexture": {"index": 0}}, "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 0.6}}})",
+      "", "", kNearest));
+  {
+    const Vec2 p(0.3f, 0.1f);
+    const Rgb t = texelRaw(wrappedTexel(p.x, "repeat"), wrappedTexel(1.0f - p.y, "repeat"));
+    const GltfPbrBsdf at = std::get<GltfPbrBsdf>(bsdfAt(withMr, surfaceAt(withMr, 0, 0, Vec2(p.x - p.y, p.y))));
+    EXPECT_NEAR(at.clearcoat, 0.6f, kTight);
+    EXPECT_NEAR(at.alpha, ggxAlphaFromRoughness(0.8f * t.g), kTight);
+  }
   // Material::bsdf: the factors × each texture's mean (the clearcoat's R mean here).
   float meanR = 0.0f;
   for (int x = 0; x < kSide; ++x)

@@ -365,24 +365,12 @@ Rgb albedoModulation(const Scene& scene, const Material& material, const AlbedoP
   return scene.textures[size_t(material.albedoTexture)].sampleLod(p.uv, p.lod) * p.vertexColor;
 }
 
-Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p) {
-  const MetallicRoughnessMap& mr = material.metallicRoughness;
-  if (!material.modelVaries()) return material.bsdf;
-  const Rgb modulation = albedoModulation(scene, material, p);
-  if (mr.texture >= 0) {
-    const Rgb texel = scene.textures[size_t(mr.texture)].sample(p.metallicRoughnessUv);
-    return ggxFromMetallicRoughness(mr.baseColor * modulation, mr.metallic * texel.b, mr.roughness * texel.g);
-  }
-  return withDiffuseAlbedo(material.bsdf, diffuseAlbedo(material.bsdf) * modulation);
-}
-
 namespace {
 
-/// The layered model at a hit of a material with glTF layer textures (PbrLayerMaps).
-GltfPbrBsdf layeredModelAt(const Scene& scene, const Material& material, const SurfaceHit& hit) {
+/// The layered model of a glTF layered material (PbrLayerMaps) at albedo point p: the layer
+/// textures read at `hit`, or their means without one.
+GltfPbrBsdf layeredModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p, const SurfaceHit* hit) {
   const PbrLayerMaps& layers = material.layers;
-  const Mesh& mesh = scene.meshes[hit.mesh];
-  const AlbedoPoint p = albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
   GltfPbrInputs in = layers.factors;
   in.baseColor *= albedoModulation(scene, material, p);
   if (material.metallicRoughness.texture >= 0) {
@@ -390,12 +378,11 @@ GltfPbrBsdf layeredModelAt(const Scene& scene, const Material& material, const S
     in.metallic *= texel.b;
     in.roughness *= texel.g;
   }
-  std::array<Rgb, PbrLayerMaps::kSlots> texel;
-  texel.fill(Rgb(1.0f));
-  for (size_t s = 0; s < texel.size(); ++s)
+  std::array<Rgb, PbrLayerMaps::kSlots> texel = layers.meanTexel;
+  for (size_t s = 0; s < texel.size() && hit; ++s)
     if (const int t = layers.texture[s]; t >= 0) {
       const TextureMapping& mapping = layers.mapping[s];
-      texel[s] = scene.textures[size_t(t)].sample(uvAt(mesh, hit.triangle, hit.barycentrics, mapping));
+      texel[s] = scene.textures[size_t(t)].sample(uvAt(scene.meshes[hit->mesh], hit->triangle, hit->barycentrics, mapping));
     }
   // Channels as glTF gives them: clearcoat R and clearcoat roughness G (raw values), the
   // colours sRGB-decoded, the specular and sheen-roughness A (decoded as coverage: alpha in R).
@@ -410,9 +397,23 @@ GltfPbrBsdf layeredModelAt(const Scene& scene, const Material& material, const S
 
 }  // namespace
 
+Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p) {
+  const MetallicRoughnessMap& mr = material.metallicRoughness;
+  if (!material.modelVaries()) return material.bsdf;
+  if (material.layers.layered) return layeredModelAt(scene, material, p, nullptr);
+  const Rgb modulation = albedoModulation(scene, material, p);
+  if (mr.texture >= 0) {
+    const Rgb texel = scene.textures[size_t(mr.texture)].sample(p.metallicRoughnessUv);
+    return ggxFromMetallicRoughness(mr.baseColor * modulation, mr.metallic * texel.b, mr.roughness * texel.g);
+  }
+  return withDiffuseAlbedo(material.bsdf, diffuseAlbedo(material.bsdf) * modulation);
+}
+
+
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit) {
   const Material& material = scene.materials[hit.material];
-  if (material.layers.any()) return layeredModelAt(scene, material, hit);
+  if (material.layers.layered && (material.layers.any() || material.modelVaries()))
+    return layeredModelAt(scene, material, albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics), &hit);
   if (!material.modelVaries()) return material.bsdf;
   return materialModelAt(scene, material, albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics));
 }

@@ -61,7 +61,13 @@ struct PbrLayerMaps {
                                                      "sheenColorTexture",        "sheenRoughnessTexture"};
   std::array<int, kSlots> texture = {-1, -1, -1, -1, -1, -1};  ///< into Scene::textures, or −1
   std::array<TextureMapping, kSlots> mapping{};
+  /// Each slot's mean texel (white without a texture): what stands in for the texel where a
+  /// model is made per point without a hit (materialModelAt).
+  std::array<Rgb, kSlots> meanTexel = {Rgb(1.0f), Rgb(1.0f), Rgb(1.0f), Rgb(1.0f), Rgb(1.0f), Rgb(1.0f)};
   GltfPbrInputs factors;
+  /// Whether the factors are set (a glTF material with a layer extension): a varying base
+  /// colour or metallic-roughness texture then rebuilds the layered model, not plain GGX.
+  bool layered = false;
   bool any() const { return std::any_of(texture.begin(), texture.end(), [](int t) { return t >= 0; }); }
 };
 
@@ -344,8 +350,9 @@ std::string mappingProblem(const Material& material);
 /// The material's model at albedo point p, the one rule bsdfAt and the renderers' albedos
 /// (lookup.h diffuseAlbedoAt, glossyDiffuseAlbedoAt) apply: the model as it is when nothing
 /// varies; with a metallic-roughness texture ggxFromMetallicRoughness(baseColor × modulation,
-/// metallic × B, roughness × G) of the texel at p.metallicRoughnessUv (full resolution);
-/// otherwise the model with its diffuse albedo × albedoModulation(p).
+/// metallic × B, roughness × G) of the texel at p.metallicRoughnessUv (full resolution), for a
+/// glTF layered material the layered model of the same (PbrLayerMaps, with the layer textures'
+/// means); otherwise the model with its diffuse albedo × albedoModulation(p).
 Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p);
 
 /// Sets Material::vertexColored from the meshes (Scene::finalize and the .plf reader call it).
