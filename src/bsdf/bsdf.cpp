@@ -175,18 +175,12 @@ class GgxAlbedoTable {
     float e0, e5, mean0, mean5;
   };
   Lookup lookup(float mu, float alpha) const {
-    const float rMin = std::sqrt(kGgxMinAlpha);
-    const float rPos = (std::sqrt(clampAlpha(alpha)) - rMin) / (1.0f - rMin) * (kRoughNodes - 1);
-    const int r0 = std::clamp(static_cast<int>(rPos), 0, kRoughNodes - 2);
-    const float tr = std::clamp(rPos - static_cast<float>(r0), 0.0f, 1.0f);
-    mu = std::clamp(mu, 0.0f, 1.0f);
-    // Node i sits at μ = (i/(N−1))²; find the segment from √μ, interpolate linearly in μ.
-    const float iPos = std::sqrt(mu) * (kMuNodes - 1);
-    const int i0 = std::clamp(static_cast<int>(iPos), 0, kMuNodes - 2);
-    const float tm = std::clamp((mu - mu_[i0]) / (mu_[i0 + 1] - mu_[i0]), 0.0f, 1.0f);
+    const Cell c = locate(mu, alpha);
     auto at = [&](const std::array<std::array<float, kMuNodes>, kRoughNodes>& t, int r) {
-      return t[r][i0] + tm * (t[r][i0 + 1] - t[r][i0]);
+      return t[r][c.i0] + c.tm * (t[r][c.i0 + 1] - t[r][c.i0]);
     };
+    const int r0 = c.r0;
+    const float tr = c.tr;
     Lookup l;
     l.e0 = at(e0_, r0) + tr * (at(e0_, r0 + 1) - at(e0_, r0));
     l.e5 = at(e5_, r0) + tr * (at(e5_, r0 + 1) - at(e5_, r0));
@@ -195,7 +189,39 @@ class GgxAlbedoTable {
     return l;
   }
 
+  /// An upper bound of the lobe albedo E = f0 (E₀ − E₅) + f90 E₅ at (μ, α): the larger of the
+  /// two roughness rows around α, each interpolated in μ. Between the first rows (α = 1e-3
+  /// and 5.4e-3) E falls steeply with α near grazing, and lookup()'s linear interpolation in
+  /// √α is up to 1.4 % below the true albedo there; the rows themselves are within 3e-3.
+  float upperAlbedo(float mu, float alpha, float f0, float f90) const {
+    const Cell c = locate(mu, alpha);
+    auto row = [&](int r) {
+      const float e0 = e0_[r][c.i0] + c.tm * (e0_[r][c.i0 + 1] - e0_[r][c.i0]);
+      const float e5 = e5_[r][c.i0] + c.tm * (e5_[r][c.i0 + 1] - e5_[r][c.i0]);
+      return f0 * (e0 - e5) + f90 * e5;
+    };
+    return std::max(row(c.r0), row(c.r0 + 1));
+  }
+
  private:
+  /// The table cell of (μ, α): roughness row r0 and the weight tr of r0 + 1, μ segment i0 and
+  /// the weight tm of i0 + 1 (node i sits at μ = (i/(N−1))²: the segment from √μ, linear in μ).
+  struct Cell {
+    int r0, i0;
+    float tr, tm;
+  };
+  Cell locate(float mu, float alpha) const {
+    const float rMin = std::sqrt(kGgxMinAlpha);
+    const float rPos = (std::sqrt(clampAlpha(alpha)) - rMin) / (1.0f - rMin) * (kRoughNodes - 1);
+    Cell c;
+    c.r0 = std::clamp(static_cast<int>(rPos), 0, kRoughNodes - 2);
+    c.tr = std::clamp(rPos - static_cast<float>(c.r0), 0.0f, 1.0f);
+    mu = std::clamp(mu, 0.0f, 1.0f);
+    c.i0 = std::clamp(static_cast<int>(std::sqrt(mu) * (kMuNodes - 1)), 0, kMuNodes - 2);
+    c.tm = std::clamp((mu - mu_[c.i0]) / (mu_[c.i0 + 1] - mu_[c.i0]), 0.0f, 1.0f);
+    return c;
+  }
+
   GgxAlbedoTable() {
     const float rMin = std::sqrt(kGgxMinAlpha);
     for (int i = 0; i < kMuNodes; ++i) {
@@ -254,10 +280,12 @@ struct GgxLobeAlbedo {
   Rgb at;
   Rgb mean;
 };
-GgxLobeAlbedo ggxLobeAlbedo(const GgxBsdf& b, float mu) {
-  const auto l = GgxAlbedoTable::get().lookup(mu, b.alpha);
-  return {b.f0 * (l.e0 - l.e5) + Rgb(l.e5), b.f0 * (l.mean0 - l.mean5) + Rgb(l.mean5)};
+/// With Fresnel from f0 to f90 (F = f0 (1 − m⁵) + f90 m⁵, m = 1 − wo·h): E = f0 (E₀ − E₅) + f90 E₅.
+GgxLobeAlbedo ggxLobeAlbedo(float alpha, const Rgb& f0, float f90, float mu) {
+  const auto l = GgxAlbedoTable::get().lookup(mu, alpha);
+  return {f0 * (l.e0 - l.e5) + Rgb(f90 * l.e5), f0 * (l.mean0 - l.mean5) + Rgb(f90 * l.mean5)};
 }
+GgxLobeAlbedo ggxLobeAlbedo(const GgxBsdf& b, float mu) { return ggxLobeAlbedo(b.alpha, b.f0, 1.0f, mu); }
 
 /// (1 − E(μ)) / √(1 − Ē) per channel, so that f_d = ρ/π · k(μo) k(μi). Zero when Ē ≈ 1 (a
 /// lobe that reflects everything leaves no energy for the base).
@@ -271,12 +299,16 @@ Rgb ggxDiffuseFactor(const GgxBsdf& b, float mu) {
   return k;
 }
 
-Rgb ggxSpecular(const GgxBsdf& b, const Vec3& wo, const Vec3& wi) {
-  const float alpha = clampAlpha(b.alpha);
+/// The GGX lobe F D G2 / (4 cos θo cos θi), F Schlick's from f0 (normal) to f90 (grazing).
+Rgb ggxSpecular(float alphaIn, const Rgb& f0, float f90, const Vec3& wo, const Vec3& wi) {
+  const float alpha = clampAlpha(alphaIn);
   const Vec3 h = glm::normalize(wo + wi);
   const float g2 = 1.0f / (1.0f + ggxLambda(alpha, wo) + ggxLambda(alpha, wi));
-  return fresnelSchlick(b.f0, glm::dot(wo, h)) * (ggxD(alpha, h) * g2 / (4.0f * wo.z * wi.z));
+  const float m = std::clamp(1.0f - glm::dot(wo, h), 0.0f, 1.0f), m2 = m * m;
+  const Rgb fresnel = f0 + (Rgb(f90) - f0) * (m2 * m2 * m);  // fresnelSchlick when f90 = 1
+  return fresnel * (ggxD(alpha, h) * g2 / (4.0f * wo.z * wi.z));
 }
+Rgb ggxSpecular(const GgxBsdf& b, const Vec3& wo, const Vec3& wi) { return ggxSpecular(b.alpha, b.f0, 1.0f, wo, wi); }
 
 /// Mixture probability of the specular lobe from the lobe albedos at wo.
 float ggxSpecularProbability(const GgxBsdf& b, const Vec3& wo) {
@@ -286,9 +318,9 @@ float ggxSpecularProbability(const GgxBsdf& b, const Vec3& wo) {
   return d + s > 0.0f ? s / (d + s) : 1.0f;
 }
 
-float ggxLobePdf(const GgxBsdf& b, const Vec3& wo, const Vec3& wi) {
+float ggxLobePdf(float alphaIn, const Vec3& wo, const Vec3& wi) {
   // p(wi) = D_wo(h) / (4 wo·h) = G1(wo) D(h) / (4 cos θo).
-  const float alpha = clampAlpha(b.alpha);
+  const float alpha = clampAlpha(alphaIn);
   const Vec3 h = glm::normalize(wo + wi);
   if (glm::dot(wo, h) <= 0.0f) return 0.0f;
   return ggxD(alpha, h) / ((1.0f + ggxLambda(alpha, wo)) * 4.0f * wo.z);
@@ -304,13 +336,263 @@ Rgb evalGgx(const GgxBsdf& b, const Vec3& wo, const Vec3& wi) {
 float pdfGgx(const GgxBsdf& b, const Vec3& wo, const Vec3& wi) {
   if (!sameHemisphereUp(wo, wi)) return 0.0f;
   const float ps = ggxSpecularProbability(b, wo);
-  return (1.0f - ps) * cosineHemispherePdf(wi.z) + ps * ggxLobePdf(b, wo, wi);
+  return (1.0f - ps) * cosineHemispherePdf(wi.z) + ps * ggxLobePdf(b.alpha, wo, wi);
 }
 
 std::optional<Vec3> sampleGgxDirection(const GgxBsdf& b, const Vec3& wo, Vec2 u) {
   const float ps = ggxSpecularProbability(b, wo);
   if (!chooseFirst(ps, u.x)) return sampleCosineHemisphere(u);
   return reflectAbout(wo, sampleGgxVisibleNormal(clampAlpha(b.alpha), wo, u));
+}
+
+// ---------------------------------------------------------------------------------------
+// glTF PBR with the specular, sheen and clearcoat layers (GltfPbrBsdf).
+//
+// Lobes (bsdf.h): the base GGX f_spec (Fresnel f0 → f90), the Charlie sheen f_s, the GGX
+// coat f_c (f0 = 0.04, f90 = 1) and the diffuse base. E_spec(μ), E_s(μ) and E_c(μ) are the
+// lobes' directional albedos ∫ f_lobe cos θi dωi at cos θo = μ (E_spec per channel; E_s for a
+// white sheen colour; E_c for weight 1). The KHR_materials_sheen README scales the layers
+// below a lobe by min(1 − w E(μo), 1 − w E(μi)) = T(wo, wi); we use the same reciprocal form
+// for the coat (its README's 1 − clearcoat·F(N·V) is one-sided: its flux-form albedo from a
+// grazing direction reaches 1 + clearcoat·(E_c(0) − Ē_c) ≈ 1.9 for a smooth coat over white),
+// with the lobe's tabulated E in place of the README's Schlick F(N·V) (which is below E for a
+// rough coat near normal incidence, where it would let the sum exceed 1).
+//   f = w_c f_c + T_c (f_s + T_s f_spec) + ρ/π g(μo) g(μi) / Ḡ,
+//   g(μ) = (1 − E_spec(μ)) (1 − w_s E_s(μ)) (1 − w_c E_c(μ)),  Ḡ = 2∫ g μ dμ,
+// w_s = max(sheenColor) ≥ each channel. Energy, per channel, for fixed wo (μo):
+//   ∫ w_c f_c cos                ≤ w_c E_c(μo)
+//   ∫ T_c f_s cos                ≤ (1 − w_c E_c(μo)) w_s E_s(μo)          (T_c ≤ 1 − w_c E_c(μo))
+//   ∫ T_c T_s f_spec cos         ≤ (1 − w_c E_c(μo)) (1 − w_s E_s(μo)) E_spec(μo)
+//   ∫ ρ/π g(μo) g(μi)/Ḡ cos dωi  = ρ g(μo)
+// and their sum is ≤ 1 for ρ ≤ 1 (it telescopes). It is 1 − (loss of the T's max) for ρ = 1:
+// the loss is what the reciprocal max takes where a layer reflects more at θi than at θo. Each
+// term is symmetric in (wo, wi), so f is reciprocal exactly. The diffuse term's separable
+// product keeps it one irradiance-like value per tixel in the light field (diffuseDirectional-
+// Factor = g/√Ḡ); Ḡ is a 64-point midpoint rule in μ² of the interpolated tables.
+//
+// The Charlie sheen (Estevez & Kulla 2017): D(h) = (2 + 1/r) sin^(1/r) θh / (2π) and the
+// visibility 1/((1 + Λ(wo) + Λ(wi)) 4 cos θo cos θi) with their fitted Λ (the README's l()).
+// Its E_s(μ, r) comes from a table (below) filled once by quadrature; where the fit makes
+// E_s exceed 1 (it is not an exact shadowing function) the lobe is scaled by 1/max_μ E_s for
+// that roughness so that it conserves energy alone.
+//
+// Sampling: a mixture of the coat's and the base's visible-normal samplers, a uniform
+// hemisphere for the sheen (its lobe is broad, peaking at grazing) and the cosine hemisphere
+// for the diffuse, chosen with probabilities ∝ the terms' albedo estimates at wo above; pdf()
+// is the full mixture.
+
+constexpr float kCoatF0 = 0.04f;  ///< the clearcoat's f0 (ior 1.5)
+
+inline float sheenRoughness(float r) { return std::clamp(r, kSheenMinRoughness, 1.0f); }
+
+inline float charlieD(float r, float cosH) {
+  const float invR = 1.0f / r;
+  const float sin2 = std::max(0.0f, 1.0f - cosH * cosH);
+  return (2.0f + invR) * std::pow(sin2, 0.5f * invR) * (0.5f * kInvPi);
+}
+
+/// Estevez & Kulla's fit l(x, r) of ln Λ (the sheen README's l()).
+inline float charlieL(float x, float r) {
+  const float t = (1.0f - r) * (1.0f - r);
+  const float a = glm::mix(21.5473f, 25.3245f, t), b = glm::mix(3.82987f, 3.32435f, t);
+  const float c = glm::mix(0.19823f, 0.16801f, t), d = glm::mix(-1.97760f, -1.27393f, t);
+  const float e = glm::mix(-4.32054f, -4.85967f, t);
+  return a / (1.0f + b * std::pow(x, c)) + d * x + e;
+}
+
+inline float charlieLambda(float cosTheta, float r) {
+  return cosTheta < 0.5f ? std::exp(charlieL(cosTheta, r))
+                         : std::exp(2.0f * charlieL(0.5f, r) - charlieL(1.0f - cosTheta, r));
+}
+
+/// The unscaled Charlie lobe D G / (4 cos θo cos θi) for both directions up, r clamped.
+float charlieLobe(float r, const Vec3& wo, const Vec3& wi) {
+  const Vec3 h = glm::normalize(wo + wi);
+  return charlieD(r, h.z) / ((1.0f + charlieLambda(wo.z, r) + charlieLambda(wi.z, r)) * 4.0f * wo.z * wi.z);
+}
+
+/// E_s(μ, r) of the Charlie lobe, on nodes μ_i = (i/(N−1))² × r uniform on
+/// [kSheenMinRoughness, 1], and the scale 1/max(1, max_μ E_s) per roughness node; lookup()
+/// returns both interpolated, E_s already scaled.
+class SheenAlbedoTable {
+ public:
+  static constexpr int kMuNodes = 32;
+  static constexpr int kRoughNodes = 16;
+  static constexpr int kQuadratureMu = 96;   ///< midpoint nodes in v, μi = v² (dense at grazing)
+  static constexpr int kQuadraturePhi = 48;  ///< midpoint nodes in φ ∈ [0, π] (the lobe is even in φ)
+
+  static const SheenAlbedoTable& get() {
+    static const SheenAlbedoTable table;
+    return table;
+  }
+
+  struct Lookup {
+    float albedo, scale;
+  };
+  Lookup lookup(float mu, float r) const {
+    const float rPos = (sheenRoughness(r) - kSheenMinRoughness) / (1.0f - kSheenMinRoughness) * (kRoughNodes - 1);
+    const int r0 = std::clamp(static_cast<int>(rPos), 0, kRoughNodes - 2);
+    const float tr = std::clamp(rPos - static_cast<float>(r0), 0.0f, 1.0f);
+    mu = std::clamp(mu, 0.0f, 1.0f);
+    const int i0 = std::clamp(static_cast<int>(std::sqrt(mu) * (kMuNodes - 1)), 0, kMuNodes - 2);
+    const float tm = std::clamp((mu - mu_[i0]) / (mu_[i0 + 1] - mu_[i0]), 0.0f, 1.0f);
+    auto at = [&](int row) { return e_[row][i0] + tm * (e_[row][i0 + 1] - e_[row][i0]); };
+    return {at(r0) + tr * (at(r0 + 1) - at(r0)), scale_[r0] + tr * (scale_[r0 + 1] - scale_[r0])};
+  }
+
+ private:
+  SheenAlbedoTable() {
+    for (int i = 0; i < kMuNodes; ++i) {
+      const float x = static_cast<float>(i) / (kMuNodes - 1);
+      mu_[i] = x * x;
+    }
+    for (int k = 0; k < kRoughNodes; ++k) {
+      const float r = kSheenMinRoughness + (1.0f - kSheenMinRoughness) * static_cast<float>(k) / (kRoughNodes - 1);
+      float peak = 0.0f;
+      for (int i = 0; i < kMuNodes; ++i) {
+        const float mu = std::max(mu_[i], 1e-4f);  // just above the horizon (see GgxAlbedoTable)
+        const Vec3 wo(std::sqrt(1.0f - mu * mu), 0.0f, mu);
+        // ∫ f μi dωi with dωi = dμi dφ, μi = v²: dμi = 2v dv; φ over [0, π] counted twice.
+        double sum = 0.0;
+        for (int a = 0; a < kQuadratureMu; ++a) {
+          const float v = (a + 0.5f) / kQuadratureMu, mi = v * v, si = std::sqrt(std::max(0.0f, 1.0f - mi * mi));
+          for (int b = 0; b < kQuadraturePhi; ++b) {
+            const float phi = kPi * (b + 0.5f) / kQuadraturePhi;
+            const Vec3 wi(si * std::cos(phi), si * std::sin(phi), mi);
+            sum += double(charlieLobe(r, wo, wi)) * mi * 2.0 * v;
+          }
+        }
+        e_[k][i] = static_cast<float>(sum * 2.0 * kPi / (double(kQuadratureMu) * kQuadraturePhi));
+        peak = std::max(peak, e_[k][i]);
+      }
+      scale_[k] = 1.0f / std::max(1.0f, peak);
+      for (float& e : e_[k]) e *= scale_[k];
+    }
+  }
+
+  std::array<float, kMuNodes> mu_{};
+  std::array<std::array<float, kMuNodes>, kRoughNodes> e_{};
+  std::array<float, kRoughNodes> scale_{};
+};
+
+inline float sheenWeight(const GltfPbrBsdf& b) { return std::max(0.0f, maxComponent(b.sheenColor)); }
+
+/// The lobes' directional albedos at μ: E_c (weight 1; the table's upper bound, so that the
+/// coat never takes less from the layers below than it reflects), E_s (white, scaled), E_spec.
+struct PbrAlbedos {
+  float coat = 0.0f, sheen = 0.0f;
+  Rgb base{0.0f};
+};
+PbrAlbedos pbrAlbedos(const GltfPbrBsdf& b, float mu) {
+  PbrAlbedos a;
+  if (b.clearcoat > 0.0f) a.coat = GgxAlbedoTable::get().upperAlbedo(mu, b.clearcoatAlpha, kCoatF0, 1.0f);
+  if (sheenWeight(b) > 0.0f) a.sheen = SheenAlbedoTable::get().lookup(mu, b.sheenRoughness).albedo;
+  a.base = ggxLobeAlbedo(b.alpha, b.f0, b.f90, mu).at;
+  return a;
+}
+
+/// g(μ) = (1 − E_spec)(1 − w_s E_s)(1 − w_c E_c), per channel, ≥ 0.
+Rgb pbrDiffuseShape(const GltfPbrBsdf& b, const PbrAlbedos& a) {
+  const float layers = std::max(0.0f, 1.0f - sheenWeight(b) * a.sheen) * std::max(0.0f, 1.0f - b.clearcoat * a.coat);
+  return glm::max(Rgb(1.0f) - a.base, Rgb(0.0f)) * layers;
+}
+
+/// Ḡ = 2∫ g(μ) μ dμ = ∫₀¹ g(√v) dv by the midpoint rule in v.
+Rgb pbrDiffuseMean(const GltfPbrBsdf& b) {
+  constexpr int kSteps = 64;
+  Rgb sum(0.0f);
+  for (int k = 0; k < kSteps; ++k) sum += pbrDiffuseShape(b, pbrAlbedos(b, std::sqrt((k + 0.5f) / kSteps)));
+  return sum / float(kSteps);
+}
+
+/// 1/√Ḡ per channel (0 where Ḡ ≈ 0: the layers leave the diffuse nothing). Ḡ does not
+/// depend on ρ; the last model's value is kept per thread (a path's vertices on one material
+/// ask for it with the same parameters many times).
+Rgb pbrDiffuseNorm(const GltfPbrBsdf& b) {
+  struct Cached {
+    GltfPbrBsdf key;
+    Rgb norm{0.0f};
+    bool valid = false;
+  };
+  thread_local Cached cache;
+  const auto& k = cache.key;
+  if (cache.valid && k.f0 == b.f0 && k.f90 == b.f90 && k.alpha == b.alpha && k.clearcoat == b.clearcoat &&
+      k.clearcoatAlpha == b.clearcoatAlpha && k.sheenColor == b.sheenColor && k.sheenRoughness == b.sheenRoughness)
+    return cache.norm;
+  const Rgb mean = pbrDiffuseMean(b);
+  Rgb n;
+  for (int c = 0; c < 3; ++c) n[c] = mean[c] > 1e-6f ? 1.0f / std::sqrt(mean[c]) : 0.0f;
+  cache = {b, n, true};
+  return n;
+}
+
+Rgb evalGltfPbr(const GltfPbrBsdf& b, const Vec3& wo, const Vec3& wi) {
+  if (!sameHemisphereUp(wo, wi)) return Rgb(0.0f);
+  const PbrAlbedos o = pbrAlbedos(b, wo.z), i = pbrAlbedos(b, wi.z);
+  const float ws = sheenWeight(b);
+  Rgb f = ggxSpecular(b.alpha, b.f0, b.f90, wo, wi) * (1.0f - ws * std::max(o.sheen, i.sheen));
+  if (ws > 0.0f) {
+    const float r = sheenRoughness(b.sheenRoughness);
+    f += b.sheenColor * (SheenAlbedoTable::get().lookup(0.0f, r).scale * charlieLobe(r, wo, wi));
+  }
+  if (b.clearcoat > 0.0f) {
+    f *= 1.0f - b.clearcoat * std::max(o.coat, i.coat);
+    f += b.clearcoat * ggxSpecular(b.clearcoatAlpha, Rgb(kCoatF0), 1.0f, wo, wi);
+  }
+  if (!isBlack(b.diffuse)) {
+    const Rgb norm = pbrDiffuseNorm(b);
+    f += b.diffuse * kInvPi * (pbrDiffuseShape(b, o) * norm) * (pbrDiffuseShape(b, i) * norm);
+  }
+  return f;
+}
+
+/// Mixture probabilities at wo of the coat, sheen, base specular and diffuse samplers: the
+/// terms' albedo estimates (luminance), normalised; all 0 when nothing reflects.
+std::array<float, 4> pbrLobeProbabilities(const GltfPbrBsdf& b, const Vec3& wo) {
+  const PbrAlbedos o = pbrAlbedos(b, wo.z);
+  const float coat = b.clearcoat * o.coat, belowCoat = std::max(0.0f, 1.0f - coat);
+  const float sheen = belowCoat * std::max(0.0f, luminance(b.sheenColor)) * o.sheen;
+  const float belowSheen = belowCoat * std::max(0.0f, 1.0f - sheenWeight(b) * o.sheen);
+  std::array<float, 4> p = {coat, sheen, belowSheen * std::max(0.0f, luminance(o.base)),
+                            std::max(0.0f, luminance(b.diffuse * pbrDiffuseShape(b, o)))};
+  const float total = p[0] + p[1] + p[2] + p[3];
+  for (float& x : p) x = total > 0.0f ? x / total : 0.0f;
+  return p;
+}
+
+float pdfGltfPbr(const GltfPbrBsdf& b, const Vec3& wo, const Vec3& wi) {
+  if (!sameHemisphereUp(wo, wi)) return 0.0f;
+  const std::array<float, 4> p = pbrLobeProbabilities(b, wo);
+  float density = p[1] * kUniformHemispherePdf + p[3] * cosineHemispherePdf(wi.z);
+  if (p[0] > 0.0f) density += p[0] * ggxLobePdf(b.clearcoatAlpha, wo, wi);
+  if (p[2] > 0.0f) density += p[2] * ggxLobePdf(b.alpha, wo, wi);
+  return density;
+}
+
+std::optional<Vec3> sampleGltfPbrDirection(const GltfPbrBsdf& b, const Vec3& wo, Vec2 u) {
+  const std::array<float, 4> p = pbrLobeProbabilities(b, wo);
+  // The lobe k whose interval [Σ_{j<k} p_j, Σ_{j≤k} p_j) holds u.x (the last one with p > 0
+  // when rounding leaves u.x past the sum), and u.x stretched over it.
+  int last = -1;
+  for (int k = 0; k < 4; ++k)
+    if (p[k] > 0.0f) last = k;
+  int lobe = -1;
+  float start = 0.0f;
+  for (int k = 0; k <= last && lobe < 0; ++k) {
+    if (!(p[k] > 0.0f)) continue;
+    if (u.x < start + p[k] || k == last) {
+      lobe = k;
+      u.x = std::clamp((u.x - start) / p[k], 0.0f, 0x1.fffffep-1f);
+    }
+    start += p[k];
+  }
+  switch (lobe) {
+    case 0: return reflectAbout(wo, sampleGgxVisibleNormal(clampAlpha(b.clearcoatAlpha), wo, u));
+    case 1: return sampleUniformHemisphere(u);
+    case 2: return reflectAbout(wo, sampleGgxVisibleNormal(clampAlpha(b.alpha), wo, u));
+    case 3: return sampleCosineHemisphere(u);
+    default: return std::nullopt;
+  }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -795,6 +1077,7 @@ Rgb eval(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) {
                         [&](const DielectricBsdf& b) {
                           return b.isSmooth() ? Rgb(0.0f) : evalRoughDielectric(b, wo, wi);
                         },
+                        [&](const GltfPbrBsdf& b) { return evalGltfPbr(b, wo, wi); },
                     },
                     bsdf);
 }
@@ -810,6 +1093,7 @@ float pdf(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) {
                         [&](const DielectricBsdf& b) {
                           return b.isSmooth() ? 0.0f : pdfRoughDielectric(b, wo, wi);
                         },
+                        [&](const GltfPbrBsdf& b) { return pdfGltfPbr(b, wo, wi); },
                     },
                     bsdf);
 }
@@ -842,6 +1126,7 @@ std::optional<BsdfSample> sample(const Bsdf& bsdf, const Vec3& wo, Vec2 u) {
                         },
                         [&](const GgxBsdf& b) { return finishSample(bsdf, wo, sampleGgxDirection(b, wo, u)); },
                         [&](const DielectricBsdf&) -> std::optional<BsdfSample> { return std::nullopt; },  // above
+                        [&](const GltfPbrBsdf& b) { return finishSample(bsdf, wo, sampleGltfPbrDirection(b, wo, u)); },
                     },
                     bsdf);
 }
@@ -881,14 +1166,20 @@ Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo) {
                           return b;
                         },
                         [&](DielectricBsdf b) -> Bsdf { return b; },
+                        [&](GltfPbrBsdf b) -> Bsdf {
+                          b.diffuse = albedo;
+                          return b;
+                        },
                     },
                     bsdf);
 }
 
 Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta) {
   if (!(cosTheta > 0.0f)) return Rgb(0.0f);
-  const auto* ggx = std::get_if<GgxBsdf>(&bsdf);
-  return ggx ? ggxDiffuseFactor(*ggx, std::min(cosTheta, 1.0f)) : Rgb(1.0f);
+  const float mu = std::min(cosTheta, 1.0f);
+  if (const auto* ggx = std::get_if<GgxBsdf>(&bsdf)) return ggxDiffuseFactor(*ggx, mu);
+  if (const auto* pbr = std::get_if<GltfPbrBsdf>(&bsdf)) return pbrDiffuseShape(*pbr, pbrAlbedos(*pbr, mu)) * pbrDiffuseNorm(*pbr);
+  return Rgb(1.0f);
 }
 
 const char* modelName(const Bsdf& bsdf) {
@@ -900,6 +1191,7 @@ const char* modelName(const Bsdf& bsdf) {
                         [](const DielectricBsdf& b) {
                           return b.thin ? "thin-dielectric" : b.isSmooth() ? "dielectric" : "rough-dielectric";
                         },
+                        [](const GltfPbrBsdf&) { return "gltf-pbr"; },
                     },
                     bsdf);
 }

@@ -169,6 +169,65 @@ struct DielectricBsdf {
   static void parameters(Self& b, F&& f) { f(b.ior), f(b.transmittance), f(b.alpha), f(b.thin), f(b.absorption); }
 };
 
+/// The glTF 2.0 PBR material with the KHR_materials_specular, KHR_materials_clearcoat and
+/// KHR_materials_sheen layers (glTF 2.0 appendix B and the extensions' READMEs), bottom up:
+///   base   f_b = f_spec + f_d: a GGX lobe (α, Schlick Fresnel from f0 at normal incidence
+///          to f90 at grazing — KHR_materials_specular's weight) over the diffuse ρ;
+///   sheen  f_s = sheenColor · D_charlie(h) / ((1 + Λ(wo) + Λ(wi)) 4 cos θo cos θi)
+///          (Estevez & Kulla 2017: the "Charlie" distribution and visibility, as the
+///          sheen README's reference), roughness r ∈ [kSheenMinRoughness, 1];
+///   coat   f_c = clearcoat · GGX(α_c, f0 = 0.04 i.e. ior 1.5, f90 = 1).
+/// Each layer scales what lies below by the sheen README's reciprocal albedo scaling,
+///   T_l(wo, wi) = 1 − w_l · max(E_l(θo), E_l(θi))     (w the layer's weight, E its lobe's
+/// directional albedo; w = max(sheenColor) for sheen, clearcoat for the coat), except the
+/// diffuse term, whose scaling is the separable product of the same factors (Kelemen-style):
+///   f = f_c + T_c (f_s + T_s f_spec) + ρ/π · g(θo) g(θi) / Ḡ,
+///   g(θ) = (1 − E_spec(θ)) (1 − w_s E_s(θ)) (1 − w_c E_c(θ)),   Ḡ = 2∫ g(μ) μ dμ.
+/// Every term is symmetric in (wo, wi) — reciprocal exactly — and ∫ f cos θi dωi ≤ 1 for
+/// ρ ≤ 1 (derivation in bsdf.cpp). With no sheen and no coat and f90 = 1 it is GgxBsdf.
+/// gltfPbrFromInputs builds it from the glTF factors.
+struct GltfPbrBsdf {
+  Rgb diffuse{0.8f};          ///< ρ = baseColor · (1 − metallic)
+  Rgb f0{0.04f};              ///< base lobe's Fresnel at normal incidence
+  float f90 = 1.0f;           ///< base lobe's Fresnel at grazing incidence, in [0, 1]
+  float alpha = 0.25f;        ///< base GGX α
+  float clearcoat = 0.0f;     ///< coat weight in [0, 1] (0: no coat)
+  float clearcoatAlpha = 0.0625f;  ///< coat GGX α
+  Rgb sheenColor{0.0f};       ///< sheen colour in [0, 1] (black: no sheen)
+  float sheenRoughness = 0.5f;  ///< Charlie roughness r (not squared), in [0, 1]
+
+  template <class Self, class F>
+  static void parameters(Self& b, F&& f) {
+    f(b.diffuse), f(b.f0), f(b.f90), f(b.alpha), f(b.clearcoat), f(b.clearcoatAlpha), f(b.sheenColor),
+        f(b.sheenRoughness);
+  }
+};
+/// The Charlie distribution's roughness floor: below it the fitted visibility term and the
+/// distribution (∝ sin^(1/r) θh) leave the range the fit was made for.
+inline constexpr float kSheenMinRoughness = 0.07f;
+
+/// The glTF inputs of GltfPbrBsdf: the core metallic-roughness factors, KHR_materials_ior's
+/// ior, KHR_materials_specular's specularFactor and specularColorFactor, KHR_materials_
+/// clearcoat's factor and roughness and KHR_materials_sheen's colour and roughness, each
+/// already multiplied by its texture where it has one.
+struct GltfPbrInputs {
+  Rgb baseColor{1.0f};
+  float metallic = 1.0f, roughness = 1.0f;
+  float ior = 1.5f;
+  float specular = 1.0f;
+  Rgb specularColor{1.0f};
+  float clearcoat = 0.0f, clearcoatRoughness = 0.0f;
+  Rgb sheenColor{0.0f};
+  float sheenRoughness = 0.0f;
+};
+/// The KHR_materials_specular mapping (its README), mixed with the metal as appendix B mixes:
+///   dielectric f0 = min(((ior − 1)/(ior + 1))² · specularColor, 1) · specular,  f90 = specular
+///   f0 = mix(dielectric f0, baseColor, metallic),  f90 = mix(specular, 1, metallic),
+///   diffuse = baseColor · (1 − metallic),  α = ggxAlphaFromRoughness(roughness),
+///   clearcoat α = ggxAlphaFromRoughness(clearcoatRoughness),
+/// the rest copied; every factor clamped to its range ([0, 1]; ior ≥ 1).
+GltfPbrBsdf gltfPbrFromInputs(const GltfPbrInputs& in);
+
 /// Exact unpolarised Fresnel reflectance of a dielectric interface for light arriving at
 /// cos θ (> 0: from the outside, < 0: from the inside) with η = n_inside / n_outside:
 ///   F = (r∥² + r⊥²)/2,  r∥ = (η cos θi − cos θt)/(η cos θi + cos θt),
@@ -185,7 +244,7 @@ void thinSheetReflectanceTransmittance(const DielectricBsdf& b, float cosTheta, 
 /// serialisation), an entry here (at the end: the index is the .plf model number), and its
 /// per-model functions in bsdf.cpp (eval/pdf/sample) and lobe.cpp (lobe, validation) — the
 /// compiler names every function a new entry still lacks. Nothing outside bsdf/ switches on it.
-using Bsdf = std::variant<LambertBsdf, MirrorBsdf, BlinnPhongBsdf, GgxBsdf, DielectricBsdf>;
+using Bsdf = std::variant<LambertBsdf, MirrorBsdf, BlinnPhongBsdf, GgxBsdf, DielectricBsdf, GltfPbrBsdf>;
 
 /// A default-constructed model of variant index `index` (the serialised model number);
 /// nullopt for an index no model has.
@@ -267,7 +326,7 @@ Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo);
 /// (lightfield.h "What is stored per chart kind").
 Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta);
 /// A short name for messages and `info`: "lambert", "mirror", "blinn-phong", "ggx",
-/// "dielectric" (smooth), "rough-dielectric", "thin-dielectric".
+/// "dielectric" (smooth), "rough-dielectric", "thin-dielectric", "gltf-pbr".
 const char* modelName(const Bsdf& bsdf);
 
 }  // namespace pl

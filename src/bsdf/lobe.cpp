@@ -18,6 +18,7 @@ LobeKind kindOf(const MirrorBsdf&) { return LobeKind::Delta; }
 LobeKind kindOf(const BlinnPhongBsdf&) { return LobeKind::Glossy; }
 LobeKind kindOf(const GgxBsdf&) { return LobeKind::Glossy; }
 LobeKind kindOf(const DielectricBsdf& b) { return b.isSmooth() ? LobeKind::Delta : LobeKind::Glossy; }
+LobeKind kindOf(const GltfPbrBsdf&) { return LobeKind::Glossy; }
 
 bool transmitsOf(const DielectricBsdf&) { return true; }
 template <class Model>
@@ -35,12 +36,18 @@ float halfWidthOf(const MirrorBsdf&) { return 0.0f; }
 float halfWidthOf(const BlinnPhongBsdf& b) { return std::acos(std::pow(0.5f, 1.0f / std::max(b.exponent, 1e-3f))); }
 float halfWidthOf(const GgxBsdf& b) { return ggxHalfWidth(b.alpha); }
 float halfWidthOf(const DielectricBsdf& b) { return b.isSmooth() ? 0.0f : ggxHalfWidth(b.alpha); }
+/// The narrowest of the lobes present: the base's or the coat's (the sheen is wider than both).
+float halfWidthOf(const GltfPbrBsdf& b) {
+  const float base = ggxHalfWidth(b.alpha);
+  return b.clearcoat > 0.0f ? std::min(base, ggxHalfWidth(b.clearcoatAlpha)) : base;
+}
 
 // ---- Diffuse part and interior ------------------------------------------------------------
 
 Rgb diffuseOf(const LambertBsdf& b) { return b.albedo; }
 Rgb diffuseOf(const BlinnPhongBsdf& b) { return b.diffuse; }
 Rgb diffuseOf(const GgxBsdf& b) { return b.diffuse; }
+Rgb diffuseOf(const GltfPbrBsdf& b) { return b.diffuse; }
 Rgb diffuseOf(const MirrorBsdf&) { return Rgb(0.0f); }
 Rgb diffuseOf(const DielectricBsdf&) { return Rgb(0.0f); }
 
@@ -84,6 +91,19 @@ std::string problemOf(const DielectricBsdf& b) {
     return fmt::format("dielectric roughness alpha {} must lie in [0, 1]", b.alpha);
   if (!isFinite(b.absorption) || glm::any(glm::lessThan(b.absorption, Rgb(0.0f))))
     return fmt::format("dielectric absorption {} must be finite and >= 0", str(b.absorption));
+  return {};
+}
+
+std::string problemOf(const GltfPbrBsdf& b) {
+  if (!inUnitRange(b.diffuse) || !inUnitRange(b.f0) || !inUnitRange(b.sheenColor))
+    return fmt::format("glTF PBR diffuse {}, f0 {} and sheen colour {} must lie in [0, 1]", str(b.diffuse), str(b.f0),
+                       str(b.sheenColor));
+  if (!(b.f90 >= 0.0f && b.f90 <= 1.0f) || !(b.clearcoat >= 0.0f && b.clearcoat <= 1.0f) ||
+      !(b.sheenRoughness >= 0.0f && b.sheenRoughness <= 1.0f))
+    return fmt::format("glTF PBR f90 {}, clearcoat {} and sheen roughness {} must lie in [0, 1]", b.f90, b.clearcoat,
+                       b.sheenRoughness);
+  if (!(b.alpha > 0.0f && b.alpha <= 1.0f) || !(b.clearcoatAlpha > 0.0f && b.clearcoatAlpha <= 1.0f))
+    return fmt::format("glTF PBR alpha {} and clearcoat alpha {} must lie in (0, 1]", b.alpha, b.clearcoatAlpha);
   return {};
 }
 
@@ -158,6 +178,24 @@ GgxBsdf ggxFromMetallicRoughness(const Rgb& baseColor, float metallic, float rou
   b.f0 = glm::mix(Rgb(0.04f), baseColor, metallic);
   b.diffuse = baseColor * (1.0f - metallic);
   b.alpha = ggxAlphaFromRoughness(roughness);
+  return b;
+}
+
+GltfPbrBsdf gltfPbrFromInputs(const GltfPbrInputs& in) {
+  const float metallic = std::clamp(in.metallic, 0.0f, 1.0f), specular = std::clamp(in.specular, 0.0f, 1.0f);
+  const Rgb base = glm::clamp(in.baseColor, 0.0f, 1.0f);
+  const float ior = std::isfinite(in.ior) ? std::max(in.ior, 1.0f) : 1.5f;
+  const float r = (ior - 1.0f) / (ior + 1.0f);
+  const Rgb dielectricF0 = glm::min(Rgb(r * r) * glm::max(in.specularColor, Rgb(0.0f)), Rgb(1.0f)) * specular;
+  GltfPbrBsdf b;
+  b.f0 = glm::mix(dielectricF0, base, metallic);
+  b.f90 = specular + (1.0f - specular) * metallic;
+  b.diffuse = base * (1.0f - metallic);
+  b.alpha = ggxAlphaFromRoughness(in.roughness);
+  b.clearcoat = std::clamp(in.clearcoat, 0.0f, 1.0f);
+  b.clearcoatAlpha = ggxAlphaFromRoughness(in.clearcoatRoughness);
+  b.sheenColor = glm::clamp(in.sheenColor, 0.0f, 1.0f);
+  b.sheenRoughness = std::clamp(in.sheenRoughness, 0.0f, 1.0f);
   return b;
 }
 

@@ -25,6 +25,14 @@
 //    texture slot has its texCoord and KHR_texture_transform (mappingOf), every texture its
 //    sampler (samplingOf). occlusionTexture is checked and ignored. A primitive without a
 //    material gets the spec's default material (baseColor 1, metallic 1, roughness 1).
+//  * KHR_materials_specular, KHR_materials_clearcoat, KHR_materials_sheen → GltfPbrBsdf
+//    (bsdf.h; gltfPbrFromInputs maps the factors, KHR_materials_ior's ior included): the
+//    factors, each in its range (an error naming the material otherwise); their textures
+//    (specular A, specularColor RGB sRGB, clearcoat R, clearcoatRoughness G, sheenColor RGB
+//    sRGB, sheenRoughness A), each with its texCoord and KHR_texture_transform, make the model
+//    per hit (scene.h PbrLayerMaps); Material::bsdf keeps the factors × each texture's mean.
+//    clearcoatNormalTexture is checked and ignored (warning). On a transmissive material the
+//    layers are ignored (warning).
 //  * Extensions: those of supportedExtensions; one required but not supported is refused,
 //    naming it; those used but not supported are warned about once (checkExtensions).
 //  * KHR_materials_transmission (transmissionFactor > 0) → DielectricBsdf: index from
@@ -68,6 +76,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -91,10 +100,11 @@ constexpr const char* kMeshopt = "EXT_meshopt_compression";
 /// uses it.
 const std::set<std::string>& supportedExtensions() {
   static const std::set<std::string> kSupported = [] {
-    std::set<std::string> names = {"KHR_lights_punctual",  "KHR_materials_emissive_strength",
-                                   "KHR_materials_ior",    "KHR_materials_transmission",
-                                   "KHR_materials_volume", "KHR_mesh_quantization",
-                                   "KHR_texture_transform"};
+    std::set<std::string> names = {"KHR_lights_punctual",       "KHR_materials_clearcoat",
+                                   "KHR_materials_emissive_strength", "KHR_materials_ior",
+                                   "KHR_materials_sheen",       "KHR_materials_specular",
+                                   "KHR_materials_transmission", "KHR_materials_volume",
+                                   "KHR_mesh_quantization",     "KHR_texture_transform"};
     if (dracoSupported()) names.insert(kDraco);
     if (meshoptSupported()) names.insert(kMeshopt);
     return names;
@@ -500,7 +510,121 @@ void applyTransmission(GltfContext& ctx, const tinygltf::Material& gltf, Materia
                  material.name);
     material.metallicRoughness = {};
   }
+  if (std::holds_alternative<GltfPbrBsdf>(material.bsdf)) {
+    spdlog::warn("{}: material '{}': KHR_materials_specular, _clearcoat and _sheen are ignored on a transmissive material",
+                 ctx.path, material.name);
+    material.layers = {};
+  }
   material.bsdf = glass;
+}
+
+/// The mean texel of a decoded texture (black for an empty one).
+Rgb meanTexel(const Image& image) {
+  glm::dvec3 sum(0.0);
+  for (const Rgb& p : image.pixels) sum += glm::dvec3(p);
+  return image.pixels.empty() ? Rgb(0.0f) : Rgb(sum / double(image.pixels.size()));
+}
+
+/// KHR_materials_specular, _clearcoat and _sheen → GltfPbrBsdf (see the header comment).
+void applyLayers(GltfContext& ctx, const tinygltf::Material& gltf, Material& material, const Rgb& baseColor,
+                 float metallic, float roughness) {
+  auto extension = [&](const char* name) -> const tinygltf::Value* {
+    const auto it = gltf.extensions.find(name);
+    return it == gltf.extensions.end() ? nullptr : &it->second;
+  };
+  const tinygltf::Value* specular = extension("KHR_materials_specular");
+  const tinygltf::Value* coat = extension("KHR_materials_clearcoat");
+  const tinygltf::Value* sheen = extension("KHR_materials_sheen");
+  if (!specular && !coat && !sheen) return;
+  auto factor = [&](const tinygltf::Value* ext, const char* key, float fallback) {
+    if (!ext || !ext->Has(key)) return fallback;
+    const tinygltf::Value& v = ext->Get(key);
+    const float x = v.IsNumber() ? float(v.GetNumberAsDouble()) : -1.0f;
+    if (!(x >= 0.0f && x <= 1.0f)) fail("{}: material '{}': {} must be a number in [0, 1]", ctx.path, material.name, key);
+    return x;
+  };
+  auto colour = [&](const tinygltf::Value* ext, const char* key, Rgb fallback, float maximum) {
+    if (!ext || !ext->Has(key)) return fallback;
+    const tinygltf::Value& v = ext->Get(key);
+    Rgb c(-1.0f);
+    if (v.IsArray() && v.ArrayLen() == 3)
+      for (int i = 0; i < 3; ++i)
+        if (v.Get(i).IsNumber()) c[i] = float(v.Get(i).GetNumberAsDouble());
+    if (!isFinite(c) || glm::any(glm::lessThan(c, Rgb(0.0f))) || maxComponent(c) > maximum)
+      fail("{}: material '{}': {} must be three numbers in [0, {}]", ctx.path, material.name, key, maximum);
+    return c;
+  };
+  PbrLayerMaps& layers = material.layers;
+  layers.layered = true;
+  GltfPbrInputs& in = layers.factors;
+  in.baseColor = baseColor;
+  in.metallic = metallic;
+  in.roughness = roughness;
+  if (const tinygltf::Value* ior = extension("KHR_materials_ior")) in.ior = extensionNumber(*ior, "ior", 1.5f);
+  if (!(in.ior >= 1.0f && std::isfinite(in.ior)))
+    fail("{}: material '{}': KHR_materials_ior.ior {} must be a finite number >= 1", ctx.path, material.name, in.ior);
+  in.specular = factor(specular, "specularFactor", 1.0f);
+  in.specularColor = colour(specular, "specularColorFactor", Rgb(1.0f), std::numeric_limits<float>::max());
+  in.clearcoat = factor(coat, "clearcoatFactor", 0.0f);
+  in.clearcoatRoughness = factor(coat, "clearcoatRoughnessFactor", 0.0f);
+  in.sheenColor = colour(sheen, "sheenColorFactor", Rgb(0.0f), 1.0f);
+  in.sheenRoughness = factor(sheen, "sheenRoughnessFactor", 0.0f);
+
+  // The textures: each slot's channel, its decoding, and its mean for Material::bsdf.
+  GltfPbrInputs mean = in;
+  struct SlotSpec {
+    PbrLayerMaps::Slot slot;
+    const tinygltf::Value* extension;
+    ImageDecode decode;
+  };
+  const SlotSpec slots[] = {{PbrLayerMaps::kSpecular, specular, ImageDecode::Coverage},
+                            {PbrLayerMaps::kSpecularColor, specular, ImageDecode::Colour},
+                            {PbrLayerMaps::kClearcoat, coat, ImageDecode::Data},
+                            {PbrLayerMaps::kClearcoatRoughness, coat, ImageDecode::Data},
+                            {PbrLayerMaps::kSheenColor, sheen, ImageDecode::Colour},
+                            {PbrLayerMaps::kSheenRoughness, sheen, ImageDecode::Coverage}};
+  for (const SlotSpec& s : slots) {
+    const char* name = PbrLayerMaps::kSlotNames[s.slot];
+    if (!s.extension || !s.extension->Has(name)) continue;
+    const tinygltf::Value& info = s.extension->Get(name);
+    if (!info.IsObject() || !info.Has("index") || !info.Get("index").IsInt())
+      fail("{}: material '{}': {} must be an object with an integer \"index\"", ctx.path, material.name, name);
+    const int index = info.Get("index").GetNumberAsInt();
+    const int texCoord = info.Has("texCoord") && info.Get("texCoord").IsInt() ? info.Get("texCoord").GetNumberAsInt() : 0;
+    tinygltf::ExtensionMap slotExtensions;
+    if (info.Has("extensions") && info.Get("extensions").IsObject())
+      for (const std::string& key : info.Get("extensions").Keys()) slotExtensions[key] = info.Get("extensions").Get(key);
+    const TextureMapping mapping = mappingOf(ctx, {name, index, texCoord, slotExtensions}, material.name);
+    // An alpha slot whose image has no alpha below 1 is 1 everywhere: the factor alone.
+    if (s.decode == ImageDecode::Coverage && !textureHasAlpha(ctx, index)) continue;
+    const int texture = textureFor(ctx, index, s.decode);
+    layers.texture[s.slot] = texture;
+    layers.mapping[s.slot] = mapping;
+    const Rgb m = meanTexel(ctx.scene.textures[size_t(texture)].image);
+    layers.meanTexel[s.slot] = m;
+    switch (s.slot) {
+      case PbrLayerMaps::kSpecular: mean.specular *= m.r; break;
+      case PbrLayerMaps::kSpecularColor: mean.specularColor *= m; break;
+      case PbrLayerMaps::kClearcoat: mean.clearcoat *= m.r; break;
+      case PbrLayerMaps::kClearcoatRoughness: mean.clearcoatRoughness *= m.g; break;
+      case PbrLayerMaps::kSheenColor: mean.sheenColor *= m; break;
+      default: mean.sheenRoughness *= m.r; break;
+    }
+  }
+  if (coat && coat->Has("clearcoatNormalTexture")) {
+    const tinygltf::Value& info = coat->Get("clearcoatNormalTexture");
+    checkTextureIndex(ctx, "clearcoatNormalTexture",
+                      info.Has("index") && info.Get("index").IsInt() ? info.Get("index").GetNumberAsInt() : -1,
+                      material.name);
+    spdlog::warn("{}: material '{}': clearcoatNormalTexture is not supported; the coat uses the base's normal",
+                 ctx.path, material.name);
+  }
+  if (material.metallicRoughness.texture >= 0) {
+    const Rgb m = meanTexel(ctx.scene.textures[size_t(material.metallicRoughness.texture)].image);
+    mean.metallic *= m.b;
+    mean.roughness *= m.g;
+  }
+  material.bsdf = gltfPbrFromInputs(mean);
 }
 
 /// The one model a material with a metallic-roughness texture keeps (Material::bsdf) for what
@@ -511,11 +635,7 @@ void applyTransmission(GltfContext& ctx, const tinygltf::Material& gltf, Materia
 /// with ā the mean of the base colour texture (`albedo`, null without one: 1). The path
 /// tracer and the per-point diffuse albedo read the texels themselves (materialModelAt).
 GgxBsdf meanMetallicRoughnessModel(const Image& texels, const MetallicRoughnessMap& mr, const Image* albedo) {
-  glm::dvec3 albedoSum(0.0);
-  if (albedo)
-    for (const Rgb& a : albedo->pixels) albedoSum += glm::dvec3(a);
-  const Rgb base = albedo && !albedo->pixels.empty() ? mr.baseColor * Rgb(albedoSum / double(albedo->pixels.size()))
-                                                     : mr.baseColor;
+  const Rgb base = albedo && !albedo->pixels.empty() ? mr.baseColor * meanTexel(*albedo) : mr.baseColor;
   double alpha = 0.0, metalness = 0.0;
   glm::dvec3 f0(0.0);
   for (const Rgb& t : texels.pixels) {
@@ -564,6 +684,7 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
   // compute occlusion themselves (docs/scenes.md).
   if (gltf.occlusionTexture.index >= 0)
     checkTextureIndex(ctx, "occlusionTexture", gltf.occlusionTexture.index, material.name);
+  applyLayers(ctx, gltf, material, baseColor, metallic, roughness);
   applyTransmission(ctx, gltf, material, baseColor, roughness);
   applyAlphaAndNormals(ctx, gltf, material);
   if (gltf.emissiveFactor.size() >= 3) {
@@ -721,6 +842,8 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
                                                           {m.metallicRoughness.texture, &m.metallicRoughness.mapping}};
     for (const auto& [texture, mapping] : slots)
       if (texture >= 0) readsSet[mapping->uvSet] = true;
+    for (int s = 0; s < PbrLayerMaps::kSlots; ++s)
+      if (m.layers.texture[size_t(s)] >= 0) readsSet[m.layers.mapping[size_t(s)].uvSet] = true;
     for (int set = 0; set < 2; ++set)
       if (readsSet[set] && attribute(set == 0 ? "TEXCOORD_0" : "TEXCOORD_1") < 0)
         fail("{}: mesh '{}': its material '{}' reads TEXCOORD_{}, which the primitive does not have", ctx.path, name,

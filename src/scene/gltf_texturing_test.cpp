@@ -252,15 +252,116 @@ TEST(GltfTexturing, ExtensionsRequiredAndUsed) {
   const fs::path dir = scratch("extensions");
   const std::string material = R"({"pbrMetallicRoughness": {"metallicFactor": 0}})";
   expectError([&] {
-    loadScene(writeQuad(dir, material, "", R"("extensionsUsed": ["KHR_materials_sheen"], "extensionsRequired": ["KHR_materials_sheen"],)"));
-  }, {"quad.gltf", "requires", "KHR_materials_sheen"});
+    loadScene(writeQuad(dir, material, "", R"("extensionsUsed": ["KHR_materials_anisotropy"], "extensionsRequired": ["KHR_materials_anisotropy"],)"));
+  }, {"quad.gltf", "requires", "KHR_materials_anisotropy"});
+  // The layers this loader reads may be required.
+  loadScene(writeQuad(dir, material, "",
+                      R"("extensionsUsed": ["KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_materials_specular"],
+                         "extensionsRequired": ["KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_materials_specular"],)"));
   const std::string log = logOf([&] {
     loadScene(writeQuad(dir, material, "",
-                        R"("extensionsUsed": ["KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_texture_transform"],)"));
+                        R"("extensionsUsed": ["KHR_materials_anisotropy", "KHR_materials_iridescence", "KHR_materials_sheen", "KHR_texture_transform"],)"));
   });
   EXPECT_EQ(occurrences(log, "ignoring glTF extension"), 1u) << log;
-  EXPECT_NE(log.find("KHR_materials_sheen, KHR_materials_clearcoat"), std::string::npos) << log;
+  EXPECT_NE(log.find("KHR_materials_anisotropy, KHR_materials_iridescence"), std::string::npos) << log;
   EXPECT_EQ(log.find("KHR_texture_transform"), std::string::npos) << log;
+  EXPECT_EQ(log.find("KHR_materials_sheen"), std::string::npos) << log;
+}
+
+// KHR_materials_specular, _clearcoat and _sheen: the factors make a GltfPbrBsdf (gltfPbrFromInputs,
+// KHR_materials_ior's ior included); the textures make it per hit, each slot with its channel,
+// decoding, texCoord and transform; Material::bsdf keeps the factors × each texture's mean.
+TEST(GltfTexturing, LayerExtensionsFactorsAndTexturesPerHit) {
+  const fs::path dir = scratch("layers");
+  const Scene factors = loadScene(writeQuad(dir, R"({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.5, 0.3, 1],
+      "metallicFactor": 0.25, "roughnessFactor": 0.6}, "extensions": {
+      "KHR_materials_ior": {"ior": 2.0},
+      "KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [1, 0.5, 0.25]},
+      "KHR_materials_clearcoat": {"clearcoatFactor": 0.7, "clearcoatRoughnessFactor": 0.2},
+      "KHR_materials_sheen": {"sheenColorFactor": [0.3, 0.2, 0.1], "sheenRoughnessFactor": 0.4}}})"));
+  const GltfPbrBsdf expected = gltfPbrFromInputs({.baseColor = Rgb(0.9f, 0.5f, 0.3f), .metallic = 0.25f,
+                                                  .roughness = 0.6f, .ior = 2.0f, .specular = 0.5f,
+                                                  .specularColor = Rgb(1.0f, 0.5f, 0.25f), .clearcoat = 0.7f,
+                                                  .clearcoatRoughness = 0.2f, .sheenColor = Rgb(0.3f, 0.2f, 0.1f),
+                                                  .sheenRoughness = 0.4f});
+  const auto& got = std::get<GltfPbrBsdf>(factors.materials[0].bsdf);
+  EXPECT_VEC3_NEAR(got.f0, expected.f0, kTight);
+  EXPECT_NEAR(got.f90, expected.f90, kTight);
+  EXPECT_VEC3_NEAR(got.diffuse, expected.diffuse, kTight);
+  EXPECT_NEAR(got.clearcoat, 0.7f, kTight);
+  EXPECT_NEAR(got.clearcoatAlpha, 0.04f, kTight);
+  EXPECT_VEC3_NEAR(got.sheenColor, Rgb(0.3f, 0.2f, 0.1f), kTight);
+  EXPECT_NEAR(got.sheenRoughness, 0.4f, kTight);
+  EXPECT_FALSE(factors.materials[0].layers.any());
+
+  // Textures (the 4×4 RGB test image, no alpha channel: the A slots stay at their factor).
+  const Scene textured = loadScene(writeQuad(dir, R"({"pbrMetallicRoughness": {"metallicFactor": 0}, "extensions": {
+      "KHR_materials_specular": {"specularColorTexture": {"index": 0}, "specularTexture": {"index": 0}},
+      "KHR_materials_clearcoat": {"clearcoatFactor": 1, "clearcoatTexture": {"index": 0},
+                                  "clearcoatRoughnessFactor": 1, "clearcoatRoughnessTexture": {"index": 0, "texCoord": 1}},
+      "KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1], "sheenColorTexture": {"index": 0,
+          "extensions": {"KHR_texture_transform": {"offset": [0.5, 0]}}}}}})",
+      R"(, "TEXCOORD_1": 2)", "", kNearest));
+  const Material& material = textured.materials[0];
+  ASSERT_TRUE(material.layers.any());
+  EXPECT_LT(material.layers.texture[PbrLayerMaps::kSpecular], 0);  // no alpha: 1 everywhere
+  EXPECT_EQ(material.layers.mapping[PbrLayerMaps::kClearcoatRoughness].uvSet, 1);
+  for (const Vec2 p : {Vec2(0.3f, 0.1f), Vec2(0.9f, 0.6f), Vec2(0.1f, 0.8f)}) {
+    const int x = wrappedTexel(p.x, "repeat"), y = wrappedTexel(1.0f - p.y, "repeat");
+    // TEXCOORD_1 is TEXCOORD_0 / 2; the sheen's transform moves u by half the image.
+    const int x1 = wrappedTexel(0.5f * p.x, "repeat"), y1 = wrappedTexel(0.5f * (1.0f - p.y), "repeat");
+    const int xs = wrappedTexel(p.x + 0.5f, "repeat");
+    const GltfPbrBsdf want = gltfPbrFromInputs({.baseColor = Rgb(1.0f), .metallic = 0.0f, .roughness = 1.0f,
+                                                .specularColor = texelLinear(x, y), .clearcoat = texelRaw(x, y).r,
+                                                .clearcoatRoughness = texelRaw(x1, y1).g,
+                                                .sheenColor = texelLinear(xs, y), .sheenRoughness = 0.0f});
+    const SurfaceHit hit = p.x >= p.y ? surfaceAt(textured, 0, 0, Vec2(p.x - p.y, p.y)) : surfaceAt(textured, 0, 1, Vec2(p.x, p.y - p.x));
+    const GltfPbrBsdf at = std::get<GltfPbrBsdf>(bsdfAt(textured, hit));
+    EXPECT_VEC3_NEAR(at.f0, want.f0, kTight);
+    EXPECT_NEAR(at.clearcoat, want.clearcoat, kTight);
+    EXPECT_NEAR(at.clearcoatAlpha, want.clearcoatAlpha, kTight);
+    EXPECT_VEC3_NEAR(at.sheenColor, want.sheenColor, kTight);
+  }
+  // A metallic-roughness texture on a layered material keeps the layers at every hit.
+  const Scene withMr = loadScene(writeQuad(dir, R"({"pbrMetallicRoughness": {"metallicFactor": 0.5, "roughnessFactor": 0.8,
+      "metallicRoughnessTexture": {"index": 0}}, "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 0.6}}})",
+      "", "", kNearest));
+  {
+    const Vec2 p(0.3f, 0.1f);
+    const Rgb t = texelRaw(wrappedTexel(p.x, "repeat"), wrappedTexel(1.0f - p.y, "repeat"));
+    const GltfPbrBsdf at = std::get<GltfPbrBsdf>(bsdfAt(withMr, surfaceAt(withMr, 0, 0, Vec2(p.x - p.y, p.y))));
+    EXPECT_NEAR(at.clearcoat, 0.6f, kTight);
+    EXPECT_NEAR(at.alpha, ggxAlphaFromRoughness(0.8f * t.g), kTight);
+  }
+  // Material::bsdf: the factors × each texture's mean (the clearcoat's R mean here).
+  float meanR = 0.0f;
+  for (int x = 0; x < kSide; ++x)
+    for (int y = 0; y < kSide; ++y) meanR += texelRaw(x, y).r / float(kSide * kSide);
+  EXPECT_NEAR(std::get<GltfPbrBsdf>(material.bsdf).clearcoat, meanR, kTight);
+}
+
+TEST(GltfTexturing, LayerExtensionErrorsNameTheMaterial) {
+  const fs::path dir = scratch("layer_errors");
+  expectError([&] {
+    loadScene(writeQuad(dir, R"({"name": "velvet", "extensions": {"KHR_materials_sheen": {"sheenColorTexture": {"index": 4}}}})"));
+  }, {"quad.gltf", "material 'velvet'", "sheenColorTexture", "texture 4"});
+  expectError([&] {
+    loadScene(writeQuad(dir, R"({"name": "lacquer", "extensions": {"KHR_materials_clearcoat": {"clearcoatTexture": {"index": 0, "texCoord": 1}}}})"));
+  }, {"quad.gltf", "mesh 'quad'", "material 'lacquer'", "TEXCOORD_1"});
+  expectError([&] {
+    loadScene(writeQuad(dir, R"({"name": "lacquer", "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1.5}}})"));
+  }, {"quad.gltf", "material 'lacquer'", "clearcoatFactor", "[0, 1]"});
+  expectError([&] {
+    loadScene(writeQuad(dir, R"({"name": "velvet", "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 2]}}})"));
+  }, {"quad.gltf", "material 'velvet'", "sheenColorFactor"});
+  expectError([&] {
+    loadScene(writeQuad(dir, R"({"name": "tinted", "extensions": {"KHR_materials_specular": {"specularTexture": {"texCoord": 0}}}})"));
+  }, {"quad.gltf", "material 'tinted'", "specularTexture", "index"});
+  const std::string log = logOf([&] {
+    loadScene(writeQuad(dir, R"({"name": "lacquer", "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1,
+        "clearcoatNormalTexture": {"index": 0}}}})"));
+  });
+  EXPECT_NE(log.find("clearcoatNormalTexture is not supported"), std::string::npos) << log;
 }
 
 TEST(GltfTexturing, BadTextureReferencesNameTheMaterialOrMesh) {

@@ -20,7 +20,9 @@
 //           | {"type": "blinn-phong", "diffuse": [r,g,b], "specular": [r,g,b], "exponent": n,
 //              "texture": "albedo.png"}
 //           | {"type": "ggx",         "diffuse": [r,g,b], "f0": [r,g,b],
-//              "alpha": a | "roughness": r (alpha = r²), "texture": "albedo.png"}
+//              "alpha": a | "roughness": r (alpha = r²), "texture": "albedo.png",
+//              and the glTF layers (any of them makes it bsdf.h's GltfPbrBsdf): "f90": 1,
+//              "clearcoat": 0, "clearcoat_roughness": 0, "sheen": [r,g,b], "sheen_roughness": 0.5}
 //       (+ for every type: "emission": [r,g,b] radiance in W·sr⁻¹·m⁻², "two_sided": false,
 //        "alpha_texture": "mask.png" (cut-out: its alpha channel, or its first channel without
 //        one), "alpha_cutoff": 0.5 (no surface where coverage < cutoff),
@@ -52,7 +54,9 @@
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <iterator>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -192,7 +196,25 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
     }
     if (!(ggx.alpha > 0.0f && ggx.alpha <= 1.0f)) fail("{}: {}: GGX alpha {} must be in (0, 1]", ctx.path, where, ggx.alpha);
     material.bsdf = ggx;
+    // The glTF layers (bsdf.h GltfPbrBsdf): any of these keys makes the model the layered one.
+    static constexpr const char* kLayerKeys[] = {"f90", "clearcoat", "clearcoat_roughness", "sheen", "sheen_roughness"};
+    if (std::any_of(std::begin(kLayerKeys), std::end(kLayerKeys), [&](const char* key) { return find(value, key); })) {
+      GltfPbrBsdf pbr;
+      pbr.diffuse = ggx.diffuse;
+      pbr.f0 = ggx.f0;
+      pbr.alpha = ggx.alpha;
+      pbr.f90 = numberOr(ctx, value, "f90", 1.0f, where);
+      pbr.clearcoat = numberOr(ctx, value, "clearcoat", 0.0f, where);
+      const float coatRoughness = numberOr(ctx, value, "clearcoat_roughness", 0.0f, where);
+      if (!(coatRoughness >= 0.0f && coatRoughness <= 1.0f))
+        fail("{}: {}: clearcoat_roughness {} must be in [0, 1]", ctx.path, where, coatRoughness);
+      pbr.clearcoatAlpha = ggxAlphaFromRoughness(coatRoughness);
+      pbr.sheenColor = colourOr(ctx, value, "sheen", Rgb(0.0f), where);
+      pbr.sheenRoughness = numberOr(ctx, value, "sheen_roughness", 0.5f, where);
+      material.bsdf = pbr;
+    }
     known.insert({"diffuse", "f0", "alpha", "roughness", "texture"});
+    known.insert(std::begin(kLayerKeys), std::end(kLayerKeys));
   } else if (type == "dielectric") {
     DielectricBsdf glass;
     glass.ior = numberOr(ctx, value, "ior", glass.ior, where);

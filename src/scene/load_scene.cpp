@@ -26,6 +26,8 @@ void appendScene(Scene& scene, Scene&& part) {
     for (int* texture :
          {&material.albedoTexture, &material.alphaTexture, &material.normalTexture, &material.metallicRoughness.texture})
       if (*texture >= 0) *texture += textureOffset;
+    for (int& texture : material.layers.texture)
+      if (texture >= 0) texture += textureOffset;
     scene.materials.push_back(std::move(material));
   }
   for (Texture& texture : part.textures) scene.textures.push_back(std::move(texture));

@@ -41,15 +41,24 @@ std::string mappingProblem(const Material& material) {
                                                                  {"alpha", &material.alphaMapping},
                                                                  {"normal", &material.normalMapping},
                                                                  {"metallic-roughness", &material.metallicRoughness.mapping}};
-  for (const auto& [slot, mapping] : slots) {
-    if (mapping->uvSet > 1) return fmt::format("the {} texture reads uv set {} (0 or 1)", slot, mapping->uvSet);
-    if (!isFinite2(mapping->offset) || !isFinite2(mapping->linear[0]) || !isFinite2(mapping->linear[1]))
+  auto mappingIssue = [](const char* slot, const TextureMapping& mapping) -> std::string {
+    if (mapping.uvSet > 1) return fmt::format("the {} texture reads uv set {} (0 or 1)", slot, mapping.uvSet);
+    if (!isFinite2(mapping.offset) || !isFinite2(mapping.linear[0]) || !isFinite2(mapping.linear[1]))
       return fmt::format("the {} texture's uv transform is not finite", slot);
-  }
+    return "";
+  };
+  for (const auto& [slot, mapping] : slots)
+    if (std::string issue = mappingIssue(slot, *mapping); !issue.empty()) return issue;
+  for (int s = 0; s < PbrLayerMaps::kSlots; ++s)
+    if (std::string issue = mappingIssue(PbrLayerMaps::kSlotNames[s], material.layers.mapping[size_t(s)]); !issue.empty())
+      return issue;
+  const bool ggxLike = std::holds_alternative<GgxBsdf>(material.bsdf) || std::holds_alternative<GltfPbrBsdf>(material.bsdf);
   const MetallicRoughnessMap& mr = material.metallicRoughness;
-  if (mr.texture >= 0 && !(std::holds_alternative<GgxBsdf>(material.bsdf) && isFinite(mr.baseColor) &&
-                           mr.metallic >= 0.0f && mr.metallic <= 1.0f && mr.roughness >= 0.0f && mr.roughness <= 1.0f))
+  if (mr.texture >= 0 && !(ggxLike && isFinite(mr.baseColor) && mr.metallic >= 0.0f && mr.metallic <= 1.0f &&
+                           mr.roughness >= 0.0f && mr.roughness <= 1.0f))
     return "a metallic-roughness texture needs a GGX model and factors in [0, 1]";
+  if (material.layers.any() && !std::holds_alternative<GltfPbrBsdf>(material.bsdf))
+    return "glTF layer textures need the layered (gltf-pbr) model";
   return "";
 }
 
@@ -85,8 +94,10 @@ void checkScene(const Scene& scene) {
       fail("{}: material '{}' has an emission {} above {:g} W/(sr m^2), too large to compute with", src,
            material.name, vecString(material.emission), kMaxEmission);
     validateMaterial(material, src);
-    for (const int texture :
-         {material.albedoTexture, material.alphaTexture, material.normalTexture, material.metallicRoughness.texture})
+    std::vector<int> textures = {material.albedoTexture, material.alphaTexture, material.normalTexture,
+                                 material.metallicRoughness.texture};
+    textures.insert(textures.end(), material.layers.texture.begin(), material.layers.texture.end());
+    for (const int texture : textures)
       if (texture < -1 || texture >= int64_t(scene.textures.size()))
         fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name, texture,
              scene.textures.size());
@@ -354,9 +365,42 @@ Rgb albedoModulation(const Scene& scene, const Material& material, const AlbedoP
   return scene.textures[size_t(material.albedoTexture)].sampleLod(p.uv, p.lod) * p.vertexColor;
 }
 
+namespace {
+
+/// The layered model of a glTF layered material (PbrLayerMaps) at albedo point p: the layer
+/// textures read at `hit`, or their means without one.
+GltfPbrBsdf layeredModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p, const SurfaceHit* hit) {
+  const PbrLayerMaps& layers = material.layers;
+  GltfPbrInputs in = layers.factors;
+  in.baseColor *= albedoModulation(scene, material, p);
+  if (material.metallicRoughness.texture >= 0) {
+    const Rgb texel = scene.textures[size_t(material.metallicRoughness.texture)].sample(p.metallicRoughnessUv);
+    in.metallic *= texel.b;
+    in.roughness *= texel.g;
+  }
+  std::array<Rgb, PbrLayerMaps::kSlots> texel = layers.meanTexel;
+  for (size_t s = 0; s < texel.size() && hit; ++s)
+    if (const int t = layers.texture[s]; t >= 0) {
+      const TextureMapping& mapping = layers.mapping[s];
+      texel[s] = scene.textures[size_t(t)].sample(uvAt(scene.meshes[hit->mesh], hit->triangle, hit->barycentrics, mapping));
+    }
+  // Channels as glTF gives them: clearcoat R and clearcoat roughness G (raw values), the
+  // colours sRGB-decoded, the specular and sheen-roughness A (decoded as coverage: alpha in R).
+  in.specular *= texel[PbrLayerMaps::kSpecular].r;
+  in.specularColor *= texel[PbrLayerMaps::kSpecularColor];
+  in.clearcoat *= texel[PbrLayerMaps::kClearcoat].r;
+  in.clearcoatRoughness *= texel[PbrLayerMaps::kClearcoatRoughness].g;
+  in.sheenColor *= texel[PbrLayerMaps::kSheenColor];
+  in.sheenRoughness *= texel[PbrLayerMaps::kSheenRoughness].r;
+  return gltfPbrFromInputs(in);
+}
+
+}  // namespace
+
 Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p) {
   const MetallicRoughnessMap& mr = material.metallicRoughness;
   if (!material.modelVaries()) return material.bsdf;
+  if (material.layers.layered) return layeredModelAt(scene, material, p, nullptr);
   const Rgb modulation = albedoModulation(scene, material, p);
   if (mr.texture >= 0) {
     const Rgb texel = scene.textures[size_t(mr.texture)].sample(p.metallicRoughnessUv);
@@ -365,8 +409,11 @@ Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoP
   return withDiffuseAlbedo(material.bsdf, diffuseAlbedo(material.bsdf) * modulation);
 }
 
+
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit) {
   const Material& material = scene.materials[hit.material];
+  if (material.layers.layered && (material.layers.any() || material.modelVaries()))
+    return layeredModelAt(scene, material, albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics), &hit);
   if (!material.modelVaries()) return material.bsdf;
   return materialModelAt(scene, material, albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics));
 }

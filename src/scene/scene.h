@@ -9,6 +9,8 @@
 #include "light/lights.h"
 #include "scene/texture.h"
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -43,6 +45,32 @@ struct MetallicRoughnessMap {
   float metallic = 1.0f, roughness = 1.0f;
 };
 
+/// The glTF layer textures of a GltfPbrBsdf material (KHR_materials_specular, _clearcoat and
+/// _sheen), each with its TextureMapping, and the material's glTF factors (`factors`) that they
+/// and the core textures multiply. The path tracer rebuilds the model at every hit (bsdfAt):
+/// gltfPbrFromInputs of the factors with baseColor × albedoModulation, metallic × B and
+/// roughness × G of a metallic-roughness texture, specular × A, specularColor × RGB,
+/// clearcoat × R, clearcoatRoughness × G, sheenColor × RGB and sheenRoughness × A of the
+/// layer textures. Everything else keeps Material::bsdf, built from the factors × each
+/// texture's mean (the bake's glossy maps, the renderers' highlights). Not stored in the .plf.
+struct PbrLayerMaps {
+  enum Slot : uint8_t { kSpecular, kSpecularColor, kClearcoat, kClearcoatRoughness, kSheenColor, kSheenRoughness, kSlots };
+  /// The glTF names of the slots, in Slot order (for messages).
+  static constexpr const char* kSlotNames[kSlots] = {"specularTexture",          "specularColorTexture",
+                                                     "clearcoatTexture",         "clearcoatRoughnessTexture",
+                                                     "sheenColorTexture",        "sheenRoughnessTexture"};
+  std::array<int, kSlots> texture = {-1, -1, -1, -1, -1, -1};  ///< into Scene::textures, or −1
+  std::array<TextureMapping, kSlots> mapping{};
+  /// Each slot's mean texel (white without a texture): what stands in for the texel where a
+  /// model is made per point without a hit (materialModelAt).
+  std::array<Rgb, kSlots> meanTexel = {Rgb(1.0f), Rgb(1.0f), Rgb(1.0f), Rgb(1.0f), Rgb(1.0f), Rgb(1.0f)};
+  GltfPbrInputs factors;
+  /// Whether the factors are set (a glTF material with a layer extension): a varying base
+  /// colour or metallic-roughness texture then rebuilds the layered model, not plain GGX.
+  bool layered = false;
+  bool any() const { return std::any_of(texture.begin(), texture.end(), [](int t) { return t >= 0; }); }
+};
+
 struct Material {
   std::string name;
   Bsdf bsdf = LambertBsdf{};
@@ -72,6 +100,8 @@ struct Material {
   TextureMapping albedoMapping, alphaMapping, normalMapping;
   /// Per-point metalness and roughness (glTF only); see MetallicRoughnessMap.
   MetallicRoughnessMap metallicRoughness;
+  /// Per-hit glTF layer textures (glTF only, path tracer only); see PbrLayerMaps.
+  PbrLayerMaps layers;
   /// Derived, not stored: whether a mesh with vertex colours (Mesh::colors) uses the material,
   /// so that its albedo varies over a surface even without a texture. Scene::finalize and the
   /// .plf reader set it (markVertexColoredMaterials).
@@ -320,8 +350,9 @@ std::string mappingProblem(const Material& material);
 /// The material's model at albedo point p, the one rule bsdfAt and the renderers' albedos
 /// (lookup.h diffuseAlbedoAt, glossyDiffuseAlbedoAt) apply: the model as it is when nothing
 /// varies; with a metallic-roughness texture ggxFromMetallicRoughness(baseColor × modulation,
-/// metallic × B, roughness × G) of the texel at p.metallicRoughnessUv (full resolution);
-/// otherwise the model with its diffuse albedo × albedoModulation(p).
+/// metallic × B, roughness × G) of the texel at p.metallicRoughnessUv (full resolution), for a
+/// glTF layered material the layered model of the same (PbrLayerMaps, with the layer textures'
+/// means); otherwise the model with its diffuse albedo × albedoModulation(p).
 Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p);
 
 /// Sets Material::vertexColored from the meshes (Scene::finalize and the .plf reader call it).
@@ -372,7 +403,8 @@ void validateMaterial(const Material& material, const std::string& sourcePath);
 /// (Texture::sample) — the path tracer integrates a pixel's footprint with its samples, and
 /// the bake averages over each tixel's footprint itself; only the light-field renderers read
 /// mip levels (lookup.h albedoTextureLod) — and with a metallic-roughness texture the GGX
-/// parameters at the hit (MetallicRoughnessMap).
+/// parameters at the hit (MetallicRoughnessMap), with glTF layer textures the layered model
+/// at the hit (PbrLayerMaps).
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit);
 
 }  // namespace pl

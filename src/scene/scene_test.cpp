@@ -377,6 +377,39 @@ TEST(JsonScene, DielectricMaterials) {
   expectError([&] { loadScene(bad.string()); }, {"bad.json", "absorption"});
 }
 
+// A ggx material with any glTF layer key is the layered model (bsdf.h GltfPbrBsdf); without,
+// it stays GgxBsdf.
+TEST(JsonScene, LayeredGgxMaterials) {
+  const fs::path dir = scratchDir("json_layers");
+  writeFile(dir / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const Scene scene = loadScene(writeFile(dir / "l.json", R"({"materials": {
+      "lacquer": {"type": "ggx", "diffuse": 0.7, "roughness": 0.6, "clearcoat": 1, "clearcoat_roughness": 0.1},
+      "velvet": {"type": "ggx", "diffuse": [0.5, 0.05, 0.05], "roughness": 0.9, "sheen": [1, 0.6, 0.6], "sheen_roughness": 0.4,
+                 "f90": 0.5},
+      "plain": {"type": "ggx", "diffuse": 0.5, "roughness": 0.5}},
+    "meshes": [{"file": "tri.obj", "material": "lacquer"}, {"file": "tri.obj", "material": "velvet"},
+               {"file": "tri.obj", "material": "plain"}]})"));
+  const auto& lacquer = std::get<GltfPbrBsdf>(materialNamed(scene, "lacquer").bsdf);
+  EXPECT_NEAR(lacquer.alpha, 0.36f, kTight);
+  EXPECT_FLOAT_EQ(lacquer.clearcoat, 1.0f);
+  EXPECT_NEAR(lacquer.clearcoatAlpha, 0.01f, kTight);
+  EXPECT_EQ(lacquer.sheenColor, Rgb(0.0f));
+  EXPECT_FLOAT_EQ(lacquer.f90, 1.0f);
+  const auto& velvet = std::get<GltfPbrBsdf>(materialNamed(scene, "velvet").bsdf);
+  EXPECT_VEC3_NEAR(velvet.sheenColor, Rgb(1.0f, 0.6f, 0.6f), kTight);
+  EXPECT_FLOAT_EQ(velvet.sheenRoughness, 0.4f);
+  EXPECT_FLOAT_EQ(velvet.f90, 0.5f);
+  EXPECT_FLOAT_EQ(velvet.clearcoat, 0.0f);
+  EXPECT_TRUE(std::holds_alternative<GgxBsdf>(materialNamed(scene, "plain").bsdf));
+  const fs::path bad = dir / "bad.json";
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "ggx", "clearcoat": 2}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "clearcoat"});
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "ggx", "clearcoat_roughness": -1}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "clearcoat_roughness"});
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "ggx", "sheen": 1.5}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "sheen"});
+}
+
 TEST(JsonScene, TixelDensityPerMaterial) {
   const fs::path dir = scratchDir("json_tixel_density");
   writeFile(dir / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
