@@ -40,7 +40,8 @@ std::string mappingProblem(const Material& material) {
   const std::pair<const char*, const TextureMapping*> slots[] = {{"albedo", &material.albedoMapping},
                                                                  {"alpha", &material.alphaMapping},
                                                                  {"normal", &material.normalMapping},
-                                                                 {"metallic-roughness", &material.metallicRoughness.mapping}};
+                                                                 {"metallic-roughness", &material.metallicRoughness.mapping},
+                                                                 {"emission", &material.emissionMapping}};
   for (const auto& [slot, mapping] : slots) {
     if (mapping->uvSet > 1) return fmt::format("the {} texture reads uv set {} (0 or 1)", slot, mapping->uvSet);
     if (!isFinite2(mapping->offset) || !isFinite2(mapping->linear[0]) || !isFinite2(mapping->linear[1]))
@@ -86,7 +87,8 @@ void checkScene(const Scene& scene) {
            material.name, vecString(material.emission), kMaxEmission);
     validateMaterial(material, src);
     for (const int texture :
-         {material.albedoTexture, material.alphaTexture, material.normalTexture, material.metallicRoughness.texture})
+         {material.albedoTexture, material.alphaTexture, material.normalTexture, material.metallicRoughness.texture,
+          material.emissionTexture})
       if (texture < -1 || texture >= int64_t(scene.textures.size()))
         fail("{}: material '{}' refers to texture {} but the scene has {}", src, material.name, texture,
              scene.textures.size());
@@ -346,12 +348,20 @@ AlbedoPoint albedoPointAt(const Scene& scene, uint32_t meshIndex, uint32_t trian
   p.vertexColor = vertexColorAt(mesh, triangle, barycentrics);
   if (material.metallicRoughness.texture >= 0)
     p.metallicRoughnessUv = uvAt(mesh, triangle, barycentrics, material.metallicRoughness.mapping);
+  if (material.emissionTexture >= 0) p.emission = emissionModulation(scene, material, meshIndex, triangle, barycentrics);
   return p;
 }
 
 Rgb albedoModulation(const Scene& scene, const Material& material, const AlbedoPoint& p) {
   if (material.albedoTexture < 0) return p.vertexColor;
   return scene.textures[size_t(material.albedoTexture)].sampleLod(p.uv, p.lod) * p.vertexColor;
+}
+
+Rgb emissionModulation(const Scene& scene, const Material& material, uint32_t mesh, uint32_t triangle,
+                       Vec2 barycentrics) {
+  if (material.emissionTexture < 0) return Rgb(1.0f);
+  return scene.textures[size_t(material.emissionTexture)].sample(
+      uvAt(scene.meshes[mesh], triangle, barycentrics, material.emissionMapping));
 }
 
 Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p) {

@@ -1117,6 +1117,35 @@ TEST(JsonScene, AlphaAndNormalTextures) {
   expectError([&] { loadScene(scene(R"("alpha_texture": "cut.png")")); }, {"cut.png", "truncated"});
 }
 
+// "emission_texture": an sRGB colour texture multiplying "emission" (emissionModulation); it
+// needs an emission to multiply, and a missing file is an error naming the material's key.
+TEST(JsonScene, EmissionTexture) {
+  const fs::path dir = scratchDir("json_emission");
+  fs::create_directories(dir / "textured" / "mat");
+  fs::copy_file(kDataDir + "textured/quad.obj", dir / "textured/quad.obj");
+  fs::copy_file(kDataDir + "textured/mat/quad.mtl", dir / "textured/mat/quad.mtl");
+  fs::copy_file(kDataDir + "textured/mat/checker.png", dir / "textured/mat/checker.png");
+  fs::copy_file(kDataDir + "textured/mat/checker.png", dir / "glow.png");
+  auto scene = [&](const std::string& material) {
+    return writeFile(dir / "s.json", R"({"meshes": [{"file": "textured/quad.obj", "material": "lamp"}],
+      "materials": {"lamp": {"type": "lambert", )" + material + "}}}");
+  };
+  const Scene loaded = loadScene(scene(R"("emission": [2, 3, 4], "emission_texture": "glow.png")"));
+  const Material& lamp = materialNamed(loaded, "lamp");
+  ASSERT_GE(lamp.emissionTexture, 0);
+  const Texture& glow = loaded.textures[size_t(lamp.emissionTexture)];
+  EXPECT_EQ(glow.decode, ImageDecode::Colour);
+  const Vec2 b(0.2f, 0.3f);
+  EXPECT_VEC3_NEAR(emissionModulation(loaded, lamp, 0, 0, b), glow.sample(uvAt(loaded.meshes[0], 0, b)), 0.0f);
+  EXPECT_VEC3_NEAR(emissionModulation(loaded, materialNamed(loadScene(scene(R"("emission": 1)")), "lamp"), 0, 0, b), Rgb(1.0f),
+                   0.0f);
+
+  expectError([&] { loadScene(scene(R"("emission": 1, "emission_texture": "gone.png")")); },
+              {"s.json", "materials.lamp.emission_texture", "gone.png", "not found"});
+  expectError([&] { loadScene(scene(R"("emission_texture": "glow.png")")); },
+              {"s.json", "materials.lamp", "emission_texture needs a non-black \"emission\""});
+}
+
 TEST(BadInput, MissingOrCorruptAlphaAndNormalTexturesInMtl) {
   const fs::path dir = scratchDir("detail_bad");
   writeFile(dir / "t.mtl", "newmtl a\nKd 1 1 1\nmap_d nothere.png\n");
