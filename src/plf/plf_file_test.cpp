@@ -213,6 +213,20 @@ class PlfFileTest : public test_support::TempDirTest {
     std::memcpy(bytes.data() + 24, &hash, 8);
   }
 
+  /// The valid file at `path`, whose scene section must be larger than `plainSceneSize` (an
+  /// optional block is there), with the byte `fromEnd` bytes before the end of that section set
+  /// to `value` and re-signed, written as `name`: the reader must refuse it with `fragments`.
+  void expectRefusedWithSceneByte(const std::string& path, uint64_t plainSceneSize, uint64_t fromEnd, uint8_t value,
+                                  const std::string& name, const std::vector<std::string>& fragments) const {
+    auto bytes = readBytes(path);
+    const auto table = sections(bytes);
+    EXPECT_GT(table[0].size, plainSceneSize);
+    bytes[table[0].offset + table[0].size - fromEnd] = value;
+    resign(bytes);
+    writeBytes(file(name), bytes);
+    expectRefused(file(name), fragments);
+  }
+
   fs::path dir_;
 };
 
@@ -938,14 +952,7 @@ TEST_F(PlfFileTest, RoundTripKeepsTexturing) {
   EXPECT_EQ(copy.scene.textures[1].image.pixels, s.textures[1].image.pixels);
 
   // The block ends SCNE with 4 sampling bytes per texture: texture 1's wrapU set to 3 is refused.
-  const auto good = readBytes(path);
-  const auto table = sections(good);
-  EXPECT_GT(table[0].size, plainScene);
-  auto bad = good;
-  bad[table[0].offset + table[0].size - 4] = 3;
-  resign(bad);
-  writeBytes(file("wrap.plf"), bad);
-  expectRefused(file("wrap.plf"), {"scene section", "unknown sampling 3"});
+  expectRefusedWithSceneByte(path, plainScene, 4, 3, "wrap.plf", {"scene section", "unknown sampling 3"});
 }
 
 // An emission texture and its mapping come back through the EMTX block, alone after the
@@ -975,16 +982,9 @@ TEST_F(PlfFileTest, RoundTripKeepsEmissionTextures) {
     EXPECT_EQ(back.emission, lamp.emission);
     for (size_t m = 1; m < copy.scene.materials.size(); ++m) EXPECT_EQ(copy.scene.materials[m].emissionTexture, -1);
     EXPECT_EQ(copy.scene.materials[3].albedoMapping.offset, s.materials[3].albedoMapping.offset);
-
-    const auto good = readBytes(path);
-    const auto table = sections(good);
-    EXPECT_GT(table[0].size, plainScene);
     // The block ends with the last material's i32 texture, u8 uv set, 6 floats: uv set 7.
-    auto bad = good;
-    bad[table[0].offset + table[0].size - 25] = 7;
-    resign(bad);
-    writeBytes(file("emission_bad.plf"), bad);
-    expectRefused(file("emission_bad.plf"), {"scene section", "the emission texture reads uv set 7"});
+    expectRefusedWithSceneByte(path, plainScene, 25, 7, "emission_bad.plf",
+                               {"scene section", "the emission texture reads uv set 7"});
   }
 }
 

@@ -52,9 +52,9 @@ struct Material {
   /// given by the triangle's winding, counter-clockwise = front) unless twoSided.
   Rgb emission{0.0f};
   bool twoSidedEmission = false;
-  /// Emission texture (glTF emissiveTexture, JSON "emission_texture"): index into
-  /// Scene::textures (ImageDecode::Colour, sRGB-decoded) or −1. Le at a point is emission ×
-  /// the texel at the point's uv (emissionAt), read at full resolution through emissionMapping.
+  /// Emission texture (glTF emissiveTexture, JSON "emission_texture"): index into Scene::textures
+  /// (ImageDecode::Colour, sRGB) or −1. Le at a point is emission × the texel at its uv through
+  /// emissionMapping, at full resolution (emissionModulation).
   int emissionTexture = -1;
   /// Alpha mask (cut-out): coverage α = alphaFactor × (alphaTexture's coverage at uv, or 1
   /// without one). Where α < alphaCutoff the surface is not there at all: ray casting (Accel)
@@ -320,9 +320,9 @@ AlbedoPoint albedoPointAt(const Scene& scene, uint32_t mesh, uint32_t triangle, 
 Rgb albedoModulation(const Scene& scene, const Material& material, const AlbedoPoint& p);
 
 /// The emission rule, written once for the path tracer, the light sampler, the bake and the
-/// renderers: what multiplies Material::emission at barycentrics (b1, b2) of triangle `triangle` of mesh `mesh` — the
-/// emission texture's texel at its slot's uv (Texture::sample: full resolution, the texture's
-/// own wrap and filter), or 1 without one.
+/// renderers: what multiplies Material::emission at barycentrics (b1, b2) of triangle
+/// `triangle` of mesh `mesh` — the emission texture's texel at its slot's uv (Texture::sample:
+/// full resolution, the texture's own wrap and filter), or 1 without one.
 Rgb emissionModulation(const Scene& scene, const Material& material, uint32_t mesh, uint32_t triangle,
                        Vec2 barycentrics);
 

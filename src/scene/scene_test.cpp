@@ -1085,18 +1085,22 @@ TEST(GltfLoader, AlphaModesAndNormalTexture) {
   expectError([&] { withMaterialKeys(R"("alphaMode": "CLIP",)", "checker.png", "bad"); }, {"quad.gltf", "alphaMode 'CLIP'"});
 }
 
+/// Copies the textured quad (OBJ, MTL, checker) into `dir` and returns a writer of dir/s.json:
+/// the quad with Lambert material `material` given the keys it is called with; it returns the path.
+std::function<std::string(const std::string&)> quadSceneWriter(const fs::path& dir, const std::string& material) {
+  fs::create_directories(dir / "textured" / "mat");
+  for (const char* f : {"textured/quad.obj", "textured/mat/quad.mtl", "textured/mat/checker.png"}) fs::copy_file(kDataDir + f, dir / f);
+  return [dir, material](const std::string& keys) {
+    return writeFile(dir / "s.json", R"({"meshes": [{"file": "textured/quad.obj", "material": ")" + material +
+                                         R"("}], "materials": {")" + material + R"(": {"type": "lambert", )" + keys + "}}}");
+  };
+}
+
 TEST(JsonScene, AlphaAndNormalTextures) {
   const fs::path dir = scratchDir("json_detail");
   fs::copy_file(kDataDir + "mask_rgba.png", dir / "mask.png");
   fs::copy_file(kDataDir + "normal_tilt.png", dir / "n.png");
-  fs::create_directories(dir / "textured" / "mat");
-  fs::copy_file(kDataDir + "textured/quad.obj", dir / "textured/quad.obj");
-  fs::copy_file(kDataDir + "textured/mat/quad.mtl", dir / "textured/mat/quad.mtl");
-  fs::copy_file(kDataDir + "textured/mat/checker.png", dir / "textured/mat/checker.png");
-  auto scene = [&](const std::string& material) {
-    return writeFile(dir / "s.json", R"({"meshes": [{"file": "textured/quad.obj", "material": "leaf"}],
-      "materials": {"leaf": {"type": "lambert", )" + material + "}}}");
-  };
+  const auto scene = quadSceneWriter(dir, "leaf");
   const Scene loaded = loadScene(scene(R"("alpha_texture": "mask.png", "alpha_cutoff": 0.2,
       "normal_texture": "n.png", "normal_scale": 0.5)"));
   const Material& leaf = materialNamed(loaded, "leaf");
@@ -1121,15 +1125,8 @@ TEST(JsonScene, AlphaAndNormalTextures) {
 // needs an emission to multiply, and a missing file is an error naming the material's key.
 TEST(JsonScene, EmissionTexture) {
   const fs::path dir = scratchDir("json_emission");
-  fs::create_directories(dir / "textured" / "mat");
-  fs::copy_file(kDataDir + "textured/quad.obj", dir / "textured/quad.obj");
-  fs::copy_file(kDataDir + "textured/mat/quad.mtl", dir / "textured/mat/quad.mtl");
-  fs::copy_file(kDataDir + "textured/mat/checker.png", dir / "textured/mat/checker.png");
+  const auto scene = quadSceneWriter(dir, "lamp");
   fs::copy_file(kDataDir + "textured/mat/checker.png", dir / "glow.png");
-  auto scene = [&](const std::string& material) {
-    return writeFile(dir / "s.json", R"({"meshes": [{"file": "textured/quad.obj", "material": "lamp"}],
-      "materials": {"lamp": {"type": "lambert", )" + material + "}}}");
-  };
   const Scene loaded = loadScene(scene(R"("emission": [2, 3, 4], "emission_texture": "glow.png")"));
   const Material& lamp = materialNamed(loaded, "lamp");
   ASSERT_GE(lamp.emissionTexture, 0);

@@ -249,15 +249,16 @@ Rgb Texture::sample(Vec2 uv) const {
 
 Rgb Texture::maxOver(Vec2 lo, Vec2 hi) const {
   if (image.empty()) return Rgb(1.0f);
-  if (!isFinite(Vec3(lo, 0.0f)) || !isFinite(Vec3(hi, 0.0f))) return Rgb(kInfinity);
   // The continuous texel coordinates of the corners (sampledFootprint's, v flipped), widened
   // by one texel on each side: that covers both the bilinear and the nearest footprints.
+  // Spans wider than the image, and coordinates too large to step through by 1 (or not
+  // finite: sample() then reads `average`), take the whole axis.
   const float x0 = std::floor(lo.x * float(image.width)) - 1.0f, x1 = std::floor(hi.x * float(image.width)) + 1.0f;
   const float y0 = std::floor((1.0f - hi.y) * float(image.height)) - 1.0f,
               y1 = std::floor((1.0f - lo.y) * float(image.height)) + 1.0f;
   auto indices = [](float first, float last, int n, TextureWrap wrap) {
     std::vector<int> out;
-    if (!(last - first < float(n))) {  // the whole axis (also for huge spans)
+    if (!(last - first < float(n) && std::abs(first) < 0x1p24f && std::abs(last) < 0x1p24f)) {
       for (int i = 0; i < n; ++i) out.push_back(i);
       return out;
     }

@@ -59,9 +59,9 @@ struct Texture {
   /// path tracer, the bake and normal/alpha maps read textures here.
   Rgb sample(Vec2 uv) const;
   /// The per-channel maximum of every level-0 texel that sample() may read at a uv in the
-  /// rectangle [lo, hi] (wrapped as `sampling` says): a bound on sample() over the rectangle,
-  /// and 0 exactly when sample() is 0 everywhere in it. Infinite for a non-finite corner. The
-  /// light sampler's test of which emitting triangles are black (light/emitters.h).
+  /// rectangle [lo, hi] (wrapped as `sampling` says; the whole image's for a non-finite
+  /// corner): a bound on sample() over the rectangle, so 0 only where sample() is 0 all over
+  /// it. The light sampler's test of which emitting triangles are black (light/emitters.h).
   Rgb maxOver(Vec2 lo, Vec2 hi) const;
   /// Trilinear: bilinear in mip levels ⌊lod⌋ and ⌊lod⌋ + 1 (`levels`), blended by the
   /// fraction of lod. lod ≤ 0 or NaN is exactly sample(uv) (magnified or unfiltered: full
