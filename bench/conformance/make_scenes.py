@@ -309,6 +309,8 @@ CASES = [
          environment={"file": ENVMAP, "scale": 1, "rotation": 0}),
     case("emissive-block", "the short block emissive (2 W/sr/m^2, one-sided), area light off",
          {**LIGHT_OFF, "shortBlock": lambert(WHITE, emission=2)}),
+    case("emissive-texture", "the short block emissive x checker.png (4 W/sr/m^2 x texel, one-sided), area light off",
+         {**LIGHT_OFF, "shortBlock": lambert(WHITE, emission=4, emission_texture=CHECKER)}),
     case("emissive-two-sided", "a two-sided emitting sheet seen from its back, area light off",
          {**LIGHT_OFF, "glow": lambert(0.5, emission=3, two_sided=True)}, STD_MESHES + ["glow_panel.obj"]),
     case("closed-room", "closed geometry: welded room with a front wall, closed blocks, camera inside",

@@ -115,7 +115,8 @@ CausticPhotons traceCausticPhotons(const Scene& scene, const Accel& accel, const
       const Vec3 normal = back ? -tri.normal : tri.normal;
       const Vec3 dir = glm::normalize(Frame::fromNormal(normal).toWorld(sampleCosineHemisphere(uDirection)));
       const float sideProbability = tri.twoSided ? 0.5f : 1.0f;
-      const Rgb flux = tri.Le(glm::dot(dir, tri.normal)) * (kPi * invPhotons / (e.areaPdf * sideProbability));
+      const Rgb flux =
+          tri.Le(glm::dot(dir, tri.normal)) * e.modulation * (kPi * invPhotons / (e.areaPdf * sideProbability));
       if (isBlack(flux)) continue;
       rays.push_back(Ray{offsetRayOrigin(e.point, tri.normal, dir), dir, 0.0f, kInfinity});
       states.push_back({uint32_t(p), flux});

@@ -438,6 +438,10 @@ void layOutTixels(const Scene& scene, const BakeSettings& settings, Parameterisa
     p.transportTiltWeights.resize(p.tixelCount);
   p.coverage.resize(p.tixelCount);
   p.transportAlbedo.resize(p.tixelCount);
+  if (std::any_of(p.charts.begin(), p.charts.end(), [&](const Chart& c) { return texturedEmitter(scene, c); })) {
+    p.emissionModulation.assign(p.tixelCount, Rgb(1.0f));
+    p.emitterTriangle.resize(p.tixelCount);
+  }
   if (settings.sunMasks) p.sunMaskLights = sunMaskLights(scene);
   SunMaskSlots allLit;
   allLit.fill(SunMask(0xffffu));

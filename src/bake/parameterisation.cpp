@@ -426,6 +426,11 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
     return albedoAt(albedoPointAt(scene, r.tris[tri].mesh, r.tris[tri].triangle, Vec2(bary[1], bary[2])));
   };
   const Rgb constantAlbedo = hasAlbedo ? albedoAt(AlbedoPoint{}) : Rgb(0.0f);
+  // A textured emitter's mean emission texture over each footprint, at full resolution.
+  const bool emitterTextured = texturedEmitter(scene, c);
+  auto emissionOn = [&](uint32_t tri, const std::array<float, 3>& bary) {
+    return emissionModulation(scene, material, r.tris[tri].mesh, r.tris[tri].triangle, Vec2(bary[1], bary[2]));
+  };
   // The normal a point of the chart gathers around (chartShadingNormalAt, lightfield.h).
   auto normalAt = [&](const FootprintSample& s) {
     const ChartRaster::Tri2& t = r.tris[s.tri];
@@ -437,7 +442,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       const uint64_t g = c.firstTixel + local;
       // Footprint: coverage and mean albedo over the sub-samples inside the polygon.
       int inside = 0;
-      Rgb albedoSum(0.0f);
+      Rgb albedoSum(0.0f), emissionSum(0.0f);
       // directionalIrradiance: the mapped normals (world, the record's side) at the samples.
       std::array<Vec3, kFootprintSamples * kFootprintSamples> mappedNormals;
       std::array<std::pair<float, FootprintSample>, kFootprintSamples * kFootprintSamples> insideSamples;
@@ -450,6 +455,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
           insideSamples[size_t(inside)] = {glm::dot(fromCentre, fromCentre), s};
           ++inside;
           if (textured) albedoSum += albedoOn(s.tri, s.bary);
+          if (emitterTextured) emissionSum += emissionOn(s.tri, s.bary);
           if (c.directionalIrradiance) {
             const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
             mappedNormals[size_t(inside - 1)] = c.isBack ? -hit.shadingNormal : hit.shadingNormal;
@@ -517,6 +523,10 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       if (c.kind == ChartKind::Diffuse && !p.sunMaskLights.empty())
         p.sunMask[g] = tixelSunMasks(scene, accel, c, r, local, i, j, point, normal, p.sunMaskLights);
 
+      if (emitterTextured && !r.tris.empty()) {
+        p.emissionModulation[g] = inside > 0 ? emissionSum / float(inside) : emissionOn(s.tri, s.bary);
+        p.emitterTriangle[g] = {r.tris[s.tri].mesh, r.tris[s.tri].triangle};
+      }
       if (hasAlbedo) {
         if (!textured) {
           p.transportAlbedo[g] = constantAlbedo;

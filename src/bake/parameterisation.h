@@ -122,7 +122,29 @@ struct Parameterisation {
   /// their count unused; every bit set on glossy and specular charts).
   std::vector<uint32_t> sunMaskLights;
   std::vector<std::array<SunMask, kMaxSunMaskLights>> sunMask;
+  /// Textured emitters (charts of a material with an emission texture; both empty when the
+  /// scene has none, other entries never read): the mean of the emission texture over the
+  /// tixel's footprint sub-samples (scene.h emissionModulation), and the triangle (mesh,
+  /// triangle) under its gather point, whose light-sampler area density the gather's MIS
+  /// weight takes for the whole tixel.
+  std::vector<Rgb> emissionModulation;
+  std::vector<std::pair<uint32_t, uint32_t>> emitterTriangle;
 };
+
+/// Whether chart c is a textured emitter (Parameterisation::emissionModulation holds its tixels).
+inline bool texturedEmitter(const Scene& scene, const Chart& c) {
+  const Material& m = scene.materials[c.material];
+  return m.emissionTexture >= 0 && m.isEmissive();
+}
+
+/// The radiance tixel `tixel` of chart record c emits towards a direction with cosine
+/// cosTheta against the record's normal: chartEmittedRadiance (lightfield.h) times the tixel's
+/// mean emission texture on a textured emitter. The bake's gather and glossy emission.
+inline Rgb tixelEmittedRadiance(const Scene& scene, const Parameterisation& p, const Chart& c, uint64_t tixel,
+                                float cosTheta) {
+  const Rgb le = chartEmittedRadiance(scene.materials[c.material], c, cosTheta);
+  return texturedEmitter(scene, c) ? le * p.emissionModulation[tixel] : le;
+}
 
 /// The frame tixel `tixel` of chart c gathers in and stores its directional map in
 /// (tixelFrameAround, lightfield.h, of its gatherNormal on a curved chart).

@@ -438,7 +438,7 @@ std::vector<Rgb> glossyOperator(const Bsdf& bsdf, uint32_t dirRes, uint32_t grid
 struct TransportState::Operators {
   std::vector<GlossyMaterial> glossy;  ///< per material; dirRes 0 = not used by a glossy chart
   LightSampler lights;
-  std::vector<float> areaPdf;          ///< per material: the emitter area density
+  std::vector<float> areaPdf;          ///< per untextured material: the emitter area density
   uint32_t lightSamples = 0;           ///< area-light shadow rays per tixel (0 without emitters)
   uint32_t sceneLightSamples = 1;      ///< shadow rays per tixel towards each non-delta scene light
   std::optional<ShadowRays> shadows;
@@ -629,10 +629,15 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   }
 
   // The light sampler the path tracer uses (light/light.h): emissive triangles chosen ∝ their
-  // power and sampled by area, whose area density is then constant per material.
+  // power and sampled by area, whose area density is then constant per untextured material
+  // (a textured one's varies by triangle: the gather reads it per tixel, emitterAreaPdfOf).
   ops->lights = LightSampler(scene);
   ops->areaPdf.assign(scene.materials.size(), 0.0f);
-  for (uint32_t m = 0; m < scene.materials.size(); ++m) ops->areaPdf[m] = ops->lights.emitterAreaPdf(m);
+  for (uint32_t mesh = 0; mesh < scene.meshes.size(); ++mesh)
+    for (uint32_t t = 0; t < scene.meshes[mesh].triangles.size(); ++t) {
+      const uint32_t m = scene.meshes[mesh].materials[t];
+      if (scene.materials[m].emissionTexture < 0) ops->areaPdf[m] = std::max(ops->areaPdf[m], ops->lights.emitterAreaPdf(mesh, t));
+    }
   ops->lightSamples = ops->lights.emissiveTriangleCount() == 0 ? 0 : settings.areaLightSamples;
   // The gather never finds the scene's lights (they are no geometry): a non-delta one gets
   // shadow rays even when the preset gives emissive surfaces none.
@@ -844,7 +849,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
             shadowRayTo(cosSigned < 0.0f ? originBehind : origin, emitterShadowTarget(sample.point, em.normal, wi));
         if (!ray) continue;
         rays.push_back(*ray);
-        pending.push_back({g, wi, em.radiance * (cosX / sPl * powerHeuristic(sPl, nPg)), true});
+        pending.push_back({g, wi, em.radiance * sample.modulation * (cosX / sPl * powerHeuristic(sPl, nPg)), true});
       }
     }
     std::vector<uint8_t> occluded(rays.size());
@@ -898,6 +903,14 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
   const std::vector<GlossyMaterial>& glossy = state.ops->glossy;
   GlassFirstShot& glassFirstShot = *state.ops->glassFirstShot;
   const std::vector<float>& areaPdf = state.ops->areaPdf;
+  const LightSampler& lights = state.ops->lights;
+  // The light sampler's area density on the emitter a gather ray found in tixel `tixel` of
+  // chart c: per material when untextured, else the triangle's under the tixel's gather point.
+  auto emitterAreaPdfOf = [&](const Chart& c, uint64_t tixel) {
+    if (!texturedEmitter(scene, c)) return areaPdf[c.material];
+    const auto [mesh, triangle] = param.emitterTriangle[tixel];
+    return lights.emitterAreaPdf(mesh, triangle);
+  };
   const uint32_t lightSamples = state.ops->lightSamples, n = state.n;
   const uint64_t tixels = param.tixelCount;
   std::vector<Rgb>& direct = state.direct;
@@ -961,11 +974,11 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
           L = environment.radiance(leaving);
         } else {
           const Chart& seen = param.charts[param.tixelChart[e.tixel()]];
-          const Material& material = scene.materials[seen.material];
-          const Rgb emitted = chartEmittedRadiance(material, seen, e.backSide() ? -1.0f : 1.0f);
+          const Rgb emitted = tixelEmittedRadiance(scene, param, seen, e.tixel(), e.backSide() ? -1.0f : 1.0f);
           if (!isBlack(emitted) && (emittersViaMirror || !(extra && extra->viaMirror))) {
             float weight = 1.0f;
-            if (lightSamples > 0 && !(extra && extra->viaMirror) && areaPdf[seen.material] > 0.0f) {
+            const float seenAreaPdf = emitterAreaPdfOf(seen, e.tixel());
+            if (lightSamples > 0 && !(extra && extra->viaMirror) && seenAreaPdf > 0.0f) {
               // The same power heuristic as the shadow rays, evaluated for this gather ray
               // against the seen chart's plane (exact for a direct hit on a planar emitter).
               const Vec3 local = direction(k);
@@ -974,7 +987,7 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
               const float denom = glm::dot(w, seen.normal);
               const float t = denom != 0.0f ? glm::dot(seen.origin - o, seen.normal) / denom : 0.0f;
               const float cosY = std::abs(denom);
-              const float pl = t > 0.0f && cosY > 0.0f ? areaPdf[seen.material] * t * t / cosY : 0.0f;
+              const float pl = t > 0.0f && cosY > 0.0f ? seenAreaPdf * t * t / cosY : 0.0f;
               const float pg = local.z * kInvPi;
               weight = pl > 0.0f ? powerHeuristic(float(n) * pg, float(lightSamples) * pl) : 1.0f;
             }
@@ -1184,10 +1197,12 @@ void finishTransport(TransportState& state) {
   // ones stay irradiance.
   for (const Chart& c : param.charts) {
     if (c.kind != ChartKind::Glossy) continue;
-    const Rgb le = chartEmittedRadiance(scene.materials[c.material], c, 1.0f);
-    if (isBlack(le)) continue;
-    for (uint64_t local = 0; local < c.tixelCount(); ++local)  // the maps, not a diffuse value
+    if (isBlack(chartEmittedRadiance(scene.materials[c.material], c, 1.0f))) continue;
+    for (uint64_t local = 0; local < c.tixelCount(); ++local) {  // the maps, not a diffuse value
+      // A textured emitter's at tixel resolution: its mean over the tixel (tixelEmittedRadiance).
+      const Rgb le = tixelEmittedRadiance(scene, param, c, c.firstTixel + local, 1.0f);
       for (uint64_t t = 0; t < c.directionTexels(); ++t) current[c.firstValue + local * c.valuesPerTixel() + t] += le;
+    }
   }
   requireFiniteValues(scene, param, current, "when adding the glossy charts' emission");
 }

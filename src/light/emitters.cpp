@@ -9,9 +9,37 @@
 
 namespace pl {
 
-Vec3 EmissiveTriangle::pointAt(Vec2 u) const {
-  const Vec2 b = sampleUniformTriangle(u);
-  return p0 + b.x * edge1 + b.y * edge2;
+Vec2 EmissiveTriangle::barycentricsAt(Vec2 u) const { return sampleUniformTriangle(u); }
+
+Rgb meanEmissionModulation(const Scene& scene, uint32_t meshIndex, uint32_t triangle) {
+  const Mesh& mesh = scene.meshes[meshIndex];
+  const Material& material = scene.materials[mesh.materials[triangle]];
+  if (material.emissionTexture < 0) return Rgb(1.0f);
+  const Texture& texture = scene.textures[size_t(material.emissionTexture)];
+  const Vec2 corner[3] = {uvAt(mesh, triangle, Vec2(0.0f), material.emissionMapping),
+                          uvAt(mesh, triangle, Vec2(1.0f, 0.0f), material.emissionMapping),
+                          uvAt(mesh, triangle, Vec2(0.0f, 1.0f), material.emissionMapping)};
+  const Vec2 e1 = corner[1] - corner[0], e2 = corner[2] - corner[0];
+  const double texels = 0.5 * std::abs(double(e1.x) * e2.y - double(e1.y) * e2.x) * texture.image.width *
+                        texture.image.height;
+  const int n = int(std::clamp(std::ceil(2.0 * std::sqrt(std::isfinite(texels) ? texels : 0.0)), 4.0, 128.0));
+  // Centroids of the n² sub-triangles: the upward ones (i, j ≥ 0, i + j ≤ n − 1) at
+  // ((i + ⅓)/n, (j + ⅓)/n), the downward ones (i + j ≤ n − 2) at ((i + ⅔)/n, (j + ⅔)/n).
+  DVec3 sum(0.0);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; i + j < n; ++j) {
+      for (const float third : {1.0f / 3.0f, 2.0f / 3.0f}) {
+        if (third > 0.5f && i + j > n - 2) continue;
+        const Vec2 b((float(i) + third) / float(n), (float(j) + third) / float(n));
+        sum += DVec3(emissionModulation(scene, material, meshIndex, triangle, b));
+      }
+    }
+  const double count = double(n) * double(n);
+  const Rgb mean(sum / count);
+  if (!isBlack(mean)) return mean;
+  const Vec2 lo = glm::min(corner[0], glm::min(corner[1], corner[2]));
+  const Vec2 hi = glm::max(corner[0], glm::max(corner[1], corner[2]));
+  return texture.maxOver(lo, hi) / float(count);
 }
 
 std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene) {
@@ -35,6 +63,8 @@ std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene) {
       e.normal = cross / length;
       e.area = 0.5f * length;
       e.radiance = material.emission;
+      e.textured = material.emissionTexture >= 0;
+      if (e.textured) e.meanModulation = meanEmissionModulation(scene, m, t);
       e.twoSided = material.twoSidedEmission;
       list.push_back(e);
     }

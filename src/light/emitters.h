@@ -24,20 +24,39 @@ struct EmissiveTriangle {
   Vec3 p0{0.0f}, edge1{0.0f}, edge2{0.0f};  ///< point = p0 + b₁·edge1 + b₂·edge2
   Vec3 normal{0.0f};                        ///< unit geometric normal (winding), the emitting side
   float area = 0.0f;
-  Rgb radiance{0.0f};                       ///< Le (W·sr⁻¹·m⁻²)
+  Rgb radiance{0.0f};                       ///< the material's emission (W·sr⁻¹·m⁻²), untextured
+  /// The mean of the emission texture over the triangle (meanEmissionModulation; exactly 1
+  /// without a texture): the triangle's mean Le is radiance × meanModulation.
+  Rgb meanModulation{1.0f};
+  bool textured = false;  ///< whether Le varies over the triangle (its material's emissionTexture)
   bool twoSided = false;
 
-  /// Le towards a direction whose cosine against `normal` is cosFront (the emission sidedness
-  /// rule of scene.h emittedRadiance: the front only, unless two-sided).
+  /// The material's emission towards a direction whose cosine against `normal` is cosFront
+  /// (the emission sidedness rule of scene.h emittedRadiance: the front only, unless
+  /// two-sided), before any texture: Le at a point is this × emissionModulation there.
   Rgb Le(float cosFront) const { return emittedRadiance(radiance, twoSided, cosFront); }
-  /// A point uniformly distributed by area for u ∈ [0, 1)² (density 1/area).
-  Vec3 pointAt(Vec2 u) const;
-  /// Exitant flux of a Lambertian emitter, π·A·Y(Le) (×2 when two-sided).
-  float power() const { return kPi * area * luminance(radiance) * (twoSided ? 2.0f : 1.0f); }
+  /// The barycentrics (b1, b2) of a point uniformly distributed by area for u ∈ [0, 1)²
+  /// (density 1/area), and that point (p0 + b1·edge1 + b2·edge2).
+  Vec2 barycentricsAt(Vec2 u) const;
+  Vec3 pointAt(Vec2 b) const { return p0 + b.x * edge1 + b.y * edge2; }
+  /// Exitant flux of a Lambertian emitter of the triangle's mean Le, π·A·Y(Le·meanModulation)
+  /// (×2 when two-sided): with a texture, its textured power.
+  float power() const { return kPi * area * luminance(radiance * meanModulation) * (twoSided ? 2.0f : 1.0f); }
 };
 
 /// Every non-degenerate triangle of an emissive material, mesh by mesh in triangle order.
 std::vector<EmissiveTriangle> emissiveTriangles(const Scene& scene);
+
+/// The mean of emissionModulation (scene.h) over triangle `triangle` of mesh `mesh` (its
+/// material has an emission texture), by the midpoint rule on a regular subdivision: the
+/// triangle cut into n² congruent triangles (n per edge in barycentric coordinates), the
+/// texture read at each one's centroid, n = clamp(⌈2·√(texels under the triangle)⌉, 4, 128)
+/// so that every texel under it gets about four reads. A triangle whose every read is black
+/// is tested exactly (Texture::maxOver its uv bounding box): black there, the mean is 0 (the
+/// triangle emits nothing anywhere, and the light sampler never picks it); otherwise it is
+/// that maximum / n², one read's worth, so that the light sampler keeps it with a small
+/// probability — any positive weight is unbiased.
+Rgb meanEmissionModulation(const Scene& scene, uint32_t mesh, uint32_t triangle);
 
 /// Everything that arrives from infinity as one light: a constant radiance plus an optional
 /// map (exactly what scene.h's Environment holds). radiance(dir) = constant + map(dir).

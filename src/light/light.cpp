@@ -66,7 +66,7 @@ Rgb ShadowRays::transmittance(Ray ray, uint64_t& rays) const {
 
 // ---- The light sampler -------------------------------------------------------------------
 
-LightSampler::LightSampler(const Scene& scene) {
+LightSampler::LightSampler(const Scene& scene) : scene_(&scene) {
   environment_ = EnvironmentLight(scene.environment.constant, scene.environment.map);
   Vec3 lo, hi;
   scene.bounds(lo, hi);
@@ -110,15 +110,21 @@ LightSampler::LightSampler(const Scene& scene) {
   if (!sceneLightWeights.empty()) sceneLightDistribution_ = Distribution1D(sceneLightWeights);
   if (!triangleWeights.empty()) triangleDistribution_ = Distribution1D(triangleWeights);
 
-  // Area density of sampleEmitterPoint: P(triangle)/A = (π·A·Y·s/Σ)/A = π·Y·s/Σ, the same for
-  // every triangle of a material (s = 2 when two-sided). Σ is in double, as the distribution's.
-  areaPdfOfMaterial_.assign(scene.materials.size(), 0.0f);
+  // Area density of sampleEmitterPoint: P(triangle)/A = (π·A·Y·s/Σ)/A = π·Y·s/Σ with Y the
+  // luminance of the triangle's mean Le (s = 2 when two-sided): the same for every triangle of
+  // an untextured material. Σ is in double, as the distribution's.
+  areaPdf_.assign(triangles_.size(), 0.0f);
   if (triangleDistribution_.total() > 0.0)
-    for (size_t m = 0; m < scene.materials.size(); ++m) {
-      const Material& material = scene.materials[m];
-      const double power = kPiD * luminance(material.emission) * (material.twoSidedEmission ? 2.0 : 1.0);
-      areaPdfOfMaterial_[m] = power > 0.0 ? static_cast<float>(power / triangleDistribution_.total()) : 0.0f;
+    for (size_t t = 0; t < triangles_.size(); ++t) {
+      const EmissiveTriangle& e = triangles_[t];
+      const double power = kPiD * luminance(e.radiance * e.meanModulation) * (e.twoSided ? 2.0 : 1.0);
+      areaPdf_[t] = power > 0.0 ? static_cast<float>(power / triangleDistribution_.total()) : 0.0f;
     }
+}
+
+Rgb LightSampler::emitterModulation(const EmissiveTriangle& e, Vec2 barycentrics) const {
+  if (!e.textured) return Rgb(1.0f);
+  return emissionModulation(*scene_, scene_->materials[e.material], e.mesh, e.triangle, barycentrics);
 }
 
 std::optional<LightSample> LightSampler::sample(const Vec3& position, Vec2 u, bool nextEventOnly) const {
@@ -138,13 +144,15 @@ std::optional<LightSample> LightSampler::sampleEntry(const Entry& entry, float s
   switch (entry.kind) {
     case Kind::Triangle: {
       const EmissiveTriangle& e = triangles_[entry.index];
-      const Vec3 point = e.pointAt(u);
+      const Vec2 b = e.barycentricsAt(u);
+      const Vec3 point = e.pointAt(b);
       const Vec3 toLight = point - position;
       const float distanceSquared = glm::dot(toLight, toLight);
       if (!(distanceSquared > 0.0f)) return std::nullopt;
       s.wi = toLight / std::sqrt(distanceSquared);
       const float cosFront = -glm::dot(e.normal, s.wi);
       s.incident = e.Le(cosFront);
+      if (e.textured) s.incident *= emitterModulation(e, b);
       const float cosLight = std::abs(cosFront);
       if (isBlack(s.incident) || !(cosLight > 0.0f)) return std::nullopt;  // the back of a one-sided emitter
       // Area density 1/A converted to solid angle at `position`: dA = r² dω / cos θlight.
@@ -193,12 +201,16 @@ float LightSampler::environmentPdf(const Vec3& dir) const {
 
 EmitterPoint LightSampler::sampleEmitterPoint(Vec2 u) const {
   float remapped = 0.0f;
-  const EmissiveTriangle& e = triangles_[triangleDistribution_.sample(u.x, &remapped)];
-  return {&e, e.pointAt(Vec2(remapped, u.y)), areaPdfOfMaterial_[e.material]};
+  const size_t chosen = triangleDistribution_.sample(u.x, &remapped);
+  const EmissiveTriangle& e = triangles_[chosen];
+  const Vec2 b = e.barycentricsAt(Vec2(remapped, u.y));
+  return {&e, e.pointAt(b), areaPdf_[chosen], emitterModulation(e, b)};
 }
 
-float LightSampler::emitterAreaPdf(uint32_t material) const {
-  return material < areaPdfOfMaterial_.size() ? areaPdfOfMaterial_[material] : 0.0f;
+float LightSampler::emitterAreaPdf(uint32_t mesh, uint32_t triangle) const {
+  if (mesh >= meshTriangleBase_.size()) return 0.0f;
+  const int32_t entry = entryOfTriangle_[meshTriangleBase_[mesh] + triangle];
+  return entry < 0 ? 0.0f : areaPdf_[entries_[static_cast<size_t>(entry)].index];
 }
 
 }  // namespace pl

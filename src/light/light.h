@@ -8,13 +8,20 @@
 //
 // Light selection: one discrete distribution over every emitter, proportional to an estimate
 // of its emitted power (luminance), each emitter's power() in emitters.h:
-//   emissive triangle  π · A · Y(Le)            (×2 when two-sided)
+//   emissive triangle  π · A · Y(Le)            (×2 when two-sided; Le the triangle's mean,
+//                      its emission texture's mean over it: meanEmissionModulation)
 //   scene light        its power(R) (lights.h: 4π·Y(I) for a point light, π R²·Y(E) for a
 //                      directional one, …)
 //   environment        π R² · ∫ Y(Le) dω
 // where R is the radius of the scene's bounding sphere. Any positive weights give an
 // unbiased estimator; these make the variance small when emitters differ a lot. The bake,
 // which samples emissive surfaces by area, uses the same weights restricted to the triangles.
+//
+// Textured emitters: a triangle is chosen ∝ its textured power and a point on it uniformly by
+// area (density P(triangle)/A, exact whatever the texture does within it); the sample's
+// radiance is the texel there (emissionModulation), so the estimate Le(x)·G/pdf is unbiased
+// for any texture — the mean only steers the choice between triangles. A triangle whose
+// texture is black under it has weight 0: it emits nothing, so nothing is missed.
 //
 // Sample numbers: the choice of emitter and the point on it come from ONE 2-D sample: u.x
 // picks the emitter and is stretched back onto [0, 1) within its bin, then (u.x', u.y) picks
@@ -94,11 +101,13 @@ struct EmitterPoint {
   const EmissiveTriangle* triangle = nullptr;
   Vec3 point{0.0f};
   float areaPdf = 0.0f;  ///< density per unit area (m⁻²), selection included
+  Rgb modulation{1.0f};  ///< the emission texture there: Le = triangle->Le(…) × modulation
 };
 
 class LightSampler {
  public:
   LightSampler() = default;
+  /// The scene must outlive the sampler (textured emitters are read from it).
   explicit LightSampler(const Scene& scene);
 
   /// Emitters with positive power: emissive triangles + scene lights + environment.
@@ -125,9 +134,10 @@ class LightSampler {
   /// A point on the emissive triangles alone, chosen with probability ∝ their power and then
   /// uniformly by area (the bake's area-light shadow rays). Requires emissiveTriangleCount() > 0.
   EmitterPoint sampleEmitterPoint(Vec2 u) const;
-  /// sampleEmitterPoint's area density on triangles of material `material`: constant per
-  /// material (π·Y(Le)·(2 if two-sided) / Σ triangle power); 0 for a material that emits nothing.
-  float emitterAreaPdf(uint32_t material) const;
+  /// sampleEmitterPoint's area density on triangle `triangle` of mesh `mesh`: π·Y(mean
+  /// Le)·(2 if two-sided) / Σ triangle power, the same on every triangle of an untextured
+  /// material; 0 on a triangle that is no light.
+  float emitterAreaPdf(uint32_t mesh, uint32_t triangle) const;
 
  private:
   enum class Kind : uint8_t { Triangle, SceneLight, Environment };
@@ -137,7 +147,10 @@ class LightSampler {
   };
   std::optional<LightSample> sampleEntry(const Entry& entry, float selectProbability, const Vec3& position,
                                          Vec2 u) const;
+  /// The emission texture at barycentrics b of e (1 when untextured).
+  Rgb emitterModulation(const EmissiveTriangle& e, Vec2 barycentrics) const;
 
+  const Scene* scene_ = nullptr;
   EnvironmentLight environment_;
   std::vector<EmissiveTriangle> triangles_;
   std::vector<Light> sceneLights_;  ///< those of scene.lights with positive power
@@ -147,7 +160,7 @@ class LightSampler {
   Distribution1D triangleDistribution_;  ///< over triangles_
   std::vector<uint32_t> meshTriangleBase_;  ///< first global triangle index of each mesh
   std::vector<int32_t> entryOfTriangle_;    ///< entry of each global triangle, or −1
-  std::vector<float> areaPdfOfMaterial_;
+  std::vector<float> areaPdf_;  ///< sampleEmitterPoint's area density, per triangles_ entry
   int32_t environmentEntry_ = -1;
 };
 

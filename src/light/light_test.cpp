@@ -148,9 +148,10 @@ TEST(LightSampler, EmitterPointsByAreaIntegrateTheArea) {
   const double area0 = 1.0, area1 = 0.5;
   const double power0 = area0 * luminance(Rgb(4.0f, 3.0f, 2.0f)), power1 = 2.0 * area1 * luminance(Rgb(1.0f, 2.0f, 6.0f));
   const double p0 = power0 / (power0 + power1);
-  EXPECT_NEAR(lights.emitterAreaPdf(0), p0 / area0, 1e-5 * p0 / area0);
-  EXPECT_NEAR(lights.emitterAreaPdf(1), (1.0 - p0) / area1, 1e-5 * (1.0 - p0) / area1);
-  EXPECT_EQ(lights.emitterAreaPdf(2), 0.0f);
+  // Mesh 0's triangles 0–1 are the first light, 2–3 the second, 4–5 the floor.
+  EXPECT_NEAR(lights.emitterAreaPdf(0, 1), p0 / area0, 1e-5 * p0 / area0);
+  EXPECT_NEAR(lights.emitterAreaPdf(0, 2), (1.0 - p0) / area1, 1e-5 * (1.0 - p0) / area1);
+  EXPECT_EQ(lights.emitterAreaPdf(0, 4), 0.0f);
   Pcg32 rng(5, 6);
   const int n = 100000;
   int onFirst = 0;

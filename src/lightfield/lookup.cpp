@@ -70,7 +70,8 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
   const Vec3 wo = -ray.direction;
   const float cosWoGeometric = glm::dot(surface.geometricNormal, wo);
   const Rgb attenuation = interiorTransmittance(material, cosWoGeometric, hit.t);  // Beer–Lambert (scene.h)
-  emitted = emittedRadiance(material, cosWoGeometric) * attenuation;
+  emitted = emittedRadiance(material, cosWoGeometric) *
+            emissionModulation(scene, material, hit.mesh, hit.triangle, hit.barycentrics) * attenuation;
   if (step >= stepLimit) return false;
   Bsdf bsdf = bsdfAt(scene, surface);
   // Rough glass is a glossy chart and never comes here, except in a .plf baked before it was
@@ -130,7 +131,8 @@ ChartShading chartShading(const LightField& lf, uint32_t chart, const SunLights&
     shading.albedoOverPi = lanes4(diffuseAlbedoAt(scene, c.material, AlbedoPoint{}) * kInvPi);
   if (c.diffuseValue && !shading.texturedAlbedo)
     shading.albedoOverPi = lanes4(glossyDiffuseAlbedoAt(scene, c.material, AlbedoPoint{}) * kInvPi);
-  shading.needsUv = (c.kind == ChartKind::Diffuse || c.diffuseValue) && shading.texturedAlbedo;
+  shading.texturedEmission = shading.emissive && c.kind == ChartKind::Diffuse && material.emissionTexture >= 0;
+  shading.needsUv = ((c.kind == ChartKind::Diffuse || c.diffuseValue) && shading.texturedAlbedo) || shading.texturedEmission;
   shading.normalMapped = (c.kind == ChartKind::Glossy || c.directionalIrradiance) && material.normalTexture >= 0;
   shading.curvedGlossy = c.kind == ChartKind::Glossy && c.curved;
   if (c.kind == ChartKind::Diffuse && sun.count > 0 &&

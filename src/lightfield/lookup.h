@@ -278,7 +278,10 @@ struct ChartShading {
   bool emissive = false;          ///< emission is not black
   bool twoSidedEmission = false;
   bool texturedAlbedo = false;    ///< diffuse albedo varies over the surface (Material::modelVaries): diffuseAlbedoAt per point
-  bool needsUv = false;           ///< a diffuse (or diffuseValue glossy) chart whose albedo varies: the lookup needs the hit's AlbedoPoint
+  /// An emissive diffuse chart with an emission texture: its emission × AlbedoPoint::emission
+  /// per point (a glossy chart's stored values carry its tixels' mean emission instead).
+  bool texturedEmission = false;
+  bool needsUv = false;           ///< a diffuse (or diffuseValue glossy) chart whose albedo varies, or a texturedEmission one: the lookup needs the hit's AlbedoPoint
   /// A normal-mapped glossy chart (lookupDirection bends the lookup by the hit's mapped normal)
   /// or directionalIrradiance diffuse chart (the irradiance is taken about it): lookupInputs
   /// needs surfaceAt's shading normal.
@@ -430,11 +433,14 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
   // caller's viewedChart chose its side by the hit triangle's normal, and it reflects
   // (cos θ taken as 1, see kCurvedChartCosine).
   const float cosTheta = c.curved ? kCurvedChartCosine : glm::dot(worldDirectionTowardsViewer, c.normal);
-  // chartEmittedRadiance (lightfield.h) on the precomputed emission of this record.
+  // chartEmittedRadiance (lightfield.h) on the precomputed emission of this record (× the
+  // emission texture at the point on a texturedEmission chart).
   const bool emits = cosTheta > 0.0f || shading.twoSidedEmission;
+  const F4 emission = shading.texturedEmission ? f4Mul(f4Load(shading.emission.v), f4FromRgb(albedo.emission))
+                                               : f4Load(shading.emission.v);
   // Behind a one-sided record: no reflected light (the caller turned two-sided ones with
   // facingChart), only two-sided emission.
-  if (!(cosTheta >= 0.0f)) return shading.emissive && emits ? f4Load(shading.emission.v) : f4Zero();
+  if (!(cosTheta >= 0.0f)) return shading.emissive && emits ? emission : f4Zero();
   if (c.kind == ChartKind::Diffuse) {
     // Le + (albedo/π) · E, lane by lane; E = the stored irradiance plus the sun masks' lights,
     // about the mapped normal on a directionalIrradiance chart.
@@ -443,14 +449,14 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
       // The path tracer's Lambertian lobe reflects only towards viewers above the mapped
       // normal (bsdf.cpp sameHemisphereUp in the shading frame).
       if (!(glm::dot(worldDirectionTowardsViewer, mappedNormal) > 0.0f))
-        return shading.emissive && emits ? f4Load(shading.emission.v) : f4Zero();
+        return shading.emissive && emits ? emission : f4Zero();
       stored = mappedNormalIrradiance(load, c, grid, stored, tiltFrameAround(c, lookupNormal).toLocal(mappedNormal));
     }
     const F4 irradiance = f4Add(stored, sunIrradianceLanes(c, shading, grid, lookupNormal, mappedNormal));
     const F4 albedoOverPi = shading.texturedAlbedo ? f4Mul(f4FromRgb(diffuseAlbedoAt(scene, c.material, albedo)), f4Splat(kInvPi))
                                                    : f4Load(shading.albedoOverPi.v);
     const F4 reflected = f4Mul(albedoOverPi, irradiance);
-    return shading.emissive && emits ? f4Add(f4Load(shading.emission.v), reflected) : reflected;
+    return shading.emissive && emits ? f4Add(emission, reflected) : reflected;
   }
   // Glossy: the stored values already include the record's emission. On a normal-mapped
   // chart the path tracer's model reflects only towards viewers above the mapped normal
@@ -583,7 +589,8 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
     const bool reflects = ((reflectingSide >> k) & 1) != 0;
     const bool emits = front || shading.twoSidedEmission;
     const F4 seen = reflects ? reflected : f4Zero();
-    result[k] = shading.emissive && emits ? f4Add(emission, seen) : seen;
+    const F4 le = shading.texturedEmission ? f4Mul(emission, f4FromRgb(albedo[k].emission)) : emission;
+    result[k] = shading.emissive && emits ? f4Add(le, seen) : seen;
   }
 #else
   for (int k = 0; k < 4; ++k) {

@@ -147,6 +147,8 @@ constexpr uint8_t kTextureEncodedFile = 1;  ///< u64 count, the image file's byt
 constexpr uint32_t kSurfaceDetailTag = 0x4c544453u;
 /// Opens SCNE's optional texturing block ("TXMP", version ≥ 5; plf_file.h).
 constexpr uint32_t kTexturingTag = 0x504d5854u;
+/// Opens SCNE's optional emission-texture block ("EMTX", version ≥ 5; plf_file.h).
+constexpr uint32_t kEmissionTextureTag = 0x58544d45u;
 
 /// Whether a scene needs the texturing block: a second uv set, vertex colours, a texture
 /// mapping other than TEXCOORD_0 as it is, a metallic-roughness texture or a sampling other
@@ -286,6 +288,14 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
       w.put(uint8_t(t.sampling.mipmaps));
     }
   }
+  // Emission textures: only when some material has one, so other files keep their layout.
+  if (std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.emissionTexture >= 0; })) {
+    w.put(kEmissionTextureTag);
+    for (const Material& m : scene.materials) {
+      w.put(int32_t(m.emissionTexture));
+      putMapping(w, m.emissionMapping);
+    }
+  }
   return std::move(w.bytes());
 }
 
@@ -386,8 +396,10 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
   const bool hasCamera = r.get<uint8_t>() != 0;
   std::string camera = r.getString();
   if (hasCamera) scene.settings.camera = std::move(camera);
+  // The optional blocks, in this order: SDTL, TXMP (version ≥ 5), EMTX (version ≥ 5).
+  const bool version5 = version >= 5;
   uint32_t tag = r.remaining() > 0 ? r.get<uint32_t>() : 0;
-  if (tag != 0 && tag != kSurfaceDetailTag && !(tag == kTexturingTag && version >= 5))
+  if (tag != 0 && tag != kSurfaceDetailTag && !((tag == kTexturingTag || tag == kEmissionTextureTag) && version5))
     r.corrupt("unexpected bytes after the scene's settings");
   if (tag == kSurfaceDetailTag) {
     tag = 0;
@@ -406,7 +418,8 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
     }
     if (r.remaining() > 0) {
       tag = r.get<uint32_t>();
-      if (!(tag == kTexturingTag && version >= 5)) r.corrupt("unexpected bytes after the surface-detail block");
+      if (!((tag == kTexturingTag || tag == kEmissionTextureTag) && version5))
+        r.corrupt("unexpected bytes after the surface-detail block");
     }
   }
   if (tag == kTexturingTag) {
@@ -431,6 +444,19 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
           mipmaps > 1)
         r.corrupt(fmt::format("texture '{}' has unknown sampling {} {} {} {}", t.path, wrapU, wrapV, nearest, mipmaps));
       t.sampling = TextureSampling{TextureWrap(wrapU), TextureWrap(wrapV), nearest != 0, mipmaps != 0};
+    }
+    tag = 0;
+    if (r.remaining() > 0) {
+      tag = r.get<uint32_t>();
+      if (tag != kEmissionTextureTag) r.corrupt("unexpected bytes after the texturing block");
+    }
+  }
+  if (tag == kEmissionTextureTag) {
+    for (Material& m : scene.materials) {
+      m.emissionTexture = r.get<int32_t>();
+      m.emissionMapping = getMapping(r);
+      if (const std::string problem = mappingProblem(m); !problem.empty())
+        r.corrupt(fmt::format("material '{}': {}", m.name, problem));
     }
   }
   r.expectEnd();

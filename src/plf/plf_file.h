@@ -46,7 +46,11 @@
 //         alpha and normal mappings (TextureMapping: u8 uv set, 4 f32 linear part column by
 //         column, 2 f32 offset), i32 metallic-roughness texture, its mapping, Rgb base colour,
 //         f32 metallic, f32 roughness; per texture u8 wrapU, u8 wrapV (TextureWrap), u8 nearest,
-//         u8 mipmaps. Without it every mapping, map and sampling is the default.
+//         u8 mipmaps. Without it every mapping, map and sampling is the default. Then
+//         (version ≥ 5), only when a material has an emission texture, an emission-texture
+//         block: u32 tag "EMTX"; per material i32 emissionTexture (−1: none) and its
+//         TextureMapping. Without it no material has one (files written before emission
+//         textures read unchanged; a reader from before them refuses a file with the block).
 //   CHRT  the charts: u64 count, then fixed 85-byte records (see encodeCharts in plf_file.cpp).
 //         The kind byte's bit 4 (version ≥ 4) marks a glossy chart whose tixels keep their
 //         diffuse irradiance after their map (Chart::diffuseValue, lightfield.h); bit 3

@@ -227,6 +227,20 @@ class PlfFileTest : public test_support::TempDirTest {
     expectRefused(file(badName), fragments);
   }
 
+  /// The valid file at `path`, whose scene section must be larger than `plainSceneSize` (an
+  /// optional block is there), with the byte `fromEnd` bytes before the end of that section set
+  /// to `value` and re-signed, written as `name`: the reader must refuse it with `fragments`.
+  void expectRefusedWithSceneByte(const std::string& path, uint64_t plainSceneSize, uint64_t fromEnd, uint8_t value,
+                                  const std::string& name, const std::vector<std::string>& fragments) const {
+    auto bytes = readBytes(path);
+    const auto table = sections(bytes);
+    EXPECT_GT(table[0].size, plainSceneSize);
+    bytes[table[0].offset + table[0].size - fromEnd] = value;
+    resign(bytes);
+    writeBytes(file(name), bytes);
+    expectRefused(file(name), fragments);
+  }
+
   fs::path dir_;
 };
 
@@ -977,14 +991,40 @@ TEST_F(PlfFileTest, RoundTripKeepsTexturing) {
   EXPECT_EQ(copy.scene.textures[1].image.pixels, s.textures[1].image.pixels);
 
   // The block ends SCNE with 4 sampling bytes per texture: texture 1's wrapU set to 3 is refused.
-  const auto good = readBytes(path);
-  const auto table = sections(good);
-  EXPECT_GT(table[0].size, plainScene);
-  auto bad = good;
-  bad[table[0].offset + table[0].size - 4] = 3;
-  resign(bad);
-  writeBytes(file("wrap.plf"), bad);
-  expectRefused(file("wrap.plf"), {"scene section", "unknown sampling 3"});
+  expectRefusedWithSceneByte(path, plainScene, 4, 3, "wrap.plf", {"scene section", "unknown sampling 3"});
+}
+
+// An emission texture and its mapping come back through the EMTX block, alone after the
+// settings or after the texturing block; files without one keep their layout (the plain
+// file's SCNE is shorter), and a bad mapping in the block is refused naming the material.
+TEST_F(PlfFileTest, RoundTripKeepsEmissionTextures) {
+  LightField original = makeTestLightField();
+  Scene& s = original.scene;
+  const std::string plainPath = file("plain.plf");
+  writeLightField(plainPath, original);
+  const uint64_t plainScene = sections(readBytes(plainPath))[0].size;
+  Material& lamp = s.materials[0];
+  lamp.emission = Rgb(3.0f, 2.0f, 1.0f);
+  lamp.emissionTexture = 1;
+  lamp.emissionMapping.linear = Mat2(Vec2(2.0f, 0.0f), Vec2(0.5f, 1.0f));
+  lamp.emissionMapping.offset = Vec2(0.25f, -1.0f);
+  for (const bool texturing : {false, true}) {
+    SCOPED_TRACE(texturing ? "after TXMP" : "alone");
+    if (texturing) s.materials[3].albedoMapping.offset = Vec2(0.5f, 0.0f);  // a TXMP block too
+    const std::string path = file("emission.plf");
+    writeLightField(path, original);
+    const LightField copy = readLightField(path);
+    const Material& back = copy.scene.materials[0];
+    EXPECT_EQ(back.emissionTexture, 1);
+    EXPECT_EQ(back.emissionMapping.linear, lamp.emissionMapping.linear);
+    EXPECT_EQ(back.emissionMapping.offset, lamp.emissionMapping.offset);
+    EXPECT_EQ(back.emission, lamp.emission);
+    for (size_t m = 1; m < copy.scene.materials.size(); ++m) EXPECT_EQ(copy.scene.materials[m].emissionTexture, -1);
+    EXPECT_EQ(copy.scene.materials[3].albedoMapping.offset, s.materials[3].albedoMapping.offset);
+    // The block ends with the last material's i32 texture, u8 uv set, 6 floats: uv set 7.
+    expectRefusedWithSceneByte(path, plainScene, 25, 7, "emission_bad.plf",
+                               {"scene section", "the emission texture reads uv set 7"});
+  }
 }
 
 // --- Sun masks (SMSK, version 3) -----------------------------------------------------------

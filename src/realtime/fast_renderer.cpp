@@ -218,7 +218,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       // shading[chart].needsUv, from the (small, cached) material array: the shading record
       // prefetched above is still on its way (waiting for it here took 8 % of renderTile).
       const Material& material = scene.materials[c.material];
-      if (c.kind != ChartKind::Diffuse || !material.modelVaries()) continue;
+      if (c.kind != ChartKind::Diffuse || !(material.modelVaries() || material.emissionTexture >= 0)) continue;
       // lookupInputs' albedo point for this hit (the same functions: the same bits).
       s.albedo[i] = albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
       if (material.albedoTexture < 0) continue;

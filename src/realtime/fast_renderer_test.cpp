@@ -125,6 +125,29 @@ TEST_F(FastRendererTest, MatchesReferenceWithGltfTexturing) {
   }
 }
 
+// An emission texture on a diffuse emitter (the glTF emissive seed, made Lambertian): the
+// emission is multiplied by the texel per pixel (AlbedoPoint::emission) in the fast renderer's
+// prefetch pass and four-wide lookups as in the reference renderer's lookupInputs — and it is
+// there at all (without the texture the image differs).
+TEST_F(FastRendererTest, MatchesReferenceWithEmissionTexture) {
+  Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/fuzz/gltf/seed-emissive-texture.gltf");
+  scene.materials[0].bsdf = LambertBsdf{Rgb(0.5f)};
+  const LightField lf = randomLightField(scene, 4);
+  ASSERT_GE(lf.scene.materials[0].emissionTexture, 0);
+  ASSERT_EQ(lf.charts[0].kind, ChartKind::Diffuse);
+  CameraDesc desc = lf.scene.automaticCamera();
+  desc.fovYDegrees = 25.0f;  // the quad fills the view
+  expectSameAsReference(lf, desc, 64, 48, RenderSettings{});
+  scene.materials[0].emissionTexture = -1;
+  const LightField plain = randomLightField(scene, 4);
+  const Accel accel(lf.scene), plainAccel(plain.scene);
+  const Camera camera(desc, 64, 48, false);
+  EXPECT_GT(compare(renderLightField(lf, accel, camera, RenderSettings{}),
+                    renderLightField(plain, plainAccel, camera, RenderSettings{}))
+                .pixelsOverTolerance,
+            1000);
+}
+
 // Curved glossy charts (two glossy spheres): both renderers read the maps in the frame around
 // the hit's interpolated normal (lookupInputs / exitantRadiance's SurfaceHit overload).
 TEST_F(FastRendererTest, MatchesReferenceOnCurvedGlossyCharts) {

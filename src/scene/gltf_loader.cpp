@@ -49,7 +49,8 @@
 //  * normalTexture → tangent-space normal map (raw values, no sRGB decoding; +x = +u,
 //    +y = up the image = +v after the flip), `scale` → normalScale (scene.h normalMapped).
 //  * emissiveFactor × KHR_materials_emissive_strength.emissiveStrength → emitted radiance in
-//    W·sr⁻¹·m⁻²; doubleSided materials emit from both sides.
+//    W·sr⁻¹·m⁻², times the emissiveTexture's sRGB-decoded texel at each point when there is
+//    one (Material::emissionTexture); doubleSided materials emit from both sides.
 //  * Perspective cameras: yfov (radians) and aspectRatio; the camera looks down its node's
 //    −z with +y up. Named after the node, else the camera, else "camera<N>".
 //  * KHR_lights_punctual point, spot and directional lights (shining down the node's −z).
@@ -696,9 +697,13 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
                                        float(gltf.emissiveFactor[2]));
   }
   if (gltf.emissiveTexture.index >= 0) {
-    checkTextureIndex(ctx, "emissiveTexture", gltf.emissiveTexture.index, material.name);
-    spdlog::warn("{}: material '{}': emissiveTexture is not supported; emissiveFactor used alone", ctx.path,
-                 material.name);
+    // sRGB colour (spec 3.9.2), multiplying the factor × strength at each point (scene.h
+    // emissionModulation). Read only where it can matter: a black factor emits nothing.
+    const TextureMapping mapping = mappingOf(ctx, slotRef("emissiveTexture", gltf.emissiveTexture), material.name);
+    if (material.isEmissive()) {
+      material.emissionMapping = mapping;
+      material.emissionTexture = textureFor(ctx, gltf.emissiveTexture.index);
+    }
   }
   material.twoSidedEmission = gltf.doubleSided;
   return material;
@@ -839,7 +844,8 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
     const std::pair<int, const TextureMapping*> slots[] = {{m.albedoTexture, &m.albedoMapping},
                                                           {m.alphaTexture, &m.alphaMapping},
                                                           {m.normalTexture, &m.normalMapping},
-                                                          {m.metallicRoughness.texture, &m.metallicRoughness.mapping}};
+                                                          {m.metallicRoughness.texture, &m.metallicRoughness.mapping},
+                                                          {m.emissionTexture, &m.emissionMapping}};
     for (const auto& [texture, mapping] : slots)
       if (texture >= 0) readsSet[mapping->uvSet] = true;
     for (int s = 0; s < PbrLayerMaps::kSlots; ++s)

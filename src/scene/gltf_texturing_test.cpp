@@ -248,6 +248,36 @@ TEST(GltfTexturing, MetallicRoughnessTexturePerHit) {
   }
 }
 
+// emissiveTexture: emissiveFactor × KHR_materials_emissive_strength × the sRGB-decoded texel,
+// read through the slot's texCoord and KHR_texture_transform — the one rule the path tracer,
+// the light sampler and the bake read (emissionModulation) and the renderers' albedo point
+// carries. A black factor emits nothing, so the texture is not even kept.
+TEST(GltfTexturing, EmissiveTextureMultipliesTheFactor) {
+  const fs::path dir = scratch("emissive");
+  const Scene scene = loadScene(writeQuad(dir,
+      R"({"name": "panel", "emissiveFactor": [1, 0.5, 0.25],
+          "emissiveTexture": {"index": 0, "texCoord": 1, "extensions": {"KHR_texture_transform": {"scale": [2, 2]}}},
+          "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}})",
+      R"(, "TEXCOORD_1": 2)", R"("extensionsUsed": ["KHR_texture_transform", "KHR_materials_emissive_strength"],)", kNearest));
+  const Material& material = scene.materials[0];
+  ASSERT_GE(material.emissionTexture, 0);
+  EXPECT_EQ(scene.textures[size_t(material.emissionTexture)].decode, ImageDecode::Colour);
+  EXPECT_VEC3_NEAR(material.emission, Rgb(4.0f, 2.0f, 1.0f), kTight);
+  for (const Vec2 p : {Vec2(0.3f, 0.1f), Vec2(0.9f, 0.6f), Vec2(0.1f, 0.8f), Vec2(0.6f, 0.35f)}) {
+    // TEXCOORD_1 is half of TEXCOORD_0 (glTF's (x, 1 − y)), scaled by 2: the texel under (x, 1 − y).
+    const Rgb expected = texelLinear(wrappedTexel(p.x, "repeat"), wrappedTexel(1.0f - p.y, "repeat"));
+    const bool lower = p.x >= p.y;
+    const Vec2 b = lower ? Vec2(p.x - p.y, p.y) : Vec2(p.x, p.y - p.x);
+    SCOPED_TRACE(fmt::format("at {}, {}", p.x, p.y));
+    EXPECT_VEC3_NEAR(emissionModulation(scene, material, 0, lower ? 0 : 1, b), expected, kTight);
+    EXPECT_VEC3_NEAR(pointAt(scene, p.x, p.y).emission, expected, kTight);
+  }
+  const Scene dark = loadScene(writeQuad(dir, R"({"emissiveTexture": {"index": 0}})"));
+  EXPECT_EQ(dark.materials[0].emissionTexture, -1);
+  EXPECT_FALSE(dark.materials[0].isEmissive());
+  EXPECT_TRUE(dark.textures.empty());
+}
+
 TEST(GltfTexturing, ExtensionsRequiredAndUsed) {
   const fs::path dir = scratch("extensions");
   const std::string material = R"({"pbrMetallicRoughness": {"metallicFactor": 0}})";
@@ -368,6 +398,11 @@ TEST(GltfTexturing, BadTextureReferencesNameTheMaterialOrMesh) {
   const fs::path dir = scratch("bad");
   expectError([&] { loadScene(writeQuad(dir, R"({"name": "paint", "pbrMetallicRoughness": {"baseColorTexture": {"index": 3}}})")); },
               {"quad.gltf", "material 'paint'", "baseColorTexture", "texture 3"});
+  expectError([&] { loadScene(writeQuad(dir, R"({"name": "glow", "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 4}})")); },
+              {"quad.gltf", "material 'glow'", "emissiveTexture", "texture 4"});
+  expectError([&] {
+    loadScene(writeQuad(dir, R"({"name": "glow", "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 0, "texCoord": 1}})"));
+  }, {"quad.gltf", "mesh 'quad'", "material 'glow'", "TEXCOORD_1"});
   expectError([&] { loadScene(writeQuad(dir, R"({"name": "paint", "occlusionTexture": {"index": 9}})")); },
               {"quad.gltf", "material 'paint'", "occlusionTexture", "texture 9"});
   expectError([&] {

@@ -24,6 +24,7 @@
 //              and the glTF layers (any of them makes it bsdf.h's GltfPbrBsdf): "f90": 1,
 //              "clearcoat": 0, "clearcoat_roughness": 0, "sheen": [r,g,b], "sheen_roughness": 0.5}
 //       (+ for every type: "emission": [r,g,b] radiance in W·sr⁻¹·m⁻², "two_sided": false,
+//        "emission_texture": "glow.png" (sRGB colour multiplying "emission" at each point),
 //        "alpha_texture": "mask.png" (cut-out: its alpha channel, or its first channel without
 //        one), "alpha_cutoff": 0.5 (no surface where coverage < cutoff),
 //        "normal_texture": "normals.png" (tangent-space, OpenGL +y = +v), "normal_scale": 1,
@@ -170,7 +171,7 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
   material.tixelDensity = numberOr(ctx, value, "tixel_density", 1.0f, where);
   if (!(material.tixelDensity > 0.0f) || !std::isfinite(material.tixelDensity))
     fail("{}: {}: tixel_density {} must be a positive number", ctx.path, where, material.tixelDensity);
-  std::set<std::string> known = {"type", "emission", "two_sided", "alpha_texture", "alpha_cutoff", "normal_texture",
+  std::set<std::string> known = {"type", "emission", "emission_texture", "two_sided", "alpha_texture", "alpha_cutoff", "normal_texture",
                                   "normal_scale", "tixel_density"};
   if (type == "lambert") {
     material.bsdf = LambertBsdf{colourOr(ctx, value, "albedo", Rgb(0.8f), where)};
@@ -239,6 +240,10 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
     fail("{}: {}: alpha_cutoff {} must be in [0, 1]", ctx.path, where, material.alphaCutoff);
   if (find(value, "alpha_cutoff") && material.alphaTexture < 0)
     fail("{}: {}: alpha_cutoff needs an alpha_texture", ctx.path, where);
+  if (const json* texture = find(value, "emission_texture")) {
+    if (!material.isEmissive()) fail("{}: {}: emission_texture needs a non-black \"emission\"", ctx.path, where);
+    material.emissionTexture = loadTexture(ctx, scene, *texture, where + ".emission_texture");
+  }
   if (const json* texture = find(value, "normal_texture"))
     material.normalTexture = loadTexture(ctx, scene, *texture, where + ".normal_texture", ImageDecode::Data);
   material.normalScale = numberOr(ctx, value, "normal_scale", material.normalScale, where);

@@ -24,7 +24,8 @@ void appendScene(Scene& scene, Scene&& part) {
   const auto textureOffset = int(scene.textures.size());
   for (Material& material : part.materials) {
     for (int* texture :
-         {&material.albedoTexture, &material.alphaTexture, &material.normalTexture, &material.metallicRoughness.texture})
+         {&material.albedoTexture, &material.alphaTexture, &material.normalTexture, &material.metallicRoughness.texture,
+          &material.emissionTexture})
       if (*texture >= 0) *texture += textureOffset;
     for (int& texture : material.layers.texture)
       if (texture >= 0) texture += textureOffset;

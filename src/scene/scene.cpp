@@ -40,7 +40,8 @@ std::string mappingProblem(const Material& material) {
   const std::pair<const char*, const TextureMapping*> slots[] = {{"albedo", &material.albedoMapping},
                                                                  {"alpha", &material.alphaMapping},
                                                                  {"normal", &material.normalMapping},
-                                                                 {"metallic-roughness", &material.metallicRoughness.mapping}};
+                                                                 {"metallic-roughness", &material.metallicRoughness.mapping},
+                                                                 {"emission", &material.emissionMapping}};
   auto mappingIssue = [](const char* slot, const TextureMapping& mapping) -> std::string {
     if (mapping.uvSet > 1) return fmt::format("the {} texture reads uv set {} (0 or 1)", slot, mapping.uvSet);
     if (!isFinite2(mapping.offset) || !isFinite2(mapping.linear[0]) || !isFinite2(mapping.linear[1]))
@@ -95,7 +96,7 @@ void checkScene(const Scene& scene) {
            material.name, vecString(material.emission), kMaxEmission);
     validateMaterial(material, src);
     std::vector<int> textures = {material.albedoTexture, material.alphaTexture, material.normalTexture,
-                                 material.metallicRoughness.texture};
+                                 material.metallicRoughness.texture, material.emissionTexture};
     textures.insert(textures.end(), material.layers.texture.begin(), material.layers.texture.end());
     for (const int texture : textures)
       if (texture < -1 || texture >= int64_t(scene.textures.size()))
@@ -357,6 +358,7 @@ AlbedoPoint albedoPointAt(const Scene& scene, uint32_t meshIndex, uint32_t trian
   p.vertexColor = vertexColorAt(mesh, triangle, barycentrics);
   if (material.metallicRoughness.texture >= 0)
     p.metallicRoughnessUv = uvAt(mesh, triangle, barycentrics, material.metallicRoughness.mapping);
+  if (material.emissionTexture >= 0) p.emission = emissionModulation(scene, material, meshIndex, triangle, barycentrics);
   return p;
 }
 
@@ -397,6 +399,13 @@ GltfPbrBsdf layeredModelAt(const Scene& scene, const Material& material, const A
 
 }  // namespace
 
+Rgb emissionModulation(const Scene& scene, const Material& material, uint32_t mesh, uint32_t triangle,
+                       Vec2 barycentrics) {
+  if (material.emissionTexture < 0) return Rgb(1.0f);
+  return scene.textures[size_t(material.emissionTexture)].sample(
+      uvAt(scene.meshes[mesh], triangle, barycentrics, material.emissionMapping));
+}
+
 Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p) {
   const MetallicRoughnessMap& mr = material.metallicRoughness;
   if (!material.modelVaries()) return material.bsdf;
@@ -408,7 +417,6 @@ Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoP
   }
   return withDiffuseAlbedo(material.bsdf, diffuseAlbedo(material.bsdf) * modulation);
 }
-
 
 Bsdf bsdfAt(const Scene& scene, const SurfaceHit& hit) {
   const Material& material = scene.materials[hit.material];

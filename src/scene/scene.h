@@ -80,6 +80,10 @@ struct Material {
   /// given by the triangle's winding, counter-clockwise = front) unless twoSided.
   Rgb emission{0.0f};
   bool twoSidedEmission = false;
+  /// Emission texture (glTF emissiveTexture, JSON "emission_texture"): index into Scene::textures
+  /// (ImageDecode::Colour, sRGB) or −1. Le at a point is emission × the texel at its uv through
+  /// emissionMapping, at full resolution (emissionModulation).
+  int emissionTexture = -1;
   /// Alpha mask (cut-out): coverage α = alphaFactor × (alphaTexture's coverage at uv, or 1
   /// without one). Where α < alphaCutoff the surface is not there at all: ray casting (Accel)
   /// skips the hit, so every renderer, shadow ray and the bake see through it. alphaTexture is
@@ -97,7 +101,7 @@ struct Material {
   float tixelDensity = 1.0f;
   /// The uv set and transform each texture slot reads (TextureMapping; all default outside
   /// glTF). The alpha mask's is the albedo texture's in glTF (both are baseColorTexture).
-  TextureMapping albedoMapping, alphaMapping, normalMapping;
+  TextureMapping albedoMapping, alphaMapping, normalMapping, emissionMapping;
   /// Per-point metalness and roughness (glTF only); see MetallicRoughnessMap.
   MetallicRoughnessMap metallicRoughness;
   /// Per-hit glTF layer textures (glTF only, path tracer only); see PbrLayerMaps.
@@ -334,6 +338,9 @@ struct AlbedoPoint {
   float lod = 0.0f;
   Rgb vertexColor{1.0f};
   Vec2 metallicRoughnessUv{0.0f};  ///< where a metallic-roughness texture is read (its own slot)
+  /// The emission texture at the point (emissionModulation; 1 without one): the renderers
+  /// multiply a diffuse chart's emission by it per pixel.
+  Rgb emission{1.0f};
 };
 AlbedoPoint albedoPointAt(const Scene& scene, uint32_t mesh, uint32_t triangle, Vec2 barycentrics);
 
@@ -341,6 +348,13 @@ AlbedoPoint albedoPointAt(const Scene& scene, uint32_t mesh, uint32_t triangle, 
 /// both renderers (lookup.h diffuseAlbedoAt): what multiplies the material's diffuse albedo at
 /// `p` — its albedo texture at p.uv and mip level p.lod (1 without one) × p.vertexColor.
 Rgb albedoModulation(const Scene& scene, const Material& material, const AlbedoPoint& p);
+
+/// The emission rule, written once for the path tracer, the light sampler, the bake and the
+/// renderers: what multiplies Material::emission at barycentrics (b1, b2) of triangle
+/// `triangle` of mesh `mesh` — the emission texture's texel at its slot's uv (Texture::sample:
+/// full resolution, the texture's own wrap and filter), or 1 without one.
+Rgb emissionModulation(const Scene& scene, const Material& material, uint32_t mesh, uint32_t triangle,
+                       Vec2 barycentrics);
 
 /// What is wrong with a material's texture mappings and metallic-roughness map ("" if nothing):
 /// a uv set other than 0 and 1, a non-finite transform, a metallic-roughness texture on a

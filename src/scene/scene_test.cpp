@@ -1118,18 +1118,22 @@ TEST(GltfLoader, AlphaModesAndNormalTexture) {
   expectError([&] { withMaterialKeys(R"("alphaMode": "CLIP",)", "checker.png", "bad"); }, {"quad.gltf", "alphaMode 'CLIP'"});
 }
 
+/// Copies the textured quad (OBJ, MTL, checker) into `dir` and returns a writer of dir/s.json:
+/// the quad with Lambert material `material` given the keys it is called with; it returns the path.
+std::function<std::string(const std::string&)> quadSceneWriter(const fs::path& dir, const std::string& material) {
+  fs::create_directories(dir / "textured" / "mat");
+  for (const char* f : {"textured/quad.obj", "textured/mat/quad.mtl", "textured/mat/checker.png"}) fs::copy_file(kDataDir + f, dir / f);
+  return [dir, material](const std::string& keys) {
+    return writeFile(dir / "s.json", R"({"meshes": [{"file": "textured/quad.obj", "material": ")" + material +
+                                         R"("}], "materials": {")" + material + R"(": {"type": "lambert", )" + keys + "}}}");
+  };
+}
+
 TEST(JsonScene, AlphaAndNormalTextures) {
   const fs::path dir = scratchDir("json_detail");
   fs::copy_file(kDataDir + "mask_rgba.png", dir / "mask.png");
   fs::copy_file(kDataDir + "normal_tilt.png", dir / "n.png");
-  fs::create_directories(dir / "textured" / "mat");
-  fs::copy_file(kDataDir + "textured/quad.obj", dir / "textured/quad.obj");
-  fs::copy_file(kDataDir + "textured/mat/quad.mtl", dir / "textured/mat/quad.mtl");
-  fs::copy_file(kDataDir + "textured/mat/checker.png", dir / "textured/mat/checker.png");
-  auto scene = [&](const std::string& material) {
-    return writeFile(dir / "s.json", R"({"meshes": [{"file": "textured/quad.obj", "material": "leaf"}],
-      "materials": {"leaf": {"type": "lambert", )" + material + "}}}");
-  };
+  const auto scene = quadSceneWriter(dir, "leaf");
   const Scene loaded = loadScene(scene(R"("alpha_texture": "mask.png", "alpha_cutoff": 0.2,
       "normal_texture": "n.png", "normal_scale": 0.5)"));
   const Material& leaf = materialNamed(loaded, "leaf");
@@ -1148,6 +1152,28 @@ TEST(JsonScene, AlphaAndNormalTextures) {
   const std::string bytes((std::istreambuf_iterator<char>(mask)), std::istreambuf_iterator<char>());
   writeFile(dir / "cut.png", bytes.substr(0, 40));  // cut inside the IDAT chunk
   expectError([&] { loadScene(scene(R"("alpha_texture": "cut.png")")); }, {"cut.png", "truncated"});
+}
+
+// "emission_texture": an sRGB colour texture multiplying "emission" (emissionModulation); it
+// needs an emission to multiply, and a missing file is an error naming the material's key.
+TEST(JsonScene, EmissionTexture) {
+  const fs::path dir = scratchDir("json_emission");
+  const auto scene = quadSceneWriter(dir, "lamp");
+  fs::copy_file(kDataDir + "textured/mat/checker.png", dir / "glow.png");
+  const Scene loaded = loadScene(scene(R"("emission": [2, 3, 4], "emission_texture": "glow.png")"));
+  const Material& lamp = materialNamed(loaded, "lamp");
+  ASSERT_GE(lamp.emissionTexture, 0);
+  const Texture& glow = loaded.textures[size_t(lamp.emissionTexture)];
+  EXPECT_EQ(glow.decode, ImageDecode::Colour);
+  const Vec2 b(0.2f, 0.3f);
+  EXPECT_VEC3_NEAR(emissionModulation(loaded, lamp, 0, 0, b), glow.sample(uvAt(loaded.meshes[0], 0, b)), 0.0f);
+  EXPECT_VEC3_NEAR(emissionModulation(loaded, materialNamed(loadScene(scene(R"("emission": 1)")), "lamp"), 0, 0, b), Rgb(1.0f),
+                   0.0f);
+
+  expectError([&] { loadScene(scene(R"("emission": 1, "emission_texture": "gone.png")")); },
+              {"s.json", "materials.lamp.emission_texture", "gone.png", "not found"});
+  expectError([&] { loadScene(scene(R"("emission_texture": "glow.png")")); },
+              {"s.json", "materials.lamp", "emission_texture needs a non-black \"emission\""});
 }
 
 TEST(BadInput, MissingOrCorruptAlphaAndNormalTexturesInMtl) {

@@ -247,6 +247,31 @@ Rgb Texture::sample(Vec2 uv) const {
   return sampleLevel(image, packed, palette, uv, kBilinearFootprint, result) ? result : average;
 }
 
+Rgb Texture::maxOver(Vec2 lo, Vec2 hi) const {
+  if (image.empty()) return Rgb(1.0f);
+  // The continuous texel coordinates of the corners (sampledFootprint's, v flipped), widened
+  // by one texel on each side: that covers both the bilinear and the nearest footprints.
+  // Spans wider than the image, and coordinates too large to step through by 1 (or not
+  // finite: sample() then reads `average`), take the whole axis.
+  const float x0 = std::floor(lo.x * float(image.width)) - 1.0f, x1 = std::floor(hi.x * float(image.width)) + 1.0f;
+  const float y0 = std::floor((1.0f - hi.y) * float(image.height)) - 1.0f,
+              y1 = std::floor((1.0f - lo.y) * float(image.height)) + 1.0f;
+  auto indices = [](float first, float last, int n, TextureWrap wrap) {
+    std::vector<int> out;
+    if (!(last - first < float(n) && std::abs(first) < 0x1p24f && std::abs(last) < 0x1p24f)) {
+      for (int i = 0; i < n; ++i) out.push_back(i);
+      return out;
+    }
+    for (float i = first; i <= last; i += 1.0f) out.push_back(wrapIndex(i, n, wrap));
+    return out;
+  };
+  Rgb result(0.0f);
+  const std::vector<int> xs = indices(x0, x1, image.width, sampling.wrapU);
+  for (const int y : indices(y0, y1, image.height, sampling.wrapV))
+    for (const int x : xs) result = glm::max(result, image.at(x, y));
+  return result;
+}
+
 Rgb Texture::sampleLod(Vec2 uv, float lod) const {
   if (!(lod > 0.0f) || mips.empty() || !sampling.mipmaps) return sample(uv);  // also NaN
   if (!sampling.isDefault()) {

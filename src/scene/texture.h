@@ -58,6 +58,11 @@ struct Texture {
   /// into the albedo; the renderers count and report non-finite radiance where it arises. The
   /// path tracer, the bake and normal/alpha maps read textures here.
   Rgb sample(Vec2 uv) const;
+  /// The per-channel maximum of every level-0 texel that sample() may read at a uv in the
+  /// rectangle [lo, hi] (wrapped as `sampling` says; the whole image's for a non-finite
+  /// corner): a bound on sample() over the rectangle, so 0 only where sample() is 0 all over
+  /// it. The light sampler's test of which emitting triangles are black (light/emitters.h).
+  Rgb maxOver(Vec2 lo, Vec2 hi) const;
   /// Trilinear: bilinear in mip levels ⌊lod⌋ and ⌊lod⌋ + 1 (`levels`), blended by the
   /// fraction of lod. lod ≤ 0 or NaN is exactly sample(uv) (magnified or unfiltered: full
   /// resolution, the same bits); lod beyond the coarsest level reads that level alone. Level l

@@ -200,15 +200,17 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
     throughput *= interiorTransmittance(material, cosWoGeometric, hit.t);  // Beer–Lambert (scene.h)
 
     if (!isBlack(emittedRadiance(material, cosWoGeometric))) {  // the emission sidedness rule (scene.h)
+      // Le at the hit: the emission times its texture there (scene.h emissionModulation).
+      const Rgb le = material.emission * emissionModulation(scene, material, hit.mesh, hit.triangle, hit.barycentrics);
       if (countEmissionFully) {
-        result += throughput * material.emission;
+        result += throughput * le;
       } else if (useMis) {
         // The density NEE would have had for this point, in solid angle at the previous
         // vertex (t from that vertex, through any thin glass crossed straight). A triangle
         // that is no light (zero power) has density 0: BSDF sampling alone finds it.
         const float lightPdf =
             lights.emitterPdf(hit.mesh, hit.triangle, distanceBefore + hit.t, std::abs(cosWoGeometric));
-        result += throughput * material.emission * powerHeuristic(previousBsdfPdf, lightPdf);
+        result += throughput * le * powerHeuristic(previousBsdfPdf, lightPdf);
       }
     }
     if (depth >= maxDepth) break;
