@@ -8,8 +8,10 @@
 //      buffer, writing its triangle id (+1; 0 = nothing) per pixel — the primary hit of the
 //      ray through the pixel centre, as the CPU renderer's one sample per pixel;
 //   2. shading: per pixel, the camera ray of Camera::generateRay through the pixel centre,
-//      intersected with the plane of that triangle (the hit point origin + t·direction, as the
-//      CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
+//      intersected with the triangles of that pixel and its 8 neighbours (the rasteriser snaps
+//      vertices to a sub-pixel grid, which can hand a centre near an edge the triangle across
+//      it; the nearest hit is the ray caster's answer), the hit point origin + t·direction (as
+//      the CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
 //      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes) in a fragment shader,
 //      times the camera weight (cos⁴θ with vignetting). A miss sees the constant environment.
 // The result is radiance (W·sr⁻¹·m⁻², camera weight included, no exposure), read back into an

@@ -225,7 +225,34 @@ void main() {
   float weight = 1.0;
   if (vignetting) weight = invLength * invLength * invLength * invLength;  // cos^4
   vec3 direction = toFilm * invLength;
-  uint id = texelFetch(ids, pixel, 0).r;
+  // The visible triangle: rasterisation snaps vertices to a sub-pixel grid, so a pixel centre
+  // within that snap of an edge may be given the triangle across it. The ray is tested against
+  // the triangles of the pixel and its 8 neighbours (Möller–Trumbore, edges inclusive) and the
+  // nearest it hits is taken — the ray caster's answer; the pixel's own triangle's plane if it
+  // hits none of them (a sliver no centre covers).
+  uint id = 0u;
+  float t = 1.0 / 0.0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      uint candidate = texelFetch(ids, clamp(pixel + ivec2(dx, dy), ivec2(0), size - 1), 0).r;
+      if (candidate == 0u || candidate == id) continue;
+      uvec4 tri = triangles[candidate - 1u];
+      vec3 p0 = positions[tri.x].xyz, e1 = positions[tri.y].xyz - p0, e2 = positions[tri.z].xyz - p0;
+      vec3 q = cross(direction, e2);
+      float det = dot(e1, q);
+      if (det == 0.0) continue;
+      vec3 s = eye - p0;
+      float u = dot(s, q) / det;
+      vec3 r = cross(s, e1);
+      float v = dot(direction, r) / det;
+      float hit = dot(e2, r) / det;
+      if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit > 0.0 && hit < t) {
+        t = hit;
+        id = candidate;
+      }
+    }
+  uint own = texelFetch(ids, pixel, 0).r;
+  if (id == 0u) id = own;
   if (id == 0u) {
     color = vec4(weight * background, 1.0);
     return;
@@ -233,7 +260,7 @@ void main() {
   uvec4 tri = triangles[id - 1u];
   vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
   vec3 n = cross(p1 - p0, p2 - p0);
-  float t = dot(p0 - eye, n) / dot(direction, n);
+  if (isinf(t)) t = dot(p0 - eye, n) / dot(direction, n);
   vec3 p = eye + t * direction;
   ChartRecord c = charts[tri.w];
   vec3 normalAtHit = c.normal.xyz, shadingNormal = c.normal.xyz;

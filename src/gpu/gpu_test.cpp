@@ -9,10 +9,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 
 #include "accel/accel.h"
+#include "bake/bake.h"
 #include "bake/parameterisation.h"
 #include "camera/camera.h"
 #include "core/error.h"
@@ -21,7 +24,9 @@
 #include "core/sampling.h"
 #include "image/compare.h"
 #include "lightfield/lookup.h"
+#include "plf/plf_file.h"
 #include "realtime/realtime.h"
+#include "support/cli_test_support.h"
 
 namespace pl {
 namespace {
@@ -113,6 +118,17 @@ TEST_F(GpuRendererTest, MatchesFastRendererOnOriginalCornellBox) {
   expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 64, 48);
 }
 
+// Baked light fields (draft preset: a smooth bake, as users render), built-in box and glossy box.
+TEST_F(GpuRendererTest, MatchesFastRendererOnDraftBakes) {
+  for (const std::string& name : {std::string("cornell"), kMcGuire + "CornellBox-Glossy.obj"}) {
+    SCOPED_TRACE(name);
+    const LightField lf = bake(loadScene(name), bakePreset("draft"));
+    GpuRenderer gpu(lf);
+    expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 64, 48);
+    expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 64, 48);
+  }
+}
+
 // The shader's lookup (the function the shading pass calls) against exitantRadiance on random
 // points and directions over every chart: both sides of each record, points off the grid
 // (clamped), grazing and below-horizon directions.
@@ -192,6 +208,60 @@ TEST_F(GpuRendererTest, GpuMemoryIsTheLightFieldAndOneFrame) {
   EXPECT_LE(gpu.gpuBytes(), expected + 6 * 16);
   EXPECT_GE(gpu.gpuBytes(), expected);
   EXPECT_NE(gpu.deviceName().find("OpenGL 4.5"), std::string::npos) << gpu.deviceName();
+}
+
+// `plenoptic render --renderer gpu` end to end: the picture of `--renderer cpu`, its stats,
+// and the refusals (what it does not draw, no OpenGL 4.5 context, --reference with it).
+class GpuRenderCliTest : public cli_test::CliTest {
+ protected:
+  void SetUp() override {
+    CliTest::SetUp();
+    writeLightField(path("box.plf"), randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 8));
+  }
+};
+
+TEST_F(GpuRenderCliTest, RendersTheCpuPicture) {
+  std::string err;
+  const std::string size = " --width 64 --height 48";
+  ASSERT_EQ(run("render " + path("box.plf") + " -o " + path("gpu.exr") + size + " --renderer gpu --stats " + path("gpu.json"),
+                nullptr, &err),
+            0)
+      << err;
+  ASSERT_EQ(run("render " + path("box.plf") + " -o " + path("cpu.exr") + size + " --renderer cpu", nullptr, &err), 0) << err;
+  const ImageComparison c = compareImages(readImage(path("gpu.exr")), readImage(path("cpu.exr")));
+  EXPECT_LE(c.relMseAverage, 1e-4);
+  EXPECT_NEAR(c.meanLuminanceRatio, 1.0, 1e-3);
+  const auto json = nlohmann::json::parse(cli_test::readFileText(path("gpu.json")));
+  EXPECT_EQ(json["renderer"], "gpu");
+  EXPECT_NE(std::string(json["device"]).find("OpenGL 4.5"), std::string::npos) << json["device"];
+  EXPECT_GT(double(json["primary_ms_median"]), 0.0);  // the rasterisation pass alone
+}
+
+TEST_F(GpuRenderCliTest, RefusesWhatItDoesNotDrawAndWritesNothing) {
+  writeLightField(path("mirror.plf"), randomLightField(loadScene(kMcGuire + "CornellBox-Mirror.obj"), 9));
+  std::string err;
+  EXPECT_NE(run("render " + path("mirror.plf") + " -o " + path("m.exr") + " --renderer gpu", nullptr, &err), 0);
+  EXPECT_NE(err.find("mirrors and glass"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(path("m.exr")));
+  EXPECT_NE(run("render " + path("box.plf") + " -o " + path("s.exr") + " --renderer gpu --spp 4", nullptr, &err), 0);
+  EXPECT_NE(err.find("more than one sample per pixel"), std::string::npos) << err;
+  EXPECT_NE(run("render " + path("box.plf") + " -o " + path("r.exr") + " --renderer gpu --reference", nullptr, &err), 0);
+  EXPECT_NE(err.find("--reference and --renderer gpu"), std::string::npos) << err;
+  EXPECT_NE(run("render " + path("box.plf") + " -o " + path("r.exr") + " --renderer vulkan", nullptr, &err), 0);
+  EXPECT_FALSE(std::filesystem::exists(path("s.exr")));
+  EXPECT_FALSE(std::filesystem::exists(path("r.exr")));
+}
+
+// A driver that offers less than OpenGL 4.5 (Mesa told to report 3.3): a clear error naming
+// the EGL error, a non-zero exit, no image.
+TEST_F(GpuRenderCliTest, NoOpenGl45ContextIsAClearError) {
+  std::string err;
+  EXPECT_NE(cli_test::runPlenoptic("render " + path("box.plf") + " -o " + path("n.exr") + " --renderer gpu --quiet", dir_,
+                                   nullptr, &err, "MESA_GL_VERSION_OVERRIDE=3.3"),
+            0);
+  EXPECT_NE(err.find("no OpenGL 4.5 core context"), std::string::npos) << err;
+  EXPECT_NE(err.find("EGL_BAD_MATCH"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(path("n.exr")));
 }
 
 }  // namespace
