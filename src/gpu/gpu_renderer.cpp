@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cstring>
 #include <limits>
-#include <optional>
 
 #include "camera/camera.h"
 #include "core/error.h"
@@ -55,9 +54,10 @@ std::string glslConstants() {
 
 // The lookup of lightfield/lookup.h in GLSL, statement for statement (the names are the C++
 // functions'): linearTap, paraboloidTexelCoordinate (paraboloid.h), directionToParaboloid
-// (paraboloid.cpp), interpolateLanes, bilinearOverTixels, facingChart / viewedChart
-// (lightfield.h) and exitantRadianceLanes for the charts gpuUnsupportedFeature lets through
-// (no textures, sun masks, tilted irradiances or curved glossy maps; Blinn-Phong's k = 1).
+// (paraboloid.cpp), interpolateLanes, bilinearOverTixels (diffuseValueOverTixels),
+// continuousFrameAround (toLocalAround), facingChart / viewedChart (lightfield.h) and
+// exitantRadianceLanes for the charts gpuUnsupportedFeature lets through (no textures, sun
+// masks or tilted irradiances; Blinn-Phong's k = 1).
 // GpuRenderer::lookup runs it against the C++ on random inputs (gpu_test).
 constexpr const char* kLookupGlsl = R"glsl(
 struct ChartRecord {
@@ -319,6 +319,17 @@ void checkGl(const char* what) {
   if (error != GL_NO_ERROR) fail("GPU renderer: {}: {}", what, glErrorName(error));
 }
 
+/// The info log of a shader or program (getLength/getLog: glGetShaderiv/glGetShaderInfoLog or
+/// the program pair).
+template <typename GetLength, typename GetLog>
+std::string infoLog(GLuint object, GetLength getLength, GetLog getLog) {
+  GLint length = 0;
+  getLength(object, GL_INFO_LOG_LENGTH, &length);
+  std::string log(size_t(std::max(length, 1)), '\0');
+  getLog(object, length, nullptr, log.data());
+  return log.c_str();
+}
+
 GLuint compileShader(GLenum type, const std::string& source, const char* name) {
   const GLuint shader = glCreateShader(type);
   const char* text = source.c_str();
@@ -327,12 +338,9 @@ GLuint compileShader(GLenum type, const std::string& source, const char* name) {
   GLint ok = 0;
   glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
   if (!ok) {
-    GLint length = 0;
-    glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
-    std::string log(size_t(std::max(length, 1)), '\0');
-    glGetShaderInfoLog(shader, length, nullptr, log.data());
+    const std::string log = infoLog(shader, glGetShaderiv, glGetShaderInfoLog);
     glDeleteShader(shader);
-    fail("GPU renderer: the {} shader does not compile: {}", name, log.c_str());
+    fail("GPU renderer: the {} shader does not compile: {}", name, log);
   }
   return shader;
 }
@@ -352,12 +360,9 @@ GLuint linkProgram(std::initializer_list<std::pair<GLenum, const char*>> stages,
   GLint ok = 0;
   glGetProgramiv(program, GL_LINK_STATUS, &ok);
   if (!ok) {
-    GLint length = 0;
-    glGetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
-    std::string log(size_t(std::max(length, 1)), '\0');
-    glGetProgramInfoLog(program, length, nullptr, log.data());
+    const std::string log = infoLog(program, glGetProgramiv, glGetProgramInfoLog);
     glDeleteProgram(program);
-    fail("GPU renderer: the {} program does not link: {}", name, log.c_str());
+    fail("GPU renderer: the {} program does not link: {}", name, log);
   }
   return program;
 }

@@ -10,13 +10,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 
 #include "accel/accel.h"
 #include "bake/bake.h"
-#include "bake/parameterisation.h"
 #include "camera/camera.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -27,28 +27,14 @@
 #include "plf/plf_file.h"
 #include "realtime/realtime.h"
 #include "support/cli_test_support.h"
+#include "support/random_light_field.h"
 
 namespace pl {
 namespace {
 
 const std::string kMcGuire = std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/";
 
-/// A light field over `scene` with the default preset's charts and random values in [0, 4)
-/// (no propagation: fast, and harsher on the lookup than a smooth bake, since every tixel and
-/// direction texel differs from its neighbours).
-LightField randomLightField(Scene scene, uint64_t seed) {
-  LightField lf;
-  lf.settings = BakeSettings{};
-  Parameterisation param = buildParameterisation(scene, lf.settings);
-  lf.charts = std::move(param.charts);
-  lf.triangleChart = std::move(param.triangleChart);
-  lf.values.resize(param.valueCount);
-  Pcg32 rng(seed, 7);
-  for (Rgb& v : lf.values) v = Rgb(4.0f * rng.uniform(), 4.0f * rng.uniform(), 4.0f * rng.uniform());
-  lf.scene = std::move(scene);
-  lf.scene.finalize();
-  return lf;
-}
+using test_support::randomLightField;
 
 CameraDesc firstCamera(const Scene& scene) { return scene.cameras.empty() ? scene.automaticCamera() : scene.cameras.front(); }
 
@@ -235,6 +221,28 @@ TEST_F(GpuRenderCliTest, RendersTheCpuPicture) {
   EXPECT_EQ(json["renderer"], "gpu");
   EXPECT_NE(std::string(json["device"]).find("OpenGL 4.5"), std::string::npos) << json["device"];
   EXPECT_GT(double(json["primary_ms_median"]), 0.0);  // the rasterisation pass alone
+}
+
+// A walk-through (--path) frame by frame, on the built-in box.
+TEST_F(GpuRenderCliTest, CameraPathFramesAreTheCpuFrames) {
+  writeLightField(path("cornell.plf"), randomLightField(makeCornellBox(), 10));
+  std::ofstream(path("path.json")) << R"({"fps": 30, "keyframes": [
+      {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0], "fov": 39},
+      {"time": 0.1, "eye": [150, 300, -400], "target": [300, 200, 300]}]})";
+  for (const std::string renderer : {"gpu", "cpu"}) {
+    std::string err;
+    ASSERT_EQ(run("render " + path("cornell.plf") + " --path " + path("path.json") + " -o " + path(renderer + "/%02d.exr") +
+                      " --width 48 --height 36 --renderer " + renderer,
+                  nullptr, &err),
+              0)
+        << err;
+  }
+  for (const std::string frame : {"00", "01", "02", "03"}) {
+    SCOPED_TRACE(frame);
+    const ImageComparison c = compareImages(readImage(path("gpu/" + frame + ".exr")), readImage(path("cpu/" + frame + ".exr")));
+    EXPECT_LE(c.relMseAverage, 1e-4);
+    EXPECT_NEAR(c.meanLuminanceRatio, 1.0, 1e-3);
+  }
 }
 
 TEST_F(GpuRenderCliTest, RefusesWhatItDoesNotDrawAndWritesNothing) {
