@@ -260,8 +260,8 @@ TEST_F(GpuRenderCliTest, RefusesWhatItDoesNotDrawAndWritesNothing) {
   EXPECT_FALSE(std::filesystem::exists(path("r.exr")));
 }
 
-// A driver that offers less than OpenGL 4.5 (Mesa told to report 3.3): a clear error naming
-// the EGL error, a non-zero exit, no image.
+// A driver that offers less than OpenGL 4.5 (Mesa told to report 3.3), and no EGL at all: a
+// clear error naming the EGL error, a non-zero exit, no image.
 TEST_F(GpuRenderCliTest, NoOpenGl45ContextIsAClearError) {
   std::string err;
   EXPECT_NE(cli_test::runPlenoptic("render " + path("box.plf") + " -o " + path("n.exr") + " --renderer gpu --quiet", dir_,
@@ -269,6 +269,14 @@ TEST_F(GpuRenderCliTest, NoOpenGl45ContextIsAClearError) {
             0);
   EXPECT_NE(err.find("no OpenGL 4.5 core context"), std::string::npos) << err;
   EXPECT_NE(err.find("EGL_BAD_MATCH"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(path("n.exr")));
+  // No EGL implementation at all (the vendor-neutral libEGL finds no vendor): no platform
+  // extension, no display — the same clear error, no abort.
+  EXPECT_EQ(cli_test::runPlenoptic("render " + path("box.plf") + " -o " + path("n.exr") + " --renderer gpu --quiet", dir_,
+                                   nullptr, &err, "__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json"),
+            1);
+  EXPECT_NE(err.find("no OpenGL 4.5 core context"), std::string::npos) << err;
+  EXPECT_NE(err.find("EGL_MESA_platform_surfaceless not offered"), std::string::npos) << err;
   EXPECT_FALSE(std::filesystem::exists(path("n.exr")));
 }
 
