@@ -21,14 +21,15 @@
 // The light field is uploaded once: its values as 16-byte RGBA (the CPU renderer's padded
 // copy), its chart records with their precomputed shading (ChartShading), the vertex positions
 // and normals (a curved glossy chart's map is read around the interpolated normal,
-// chartShadingNormalAt) and the triangle → chart map. So GPU memory is 16 bytes per value +
-// 128 per chart + 32 per vertex + 28 per triangle + the frame's targets (id, depth and
-// radiance: 24 bytes per pixel).
+// chartShadingNormalAt), the triangle → chart map and the sun masks (one uint each; the masked
+// lights are uniforms). So GPU memory is 16 bytes per value + 128 per chart + 32 per vertex +
+// 28 per triangle + 4 per sun mask + the frame's targets (id, depth and radiance: 24 bytes
+// per pixel).
 //
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
 // picture): mirrors and glass (specular charts), albedo textures and vertex colours, normal
-// maps, alpha masks, sun masks, punctual highlights, rough glass, GGX diffuse bases,
+// maps, alpha masks, punctual highlights, rough glass, GGX diffuse bases,
 // environment maps (a constant environment is drawn); and of the render settings, more than one
 // sample per pixel (and so thin lenses).
 //

@@ -17,14 +17,14 @@ namespace {
 // Chart record flags (ChartGpu::info.z). The GLSL constants are generated from these
 // (glslConstants), so the shader and the upload cannot disagree.
 constexpr uint32_t kFlagTwoSided = 1u, kFlagBack = 2u, kFlagCurved = 4u, kFlagDiffuseValue = 8u, kFlagEmissive = 16u,
-                   kFlagTwoSidedEmission = 32u;
+                   kFlagTwoSidedEmission = 32u, kFlagSunMasks = 64u;
 
 /// One chart record as the shaders read it (std430: eight 16-byte rows).
 struct ChartGpu {
   float origin[4];        ///< xyz: Chart::origin; w: 1 / tixelSize (ChartShading::inverseTixelSize)
   float axisU[4], axisV[4], normal[4];
   uint32_t grid[4];       ///< resU, resV, dirRes, firstValue
-  uint32_t info[4];       ///< valuesPerTixel, kind (ChartKind), flags, 0
+  uint32_t info[4];       ///< valuesPerTixel, kind (ChartKind), flags, firstTixel (its sun masks)
   float emission[4];      ///< ChartShading::emission
   float albedoOverPi[4];  ///< ChartShading::albedoOverPi
 };
@@ -38,18 +38,19 @@ struct TriangleGpu {
 
 // Shader storage bindings.
 constexpr GLuint kValuesBinding = 0, kChartsBinding = 1, kPositionsBinding = 2, kTrianglesBinding = 3,
-                 kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6;
+                 kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7;
 
 std::string glslConstants() {
   return fmt::format(
       "const uint kDiffuse = {}u, kGlossy = {}u, kSpecular = {}u;\n"
       "const uint kFlagTwoSided = {}u, kFlagBack = {}u, kFlagCurved = {}u, kFlagDiffuseValue = {}u, kFlagEmissive = {}u, "
-      "kFlagTwoSidedEmission = {}u;\n"
+      "kFlagTwoSidedEmission = {}u, kFlagSunMasks = {}u;\nconst int kMaxSunMaskLights = {}, kSunMaskSide = {};\n"
       "#define VALUES_BINDING {}\n#define CHARTS_BINDING {}\n#define POSITIONS_BINDING {}\n#define TRIANGLES_BINDING {}\n"
-      "#define QUERIES_BINDING {}\n#define RESULTS_BINDING {}\n#define NORMALS_BINDING {}\n",
+      "#define QUERIES_BINDING {}\n#define RESULTS_BINDING {}\n#define NORMALS_BINDING {}\n#define SUN_MASKS_BINDING {}\n",
       unsigned(ChartKind::Diffuse), unsigned(ChartKind::Glossy), unsigned(ChartKind::Specular), kFlagTwoSided, kFlagBack,
-      kFlagCurved, kFlagDiffuseValue, kFlagEmissive, kFlagTwoSidedEmission, kValuesBinding, kChartsBinding,
-      kPositionsBinding, kTrianglesBinding, kQueriesBinding, kResultsBinding, kNormalsBinding);
+      kFlagCurved, kFlagDiffuseValue, kFlagEmissive, kFlagTwoSidedEmission, kFlagSunMasks, kMaxSunMaskLights, kSunMaskSide,
+      kValuesBinding, kChartsBinding, kPositionsBinding, kTrianglesBinding, kQueriesBinding, kResultsBinding, kNormalsBinding,
+      kSunMasksBinding);
 }
 
 // The lookup of lightfield/lookup.h in GLSL, statement for statement (the names are the C++
@@ -57,7 +58,8 @@ std::string glslConstants() {
 // (paraboloid.cpp), interpolateLanes, bilinearOverTixels (diffuseValueOverTixels),
 // continuousFrameAround (toLocalAround), facingChart / viewedChart (lightfield.h) and
 // exitantRadianceLanes for the charts gpuUnsupportedFeature lets through (no textures, sun
-// masks or tilted irradiances; Blinn-Phong's k = 1).
+// masks or tilted irradiances; Blinn-Phong's k = 1), with sunVisibility and sunIrradianceLanes
+// for the sun masks.
 // GpuRenderer::lookup runs it against the C++ on random inputs (gpu_test).
 constexpr const char* kLookupGlsl = R"glsl(
 struct ChartRecord {
@@ -70,6 +72,10 @@ struct ChartRecord {
 };
 layout(std430, binding = VALUES_BINDING) readonly buffer Values { vec4 values[]; };
 layout(std430, binding = CHARTS_BINDING) readonly buffer Charts { ChartRecord charts[]; };
+// LightField::sunMasks, one uint per mask; SunLights: direction towards each light, irradiance.
+layout(std430, binding = SUN_MASKS_BINDING) readonly buffer SunMasks { uint sunMasks[]; };
+uniform uint sunCount;
+uniform vec3 sunTowards[kMaxSunMaskLights], sunIrradiance[kMaxSunMaskLights];
 
 struct LinearTap { uint i0, i1; float f; };
 LinearTap linearTap(float x, uint count) {
@@ -134,6 +140,48 @@ vec3 diffuseValueOverTixels(ChartRecord c, vec2 grid) {
                tu.f * tv.f * values[valueIndex(c, tu.i1, tv.i1, 0u, 0u) + map].rgb;
   return lower + upper;
 }
+// sunVisibility (lightfield.h): light l's mask bilinear between the four nearest sub-samples.
+void sunAxis(float g, uint res, out uint s0, out uint s1, out float f) {
+  uint side = uint(kSunMaskSide);
+  float last = float(res * side - 1u);
+  float unclamped = float(kSunMaskSide) * (g + 0.5) - 0.5;
+  float s = unclamped > 0.0 ? min(unclamped, last) : 0.0;  // NaN -> 0
+  s0 = uint(s);
+  s1 = min(s0 + 1u, res * side - 1u);
+  f = s - float(s0);
+}
+float sunBit(ChartRecord c, uint light, uint su, uint sv) {
+  uint side = uint(kSunMaskSide);
+  uint tixel = (sv / side) * c.grid.x + su / side;
+  uint b = (sv % side) * side + su % side;
+  return float((sunMasks[(c.info.w + tixel) * sunCount + light] >> b) & 1u);
+}
+float sunVisibility(ChartRecord c, uint light, vec2 grid) {
+  uint u0, u1, v0, v1;
+  float fu, fv;
+  sunAxis(grid.x, c.grid.x, u0, u1, fu);
+  sunAxis(grid.y, c.grid.y, v0, v1, fv);
+  uint side = uint(kSunMaskSide);
+  if (u0 / side == u1 / side && v0 / side == v1 / side) {
+    uint mask = sunMasks[(c.info.w + (v0 / side) * c.grid.x + u0 / side) * sunCount + light];
+    if (mask == 0xffffu) return 1.0;
+    if (mask == 0u) return 0.0;
+  }
+  return (1.0 - fv) * ((1.0 - fu) * sunBit(c, light, u0, v0) + fu * sunBit(c, light, u1, v0)) +
+         fv * ((1.0 - fu) * sunBit(c, light, u0, v1) + fu * sunBit(c, light, u1, v1));
+}
+// sunIrradianceLanes (lookup.h) without a normal map: n' = n.
+vec3 sunIrradianceAt(ChartRecord c, vec2 grid, vec3 normal) {
+  vec3 sum = vec3(0.0);
+  for (uint l = 0u; l < sunCount; ++l) {
+    if (!(dot(normal, sunTowards[l]) > 0.0)) continue;
+    float cosTheta = dot(normal, sunTowards[l]);
+    if (!(cosTheta > 0.0)) continue;
+    float lit = sunVisibility(c, l, grid);
+    if (lit > 0.0) sum += sunIrradiance[l] * (cosTheta * lit);
+  }
+  return sum;
+}
 // continuousFrameAround (lightfield.h) on a curved chart, the chart frame on a planar one,
 // and Frame::fromNormal (core/math.h) where axisU is too close to the normal.
 vec3 toLocalAround(ChartRecord c, vec3 n, vec3 w) {
@@ -170,8 +218,13 @@ vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, ve
   bool emits = cosTheta > 0.0 || (flags & kFlagTwoSidedEmission) != 0u;
   vec3 emission = (flags & kFlagEmissive) != 0u && emits ? c.emission.rgb : vec3(0.0);
   if (!(cosTheta >= 0.0)) return emission;
-  if (c.info.y == kDiffuse) return emission + c.albedoOverPi.rgb * interpolateLanes(c, grid, vec2(0.0));
+  // lookupNormalAt: the chart normal, or on a curved chart the interpolated one (chartShadingNormalAt).
   vec3 lookupNormal = (flags & kFlagBack) != 0u ? -shadingNormal : shadingNormal;
+  if (c.info.y == kDiffuse) {
+    vec3 irradiance = interpolateLanes(c, grid, vec2(0.0));
+    if ((flags & kFlagSunMasks) != 0u) irradiance += sunIrradianceAt(c, grid, lookupNormal);
+    return emission + c.albedoOverPi.rgb * irradiance;
+  }
   vec3 local = toLocalAround(c, lookupNormal, towardsViewer);
   vec3 mapped = interpolateLanes(c, grid, directionToParaboloid(local));
   if ((flags & kFlagDiffuseValue) == 0u) return mapped;
@@ -384,7 +437,6 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
   if (scene.environment.map) return "environment maps (a constant environment is drawn)";
   for (const Material& m : scene.materials)
     if (m.isMasked()) return "alpha masks";
-  if (lf.sunMaskLightCount > 0) return "sun masks (bake with --sun-masks off, or render on the CPU)";
   // PunctualHighlights::active() without its shadow-ray machinery: a bake with punctual
   // highlights, a delta light, and a glossy chart to show them.
   const bool glossy = std::any_of(lf.charts.begin(), lf.charts.end(), [](const Chart& c) { return c.kind == ChartKind::Glossy; });
@@ -402,7 +454,8 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
     if (c.diffuseValue && std::holds_alternative<GgxBsdf>(scene.materials[c.material].bsdf))
       return "GGX materials with a diffuse base";
   }
-  if (lf.values.size() >= std::numeric_limits<uint32_t>::max()) return "more than 2^32 light-field values";
+  if (lf.values.size() >= std::numeric_limits<uint32_t>::max() || lf.sunMasks.size() >= std::numeric_limits<uint32_t>::max())
+    return "more than 2^32 light-field values";
   return {};
 }
 
@@ -414,7 +467,7 @@ std::string gpuUnsupportedSetting(const RenderSettings& settings, const Camera& 
 
 struct GpuRenderer::State {
   gpu::EglContext context;
-  GLuint buffers[6] = {};  // values, charts, positions, triangles, indices, normals
+  GLuint buffers[7] = {};  // values, charts, positions, triangles, indices, normals, sun masks
   GLuint vertexArray = 0, emptyVertexArray = 0;
   GLuint visibilityProgram = 0, shadingProgram = 0, lookupProgram = 0;
   GLuint idTexture = 0, depthBuffer = 0, colorTexture = 0, visibilityFramebuffer = 0, shadingFramebuffer = 0;
@@ -426,7 +479,7 @@ struct GpuRenderer::State {
 
   ~State() {
     context.makeCurrent();
-    glDeleteBuffers(6, buffers);
+    glDeleteBuffers(7, buffers);
     glDeleteVertexArrays(1, &vertexArray);
     glDeleteVertexArrays(1, &emptyVertexArray);
     glDeleteProgram(visibilityProgram);
@@ -497,8 +550,9 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                  {uint32_t(c.valuesPerTixel()), uint32_t(c.kind),
                   (c.sides == 2 ? kFlagTwoSided : 0u) | (c.isBack ? kFlagBack : 0u) | (c.curved ? kFlagCurved : 0u) |
                       (c.diffuseValue ? kFlagDiffuseValue : 0u) | (shading.emissive ? kFlagEmissive : 0u) |
-                      (shading.twoSidedEmission ? kFlagTwoSidedEmission : 0u),
-                  0u},
+                      (shading.twoSidedEmission ? kFlagTwoSidedEmission : 0u) |
+                      (shading.sunMasks != nullptr ? kFlagSunMasks : 0u),
+                  uint32_t(c.firstTixel)},
                  {},
                  {}};
     std::memcpy(g.emission, shading.emission.v, sizeof(g.emission));
@@ -532,7 +586,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   if (!positions.empty()) s.near = std::max(1e-6f * glm::length(upper - lower), std::numeric_limits<float>::min());
   s.indexCount = GLsizei(indices.size());
 
-  glCreateBuffers(6, s.buffers);
+  glCreateBuffers(7, s.buffers);
   auto upload = [&](GLuint buffer, const void* data, size_t bytes) {
     // A zero-sized buffer cannot be bound to a storage block: 16 bytes stand in.
     glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), bytes > 0 ? data : nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -544,6 +598,8 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   upload(s.buffers[3], triangles.data(), triangles.size() * sizeof(TriangleGpu));
   upload(s.buffers[4], indices.data(), indices.size() * sizeof(uint32_t));
   upload(s.buffers[5], normals.data(), normals.size() * sizeof(float));
+  const std::vector<uint32_t> sunMasks(lightField.sunMasks.begin(), lightField.sunMasks.end());
+  upload(s.buffers[6], sunMasks.data(), sunMasks.size() * sizeof(uint32_t));
   checkGl("uploading the light field (out of GPU memory?)");
 
   glCreateVertexArrays(1, &s.vertexArray);
@@ -566,6 +622,18 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPositionsBinding, s.buffers[2]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTrianglesBinding, s.buffers[3]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kNormalsBinding, s.buffers[5]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSunMasksBinding, s.buffers[6]);
+  for (GLuint program : {s.shadingProgram, s.lookupProgram}) {
+    glProgramUniform1ui(program, glGetUniformLocation(program, "sunCount"), sun.count);
+    for (uint32_t l = 0; l < sun.count; ++l) {
+      const std::string index = fmt::format("[{}]", l);
+      const Vec3& towards = sun.towardsLight[l];
+      const float* irradiance = sun.irradiance[l].v;
+      glProgramUniform3f(program, glGetUniformLocation(program, ("sunTowards" + index).c_str()), towards.x, towards.y, towards.z);
+      glProgramUniform3f(program, glGetUniformLocation(program, ("sunIrradiance" + index).c_str()), irradiance[0],
+                         irradiance[1], irradiance[2]);
+    }
+  }
   // Reversed Z: depth = near / z ∈ (0, 1], nearer is larger.
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   checkGl("setting up the shaders");
