@@ -53,6 +53,8 @@ std::string gpuUnsupportedFeature(const LightField& lightField);
 
 /// The first of `settings` (for `camera`) the GPU renderer does not support yet; empty if none.
 std::string gpuUnsupportedSetting(const RenderSettings& settings, const Camera& camera);
+/// Throws pl::Error naming gpuUnsupportedSetting's answer, if any.
+void checkGpuSettings(const RenderSettings& settings, const Camera& camera);
 
 /// Whether a headless OpenGL 4.5 core context can be created here; `why` gets the EGL/GL
 /// error when not.

@@ -465,6 +465,11 @@ std::string gpuUnsupportedSetting(const RenderSettings& settings, const Camera& 
   return {};
 }
 
+void checkGpuSettings(const RenderSettings& settings, const Camera& camera) {
+  if (const std::string missing = gpuUnsupportedSetting(settings, camera); !missing.empty())
+    fail("GPU renderer: {} not supported yet (render with --renderer cpu)", missing);
+}
+
 struct GpuRenderer::State {
   gpu::EglContext context;
   GLuint buffers[7] = {};  // values, charts, positions, triangles, indices, normals, sun masks
@@ -664,8 +669,7 @@ void GpuRenderer::drawVisibility(const Camera& camera) {
 
 void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) {
   checkRenderSettings(settings);
-  if (const std::string missing = gpuUnsupportedSetting(settings, camera); !missing.empty())
-    fail("GPU renderer: {} not supported yet (render with --renderer cpu)", missing);
+  checkGpuSettings(settings, camera);
   drawVisibility(camera);
   State& s = *state_;
   setCameraUniforms(s.shadingProgram, camera);

@@ -112,8 +112,7 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   std::optional<GpuRenderer> gpuRenderer;
   if (o.gpu) {
     gpuRenderer.emplace(lightField);
-    if (const std::string missing = gpuUnsupportedSetting(o.render, camera); !missing.empty())
-      fail("GPU renderer: {} not supported yet (render with --renderer cpu)", missing);
+    checkGpuSettings(o.render, camera);
   }
 
   RenderSettings settings = o.render;
