@@ -1,5 +1,6 @@
 // `plenoptic render IN.plf -o OUT.exr|png`: the fast light-field renderer (src/realtime, the
-// default) or, with --reference, the straightforward one (src/render/render.h), through the
+// default; --renderer gpu: the same picture through OpenGL, src/gpu) or, with --reference, the
+// straightforward one (src/render/render.h), through the
 // shared camera, exposure and tone-mapping flags. With --path PATH.json it renders a
 // walk-through (camera/camera_path.h) to an image sequence (-o frames/%04d.png) or an MP4
 // video (-o walk.mp4, through ffmpeg). The work is RenderJob's (src/jobs/jobs.h): flags → job →
@@ -29,7 +30,8 @@ void runRender(const RenderJobOptions& options, const GlobalOptions& global) {
   const int spp = stats.spp;
   fmt::print("wrote {} ({}x{}, {} sample{}/pixel, {} renderer, {} frame{}: median {:.2f} ms/frame = {:.1f} fps; "
              "load {:.3f} s, BVH {:.3f} s)\n",
-             options.output, stats.width, stats.height, spp, spp == 1 ? "" : "s", stats.renderer, stats.frames,
+             options.output, stats.width, stats.height, spp, spp == 1 ? "" : "s",
+             stats.device.empty() ? stats.renderer : fmt::format("{} ({})", stats.renderer, stats.device), stats.frames,
              stats.frames == 1 ? "" : "s", stats.msPerFrameMedian, stats.fps, stats.loadSeconds,
              stats.accelBuildSeconds);
 }
@@ -51,6 +53,12 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
   addRenderSettingsOptions(*command, options->render);
   command->add_flag("--reference", options->reference,
                     "Use the straightforward reference renderer (src/render) instead of the fast one (the default)");
+  command
+      ->add_option_function<std::string>(
+          "--renderer", [options](const std::string& name) { options->gpu = name == "gpu"; },
+          "The fast renderer on the CPU (cpu, the default) or on the GPU through OpenGL 4.5 and headless EGL (gpu; "
+          "refuses what it does not draw yet: docs/limitations.md)")
+      ->check(CLI::IsMember({"cpu", "gpu"}));
   command->add_option("--path", options->pathFile,
                       "Camera path JSON (keyframes; see docs/user-guide.md): render a walk-through to -o frames/%04d.png or -o walk.mp4");
   command->add_option("--stats", options->statsPath,

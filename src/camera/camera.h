@@ -73,6 +73,10 @@ class Camera {
 
   Vec3 eye() const { return eye_; }
   Vec3 forward() const { return forward_; }  ///< optical axis, unit
+  Vec3 right() const { return right_; }      ///< film +x in world space, unit
+  Vec3 up() const { return up_; }            ///< film −y (up on the image) in world space, unit
+  float tanHalfFovY() const { return tanHalfFovY_; }
+  float aspect() const { return aspect_; }   ///< width / height
   float focalLengthMm() const { return focalLengthMm_; }   ///< physical (35 mm format)
   float apertureRadius() const { return apertureRadius_; }  ///< scene units (0 = pinhole)
   float focusDistance() const { return focusDistance_; }    ///< scene units

@@ -222,6 +222,9 @@ struct RenderJobOptions {
   static constexpr int kMaxFrames = 100000;
   RenderSettings render;  ///< samples, mirror depth, seed (showProgress is set by run())
   bool reference = false;  ///< the straightforward renderer (render/) instead of the fast one
+  /// The GPU renderer (src/gpu, OpenGL 4.5 through headless EGL) instead of the CPU fast one;
+  /// refused (pl::Error naming what is missing) for a light field or settings it cannot draw.
+  bool gpu = false;
   std::string pathFile;    ///< camera path JSON: a walk-through, one output per frame
   ViewSettings view;
   int threads = 0;  ///< 0 = all hardware threads
@@ -230,11 +233,13 @@ struct RenderJobOptions {
 /// What `plenoptic render --stats` writes.
 struct RenderJobStats {
   std::string input, output, camera, renderer, path;
+  std::string device;  ///< the GPU renderer's GL_RENDERER and GL_VERSION; empty for the CPU ones
   int width = 0, height = 0, spp = 0, threads = 0, frames = 0;  ///< spp: camera samples per pixel used
   uint32_t mirrorDepth = 0;
   double msPerFrameMedian = 0, msPerFrameMin = 0, msPerFrameMax = 0, fps = 0;
-  /// The primary rays alone (FastRenderer::castPrimaryRays) on the same cameras, timed after
-  /// the frames when stats are written for the fast renderer; 0 = not timed.
+  /// The primary rays alone (FastRenderer::castPrimaryRays; with the GPU renderer its
+  /// rasterisation pass, GpuRenderer::drawVisibility) on the same cameras, timed after the
+  /// frames when stats are written for the fast or GPU renderer; 0 = not timed.
   double primaryMsMedian = 0, primaryMsMin = 0;
   double loadSeconds = 0, accelBuildSeconds = 0;
   uint64_t fileBytes = 0;

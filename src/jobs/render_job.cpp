@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <utility>
 
 #include "accel/accel.h"
@@ -10,6 +11,7 @@
 #include "core/file_io.h"
 #include "core/parallel.h"
 #include "core/timing.h"
+#include "gpu/gpu.h"
 #include "image/frame_output.h"
 #include "jobs/jobs.h"
 #include "plf/plf_file.h"
@@ -32,6 +34,7 @@ std::string RenderJobStats::toJson() const {
   json["mirror_depth"] = mirrorDepth;
   json["threads"] = threads;
   json["renderer"] = renderer;
+  if (!device.empty()) json["device"] = device;
   if (!path.empty()) json["path"] = path;
   json["frames"] = frames;
   json["ms_per_frame_median"] = msPerFrameMedian;
@@ -52,6 +55,7 @@ std::string RenderJobStats::toJson() const {
 RenderJob::RenderJob(RenderJobOptions options) : options_(std::move(options)) {
   const RenderJobOptions& o = options_;
   o.view.checkImageSize("");
+  if (o.gpu && o.reference) failUsage("--reference and --renderer gpu cannot be combined");
   if (o.frames < 1 || o.frames > RenderJobOptions::kMaxFrames)
     failUsage("--frames {} is out of range (1..{})", o.frames, RenderJobOptions::kMaxFrames);
   // Every output is checked before the light field is read (core/file_io.h).
@@ -104,6 +108,12 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   const CameraDesc cameraDesc = view.resolveCamera(lightField.scene);
   const Camera camera(cameraDesc, view.width, view.height, view.vignetting, view.metresPerUnit(lightField.scene));
   const FastRenderer fastRenderer(lightField, accel);
+  // The GPU renderer refuses here, before any frame, what it cannot draw yet (gpu.h).
+  std::optional<GpuRenderer> gpuRenderer;
+  if (o.gpu) {
+    gpuRenderer.emplace(lightField);
+    checkGpuSettings(o.render, camera);
+  }
 
   RenderSettings settings = o.render;
   settings.showProgress = o.frames == 1 && o.reference;
@@ -120,6 +130,8 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
     const auto start = SteadyClock::now();
     if (o.reference) {
       image = renderLightField(lightField, accel, frameCamera, settings);
+    } else if (gpuRenderer) {
+      gpuRenderer->render(frameCamera, settings, image);
     } else {
       fastRenderer.render(frameCamera, settings, image);
     }
@@ -153,7 +165,8 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   std::vector<float> depth;
   for (const Camera& frameCamera : frameCameras) {
     const auto start = SteadyClock::now();
-    fastRenderer.castPrimaryRays(frameCamera, settings, depth);
+    if (gpuRenderer) gpuRenderer->drawVisibility(frameCamera);
+    else fastRenderer.castPrimaryRays(frameCamera, settings, depth);
     primaryMs.push_back(1e3 * secondsSince(start));
   }
 
@@ -166,7 +179,8 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   stats.spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
   stats.mirrorDepth = effectiveMirrorDepth(settings, lightField.settings.mirrorDepth);
   stats.threads = pool.threads();
-  stats.renderer = o.reference ? "reference" : "fast";
+  stats.renderer = o.reference ? "reference" : gpuRenderer ? "gpu" : "fast";
+  if (gpuRenderer) stats.device = gpuRenderer->deviceName();
   stats.path = o.pathFile;
   stats.frames = frames;
   stats.msPerFrameMedian = median(frameMs);

@@ -20,29 +20,14 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/rng.h"
-#include "bake/parameterisation.h"
 #include "render/render.h"
 #include "support/glossy_spheres.h"
+#include "support/random_light_field.h"
 
 namespace pl {
 namespace {
 
-/// A light field over `scene` with the default preset's charts and *random* values in
-/// [0, 4): a harsher test of the 16-neighbour lookup than a smooth bake (every tixel and
-/// direction texel differs from its neighbours), and fast (no propagation).
-LightField randomLightField(Scene scene, uint64_t seed) {
-  LightField lf;
-  lf.settings = BakeSettings{};
-  Parameterisation param = buildParameterisation(scene, lf.settings);
-  lf.charts = std::move(param.charts);
-  lf.triangleChart = std::move(param.triangleChart);
-  lf.values.resize(param.valueCount);
-  Pcg32 rng(seed, 7);
-  for (Rgb& v : lf.values) v = Rgb(4.0f * rng.uniform(), 4.0f * rng.uniform(), 4.0f * rng.uniform());
-  lf.scene = std::move(scene);
-  lf.scene.finalize();  // the move keeps the Embree padding, but be explicit
-  return lf;
-}
+using test_support::randomLightField;
 
 struct Difference {
   double maxAbsolute = 0.0;

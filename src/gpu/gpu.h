@@ -1,0 +1,107 @@
+#pragma once
+// The GPU light-field renderer (OpenGL 4.5 core, through a headless EGL context): the fast
+// renderer's picture (realtime/realtime.h) drawn by the graphics processor — or, on a machine
+// without one, by Mesa's llvmpipe software rasteriser, which is how the tests run it.
+//
+// A frame is two passes:
+//   1. visibility: every triangle of the scene rasterised once with a reversed-Z float depth
+//      buffer, writing its triangle id (+1; 0 = nothing) per pixel — the primary hit of the
+//      ray through the pixel centre, as the CPU renderer's one sample per pixel;
+//   2. shading: per pixel, the camera ray of Camera::generateRay through the pixel centre,
+//      intersected with the triangles of that pixel and its 8 neighbours (the rasteriser snaps
+//      vertices to a sub-pixel grid, which can hand a centre near an edge the triangle across
+//      it; the nearest hit is the ray caster's answer), the hit point origin + t·direction (as
+//      the CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
+//      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes) in a fragment shader,
+//      times the camera weight (cos⁴θ with vignetting). A miss sees the constant environment.
+// The result is radiance (W·sr⁻¹·m⁻², camera weight included, no exposure), read back into an
+// Image exactly where FastRenderer::render writes it; exposure and tone mapping are then the
+// same CPU code for both renderers (jobs/ ViewSettings::writeImage).
+//
+// The light field is uploaded once: its values as 16-byte RGBA (the CPU renderer's padded
+// copy), its chart records with their precomputed shading (ChartShading), the vertex positions
+// and normals (a curved glossy chart's map is read around the interpolated normal,
+// chartShadingNormalAt), the triangle → chart map and the sun masks (one uint each; the masked
+// lights are uniforms). So GPU memory is 16 bytes per value + 128 per chart + 32 per vertex +
+// 28 per triangle + 4 per sun mask + the frame's targets (id, depth and radiance: 24 bytes
+// per pixel).
+//
+// What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
+// the constructor refuses such a light field with that name rather than draw a different
+// picture): mirrors and glass (specular charts), albedo textures and vertex colours, normal
+// maps, alpha masks, punctual highlights, rough glass, GGX diffuse bases,
+// environment maps (a constant environment is drawn); and of the render settings, more than one
+// sample per pixel (and so thin lenses).
+//
+// The shader's lookup is checked against the C++ one (exitantRadiance) on random inputs by
+// GpuRenderer::lookup, which runs the very GLSL function the shading pass calls.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+#include "lightfield/lightfield.h"
+#include "lightfield/render_settings.h"
+
+namespace pl {
+
+class Camera;
+
+/// The first feature of `lightField` the GPU renderer does not draw yet, as a phrase for a
+/// message ("mirrors and glass (specular charts)", …); empty when it draws all of it.
+std::string gpuUnsupportedFeature(const LightField& lightField);
+
+/// The first of `settings` (for `camera`) the GPU renderer does not support yet; empty if none.
+std::string gpuUnsupportedSetting(const RenderSettings& settings, const Camera& camera);
+/// Throws pl::Error naming gpuUnsupportedSetting's answer, if any.
+void checkGpuSettings(const RenderSettings& settings, const Camera& camera);
+
+/// Whether a headless OpenGL 4.5 core context can be created here; `why` gets the EGL/GL
+/// error when not.
+bool gpuAvailable(std::string* why = nullptr);
+
+class GpuRenderer {
+ public:
+  /// Creates the headless context (EGL: Mesa's surfaceless platform, else the default display
+  /// with a 1×1 pbuffer), compiles the shaders and uploads the light field. Throws pl::Error
+  /// naming the EGL or GL error when no OpenGL 4.5 core context can be had, and naming the
+  /// feature (gpuUnsupportedFeature) for a light field it cannot draw. `lightField` must
+  /// outlive the renderer. The context belongs to the renderer: use it from one thread.
+  explicit GpuRenderer(const LightField& lightField);
+  ~GpuRenderer();
+  GpuRenderer(const GpuRenderer&) = delete;
+  GpuRenderer& operator=(const GpuRenderer&) = delete;
+
+  /// Renders camera.width() × camera.height() pixels of radiance into `image` (resized only
+  /// when its size differs), like FastRenderer::render. Throws pl::Error for settings it does
+  /// not support (gpuUnsupportedSetting).
+  void render(const Camera& camera, const RenderSettings& settings, Image& image);
+
+  /// The rasterisation pass alone (`render --stats` primary_ms_median for this renderer),
+  /// finished on the GPU before it returns.
+  void drawVisibility(const Camera& camera);
+
+  /// One lookup query: the chart record as triangleChart gives it (facingChart turns it to the
+  /// side the viewer is on), a world point and the unit direction towards the viewer.
+  struct LookupQuery {
+    uint32_t chart = 0;
+    Vec3 position{0.0f}, towardsViewer{0.0f, 0.0f, 1.0f};
+  };
+  /// The shading pass's lookup function run on each query in a compute shader: the radiance
+  /// exitantRadiance(lightField, chart, position, towardsViewer, uv) gives on the CPU (planar
+  /// charts; curved ones are read around the chart normal here).
+  std::vector<Rgb> lookup(const std::vector<LookupQuery>& queries);
+
+  /// The GL_RENDERER and GL_VERSION strings of the context (e.g. "llvmpipe (LLVM 15.0.6, 256
+  /// bits)", "4.5 (Core Profile) Mesa 22.3.6").
+  std::string deviceName() const;
+  /// Bytes of GPU buffers and textures this renderer holds (the light field's and the frame's).
+  uint64_t gpuBytes() const;
+
+ private:
+  struct State;
+  const LightField& lightField_;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace pl

@@ -1,0 +1,741 @@
+// The GPU light-field renderer (gpu.h): uploads, shaders and the two passes of a frame.
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+#include "camera/camera.h"
+#include "core/error.h"
+#include "gpu/egl_context.h"
+#include "gpu/gpu.h"
+#include "lightfield/lookup.h"
+
+namespace pl {
+namespace {
+
+// Chart record flags (ChartGpu::info.z). The GLSL constants are generated from these
+// (glslConstants), so the shader and the upload cannot disagree.
+constexpr uint32_t kFlagTwoSided = 1u, kFlagBack = 2u, kFlagCurved = 4u, kFlagDiffuseValue = 8u, kFlagEmissive = 16u,
+                   kFlagTwoSidedEmission = 32u, kFlagSunMasks = 64u;
+
+/// One chart record as the shaders read it (std430: eight 16-byte rows).
+struct ChartGpu {
+  float origin[4];        ///< xyz: Chart::origin; w: 1 / tixelSize (ChartShading::inverseTixelSize)
+  float axisU[4], axisV[4], normal[4];
+  uint32_t grid[4];       ///< resU, resV, dirRes, firstValue
+  uint32_t info[4];       ///< valuesPerTixel, kind (ChartKind), flags, firstTixel (its sun masks)
+  float emission[4];      ///< ChartShading::emission
+  float albedoOverPi[4];  ///< ChartShading::albedoOverPi
+};
+static_assert(sizeof(ChartGpu) == 128);
+
+/// A triangle as the shading pass reads it: its three vertices (indices into the positions)
+/// and its chart (LightField::triangleChart, the front record).
+struct TriangleGpu {
+  uint32_t v[3], chart;
+};
+
+// Shader storage bindings.
+constexpr GLuint kValuesBinding = 0, kChartsBinding = 1, kPositionsBinding = 2, kTrianglesBinding = 3,
+                 kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7;
+
+std::string glslConstants() {
+  return fmt::format(
+      "const uint kDiffuse = {}u, kGlossy = {}u, kSpecular = {}u;\n"
+      "const uint kFlagTwoSided = {}u, kFlagBack = {}u, kFlagCurved = {}u, kFlagDiffuseValue = {}u, kFlagEmissive = {}u, "
+      "kFlagTwoSidedEmission = {}u, kFlagSunMasks = {}u;\nconst int kMaxSunMaskLights = {}, kSunMaskSide = {};\n"
+      "#define VALUES_BINDING {}\n#define CHARTS_BINDING {}\n#define POSITIONS_BINDING {}\n#define TRIANGLES_BINDING {}\n"
+      "#define QUERIES_BINDING {}\n#define RESULTS_BINDING {}\n#define NORMALS_BINDING {}\n#define SUN_MASKS_BINDING {}\n",
+      unsigned(ChartKind::Diffuse), unsigned(ChartKind::Glossy), unsigned(ChartKind::Specular), kFlagTwoSided, kFlagBack,
+      kFlagCurved, kFlagDiffuseValue, kFlagEmissive, kFlagTwoSidedEmission, kFlagSunMasks, kMaxSunMaskLights, kSunMaskSide,
+      kValuesBinding, kChartsBinding, kPositionsBinding, kTrianglesBinding, kQueriesBinding, kResultsBinding, kNormalsBinding,
+      kSunMasksBinding);
+}
+
+// The lookup of lightfield/lookup.h in GLSL, statement for statement (the names are the C++
+// functions'): linearTap, paraboloidTexelCoordinate (paraboloid.h), directionToParaboloid
+// (paraboloid.cpp), interpolateLanes, bilinearOverTixels (diffuseValueOverTixels),
+// continuousFrameAround (toLocalAround), facingChart / viewedChart (lightfield.h) and
+// exitantRadianceLanes for the charts gpuUnsupportedFeature lets through (no textures, sun
+// masks or tilted irradiances; Blinn-Phong's k = 1), with sunVisibility and sunIrradianceLanes
+// for the sun masks.
+// GpuRenderer::lookup runs it against the C++ on random inputs (gpu_test).
+constexpr const char* kLookupGlsl = R"glsl(
+struct ChartRecord {
+  vec4 origin;  // w: 1 / tixel size
+  vec4 axisU, axisV, normal;
+  uvec4 grid;   // resU, resV, dirRes, firstValue
+  uvec4 info;   // valuesPerTixel, kind, flags
+  vec4 emission;
+  vec4 albedoOverPi;
+};
+layout(std430, binding = VALUES_BINDING) readonly buffer Values { vec4 values[]; };
+layout(std430, binding = CHARTS_BINDING) readonly buffer Charts { ChartRecord charts[]; };
+// LightField::sunMasks, one uint per mask; SunLights: direction towards each light, irradiance.
+layout(std430, binding = SUN_MASKS_BINDING) readonly buffer SunMasks { uint sunMasks[]; };
+uniform uint sunCount;
+uniform vec3 sunTowards[kMaxSunMaskLights], sunIrradiance[kMaxSunMaskLights];
+
+struct LinearTap { uint i0, i1; float f; };
+LinearTap linearTap(float x, uint count) {
+  uint last = count - 1u;
+  float positive = x > 0.0 ? x : 0.0;  // NaN -> 0
+  float lastF = float(last);
+  float clamped = positive < lastF ? positive : lastF;
+  LinearTap tap;
+  tap.i0 = uint(clamped);
+  uint next = tap.i0 + (clamped > 0.0 ? 1u : 0u);
+  tap.i1 = next < last ? next : last;
+  tap.f = clamped - float(tap.i0);
+  return tap;
+}
+float paraboloidTexelCoordinate(float x, uint resolution) { return (x + 1.0) * 0.5 * float(resolution) - 0.5; }
+vec2 directionToParaboloid(vec3 d) {
+  if (d.z >= 0.0) {
+    float inv = 1.0 / (1.0 + d.z);
+    return vec2(d.x * inv, d.y * inv);
+  }
+  float r = sqrt(d.x * d.x + d.y * d.y);
+  if (r == 0.0) return vec2(0.0);
+  return vec2(d.x / r, d.y / r);
+}
+uint valueIndex(ChartRecord c, uint i, uint j, uint s, uint t) {
+  return c.grid.w + (j * c.grid.x + i) * c.info.x + t * c.grid.z + s;
+}
+vec3 interpolateLanes(ChartRecord c, vec2 grid, vec2 st) {
+  LinearTap tu = linearTap(grid.x, c.grid.x), tv = linearTap(grid.y, c.grid.y);
+  uint is[2] = uint[2](tu.i0, tu.i1), js[2] = uint[2](tv.i0, tv.i1);
+  float wu[2] = float[2](1.0 - tu.f, tu.f), wv[2] = float[2](1.0 - tv.f, tv.f);
+  if (c.grid.z == 1u) {
+    vec3 lower = wu[0] * wv[0] * values[valueIndex(c, is[0], js[0], 0u, 0u)].rgb +
+                 wu[1] * wv[0] * values[valueIndex(c, is[1], js[0], 0u, 0u)].rgb;
+    vec3 upper = wu[0] * wv[1] * values[valueIndex(c, is[0], js[1], 0u, 0u)].rgb +
+                 wu[1] * wv[1] * values[valueIndex(c, is[1], js[1], 0u, 0u)].rgb;
+    return lower + upper;
+  }
+  LinearTap ta = linearTap(paraboloidTexelCoordinate(st.x, c.grid.z), c.grid.z);
+  LinearTap tb = linearTap(paraboloidTexelCoordinate(st.y, c.grid.z), c.grid.z);
+  uint as[2] = uint[2](ta.i0, ta.i1), bs[2] = uint[2](tb.i0, tb.i1);
+  float wa[2] = float[2](1.0 - ta.f, ta.f), wb[2] = float[2](1.0 - tb.f, tb.f);
+  vec3 sum = vec3(0.0);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 2; ++x) {
+      float wPos = wu[x] * wv[y];
+      if (wPos == 0.0) continue;
+      vec3 inner = vec3(0.0);
+      for (int b = 0; b < 2; ++b)
+        for (int a = 0; a < 2; ++a) inner += wa[a] * wb[b] * values[valueIndex(c, is[x], js[y], as[a], bs[b])].rgb;
+      sum += wPos * inner;
+    }
+  return sum;
+}
+// The glossy charts' diffuse irradiance, bilinear over the tixels (after each tixel's map).
+vec3 diffuseValueOverTixels(ChartRecord c, vec2 grid) {
+  LinearTap tu = linearTap(grid.x, c.grid.x), tv = linearTap(grid.y, c.grid.y);
+  uint map = c.grid.z * c.grid.z;
+  vec3 lower = (1.0 - tu.f) * (1.0 - tv.f) * values[valueIndex(c, tu.i0, tv.i0, 0u, 0u) + map].rgb +
+               tu.f * (1.0 - tv.f) * values[valueIndex(c, tu.i1, tv.i0, 0u, 0u) + map].rgb;
+  vec3 upper = (1.0 - tu.f) * tv.f * values[valueIndex(c, tu.i0, tv.i1, 0u, 0u) + map].rgb +
+               tu.f * tv.f * values[valueIndex(c, tu.i1, tv.i1, 0u, 0u) + map].rgb;
+  return lower + upper;
+}
+// sunVisibility (lightfield.h): light l's mask bilinear between the four nearest sub-samples.
+void sunAxis(float g, uint res, out uint s0, out uint s1, out float f) {
+  uint side = uint(kSunMaskSide);
+  float last = float(res * side - 1u);
+  float unclamped = float(kSunMaskSide) * (g + 0.5) - 0.5;
+  float s = unclamped > 0.0 ? min(unclamped, last) : 0.0;  // NaN -> 0
+  s0 = uint(s);
+  s1 = min(s0 + 1u, res * side - 1u);
+  f = s - float(s0);
+}
+float sunBit(ChartRecord c, uint light, uint su, uint sv) {
+  uint side = uint(kSunMaskSide);
+  uint tixel = (sv / side) * c.grid.x + su / side;
+  uint b = (sv % side) * side + su % side;
+  return float((sunMasks[(c.info.w + tixel) * sunCount + light] >> b) & 1u);
+}
+float sunVisibility(ChartRecord c, uint light, vec2 grid) {
+  uint u0, u1, v0, v1;
+  float fu, fv;
+  sunAxis(grid.x, c.grid.x, u0, u1, fu);
+  sunAxis(grid.y, c.grid.y, v0, v1, fv);
+  uint side = uint(kSunMaskSide);
+  if (u0 / side == u1 / side && v0 / side == v1 / side) {
+    uint mask = sunMasks[(c.info.w + (v0 / side) * c.grid.x + u0 / side) * sunCount + light];
+    if (mask == 0xffffu) return 1.0;
+    if (mask == 0u) return 0.0;
+  }
+  return (1.0 - fv) * ((1.0 - fu) * sunBit(c, light, u0, v0) + fu * sunBit(c, light, u1, v0)) +
+         fv * ((1.0 - fu) * sunBit(c, light, u0, v1) + fu * sunBit(c, light, u1, v1));
+}
+// sunIrradianceLanes (lookup.h) without a normal map: n' = n.
+vec3 sunIrradianceAt(ChartRecord c, vec2 grid, vec3 normal) {
+  vec3 sum = vec3(0.0);
+  for (uint l = 0u; l < sunCount; ++l) {
+    if (!(dot(normal, sunTowards[l]) > 0.0)) continue;
+    float cosTheta = dot(normal, sunTowards[l]);
+    if (!(cosTheta > 0.0)) continue;
+    float lit = sunVisibility(c, l, grid);
+    if (lit > 0.0) sum += sunIrradiance[l] * (cosTheta * lit);
+  }
+  return sum;
+}
+// continuousFrameAround (lightfield.h) on a curved chart, the chart frame on a planar one,
+// and Frame::fromNormal (core/math.h) where axisU is too close to the normal.
+vec3 toLocalAround(ChartRecord c, vec3 n, vec3 w) {
+  if ((c.info.z & kFlagCurved) == 0u) return vec3(dot(w, c.axisU.xyz), dot(w, c.axisV.xyz), dot(w, c.normal.xyz));
+  vec3 u = c.axisU.xyz - dot(c.axisU.xyz, n) * n;
+  float len = length(u);
+  if (len > 1e-3) {
+    vec3 unitU = u / len;
+    return vec3(dot(w, unitU), dot(w, cross(n, unitU)), dot(w, n));
+  }
+  float sign = n.z >= 0.0 ? 1.0 : -1.0;
+  float a = -1.0 / (sign + n.z);
+  float b = n.x * n.y * a;
+  vec3 s = vec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  vec3 t = vec3(b, sign + n.y * n.y * a, -n.y);
+  return vec3(dot(w, s), dot(w, t), dot(w, n));
+}
+// The radiance towards the viewer (unit towardsViewer) at world point p of the surface whose
+// triangle maps to chart record `chart` (triangleChart's front record): normalAtHit is
+// chartNormalAt's normal there (the record's side), shadingNormal interpolatedNormal's (the
+// front's; a curved glossy chart's map is read around it, chartShadingNormalAt). viewedChart,
+// then exitantRadianceLanes.
+vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, vec3 shadingNormal) {
+  ChartRecord c = charts[chart];
+  uint flags = c.info.z;
+  float side = dot(towardsViewer, normalAtHit);
+  if ((flags & kFlagCurved) != 0u && (flags & kFlagTwoSided) == 0u && side < 0.0) return vec3(0.0);
+  if ((flags & kFlagTwoSided) != 0u && (flags & kFlagBack) == 0u && side < 0.0) c = charts[chart + 1u];
+  flags = c.info.z;
+  if (c.info.y == kSpecular) return vec3(0.0);
+  vec3 d = p - c.origin.xyz;
+  vec2 grid = vec2(dot(d, c.axisU.xyz) * c.origin.w - 0.5, dot(d, c.axisV.xyz) * c.origin.w - 0.5);
+  float cosTheta = (flags & kFlagCurved) != 0u ? 1.0 : dot(towardsViewer, c.normal.xyz);
+  bool emits = cosTheta > 0.0 || (flags & kFlagTwoSidedEmission) != 0u;
+  vec3 emission = (flags & kFlagEmissive) != 0u && emits ? c.emission.rgb : vec3(0.0);
+  if (!(cosTheta >= 0.0)) return emission;
+  // lookupNormalAt: the chart normal, or on a curved chart the interpolated one (chartShadingNormalAt).
+  vec3 lookupNormal = (flags & kFlagBack) != 0u ? -shadingNormal : shadingNormal;
+  if (c.info.y == kDiffuse) {
+    vec3 irradiance = interpolateLanes(c, grid, vec2(0.0));
+    if ((flags & kFlagSunMasks) != 0u) irradiance += sunIrradianceAt(c, grid, lookupNormal);
+    return emission + c.albedoOverPi.rgb * irradiance;
+  }
+  vec3 local = toLocalAround(c, lookupNormal, towardsViewer);
+  vec3 mapped = interpolateLanes(c, grid, directionToParaboloid(local));
+  if ((flags & kFlagDiffuseValue) == 0u) return mapped;
+  float k = local.z > 0.0 ? 1.0 : 0.0;  // diffuseDirectionalFactor of Blinn-Phong
+  return mapped + c.albedoOverPi.rgb * k * diffuseValueOverTixels(c, grid);
+}
+)glsl";
+
+// Pass 1: the triangles' ids at the pixel centres, nearest first (reversed Z: depth = near / z).
+constexpr const char* kVisibilityVertex = R"glsl(
+layout(location = 0) in vec3 position;
+uniform vec3 eye, forward, right, up;
+uniform float tanHalfFovY, aspect, near;
+void main() {
+  vec3 v = position - eye;
+  float z = dot(v, forward);
+  // Film y grows downwards and so do the GL rows here (row 0 = the image's top row).
+  gl_Position = vec4(dot(v, right) / (tanHalfFovY * aspect), -dot(v, up) / tanHalfFovY, near, z);
+}
+)glsl";
+constexpr const char* kVisibilityFragment = R"glsl(
+out uint id;
+void main() { id = uint(gl_PrimitiveID) + 1u; }
+)glsl";
+
+// Pass 2: per pixel, the camera ray through its centre (Camera::generateRay), the hit on the
+// visible triangle's plane, and the lookup.
+constexpr const char* kShadingVertex = R"glsl(
+void main() {
+  vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
+}
+)glsl";
+constexpr const char* kShadingFragment = R"glsl(
+layout(std430, binding = POSITIONS_BINDING) readonly buffer Positions { vec4 positions[]; };
+layout(std430, binding = TRIANGLES_BINDING) readonly buffer Triangles { uvec4 triangles[]; };
+layout(std430, binding = NORMALS_BINDING) readonly buffer Normals { vec4 normals[]; };  // w = 0: none
+layout(binding = 0) uniform usampler2D ids;
+uniform vec3 eye, forward, right, up, background;
+uniform float tanHalfFovY, aspect;
+uniform ivec2 size;
+uniform bool vignetting;
+out vec4 color;
+void main() {
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  vec2 film = vec2(pixel) + 0.5;
+  float sx = (2.0 * film.x / float(size.x) - 1.0) * tanHalfFovY * aspect;
+  float sy = (1.0 - 2.0 * film.y / float(size.y)) * tanHalfFovY;
+  vec3 toFilm = forward + sx * right + sy * up;
+  float invLength = 1.0 / length(toFilm);
+  float weight = 1.0;
+  if (vignetting) weight = invLength * invLength * invLength * invLength;  // cos^4
+  vec3 direction = toFilm * invLength;
+  // The visible triangle: rasterisation snaps vertices to a sub-pixel grid, so a pixel centre
+  // within that snap of an edge may be given the triangle across it. The ray is tested against
+  // the triangles of the pixel and its 8 neighbours (Möller–Trumbore, edges inclusive) and the
+  // nearest it hits is taken — the ray caster's answer; the pixel's own triangle's plane if it
+  // hits none of them (a sliver no centre covers).
+  uint id = 0u;
+  float t = 1.0 / 0.0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      uint candidate = texelFetch(ids, clamp(pixel + ivec2(dx, dy), ivec2(0), size - 1), 0).r;
+      if (candidate == 0u || candidate == id) continue;
+      uvec4 tri = triangles[candidate - 1u];
+      vec3 p0 = positions[tri.x].xyz, e1 = positions[tri.y].xyz - p0, e2 = positions[tri.z].xyz - p0;
+      vec3 q = cross(direction, e2);
+      float det = dot(e1, q);
+      if (det == 0.0) continue;
+      vec3 s = eye - p0;
+      float u = dot(s, q) / det;
+      vec3 r = cross(s, e1);
+      float v = dot(direction, r) / det;
+      float hit = dot(e2, r) / det;
+      if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit > 0.0 && hit < t) {
+        t = hit;
+        id = candidate;
+      }
+    }
+  uint own = texelFetch(ids, pixel, 0).r;
+  if (id == 0u) id = own;
+  if (id == 0u) {
+    color = vec4(weight * background, 1.0);
+    return;
+  }
+  uvec4 tri = triangles[id - 1u];
+  vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
+  vec3 n = cross(p1 - p0, p2 - p0);
+  if (isinf(t)) t = dot(p0 - eye, n) / dot(direction, n);
+  vec3 p = eye + t * direction;
+  ChartRecord c = charts[tri.w];
+  vec3 normalAtHit = c.normal.xyz, shadingNormal = c.normal.xyz;
+  if ((c.info.z & kFlagCurved) != 0u) {
+    // triangleNormal, then interpolatedNormal (scene.h) at the hit's barycentrics (b1, b2).
+    float length2 = dot(n, n);
+    normalAtHit = length2 > 0.0 ? n / sqrt(length2) : vec3(0.0);
+    shadingNormal = normalAtHit;
+    if (normals[tri.x].w != 0.0) {
+      vec3 e1 = p1 - p0, e2 = p2 - p0, v = p - p0;
+      float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), v1 = dot(v, e1), v2 = dot(v, e2);
+      float denominator = d11 * d22 - d12 * d12;
+      float b1 = (d22 * v1 - d12 * v2) / denominator, b2 = (d11 * v2 - d12 * v1) / denominator;
+      vec3 interpolated = (1.0 - b1 - b2) * normals[tri.x].xyz + b1 * normals[tri.y].xyz + b2 * normals[tri.z].xyz;
+      float len = length(interpolated);
+      if (len > 1e-6 && !isinf(len) && !isnan(len)) {
+        shadingNormal = interpolated / len;
+        if (dot(shadingNormal, normalAtHit) < 0.0) shadingNormal = -shadingNormal;
+      }
+    }
+  }
+  color = vec4(weight * lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal), 1.0);
+}
+)glsl";
+
+// The lookup on queries (GpuRenderer::lookup).
+constexpr const char* kLookupCompute = R"glsl(
+layout(local_size_x = 64) in;
+struct Query { vec4 position; vec4 towardsViewer; };  // position.w: the chart, as uint bits
+layout(std430, binding = QUERIES_BINDING) readonly buffer Queries { Query queries[]; };
+layout(std430, binding = RESULTS_BINDING) writeonly buffer Results { vec4 results[]; };
+uniform uint count;
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  uint chart = floatBitsToUint(queries[i].position.w);
+  vec3 normal = charts[chart].normal.xyz;
+  results[i] = vec4(lookupRadiance(chart, queries[i].position.xyz, queries[i].towardsViewer.xyz, normal, normal), 0.0);
+}
+)glsl";
+
+const char* glErrorName(GLenum error) {
+  switch (error) {
+    case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
+    default: return "an unknown GL error";
+  }
+}
+
+/// Throws pl::Error naming the GL error raised since the last check, if any, and `what`.
+void checkGl(const char* what) {
+  const GLenum error = glGetError();
+  if (error != GL_NO_ERROR) fail("GPU renderer: {}: {}", what, glErrorName(error));
+}
+
+/// The info log of a shader or program (getLength/getLog: glGetShaderiv/glGetShaderInfoLog or
+/// the program pair).
+template <typename GetLength, typename GetLog>
+std::string infoLog(GLuint object, GetLength getLength, GetLog getLog) {
+  GLint length = 0;
+  getLength(object, GL_INFO_LOG_LENGTH, &length);
+  std::string log(size_t(std::max(length, 1)), '\0');
+  getLog(object, length, nullptr, log.data());
+  return log.c_str();
+}
+
+GLuint compileShader(GLenum type, const std::string& source, const char* name) {
+  const GLuint shader = glCreateShader(type);
+  const char* text = source.c_str();
+  glShaderSource(shader, 1, &text, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    const std::string log = infoLog(shader, glGetShaderiv, glGetShaderInfoLog);
+    glDeleteShader(shader);
+    fail("GPU renderer: the {} shader does not compile: {}", name, log);
+  }
+  return shader;
+}
+
+/// A program of the given stages, each source prefixed by the version line and the generated
+/// constants (and, where `lookup`, the lookup functions).
+GLuint linkProgram(std::initializer_list<std::pair<GLenum, const char*>> stages, const char* name, bool lookup) {
+  const std::string prefix = "#version 450 core\n" + glslConstants() + (lookup ? kLookupGlsl : "");
+  const GLuint program = glCreateProgram();
+  std::vector<GLuint> shaders;
+  for (const auto& [type, source] : stages) {
+    shaders.push_back(compileShader(type, prefix + source, name));
+    glAttachShader(program, shaders.back());
+  }
+  glLinkProgram(program);
+  for (GLuint shader : shaders) glDeleteShader(shader);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    const std::string log = infoLog(program, glGetProgramiv, glGetProgramInfoLog);
+    glDeleteProgram(program);
+    fail("GPU renderer: the {} program does not link: {}", name, log);
+  }
+  return program;
+}
+
+void setCameraUniforms(GLuint program, const Camera& camera) {
+  auto vec3 = [&](const char* name, const Vec3& v) { glProgramUniform3f(program, glGetUniformLocation(program, name), v.x, v.y, v.z); };
+  vec3("eye", camera.eye());
+  vec3("forward", camera.forward());
+  vec3("right", camera.right());
+  vec3("up", camera.up());
+  glProgramUniform1f(program, glGetUniformLocation(program, "tanHalfFovY"), camera.tanHalfFovY());
+  glProgramUniform1f(program, glGetUniformLocation(program, "aspect"), camera.aspect());
+}
+
+}  // namespace
+
+std::string gpuUnsupportedFeature(const LightField& lf) {
+  const Scene& scene = lf.scene;
+  if (scene.environment.map) return "environment maps (a constant environment is drawn)";
+  for (const Material& m : scene.materials)
+    if (m.isMasked()) return "alpha masks";
+  // PunctualHighlights::active() without its shadow-ray machinery: a bake with punctual
+  // highlights, a delta light, and a glossy chart to show them.
+  const bool glossy = std::any_of(lf.charts.begin(), lf.charts.end(), [](const Chart& c) { return c.kind == ChartKind::Glossy; });
+  if (lf.settings.punctualHighlights && glossy)
+    for (const Light& light : scene.lights)
+      if (isDeltaLight(light)) return "punctual highlights (point, spot and directional lights on glossy charts)";
+  const SunLights sun = sunLightsOf(lf);
+  for (uint32_t i = 0; i < lf.charts.size(); ++i) {
+    const Chart& c = lf.charts[i];
+    if (c.kind == ChartKind::Specular) return "mirrors and glass (specular charts)";
+    const ChartShading shading = chartShading(lf, i, sun);
+    if (shading.texturedAlbedo) return "albedo textures, metallic-roughness textures and vertex colours";
+    if (shading.normalMapped || c.directionalIrradiance) return "normal maps";
+    if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) return "rough glass";
+    if (c.diffuseValue && std::holds_alternative<GgxBsdf>(scene.materials[c.material].bsdf))
+      return "GGX materials with a diffuse base";
+  }
+  if (lf.values.size() >= std::numeric_limits<uint32_t>::max() || lf.sunMasks.size() >= std::numeric_limits<uint32_t>::max())
+    return "more than 2^32 light-field values";
+  return {};
+}
+
+std::string gpuUnsupportedSetting(const RenderSettings& settings, const Camera& camera) {
+  if (camera.isThinLens()) return "thin-lens cameras (depth of field)";
+  if (effectiveSamplesPerPixel(settings, false) != 1) return "more than one sample per pixel";
+  return {};
+}
+
+void checkGpuSettings(const RenderSettings& settings, const Camera& camera) {
+  if (const std::string missing = gpuUnsupportedSetting(settings, camera); !missing.empty())
+    fail("GPU renderer: {} not supported yet (render with --renderer cpu)", missing);
+}
+
+struct GpuRenderer::State {
+  gpu::EglContext context;
+  GLuint buffers[7] = {};  // values, charts, positions, triangles, indices, normals, sun masks
+  GLuint vertexArray = 0, emptyVertexArray = 0;
+  GLuint visibilityProgram = 0, shadingProgram = 0, lookupProgram = 0;
+  GLuint idTexture = 0, depthBuffer = 0, colorTexture = 0, visibilityFramebuffer = 0, shadingFramebuffer = 0;
+  int width = 0, height = 0;
+  GLsizei indexCount = 0;
+  float near = 1e-6f;
+  uint64_t bufferBytes = 0;
+  Rgb background{0.0f};
+
+  ~State() {
+    context.makeCurrent();
+    glDeleteBuffers(7, buffers);
+    glDeleteVertexArrays(1, &vertexArray);
+    glDeleteVertexArrays(1, &emptyVertexArray);
+    glDeleteProgram(visibilityProgram);
+    glDeleteProgram(shadingProgram);
+    glDeleteProgram(lookupProgram);
+    releaseTargets();
+  }
+  void releaseTargets() {
+    glDeleteFramebuffers(1, &visibilityFramebuffer);
+    glDeleteFramebuffers(1, &shadingFramebuffer);
+    glDeleteTextures(1, &idTexture);
+    glDeleteTextures(1, &colorTexture);
+    glDeleteRenderbuffers(1, &depthBuffer);
+    visibilityFramebuffer = shadingFramebuffer = idTexture = colorTexture = depthBuffer = 0;
+    width = height = 0;
+  }
+  /// The frame's targets at width × height (re-made only when the size changes).
+  void ensureTargets(int w, int h) {
+    if (w == width && h == height) return;
+    releaseTargets();
+    glCreateTextures(GL_TEXTURE_2D, 1, &idTexture);
+    glTextureStorage2D(idTexture, 1, GL_R32UI, w, h);
+    // (An integer texture with the default linear filters is incomplete and reads as 0.)
+    glTextureParameteri(idTexture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(idTexture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glCreateRenderbuffers(1, &depthBuffer);
+    glNamedRenderbufferStorage(depthBuffer, GL_DEPTH_COMPONENT32F, w, h);
+    glCreateTextures(GL_TEXTURE_2D, 1, &colorTexture);
+    glTextureStorage2D(colorTexture, 1, GL_RGBA32F, w, h);
+    glCreateFramebuffers(1, &visibilityFramebuffer);
+    glNamedFramebufferTexture(visibilityFramebuffer, GL_COLOR_ATTACHMENT0, idTexture, 0);
+    glNamedFramebufferRenderbuffer(visibilityFramebuffer, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depthBuffer);
+    glCreateFramebuffers(1, &shadingFramebuffer);
+    glNamedFramebufferTexture(shadingFramebuffer, GL_COLOR_ATTACHMENT0, colorTexture, 0);
+    for (GLuint fb : {visibilityFramebuffer, shadingFramebuffer})
+      if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        fail("GPU renderer: a {}x{} framebuffer is incomplete", w, h);
+    checkGl("creating the frame's targets");
+    width = w;
+    height = h;
+  }
+  uint64_t targetBytes() const { return uint64_t(width) * uint64_t(height) * (4 + 4 + 16); }
+};
+
+GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField) {
+  if (const std::string missing = gpuUnsupportedFeature(lightField); !missing.empty())
+    fail("GPU renderer: this light field has {}, which the GPU renderer does not draw yet (render it with --renderer cpu)",
+         missing);
+  state_ = std::make_unique<State>();
+  State& s = *state_;
+  const Scene& scene = lightField.scene;
+  s.background = scene.environment.constant;
+
+  // The light field: values as RGBA (the fast renderer's padded copy), chart records.
+  std::vector<float> values(lightField.values.size() * 4, 0.0f);
+  for (size_t i = 0; i < lightField.values.size(); ++i) std::memcpy(&values[4 * i], &lightField.values[i], sizeof(Rgb));
+  const SunLights sun = sunLightsOf(lightField);
+  std::vector<ChartGpu> charts(lightField.charts.size());
+  for (uint32_t i = 0; i < charts.size(); ++i) {
+    const Chart& c = lightField.charts[i];
+    const ChartShading shading = chartShading(lightField, i, sun);
+    ChartGpu& g = charts[i];
+    g = ChartGpu{{c.origin.x, c.origin.y, c.origin.z, shading.inverseTixelSize},
+                 {c.axisU.x, c.axisU.y, c.axisU.z, 0.0f},
+                 {c.axisV.x, c.axisV.y, c.axisV.z, 0.0f},
+                 {c.normal.x, c.normal.y, c.normal.z, 0.0f},
+                 {c.resU, c.resV, c.dirRes, uint32_t(c.firstValue)},
+                 {uint32_t(c.valuesPerTixel()), uint32_t(c.kind),
+                  (c.sides == 2 ? kFlagTwoSided : 0u) | (c.isBack ? kFlagBack : 0u) | (c.curved ? kFlagCurved : 0u) |
+                      (c.diffuseValue ? kFlagDiffuseValue : 0u) | (shading.emissive ? kFlagEmissive : 0u) |
+                      (shading.twoSidedEmission ? kFlagTwoSidedEmission : 0u) |
+                      (shading.sunMasks != nullptr ? kFlagSunMasks : 0u),
+                  uint32_t(c.firstTixel)},
+                 {},
+                 {}};
+    std::memcpy(g.emission, shading.emission.v, sizeof(g.emission));
+    std::memcpy(g.albedoOverPi, shading.albedoOverPi.v, sizeof(g.albedoOverPi));
+  }
+  // The geometry: every mesh's positions in one array, triangles with global vertex indices
+  // (so gl_PrimitiveID of the one draw call is the triangle's index here) and their charts.
+  std::vector<float> positions, normals;
+  std::vector<TriangleGpu> triangles;
+  std::vector<uint32_t> indices;
+  Vec3 lower(std::numeric_limits<float>::max()), upper(-std::numeric_limits<float>::max());
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    const uint32_t first = uint32_t(positions.size() / 4);
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+      const Vec3& p = mesh.positions[v];
+      positions.insert(positions.end(), {p.x, p.y, p.z, 1.0f});
+      const Vec3 n = mesh.normals.empty() ? Vec3(0.0f) : mesh.normals[v];
+      normals.insert(normals.end(), {n.x, n.y, n.z, mesh.normals.empty() ? 0.0f : 1.0f});
+      lower = glm::min(lower, p);
+      upper = glm::max(upper, p);
+    }
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const UVec3 tri = mesh.triangles[t];
+      triangles.push_back({{first + tri[0], first + tri[1], first + tri[2]}, lightField.triangleChart[m][t]});
+      indices.insert(indices.end(), {first + tri[0], first + tri[1], first + tri[2]});
+    }
+  }
+  // The near plane: a millionth of the scene's diagonal (depth is near / z in a float buffer,
+  // so its precision does not depend on it; only what is nearer than it is cut away).
+  if (!positions.empty()) s.near = std::max(1e-6f * glm::length(upper - lower), std::numeric_limits<float>::min());
+  s.indexCount = GLsizei(indices.size());
+
+  glCreateBuffers(7, s.buffers);
+  auto upload = [&](GLuint buffer, const void* data, size_t bytes) {
+    // A zero-sized buffer cannot be bound to a storage block: 16 bytes stand in.
+    glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), bytes > 0 ? data : nullptr, GL_DYNAMIC_STORAGE_BIT);
+    s.bufferBytes += std::max<size_t>(bytes, 16);
+  };
+  upload(s.buffers[0], values.data(), values.size() * sizeof(float));
+  upload(s.buffers[1], charts.data(), charts.size() * sizeof(ChartGpu));
+  upload(s.buffers[2], positions.data(), positions.size() * sizeof(float));
+  upload(s.buffers[3], triangles.data(), triangles.size() * sizeof(TriangleGpu));
+  upload(s.buffers[4], indices.data(), indices.size() * sizeof(uint32_t));
+  upload(s.buffers[5], normals.data(), normals.size() * sizeof(float));
+  const std::vector<uint32_t> sunMasks(lightField.sunMasks.begin(), lightField.sunMasks.end());
+  upload(s.buffers[6], sunMasks.data(), sunMasks.size() * sizeof(uint32_t));
+  checkGl("uploading the light field (out of GPU memory?)");
+
+  glCreateVertexArrays(1, &s.vertexArray);
+  glVertexArrayVertexBuffer(s.vertexArray, 0, s.buffers[2], 0, 4 * sizeof(float));
+  glVertexArrayElementBuffer(s.vertexArray, s.buffers[4]);
+  glEnableVertexArrayAttrib(s.vertexArray, 0);
+  glVertexArrayAttribFormat(s.vertexArray, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(s.vertexArray, 0, 0);
+  glCreateVertexArrays(1, &s.emptyVertexArray);
+
+  s.visibilityProgram =
+      linkProgram({{GL_VERTEX_SHADER, kVisibilityVertex}, {GL_FRAGMENT_SHADER, kVisibilityFragment}}, "visibility", false);
+  s.shadingProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, kShadingFragment}}, "shading", true);
+  s.lookupProgram = linkProgram({{GL_COMPUTE_SHADER, kLookupCompute}}, "lookup", true);
+  glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
+  glProgramUniform3f(s.shadingProgram, glGetUniformLocation(s.shadingProgram, "background"), s.background.x,
+                     s.background.y, s.background.z);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kValuesBinding, s.buffers[0]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kChartsBinding, s.buffers[1]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPositionsBinding, s.buffers[2]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTrianglesBinding, s.buffers[3]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kNormalsBinding, s.buffers[5]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSunMasksBinding, s.buffers[6]);
+  for (GLuint program : {s.shadingProgram, s.lookupProgram}) {
+    glProgramUniform1ui(program, glGetUniformLocation(program, "sunCount"), sun.count);
+    for (uint32_t l = 0; l < sun.count; ++l) {
+      const std::string index = fmt::format("[{}]", l);
+      const Vec3& towards = sun.towardsLight[l];
+      const float* irradiance = sun.irradiance[l].v;
+      glProgramUniform3f(program, glGetUniformLocation(program, ("sunTowards" + index).c_str()), towards.x, towards.y, towards.z);
+      glProgramUniform3f(program, glGetUniformLocation(program, ("sunIrradiance" + index).c_str()), irradiance[0],
+                         irradiance[1], irradiance[2]);
+    }
+  }
+  // Reversed Z: depth = near / z ∈ (0, 1], nearer is larger.
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  checkGl("setting up the shaders");
+}
+
+GpuRenderer::~GpuRenderer() = default;
+
+void GpuRenderer::drawVisibility(const Camera& camera) {
+  State& s = *state_;
+  s.context.makeCurrent();
+  s.ensureTargets(camera.width(), camera.height());
+  setCameraUniforms(s.visibilityProgram, camera);
+  glBindFramebuffer(GL_FRAMEBUFFER, s.visibilityFramebuffer);
+  glViewport(0, 0, camera.width(), camera.height());
+  const GLuint noTriangle = 0;
+  glClearNamedFramebufferuiv(s.visibilityFramebuffer, GL_COLOR, 0, &noTriangle);
+  const float farthest = 0.0f;
+  glClearNamedFramebufferfv(s.visibilityFramebuffer, GL_DEPTH, 0, &farthest);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDisable(GL_CULL_FACE);
+  glUseProgram(s.visibilityProgram);
+  glBindVertexArray(s.vertexArray);
+  glDrawElements(GL_TRIANGLES, s.indexCount, GL_UNSIGNED_INT, nullptr);
+  glFinish();
+  checkGl("the visibility pass");
+}
+
+void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) {
+  checkRenderSettings(settings);
+  checkGpuSettings(settings, camera);
+  drawVisibility(camera);
+  State& s = *state_;
+  setCameraUniforms(s.shadingProgram, camera);
+  glProgramUniform2i(s.shadingProgram, glGetUniformLocation(s.shadingProgram, "size"), camera.width(), camera.height());
+  glProgramUniform1i(s.shadingProgram, glGetUniformLocation(s.shadingProgram, "vignetting"), camera.vignetting() ? 1 : 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, s.shadingFramebuffer);
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(s.shadingProgram);
+  glBindTextureUnit(0, s.idTexture);
+  glBindVertexArray(s.emptyVertexArray);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  if (image.width != camera.width() || image.height != camera.height()) image = Image(camera.width(), camera.height());
+  // GL row y is image row y (the projection flips film y): read straight into the pixels.
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadnPixels(0, 0, camera.width(), camera.height(), GL_RGB, GL_FLOAT, GLsizei(image.pixels.size() * sizeof(Rgb)),
+                image.pixels.data());
+  checkGl("the shading pass");
+}
+
+std::vector<Rgb> GpuRenderer::lookup(const std::vector<LookupQuery>& queries) {
+  State& s = *state_;
+  s.context.makeCurrent();
+  std::vector<float> input;
+  input.reserve(queries.size() * 8);
+  for (const LookupQuery& q : queries) {
+    float chart;
+    std::memcpy(&chart, &q.chart, sizeof(float));
+    input.insert(input.end(), {q.position.x, q.position.y, q.position.z, chart, q.towardsViewer.x, q.towardsViewer.y,
+                               q.towardsViewer.z, 0.0f});
+  }
+  GLuint buffers[2];
+  glCreateBuffers(2, buffers);
+  const size_t count = queries.size();
+  glNamedBufferStorage(buffers[0], GLsizeiptr(std::max<size_t>(input.size() * sizeof(float), 16)), input.empty() ? nullptr : input.data(), 0);
+  glNamedBufferStorage(buffers[1], GLsizeiptr(std::max<size_t>(count * 16, 16)), nullptr, GL_MAP_READ_BIT);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kQueriesBinding, buffers[0]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kResultsBinding, buffers[1]);
+  glUseProgram(s.lookupProgram);
+  glProgramUniform1ui(s.lookupProgram, glGetUniformLocation(s.lookupProgram, "count"), GLuint(count));
+  glDispatchCompute(GLuint((count + 63) / 64), 1, 1);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  std::vector<float> output(count * 4);
+  if (count > 0) glGetNamedBufferSubData(buffers[1], 0, GLsizeiptr(output.size() * sizeof(float)), output.data());
+  glDeleteBuffers(2, buffers);
+  checkGl("the lookup queries");
+  std::vector<Rgb> result(count);
+  for (size_t i = 0; i < count; ++i) result[i] = Rgb(output[4 * i], output[4 * i + 1], output[4 * i + 2]);
+  return result;
+}
+
+std::string GpuRenderer::deviceName() const {
+  state_->context.makeCurrent();
+  return fmt::format("{}, OpenGL {}", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+                     reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+}
+
+uint64_t GpuRenderer::gpuBytes() const { return state_->bufferBytes + state_->targetBytes(); }
+
+bool gpuAvailable(std::string* why) {
+  try {
+    const gpu::EglContext context;
+    return true;
+  } catch (const Error& e) {
+    if (why != nullptr) *why = e.what();
+    return false;
+  }
+}
+
+}  // namespace pl

@@ -1,0 +1,313 @@
+// The GPU renderer (gpu.h) against the CPU fast renderer (realtime.h) on the same light field
+// and camera, its shader lookup against the C++ one on random inputs, and its refusals. On a
+// machine without a GPU this runs on Mesa's llvmpipe through surfaceless EGL (the bootstrap
+// installs it), so a missing context is a failure here, not a skip.
+#include "gpu/gpu.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+
+#include "accel/accel.h"
+#include "bake/bake.h"
+#include "camera/camera.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "image/compare.h"
+#include "lightfield/lookup.h"
+#include "plf/plf_file.h"
+#include "realtime/realtime.h"
+#include "support/cli_test_support.h"
+#include "support/random_light_field.h"
+
+namespace pl {
+namespace {
+
+const std::string kMcGuire = std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/";
+
+using test_support::randomLightField;
+
+CameraDesc firstCamera(const Scene& scene) { return scene.cameras.empty() ? scene.automaticCamera() : scene.cameras.front(); }
+
+/// A view from inside the box into a corner at an angle (grazing lookups, walls seen from
+/// near and far).
+CameraDesc insideCamera(const Scene& scene) {
+  CameraDesc inside = firstCamera(scene);
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  inside.eye = lo + Vec3(0.8f, 0.7f, 0.6f) * (hi - lo);
+  inside.target = lo + Vec3(0.05f, 0.1f, 0.1f) * (hi - lo);
+  inside.fovYDegrees = 70.0f;
+  return inside;
+}
+
+class GpuRendererTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    std::string why;
+    ASSERT_TRUE(gpuAvailable(&why)) << why;
+  }
+  ThreadPool pool_{2};
+};
+
+/// The GPU and the CPU fast renderer's images of `lf` from `desc` at width × height: relMSE
+/// ≤ 1e-4 and mean luminance within 0.1 %. Only pixels whose visible triangle differs between
+/// rasterisation and ray casting (a silhouette pixel centre within float rounding of an edge)
+/// may differ by more than rounding.
+void expectSameAsFastRenderer(const LightField& lf, GpuRenderer& gpu, const CameraDesc& desc, int width, int height,
+                              bool vignetting = false) {
+  const Accel accel(lf.scene);
+  const Camera camera(desc, width, height, vignetting);
+  const FastRenderer fast(lf, accel);
+  const Image expected = fast.render(camera, RenderSettings{});
+  Image image;
+  gpu.render(camera, RenderSettings{}, image);
+  ASSERT_EQ(image.width, width);
+  ASSERT_EQ(image.height, height);
+  const ImageComparison c = compareImages(image, expected);
+  EXPECT_EQ(c.nonFinitePixels, 0u);
+  EXPECT_LE(c.relMseAverage, 1e-4) << "max |difference| " << c.maxAbsError << " at (" << c.maxErrorX << ", " << c.maxErrorY << ")";
+  EXPECT_NEAR(c.meanLuminanceRatio, 1.0, 1e-3);
+  std::printf("%dx%d: relMSE %.3g, mean luminance ratio %.6f, max |difference| %.3g\n", width, height, c.relMseAverage,
+              c.meanLuminanceRatio, c.maxAbsError);
+}
+
+TEST_F(GpuRendererTest, MatchesFastRendererOnCornellBox) {
+  const LightField lf = randomLightField(makeCornellBox(), 1);
+  GpuRenderer gpu(lf);
+  expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 64, 48);
+  expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 80, 60);
+  // Vignetting (cos⁴θ camera weights), and a second size on the same renderer (new targets).
+  expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 48, 64, true);
+}
+
+TEST_F(GpuRendererTest, MatchesFastRendererOnGlossyCornellBox) {
+  const LightField lf = randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 2);
+  ASSERT_GT(std::count_if(lf.charts.begin(), lf.charts.end(), [](const Chart& c) { return c.kind == ChartKind::Glossy; }), 0);
+  GpuRenderer gpu(lf);
+  expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 64, 48);
+  expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 80, 60);
+}
+
+TEST_F(GpuRendererTest, MatchesFastRendererOnOriginalCornellBox) {
+  const LightField lf = randomLightField(loadScene(kMcGuire + "CornellBox-Original.obj"), 3);
+  GpuRenderer gpu(lf);
+  expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 64, 48);
+}
+
+// Baked light fields (draft preset: a smooth bake, as users render), built-in box and glossy box.
+TEST_F(GpuRendererTest, MatchesFastRendererOnDraftBakes) {
+  for (const std::string& name : {std::string("cornell"), kMcGuire + "CornellBox-Glossy.obj"}) {
+    SCOPED_TRACE(name);
+    const LightField lf = bake(loadScene(name), bakePreset("draft"));
+    GpuRenderer gpu(lf);
+    expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 64, 48);
+    expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 64, 48);
+  }
+}
+
+/// `lf` lit by a sun as well, with random sun masks (every bit pattern: wholly lit, wholly
+/// shadowed and mixed tixels) and its punctual highlights taken as part of its glossy maps.
+LightField withRandomSunMasks(LightField lf, uint64_t seed) {
+  lf.scene.lights.push_back(DirectionalLight{glm::normalize(Vec3(0.3f, -1.0f, 0.4f)), Rgb(3.0f, 2.5f, 2.0f)});
+  lf.scene.finalize();
+  lf.settings.punctualHighlights = false;
+  lf.sunMaskLightCount = uint32_t(sunMaskLights(lf.scene).size());
+  uint64_t tixels = 0;
+  for (const Chart& c : lf.charts) tixels = std::max(tixels, c.firstTixel + c.tixelCount());
+  Pcg32 rng(seed, 5);
+  lf.sunMasks.resize(tixels * lf.sunMaskLightCount);
+  for (SunMask& m : lf.sunMasks) {
+    const uint32_t kind = rng.next() % 3;
+    m = kind == 0 ? SunMask(0) : kind == 1 ? SunMask(0xffff) : SunMask(rng.next() & 0xffff);
+  }
+  return lf;
+}
+
+TEST_F(GpuRendererTest, MatchesFastRendererWithSunMasks) {
+  for (const std::string& file : {std::string("CornellBox-Original.obj"), std::string("CornellBox-Glossy.obj")}) {
+    SCOPED_TRACE(file);
+    const LightField lf = withRandomSunMasks(randomLightField(loadScene(kMcGuire + file), 11), 12);
+    ASSERT_EQ(lf.sunMaskLightCount, 1u);
+    GpuRenderer gpu(lf);
+    expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 64, 48);
+    expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 64, 48);
+  }
+}
+
+// The shader's lookup (the function the shading pass calls) against exitantRadiance on random
+// points and directions over every chart: both sides of each record, points off the grid
+// (clamped), grazing and below-horizon directions.
+TEST_F(GpuRendererTest, ShaderLookupMatchesCppLookup) {
+  for (const std::string& file : {std::string("CornellBox-Glossy.obj"), std::string("CornellBox-Original.obj")}) {
+    const LightField lf = withRandomSunMasks(randomLightField(loadScene(kMcGuire + file), 4), 13);
+    GpuRenderer gpu(lf);
+    Pcg32 rng(11, 3);
+    std::vector<GpuRenderer::LookupQuery> queries;
+    while (queries.size() < 4000) {
+      // A front record (as triangleChart gives them; the chart normal decides the side).
+      const uint32_t chart = rng.next() % uint32_t(lf.charts.size());
+      const Chart& c = lf.charts[chart];
+      if (c.isBack) continue;
+      const float u = (1.4f * rng.uniform() - 0.2f) * float(c.resU) * c.tixelSize;
+      const float v = (1.4f * rng.uniform() - 0.2f) * float(c.resV) * c.tixelSize;
+      GpuRenderer::LookupQuery q;
+      q.chart = chart;
+      q.position = c.origin + u * c.axisU + v * c.axisV;
+      q.towardsViewer = sampleUniformSphere(Vec2(rng.uniform(), rng.uniform()));
+      // Behind a one-sided curved record a view ray sees nothing (viewedChart), which this
+      // overload of exitantRadiance, having no triangle, does not model.
+      if (c.curved && c.sides == 1 && glm::dot(q.towardsViewer, c.normal) < 0.0f) continue;
+      queries.push_back(q);
+    }
+    const std::vector<Rgb> gpuValues = gpu.lookup(queries);
+    ASSERT_EQ(gpuValues.size(), queries.size());
+    int differing = 0;
+    double worst = 0.0;
+    for (size_t i = 0; i < queries.size(); ++i) {
+      const Rgb expected = exitantRadiance(lf, queries[i].chart, queries[i].position, queries[i].towardsViewer, Vec2(0.0f));
+      for (int ch = 0; ch < 3; ++ch) {
+        // Float rounding (a fused multiply-add here or there) on values up to ≈ 4; a wrong tap,
+        // weight or side is off by ≥ 1e-2.
+        const double diff = std::abs(double(gpuValues[i][ch]) - double(expected[ch]));
+        worst = std::max(worst, diff);
+        if (!(diff <= 1e-4)) ++differing;
+      }
+    }
+    EXPECT_EQ(differing, 0) << file << ": worst difference " << worst;
+  }
+}
+
+TEST_F(GpuRendererTest, RefusesWhatItDoesNotDrawYet) {
+  const LightField mirror = randomLightField(loadScene(kMcGuire + "CornellBox-Mirror.obj"), 5);
+  EXPECT_EQ(gpuUnsupportedFeature(mirror), "mirrors and glass (specular charts)");
+  try {
+    GpuRenderer gpu(mirror);
+    ADD_FAILURE() << "the mirror box was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("mirrors and glass"), std::string::npos) << e.what();
+  }
+  const LightField box = randomLightField(makeCornellBox(), 6);
+  EXPECT_EQ(gpuUnsupportedFeature(box), "");
+  GpuRenderer gpu(box);
+  RenderSettings settings;
+  settings.samplesPerPixel = 4;
+  Image image;
+  const Camera camera(firstCamera(box.scene), 16, 12);
+  try {
+    gpu.render(camera, settings, image);
+    ADD_FAILURE() << "4 samples per pixel were accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("more than one sample per pixel"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(GpuRendererTest, GpuMemoryIsTheLightFieldAndOneFrame) {
+  const LightField lf = randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 7);
+  GpuRenderer gpu(lf);
+  Image image;
+  gpu.render(Camera(firstCamera(lf.scene), 64, 48), RenderSettings{}, image);
+  // Values as 16-byte RGBA, 128 bytes per chart record, the geometry, and 24 bytes per pixel.
+  uint64_t geometry = 0;
+  for (const Mesh& m : lf.scene.meshes) geometry += m.positions.size() * 32 + m.triangles.size() * 28;
+  const uint64_t expected = lf.values.size() * 16 + lf.charts.size() * 128 + geometry + 64 * 48 * 24;
+  EXPECT_LE(gpu.gpuBytes(), expected + 7 * 16);
+  EXPECT_GE(gpu.gpuBytes(), expected);
+  EXPECT_NE(gpu.deviceName().find("OpenGL 4.5"), std::string::npos) << gpu.deviceName();
+}
+
+// `plenoptic render --renderer gpu` end to end: the picture of `--renderer cpu`, its stats,
+// and the refusals (what it does not draw, no OpenGL 4.5 context, --reference with it).
+class GpuRenderCliTest : public cli_test::CliTest {
+ protected:
+  void SetUp() override {
+    CliTest::SetUp();
+    writeLightField(path("box.plf"), randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 8));
+  }
+};
+
+TEST_F(GpuRenderCliTest, RendersTheCpuPicture) {
+  std::string err;
+  const std::string size = " --width 64 --height 48";
+  ASSERT_EQ(run("render " + path("box.plf") + " -o " + path("gpu.exr") + size + " --renderer gpu --stats " + path("gpu.json"),
+                nullptr, &err),
+            0)
+      << err;
+  ASSERT_EQ(run("render " + path("box.plf") + " -o " + path("cpu.exr") + size + " --renderer cpu", nullptr, &err), 0) << err;
+  const ImageComparison c = compareImages(readImage(path("gpu.exr")), readImage(path("cpu.exr")));
+  EXPECT_LE(c.relMseAverage, 1e-4);
+  EXPECT_NEAR(c.meanLuminanceRatio, 1.0, 1e-3);
+  const auto json = nlohmann::json::parse(cli_test::readFileText(path("gpu.json")));
+  EXPECT_EQ(json["renderer"], "gpu");
+  EXPECT_NE(std::string(json["device"]).find("OpenGL 4.5"), std::string::npos) << json["device"];
+  EXPECT_GT(double(json["primary_ms_median"]), 0.0);  // the rasterisation pass alone
+}
+
+// A walk-through (--path) frame by frame, on the built-in box.
+TEST_F(GpuRenderCliTest, CameraPathFramesAreTheCpuFrames) {
+  writeLightField(path("cornell.plf"), randomLightField(makeCornellBox(), 10));
+  std::ofstream(path("path.json")) << R"({"fps": 30, "keyframes": [
+      {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0], "fov": 39},
+      {"time": 0.1, "eye": [150, 300, -400], "target": [300, 200, 300]}]})";
+  for (const std::string renderer : {"gpu", "cpu"}) {
+    std::string err;
+    ASSERT_EQ(run("render " + path("cornell.plf") + " --path " + path("path.json") + " -o " + path(renderer + "/%02d.exr") +
+                      " --width 48 --height 36 --renderer " + renderer,
+                  nullptr, &err),
+              0)
+        << err;
+  }
+  for (const std::string frame : {"00", "01", "02", "03"}) {
+    SCOPED_TRACE(frame);
+    const ImageComparison c = compareImages(readImage(path("gpu/" + frame + ".exr")), readImage(path("cpu/" + frame + ".exr")));
+    EXPECT_LE(c.relMseAverage, 1e-4);
+    EXPECT_NEAR(c.meanLuminanceRatio, 1.0, 1e-3);
+  }
+}
+
+TEST_F(GpuRenderCliTest, RefusesWhatItDoesNotDrawAndWritesNothing) {
+  writeLightField(path("mirror.plf"), randomLightField(loadScene(kMcGuire + "CornellBox-Mirror.obj"), 9));
+  std::string err;
+  EXPECT_NE(run("render " + path("mirror.plf") + " -o " + path("m.exr") + " --renderer gpu", nullptr, &err), 0);
+  EXPECT_NE(err.find("mirrors and glass"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(path("m.exr")));
+  EXPECT_NE(run("render " + path("box.plf") + " -o " + path("s.exr") + " --renderer gpu --spp 4", nullptr, &err), 0);
+  EXPECT_NE(err.find("more than one sample per pixel"), std::string::npos) << err;
+  EXPECT_NE(run("render " + path("box.plf") + " -o " + path("r.exr") + " --renderer gpu --reference", nullptr, &err), 0);
+  EXPECT_NE(err.find("--reference and --renderer gpu"), std::string::npos) << err;
+  EXPECT_NE(run("render " + path("box.plf") + " -o " + path("r.exr") + " --renderer vulkan", nullptr, &err), 0);
+  EXPECT_FALSE(std::filesystem::exists(path("s.exr")));
+  EXPECT_FALSE(std::filesystem::exists(path("r.exr")));
+}
+
+// A driver that offers less than OpenGL 4.5 (Mesa told to report 3.3), and no EGL at all: a
+// clear error naming the EGL error, a non-zero exit, no image.
+TEST_F(GpuRenderCliTest, NoOpenGl45ContextIsAClearError) {
+  std::string err;
+  EXPECT_NE(cli_test::runPlenoptic("render " + path("box.plf") + " -o " + path("n.exr") + " --renderer gpu --quiet", dir_,
+                                   nullptr, &err, "MESA_GL_VERSION_OVERRIDE=3.3"),
+            0);
+  EXPECT_NE(err.find("no OpenGL 4.5 core context"), std::string::npos) << err;
+  EXPECT_NE(err.find("EGL_BAD_MATCH"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(path("n.exr")));
+  // No EGL implementation at all (the vendor-neutral libEGL finds no vendor): no platform
+  // extension, no display — the same clear error, no abort.
+  EXPECT_EQ(cli_test::runPlenoptic("render " + path("box.plf") + " -o " + path("n.exr") + " --renderer gpu --quiet", dir_,
+                                   nullptr, &err, "__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json"),
+            1);
+  EXPECT_NE(err.find("no OpenGL 4.5 core context"), std::string::npos) << err;
+  EXPECT_NE(err.find("EGL_MESA_platform_surfaceless not offered"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(path("n.exr")));
+}
+
+}  // namespace
+}  // namespace pl
