@@ -451,7 +451,12 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
     if (shading.texturedAlbedo) return "albedo textures, metallic-roughness textures and vertex colours";
     if (shading.normalMapped || c.directionalIrradiance) return "normal maps";
     if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) return "rough glass";
-    if (c.diffuseValue && std::holds_alternative<GgxBsdf>(scene.materials[c.material].bsdf))
+    if (shading.texturedEmission) return "emission textures";
+    // The shader takes a glossy chart's diffuse part as Blinn-Phong's, k(μ) = 1; GGX-like
+    // models (GgxBsdf, GltfPbrBsdf) couple it to the lobe's albedo.
+    const Bsdf& model = scene.materials[c.material].bsdf;
+    if (c.diffuseValue && (diffuseDirectionalFactor(model, 0.25f) != Rgb(1.0f) ||
+                           diffuseDirectionalFactor(model, 1.0f) != Rgb(1.0f)))
       return "GGX materials with a diffuse base";
   }
   if (lf.values.size() >= std::numeric_limits<uint32_t>::max() || lf.sunMasks.size() >= std::numeric_limits<uint32_t>::max())

@@ -196,6 +196,16 @@ TEST_F(GpuRendererTest, RefusesWhatItDoesNotDrawYet) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("mirrors and glass"), std::string::npos) << e.what();
   }
+  // A diffuse emitter with an emission texture (the glTF emissive seed, made Lambertian), and
+  // glossy charts whose diffuse share follows the lobe (the glTF layered model's): both need
+  // per-pixel terms the shader does not have yet.
+  Scene emissive = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/fuzz/gltf/seed-emissive-texture.gltf");
+  emissive.materials[0].bsdf = LambertBsdf{Rgb(0.5f)};
+  EXPECT_EQ(gpuUnsupportedFeature(randomLightField(emissive, 7)), "emission textures");
+  Scene layered = makeCornellBox();
+  for (Material& m : layered.materials)
+    if (!m.isEmissive()) m.bsdf = GltfPbrBsdf{};
+  EXPECT_EQ(gpuUnsupportedFeature(randomLightField(layered, 8)), "GGX materials with a diffuse base");
   const LightField box = randomLightField(makeCornellBox(), 6);
   EXPECT_EQ(gpuUnsupportedFeature(box), "");
   GpuRenderer gpu(box);
