@@ -42,14 +42,8 @@ lf_samples=${LF_SAMPLES:-16}
 threads=${THREADS:-2}
 blender=${BLENDER:-blender}
 
-if ! command -v "$blender" > /dev/null 2>&1; then
-  echo "$0: Blender is not installed ('$blender' not found; apt-get install -y blender): skipping the Cycles comparison"
-  exit 0
-fi
-if [[ ! -x "$plenoptic" ]]; then
-  echo "$0: $plenoptic is not an executable (build it first: make build)" >&2
-  exit 1
-fi
+source "$here/blender_common.sh"
+require_blender_and_plenoptic "$blender" "$plenoptic"
 mkdir -p "$work"
 size=(--width "$width" --height "$height")
 echo "Blender: $("$blender" --version 2> /dev/null | head -1); $threads threads; ${width}x${height}; $spp spp" >&2
