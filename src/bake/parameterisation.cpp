@@ -38,10 +38,11 @@ bool isMirrorLike(const Bsdf& bsdf, const BakeSettings& settings) {
   // Only a model that is all lobe: a diffuse part would need a stored irradiance beside the
   // traced lobe, and rough glass is a glossy chart on both sides.
   if (isDelta(bsdf) || isDiffuse(bsdf) || hasTransmission(bsdf) || !isBlack(diffuseAlbedo(bsdf))) return false;
-  // Narrower than a quarter texel of the largest map the preset allows (a texel spans ≈ 4/R
-  // radians): such a map would hold the lobe's reflection as the bilinear tent of texels four
+  // Narrower than half a texel of the largest map the preset allows (a texel spans ≈ 4/R
+  // radians): such a map would hold the lobe's reflection as the bilinear tent of texels two
   // or more lobe widths apart, the reflection of a lamp a smear around a wrong core, while
-  // the traced lobe, this narrow, adds little noise.
+  // the traced lobe, its emitters sampled at each hit (lookup.h MirrorLikeLights), adds
+  // little noise.
   const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
   return lobeMapResolution(reflectedLobeWidth(bsdf)) > kMirrorLikeTexels * cap;
 }

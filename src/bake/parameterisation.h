@@ -163,12 +163,12 @@ ChartKind chartKindOf(const Bsdf& bsdf, const BakeSettings& settings);
 /// lobe `lobeWidth` radians wide at half maximum (≈ 16 / lobeWidth), at least 2.
 uint32_t lobeMapResolution(float lobeWidth);
 /// A glossy lobe counts as mirror-like when lobeMapResolution asks for more than this many
-/// times the preset's cap (settings.glossyDirRes): the lobe is narrower than a quarter of a
-/// texel of the largest map (docs/design.md, "Glossy lobes and the map size", has the
-/// measurements that place the boundary there).
-inline constexpr uint32_t kMirrorLikeTexels = 16;
+/// times the preset's cap (settings.glossyDirRes): the lobe is narrower than half a texel of
+/// the largest map (docs/design.md, "Glossy lobes and the map size", has the measurements
+/// that place the boundary there).
+inline constexpr uint32_t kMirrorLikeTexels = 8;
 /// Whether `bsdf` is a glossy model without a diffuse part (a metal) whose lobe is narrower
-/// than a quarter texel of the preset's largest map: its charts are Specular, and every lookup
+/// than half a texel of the preset's largest map: its charts are Specular, and every lookup
 /// continues the ray by sampling the lobe (lightfield/lookup.h followSpecular).
 bool isMirrorLike(const Bsdf& bsdf, const BakeSettings& settings);
 /// Whether charts of `material` may be curved ("Curved charts" above): Lambertian and glossy

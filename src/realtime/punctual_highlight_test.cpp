@@ -88,8 +88,8 @@ TEST_F(PunctualHighlightTest, PointLightHighlightsOnGlossyWallsMatchThePathTrace
 // Mirror-like charts (bake/parameterisation.h isMirrorLike) store nothing, so their punctual
 // highlights are added at every specular hit of a view ray's chain, as the path tracer's
 // next-event estimation adds them at every bounce. The same box with every wall and block a
-// GGX metal of roughness 0.2 over its own colour (mirror-like at draft: FWHM 5.9°, below a
-// quarter of the 8² map's 29° texels), lit only by the point light.
+// GGX metal of roughness 0.2 over its own colour (mirror-like at draft: FWHM 5.9°, below
+// half of the 8² map's 29° texels), lit only by the point light.
 // Measured (48 × 48, draft): LF/PT 1.104, relMSE 1.67 at 16 samples per pixel against 256 spp;
 // 0.988, 0.49 at 64 against 1024 — the traced lobes' fireflies (no next-event estimation of the
 // highlights the chains pass on), not a bias. Without highlights at the specular hits the image
