@@ -73,7 +73,20 @@ uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings) {
     case ChartKind::Glossy: break;
   }
   const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
-  return std::min(lobeMapResolution(reflectedLobeWidth(bsdf)), cap);
+  const uint32_t wanted = lobeMapResolution(reflectedLobeWidth(bsdf));
+  return std::min(wanted, isStrongNarrowLobe(bsdf, settings) ? kStrongNarrowLobeCapFactor * cap : cap);
+}
+
+bool isStrongNarrowLobe(const Bsdf& bsdf, const BakeSettings& settings) {
+  if (isDelta(bsdf) || isDiffuse(bsdf) || hasTransmission(bsdf)) return false;
+  // Narrower than two thirds of a texel at the cap (a texel spans ≈ 4/R radians, so the lobe
+  // asks for more than 6 × the cap): the map keeps the lobe's reflection of a lamp as the
+  // bilinear tent of texels wider than the lobe, its core too dark and its halo too bright.
+  const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
+  if (lobeMapResolution(reflectedLobeWidth(bsdf)) <= kStrongNarrowLobeTexels * cap) return false;
+  // And strong: what that smear costs grows with the lobe's share of the reflected light. The
+  // lobe alone (the model without its diffuse part), at normal incidence, luminance.
+  return luminance(albedo(withDiffuseAlbedo(bsdf, Rgb(0.0f)), Vec3(0.0f, 0.0f, 1.0f))) >= kStrongLobeAlbedo;
 }
 
 float sceneScale(const Scene& scene, const Accel& accel) {

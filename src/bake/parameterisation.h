@@ -55,7 +55,7 @@
 //   Blinn-Phong / GGX without a diffuse part whose lobe is narrower than one texel of the
 //   largest map (isMirrorLike) → Specular too: followed through by sampling the lobe;
 //   Blinn-Phong / GGX / rough glass → Glossy, dirRes from the lobe width (lobeMapResolution),
-//   capped by glossyDirRes.
+//   capped by glossyDirRes (twice that for a strong narrow lobe: isStrongNarrowLobe).
 //
 // Sides (lightfield.h "Sides"): the diffuse and glossy charts of an open surface — a connected
 // set of triangles (welded edges, any material) that is not closed and consistently wound —
@@ -176,8 +176,24 @@ bool isMirrorLike(const Bsdf& bsdf, const BakeSettings& settings);
 /// mirror-like lobes.
 bool mayGrowCurvedCharts(const Material& material, const BakeSettings& settings);
 /// Paraboloid map resolution for a material (1 diffuse, 0 specular, glossy: lobeMapResolution
-/// of its lobe, capped by settings.glossyDirRes).
+/// of its lobe, capped by settings.glossyDirRes, or by kStrongNarrowLobeCapFactor × that for
+/// a strong narrow lobe, isStrongNarrowLobe).
 uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings);
+/// A glossy lobe is narrow when lobeMapResolution asks for more than this many times the
+/// preset's cap: narrower than two thirds of a texel of the capped map.
+inline constexpr uint32_t kStrongNarrowLobeTexels = 6;
+/// A narrow lobe is strong when the model without its diffuse part reflects at least this
+/// much at normal incidence (luminance): a Blinn-Phong lobe of specular 0.35 or a metal, not a
+/// dielectric's f0 0.04, whose smeared reflections are within the targets (docs/design.md,
+/// "Glossy lobes and the map size", has the measurements).
+inline constexpr float kStrongLobeAlbedo = 0.25f;
+/// A strong narrow lobe's map may have this many times the preset's cap across (so this
+/// squared times the values per tixel).
+inline constexpr uint32_t kStrongNarrowLobeCapFactor = 2;
+/// Whether `bsdf` is a glossy model (Blinn-Phong, GGX, not rough glass) whose lobe is narrow
+/// and strong (kStrongNarrowLobeTexels, kStrongLobeAlbedo) for the preset's cap. Mirror-like
+/// lobes (isMirrorLike) are too, but store no map.
+bool isStrongNarrowLobe(const Bsdf& bsdf, const BakeSettings& settings);
 /// The scene's room scale (scene units): the side of the empty cube whose mean free path
 /// equals the scene's. For a closed cavity of volume V and surface area S, the mean length of
 /// the free paths leaving its surface cosine-weighted is 4V/S (Cauchy's formula), 2a/3 for a
