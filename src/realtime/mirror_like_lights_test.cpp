@@ -16,6 +16,7 @@
 #include "realtime/realtime.h"
 #include "render/render.h"
 #include "scene/scene.h"
+#include "support/fast_vs_reference.h"
 #include "support/light_field_vs_trace.h"
 
 namespace pl {
@@ -60,12 +61,8 @@ TEST_F(MirrorLikeLightsTest, LampReflectionsInMirrorLikeMetalMatchThePathTracer)
 
   // The fast renderer samples the same lights with the same numbers (one and four samples per
   // pixel): only the hit points' rounding differs, a missing or doubled term would be above 1e-2.
-  const FastRenderer fast(lf, accel);
   for (int spp : {1, 4}) {
-    RenderSettings render;
-    render.samplesPerPixel = spp;
-    render.showProgress = false;
-    const ImageComparison same = compareImages(fast.render(camera, render), renderLightField(lf, accel, camera, render));
+    const ImageComparison same = test_support::fastAgainstReferenceRenderer(lf, accel, camera, spp);
     std::printf("fast vs reference renderer, %d spp: relMSE %.3g, mean ratio %.7f\n", spp, same.relMseAverage,
                 same.meanLuminanceRatio);
     EXPECT_LT(same.relMseAverage, 1e-6) << spp;
