@@ -86,7 +86,7 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
                       "Override the preset: gather directions per tixel (rounded to a square)")
       ->check(CLI::Range(1u, 65536u));
   command->add_option("--glossy-res", options->glossyDirRes,
-                      "Override the preset: the largest paraboloid map (texels across) of a glossy chart")
+                      "Override the preset: the largest paraboloid map (texels across) of a glossy chart (twice that for a strong narrow lobe)")
       ->check(CLI::Range(2u, 256u));
   command->add_option("--light-samples", options->lightSamples,
                       "Override the preset: shadow rays per tixel towards emissive surfaces")

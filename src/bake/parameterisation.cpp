@@ -38,10 +38,11 @@ bool isMirrorLike(const Bsdf& bsdf, const BakeSettings& settings) {
   // Only a model that is all lobe: a diffuse part would need a stored irradiance beside the
   // traced lobe, and rough glass is a glossy chart on both sides.
   if (isDelta(bsdf) || isDiffuse(bsdf) || hasTransmission(bsdf) || !isBlack(diffuseAlbedo(bsdf))) return false;
-  // Narrower than a quarter texel of the largest map the preset allows (a texel spans ≈ 4/R
-  // radians): such a map would hold the lobe's reflection as the bilinear tent of texels four
+  // Narrower than half a texel of the largest map the preset allows (a texel spans ≈ 4/R
+  // radians): such a map would hold the lobe's reflection as the bilinear tent of texels two
   // or more lobe widths apart, the reflection of a lamp a smear around a wrong core, while
-  // the traced lobe, this narrow, adds little noise.
+  // the traced lobe, its emitters sampled at each hit (lookup.h MirrorLikeLights), adds
+  // little noise.
   const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
   return lobeMapResolution(reflectedLobeWidth(bsdf)) > kMirrorLikeTexels * cap;
 }
@@ -72,7 +73,20 @@ uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings) {
     case ChartKind::Glossy: break;
   }
   const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
-  return std::min(lobeMapResolution(reflectedLobeWidth(bsdf)), cap);
+  const uint32_t wanted = lobeMapResolution(reflectedLobeWidth(bsdf));
+  return std::min(wanted, isStrongNarrowLobe(bsdf, settings) ? kStrongNarrowLobeCapFactor * cap : cap);
+}
+
+bool isStrongNarrowLobe(const Bsdf& bsdf, const BakeSettings& settings) {
+  if (isDelta(bsdf) || isDiffuse(bsdf) || hasTransmission(bsdf)) return false;
+  // Narrower than two thirds of a texel at the cap (a texel spans ≈ 4/R radians, so the lobe
+  // asks for more than 6 × the cap): the map keeps the lobe's reflection of a lamp as the
+  // bilinear tent of texels wider than the lobe, its core too dark and its halo too bright.
+  const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
+  if (lobeMapResolution(reflectedLobeWidth(bsdf)) <= kStrongNarrowLobeTexels * cap) return false;
+  // And strong: what that smear costs grows with the lobe's share of the reflected light. The
+  // lobe alone (the model without its diffuse part), at normal incidence, luminance.
+  return luminance(albedo(withDiffuseAlbedo(bsdf, Rgb(0.0f)), Vec3(0.0f, 0.0f, 1.0f))) >= kStrongLobeAlbedo;
 }
 
 float sceneScale(const Scene& scene, const Accel& accel) {

@@ -55,7 +55,7 @@
 //   Blinn-Phong / GGX without a diffuse part whose lobe is narrower than one texel of the
 //   largest map (isMirrorLike) → Specular too: followed through by sampling the lobe;
 //   Blinn-Phong / GGX / rough glass → Glossy, dirRes from the lobe width (lobeMapResolution),
-//   capped by glossyDirRes.
+//   capped by glossyDirRes (twice that for a strong narrow lobe: isStrongNarrowLobe).
 //
 // Sides (lightfield.h "Sides"): the diffuse and glossy charts of an open surface — a connected
 // set of triangles (welded edges, any material) that is not closed and consistently wound —
@@ -163,12 +163,12 @@ ChartKind chartKindOf(const Bsdf& bsdf, const BakeSettings& settings);
 /// lobe `lobeWidth` radians wide at half maximum (≈ 16 / lobeWidth), at least 2.
 uint32_t lobeMapResolution(float lobeWidth);
 /// A glossy lobe counts as mirror-like when lobeMapResolution asks for more than this many
-/// times the preset's cap (settings.glossyDirRes): the lobe is narrower than a quarter of a
-/// texel of the largest map (docs/design.md, "Glossy lobes and the map size", has the
-/// measurements that place the boundary there).
-inline constexpr uint32_t kMirrorLikeTexels = 16;
+/// times the preset's cap (settings.glossyDirRes): the lobe is narrower than half a texel of
+/// the largest map (docs/design.md, "Glossy lobes and the map size", has the measurements
+/// that place the boundary there).
+inline constexpr uint32_t kMirrorLikeTexels = 8;
 /// Whether `bsdf` is a glossy model without a diffuse part (a metal) whose lobe is narrower
-/// than a quarter texel of the preset's largest map: its charts are Specular, and every lookup
+/// than half a texel of the preset's largest map: its charts are Specular, and every lookup
 /// continues the ray by sampling the lobe (lightfield/lookup.h followSpecular).
 bool isMirrorLike(const Bsdf& bsdf, const BakeSettings& settings);
 /// Whether charts of `material` may be curved ("Curved charts" above): Lambertian and glossy
@@ -176,8 +176,24 @@ bool isMirrorLike(const Bsdf& bsdf, const BakeSettings& settings);
 /// mirror-like lobes.
 bool mayGrowCurvedCharts(const Material& material, const BakeSettings& settings);
 /// Paraboloid map resolution for a material (1 diffuse, 0 specular, glossy: lobeMapResolution
-/// of its lobe, capped by settings.glossyDirRes).
+/// of its lobe, capped by settings.glossyDirRes, or by kStrongNarrowLobeCapFactor × that for
+/// a strong narrow lobe, isStrongNarrowLobe).
 uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings);
+/// A glossy lobe is narrow when lobeMapResolution asks for more than this many times the
+/// preset's cap: narrower than two thirds of a texel of the capped map.
+inline constexpr uint32_t kStrongNarrowLobeTexels = 6;
+/// A narrow lobe is strong when the model without its diffuse part reflects at least this
+/// much at normal incidence (luminance): a Blinn-Phong lobe of specular 0.35 or a metal, not a
+/// dielectric's f0 0.04, whose smeared reflections are within the targets (docs/design.md,
+/// "Glossy lobes and the map size", has the measurements).
+inline constexpr float kStrongLobeAlbedo = 0.25f;
+/// A strong narrow lobe's map may have this many times the preset's cap across (so this
+/// squared times the values per tixel).
+inline constexpr uint32_t kStrongNarrowLobeCapFactor = 2;
+/// Whether `bsdf` is a glossy model (Blinn-Phong, GGX, not rough glass) whose lobe is narrow
+/// and strong (kStrongNarrowLobeTexels, kStrongLobeAlbedo) for the preset's cap. Mirror-like
+/// lobes (isMirrorLike) are too, but store no map.
+bool isStrongNarrowLobe(const Bsdf& bsdf, const BakeSettings& settings);
 /// The scene's room scale (scene units): the side of the empty cube whose mean free path
 /// equals the scene's. For a closed cavity of volume V and surface area S, the mean length of
 /// the free paths leaving its surface cosine-weighted is 4V/S (Cauchy's formula), 2a/3 for a

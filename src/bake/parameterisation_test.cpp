@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <set>
+#include <string>
+#include <utility>
 
 #include "bake/bake.h"
 #include "core/progress.h"
@@ -320,9 +322,37 @@ TEST(Parameterisation, DirectionalResolutionByMaterial) {
   const uint32_t narrow = directionalResolution(BlinnPhongBsdf{Rgb(0.3f), Rgb(0.3f), 80.0f}, settings);
   EXPECT_LT(wide, narrow);  // sharper lobes need finer maps
   EXPECT_LE(narrow, 16u);
-  EXPECT_EQ(directionalResolution(BlinnPhongBsdf{Rgb(0.3f), Rgb(0.3f), 100000.0f}, settings), 16u);  // capped
+  EXPECT_EQ(directionalResolution(BlinnPhongBsdf{Rgb(0.3f), Rgb(0.1f), 100000.0f}, settings), 16u);  // capped
   EXPECT_LT(directionalResolution(GgxBsdf{Rgb(0.2f), Rgb(0.04f), 0.5f}, settings),
             directionalResolution(GgxBsdf{Rgb(0.2f), Rgb(0.04f), 0.1f}, settings));
+}
+
+TEST(Parameterisation, StrongNarrowLobesGetTwiceTheCap) {
+  // Blinn-Phong exponent 1000 (FWHM 8.5°, R 108) over a diffuse colour, specular 0.35: narrower
+  // than two thirds of a texel at the draft (8) and default (16) caps, not at high's (24).
+  const BlinnPhongBsdf strong{Rgb(0.6f), Rgb(0.35f), 1000.0f};
+  const BlinnPhongBsdf weak{Rgb(0.6f), Rgb(0.1f), 1000.0f};  // the same lobe, a weak one
+  ASSERT_EQ(lobeMapResolution(4.0f * lobeHalfWidth(strong)), 108u);
+  for (const auto& [preset, strongRes] : {std::pair<const char*, uint32_t>{"draft", 16u}, {"default", 32u}, {"high", 24u}}) {
+    const BakeSettings settings = bakePreset(preset);
+    SCOPED_TRACE(preset);
+    EXPECT_EQ(isStrongNarrowLobe(strong, settings), std::string(preset) != "high");
+    EXPECT_EQ(directionalResolution(strong, settings), strongRes);
+    EXPECT_FALSE(isStrongNarrowLobe(weak, settings));
+    EXPECT_EQ(directionalResolution(weak, settings), settings.glossyDirRes);
+    // A GGX dielectric's lobe (f0 0.04) is weak however narrow: roughness 0.05 keeps the cap.
+    EXPECT_FALSE(isStrongNarrowLobe(GgxBsdf{Rgb(0.8f), Rgb(0.04f), 0.0025f}, settings));
+    // A lobe that asks for no more than the doubled cap gets what it asks for: GGX metal
+    // roughness 0.3 (R 70) at draft is mirror-like (no map); at default a strong narrow lobe
+    // only if R > 96, so it keeps 16.
+    EXPECT_EQ(directionalResolution(GgxBsdf{Rgb(0.0f), Rgb(0.9f), 0.09f}, settings),
+              std::string(preset) == "draft" ? 0u : settings.glossyDirRes);
+  }
+  // Rough glass, mirrors and Lambert are never strong narrow lobes.
+  const BakeSettings settings = bakePreset("default");
+  EXPECT_FALSE(isStrongNarrowLobe(DielectricBsdf{1.5f, Rgb(1.0f), 0.0025f}, settings));
+  EXPECT_FALSE(isStrongNarrowLobe(MirrorBsdf{}, settings));
+  EXPECT_FALSE(isStrongNarrowLobe(LambertBsdf{}, settings));
 }
 
 TEST(Parameterisation, MapResolutionFollowsTheLobeWidth) {
@@ -339,7 +369,7 @@ TEST(Parameterisation, MapResolutionFollowsTheLobeWidth) {
   EXPECT_EQ(directionalResolution(GgxBsdf{Rgb(0.2f), Rgb(0.04f), alpha}, settings), expected);
 }
 
-TEST(Parameterisation, MetalLobesNarrowerThanAQuarterTexelAtTheCapAreMirrorLike) {
+TEST(Parameterisation, MetalLobesNarrowerThanHalfATexelAtTheCapAreMirrorLike) {
   for (const char* preset : {"draft", "default", "high"}) {
     const BakeSettings settings = bakePreset(preset);
     SCOPED_TRACE(preset);
@@ -357,8 +387,9 @@ TEST(Parameterisation, MetalLobesNarrowerThanAQuarterTexelAtTheCapAreMirrorLike)
     const GgxBsdf rough{Rgb(0.0f), Rgb(0.9f), 0.36f};
     EXPECT_FALSE(isMirrorLike(rough, settings));
     EXPECT_EQ(chartKindOf(rough, settings), ChartKind::Glossy);
-    // GGX metal roughness 0.3 (FWHM 13°) keeps its map at every preset.
-    EXPECT_FALSE(isMirrorLike(GgxBsdf{Rgb(0.0f), Rgb(0.9f), 0.09f}, settings));
+    // GGX metal roughness 0.3 (FWHM 13°, R 70): below half a texel of the draft map (29°),
+    // traced there; the default and high maps keep it.
+    EXPECT_EQ(isMirrorLike(GgxBsdf{Rgb(0.0f), Rgb(0.9f), 0.09f}, settings), std::string(preset) == "draft");
     // Rough glass and mirrors keep their kinds.
     EXPECT_FALSE(isMirrorLike(DielectricBsdf{1.5f, Rgb(1.0f), 0.0025f}, settings));
     EXPECT_FALSE(isMirrorLike(MirrorBsdf{}, settings));

@@ -213,4 +213,33 @@ float LightSampler::emitterAreaPdf(uint32_t mesh, uint32_t triangle) const {
   return entry < 0 ? 0.0f : areaPdf_[entries_[static_cast<size_t>(entry)].index];
 }
 
+Rgb nextEventEstimate(const LightSampler& lights, const ShadowRays& shadows, const Vec3& position,
+                      const ScatteringFrame& scattering, const Bsdf& bsdf, Vec2 u, NextEvent mode, uint64_t& rays) {
+  const std::optional<LightSample> light = lights.sample(position, u, /*nextEventOnly=*/mode == NextEvent::SceneLightsOnly);
+  if (!light || (mode == NextEvent::MisFindableOnly && light->nextEventOnly)) return Rgb(0.0f);
+  const Vec3& wi = light->wi;  // towards the light, world space
+  const auto& [geometricNormal, frame, woLocal] = scattering;
+
+  // A reflecting BSDF receives light only from above the geometric surface (this also stops
+  // light leaking through when shading normals bend over the horizon); a transmitting one
+  // from the side where the shading frame puts wi (both normals agree on it).
+  const Vec3 wiLocal = frame.toLocal(wi);
+  if (!usableSide(wi, wiLocal, geometricNormal, bsdf)) return Rgb(0.0f);
+  const Rgb f = eval(bsdf, woLocal, wiLocal);
+  const float cosIn = std::abs(wiLocal.z);
+  if (isBlack(f) || !(cosIn > 0.0f)) return Rgb(0.0f);
+
+  const Vec3 origin = offsetRayOrigin(position, geometricNormal, wi);
+  const std::optional<Ray> shadow =
+      light->infinite ? std::optional<Ray>(Ray{origin, wi, 0.0f, kInfinity}) : shadowRayTo(origin, light->target);
+  if (!shadow) return Rgb(0.0f);
+  const Rgb visible = shadows.transmittance(*shadow, rays);
+  if (isBlack(visible)) return Rgb(0.0f);
+
+  const Rgb unweighted = visible * f * cosIn * light->incident / light->pdf;
+  const bool mis = mode == NextEvent::Mis || mode == NextEvent::MisFindableOnly;
+  if (light->nextEventOnly || !mis) return unweighted;
+  return unweighted * powerHeuristic(light->pdf, pdf(bsdf, woLocal, wiLocal));
+}
+
 }  // namespace pl

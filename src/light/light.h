@@ -164,4 +164,29 @@ class LightSampler {
   int32_t environmentEntry_ = -1;
 };
 
+// ---- Next-event estimation ---------------------------------------------------------------
+
+/// Which lights a next-event estimate samples, and how it weights them.
+enum class NextEvent : uint8_t {
+  /// Every light, MIS-weighted (power heuristic) against the BSDF's density where BSDF
+  /// sampling could find the light too (the path tracer's default strategy).
+  Mis,
+  /// Every light, full weight (the path tracer's light-only strategy).
+  LightOnly,
+  /// The scene lights alone, full weight (the BSDF-only strategy: the lights no BSDF-sampled
+  /// ray finds).
+  SceneLightsOnly,
+  /// The lights BSDF sampling can find (emissive triangles, the environment), MIS-weighted:
+  /// a sample that chooses a scene light counts 0, for a caller that adds those another way
+  /// (the light-field renderers at mirror-like lobes, lightfield/lookup.h MirrorLikeLights).
+  MisFindableOnly,
+};
+
+/// One next-event sample at a non-delta scattering vertex `position` (a ScatteringFrame and
+/// its BSDF, scene.h): LightSampler::sample with the 2-D number u, the BSDF against it
+/// (usableSide on both directions), a shadow ray (ShadowRays: thin glass passes, `rays` counts
+/// them), weighted as `mode` says. Returns f·|cos θi|·Li·T/pdf × weight (W·sr⁻¹·m⁻²).
+Rgb nextEventEstimate(const LightSampler& lights, const ShadowRays& shadows, const Vec3& position,
+                      const ScatteringFrame& scattering, const Bsdf& bsdf, Vec2 u, NextEvent mode, uint64_t& rays);
+
 }  // namespace pl

@@ -63,8 +63,13 @@ Vec2 specularLobeU(const Ray& ray) {
   return Vec2(float(h >> 40) * 0x1p-24f, float((h >> 16) & 0xffffffULL) * 0x1p-24f);
 }
 
+Vec2 nextEventU(const Ray& ray) {
+  const uint64_t h = hashCombine(specularRayHash(ray), 0x4e45454cULL);
+  return Vec2(float(h >> 40) * 0x1p-24f, float((h >> 16) & 0xffffffULL) * 0x1p-24f);
+}
+
 bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint32_t step, uint32_t stepLimit,
-                    Rgb& emitted, Ray& next, Rgb& weight) {
+                    Rgb& emitted, Ray& next, Rgb& weight, SpecularStep* sampled) {
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
   const Material& material = scene.materials[surface.material];
   const Vec3 wo = -ray.direction;
@@ -87,6 +92,11 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
   if (!bs || (!lobe && !bs->sample.delta)) return false;
   next = Ray{offsetRayOrigin(surface.position, scattering.geometricNormal, bs->wi), bs->wi, 0.0f, kInfinity};
   weight = bs->sample.weight * attenuation;
+  if (sampled != nullptr) {
+    const auto* sheet = std::get_if<DielectricBsdf>(&bsdf);
+    *sampled = SpecularStep{lobe ? bs->sample.pdf : 0.0f,
+                            sheet != nullptr && sheet->thin && scattering.woLocal.z * bs->sample.wi.z < 0.0f};
+  }
   if (step >= kSpecularRouletteStep) {
     // Russian roulette on the branch weight: continue with probability q = min(1, max
     // channel) and divide by q, so the expected weight is unchanged (unbiased). Weights ≥ 1
@@ -237,6 +247,55 @@ Rgb PunctualHighlights::radiance(uint32_t chart, const RayHit& hit, const Vec3& 
     if (!isBlack(visible)) sum += visible * f * cosIn * incident;
   }
   return sum;
+}
+
+MirrorLikeLights::MirrorLikeLights(const LightField& lf, const Accel& accel) : lf_(lf) {
+  const bool mirrorLike = std::any_of(lf.charts.begin(), lf.charts.end(), [&](const Chart& c) {
+    return isMirrorLikeRecord(c, lf.scene.materials[c.material].bsdf);
+  });
+  if (!mirrorLike) return;
+  LightSampler sampler(lf.scene);
+  if (sampler.emissiveTriangleCount() == 0 && !sampler.hasEnvironment()) return;
+  sampler_.emplace(std::move(sampler));
+  shadows_.emplace(lf.scene, accel);
+}
+
+Rgb MirrorLikeLights::radiance(uint32_t chart, const Ray& ray, const RayHit& hit) const {
+  const Scene& scene = lf_.scene;
+  const Chart& c = lf_.charts[chart];
+  if (!sampler_ || !isMirrorLikeRecord(c, scene.materials[c.material].bsdf)) return Rgb(0.0f);
+  // The frame and model followSpecular samples the lobe in, so the two densities agree.
+  const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
+  const Bsdf bsdf = bsdfAt(scene, surface);
+  const Vec3 wo = -ray.direction;
+  const ScatteringFrame scattering = scatteringFrame(surface, wo, bsdf);
+  if (!usableSide(wo, scattering.woLocal, scattering.geometricNormal, bsdf)) return Rgb(0.0f);
+  uint64_t rays = 0;  // no renderer reports them
+  return nextEventEstimate(*sampler_, *shadows_, surface.position, scattering, bsdf, nextEventU(ray),
+                           NextEvent::MisFindableOnly, rays);
+}
+
+float MirrorLikeLights::emissionWeight(const Ray& ray, const RayHit& hit, const LobeChain& chain) const {
+  if (!sampler_ || !(chain.pdf > 0.0f)) return 1.0f;
+  const float cosLight = std::abs(glm::dot(triangleNormal(lf_.scene.meshes[hit.mesh], hit.triangle), ray.direction));
+  return powerHeuristic(chain.pdf, sampler_->emitterPdf(hit.mesh, hit.triangle, chain.distance + hit.t, cosLight));
+}
+
+float MirrorLikeLights::environmentWeight(const Vec3& direction, const LobeChain& chain) const {
+  if (!sampler_ || !(chain.pdf > 0.0f) || !sampler_->hasEnvironment()) return 1.0f;
+  return powerHeuristic(chain.pdf, sampler_->environmentPdf(direction));
+}
+
+Rgb MirrorLikeLights::overcountedEmission(const Ray& ray, const RayHit& hit, const LobeChain& chain) const {
+  if (!sampler_ || !(chain.pdf > 0.0f)) return Rgb(0.0f);
+  const Scene& scene = lf_.scene;
+  const Mesh& mesh = scene.meshes[hit.mesh];
+  const Material& material = scene.materials[mesh.materials[hit.triangle]];
+  const float cosFront = glm::dot(triangleNormal(mesh, hit.triangle), -ray.direction);
+  const Rgb le = emittedRadiance(material, cosFront);
+  if (isBlack(le)) return Rgb(0.0f);
+  return (1.0f - emissionWeight(ray, hit, chain)) * le *
+         emissionModulation(scene, material, hit.mesh, hit.triangle, hit.barycentrics);
 }
 
 }  // namespace pl

@@ -248,9 +248,34 @@ inline float albedoLodAt(const Scene& scene, uint32_t material, uint32_t mesh, u
 ///    that length cost what they did with a hard cut there; longer ones (light circling inside
 ///    a glass ball by near-total internal reflection, mirror corridors) go on to `stepLimit`.
 /// Returns false when the chain ends here (step limit, roulette, no delta lobe, a direction
-/// on the wrong side of the geometric surface at grazing angles).
+/// on the wrong side of the geometric surface at grazing angles). `sampled`, when given, gets
+/// how `next` was chosen (SpecularStep), for the renderers' MIS at mirror-like lobes.
+struct SpecularStep;
 bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint32_t step, uint32_t stepLimit,
-                    Rgb& emitted, Ray& next, Rgb& weight);
+                    Rgb& emitted, Ray& next, Rgb& weight, SpecularStep* sampled = nullptr);
+
+/// How one followSpecular step chose its continued ray.
+struct SpecularStep {
+  /// The solid-angle density (sr⁻¹) of the continued direction when a mirror-like lobe
+  /// sampled it; 0 after a delta step (mirror, glass), a direction no light sample can take.
+  float lobePdf = 0.0f;
+  /// A straight pass through a thin glass sheet (direction unchanged; shadow rays pass such
+  /// sheets too), which keeps the density of the direction sampled before it.
+  bool straightThrough = false;
+};
+
+/// The MIS state of a view ray along a specular chain (MirrorLikeLights): the density with
+/// which a mirror-like lobe sampled its direction (0: the camera ray, or a delta step) and the
+/// distance travelled since the vertex that sampled it (straight passes through thin sheets
+/// keep both, as in the path tracer).
+struct LobeChain {
+  float pdf = 0.0f;
+  float distance = 0.0f;  ///< scene units, up to the ray's origin
+  /// The chain after a followSpecular step at a hit `hitDistance` along the current ray.
+  LobeChain after(const SpecularStep& step, float hitDistance) const {
+    return step.straightThrough ? LobeChain{pdf, distance + hitDistance} : LobeChain{step.lobePdf, 0.0f};
+  }
+};
 
 /// The chain step from which followSpecular plays Russian roulette on the branch weight.
 inline constexpr uint32_t kSpecularRouletteStep = 8;
@@ -265,6 +290,10 @@ Vec2 specularLobeU(const Ray& ray);
 /// The uniform number in [0, 1) that followSpecular plays its roulette with for `ray`
 /// (other bits of the same hash as specularBranchU: independent of the branch).
 float specularRouletteU(const Ray& ray);
+
+/// The two uniform numbers in [0, 1) of the light sample MirrorLikeLights takes at the hit of
+/// `ray` (a third hash of its bits: independent of the lobe's own sample there).
+Vec2 nextEventU(const Ray& ray);
 
 struct SunLights;
 
@@ -631,6 +660,43 @@ class PunctualHighlights {
   std::vector<Light> lights_;  ///< the scene's delta lights
   std::optional<ShadowRays> shadows_;
   std::vector<Bsdf> withoutDiffuse_;  ///< per material
+};
+
+/// Next-event estimation of the emissive surfaces and the sky at the hits of mirror-like
+/// lobes (Specular records of a glossy model, bake/parameterisation.h isMirrorLike), which the
+/// renderers otherwise find only by the lobe's own sample: a small lamp in a metal's lobe
+/// would then be fireflies. As the path tracer does, each mirror-like hit of a view ray takes
+/// one light sample (light/light.h nextEventEstimate, the numbers nextEventU of the arriving
+/// ray), weighted by the power heuristic against the lobe's density, and the emission the
+/// lobe's sampled ray then finds — on an emitter's chart, a mirror-like or mirror chart, or the
+/// sky — is weighted by the power heuristic the other way (emissionWeight,
+/// environmentWeight). The scene's lights (point, spot, directional, sphere), which no
+/// sampled ray finds, are not sampled here: PunctualHighlights adds the delta ones. Inactive
+/// (nothing added, every weight 1) without mirror-like charts or without emissive triangles
+/// and a lit sky.
+class MirrorLikeLights {
+ public:
+  /// lf and accel must outlive it.
+  MirrorLikeLights(const LightField& lf, const Accel& accel);
+  bool active() const { return sampler_.has_value(); }
+  /// The MIS-weighted light sample at record `chart` (any record of the hit triangle's chart)
+  /// where `ray` hits it at `hit`; 0 unless it is mirror-like.
+  Rgb radiance(uint32_t chart, const Ray& ray, const RayHit& hit) const;
+  /// The weight of the emission that `ray`, continued along `chain`, finds at `hit`: the power
+  /// heuristic of the lobe's density against the light sampler's for that point of the
+  /// emitter (1 when chain.pdf is 0 or inactive).
+  float emissionWeight(const Ray& ray, const RayHit& hit, const LobeChain& chain) const;
+  /// The same for the sky that `direction` (unit) leaves the scene in.
+  float environmentWeight(const Vec3& direction, const LobeChain& chain) const;
+  /// The part of the emission a lookup at `hit` counts that next-event estimation at the
+  /// chain's mirror-like hit counted already: (1 − emissionWeight) · Le there, towards the
+  /// viewer, its emission texture included (0 when chain.pdf is 0 or inactive).
+  Rgb overcountedEmission(const Ray& ray, const RayHit& hit, const LobeChain& chain) const;
+
+ private:
+  const LightField& lf_;
+  std::optional<LightSampler> sampler_;
+  std::optional<ShadowRays> shadows_;
 };
 
 inline Rgb exitantRadiance(const Scene& scene, const Chart& c, const ChartShading& shading, const Rgb* values,

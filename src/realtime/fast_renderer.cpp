@@ -32,6 +32,7 @@ struct FastRenderer::Scratch {
   std::vector<uint32_t> mirrorSlot, nextSlot;
   std::vector<Rgb> mirrorThroughput, nextThroughput;
   std::vector<float> mirrorDistance, nextDistance;  ///< length of the chain so far (scene units; ray cones)
+  std::vector<LobeChain> mirrorChain, nextChain;    ///< the MIS state at mirror-like lobes (render.cpp's `chain`)
   std::vector<uint32_t> reflectedSamples;  ///< camera samples that hit a mirror (one sample per pixel)
 };
 
@@ -49,7 +50,7 @@ inline void prefetchBytes(const void* p, size_t bytes) {
 }  // namespace
 
 FastRenderer::FastRenderer(const LightField& lightField, const Accel& accel, uint64_t prefetchLookupBytes)
-    : lightField_(lightField), accel_(accel), sun_(sunLightsOf(lightField)), highlights_(lightField, accel) {
+    : lightField_(lightField), accel_(accel), sun_(sunLightsOf(lightField)), highlights_(lightField, accel), lobeLights_(lightField, accel) {
   const Scene& scene = lightField.scene;
   paddedValues_.reserve(lightField.values.size());
   for (const Rgb& v : lightField.values) paddedValues_.push_back(lanes4(v));
@@ -163,6 +164,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
   s.mirrorSlot.clear();
   s.mirrorThroughput.clear();
   s.mirrorDistance.clear();
+  s.mirrorChain.clear();
   Rgb* out = image.pixels.data();
   // The chart record sample i sees: its triangle's chart, turned to the side facing the camera
   // (kNoChartRecord behind a one-sided curved record: viewedChart).
@@ -298,13 +300,16 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       } else {
         Ray reflected;
         Rgb reflectance;
-        const bool more = followSpecular(scene, ray, hit, 0, mirrorDepth, radiance, reflected, reflectance);
+        SpecularStep step;
+        const bool more = followSpecular(scene, ray, hit, 0, mirrorDepth, radiance, reflected, reflectance, &step);
         if (highlights_.active()) radiance += highlights_.radiance(chart, hit, -ray.direction);  // mirror-like lobes
+        if (lobeLights_.active()) radiance += lobeLights_.radiance(chart, ray, hit);
         if (more) {
           s.mirrorRays.push_back(reflected);
           s.mirrorSlot.push_back(uint32_t(i));
           s.mirrorThroughput.push_back(reflectance);
           s.mirrorDistance.push_back(hit.t);
+          s.mirrorChain.push_back(LobeChain{}.after(step, hit.t));
         }
       }
     }
@@ -324,14 +329,17 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     s.nextSlot.clear();
     s.nextThroughput.clear();
     s.nextDistance.clear();
+    s.nextChain.clear();
     for (size_t i = 0; i < active; ++i) {
       const Ray& ray = s.mirrorRays[i];
       const RayHit& hit = s.mirrorHits[i];
       const uint32_t slot = s.mirrorSlot[i];
       const Rgb throughput = s.mirrorThroughput[i];
       const float distance = s.mirrorDistance[i] + hit.t;  // the reference's running sum (render.cpp)
+      const LobeChain& chain = s.mirrorChain[i];
       if (!hit.hit()) {
-        s.radiance[slot] += throughput * backgroundRadiance(scene.environment, ray.direction);
+        s.radiance[slot] +=
+            throughput * lobeLights_.environmentWeight(ray.direction, chain) * backgroundRadiance(scene.environment, ray.direction);
         continue;
       }
       const uint32_t chart = viewedChart(charts, triangleChart_[meshFirstTriangle_[hit.mesh] + hit.triangle], -ray.direction,
@@ -343,8 +351,9 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         Vec3 lookupNormal, mappedNormal;
         lookupInputs(scene, c, shading[chart], hit, -ray.direction, coneSpread * distance, albedo, lookupNormal,
                      mappedNormal);
-        s.radiance[slot] += throughput * exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction,
-                                                         -ray.direction, lookupNormal, mappedNormal, albedo);
+        s.radiance[slot] += throughput * (exitantRadiance(scene, c, shading[chart], values, ray.origin + hit.t * ray.direction,
+                                                          -ray.direction, lookupNormal, mappedNormal, albedo) -
+                                          lobeLights_.overcountedEmission(ray, hit, chain));
         if (c.kind == ChartKind::Glossy && highlights_.active())
           s.radiance[slot] += throughput * highlights_.radiance(chart, hit, -ray.direction);
         continue;
@@ -352,20 +361,24 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       Rgb emitted;
       Ray reflected;
       Rgb reflectance;
-      const bool more = followSpecular(scene, ray, hit, reflections, mirrorDepth, emitted, reflected, reflectance);
-      s.radiance[slot] += throughput * emitted;
+      SpecularStep step;
+      const bool more = followSpecular(scene, ray, hit, reflections, mirrorDepth, emitted, reflected, reflectance, &step);
+      s.radiance[slot] += throughput * lobeLights_.emissionWeight(ray, hit, chain) * emitted;
       if (highlights_.active()) s.radiance[slot] += throughput * highlights_.radiance(chart, hit, -ray.direction);
+      if (lobeLights_.active()) s.radiance[slot] += throughput * lobeLights_.radiance(chart, ray, hit);
       if (more) {
         s.nextRays.push_back(reflected);
         s.nextSlot.push_back(slot);
         s.nextThroughput.push_back(throughput * reflectance);
         s.nextDistance.push_back(distance);
+        s.nextChain.push_back(chain.after(step, hit.t));
       }
     }
     std::swap(s.mirrorRays, s.nextRays);
     std::swap(s.mirrorSlot, s.nextSlot);
     std::swap(s.mirrorThroughput, s.nextThroughput);
     std::swap(s.mirrorDistance, s.nextDistance);
+    std::swap(s.mirrorChain, s.nextChain);
   }
 
   // Pixel = mean over its samples of weight × radiance (the reference's order of sums).

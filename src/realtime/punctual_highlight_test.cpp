@@ -16,6 +16,7 @@
 #include "realtime/realtime.h"
 #include "render/render.h"
 #include "scene/scene.h"
+#include "support/fast_vs_reference.h"
 #include "support/light_field_vs_trace.h"
 
 namespace pl {
@@ -72,12 +73,8 @@ TEST_F(PunctualHighlightTest, PointLightHighlightsOnGlossyWallsMatchThePathTrace
   // 3.8e-13 and 1.2e-13, mean ratio 1 to 7 digits); a missing or doubled highlight would be
   // above 1e-2. Bounds: relMSE 1e-6, ratio 1e-4.
   const Accel accel(lf.scene);
-  const FastRenderer fast(lf, accel);
   for (int spp : {1, 4}) {
-    RenderSettings render;
-    render.samplesPerPixel = spp;
-    render.showProgress = false;
-    const ImageComparison same = compareImages(fast.render(camera, render), renderLightField(lf, accel, camera, render));
+    const ImageComparison same = test_support::fastAgainstReferenceRenderer(lf, accel, camera, spp);
     std::printf("fast vs reference renderer, %d spp: relMSE %.3g, mean ratio %.7f\n", spp, same.relMseAverage,
                 same.meanLuminanceRatio);
     EXPECT_LT(same.relMseAverage, 1e-6) << spp;
@@ -88,8 +85,8 @@ TEST_F(PunctualHighlightTest, PointLightHighlightsOnGlossyWallsMatchThePathTrace
 // Mirror-like charts (bake/parameterisation.h isMirrorLike) store nothing, so their punctual
 // highlights are added at every specular hit of a view ray's chain, as the path tracer's
 // next-event estimation adds them at every bounce. The same box with every wall and block a
-// GGX metal of roughness 0.2 over its own colour (mirror-like at draft: FWHM 5.9°, below a
-// quarter of the 8² map's 29° texels), lit only by the point light.
+// GGX metal of roughness 0.2 over its own colour (mirror-like at draft: FWHM 5.9°, below
+// half of the 8² map's 29° texels), lit only by the point light.
 // Measured (48 × 48, draft): LF/PT 1.104, relMSE 1.67 at 16 samples per pixel against 256 spp;
 // 0.988, 0.49 at 64 against 1024 — the traced lobes' fireflies (no next-event estimation of the
 // highlights the chains pass on), not a bias. Without highlights at the specular hits the image
@@ -111,11 +108,7 @@ TEST_F(PunctualHighlightTest, PointLightHighlightsOnMirrorLikeMetalMatchThePathT
   EXPECT_LT(with.relMseAverage, 2.5);
   // The fast renderer follows the same chains and adds the same highlights.
   const Accel accel(lf.scene);
-  const FastRenderer fast(lf, accel);
-  RenderSettings render;
-  render.samplesPerPixel = 1;
-  render.showProgress = false;
-  const ImageComparison same = compareImages(fast.render(camera, render), renderLightField(lf, accel, camera, render));
+  const ImageComparison same = test_support::fastAgainstReferenceRenderer(lf, accel, camera, 1);
   std::printf("fast vs reference renderer: relMSE %.3g, mean ratio %.7f\n", same.relMseAverage, same.meanLuminanceRatio);
   EXPECT_LT(same.relMseAverage, 1e-6);
   EXPECT_NEAR(same.meanLuminanceRatio, 1.0, 1e-4);

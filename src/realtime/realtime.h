@@ -105,6 +105,7 @@ class FastRenderer {
   const Accel& accel_;
   SunLights sun_;                      ///< the sun masks' lights (the shading points at it)
   PunctualHighlights highlights_;      ///< the punctual lights' highlights on glossy charts (lightfield.h)
+  MirrorLikeLights lobeLights_;        ///< the emitters sampled at mirror-like lobes (lookup.h)
   std::vector<ChartShading> shading_;  ///< per chart
   bool anyTexturedChart_ = false;      ///< some chart's shading needsUv: renderTile prefetches texels
   /// Values and chart records take more than the constructor's prefetchLookupBytes:

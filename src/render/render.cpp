@@ -24,14 +24,18 @@ namespace {
 /// Mirrors and glass are followed as a chain of reflections/refractions with the weights multiplied in
 /// (`throughput`); the first non-specular chart ends it with the light-field lookup, its
 /// albedo texture read at the level of the ray cone (coneSpread × the chain's length so far,
-/// textureConeSpread).
-Rgb radianceFromHit(const LightField& lf, const Accel& accel, const PunctualHighlights& highlights, Ray ray, RayHit hit,
-                    uint32_t mirrorDepth, float coneSpread) {
+/// textureConeSpread). At mirror-like lobes the emitters are sampled too (MirrorLikeLights),
+/// and the emission the lobe's sampled ray finds is weighted against that (`chain`).
+Rgb radianceFromHit(const LightField& lf, const Accel& accel, const PunctualHighlights& highlights,
+                    const MirrorLikeLights& lobeLights, Ray ray, RayHit hit, uint32_t mirrorDepth, float coneSpread) {
   const Scene& scene = lf.scene;
   Rgb throughput(1.0f), result(0.0f);
   float distance = 0.0f;  // along the chain, scene units
+  LobeChain chain;
   for (uint32_t reflections = 0;; ++reflections) {
-    if (!hit.hit()) return result + throughput * backgroundRadiance(scene.environment, ray.direction);
+    if (!hit.hit())
+      return result + throughput * lobeLights.environmentWeight(ray.direction, chain) *
+                          backgroundRadiance(scene.environment, ray.direction);
     distance += hit.t;
     const Chart& chart = lf.charts[lf.triangleChart[hit.mesh][hit.triangle]];
     if (chart.kind != ChartKind::Specular) {
@@ -43,19 +47,23 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, const PunctualHigh
                                             scene.meshes[hit.mesh], hit.triangle);
         if (viewed != kNoChartRecord) seen += highlights.radiance(viewed, hit, -ray.direction);
       }
-      return result + throughput * seen;
+      return result + throughput * (seen - lobeLights.overcountedEmission(ray, hit, chain));
     }
 
     // An ideal mirror or glass: its own emission (if any) plus the branch weight times what
     // the reflected or refracted direction sees.
     Rgb emitted, reflectance;
     Ray reflected;
-    const bool more = followSpecular(scene, ray, hit, reflections, mirrorDepth, emitted, reflected, reflectance);
-    result += throughput * emitted;
+    SpecularStep step;
+    const bool more = followSpecular(scene, ray, hit, reflections, mirrorDepth, emitted, reflected, reflectance, &step);
+    result += throughput * lobeLights.emissionWeight(ray, hit, chain) * emitted;
+    const uint32_t record = lf.triangleChart[hit.mesh][hit.triangle];
     if (highlights.active())  // a mirror-like lobe's (lightfield/lookup.h PunctualHighlights)
-      result += throughput * highlights.radiance(lf.triangleChart[hit.mesh][hit.triangle], hit, -ray.direction);
+      result += throughput * highlights.radiance(record, hit, -ray.direction);
+    if (lobeLights.active()) result += throughput * lobeLights.radiance(record, ray, hit);
     if (!more) return result;
     throughput *= reflectance;
+    chain = chain.after(step, hit.t);
     ray = reflected;
     hit = RayHit{};
     accel.intersect(ray, hit);
@@ -74,6 +82,7 @@ Image renderLightField(const LightField& lf, const Accel& accel, const Camera& c
   const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
   Image image(width, height);
   const PunctualHighlights highlights(lf, accel);
+  const MirrorLikeLights lobeLights(lf, accel);
 
   std::unique_ptr<Progress> progress;
   if (settings.showProgress) progress = std::make_unique<Progress>("rendering", uint64_t(tilesX) * uint64_t(tilesY));
@@ -109,7 +118,7 @@ Image renderLightField(const LightField& lf, const Accel& accel, const Camera& c
         for (int x = x0; x < x1; ++x) {
           Rgb sum(0.0f);
           for (int k = 0; k < spp; ++k, ++i)
-            if (weights[i] > 0.0f) sum += weights[i] * radianceFromHit(lf, accel, highlights, rays[i], hits[i], mirrorDepth, coneSpread);
+            if (weights[i] > 0.0f) sum += weights[i] * radianceFromHit(lf, accel, highlights, lobeLights, rays[i], hits[i], mirrorDepth, coneSpread);
           image.at(x, y) = sum / float(spp);
         }
       if (progress) progress->advance();

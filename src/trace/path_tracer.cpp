@@ -118,45 +118,23 @@ struct PathTracer::Impl {
 
   Impl(const Scene& s, const Accel& a) : scene(s), accel(a), lights(s), shadows(s, a) {}
 
-  Rgb directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame, const Vec3& woLocal,
-                  const Bsdf& bsdf, const TraceSettings& settings, int depth, Sampler& sampler,
-                  Counters& counters) const;
+  Rgb directLight(const ScatteringFrame& scattering, const Vec3& position, const Bsdf& bsdf,
+                  const TraceSettings& settings, int depth, Sampler& sampler, Counters& counters) const;
   Rgb radiance(Ray ray, Sampler& sampler, const TraceSettings& settings, Counters& counters) const;
   void tracePixel(const Camera& camera, const ZSobolLayout& layout, const TraceSettings& settings, int x, int y,
                   PixelAccumulator& acc, Counters& counters) const;
 };
 
-// Next-event estimation at a non-delta vertex: one light sample, MIS-weighted against the
-// BSDF's density when the light could also be hit by BSDF sampling.
-Rgb PathTracer::Impl::directLight(const Vec3& position, const Vec3& geometricNormal, const Frame& frame,
-                                  const Vec3& woLocal, const Bsdf& bsdf, const TraceSettings& settings, int depth,
-                                  Sampler& sampler, Counters& counters) const {
+// Next-event estimation at a non-delta vertex: one light sample (light.h nextEventEstimate),
+// MIS-weighted against the BSDF's density when the light could also be hit by BSDF sampling.
+Rgb PathTracer::Impl::directLight(const ScatteringFrame& scattering, const Vec3& position, const Bsdf& bsdf,
+                                  const TraceSettings& settings, int depth, Sampler& sampler, Counters& counters) const {
   sampler.setDimension(bounceDimension(depth, kLightSample));
   const Vec2 u = sampler.get2D();
-  const std::optional<LightSample> light =
-      lights.sample(position, u, /*nextEventOnly=*/settings.strategy == TraceStrategy::BsdfOnly);
-  if (!light) return Rgb(0.0f);
-  const Vec3& wi = light->wi;  // towards the light, world space
-
-  // A reflecting BSDF receives light only from above the geometric surface (this also stops
-  // light leaking through when shading normals bend over the horizon); a transmitting one
-  // from the side where the shading frame puts wi (both normals agree on it).
-  const Vec3 wiLocal = frame.toLocal(wi);
-  if (!usableSide(wi, wiLocal, geometricNormal, bsdf)) return Rgb(0.0f);
-  const Rgb f = eval(bsdf, woLocal, wiLocal);
-  const float cosIn = std::abs(wiLocal.z);
-  if (isBlack(f) || !(cosIn > 0.0f)) return Rgb(0.0f);
-
-  const Vec3 origin = offsetRayOrigin(position, geometricNormal, wi);
-  const std::optional<Ray> shadow =
-      light->infinite ? std::optional<Ray>(Ray{origin, wi, 0.0f, kInfinity}) : shadowRayTo(origin, light->target);
-  if (!shadow) return Rgb(0.0f);
-  const Rgb visible = shadows.transmittance(*shadow, counters.rays);
-  if (isBlack(visible)) return Rgb(0.0f);
-
-  const Rgb unweighted = visible * f * cosIn * light->incident / light->pdf;
-  if (light->nextEventOnly || settings.strategy != TraceStrategy::Mis) return unweighted;
-  return unweighted * powerHeuristic(light->pdf, pdf(bsdf, woLocal, wiLocal));
+  const NextEvent mode = settings.strategy == TraceStrategy::Mis        ? NextEvent::Mis
+                         : settings.strategy == TraceStrategy::BsdfOnly ? NextEvent::SceneLightsOnly
+                                                                        : NextEvent::LightOnly;
+  return nextEventEstimate(lights, shadows, position, scattering, bsdf, u, mode, counters.rays);
 }
 
 Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& settings, Counters& counters) const {
@@ -225,7 +203,7 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
 
     if (!isDelta(bsdf)) {
       result += throughput *
-                directLight(surface.position, geometricNormal, frame, woLocal, bsdf, settings, depth, sampler, counters);
+                directLight(scattering, surface.position, bsdf, settings, depth, sampler, counters);
     }
 
     sampler.setDimension(bounceDimension(depth, kBsdfSample));
