@@ -60,6 +60,21 @@ void checkGpuSettings(const RenderSettings& settings, const Camera& camera);
 /// error when not.
 bool gpuAvailable(std::string* why = nullptr);
 
+/// What a headless OpenGL 4.5 core context reports here (probeGpu).
+struct GpuProbe {
+  bool available = false;
+  std::string error;      ///< why there is none (the EGL error), when !available
+  std::string device;     ///< as GpuRenderer::deviceName
+  bool software = false;  ///< a software rasteriser (isSoftwareRasteriser): no graphics card
+};
+/// Creates a context for a moment and asks it (no shaders, no upload).
+GpuProbe probeGpu();
+
+/// Whether a GL_RENDERER string names one of Mesa's software rasterisers (llvmpipe, softpipe,
+/// swrast "Software Rasterizer"), which run on the CPU: there the CPU fast renderer is faster
+/// (docs/benchmarks.md), so `view` takes the GPU renderer only when asked to.
+bool isSoftwareRasteriser(const std::string& glRenderer);
+
 class GpuRenderer {
  public:
   /// Creates the headless context (EGL: Mesa's surfaceless platform, else the default display

@@ -2,6 +2,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <limits>
 
@@ -420,6 +421,12 @@ GLuint linkProgram(std::initializer_list<std::pair<GLenum, const char*>> stages,
   return program;
 }
 
+/// GL_RENDERER and GL_VERSION of the current context (GpuRenderer::deviceName).
+std::string currentDeviceName() {
+  return fmt::format("{}, OpenGL {}", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+                     reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+}
+
 void setCameraUniforms(GLuint program, const Camera& camera) {
   auto vec3 = [&](const char* name, const Vec3& v) { glProgramUniform3f(program, glGetUniformLocation(program, name), v.x, v.y, v.z); };
   vec3("eye", camera.eye());
@@ -727,20 +734,36 @@ std::vector<Rgb> GpuRenderer::lookup(const std::vector<LookupQuery>& queries) {
 
 std::string GpuRenderer::deviceName() const {
   state_->context.makeCurrent();
-  return fmt::format("{}, OpenGL {}", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
-                     reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+  return currentDeviceName();
 }
 
 uint64_t GpuRenderer::gpuBytes() const { return state_->bufferBytes + state_->targetBytes(); }
 
 bool gpuAvailable(std::string* why) {
+  const GpuProbe probe = probeGpu();
+  if (why != nullptr) *why = probe.error;
+  return probe.available;
+}
+
+GpuProbe probeGpu() {
+  GpuProbe probe;
   try {
     const gpu::EglContext context;
-    return true;
+    probe.available = true;
+    probe.device = currentDeviceName();
+    probe.software = isSoftwareRasteriser(reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
   } catch (const Error& e) {
-    if (why != nullptr) *why = e.what();
-    return false;
+    probe.error = e.what();
   }
+  return probe;
+}
+
+bool isSoftwareRasteriser(const std::string& glRenderer) {
+  std::string name = glRenderer;
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  for (const char* software : {"llvmpipe", "softpipe", "software rasterizer"})
+    if (name.find(software) != std::string::npos) return true;
+  return false;
 }
 
 }  // namespace pl
