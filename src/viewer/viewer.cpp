@@ -191,6 +191,12 @@ class FrameRenderer {
   }
 
   bool gpu() const { return gpu_ != nullptr; }
+  /// Whether it renders several jittered samples per pixel (the refinement of a still view).
+  bool multiSample(const Camera& camera) const {
+    RenderSettings two;
+    two.samplesPerPixel = 2;
+    return !gpu_ || gpu_->unsupportedSetting(two, camera).empty();
+  }
   const std::string& name() const { return name_; }
   const std::string& fallback() const { return fallback_; }
   void render(const Camera& camera, const RenderSettings& settings, Image& image) {
@@ -225,7 +231,9 @@ class FrameRenderer {
     }
     try {
       gpu_ = std::make_unique<GpuRenderer>(lightField);
+      gpu_->checkSettings(options.render, camera);  // what this driver lacks
     } catch (const Error& e) {
+      gpu_.reset();
       if (asked) throw;
       return oneLine(e.what());
     }
@@ -368,7 +376,7 @@ class ViewerSession {
   ///   the camera moved (or the size changed, or no frame yet): the view at the controller's
   ///     scale (1 with the GPU renderer or when still);
   ///   still after a scaled frame: the view at full resolution;
-  ///   still after that (CPU renderer): one refinement batch of jittered samples (seed + batch
+  ///   still after that: one refinement batch of jittered samples (seed + batch
   ///     number), averaged with the earlier ones, until kRefinedSamples per pixel;
   ///   then nothing.
   double renderFrame(int width, int height) {
@@ -395,7 +403,8 @@ class ViewerSession {
     const int spp = baseSpp(), batchSpp = std::max(2, spp);
     const bool baseIsBatch = spp == batchSpp;
     const int done = shown_ == Shown::Refined ? batches_ * batchSpp : baseIsBatch ? spp : 0;
-    if (renderer_.gpu() || done + batchSpp > std::max(spp, ViewerOptions::kRefinedSamples)) return 0.0;
+    if (done + batchSpp > std::max(spp, ViewerOptions::kRefinedSamples) || !renderer_.multiSample(cameraAt(1, 1)))
+      return 0.0;
     if (shown_ == Shown::Base) {
       accumulation_ = baseIsBatch ? frame_ : Image(width, height);
       batches_ = baseIsBatch ? 1 : 0;

@@ -14,12 +14,12 @@
 // uses SDL's software renderer, so that no second OpenGL context competes for the thread), so
 // both show, and screenshot, exactly what `plenoptic render` writes.
 //
-// Frame rate (CPU renderer): while the camera moves each frame is rendered at the reduced
-// internal resolution RenderScaleController (render_scale.h) picks for the frame-rate target
-// and upscaled (bilinear) to the window; when it stops, the frame is rendered at full
-// resolution, then refined with batches of jittered samples averaged up to kRefinedSamples
-// per pixel; then the loop waits for input. The GPU renderer draws every frame at full
-// resolution. Screenshots are always the full-resolution frame at the --spp samples (what
+// Frame rate: with the CPU renderer, while the camera moves each frame is rendered at the
+// reduced internal resolution RenderScaleController (render_scale.h) picks for the frame-rate
+// target and upscaled (bilinear) to the window (the GPU renderer draws every frame at full
+// resolution). When the camera stops, the frame is rendered at full resolution, then (both
+// renderers) refined with batches of jittered samples averaged up to kRefinedSamples per
+// pixel; then the loop waits for input. Screenshots are always the full-resolution frame at the --spp samples (what
 // `render` writes), rendered for the purpose when the window shows a scaled or refined one.
 //
 // Controls:
@@ -70,7 +70,7 @@ struct ViewerOptions {
   RenderSettings render;             ///< samples, mirror depth, seed
   ViewerRendererChoice renderer = ViewerRendererChoice::Automatic;
   double targetFps = 30.0;           ///< CPU renderer: frame rate held while moving; 0 = always full resolution
-  static constexpr int kRefinedSamples = 16;  ///< CPU renderer: samples per pixel a still view is refined to
+  static constexpr int kRefinedSamples = 16;  ///< samples per pixel a still view is refined to
   int frames = 0;                    ///< > 0: quit after this many frames
   std::string screenshotPath;        ///< written after the last frame (.png or .exr/.hdr/.pfm)
   std::optional<CameraPath> path;    ///< scripted camera (overrides keys and mouse)

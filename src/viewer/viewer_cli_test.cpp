@@ -225,9 +225,9 @@ TEST_F(ViewerCliTest, FallsBackToTheCpuRendererWithOneWarningLine) {
   EXPECT_NE(run("view " + path("mirror.plf") + " --renderer gpu --frames 1" + size, nullptr, &errors), 0);
   EXPECT_NE(errors.find("mirrors and glass"), std::string::npos) << errors;
   EXPECT_NE(errors.find("--renderer cpu"), std::string::npos) << errors;
-  // Settings it does not support yet (several samples per pixel) likewise.
-  ASSERT_EQ(run("view " + path("cornell.plf") + " --spp 4 --frames 1" + size, nullptr, &errors), 0) << errors;
-  EXPECT_NE(errors.find("does not support more than one sample per pixel"), std::string::npos) << errors;
+  // Settings it does not support yet (a thin lens) likewise.
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --aperture 2.8 --frames 1" + size, nullptr, &errors), 0) << errors;
+  EXPECT_NE(errors.find("does not support thin-lens cameras"), std::string::npos) << errors;
   // The CPU renderer asked for: no warning.
   ASSERT_EQ(run("view " + path("cornell.plf") + " --renderer cpu --frames 1" + size, nullptr, &errors), 0) << errors;
   EXPECT_EQ(linesWith(errors, "warning"), 0) << errors;
