@@ -13,7 +13,8 @@
 //      it; the nearest hit is the ray caster's answer), the hit point origin + t·direction (as
 //      the CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
 //      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes) in a fragment shader,
-//      times the camera weight (cos⁴θ with vignetting). A miss sees the constant environment.
+//      times the camera weight (cos⁴θ with vignetting). A miss sees the environment (the
+//      constant and the map: EnvironmentMap::radiance, bilinear in the lat-long image).
 // The result is radiance (W·sr⁻¹·m⁻², camera weight included, no exposure), read back into an
 // Image exactly where FastRenderer::render writes it; exposure and tone mapping are then the
 // same CPU code for both renderers (jobs/ ViewSettings::writeImage).
@@ -21,16 +22,17 @@
 // The light field is uploaded once: its values as 16-byte RGBA (the CPU renderer's padded
 // copy), its chart records with their precomputed shading (ChartShading), the vertex positions
 // and normals (a curved glossy chart's map is read around the interpolated normal,
-// chartShadingNormalAt), the triangle → chart map and the sun masks (one uint each; the masked
-// lights are uniforms). So GPU memory is 16 bytes per value + 128 per chart + 32 per vertex +
-// 28 per triangle + 4 per sun mask + the frame's targets (radiance 16 bytes per pixel; id
+// chartShadingNormalAt), the triangle → chart map, the sun masks (one uint each; the masked
+// lights are uniforms) and the environment map's texels (RGBA). So GPU memory is 16 bytes per
+// value + 128 per chart + 32 per vertex + 28 per triangle + 4 per sun mask + 16 per
+// environment texel + the frame's targets (radiance 16 bytes per pixel; id
 // and depth 8 bytes per pixel, or per texel of the finer multi-sample visibility pass).
 //
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
 // picture): mirrors and glass (specular charts), albedo textures and vertex colours, normal
-// maps, alpha masks, punctual highlights, rough glass, GGX diffuse bases,
-// environment maps (a constant environment is drawn); and of the render settings, thin lenses.
+// maps, alpha masks, punctual highlights, rough glass, GGX diffuse bases; and of the render
+// settings, thin lenses.
 //
 // Several samples per pixel: the shading pass loops over the pixel's samples at the CPU
 // renderers' jittered film points (Pcg32::forKey in 64-bit GLSL integers,

@@ -9,6 +9,7 @@
 
 #include "camera/camera.h"
 #include "core/error.h"
+#include "env/env.h"
 #include "gpu/egl_context.h"
 #include "gpu/gpu.h"
 #include "lightfield/lookup.h"
@@ -52,7 +53,8 @@ int multiSampleIdScale(int width, int height) {
 
 // Shader storage bindings.
 constexpr GLuint kValuesBinding = 0, kChartsBinding = 1, kPositionsBinding = 2, kTrianglesBinding = 3,
-                 kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7;
+                 kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7,
+                 kEnvironmentBinding = 8;
 
 std::string glslConstants() {
   return fmt::format(
@@ -60,11 +62,12 @@ std::string glslConstants() {
       "const uint kFlagTwoSided = {}u, kFlagBack = {}u, kFlagCurved = {}u, kFlagDiffuseValue = {}u, kFlagEmissive = {}u, "
       "kFlagTwoSidedEmission = {}u, kFlagSunMasks = {}u;\nconst int kMaxSunMaskLights = {}, kSunMaskSide = {};\n"
       "#define VALUES_BINDING {}\n#define CHARTS_BINDING {}\n#define POSITIONS_BINDING {}\n#define TRIANGLES_BINDING {}\n"
-      "#define QUERIES_BINDING {}\n#define RESULTS_BINDING {}\n#define NORMALS_BINDING {}\n#define SUN_MASKS_BINDING {}\n",
+      "#define QUERIES_BINDING {}\n#define RESULTS_BINDING {}\n#define NORMALS_BINDING {}\n#define SUN_MASKS_BINDING {}\n"
+      "#define ENVIRONMENT_BINDING {}\n",
       unsigned(ChartKind::Diffuse), unsigned(ChartKind::Glossy), unsigned(ChartKind::Specular), kFlagTwoSided, kFlagBack,
       kFlagCurved, kFlagDiffuseValue, kFlagEmissive, kFlagTwoSidedEmission, kFlagSunMasks, kMaxSunMaskLights, kSunMaskSide,
       kValuesBinding, kChartsBinding, kPositionsBinding, kTrianglesBinding, kQueriesBinding, kResultsBinding, kNormalsBinding,
-      kSunMasksBinding);
+      kSunMasksBinding, kEnvironmentBinding);
 }
 
 // The lookup of lightfield/lookup.h in GLSL, statement for statement (the names are the C++
@@ -284,6 +287,37 @@ uniform int idScale;  // the ids are at idScale × the image's resolution
 uniform bool vignetting;
 out vec4 color;
 
+// Environment::radiance (scene.h): the constant plus, where the scene has one, its map —
+// EnvironmentMap::radiance (env/env.h): rotated about +y (envRotation = cos, sin), looked up
+// bilinearly in the lat-long image (LatLongMap::lookup: u wraps, v clamps), scaled.
+layout(std430, binding = ENVIRONMENT_BINDING) readonly buffer EnvironmentTexels { vec4 envTexels[]; };
+uniform bool hasEnvironmentMap;
+uniform ivec2 envSize;
+uniform float envScale;
+uniform vec2 envRotation;
+vec3 envTexel(int x, int y) { return envTexels[y * envSize.x + x].rgb; }
+vec3 environmentRadiance(vec3 d) {
+  if (!hasEnvironmentMap) return background;
+  vec3 m = vec3(envRotation.x * d.x - envRotation.y * d.z, d.y, envRotation.y * d.x + envRotation.x * d.z);
+  // LatLongMap::uv, in float (the C++ takes atan2 and acos in double: GLSL has them in float only).
+  const float pi = 3.14159265358979;
+  float u = atan(m.z, m.x) / (2.0 * pi) + 0.5;
+  if (u >= 1.0) u -= 1.0;
+  if (u < 0.0) u += 1.0;
+  u = min(u, 0.99999994);  // 0x1.fffffep-1
+  float v = acos(clamp(m.y / length(m), -1.0, 1.0)) / pi;
+  float fx = u * float(envSize.x) - 0.5, fy = v * float(envSize.y) - 0.5;
+  float x0f = floor(fx), y0f = floor(fy);
+  float ax = fx - x0f, ay = fy - y0f;
+  int x0 = int(x0f) % envSize.x;
+  if (x0 < 0) x0 += envSize.x;
+  int x1 = (x0 + 1) % envSize.x;
+  int y0 = clamp(int(y0f), 0, envSize.y - 1), y1 = clamp(int(y0f) + 1, 0, envSize.y - 1);
+  vec3 top = (1.0 - ax) * envTexel(x0, y0) + ax * envTexel(x1, y0);
+  vec3 bottom = (1.0 - ax) * envTexel(x0, y1) + ax * envTexel(x1, y1);
+  return background + envScale * ((1.0 - ay) * top + ay * bottom);
+}
+
 // The camera weight times the radiance along the camera ray through film point `film` (pixel
 // units, Camera::generateRay's pinhole). `jittered`: the film point is anywhere in its pixel,
 // not the centre (see the miss rule below).
@@ -328,7 +362,7 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
       }
     }
   if (id == 0u && !(jittered && besideBackground)) id = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
-  if (id == 0u) return weight * background;
+  if (id == 0u) return weight * environmentRadiance(direction);
   uvec4 tri = triangles[id - 1u];
   vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
   vec3 n = cross(p1 - p0, p2 - p0);
@@ -514,7 +548,6 @@ void setCameraUniforms(GLuint program, const Camera& camera) {
 
 std::string gpuUnsupportedFeature(const LightField& lf) {
   const Scene& scene = lf.scene;
-  if (scene.environment.map) return "environment maps (a constant environment is drawn)";
   for (const Material& m : scene.materials)
     if (m.isMasked()) return "alpha masks";
   // PunctualHighlights::active() without its shadow-ray machinery: a bake with punctual
@@ -551,7 +584,7 @@ std::string gpuUnsupportedSetting(const RenderSettings& /*settings*/, const Came
 
 struct GpuRenderer::State {
   gpu::EglContext context;
-  GLuint buffers[7] = {};  // values, charts, positions, triangles, indices, normals, sun masks
+  GLuint buffers[8] = {};  // values, charts, positions, triangles, indices, normals, sun masks, environment map
   GLuint vertexArray = 0, emptyVertexArray = 0;
   GLuint visibilityProgram = 0, shadingProgram = 0, lookupProgram = 0;
   /// The shading pass with several jittered samples per pixel; 0 where the driver lacks
@@ -567,7 +600,7 @@ struct GpuRenderer::State {
 
   ~State() {
     context.makeCurrent();
-    glDeleteBuffers(7, buffers);
+    glDeleteBuffers(8, buffers);
     glDeleteVertexArrays(1, &vertexArray);
     glDeleteVertexArrays(1, &emptyVertexArray);
     glDeleteProgram(visibilityProgram);
@@ -679,7 +712,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   if (!positions.empty()) s.near = std::max(1e-6f * glm::length(upper - lower), std::numeric_limits<float>::min());
   s.indexCount = GLsizei(indices.size());
 
-  glCreateBuffers(7, s.buffers);
+  glCreateBuffers(8, s.buffers);
   auto upload = [&](GLuint buffer, const void* data, size_t bytes) {
     // A zero-sized buffer cannot be bound to a storage block: 16 bytes stand in.
     glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), bytes > 0 ? data : nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -693,6 +726,15 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   upload(s.buffers[5], normals.data(), normals.size() * sizeof(float));
   const std::vector<uint32_t> sunMasks(lightField.sunMasks.begin(), lightField.sunMasks.end());
   upload(s.buffers[6], sunMasks.data(), sunMasks.size() * sizeof(uint32_t));
+  // The environment map's lat-long texels as RGBA (none: a 16-byte stand-in).
+  const EnvironmentMap* environmentMap = scene.environment.map.get();
+  std::vector<float> envTexels;
+  if (environmentMap != nullptr) {
+    const Image& image = environmentMap->map().image;
+    envTexels.resize(image.pixels.size() * 4, 0.0f);
+    for (size_t i = 0; i < image.pixels.size(); ++i) std::memcpy(&envTexels[4 * i], &image.pixels[i], sizeof(Rgb));
+  }
+  upload(s.buffers[7], envTexels.data(), envTexels.size() * sizeof(float));
   checkGl("uploading the light field (out of GPU memory?)");
 
   glCreateVertexArrays(1, &s.vertexArray);
@@ -712,16 +754,27 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                        "multi-sample shading", true,
                                        "#extension GL_ARB_gpu_shader_int64 : require\n#define MULTISAMPLE\n");
   glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
-  for (GLuint program : {s.shadingProgram, s.multisampleProgram})
-    if (program != 0)
-      glProgramUniform3f(program, glGetUniformLocation(program, "background"), s.background.x, s.background.y,
-                         s.background.z);
+  for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {
+    if (program == 0) continue;
+    glProgramUniform3f(program, glGetUniformLocation(program, "background"), s.background.x, s.background.y,
+                       s.background.z);
+    glProgramUniform1i(program, glGetUniformLocation(program, "hasEnvironmentMap"), environmentMap != nullptr ? 1 : 0);
+    if (environmentMap != nullptr) {
+      // The map's rotation as EnvironmentMap::toMap applies it: toMap(+x) = (cos, 0, sin).
+      const Vec3 rotatedX = environmentMap->toMap(Vec3(1.0f, 0.0f, 0.0f));
+      glProgramUniform2i(program, glGetUniformLocation(program, "envSize"), environmentMap->map().width(),
+                         environmentMap->map().height());
+      glProgramUniform1f(program, glGetUniformLocation(program, "envScale"), environmentMap->scale());
+      glProgramUniform2f(program, glGetUniformLocation(program, "envRotation"), rotatedX.x, rotatedX.z);
+    }
+  }
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kValuesBinding, s.buffers[0]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kChartsBinding, s.buffers[1]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPositionsBinding, s.buffers[2]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTrianglesBinding, s.buffers[3]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kNormalsBinding, s.buffers[5]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSunMasksBinding, s.buffers[6]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kEnvironmentBinding, s.buffers[7]);
   for (GLuint program : {s.shadingProgram, s.lookupProgram, s.multisampleProgram}) {
     if (program == 0) continue;
     glProgramUniform1ui(program, glGetUniformLocation(program, "sunCount"), sun.count);
