@@ -97,7 +97,7 @@ class GpuRenderer {
   /// Renders camera.width() × camera.height() pixels of radiance into `image` (resized only
   /// when its size differs), like FastRenderer::render: one ray through each pixel centre, or
   /// with several samples per pixel the CPU renderers' jittered film points
-  /// (Pcg32::forKey(pixel, k, seed)), averaged. Throws pl::Error for settings it does not
+  /// (jitteredPixelSample, render_settings.h), averaged. Throws pl::Error for settings it does not
   /// support (checkSettings).
   void render(const Camera& camera, const RenderSettings& settings, Image& image);
 

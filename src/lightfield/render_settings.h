@@ -57,8 +57,9 @@ inline int effectiveSamplesPerPixel(const RenderSettings& settings, bool thinLen
 /// seed) in the order film y, film x, lens y, lens x. (That order is the one GCC's
 /// right-to-left evaluation gave the constructor calls these draws were first written as, so
 /// images stay what they were; it is spelled out because C++ leaves the order of arguments
-/// unspecified, and the GPU renderer draws the same points.) The reference, the fast and the
-/// GPU renderer all take their samples from here.
+/// unspecified, and the GPU renderer draws the same points.) The reference and the fast
+/// renderer take their samples from here; the GPU renderer's shader is a GLSL copy, checked
+/// against them by gpu_test.
 inline void jitteredPixelSample(int x, int y, uint64_t pixel, int k, uint64_t seed, Vec2& film, Vec2& lens) {
   Pcg32 rng = Pcg32::forKey(pixel, uint64_t(k), seed);
   const float filmY = rng.uniform();
