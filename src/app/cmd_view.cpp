@@ -44,8 +44,9 @@ void runView(const ViewCommandOptions& options, const GlobalOptions& global) {
   if (!options.pathFile.empty()) viewer.path = loadCameraPath(options.pathFile);
   viewer.title = "plenoptic view " + options.input;
   const ViewerResult result = runViewer(lightField, accel, viewer);
-  fmt::print("view: {} frames, median {:.2f} ms/frame (render {:.2f} ms){}\n", result.frames, result.msPerFrameMedian,
-             result.renderMsMedian, viewer.screenshotPath.empty() ? "" : ", screenshot " + viewer.screenshotPath);
+  fmt::print("view: {} frames rendered, median {:.2f} ms/frame (render {:.2f} ms), renderer {}{}\n", result.frames,
+             result.msPerFrameMedian, result.renderMsMedian, result.renderer,
+             viewer.screenshotPath.empty() ? "" : ", screenshot " + viewer.screenshotPath);
 }
 
 }  // namespace
@@ -68,6 +69,19 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   command->add_option("--speed", viewer.speed, "Movement speed in scene units per second (0 = automatic)")
       ->check(CLI::Range(0.0f, 1e9f));
+  command
+      ->add_option_function<std::string>(
+          "--renderer",
+          [options](const std::string& name) {
+            options->viewer.renderer = name == "gpu" ? ViewerRendererChoice::Gpu : ViewerRendererChoice::Cpu;
+          },
+          "gpu (OpenGL 4.5 through EGL) or cpu (the fast renderer); default: the GPU one on a graphics card when it "
+          "draws this light field, else the CPU one with a warning saying why")
+      ->check(CLI::IsMember({"cpu", "gpu"}));
+  command->add_option("--target-fps", viewer.targetFps,
+                      "CPU renderer: frame rate held while moving, by rendering at a lower resolution (0 = always full)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
   addRenderSettingsOptions(*command, viewer.render);
   options->view.width = viewer.width;
   options->view.height = viewer.height;

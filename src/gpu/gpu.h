@@ -13,7 +13,8 @@
 //      it; the nearest hit is the ray caster's answer), the hit point origin + t·direction (as
 //      the CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
 //      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes) in a fragment shader,
-//      times the camera weight (cos⁴θ with vignetting). A miss sees the constant environment.
+//      times the camera weight (cos⁴θ with vignetting). A miss sees the environment (the
+//      constant and the map: EnvironmentMap::radiance, bilinear in the lat-long image).
 // The result is radiance (W·sr⁻¹·m⁻², camera weight included, no exposure), read back into an
 // Image exactly where FastRenderer::render writes it; exposure and tone mapping are then the
 // same CPU code for both renderers (jobs/ ViewSettings::writeImage).
@@ -21,17 +22,24 @@
 // The light field is uploaded once: its values as 16-byte RGBA (the CPU renderer's padded
 // copy), its chart records with their precomputed shading (ChartShading), the vertex positions
 // and normals (a curved glossy chart's map is read around the interpolated normal,
-// chartShadingNormalAt), the triangle → chart map and the sun masks (one uint each; the masked
-// lights are uniforms). So GPU memory is 16 bytes per value + 128 per chart + 32 per vertex +
-// 28 per triangle + 4 per sun mask + the frame's targets (id, depth and radiance: 24 bytes
-// per pixel).
+// chartShadingNormalAt), the triangle → chart map, the sun masks (one uint each; the masked
+// lights are uniforms) and the environment map's texels (RGBA). So GPU memory is 16 bytes per
+// value + 128 per chart + 32 per vertex + 28 per triangle + 4 per sun mask + 16 per
+// environment texel + the frame's targets (radiance 16 bytes per pixel; id
+// and depth 8 bytes per pixel, or per texel of the finer multi-sample visibility pass).
 //
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
 // picture): mirrors and glass (specular charts), albedo textures and vertex colours, normal
-// maps, alpha masks, punctual highlights, rough glass, GGX diffuse bases,
-// environment maps (a constant environment is drawn); and of the render settings, more than one
-// sample per pixel (and so thin lenses).
+// maps, alpha masks, punctual highlights, rough glass, GGX diffuse bases; and of the render
+// settings, thin lenses.
+//
+// Several samples per pixel: the shading pass loops over the pixel's samples at the CPU
+// renderers' jittered film points (Pcg32::forKey in 64-bit GLSL integers,
+// GL_ARB_gpu_shader_int64); the visibility pass is then drawn at a finer resolution (16× per
+// axis on small images, 4× at 1920×1080: its targets stay within 256 MiB) and each jittered ray
+// looks for its triangle among those seen at the 3×3 of those finer texel centres around its
+// film point, so only a triangle that covers none of them (one seen almost edge-on) is missed.
 //
 // The shader's lookup is checked against the C++ one (exitantRadiance) on random inputs by
 // GpuRenderer::lookup, which runs the very GLSL function the shading pass calls.
@@ -51,14 +59,28 @@ class Camera;
 /// message ("mirrors and glass (specular charts)", …); empty when it draws all of it.
 std::string gpuUnsupportedFeature(const LightField& lightField);
 
-/// The first of `settings` (for `camera`) the GPU renderer does not support yet; empty if none.
+/// The first of `settings` (for `camera`) the GPU renderer does not support yet, whatever the
+/// driver; empty if none (GpuRenderer::unsupportedSetting adds what this driver lacks).
 std::string gpuUnsupportedSetting(const RenderSettings& settings, const Camera& camera);
-/// Throws pl::Error naming gpuUnsupportedSetting's answer, if any.
-void checkGpuSettings(const RenderSettings& settings, const Camera& camera);
 
 /// Whether a headless OpenGL 4.5 core context can be created here; `why` gets the EGL/GL
 /// error when not.
 bool gpuAvailable(std::string* why = nullptr);
+
+/// What a headless OpenGL 4.5 core context reports here (probeGpu).
+struct GpuProbe {
+  bool available = false;
+  std::string error;      ///< why there is none (the EGL error), when !available
+  std::string device;     ///< as GpuRenderer::deviceName
+  bool software = false;  ///< a software rasteriser (isSoftwareRasteriser): no graphics card
+};
+/// Creates a context for a moment and asks it (no shaders, no upload).
+GpuProbe probeGpu();
+
+/// Whether a GL_RENDERER string names one of Mesa's software rasterisers (llvmpipe, softpipe,
+/// swrast "Software Rasterizer"), which run on the CPU: there the CPU fast renderer is faster
+/// (docs/benchmarks.md), so `view` takes the GPU renderer only when asked to.
+bool isSoftwareRasteriser(const std::string& glRenderer);
 
 class GpuRenderer {
  public:
@@ -73,13 +95,22 @@ class GpuRenderer {
   GpuRenderer& operator=(const GpuRenderer&) = delete;
 
   /// Renders camera.width() × camera.height() pixels of radiance into `image` (resized only
-  /// when its size differs), like FastRenderer::render. Throws pl::Error for settings it does
-  /// not support (gpuUnsupportedSetting).
+  /// when its size differs), like FastRenderer::render: one ray through each pixel centre, or
+  /// with several samples per pixel the CPU renderers' jittered film points
+  /// (jitteredPixelSample, render_settings.h), averaged. Throws pl::Error for settings it does not
+  /// support (checkSettings).
   void render(const Camera& camera, const RenderSettings& settings, Image& image);
 
+  /// gpuUnsupportedSetting, and what this driver lacks for `settings` (several samples per
+  /// pixel need GL_ARB_gpu_shader_int64); empty when render() can draw them.
+  std::string unsupportedSetting(const RenderSettings& settings, const Camera& camera) const;
+  /// checkRenderSettings, then throws pl::Error naming unsupportedSetting's answer, if any.
+  void checkSettings(const RenderSettings& settings, const Camera& camera) const;
+
   /// The rasterisation pass alone (`render --stats` primary_ms_median for this renderer),
-  /// finished on the GPU before it returns.
-  void drawVisibility(const Camera& camera);
+  /// finished on the GPU before it returns; idScale: at that many times the camera's
+  /// resolution per axis (render() takes more than 1 for several samples per pixel).
+  void drawVisibility(const Camera& camera, int idScale = 1);
 
   /// One lookup query: the chart record as triangleChart gives it (facingChart turns it to the
   /// side the viewer is on), a world point and the unit direction towards the viewer.

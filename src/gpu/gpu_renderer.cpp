@@ -2,11 +2,14 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
 #include "camera/camera.h"
 #include "core/error.h"
+#include "env/env.h"
 #include "gpu/egl_context.h"
 #include "gpu/gpu.h"
 #include "lightfield/lookup.h"
@@ -36,9 +39,22 @@ struct TriangleGpu {
   uint32_t v[3], chart;
 };
 
+/// The visibility pass's resolution, per axis, relative to a width × height image's with
+/// several samples per pixel: a jittered ray looks for its triangle among those seen at the 3×3
+/// id texels around its film point, so a triangle that covers none of these finer texel centres
+/// (one seen almost edge-on) is missed. As fine as 16× while the id and depth targets stay
+/// within kMaxIdTexels (8 bytes each: 256 MiB): 16× up to 256×192 pixels, 10× at 640×480,
+/// 4× at 1920×1080, never below 1×.
+constexpr uint64_t kMaxIdTexels = uint64_t(1) << 25;
+int multiSampleIdScale(int width, int height) {
+  const double scale = std::sqrt(double(kMaxIdTexels) / (double(width) * double(height)));
+  return std::clamp(int(scale), 1, 16);
+}
+
 // Shader storage bindings.
 constexpr GLuint kValuesBinding = 0, kChartsBinding = 1, kPositionsBinding = 2, kTrianglesBinding = 3,
-                 kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7;
+                 kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7,
+                 kEnvironmentBinding = 8;
 
 std::string glslConstants() {
   return fmt::format(
@@ -46,11 +62,12 @@ std::string glslConstants() {
       "const uint kFlagTwoSided = {}u, kFlagBack = {}u, kFlagCurved = {}u, kFlagDiffuseValue = {}u, kFlagEmissive = {}u, "
       "kFlagTwoSidedEmission = {}u, kFlagSunMasks = {}u;\nconst int kMaxSunMaskLights = {}, kSunMaskSide = {};\n"
       "#define VALUES_BINDING {}\n#define CHARTS_BINDING {}\n#define POSITIONS_BINDING {}\n#define TRIANGLES_BINDING {}\n"
-      "#define QUERIES_BINDING {}\n#define RESULTS_BINDING {}\n#define NORMALS_BINDING {}\n#define SUN_MASKS_BINDING {}\n",
+      "#define QUERIES_BINDING {}\n#define RESULTS_BINDING {}\n#define NORMALS_BINDING {}\n#define SUN_MASKS_BINDING {}\n"
+      "#define ENVIRONMENT_BINDING {}\n",
       unsigned(ChartKind::Diffuse), unsigned(ChartKind::Glossy), unsigned(ChartKind::Specular), kFlagTwoSided, kFlagBack,
       kFlagCurved, kFlagDiffuseValue, kFlagEmissive, kFlagTwoSidedEmission, kFlagSunMasks, kMaxSunMaskLights, kSunMaskSide,
       kValuesBinding, kChartsBinding, kPositionsBinding, kTrianglesBinding, kQueriesBinding, kResultsBinding, kNormalsBinding,
-      kSunMasksBinding);
+      kSunMasksBinding, kEnvironmentBinding);
 }
 
 // The lookup of lightfield/lookup.h in GLSL, statement for statement (the names are the C++
@@ -266,11 +283,45 @@ layout(binding = 0) uniform usampler2D ids;
 uniform vec3 eye, forward, right, up, background;
 uniform float tanHalfFovY, aspect;
 uniform ivec2 size;
+uniform int idScale;  // the ids are at idScale × the image's resolution
 uniform bool vignetting;
 out vec4 color;
-void main() {
-  ivec2 pixel = ivec2(gl_FragCoord.xy);
-  vec2 film = vec2(pixel) + 0.5;
+
+// Environment::radiance (scene.h): the constant plus, where the scene has one, its map —
+// EnvironmentMap::radiance (env/env.h): rotated about +y (envRotation = cos, sin), looked up
+// bilinearly in the lat-long image (LatLongMap::lookup: u wraps, v clamps), scaled.
+layout(std430, binding = ENVIRONMENT_BINDING) readonly buffer EnvironmentTexels { vec4 envTexels[]; };
+uniform bool hasEnvironmentMap;
+uniform ivec2 envSize;
+uniform float envScale;
+uniform vec2 envRotation;
+vec3 envTexel(int x, int y) { return envTexels[y * envSize.x + x].rgb; }
+vec3 environmentRadiance(vec3 d) {
+  if (!hasEnvironmentMap) return background;
+  vec3 m = vec3(envRotation.x * d.x - envRotation.y * d.z, d.y, envRotation.y * d.x + envRotation.x * d.z);
+  // LatLongMap::uv, in float (the C++ takes atan2 and acos in double: GLSL has them in float only).
+  const float pi = 3.14159265358979;
+  float u = atan(m.z, m.x) / (2.0 * pi) + 0.5;
+  if (u >= 1.0) u -= 1.0;
+  if (u < 0.0) u += 1.0;
+  u = min(u, 0.99999994);  // 0x1.fffffep-1
+  float v = acos(clamp(m.y / length(m), -1.0, 1.0)) / pi;
+  float fx = u * float(envSize.x) - 0.5, fy = v * float(envSize.y) - 0.5;
+  float x0f = floor(fx), y0f = floor(fy);
+  float ax = fx - x0f, ay = fy - y0f;
+  int x0 = int(x0f) % envSize.x;
+  if (x0 < 0) x0 += envSize.x;
+  int x1 = (x0 + 1) % envSize.x;
+  int y0 = clamp(int(y0f), 0, envSize.y - 1), y1 = clamp(int(y0f) + 1, 0, envSize.y - 1);
+  vec3 top = (1.0 - ax) * envTexel(x0, y0) + ax * envTexel(x1, y0);
+  vec3 bottom = (1.0 - ax) * envTexel(x0, y1) + ax * envTexel(x1, y1);
+  return background + envScale * ((1.0 - ay) * top + ay * bottom);
+}
+
+// The camera weight times the radiance along the camera ray through film point `film` (pixel
+// units, Camera::generateRay's pinhole). `jittered`: the film point is anywhere in its pixel,
+// not the centre (see the miss rule below).
+vec3 sampleRadiance(vec2 film, bool jittered) {
   float sx = (2.0 * film.x / float(size.x) - 1.0) * tanHalfFovY * aspect;
   float sy = (1.0 - 2.0 * film.y / float(size.y)) * tanHalfFovY;
   vec3 toFilm = forward + sx * right + sy * up;
@@ -278,16 +329,22 @@ void main() {
   float weight = 1.0;
   if (vignetting) weight = invLength * invLength * invLength * invLength;  // cos^4
   vec3 direction = toFilm * invLength;
-  // The visible triangle: rasterisation snaps vertices to a sub-pixel grid, so a pixel centre
+  // The visible triangle: rasterisation snaps vertices to a sub-pixel grid, so a texel centre
   // within that snap of an edge may be given the triangle across it. The ray is tested against
-  // the triangles of the pixel and its 8 neighbours (Möller–Trumbore, edges inclusive) and the
-  // nearest it hits is taken — the ray caster's answer; the pixel's own triangle's plane if it
-  // hits none of them (a sliver no centre covers).
+  // the triangles of the id texel the film point falls in and its 8 neighbours (Möller–Trumbore,
+  // edges inclusive) and the nearest it hits is taken — the ray caster's answer. If it hits
+  // none of them: through the pixel centre, the texel's own triangle's plane (a sliver no
+  // centre covers); through a jittered point, the environment where a neighbour sees it (past
+  // a silhouette), else the own triangle's plane too.
+  ivec2 texel = ivec2(floor(film * float(idScale)));
+  ivec2 lastTexel = size * idScale - 1;
   uint id = 0u;
+  bool besideBackground = false;
   float t = 1.0 / 0.0;
   for (int dy = -1; dy <= 1; ++dy)
     for (int dx = -1; dx <= 1; ++dx) {
-      uint candidate = texelFetch(ids, clamp(pixel + ivec2(dx, dy), ivec2(0), size - 1), 0).r;
+      uint candidate = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r;
+      if (candidate == 0u) besideBackground = true;
       if (candidate == 0u || candidate == id) continue;
       uvec4 tri = triangles[candidate - 1u];
       vec3 p0 = positions[tri.x].xyz, e1 = positions[tri.y].xyz - p0, e2 = positions[tri.z].xyz - p0;
@@ -304,12 +361,8 @@ void main() {
         id = candidate;
       }
     }
-  uint own = texelFetch(ids, pixel, 0).r;
-  if (id == 0u) id = own;
-  if (id == 0u) {
-    color = vec4(weight * background, 1.0);
-    return;
-  }
+  if (id == 0u && !(jittered && besideBackground)) id = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
+  if (id == 0u) return weight * environmentRadiance(direction);
   uvec4 tri = triangles[id - 1u];
   vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
   vec3 n = cross(p1 - p0, p2 - p0);
@@ -335,8 +388,62 @@ void main() {
       }
     }
   }
-  color = vec4(weight * lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal), 1.0);
+  return weight * lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal);
 }
+
+#ifdef MULTISAMPLE
+// Pcg32::forKey, mix64 and hashCombine (core/rng.h) in 64-bit integers
+// (GL_ARB_gpu_shader_int64): the CPU renderers' sample positions.
+uniform uvec2 seed;  // (low, high) 32 bits
+uniform int spp;
+uint64_t mix64(uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9UL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebUL;
+  x ^= x >> 31;
+  return x;
+}
+uint64_t hashCombine(uint64_t a, uint64_t b) { return mix64(a ^ (mix64(b) + 0x9e3779b97f4a7c15UL)); }
+struct Pcg32 { uint64_t state, inc; };
+uint pcgNext(inout Pcg32 rng) {
+  uint64_t old = rng.state;
+  rng.state = old * 6364136223846793005UL + rng.inc;
+  uint xorshifted = uint(((old >> 18) ^ old) >> 27);
+  uint rot = uint(old >> 59);
+  return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
+}
+Pcg32 pcgForKey(uint64_t a, uint64_t b, uint64_t c) {
+  Pcg32 rng;
+  uint64_t initState = hashCombine(hashCombine(a, b), c);
+  rng.state = 0UL;
+  rng.inc = (mix64(c + 0x632be59bd9b4e019UL) << 1) | 1UL;
+  pcgNext(rng);
+  rng.state += initState;
+  pcgNext(rng);
+  return rng;
+}
+float pcgUniform(inout Pcg32 rng) { return float(pcgNext(rng) >> 8) * exp2(-24.0); }
+void main() {
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  uint64_t index = uint64_t(pixel.y) * uint64_t(size.x) + uint64_t(pixel.x);
+  uint64_t seed64 = (uint64_t(seed.y) << 32) | uint64_t(seed.x);
+  vec3 sum = vec3(0.0);
+  for (int k = 0; k < spp; ++k) {
+    // jitteredPixelSample (render_settings.h): film y is drawn first.
+    Pcg32 rng = pcgForKey(index, uint64_t(k), seed64);
+    float filmY = pcgUniform(rng);
+    float filmX = pcgUniform(rng);
+    sum += sampleRadiance(vec2(float(pixel.x) + filmX, float(pixel.y) + filmY), true);
+  }
+  color = vec4(sum / float(spp), 1.0);
+}
+#else
+void main() {
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  color = vec4(sampleRadiance(vec2(pixel) + 0.5, false), 1.0);
+}
+#endif
 )glsl";
 
 // The lookup on queries (GpuRenderer::lookup).
@@ -398,10 +505,11 @@ GLuint compileShader(GLenum type, const std::string& source, const char* name) {
   return shader;
 }
 
-/// A program of the given stages, each source prefixed by the version line and the generated
-/// constants (and, where `lookup`, the lookup functions).
-GLuint linkProgram(std::initializer_list<std::pair<GLenum, const char*>> stages, const char* name, bool lookup) {
-  const std::string prefix = "#version 450 core\n" + glslConstants() + (lookup ? kLookupGlsl : "");
+/// A program of the given stages, each source prefixed by the version line, `header`
+/// (extensions, defines), the generated constants and, where `lookup`, the lookup functions.
+GLuint linkProgram(std::initializer_list<std::pair<GLenum, const char*>> stages, const char* name, bool lookup,
+                   const char* header = "") {
+  const std::string prefix = "#version 450 core\n" + std::string(header) + glslConstants() + (lookup ? kLookupGlsl : "");
   const GLuint program = glCreateProgram();
   std::vector<GLuint> shaders;
   for (const auto& [type, source] : stages) {
@@ -420,6 +528,12 @@ GLuint linkProgram(std::initializer_list<std::pair<GLenum, const char*>> stages,
   return program;
 }
 
+/// GL_RENDERER and GL_VERSION of the current context (GpuRenderer::deviceName).
+std::string currentDeviceName() {
+  return fmt::format("{}, OpenGL {}", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+                     reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+}
+
 void setCameraUniforms(GLuint program, const Camera& camera) {
   auto vec3 = [&](const char* name, const Vec3& v) { glProgramUniform3f(program, glGetUniformLocation(program, name), v.x, v.y, v.z); };
   vec3("eye", camera.eye());
@@ -434,7 +548,6 @@ void setCameraUniforms(GLuint program, const Camera& camera) {
 
 std::string gpuUnsupportedFeature(const LightField& lf) {
   const Scene& scene = lf.scene;
-  if (scene.environment.map) return "environment maps (a constant environment is drawn)";
   for (const Material& m : scene.materials)
     if (m.isMasked()) return "alpha masks";
   // PunctualHighlights::active() without its shadow-ray machinery: a bake with punctual
@@ -464,24 +577,22 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
   return {};
 }
 
-std::string gpuUnsupportedSetting(const RenderSettings& settings, const Camera& camera) {
+std::string gpuUnsupportedSetting(const RenderSettings& /*settings*/, const Camera& camera) {
   if (camera.isThinLens()) return "thin-lens cameras (depth of field)";
-  if (effectiveSamplesPerPixel(settings, false) != 1) return "more than one sample per pixel";
   return {};
-}
-
-void checkGpuSettings(const RenderSettings& settings, const Camera& camera) {
-  if (const std::string missing = gpuUnsupportedSetting(settings, camera); !missing.empty())
-    fail("GPU renderer: {} not supported yet (render with --renderer cpu)", missing);
 }
 
 struct GpuRenderer::State {
   gpu::EglContext context;
-  GLuint buffers[7] = {};  // values, charts, positions, triangles, indices, normals, sun masks
+  GLuint buffers[8] = {};  // values, charts, positions, triangles, indices, normals, sun masks, environment map
   GLuint vertexArray = 0, emptyVertexArray = 0;
   GLuint visibilityProgram = 0, shadingProgram = 0, lookupProgram = 0;
+  /// The shading pass with several jittered samples per pixel; 0 where the driver lacks
+  /// GL_ARB_gpu_shader_int64 (the sample positions' 64-bit hash).
+  GLuint multisampleProgram = 0;
   GLuint idTexture = 0, depthBuffer = 0, colorTexture = 0, visibilityFramebuffer = 0, shadingFramebuffer = 0;
   int width = 0, height = 0;
+  int idScale = 1;  ///< the visibility targets are idScale·width × idScale·height
   GLsizei indexCount = 0;
   float near = 1e-6f;
   uint64_t bufferBytes = 0;
@@ -489,12 +600,13 @@ struct GpuRenderer::State {
 
   ~State() {
     context.makeCurrent();
-    glDeleteBuffers(7, buffers);
+    glDeleteBuffers(8, buffers);
     glDeleteVertexArrays(1, &vertexArray);
     glDeleteVertexArrays(1, &emptyVertexArray);
     glDeleteProgram(visibilityProgram);
     glDeleteProgram(shadingProgram);
     glDeleteProgram(lookupProgram);
+    glDeleteProgram(multisampleProgram);
     releaseTargets();
   }
   void releaseTargets() {
@@ -506,17 +618,18 @@ struct GpuRenderer::State {
     visibilityFramebuffer = shadingFramebuffer = idTexture = colorTexture = depthBuffer = 0;
     width = height = 0;
   }
-  /// The frame's targets at width × height (re-made only when the size changes).
-  void ensureTargets(int w, int h) {
-    if (w == width && h == height) return;
+  /// The frame's targets: radiance at width × height, triangle ids and depth at scale·width ×
+  /// scale·height (re-made only when a size changes).
+  void ensureTargets(int w, int h, int scale) {
+    if (w == width && h == height && scale == idScale) return;
     releaseTargets();
     glCreateTextures(GL_TEXTURE_2D, 1, &idTexture);
-    glTextureStorage2D(idTexture, 1, GL_R32UI, w, h);
+    glTextureStorage2D(idTexture, 1, GL_R32UI, w * scale, h * scale);
     // (An integer texture with the default linear filters is incomplete and reads as 0.)
     glTextureParameteri(idTexture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(idTexture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glCreateRenderbuffers(1, &depthBuffer);
-    glNamedRenderbufferStorage(depthBuffer, GL_DEPTH_COMPONENT32F, w, h);
+    glNamedRenderbufferStorage(depthBuffer, GL_DEPTH_COMPONENT32F, w * scale, h * scale);
     glCreateTextures(GL_TEXTURE_2D, 1, &colorTexture);
     glTextureStorage2D(colorTexture, 1, GL_RGBA32F, w, h);
     glCreateFramebuffers(1, &visibilityFramebuffer);
@@ -530,8 +643,11 @@ struct GpuRenderer::State {
     checkGl("creating the frame's targets");
     width = w;
     height = h;
+    idScale = scale;
   }
-  uint64_t targetBytes() const { return uint64_t(width) * uint64_t(height) * (4 + 4 + 16); }
+  uint64_t targetBytes() const {
+    return uint64_t(width) * uint64_t(height) * (16 + uint64_t(idScale) * uint64_t(idScale) * (4 + 4));
+  }
 };
 
 GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField) {
@@ -596,7 +712,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   if (!positions.empty()) s.near = std::max(1e-6f * glm::length(upper - lower), std::numeric_limits<float>::min());
   s.indexCount = GLsizei(indices.size());
 
-  glCreateBuffers(7, s.buffers);
+  glCreateBuffers(8, s.buffers);
   auto upload = [&](GLuint buffer, const void* data, size_t bytes) {
     // A zero-sized buffer cannot be bound to a storage block: 16 bytes stand in.
     glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), bytes > 0 ? data : nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -610,6 +726,15 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   upload(s.buffers[5], normals.data(), normals.size() * sizeof(float));
   const std::vector<uint32_t> sunMasks(lightField.sunMasks.begin(), lightField.sunMasks.end());
   upload(s.buffers[6], sunMasks.data(), sunMasks.size() * sizeof(uint32_t));
+  // The environment map's lat-long texels as RGBA (none: a 16-byte stand-in).
+  const EnvironmentMap* environmentMap = scene.environment.map.get();
+  std::vector<float> envTexels;
+  if (environmentMap != nullptr) {
+    const Image& image = environmentMap->map().image;
+    envTexels.resize(image.pixels.size() * 4, 0.0f);
+    for (size_t i = 0; i < image.pixels.size(); ++i) std::memcpy(&envTexels[4 * i], &image.pixels[i], sizeof(Rgb));
+  }
+  upload(s.buffers[7], envTexels.data(), envTexels.size() * sizeof(float));
   checkGl("uploading the light field (out of GPU memory?)");
 
   glCreateVertexArrays(1, &s.vertexArray);
@@ -624,16 +749,34 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
       linkProgram({{GL_VERTEX_SHADER, kVisibilityVertex}, {GL_FRAGMENT_SHADER, kVisibilityFragment}}, "visibility", false);
   s.shadingProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, kShadingFragment}}, "shading", true);
   s.lookupProgram = linkProgram({{GL_COMPUTE_SHADER, kLookupCompute}}, "lookup", true);
+  if (epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
+    s.multisampleProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, kShadingFragment}},
+                                       "multi-sample shading", true,
+                                       "#extension GL_ARB_gpu_shader_int64 : require\n#define MULTISAMPLE\n");
   glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
-  glProgramUniform3f(s.shadingProgram, glGetUniformLocation(s.shadingProgram, "background"), s.background.x,
-                     s.background.y, s.background.z);
+  for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {
+    if (program == 0) continue;
+    glProgramUniform3f(program, glGetUniformLocation(program, "background"), s.background.x, s.background.y,
+                       s.background.z);
+    glProgramUniform1i(program, glGetUniformLocation(program, "hasEnvironmentMap"), environmentMap != nullptr ? 1 : 0);
+    if (environmentMap != nullptr) {
+      // The map's rotation as EnvironmentMap::toMap applies it: toMap(+x) = (cos, 0, sin).
+      const Vec3 rotatedX = environmentMap->toMap(Vec3(1.0f, 0.0f, 0.0f));
+      glProgramUniform2i(program, glGetUniformLocation(program, "envSize"), environmentMap->map().width(),
+                         environmentMap->map().height());
+      glProgramUniform1f(program, glGetUniformLocation(program, "envScale"), environmentMap->scale());
+      glProgramUniform2f(program, glGetUniformLocation(program, "envRotation"), rotatedX.x, rotatedX.z);
+    }
+  }
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kValuesBinding, s.buffers[0]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kChartsBinding, s.buffers[1]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPositionsBinding, s.buffers[2]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTrianglesBinding, s.buffers[3]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kNormalsBinding, s.buffers[5]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSunMasksBinding, s.buffers[6]);
-  for (GLuint program : {s.shadingProgram, s.lookupProgram}) {
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kEnvironmentBinding, s.buffers[7]);
+  for (GLuint program : {s.shadingProgram, s.lookupProgram, s.multisampleProgram}) {
+    if (program == 0) continue;
     glProgramUniform1ui(program, glGetUniformLocation(program, "sunCount"), sun.count);
     for (uint32_t l = 0; l < sun.count; ++l) {
       const std::string index = fmt::format("[{}]", l);
@@ -651,13 +794,13 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
 
 GpuRenderer::~GpuRenderer() = default;
 
-void GpuRenderer::drawVisibility(const Camera& camera) {
+void GpuRenderer::drawVisibility(const Camera& camera, int idScale) {
   State& s = *state_;
   s.context.makeCurrent();
-  s.ensureTargets(camera.width(), camera.height());
+  s.ensureTargets(camera.width(), camera.height(), idScale);
   setCameraUniforms(s.visibilityProgram, camera);
   glBindFramebuffer(GL_FRAMEBUFFER, s.visibilityFramebuffer);
-  glViewport(0, 0, camera.width(), camera.height());
+  glViewport(0, 0, camera.width() * idScale, camera.height() * idScale);
   const GLuint noTriangle = 0;
   glClearNamedFramebufferuiv(s.visibilityFramebuffer, GL_COLOR, 0, &noTriangle);
   const float farthest = 0.0f;
@@ -672,17 +815,41 @@ void GpuRenderer::drawVisibility(const Camera& camera) {
   checkGl("the visibility pass");
 }
 
-void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) {
+std::string GpuRenderer::unsupportedSetting(const RenderSettings& settings, const Camera& camera) const {
+  if (std::string missing = gpuUnsupportedSetting(settings, camera); !missing.empty()) return missing;
+  if (effectiveSamplesPerPixel(settings, camera.isThinLens()) > 1 && state_->multisampleProgram == 0)
+    return "more than one sample per pixel on this driver (it lacks GL_ARB_gpu_shader_int64)";
+  return {};
+}
+
+void GpuRenderer::checkSettings(const RenderSettings& settings, const Camera& camera) const {
   checkRenderSettings(settings);
-  checkGpuSettings(settings, camera);
-  drawVisibility(camera);
+  if (const std::string missing = unsupportedSetting(settings, camera); !missing.empty())
+    fail("GPU renderer: {} not supported yet (render with --renderer cpu)", missing);
+}
+
+void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) {
+  checkSettings(settings, camera);
+  // One sample: the pixel centre; several: jitteredPixelSample's film points, whose triangles
+  // are looked for in a visibility pass at a finer resolution (multiSampleIdScale).
+  const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
+  const int idScale = spp > 1 ? multiSampleIdScale(camera.width(), camera.height()) : 1;
+  drawVisibility(camera, idScale);
   State& s = *state_;
-  setCameraUniforms(s.shadingProgram, camera);
-  glProgramUniform2i(s.shadingProgram, glGetUniformLocation(s.shadingProgram, "size"), camera.width(), camera.height());
-  glProgramUniform1i(s.shadingProgram, glGetUniformLocation(s.shadingProgram, "vignetting"), camera.vignetting() ? 1 : 0);
+  const GLuint program = spp > 1 ? s.multisampleProgram : s.shadingProgram;
+  setCameraUniforms(program, camera);
+  glProgramUniform2i(program, glGetUniformLocation(program, "size"), camera.width(), camera.height());
+  glProgramUniform1i(program, glGetUniformLocation(program, "idScale"), idScale);
+  glProgramUniform1i(program, glGetUniformLocation(program, "vignetting"), camera.vignetting() ? 1 : 0);
+  if (spp > 1) {
+    glProgramUniform1i(program, glGetUniformLocation(program, "spp"), spp);
+    glProgramUniform2ui(program, glGetUniformLocation(program, "seed"), GLuint(settings.seed & 0xffffffffu),
+                        GLuint(settings.seed >> 32));
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, s.shadingFramebuffer);
+  glViewport(0, 0, camera.width(), camera.height());
   glDisable(GL_DEPTH_TEST);
-  glUseProgram(s.shadingProgram);
+  glUseProgram(program);
   glBindTextureUnit(0, s.idTexture);
   glBindVertexArray(s.emptyVertexArray);
   glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -727,20 +894,36 @@ std::vector<Rgb> GpuRenderer::lookup(const std::vector<LookupQuery>& queries) {
 
 std::string GpuRenderer::deviceName() const {
   state_->context.makeCurrent();
-  return fmt::format("{}, OpenGL {}", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
-                     reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+  return currentDeviceName();
 }
 
 uint64_t GpuRenderer::gpuBytes() const { return state_->bufferBytes + state_->targetBytes(); }
 
 bool gpuAvailable(std::string* why) {
+  const GpuProbe probe = probeGpu();
+  if (why != nullptr) *why = probe.error;
+  return probe.available;
+}
+
+GpuProbe probeGpu() {
+  GpuProbe probe;
   try {
     const gpu::EglContext context;
-    return true;
+    probe.available = true;
+    probe.device = currentDeviceName();
+    probe.software = isSoftwareRasteriser(reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
   } catch (const Error& e) {
-    if (why != nullptr) *why = e.what();
-    return false;
+    probe.error = e.what();
   }
+  return probe;
+}
+
+bool isSoftwareRasteriser(const std::string& glRenderer) {
+  std::string name = glRenderer;
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  for (const char* software : {"llvmpipe", "softpipe", "software rasterizer"})
+    if (name.find(software) != std::string::npos) return true;
+  return false;
 }
 
 }  // namespace pl

@@ -112,7 +112,7 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   std::optional<GpuRenderer> gpuRenderer;
   if (o.gpu) {
     gpuRenderer.emplace(lightField);
-    checkGpuSettings(o.render, camera);
+    gpuRenderer->checkSettings(o.render, camera);
   }
 
   RenderSettings settings = o.render;

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/math.h"
+#include "core/rng.h"
 
 namespace pl {
 
@@ -49,6 +50,24 @@ inline void checkRenderSettings(const RenderSettings& settings) {
 /// thin-lens camera and 1 (the pixel centre) for a pinhole.
 inline int effectiveSamplesPerPixel(const RenderSettings& settings, bool thinLens) {
   return settings.samplesPerPixel > 0 ? settings.samplesPerPixel : thinLens ? RenderSettings::kThinLensSamples : 1;
+}
+
+/// Sample k of pixel (x, y) — pixel index y·width + x — when a pixel has several samples: its
+/// film point (pixel units) and lens point (in [0, 1)²), drawn from Pcg32::forKey(pixel, k,
+/// seed) in the order film y, film x, lens y, lens x. (That order is the one GCC's
+/// right-to-left evaluation gave the constructor calls these draws were first written as, so
+/// images stay what they were; it is spelled out because C++ leaves the order of arguments
+/// unspecified, and the GPU renderer draws the same points.) The reference and the fast
+/// renderer take their samples from here; the GPU renderer's shader is a GLSL copy, checked
+/// against them by gpu_test.
+inline void jitteredPixelSample(int x, int y, uint64_t pixel, int k, uint64_t seed, Vec2& film, Vec2& lens) {
+  Pcg32 rng = Pcg32::forKey(pixel, uint64_t(k), seed);
+  const float filmY = rng.uniform();
+  const float filmX = rng.uniform();
+  const float lensY = rng.uniform();
+  const float lensX = rng.uniform();
+  film = Vec2(float(x) + filmX, float(y) + filmY);
+  lens = Vec2(lensX, lensY);
 }
 
 /// The mirror-depth rule: settings.mirrorDepth when ≥ 0, else the bake's own

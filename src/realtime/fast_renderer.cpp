@@ -118,10 +118,9 @@ size_t FastRenderer::tileCameraRays(const Camera& camera, int spp, uint64_t seed
           const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
           pixelIndex[p++] = uint32_t(pixel);
           for (int k = 0; k < spp; ++k) {
-            // Exactly the reference's sample positions (render.cpp): Pcg32::forKey(pixel, k, seed).
-            Pcg32 rng = Pcg32::forKey(pixel, uint64_t(k), seed);
-            const Vec2 film(float(x) + rng.uniform(), float(y) + rng.uniform());
-            const Vec2 lens(rng.uniform(), rng.uniform());
+            // Exactly the reference's sample positions (render.cpp).
+            Vec2 film, lens;
+            jitteredPixelSample(x, y, pixel, k, seed, film, lens);
             if (pending == kBatch) flush();
             ::new (static_cast<void*>(batch + pending)) Camera::Sample(camera.generateRay(film, lens));
             ++pending;

@@ -101,11 +101,7 @@ Image renderLightField(const LightField& lf, const Accel& accel, const Camera& c
           const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
           for (int k = 0; k < spp; ++k) {
             Vec2 film(float(x) + 0.5f, float(y) + 0.5f), lens(0.5f);
-            if (spp > 1) {
-              Pcg32 rng = Pcg32::forKey(pixel, uint64_t(k), settings.seed);
-              film = Vec2(float(x) + rng.uniform(), float(y) + rng.uniform());
-              lens = Vec2(rng.uniform(), rng.uniform());
-            }
+            if (spp > 1) jitteredPixelSample(x, y, pixel, k, settings.seed, film, lens);
             const Camera::Sample cs = camera.generateRay(film, lens);
             rays.push_back(cs.ray);
             weights.push_back(cs.weight);

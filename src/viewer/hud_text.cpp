@@ -109,13 +109,4 @@ void drawHudText(uint32_t* pixels, int pitchBytes, int width, int height, int x,
   }
 }
 
-void darkenRect(uint32_t* pixels, int pitchBytes, int width, int height, int x0, int y0, int x1, int y1) {
-  x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, width), y1 = std::min(y1, height);
-  for (int y = y0; y < y1; ++y) {
-    uint32_t* line = reinterpret_cast<uint32_t*>(reinterpret_cast<uint8_t*>(pixels) + size_t(y) * size_t(pitchBytes));
-    // Halve each 8-bit channel: shift right and mask off the bits that crossed channels.
-    for (int x = x0; x < x1; ++x) line[x] = 0xFF000000u | ((line[x] >> 1) & 0x007F7F7Fu);
-  }
-}
-
 }  // namespace pl

@@ -18,7 +18,4 @@ int hudTextWidth(const std::string& text, int scale);
 void drawHudText(uint32_t* pixels, int pitchBytes, int width, int height, int x, int y, const std::string& text,
                  int scale, uint32_t color);
 
-/// Darkens the rectangle [x0, x1) × [y0, y1) to half brightness (a backdrop for text).
-void darkenRect(uint32_t* pixels, int pitchBytes, int width, int height, int x0, int y0, int x1, int y1);
-
 }  // namespace pl

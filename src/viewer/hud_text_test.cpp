@@ -47,12 +47,5 @@ TEST(HudText, ClipsAtTheBufferEdges) {
   EXPECT_GT(b.count(0xFFFFFFFFu), 0);  // drew what fits, no out-of-bounds writes (ASan/valgrind clean)
 }
 
-TEST(HudText, DarkensToHalfBrightness) {
-  Buffer b(4, 4, 0xFFC864FEu);
-  darkenRect(b.pixels.data(), b.width * 4, b.width, b.height, 1, 1, 10, 10);
-  EXPECT_EQ(b.at(0, 0), 0xFFC864FEu);
-  EXPECT_EQ(b.at(2, 2), 0xFF64327Fu);  // each channel halved: C8→64, 64→32, FE→7F
-}
-
 }  // namespace
 }  // namespace pl

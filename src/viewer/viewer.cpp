@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -17,10 +18,12 @@
 #include "core/timing.h"
 #include "image/display.h"
 #include "image/frame_output.h"
+#include "gpu/gpu.h"
 #include "image/image.h"
 #include "realtime/realtime.h"
 #include "viewer/fly_camera.h"
 #include "viewer/hud_text.h"
+#include "viewer/render_scale.h"
 
 namespace pl {
 namespace {
@@ -33,10 +36,13 @@ constexpr float kRadiansPerPixel = 0.004f;  ///< mouse look sensitivity
 constexpr int kHudScale = 2;
 constexpr size_t kTimingWindow = 60;  ///< frames averaged for the HUD's fps
 
-/// Owns SDL's window, renderer and streaming texture; releases them in reverse order.
+/// Owns SDL's window, renderer and streaming textures (the frame, and the HUD over it);
+/// releases them in reverse order.
 class Window {
  public:
-  Window(const std::string& title, int width, int height) {
+  /// softwareRenderer: SDL's software renderer even where an accelerated one exists (the GPU
+  /// light-field renderer keeps its own OpenGL context current on this thread).
+  Window(const std::string& title, int width, int height, bool softwareRenderer) {
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
       const char* driver = std::getenv("SDL_VIDEODRIVER");
       fail("view: cannot initialise SDL video{}: {} (no display? run under xvfb-run, or set SDL_VIDEODRIVER=dummy "
@@ -46,12 +52,18 @@ class Window {
     window_ = SDL_CreateWindow(title.c_str(), SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, width, height,
                                SDL_WINDOW_RESIZABLE);
     if (!window_) fail("view: cannot open a {}x{} window: {}", width, height, SDL_GetError());
-    renderer_ = SDL_CreateRenderer(window_, -1, SDL_RENDERER_ACCELERATED);
+    // (SDL's software renderer draws into the window surface, which SDL itself would back
+    // with an OpenGL texture on X11 unless told not to.)
+    if (softwareRenderer) SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
+    if (!softwareRenderer) renderer_ = SDL_CreateRenderer(window_, -1, SDL_RENDERER_ACCELERATED);
     if (!renderer_) renderer_ = SDL_CreateRenderer(window_, -1, SDL_RENDERER_SOFTWARE);
     if (!renderer_) fail("view: cannot create an SDL renderer: {}", SDL_GetError());
+    // A frame rendered below the window's size is upscaled bilinearly.
+    SDL_SetHint(SDL_HINT_RENDER_SCALE_QUALITY, "linear");
   }
   ~Window() {
-    if (texture_) SDL_DestroyTexture(texture_);
+    if (hud_) SDL_DestroyTexture(hud_);
+    if (frame_) SDL_DestroyTexture(frame_);
     if (renderer_) SDL_DestroyRenderer(renderer_);
     if (window_) SDL_DestroyWindow(window_);
     SDL_Quit();
@@ -64,27 +76,44 @@ class Window {
     if (SDL_GetRendererOutputSize(renderer_, &width, &height) != 0 || width < 1 || height < 1)
       SDL_GetWindowSize(window_, &width, &height);
   }
-  /// A streaming texture of the given size (re-created after a resize).
-  SDL_Texture* texture(int width, int height) {
-    if (texture_ && width == textureWidth_ && height == textureHeight_) return texture_;
-    if (texture_) SDL_DestroyTexture(texture_);
-    texture_ = SDL_CreateTexture(renderer_, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, width, height);
-    if (!texture_) fail("view: cannot create a {}x{} texture: {}", width, height, SDL_GetError());
-    textureWidth_ = width;
-    textureHeight_ = height;
-    return texture_;
-  }
+  /// Locks the frame texture at width × height (re-created when the size differs); the pixels
+  /// are 0xAARRGGBB words, `pitch` bytes per row, until present().
+  uint32_t* lockFrame(int width, int height, int& pitch) { return lock(frame_, frameSize_, width, height, pitch, false); }
+  /// Locks the HUD texture (blended over the frame's top-left corner at the window's scale).
+  uint32_t* lockHud(int width, int height, int& pitch) { return lock(hud_, hudSize_, width, height, pitch, true); }
+  /// Shows the frame stretched over the window and the HUD over it.
   void present() {
+    SDL_UnlockTexture(frame_);
     SDL_RenderClear(renderer_);
-    SDL_RenderCopy(renderer_, texture_, nullptr, nullptr);
+    SDL_RenderCopy(renderer_, frame_, nullptr, nullptr);
+    if (hud_) {
+      SDL_UnlockTexture(hud_);
+      const SDL_Rect rect{0, 0, hudSize_[0], hudSize_[1]};
+      SDL_RenderCopy(renderer_, hud_, nullptr, &rect);
+    }
     SDL_RenderPresent(renderer_);
   }
 
  private:
+  uint32_t* lock(SDL_Texture*& texture, int (&size)[2], int width, int height, int& pitch, bool blend) {
+    if (!texture || width != size[0] || height != size[1]) {
+      if (texture) SDL_DestroyTexture(texture);
+      texture = SDL_CreateTexture(renderer_, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, width, height);
+      if (!texture) fail("view: cannot create a {}x{} texture: {}", width, height, SDL_GetError());
+      SDL_SetTextureBlendMode(texture, blend ? SDL_BLENDMODE_BLEND : SDL_BLENDMODE_NONE);
+      size[0] = width;
+      size[1] = height;
+    }
+    void* pixels = nullptr;
+    if (SDL_LockTexture(texture, nullptr, &pixels, &pitch) != 0) fail("view: cannot lock a texture: {}", SDL_GetError());
+    return static_cast<uint32_t*>(pixels);
+  }
+
   SDL_Window* window_ = nullptr;
   SDL_Renderer* renderer_ = nullptr;
-  SDL_Texture* texture_ = nullptr;
-  int textureWidth_ = 0, textureHeight_ = 0;
+  SDL_Texture* frame_ = nullptr;
+  SDL_Texture* hud_ = nullptr;
+  int frameSize_[2] = {0, 0}, hudSize_[2] = {0, 0};
 };
 
 ToneMapOperator nextOperator(ToneMapOperator op) {
@@ -124,6 +153,8 @@ namespace {
 void checkViewerOptions(const ViewerOptions& options) {
   if (options.width < 1 || options.height < 1) fail("view: window size {}x{} is invalid", options.width, options.height);
   if (options.frames < 0) fail("view: --frames must be ≥ 0, got {}", options.frames);
+  if (!(options.targetFps >= 0.0) || options.targetFps > 1000.0)
+    fail("view: --target-fps must be within 0..1000, got {}", options.targetFps);
   if (!options.screenshotPath.empty() && options.frames == 0 && !options.path)
     fail("view: --screenshot needs --frames N or --path (it is written after the last frame)");
   isFramePattern(options.screenshotPattern, "screenshot pattern");  // validates it
@@ -137,6 +168,91 @@ float flySpeed(const Scene& scene, const ViewerOptions& options) {
   return 0.25f * std::max(glm::length(hi - lo), 1e-6f);
 }
 
+/// `text` on one line (a shader's multi-line driver log joined with " | ").
+std::string oneLine(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  for (size_t i = text.find('\n'); i != std::string::npos; i = text.find('\n', i)) text.replace(i, 1, " | ");
+  return text;
+}
+
+/// The light-field renderer of a session: the GPU one or the CPU fast one, chosen as viewer.h
+/// says.
+class FrameRenderer {
+ public:
+  FrameRenderer(const LightField& lightField, const Accel& accel, const ViewerOptions& options) {
+    if (options.renderer != ViewerRendererChoice::Cpu) fallback_ = tryGpu(lightField, options);
+    if (gpu_) {
+      name_ = fmt::format("gpu ({})", gpu_->deviceName());
+      return;
+    }
+    if (!fallback_.empty()) fmt::print(stderr, "plenoptic: warning: view uses the CPU renderer: {}\n", fallback_);
+    cpu_ = std::make_unique<FastRenderer>(lightField, accel);
+    name_ = "cpu";
+  }
+
+  bool gpu() const { return gpu_ != nullptr; }
+  /// Whether it renders several jittered samples per pixel (the refinement of a still view).
+  bool multiSample(const Camera& camera) const {
+    RenderSettings two;
+    two.samplesPerPixel = 2;
+    return !gpu_ || gpu_->unsupportedSetting(two, camera).empty();
+  }
+  const std::string& name() const { return name_; }
+  const std::string& fallback() const { return fallback_; }
+  void render(const Camera& camera, const RenderSettings& settings, Image& image) {
+    if (gpu_) {
+      gpu_->render(camera, settings, image);
+    } else {
+      cpu_->render(camera, settings, image);
+    }
+  }
+
+ private:
+  /// Sets gpu_ when the GPU renderer can draw; returns why not (Automatic) or throws (Gpu).
+  std::string tryGpu(const LightField& lightField, const ViewerOptions& options) {
+    const bool asked = options.renderer == ViewerRendererChoice::Gpu;
+    const Camera camera(options.camera, options.width, options.height, options.vignetting, options.metresPerUnit);
+    std::string refused;
+    if (const std::string feature = gpuUnsupportedFeature(lightField); !feature.empty())
+      refused = fmt::format("the GPU renderer does not draw {} yet", feature);
+    else if (const std::string setting = gpuUnsupportedSetting(options.render, camera); !setting.empty())
+      refused = fmt::format("the GPU renderer does not support {} yet", setting);
+    if (!refused.empty()) {
+      if (asked) fail("view: {} (use --renderer cpu)", refused);
+      return refused;
+    }
+    if (!asked) {
+      const GpuProbe probe = probeGpu();
+      if (!probe.available) return oneLine(probe.error);
+      if (probe.software)
+        return fmt::format("OpenGL here is a software rasteriser ({}), slower than the CPU renderer "
+                           "(--renderer gpu takes it anyway)",
+                           probe.device);
+    }
+    try {
+      gpu_ = std::make_unique<GpuRenderer>(lightField);
+      gpu_->checkSettings(options.render, camera);  // what this driver lacks
+    } catch (const Error& e) {
+      gpu_.reset();
+      if (asked) throw;
+      return oneLine(e.what());
+    }
+    return {};
+  }
+
+  std::unique_ptr<GpuRenderer> gpu_;
+  std::unique_ptr<FastRenderer> cpu_;
+  std::string name_, fallback_;
+};
+
+/// What the window shows (ViewerSession::renderFrame's states).
+enum class Shown {
+  Nothing,  ///< no frame yet (or the window was resized)
+  Scaled,   ///< the view at a reduced internal resolution (the camera is moving)
+  Base,     ///< the view at full resolution and the settings' samples per pixel
+  Refined,  ///< the average of refinement batches at full resolution
+};
+
 /// One viewer session: what the walk-through loop carries from frame to frame, and the steps
 /// of a frame — input, camera, render and display, HUD — in the order runViewer calls them.
 class ViewerSession {
@@ -145,8 +261,9 @@ class ViewerSession {
       : options_(options),
         speed_(flySpeed(lightField.scene, options)),
         fly_(options.camera, speed_),
-        renderer_(lightField, accel),
-        window_(options.title, options.width, options.height),
+        renderer_(lightField, accel, options),
+        window_(options.title, options.width, options.height, renderer_.gpu()),
+        scale_(renderer_.gpu() ? 0.0 : options.targetFps),
         toneMap_(options.toneMap),
         recorder_(options.recordInterval),
         start_(Clock::now()) {}
@@ -195,29 +312,34 @@ class ViewerSession {
     recorder_.sample(secondsAt(frameStart), fly_.desc());
   }
 
-  /// Renders the frame at the window's size, encodes it into the window's texture with the
-  /// HUD on top, and presents it.
-  void renderAndPresent(Clock::time_point frameStart) {
+  /// Renders what the frame needs (renderFrame) at the window's size, encodes it into the
+  /// window's texture, draws the HUD, and presents them. Returns whether anything was rendered.
+  bool renderAndPresent(Clock::time_point frameStart) {
     int width = 0, height = 0;
     window_.outputSize(width, height);
-    const Camera camera(fly_.desc(), width, height, options_.vignetting, options_.metresPerUnit);
     const Clock::time_point renderStart = Clock::now();
-    renderer_.render(camera, options_.render, radiance_);
-    renderMs_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
+    const double scale = renderFrame(width, height);
+    const bool rendered = scale > 0.0;
+    if (rendered) renderMs_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
 
-    SDL_Texture* texture = window_.texture(width, height);
-    void* locked = nullptr;
     int pitch = 0;
-    if (SDL_LockTexture(texture, nullptr, &locked, &pitch) != 0) fail("view: cannot lock the texture: {}", SDL_GetError());
-    uint32_t* pixels = static_cast<uint32_t*>(locked);
-    display_.encode(radiance_, exposureScale(), toneMap_, pixels, pitch);
-    drawHud(pixels, pitch, width, height, frameStart);
-    SDL_UnlockTexture(texture);
+    uint32_t* pixels = window_.lockFrame(frame_.width, frame_.height, pitch);
+    display_.encode(frame_, exposureScale(), toneMap_, pixels, pitch);
+    drawHud(width, height, frameStart);
     window_.present();
+    // The frame-rate controller learns from frames at the settings' own samples per pixel.
+    if (rendered && shown_ != Shown::Refined)
+      scale_.record(scale, std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
+    return rendered;
   }
 
-  /// Counts the frame's time (the HUD's fps averages the last kTimingWindow frames).
-  void endFrame(Clock::time_point frameStart) {
+  /// Counts a frame that rendered (the HUD's fps averages the last kTimingWindow of them);
+  /// after one that did not (nothing left to refine) an interactive session waits for input.
+  void endFrame(Clock::time_point frameStart, bool rendered) {
+    if (!rendered) {
+      if (options_.frames == 0 && !options_.path) SDL_WaitEventTimeout(nullptr, kIdleWaitMs);
+      return;
+    }
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
     frameMs_.push_back(ms);
     recentMs_.push_back(ms);
@@ -227,19 +349,87 @@ class ViewerSession {
   /// Saves a recording still running and the requested screenshot; the session's timings.
   ViewerResult finish() {
     if (recorder_.recording()) stopRecording(Clock::now());
-    if (!options_.screenshotPath.empty() && !radiance_.empty())
-      writeFrame(options_.screenshotPath, radiance_, exposureScale(), toneMap_);
+    if (!options_.screenshotPath.empty() && shown_ != Shown::Nothing)
+      writeFrame(options_.screenshotPath, baseFrame(), exposureScale(), toneMap_);
     ViewerResult result;
     result.frames = int(frameMs_.size());
     result.msPerFrameMedian = median(frameMs_);
     result.renderMsMedian = median(renderMs_);
+    result.renderer = renderer_.name();
+    result.fallback = renderer_.fallback();
     return result;
   }
 
  private:
+  static constexpr int kIdleWaitMs = 50;
+
   double secondsAt(Clock::time_point t) const { return std::chrono::duration<double>(t - start_).count(); }
   /// The starting exposure with the +/− offset.
   float exposureScale() const { return options_.exposureScale * std::exp2(exposureEv_); }
+  Camera cameraAt(int width, int height) const {
+    return Camera(fly_.desc(), width, height, options_.vignetting, options_.metresPerUnit);
+  }
+  int baseSpp() const { return effectiveSamplesPerPixel(options_.render, cameraAt(1, 1).isThinLens()); }
+
+  /// Renders into frame_ what the window should show next at width × height, and returns the
+  /// scale it rendered at (0: nothing rendered, frame_ is still right):
+  ///   the camera moved (or the size changed, or no frame yet): the view at the controller's
+  ///     scale (1 with the GPU renderer or when still);
+  ///   still after a scaled frame: the view at full resolution;
+  ///   still after that: one refinement batch of jittered samples (seed + batch
+  ///     number), averaged with the earlier ones, until kRefinedSamples per pixel;
+  ///   then nothing.
+  double renderFrame(int width, int height) {
+    const CameraDesc desc = fly_.desc();
+    const bool moved = shown_ == Shown::Nothing || width != shownWidth_ || height != shownHeight_ ||
+                       desc.eye != shownDesc_.eye || desc.target != shownDesc_.target || desc.up != shownDesc_.up ||
+                       desc.fovYDegrees != shownDesc_.fovYDegrees;
+    const bool first = shown_ == Shown::Nothing;
+    shownDesc_ = desc;
+    shownWidth_ = width;
+    shownHeight_ = height;
+    if (moved || shown_ == Shown::Scaled) {
+      // The very first frame is at full resolution: the controller has no frame time yet.
+      const double scale = moved && !first ? scale_.scale(true) : 1.0;
+      int w = width, h = height;
+      scaledSize(width, height, scale, w, h);
+      renderer_.render(cameraAt(w, h), options_.render, frame_);
+      shown_ = scale < 1.0 ? Shown::Scaled : Shown::Base;
+      batches_ = 0;
+      return scale;
+    }
+    // Refinement: batches of max(2, spp) jittered samples (one sample per pixel is the pixel
+    // centre); a base frame of ≥ 2 samples is the first batch.
+    const int spp = baseSpp(), batchSpp = std::max(2, spp);
+    const bool baseIsBatch = spp == batchSpp;
+    const int done = shown_ == Shown::Refined ? batches_ * batchSpp : baseIsBatch ? spp : 0;
+    if (done + batchSpp > std::max(spp, ViewerOptions::kRefinedSamples) || !renderer_.multiSample(cameraAt(1, 1)))
+      return 0.0;
+    if (shown_ == Shown::Base) {
+      accumulation_ = baseIsBatch ? frame_ : Image(width, height);
+      batches_ = baseIsBatch ? 1 : 0;
+    }
+    RenderSettings batch = options_.render;
+    batch.samplesPerPixel = batchSpp;
+    batch.seed = options_.render.seed + uint64_t(batches_) + 1;
+    renderer_.render(cameraAt(width, height), batch, batchImage_);
+    ++batches_;
+    const float weight = 1.0f / float(batches_);
+    for (size_t i = 0; i < frame_.pixels.size(); ++i) {
+      accumulation_.pixels[i] += batchImage_.pixels[i];
+      frame_.pixels[i] = accumulation_.pixels[i] * weight;
+    }
+    shown_ = Shown::Refined;
+    return 1.0;
+  }
+
+  /// The shown view at full resolution and the settings' samples per pixel: what `plenoptic
+  /// render` writes (rendered for the purpose when the window shows a scaled or refined frame).
+  const Image& baseFrame() {
+    if (shown_ == Shown::Base) return frame_;
+    renderer_.render(cameraAt(shownWidth_, shownHeight_), options_.render, screenshot_);
+    return screenshot_;
+  }
 
   void handleKey(const SDL_KeyboardEvent& key, Clock::time_point frameStart) {
     const SDL_Keycode code = key.keysym.sym;
@@ -247,9 +437,9 @@ class ViewerSession {
     if (code == SDLK_PLUS || code == SDLK_EQUALS || code == SDLK_KP_PLUS) exposureEv_ += kExposureStepEv;
     if (code == SDLK_MINUS || code == SDLK_KP_MINUS) exposureEv_ -= kExposureStepEv;
     if (code == SDLK_t) toneMap_.op = nextOperator(toneMap_.op);
-    if (code == SDLK_F12 && !radiance_.empty()) {
+    if (code == SDLK_F12 && shown_ != Shown::Nothing) {
       const std::string path = formatFramePath(options_.screenshotPattern, screenshots_++);
-      writeFrame(path, radiance_, exposureScale(), toneMap_);
+      writeFrame(path, baseFrame(), exposureScale(), toneMap_);
       showMessage("wrote " + path);
     }
     if ((code == SDLK_p || code == SDLK_r) && key.repeat == 0) {
@@ -274,18 +464,23 @@ class ViewerSession {
     messageUntil_ = Clock::now() + std::chrono::seconds(3);
   }
 
-  /// The HUD: fps over the last frames, frame time, camera, exposure, tone mapping and the
-  /// transient message, on a darkened box at the top left.
-  void drawHud(uint32_t* pixels, int pitch, int width, int height, Clock::time_point frameStart) const {
+  /// The HUD, at the window's resolution whatever the frame's: fps over the last frames, frame
+  /// time, the renderer, render scale and samples, camera, exposure, tone mapping and the
+  /// transient message, white on a half-transparent black box at the top left.
+  void drawHud(int width, int height, Clock::time_point frameStart) {
     const double meanMs = recentMs_.empty() ? 0.0 : [&] {
       double sum = 0.0;
       for (double ms : recentMs_) sum += ms;
       return sum / double(recentMs_.size());
     }();
     const Vec3 eye = fly_.eye();
+    const int spp = shown_ == Shown::Refined ? batches_ * std::max(2, baseSpp()) : baseSpp();
     std::vector<std::string> lines = {
         fmt::format("{:.1f} FPS  {:.2f} MS/FRAME  (RENDER {:.2f} MS)  {}X{}", meanMs > 0 ? 1e3 / meanMs : 0.0, meanMs,
-                    renderMs_.back(), width, height),
+                    renderMs_.empty() ? 0.0 : renderMs_.back(), width, height),
+        fmt::format("{} RENDERER  SCALE {:.0f}% ({}X{})  {} SPP{}", renderer_.gpu() ? "GPU" : "CPU",
+                    100.0 * double(frame_.width) / double(width), frame_.width, frame_.height, spp,
+                    !renderer_.gpu() && scale_.targetFps() > 0 ? fmt::format("  TARGET {:g} FPS", scale_.targetFps()) : ""),
         fmt::format("EYE {:.3g} {:.3g} {:.3g}", eye.x, eye.y, eye.z),
         fmt::format("EXPOSURE {:+.1f} EV  TONEMAP {}{}", exposureEv_, toneMapOperatorName(toneMap_.op),
                     recorder_.recording() ? "  [REC]" : ""),
@@ -293,22 +488,35 @@ class ViewerSession {
     if (!message_.empty() && frameStart < messageUntil_) lines.push_back(message_);
     int hudWidth = 0;
     for (const std::string& line : lines) hudWidth = std::max(hudWidth, hudTextWidth(line, kHudScale));
-    const int hudHeight = int(lines.size()) * kLineAdvance * kHudScale + 6;
-    darkenRect(pixels, pitch, width, height, 0, 0, hudWidth + 12, hudHeight);
+    hudWidth = std::min(hudWidth + 12, width);
+    const int hudHeight = std::min(int(lines.size()) * kLineAdvance * kHudScale + 6, height);
+    int pitch = 0;
+    uint32_t* pixels = window_.lockHud(hudWidth, hudHeight, pitch);
+    for (int y = 0; y < hudHeight; ++y)
+      std::fill_n(reinterpret_cast<uint32_t*>(reinterpret_cast<uint8_t*>(pixels) + size_t(y) * size_t(pitch)), hudWidth,
+                  kHudBackdrop);
     for (size_t i = 0; i < lines.size(); ++i)
-      drawHudText(pixels, pitch, width, height, 6, 4 + int(i) * kLineAdvance * kHudScale, lines[i], kHudScale,
+      drawHudText(pixels, pitch, hudWidth, hudHeight, 6, 4 + int(i) * kLineAdvance * kHudScale, lines[i], kHudScale,
                   0xFFFFFFFFu);
   }
+  static constexpr uint32_t kHudBackdrop = 0x80000000u;  ///< black at half opacity (ARGB)
 
   const ViewerOptions& options_;
   const float speed_;
   FlyCamera fly_;
-  const FastRenderer renderer_;
+  FrameRenderer renderer_;
   DisplayEncoder display_;
   Window window_;
+  RenderScaleController scale_;
   float exposureEv_ = 0.0f;  ///< the +/− offset on top of options.exposureScale
   ToneMapSettings toneMap_;
-  Image radiance_;  ///< the last frame
+  Image frame_;         ///< what the window shows (radiance; scaled, base or refined)
+  Image accumulation_;  ///< the sum of the refinement batches
+  Image batchImage_, screenshot_;
+  Shown shown_ = Shown::Nothing;
+  CameraDesc shownDesc_;
+  int shownWidth_ = 0, shownHeight_ = 0;
+  int batches_ = 0;  ///< refinement batches in accumulation_
   std::vector<double> frameMs_, renderMs_, recentMs_;
   int screenshots_ = 0;
   bool dragging_ = false, quit_ = false;
@@ -331,8 +539,8 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
     previous = frameStart;
     session.handleEvents(frameStart);
     session.moveCamera(frame, dt, frameStart);
-    session.renderAndPresent(frameStart);
-    session.endFrame(frameStart);
+    const bool rendered = session.renderAndPresent(frameStart);
+    session.endFrame(frameStart, rendered);
   }
   return session.finish();
 }

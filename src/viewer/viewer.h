@@ -1,7 +1,26 @@
 #pragma once
 // `plenoptic view`: an interactive walk-through of a baked light field in an SDL2 window,
-// rendered every frame by the fast renderer (realtime/realtime.h). SDL is behind viewer.cpp
-// only.
+// rendered by the GPU renderer (gpu/gpu.h) or the CPU fast renderer (realtime/realtime.h).
+// SDL is behind viewer.cpp only.
+//
+// The renderer (ViewerRendererChoice): by default the GPU renderer when a hardware OpenGL 4.5
+// core context exists and it draws this light field with these settings; otherwise the CPU
+// renderer, with one warning line on stderr saying why (no EGL or GL 4.5 context, a software
+// rasteriser such as llvmpipe — slower than the CPU renderer, a shader that does not compile,
+// a feature the GPU renderer does not draw yet). Asked for explicitly, the GPU renderer
+// refuses with that error instead. Either way a frame is radiance in an Image that the CPU
+// encodes (exposure, tone mapping, sRGB) into the window: the GPU renderer's frame is read
+// back from its headless EGL context and blitted, as the CPU renderer's is (the window then
+// uses SDL's software renderer, so that no second OpenGL context competes for the thread), so
+// both show, and screenshot, exactly what `plenoptic render` writes.
+//
+// Frame rate: with the CPU renderer, while the camera moves each frame is rendered at the
+// reduced internal resolution RenderScaleController (render_scale.h) picks for the frame-rate
+// target and upscaled (bilinear) to the window (the GPU renderer draws every frame at full
+// resolution). When the camera stops, the frame is rendered at full resolution, then (both
+// renderers) refined with batches of jittered samples averaged up to kRefinedSamples per
+// pixel; then the loop waits for input. Screenshots are always the full-resolution frame at the --spp samples (what
+// `render` writes), rendered for the purpose when the window shows a scaled or refined one.
 //
 // Controls:
 //   W/S, A/D, Q/E   move forward/back, left/right, down/up (E up, Q down, along the world up)
@@ -12,10 +31,11 @@
 //   P or R          start/stop recording the flown path (saved as camera-path JSON)
 //   Esc             quit (a recording in progress is saved first)
 // The window is resizable; the image is rendered at the window's size. The HUD shows fps,
-// frame time (render + display), camera position, exposure and tone mapping.
+// frame time (render + display), the renderer, the render scale and samples per pixel, camera
+// position, exposure and tone mapping.
 //
-// Headless use (tests, CI): `frames` > 0 renders that many frames and quits; `screenshotPath`
-// is then written from the last frame; `path` drives the camera (frame k at the path's time
+// Headless use (tests, CI): `frames` > 0 runs that many frames of the loop and quits;
+// `screenshotPath` is then written from the last frame's view; `path` drives the camera (frame k at the path's time
 // t₀ + k/fps, independent of the wall clock). Works under SDL_VIDEODRIVER=dummy (no window
 // on screen, SDL's software framebuffer) or offscreen, or xvfb-run.
 #include <optional>
@@ -33,6 +53,13 @@ namespace pl {
 
 class Accel;
 
+/// Which light-field renderer the viewer draws with (`view --renderer`).
+enum class ViewerRendererChoice {
+  Automatic,  ///< the GPU one where it can (see the top of this file), else the CPU one
+  Gpu,        ///< the GPU one, or an error saying why not
+  Cpu,        ///< the CPU fast renderer
+};
+
 struct ViewerOptions {
   int width = 1024, height = 768;    ///< initial window (and image) size
   CameraDesc camera;                 ///< starting camera
@@ -41,6 +68,9 @@ struct ViewerOptions {
   float exposureScale = 1.0f;        ///< radiance → pixel value at the start (exposure.h)
   ToneMapSettings toneMap;           ///< at the start; T changes the operator
   RenderSettings render;             ///< samples, mirror depth, seed
+  ViewerRendererChoice renderer = ViewerRendererChoice::Automatic;
+  double targetFps = 30.0;           ///< CPU renderer: frame rate held while moving; 0 = always full resolution
+  static constexpr int kRefinedSamples = 16;  ///< samples per pixel a still view is refined to
   int frames = 0;                    ///< > 0: quit after this many frames
   std::string screenshotPath;        ///< written after the last frame (.png or .exr/.hdr/.pfm)
   std::optional<CameraPath> path;    ///< scripted camera (overrides keys and mouse)
@@ -55,12 +85,15 @@ struct ViewerOptions {
 struct ViewerResult {
   int frames = 0;
   double msPerFrameMedian = 0.0;  ///< render + display + present
-  double renderMsMedian = 0.0;    ///< the fast renderer alone
+  double renderMsMedian = 0.0;    ///< the renderer alone (frames that rendered)
+  std::string renderer;           ///< "gpu (DEVICE)" or "cpu"
+  std::string fallback;           ///< why the CPU renderer was taken in Automatic mode; empty otherwise
 };
 
 /// Opens the window and runs until Esc/close, or for options.frames frames. Throws pl::Error
 /// when SDL cannot open a window (the message names the video driver and suggests
-/// SDL_VIDEODRIVER=dummy or xvfb-run), and for bad options.
+/// SDL_VIDEODRIVER=dummy or xvfb-run), for bad options, and when the GPU renderer was asked
+/// for and cannot draw (gpu/gpu.h's message).
 ViewerResult runViewer(const LightField& lightField, const Accel& accel, const ViewerOptions& options);
 
 /// True when SDL can open a window on a real display here (x11, wayland, ...; SDL's headless

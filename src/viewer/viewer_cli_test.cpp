@@ -1,6 +1,7 @@
-// `plenoptic view` headless (SDL_VIDEODRIVER=dummy): the screenshot after N frames is the
-// image `plenoptic render` writes for the same view, with and without a scripted camera
-// path; the walk-through output of `render --path`; and the error paths.
+// `plenoptic view` headless (SDL_VIDEODRIVER=dummy, and an X window under Xvfb): the
+// screenshot after N frames is the image `plenoptic render` writes for the same view and
+// renderer (CPU and GPU), with and without a scripted camera path; the fallback to the CPU
+// renderer; the walk-through output of `render --path`; and the error paths.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,10 +17,12 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/rng.h"
+#include "gpu/gpu.h"
 #include "image/frame_output.h"
 #include "image/image.h"
 #include "plf/plf_file.h"
 #include "support/cli_test_support.h"
+#include "support/random_light_field.h"
 #include "viewer/viewer.h"
 
 namespace pl {
@@ -67,7 +70,9 @@ TEST_F(ViewerCliTest, ScreenshotAfterFramesEqualsRender) {
   const std::string size = " --width 160 --height 120";
   ASSERT_EQ(run("render " + path("cornell.plf") + " -o " + path("render.png") + size), 0);
   std::string errors;
-  ASSERT_EQ(run("view " + path("cornell.plf") + " --frames 3 --screenshot " + path("view.png") + size, nullptr, &errors), 0)
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --renderer cpu --frames 3 --screenshot " + path("view.png") + size,
+                nullptr, &errors),
+            0)
       << errors;
   // Same fast renderer, same camera, same exposure and tone-mapping code: identical pixels
   // (the HUD is drawn on the window only, never into screenshots).
@@ -75,7 +80,7 @@ TEST_F(ViewerCliTest, ScreenshotAfterFramesEqualsRender) {
   // The same holds with exposure and tone-mapping flags.
   const std::string look = size + " --exposure 1.5 --tonemap clamp";
   ASSERT_EQ(run("render " + path("cornell.plf") + " -o " + path("render2.png") + look), 0);
-  ASSERT_EQ(run("view " + path("cornell.plf") + " --frames 2 --screenshot " + path("view2.png") + look), 0);
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --renderer cpu --frames 2 --screenshot " + path("view2.png") + look), 0);
   EXPECT_EQ(differingPixels(path("render2.png"), path("view2.png")), 0);
   // And the image is not the same for both looks (the flags reached the viewer).
   EXPECT_GT(differingPixels(path("view.png"), path("view2.png")), 0);
@@ -91,8 +96,10 @@ TEST_F(ViewerCliTest, ScriptedPathEndsWhereRenderOfTheLastKeyframeIs) {
   }
   const std::string size = " --width 96 --height 72";
   std::string errors;
-  // 1 s at 4 fps: frames at 0, 0.25, 0.5, 0.75, 1 — the last one on the last keyframe.
-  ASSERT_EQ(run("view " + path("cornell.plf") + " --path " + path("walk.json") + " --screenshot " + path("view.png") + size,
+  // 1 s at 4 fps: frames at 0, 0.25, 0.5, 0.75, 1 — the last one on the last keyframe. The
+  // moving camera is drawn at a reduced resolution (a 1000 fps target), the screenshot at full.
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --renderer cpu --target-fps 1000 --path " + path("walk.json") +
+                    " --screenshot " + path("view.png") + size,
                 nullptr, &errors),
             0)
       << errors;
@@ -119,8 +126,117 @@ TEST_F(ViewerCliTest, ScriptedPathEndsWhereRenderOfTheLastKeyframeIs) {
   EXPECT_NE(text.str().find("\"fps\""), std::string::npos);
 }
 
+// The GPU renderer in the viewer: its screenshot is the image `render --renderer gpu` writes,
+// headless (SDL's dummy driver) and in an X window (Xvfb).
+TEST_F(ViewerCliTest, GpuScreenshotEqualsGpuRender) {
+  const std::string size = " --width 160 --height 120";
+  std::string out, errors;
+  ASSERT_EQ(run("render " + path("cornell.plf") + " --renderer gpu -o " + path("render.png") + size, nullptr, &errors), 0)
+      << errors;
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --renderer gpu --frames 3 --screenshot " + path("view.png") + size, &out,
+                &errors),
+            0)
+      << errors;
+  EXPECT_NE(out.find("renderer gpu ("), std::string::npos) << out;  // "renderer gpu (llvmpipe …, OpenGL 4.5 …)"
+  EXPECT_EQ(differingPixels(path("render.png"), path("view.png")), 0);
+}
+
+TEST_F(ViewerCliTest, GpuScreenshotUnderXvfbEqualsGpuRender) {
+  if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/bootstrap.sh installs it)";
+  {
+    std::ofstream json(path("walk.json"));
+    json << R"({"fps": 4, "keyframes": [
+      {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0], "fov": 39},
+      {"time": 0.5, "eye": [350, 250, -300], "target": [250, 150, 300], "fov": 55}]})";
+  }
+  const std::string size = " --width 128 --height 96";
+  std::string out, errors;
+  ASSERT_EQ(run("render " + path("cornell.plf") + " --renderer gpu -o " + path("render.png") + size +
+                    " --eye 350,250,-300 --target 250,150,300 --fov 55",
+                nullptr, &errors),
+            0)
+      << errors;
+  // xvfb-run starts a virtual X server (-a: on a free display number) and runs the viewer in an
+  // X11 window on it.
+  const int code = cli_test::runPlenoptic("view " + path("cornell.plf") + " --renderer gpu --path " + path("walk.json") +
+                                              " --screenshot " + path("view.png") + size + " --quiet",
+                                          dir_, &out, &errors, "SDL_VIDEODRIVER=x11 xvfb-run -a -s '-screen 0 320x240x24'");
+  ASSERT_EQ(code, 0) << out << errors;
+  EXPECT_NE(out.find("renderer gpu ("), std::string::npos) << out;
+  EXPECT_EQ(differingPixels(path("render.png"), path("view.png")), 0);
+}
+
+/// The light field of McGuire's mirror box (a chart the GPU renderer does not draw yet).
+void writeMirrorLightField(const std::string& file) {
+  writeLightField(file, test_support::randomLightField(
+                            loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/CornellBox-Mirror.obj"), 5));
+}
+
+/// The lines of `text` that contain `word`.
+int linesWith(const std::string& text, const std::string& word) {
+  std::istringstream lines(text);
+  int count = 0;
+  for (std::string line; std::getline(lines, line);) count += line.find(word) != std::string::npos;
+  return count;
+}
+
+// By default the viewer takes the GPU renderer where it can; otherwise it draws with the CPU
+// one after one warning line saying why — and the picture is the CPU renderer's.
+TEST_F(ViewerCliTest, FallsBackToTheCpuRendererWithOneWarningLine) {
+  const std::string size = " --width 96 --height 72";
+  ASSERT_EQ(run("render " + path("cornell.plf") + " --renderer cpu -o " + path("cpu.png") + size), 0);
+  struct Case {
+    std::string environment, why;
+  };
+  const bool software = [] {
+    const GpuProbe probe = probeGpu();
+    return probe.available && probe.software;
+  }();
+  std::vector<Case> cases = {{"MESA_GL_VERSION_OVERRIDE=3.3", "EGL_BAD_MATCH"},
+                             {"__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json", "no OpenGL 4.5 core context"}};
+  if (software) cases.push_back({"", "software rasteriser"});  // llvmpipe: the tests' machines
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.environment);
+    std::string out, errors;
+    ASSERT_EQ(cli_test::runPlenoptic("view " + path("cornell.plf") + " --frames 2 --screenshot " + path("view.png") + size +
+                                         " --quiet",
+                                     dir_, &out, &errors, c.environment),
+              0)
+        << errors;
+    EXPECT_EQ(linesWith(errors, "warning"), 1) << errors;
+    EXPECT_NE(errors.find("plenoptic: warning: view uses the CPU renderer: "), std::string::npos) << errors;
+    EXPECT_NE(errors.find(c.why), std::string::npos) << errors;
+    EXPECT_NE(out.find("renderer cpu"), std::string::npos) << out;
+    EXPECT_EQ(differingPixels(path("cpu.png"), path("view.png")), 0);
+    // Asked for by name, the GPU renderer is an error instead.
+    if (c.environment.empty()) continue;
+    EXPECT_NE(cli_test::runPlenoptic("view " + path("cornell.plf") + " --renderer gpu --frames 1" + size + " --quiet", dir_,
+                                     nullptr, &errors, c.environment),
+              0);
+    EXPECT_NE(errors.find(c.why), std::string::npos) << errors;
+  }
+  // A light field the GPU renderer does not draw yet: the warning names the feature.
+  writeMirrorLightField(path("mirror.plf"));
+  std::string out, errors;
+  ASSERT_EQ(run("view " + path("mirror.plf") + " --frames 1" + size, &out, &errors), 0) << errors;
+  EXPECT_EQ(linesWith(errors, "warning"), 1) << errors;
+  EXPECT_NE(errors.find("view uses the CPU renderer: the GPU renderer does not draw mirrors and glass"), std::string::npos)
+      << errors;
+  EXPECT_NE(run("view " + path("mirror.plf") + " --renderer gpu --frames 1" + size, nullptr, &errors), 0);
+  EXPECT_NE(errors.find("mirrors and glass"), std::string::npos) << errors;
+  EXPECT_NE(errors.find("--renderer cpu"), std::string::npos) << errors;
+  // Settings it does not support yet (a thin lens) likewise.
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --aperture 2.8 --frames 1" + size, nullptr, &errors), 0) << errors;
+  EXPECT_NE(errors.find("does not support thin-lens cameras"), std::string::npos) << errors;
+  // The CPU renderer asked for: no warning.
+  ASSERT_EQ(run("view " + path("cornell.plf") + " --renderer cpu --frames 1" + size, nullptr, &errors), 0) << errors;
+  EXPECT_EQ(linesWith(errors, "warning"), 0) << errors;
+}
+
 TEST_F(ViewerCliTest, BadInputsAreClearErrors) {
   std::string errors;
+  EXPECT_NE(run("view " + path("cornell.plf") + " --renderer vulkan --frames 1", nullptr, &errors), 0);
+  EXPECT_NE(run("view " + path("cornell.plf") + " --target-fps -1 --frames 1", nullptr, &errors), 0);
   EXPECT_NE(run("view " + path("cornell.plf") + " --screenshot " + path("x.png"), nullptr, &errors), 0);
   EXPECT_NE(errors.find("--screenshot needs --frames"), std::string::npos) << errors;
   {
