@@ -244,10 +244,6 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     fail("{}: {} tixels exceed the visibility field's limit of {}", scene.sourcePath, param.tixelCount,
          VisibilityEntry::kIndexMask - 1);
   const uint32_t n = field.directionsPerTixel();
-  std::vector<VisibilityEntry> entries;
-  entries.reserve(heldTixels * n);
-  adviseHugePages(entries.data(), heldTixels * n * sizeof(VisibilityEntry));
-  entries.resize(heldTixels * n);
   std::vector<Vec3> directionTable(size_t(n) * kJitterCount);  // [cell][sub-cell]
   for (uint32_t k = 0; k < n; ++k)
     for (uint32_t j = 0; j < kJitterCount; ++j) directionTable[size_t(k) * kJitterCount + j] = cellDirection(k, j, field.gridSide, settings.seed);
@@ -271,6 +267,9 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
   }
   const uint64_t blockCount = blockList.size();
   std::vector<std::vector<std::pair<uint64_t, VisibilityExtra>>> blockExtras(blockCount);
+  // Each block's entries are traced into a buffer of its own and encoded (plv_file.h, "Compact
+  // entries") as soon as it is done: the field is never held at 8 bytes per entry.
+  std::vector<EncodedRun> blockEntries(blockCount);
   std::atomic<uint64_t> rayCount{0};
   Progress progress("visibility", heldTixels);
 
@@ -285,6 +284,7 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     std::vector<RayHit> hits;
     std::vector<PathState> states, nextStates;
     std::vector<uint8_t> jitters;
+    std::vector<VisibilityEntry> entries((t1 - t0) * n);  // of this block: entry k of tixel g at (g − t0)·n + k
     rays.reserve((t1 - t0) * n);
     states.reserve((t1 - t0) * n);
     auto& extras = blockExtras[block];
@@ -318,7 +318,7 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
       for (size_t r = 0; r < rays.size(); ++r) {
         const Ray& ray = rays[r];
         const PathState& state = states[r];
-        VisibilityEntry& entry = entries[state.entry];
+        VisibilityEntry& entry = entries[state.entry - localBase * n];
         const RayHit& hit = hits[r];
         if (!hit.hit()) {
           entry.target = VisibilityEntry::kEscape;
@@ -371,6 +371,10 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
       std::swap(states, nextStates);
     }
     std::sort(extras.begin(), extras.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    EncodedRun& run = blockEntries[block];
+    run.bytes.reserve((t1 - t0) * maxEncodedTixelBytes(n));
+    for (uint64_t g = t0; g < t1; ++g) run.add(entries.data() + (g - t0) * n, n);
+    run.bytes.shrink_to_fit();
     progress.advance(t1 - t0);
   });
   progress.finish();
@@ -387,7 +391,7 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     for (const auto& item : list) extras.push_back(item.second);
     std::vector<std::pair<uint64_t, VisibilityExtra>>().swap(list);
   }
-  field.entries = FieldArray<VisibilityEntry>(std::move(entries));
+  field.assembleEntries(blockEntries);
   field.extraOffset = FieldArray<uint64_t>(std::move(extraOffset));
   field.extras = FieldArray<VisibilityExtra>(std::move(extras));
   field.rays = rayCount.load();

@@ -60,8 +60,12 @@ struct VisibilityShard {
     }
     return localStart[lo] + (g - ranges[lo].begin);
   }
-  /// Tixel g's N entries and its first extra record.
-  const VisibilityEntry* entries(uint64_t g) const { return field.entries.data() + local(g) * field.directionsPerTixel(); }
+  /// Tixel g's N entries, decoded into `scratch` (room for N), which it returns.
+  const VisibilityEntry* entries(uint64_t g, VisibilityEntry* scratch) const {
+    field.decode(local(g), scratch);
+    return scratch;
+  }
+  /// Tixel g's first extra record.
   const VisibilityExtra* extras(uint64_t g) const { return field.extras.data() + field.extraOffset[local(g)]; }
 };
 
