@@ -121,5 +121,24 @@ TEST_F(BakeCli, RefusesBadInput) {
   EXPECT_NE(err.find("c.plv"), std::string::npos) << err;
 }
 
+TEST_F(BakeCli, MaxMemoryCapsTheMemoryGuard) {
+  std::string out, err;
+  const std::string plf = path("m.plf");
+  const std::string common = "bake cornell -o \"" + plf + "\" --preset draft --tixels-across 8 --directions 16 --quiet";
+  // A cap far below the bake's estimate: refused before any output, naming estimate, cap and flags.
+  EXPECT_EQ(run(common + " --max-memory 1M", &out, &err), 1) << err;
+  EXPECT_NE(err.find("bake (visibility field and light-field values): estimated memory "), std::string::npos) << err;
+  EXPECT_NE(err.find("exceeds --max-memory 0.00 GiB; lower --preset, --tixels-across or --directions"), std::string::npos)
+      << err;
+  EXPECT_FALSE(fs::exists(plf));
+  EXPECT_FALSE(fs::exists(path("m.plv")));
+  // A cap above it: baked.
+  EXPECT_EQ(run(common + " --max-memory 1G", &out, &err), 0) << err;
+  EXPECT_TRUE(fs::exists(plf));
+  // Not a size: a usage error naming the flag.
+  EXPECT_NE(run(common + " --max-memory lots", &out, &err), 0);
+  EXPECT_NE(err.find("--max-memory: 'lots' is not a memory size"), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace pl

@@ -632,6 +632,14 @@ TEST_F(BakeTest, CornellBoxVisibilityFieldIsSane) {
   const double fraction = double(escaped) / double(entries.size());
   EXPECT_GT(fraction, 0.05);
   EXPECT_LT(fraction, 0.4);
+  // The memory guard's figure, measured on a sample of tixels, is close to what the field holds
+  // and well below 8 bytes per entry.
+  const double estimate = estimateVisibilityBytesPerTixel(scene, accel, param, settings, {TixelRange{0, param.tixelCount}});
+  const double held = double(field.bytes()) / double(field.tixelCount);
+  EXPECT_NEAR(estimate / held, 1.0, 0.1) << estimate << " " << held;
+  EXPECT_LT(held, 64 * 6.0);
+  EXPECT_LT(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, 0, estimate),
+            bakeMemoryEstimate(param.tixelCount, param.valueCount, settings));
 }
 
 // The gather's sub-cells are multi-jittered: along each column of cells every sub-column is

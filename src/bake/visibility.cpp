@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "accel/accel.h"
 #include "core/error.h"
@@ -232,7 +233,8 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 }
 
 VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
-                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges) {
+                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges,
+                                       bool showProgress) {
   const auto start = std::chrono::steady_clock::now();
   VisibilityField field;
   field.gridSide = gatherGridSide(settings.gatherDirections);
@@ -271,7 +273,8 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
   // entries") as soon as it is done: the field is never held at 8 bytes per entry.
   std::vector<EncodedRun> blockEntries(blockCount);
   std::atomic<uint64_t> rayCount{0};
-  Progress progress("visibility", heldTixels);
+  std::optional<Progress> progress;
+  if (showProgress) progress.emplace("visibility", heldTixels);
 
   struct PathState {
     uint64_t entry;
@@ -375,9 +378,9 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     run.bytes.reserve((t1 - t0) * maxEncodedTixelBytes(n));
     for (uint64_t g = t0; g < t1; ++g) run.add(entries.data() + (g - t0) * n, n);
     run.bytes.shrink_to_fit();
-    progress.advance(t1 - t0);
+    if (progress) progress->advance(t1 - t0);
   });
-  progress.finish();
+  if (progress) progress->finish();
 
   // Per-tixel offsets of the extra records, then the records in entry order.
   std::vector<uint64_t> extraOffset(heldTixels + 1, 0);
@@ -397,6 +400,27 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
   field.rays = rayCount.load();
   field.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return VisibilityShard::of(std::move(field), ranges);
+}
+
+double estimateVisibilityBytesPerTixel(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges) {
+  uint64_t held = 0;
+  for (const TixelRange& r : ranges) held += r.size();
+  if (held == 0) return 0.0;
+  const uint64_t n = uint64_t(gatherGridSide(settings.gatherDirections)) * gatherGridSide(settings.gatherDirections);
+  const uint64_t count = std::clamp<uint64_t>(kVisibilitySampleRays / n, 1, held);
+  // The middle tixel of each of `count` equal runs of the held tixels (in their order).
+  std::vector<TixelRange> sample;
+  size_t r = 0;
+  uint64_t before = 0;  // held tixels in ranges[0, r)
+  for (uint64_t i = 0; i < count; ++i) {
+    const uint64_t local = (2 * i + 1) * held / (2 * count);
+    while (local >= before + ranges[r].size()) before += ranges[r++].size();
+    const uint64_t g = ranges[r].begin + (local - before);
+    if (sample.empty() || sample.back().end <= g) sample.push_back({g, g + 1});
+  }
+  const VisibilityShard traced = computeVisibilityShard(scene, accel, param, settings, sample, false);
+  return double(traced.field.bytes()) / double(traced.field.tixelCount);
 }
 
 }  // namespace pl

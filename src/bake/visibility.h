@@ -123,6 +123,17 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 /// rank's shard, whose hash is visibilityShardHash. Every tixel's entries are the same as in
 /// the whole field (a tixel's rays depend only on the tixel, the seed and the scene).
 VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges,
+                                       bool showProgress = true);
+
+/// Rays a visibility memory estimate traces (estimateVisibilityBytesPerTixel): a few
+/// hundredths of a second, against the minutes of a field that needs an estimate.
+inline constexpr uint64_t kVisibilitySampleRays = uint64_t(1) << 16;
+/// Bytes per tixel that the field of `ranges` (sorted, disjoint) will hold in memory — its
+/// encoded entries, offsets and extra records (VisibilityField::bytes) — measured on a sample
+/// of its tixels spread evenly over them (about kVisibilitySampleRays gather rays, at least one
+/// tixel), traced as the field would be: the encoding's size depends on what the rays see.
+double estimateVisibilityBytesPerTixel(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                        const BakeSettings& settings, const std::vector<TixelRange>& ranges);
 
 }  // namespace pl

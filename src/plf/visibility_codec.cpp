@@ -82,15 +82,23 @@ void VisibilityField::assembleEntries(std::vector<EncodedRun>& runs) {
   std::vector<unsigned char> joined;
   joined.reserve(total + kEntryBytesPadding);  // pages are touched only as the runs are copied in
   adviseHugePages(joined.data(), total + kEntryBytesPadding);
-  uint64_t t = 0;
+  // The runs are small heap blocks: what they free is handed back every kReleaseBytes copied.
+  constexpr uint64_t kReleaseBytes = uint64_t(1) << 26;
+  uint64_t t = 0, sinceRelease = 0;
   for (EncodedRun& run : runs) {
     for (uint32_t size : run.tixelBytes) {
       offsets[t + 1] = offsets[t] + size;
       ++t;
     }
     joined.insert(joined.end(), run.bytes.begin(), run.bytes.end());
+    sinceRelease += run.bytes.size();
     run = EncodedRun{};
+    if (sinceRelease >= kReleaseBytes) {
+      releaseFreedMemory();
+      sinceRelease = 0;
+    }
   }
+  releaseFreedMemory();
   joined.resize(total + kEntryBytesPadding, 0);
   entryBytes = FieldArray<unsigned char>(std::move(joined));
   entryOffset = FieldArray<uint64_t>(std::move(offsets));
