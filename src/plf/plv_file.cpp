@@ -128,66 +128,77 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
   });
 }
 
-bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
-                    uint64_t targetTixels) {
-  auto reason = [&](std::string text) {
-    if (why) *why = std::move(text);
-    return false;
-  };
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return reason(fmt::format("{} does not exist", path));
-  const auto file = std::make_shared<const MappedFile>(path);
-  const std::span<const unsigned char> bytes = file->bytes();
-  const uint64_t fileSize = bytes.size();
-  if (fileSize < kPlvHeaderSize) fail("{}: truncated visibility field ({} bytes, header needs {})", path, fileSize, kPlvHeaderSize);
+namespace {
+
+/// A .plv's header (plv_file.h).
+struct PlvHeader {
+  uint32_t version = 0, gridSide = 0;
+  uint64_t hash = 0, tixelCount = 0, entryCount = 0, extraCount = 0, payloadHash = 0;
+};
+
+/// Reads the header of `bytes` (the file `path`); fails on a file that is not a .plv. The counts
+/// are checked only for the current version (checkCounts).
+PlvHeader readPlvHeader(const std::string& path, std::span<const unsigned char> bytes) {
+  if (bytes.size() < kPlvHeaderSize)
+    fail("{}: truncated visibility field ({} bytes, header needs {})", path, bytes.size(), kPlvHeaderSize);
   size_t at = 0;
   auto get = [&](void* data, size_t size) {
     std::memcpy(data, bytes.data() + at, size);
     at += size;
   };
   char magic[8];
-  uint32_t version = 0, gridSide = 0;
-  uint64_t hash = 0, tixelCount = 0, entryCount = 0, extraCount = 0, payloadHash = 0;
+  PlvHeader h;
   get(magic, 8);
   if (std::memcmp(magic, kPlvMagic, 8) != 0) fail("{}: not a plenoptic visibility field (bad magic)", path);
-  get(&version, 4);
-  if (version != kPlvVersion) {
-    // An older field is not an error: it is traced again, as a stale one is.
-    if (version < kPlvVersion)
-      return reason(fmt::format("{} has the older format version {} (this program writes version {})", path, version,
-                                kPlvVersion));
-    fail("{}: visibility field version {} (this program reads version {})", path, version, kPlvVersion);
-  }
-  get(&gridSide, 4);
-  get(&hash, 8);
-  get(&tixelCount, 8);
-  get(&entryCount, 8);
-  get(&extraCount, 8);
-  get(&payloadHash, 8);
-  if (hash != expectedHash)
-    return reason(fmt::format("{} was traced for different geometry, parameterisation or settings (hash {:016x}, expected {:016x})",
-                              path, hash, expectedHash));
-  if (gridSide == 0 || gridSide > kMaxGatherGridSide || tixelCount > VisibilityEntry::kIndexMask ||
-      entryCount != tixelCount * uint64_t(gridSide) * gridSide || extraCount > entryCount)
-    fail("{}: inconsistent counts in the header (grid {}, {} tixels, {} entries, {} extra records)", path, gridSide,
-         tixelCount, entryCount, extraCount);
-  const uint64_t n = uint64_t(gridSide) * gridSide;
+  get(&h.version, 4);
+  if (h.version > kPlvVersion) fail("{}: visibility field version {} (this program reads version {})", path, h.version, kPlvVersion);
+  get(&h.gridSide, 4);
+  get(&h.hash, 8);
+  get(&h.tixelCount, 8);
+  get(&h.entryCount, 8);
+  get(&h.extraCount, 8);
+  get(&h.payloadHash, 8);
+  return h;
+}
+
+/// The payload's layout, checked: the block size, the frame table, and where each block's
+/// encoded entries start in the field's entry bytes (blockEntryStart[B]: their total).
+struct PlvLayout {
+  uint64_t perBlock = 0, blocks = 0;
+  std::vector<uint64_t> frameSizes, contentSizes, frameOffset, blockEntryStart;
+};
+
+/// Checks the counts of a current-version header, the payload's checksum, its frame table and
+/// every frame's declared size (before anything is allocated for the decoded field: a forged
+/// header or table is refused, not obeyed). Fails naming `path` on anything corrupt.
+PlvLayout readPlvLayout(const std::string& path, std::span<const unsigned char> bytes, const PlvHeader& h) {
+  const uint64_t fileSize = bytes.size();
+  const uint64_t tixelCount = h.tixelCount, extraCount = h.extraCount;
+  if (h.gridSide == 0 || h.gridSide > kMaxGatherGridSide || tixelCount > VisibilityEntry::kIndexMask ||
+      h.entryCount != tixelCount * uint64_t(h.gridSide) * h.gridSide || extraCount > h.entryCount)
+    fail("{}: inconsistent counts in the header (grid {}, {} tixels, {} entries, {} extra records)", path, h.gridSide,
+         tixelCount, h.entryCount, extraCount);
+  const uint64_t n = uint64_t(h.gridSide) * h.gridSide;
 
   // The payload: its checksum first (a damaged file is "corrupt", whatever its damage happens
   // to break), then the frame table at its end, checked against the bytes present.
   const std::span<const unsigned char> payload = bytes.subspan(kPlvHeaderSize);
-  if (xxh64(payload.data(), payload.size()) != payloadHash)
+  if (xxh64(payload.data(), payload.size()) != h.payloadHash)
     fail("{}: corrupt or truncated visibility field (payload checksum mismatch)", path);
   if (payload.size() < 8) fail("{}: truncated visibility field (no block size)", path);
-  uint64_t perBlock;
-  std::memcpy(&perBlock, payload.data(), 8);
-  if (perBlock == 0 || perBlock > kMaxBlockEntryBytes / (n * sizeof(VisibilityEntry)))
-    fail("{}: corrupt visibility field: {} tixels per block of {} directions each", path, perBlock, n);
-  const uint64_t blocks = (tixelCount + perBlock - 1) / perBlock;
+  PlvLayout l;
+  std::memcpy(&l.perBlock, payload.data(), 8);
+  if (l.perBlock == 0 || l.perBlock > kMaxBlockEntryBytes / (n * sizeof(VisibilityEntry)))
+    fail("{}: corrupt visibility field: {} tixels per block of {} directions each", path, l.perBlock, n);
+  const uint64_t perBlock = l.perBlock;
+  const uint64_t blocks = l.blocks = (tixelCount + perBlock - 1) / perBlock;
   const uint64_t tableBytes = 2 * (blocks + 1) * sizeof(uint64_t);
   if (payload.size() < 8 + tableBytes)
     fail("{}: truncated visibility field: {} bytes cannot hold the table of {} frames", path, fileSize, blocks + 1);
-  std::vector<uint64_t> frameSizes(blocks + 1), contentSizes(blocks + 1);
+  std::vector<uint64_t>& frameSizes = l.frameSizes;
+  std::vector<uint64_t>& contentSizes = l.contentSizes;
+  frameSizes.resize(blocks + 1);
+  contentSizes.resize(blocks + 1);
   std::memcpy(frameSizes.data(), payload.data() + payload.size() - tableBytes, tableBytes / 2);
   std::memcpy(contentSizes.data(), payload.data() + payload.size() - tableBytes / 2, tableBytes / 2);
   const uint64_t framesBytes = payload.size() - 8 - tableBytes;
@@ -200,30 +211,82 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
     fail("{}: corrupt visibility field: {} bytes of frames present, the table describes {}", path, framesBytes, sum);
 
   // Every frame must declare the size the table gives it, and that size must lie within what
-  // its tixels' encodings can take, before anything is allocated for the decoded field; then
-  // the field must fit in memory: a forged header or table is refused, not obeyed.
-  std::vector<uint64_t> blockEntryStart(blocks + 1, 0);  // of each block in the field's entry bytes
-  {
-    const unsigned char* frame = payload.data() + 8;
-    for (uint64_t b = 0; b <= blocks; ++b) {
-      const uint64_t tixels = b < blocks ? std::min(tixelCount - b * perBlock, perBlock) : 0;
-      if (b < blocks) {
-        const uint64_t least = tixels * (sizeof(uint32_t) + kTagBytes(uint32_t(n)));
-        const uint64_t most = tixels * (sizeof(uint32_t) + maxEncodedTixelBytes(uint32_t(n)));
-        if (contentSizes[b] < least || contentSizes[b] > most)
-          fail("{}: corrupt visibility field: block {} of {} tixels declares {} bytes (between {} and {})", path, b,
-               tixels, contentSizes[b], least, most);
-        blockEntryStart[b + 1] = blockEntryStart[b] + contentSizes[b] - tixels * sizeof(uint32_t);
-      } else if (contentSizes[b] != (tixelCount + 1) * sizeof(uint64_t) + extraCount * sizeof(VisibilityExtra)) {
-        fail("{}: corrupt visibility field: the extra records' frame declares {} bytes", path, contentSizes[b]);
-      }
-      detail::zstdCheckFrame({frame, frameSizes[b]}, contentSizes[b], fmt::format("{}: visibility frame {}", path, b));
-      frame += frameSizes[b];
+  // its tixels' encodings can take.
+  l.blockEntryStart.assign(blocks + 1, 0);  // of each block in the field's entry bytes
+  l.frameOffset.assign(blocks + 2, kPlvHeaderSize + 8);  // of each frame in the file
+  for (uint64_t b = 0; b <= blocks; ++b) {
+    const uint64_t tixels = b < blocks ? std::min(tixelCount - b * perBlock, perBlock) : 0;
+    if (b < blocks) {
+      const uint64_t least = tixels * (sizeof(uint32_t) + kTagBytes(uint32_t(n)));
+      const uint64_t most = tixels * (sizeof(uint32_t) + maxEncodedTixelBytes(uint32_t(n)));
+      if (contentSizes[b] < least || contentSizes[b] > most)
+        fail("{}: corrupt visibility field: block {} of {} tixels declares {} bytes (between {} and {})", path, b,
+             tixels, contentSizes[b], least, most);
+      l.blockEntryStart[b + 1] = l.blockEntryStart[b] + contentSizes[b] - tixels * sizeof(uint32_t);
+    } else if (contentSizes[b] != (tixelCount + 1) * sizeof(uint64_t) + extraCount * sizeof(VisibilityExtra)) {
+      fail("{}: corrupt visibility field: the extra records' frame declares {} bytes", path, contentSizes[b]);
     }
+    detail::zstdCheckFrame(bytes.subspan(l.frameOffset[b], frameSizes[b]), contentSizes[b],
+                           fmt::format("{}: visibility frame {}", path, b));
+    l.frameOffset[b + 1] = l.frameOffset[b] + frameSizes[b];
   }
+  return l;
+}
+
+/// Bytes a field of this header and entry-byte total holds in memory (VisibilityField::bytes).
+uint64_t heldBytes(const PlvHeader& h, uint64_t entryBytes) {
+  return entryBytes + kEntryBytesPadding + 2 * (h.tixelCount + 1) * sizeof(uint64_t) + h.extraCount * sizeof(VisibilityExtra);
+}
+
+}  // namespace
+
+VisibilityFileInfo readVisibilityInfo(const std::string& path) {
+  const MappedFile file(path);
+  const std::span<const unsigned char> bytes = file.bytes();
+  const PlvHeader h = readPlvHeader(path, bytes);
+  VisibilityFileInfo info;
+  info.version = h.version;
+  info.gridSide = h.gridSide;
+  info.hash = h.hash;
+  info.tixelCount = h.tixelCount;
+  info.entryCount = h.entryCount;
+  info.extraCount = h.extraCount;
+  info.fileBytes = bytes.size();
+  if (h.version == kPlvVersion) {
+    const PlvLayout l = readPlvLayout(path, bytes, h);
+    info.entryBytes = l.blockEntryStart[l.blocks];
+    info.heldBytes = heldBytes(h, info.entryBytes);
+  }
+  return info;
+}
+
+bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
+                    uint64_t targetTixels) {
+  auto reason = [&](std::string text) {
+    if (why) *why = std::move(text);
+    return false;
+  };
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return reason(fmt::format("{} does not exist", path));
+  const auto file = std::make_shared<const MappedFile>(path);
+  const std::span<const unsigned char> bytes = file->bytes();
+  const PlvHeader h = readPlvHeader(path, bytes);
+  // An older field is not an error: it is traced again, as a stale one is.
+  if (h.version < kPlvVersion)
+    return reason(fmt::format("{} has the older format version {} (this program writes version {})", path, h.version,
+                              kPlvVersion));
+  if (h.hash != expectedHash)
+    return reason(fmt::format("{} was traced for different geometry, parameterisation or settings (hash {:016x}, expected {:016x})",
+                              path, h.hash, expectedHash));
+  const PlvLayout layout = readPlvLayout(path, bytes, h);
+  const uint64_t tixelCount = h.tixelCount, extraCount = h.extraCount, blocks = layout.blocks, perBlock = layout.perBlock;
+  const uint64_t n = uint64_t(h.gridSide) * h.gridSide;
+  const std::vector<uint64_t>& frameSizes = layout.frameSizes;
+  const std::vector<uint64_t>& contentSizes = layout.contentSizes;
+  const std::vector<uint64_t>& frameOffset = layout.frameOffset;
+  const std::vector<uint64_t>& blockEntryStart = layout.blockEntryStart;
   const uint64_t entryBytesTotal = blockEntryStart[blocks];
-  const uint64_t decodedBytes = entryBytesTotal + 2 * (tixelCount + 1) * sizeof(uint64_t) + extraCount * sizeof(VisibilityExtra);
-  requireMemory(decodedBytes, fmt::format("{}: the visibility field", path), "bake at a coarser --preset");
+  requireMemory(heldBytes(h, entryBytesTotal), fmt::format("{}: the visibility field", path), "bake at a coarser --preset");
 
   std::vector<unsigned char> entryBytes;
   entryBytes.reserve(entryBytesTotal + kEntryBytesPadding);
@@ -231,8 +294,6 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   entryBytes.resize(entryBytesTotal + kEntryBytesPadding);
   std::vector<uint64_t> entryOffset(tixelCount + 1, 0);
   entryOffset[tixelCount] = entryBytesTotal;
-  std::vector<uint64_t> frameOffset(blocks + 2, 8);  // of each frame in the payload
-  for (uint64_t b = 0; b <= blocks; ++b) frameOffset[b + 1] = frameOffset[b] + frameSizes[b];
   std::vector<uint64_t> flaggedPerTixel(tixelCount);
   const uint64_t targets = targetTixels > 0 ? targetTixels : tixelCount;
   // Blocks decode independently, in parallel; every tixel's encoding is decoded once, checked,
@@ -240,7 +301,7 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   parallelFor(blocks, [&](uint64_t b) {
     const uint64_t t0 = b * perBlock, t1 = std::min(tixelCount, t0 + perBlock);
     std::vector<unsigned char> raw(contentSizes[b]);
-    detail::zstdDecompressInto(payload.subspan(frameOffset[b], frameSizes[b]), raw,
+    detail::zstdDecompressInto(bytes.subspan(frameOffset[b], frameSizes[b]), raw,
                                fmt::format("{}: visibility block {}", path, b));
     const unsigned char* encoded = raw.data() + (t1 - t0) * sizeof(uint32_t);
     const uint64_t encodedBytes = raw.size() - (t1 - t0) * sizeof(uint32_t);
@@ -268,7 +329,7 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   std::vector<uint64_t> extraOffset(tixelCount + 1);
   std::vector<VisibilityExtra> extras(extraCount);
   std::vector<unsigned char> raw(contentSizes[blocks]);
-  detail::zstdDecompressInto(payload.subspan(frameOffset[blocks], frameSizes[blocks]), raw,
+  detail::zstdDecompressInto(bytes.subspan(frameOffset[blocks], frameSizes[blocks]), raw,
                              fmt::format("{}: visibility extra records", path));
   std::memcpy(extraOffset.data(), raw.data(), extraOffset.size() * sizeof(uint64_t));
   if (extraCount > 0)
@@ -296,9 +357,9 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   }
 
   VisibilityField f;
-  f.gridSide = gridSide;
+  f.gridSide = h.gridSide;
   f.tixelCount = tixelCount;
-  f.hash = hash;
+  f.hash = h.hash;
   f.entryBytes = FieldArray<unsigned char>(std::move(entryBytes));
   f.entryOffset = FieldArray<uint64_t>(std::move(entryOffset));
   f.extraOffset = FieldArray<uint64_t>(std::move(extraOffset));

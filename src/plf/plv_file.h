@@ -259,6 +259,19 @@ void writeVisibility(const std::string& path, const VisibilityField& field);
 /// Bytes writeVisibility holds besides the field itself (one batch of blocks and frames).
 uint64_t visibilityWriteBufferBytes(uint32_t gridSide);
 
+/// What a .plv holds, from its header and frame table (`plenoptic info FILE.plv`).
+struct VisibilityFileInfo {
+  uint32_t version = 0, gridSide = 0;
+  uint64_t hash = 0, tixelCount = 0, entryCount = 0, extraCount = 0;
+  uint64_t fileBytes = 0;
+  uint64_t entryBytes = 0;  ///< the encoded entries (0 for an older version, which is not read further)
+  uint64_t heldBytes = 0;   ///< what the field takes in memory once read (VisibilityField::bytes; 0: older version)
+};
+/// Reads a .plv's header and, for the current version, checks its payload checksum and frame
+/// table (without decoding the entries). Throws pl::Error naming the file when it is not a .plv
+/// or is corrupt.
+VisibilityFileInfo readVisibilityInfo(const std::string& path);
+
 /// Reads and decodes a field into memory (the in-memory layout above: the bytes the bake's
 /// memory estimate counts, checked with requireMemory before allocating). Returns false and
 /// sets *why when the file is absent, of an older format version, or its hash differs from
