@@ -10,6 +10,7 @@
 #include "app/commands.h"
 #include "bake/bake.h"
 #include "core/error.h"
+#include "core/memory.h"
 #include "core/progress.h"
 #include "distributed/communicator.h"
 #include "jobs/jobs.h"
@@ -74,6 +75,12 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
                     "(checked by hash); otherwise recompute it and say why");
   command->add_option("--visibility", options->visibilityPath,
                       "Where the visibility field is saved/looked for (default: OUT with extension .plv)");
+  command
+      ->add_option_function<std::string>(
+          "--max-memory", [options](const std::string& s) { options->maxMemory = parseMemorySize(s, "--max-memory"); },
+          "The most memory the bake may plan to use, e.g. 12G or 800M: a bake whose estimate exceeds it (or the "
+          "available memory) is refused before it starts")
+      ->type_name("SIZE");
   command->add_option("--stats", options->statsPath, "Write timings and counts as JSON");
   command->add_option("--compress", options->compress,
                       "How the values are stored: none (float32), lossless (bit-exact), bc1 (S3TC), hdr (log codes)")

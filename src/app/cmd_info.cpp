@@ -1,8 +1,13 @@
 // `plenoptic info IN.plf [--json] [--no-verify]`: what a light-field file holds — format
 // version, the embedded scene, charts by kind, tixels, values, sun masks, section sizes, and
 // the bake's settings and statistics — read without decoding the values (plf/plf_file.h).
+// `plenoptic info IN.plv [--json]`: a visibility field's counts and bytes per entry
+// (plf/plv_file.h), read without decoding the entries.
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -12,6 +17,7 @@
 #include "core/error.h"
 #include "plf/compression.h"
 #include "plf/plf_file.h"
+#include "plf/plv_file.h"
 
 namespace pl {
 namespace {
@@ -172,18 +178,68 @@ void printHuman(const PlfInfo& info) {
              st.iterations, st.residual, st.visibilityRays, humanBytes(st.peakRssBytes));
 }
 
+/// A .plv (visibility field): its counts and its bytes per entry on disk and in memory.
+void printVisibility(const std::string& path, bool json) {
+  const VisibilityFileInfo v = readVisibilityInfo(path);
+  const bool current = v.version == kPlvVersion;
+  const double entries = double(std::max<uint64_t>(v.entryCount, 1));
+  if (json) {
+    nlohmann::json j = {{"path", path},
+                        {"kind", "visibility field"},
+                        {"version", v.version},
+                        {"current_version", current},
+                        {"gather_directions", uint64_t(v.gridSide) * v.gridSide},
+                        {"tixels", v.tixelCount},
+                        {"entries", v.entryCount},
+                        {"extra_records", v.extraCount},
+                        {"hash", fmt::format("{:016x}", v.hash)},
+                        {"file_bytes", v.fileBytes},
+                        {"file_bytes_per_entry", double(v.fileBytes) / entries}};
+    if (current) {
+      j["entry_bytes"] = v.entryBytes;
+      j["entry_bytes_per_entry"] = double(v.entryBytes) / entries;
+      j["memory_bytes"] = v.heldBytes;
+      j["memory_bytes_per_entry"] = double(v.heldBytes) / entries;
+    }
+    fmt::print("{}\n", j.dump(2));
+    return;
+  }
+  fmt::print("{}: plenoptic visibility field, format version {} ({} bytes)\n", path, v.version, v.fileBytes);
+  if (!current) {
+    fmt::print("format       older than this program's version {}: a bake traces the field again\n", kPlvVersion);
+    return;
+  }
+  fmt::print("checksums    payload and frame table verified\n");
+  fmt::print("field        {} tixels × {} gather directions = {} entries, {} extra records, hash {:016x}\n", v.tixelCount,
+             uint64_t(v.gridSide) * v.gridSide, v.entryCount, v.extraCount, v.hash);
+  fmt::print("on disk      {} ({:.2f} bytes per entry)\n", humanBytes(v.fileBytes), double(v.fileBytes) / entries);
+  fmt::print("in memory    {} ({:.2f} bytes per entry; the encoded entries alone {:.2f})\n", humanBytes(v.heldBytes),
+             double(v.heldBytes) / entries, double(v.entryBytes) / entries);
+}
+
+bool isVisibilityFile(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".plv";
+}
+
 }  // namespace
 
 void addInfoCommand(CLI::App& app, const GlobalOptions& global) {
   auto options = std::make_shared<InfoOptions>();
   CLI::App* command = app.add_subcommand("info", "Show what a light-field file (.plf) contains: format, scene, "
-                                                 "charts, sizes, bake settings and statistics");
-  command->add_option("input", options->input, "Light-field file (.plf)")->required();
+                                                 "charts, sizes, bake settings and statistics; or a visibility "
+                                                 "field (.plv): counts and bytes per entry on disk and in memory");
+  command->add_option("input", options->input, "Light-field file (.plf) or visibility field (.plv)")->required();
   command->add_flag("--json", options->json, "Print one JSON object instead of text");
   command->add_flag("--no-verify", options->noVerify,
                     "Do not recompute the checksums of the triangle-chart and value sections (faster on huge files)");
   command->callback([options, &global] {
     Runtime runtime(global);
+    if (isVisibilityFile(options->input)) {
+      printVisibility(options->input, options->json);
+      return;
+    }
     const PlfInfo info = readLightFieldInfo(options->input, !options->noVerify);
     if (options->json)
       fmt::print("{}\n", toJson(info).dump(2));

@@ -86,14 +86,19 @@ struct BakeOptions {
 };
 
 /// Bytes of the bake's large arrays for this parameterisation and these settings: the
-/// visibility field (an 8-byte entry per tixel and gather direction, plus a 64-bit offset per
-/// tixel) with the .plv writer's buffers (visibilityWriteBufferBytes) and, during propagation,
-/// three arrays of RGB values (current, first shot, previous iteration) and a 64-byte
-/// transport quad plus a 4-byte change per tixel. What the bake allocates after the check: the
-/// scene and the BVH, already resident then, are not in it (nor the field's rare extra
-/// records: mirror chains, glossy targets).
+/// visibility field (its encoded entries, per-tixel offsets and extra records: visibilityBytes-
+/// PerTixel per held tixel, measured by estimateVisibilityBytesPerTixel, times
+/// kVisibilityEstimateMargin; 0 = not measured: 8 bytes per entry) with the .plv writer's
+/// buffers (visibilityWriteBufferBytes) and, during propagation, three arrays of RGB values
+/// (current, first shot, previous iteration) and a 64-byte transport quad plus a 4-byte change
+/// per tixel. What the bake allocates after the check: the scene and the BVH, already resident
+/// then, are not in it.
 /// visibilityTixels: the tixels of the field this process holds (a rank's shard); 0 = all.
-uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings, uint64_t visibilityTixels = 0);
+uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings, uint64_t visibilityTixels = 0,
+                            double visibilityBytesPerTixel = 0.0);
+/// Margin on a visibility field's size measured on a sample: the sample's tixels are spread
+/// evenly, but what they see varies from chart to chart.
+inline constexpr double kVisibilityEstimateMargin = 1.15;
 
 /// Bakes `scene` (moved into the result). Throws pl::Error on failures.
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options = {});

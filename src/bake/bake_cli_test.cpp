@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -119,6 +120,59 @@ TEST_F(BakeCli, RefusesBadInput) {
   fs::resize_file(path("c.plv"), fs::file_size(path("c.plv")) - 3);
   EXPECT_NE(run(common + " --reuse-visibility", &out, &err), 0);
   EXPECT_NE(err.find("c.plv"), std::string::npos) << err;
+}
+
+TEST_F(BakeCli, InfoShowsAVisibilityFieldsBytesPerEntry) {
+  std::string out, err;
+  const std::string plv = path("v.plv");
+  ASSERT_EQ(run("bake cornell -o \"" + path("v.plf") + "\" --preset draft --tixels-across 8 --directions 16 --quiet", &out, &err), 0)
+      << err;
+  ASSERT_EQ(run("info \"" + plv + "\"", &out, &err), 0) << err;
+  EXPECT_NE(out.find("plenoptic visibility field, format version 4"), std::string::npos) << out;
+  EXPECT_NE(out.find("× 16 gather directions"), std::string::npos) << out;
+  EXPECT_NE(out.find(" bytes per entry; the encoded entries alone "), std::string::npos) << out;
+  ASSERT_EQ(run("info --json \"" + plv + "\"", &out, &err), 0) << err;
+  const nlohmann::json j = nlohmann::json::parse(out);
+  EXPECT_EQ(j["gather_directions"], 16);
+  EXPECT_GT(j["memory_bytes_per_entry"].get<double>(), 0.25);  // at least the tags
+  EXPECT_LT(j["memory_bytes_per_entry"].get<double>(), 8.0);
+  EXPECT_EQ(j["entries"].get<uint64_t>(), j["tixels"].get<uint64_t>() * 16);
+  // An older version is named as such; damage is an error naming the file.
+  std::string bytes;
+  {
+    std::ifstream in(plv, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  bytes[8] = 3;
+  {
+    std::ofstream o(path("old.plv"), std::ios::binary);
+    o << bytes;
+  }
+  ASSERT_EQ(run("info \"" + path("old.plv") + "\"", &out, &err), 0) << err;
+  EXPECT_NE(out.find("format       older than this program's version 4: a bake traces the field again"), std::string::npos)
+      << out;
+  fs::resize_file(plv, fs::file_size(plv) - 3);
+  EXPECT_EQ(run("info \"" + plv + "\"", &out, &err), 1);
+  EXPECT_NE(err.find("v.plv: corrupt or truncated visibility field"), std::string::npos) << err;
+}
+
+TEST_F(BakeCli, MaxMemoryCapsTheMemoryGuard) {
+  std::string out, err;
+  const std::string plf = path("m.plf");
+  const std::string common = "bake cornell -o \"" + plf + "\" --preset draft --tixels-across 8 --directions 16 --quiet";
+  // A cap far below the bake's estimate: refused before any output, naming estimate, cap and flags.
+  EXPECT_EQ(run(common + " --max-memory 1M", &out, &err), 1) << err;
+  EXPECT_NE(err.find("bake (visibility field and light-field values): estimated memory "), std::string::npos) << err;
+  EXPECT_NE(err.find("exceeds --max-memory 0.00 GiB; lower --preset, --tixels-across or --directions"), std::string::npos)
+      << err;
+  EXPECT_FALSE(fs::exists(plf));
+  EXPECT_FALSE(fs::exists(path("m.plv")));
+  // A cap above it: baked.
+  EXPECT_EQ(run(common + " --max-memory 1G", &out, &err), 0) << err;
+  EXPECT_TRUE(fs::exists(plf));
+  // Not a size: a usage error naming the flag.
+  EXPECT_NE(run(common + " --max-memory lots", &out, &err), 0);
+  EXPECT_NE(err.find("--max-memory: 'lots' is not a memory size"), std::string::npos) << err;
 }
 
 }  // namespace

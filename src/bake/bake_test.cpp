@@ -512,14 +512,18 @@ TEST_F(BakeTest, StaleOrCorruptVisibilityFiles) {
   VisibilityField read;
   std::string why;
   ASSERT_TRUE(readVisibility(plv, field.hash, read, &why)) << why;
-  EXPECT_EQ(read.entries.size(), field.entries.size());
+  EXPECT_EQ(read.entryCount(), field.entryCount());
   EXPECT_EQ(read.extras.size(), field.extras.size());
-  EXPECT_EQ(std::memcmp(read.entries.data(), field.entries.data(), field.entries.size() * sizeof(VisibilityEntry)), 0);
+  const std::vector<VisibilityEntry> readEntries = read.decodeAll(), fieldEntries = field.decodeAll();
+  EXPECT_EQ(std::memcmp(readEntries.data(), fieldEntries.data(), fieldEntries.size() * sizeof(VisibilityEntry)), 0);
+  ASSERT_EQ(read.entryBytes.size(), field.entryBytes.size());
+  EXPECT_TRUE(std::equal(read.entryBytes.begin(), read.entryBytes.end(), field.entryBytes.begin()));
   ASSERT_EQ(read.extraOffset.size(), field.extraOffset.size());
   EXPECT_TRUE(std::equal(read.extraOffset.begin(), read.extraOffset.end(), field.extraOffset.begin()));
   EXPECT_EQ(std::memcmp(read.extras.data(), field.extras.data(), field.extras.size() * sizeof(VisibilityExtra)), 0);
-  // Compressed: fewer bytes than the 8-byte entries alone (index and fraction planes + zstd).
-  EXPECT_LT(std::filesystem::file_size(plv), field.entries.size() * sizeof(VisibilityEntry));
+  // Compact in memory and on disk: fewer bytes than 8-byte entries.
+  EXPECT_LT(field.entryBytes.size(), field.entryCount() * sizeof(VisibilityEntry));
+  EXPECT_LT(std::filesystem::file_size(plv), field.entryBytes.size());
 
   // Stale: a different expected hash is not an error, but a reason.
   EXPECT_FALSE(readVisibility(plv, field.hash ^ 1, read, &why));
@@ -574,11 +578,15 @@ TEST_F(BakeTest, VisibilityFileOfAnOlderVersionIsRetracedAndLyingFramesAreRefuse
   writeVariant(older);
   EXPECT_FALSE(readVisibility(plv, field.hash, read, &why));
   EXPECT_NE(why.find("older format version 2"), std::string::npos) << why;
-  // The frame table at the end made to lie (two frames' sizes swapped, consistent total, valid
-  // checksum): refused by the frame check before the field is allocated, naming the file.
+  // The frame table at the end made to lie (two frames' stored sizes swapped, consistent total,
+  // valid checksum): refused by the frame check before the field is allocated, naming the file.
   auto lying = good;
   uint64_t first, last;
-  const size_t lastAt = lying.size() - 8, firstAt = lastAt - 8;  // the last entry block's and the extras' sizes
+  // The table: stored sizes of the B + 1 frames, then their content sizes (u64 each).
+  uint64_t perBlock;
+  std::memcpy(&perBlock, lying.data() + 56, 8);
+  const uint64_t tableFrames = (field.tixelCount + perBlock - 1) / perBlock + 1;
+  const size_t lastAt = lying.size() - 8 * (tableFrames + 1), firstAt = lastAt - 8;  // the last entry block's and the extras' stored sizes
   std::memcpy(&first, lying.data() + firstAt, 8);
   std::memcpy(&last, lying.data() + lastAt, 8);
   ASSERT_NE(first, last);
@@ -593,10 +601,10 @@ TEST_F(BakeTest, VisibilityFileOfAnOlderVersionIsRetracedAndLyingFramesAreRefuse
     EXPECT_NE(std::string(e.what()).find("box.plv: visibility frame"), std::string::npos) << e.what();
   }
   // A tixel index past the field's end inside a valid frame (written through writeVisibility).
-  std::vector<VisibilityEntry> entries(field.entries.begin(), field.entries.end());
+  std::vector<VisibilityEntry> entries = field.decodeAll();
   entries[5].target = uint32_t(field.tixelCount) + 3;
   VisibilityField bad = field;
-  bad.entries = FieldArray<VisibilityEntry>(std::move(entries));
+  bad.setEntries(entries.data());
   writeVisibility(plv, bad);
   try {
     readVisibility(plv, field.hash, read, &why);
@@ -613,16 +621,25 @@ TEST_F(BakeTest, CornellBoxVisibilityFieldIsSane) {
   const Parameterisation param = buildParameterisation(scene, settings);
   const Accel accel(scene);
   const VisibilityField field = computeVisibility(scene, accel, param, settings);
-  EXPECT_EQ(field.entries.size(), param.tixelCount * 64);
+  EXPECT_EQ(field.entryCount(), param.tixelCount * 64);
   EXPECT_EQ(field.rays, param.tixelCount * 64);  // no mirrors: one ray per entry
   EXPECT_TRUE(field.extras.empty());             // no glossy or mirror targets
   // The box is open at the front only: a minority of gather rays escape, and no ray from the
   // inside of the room may hit a surface from behind except from tixels under the blocks.
   uint64_t escaped = 0;
-  for (const VisibilityEntry& e : field.entries) escaped += e.escaped() ? 1 : 0;
-  const double fraction = double(escaped) / double(field.entries.size());
+  const std::vector<VisibilityEntry> entries = field.decodeAll();
+  for (const VisibilityEntry& e : entries) escaped += e.escaped() ? 1 : 0;
+  const double fraction = double(escaped) / double(entries.size());
   EXPECT_GT(fraction, 0.05);
   EXPECT_LT(fraction, 0.4);
+  // The memory guard's figure, measured on a sample of tixels, is close to what the field holds
+  // and well below 8 bytes per entry.
+  const double estimate = estimateVisibilityBytesPerTixel(scene, accel, param, settings, {TixelRange{0, param.tixelCount}});
+  const double held = double(field.bytes()) / double(field.tixelCount);
+  EXPECT_NEAR(estimate / held, 1.0, 0.1) << estimate << " " << held;
+  EXPECT_LT(held, 64 * 6.0);
+  EXPECT_LT(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, 0, estimate),
+            bakeMemoryEstimate(param.tixelCount, param.valueCount, settings));
 }
 
 // The gather's sub-cells are multi-jittered: along each column of cells every sub-column is

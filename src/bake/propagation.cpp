@@ -938,11 +938,12 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
   parallelForRange(end - begin, 16, [&](uint64_t r0, uint64_t r1) {
     const uint64_t t0 = begin + r0, t1 = begin + r1;
     std::vector<Lanes4> incoming(n);  // per gather cell, kept for glossy tixels
+    std::vector<VisibilityEntry> decoded(n);
     std::vector<uint8_t> subCells;
     for (uint64_t g = t0; g < t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
-      const VisibilityEntry* entries = vis.entries(g);
+      const VisibilityEntry* entries = vis.entries(g, decoded.data());
       const VisibilityExtra* extras = vis.extras(g);
       uint64_t cursor = 0;
       const TixelFrame frame = tixelFrame(param, c, g);  // the gather rays' frame (visibility.cpp)
@@ -1118,6 +1119,7 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
   std::vector<float>& change = state.change;
   parallelForRange(end - begin, 16, [&](uint64_t t0, uint64_t t1) {
     std::vector<Lanes4> incoming(n), twinIncoming;
+    std::vector<VisibilityEntry> decoded(n);
     std::vector<uint8_t> subCells;
     for (uint64_t g = begin + t0; g < begin + t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
@@ -1125,7 +1127,7 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
       auto slowPath = [&](VisibilityEntry e, const VisibilityExtra* extra) {
         return slowPathRadiance(state, e, extra, begin, end);
       };
-      const VisibilityEntry* entries = vis.entries(g);
+      const VisibilityEntry* entries = vis.entries(g, decoded.data());
       const VisibilityExtra* extras = vis.extras(g);
       const F4 sum = c.kind == ChartKind::Glossy || c.directionalIrradiance
                          ? gatherTixel<true>(entries, n, ops.quads.data(), ops.quads.size(), extras, incoming.data(), slowPath)
@@ -1152,7 +1154,7 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
           // Rough glass: plus the transmission of what the twin record gathers now.
           const uint64_t twin = twinTixel(param, g);
           twinIncoming.resize(n);
-          const F4 twinSum = gatherTixel<true>(vis.entries(twin), n, ops.quads.data(), ops.quads.size(), vis.extras(twin),
+          const F4 twinSum = gatherTixel<true>(vis.entries(twin, decoded.data()), n, ops.quads.data(), ops.quads.size(), vis.extras(twin),
                                                twinIncoming.data(), slowPath);
           gm.transmission[c.isBack ? 1 : 0].apply(twinIncoming.data(), twinSum, out);
         }

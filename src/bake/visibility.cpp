@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "accel/accel.h"
 #include "core/error.h"
@@ -232,7 +233,8 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 }
 
 VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
-                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges) {
+                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges,
+                                       bool showProgress) {
   const auto start = std::chrono::steady_clock::now();
   VisibilityField field;
   field.gridSide = gatherGridSide(settings.gatherDirections);
@@ -244,10 +246,6 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     fail("{}: {} tixels exceed the visibility field's limit of {}", scene.sourcePath, param.tixelCount,
          VisibilityEntry::kIndexMask - 1);
   const uint32_t n = field.directionsPerTixel();
-  std::vector<VisibilityEntry> entries;
-  entries.reserve(heldTixels * n);
-  adviseHugePages(entries.data(), heldTixels * n * sizeof(VisibilityEntry));
-  entries.resize(heldTixels * n);
   std::vector<Vec3> directionTable(size_t(n) * kJitterCount);  // [cell][sub-cell]
   for (uint32_t k = 0; k < n; ++k)
     for (uint32_t j = 0; j < kJitterCount; ++j) directionTable[size_t(k) * kJitterCount + j] = cellDirection(k, j, field.gridSide, settings.seed);
@@ -271,8 +269,12 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
   }
   const uint64_t blockCount = blockList.size();
   std::vector<std::vector<std::pair<uint64_t, VisibilityExtra>>> blockExtras(blockCount);
+  // Each block's entries are traced into a buffer of its own and encoded (plv_file.h, "Compact
+  // entries") as soon as it is done: the field is never held at 8 bytes per entry.
+  std::vector<EncodedRun> blockEntries(blockCount);
   std::atomic<uint64_t> rayCount{0};
-  Progress progress("visibility", heldTixels);
+  std::optional<Progress> progress;
+  if (showProgress) progress.emplace("visibility", heldTixels);
 
   struct PathState {
     uint64_t entry;
@@ -285,6 +287,7 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     std::vector<RayHit> hits;
     std::vector<PathState> states, nextStates;
     std::vector<uint8_t> jitters;
+    std::vector<VisibilityEntry> entries((t1 - t0) * n);  // of this block: entry k of tixel g at (g − t0)·n + k
     rays.reserve((t1 - t0) * n);
     states.reserve((t1 - t0) * n);
     auto& extras = blockExtras[block];
@@ -318,7 +321,7 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
       for (size_t r = 0; r < rays.size(); ++r) {
         const Ray& ray = rays[r];
         const PathState& state = states[r];
-        VisibilityEntry& entry = entries[state.entry];
+        VisibilityEntry& entry = entries[state.entry - localBase * n];
         const RayHit& hit = hits[r];
         if (!hit.hit()) {
           entry.target = VisibilityEntry::kEscape;
@@ -371,9 +374,13 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
       std::swap(states, nextStates);
     }
     std::sort(extras.begin(), extras.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    progress.advance(t1 - t0);
+    EncodedRun& run = blockEntries[block];
+    run.bytes.reserve((t1 - t0) * maxEncodedTixelBytes(n));
+    for (uint64_t g = t0; g < t1; ++g) run.add(entries.data() + (g - t0) * n, n);
+    run.bytes.shrink_to_fit();
+    if (progress) progress->advance(t1 - t0);
   });
-  progress.finish();
+  if (progress) progress->finish();
 
   // Per-tixel offsets of the extra records, then the records in entry order.
   std::vector<uint64_t> extraOffset(heldTixels + 1, 0);
@@ -387,12 +394,33 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     for (const auto& item : list) extras.push_back(item.second);
     std::vector<std::pair<uint64_t, VisibilityExtra>>().swap(list);
   }
-  field.entries = FieldArray<VisibilityEntry>(std::move(entries));
+  field.assembleEntries(blockEntries);
   field.extraOffset = FieldArray<uint64_t>(std::move(extraOffset));
   field.extras = FieldArray<VisibilityExtra>(std::move(extras));
   field.rays = rayCount.load();
   field.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return VisibilityShard::of(std::move(field), ranges);
+}
+
+double estimateVisibilityBytesPerTixel(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges) {
+  uint64_t held = 0;
+  for (const TixelRange& r : ranges) held += r.size();
+  if (held == 0) return 0.0;
+  const uint64_t n = uint64_t(gatherGridSide(settings.gatherDirections)) * gatherGridSide(settings.gatherDirections);
+  const uint64_t count = std::clamp<uint64_t>(kVisibilitySampleRays / n, 1, held);
+  // The middle tixel of each of `count` equal runs of the held tixels (in their order).
+  std::vector<TixelRange> sample;
+  size_t r = 0;
+  uint64_t before = 0;  // held tixels in ranges[0, r)
+  for (uint64_t i = 0; i < count; ++i) {
+    const uint64_t local = (2 * i + 1) * held / (2 * count);
+    while (local >= before + ranges[r].size()) before += ranges[r++].size();
+    const uint64_t g = ranges[r].begin + (local - before);
+    if (sample.empty() || sample.back().end <= g) sample.push_back({g, g + 1});
+  }
+  const VisibilityShard traced = computeVisibilityShard(scene, accel, param, settings, sample, false);
+  return double(traced.field.bytes()) / double(traced.field.tixelCount);
 }
 
 }  // namespace pl

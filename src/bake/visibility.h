@@ -60,8 +60,12 @@ struct VisibilityShard {
     }
     return localStart[lo] + (g - ranges[lo].begin);
   }
-  /// Tixel g's N entries and its first extra record.
-  const VisibilityEntry* entries(uint64_t g) const { return field.entries.data() + local(g) * field.directionsPerTixel(); }
+  /// Tixel g's N entries, decoded into `scratch` (room for N), which it returns.
+  const VisibilityEntry* entries(uint64_t g, VisibilityEntry* scratch) const {
+    field.decode(local(g), scratch);
+    return scratch;
+  }
+  /// Tixel g's first extra record.
   const VisibilityExtra* extras(uint64_t g) const { return field.extras.data() + field.extraOffset[local(g)]; }
 };
 
@@ -119,6 +123,17 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 /// rank's shard, whose hash is visibilityShardHash. Every tixel's entries are the same as in
 /// the whole field (a tixel's rays depend only on the tixel, the seed and the scene).
 VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges,
+                                       bool showProgress = true);
+
+/// Rays a visibility memory estimate traces (estimateVisibilityBytesPerTixel): a few
+/// hundredths of a second, against the minutes of a field that needs an estimate.
+inline constexpr uint64_t kVisibilitySampleRays = uint64_t(1) << 16;
+/// Bytes per tixel that the field of `ranges` (sorted, disjoint) will hold in memory — its
+/// encoded entries, offsets and extra records (VisibilityField::bytes) — measured on a sample
+/// of its tixels spread evenly over them (about kVisibilitySampleRays gather rays, at least one
+/// tixel), traced as the field would be: the encoding's size depends on what the rays see.
+double estimateVisibilityBytesPerTixel(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                        const BakeSettings& settings, const std::vector<TixelRange>& ranges);
 
 }  // namespace pl

@@ -424,6 +424,34 @@ TEST(Memory, AvailableMemoryIsKnownAndTheGuardNamesEstimateAndFlags) {
   }
 }
 
+TEST(Memory, AUsersCapIsRespectedBelowTheAvailableMemory) {
+  EXPECT_NO_THROW(requireMemory(1 << 20, "test", "lower --size", uint64_t(2) << 20));
+  try {
+    requireMemory(uint64_t(3) << 30, "bake", "lower --preset", uint64_t(1) << 30);
+    FAIL() << "3 GiB were accepted under a 1 GiB cap";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "bake: estimated memory 3.00 GiB exceeds --max-memory 1.00 GiB; lower --preset");
+  }
+}
+
+TEST(Memory, MemorySizesParseWithBinaryUnits) {
+  EXPECT_EQ(parseMemorySize("1073741824", "--max-memory"), uint64_t(1) << 30);
+  EXPECT_EQ(parseMemorySize("800M", "--max-memory"), uint64_t(800) << 20);
+  EXPECT_EQ(parseMemorySize("12G", "--max-memory"), uint64_t(12) << 30);
+  EXPECT_EQ(parseMemorySize("12gib", "--max-memory"), uint64_t(12) << 30);
+  EXPECT_EQ(parseMemorySize("1.5GB", "--max-memory"), uint64_t(3) << 29);
+  EXPECT_EQ(parseMemorySize("2T", "--max-memory"), uint64_t(2) << 40);
+  for (const char* bad : {"", "G", "lots", "-1G", "12X", "1e9", "12 G", "512K", "0"}) {
+    try {
+      parseMemorySize(bad, "--max-memory");
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find("--max-memory: '" + std::string(bad) + "' is not a memory size"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 // --- XXH64 (core/hash.h) ---------------------------------------------------------------------------------
 
 TEST(Xxh64, MatchesReferenceVectors) {

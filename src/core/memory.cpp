@@ -1,12 +1,19 @@
 // Memory figures of the process and the system (see memory.h).
 #include "core/memory.h"
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <sys/resource.h>
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <string>
 
@@ -54,10 +61,42 @@ std::optional<uint64_t> availableMemoryBytes() {
   return available;
 }
 
-void requireMemory(uint64_t bytes, std::string_view what, std::string_view how) {
+void requireMemory(uint64_t bytes, std::string_view what, std::string_view how, uint64_t limit) {
   const std::optional<uint64_t> available = availableMemoryBytes();
-  if (available && bytes > *available)
+  if (available && bytes > *available && !(limit > 0 && limit < *available))
     fail("{}: estimated memory {} exceeds the {} available; {}", what, gibibytes(bytes), gibibytes(*available), how);
+  if (limit > 0 && bytes > limit)
+    fail("{}: estimated memory {} exceeds --max-memory {}; {}", what, gibibytes(bytes), gibibytes(limit), how);
+}
+
+uint64_t parseMemorySize(std::string_view text, std::string_view option) {
+  auto refuse = [&]() -> uint64_t {
+    failUsage("{}: '{}' is not a memory size (e.g. 12G, 800M, or bytes; at least 1M)", option, text);
+  };
+  std::string s(text);
+  for (char& c : s) c = char(std::toupper(static_cast<unsigned char>(c)));
+  for (const char* suffix : {"IB", "B"})
+    if (s.size() > std::strlen(suffix) && s.ends_with(suffix) && !std::isdigit(static_cast<unsigned char>(s[s.size() - std::strlen(suffix) - 1])))
+      s.resize(s.size() - std::strlen(suffix));
+  double scale = 1.0;
+  if (!s.empty()) {
+    const size_t unit = std::string_view("KMGT").find(s.back());
+    if (unit != std::string_view::npos) {
+      scale = std::ldexp(1.0, 10 * int(unit + 1));
+      s.pop_back();
+    }
+  }
+  if (s.empty() || s.find_first_not_of("0123456789.") != std::string::npos) return refuse();
+  char* end = nullptr;
+  const double value = std::strtod(s.c_str(), &end);
+  if (end != s.c_str() + s.size() || !(value * scale >= double(1 << 20)) || value * scale > 0x1p62) return refuse();
+  return uint64_t(value * scale);
+}
+
+void releaseFreedMemory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
 }
 
 void adviseHugePages(void* data, size_t bytes) {

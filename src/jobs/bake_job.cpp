@@ -130,9 +130,9 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
   bakeOptions.visibilityPath = visibilityPath_;
   bakeOptions.reuseVisibility = options_.reuseVisibility;
   bakeOptions.log = options_.log;
-  bakeOptions.checkMemory = [](uint64_t bytes) {
+  bakeOptions.checkMemory = [limit = options_.maxMemory](uint64_t bytes) {
     requireMemory(bytes, "bake (visibility field and light-field values)",
-                  "lower --preset, --tixels-across or --directions");
+                  "lower --preset, --tixels-across or --directions", limit);
   };
   bakeOptions.communicator = options_.communicator;
   DistributedBakeStats distributed;

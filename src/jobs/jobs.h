@@ -162,6 +162,10 @@ struct BakeJobOptions {
   bool punctualHighlights = true;  ///< BakeSettings::punctualHighlights (`--punctual-highlights`)
   int64_t causticPhotons = -1;  ///< BakeSettings::causticPhotons (`--caustic-photons`); −1 = the preset's, 0 = no caustic pass
   bool reuseVisibility = false;
+  /// The most memory the bake may plan to use (`--max-memory`, parseMemorySize): the memory
+  /// guard refuses a bake whose estimate exceeds it, as one that exceeds the available memory;
+  /// 0 = the available memory alone.
+  uint64_t maxMemory = 0;
   std::string compress = "none";  ///< none | lossless | bc1 | hdr (plf/compression.h)
   uint64_t seed = 0;
   int threads = 0;  ///< 0 = all hardware threads

@@ -36,41 +36,28 @@ uint64_t tixelsPerBlock(uint32_t directionsPerTixel) {
   return std::max<uint64_t>(1, kBlockEntryBytes / (uint64_t(directionsPerTixel) * sizeof(VisibilityEntry)));
 }
 
-/// The bytes of an entry block before zstd (see the layout in plv_file.h): all targets, then all
-/// fu, then all fv. Measured on Sponza's default field (43.5 M entries, zstd level 1): 3.89
-/// bytes per entry interleaved, 3.46 split so, 3.58 with the targets also delta-coded against
-/// the previous entry's (neighbouring directions mostly see the same chart, but the index
-/// jumps between charts cost more than the deltas save).
-void encodeEntryBlock(const VisibilityEntry* entries, uint64_t count, unsigned char* out) {
-  for (uint64_t i = 0; i < count; ++i) {
-    std::memcpy(out + 4 * i, &entries[i].target, 4);
-    std::memcpy(out + 4 * count + 2 * i, &entries[i].fu, 2);
-    std::memcpy(out + 6 * count + 2 * i, &entries[i].fv, 2);
-  }
-}
-
-void decodeEntryBlock(const unsigned char* in, uint64_t count, VisibilityEntry* entries) {
-  for (uint64_t i = 0; i < count; ++i) {
-    std::memcpy(&entries[i].target, in + 4 * i, 4);
-    std::memcpy(&entries[i].fu, in + 4 * count + 2 * i, 2);
-    std::memcpy(&entries[i].fv, in + 6 * count + 2 * i, 2);
-  }
+/// An entry block's frame content (see the layout in plv_file.h): the block's tixels' encoded
+/// sizes (u32 each), then their encodings. Its bytes, for tixels [t0, t1).
+uint64_t blockContentBytes(const VisibilityField& field, uint64_t t0, uint64_t t1) {
+  return (t1 - t0) * sizeof(uint32_t) + field.entryOffset[t1] - field.entryOffset[t0];
 }
 
 }  // namespace
 
 uint64_t visibilityWriteBufferBytes(uint32_t gridSide) {
-  // Per block of a batch: its compressed frame (at most the raw size plus zstd's small
-  // bound, counted as the raw size twice) while a worker also holds the raw transformed copy.
-  const uint64_t blockBytes = tixelsPerBlock(gridSide * gridSide) * gridSide * gridSide * sizeof(VisibilityEntry);
-  return kWriteBatchBlocks * 2 * blockBytes;
+  // Per block of a batch: its compressed frame (at most the content plus zstd's small bound,
+  // counted as the content twice) while a worker also holds the content; the content is at most
+  // the sizes and the encoded entries, which take fewer than 8 bytes per entry.
+  const uint32_t n = gridSide * gridSide;
+  const uint64_t blockBytes = tixelsPerBlock(n) * (sizeof(uint32_t) + maxEncodedTixelBytes(n));
+  return kWriteBatchBlocks * 3 * blockBytes;
 }
 
 void writeVisibility(const std::string& path, const VisibilityField& field) {
   const uint64_t n = field.directionsPerTixel();
   const uint64_t perBlock = tixelsPerBlock(uint32_t(n));
   const uint64_t blocks = (field.tixelCount + perBlock - 1) / perBlock;
-  const uint64_t entryCount = field.entries.size(), extraCount = field.extras.size();
+  const uint64_t entryCount = field.entryCount(), extraCount = field.extras.size();
 
   writeFileAtomically(path, [&](const std::string& temp) {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
@@ -94,8 +81,9 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
 
     // Entry blocks compressed a batch at a time in parallel, written in order: memory stays
     // bounded by one batch of frames whatever the field's size.
-    std::vector<uint64_t> frameSizes;
+    std::vector<uint64_t> frameSizes, contentSizes;
     frameSizes.reserve(blocks + 1);
+    contentSizes.reserve(blocks + 1);
     const uint64_t batch = kWriteBatchBlocks;
     std::vector<std::vector<unsigned char>> frames(batch);
     Progress progress("visibility: writing", blocks);
@@ -103,13 +91,20 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
       const uint64_t b1 = std::min(blocks, b0 + batch);
       parallelFor(b1 - b0, [&](uint64_t i) {
         const uint64_t t0 = (b0 + i) * perBlock, t1 = std::min(field.tixelCount, t0 + perBlock);
-        std::vector<unsigned char> raw((t1 - t0) * n * sizeof(VisibilityEntry));
-        encodeEntryBlock(field.entries.data() + t0 * n, (t1 - t0) * n, raw.data());
+        std::vector<unsigned char> raw(blockContentBytes(field, t0, t1));
+        for (uint64_t t = t0; t < t1; ++t) {
+          const uint32_t size = uint32_t(field.entryOffset[t + 1] - field.entryOffset[t]);
+          std::memcpy(raw.data() + (t - t0) * sizeof(uint32_t), &size, sizeof(uint32_t));
+        }
+        std::memcpy(raw.data() + (t1 - t0) * sizeof(uint32_t), field.entryBytes.data() + field.entryOffset[t0],
+                    field.entryOffset[t1] - field.entryOffset[t0]);
         frames[i] = detail::zstdCompress(raw, kPlvZstdLevel);
       });
       for (uint64_t i = 0; i < b1 - b0; ++i) {
+        const uint64_t t0 = (b0 + i) * perBlock, t1 = std::min(field.tixelCount, t0 + perBlock);
         putPayload(frames[i].data(), frames[i].size());
         frameSizes.push_back(frames[i].size());
+        contentSizes.push_back(blockContentBytes(field, t0, t1));
       }
       progress.advance(b1 - b0);
     }
@@ -122,13 +117,147 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
     const std::vector<unsigned char> tailFrame = detail::zstdCompress(tail, kPlvZstdLevel);
     putPayload(tailFrame.data(), tailFrame.size());
     frameSizes.push_back(tailFrame.size());
+    contentSizes.push_back(tail.size());
     putPayload(frameSizes.data(), frameSizes.size() * sizeof(uint64_t));
+    putPayload(contentSizes.data(), contentSizes.size() * sizeof(uint64_t));
     const uint64_t digest = payloadHash.digest();
     out.seekp(kPlvHeaderSize - 8);
     put(&digest, 8);
     out.flush();
     if (!out) fail("write failed (disk full?)");
   });
+}
+
+namespace {
+
+/// A .plv's header (plv_file.h).
+struct PlvHeader {
+  uint32_t version = 0, gridSide = 0;
+  uint64_t hash = 0, tixelCount = 0, entryCount = 0, extraCount = 0, payloadHash = 0;
+};
+
+/// Reads the header of `bytes` (the file `path`); fails on a file that is not a .plv. The counts
+/// are checked only for the current version (checkCounts).
+PlvHeader readPlvHeader(const std::string& path, std::span<const unsigned char> bytes) {
+  if (bytes.size() < kPlvHeaderSize)
+    fail("{}: truncated visibility field ({} bytes, header needs {})", path, bytes.size(), kPlvHeaderSize);
+  size_t at = 0;
+  auto get = [&](void* data, size_t size) {
+    std::memcpy(data, bytes.data() + at, size);
+    at += size;
+  };
+  char magic[8];
+  PlvHeader h;
+  get(magic, 8);
+  if (std::memcmp(magic, kPlvMagic, 8) != 0) fail("{}: not a plenoptic visibility field (bad magic)", path);
+  get(&h.version, 4);
+  if (h.version > kPlvVersion) fail("{}: visibility field version {} (this program reads version {})", path, h.version, kPlvVersion);
+  get(&h.gridSide, 4);
+  get(&h.hash, 8);
+  get(&h.tixelCount, 8);
+  get(&h.entryCount, 8);
+  get(&h.extraCount, 8);
+  get(&h.payloadHash, 8);
+  return h;
+}
+
+/// The payload's layout, checked: the block size, the frame table, and where each block's
+/// encoded entries start in the field's entry bytes (blockEntryStart[B]: their total).
+struct PlvLayout {
+  uint64_t perBlock = 0, blocks = 0;
+  std::vector<uint64_t> frameSizes, contentSizes, frameOffset, blockEntryStart;
+};
+
+/// Checks the counts of a current-version header, the payload's checksum, its frame table and
+/// every frame's declared size (before anything is allocated for the decoded field: a forged
+/// header or table is refused, not obeyed). Fails naming `path` on anything corrupt.
+PlvLayout readPlvLayout(const std::string& path, std::span<const unsigned char> bytes, const PlvHeader& h) {
+  const uint64_t fileSize = bytes.size();
+  const uint64_t tixelCount = h.tixelCount, extraCount = h.extraCount;
+  if (h.gridSide == 0 || h.gridSide > kMaxGatherGridSide || tixelCount > VisibilityEntry::kIndexMask ||
+      h.entryCount != tixelCount * uint64_t(h.gridSide) * h.gridSide || extraCount > h.entryCount)
+    fail("{}: inconsistent counts in the header (grid {}, {} tixels, {} entries, {} extra records)", path, h.gridSide,
+         tixelCount, h.entryCount, extraCount);
+  const uint64_t n = uint64_t(h.gridSide) * h.gridSide;
+
+  // The payload: its checksum first (a damaged file is "corrupt", whatever its damage happens
+  // to break), then the frame table at its end, checked against the bytes present.
+  const std::span<const unsigned char> payload = bytes.subspan(kPlvHeaderSize);
+  if (xxh64(payload.data(), payload.size()) != h.payloadHash)
+    fail("{}: corrupt or truncated visibility field (payload checksum mismatch)", path);
+  if (payload.size() < 8) fail("{}: truncated visibility field (no block size)", path);
+  PlvLayout l;
+  std::memcpy(&l.perBlock, payload.data(), 8);
+  if (l.perBlock == 0 || l.perBlock > kMaxBlockEntryBytes / (n * sizeof(VisibilityEntry)))
+    fail("{}: corrupt visibility field: {} tixels per block of {} directions each", path, l.perBlock, n);
+  const uint64_t perBlock = l.perBlock;
+  const uint64_t blocks = l.blocks = (tixelCount + perBlock - 1) / perBlock;
+  const uint64_t tableBytes = 2 * (blocks + 1) * sizeof(uint64_t);
+  if (payload.size() < 8 + tableBytes)
+    fail("{}: truncated visibility field: {} bytes cannot hold the table of {} frames", path, fileSize, blocks + 1);
+  std::vector<uint64_t>& frameSizes = l.frameSizes;
+  std::vector<uint64_t>& contentSizes = l.contentSizes;
+  frameSizes.resize(blocks + 1);
+  contentSizes.resize(blocks + 1);
+  std::memcpy(frameSizes.data(), payload.data() + payload.size() - tableBytes, tableBytes / 2);
+  std::memcpy(contentSizes.data(), payload.data() + payload.size() - tableBytes / 2, tableBytes / 2);
+  const uint64_t framesBytes = payload.size() - 8 - tableBytes;
+  uint64_t sum = 0;
+  for (uint64_t size : frameSizes) {
+    if (size > framesBytes - sum) fail("{}: corrupt visibility field: the frame sizes exceed the {} bytes present", path, framesBytes);
+    sum += size;
+  }
+  if (sum != framesBytes)
+    fail("{}: corrupt visibility field: {} bytes of frames present, the table describes {}", path, framesBytes, sum);
+
+  // Every frame must declare the size the table gives it, and that size must lie within what
+  // its tixels' encodings can take.
+  l.blockEntryStart.assign(blocks + 1, 0);  // of each block in the field's entry bytes
+  l.frameOffset.assign(blocks + 2, kPlvHeaderSize + 8);  // of each frame in the file
+  for (uint64_t b = 0; b <= blocks; ++b) {
+    const uint64_t tixels = b < blocks ? std::min(tixelCount - b * perBlock, perBlock) : 0;
+    if (b < blocks) {
+      const uint64_t least = tixels * (sizeof(uint32_t) + kTagBytes(uint32_t(n)));
+      const uint64_t most = tixels * (sizeof(uint32_t) + maxEncodedTixelBytes(uint32_t(n)));
+      if (contentSizes[b] < least || contentSizes[b] > most)
+        fail("{}: corrupt visibility field: block {} of {} tixels declares {} bytes (between {} and {})", path, b,
+             tixels, contentSizes[b], least, most);
+      l.blockEntryStart[b + 1] = l.blockEntryStart[b] + contentSizes[b] - tixels * sizeof(uint32_t);
+    } else if (contentSizes[b] != (tixelCount + 1) * sizeof(uint64_t) + extraCount * sizeof(VisibilityExtra)) {
+      fail("{}: corrupt visibility field: the extra records' frame declares {} bytes", path, contentSizes[b]);
+    }
+    detail::zstdCheckFrame(bytes.subspan(l.frameOffset[b], frameSizes[b]), contentSizes[b],
+                           fmt::format("{}: visibility frame {}", path, b));
+    l.frameOffset[b + 1] = l.frameOffset[b] + frameSizes[b];
+  }
+  return l;
+}
+
+/// Bytes a field of this header and entry-byte total holds in memory (VisibilityField::bytes).
+uint64_t heldBytes(const PlvHeader& h, uint64_t entryBytes) {
+  return entryBytes + kEntryBytesPadding + 2 * (h.tixelCount + 1) * sizeof(uint64_t) + h.extraCount * sizeof(VisibilityExtra);
+}
+
+}  // namespace
+
+VisibilityFileInfo readVisibilityInfo(const std::string& path) {
+  const MappedFile file(path);
+  const std::span<const unsigned char> bytes = file.bytes();
+  const PlvHeader h = readPlvHeader(path, bytes);
+  VisibilityFileInfo info;
+  info.version = h.version;
+  info.gridSide = h.gridSide;
+  info.hash = h.hash;
+  info.tixelCount = h.tixelCount;
+  info.entryCount = h.entryCount;
+  info.extraCount = h.extraCount;
+  info.fileBytes = bytes.size();
+  if (h.version == kPlvVersion) {
+    const PlvLayout l = readPlvLayout(path, bytes, h);
+    info.entryBytes = l.blockEntryStart[l.blocks];
+    info.heldBytes = heldBytes(h, info.entryBytes);
+  }
+  return info;
 }
 
 bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
@@ -141,113 +270,66 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   if (!std::filesystem::exists(path, ec)) return reason(fmt::format("{} does not exist", path));
   const auto file = std::make_shared<const MappedFile>(path);
   const std::span<const unsigned char> bytes = file->bytes();
-  const uint64_t fileSize = bytes.size();
-  if (fileSize < kPlvHeaderSize) fail("{}: truncated visibility field ({} bytes, header needs {})", path, fileSize, kPlvHeaderSize);
-  size_t at = 0;
-  auto get = [&](void* data, size_t size) {
-    std::memcpy(data, bytes.data() + at, size);
-    at += size;
-  };
-  char magic[8];
-  uint32_t version = 0, gridSide = 0;
-  uint64_t hash = 0, tixelCount = 0, entryCount = 0, extraCount = 0, payloadHash = 0;
-  get(magic, 8);
-  if (std::memcmp(magic, kPlvMagic, 8) != 0) fail("{}: not a plenoptic visibility field (bad magic)", path);
-  get(&version, 4);
-  if (version != kPlvVersion) {
-    // An older field is not an error: it is traced again, as a stale one is.
-    if (version < kPlvVersion)
-      return reason(fmt::format("{} has the older format version {} (this program writes version {})", path, version,
-                                kPlvVersion));
-    fail("{}: visibility field version {} (this program reads version {})", path, version, kPlvVersion);
-  }
-  get(&gridSide, 4);
-  get(&hash, 8);
-  get(&tixelCount, 8);
-  get(&entryCount, 8);
-  get(&extraCount, 8);
-  get(&payloadHash, 8);
-  if (hash != expectedHash)
+  const PlvHeader h = readPlvHeader(path, bytes);
+  // An older field is not an error: it is traced again, as a stale one is.
+  if (h.version < kPlvVersion)
+    return reason(fmt::format("{} has the older format version {} (this program writes version {})", path, h.version,
+                              kPlvVersion));
+  if (h.hash != expectedHash)
     return reason(fmt::format("{} was traced for different geometry, parameterisation or settings (hash {:016x}, expected {:016x})",
-                              path, hash, expectedHash));
-  if (gridSide == 0 || gridSide > kMaxGatherGridSide || tixelCount > VisibilityEntry::kIndexMask ||
-      entryCount != tixelCount * uint64_t(gridSide) * gridSide || extraCount > entryCount)
-    fail("{}: inconsistent counts in the header (grid {}, {} tixels, {} entries, {} extra records)", path, gridSide,
-         tixelCount, entryCount, extraCount);
-  const uint64_t n = uint64_t(gridSide) * gridSide;
+                              path, h.hash, expectedHash));
+  const PlvLayout layout = readPlvLayout(path, bytes, h);
+  const uint64_t tixelCount = h.tixelCount, extraCount = h.extraCount, blocks = layout.blocks, perBlock = layout.perBlock;
+  const uint64_t n = uint64_t(h.gridSide) * h.gridSide;
+  const std::vector<uint64_t>& frameSizes = layout.frameSizes;
+  const std::vector<uint64_t>& contentSizes = layout.contentSizes;
+  const std::vector<uint64_t>& frameOffset = layout.frameOffset;
+  const std::vector<uint64_t>& blockEntryStart = layout.blockEntryStart;
+  const uint64_t entryBytesTotal = blockEntryStart[blocks];
+  requireMemory(heldBytes(h, entryBytesTotal), fmt::format("{}: the visibility field", path), "bake at a coarser --preset");
 
-  // The payload: its checksum first (a damaged file is "corrupt", whatever its damage happens
-  // to break), then the frame table at its end, checked against the bytes present.
-  const std::span<const unsigned char> payload = bytes.subspan(kPlvHeaderSize);
-  if (xxh64(payload.data(), payload.size()) != payloadHash)
-    fail("{}: corrupt or truncated visibility field (payload checksum mismatch)", path);
-  if (payload.size() < 8) fail("{}: truncated visibility field (no block size)", path);
-  uint64_t perBlock;
-  std::memcpy(&perBlock, payload.data(), 8);
-  if (perBlock == 0 || perBlock > kMaxBlockEntryBytes / (n * sizeof(VisibilityEntry)))
-    fail("{}: corrupt visibility field: {} tixels per block of {} directions each", path, perBlock, n);
-  const uint64_t blocks = (tixelCount + perBlock - 1) / perBlock;
-  const uint64_t tableBytes = (blocks + 1) * sizeof(uint64_t);
-  if (payload.size() < 8 + tableBytes)
-    fail("{}: truncated visibility field: {} bytes cannot hold the table of {} frames", path, fileSize, blocks + 1);
-  std::vector<uint64_t> frameSizes(blocks + 1);
-  std::memcpy(frameSizes.data(), payload.data() + payload.size() - tableBytes, tableBytes);
-  const uint64_t framesBytes = payload.size() - 8 - tableBytes;
-  uint64_t sum = 0;
-  for (uint64_t size : frameSizes) {
-    if (size > framesBytes - sum) fail("{}: corrupt visibility field: the frame sizes exceed the {} bytes present", path, framesBytes);
-    sum += size;
-  }
-  if (sum != framesBytes)
-    fail("{}: corrupt visibility field: {} bytes of frames present, the table describes {}", path, framesBytes, sum);
-
-  // Every frame must declare the size its place in the layout gives it before anything is
-  // allocated for the decoded field; then the field must fit in memory (the same bytes as the
-  // bake's estimate for this parameterisation): a forged header is refused, not obeyed.
-  const uint64_t decodedBytes = entryCount * sizeof(VisibilityEntry) + (tixelCount + 1) * sizeof(uint64_t) +
-                                extraCount * sizeof(VisibilityExtra);
-  {
-    const unsigned char* frame = payload.data() + 8;
-    for (uint64_t b = 0; b <= blocks; ++b) {
-      const uint64_t tixels = b < blocks ? std::min(tixelCount - b * perBlock, perBlock) : 0;
-      const uint64_t expected = b < blocks ? tixels * n * sizeof(VisibilityEntry)
-                                           : (tixelCount + 1) * sizeof(uint64_t) + extraCount * sizeof(VisibilityExtra);
-      detail::zstdCheckFrame({frame, frameSizes[b]}, expected, fmt::format("{}: visibility frame {}", path, b));
-      frame += frameSizes[b];
-    }
-  }
-  requireMemory(decodedBytes, fmt::format("{}: the visibility field", path), "bake at a coarser --preset");
-
-  std::vector<VisibilityEntry> entries;
-  entries.reserve(entryCount);
-  adviseHugePages(entries.data(), entryCount * sizeof(VisibilityEntry));
-  entries.resize(entryCount);
-  std::vector<uint64_t> frameOffset(blocks + 2, 8);  // of each frame in the payload
-  for (uint64_t b = 0; b <= blocks; ++b) frameOffset[b + 1] = frameOffset[b] + frameSizes[b];
+  std::vector<unsigned char> entryBytes;
+  entryBytes.reserve(entryBytesTotal + kEntryBytesPadding);
+  adviseHugePages(entryBytes.data(), entryBytesTotal + kEntryBytesPadding);
+  entryBytes.resize(entryBytesTotal + kEntryBytesPadding);
+  std::vector<uint64_t> entryOffset(tixelCount + 1, 0);
+  entryOffset[tixelCount] = entryBytesTotal;
   std::vector<uint64_t> flaggedPerTixel(tixelCount);
-  // Blocks decode independently, in parallel (≈ 220 MB/s of entries per core at zstd level 1).
+  const uint64_t targets = targetTixels > 0 ? targetTixels : tixelCount;
+  // Blocks decode independently, in parallel; every tixel's encoding is decoded once, checked,
+  // so that the gather may decode it unchecked and index without bounds checks.
   parallelFor(blocks, [&](uint64_t b) {
     const uint64_t t0 = b * perBlock, t1 = std::min(tixelCount, t0 + perBlock);
-    std::vector<unsigned char> raw((t1 - t0) * n * sizeof(VisibilityEntry));
-    detail::zstdDecompressInto(payload.subspan(frameOffset[b], frameSizes[b]), raw,
+    std::vector<unsigned char> raw(contentSizes[b]);
+    detail::zstdDecompressInto(bytes.subspan(frameOffset[b], frameSizes[b]), raw,
                                fmt::format("{}: visibility block {}", path, b));
-    decodeEntryBlock(raw.data(), (t1 - t0) * n, entries.data() + t0 * n);
-    // The structural checks that let propagation index without bounds checks.
+    const unsigned char* encoded = raw.data() + (t1 - t0) * sizeof(uint32_t);
+    const uint64_t encodedBytes = raw.size() - (t1 - t0) * sizeof(uint32_t);
+    std::memcpy(entryBytes.data() + blockEntryStart[b], encoded, encodedBytes);
+    std::vector<VisibilityEntry> decoded(n);
+    uint64_t used = 0;
     for (uint64_t g = t0; g < t1; ++g) {
+      uint32_t size;
+      std::memcpy(&size, raw.data() + (g - t0) * sizeof(uint32_t), sizeof(uint32_t));
+      if (size > encodedBytes - used ||
+          decodeTixelEntries<true>(encoded + used, size, uint32_t(n), decoded.data()) != size)
+        fail("{}: corrupt visibility field: the entries of tixel {} do not decode", path, g);
+      entryOffset[g] = blockEntryStart[b] + used;
+      used += size;
       uint64_t flagged = 0;
-      for (uint64_t k = 0; k < n; ++k) {
-        const VisibilityEntry e = entries[g * n + k];
-        if (!e.escaped() && e.tixel() >= (targetTixels > 0 ? targetTixels : tixelCount))
-          fail("{}: an entry of tixel {} points outside the field", path, g);
+      for (const VisibilityEntry& e : decoded) {
+        if (!e.escaped() && e.tixel() >= targets) fail("{}: an entry of tixel {} points outside the field", path, g);
         flagged += e.hasExtra() ? 1 : 0;
       }
       flaggedPerTixel[g] = flagged;
     }
+    if (used != encodedBytes)
+      fail("{}: corrupt visibility field: block {} holds {} bytes past its tixels", path, b, encodedBytes - used);
   });
   std::vector<uint64_t> extraOffset(tixelCount + 1);
   std::vector<VisibilityExtra> extras(extraCount);
-  std::vector<unsigned char> raw(decodedBytes - entryCount * sizeof(VisibilityEntry));
-  detail::zstdDecompressInto(payload.subspan(frameOffset[blocks], frameSizes[blocks]), raw,
+  std::vector<unsigned char> raw(contentSizes[blocks]);
+  detail::zstdDecompressInto(bytes.subspan(frameOffset[blocks], frameSizes[blocks]), raw,
                              fmt::format("{}: visibility extra records", path));
   std::memcpy(extraOffset.data(), raw.data(), extraOffset.size() * sizeof(uint64_t));
   if (extraCount > 0)
@@ -275,10 +357,11 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   }
 
   VisibilityField f;
-  f.gridSide = gridSide;
+  f.gridSide = h.gridSide;
   f.tixelCount = tixelCount;
-  f.hash = hash;
-  f.entries = FieldArray<VisibilityEntry>(std::move(entries));
+  f.hash = h.hash;
+  f.entryBytes = FieldArray<unsigned char>(std::move(entryBytes));
+  f.entryOffset = FieldArray<uint64_t>(std::move(entryOffset));
   f.extraOffset = FieldArray<uint64_t>(std::move(extraOffset));
   f.extras = FieldArray<VisibilityExtra>(std::move(extras));
   field = std::move(f);

@@ -3,7 +3,7 @@
 // field so that a bake whose geometry, parameterisation and settings are unchanged reuses it
 // (bake/visibility.h traces it and says what its directions are; bake/bake.h decides reuse).
 //
-// .plv layout (version 3; little-endian; written by writeVisibility, validated by readVisibility):
+// .plv layout (version 4; little-endian; written by writeVisibility, validated by readVisibility):
 //   header, 56 bytes:
 //   magic        8 bytes  "PLVIS\0\r\n"
 //   version      u32      kPlvVersion
@@ -14,17 +14,18 @@
 //   extraCount   u64
 //   payloadHash  u64      XXH64 (seed 0, as the .plf checksums) of every byte after the header
 //   payload:
-//   tixelsPerBlock u64    tixels per entry block (≈ 512 KiB of entries; the last block may
-//                         hold fewer): B = ⌈tixelCount / tixelsPerBlock⌉ blocks
+//   tixelsPerBlock u64    tixels per entry block (≈ 64 Ki entries; the last block may hold
+//                         fewer): B = ⌈tixelCount / tixelsPerBlock⌉ blocks
 //   frames       B zstd frames of entry blocks, in tixel order, then one zstd frame of
 //                extraOffset (u64 × (tixelCount + 1)) followed by the extras (24 bytes each)
 //   frameSizes   u64 × (B + 1): the stored bytes of each frame, in order
-// An entry block of k entries, before zstd (encodeEntryBlock): the k targets (u32), then the
-// k fu (u16), then the k fv (u16). Decoding restores the 8-byte entries below exactly,
-// so a reused field gives the same light field bit for bit. Version 2 was the raw entries
-// (8 bytes each, memory-mapped): a version-2 file is traced again, like a stale one.
+//   contentSizes u64 × (B + 1): the bytes each frame decompresses to
+// An entry block's content: its tixels' encoded sizes (u32 each), then their encodings, in
+// tixel order (the compact entries below, as held in memory), so reading it back gives the same
+// entries bit for bit. Version 3 held the raw 8-byte entries split into planes, version 2 the
+// raw entries: an older field is traced again, like a stale one.
 //
-// Entries (8 bytes in memory, tixel-major: entry k of tixel g at g·N + k; compressed on disk):
+// Entries (8 bytes decoded; tixel-major: entry k of tixel g; held encoded, "Compact entries"):
 //   target  bits 0–29: global index of the tixel at the lower-left of the 2×2 bilinear
 //                      footprint of the seen point (kEscape: nothing was hit)
 //           bit 30:    the seen chart was hit from behind (its back side)
@@ -38,7 +39,9 @@
 //               that leaves the scene after mirrors, the octahedral encoding of its final
 //               world direction (to look the environment up)
 //   viaMirror   whether the path went through at least one mirror
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -49,7 +52,7 @@ namespace pl {
 
 /// The .plv format version this program reads and writes (visibilityHash includes it, so a
 /// field of another version is traced again).
-inline constexpr uint32_t kPlvVersion = 3;  // 2: multi-jittered gather directions; 3: compressed blocks
+inline constexpr uint32_t kPlvVersion = 4;  // 2: multi-jittered gather directions; 3: compressed blocks; 4: compact entries
 /// Largest gather grid side m a field may have (gatherDirections ≤ 65 536); a .plv declaring
 /// more is corrupt.
 inline constexpr uint32_t kMaxGatherGridSide = 256;
@@ -67,7 +70,7 @@ struct VisibilityEntry {
   bool backSide() const { return (target & kBackSide) != 0; }
   bool hasExtra() const { return (target & kHasExtra) != 0; }
 };
-static_assert(sizeof(VisibilityEntry) == 8);
+static_assert(sizeof(VisibilityEntry) == 8 && offsetof(VisibilityEntry, fu) == 4 && offsetof(VisibilityEntry, fv) == 6);
 
 struct VisibilityExtra {
   Rgb throughput{1.0f};
@@ -102,19 +105,149 @@ class FieldArray {
   size_t size_ = 0;
 };
 
+// ---- Compact entries ----------------------------------------------------------------------
+// In memory (and in the .plv, under zstd) a tixel's N entries are encoded one after another,
+// losslessly, so that the field takes a few bytes per entry instead of 8; the gather decodes
+// each tixel's entries into a small buffer as it reaches it (docs/design.md, Visibility field,
+// has the measurements behind this choice). A tixel's encoding:
+//   tags     ⌈N/4⌉ bytes: a 2-bit tag per entry, entry k in bits 2(k mod 4) of byte k/4
+//   payload  per entry in order, by tag:
+//     kTagEscape   (0) nothing: target = kEscape, fu = fv = 0 (nothing seen, no extra record)
+//     kTagNear     (1) i8 delta, fu, fv (u16 each): no flags, tixel = previous + delta
+//     kTagFar      (2) i16 delta, fu, fv: likewise
+//     kTagGeneral  (3) LEB128 varint of zigzag(delta)·4 + (target >> 30), then fu, fv: any
+//                      entry (flags set, escapes with an extra record, long jumps)
+// "previous" is the tixel index of the tixel's last earlier entry that saw a tixel (escapes
+// leave it unchanged), 0 before the first. The delta is taken on the 30-bit index field.
+// Neighbouring gather directions mostly see the same chart a few tixels apart, so most entries
+// take 5 or 6 bytes; the fractions (4 bytes) keep every bit, so the gather — and the light
+// field — are exactly as with 8-byte entries.
+inline constexpr uint32_t kTagEscape = 0, kTagNear = 1, kTagFar = 2, kTagGeneral = 3;
+/// Bytes of a tixel's tag plane.
+constexpr uint64_t kTagBytes(uint32_t n) { return (uint64_t(n) + 3) / 4; }
+/// Most bytes one entry's payload may take (kTagGeneral: a 5-byte varint and the fractions).
+inline constexpr uint64_t kMaxEntryPayloadBytes = 9;
+/// Most bytes n entries may take encoded (the buffer encodeTixelEntries needs).
+constexpr uint64_t maxEncodedTixelBytes(uint32_t n) { return kTagBytes(n) + uint64_t(n) * kMaxEntryPayloadBytes; }
+
+/// Encodes n entries (any values) into out (maxEncodedTixelBytes(n) bytes); returns the bytes used.
+size_t encodeTixelEntries(const VisibilityEntry* entries, uint32_t n, unsigned char* out);
+
+/// Zero bytes that follow a field's last encoded tixel, so that the unchecked decoder may read a
+/// whole 8-byte word wherever an entry starts.
+inline constexpr size_t kEntryBytesPadding = 8;
+
+/// Decodes n entries encoded by encodeTixelEntries from in[0, size) into out. Checked: returns
+/// the bytes consumed, or 0 when the bytes run out, decode to an index outside [0, kEscape] or
+/// take a form the encoder never writes (a corrupt file). Unchecked (the gather's, on a field
+/// that the checked decoder accepted): size is ignored, and kEntryBytesPadding bytes past the
+/// tixel's encoding must be readable; the result is the same.
+template <bool Checked>
+inline size_t decodeTixelEntries(const unsigned char* in, size_t size, uint32_t n, VisibilityEntry* out) {
+  if (Checked && size < kTagBytes(n)) return 0;
+  const unsigned char* at = in + kTagBytes(n);
+  [[maybe_unused]] const unsigned char* const end = in + size;
+  int64_t previous = 0;
+  for (uint32_t k = 0; k < n; ++k) {
+    const uint32_t tag = (in[k / 4] >> (2 * (k % 4))) & 3u;
+    if constexpr (!Checked) {
+      if (tag != kTagGeneral) [[likely]] {
+        // Without branches, as the mix of these three tags is unpredictable: the next 8 bytes
+        // hold the delta (kTagNear: 1 byte, kTagFar: 2, kTagEscape: none — the tag is its
+        // length) and then the fractions.
+        uint64_t word;
+        std::memcpy(&word, at, 8);
+        // Masks, not conditionals, which compilers would turn back into branches.
+        const uint64_t near = 0 - uint64_t(tag == kTagNear), far = 0 - uint64_t(tag == kTagFar);
+        const uint64_t hit = near | far;
+        previous += int64_t((uint64_t(int64_t(int8_t(word))) & near) | (uint64_t(int64_t(int16_t(word))) & far));
+        // The entry as one 8-byte word (target, then fu and fv: little-endian, one store).
+        const uint64_t packed = ((uint64_t(uint32_t(previous)) | ((word >> (8 * tag)) << 32)) & hit) |
+                                (uint64_t(VisibilityEntry::kEscape) & ~hit);
+        std::memcpy(static_cast<void*>(&out[k]), &packed, 8);
+        at += (tag + 4) & hit;
+        continue;
+      }
+    }
+    if (tag == kTagEscape) {
+      out[k] = VisibilityEntry{};
+      continue;
+    }
+    int64_t index;
+    uint32_t flags = 0;
+    if (tag == kTagNear) {
+      if (Checked && end - at < 1) return 0;
+      index = previous + int8_t(at[0]);
+      at += 1;
+    } else if (tag == kTagFar) {
+      if (Checked && end - at < 2) return 0;
+      int16_t d;
+      std::memcpy(&d, at, 2);
+      index = previous + d;
+      at += 2;
+    } else {
+      uint64_t v = 0;
+      for (int shift = 0;; shift += 7) {
+        if (Checked && (at == end || shift > 28)) return 0;  // ≤ 33 bits: zigzag(delta)·4 + flags
+        const uint8_t byte = *at++;
+        v |= uint64_t(byte & 0x7f) << shift;
+        if ((byte & 0x80) == 0) break;
+      }
+      flags = uint32_t(v & 3u) << 30;
+      index = previous + (int64_t(v >> 3) ^ -int64_t((v >> 2) & 1));  // un-zigzag of v >> 2
+    }
+    if (Checked && (index < 0 || index > int64_t(VisibilityEntry::kIndexMask) || end - at < 4 ||
+                    (tag != kTagGeneral && index == int64_t(VisibilityEntry::kEscape))))
+      return 0;
+    VisibilityEntry e;
+    e.target = uint32_t(index) | flags;
+    std::memcpy(&e.fu, at, 2);
+    std::memcpy(&e.fv, at + 2, 2);
+    at += 4;
+    if (index != int64_t(VisibilityEntry::kEscape)) previous = index;
+    out[k] = e;
+  }
+  return size_t(at - in);
+}
+
+/// A run of consecutive tixels' encoded entries: a bake encodes its field a run at a time, in
+/// parallel, and assembleEntries joins the runs.
+struct EncodedRun {
+  std::vector<unsigned char> bytes;
+  std::vector<uint32_t> tixelBytes;  ///< per tixel of the run, in order: its encoding's size
+
+  /// Appends the encoding of one tixel's n entries.
+  void add(const VisibilityEntry* entries, uint32_t n);
+};
+
 struct VisibilityField {
   uint32_t gridSide = 0;          ///< m: N = m² gather directions per tixel
   uint64_t tixelCount = 0;
   uint64_t hash = 0;              ///< of geometry + parameterisation + settings (visibilityHash)
-  FieldArray<VisibilityEntry> entries;    ///< tixelCount × N
+  FieldArray<unsigned char> entryBytes;   ///< the tixels' encoded entries, one after another
+  FieldArray<uint64_t> entryOffset;       ///< tixelCount + 1: where tixel t's encoding starts
   FieldArray<uint64_t> extraOffset;       ///< tixelCount + 1
   FieldArray<VisibilityExtra> extras;
   uint64_t rays = 0;              ///< rays traced to build it (gather + mirror continuations)
   double seconds = 0.0;
 
   uint32_t directionsPerTixel() const { return gridSide * gridSide; }
+  uint64_t entryCount() const { return tixelCount * directionsPerTixel(); }
+  /// Decodes tixel t's (field index, not global) N entries into out[0, N).
+  void decode(uint64_t t, VisibilityEntry* out) const {
+    decodeTixelEntries<false>(entryBytes.data() + entryOffset[t], 0, directionsPerTixel(), out);
+  }
+  /// Every entry, tixel-major (tests and tools; the bake decodes a tixel at a time).
+  std::vector<VisibilityEntry> decodeAll() const;
+  /// Encodes tixelCount · N entries (tixel-major) as the field's entries (gridSide and
+  /// tixelCount set before).
+  void setEntries(const VisibilityEntry* entries);
+  /// Sets the field's entries to `runs` in order (their tixels must total tixelCount), freeing
+  /// each run as it is copied, so that the runs and the field are not held twice.
+  void assembleEntries(std::vector<EncodedRun>& runs);
+  /// Bytes the field holds in memory.
   uint64_t bytes() const {
-    return entries.size() * sizeof(VisibilityEntry) + extraOffset.size() * sizeof(uint64_t) +
+    return entryBytes.size() + entryOffset.size() * sizeof(uint64_t) + extraOffset.size() * sizeof(uint64_t) +
            extras.size() * sizeof(VisibilityExtra);
   }
 };
@@ -125,6 +258,19 @@ void writeVisibility(const std::string& path, const VisibilityField& field);
 
 /// Bytes writeVisibility holds besides the field itself (one batch of blocks and frames).
 uint64_t visibilityWriteBufferBytes(uint32_t gridSide);
+
+/// What a .plv holds, from its header and frame table (`plenoptic info FILE.plv`).
+struct VisibilityFileInfo {
+  uint32_t version = 0, gridSide = 0;
+  uint64_t hash = 0, tixelCount = 0, entryCount = 0, extraCount = 0;
+  uint64_t fileBytes = 0;
+  uint64_t entryBytes = 0;  ///< the encoded entries (0 for an older version, which is not read further)
+  uint64_t heldBytes = 0;   ///< what the field takes in memory once read (VisibilityField::bytes; 0: older version)
+};
+/// Reads a .plv's header and, for the current version, checks its payload checksum and frame
+/// table (without decoding the entries). Throws pl::Error naming the file when it is not a .plv
+/// or is corrupt.
+VisibilityFileInfo readVisibilityInfo(const std::string& path);
 
 /// Reads and decodes a field into memory (the in-memory layout above: the bytes the bake's
 /// memory estimate counts, checked with requireMemory before allocating). Returns false and

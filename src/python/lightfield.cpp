@@ -8,6 +8,7 @@
 #include "bindings.h"
 #include "camera/camera_path.h"
 #include "core/error.h"
+#include "core/memory.h"
 #include "plf/compression.h"
 #include "plf/plf_file.h"
 
@@ -126,8 +127,10 @@ void bindLightField(py::module_& m) {
   m.def(
       "bake",
       [](const Scene& scene, const std::string& preset, uint64_t seed, int threads, std::optional<std::string> visibility,
-         bool reuseVisibility, bool sunMasks, bool punctualHighlights, std::optional<int64_t> causticPhotons) {
+         bool reuseVisibility, bool sunMasks, bool punctualHighlights, std::optional<int64_t> causticPhotons,
+         std::optional<std::string> maxMemory) {
         BakeJobOptions options;
+        if (maxMemory) options.maxMemory = parseMemorySize(*maxMemory, "max_memory");
         options.sunMasks = sunMasks;
         options.punctualHighlights = punctualHighlights;
         if (causticPhotons) {
@@ -156,12 +159,13 @@ void bindLightField(py::module_& m) {
       },
       py::arg("scene"), py::arg("preset") = "default", py::arg("seed") = 0, py::arg("threads") = 0,
       py::arg("visibility") = py::none(), py::arg("reuse_visibility") = false, py::arg("sun_masks") = true,
-      py::arg("punctual_highlights") = true, py::arg("caustic_photons") = py::none(),
+      py::arg("punctual_highlights") = true, py::arg("caustic_photons") = py::none(), py::arg("max_memory") = py::none(),
       "Bakes `scene`'s light field (what `plenoptic bake` does). visibility: a .plv path where the visibility field\n"
       "is saved; with reuse_visibility=True it is read back when the geometry and settings match (so a bake after\n"
       "editing only lights or emission re-runs the propagation alone). sun_masks=False: `--sun-masks off`;\n"
       "punctual_highlights=False: `--punctual-highlights off`; caustic_photons=N: `--caustic-photons N` (None:\n"
-      "the preset's).");
+      "the preset's); max_memory=\"12G\": `--max-memory 12G` (the bake is refused, before it starts, when its\n"
+      "memory estimate exceeds it).");
 
   m.def(
       "load_light_field",

@@ -113,6 +113,14 @@ def test_texture_lod_is_a_render_option(tmp_path):
     assert np.array_equal(frames[0], lf.render(width=16, height=16, camera=far, texture_lod=False))
 
 
+def test_max_memory_caps_the_bake_memory_guard(cornell):
+    with pytest.raises(plenoptic.Error, match="exceeds --max-memory 0.00 GiB"):
+        plenoptic.bake(cornell, preset="draft", max_memory="1M")
+    with pytest.raises(plenoptic.UsageError, match="max_memory: 'lots' is not a memory size"):
+        plenoptic.bake(cornell, preset="draft", max_memory="lots")
+    assert plenoptic.bake(cornell, preset="draft", max_memory="4G").stats["tixels"] > 0
+
+
 def test_sun_masks_are_a_bake_option(tmp_path):
     # A quad in the sun: with sun masks (the default) the directional light is stored as masks
     # and added back at render time, with sun_masks=False it stays in the values, as
