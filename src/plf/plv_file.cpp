@@ -137,7 +137,7 @@ struct PlvHeader {
 };
 
 /// Reads the header of `bytes` (the file `path`); fails on a file that is not a .plv. The counts
-/// are checked only for the current version (checkCounts).
+/// are checked only for the current version (readPlvLayout).
 PlvHeader readPlvHeader(const std::string& path, std::span<const unsigned char> bytes) {
   if (bytes.size() < kPlvHeaderSize)
     fail("{}: truncated visibility field ({} bytes, header needs {})", path, bytes.size(), kPlvHeaderSize);

@@ -252,8 +252,8 @@ struct VisibilityField {
   }
 };
 
-/// Writes the field atomically (temp + rename), compressed: zstd frames of blocks of
-/// entries split into index and fraction planes (format: above), with a progress bar.
+/// Writes the field atomically (temp + rename): zstd frames of blocks of tixels' encoded
+/// entries (format: above), with a progress bar.
 void writeVisibility(const std::string& path, const VisibilityField& field);
 
 /// Bytes writeVisibility holds besides the field itself (one batch of blocks and frames).
@@ -272,12 +272,12 @@ struct VisibilityFileInfo {
 /// or is corrupt.
 VisibilityFileInfo readVisibilityInfo(const std::string& path);
 
-/// Reads and decodes a field into memory (the in-memory layout above: the bytes the bake's
-/// memory estimate counts, checked with requireMemory before allocating). Returns false and
+/// Reads a field into memory, encoded as the bake holds it ("Compact entries"; its size,
+/// VisibilityField::bytes, is checked with requireMemory before allocating). Returns false and
 /// sets *why when the file is absent, of an older format version, or its hash differs from
 /// expectedHash (a stale field is not an error); throws pl::Error naming the file when it is
 /// present but corrupt or truncated (header, payload checksum, every frame and every index are
-/// checked before it returns).
+/// checked, every tixel's encoding decoded once, before it returns).
 /// targetTixels: how many tixels the entries may point at (0: the file's own tixel count; a
 /// shard's entries point at any tixel of the scene).
 bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
