@@ -8,14 +8,18 @@
 # Cycles renders as in bench/vs_cycles.sh (bench/cycles_common.py: CPU, box filter 1 px, no
 # denoising, adaptive sampling or clamping, bounce limits 1024, black world, linear EXR; the
 # walls and light from the .mtl, Lambertian and one-sided emission), the subsurface materials
-# with its Subsurface Scattering node, Random Walk (Fixed Radius), colour = albedo, radius =
-# radius, scale 1, anisotropy 0 (bench/sss_vs_cycles_blender.py) — the model plenoptic follows
-# (Chiang et al. 2016's albedo mapping, diffuse boundary without Fresnel). Two differences of
+# with its Subsurface Scattering node, Random Walk (Fixed Radius), scale 1, anisotropy 0, colour
+# and radius set so that Cycles has plenoptic's medium (bench/sss_vs_cycles_blender.py) — the
+# model plenoptic follows (a random walk, diffuse boundary without Fresnel). Two differences of
 # Cycles remain, both documented in docs/benchmarks.md: a walk ends after 256 steps
 # (BSSRDF_MAX_BOUNCES; plenoptic's after 4096), and a path that already bounced off a diffuse
 # surface sees subsurface materials as Lambertian of their albedo (no walk).
 # Blender then draws each object in a flat colour of its own; the object regions are the
 # pixels whose colour and four neighbours' are within 0.02 of one object's.
+#
+# SCENE=bench/scenes/sss-furnace.json renders the sphere and the slab alone under a white sky
+# of radiance 1 instead: each pixel is then the albedo of one walk, with no light between the
+# objects, which isolates the walk from Cycles' two differences.
 #
 # Printed (and written to WORKDIR/sss_vs_cycles.md): per region (sphere, slab, walls, whole
 # image), mean luminance of plenoptic's path trace with its standard error (`trace
@@ -89,6 +93,8 @@ print("| region | pixels | plenoptic Y (± s.e.) | Cycles Y | Cycles / plenoptic
 print("|---|---:|---:|---:|---:|")
 for name, mask in regions:
     n = int(mask.sum())
+    if n == 0:  # e.g. no walls in the furnace
+        continue
     y_pt, y_cy = float((pt[mask] @ weights).mean()), float((cy[mask] @ weights).mean())
     se = float(np.sqrt((var[mask] @ (weights ** 2)).sum()) / n)  # pixels independent
     print(f"| {name} | {n} | {y_pt:.4f} ± {se:.4f} | {y_cy:.4f} | {y_cy / y_pt:.4f} |")

@@ -6,7 +6,8 @@
 # import_obj); each material the JSON makes subsurface becomes a Subsurface Scattering node,
 # method Random Walk (Fixed Radius), scale 1, with the colour and radius that give Cycles the
 # same medium as plenoptic (cycles_inputs below). The camera is
-# McGuire's (cycles_common.py mcguire_camera), which the JSON scene repeats. Writes OUT.exr,
+# McGuire's (cycles_common.py mcguire_camera), which the JSON scene repeats; the world is black,
+# or the JSON's grey environment colour. Writes OUT.exr,
 # OUT.pfm and the object regions OUT.ids.pfm / OUT.ids.json (cycles_common.py render_object_ids).
 import json
 import math
@@ -46,16 +47,18 @@ def cycles_alpha(albedo):
 
 def cycles_inputs(albedo, radius):
     """The Subsurface Scattering node's colour and radius that give Cycles 3.4 plenoptic's
-    medium: Cycles' Random Walk (Fixed Radius) no longer uses Chiang's mapping but its own fit
-    of α (cycles_alpha, increasing in the albedo: inverted by bisection) and σt = 1/radius, so
-    the same numbers would give a different medium. Cycles divides the colour out of the walk's
-    weight, so only its α matters."""
+    medium. Cycles' Random Walk (Fixed Radius) no longer uses Chiang's mapping: α comes from its
+    own fit (cycles_alpha, increasing in the albedo: inverted here by bisection), and the mean
+    free path is the radius × 1/(4π) (kernel/closure/bssrdf.h bssrdf_setup_radius: "so it gives
+    similar looking result to older Cubic, Gaussian and Burley models"), so the same numbers
+    would give a different medium. Cycles divides the colour out of the walk's weight, so only
+    its α matters."""
     alpha, free_path = plenoptic_medium(albedo, radius)
     lo, hi = 0.0, 1.0
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if cycles_alpha(mid) < alpha else (lo, mid)
-    return 0.5 * (lo + hi), free_path
+    return 0.5 * (lo + hi), free_path * 4.0 * math.pi
 
 
 def build_subsurface(material, parameters):
@@ -92,7 +95,7 @@ for name, parameters in description.get("materials", {}).items():
     if parameters.get("type") != "subsurface":
         raise SystemExit(f"{scene_path}: material {name}: only subsurface overrides are supported")
     build_subsurface(bpy.data.materials[name], parameters)
-uniform_world(scene)
+uniform_world(scene, float(description.get("environment", {}).get("color", 0.0)))
 mcguire_camera(scene)
 configure_cycles(scene, out_path, spp, seed, width, height, threads)
 render_to_pfm(out_path)

@@ -9,6 +9,7 @@
                          plain grey Lambertian stand-ins.
   sss-cornell.json       the OBJ with `sphere` and `slab` made subsurface and the camera of
                          bench/vs_cycles.sh (eye (0, 1, 3.5), target (0, 1, 0), 40° vertical).
+  sss-furnace.obj, .json the sphere and the slab alone under a white sky of radiance 1.
 
 The Blender script (bench/sss_vs_cycles_blender.py) reads the same JSON for the subsurface
 parameters, so the two renderers cannot disagree on them. Usage: make_sss_cornell.py
@@ -87,27 +88,32 @@ def main():
     objects = [(name, quad, [(0, 1, 2), (0, 2, 3)]) for name, quad in WALLS]
     objects.append(("sphere", *icosphere((-0.42, 0.36, 0.25), 0.35, 3)))
     objects.append(("slab", *box((0.42, 0.46, -0.3), (0.7, 0.9, 0.06), -25.0)))
-    lines = ["# Written by bench/scenes/make_sss_cornell.py: McGuire's CornellBox-Original walls",
-             "# (public domain) with a subsurface sphere and slab (sss-cornell.json)", "mtllib sss-cornell.mtl"]
-    base = 1
-    for name, points, faces in objects:
-        lines += [f"o {name}", f"usemtl {name}"]
-        lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in points]
-        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in faces]
-        base += len(points)
-    with open(os.path.join(HERE, "sss-cornell.obj"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    # The box, and the furnace: the two objects alone under a white sky of radiance 1, where
+    # each pixel is one walk's albedo (no transport between objects).
+    for stem, kept, extra in (("sss-cornell", objects, {}),
+                              ("sss-furnace", objects[-2:], {"environment": {"color": 1}})):
+        lines = ["# Written by bench/scenes/make_sss_cornell.py: McGuire's CornellBox-Original walls",
+                 f"# (public domain) with a subsurface sphere and slab ({stem}.json)", "mtllib sss-cornell.mtl"]
+        base = 1
+        for name, points, faces in kept:
+            lines += [f"o {name}", f"usemtl {name}"]
+            lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in points]
+            lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in faces]
+            base += len(points)
+        with open(os.path.join(HERE, stem + ".obj"), "w") as f:
+            f.write("\n".join(lines) + "\n")
+        scene = {
+            "meshes": [{"file": stem + ".obj"}],
+            "materials": SUBSURFACE,
+            "cameras": [{"name": "main", "eye": [0, 1, 3.5], "target": [0, 1, 0], "up": [0, 1, 0], "fov": 40}],
+            **extra,
+        }
+        with open(os.path.join(HERE, stem + ".json"), "w") as f:
+            f.write("{\n" + ",\n".join(f' "{key}": {json.dumps(value)}' for key, value in scene.items()) + "\n}\n")
     with open(os.path.join(HERE, "sss-cornell.mtl"), "w") as f:
         f.write("# Written by bench/scenes/make_sss_cornell.py\n")
         for name, body in MTL.items():
             f.write(f"\nnewmtl {name}\n{body}\n")
-    scene = {
-        "meshes": [{"file": "sss-cornell.obj"}],
-        "materials": SUBSURFACE,
-        "cameras": [{"name": "main", "eye": [0, 1, 3.5], "target": [0, 1, 0], "up": [0, 1, 0], "fov": 40}],
-    }
-    with open(os.path.join(HERE, "sss-cornell.json"), "w") as f:
-        f.write("{\n" + ",\n".join(f' "{key}": {json.dumps(value)}' for key, value in scene.items()) + "\n}\n")
 
 
 if __name__ == "__main__":

@@ -106,15 +106,17 @@ size_t openSubsurfaceEdges(const Scene& scene, const Mesh& mesh) {
 }
 
 void warnAboutOpenSubsurfaceMeshes(const Scene& scene) {
-  for (const Mesh& mesh : scene.meshes) {
+  for (size_t index = 0; index < scene.meshes.size(); ++index) {
+    const Mesh& mesh = scene.meshes[index];
     const auto first = std::find_if(mesh.materials.begin(), mesh.materials.end(), [&](uint32_t m) {
       return subsurfaceMedium(scene.materials[m].bsdf).has_value();
     });
     if (first == mesh.materials.end()) continue;
     if (const size_t open = openSubsurfaceEdges(scene, mesh); open > 0)
-      spdlog::warn("{}: mesh '{}': its subsurface triangles (material '{}') do not enclose a volume ({} open, "
+      spdlog::warn("{}: mesh {}: its subsurface triangles (material '{}') do not enclose a volume ({} open, "
                    "non-manifold or inconsistently wound edge(s)): random walks inside leak out through the gaps",
-                   scene.sourcePath, mesh.name, scene.materials[*first].name, open);
+                   scene.sourcePath, mesh.name.empty() ? fmt::format("#{} (unnamed)", index) : "'" + mesh.name + "'",
+                   scene.materials[*first].name, open);
   }
 }
 

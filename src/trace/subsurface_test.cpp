@@ -19,6 +19,7 @@
 #include "accel/accel.h"
 #include "core/progress.h"
 #include "scene/scene.h"
+#include "support/box_mesh.h"
 #include "support/sphere_mesh.h"
 #include "trace/trace.h"
 
@@ -65,26 +66,7 @@ struct Lit {
 /// semi-infinite slab seen at the centre of its top face (y = 0).
 void addThickSlab(Mesh& mesh) {
   const float h = 20.0f;
-  const Vec3 lo(-h, -2.0f * h, -h), hi(h, 0.0f, h);
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = 0; side < 2; ++side) {
-      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-      Vec3 c[4];
-      const int cu[4] = {0, 1, 1, 0}, cv[4] = {0, 0, 1, 1};
-      for (int k = 0; k < 4; ++k) {
-        c[k][axis] = side ? hi[axis] : lo[axis];
-        c[k][u] = cu[k] ? hi[u] : lo[u];
-        c[k][v] = cv[k] ? hi[v] : lo[v];
-      }
-      Vec3 outward(0.0f);
-      outward[axis] = side ? 1.0f : -1.0f;
-      if (glm::dot(glm::cross(c[1] - c[0], c[2] - c[0]), outward) < 0.0f) std::swap(c[1], c[3]);
-      const auto base = static_cast<uint32_t>(mesh.positions.size());
-      mesh.positions.insert(mesh.positions.end(), {c[0], c[1], c[2], c[3]});
-      mesh.triangles.push_back(UVec3(base, base + 1, base + 2));
-      mesh.triangles.push_back(UVec3(base, base + 2, base + 3));
-      mesh.materials.insert(mesh.materials.end(), {0u, 0u});
-    }
+  test_support::addBox(mesh, Vec3(-h, -2.0f * h, -h), Vec3(h, 0.0f, h), 0);
 }
 
 void addUnitSphere(Mesh& mesh) { test_support::addSphere(mesh, Vec3(0.0f), 1.0f, 32, 64, 0); }
