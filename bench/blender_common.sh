@@ -1,5 +1,5 @@
 # Sourced by the bench scripts that compare with Blender Cycles (bench/vs_cycles.sh,
-# bench/gltf_vs_cycles.sh): Blender is optional — without it the script says so and exits 0 —
+# bench/gltf_vs_cycles.sh, bench/sss_vs_cycles.sh): Blender is optional — without it the script says so and exits 0 —
 # while plenoptic must be built.
 #   require_blender_and_plenoptic BLENDER PLENOPTIC
 require_blender_and_plenoptic() {

@@ -1,6 +1,8 @@
 # Cycles set up as plenoptic's path tracer renders, shared by the Blender scripts of
-# bench/vs_cycles.sh and bench/gltf_vs_cycles.sh (imported inside Blender's Python; see
+# bench/vs_cycles.sh, bench/gltf_vs_cycles.sh and bench/sss_vs_cycles.sh (imported inside Blender's Python; see
 # bench/vs_cycles.sh for why each setting).
+import json
+import math
 import os
 import struct
 import time
@@ -76,3 +78,123 @@ def render_to_pfm(out_path):
         f.write(struct.pack(f"<{len(rgb)}f", *rgb))
     bpy.data.images.remove(image)
     return seconds
+
+
+def read_mtl(path):
+    """name → {keyword: [floats]} for Kd, Ks, Ke, Ns."""
+    materials, current = {}, None
+    for line in open(path):
+        parts = line.split("#")[0].split()
+        if not parts:
+            continue
+        if parts[0] == "newmtl":
+            current = materials.setdefault(parts[1], {})
+        elif current is not None and parts[0] in ("Kd", "Ks", "Ke", "Ns"):
+            current[parts[0]] = [float(x) for x in parts[1:]]
+    return materials
+
+
+def mtl_path(obj):
+    for line in open(obj):
+        parts = line.split()
+        if parts and parts[0] == "mtllib":
+            return os.path.join(os.path.dirname(obj), parts[1])
+    raise SystemExit(f"{obj}: no mtllib")
+
+
+def build_material(material, mtl):
+    kd = mtl.get("Kd", [0.0, 0.0, 0.0])
+    ks = mtl.get("Ks", [0.0, 0.0, 0.0])
+    ke = mtl.get("Ke", [0.0, 0.0, 0.0])
+    ns = mtl.get("Ns", [0.0])[0]
+    if max(ks) > 0.0:  # plenoptic's OBJ loader: Kd + Ks ≤ 1 per channel
+        for c in range(3):
+            total = kd[c] + ks[c]
+            if total > 1.0:
+                kd[c], ks[c] = kd[c] / total, ks[c] / total
+    material.use_nodes = True
+    nodes, links = material.node_tree.nodes, material.node_tree.links
+    nodes.clear()
+    output = nodes.new("ShaderNodeOutputMaterial")
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (*kd, 1.0)
+    diffuse.inputs["Roughness"].default_value = 0.0  # Lambertian
+    shader = diffuse.outputs[0]
+    if max(ks) > 0.0:
+        glossy = nodes.new("ShaderNodeBsdfGlossy")
+        glossy.distribution = "GGX"
+        glossy.inputs["Color"].default_value = (*ks, 1.0)
+        glossy.inputs["Roughness"].default_value = (2.0 / (ns + 2.0)) ** 0.25
+        add = nodes.new("ShaderNodeAddShader")
+        links.new(shader, add.inputs[0])
+        links.new(glossy.outputs[0], add.inputs[1])
+        shader = add.outputs[0]
+    if max(ke) > 0.0:
+        emission = nodes.new("ShaderNodeEmission")
+        emission.inputs["Color"].default_value = (*ke, 1.0)
+        emission.inputs["Strength"].default_value = 1.0  # radiance = colour × strength
+        geometry = nodes.new("ShaderNodeNewGeometry")
+        one_sided = nodes.new("ShaderNodeMixShader")  # front: emission; back: nothing (black)
+        links.new(geometry.outputs["Backfacing"], one_sided.inputs["Fac"])
+        links.new(emission.outputs[0], one_sided.inputs[1])
+        add = nodes.new("ShaderNodeAddShader")
+        links.new(shader, add.inputs[0])
+        links.new(one_sided.outputs[0], add.inputs[1])
+        shader = add.outputs[0]
+    links.new(shader, output.inputs["Surface"])
+
+
+def import_obj(obj_path):
+    """Imports an OBJ (y up, as plenoptic reads it) with its materials rebuilt from the .mtl
+    (build_material). OBJ is y-up, Blender z-up: (x, y, z)_obj → (x, −z, y)_blender."""
+    bpy.ops.wm.obj_import(filepath=obj_path, forward_axis="NEGATIVE_Z", up_axis="Y")
+    mtls = read_mtl(mtl_path(obj_path))
+    for material in bpy.data.materials:
+        if material.name not in mtls:
+            raise SystemExit(f"material {material.name} is not in the .mtl")
+        build_material(material, mtls[material.name])
+
+
+def mcguire_camera(scene):
+    """The camera of McGuire's Cornell boxes: eye (0, 1, 3.5), target (0, 1, 0) in OBJ
+    coordinates, 40° vertical field of view."""
+    camera_data = bpy.data.cameras.new("camera")
+    camera_data.sensor_fit = "VERTICAL"
+    camera_data.angle_y = math.radians(40.0)
+    camera = bpy.data.objects.new("camera", camera_data)
+    camera.location = (0.0, -3.5, 1.0)                     # obj (0, 1, 3.5)
+    camera.rotation_euler = (math.radians(90.0), 0.0, 0.0)  # looks along +y_blender = −z_obj
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+
+
+def render_object_ids(scene, out_path, seed, width, height, threads):
+    """The object regions: every material replaced by a flat emission of the object's own
+    colour, rendered with 16 samples and no bounces to OUT.ids.exr/.pfm, with OUT.ids.json
+    (object name → that colour)."""
+    names = sorted(o.name for o in scene.objects if o.type == "MESH")
+    colours = {}
+    for index, name in enumerate(names):
+        # Well-separated colours: the index's bits spread over the channels, in steps of 0.25.
+        colour = (0.25 * (1 + index % 3), 0.25 * (1 + (index // 3) % 3), 0.25 * (1 + (index // 9) % 3))
+        colours[name] = colour
+        material = bpy.data.materials.new(f"id_{name}")
+        material.use_nodes = True
+        nodes = material.node_tree.nodes
+        nodes.clear()
+        emission = nodes.new("ShaderNodeEmission")
+        emission.inputs["Color"].default_value = (*colour, 1.0)
+        emission.inputs["Strength"].default_value = 1.0
+        output = nodes.new("ShaderNodeOutputMaterial")
+        material.node_tree.links.new(emission.outputs[0], output.inputs["Surface"])
+        obj = bpy.data.objects[name]
+        for slot in obj.material_slots:
+            slot.material = material
+        if not obj.material_slots:
+            obj.data.materials.append(material)
+    ids_path = os.path.splitext(out_path)[0] + ".ids.exr"
+    configure_cycles(scene, ids_path, 16, seed, width, height, threads)
+    scene.cycles.max_bounces = 0
+    render_to_pfm(ids_path)
+    with open(os.path.splitext(out_path)[0] + ".ids.json", "w") as f:
+        json.dump(colours, f, indent=1)

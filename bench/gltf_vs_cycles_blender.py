@@ -17,7 +17,6 @@
 # Writes OUT.exr and OUT.pfm (linear RGB), OUT.ids.pfm (each object drawn in a flat colour of its own, 16 samples, to find the object
 # regions) and OUT.ids.json (object name -> that colour), and prints the material set-up the
 # importer made, for the differences the script explains.
-import json
 import os
 import sys
 
@@ -27,7 +26,7 @@ numpy.bool = bool  # Blender 3.4's glTF importer still uses numpy.bool, gone in 
 import bpy  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cycles_common import configure_cycles, render_to_pfm, uniform_world  # noqa: E402
+from cycles_common import configure_cycles, render_object_ids, render_to_pfm, uniform_world  # noqa: E402
 
 arguments = sys.argv[sys.argv.index("--") + 1:]
 scene_path, out_path, spp, seed, width, height, threads = arguments[:7]
@@ -126,30 +125,4 @@ for material in bpy.data.materials:
                   f"{sorted(i.name for i in node.inputs if i.is_linked)}")
 render_to_pfm(out_path)
 
-# The object regions: every material replaced by a flat emission of the object's own colour.
-names = sorted(o.name for o in scene.objects if o.type == "MESH")
-colours = {}
-for index, name in enumerate(names):
-    # Well-separated colours: the index's bits spread over the channels, in steps of 0.25.
-    colour = (0.25 * (1 + index % 3), 0.25 * (1 + (index // 3) % 3), 0.25 * (1 + (index // 9) % 3))
-    colours[name] = colour
-    material = bpy.data.materials.new(f"id_{name}")
-    material.use_nodes = True
-    nodes = material.node_tree.nodes
-    nodes.clear()
-    emission = nodes.new("ShaderNodeEmission")
-    emission.inputs["Color"].default_value = (*colour, 1.0)
-    emission.inputs["Strength"].default_value = 1.0
-    output = nodes.new("ShaderNodeOutputMaterial")
-    material.node_tree.links.new(emission.outputs[0], output.inputs["Surface"])
-    obj = bpy.data.objects[name]
-    for slot in obj.material_slots:
-        slot.material = material
-    if not obj.material_slots:
-        obj.data.materials.append(material)
-ids_path = os.path.splitext(out_path)[0] + ".ids.exr"
-configure_cycles(scene, ids_path, 16, seed, width, height, threads)
-scene.cycles.max_bounces = 0
-render_to_pfm(ids_path)
-with open(os.path.splitext(out_path)[0] + ".ids.json", "w") as f:
-    json.dump(colours, f, indent=1)
+render_object_ids(scene, out_path, seed, width, height, threads)

@@ -260,7 +260,19 @@ BakeStats bakeStats(const Parameterisation& param, const Transport& t, const Dis
 
 }  // namespace
 
+void requireBakeableMaterials(const Scene& scene) {
+  std::vector<uint8_t> used(scene.materials.size(), 0);
+  for (const Mesh& mesh : scene.meshes)
+    for (const uint32_t m : mesh.materials) used[m] = 1;
+  for (size_t m = 0; m < scene.materials.size(); ++m)
+    if (used[m] && subsurfaceMedium(scene.materials[m].bsdf))
+      fail("{}: material '{}' is subsurface, which the light-field bake does not model (light would leave "
+           "where it entered, not through the object); render the scene with `plenoptic trace`",
+           scene.sourcePath, scene.materials[m].name);
+}
+
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options) {
+  requireBakeableMaterials(scene);
   const auto start = std::chrono::steady_clock::now();
   const Note note = [&](const std::string& text) {
     if (options.log) options.log(text);

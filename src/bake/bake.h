@@ -100,7 +100,14 @@ uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings
 /// evenly, but what they see varies from chart to chart.
 inline constexpr double kVisibilityEstimateMargin = 1.15;
 
-/// Bakes `scene` (moved into the result). Throws pl::Error on failures.
+/// Throws pl::Error naming the file and the material when a triangle of the scene has a
+/// material the bake does not model: subsurface scattering (bsdf.h SubsurfaceBsdf), whose light
+/// leaves the object away from where it entered — only the path tracer renders it. bake()
+/// calls it first, before any ray is traced or anything written.
+void requireBakeableMaterials(const Scene& scene);
+
+/// Bakes `scene` (moved into the result). Throws pl::Error on failures, among them a scene
+/// requireBakeableMaterials refuses.
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options = {});
 
 }  // namespace pl

@@ -23,11 +23,14 @@
 #include "plf/plf_file.h"
 #include "bake/propagation.h"
 #include "bake/visibility.h"
+#include "support/expect_error.h"
 #include "support/quad_mesh.h"
 #include "support/mask_texture.h"
 
 namespace pl {
 namespace {
+
+using test_support::expectError;
 
 // A closed axis-aligned box [0, size]³ of 6 quads wound to face inwards; quad `special` (or
 // none when −1) gets material 1, all others material 0.
@@ -125,6 +128,21 @@ TEST_F(BakeTest, WhiteFurnaceWithAreaLightSampling) {
   // direct part is a smaller fraction of the total); 5 % leaves room for other seeds.
   checkFurnace(0.5f, 16, 0.05f);
   checkFurnace(0.9f, 16, 0.05f);
+}
+
+// The bake does not model subsurface scattering: a scene using it is refused before any ray
+// is traced, naming the file, the material and the path tracer that renders it. An unused
+// subsurface material does not matter.
+TEST_F(BakeTest, RefusesSubsurfaceMaterials) {
+  Material wall;
+  wall.name = "wall";
+  wall.emission = Rgb(0.1f);
+  Material marble;
+  marble.name = "marble";
+  marble.bsdf = SubsurfaceBsdf{Rgb(0.8f), Rgb(0.2f)};
+  expectError([&] { bake(makeClosedBox(3.0f, wall, marble, 2), smallSettings()); },
+              {"furnace box", "'marble'", "subsurface", "plenoptic trace"});
+  EXPECT_NO_THROW(requireBakeableMaterials(makeClosedBox(3.0f, wall, marble)));
 }
 
 TEST_F(BakeTest, MirrorFurnace) {

@@ -42,6 +42,19 @@ Rgb evalLambert(const LambertBsdf& b, const Vec3& wo, const Vec3& wi) {
   return sameHemisphereUp(wo, wi) ? b.albedo * kInvPi : Rgb(0.0f);
 }
 
+std::optional<BsdfSample> sampleLambert(const LambertBsdf& b, Vec2 u) {
+  BsdfSample s;
+  s.wi = sampleCosineHemisphere(u);
+  if (s.wi.z <= 0.0f) return std::nullopt;
+  s.pdf = cosineHemispherePdf(s.wi.z);
+  s.f = b.albedo * kInvPi;
+  s.weight = b.albedo;  // f cos / pdf = (ρ/π) cos / (cos/π)
+  return s;
+}
+
+/// A subsurface model seen as a BSDF (bsdf.h SubsurfaceBsdf): Lambertian of its albedo.
+LambertBsdf surfaceLambert(const SubsurfaceBsdf& b) { return LambertBsdf{b.albedo}; }
+
 // ---------------------------------------------------------------------------------------
 // Mirror: f = R(θo) δ(wi − mirror(wo)) / cos θi. Only sample() produces it.
 
@@ -1078,15 +1091,16 @@ Rgb eval(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) {
                           return b.isSmooth() ? Rgb(0.0f) : evalRoughDielectric(b, wo, wi);
                         },
                         [&](const GltfPbrBsdf& b) { return evalGltfPbr(b, wo, wi); },
+                        [&](const SubsurfaceBsdf& b) { return evalLambert(surfaceLambert(b), wo, wi); },
                     },
                     bsdf);
 }
 
 float pdf(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi) {
+  const auto lambertPdf = [&] { return sameHemisphereUp(wo, wi) ? cosineHemispherePdf(wi.z) : 0.0f; };
   return std::visit(Overloaded{
-                        [&](const LambertBsdf&) {
-                          return sameHemisphereUp(wo, wi) ? cosineHemispherePdf(wi.z) : 0.0f;
-                        },
+                        [&](const LambertBsdf&) { return lambertPdf(); },
+                        [&](const SubsurfaceBsdf&) { return lambertPdf(); },
                         [&](const MirrorBsdf&) { return 0.0f; },
                         [&](const BlinnPhongBsdf& b) { return pdfBlinnPhong(b, wo, wi); },
                         [&](const GgxBsdf& b) { return pdfGgx(b, wo, wi); },
@@ -1105,15 +1119,7 @@ std::optional<BsdfSample> sample(const Bsdf& bsdf, const Vec3& wo, Vec2 u) {
   }
   if (!(cosTheta(wo) > 0.0f)) return std::nullopt;
   return std::visit(Overloaded{
-                        [&](const LambertBsdf& b) -> std::optional<BsdfSample> {
-                          BsdfSample s;
-                          s.wi = sampleCosineHemisphere(u);
-                          if (s.wi.z <= 0.0f) return std::nullopt;
-                          s.pdf = cosineHemispherePdf(s.wi.z);
-                          s.f = b.albedo * kInvPi;
-                          s.weight = b.albedo;  // f cos / pdf = (ρ/π) cos / (cos/π)
-                          return s;
-                        },
+                        [&](const LambertBsdf& b) { return sampleLambert(b, u); },
                         [&](const MirrorBsdf& b) -> std::optional<BsdfSample> {
                           BsdfSample s;
                           s.wi = mirrorLocal(wo);
@@ -1127,6 +1133,7 @@ std::optional<BsdfSample> sample(const Bsdf& bsdf, const Vec3& wo, Vec2 u) {
                         [&](const GgxBsdf& b) { return finishSample(bsdf, wo, sampleGgxDirection(b, wo, u)); },
                         [&](const DielectricBsdf&) -> std::optional<BsdfSample> { return std::nullopt; },  // above
                         [&](const GltfPbrBsdf& b) { return finishSample(bsdf, wo, sampleGltfPbrDirection(b, wo, u)); },
+                        [&](const SubsurfaceBsdf& b) { return sampleLambert(surfaceLambert(b), u); },
                     },
                     bsdf);
 }
@@ -1136,6 +1143,7 @@ Rgb albedo(const Bsdf& bsdf, const Vec3& wo) {
   if (!(wo.z > 0.0f) && !(dielectric && wo.z < 0.0f)) return Rgb(0.0f);
   if (dielectric && dielectric->isSmooth()) return dielectricAlbedo(*dielectric, wo);
   if (const auto* l = std::get_if<LambertBsdf>(&bsdf)) return l->albedo;
+  if (const auto* l = std::get_if<SubsurfaceBsdf>(&bsdf)) return l->albedo;
   if (const auto* m = std::get_if<MirrorBsdf>(&bsdf)) return mirrorReflectance(*m, wo.z);
   // Deterministic importance-sampled quadrature: the mean of sample() weights over a
   // midpoint grid of the unit square. The mixture sampler covers the whole support of f, so
@@ -1170,6 +1178,10 @@ Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo) {
                           b.diffuse = albedo;
                           return b;
                         },
+                        [&](SubsurfaceBsdf b) -> Bsdf {
+                          b.albedo = albedo;
+                          return b;
+                        },
                     },
                     bsdf);
 }
@@ -1192,6 +1204,7 @@ const char* modelName(const Bsdf& bsdf) {
                           return b.thin ? "thin-dielectric" : b.isSmooth() ? "dielectric" : "rough-dielectric";
                         },
                         [](const GltfPbrBsdf&) { return "gltf-pbr"; },
+                        [](const SubsurfaceBsdf&) { return "subsurface"; },
                     },
                     bsdf);
 }

@@ -228,6 +228,43 @@ struct GltfPbrInputs {
 /// the rest copied; every factor clamped to its range ([0, 1]; ior ≥ 1).
 GltfPbrBsdf gltfPbrFromInputs(const GltfPbrInputs& in);
 
+/// Subsurface scattering: a translucent solid (marble, wax, skin, milk, jade) whose closed mesh
+/// bounds a homogeneous medium — the model of Chiang, Kutz & Burley 2016 ("Practical and
+/// Controllable Subsurface Scattering for Production Path Tracing"), which Blender Cycles calls
+/// Random Walk (Fixed Radius). Inside, light travels in straight lines between scattering
+/// events, is attenuated with the extinction coefficient σt, keeps the fraction α (the single-
+/// scattering albedo) at each event and leaves it in a uniformly random direction (isotropic
+/// phase function). Both are per RGB channel, derived from the user's albedo A and radius d by
+/// subsurfaceMedium() below. The boundary is diffuse and index-matched: a path entering the
+/// surface continues in a cosine-distributed direction into the object, and light leaving it
+/// leaves cosine-distributed (as from a Lambertian surface of albedo 1), with no Fresnel.
+///
+/// As a BSDF — eval/pdf/sample, what anything without a random walk sees — it is Lambertian of
+/// albedo A, the reflectance the mapping gives a thick slab (where light leaves close to where
+/// it entered); the path tracer replaces it by the walk through the medium (trace.h), and the
+/// light-field bake refuses it (bake.h requireBakeableMaterials).
+struct SubsurfaceBsdf {
+  Rgb albedo{0.8f};  ///< A in [0, 1): the multiple-scattering albedo of a thick slab
+  Rgb radius{1.0f};  ///< d > 0 (scene units): the distance light travels inside, per channel
+
+  template <class Self, class F>
+  static void parameters(Self& b, F&& f) { f(b.albedo), f(b.radius); }
+};
+
+/// The interior medium of a SubsurfaceBsdf, per RGB channel.
+struct SubsurfaceMedium {
+  Rgb sigmaT{1.0f};  ///< extinction coefficient σt (per scene unit)
+  Rgb alpha{0.0f};   ///< single-scattering albedo α = σs / σt, in [0, 1)
+};
+/// Chiang et al. 2016's mapping, per channel, from the albedo A and radius d:
+///   α  = 1 − exp(−5.09406 A + 2.61188 A² − 4.31805 A³),
+///   σt = 1 / (d · s),   s = 1.9 − A + 3.5 (A − 0.8)².
+/// α is meant as the single-scattering albedo for which a semi-infinite slab of the medium under
+/// uniform light reflects the fraction A — a fit, close for A ≤ 0.8 and short of A above (the
+/// slab reflects 0.90 at A = 0.95; measured in docs/design.md) — and 1/σt = d·s the mean free
+/// path, scaled so that the light's lateral spread is about d.
+SubsurfaceMedium subsurfaceMedium(const SubsurfaceBsdf& b);
+
 /// Exact unpolarised Fresnel reflectance of a dielectric interface for light arriving at
 /// cos θ (> 0: from the outside, < 0: from the inside) with η = n_inside / n_outside:
 ///   F = (r∥² + r⊥²)/2,  r∥ = (η cos θi − cos θt)/(η cos θi + cos θt),
@@ -244,7 +281,8 @@ void thinSheetReflectanceTransmittance(const DielectricBsdf& b, float cosTheta, 
 /// serialisation), an entry here (at the end: the index is the .plf model number), and its
 /// per-model functions in bsdf.cpp (eval/pdf/sample) and lobe.cpp (lobe, validation) — the
 /// compiler names every function a new entry still lacks. Nothing outside bsdf/ switches on it.
-using Bsdf = std::variant<LambertBsdf, MirrorBsdf, BlinnPhongBsdf, GgxBsdf, DielectricBsdf, GltfPbrBsdf>;
+using Bsdf =
+    std::variant<LambertBsdf, MirrorBsdf, BlinnPhongBsdf, GgxBsdf, DielectricBsdf, GltfPbrBsdf, SubsurfaceBsdf>;
 
 /// A default-constructed model of variant index `index` (the serialised model number);
 /// nullopt for an index no model has.
@@ -282,11 +320,14 @@ Rgb diffuseAlbedo(const Bsdf& bsdf);
 /// The Beer–Lambert absorption σa (per scene unit) inside a closed dielectric; black for
 /// every other model (per hit).
 Rgb interiorAbsorption(const Bsdf& bsdf);
+/// The medium of a SubsurfaceBsdf model; nullopt for every other model (per hit).
+std::optional<SubsurfaceMedium> subsurfaceMedium(const Bsdf& bsdf);
 
 /// The reason the model's parameters violate the contract above ("" when valid): reflectances
 /// in [0, 1] (more would create energy), Blinn-Phong diffuse + specular ≤ 1 per channel and a
 /// finite exponent ≥ 0, GGX α in (0, 1], a dielectric's finite positive index, transmittance in
-/// [0, 1], α in [0, 1] and finite absorption ≥ 0. Callers prefix file and material.
+/// [0, 1], α in [0, 1] and finite absorption ≥ 0, a subsurface albedo in [0, 1) and finite radius > 0.
+/// Callers prefix file and material.
 std::string bsdfProblem(const Bsdf& bsdf);
 
 struct BsdfSample {
@@ -326,7 +367,7 @@ Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo);
 /// (lightfield.h "What is stored per chart kind").
 Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta);
 /// A short name for messages and `info`: "lambert", "mirror", "blinn-phong", "ggx",
-/// "dielectric" (smooth), "rough-dielectric", "thin-dielectric", "gltf-pbr".
+/// "dielectric" (smooth), "rough-dielectric", "thin-dielectric", "gltf-pbr", "subsurface".
 const char* modelName(const Bsdf& bsdf);
 
 }  // namespace pl

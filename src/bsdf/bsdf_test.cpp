@@ -45,6 +45,8 @@ std::string label(const Bsdf& b) {
                  ",a=" + std::to_string(m.alpha) + ")";
         if constexpr (std::is_same_v<T, DielectricBsdf>)
           return "dielectric(ior=" + std::to_string(m.ior) + ",a=" + std::to_string(m.alpha) + ")";
+        if constexpr (std::is_same_v<T, SubsurfaceBsdf>)
+          return "subsurface(A=" + std::to_string(m.albedo.r) + ",d=" + std::to_string(m.radius.r) + ")";
         if constexpr (std::is_same_v<T, GltfPbrBsdf>)
           return "gltf-pbr(kd=" + std::to_string(m.diffuse.r) + ",f0=" + std::to_string(m.f0.r) +
                  ",f90=" + std::to_string(m.f90) + ",a=" + std::to_string(m.alpha) +
@@ -80,6 +82,9 @@ std::vector<Bsdf> smoothModels() {
                          .sheenColor = Rgb(0.5f), .sheenRoughness = 0.7f}),
       gltfPbrFromInputs({.baseColor = Rgb(1.0f), .metallic = 0.0f, .roughness = 0.3f, .clearcoat = 1.0f,
                          .clearcoatRoughness = 0.2f, .sheenColor = Rgb(1.0f), .sheenRoughness = 0.5f}),
+      // Subsurface seen as a BSDF (Lambertian of its albedo); last, so that the random streams
+      // the tests draw for the models above are unchanged.
+      SubsurfaceBsdf{Rgb(0.9f, 0.6f, 0.2f), Rgb(1.0f, 0.5f, 0.25f)},
   };
 }
 
@@ -955,7 +960,8 @@ TEST(Lobe, DescriptorClassifiesEveryModel) {
   glass.thin = true;  // thin sheets are smooth whatever alpha says
   EXPECT_EQ(describe(glass).kind, LobeKind::Delta);
   // The per-hit queries agree with the descriptor.
-  for (const Bsdf& b : std::vector<Bsdf>{LambertBsdf{}, MirrorBsdf{}, BlinnPhongBsdf{}, GgxBsdf{}, DielectricBsdf{}, GltfPbrBsdf{}}) {
+  for (const Bsdf& b : std::vector<Bsdf>{LambertBsdf{}, MirrorBsdf{}, BlinnPhongBsdf{}, GgxBsdf{}, DielectricBsdf{}, GltfPbrBsdf{},
+                                                   SubsurfaceBsdf{}}) {
     const LobeDescriptor d = describe(b);
     EXPECT_EQ(isDelta(b), d.kind == LobeKind::Delta) << modelName(b);
     EXPECT_EQ(isDiffuse(b), d.kind == LobeKind::Diffuse) << modelName(b);
@@ -996,6 +1002,12 @@ TEST(Lobe, ProblemsNameTheParameter) {
   glass = DielectricBsdf{};
   glass.absorption = Rgb(-1.0f);
   EXPECT_NE(bsdfProblem(glass).find("absorption"), std::string::npos);
+  EXPECT_EQ(bsdfProblem(SubsurfaceBsdf{}), "");
+  EXPECT_EQ(bsdfProblem(SubsurfaceBsdf{Rgb(0.0f), Rgb(1e-4f)}), "");
+  EXPECT_NE(bsdfProblem(SubsurfaceBsdf{Rgb(1.0f, 0.5f, 0.5f), Rgb(1.0f)}).find("subsurface albedo"), std::string::npos);
+  EXPECT_NE(bsdfProblem(SubsurfaceBsdf{Rgb(-0.1f), Rgb(1.0f)}).find("subsurface albedo"), std::string::npos);
+  EXPECT_NE(bsdfProblem(SubsurfaceBsdf{Rgb(0.5f), Rgb(1.0f, 0.0f, 1.0f)}).find("subsurface radius"), std::string::npos);
+  EXPECT_NE(bsdfProblem(SubsurfaceBsdf{Rgb(0.5f), Rgb(kInfinity)}).find("subsurface radius"), std::string::npos);
   // 0.7 + 0.3 rounds a hair above 1 in float: accepted.
   EXPECT_EQ(bsdfProblem(BlinnPhongBsdf{Rgb(0.7f), Rgb(0.3f), 10.0f}), "");
 }
@@ -1020,13 +1032,51 @@ TEST(Lobe, RoughnessConversions) {
   }
 }
 
+TEST(Subsurface, ChiangMappingPerChannel) {
+  // The formulas of Chiang et al. 2016 (bsdf.h), channel by channel, at values worked by hand:
+  // A = 0: α = 0 (a pure absorber), s = 1.9 + 3.5·0.64 = 4.14; A = 0.8: s = 1.1,
+  // α = 1 − exp(−4.075248 + 1.6716032 − 2.2108416) = 1 − exp(−4.6144864).
+  const SubsurfaceMedium m = subsurfaceMedium(SubsurfaceBsdf{Rgb(0.0f, 0.8f, 0.5f), Rgb(1.0f, 2.0f, 0.5f)});
+  EXPECT_FLOAT_EQ(m.alpha[0], 0.0f);
+  EXPECT_FLOAT_EQ(m.sigmaT[0], 1.0f / 4.14f);
+  EXPECT_NEAR(m.alpha[1], 1.0 - std::exp(-4.6144864), 1e-6);
+  EXPECT_FLOAT_EQ(m.sigmaT[1], 1.0f / (2.0f * 1.1f));
+  const double a = 0.5;
+  EXPECT_NEAR(m.alpha[2], 1.0 - std::exp(-5.09406 * a + 2.61188 * a * a - 4.31805 * a * a * a), 1e-6);
+  EXPECT_NEAR(m.sigmaT[2], 1.0 / (0.5 * (1.9 - a + 3.5 * (a - 0.8) * (a - 0.8))), 1e-5);
+  // α rises with A and stays below 1 over the valid range [0, 1).
+  float previous = -1.0f;
+  for (float albedo = 0.0f; albedo < 1.0f; albedo += 0.05f) {
+    const float alpha = subsurfaceMedium(SubsurfaceBsdf{Rgb(albedo), Rgb(1.0f)}).alpha[0];
+    EXPECT_GT(alpha, previous) << albedo;
+    EXPECT_LT(alpha, 1.0f) << albedo;
+    previous = alpha;
+  }
+  // Only the subsurface model has a medium.
+  EXPECT_TRUE(subsurfaceMedium(Bsdf(SubsurfaceBsdf{})));
+  EXPECT_FALSE(subsurfaceMedium(Bsdf(LambertBsdf{})));
+}
+
+TEST(Subsurface, SeenAsABsdfItIsLambertianOfItsAlbedo) {
+  const SubsurfaceBsdf sss{Rgb(0.7f, 0.4f, 0.1f), Rgb(0.3f)};
+  const Vec3 wo = directionAt(30.0f), wi = directionAt(60.0f, 120.0f);
+  EXPECT_EQ(eval(sss, wo, wi), eval(LambertBsdf{sss.albedo}, wo, wi));
+  EXPECT_EQ(pdf(sss, wo, wi), pdf(LambertBsdf{sss.albedo}, wo, wi));
+  EXPECT_EQ(albedo(sss, wo), sss.albedo);
+  EXPECT_EQ(describe(sss).diffuseAlbedo, sss.albedo);
+  EXPECT_EQ(std::get<SubsurfaceBsdf>(withDiffuseAlbedo(sss, Rgb(0.2f))).albedo, Rgb(0.2f));
+  EXPECT_EQ(std::get<SubsurfaceBsdf>(withDiffuseAlbedo(sss, Rgb(0.2f))).radius, sss.radius);
+  EXPECT_STREQ(modelName(sss), "subsurface");
+}
+
 TEST(Lobe, ParametersHookVisitsEveryFieldAndRebuildsTheModel) {
   // Writing every model through its hook into floats and reading them back into a default
   // model of the same index gives the same model (the .plf encoding relies on this).
   const std::vector<Bsdf> models = {LambertBsdf{Rgb(0.1f, 0.2f, 0.3f)}, MirrorBsdf{Rgb(0.9f), true},
                                     BlinnPhongBsdf{Rgb(0.2f), Rgb(0.3f), 17.0f},
                                     GgxBsdf{Rgb(0.4f), Rgb(0.05f), 0.3f},
-                                    DielectricBsdf{1.33f, Rgb(0.9f), 0.2f, true, Rgb(0.5f)}};
+                                    DielectricBsdf{1.33f, Rgb(0.9f), 0.2f, true, Rgb(0.5f)},
+                                    SubsurfaceBsdf{Rgb(0.8f, 0.5f, 0.2f), Rgb(0.1f, 0.2f, 0.3f)}};
   for (const Bsdf& model : models) {
     std::vector<float> values;
     std::visit([&](const auto& b) {

@@ -162,7 +162,7 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
   const std::string where = "materials." + name;
   if (!value.is_object()) fail("{}: {}: expected an object", ctx.path, where);
   const json* typeValue = find(value, "type");
-  if (!typeValue) fail("{}: {}: missing \"type\" (lambert, mirror, blinn-phong, ggx, dielectric)", ctx.path, where);
+  if (!typeValue) fail("{}: {}: missing \"type\" (lambert, mirror, blinn-phong, ggx, dielectric, subsurface)", ctx.path, where);
   const std::string type = stringOf(ctx, *typeValue, where + ".type");
   Material material;
   material.name = name;
@@ -228,8 +228,13 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
     if (glass.thin && roughness > 0.0f) fail("{}: {}: a thin dielectric is smooth (roughness must be 0)", ctx.path, where);
     material.bsdf = glass;
     known.insert({"ior", "transmittance", "roughness", "thin", "absorption"});
+  } else if (type == "subsurface") {
+    const json* radius = find(value, "radius");
+    if (!radius) fail("{}: {}: a subsurface material needs \"radius\" (scene units, a number or [r, g, b])", ctx.path, where);
+    material.bsdf = SubsurfaceBsdf{colourOr(ctx, value, "albedo", Rgb(0.8f), where), colour(ctx, *radius, where + ".radius")};
+    known.insert({"albedo", "radius", "texture"});
   } else {
-    fail("{}: {}: unknown material type '{}' (lambert, mirror, blinn-phong, ggx, dielectric)", ctx.path, where, type);
+    fail("{}: {}: unknown material type '{}' (lambert, mirror, blinn-phong, ggx, dielectric, subsurface)", ctx.path, where, type);
   }
   checkKeys(ctx, value, known, where);
   if (const json* texture = find(value, "texture")) material.albedoTexture = loadTexture(ctx, scene, *texture, where + ".texture");

@@ -5,9 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <fmt/format.h>
+#include <map>
 #include <spdlog/spdlog.h>
 #include <string>
+#include <utility>
 
 namespace pl {
 
@@ -69,6 +72,52 @@ void markVertexColoredMaterials(Scene& scene) {
     if (!mesh.colors.empty())
       for (const uint32_t material : mesh.materials)
         if (material < scene.materials.size()) scene.materials[material].vertexColored = true;
+}
+
+size_t openSubsurfaceEdges(const Scene& scene, const Mesh& mesh) {
+  // Vertices welded by position, quantised to 1e-6 of the mesh's extent (a seam splits
+  // vertices of equal position, and computed ones such as a sphere's pole differ in the last
+  // bits), then every directed edge a → b of a subsurface triangle must be matched by exactly
+  // one b → a. Edges that the weld collapses to a point are no edges.
+  Vec3 lo(kInfinity), hi(-kInfinity);
+  for (const Vec3& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  const double step = std::max(1e-6 * double(maxComponent(hi - lo)), 1e-30);
+  std::map<std::array<int64_t, 3>, uint32_t> weldedOf;
+  std::vector<uint32_t> welded(mesh.positions.size());
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    const Vec3 p = mesh.positions[v] - lo;
+    const std::array<int64_t, 3> key = {std::llround(p.x / step), std::llround(p.y / step), std::llround(p.z / step)};
+    welded[v] = weldedOf.try_emplace(key, uint32_t(weldedOf.size())).first->second;
+  }
+  std::map<std::pair<uint32_t, uint32_t>, uint32_t> directed;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    if (!subsurfaceMedium(scene.materials[mesh.materials[t]].bsdf)) continue;
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = welded[mesh.triangles[t][e]], b = welded[mesh.triangles[t][(e + 1) % 3]];
+      if (a != b) ++directed[{a, b}];
+    }
+  }
+  size_t open = 0;
+  for (const auto& [edge, count] : directed) {
+    const auto back = directed.find({edge.second, edge.first});
+    if (count != 1 || back == directed.end() || back->second != 1) ++open;
+  }
+  return open;
+}
+
+void warnAboutOpenSubsurfaceMeshes(const Scene& scene) {
+  for (size_t index = 0; index < scene.meshes.size(); ++index) {
+    const Mesh& mesh = scene.meshes[index];
+    const auto first = std::find_if(mesh.materials.begin(), mesh.materials.end(), [&](uint32_t m) {
+      return subsurfaceMedium(scene.materials[m].bsdf).has_value();
+    });
+    if (first == mesh.materials.end()) continue;
+    if (const size_t open = openSubsurfaceEdges(scene, mesh); open > 0)
+      spdlog::warn("{}: mesh {}: its subsurface triangles (material '{}') do not enclose a volume ({} open, "
+                   "non-manifold or inconsistently wound edge(s)): random walks inside leak out through the gaps",
+                   scene.sourcePath, mesh.name.empty() ? fmt::format("#{} (unnamed)", index) : "'" + mesh.name + "'",
+                   scene.materials[*first].name, open);
+  }
 }
 
 /// The model's own validation (bsdf.h bsdfProblem), prefixed with the file and material.
@@ -220,6 +269,7 @@ void Scene::finalize() {
   for (Mesh& mesh : meshes) mesh.positions.reserve(mesh.positions.size() + 1);
 
   for (Light& light : lights) normaliseLightDirections(light);
+  warnAboutOpenSubsurfaceMeshes(*this);
 }
 
 bool Scene::hasThinGlass() const {

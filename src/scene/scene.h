@@ -408,6 +408,15 @@ struct Scattered {
 };
 std::optional<Scattered> scatter(const ScatteringFrame& f, const Bsdf& bsdf, Vec2 u);
 
+/// The number of edges of mesh's subsurface triangles (bsdf.h SubsurfaceBsdf) that do not close
+/// a volume: vertices welded by position (to 1e-6 of the mesh's extent), an edge is closed when
+/// exactly one triangle runs along it each way. 0 for a closed, consistently wound surface (or no subsurface triangles).
+size_t openSubsurfaceEdges(const Scene& scene, const Mesh& mesh);
+/// Logs a warning naming the file, the mesh and the material for every mesh whose subsurface
+/// triangles are not closed (openSubsurfaceEdges): a random walk leaves the medium only through
+/// its surface, so through a gap it escapes into the open. Scene::finalize() calls it.
+void warnAboutOpenSubsurfaceMeshes(const Scene& scene);
+
 /// Throws pl::Error (naming sourcePath and the material) unless the material's model is valid
 /// (bsdf.h bsdfProblem: energy conserved, parameters in range). Scene::finalize() checks every
 /// material of a scene with it.

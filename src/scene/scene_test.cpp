@@ -377,6 +377,42 @@ TEST(JsonScene, DielectricMaterials) {
   expectError([&] { loadScene(bad.string()); }, {"bad.json", "absorption"});
 }
 
+TEST(JsonScene, SubsurfaceMaterials) {
+  const fs::path dir = scratchDir("json_sss");
+  // A closed tetrahedron (wound outwards) and an open triangle.
+  writeFile(dir / "tet.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  writeFile(dir / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const Scene scene = loadScene(writeFile(dir / "s.json", R"({"materials": {
+      "marble": {"type": "subsurface", "albedo": [0.9, 0.8, 0.7], "radius": [0.3, 0.2, 0.1], "tixel_density": 2},
+      "wax": {"type": "subsurface", "radius": 0.5}},
+    "meshes": [{"file": "tet.obj", "material": "marble"}, {"file": "tri.obj", "material": "wax"}]})"));
+  const auto& marble = std::get<SubsurfaceBsdf>(materialNamed(scene, "marble").bsdf);
+  EXPECT_VEC3_NEAR(marble.albedo, Rgb(0.9f, 0.8f, 0.7f), kTight);
+  EXPECT_VEC3_NEAR(marble.radius, Rgb(0.3f, 0.2f, 0.1f), kTight);
+  const auto& wax = std::get<SubsurfaceBsdf>(materialNamed(scene, "wax").bsdf);
+  EXPECT_VEC3_NEAR(wax.albedo, Rgb(0.8f), kTight);  // the default, as Lambert's
+  EXPECT_VEC3_NEAR(wax.radius, Rgb(0.5f), kTight);
+  // The closed tetrahedron has no open edge; the lone triangle (which loads with a warning
+  // naming it) has three.
+  ASSERT_EQ(scene.meshes.size(), 2u);
+  EXPECT_EQ(openSubsurfaceEdges(scene, scene.meshes[0]), 0u);
+  EXPECT_EQ(openSubsurfaceEdges(scene, scene.meshes[1]), 3u);
+
+  const fs::path bad = dir / "bad.json";
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "subsurface", "albedo": 0.5}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "materials.w", "radius"});
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "subsurface", "albedo": 1, "radius": 1}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "'w'", "subsurface albedo", "[0, 1)"});
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "subsurface", "albedo": -0.5, "radius": 1}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "subsurface albedo"});
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "subsurface", "radius": [1, 0, 1]}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "'w'", "subsurface radius"});
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "subsurface", "radius": "big"}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "materials.w.radius"});
+  writeFile(bad, R"({"include_cornell": true, "materials": {"w": {"type": "subsurface", "radius": 1, "ior": 1.4}}})");
+  expectError([&] { loadScene(bad.string()); }, {"bad.json", "materials.w", "unknown key 'ior'"});
+}
+
 // A ggx material with any glTF layer key is the layered model (bsdf.h GltfPbrBsdf); without,
 // it stays GgxBsdf.
 TEST(JsonScene, LayeredGgxMaterials) {

@@ -130,6 +130,28 @@ TEST_F(TraceCliTest, FurnaceWithDefaultFlagsIsUnbiased) {
   EXPECT_EQ(nlohmann::json::parse(std::ifstream(path("e.json"))).at("max_depth").get<int>(), 0);
 }
 
+// A subsurface material renders (path tracer only); on an open mesh it loads with a warning
+// naming the file, the mesh and the material, and `bake` refuses it, writing nothing.
+TEST_F(TraceCliTest, SubsurfaceOnAnOpenMeshWarnsAndTheBakeRefusesIt) {
+  std::ofstream(path("tri.obj")) << "o sheet\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(path("s.json")) << R"({"meshes": [{"file": "tri.obj", "material": "wax"}],
+      "materials": {"wax": {"type": "subsurface", "albedo": 0.7, "radius": 0.1}},
+      "environment": {"color": 1}})";
+  std::string output, errors;
+  const std::string image = path("s.pfm");
+  ASSERT_EQ(run("trace " + path("s.json") + " -o " + image + " --width 8 --height 8 --spp 2", &output, &errors), 0)
+      << errors;
+  EXPECT_TRUE(fs::exists(image));
+  const std::string log = output + errors;  // the log's warnings go to either stream
+  for (const char* needle : {"s.json", "mesh 'sheet'", "'wax'", "do not enclose a volume", "leak"})
+    EXPECT_NE(log.find(needle), std::string::npos) << needle << " in: " << log;
+  const std::string field = path("s.plf");
+  EXPECT_NE(run("bake " + path("s.json") + " -o " + field, nullptr, &errors), 0);
+  for (const char* needle : {"s.json", "material 'wax' is subsurface", "plenoptic trace"})
+    EXPECT_NE(errors.find(needle), std::string::npos) << needle << " in: " << errors;
+  EXPECT_FALSE(fs::exists(field));
+}
+
 TEST_F(TraceCliTest, MissingSceneFileFailsCleanly) {
   const std::string out = path("never.exr");
   std::string errors;

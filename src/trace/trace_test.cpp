@@ -18,12 +18,15 @@
 #include "image/compare.h"
 #include "image/image.h"
 #include "scene/scene.h"
+#include "support/box_mesh.h"
 #include "support/mask_texture.h"
 #include "support/sphere_mesh.h"
 #include "trace/trace.h"
 
 namespace pl {
 namespace {
+
+using test_support::addBox;
 
 class TraceTest : public ::testing::Test {
  protected:
@@ -256,24 +259,6 @@ uint32_t addDielectric(Scene& scene, const DielectricBsdf& glass) {
   m.bsdf = glass;
   scene.materials.push_back(m);
   return static_cast<uint32_t>(scene.materials.size() - 1);
-}
-
-/// The box [lo, hi] with its faces wound outwards.
-void addBox(Mesh& mesh, const Vec3& lo, const Vec3& hi, uint32_t material) {
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = 0; side < 2; ++side) {
-      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-      Vec3 corners[4];
-      const int cu[4] = {0, 1, 1, 0}, cv[4] = {0, 0, 1, 1};
-      for (int k = 0; k < 4; ++k) {
-        corners[k][axis] = side ? hi[axis] : lo[axis];
-        corners[k][u] = cu[k] ? hi[u] : lo[u];
-        corners[k][v] = cv[k] ? hi[v] : lo[v];
-      }
-      Vec3 outward(0.0f);
-      outward[axis] = side ? 1.0f : -1.0f;
-      addQuad(mesh, corners[0], corners[1], corners[2], corners[3], outward, material);
-    }
 }
 
 // Glass furnace: a clear dielectric sphere under a constant environment Le. Whatever a path
