@@ -7,7 +7,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cctype>
 #include <cstdlib>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +24,7 @@
 #include "realtime/realtime.h"
 #include "viewer/fly_camera.h"
 #include "viewer/hud_text.h"
+#include "viewer/live_relight.h"
 
 namespace pl {
 namespace {
@@ -87,6 +91,25 @@ class Window {
   int textureWidth_ = 0, textureHeight_ = 0;
 };
 
+/// The relighting key of an SDL key (viewer.h), if it is one.
+std::optional<RelightKey> relightKeyOf(SDL_Keycode code) {
+  switch (code) {
+    case SDLK_TAB: return RelightKey::NextSource;
+    case SDLK_o: return RelightKey::ToggleSource;
+    case SDLK_LEFTBRACKET: return RelightKey::Dimmer;
+    case SDLK_RIGHTBRACKET: return RelightKey::Brighter;
+    case SDLK_c: return RelightKey::NextColour;
+    case SDLK_j: return RelightKey::SunLeft;
+    case SDLK_l: return RelightKey::SunRight;
+    case SDLK_i: return RelightKey::SunUp;
+    case SDLK_k: return RelightKey::SunDown;
+    case SDLK_m: return RelightKey::NextMaterial;
+    case SDLK_COMMA: return RelightKey::Darker;
+    case SDLK_PERIOD: return RelightKey::Lighter;
+    default: return std::nullopt;
+  }
+}
+
 ToneMapOperator nextOperator(ToneMapOperator op) {
   switch (op) {
     case ToneMapOperator::Reinhard: return ToneMapOperator::Linear;
@@ -124,9 +147,14 @@ namespace {
 void checkViewerOptions(const ViewerOptions& options) {
   if (options.width < 1 || options.height < 1) fail("view: window size {}x{} is invalid", options.width, options.height);
   if (options.frames < 0) fail("view: --frames must be ≥ 0, got {}", options.frames);
-  if (!options.screenshotPath.empty() && options.frames == 0 && !options.path)
+  if (!options.screenshotPath.empty() && options.frames == 0 && !options.path && options.relightKeys.empty())
     fail("view: --screenshot needs --frames N or --path (it is written after the last frame)");
   isFramePattern(options.screenshotPattern, "screenshot pattern");  // validates it
+  for (char c : options.relightKeys)
+    if (!relightKeyOf(c == '\t' ? SDLK_TAB : SDL_Keycode(std::tolower(static_cast<unsigned char>(c)))))
+      fail("view: '{}' in the relighting keys is not one (Tab O [ ] C J L I K M , .)", c);
+  if (!options.relightKeys.empty() && options.visibilityPath.empty())
+    fail("view: relighting keys need the light field's visibility field (.plv)");
 }
 
 /// Scene units per second: the option, or a quarter of the scene's diagonal.
@@ -149,9 +177,22 @@ class ViewerSession {
         window_(options.title, options.width, options.height),
         toneMap_(options.toneMap),
         recorder_(options.recordInterval),
-        start_(Clock::now()) {}
+        start_(Clock::now()) {
+    if (!options.visibilityPath.empty()) {
+      live_ = std::make_unique<LiveRelight>(lightField, accel, options.visibilityPath);
+      for (char c : options.relightKeys)
+        live_->press(*relightKeyOf(c == '\t' ? SDLK_TAB : SDL_Keycode(std::tolower(static_cast<unsigned char>(c)))));
+    }
+  }
 
   bool quit() const { return quit_; }
+  /// Whether the scripted relighting keys (ViewerOptions::relightKeys) are done: converged,
+  /// or refused.
+  bool relightDone() const {
+    if (!live_) return true;
+    const RelightStatus status = live_->status();
+    return !status.message.empty() || (status.ready && !status.running && status.converged && live_->showsNewest());
+  }
 
   /// SDL's queued events: quit, mouse look, exposure, tone mapping, screenshots, recording.
   void handleEvents(Clock::time_point frameStart) {
@@ -201,8 +242,10 @@ class ViewerSession {
     int width = 0, height = 0;
     window_.outputSize(width, height);
     const Camera camera(fly_.desc(), width, height, options_.vignetting, options_.metresPerUnit);
+    if (live_) live_->update();
+    const FastRenderer& renderer = live_ && live_->renderer() ? *live_->renderer() : renderer_;
     const Clock::time_point renderStart = Clock::now();
-    renderer_.render(camera, options_.render, radiance_);
+    renderer.render(camera, options_.render, radiance_);
     renderMs_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
 
     SDL_Texture* texture = window_.texture(width, height);
@@ -220,6 +263,7 @@ class ViewerSession {
   void endFrame(Clock::time_point frameStart) {
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
     frameMs_.push_back(ms);
+    if (live_ && live_->status().running) relightMs_.push_back(ms);
     recentMs_.push_back(ms);
     if (recentMs_.size() > kTimingWindow) recentMs_.erase(recentMs_.begin());
   }
@@ -233,6 +277,18 @@ class ViewerSession {
     result.frames = int(frameMs_.size());
     result.msPerFrameMedian = median(frameMs_);
     result.renderMsMedian = median(renderMs_);
+    if (live_) {
+      const RelightStatus status = live_->status();
+      result.relightFrames = int(relightMs_.size());
+      result.relightMsPerFrameMedian = relightMs_.empty() ? 0.0 : median(relightMs_);
+      result.relightFirstFrameSeconds = status.firstFrameSeconds;
+      result.relightSeconds = status.seconds;
+      result.relightSunMaskSeconds = status.sunMaskSeconds;
+      result.relightFirstShotSeconds = status.firstShotSeconds;
+      result.relightIterations = status.iteration;
+      result.relightConverged = status.converged && !status.running;
+      result.relightMessage = status.message;
+    }
     return result;
   }
 
@@ -247,6 +303,8 @@ class ViewerSession {
     if (code == SDLK_PLUS || code == SDLK_EQUALS || code == SDLK_KP_PLUS) exposureEv_ += kExposureStepEv;
     if (code == SDLK_MINUS || code == SDLK_KP_MINUS) exposureEv_ -= kExposureStepEv;
     if (code == SDLK_t) toneMap_.op = nextOperator(toneMap_.op);
+    if (code == SDLK_h) relightHud_ = !relightHud_;
+    if (const std::optional<RelightKey> relight = relightKeyOf(code); relight && live_) live_->press(*relight);
     if (code == SDLK_F12 && !radiance_.empty()) {
       const std::string path = formatFramePath(options_.screenshotPattern, screenshots_++);
       writeFrame(path, radiance_, exposureScale(), toneMap_);
@@ -290,6 +348,8 @@ class ViewerSession {
         fmt::format("EXPOSURE {:+.1f} EV  TONEMAP {}{}", exposureEv_, toneMapOperatorName(toneMap_.op),
                     recorder_.recording() ? "  [REC]" : ""),
     };
+    if (live_ && relightHud_)
+      for (std::string& line : live_->hudLines()) lines.push_back(std::move(line));
     if (!message_.empty() && frameStart < messageUntil_) lines.push_back(message_);
     int hudWidth = 0;
     for (const std::string& line : lines) hudWidth = std::max(hudWidth, hudTextWidth(line, kHudScale));
@@ -309,7 +369,9 @@ class ViewerSession {
   float exposureEv_ = 0.0f;  ///< the +/− offset on top of options.exposureScale
   ToneMapSettings toneMap_;
   Image radiance_;  ///< the last frame
-  std::vector<double> frameMs_, renderMs_, recentMs_;
+  std::vector<double> frameMs_, renderMs_, recentMs_, relightMs_;
+  std::unique_ptr<LiveRelight> live_;  ///< the relighting keys' (null without a visibility field)
+  bool relightHud_ = true;
   int screenshots_ = 0;
   bool dragging_ = false, quit_ = false;
   PathRecorder recorder_;
@@ -324,8 +386,11 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
   checkViewerOptions(options);
   ViewerSession session(lightField, accel, options);
   const int totalFrames = options.frames > 0 ? options.frames : options.path ? options.path->frameCount() : 0;
+  // Scripted relighting keys without a frame count: until the relighting is done.
+  const bool untilRelit = totalFrames == 0 && !options.relightKeys.empty();
   Clock::time_point previous = Clock::now();
-  for (int frame = 0; !session.quit() && (totalFrames == 0 || frame < totalFrames); ++frame) {
+  for (int frame = 0; !session.quit() && (totalFrames == 0 || frame < totalFrames) && !(untilRelit && session.relightDone());
+       ++frame) {
     const Clock::time_point frameStart = Clock::now();
     const float dt = std::min(float(std::chrono::duration<double>(frameStart - previous).count()), 0.25f);
     previous = frameStart;
