@@ -14,6 +14,7 @@
 #endif
 
 #include "bake/relight.h"
+#include "core/cancel.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "light/lights.h"
@@ -79,7 +80,11 @@ LiveRelight::~LiveRelight() {
   }
   restart_ = true;
   wake_.notify_all();
+  // A set-up or an iteration in progress (minutes and seconds on a large scene) stops at its
+  // next cancellation point (core/cancel.h): the viewer is closing, nothing else runs.
+  requestCancellation();
   thread_.join();
+  clearCancellation();
 }
 
 void LiveRelight::press(RelightKey key) {

@@ -60,7 +60,7 @@ class LiveRelight {
   /// Starts the background thread, which builds the Relighter from `lightField` and the .plv
   /// at visibilityPath (its errors go to status().message). lightField and accel must outlive it.
   LiveRelight(const LightField& lightField, const Accel& accel, const std::string& visibilityPath);
-  ~LiveRelight();  ///< stops the propagation (at its next iteration) and joins the thread
+  ~LiveRelight();  ///< stops the worker (cancelling its set-up or iteration: core/cancel.h) and joins it
   LiveRelight(const LiveRelight&) = delete;
   LiveRelight& operator=(const LiveRelight&) = delete;
 

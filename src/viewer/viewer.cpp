@@ -110,6 +110,11 @@ std::optional<RelightKey> relightKeyOf(SDL_Keycode code) {
   }
 }
 
+/// The relighting key of a character of ViewerOptions::relightKeys ('\t' = Tab; any case).
+std::optional<RelightKey> relightKeyOfChar(char c) {
+  return relightKeyOf(c == '\t' ? SDLK_TAB : SDL_Keycode(std::tolower(static_cast<unsigned char>(c))));
+}
+
 ToneMapOperator nextOperator(ToneMapOperator op) {
   switch (op) {
     case ToneMapOperator::Reinhard: return ToneMapOperator::Linear;
@@ -151,7 +156,7 @@ void checkViewerOptions(const ViewerOptions& options) {
     fail("view: --screenshot needs --frames N or --path (it is written after the last frame)");
   isFramePattern(options.screenshotPattern, "screenshot pattern");  // validates it
   for (char c : options.relightKeys)
-    if (!relightKeyOf(c == '\t' ? SDLK_TAB : SDL_Keycode(std::tolower(static_cast<unsigned char>(c)))))
+    if (!relightKeyOfChar(c))
       fail("view: '{}' in the relighting keys is not one (Tab O [ ] C J L I K M , .)", c);
   if (!options.relightKeys.empty() && options.visibilityPath.empty())
     fail("view: relighting keys need the light field's visibility field (.plv)");
@@ -181,7 +186,7 @@ class ViewerSession {
     if (!options.visibilityPath.empty()) {
       live_ = std::make_unique<LiveRelight>(lightField, accel, options.visibilityPath);
       for (char c : options.relightKeys)
-        live_->press(*relightKeyOf(c == '\t' ? SDLK_TAB : SDL_Keycode(std::tolower(static_cast<unsigned char>(c)))));
+        live_->press(*relightKeyOfChar(c));
     }
   }
 
