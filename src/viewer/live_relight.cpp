@@ -241,7 +241,11 @@ void LiveRelight::work() {
       status_.running = false;
       status_.message = e.what();
       lights_ = relighter_->scene().lights;
-      for (uint32_t m = 0; m < emission_.size(); ++m) emission_[m] = relighter_->scene().materials[m].emission;
+      for (uint32_t m = 0; m < emission_.size(); ++m) {
+        const Material& material = relighter_->scene().materials[m];
+        emission_[m] = material.emission;
+        if (const auto* lambert = std::get_if<LambertBsdf>(&material.bsdf)) albedo_[m] = lambert->albedo;
+      }
     }
   }
 }
