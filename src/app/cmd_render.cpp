@@ -60,7 +60,10 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global) {
           "refuses what it does not draw yet: docs/limitations.md)")
       ->check(CLI::IsMember({"cpu", "gpu"}));
   command->add_option("--path", options->pathFile,
-                      "Camera path JSON (keyframes; see docs/user-guide.md): render a walk-through to -o frames/%04d.png or -o walk.mp4");
+                      "Camera path JSON (keyframes; see docs/user-guide.md): render a walk-through to -o frames/%04d.png or -o walk.mp4; "
+                      "light keyframes in it relight every frame");
+  command->add_option("--visibility", options->visibilityPath,
+                      "The visibility field (.plv) that a path with light keyframes relights from (default: the .plf's X.plv)");
   command->add_option("--stats", options->statsPath,
                       "Write JSON: frames, ms_per_frame_median, fps, primary_ms_median (primary rays alone), load and BVH times");
   addCameraOptions(*command, options->view);

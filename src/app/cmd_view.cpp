@@ -2,12 +2,14 @@
 // shared camera, exposure and tone-mapping flags, plus headless flags for tests and CI.
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <memory>
 #include <string>
 
 #include "accel/accel.h"
 #include "app/commands.h"
 #include "app/view_options.h"
+#include "bake/relight.h"
 #include "camera/camera_path.h"
 #include "core/error.h"
 #include "plf/plf_file.h"
@@ -43,10 +45,24 @@ void runView(const ViewCommandOptions& options, const GlobalOptions& global) {
   viewer.render.seed = global.seed;
   if (!options.pathFile.empty()) viewer.path = loadCameraPath(options.pathFile);
   viewer.title = "plenoptic view " + options.input;
+  // The relighting keys need the visibility field: the one named, else X.plv beside X.plf.
+  if (viewer.visibilityPath.empty()) {
+    const std::string beside = visibilityPathFor(options.input);
+    if (std::filesystem::exists(beside)) viewer.visibilityPath = beside;
+    else if (!viewer.relightKeys.empty()) fail("view: --relight-keys needs the visibility field {}, which is not there", beside);
+    else fmt::print("view: no {}: the relighting keys are off (bake with -o next to it to get one)\n", beside);
+  }
   const ViewerResult result = runViewer(lightField, accel, viewer);
   fmt::print("view: {} frames rendered, median {:.2f} ms/frame (render {:.2f} ms), renderer {}{}\n", result.frames,
              result.msPerFrameMedian, result.renderMsMedian, result.renderer,
              viewer.screenshotPath.empty() ? "" : ", screenshot " + viewer.screenshotPath);
+  if (!viewer.relightKeys.empty())
+    fmt::print("view: relit: {} iterations ({}), first frame {:.3f} s (sun masks {:.3f} s, first shot {:.3f} s), {:.3f} s "
+               "in all; {} frames while propagating, median {:.2f} ms/frame{}\n",
+               result.relightIterations, result.relightConverged ? "converged" : "not converged",
+               result.relightFirstFrameSeconds, result.relightSunMaskSeconds, result.relightFirstShotSeconds,
+               result.relightSeconds, result.relightFrames, result.relightMsPerFrameMedian,
+               result.relightMessage.empty() ? "" : "; " + result.relightMessage);
 }
 
 }  // namespace
@@ -82,6 +98,11 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
                       "CPU renderer: frame rate held while moving, by rendering at a lower resolution (0 = always full)")
       ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
+  command->add_option("--visibility", viewer.visibilityPath,
+                      "The visibility field (.plv) the relighting keys re-propagate from (default: the .plf's X.plv when it exists)");
+  command->add_option("--relight-keys", viewer.relightKeys,
+                      "Press these relighting keys at the first frame (e.g. JJ] : sun 10 degrees left, brighter); without "
+                      "--frames, quit once the light field has converged (headless benchmarks)");
   addRenderSettingsOptions(*command, viewer.render);
   options->view.width = viewer.width;
   options->view.height = viewer.height;

@@ -220,20 +220,6 @@ DistributedBakeStats gatherDistributedStats(Communicator& comm, const ShardPlan&
   return distributed;
 }
 
-/// The charts, values and sun masks of the light field from the parameterisation and the
-/// propagated values (moved out of `values`): the masked lights leave the stored irradiance
-/// and go with the masks (lightfield.h "Sun masks").
-void storeLightField(LightField& lf, const Parameterisation& param, std::vector<Rgb>&& values) {
-  lf.charts = param.charts;
-  lf.triangleChart = param.triangleChart;
-  lf.values = std::move(values);
-  removeSunMaskedDirect(lf.scene, param, lf.values);
-  lf.sunMaskLightCount = uint32_t(param.sunMaskLights.size());
-  lf.sunMasks.reserve(param.tixelCount * lf.sunMaskLightCount);
-  for (uint64_t g = 0; g < param.tixelCount && lf.sunMaskLightCount > 0; ++g)
-    lf.sunMasks.insert(lf.sunMasks.end(), param.sunMask[g].begin(), param.sunMask[g].begin() + lf.sunMaskLightCount);
-}
-
 /// The bake's statistics (lightfield.h BakeStats) but its total time and peak memory, which
 /// the caller adds last: visibility time is the slowest rank's, rays are every rank's.
 BakeStats bakeStats(const Parameterisation& param, const Transport& t, const DistributedBakeStats& distributed) {
@@ -310,6 +296,8 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   lf.stats.seconds = secondsSince(start);
   lf.stats.peakRssBytes = peakRssBytes();
   if (options.distributedStats) *options.distributedStats = std::move(distributed);
+  if (options.keepParameterisation) *options.keepParameterisation = std::move(param);
+  if (options.keepVisibility) *options.keepVisibility = std::move(transport.visibility);
   return lf;
 }
 

@@ -12,6 +12,8 @@
 namespace pl {
 
 class Communicator;
+struct Parameterisation;
+struct VisibilityShard;
 
 /// A named quality preset. Densities are relative to the scene's room scale (sceneScale,
 /// parameterisation.h), so a scene in millimetres and one in metres get the same grids; the
@@ -83,6 +85,10 @@ struct BakeOptions {
   Communicator* communicator = nullptr;
   /// Receives what the distributed bake measured. May be null.
   DistributedBakeStats* distributedStats = nullptr;
+  /// Receive the parameterisation and the visibility field (this rank's shard) instead of
+  /// their being freed: what relighting needs in memory (relight.h). May be null.
+  Parameterisation* keepParameterisation = nullptr;
+  VisibilityShard* keepVisibility = nullptr;
 };
 
 /// Bytes of the bake's large arrays for this parameterisation and these settings: the

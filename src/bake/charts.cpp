@@ -437,6 +437,7 @@ void layOutTixels(const Scene& scene, const BakeSettings& settings, Parameterisa
   if (std::any_of(p.charts.begin(), p.charts.end(), [](const Chart& c) { return c.directionalIrradiance; }))
     p.transportTiltWeights.resize(p.tixelCount);
   p.coverage.resize(p.tixelCount);
+  p.borrowedPoint.assign(p.tixelCount, 0);
   p.transportAlbedo.resize(p.tixelCount);
   if (std::any_of(p.charts.begin(), p.charts.end(), [&](const Chart& c) { return texturedEmitter(scene, c); })) {
     p.emissionModulation.assign(p.tixelCount, Rgb(1.0f));

@@ -562,6 +562,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
   if (!fillFromNearestSeed(c, source)) return;  // the whole chart is buried: nothing visible to borrow from
   for (uint32_t k = 0; k < isBuried.size(); ++k)
     if (isBuried[k]) {
+      p.borrowedPoint[c.firstTixel + k] = 1;
       p.gatherPoint[c.firstTixel + k] = p.gatherPoint[c.firstTixel + source[k]];
       if (c.curved) p.gatherNormal[c.firstTixel + k] = p.gatherNormal[c.firstTixel + source[k]];
       if (c.directionalIrradiance) p.transportTiltWeights[c.firstTixel + k] = p.transportTiltWeights[c.firstTixel + source[k]];
@@ -582,6 +583,31 @@ Parameterisation buildParameterisation(const Scene& scene, const Accel& accel, c
   Parameterisation p = buildCharts(scene, accel, settings);
   fillTixels(scene, accel, p, 0, uint32_t(p.charts.size()));
   return p;
+}
+
+void recomputeSunMasks(const Scene& scene, const Accel& accel, Parameterisation& p, size_t slot) {
+  if (slot >= p.sunMaskLights.size())
+    fail("{}: sun mask slot {} is not one of the {} masked lights", scene.sourcePath, slot, p.sunMaskLights.size());
+  const std::vector<uint32_t> light{p.sunMaskLights[slot]};
+  parallelFor(p.charts.size(), [&](uint64_t ci) {
+    const Chart& c = p.charts[ci];
+    if (c.kind != ChartKind::Diffuse) return;
+    const ChartRaster r = rasteriseChart(scene, c, p.chartTriangles[ci]);
+    // What fillChartTixels did: each tixel's masks at its gather point and normal, then the
+    // wholly buried tixels' from their nearest unburied neighbour (the same breadth-first order).
+    std::vector<uint32_t> source(c.tixelCount(), UINT32_MAX);
+    for (uint32_t local = 0; local < c.tixelCount(); ++local) {
+      const uint64_t g = c.firstTixel + local;
+      if (p.borrowedPoint[g]) continue;
+      source[local] = local;
+      const Vec3 normal = c.curved ? p.gatherNormal[g] : c.normal;
+      p.sunMask[g][slot] = tixelSunMasks(scene, accel, c, r, local, local % c.resU, local / c.resU, p.gatherPoint[g],
+                                         normal, light)[0];
+    }
+    if (!fillFromNearestSeed(c, source)) return;
+    for (uint32_t local = 0; local < c.tixelCount(); ++local)
+      if (p.borrowedPoint[c.firstTixel + local]) p.sunMask[c.firstTixel + local][slot] = p.sunMask[c.firstTixel + source[local]][slot];
+  });
 }
 
 void fillTixels(const Scene& scene, const Accel& accel, Parameterisation& p, uint32_t firstRecord, uint32_t endRecord) {

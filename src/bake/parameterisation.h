@@ -116,6 +116,9 @@ struct Parameterisation {
   /// "Normal-mapped diffuse charts"; transportTiltWeights in parameterisation.cpp).
   std::vector<TiltWeights> transportTiltWeights;
   std::vector<float> coverage;        ///< fraction of the tixel's square covered by the polygon
+  /// 1 for a wholly buried tixel (no footprint sub-sample outside other geometry), whose
+  /// gather point and sun masks are its nearest unburied neighbour's (fillTixels).
+  std::vector<uint8_t> borrowedPoint;
   std::vector<Rgb> transportAlbedo;   ///< diffuse charts, and glossy diffuseValue ones' diffuse part: mean albedo over the tixel's footprint
   /// Sun masks (lightfield.h "Sun masks"): the scene lights masked (sunMaskLights, or none
   /// when BakeSettings::sunMasks is off) and per tixel one mask per masked light (slots past
@@ -225,6 +228,10 @@ Parameterisation buildCharts(const Scene& scene, const Accel& accel, const BakeS
 /// parameterisation's time on a large scene. A record's tixels depend
 /// only on the record, so ranks can fill disjoint records and exchange them (shard.h).
 void fillTixels(const Scene& scene, const Accel& accel, Parameterisation& p, uint32_t firstRecord, uint32_t endRecord);
+/// Traces the sun masks of masked light `slot` (of p.sunMaskLights) again, for every diffuse
+/// tixel, as fillTixels does for the light's current direction: what relighting (relight.h)
+/// recomputes when a sun moves. The other slots are left alone.
+void recomputeSunMasks(const Scene& scene, const Accel& accel, Parameterisation& p, size_t slot);
 /// The same, building its own Accel for the scene scale.
 Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& settings);
 

@@ -628,17 +628,7 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
     }
   }
 
-  // The light sampler the path tracer uses (light/light.h): emissive triangles chosen ∝ their
-  // power and sampled by area, whose area density is then constant per untextured material
-  // (a textured one's varies by triangle: the gather reads it per tixel, emitterAreaPdfOf).
-  ops->lights = LightSampler(scene);
-  ops->areaPdf.assign(scene.materials.size(), 0.0f);
-  for (uint32_t mesh = 0; mesh < scene.meshes.size(); ++mesh)
-    for (uint32_t t = 0; t < scene.meshes[mesh].triangles.size(); ++t) {
-      const uint32_t m = scene.meshes[mesh].materials[t];
-      if (scene.materials[m].emissionTexture < 0) ops->areaPdf[m] = std::max(ops->areaPdf[m], ops->lights.emitterAreaPdf(mesh, t));
-    }
-  ops->lightSamples = ops->lights.emissiveTriangleCount() == 0 ? 0 : settings.areaLightSamples;
+  refreshEmitters(*this);
   // The gather never finds the scene's lights (they are no geometry): a non-delta one gets
   // shadow rays even when the preset gives emissive surfaces none.
   ops->sceneLightSamples = std::max(1u, settings.areaLightSamples);
@@ -648,7 +638,6 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   // caustic pass (caustics.h), so crossing glass here too would count them twice.
   ops->shadows.emplace(scene, accel);
   ops->glassFirstShot.emplace(scene, param, n);
-  caustics = shootsCaustics(param, ops->lights, settings);
 
   direct.assign(param.valueCount, Rgb(0.0f));
   const bool glossyReflector = std::any_of(param.charts.begin(), param.charts.end(), [&](const Chart& c) {
@@ -675,6 +664,23 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
         }
       }
   }
+}
+
+void refreshEmitters(TransportState& state) {
+  const Scene& scene = state.scene;
+  TransportState::Operators& ops = *state.ops;
+  // The light sampler the path tracer uses (light/light.h): emissive triangles chosen ∝ their
+  // power and sampled by area, whose area density is then constant per untextured material
+  // (a textured one's varies by triangle: the gather reads it per tixel, emitterAreaPdfOf).
+  ops.lights = LightSampler(scene);
+  ops.areaPdf.assign(scene.materials.size(), 0.0f);
+  for (uint32_t mesh = 0; mesh < scene.meshes.size(); ++mesh)
+    for (uint32_t t = 0; t < scene.meshes[mesh].triangles.size(); ++t) {
+      const uint32_t m = scene.meshes[mesh].materials[t];
+      if (scene.materials[m].emissionTexture < 0) ops.areaPdf[m] = std::max(ops.areaPdf[m], ops.lights.emitterAreaPdf(mesh, t));
+    }
+  ops.lightSamples = ops.lights.emissiveTriangleCount() == 0 ? 0 : state.settings.areaLightSamples;
+  state.caustics = shootsCaustics(state.param, ops.lights, state.settings);
 }
 
 std::vector<uint64_t> propagationBatches(const Parameterisation& param) {
@@ -734,7 +740,22 @@ void removeSunMaskedDirect(const Scene& scene, const Parameterisation& param, st
   });
 }
 
-void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progress* progress) {
+void storeLightField(LightField& lf, const Parameterisation& param, std::vector<Rgb>&& values) {
+  lf.charts = param.charts;
+  lf.triangleChart = param.triangleChart;
+  lf.values = std::move(values);
+  removeSunMaskedDirect(lf.scene, param, lf.values);
+  lf.sunMaskLightCount = uint32_t(param.sunMaskLights.size());
+  lf.sunMasks.reserve(param.tixelCount * lf.sunMaskLightCount);
+  for (uint64_t g = 0; g < param.tixelCount && lf.sunMaskLightCount > 0; ++g)
+    lf.sunMasks.insert(lf.sunMasks.end(), param.sunMask[g].begin(), param.sunMask[g].begin() + lf.sunMaskLightCount);
+}
+
+void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progress* progress,
+                     const ShadowRaySources& sources) {
+  if (!sources.lights.empty() && sources.lights.size() != state.scene.lights.size())
+    fail("{}: shadow-ray sources name {} lights, the scene has {}", state.scene.sourcePath, sources.lights.size(),
+         state.scene.lights.size());
   const Scene& scene = state.scene;
   const Accel& accel = state.accel;
   const Parameterisation& param = state.param;
@@ -779,6 +800,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       // the other (|cos θ|; the BSDF chooses, see the Pending loop below).
       const bool bothSides = isRoughGlassChart(c, scene.materials[c.material].bsdf);
       for (size_t li = 0; li < sceneLights.size(); ++li) {
+        if (!sources.lights.empty() && !sources.lights[li]) continue;
         const Light& light = sceneLights[li];
         // A masked light on a diffuse tixel: its footprint's mean visibility, no ray
         // (lightfield.h "Sun masks"; sunMaskedIrradiance, which the bake takes back out).
@@ -813,7 +835,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
           pending.push_back({g, in->wi, irradiance, !delta});
         }
       }
-      if (lightSamples == 0) continue;
+      if (lightSamples == 0 || !sources.emitters) continue;
       // Every accepted sample direction has cos θx > 0, so all of this tixel's shadow rays
       // start at the same offset origin (rough glass: one on each side).
       const Vec3 origin = offsetRayOrigin(x, normal, normal);
@@ -1187,10 +1209,11 @@ double transportChange(const TransportState& state) {
   return areaWeightedSum(state.param, [&](uint64_t g, const Chart&, uint64_t) { return double(state.change[g]); });
 }
 
-void finishTransport(TransportState& state) {
+void finishTransport(TransportState& state) { finishValues(state, state.current); }
+
+void finishValues(const TransportState& state, std::vector<Rgb>& current) {
   const Scene& scene = state.scene;
   const Parameterisation& param = state.param;
-  std::vector<Rgb>& current = state.current;
   // The punctual lights' direct highlights leave the stored maps (lightfield.h "Punctual
   // highlights"): the renderers evaluate them per pixel.
   if (!state.punctualGlossy.empty())
@@ -1313,44 +1336,7 @@ const VisibilityShard& shootFirstShot(TransportState& state, const ShardPlan& pl
 // before the next batch, and the batch's transport is refreshed on every rank from the
 // exchanged values, so each batch still sees this iteration's values of the batches before
 // it. The stopping rule then runs on every rank over the same values in the same order.
-constexpr float kOverRelaxation = 1.2f;
-
-/// When to stop. The residual is the relative change of the total outgoing power, |ΔP| / P,
-/// and iteration stops once it is below the tolerance — and once, too, the error that remains is:
-///   * with over-relaxation, changes of opposite sign in different tixels could cancel in ΔP
-///     while the values still swing, so the L1 change δ = Σ area·|Δ exitance| / P is tracked
-///     (for plain Gauss–Seidel every change is ≥ 0 and δ = |ΔP|/P);
-///   * the error left after a change δ is the rest of a geometric series, δ·ρ̂/(1 − ρ̂), with
-///     ρ̂ = δ_k / δ_{k−1} the measured contraction: below δ while ρ̂ < ½, but 9·δ for a bright
-///     closed scene converging at ρ̂ = 0.9, where the last change alone would stop too early.
-/// Both |ΔP|/P and δ·ρ̂/(1 − ρ̂) must be below the tolerance. It also owns ω, which falls back to
-/// 1 when δ grows after the second iteration.
-class StoppingRule {
- public:
-  StoppingRule(double startPower, float tolerance) : previousPower_(startPower), tolerance_(tolerance) {}
-
-  /// After iteration `iteration` (from 1) with total power `power` and L1 change `changed`
-  /// (transportPower, transportChange): sets result.iterations and result.residual, and
-  /// whether to stop.
-  bool converged(uint32_t iteration, double power, double changed, PropagationResult& result) {
-    const double l1Change = power > 0.0 ? changed / power : 0.0;
-    if (iteration > 2 && l1Change > previousL1Change_) omega_ = 1.0f;
-    const double contraction = previousL1Change_ > 0.0 ? l1Change / previousL1Change_ : 1.0;
-    const double remainingError = l1Change == 0.0 ? 0.0 : (contraction < 1.0 ? l1Change * contraction / (1.0 - contraction) : kInfinity);
-    result.iterations = iteration;
-    result.residual = power > 0.0 ? std::abs(power - previousPower_) / power : 0.0;
-    previousPower_ = power;
-    previousL1Change_ = l1Change;
-    return result.residual < tolerance_ && remainingError < tolerance_;
-  }
-  /// The over-relaxation of the next iteration.
-  float omega() const { return omega_; }
-
- private:
-  double previousPower_, previousL1Change_ = 0.0;
-  float tolerance_;
-  float omega_ = kOverRelaxation;
-};
+// (kOverRelaxation, propagation.h.)
 
 /// One iteration: every batch in order, this rank's part gathered (gatherIteration), the
 /// parts exchanged, the batch's transport refreshed and the change of the other ranks'
@@ -1390,9 +1376,7 @@ void iterate(TransportState& state, const VisibilityShard& vis, const ShardPlan&
   // The previous iteration's values are needed only by lookups in glossy charts of the batch
   // being updated (diffuse lookups read the quads, which lag by a batch), and by the change of
   // the tixels other ranks updated.
-  const bool anyGlossy = std::any_of(param.charts.begin(), param.charts.end(),
-                                     [](const Chart& c) { return c.kind == ChartKind::Glossy; });
-  const bool keepPrevious = anyGlossy || plan.ranks > 1;
+  const bool keepPrevious = keepsPreviousValues(param) || plan.ranks > 1;
   StoppingRule stopping(transportPower(state, state.current), settings.tolerance);
   Progress progress("propagation", settings.maxIterations);
   for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
@@ -1417,6 +1401,18 @@ void iterate(TransportState& state, const VisibilityShard& vis, const ShardPlan&
 }
 
 }  // namespace
+
+bool keepsPreviousValues(const Parameterisation& param) {
+  return std::any_of(param.charts.begin(), param.charts.end(), [](const Chart& c) { return c.kind == ChartKind::Glossy; });
+}
+
+void iterateTransport(TransportState& state, const VisibilityShard& vis, float omega) {
+  SingleProcess single;
+  const ShardPlan plan = planShards(state.scene, state.param, state.settings, 1);
+  ValueExchange exchange(state.param, plan, single);
+  PropagationResult times;
+  iterateOnce(state, vis, plan, 0, omega, exchange, keepsPreviousValues(state.param), times);
+}
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const std::function<const VisibilityShard&()>& visibility, const BakeSettings& settings,

@@ -146,10 +146,18 @@ struct TransportState {
   std::unique_ptr<Operators> ops;
 };
 
+/// Which sources shootShadowRays shoots: by default every scene light and the emissive
+/// surfaces; relighting (relight.h) shoots each light on its own.
+struct ShadowRaySources {
+  std::vector<uint8_t> lights;  ///< per scene light, whether it is shot; empty = every one
+  bool emitters = true;         ///< the emissive surfaces' light samples
+};
+
 /// First shot, shadow rays: the scene's lights and emissive surfaces seen from
 /// tixels [begin, end) are added to state.direct. Needs no visibility field. Advances
 /// `progress` (may be null) by the tixels done.
-void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progress* progress = nullptr);
+void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progress* progress = nullptr,
+                     const ShadowRaySources& sources = {});
 /// Sun masks (lightfield.h): the slot of scene light `light` among param.sunMaskLights, or −1.
 int sunMaskSlot(const Parameterisation& param, uint32_t light);
 /// What masked light `light` (slot `slot`) adds to diffuse tixel `tixel`'s irradiance in the
@@ -160,6 +168,10 @@ Rgb sunMaskedIrradiance(const Parameterisation& param, const Light& light, uint6
 /// tixel's final irradiance: the light field stores the rest, and the renderers add those
 /// lights at each point through the masks (lightfield.h "Sun masks"). Clamped at 0.
 void removeSunMaskedDirect(const Scene& scene, const Parameterisation& param, std::vector<Rgb>& values);
+/// The charts, values and sun masks of `lf` from the parameterisation and the propagated
+/// values (moved out of `values`): the masked lights leave the stored irradiance
+/// (removeSunMaskedDirect) and go with the masks. lf.scene must be the propagation's scene.
+void storeLightField(LightField& lf, const Parameterisation& param, std::vector<Rgb>&& values);
 /// First shot, gather: emission and environment arriving along the gather rays of tixels
 /// [begin, end) are added to state.direct. Throws pl::Error when `vis` does not hold the range
 /// or has another gather grid.
@@ -193,8 +205,62 @@ void updateTransport(TransportState& state, uint64_t begin, uint64_t end);
 double transportPower(const TransportState& state, const std::vector<Rgb>& values);
 /// Σ area × state.change (W): the L1 change of the last iteration.
 double transportChange(const TransportState& state);
+/// Rebuilds what the first shot derives from the scene's emissive surfaces (the light sampler,
+/// its area densities, whether caustics are shot) after their emission changed (relight.h).
+void refreshEmitters(TransportState& state);
+
+/// Over-relaxation of the iteration (SOR; the .cpp explains the choice).
+inline constexpr float kOverRelaxation = 1.2f;
+
+/// When to stop. The residual is the relative change of the total outgoing power, |ΔP| / P,
+/// and iteration stops once it is below the tolerance — and once, too, the error that remains is:
+///   * with over-relaxation, changes of opposite sign in different tixels could cancel in ΔP
+///     while the values still swing, so the L1 change δ = Σ area·|Δ exitance| / P is tracked
+///     (for plain Gauss–Seidel every change is ≥ 0 and δ = |ΔP|/P);
+///   * the error left after a change δ is the rest of a geometric series, δ·ρ̂/(1 − ρ̂), with
+///     ρ̂ = δ_k / δ_{k−1} the measured contraction: below δ while ρ̂ < ½, but 9·δ for a bright
+///     closed scene converging at ρ̂ = 0.9, where the last change alone would stop too early.
+/// Both |ΔP|/P and δ·ρ̂/(1 − ρ̂) must be below the tolerance. It also owns ω, which falls back to
+/// 1 when δ grows after the second iteration.
+class StoppingRule {
+ public:
+  StoppingRule(double startPower, float tolerance) : previousPower_(startPower), tolerance_(tolerance) {}
+
+  /// After iteration `iteration` (from 1) with total power `power` and L1 change `changed`
+  /// (transportPower, transportChange): sets result.iterations and result.residual, and
+  /// whether to stop.
+  bool converged(uint32_t iteration, double power, double changed, PropagationResult& result) {
+    const double l1Change = power > 0.0 ? changed / power : 0.0;
+    if (iteration > 2 && l1Change > previousL1Change_) omega_ = 1.0f;
+    const double contraction = previousL1Change_ > 0.0 ? l1Change / previousL1Change_ : 1.0;
+    const double remainingError = l1Change == 0.0 ? 0.0 : (contraction < 1.0 ? l1Change * contraction / (1.0 - contraction) : kInfinity);
+    result.iterations = iteration;
+    result.residual = power > 0.0 ? std::abs(power - previousPower_) / power : 0.0;
+    previousPower_ = power;
+    previousL1Change_ = l1Change;
+    return result.residual < tolerance_ && remainingError < tolerance_;
+  }
+  /// The over-relaxation of the next iteration.
+  float omega() const { return omega_; }
+
+ private:
+  double previousPower_, previousL1Change_ = 0.0;
+  float tolerance_;
+  float omega_ = kOverRelaxation;
+};
+
+/// Whether the iteration keeps state.previousValues (the parameterisation has glossy charts).
+bool keepsPreviousValues(const Parameterisation& param);
+/// One iteration of one process, as propagate() runs it: every batch in order, gathered
+/// (gatherIteration with over-relaxation `omega`) and its transport refreshed. Starts from
+/// state.current and the transport quads as they are (beginIteration, or a warm start whose
+/// quads updateTransport refreshed).
+void iterateTransport(TransportState& state, const VisibilityShard& vis, float omega);
+
 /// Ends the propagation: glossy values get their emission. state.current is then the result.
 void finishTransport(TransportState& state);
+/// finishTransport's step on `values` (an iterate in state.current's layout) instead of state.current.
+void finishValues(const TransportState& state, std::vector<Rgb>& values);
 
 /// A reflected lobe (Blinn-Phong, GGX) whose full width at half maximum spans fewer than
 /// kNarrowLobeSubsamples of glossyOperator's cell sub-samples: its operator is built by

@@ -173,6 +173,7 @@ TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, P
   exchange(param.coverage);
   exchange(param.transportAlbedo);
   exchange(param.sunMask);
+  exchange(param.borrowedPoint);
   timing.exchangeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - filled).count();
   return timing;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "core/error.h"
@@ -111,6 +112,85 @@ CameraPose CameraPath::at(double time) const {
   return pose;
 }
 
+namespace {
+
+/// A keyframe's "lights": an array of {"light": index, parameter: number or [x, y, z], ...}.
+std::vector<LightKeyframe> readLightKeyframes(const Json& value, const std::string& where) {
+  if (!value.is_array()) fail("{}: 'lights' must be an array of objects", where);
+  std::vector<LightKeyframe> out;
+  for (size_t j = 0; j < value.size(); ++j) {
+    LightKeyframe light;
+    light.where = fmt::format("{}: lights[{}]", where, j);
+    const Json& entry = value[j];
+    if (!entry.is_object() || !entry.contains("light"))
+      fail("{}: expected an object with \"light\" (the light's index)", light.where);
+    for (const auto& [key, field] : entry.items()) {
+      if (key == "light") {
+        const double index = readNumber(field, light.where, "light");
+        if (!(index >= 0.0 && index < 65536.0 && index == std::floor(index)))
+          fail("{}: 'light' must be a light's index (0, 1, …), got {}", light.where, field.dump());
+        light.light = uint32_t(index);
+      } else if (field.is_array()) {
+        light.parameters[key] = readVec3(field, light.where, key.c_str());
+      } else {
+        light.parameters[key] = float(readNumber(field, light.where, key.c_str()));
+      }
+    }
+    out.push_back(std::move(light));
+  }
+  return out;
+}
+
+/// Linear interpolation; a number beside three numbers (a grey emission beside a colour) is
+/// taken as three equal ones.
+LightParameterValue lerpParameter(const LightParameterValue& a, const LightParameterValue& b, float t) {
+  if (std::holds_alternative<float>(a) && std::holds_alternative<float>(b))
+    return std::get<float>(a) + (std::get<float>(b) - std::get<float>(a)) * t;
+  auto vec = [](const LightParameterValue& v) { return std::holds_alternative<float>(v) ? Vec3(std::get<float>(v)) : std::get<Vec3>(v); };
+  return vec(a) + (vec(b) - vec(a)) * t;
+}
+
+}  // namespace
+
+bool CameraPath::animatesLights() const {
+  return std::any_of(keyframes.begin(), keyframes.end(), [](const CameraKeyframe& k) { return !k.lights.empty(); });
+}
+
+void CameraPath::lightsAt(double time, std::vector<Light>& lights) const {
+  // Per (light, parameter): the keyframes that set it, in time order.
+  struct Key {
+    double time;
+    const LightParameterValue* value;
+    const std::string* where;
+  };
+  std::map<std::pair<uint32_t, std::string>, std::vector<Key>> tracks;
+  for (const CameraKeyframe& k : keyframes)
+    for (const LightKeyframe& l : k.lights) {
+      if (l.light >= lights.size()) fail("{}: light {} does not exist (the scene has {})", l.where, l.light, lights.size());
+      for (const auto& [name, value] : l.parameters) tracks[{l.light, name}].push_back({k.time, &value, &l.where});
+    }
+  for (const auto& [id, keys] : tracks) {
+    const auto next = std::upper_bound(keys.begin(), keys.end(), time, [](double t, const Key& k) { return t < k.time; });
+    LightParameterValue value = *keys.front().value;
+    if (next == keys.end()) {
+      value = *keys.back().value;
+    } else if (next != keys.begin()) {
+      const Key& a = *(next - 1);
+      value = lerpParameter(*a.value, *next->value, float((time - a.time) / (next->time - a.time)));
+    }
+    Light& light = lights[id.first];
+    const std::string& where = *keys.front().where;
+    setLightParameters(light, {{id.second, value}}, where, {.anglesInDegrees = true});
+    if (const std::string problem = lightProblem(light); !problem.empty())
+      fail("{}: at time {}: {} light {} {}", where, time, lightTypeName(light), id.first, problem);
+    const Rgb emission = lightEmission(light);
+    if (emission.r < 0.0f || emission.g < 0.0f || emission.b < 0.0f)
+      fail("{}: at time {}: light {}'s {} must not be negative", where, time, id.first, lightEmissionName(light));
+    normaliseLightDirections(light);
+    prepareLight(light);
+  }
+}
+
 CameraPath parseCameraPath(const std::string& text, const std::string& source) {
   Json root;
   try {
@@ -156,8 +236,10 @@ CameraPath parseCameraPath(const std::string& text, const std::string& source) {
         const double fov = readNumber(value, where, "fov");
         if (!(fov > 0.0 && fov < 180.0)) fail("{}: 'fov' must be in (0, 180) degrees, got {}", where, fov);
         frame.fovYDegrees = float(fov);
+      } else if (key == "lights") {
+        frame.lights = readLightKeyframes(value, where);
       } else {
-        fail("{}: unknown key '{}' (expected time, eye, target, fov, up)", where, key);
+        fail("{}: unknown key '{}' (expected time, eye, target, fov, up, lights)", where, key);
       }
     }
     if (!hasTime) fail("{}: missing 'time'", where);
@@ -207,6 +289,15 @@ std::string cameraPathToJson(const CameraPath& path) {
     key["target"] = {k.target.x, k.target.y, k.target.z};
     key["up"] = {k.up.x, k.up.y, k.up.z};
     if (k.fovYDegrees) key["fov"] = *k.fovYDegrees;
+    for (const LightKeyframe& l : k.lights) {
+      Json light;
+      light["light"] = l.light;
+      for (const auto& [name, value] : l.parameters) {
+        if (const float* f = std::get_if<float>(&value)) light[name] = *f;
+        else light[name] = {std::get<Vec3>(value).x, std::get<Vec3>(value).y, std::get<Vec3>(value).z};
+      }
+      key["lights"].push_back(light);
+    }
     keys.push_back(key);
   }
   root["keyframes"] = keys;

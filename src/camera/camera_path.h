@@ -26,14 +26,31 @@
 // (the camera standing still) makes that segment constant. fov uses the uniform Catmull–Rom
 // spline (cubic Hermite with tangents (f_{i+1} − f_{i−1})/2) clamped to [1°, 179°]; up is
 // interpolated linearly and renormalised. Times outside the keyframes clamp to the ends.
+//
+// Light keyframes (time of day; `render --path` relights between frames, bake/relight.h): a
+// keyframe may also set parameters of the scene's lights,
+//   "lights": [{"light": 0, "direction": [x, y, z], "irradiance": [r, g, b]}, ...]
+// "light" the index of the light in the scene, the other keys its parameters as a JSON scene
+// names them (docs/scenes.md: position, direction, intensity or irradiance — a number is
+// grey —, inner_angle and outer_angle in degrees, radius). A parameter is interpolated
+// linearly in time between the keyframes that set it (a direction then renormalised), held
+// before the first and after the last of them; what no keyframe sets keeps the scene's value.
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "core/math.h"
+#include "light/lights.h"
 #include "scene/scene.h"
 
 namespace pl {
+
+/// One light's parameters set by a keyframe.
+struct LightKeyframe {
+  uint32_t light = 0;         ///< index into the scene's lights
+  LightParameters parameters;  ///< by the JSON scene's names; angles in degrees
+  std::string where;           ///< "<file>: keyframe 2: lights[0]", for errors
+};
 
 struct CameraKeyframe {
   double time = 0.0;  ///< seconds
@@ -41,6 +58,7 @@ struct CameraKeyframe {
   Vec3 target{0.0f};
   Vec3 up{0.0f, 1.0f, 0.0f};
   std::optional<float> fovYDegrees;  ///< after loading: set on all keyframes or on none
+  std::vector<LightKeyframe> lights;  ///< light keyframes (header comment)
 };
 
 /// Where the camera is at one instant.
@@ -63,6 +81,12 @@ struct CameraPath {
   double frameTime(int frame) const { return startTime() + double(frame) / fps; }
   /// The interpolated pose at `time` (seconds; clamped to the keyframes' range).
   CameraPose at(double time) const;
+  /// Whether some keyframe sets a light's parameters.
+  bool animatesLights() const;
+  /// `lights` (the scene's) with the light keyframes' parameters at `time`. Throws pl::Error
+  /// naming the keyframe for a light index out of range, a parameter the light's type does not
+  /// have, or a value out of range (lightProblem).
+  void lightsAt(double time, std::vector<Light>& lights) const;
 };
 
 /// Parses the JSON text of a path file; `source` names it in error messages

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "light/lights.h"
 #include "support/temp_dir_test.h"
 
 namespace pl {
@@ -184,6 +185,64 @@ TEST_F(CameraPathFile, RoundTripsThroughTheFile) {
     EXPECT_EQ(back.keyframes[i].target, path.keyframes[i].target);
     EXPECT_EQ(back.keyframes[i].fovYDegrees, path.keyframes[i].fovYDegrees);
   }
+}
+
+
+// Light keyframes: each parameter linear in time between the keyframes that set it, held
+// outside them; a direction renormalised; what no keyframe sets keeps the scene's value.
+TEST(CameraPath, InterpolatesLightKeyframes) {
+  const CameraPath path = parseCameraPath(R"({"fps": 10, "keyframes": [
+      {"time": 0, "eye": [0, 0, 5], "target": [0, 0, 0],
+       "lights": [{"light": 1, "direction": [1, -1, 0], "irradiance": [2, 2, 2]}]},
+      {"time": 1, "eye": [0, 0, 5], "target": [0, 0, 0], "lights": [{"light": 1, "irradiance": 4}]},
+      {"time": 2, "eye": [0, 0, 5], "target": [0, 0, 0], "lights": [{"light": 1, "direction": [-1, -1, 0]}]}]})",
+                                          "sun.json");
+  ASSERT_TRUE(path.animatesLights());
+  const std::vector<Light> scene = {createLight("point", {{"intensity", 7.0f}}, "p"),
+                                    createLight("directional", {{"direction", Vec3(0, -1, 0)}}, "d")};
+  std::vector<Light> at = scene;
+  path.lightsAt(0.5, at);
+  EXPECT_EQ(lightEmission(at[0]), Rgb(7.0f));  // not animated
+  EXPECT_NEAR(lightEmission(at[1]).g, 3.0f, 1e-6f);
+  // The direction is keyed at 0 and 2: at 0.5 a quarter of the way, renormalised.
+  const Vec3 expected = glm::normalize(Vec3(0.5f, -1.0f, 0.0f));
+  const Vec3 direction = std::get<DirectionalLight>(at[1]).direction;
+  EXPECT_NEAR(direction.x, expected.x, 1e-5f);
+  EXPECT_NEAR(direction.y, expected.y, 1e-5f);
+  at = scene;
+  path.lightsAt(5.0, at);  // held after the last keyframe
+  EXPECT_NEAR(lightEmission(at[1]).r, 4.0f, 1e-6f);
+  EXPECT_NEAR(std::get<DirectionalLight>(at[1]).direction.x, -std::sqrt(0.5f), 1e-5f);
+  // Round trip through the file format.
+  const CameraPath again = parseCameraPath(cameraPathToJson(path), "again.json");
+  std::vector<Light> a = scene, b = scene;
+  path.lightsAt(1.3, a);
+  again.lightsAt(1.3, b);
+  EXPECT_EQ(lightEmission(a[1]), lightEmission(b[1]));
+  EXPECT_EQ(std::get<DirectionalLight>(a[1]).direction, std::get<DirectionalLight>(b[1]).direction);
+}
+
+TEST(CameraPath, BadLightKeyframesNameTheKeyframe) {
+  auto lightsAt = [](const std::string& lights, std::vector<Light> scene) {
+    parseCameraPath(R"({"keyframes": [{"time": 0, "eye": [0, 0, 5], "target": [0, 0, 0], "lights": )" + lights + "}]}",
+                    "bad.json")
+        .lightsAt(0.0, scene);
+  };
+  const std::vector<Light> one = {createLight("point", {}, "p")};
+  auto expectError = [&](const std::string& lights, const std::string& message) {
+    try {
+      lightsAt(lights, one);
+      ADD_FAILURE() << "accepted " << lights;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  };
+  expectError(R"({"light": 0})", "'lights' must be an array");
+  expectError(R"([{"intensity": 1}])", "bad.json: keyframe 0: lights[0]: expected an object with \"light\"");
+  expectError(R"([{"light": -1}])", "'light' must be a light's index");
+  expectError(R"([{"light": 3, "intensity": 1}])", "light 3 does not exist (the scene has 1)");
+  expectError(R"([{"light": 0, "irradiance": 1}])", "unknown key 'irradiance' for a point light");
+  expectError(R"([{"light": 0, "intensity": -1}])", "at time 0");
 }
 
 }  // namespace

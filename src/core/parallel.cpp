@@ -7,6 +7,7 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <tbb/task_scheduler_observer.h>
 #include <xmmintrin.h>
 
@@ -49,6 +50,15 @@ ThreadPool::ThreadPool(int threads) : impl_(std::make_unique<Impl>()) {
 }
 
 ThreadPool::~ThreadPool() = default;
+
+void runWithThreads(int threads, const std::function<void()>& work) {
+  ensureDenormalObserver();
+  tbb::task_arena arena(threads > 0 ? threads : 1);
+  arena.execute([&] {
+    enableFlushDenormals();
+    work();
+  });
+}
 
 void parallelForRange(uint64_t count, uint64_t grain, const std::function<void(uint64_t, uint64_t)>& body) {
   if (count == 0) return;

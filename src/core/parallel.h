@@ -29,6 +29,11 @@ class ThreadPool {
 /// Sets FTZ/DAZ on the calling thread (the observer does it for TBB workers).
 void enableFlushDenormals();
 
+/// Runs work() with the parallel loops it starts limited to `threads` threads, the calling
+/// thread among them (a task arena of its own), so that loops started by other threads keep
+/// the pool: the viewer's background propagation on one thread beside the renderer's loops.
+void runWithThreads(int threads, const std::function<void()>& work);
+
 /// Calls body(begin, end) on disjoint sub-ranges of [0, count), in parallel. grain is the
 /// smallest range handed to one task. Each sub-range starts with a cancellation point
 /// (core/cancel.h): once cancellation is requested, the loop stops and pl::Cancelled is thrown.

@@ -13,6 +13,7 @@
 #include "jobs/jobs.h"
 #include "bake/bake.h"
 #include "bake/shard.h"
+#include "bake/relight.h"
 #include "distributed/communicator.h"
 #include "plf/compression.h"
 #include "plf/plf_file.h"
@@ -68,7 +69,7 @@ BakeJob::BakeJob(BakeJobOptions options) : options_(std::move(options)) {
   if (!options_.output.empty()) checkOutputPath(options_.output, {".plf"}, "-o");
   visibilityPath_ = options_.visibilityPath;
   if (visibilityPath_.empty() && !options_.output.empty())
-    visibilityPath_ = std::filesystem::path(options_.output).replace_extension(".plv").string();
+    visibilityPath_ = visibilityPathFor(options_.output);
   if (!visibilityPath_.empty()) checkOutputPath(visibilityPath_, {".plv"}, "--visibility");
   if (!options_.statsPath.empty()) checkOutputPath(options_.statsPath, {}, "--stats");
   checkDistinctOutputs({{"-o", options_.output}, {"--visibility", visibilityPath_}, {"--stats", options_.statsPath}});
@@ -137,6 +138,8 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
   bakeOptions.communicator = options_.communicator;
   DistributedBakeStats distributed;
   bakeOptions.distributedStats = &distributed;
+  bakeOptions.keepParameterisation = options_.keepParameterisation;
+  bakeOptions.keepVisibility = options_.keepVisibility;
   BakeJobResult result{bake(std::move(scene), settings(), bakeOptions), {}};
   const LightField& lf = result.lightField;
   BakeJobStats& stats = result.stats;

@@ -174,6 +174,9 @@ struct BakeJobOptions {
   /// The ranks of a distributed bake (distributed/communicator.h); null = one process. Every
   /// rank runs the job; only rank 0 writes the .plf and the stats.
   Communicator* communicator = nullptr;
+  /// Receive the parameterisation and the visibility field for relighting (BakeOptions). May be null.
+  Parameterisation* keepParameterisation = nullptr;
+  VisibilityShard* keepVisibility = nullptr;
 };
 
 /// What `plenoptic bake --stats` writes.
@@ -230,6 +233,9 @@ struct RenderJobOptions {
   /// refused (pl::Error naming what is missing) for a light field or settings it cannot draw.
   bool gpu = false;
   std::string pathFile;    ///< camera path JSON: a walk-through, one output per frame
+  /// The visibility field (.plv) that a path with light keyframes relights from (bake/relight.h);
+  /// empty: run(plfPath) takes the .plf's X.plv, run(LightField) refuses such a path.
+  std::string visibilityPath;
   ViewSettings view;
   int threads = 0;  ///< 0 = all hardware threads
 };
@@ -247,6 +253,11 @@ struct RenderJobStats {
   double primaryMsMedian = 0, primaryMsMin = 0;
   double loadSeconds = 0, accelBuildSeconds = 0;
   uint64_t fileBytes = 0;
+  /// A path with light keyframes: frames relit, iterations, and the time relighting took
+  /// (excluded from the frame times; the Relighter's set-up included).
+  int relitFrames = 0;
+  uint64_t relightIterations = 0;
+  double relightSeconds = 0;
   std::string toJson() const;
 };
 
@@ -263,7 +274,8 @@ class RenderJob {
   const RenderJobOptions& options() const { return options_; }
 
  private:
-  RenderJobResult render(const LightField& lightField, double loadSeconds, uint64_t fileBytes) const;
+  RenderJobResult render(const LightField& lightField, double loadSeconds, uint64_t fileBytes,
+                         const std::string& visibilityPath) const;
   RenderJobOptions options_;
   std::optional<CameraPath> cameraPath_;
 };

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "accel/accel.h"
+#include "bake/relight.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/parallel.h"
@@ -49,6 +50,8 @@ std::string RenderJobStats::toJson() const {
   json["load_seconds"] = loadSeconds;
   json["accel_build_seconds"] = accelBuildSeconds;
   json["file_bytes"] = fileBytes;
+  if (relitFrames > 0)
+    json["relight"] = {{"frames", relitFrames}, {"iterations", relightIterations}, {"seconds", relightSeconds}};
   return json.dump(2) + "\n";
 }
 
@@ -80,6 +83,8 @@ RenderJob::RenderJob(RenderJobOptions options) : options_(std::move(options)) {
   if (!o.statsPath.empty()) checkOutputPath(o.statsPath, {}, "--stats");
   checkDistinctOutputs({{"-o", o.output}, {"--stats", o.statsPath}});
   if (!o.pathFile.empty()) cameraPath_ = loadCameraPath(o.pathFile);
+  if (cameraPath_ && cameraPath_->animatesLights() && o.gpu)
+    failUsage("--path {}: light keyframes are relit for the CPU renderers; leave out --renderer gpu", o.pathFile);
   if (video && findFfmpeg().empty())
     fail("-o {}: MP4 output needs ffmpeg, which is not installed (not found on PATH); write an image sequence "
          "instead, e.g. -o frames/%04d.png",
@@ -90,12 +95,16 @@ RenderJobResult RenderJob::run(const std::string& plfPath) const {
   const auto loadStart = SteadyClock::now();
   const LightField lightField = readLightField(plfPath);
   const double loadSeconds = secondsSince(loadStart);
-  return render(lightField, loadSeconds, std::filesystem::file_size(plfPath));
+  const std::string visibility = options_.visibilityPath.empty() ? visibilityPathFor(plfPath) : options_.visibilityPath;
+  return render(lightField, loadSeconds, std::filesystem::file_size(plfPath), visibility);
 }
 
-RenderJobResult RenderJob::run(const LightField& lightField) const { return render(lightField, 0.0, 0); }
+RenderJobResult RenderJob::run(const LightField& lightField) const {
+  return render(lightField, 0.0, 0, options_.visibilityPath);
+}
 
-RenderJobResult RenderJob::render(const LightField& lightField, double loadSeconds, uint64_t fileBytes) const {
+RenderJobResult RenderJob::render(const LightField& lightField, double loadSeconds, uint64_t fileBytes,
+                                  const std::string& visibilityPath) const {
   const RenderJobOptions& o = options_;
   const ThreadPool pool(o.threads);
   const ViewSettings& view = o.view;
@@ -115,6 +124,35 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
     gpuRenderer->checkSettings(o.render, camera);
   }
 
+  // Light keyframes: every frame relit from the visibility field (bake/relight.h), then drawn
+  // from `relit` by a renderer built for it.
+  std::optional<Relighter> relighter;
+  std::optional<LightField> relit;
+  std::optional<FastRenderer> relitRenderer;
+  double relightSeconds = 0.0;
+  uint64_t relightIterations = 0;
+  if (cameraPath_ && cameraPath_->animatesLights()) {
+    const auto start = SteadyClock::now();
+    std::vector<Light> lights = lightField.scene.lights;
+    cameraPath_->lightsAt(cameraPath_->startTime(), lights);  // the keyframes' errors before any work
+    if (visibilityPath.empty())
+      fail("{}: the camera path animates lights, which needs the light field's visibility field (.plv)", o.pathFile);
+    relighter.emplace(lightField, visibilityPath);
+    relit.emplace(relighter->lightField());
+    relightSeconds += secondsSince(start);
+  }
+  auto relightFor = [&](double time) {
+    const auto start = SteadyClock::now();
+    std::vector<Light> lights = lightField.scene.lights;
+    cameraPath_->lightsAt(time, lights);
+    for (uint32_t l = 0; l < lights.size(); ++l) relighter->setLight(l, lights[l]);
+    relightIterations += relighter->relight().iterations;
+    relitRenderer.reset();
+    relighter->update(*relit);
+    relitRenderer.emplace(*relit, accel);
+    relightSeconds += secondsSince(start);
+  };
+
   RenderSettings settings = o.render;
   settings.showProgress = o.frames == 1 && o.reference;
   RenderJobResult result;
@@ -129,11 +167,11 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   auto renderFrame = [&](const Camera& frameCamera) {
     const auto start = SteadyClock::now();
     if (o.reference) {
-      image = renderLightField(lightField, accel, frameCamera, settings);
+      image = renderLightField(relit ? *relit : lightField, accel, frameCamera, settings);
     } else if (gpuRenderer) {
       gpuRenderer->render(frameCamera, settings, image);
     } else {
-      fastRenderer.render(frameCamera, settings, image);
+      (relitRenderer ? *relitRenderer : fastRenderer).render(frameCamera, settings, image);
     }
     frameMs.push_back(1e3 * secondsSince(start));
     if (timePrimary) frameCameras.push_back(frameCamera);
@@ -153,8 +191,11 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
     walk.metresPerUnit = view.metresPerUnit(lightField.scene);
     walk.exposureScale = view.exposureScale();
     walk.toneMap = view.toneMapSettings();
+    int frame = 0;
     const WalkthroughResult walked =
         renderWalkthrough(*cameraPath_, cameraDesc, walk, [&](const Camera& frameCamera, Image& frameImage) {
+          if (relighter) relightFor(cameraPath_->frameTime(frame));
+          ++frame;
           renderFrame(frameCamera);
           std::swap(frameImage, image);
         });
@@ -194,6 +235,11 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   stats.loadSeconds = loadSeconds;
   stats.accelBuildSeconds = accelSeconds;
   stats.fileBytes = fileBytes;
+  if (relighter) {
+    stats.relitFrames = frames;
+    stats.relightIterations = relightIterations;
+    stats.relightSeconds = relightSeconds;
+  }
   if (!o.statsPath.empty()) writeFileAtomically(o.statsPath, stats.toJson());
   return result;
 }

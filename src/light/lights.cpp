@@ -188,6 +188,12 @@ Light createLight(std::string_view type, const LightParameters& parameters, cons
                   LightCreation options) {
   std::optional<Light> light = lightNamed(type, kLightIndices);
   if (!light) fail("{}: unknown light type '{}' ({})", where, type, lightTypeNames());
+  setLightParameters(*light, parameters, where, options);
+  return *light;
+}
+
+void setLightParameters(Light& light, const LightParameters& parameters, const std::string& where,
+                        LightCreation options) {
   std::set<std::string_view> known;
   std::visit(
       [&](auto& l) {
@@ -212,9 +218,8 @@ Light createLight(std::string_view type, const LightParameters& parameters, cons
             if (!known.count(entry.first))
               fail("{}: unknown key '{}' for a {} light ({})", where, entry.first, T::kType, parameterNames<T>());
       },
-      *light);
-  prepareLight(*light);
-  return *light;
+      light);
+  prepareLight(light);
 }
 
 // ---- Generic steps over the parameters ---------------------------------------------------

@@ -208,6 +208,10 @@ struct LightCreation {
 /// wrong shape. Ranges are checked by lightProblem (Scene::finalize).
 Light createLight(std::string_view type, const LightParameters& parameters, const std::string& where,
                   LightCreation options = {});
+/// Sets the named parameters of an existing light (createLight's step after choosing the
+/// type; the same errors), then prepares it. Ranges are not checked (lightProblem).
+void setLightParameters(Light& light, const LightParameters& parameters, const std::string& where,
+                        LightCreation options = {});
 /// The type names, in variant order: "point, spot, directional, sphere".
 std::string lightTypeNames();
 /// A default light of variant index `index` (the .plf light number), for filling through

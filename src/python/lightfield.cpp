@@ -6,6 +6,9 @@
 #include <vector>
 
 #include "bindings.h"
+#include "bake/parameterisation.h"
+#include "bake/relight.h"
+#include "bake/visibility.h"
 #include "camera/camera_path.h"
 #include "core/error.h"
 #include "core/memory.h"
@@ -15,11 +18,55 @@
 namespace pl::python {
 namespace {
 
+/// What relighting a light field needs (bake/relight.h), shared by the light fields relit
+/// from one bake or file: the bake's parameterisation and visibility field until the first
+/// relight() makes the Relighter of them, or the .plv path a loaded file relights from.
+struct RelightSource {
+  std::optional<Parameterisation> param;
+  std::optional<VisibilityShard> visibility;
+  std::string visibilityPath;
+  std::shared_ptr<Relighter> relighter;
+};
+
 /// A baked or loaded light field, shared by the Python objects that refer to it.
 struct PyLightField {
   std::shared_ptr<const LightField> lightField;
-  py::dict stats;  ///< the bake's --stats JSON (empty for a loaded file)
+  py::dict stats;  ///< the bake's --stats JSON (empty for a loaded file); relight()'s for a relit one
+  std::shared_ptr<RelightSource> relight;
 };
+
+/// The Relighter of `lf`, made on first use.
+Relighter& relighterOf(const PyLightField& lf) {
+  RelightSource& source = *lf.relight;
+  if (source.relighter) return *source.relighter;
+  if (source.visibility) {
+    source.relighter = std::make_shared<Relighter>(*lf.lightField, std::move(*source.visibility), std::move(*source.param));
+    source.visibility.reset();
+    source.param.reset();
+  } else if (!source.visibilityPath.empty()) {
+    source.relighter = std::make_shared<Relighter>(*lf.lightField, source.visibilityPath);
+  } else {
+    throw UsageError(fmt::format("{}: relight needs the visibility field, which this light field no longer holds: bake "
+                                 "with keep_visibility=True, or save it and load it with its .plv",
+                                 lf.lightField->scene.sourcePath));
+  }
+  return *source.relighter;
+}
+
+py::dict relightStatsDict(const RelightStats& s) {
+  py::dict d;
+  d["iterations"] = s.iterations;
+  d["residual"] = s.residual;
+  d["converged"] = s.converged;
+  d["seconds"] = s.seconds;
+  d["first_frame_seconds"] = s.firstFrameSeconds;
+  d["sun_mask_seconds"] = s.sunMaskSeconds;
+  d["first_shot_seconds"] = s.firstShotSeconds;
+  d["lights_shot"] = s.lightsShot;
+  d["sun_masks_traced"] = s.sunMasksTraced;
+  d["emitters_shot"] = s.emittersShot;
+  return d;
+}
 
 /// Camera samples per pixel from the `spp` keyword or its former name `samples` (still
 /// accepted); 0 = automatic when neither is given.
@@ -116,6 +163,27 @@ void bindLightField(py::module_& m) {
           py::arg("texture_lod") = true, py::kw_only(), py::arg("samples") = py::none(),
           "Renders a walk-through: path is a camera path JSON file (what `plenoptic render --path` renders, frame k at\n"
           "t0 + k/fps, posed on `camera`) or a list of Cameras. Returns a list of float32 (height, width, 3) frames.")
+      .def(
+          "relight",
+          [](const PyLightField& lf, const Scene& scene) {
+            PyLightField out;
+            out.relight = lf.relight;
+            const RelightStats stats = runInterruptible([&] {
+              Relighter& relighter = relighterOf(lf);
+              relighter.setScene(scene);
+              const RelightStats result = relighter.relight();
+              out.lightField = std::make_shared<const LightField>(relighter.lightField());
+              return result;
+            });
+            out.stats = relightStatsDict(stats);
+            return out;
+          },
+          py::arg("scene"),
+          "The light field relit for `scene` — the Scene it was baked from, edited with set_light_color,\n"
+          "set_light_direction, set_emission or set_albedo — from the visibility field in memory (kept by bake, or the\n"
+          ".plv beside a loaded .plf), warm-started from the last relit solution. Refused (plenoptic.Error, with the\n"
+          "command that re-bakes) for changes the stored field cannot serve: geometry, a material's model, a light\n"
+          "added, removed or of another type. stats: iterations, residual, converged, seconds, first_frame_seconds, ….")
       .def("__repr__", [](const PyLightField& lf) {
         const LightField& field = *lf.lightField;
         uint64_t tixels = 0;
@@ -128,9 +196,16 @@ void bindLightField(py::module_& m) {
       "bake",
       [](const Scene& scene, const std::string& preset, uint64_t seed, int threads, std::optional<std::string> visibility,
          bool reuseVisibility, bool sunMasks, bool punctualHighlights, std::optional<int64_t> causticPhotons,
-         std::optional<std::string> maxMemory) {
+         std::optional<std::string> maxMemory, bool keepVisibility) {
         BakeJobOptions options;
         if (maxMemory) options.maxMemory = parseMemorySize(*maxMemory, "max_memory");
+        auto relight = std::make_shared<RelightSource>();
+        if (keepVisibility) {
+          relight->param.emplace();
+          relight->visibility.emplace();
+          options.keepParameterisation = &*relight->param;
+          options.keepVisibility = &*relight->visibility;
+        }
         options.sunMasks = sunMasks;
         options.punctualHighlights = punctualHighlights;
         if (causticPhotons) {
@@ -155,26 +230,32 @@ void bindLightField(py::module_& m) {
         PyLightField lf;
         lf.stats = statsDict(result.stats.toJson());
         lf.lightField = std::make_shared<const LightField>(std::move(result.lightField));
+        lf.relight = std::move(relight);
         return lf;
       },
       py::arg("scene"), py::arg("preset") = "default", py::arg("seed") = 0, py::arg("threads") = 0,
       py::arg("visibility") = py::none(), py::arg("reuse_visibility") = false, py::arg("sun_masks") = true,
       py::arg("punctual_highlights") = true, py::arg("caustic_photons") = py::none(), py::arg("max_memory") = py::none(),
+      py::arg("keep_visibility") = true,
       "Bakes `scene`'s light field (what `plenoptic bake` does). visibility: a .plv path where the visibility field\n"
       "is saved; with reuse_visibility=True it is read back when the geometry and settings match (so a bake after\n"
       "editing only lights or emission re-runs the propagation alone). sun_masks=False: `--sun-masks off`;\n"
       "punctual_highlights=False: `--punctual-highlights off`; caustic_photons=N: `--caustic-photons N` (None:\n"
       "the preset's); max_memory=\"12G\": `--max-memory 12G` (the bake is refused, before it starts, when its\n"
-      "memory estimate exceeds it).");
+      "memory estimate exceeds it). keep_visibility=True keeps the visibility field in memory for LightField.relight\n"
+      "(False frees it).");
 
   m.def(
       "load_light_field",
-      [](const std::string& path) {
+      [](const std::string& path, std::optional<std::string> visibility) {
         PyLightField lf;
         lf.lightField = runInterruptible([&] { return std::make_shared<const LightField>(readLightField(path)); });
+        lf.relight = std::make_shared<RelightSource>();
+        lf.relight->visibilityPath = visibility ? *visibility : visibilityPathFor(path);
         return lf;
       },
-      py::arg("path"), "Reads a .plf file.");
+      py::arg("path"), py::arg("visibility") = py::none(),
+      "Reads a .plf file. visibility: the .plv that relight() reads (default: the .plf's X.plv), when first needed.");
 }
 
 }  // namespace pl::python

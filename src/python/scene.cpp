@@ -107,6 +107,20 @@ void bindScene(py::module_& m) {
              throw UsageError(fmt::format("{}: no material '{}'", s.sourcePath, material));
            },
            py::arg("material"), py::arg("rgb"), "Sets the emitted radiance (r, g, b) of a material, W/(sr m^2)")
+      .def("set_albedo",
+           [](Scene& s, const std::string& material, const std::vector<float>& rgb) {
+             const Rgb albedo = nonNegative(toRgb(rgb, "set_albedo"), "set_albedo");
+             if (albedo.r > 1.0f || albedo.g > 1.0f || albedo.b > 1.0f)
+               throw UsageError("set_albedo: an albedo is at most 1 in every channel");
+             for (Material& mat : s.materials)
+               if (mat.name == material) {
+                 mat.bsdf = withDiffuseAlbedo(mat.bsdf, albedo);
+                 return;
+               }
+             throw UsageError(fmt::format("{}: no material '{}'", s.sourcePath, material));
+           },
+           py::arg("material"), py::arg("rgb"),
+           "Sets the diffuse albedo (r, g, b) of a material (a Lambertian one's albedo; relight() takes only those)")
       .def("__repr__", [](const Scene& s) {
         return fmt::format("<plenoptic.Scene '{}': {}, {}, {}, {}>", s.sourcePath, count(s.triangleCount(), "triangle"),
                            count(s.materials.size(), "material"), count(s.cameras.size(), "camera"),

@@ -2,9 +2,11 @@
 // light field: what they print and write, and how they refuse bad input.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -286,6 +288,70 @@ TEST_F(RenderCliTest, OlderAndCurrentFixturesReadAndRewriteByteForByte) {
     ASSERT_EQ(run("info " + fixture, &out, &err), 0) << err;
     EXPECT_NE(out.find("format version " + name.substr(6, 1)), std::string::npos) << out;
   }
+}
+
+
+/// A floor and a wall standing on it under a grey sky and a sun (`irradiance`, travelling
+/// `direction`), as an OBJ and a JSON scene with a camera "view"; returns the JSON's path.
+std::string writeSunScene(const std::function<std::string(const std::string&)>& path, const std::string& name,
+                          const std::string& direction, const std::string& irradiance) {
+  std::ofstream(path("floor.obj")) << "v 0 0 0\nv 0 0 10\nv 10 0 10\nv 10 0 0\n"
+                                      "v 3 0 5\nv 7 0 5\nv 7 3 5\nv 3 3 5\n"
+                                      "f 1 2 3\nf 1 3 4\nf 5 6 7\nf 5 7 8\n";
+  const std::string json = path(name);
+  std::ofstream(json) << R"({"meshes": [{"file": "floor.obj"}],
+      "lights": [{"type": "directional", "direction": )" << direction << R"(, "irradiance": )" << irradiance << R"(}],
+      "environment": {"color": [0.2, 0.3, 0.5]},
+      "cameras": [{"name": "view", "eye": [5, 6, -6], "target": [5, 0, 5], "fov": 60}]})";
+  return json;
+}
+
+double meanLuminance(const Image& image) {
+  double sum = 0.0;
+  for (const Rgb& p : image.pixels) sum += luminance(p);
+  return sum / double(image.pixels.size());
+}
+
+// A camera path with light keyframes relights every frame: its last frame is the light field
+// of the scene as the last keyframe leaves it (within the bake's tolerance).
+TEST_F(RenderCliTest, PathWithLightKeyframesRelightsEveryFrame) {
+  const std::string bakeFlags = " --preset draft --tixels-across 12 --directions 64 --tolerance 1e-4";
+  const std::string scene = writeSunScene([&](const std::string& n) { return path(n); }, "sun.json", "[0.3, -1, 0.6]", "3");
+  std::string err;
+  ASSERT_EQ(run("bake " + scene + " -o " + path("sun.plf") + bakeFlags, nullptr, &err), 0) << err;
+  std::ofstream(path("day.json")) << R"({"fps": 2, "keyframes": [
+      {"time": 0, "eye": [5, 6, -6], "target": [5, 0, 5],
+       "lights": [{"light": 0, "direction": [0.3, -1, 0.6], "irradiance": 3}]},
+      {"time": 1, "eye": [5, 6, -6], "target": [5, 0, 5],
+       "lights": [{"light": 0, "direction": [-0.3, -1, 0.6], "irradiance": [6, 4, 2]}]}]})";
+  const std::string stats = path("day_stats.json");
+  ASSERT_EQ(run("render " + path("sun.plf") + " --path " + path("day.json") + " -o " + path("day/%02d.pfm") +
+                    " --width 32 --height 24 --camera view --stats " + stats,
+                nullptr, &err),
+            0)
+      << err;
+  const nlohmann::json json = nlohmann::json::parse(cli_test::readFileText(stats));
+  EXPECT_EQ(json["frames"], 3);
+  EXPECT_EQ(json["relight"]["frames"], 3);
+  // The last frame against a bake of the scene as the path ends.
+  const std::string dusk = writeSunScene([&](const std::string& n) { return path(n); }, "dusk.json", "[-0.3, -1, 0.6]",
+                                         "[6, 4, 2]");
+  ASSERT_EQ(run("bake " + dusk + " -o " + path("dusk.plf") + bakeFlags, nullptr, &err), 0) << err;
+  ASSERT_EQ(run("render " + path("dusk.plf") + " -o " + path("dusk.pfm") + " --width 32 --height 24 --camera view",
+                nullptr, &err),
+            0)
+      << err;
+  const double last = meanLuminance(readImage(path("day/02.pfm"))), first = meanLuminance(readImage(path("day/00.pfm")));
+  EXPECT_NEAR(last, meanLuminance(readImage(path("dusk.pfm"))), 2e-3 * last);
+  EXPECT_GT(std::abs(last - first), 0.05 * first);  // the light changed along the path
+  // Without the .plv the path cannot be relit: the message names the file it needs.
+  fs::remove(path("sun.plv"));
+  EXPECT_NE(run("render " + path("sun.plf") + " --path " + path("day.json") + " -o " + path("day2/%02d.pfm") +
+                    " --width 8 --height 6",
+                nullptr, &err),
+            0);
+  EXPECT_NE(err.find(path("sun.plv")), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("day2/00.pfm")));
 }
 
 }  // namespace

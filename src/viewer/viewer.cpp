@@ -8,7 +8,10 @@
 #include <chrono>
 #include <memory>
 #include <cmath>
+#include <cctype>
 #include <cstdlib>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +26,7 @@
 #include "realtime/realtime.h"
 #include "viewer/fly_camera.h"
 #include "viewer/hud_text.h"
+#include "viewer/live_relight.h"
 #include "viewer/render_scale.h"
 
 namespace pl {
@@ -116,6 +120,30 @@ class Window {
   int frameSize_[2] = {0, 0}, hudSize_[2] = {0, 0};
 };
 
+/// The relighting key of an SDL key (viewer.h), if it is one.
+std::optional<RelightKey> relightKeyOf(SDL_Keycode code) {
+  switch (code) {
+    case SDLK_TAB: return RelightKey::NextSource;
+    case SDLK_o: return RelightKey::ToggleSource;
+    case SDLK_LEFTBRACKET: return RelightKey::Dimmer;
+    case SDLK_RIGHTBRACKET: return RelightKey::Brighter;
+    case SDLK_c: return RelightKey::NextColour;
+    case SDLK_j: return RelightKey::SunLeft;
+    case SDLK_l: return RelightKey::SunRight;
+    case SDLK_i: return RelightKey::SunUp;
+    case SDLK_k: return RelightKey::SunDown;
+    case SDLK_m: return RelightKey::NextMaterial;
+    case SDLK_COMMA: return RelightKey::Darker;
+    case SDLK_PERIOD: return RelightKey::Lighter;
+    default: return std::nullopt;
+  }
+}
+
+/// The relighting key of a character of ViewerOptions::relightKeys ('\t' = Tab; any case).
+std::optional<RelightKey> relightKeyOfChar(char c) {
+  return relightKeyOf(c == '\t' ? SDLK_TAB : SDL_Keycode(std::tolower(static_cast<unsigned char>(c))));
+}
+
 ToneMapOperator nextOperator(ToneMapOperator op) {
   switch (op) {
     case ToneMapOperator::Reinhard: return ToneMapOperator::Linear;
@@ -155,9 +183,14 @@ void checkViewerOptions(const ViewerOptions& options) {
   if (options.frames < 0) fail("view: --frames must be ≥ 0, got {}", options.frames);
   if (!(options.targetFps >= 0.0) || options.targetFps > 1000.0)
     fail("view: --target-fps must be within 0..1000, got {}", options.targetFps);
-  if (!options.screenshotPath.empty() && options.frames == 0 && !options.path)
+  if (!options.screenshotPath.empty() && options.frames == 0 && !options.path && options.relightKeys.empty())
     fail("view: --screenshot needs --frames N or --path (it is written after the last frame)");
   isFramePattern(options.screenshotPattern, "screenshot pattern");  // validates it
+  for (char c : options.relightKeys)
+    if (!relightKeyOfChar(c))
+      fail("view: '{}' in the relighting keys is not one (Tab O [ ] C J L I K M , .)", c);
+  if (!options.relightKeys.empty() && options.visibilityPath.empty())
+    fail("view: relighting keys need the light field's visibility field (.plv)");
 }
 
 /// Scene units per second: the option, or a quarter of the scene's diagonal.
@@ -266,9 +299,22 @@ class ViewerSession {
         scale_(renderer_.gpu() ? 0.0 : options.targetFps),
         toneMap_(options.toneMap),
         recorder_(options.recordInterval),
-        start_(Clock::now()) {}
+        start_(Clock::now()) {
+    if (!options.visibilityPath.empty()) {
+      live_ = std::make_unique<LiveRelight>(lightField, accel, options.visibilityPath);
+      for (char c : options.relightKeys)
+        live_->press(*relightKeyOfChar(c));
+    }
+  }
 
   bool quit() const { return quit_; }
+  /// Whether the scripted relighting keys (ViewerOptions::relightKeys) are done: converged,
+  /// or refused.
+  bool relightDone() const {
+    if (!live_) return true;
+    const RelightStatus status = live_->status();
+    return !status.message.empty() || (status.ready && !status.running && status.converged && live_->showsNewest());
+  }
 
   /// SDL's queued events: quit, mouse look, exposure, tone mapping, screenshots, recording.
   void handleEvents(Clock::time_point frameStart) {
@@ -318,7 +364,8 @@ class ViewerSession {
     int width = 0, height = 0;
     window_.outputSize(width, height);
     const Clock::time_point renderStart = Clock::now();
-    const double scale = renderFrame(width, height);
+    const bool relit = live_ && live_->update();
+    const double scale = renderFrame(width, height, relit);
     const bool rendered = scale > 0.0;
     if (rendered) renderMs_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
 
@@ -342,6 +389,7 @@ class ViewerSession {
     }
     const double ms = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
     frameMs_.push_back(ms);
+    if (live_ && live_->status().running) relightMs_.push_back(ms);
     recentMs_.push_back(ms);
     if (recentMs_.size() > kTimingWindow) recentMs_.erase(recentMs_.begin());
   }
@@ -357,6 +405,18 @@ class ViewerSession {
     result.renderMsMedian = median(renderMs_);
     result.renderer = renderer_.name();
     result.fallback = renderer_.fallback();
+    if (live_) {
+      const RelightStatus status = live_->status();
+      result.relightFrames = int(relightMs_.size());
+      result.relightMsPerFrameMedian = relightMs_.empty() ? 0.0 : median(relightMs_);
+      result.relightFirstFrameSeconds = status.firstFrameSeconds;
+      result.relightSeconds = status.seconds;
+      result.relightSunMaskSeconds = status.sunMaskSeconds;
+      result.relightFirstShotSeconds = status.firstShotSeconds;
+      result.relightIterations = status.iteration;
+      result.relightConverged = status.converged && !status.running;
+      result.relightMessage = status.message;
+    }
     return result;
   }
 
@@ -379,9 +439,9 @@ class ViewerSession {
   ///   still after that: one refinement batch of jittered samples (seed + batch
   ///     number), averaged with the earlier ones, until kRefinedSamples per pixel;
   ///   then nothing.
-  double renderFrame(int width, int height) {
+  double renderFrame(int width, int height, bool relit) {
     const CameraDesc desc = fly_.desc();
-    const bool moved = shown_ == Shown::Nothing || width != shownWidth_ || height != shownHeight_ ||
+    const bool moved = relit || shown_ == Shown::Nothing || width != shownWidth_ || height != shownHeight_ ||
                        desc.eye != shownDesc_.eye || desc.target != shownDesc_.target || desc.up != shownDesc_.up ||
                        desc.fovYDegrees != shownDesc_.fovYDegrees;
     const bool first = shown_ == Shown::Nothing;
@@ -393,7 +453,7 @@ class ViewerSession {
       const double scale = moved && !first ? scale_.scale(true) : 1.0;
       int w = width, h = height;
       scaledSize(width, height, scale, w, h);
-      renderer_.render(cameraAt(w, h), options_.render, frame_);
+      draw(cameraAt(w, h), options_.render, frame_);
       shown_ = scale < 1.0 ? Shown::Scaled : Shown::Base;
       batches_ = 0;
       return scale;
@@ -412,7 +472,7 @@ class ViewerSession {
     RenderSettings batch = options_.render;
     batch.samplesPerPixel = batchSpp;
     batch.seed = options_.render.seed + uint64_t(batches_) + 1;
-    renderer_.render(cameraAt(width, height), batch, batchImage_);
+    draw(cameraAt(width, height), batch, batchImage_);
     ++batches_;
     const float weight = 1.0f / float(batches_);
     for (size_t i = 0; i < frame_.pixels.size(); ++i) {
@@ -423,11 +483,21 @@ class ViewerSession {
     return 1.0;
   }
 
+  /// Renders with the relit light field's CPU renderer once live relighting has published one
+  /// (the GPU renderer draws the baked light field only), else with the session's renderer.
+  void draw(const Camera& camera, const RenderSettings& settings, Image& image) {
+    if (const FastRenderer* relit = live_ ? live_->renderer() : nullptr) {
+      relit->render(camera, settings, image);
+    } else {
+      renderer_.render(camera, settings, image);
+    }
+  }
+
   /// The shown view at full resolution and the settings' samples per pixel: what `plenoptic
   /// render` writes (rendered for the purpose when the window shows a scaled or refined frame).
   const Image& baseFrame() {
     if (shown_ == Shown::Base) return frame_;
-    renderer_.render(cameraAt(shownWidth_, shownHeight_), options_.render, screenshot_);
+    draw(cameraAt(shownWidth_, shownHeight_), options_.render, screenshot_);
     return screenshot_;
   }
 
@@ -437,6 +507,8 @@ class ViewerSession {
     if (code == SDLK_PLUS || code == SDLK_EQUALS || code == SDLK_KP_PLUS) exposureEv_ += kExposureStepEv;
     if (code == SDLK_MINUS || code == SDLK_KP_MINUS) exposureEv_ -= kExposureStepEv;
     if (code == SDLK_t) toneMap_.op = nextOperator(toneMap_.op);
+    if (code == SDLK_h) relightHud_ = !relightHud_;
+    if (const std::optional<RelightKey> relight = relightKeyOf(code); relight && live_) live_->press(*relight);
     if (code == SDLK_F12 && shown_ != Shown::Nothing) {
       const std::string path = formatFramePath(options_.screenshotPattern, screenshots_++);
       writeFrame(path, baseFrame(), exposureScale(), toneMap_);
@@ -485,6 +557,8 @@ class ViewerSession {
         fmt::format("EXPOSURE {:+.1f} EV  TONEMAP {}{}", exposureEv_, toneMapOperatorName(toneMap_.op),
                     recorder_.recording() ? "  [REC]" : ""),
     };
+    if (live_ && relightHud_)
+      for (std::string& line : live_->hudLines()) lines.push_back(std::move(line));
     if (!message_.empty() && frameStart < messageUntil_) lines.push_back(message_);
     int hudWidth = 0;
     for (const std::string& line : lines) hudWidth = std::max(hudWidth, hudTextWidth(line, kHudScale));
@@ -517,7 +591,9 @@ class ViewerSession {
   CameraDesc shownDesc_;
   int shownWidth_ = 0, shownHeight_ = 0;
   int batches_ = 0;  ///< refinement batches in accumulation_
-  std::vector<double> frameMs_, renderMs_, recentMs_;
+  std::vector<double> frameMs_, renderMs_, recentMs_, relightMs_;
+  std::unique_ptr<LiveRelight> live_;  ///< the relighting keys' (null without a visibility field)
+  bool relightHud_ = true;
   int screenshots_ = 0;
   bool dragging_ = false, quit_ = false;
   PathRecorder recorder_;
@@ -532,8 +608,11 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
   checkViewerOptions(options);
   ViewerSession session(lightField, accel, options);
   const int totalFrames = options.frames > 0 ? options.frames : options.path ? options.path->frameCount() : 0;
+  // Scripted relighting keys without a frame count: until the relighting is done.
+  const bool untilRelit = totalFrames == 0 && !options.relightKeys.empty();
   Clock::time_point previous = Clock::now();
-  for (int frame = 0; !session.quit() && (totalFrames == 0 || frame < totalFrames); ++frame) {
+  for (int frame = 0; !session.quit() && (totalFrames == 0 || frame < totalFrames) && !(untilRelit && session.relightDone());
+       ++frame) {
     const Clock::time_point frameStart = Clock::now();
     const float dt = std::min(float(std::chrono::duration<double>(frameStart - previous).count()), 0.25f);
     previous = frameStart;

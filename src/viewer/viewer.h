@@ -30,6 +30,11 @@
 //   F12             screenshot (PNG: exposure + tone mapping as `plenoptic render` writes it)
 //   P or R          start/stop recording the flown path (saved as camera-path JSON)
 //   Esc             quit (a recording in progress is saved first)
+// Relighting (when the light field's visibility field is at hand; live_relight.h): Tab selects
+// a light or the emitters, O switches it, [ / ] dims / brightens it, C recolours it, J/L and
+// I/K turn the sun, M selects a material and , / . darken / lighten its albedo; the light
+// field re-propagates in the background and the view shows each iteration.
+//   H               show or hide the relighting lines of the HUD
 // The window is resizable; the image is rendered at the window's size. The HUD shows fps,
 // frame time (render + display), the renderer, the render scale and samples per pixel, camera
 // position, exposure and tone mapping.
@@ -79,6 +84,11 @@ struct ViewerOptions {
   float speed = 0.0f;                ///< scene units per second; 0 = a quarter of the scene diagonal
   double recordInterval = 0.25;      ///< seconds between recorded keyframes
   std::string title = "plenoptic";
+  /// The .plv the relighting keys re-propagate from; empty = no relighting (live_relight.h).
+  std::string visibilityPath;
+  /// Relighting keys pressed at the first frame (headless runs and benchmarks): the characters
+  /// of the keys above ("\t" for Tab), e.g. "JJJ]".
+  std::string relightKeys;
 };
 
 /// What a viewer session did (for messages and tests).
@@ -88,6 +98,15 @@ struct ViewerResult {
   double renderMsMedian = 0.0;    ///< the renderer alone (frames that rendered)
   std::string renderer;           ///< "gpu (DEVICE)" or "cpu"
   std::string fallback;           ///< why the CPU renderer was taken in Automatic mode; empty otherwise
+  /// With relighting: frames drawn while the propagation ran, their median time, and the
+  /// last relight's times and state (seconds; live_relight.h RelightStatus).
+  int relightFrames = 0;
+  double relightMsPerFrameMedian = 0.0;
+  double relightFirstFrameSeconds = 0.0, relightSeconds = 0.0;
+  double relightSunMaskSeconds = 0.0, relightFirstShotSeconds = 0.0;  ///< of relightFirstFrameSeconds
+  uint32_t relightIterations = 0;
+  bool relightConverged = false;
+  std::string relightMessage;
 };
 
 /// Opens the window and runs until Esc/close, or for options.frames frames. Throws pl::Error

@@ -306,5 +306,35 @@ TEST_F(ViewerCliTest, DemoWithoutDisplayRendersTheWalkThroughToFiles) {
   EXPECT_EQ(fs::exists(dir_ / "demo" / "walk.mp4"), !findFfmpeg().empty());
 }
 
+
+// Relighting keys headless: `--relight-keys` without --frames runs until the relit light field
+// has converged, and its screenshot is the render of a bake of the relit scene.
+TEST_F(ViewerCliTest, RelightingKeysConvergeToTheRelitScene) {
+  std::string err, out;
+  const std::string flags = " --preset draft --tixels-across 8 --directions 64 --tolerance 1e-4";
+  ASSERT_EQ(run("bake cornell -o " + path("baked.plf") + flags, nullptr, &err), 0) << err;
+  ASSERT_EQ(run("view " + path("baked.plf") + " --relight-keys ] --width 48 --height 32 --screenshot " +
+                    path("relit.pfm"),
+                &out, &err),
+            0)
+      << err;
+  EXPECT_NE(out.find("view: relit:"), std::string::npos) << out;
+  EXPECT_NE(out.find("(converged)"), std::string::npos) << out;
+  // The emitters × 1.25: the same image as the baked one × 1.25.
+  ASSERT_EQ(run("render " + path("baked.plf") + " -o " + path("baked.pfm") + " --width 48 --height 32", nullptr, &err), 0)
+      << err;
+  const Image relit = readImage(path("relit.pfm")), baked = readImage(path("baked.pfm"));
+  ASSERT_EQ(relit.pixels.size(), baked.pixels.size());
+  double a = 0.0, b = 0.0;
+  for (size_t i = 0; i < relit.pixels.size(); ++i) a += relit.pixels[i].g, b += baked.pixels[i].g;
+  EXPECT_NEAR(a, 1.25 * b, 1e-3 * a);
+  // Keys that are not relighting keys, or no visibility field: refused before any window.
+  EXPECT_NE(run("view " + path("baked.plf") + " --relight-keys x --frames 1", nullptr, &err), 0);
+  EXPECT_NE(err.find("'x'"), std::string::npos) << err;
+  fs::remove(path("baked.plv"));
+  EXPECT_NE(run("view " + path("baked.plf") + " --relight-keys ] --frames 1", nullptr, &err), 0);
+  EXPECT_NE(err.find("visibility"), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace pl

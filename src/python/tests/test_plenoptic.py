@@ -190,6 +190,60 @@ def test_editing_emission_and_rebaking_with_the_reused_visibility_equals_a_full_
     assert np.array_equal(reused.render(width=32, height=24), full.render(width=32, height=24))
 
 
+def test_relight_equals_a_fresh_bake_of_the_edited_scene():
+    scene = plenoptic.load_scene("cornell")
+    lf = plenoptic.bake(scene, preset="draft")
+    scene.set_emission("light", [30.0, 20.0, 10.0])
+    scene.set_albedo("red", [0.2, 0.5, 0.7])
+    relit = lf.relight(scene)
+    assert relit.stats["converged"] is True and relit.stats["lights_shot"] == 0
+    fresh = plenoptic.bake(scene, preset="draft")
+    a, b = relit.render(width=32, height=24), fresh.render(width=32, height=24)
+    # Both stop at the draft preset's tolerance (5e-3 of the total power).
+    assert plenoptic.compare(a, b)["mean_luminance_ratio"] == pytest.approx(1.0, abs=5e-3)
+    assert plenoptic.compare(a, lf.render(width=32, height=24))["relmse"] > 0.01  # the edit shows
+    # Relighting again goes on from the relit solution; the original light field is unchanged.
+    scene.set_emission("light", [10.0, 10.0, 10.0])
+    again = relit.relight(scene)
+    assert again.stats["converged"] is True
+    assert np.array_equal(lf.render(width=8, height=6), plenoptic.bake(plenoptic.load_scene("cornell"),
+                                                                       preset="draft").render(width=8, height=6))
+
+
+def test_relight_moves_the_sun_of_a_loaded_light_field_from_its_plv(tmp_path):
+    quad = os.path.join(DATA, "scene", "textured", "quad.obj")
+    (tmp_path / "sun.json").write_text(json.dumps({
+        "meshes": [{"file": quad}], "environment": {"color": [0.1, 0.1, 0.1]},
+        "lights": [{"type": "directional", "direction": [0.3, 0.2, -1.0], "irradiance": [2.0, 2.0, 2.0]}]}))
+    scene = plenoptic.load_scene(str(tmp_path / "sun.json"))
+    plenoptic.bake(scene, preset="draft", visibility=str(tmp_path / "sun.plv")).save(str(tmp_path / "sun.plf"))
+    loaded = plenoptic.load_light_field(str(tmp_path / "sun.plf"))
+    scene.set_light_direction(0, [0.0, 0.0, -1.0])  # straight down: more light on the quad
+    relit = loaded.relight(scene)
+    assert relit.stats["sun_masks_traced"] == 1 and relit.stats["lights_shot"] == 1
+    camera = plenoptic.Camera(eye=[0.5, 0.5, 2.0], target=[0.5, 0.5, 0.0], fov=30.0)
+    fresh = plenoptic.bake(scene, preset="draft").render(width=16, height=16, camera=camera)
+    assert np.allclose(relit.render(width=16, height=16, camera=camera), fresh, rtol=5e-3, atol=1e-6)
+    with pytest.raises(plenoptic.UsageError, match="light 3 does not exist"):
+        scene.set_light_direction(3, [0.0, 0.0, -1.0])
+
+
+def test_relight_refuses_what_the_visibility_field_cannot_serve(tmp_path):
+    scene = plenoptic.load_scene("cornell")
+    lf = plenoptic.bake(scene, preset="draft")
+    lf.save(str(tmp_path / "alone.plf"))
+    # Loaded without its .plv: the message names the file it needs.
+    with pytest.raises(plenoptic.Error, match="alone.plv"):
+        plenoptic.load_light_field(str(tmp_path / "alone.plf")).relight(scene)
+    with pytest.raises(plenoptic.Error, match="keep_visibility"):
+        plenoptic.bake(scene, preset="draft", keep_visibility=False).relight(scene)
+    other = plenoptic.load_scene(os.path.join(DATA, "cornell-mcguire", "CornellBox-Original.obj"))
+    with pytest.raises(plenoptic.Error, match="cannot relight.*plenoptic bake"):
+        lf.relight(other)
+    with pytest.raises(plenoptic.UsageError, match="at most 1"):
+        scene.set_albedo("red", [2.0, 0.0, 0.0])
+
+
 def test_image_round_trip_and_compare(tmp_path):
     rng = np.random.default_rng(3)
     image = rng.random((5, 7, 3), dtype=np.float32)

@@ -1,0 +1,315 @@
+// Relighting (relight.h): after sequences of changes the relit light field equals a fresh bake
+// of the changed scene within the bake's tolerance; warm against cold start; refusals.
+#include "bake/relight.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "bake/bake.h"
+#include "bake/parameterisation.h"
+#include "bake/visibility.h"
+#include "core/error.h"
+#include "core/progress.h"
+#include "light/lights.h"
+#include "support/quad_mesh.h"
+
+namespace pl {
+namespace {
+
+class RelightTest : public ::testing::Test {
+ protected:
+  void SetUp() override { Progress::setEnabled(false); }
+};
+
+BakeSettings testSettings(float tixelsAcross = 10.0f) {
+  BakeSettings s = bakePreset("draft");
+  s.tixelsAcrossScene = tixelsAcross;
+  s.gatherDirections = 64;
+  s.areaLightSamples = 8;
+  s.tolerance = 1e-4f;
+  s.maxIterations = 400;
+  return s;
+}
+
+/// A bake with its parameterisation and visibility field kept, as a Relighter.
+Relighter bakeForRelight(const Scene& scene, const BakeSettings& settings, LightField* baked = nullptr) {
+  Parameterisation param;
+  VisibilityShard visibility;
+  BakeOptions options;
+  options.keepParameterisation = &param;
+  options.keepVisibility = &visibility;
+  LightField lf = bake(scene, settings, options);
+  Relighter relighter(lf, std::move(visibility), std::move(param));
+  if (baked) *baked = std::move(lf);
+  return relighter;
+}
+
+/// Σ|Y(a − b)| / Σ Y(b) over the values: the relative L1 difference of two light fields.
+double relativeDifference(const LightField& a, const LightField& b) {
+  EXPECT_EQ(a.values.size(), b.values.size());
+  double diff = 0.0, total = 0.0;
+  for (size_t v = 0; v < a.values.size() && v < b.values.size(); ++v) {
+    diff += std::abs(double(luminance(a.values[v] - b.values[v])));
+    total += std::abs(double(luminance(b.values[v])));
+  }
+  return total > 0.0 ? diff / total : diff;
+}
+
+/// The relit field against a fresh bake of the relighter's scene: the same within the
+/// tolerance's order (both stop when their remaining error is below it), and the same sun masks.
+void expectFreshBake(const Relighter& relighter, const BakeSettings& settings, const char* step) {
+  const LightField relit = relighter.lightField();
+  const LightField fresh = bake(relighter.scene(), settings);
+  EXPECT_LT(relativeDifference(relit, fresh), 5.0 * settings.tolerance) << step;
+  EXPECT_EQ(relit.sunMasks, fresh.sunMasks) << step;
+  EXPECT_EQ(relit.sunMaskLightCount, fresh.sunMaskLightCount) << step;
+}
+
+uint32_t materialIndex(const Scene& scene, const std::string& name) {
+  for (uint32_t m = 0; m < scene.materials.size(); ++m)
+    if (scene.materials[m].name == name) return m;
+  ADD_FAILURE() << "no material " << name;
+  return 0;
+}
+
+Scene cornellWithPointLight() {
+  Scene scene = makeCornellBox();
+  scene.lights.push_back(createLight("point", {{"position", Vec3(278.0f, 400.0f, 200.0f)}, {"intensity", Vec3(2e4f)}},
+                                     "test light"));
+  scene.finalize();
+  return scene;
+}
+
+TEST_F(RelightTest, CornellSequenceEqualsFreshBakes) {
+  const BakeSettings settings = testSettings();
+  Relighter relighter = bakeForRelight(cornellWithPointLight(), settings);
+  const uint32_t light = materialIndex(relighter.scene(), "light");
+  const uint32_t red = materialIndex(relighter.scene(), "red");
+  EXPECT_FALSE(relighter.pending());
+
+  // 1. The area light recoloured: D_e scaled, nothing traced.
+  relighter.setEmission(light, relighter.scene().materials[light].emission * Rgb(0.5f, 1.0f, 2.0f));
+  EXPECT_TRUE(relighter.pending());
+  RelightStats stats = relighter.relight();
+  EXPECT_TRUE(stats.emittersScaled);
+  EXPECT_FALSE(stats.emittersShot);
+  EXPECT_EQ(stats.lightsShot, 0u);
+  EXPECT_TRUE(stats.converged);
+  EXPECT_FALSE(relighter.pending());
+  expectFreshBake(relighter, settings, "area light recoloured");
+
+  // 2. The point light moved and recoloured: only its first shot traced.
+  Light moved = relighter.scene().lights[0];
+  std::get<PointLight>(moved).position = Vec3(150.0f, 300.0f, 250.0f);
+  setLightEmission(moved, Rgb(1e4f, 3e4f, 1e4f));
+  relighter.setLight(0, moved);
+  stats = relighter.relight();
+  EXPECT_EQ(stats.lightsShot, 1u);
+  EXPECT_FALSE(stats.emittersShot);
+  EXPECT_TRUE(stats.converged);
+  expectFreshBake(relighter, settings, "point light moved");
+
+  // 3. An albedo, then 4. the point light switched off.
+  relighter.setAlbedo(red, Rgb(0.2f, 0.5f, 0.7f));
+  stats = relighter.relight();
+  EXPECT_EQ(stats.lightsShot, 0u);
+  EXPECT_TRUE(stats.converged);
+  expectFreshBake(relighter, settings, "albedo");
+  relighter.setLightEmission(0, Rgb(0.0f));
+  stats = relighter.relight();
+  EXPECT_EQ(stats.lightsShot, 0u);
+  expectFreshBake(relighter, settings, "point light off");
+}
+
+// The built-in box's one light recoloured: the solution is scaled per channel, exactly
+// converged, without an iteration.
+TEST_F(RelightTest, RecolouringTheOnlyLightScalesTheSolution) {
+  const BakeSettings settings = testSettings();
+  LightField baked;
+  Relighter relighter = bakeForRelight(makeCornellBox(), settings, &baked);
+  const uint32_t light = materialIndex(relighter.scene(), "light");
+  relighter.setEmission(light, relighter.scene().materials[light].emission * 3.0f);
+  uint32_t calls = 0;
+  const RelightStats stats = relighter.relight([&](const RelightProgress& p) {
+    ++calls;
+    EXPECT_EQ(p.iteration, 0u);
+    EXPECT_TRUE(p.converged);
+    return true;
+  });
+  EXPECT_TRUE(stats.scaledWarmStart);
+  EXPECT_EQ(stats.iterations, 0u);
+  EXPECT_EQ(calls, 1u);
+  const LightField relit = relighter.lightField();
+  for (size_t v = 0; v < baked.values.size(); v += 97)
+    EXPECT_NEAR(relit.values[v].g, 3.0f * baked.values[v].g, 1e-4f * (1.0f + baked.values[v].g));
+  expectFreshBake(relighter, settings, "recoloured");
+}
+
+// Glossy charts (the McGuire glossy box: Blinn-Phong sphere and floor) through emission,
+// albedo and a point light's changes.
+TEST_F(RelightTest, GlossyBoxSequenceEqualsFreshBakes) {
+  Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/CornellBox-Glossy.obj");
+  scene.lights.push_back(createLight("point", {{"position", Vec3(0.0f, 1.2f, 0.3f)}, {"intensity", Vec3(0.5f)}}, "test"));
+  scene.finalize();
+  const BakeSettings settings = testSettings(8.0f);
+  Relighter relighter = bakeForRelight(scene, settings);
+  const uint32_t light = materialIndex(relighter.scene(), "light");
+  relighter.setEmission(light, Rgb(0.5f, 0.8f, 1.5f));
+  relighter.setLightEmission(0, Rgb(1.0f, 0.3f, 0.2f));
+  RelightStats stats = relighter.relight();
+  EXPECT_TRUE(stats.converged);
+  expectFreshBake(relighter, settings, "glossy: emission and light colour");
+  Light moved = relighter.scene().lights[0];
+  std::get<PointLight>(moved).position = Vec3(-0.4f, 1.0f, 0.0f);
+  relighter.setLight(0, moved);
+  relighter.setAlbedo(materialIndex(relighter.scene(), "rightWall"), Rgb(0.1f, 0.2f, 0.8f));
+  EXPECT_THROW(relighter.setAlbedo(materialIndex(relighter.scene(), "sphere"), Rgb(0.5f)), Error);  // Blinn-Phong
+  stats = relighter.relight();
+  EXPECT_EQ(stats.lightsShot, 1u);
+  EXPECT_TRUE(stats.converged);
+  expectFreshBake(relighter, settings, "glossy: light moved, albedo");
+}
+
+/// An open scene under a grey sky: a floor, a wall standing on it and a sun.
+Scene sunScene(const Vec3& sunDirection) {
+  Scene scene;
+  scene.sourcePath = "sun test";
+  Material ground;
+  ground.name = "ground";
+  ground.bsdf = LambertBsdf{Rgb(0.6f)};
+  scene.materials.push_back(ground);
+  Mesh mesh;
+  test_support::addQuad(mesh, Vec3(0, 0, 0), Vec3(0, 0, 10), Vec3(10, 0, 10), Vec3(10, 0, 0), 0);
+  test_support::addQuad(mesh, Vec3(3, 0, 5), Vec3(7, 0, 5), Vec3(7, 3, 5), Vec3(3, 3, 5), 0);
+  scene.meshes.push_back(std::move(mesh));
+  scene.environment.constant = Rgb(0.2f, 0.3f, 0.5f);
+  scene.lights.push_back(createLight("directional", {{"direction", sunDirection}, {"irradiance", Vec3(3.0f)}}, "sun"));
+  scene.finalize();
+  return scene;
+}
+
+Vec3 sunAt(float elevationDegrees, float azimuthDegrees) {
+  const float e = elevationDegrees * kPi / 180.0f, a = azimuthDegrees * kPi / 180.0f;
+  return -Vec3(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
+}
+
+TEST_F(RelightTest, SunMovedRetracesItsMasksOnly) {
+  const BakeSettings settings = testSettings(16.0f);
+  Relighter relighter = bakeForRelight(sunScene(sunAt(40.0f, 20.0f)), settings);
+  ASSERT_EQ(relighter.parameterisation().sunMaskLights.size(), 1u);
+  Light sun = relighter.scene().lights[0];
+  std::get<DirectionalLight>(sun).direction = sunAt(40.0f, 30.0f);  // 10° of azimuth
+  relighter.setLight(0, sun);
+  RelightStats stats = relighter.relight();
+  EXPECT_EQ(stats.sunMasksTraced, 1u);
+  EXPECT_EQ(stats.lightsShot, 1u);
+  EXPECT_FALSE(stats.emittersShot);
+  EXPECT_TRUE(stats.converged);
+  expectFreshBake(relighter, settings, "sun moved");  // masks bit for bit
+  // Sun colour: nothing traced.
+  relighter.setLightEmission(0, Rgb(4.0f, 3.0f, 2.0f));
+  stats = relighter.relight();
+  EXPECT_EQ(stats.sunMasksTraced, 0u);
+  EXPECT_EQ(stats.lightsShot, 0u);
+  expectFreshBake(relighter, settings, "sun recoloured");
+}
+
+// A small change starts near the solution: fewer iterations than a cold bake, the same field.
+TEST_F(RelightTest, WarmStartNeedsFewerIterationsThanColdStart) {
+  const BakeSettings settings = testSettings();
+  Relighter relighter = bakeForRelight(cornellWithPointLight(), settings);
+  Light moved = relighter.scene().lights[0];
+  std::get<PointLight>(moved).position += Vec3(20.0f, 0.0f, 0.0f);
+  relighter.setLight(0, moved);
+  const RelightStats warm = relighter.relight();
+  const LightField cold = bake(relighter.scene(), settings);
+  EXPECT_TRUE(warm.converged);
+  EXPECT_LT(warm.iterations, cold.stats.iterations);
+  EXPECT_LT(relativeDifference(relighter.lightField(), cold), 5.0 * settings.tolerance);
+}
+
+// Iteration by iteration: the callback sees every iteration and may stop; the next relight()
+// goes on to the same result.
+TEST_F(RelightTest, CancelledRelightGoesOnLater) {
+  const BakeSettings settings = testSettings();
+  Relighter relighter = bakeForRelight(cornellWithPointLight(), settings);
+  relighter.setAlbedo(materialIndex(relighter.scene(), "white"), Rgb(0.3f));
+  const RelightStats first = relighter.relight([](const RelightProgress& p) { return p.iteration < 1; });
+  EXPECT_TRUE(first.cancelled);
+  EXPECT_FALSE(first.converged);
+  EXPECT_EQ(first.iterations, 1u);
+  EXPECT_FALSE(relighter.pending());
+  std::vector<double> residuals;
+  const RelightStats rest = relighter.relight([&](const RelightProgress& p) {
+    if (p.iteration > 0) residuals.push_back(p.residual);
+    return true;
+  });
+  EXPECT_TRUE(rest.converged);
+  EXPECT_EQ(residuals.size(), rest.iterations);
+  expectFreshBake(relighter, settings, "after a cancelled relight");
+}
+
+void expectRefused(const std::function<void()>& change, const std::string& what) {
+  try {
+    change();
+    ADD_FAILURE() << "not refused: " << what;
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("cannot relight"), std::string::npos) << message;
+    EXPECT_NE(message.find("plenoptic bake"), std::string::npos) << message;
+  }
+}
+
+TEST_F(RelightTest, RefusesWhatTheFieldCannotServe) {
+  const BakeSettings settings = testSettings(6.0f);
+  Relighter relighter = bakeForRelight(cornellWithPointLight(), settings);
+  const Scene original = relighter.scene();
+  expectRefused([&] { relighter.setLight(0, createLight("spot", {{"position", Vec3(278.0f, 400.0f, 200.0f)}}, "t")); },
+                "a new light type");
+  expectRefused([&] {
+    Scene moved = original;
+    moved.meshes[0].positions[0] += Vec3(10.0f);
+    relighter.setScene(moved);
+  }, "geometry moved");
+  expectRefused([&] {
+    Scene glass = original;
+    glass.materials[materialIndex(glass, "red")].bsdf = DielectricBsdf{};
+    relighter.setScene(glass);
+  }, "diffuse to glass");
+  expectRefused([&] {
+    Scene more = original;
+    more.lights.push_back(more.lights[0]);
+    relighter.setScene(more);
+  }, "a light added");
+  expectRefused([&] {
+    Light outside = original.lights[0];
+    std::get<PointLight>(outside).position = Vec3(278.0f, 273.0f, 2000.0f);  // behind the back wall
+    relighter.setLight(0, outside);
+  }, "a light behind a one-sided wall");
+  // Refusals change nothing.
+  EXPECT_FALSE(relighter.pending());
+  // A setScene with only lighting edits is taken.
+  Scene edited = original;
+  setLightEmission(edited.lights[0], Rgb(1e3f));
+  edited.materials[materialIndex(edited, "green")].bsdf = LambertBsdf{Rgb(0.1f, 0.9f, 0.1f)};
+  relighter.setScene(edited);
+  EXPECT_TRUE(relighter.pending());
+  EXPECT_TRUE(relighter.relight().converged);
+  expectFreshBake(relighter, settings, "setScene");
+}
+
+TEST_F(RelightTest, RefusesAVisibilityFieldOfAnotherScene) {
+  const BakeSettings settings = testSettings(6.0f);
+  Parameterisation param;
+  VisibilityShard visibility;
+  BakeOptions options;
+  options.keepParameterisation = &param;
+  options.keepVisibility = &visibility;
+  bake(makeCornellBox(), settings, options);
+  const LightField other = bake(sunScene(sunAt(40.0f, 0.0f)), settings);
+  EXPECT_THROW(Relighter(other, std::move(visibility)), Error);
+}
+
+}  // namespace
+}  // namespace pl

@@ -1,0 +1,90 @@
+// The viewer's live relighting (live_relight.h) without a window: keys edit the lighting, the
+// background propagation converges, and the light field on screen is the relit one.
+#include "viewer/live_relight.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "accel/accel.h"
+#include "bake/bake.h"
+#include "core/progress.h"
+
+namespace pl {
+namespace {
+
+class LiveRelightTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    Progress::setEnabled(false);
+    dir_ = std::filesystem::temp_directory_path() / "plenoptic_live_relight_test";
+    std::filesystem::create_directories(dir_);
+    BakeSettings settings = bakePreset("draft");
+    settings.tixelsAcrossScene = 8.0f;
+    settings.gatherDirections = 64;
+    settings.tolerance = 1e-4f;
+    BakeOptions options;
+    options.visibilityPath = (dir_ / "cornell.plv").string();
+    lightField_ = bake(makeCornellBox(), settings, options);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  /// Σ of the diffuse values' green channel: the light field's brightness.
+  static double total(const LightField& lf) {
+    double sum = 0.0;
+    for (const Rgb& v : lf.values) sum += v.g;
+    return sum;
+  }
+
+  std::filesystem::path dir_;
+  LightField lightField_;
+};
+
+TEST_F(LiveRelightTest, KeysRelightInTheBackground) {
+  const Accel accel(lightField_.scene);
+  LiveRelight live(lightField_, accel, (dir_ / "cornell.plv").string());
+  EXPECT_EQ(live.renderer(), nullptr);
+  EXPECT_EQ(&live.lightField(), &lightField_);
+  // The built-in box has no scene lights: the first source is its emitters.
+  live.press(RelightKey::Brighter);
+  live.waitIdle();
+  live.update();
+  ASSERT_NE(live.renderer(), nullptr);
+  RelightStatus status = live.status();
+  EXPECT_TRUE(status.ready);
+  EXPECT_TRUE(status.converged);
+  EXPECT_TRUE(status.message.empty()) << status.message;
+  EXPECT_NEAR(total(live.lightField()), 1.25 * total(lightField_), 1e-3 * total(lightField_));
+  EXPECT_NE(live.hudLines().back().find("CONVERGED"), std::string::npos);
+  // Emitters off: a dark box.
+  live.press(RelightKey::ToggleSource);
+  live.waitIdle();
+  live.update();
+  EXPECT_NEAR(total(live.lightField()), 0.0, 1e-6 * total(lightField_));
+  // On again, and a darker material: less light than before.
+  live.press(RelightKey::ToggleSource);
+  for (int k = 0; k < 5; ++k) live.press(RelightKey::Darker);
+  live.waitIdle();
+  live.update();
+  status = live.status();
+  EXPECT_TRUE(status.converged);
+  EXPECT_LT(total(live.lightField()), 1.25 * total(lightField_));
+  // Turning a sun that is not there does nothing and refuses nothing.
+  live.press(RelightKey::SunLeft);
+  live.waitIdle();
+  EXPECT_TRUE(live.status().message.empty());
+}
+
+TEST_F(LiveRelightTest, AMissingVisibilityFieldTurnsRelightingOff) {
+  const Accel accel(lightField_.scene);
+  LiveRelight live(lightField_, accel, (dir_ / "absent.plv").string());
+  live.press(RelightKey::Brighter);
+  live.waitIdle();
+  const RelightStatus status = live.status();
+  EXPECT_FALSE(status.ready);
+  EXPECT_NE(status.message.find("absent.plv"), std::string::npos) << status.message;
+  EXPECT_EQ(live.renderer(), nullptr);
+}
+
+}  // namespace
+}  // namespace pl
