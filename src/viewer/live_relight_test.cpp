@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <string>
 
 #include "accel/accel.h"
 #include "bake/bake.h"
@@ -17,7 +18,9 @@ class LiveRelightTest : public ::testing::Test {
  protected:
   void SetUp() override {
     Progress::setEnabled(false);
-    dir_ = std::filesystem::temp_directory_path() / "plenoptic_live_relight_test";
+    // One directory per test: ctest runs the tests of this fixture in parallel processes.
+    dir_ = std::filesystem::temp_directory_path() /
+           (std::string("plenoptic_live_relight_test_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::create_directories(dir_);
     BakeSettings settings = bakePreset("draft");
     settings.tixelsAcrossScene = 8.0f;
