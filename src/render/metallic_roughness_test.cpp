@@ -44,18 +44,19 @@ Scene rampBox(int texel) {
   for (Material& m : scene.materials) {
     if (m.name != "white") continue;
     if (texel >= 0) {
-      m.bsdf = ggxFromMetallicRoughness(Rgb(0.8f), rampTexel(texel).b, rampTexel(texel).g);
+      m.bsdf = gltfMetallicRoughnessModel(Rgb(0.8f), rampTexel(texel).b, rampTexel(texel).g);
       continue;
     }
     m.metallicRoughness = {int(scene.textures.size()) - 1, TextureMapping{}, Rgb(0.8f), 1.0f, 1.0f};
-    // The texture's mean lobe, as the glTF loader sets it.
-    GgxBsdf mean{Rgb(0.0f), Rgb(0.0f), 0.0f};
+    // The texture's mean lobe, as the glTF loader sets it: the model of the mean metalness
+    // with the mean α.
+    float metalness = 0.0f, alpha = 0.0f;
     for (int x = 0; x < kRampTexels; ++x) {
-      const GgxBsdf at = ggxFromMetallicRoughness(Rgb(0.8f), rampTexel(x).b, rampTexel(x).g);
-      mean.diffuse += at.diffuse / float(kRampTexels);
-      mean.f0 += at.f0 / float(kRampTexels);
-      mean.alpha += at.alpha / float(kRampTexels);
+      metalness += rampTexel(x).b / float(kRampTexels);
+      alpha += ggxAlphaFromRoughness(rampTexel(x).g) / float(kRampTexels);
     }
+    GltfPbrBsdf mean = std::get<GltfPbrBsdf>(gltfMetallicRoughnessModel(Rgb(0.8f), metalness, 1.0f));
+    mean.alpha = alpha;
     m.bsdf = mean;
   }
   scene.finalize();
