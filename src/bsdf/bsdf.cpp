@@ -1193,6 +1193,19 @@ Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo) {
                     bsdf);
 }
 
+Rgb specularF0(const Bsdf& bsdf) {
+  if (const auto* ggx = std::get_if<GgxBsdf>(&bsdf)) return ggx->f0;
+  if (const auto* pbr = std::get_if<GltfPbrBsdf>(&bsdf)) return pbr->f0;
+  return Rgb(0.0f);
+}
+
+Bsdf withSpecularF0(const Bsdf& bsdf, const Rgb& f0) {
+  Bsdf b = bsdf;
+  if (auto* ggx = std::get_if<GgxBsdf>(&b)) ggx->f0 = f0;
+  if (auto* pbr = std::get_if<GltfPbrBsdf>(&b)) pbr->f0 = f0;
+  return b;
+}
+
 Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta) {
   if (!(cosTheta > 0.0f)) return Rgb(0.0f);
   const float mu = std::min(cosTheta, 1.0f);

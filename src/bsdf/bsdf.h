@@ -337,6 +337,12 @@ Rgb albedo(const Bsdf& bsdf, const Vec3& wo);
 /// The model with its diffuse albedo replaced (texture lookups at a hit point). Models with
 /// no diffuse part are returned unchanged.
 Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo);
+/// The Fresnel reflectance at normal incidence of the model's glossy lobe (GGX, glTF: f0;
+/// black for other models), and the model with it replaced (others unchanged). The lobe is
+/// linear in it (Schlick's F = f0 (1 − m⁵) + f90 m⁵), which the bake uses to give each tixel
+/// of a metallic-roughness-textured material its own f0 (propagation.cpp GlossyMaterial).
+Rgb specularF0(const Bsdf& bsdf);
+Bsdf withSpecularF0(const Bsdf& bsdf, const Rgb& f0);
 /// The directional factor k(μ) of the model's diffuse part: every model's diffuse term is
 ///   f_diffuse(wo, wi) = diffuseAlbedo(bsdf)/π · k(μo) · k(μi)        (μ = cos θ, per channel)
 /// — k = 1 for Lambert and Blinn-Phong (a plain Lambertian term); for GGX
