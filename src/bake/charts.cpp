@@ -439,6 +439,8 @@ void layOutTixels(const Scene& scene, const BakeSettings& settings, Parameterisa
   p.coverage.resize(p.tixelCount);
   p.borrowedPoint.assign(p.tixelCount, 0);
   p.transportAlbedo.resize(p.tixelCount);
+  if (std::any_of(p.charts.begin(), p.charts.end(), [&](const Chart& c) { return perTixelSpecularF0(scene, c); }))
+    p.specularF0.resize(p.tixelCount);
   if (std::any_of(p.charts.begin(), p.charts.end(), [&](const Chart& c) { return texturedEmitter(scene, c); })) {
     p.emissionModulation.assign(p.tixelCount, Rgb(1.0f));
     p.emitterTriangle.resize(p.tixelCount);

@@ -440,6 +440,12 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
     return albedoAt(albedoPointAt(scene, r.tris[tri].mesh, r.tris[tri].triangle, Vec2(bary[1], bary[2])));
   };
   const Rgb constantAlbedo = hasAlbedo ? albedoAt(AlbedoPoint{}) : Rgb(0.0f);
+  // A metallic-roughness texture: the point models' lobe f0, averaged like the albedo.
+  const bool tixelF0 = perTixelSpecularF0(scene, c);
+  auto f0On = [&](uint32_t tri, const std::array<float, 3>& bary) {
+    return specularF0(materialModelAt(scene, material, albedoPointAt(scene, r.tris[tri].mesh, r.tris[tri].triangle,
+                                                                       Vec2(bary[1], bary[2]))));
+  };
   // A textured emitter's mean emission texture over each footprint, at full resolution.
   const bool emitterTextured = texturedEmitter(scene, c);
   auto emissionOn = [&](uint32_t tri, const std::array<float, 3>& bary) {
@@ -456,7 +462,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       const uint64_t g = c.firstTixel + local;
       // Footprint: coverage and mean albedo over the sub-samples inside the polygon.
       int inside = 0;
-      Rgb albedoSum(0.0f), emissionSum(0.0f);
+      Rgb albedoSum(0.0f), emissionSum(0.0f), f0Sum(0.0f);
       // directionalIrradiance: the mapped normals (world, the record's side) at the samples.
       std::array<Vec3, kFootprintSamples * kFootprintSamples> mappedNormals;
       std::array<std::pair<float, FootprintSample>, kFootprintSamples * kFootprintSamples> insideSamples;
@@ -469,6 +475,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
           insideSamples[size_t(inside)] = {glm::dot(fromCentre, fromCentre), s};
           ++inside;
           if (textured) albedoSum += albedoOn(s.tri, s.bary);
+          if (tixelF0) f0Sum += f0On(s.tri, s.bary);
           if (emitterTextured) emissionSum += emissionOn(s.tri, s.bary);
           if (c.directionalIrradiance) {
             const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
@@ -541,6 +548,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
         p.emissionModulation[g] = inside > 0 ? emissionSum / float(inside) : emissionOn(s.tri, s.bary);
         p.emitterTriangle[g] = {r.tris[s.tri].mesh, r.tris[s.tri].triangle};
       }
+      if (tixelF0 && !r.tris.empty()) p.specularF0[g] = inside > 0 ? f0Sum / float(inside) : f0On(s.tri, s.bary);
       if (hasAlbedo) {
         if (!textured) {
           p.transportAlbedo[g] = constantAlbedo;

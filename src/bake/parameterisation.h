@@ -120,6 +120,11 @@ struct Parameterisation {
   /// gather point and sun masks are its nearest unburied neighbour's (fillTixels).
   std::vector<uint8_t> borrowedPoint;
   std::vector<Rgb> transportAlbedo;   ///< diffuse charts, and glossy diffuseValue ones' diffuse part: mean albedo over the tixel's footprint
+  /// Glossy charts of a material with a metallic-roughness texture (empty when no chart has
+  /// one; other entries are never read): the mean over the tixel's footprint of the point
+  /// models' lobe f0 (bsdf.h specularF0 of scene.h materialModelAt), which the bake's glossy
+  /// maps take in place of the material model's (propagation.cpp GlossyMaterial).
+  std::vector<Rgb> specularF0;
   /// Sun masks (lightfield.h "Sun masks"): the scene lights masked (sunMaskLights, or none
   /// when BakeSettings::sunMasks is off) and per tixel one mask per masked light (slots past
   /// their count unused; every bit set on glossy and specular charts).
@@ -138,6 +143,12 @@ struct Parameterisation {
 inline bool texturedEmitter(const Scene& scene, const Chart& c) {
   const Material& m = scene.materials[c.material];
   return m.emissionTexture >= 0 && m.isEmissive();
+}
+
+/// Whether chart c's tixels keep their own lobe f0 (Parameterisation::specularF0): a glossy
+/// chart of a material whose metallic-roughness texture varies its model per point.
+inline bool perTixelSpecularF0(const Scene& scene, const Chart& c) {
+  return c.kind == ChartKind::Glossy && scene.materials[c.material].metallicRoughness.texture >= 0;
 }
 
 /// The radiance tixel `tixel` of chart record c emits towards a direction with cosine

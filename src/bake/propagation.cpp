@@ -156,6 +156,28 @@ struct GlossyMaterial {
   Bsdf specular;
   std::vector<Lanes4> diffuseWeight;  ///< w_k per gather cell
   Rgb diffuseExitance{0.0f};
+  // Per-tixel f0 (perTixelSpecularF0: a metallic-roughness texture; not for narrow lobes,
+  // whose operator is sampled): op above is the mapped model's at f0 = 0 and f0Slope the
+  // change per unit f0 — Schlick's F = f0 (1 − m⁵) + f90 m⁵ is linear in f0 and nothing else
+  // of the model depends on it — so that a tixel of f0 f reflects op·L + f ⊙ (f0Slope·L).
+  bool tixelF0 = false;
+  SparseOperator f0Slope;
+  /// out[c] += Lo(c), the chart's reflection of incoming radiance (and its sum) at tixel g.
+  void reflect(const Chart& c, const Parameterisation& param, uint64_t g, const Lanes4* incoming, F4 incomingSum,
+               Rgb* out) const {
+    reflection(c).apply(incoming, incomingSum, out);
+    if (!tixelF0) return;
+    thread_local std::vector<Rgb> slope;
+    slope.assign(f0Slope.floor.size(), Rgb(0.0f));
+    f0Slope.apply(incoming, incomingSum, slope.data());
+    const Rgb f0 = param.specularF0[g];
+    for (size_t t = 0; t < slope.size(); ++t) out[t] += f0 * slope[t];
+  }
+  /// The model the first shot evaluates for tixel g's map: the mapped model, with the tixel's
+  /// f0 where it has its own.
+  Bsdf mappedAt(const Bsdf& mapped, const Parameterisation& param, uint64_t g) const {
+    return tixelF0 ? withSpecularF0(mapped, param.specularF0[g]) : mapped;
+  }
   /// out[directionTexels] += Σ_k w_k L_k (a chart with a diffuse value; nothing otherwise).
   void addDiffuse(const Chart& c, const Lanes4* incoming, Rgb* out) const {
     if (!diffuse) return;
@@ -612,8 +634,14 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
     const Bsdf& bsdf = scene.materials[c.material].bsdf;
     if (c.diffuseValue) addDiffusePart(g, bsdf, gridSide);
     const Bsdf& mapped = g.diffuse ? g.specular : bsdf;
-    std::vector<Rgb> dense = glossyOperator(mapped, c.dirRes, gridSide);
+    g.tixelF0 = perTixelSpecularF0(scene, c) && !isNarrowLobe(mapped, gridSide) && !hasTransmission(mapped);
+    std::vector<Rgb> dense = glossyOperator(g.tixelF0 ? withSpecularF0(mapped, Rgb(0.0f)) : mapped, c.dirRes, gridSide);
     g.op = SparseOperator::fromDense(dense, c.dirRes * c.dirRes, n);
+    if (g.tixelF0) {
+      std::vector<Rgb> slope = glossyOperator(withSpecularF0(mapped, Rgb(1.0f)), c.dirRes, gridSide);
+      for (size_t e = 0; e < slope.size(); ++e) slope[e] -= dense[e];
+      g.f0Slope = SparseOperator::fromDense(slope, c.dirRes * c.dirRes, n);
+    }
     if (isNarrowLobe(mapped, gridSide)) {
       for (Rgb& w : dense) w *= float(n) * kInvPi;
       g.cellBsdf = std::move(dense);
@@ -895,7 +923,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         // otherwise alias between texel centres). Area-light samples are many per tixel and
         // already spread over the emitter: the texel-centre value suffices and costs 9× less.
         // The maps get the model without its diffuse part when the tixel keeps that part's Ẽ.
-        const Bsdf& mapped = gm.diffuse ? gm.specular : bsdf;
+        const Bsdf mapped = gm.mappedAt(gm.diffuse ? gm.specular : bsdf, param, p.tixel);
         // A delta light's highlight on a reflecting glossy chart is also noted apart, to be
         // taken out of the stored maps at the end (punctualGlossy).
         const bool highlight = !p.areaSample && !glass && !punctualGlossy.empty();
@@ -1029,7 +1057,7 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
         direct[vb] += sum * (kPi / float(n));
         if (c.directionalIrradiance) addTiltedGather(state, c, g, incoming.data(), subCells, &direct[vb + 1]);
       } else {
-        glossy[c.material].reflection(c).apply(incoming.data(), f4FromRgb(sum), direct.data() + vb);
+        glossy[c.material].reflect(c, param, g, incoming.data(), f4FromRgb(sum), direct.data() + vb);
         glossy[c.material].addDiffuse(c, incoming.data(), direct.data() + vb);
         if (c.directionalIrradiance)
           addTiltedGather(state, c, g, incoming.data(), subCells, direct.data() + vb + c.directionTexels() + 1);
@@ -1169,7 +1197,7 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
         Rgb* out = current.data() + vb;
         std::copy_n(direct.data() + vb, c.valuesPerTixel(), out);
         const GlossyMaterial& gm = glossy[c.material];
-        gm.reflection(c).apply(incoming.data(), sum, out);
+        gm.reflect(c, param, g, incoming.data(), sum, out);
         gm.addDiffuse(c, incoming.data(), out);
         if (c.directionalIrradiance) addTiltedGather(state, c, g, incoming.data(), subCells, out + c.directionTexels() + 1);
         if (gm.glass) {

@@ -172,6 +172,7 @@ TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, P
   exchange(param.gatherNormal);
   exchange(param.coverage);
   exchange(param.transportAlbedo);
+  if (!param.specularF0.empty()) exchange(param.specularF0);
   exchange(param.sunMask);
   exchange(param.borrowedPoint);
   timing.exchangeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - filled).count();

@@ -364,24 +364,34 @@ std::optional<Vec3> sampleGgxDirection(const GgxBsdf& b, const Vec3& wo, Vec2 u)
 // Lobes (bsdf.h): the base GGX f_spec (Fresnel f0 → f90), the Charlie sheen f_s, the GGX
 // coat f_c (f0 = 0.04, f90 = 1) and the diffuse base. E_spec(μ), E_s(μ) and E_c(μ) are the
 // lobes' directional albedos ∫ f_lobe cos θi dωi at cos θo = μ (E_spec per channel; E_s for a
-// white sheen colour; E_c for weight 1). The KHR_materials_sheen README scales the layers
+// white sheen colour; E_c for weight 1); E_d(μ) is the albedo of the base's GGX lobe with the
+// dielectric member's Fresnel (dielectricF0 → dielectricF90), the share the diffuse gives up. The KHR_materials_sheen README scales the layers
 // below a lobe by min(1 − w E(μo), 1 − w E(μi)) = T(wo, wi); we use the same reciprocal form
 // for the coat (its README's 1 − clearcoat·F(N·V) is one-sided: its flux-form albedo from a
 // grazing direction reaches 1 + clearcoat·(E_c(0) − Ē_c) ≈ 1.9 for a smooth coat over white),
 // with the lobe's tabulated E in place of the README's Schlick F(N·V) (which is below E for a
 // rough coat near normal incidence, where it would let the sum exceed 1).
 //   f = w_c f_c + T_c (f_s + T_s f_spec) + ρ/π g(μo) g(μi) / Ḡ,
-//   g(μ) = (1 − E_spec(μ)) (1 − w_s E_s(μ)) (1 − w_c E_c(μ)),  Ḡ = 2∫ g μ dμ,
+//   g(μ) = (1 − E_d(μ)) (1 − w_s E_s(μ)) (1 − w_c E_c(μ)),  Ḡ = 2∫ g μ dμ,
 // w_s = max(sheenColor) ≥ each channel. Energy, per channel, for fixed wo (μo):
 //   ∫ w_c f_c cos                ≤ w_c E_c(μo)
 //   ∫ T_c f_s cos                ≤ (1 − w_c E_c(μo)) w_s E_s(μo)          (T_c ≤ 1 − w_c E_c(μo))
 //   ∫ T_c T_s f_spec cos         ≤ (1 − w_c E_c(μo)) (1 − w_s E_s(μo)) E_spec(μo)
 //   ∫ ρ/π g(μo) g(μi)/Ḡ cos dωi  = ρ g(μo)
-// and their sum is ≤ 1 for ρ ≤ 1 (it telescopes). It is 1 − (loss of the T's max) for ρ = 1:
-// the loss is what the reciprocal max takes where a layer reflects more at θi than at θo. Each
+// and their sum is ≤ 1 when E_spec + ρ (1 − E_d) ≤ 1 (it telescopes). E is linear in the
+// Fresnel's ends: E = f0 A(μ) + f90 B(μ) with A = E₀ − E₅ ≥ 0, B = E₅ ≥ 0, A + B = E₀ ≤ 1
+// (the GGX tables below), so E_spec + ρ (1 − E_d) = ρ + (f0 − ρ dielectricF0) A + (f90 −
+// ρ dielectricF90) B, a linear function on the triangle of (A, B), at most 1 iff it is at its
+// corners: ρ ≤ 1, f0 ≤ 1 − ρ (1 − dielectricF0), f90 ≤ 1 − ρ (1 − dielectricF90) (bsdf.h;
+// lobe.cpp checks them). glTF's mix (f0 = mix(f0_d, c, m), f90 = mix(f90_d, 1, m),
+// ρ = c (1 − m)) leaves 1 − ρ(1 − f0_d) − f0 = (1 − c)(1 − (1 − m) f0_d) ≥ 0 and
+// (1 − m)(1 − f90_d)(1 − c) ≥ 0. With a white base and a white sheen and coat it is
+// 1 − (loss of the T's max) − m (1 − E_metal): the loss is what the reciprocal max takes where
+// a layer reflects more at θi than at θo, the second term the metal lobe's own. Each
 // term is symmetric in (wo, wi), so f is reciprocal exactly. The diffuse term's separable
 // product keeps it one irradiance-like value per tixel in the light field (diffuseDirectional-
-// Factor = g/√Ḡ); Ḡ is a 64-point midpoint rule in μ² of the interpolated tables.
+// Factor = g/√Ḡ); Ḡ is the GGX table's exact mean without layers, else a 64-point midpoint
+// rule in μ² of the interpolated tables.
 //
 // The Charlie sheen (Estevez & Kulla 2017): D(h) = (2 + 1/r) sin^(1/r) θh / (2π) and the
 // visibility 1/((1 + Λ(wo) + Λ(wi)) 4 cos θo cos θi) with their fitted Λ (the README's l()).
@@ -495,23 +505,31 @@ inline float sheenWeight(const GltfPbrBsdf& b) { return std::max(0.0f, maxCompon
 struct PbrAlbedos {
   float coat = 0.0f, sheen = 0.0f;
   Rgb base{0.0f};
+  Rgb dielectric{0.0f};  ///< E_d: the base lobe's albedo with the dielectric member's Fresnel
 };
 PbrAlbedos pbrAlbedos(const GltfPbrBsdf& b, float mu) {
   PbrAlbedos a;
   if (b.clearcoat > 0.0f) a.coat = GgxAlbedoTable::get().upperAlbedo(mu, b.clearcoatAlpha, kCoatF0, 1.0f);
   if (sheenWeight(b) > 0.0f) a.sheen = SheenAlbedoTable::get().lookup(mu, b.sheenRoughness).albedo;
   a.base = ggxLobeAlbedo(b.alpha, b.f0, b.f90, mu).at;
+  a.dielectric = b.dielectricF0 == b.f0 && b.dielectricF90 == b.f90
+                     ? a.base
+                     : ggxLobeAlbedo(b.alpha, b.dielectricF0, b.dielectricF90, mu).at;
   return a;
 }
 
-/// g(μ) = (1 − E_spec)(1 − w_s E_s)(1 − w_c E_c), per channel, ≥ 0.
+/// g(μ) = (1 − E_d)(1 − w_s E_s)(1 − w_c E_c), per channel, ≥ 0.
 Rgb pbrDiffuseShape(const GltfPbrBsdf& b, const PbrAlbedos& a) {
   const float layers = std::max(0.0f, 1.0f - sheenWeight(b) * a.sheen) * std::max(0.0f, 1.0f - b.clearcoat * a.coat);
-  return glm::max(Rgb(1.0f) - a.base, Rgb(0.0f)) * layers;
+  return glm::max(Rgb(1.0f) - a.dielectric, Rgb(0.0f)) * layers;
 }
 
-/// Ḡ = 2∫ g(μ) μ dμ = ∫₀¹ g(√v) dv by the midpoint rule in v.
+/// Ḡ = 2∫ g(μ) μ dμ. Without a coat and a sheen g = 1 − E_d, and Ḡ = 1 − Ē_d exactly for the
+/// interpolated table (GgxBsdf's Ē: the model is then GgxBsdf when the dielectric Fresnel is
+/// the lobe's); with layers ∫₀¹ g(√v) dv by the midpoint rule in v.
 Rgb pbrDiffuseMean(const GltfPbrBsdf& b) {
+  if (!(b.clearcoat > 0.0f) && !(sheenWeight(b) > 0.0f))
+    return glm::max(Rgb(1.0f) - ggxLobeAlbedo(b.alpha, b.dielectricF0, b.dielectricF90, 1.0f).mean, Rgb(0.0f));
   constexpr int kSteps = 64;
   Rgb sum(0.0f);
   for (int k = 0; k < kSteps; ++k) sum += pbrDiffuseShape(b, pbrAlbedos(b, std::sqrt((k + 0.5f) / kSteps)));
@@ -530,7 +548,8 @@ Rgb pbrDiffuseNorm(const GltfPbrBsdf& b) {
   thread_local Cached cache;
   const auto& k = cache.key;
   if (cache.valid && k.f0 == b.f0 && k.f90 == b.f90 && k.alpha == b.alpha && k.clearcoat == b.clearcoat &&
-      k.clearcoatAlpha == b.clearcoatAlpha && k.sheenColor == b.sheenColor && k.sheenRoughness == b.sheenRoughness)
+      k.clearcoatAlpha == b.clearcoatAlpha && k.sheenColor == b.sheenColor && k.sheenRoughness == b.sheenRoughness &&
+      k.dielectricF0 == b.dielectricF0 && k.dielectricF90 == b.dielectricF90)
     return cache.norm;
   const Rgb mean = pbrDiffuseMean(b);
   Rgb n;
@@ -1184,6 +1203,19 @@ Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo) {
                         },
                     },
                     bsdf);
+}
+
+Rgb specularF0(const Bsdf& bsdf) {
+  if (const auto* ggx = std::get_if<GgxBsdf>(&bsdf)) return ggx->f0;
+  if (const auto* pbr = std::get_if<GltfPbrBsdf>(&bsdf)) return pbr->f0;
+  return Rgb(0.0f);
+}
+
+Bsdf withSpecularF0(const Bsdf& bsdf, const Rgb& f0) {
+  Bsdf b = bsdf;
+  if (auto* ggx = std::get_if<GgxBsdf>(&b)) ggx->f0 = f0;
+  if (auto* pbr = std::get_if<GltfPbrBsdf>(&b)) pbr->f0 = f0;
+  return b;
 }
 
 Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta) {

@@ -119,11 +119,6 @@ float blinnPhongExponentFromAlpha(float alpha);
 /// The inverse, α = √(2/(n + 2)).
 float alphaFromBlinnPhongExponent(float exponent);
 
-/// The glTF 2.0 metallic-roughness material as a GgxBsdf (the mapping of the glTF spec's
-/// appendix B): f0 = mix(0.04, baseColor, metallic), diffuse = baseColor·(1 − metallic),
-/// α = ggxAlphaFromRoughness(roughness). metallic and roughness are clamped to [0, 1].
-GgxBsdf ggxFromMetallicRoughness(const Rgb& baseColor, float metallic, float roughness);
-
 /// Exact normalisation of the Blinn-Phong lobe cos^n θh so that ∫ N cos^n θh cos θi dωi = 1
 /// at normal incidence: N(n) = (n + 2)(n + 4) / (8π (2^(−n/2) + n)) (F. Giesen, "The
 /// Blinn-Phong normalization zoo", 2009). n = 0 gives 1/π (Lambert).
@@ -172,7 +167,11 @@ struct DielectricBsdf {
 /// The glTF 2.0 PBR material with the KHR_materials_specular, KHR_materials_clearcoat and
 /// KHR_materials_sheen layers (glTF 2.0 appendix B and the extensions' READMEs), bottom up:
 ///   base   f_b = f_spec + f_d: a GGX lobe (α, Schlick Fresnel from f0 at normal incidence
-///          to f90 at grazing — KHR_materials_specular's weight) over the diffuse ρ;
+///          to f90 at grazing — KHR_materials_specular's weight) over the diffuse ρ. glTF's
+///          base is mix(dielectric, metal, metallic); Schlick's F is linear in (f0, f90), so
+///          the two members' lobes sum to one lobe of the mixed (f0, f90), and the diffuse
+///          (the dielectric's, ρ = baseColor·(1 − metallic)) gives up the share of the
+///          dielectric member's lobe alone: E_d below, of (dielectricF0, dielectricF90);
 ///   sheen  f_s = sheenColor · D_charlie(h) / ((1 + Λ(wo) + Λ(wi)) 4 cos θo cos θi)
 ///          (Estevez & Kulla 2017: the "Charlie" distribution and visibility, as the
 ///          sheen README's reference), roughness r ∈ [kSheenMinRoughness, 1];
@@ -182,10 +181,14 @@ struct DielectricBsdf {
 /// directional albedo; w = max(sheenColor) for sheen, clearcoat for the coat), except the
 /// diffuse term, whose scaling is the separable product of the same factors (Kelemen-style):
 ///   f = f_c + T_c (f_s + T_s f_spec) + ρ/π · g(θo) g(θi) / Ḡ,
-///   g(θ) = (1 − E_spec(θ)) (1 − w_s E_s(θ)) (1 − w_c E_c(θ)),   Ḡ = 2∫ g(μ) μ dμ.
-/// Every term is symmetric in (wo, wi) — reciprocal exactly — and ∫ f cos θi dωi ≤ 1 for
-/// ρ ≤ 1 (derivation in bsdf.cpp). With no sheen and no coat and f90 = 1 it is GgxBsdf.
-/// gltfPbrFromInputs builds it from the glTF factors.
+///   g(θ) = (1 − E_d(θ)) (1 − w_s E_s(θ)) (1 − w_c E_c(θ)),   Ḡ = 2∫ g(μ) μ dμ,
+/// E_d the directional albedo of the GGX lobe of α with Fresnel from dielectricF0 to
+/// dielectricF90. Every term is symmetric in (wo, wi) — reciprocal exactly — and ∫ f cos θi
+/// dωi ≤ 1 when, per channel, ρ ≤ 1, f0 ≤ 1 − ρ (1 − dielectricF0) and f90 ≤ 1 − ρ (1 −
+/// dielectricF90) (derivation in bsdf.cpp; every glTF mapping meets it, and so does
+/// dielectricF0 = f0, dielectricF90 = f90: the diffuse coupled to the whole lobe, as GgxBsdf
+/// couples it). With no sheen and no coat, f90 = 1 and the dielectric Fresnel the lobe's, it is
+/// GgxBsdf. gltfPbrFromInputs builds it from the glTF factors.
 struct GltfPbrBsdf {
   Rgb diffuse{0.8f};          ///< ρ = baseColor · (1 − metallic)
   Rgb f0{0.04f};              ///< base lobe's Fresnel at normal incidence
@@ -195,11 +198,17 @@ struct GltfPbrBsdf {
   float clearcoatAlpha = 0.0625f;  ///< coat GGX α
   Rgb sheenColor{0.0f};       ///< sheen colour in [0, 1] (black: no sheen)
   float sheenRoughness = 0.5f;  ///< Charlie roughness r (not squared), in [0, 1]
+  /// The dielectric member's Fresnel (f0 at normal incidence, f90 at grazing), whose lobe the
+  /// diffuse gives up (E_d above); both in [0, 1].
+  Rgb dielectricF0{0.04f};
+  float dielectricF90 = 1.0f;
 
+  /// The .plf encodes the fields in this order; files of format version 5 and older end the
+  /// list at sheenRoughness and mean dielectricF0 = f0, dielectricF90 = f90 (plf_file.cpp).
   template <class Self, class F>
   static void parameters(Self& b, F&& f) {
     f(b.diffuse), f(b.f0), f(b.f90), f(b.alpha), f(b.clearcoat), f(b.clearcoatAlpha), f(b.sheenColor),
-        f(b.sheenRoughness);
+        f(b.sheenRoughness), f(b.dielectricF0), f(b.dielectricF90);
   }
 };
 /// The Charlie distribution's roughness floor: below it the fitted visibility term and the
@@ -223,6 +232,7 @@ struct GltfPbrInputs {
 /// The KHR_materials_specular mapping (its README), mixed with the metal as appendix B mixes:
 ///   dielectric f0 = min(((ior − 1)/(ior + 1))² · specularColor, 1) · specular,  f90 = specular
 ///   f0 = mix(dielectric f0, baseColor, metallic),  f90 = mix(specular, 1, metallic),
+///   dielectricF0 = dielectric f0,  dielectricF90 = specular,
 ///   diffuse = baseColor · (1 − metallic),  α = ggxAlphaFromRoughness(roughness),
 ///   clearcoat α = ggxAlphaFromRoughness(clearcoatRoughness),
 /// the rest copied; every factor clamped to its range ([0, 1]; ior ≥ 1).
@@ -287,6 +297,17 @@ using Bsdf =
 /// A default-constructed model of variant index `index` (the serialised model number);
 /// nullopt for an index no model has.
 std::optional<Bsdf> bsdfOfIndex(size_t index);
+
+/// The glTF 2.0 metallic-roughness material (the spec's appendix B): the BRDF
+///   mix(dielectric_brdf, metal_brdf, metallic),
+///   dielectric_brdf = a GGX lobe of f0 0.04 over the diffuse baseColor, which gives up that
+///                     lobe's share (fresnel_mix),   metal_brdf = a GGX lobe of f0 baseColor,
+/// α = ggxAlphaFromRoughness(roughness), metallic and roughness clamped to [0, 1]. Where
+/// metallic is 0 or 1 the mix has one member and this is the GgxBsdf {diffuse = baseColor·
+/// (1 − metallic), f0 = mix(0.04, baseColor, metallic), α}; in between it is the GltfPbrBsdf of
+/// gltfPbrFromInputs, whose diffuse base gives up only the dielectric lobe's share (a GgxBsdf
+/// of the mixed f0 would couple it to the brighter mixed lobe).
+Bsdf gltfMetallicRoughnessModel(const Rgb& baseColor, float metallic, float roughness);
 
 // ---- What other modules need to know about a model (the lobe descriptor) ----------------
 
@@ -357,6 +378,12 @@ Rgb albedo(const Bsdf& bsdf, const Vec3& wo);
 /// The model with its diffuse albedo replaced (texture lookups at a hit point). Models with
 /// no diffuse part are returned unchanged.
 Bsdf withDiffuseAlbedo(const Bsdf& bsdf, const Rgb& albedo);
+/// The Fresnel reflectance at normal incidence of the model's glossy lobe (GGX, glTF: f0;
+/// black for other models), and the model with it replaced (others unchanged). The lobe is
+/// linear in it (Schlick's F = f0 (1 − m⁵) + f90 m⁵), which the bake uses to give each tixel
+/// of a metallic-roughness-textured material its own f0 (propagation.cpp GlossyMaterial).
+Rgb specularF0(const Bsdf& bsdf);
+Bsdf withSpecularF0(const Bsdf& bsdf, const Rgb& f0);
 /// The directional factor k(μ) of the model's diffuse part: every model's diffuse term is
 ///   f_diffuse(wo, wi) = diffuseAlbedo(bsdf)/π · k(μo) · k(μi)        (μ = cos θ, per channel)
 /// — k = 1 for Lambert and Blinn-Phong (a plain Lambertian term); for GGX

@@ -51,7 +51,8 @@ std::string label(const Bsdf& b) {
           return "gltf-pbr(kd=" + std::to_string(m.diffuse.r) + ",f0=" + std::to_string(m.f0.r) +
                  ",f90=" + std::to_string(m.f90) + ",a=" + std::to_string(m.alpha) +
                  ",coat=" + std::to_string(m.clearcoat) + "/" + std::to_string(m.clearcoatAlpha) +
-                 ",sheen=" + std::to_string(m.sheenColor.r) + "/" + std::to_string(m.sheenRoughness) + ")";
+                 ",sheen=" + std::to_string(m.sheenColor.r) + "/" + std::to_string(m.sheenRoughness) +
+                 ",dielectric=" + std::to_string(m.dielectricF0.r) + "/" + std::to_string(m.dielectricF90) + ")";
       },
       b);
 }
@@ -70,7 +71,9 @@ std::vector<Bsdf> smoothModels() {
       GgxBsdf{Rgb(0.8f, 0.4f, 0.2f), Rgb(0.04f), 0.3f},
       GgxBsdf{Rgb(1.0f), Rgb(0.04f), 0.8f},
       GgxBsdf{Rgb(0.5f), Rgb(0.9f, 0.6f, 0.3f), 0.05f},
-      ggxFromMetallicRoughness(Rgb(0.9f, 0.7f, 0.3f), 1.0f, 0.5f),
+      gltfMetallicRoughnessModel(Rgb(0.9f, 0.7f, 0.3f), 1.0f, 0.5f),
+      // glTF's mix of a dielectric and a metal at fractional metalness (GltfPbrBsdf).
+      gltfMetallicRoughnessModel(Rgb(0.9f, 0.6f, 0.2f), 0.5f, 0.4f),
       // glTF PBR: a clearcoat over a coloured dielectric; a sheen over a rough base; every
       // layer at once with a tinted, weakened specular over a half metal; all white.
       gltfPbrFromInputs({.baseColor = Rgb(0.8f, 0.5f, 0.3f), .metallic = 0.0f, .roughness = 0.5f,
@@ -767,11 +770,11 @@ TEST(Bsdf, NamesFlagsAndDiffuseReplacement) {
 }
 
 TEST(Ggx, MetallicRoughnessMapping) {
-  const GgxBsdf dielectric = ggxFromMetallicRoughness(Rgb(0.5f, 0.2f, 0.1f), 0.0f, 0.5f);
+  const GgxBsdf dielectric = std::get<GgxBsdf>(gltfMetallicRoughnessModel(Rgb(0.5f, 0.2f, 0.1f), 0.0f, 0.5f));
   EXPECT_EQ(dielectric.f0, Rgb(0.04f));
   EXPECT_EQ(dielectric.diffuse, Rgb(0.5f, 0.2f, 0.1f));
   EXPECT_FLOAT_EQ(dielectric.alpha, 0.25f);
-  const GgxBsdf metal = ggxFromMetallicRoughness(Rgb(0.9f, 0.6f, 0.3f), 1.0f, 0.0f);
+  const GgxBsdf metal = std::get<GgxBsdf>(gltfMetallicRoughnessModel(Rgb(0.9f, 0.6f, 0.3f), 1.0f, 0.0f));
   EXPECT_EQ(metal.f0, Rgb(0.9f, 0.6f, 0.3f));
   EXPECT_EQ(metal.diffuse, Rgb(0.0f));
   EXPECT_FLOAT_EQ(metal.alpha, kGgxMinAlpha);
@@ -814,6 +817,17 @@ TEST(GltfPbr, SpecularExtensionMapping) {
   bad = layers;
   bad.clearcoatAlpha = 0.0f;
   EXPECT_NE(bsdfProblem(bad).find("clearcoat alpha"), std::string::npos);
+  // A diffuse that the dielectric's lobe leaves under a brighter whole lobe would reflect more
+  // than arrives (bsdf.cpp: f0 <= 1 - diffuse (1 - dielectric f0)).
+  bad = GltfPbrBsdf{};
+  bad.diffuse = Rgb(1.0f);
+  bad.f0 = Rgb(0.5f);
+  bad.dielectricF0 = Rgb(0.04f);
+  EXPECT_NE(bsdfProblem(bad).find("dielectric f0"), std::string::npos);
+  bad.dielectricF0 = bad.f0;  // coupled to the whole lobe: fine
+  EXPECT_EQ(bsdfProblem(bad), "");
+  bad.dielectricF90 = 2.0f;
+  EXPECT_NE(bsdfProblem(bad).find("f90"), std::string::npos);
   EXPECT_STREQ(modelName(layers), "gltf-pbr");
   EXPECT_EQ(describe(layers).kind, LobeKind::Glossy);
   // The narrower of the base's and the coat's lobes.
@@ -821,21 +835,51 @@ TEST(GltfPbr, SpecularExtensionMapping) {
 }
 
 TEST(GltfPbr, WithoutLayersItIsTheGgxModel) {
-  // No coat, no sheen, specular 1: the GgxBsdf of the same factors, up to Ḡ's quadrature.
+  // No coat, no sheen, specular 1, metalness 0 or 1: the GgxBsdf of the same factors (up to
+  // float rounding: Ḡ is the table's exact mean in both).
   const Rgb base(0.9f, 0.5f, 0.2f);
-  for (float metallic : {0.0f, 0.4f})
+  for (float metallic : {0.0f, 1.0f})
     for (float roughness : {0.2f, 0.7f}) {
       const Bsdf pbr = gltfPbrFromInputs({.baseColor = base, .metallic = metallic, .roughness = roughness});
-      const Bsdf ggx = ggxFromMetallicRoughness(base, metallic, roughness);
+      const Bsdf ggx = gltfMetallicRoughnessModel(base, metallic, roughness);
+      ASSERT_TRUE(std::holds_alternative<GgxBsdf>(ggx));
       Pcg32 rng(3, 3);
       for (int k = 0; k < 2000; ++k) {
         const Vec3 wo = sampleUniformHemisphere({rng.uniform(), rng.uniform()});
         const Vec3 wi = sampleUniformHemisphere({rng.uniform(), rng.uniform()});
         const Rgb a = eval(pbr, wo, wi), b = eval(ggx, wo, wi);
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 2e-3f * std::max(1.0f, b[c]));
-        EXPECT_NEAR(pdf(pbr, wo, wi), pdf(ggx, wo, wi), 1e-3f * std::max(1.0f, pdf(ggx, wo, wi)));
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 1e-5f * std::max(1.0f, b[c]));
+        EXPECT_NEAR(pdf(pbr, wo, wi), pdf(ggx, wo, wi), 1e-5f * std::max(1.0f, pdf(ggx, wo, wi)));
       }
     }
+}
+
+TEST(GltfPbr, FractionalMetalnessIsTheSpecsMix) {
+  // glTF 2.0 appendix B: material = mix(dielectric_brdf, metal_brdf, metallic), the members
+  // being the model at metalness 0 and 1 (GgxBsdf). The diffuse of the mix gives up only the
+  // dielectric's lobe: a GGX model of the mixed F0 coupling its diffuse to the whole (brighter)
+  // lobe reflects 18 % less at metalness 0.5 on this gold (normal incidence, roughness 0.5).
+  const Rgb gold(1.0f, 0.77f, 0.34f);
+  for (float metallic : {0.25f, 0.5f, 0.8f})
+    for (float roughness : {0.2f, 0.5f, 0.9f}) {
+      const Bsdf mixed = gltfMetallicRoughnessModel(gold, metallic, roughness);
+      ASSERT_TRUE(std::holds_alternative<GltfPbrBsdf>(mixed));
+      EXPECT_EQ(bsdfProblem(mixed), "");
+      const Bsdf dielectric = gltfMetallicRoughnessModel(gold, 0.0f, roughness);
+      const Bsdf metal = gltfMetallicRoughnessModel(gold, 1.0f, roughness);
+      Pcg32 rng(7, 7);
+      for (int k = 0; k < 2000; ++k) {
+        const Vec3 wo = sampleUniformHemisphere({rng.uniform(), rng.uniform()});
+        const Vec3 wi = sampleUniformHemisphere({rng.uniform(), rng.uniform()});
+        const Rgb spec = (1.0f - metallic) * eval(dielectric, wo, wi) + metallic * eval(metal, wo, wi);
+        const Rgb got = eval(mixed, wo, wi);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], spec[c], 1e-5f * std::max(1.0f, spec[c])) << label(mixed);
+      }
+    }
+  const Bsdf half = gltfMetallicRoughnessModel(gold, 0.5f, 0.5f);
+  const Bsdf coupled = GgxBsdf{gold * 0.5f, glm::mix(Rgb(0.04f), gold, 0.5f), 0.25f};
+  const Vec3 normal(0.0f, 0.0f, 1.0f);
+  EXPECT_NEAR(luminance(albedo(coupled, normal)) / luminance(albedo(half, normal)), 0.82, 0.02);
 }
 
 TEST(GltfPbr, WhiteFurnace) {
@@ -1076,7 +1120,9 @@ TEST(Lobe, ParametersHookVisitsEveryFieldAndRebuildsTheModel) {
                                     BlinnPhongBsdf{Rgb(0.2f), Rgb(0.3f), 17.0f},
                                     GgxBsdf{Rgb(0.4f), Rgb(0.05f), 0.3f},
                                     DielectricBsdf{1.33f, Rgb(0.9f), 0.2f, true, Rgb(0.5f)},
-                                    SubsurfaceBsdf{Rgb(0.8f, 0.5f, 0.2f), Rgb(0.1f, 0.2f, 0.3f)}};
+                                    SubsurfaceBsdf{Rgb(0.8f, 0.5f, 0.2f), Rgb(0.1f, 0.2f, 0.3f)},
+                                    gltfPbrFromInputs({.baseColor = Rgb(0.7f), .metallic = 0.4f, .specular = 0.6f,
+                                                       .clearcoat = 0.3f, .sheenColor = Rgb(0.2f)})};
   for (const Bsdf& model : models) {
     std::vector<float> values;
     std::visit([&](const auto& b) {

@@ -107,6 +107,16 @@ std::string problemOf(const GltfPbrBsdf& b) {
                        b.sheenRoughness);
   if (!(b.alpha > 0.0f && b.alpha <= 1.0f) || !(b.clearcoatAlpha > 0.0f && b.clearcoatAlpha <= 1.0f))
     return fmt::format("glTF PBR alpha {} and clearcoat alpha {} must lie in (0, 1]", b.alpha, b.clearcoatAlpha);
+  if (!inUnitRange(b.dielectricF0) || !(b.dielectricF90 >= 0.0f && b.dielectricF90 <= 1.0f))
+    return fmt::format("glTF PBR dielectric f0 {} and f90 {} must lie in [0, 1]", str(b.dielectricF0), b.dielectricF90);
+  // The energy bound of the diffuse's coupling (bsdf.cpp): f0 ≤ 1 − ρ (1 − dielectric f0),
+  // f90 ≤ 1 − ρ (1 − dielectric f90) per channel.
+  for (int c = 0; c < 3; ++c)
+    if (b.f0[c] > 1.0f - b.diffuse[c] * (1.0f - b.dielectricF0[c]) + kSumSlack ||
+        b.f90 > 1.0f - b.diffuse[c] * (1.0f - b.dielectricF90) + kSumSlack)
+      return fmt::format("glTF PBR f0 {} and f90 {} exceed what the diffuse {} under the dielectric f0 {} and f90 {} "
+                         "leaves (f0 <= 1 - diffuse (1 - dielectric f0), likewise f90)",
+                         str(b.f0), b.f90, str(b.diffuse), str(b.dielectricF0), b.dielectricF90);
   return {};
 }
 
@@ -201,8 +211,10 @@ float blinnPhongExponentFromAlpha(float alpha) { return std::max(0.0f, 2.0f / (a
 
 float alphaFromBlinnPhongExponent(float exponent) { return std::sqrt(2.0f / (std::max(exponent, 0.0f) + 2.0f)); }
 
-GgxBsdf ggxFromMetallicRoughness(const Rgb& baseColor, float metallic, float roughness) {
+Bsdf gltfMetallicRoughnessModel(const Rgb& baseColor, float metallic, float roughness) {
   metallic = std::clamp(metallic, 0.0f, 1.0f);
+  if (metallic > 0.0f && metallic < 1.0f)
+    return gltfPbrFromInputs({.baseColor = baseColor, .metallic = metallic, .roughness = roughness});
   GgxBsdf b;
   b.f0 = glm::mix(Rgb(0.04f), baseColor, metallic);
   b.diffuse = baseColor * (1.0f - metallic);
@@ -219,6 +231,8 @@ GltfPbrBsdf gltfPbrFromInputs(const GltfPbrInputs& in) {
   GltfPbrBsdf b;
   b.f0 = glm::mix(dielectricF0, base, metallic);
   b.f90 = specular + (1.0f - specular) * metallic;
+  b.dielectricF0 = dielectricF0;
+  b.dielectricF90 = specular;
   b.diffuse = base * (1.0f - metallic);
   b.alpha = ggxAlphaFromRoughness(in.roughness);
   b.clearcoat = std::clamp(in.clearcoat, 0.0f, 1.0f);

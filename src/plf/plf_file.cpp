@@ -103,19 +103,33 @@ void putBsdf(ByteWriter& w, const Bsdf& bsdf) {
       bsdf);
 }
 
-Bsdf getBsdf(ByteReader& r) {
+// Version 6 appended the glTF model's (5) dielectric Fresnel, dielectricF0 and dielectricF90:
+// an older file's model ends before them and means the diffuse coupled to the whole lobe,
+// dielectricF0 = f0 and dielectricF90 = f90 (bsdf.h GltfPbrBsdf).
+constexpr size_t kGltfPbrFieldsBeforeVersion6 = 8;
+
+Bsdf getBsdf(ByteReader& r, uint32_t version) {
   const uint32_t model = r.get<uint32_t>();
   std::optional<Bsdf> bsdf = bsdfOfIndex(model);
   if (!bsdf) r.corrupt(fmt::format("unknown BSDF model {}", model));
+  auto* gltf = std::get_if<GltfPbrBsdf>(&*bsdf);
+  const bool older = gltf && version < 6;
+  size_t fieldsLeft = older ? kGltfPbrFieldsBeforeVersion6 : SIZE_MAX;
   std::visit(
       [&](auto& b) {
         std::decay_t<decltype(b)>::parameters(b, [&](auto& field) {
+          if (fieldsLeft == 0) return;
+          --fieldsLeft;
           using Field = std::decay_t<decltype(field)>;
           if constexpr (std::is_same_v<Field, bool>) field = r.get<uint8_t>() != 0;
           else field = r.get<Field>();
         });
       },
       *bsdf);
+  if (older) {
+    gltf->dielectricF0 = gltf->f0;
+    gltf->dielectricF90 = gltf->f90;
+  }
   return *bsdf;
 }
 
@@ -328,7 +342,7 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
   scene.materials.resize(r.getCount(kMinMaterialBytes, "materials"));
   for (Material& m : scene.materials) {
     m.name = r.getString();
-    m.bsdf = getBsdf(r);
+    m.bsdf = getBsdf(r, version);
     m.albedoTexture = r.get<int32_t>();
     m.emission = r.get<Rgb>();
     m.twoSidedEmission = r.get<uint8_t>() != 0;

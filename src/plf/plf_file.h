@@ -72,10 +72,12 @@
 //
 // Versions: 1 textures as float pixels; 2 textures as their image file's bytes; 3 an optional
 // SMSK section (sun masks); 4 glossy charts with a diffuse value per tixel (CHRT bit 4); 5 the
-// SCNE texturing block and normal-mapped diffuse charts with tilted irradiances (CHRT bit 3). A
+// SCNE texturing block and normal-mapped diffuse charts with tilted irradiances (CHRT bit 3); 6
+// the glTF model's (BSDF 5) dielectric Fresnel after its other parameters. A
 // file without sun masks differs from version 2 only in the version field (and so the header
 // hash); a version 3 file from version 4 only there when no chart has the bit; a version 4 file
-// from version 5 only there when the scene has no texturing block and no chart has bit 3.
+// from version 5 only there when the scene has no texturing block and no chart has bit 3; a
+// version 5 file from version 6 only there when no material has the glTF model.
 //
 // The version is checked right after the magic, before anything else is interpreted, so a
 // future layout can change everything after it (versions 1 to kPlfVersion are read). Reading never trusts the file: the magic,
@@ -100,10 +102,13 @@ namespace pl {
 /// is what a chart without it means). 5: SCNE may end with a texturing block (glTF texture
 /// mappings, second uv sets, vertex colours, metallic-roughness textures, samplers), and
 /// normal-mapped diffuse charts may keep tilted irradiances per tixel (older files show such
-/// charts flat, which is what a chart without them means). Readers also read versions 1 (the
-/// same as 2 but for the texture records), 2 (as 3, never with SMSK), 3 (as 4, never with the
-/// chart bit) and 4 (as 5, never with the texturing block or CHRT bit 3).
-inline constexpr uint32_t kPlfVersion = 5;
+/// charts flat, which is what a chart without them means). 6: the glTF model (BSDF 5) ends
+/// with its dielectric Fresnel (bsdf.h GltfPbrBsdf: fractional metalness as glTF mixes it).
+/// Readers also read versions 1 (the same as 2 but for the texture records), 2 (as 3, never
+/// with SMSK), 3 (as 4, never with the chart bit), 4 (as 5, never with the texturing block or
+/// CHRT bit 3) and 5 (as 6, the glTF model without its dielectric Fresnel, which is then the
+/// lobe's: the diffuse coupled to the whole lobe, what version 5 meant).
+inline constexpr uint32_t kPlfVersion = 6;
 inline constexpr uint32_t kPlfOldestReadableVersion = 1;
 inline constexpr size_t kPlfHeaderSize = 32;
 inline constexpr size_t kPlfSectionEntrySize = 48;

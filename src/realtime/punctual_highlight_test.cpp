@@ -36,7 +36,7 @@ Scene glossyBoxWithPointLight(float metallic = 0.0f) {
   for (Material& m : scene.materials) {
     if (m.isEmissive()) m.emission = Rgb(0.0f);
     else if (const auto* lambert = std::get_if<LambertBsdf>(&m.bsdf))
-      m.bsdf = ggxFromMetallicRoughness(lambert->albedo, metallic, 0.2f);
+      m.bsdf = gltfMetallicRoughnessModel(lambert->albedo, metallic, 0.2f);
   }
   scene.lights.push_back(PointLight{Vec3(278.0f, 498.0f, 279.5f), Rgb(250000.0f)});  // W·sr⁻¹ in millimetre units
   scene.finalize();

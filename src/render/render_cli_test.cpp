@@ -244,16 +244,18 @@ TEST_F(RenderCliTest, RefusesBadInputWithoutWritingAnything) {
 // without lights does not get, and "sun_masks" among the settings), quad-v4.plf by the
 // version-4 writer (a chart bit for glossy charts' diffuse values; the quad is diffuse),
 // quad-v5.plf by the version-5 writer (SCNE's texturing block, which the untextured quad does
-// not get, and a chart bit for normal-mapped diffuse charts, which it has not either). They
+// not get, and a chart bit for normal-mapped diffuse charts, which it has not either),
+// quad-v6.plf by the version-6 writer (the glTF model's dielectric Fresnel; the quad's
+// material is Lambertian). They
 // pin the format: a change of the byte layout without a new version number
 // fails here, and files of the older version must still read. Regenerate the current one
 // deliberately (after bumping kPlfVersion and keeping a reader for old files) with
 //   PLENOPTIC_REGENERATE_FIXTURES=1 ./render_cli_test --gtest_filter='*Fixture*'
 TEST_F(RenderCliTest, OlderAndCurrentFixturesReadAndRewriteByteForByte) {
-  const std::string current = std::string(PLENOPTIC_TEST_DATA_DIR) + "/render/quad-v5.plf";
+  const std::string current = std::string(PLENOPTIC_TEST_DATA_DIR) + "/render/quad-v6.plf";
   if (std::getenv("PLENOPTIC_REGENERATE_FIXTURES")) writeLightField(current, makeQuadLightField());
   const LightField expected = makeQuadLightField();
-  for (const std::string name : {"quad-v1.plf", "quad-v2.plf", "quad-v3.plf", "quad-v4.plf", "quad-v5.plf"}) {
+  for (const std::string name : {"quad-v1.plf", "quad-v2.plf", "quad-v3.plf", "quad-v4.plf", "quad-v5.plf", "quad-v6.plf"}) {
     const std::string fixture = std::string(PLENOPTIC_TEST_DATA_DIR) + "/render/" + name;
     const LightField lf = readLightField(fixture);
     EXPECT_EQ(lf.scene.sourcePath, expected.scene.sourcePath);

@@ -75,7 +75,7 @@ Figures compare(const Bsdf& bsdf) {
 // Bounds: the ratio within 0.03 and relMSE below 0.01, which the untextured light field
 // misses by 10× and more.
 TEST_F(TexturedGlossyTest, TexturedGgxWallsMatchThePathTracer) {
-  const Figures f = compare(ggxFromMetallicRoughness(Rgb(0.8f), 0.0f, 0.6f));
+  const Figures f = compare(gltfMetallicRoughnessModel(Rgb(0.8f), 0.0f, 0.6f));
   std::printf("textured GGX: LF/PT %.4f relMSE %.5f (untextured/textured path trace %.3f)\n", f.ratio, f.relMse,
               f.untexturedRatio);
   EXPECT_GT(f.untexturedRatio, 1.3);  // the texture matters: without it the box is much brighter

@@ -11,11 +11,14 @@
 //    not, KHR_draco_mesh_compression- or EXT_meshopt_compression-compressed or plain
 //    (gltf_compression.h). Other modes: warning, skipped. A texture slot reading a TEXCOORD set
 //    the primitive lacks is an error naming the mesh and the material.
-//  * Metallic-roughness materials → GgxBsdf:
+//  * Metallic-roughness materials → bsdf.h gltfMetallicRoughnessModel: the spec's
+//    mix(dielectric, metal, metallic) — a GgxBsdf where metallic is 0 or 1,
 //        diffuse = baseColor · (1 − metallic)
 //        f0      = mix(0.04, baseColor, metallic)        (0.04: dielectric F0 of the spec)
 //        alpha   = max(roughness², 1e-3)                 (GGX α; the floor keeps the
 //                                                         microfacet distribution finite)
+//    and in between the GltfPbrBsdf of the same, whose diffuse gives up only the dielectric
+//    member's lobe.
 //    baseColor = baseColorFactor.rgb; baseColorTexture → albedo texture and COLOR_0 → vertex
 //    colours, both multiplying `diffuse` (so they tint dielectrics; a metal's f0 keeps the
 //    factor only), texels sRGB 8/16-bit decoded to linear; v is flipped to our bottom-left
@@ -630,26 +633,24 @@ void applyLayers(GltfContext& ctx, const tinygltf::Material& gltf, Material& mat
 
 /// The one model a material with a metallic-roughness texture keeps (Material::bsdf) for what
 /// takes one model per material — the bake's glossy lobe and chart classification, the
-/// renderers' punctual highlights: the texture's mean over its texels of each GGX parameter,
-///   α = mean of ggxAlpha(roughness·G),  F0 = mean of mix(0.04, baseColor·ā, metallic·B),
-///   diffuse = baseColor·ā · (1 − mean of metallic·B)
-/// with ā the mean of the base colour texture (`albedo`, null without one: 1). The path
-/// tracer and the per-point diffuse albedo read the texels themselves (materialModelAt).
-GgxBsdf meanMetallicRoughnessModel(const Image& texels, const MetallicRoughnessMap& mr, const Image* albedo) {
+/// renderers' punctual highlights: gltfMetallicRoughnessModel(baseColor·ā, m̄) with its α
+/// replaced by ᾱ, the means over the texels of m = metallic·B and α = ggxAlpha(roughness·G)
+/// (ā the mean of the base colour texture, `albedo`, null without one: 1). Its F0 = mix(0.04,
+/// baseColor·ā, m̄) and diffuse baseColor·ā·(1 − m̄) are the texels' means too (both linear in
+/// m). The path tracer and the per-point diffuse albedo read the texels themselves
+/// (materialModelAt).
+Bsdf meanMetallicRoughnessModel(const Image& texels, const MetallicRoughnessMap& mr, const Image* albedo) {
   const Rgb base = albedo && !albedo->pixels.empty() ? mr.baseColor * meanTexel(*albedo) : mr.baseColor;
   double alpha = 0.0, metalness = 0.0;
-  glm::dvec3 f0(0.0);
   for (const Rgb& t : texels.pixels) {
-    const GgxBsdf at = ggxFromMetallicRoughness(base, mr.metallic * t.b, mr.roughness * t.g);
-    alpha += at.alpha;
-    f0 += glm::dvec3(at.f0);
+    alpha += ggxAlphaFromRoughness(mr.roughness * t.g);
     metalness += std::clamp(mr.metallic * t.b, 0.0f, 1.0f);
   }
   const double n = double(std::max<size_t>(1, texels.pixels.size()));
-  GgxBsdf mean;
-  mean.alpha = float(alpha / n);
-  mean.f0 = Rgb(f0 / n);
-  mean.diffuse = base * float(1.0 - metalness / n);
+  Bsdf mean = gltfMetallicRoughnessModel(base, float(metalness / n), 1.0f);
+  std::visit([&](auto& b) {
+    if constexpr (requires { b.alpha; }) b.alpha = float(alpha / n);
+  }, mean);
   return mean;
 }
 
@@ -664,7 +665,7 @@ Material convertMaterial(GltfContext& ctx, const tinygltf::Material& gltf, int i
 
   Material material;
   material.name = gltf.name.empty() ? fmt::format("material{}", index) : gltf.name;
-  material.bsdf = ggxFromMetallicRoughness(baseColor, metallic, roughness);
+  material.bsdf = gltfMetallicRoughnessModel(baseColor, metallic, roughness);
   if (pbr.baseColorTexture.index >= 0) {
     material.albedoMapping = mappingOf(ctx, slotRef("baseColorTexture", pbr.baseColorTexture), material.name);
     material.albedoTexture = textureFor(ctx, pbr.baseColorTexture.index);

@@ -228,8 +228,9 @@ TEST(GltfTexturing, VertexColorScalesTheAlbedo) {
   EXPECT_VEC3_NEAR(diffuseAlbedo(bsdfAt(plain, hit)), Rgb(0.8f, 0.6f, 0.4f), kTight);
 }
 
-// A metallicRoughnessTexture sets the GGX parameters at each hit: B × metallicFactor is the
-// metalness, G × roughnessFactor the roughness (raw values, no sRGB decoding).
+// A metallicRoughnessTexture sets the model at each hit: B × metallicFactor is the metalness,
+// G × roughnessFactor the roughness (raw values, no sRGB decoding); at fractional metalness
+// glTF's mix of a dielectric and a metal (bsdf.h gltfMetallicRoughnessModel).
 TEST(GltfTexturing, MetallicRoughnessTexturePerHit) {
   const fs::path dir = scratch("mr");
   const Scene scene = loadScene(writeQuad(dir,
@@ -239,12 +240,21 @@ TEST(GltfTexturing, MetallicRoughnessTexturePerHit) {
   ASSERT_GE(material.metallicRoughness.texture, 0);
   for (const Vec2 p : {Vec2(0.3f, 0.1f), Vec2(0.9f, 0.6f), Vec2(0.1f, 0.8f)}) {
     const Rgb texel = texelRaw(wrappedTexel(p.x, "repeat"), wrappedTexel(1.0f - p.y, "repeat"));
-    const GgxBsdf expected = ggxFromMetallicRoughness(Rgb(0.9f, 0.5f, 0.3f), 0.5f * texel.b, 0.8f * texel.g);
+    const Bsdf expected = gltfMetallicRoughnessModel(Rgb(0.9f, 0.5f, 0.3f), 0.5f * texel.b, 0.8f * texel.g);
     const SurfaceHit hit = p.x >= p.y ? surfaceAt(scene, 0, 0, Vec2(p.x - p.y, p.y)) : surfaceAt(scene, 0, 1, Vec2(p.x, p.y - p.x));
-    const GgxBsdf got = std::get<GgxBsdf>(bsdfAt(scene, hit));
-    EXPECT_NEAR(got.alpha, expected.alpha, kTight);
-    EXPECT_VEC3_NEAR(got.f0, expected.f0, kTight);
-    EXPECT_VEC3_NEAR(got.diffuse, expected.diffuse, kTight);
+    const Bsdf got = bsdfAt(scene, hit);
+    ASSERT_EQ(got.index(), expected.index());
+    std::visit([&](const auto& want) {
+      using Model = std::decay_t<decltype(want)>;
+      if constexpr (std::is_same_v<Model, GgxBsdf> || std::is_same_v<Model, GltfPbrBsdf>) {
+        const Model& at = std::get<Model>(got);
+        EXPECT_NEAR(at.alpha, want.alpha, kTight);
+        EXPECT_VEC3_NEAR(at.f0, want.f0, kTight);
+        EXPECT_VEC3_NEAR(at.diffuse, want.diffuse, kTight);
+      } else {
+        ADD_FAILURE() << "a metallic-roughness material made a " << modelName(want);
+      }
+    }, expected);
   }
 }
 

@@ -212,6 +212,9 @@ Material parseMaterial(const JsonContext& ctx, Scene& scene, const std::string& 
       pbr.clearcoatAlpha = ggxAlphaFromRoughness(coatRoughness);
       pbr.sheenColor = colourOr(ctx, value, "sheen", Rgb(0.0f), where);
       pbr.sheenRoughness = numberOr(ctx, value, "sheen_roughness", 0.5f, where);
+      // The diffuse under the whole lobe, as "ggx" couples it (no metal member).
+      pbr.dielectricF0 = pbr.f0;
+      pbr.dielectricF90 = pbr.f90;
       material.bsdf = pbr;
     }
     known.insert({"diffuse", "f0", "alpha", "roughness", "texture"});

@@ -463,7 +463,7 @@ Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoP
   const Rgb modulation = albedoModulation(scene, material, p);
   if (mr.texture >= 0) {
     const Rgb texel = scene.textures[size_t(mr.texture)].sample(p.metallicRoughnessUv);
-    return ggxFromMetallicRoughness(mr.baseColor * modulation, mr.metallic * texel.b, mr.roughness * texel.g);
+    return gltfMetallicRoughnessModel(mr.baseColor * modulation, mr.metallic * texel.b, mr.roughness * texel.g);
   }
   return withDiffuseAlbedo(material.bsdf, diffuseAlbedo(material.bsdf) * modulation);
 }

@@ -34,7 +34,7 @@ struct TextureMapping {
 };
 
 /// A metallic-roughness texture (glTF pbrMetallicRoughness.metallicRoughnessTexture) on a
-/// GgxBsdf material: at each point the model is ggxFromMetallicRoughness(baseColor ×
+/// GGX-like material: at each point the model is gltfMetallicRoughnessModel(baseColor ×
 /// albedo modulation (albedoModulation), metallic × B, roughness × G), B and G the texel's
 /// blue and green channels (raw values), the factors the material's own. `texture` is an
 /// index into Scene::textures (ImageDecode::Data) or −1 (none: the material's bsdf as it is).
@@ -363,7 +363,7 @@ std::string mappingProblem(const Material& material);
 
 /// The material's model at albedo point p, the one rule bsdfAt and the renderers' albedos
 /// (lookup.h diffuseAlbedoAt, glossyDiffuseAlbedoAt) apply: the model as it is when nothing
-/// varies; with a metallic-roughness texture ggxFromMetallicRoughness(baseColor × modulation,
+/// varies; with a metallic-roughness texture gltfMetallicRoughnessModel(baseColor × modulation,
 /// metallic × B, roughness × G) of the texel at p.metallicRoughnessUv (full resolution), for a
 /// glTF layered material the layered model of the same (PbrLayerMaps, with the layer textures'
 /// means); otherwise the model with its diffuse albedo × albedoModulation(p).

@@ -535,15 +535,18 @@ TEST_P(GltfFile, HierarchyCamerasLightsAndMaterial) {
   EXPECT_NEAR(hit.uv.x, 0.25f, kTight);
   EXPECT_NEAR(hit.uv.y, 0.75f, kTight);
 
-  // Material: diffuse = 0.5·(1 − 0.25) = 0.375, f0 = 0.04 + 0.25·(0.5 − 0.04) = 0.155,
-  // alpha = 0.5² = 0.25, emission = (1, 0.5, 0)·4.
+  // Material (metalness 0.25: glTF's mix of a dielectric and a metal, bsdf.h
+  // gltfMetallicRoughnessModel): diffuse = 0.5·(1 − 0.25) = 0.375, f0 = 0.04 + 0.25·(0.5 −
+  // 0.04) = 0.155, the diffuse under the dielectric's f0 0.04, alpha = 0.5² = 0.25, emission =
+  // (1, 0.5, 0)·4.
   const Material& material = materialNamed(scene, "textured");
-  const auto& ggx = std::get<GgxBsdf>(material.bsdf);
+  const auto& ggx = std::get<GltfPbrBsdf>(material.bsdf);
   EXPECT_VEC3_NEAR(ggx.diffuse, Rgb(0.375f), kTight);
   EXPECT_VEC3_NEAR(ggx.f0, Rgb(0.155f), kTight);
+  EXPECT_VEC3_NEAR(ggx.dielectricF0, Rgb(0.04f), kTight);
   EXPECT_NEAR(ggx.alpha, 0.25f, kTight);
   EXPECT_VEC3_NEAR(material.emission, Rgb(4.0f, 2.0f, 0.0f), kTight);
-  const auto textured = std::get<GgxBsdf>(bsdfAt(scene, hit));
+  const auto textured = std::get<GltfPbrBsdf>(bsdfAt(scene, hit));
   EXPECT_VEC3_NEAR(textured.diffuse, Rgb(0.375f, 0.0f, 0.0f), kTight);
 
   // Camera under Parent at local (0,0,5): eye (5, 1, 0), looking down local −z ↦ (−1, 0, 0).
