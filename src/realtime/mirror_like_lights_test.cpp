@@ -34,7 +34,7 @@ Scene metalBox() {
   Scene scene = makeCornellBox();
   for (Material& m : scene.materials)
     if (const auto* lambert = std::get_if<LambertBsdf>(&m.bsdf); lambert && m.name == "white")
-      m.bsdf = ggxFromMetallicRoughness(lambert->albedo, 1.0f, 0.2f);
+      m.bsdf = gltfMetallicRoughnessModel(lambert->albedo, 1.0f, 0.2f);
   scene.finalize();
   return scene;
 }
