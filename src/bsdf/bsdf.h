@@ -240,8 +240,9 @@ GltfPbrBsdf gltfPbrFromInputs(const GltfPbrInputs& in);
 
 /// Subsurface scattering: a translucent solid (marble, wax, skin, milk, jade) whose closed mesh
 /// bounds a homogeneous medium — the model of Chiang, Kutz & Burley 2016 ("Practical and
-/// Controllable Subsurface Scattering for Production Path Tracing"), which Blender Cycles calls
-/// Random Walk (Fixed Radius). Inside, light travels in straight lines between scattering
+/// Controllable Subsurface Scattering for Production Path Tracing"), which Blender Cycles used
+/// for its random walk before 3.0 (Cycles 3.x fits the albedo differently and scales the radius;
+/// bench/sss_vs_cycles_blender.py converts). Inside, light travels in straight lines between scattering
 /// events, is attenuated with the extinction coefficient σt, keeps the fraction α (the single-
 /// scattering albedo) at each event and leaves it in a uniformly random direction (isotropic
 /// phase function). Both are per RGB channel, derived from the user's albedo A and radius d by
