@@ -35,7 +35,7 @@
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
 // picture): mirror-like glossy lobes (specular charts of a glossy model), albedo textures and
-// vertex colours, normal maps, alpha masks, punctual highlights, rough glass, GGX diffuse
+// vertex colours, normal maps, alpha masks, punctual highlights, GGX diffuse
 // bases; and of the render settings, thin lenses.
 //
 // Several samples per pixel: the shading pass loops over the pixel's samples at the CPU

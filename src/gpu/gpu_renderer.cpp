@@ -620,7 +620,6 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
     const ChartShading shading = chartShading(lf, i, sun);
     if (shading.texturedAlbedo) return "albedo textures, metallic-roughness textures and vertex colours";
     if (shading.normalMapped || c.directionalIrradiance) return "normal maps";
-    if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) return "rough glass";
     if (shading.texturedEmission) return "emission textures";
     // The shader takes a glossy chart's diffuse part as Blinn-Phong's, k(μ) = 1; GGX-like
     // models (GgxBsdf, GltfPbrBsdf) couple it to the lobe's albedo.
