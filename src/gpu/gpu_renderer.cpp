@@ -13,6 +13,7 @@
 #include "gpu/egl_context.h"
 #include "gpu/gpu.h"
 #include "gpu/gpu_bvh.h"
+#include "gpu/gpu_highlights.h"
 #include "gpu/gpu_specular.h"
 #include "lightfield/lookup.h"
 
@@ -370,6 +371,10 @@ uniform uint mirrorDepth;  // effectiveMirrorDepth
 // gpu_specular.h (its chunk follows this shader's main).
 vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv, uint mirrorDepth);
 #endif
+#ifdef HIGHLIGHTS
+// gpu_highlights.h (its chunk follows this shader's main).
+vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer);
+#endif
 
 // The camera weight times the radiance along the camera ray through film point `film` (pixel
 // units, Camera::generateRay's pinhole). `jittered`: the film point is anywhere in its pixel,
@@ -428,10 +433,17 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
   vec2 uv = vec2((d22 * v1 - d12 * v2) / denominator, (d11 * v2 - d12 * v1) / denominator);
   vec3 normalAtHit, shadingNormal;
   hitNormals(tri, uv, normalAtHit, shadingNormal);
-#ifdef SPECULAR
+#if defined(SPECULAR) || defined(HIGHLIGHTS)
   uint record = viewedRecord(tri.w, -direction, normalAtHit);
+#endif
+#ifdef SPECULAR
   if (record != kNoRecord && charts[record].info.y == kSpecular)
     return weight * specularChain(eye, direction, t, id - 1u, uv, mirrorDepth);
+#endif
+#ifdef HIGHLIGHTS
+  if (record != kNoRecord)
+    return weight * (lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal) +
+                     punctualHighlights(record, id - 1u, uv, -direction));
 #endif
   return weight * lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal);
 }
@@ -608,12 +620,7 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
   for (const Material& m : scene.materials)
     if (m.isMasked()) return "alpha masks";
   if (std::string specular = gpuUnsupportedSpecular(lf); !specular.empty()) return specular;
-  // PunctualHighlights::active() without its shadow-ray machinery: a bake with punctual
-  // highlights, a delta light, and a glossy chart to show them.
-  const bool glossy = std::any_of(lf.charts.begin(), lf.charts.end(), [](const Chart& c) { return c.kind == ChartKind::Glossy; });
-  if (lf.settings.punctualHighlights && glossy)
-    for (const Light& light : scene.lights)
-      if (isDeltaLight(light)) return "punctual highlights (point, spot and directional lights on glossy charts)";
+  if (std::string highlights = gpuUnsupportedHighlights(lf); !highlights.empty()) return highlights;
   const SunLights sun = sunLightsOf(lf);
   for (uint32_t i = 0; i < lf.charts.size(); ++i) {
     const Chart& c = lf.charts[i];
@@ -643,12 +650,14 @@ struct GpuRenderer::State {
   GLuint buffers[8] = {};  // values, charts, positions, triangles, indices, normals, sun masks, environment map
   GLuint vertexArray = 0, emptyVertexArray = 0;
   GLuint visibilityProgram = 0, shadingProgram = 0, lookupProgram = 0;
-  /// The BVH (gpu_bvh.h: nodes, order) and the specular chains' materials (gpu_specular.h:
-  /// per material, per triangle); the BVH is built with the first program that traces rays.
-  GLuint rayBuffers[4] = {};
+  /// The BVH (gpu_bvh.h: nodes, order), the materials of the specular chains and shadow rays
+  /// (gpu_specular.h: per material, per triangle) and the highlights' lights and models
+  /// (gpu_highlights.h); the BVH is built with the first program that traces rays.
+  GLuint rayBuffers[6] = {};
   bool bvhUploaded = false;
   GLuint intersectProgram = 0;  ///< GpuRenderer::intersect's, made on its first call
   bool specular = false;        ///< the light field has specular charts: the shading passes trace their chains
+  bool highlights = false;      ///< gpuHighlightsActive: the shading passes add punctual highlights
   /// The shading pass with several jittered samples per pixel; 0 where the driver lacks
   /// GL_ARB_gpu_shader_int64 (the sample positions' 64-bit hash).
   GLuint multisampleProgram = 0;
@@ -663,7 +672,7 @@ struct GpuRenderer::State {
   ~State() {
     context.makeCurrent();
     glDeleteBuffers(8, buffers);
-    glDeleteBuffers(4, rayBuffers);
+    glDeleteBuffers(6, rayBuffers);
     glDeleteProgram(intersectProgram);
     glDeleteVertexArrays(1, &vertexArray);
     glDeleteVertexArrays(1, &emptyVertexArray);
@@ -821,13 +830,16 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   }
   upload(s.buffers[7], envTexels.data(), envTexels.size() * sizeof(float));
   checkGl("uploading the light field (out of GPU memory?)");
-  // Mirrors and glass: the BVH their rays are traced through and the materials they follow.
+  // Mirrors and glass, punctual highlights: the BVH their rays are traced through, the
+  // materials they follow or pass (thin glass), the highlights' lights and models.
   s.specular = hasSpecularCharts(lightField);
-  if (s.specular) {
-    if (!epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
-      fail("GPU renderer: this light field has mirrors or glass, which need GL_ARB_gpu_shader_int64 (this driver, {}, "
-           "lacks it; render it with --renderer cpu)",
-           currentDeviceName());
+  s.highlights = gpuHighlightsActive(lightField);
+  if (s.specular && !epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
+    fail("GPU renderer: this light field has mirrors or glass, which need GL_ARB_gpu_shader_int64 (this driver, {}, "
+         "lacks it; render it with --renderer cpu)",
+         currentDeviceName());
+  const bool traces = s.specular || s.highlights;
+  if (traces) {
     s.uploadBvh(scene);
     const std::vector<SpecularMaterialGpu> materials = specularMaterials(scene);
     std::vector<uint32_t> triangleMaterials;
@@ -838,6 +850,16 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSpecularMaterialsBinding, s.rayBuffers[2]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTriangleMaterialsBinding, s.rayBuffers[3]);
     checkGl("uploading the materials of mirrors and glass");
+  }
+  const std::vector<HighlightLightGpu> highlightLightRecords = s.highlights ? highlightLights(scene) : std::vector<HighlightLightGpu>{};
+  if (s.highlights) {
+    const std::vector<HighlightModelGpu> models = highlightModels(scene);
+    glCreateBuffers(2, s.rayBuffers + 4);
+    upload(s.rayBuffers[4], highlightLightRecords.data(), highlightLightRecords.size() * sizeof(HighlightLightGpu));
+    upload(s.rayBuffers[5], models.data(), models.size() * sizeof(HighlightModelGpu));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kHighlightLightsBinding, s.rayBuffers[4]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kHighlightModelsBinding, s.rayBuffers[5]);
+    checkGl("uploading the punctual lights");
   }
 
   glCreateVertexArrays(1, &s.vertexArray);
@@ -850,20 +872,29 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
 
   s.visibilityProgram =
       linkProgram({{GL_VERTEX_SHADER, kVisibilityVertex}, {GL_FRAGMENT_SHADER, kVisibilityFragment}}, "visibility", false);
-  // With specular charts the shading passes carry the BVH traversal and the chains after their main.
+  // With specular charts or highlights the shading passes carry the BVH traversal, the
+  // highlights and the chains after their main.
   const std::string int64 = "#extension GL_ARB_gpu_shader_int64 : require\n";
-  const std::string specularHeader = s.specular ? int64 + "#define SPECULAR\n" + bvhGlslConstants() + specularGlslConstants() : "";
-  const std::string shading = std::string(kGeometryGlsl) + kShadingFragment + (s.specular ? std::string(kBvhGlsl) + kSpecularGlsl : "");
+  const std::string specularHeader = (s.specular ? int64 + "#define SPECULAR\n" : "") +
+                                     (s.highlights ? "#define HIGHLIGHTS\n" + highlightGlslConstants() : "") +
+                                     (traces ? bvhGlslConstants() + specularGlslConstants() : "");
+  const std::string shading = std::string(kGeometryGlsl) + kShadingFragment +
+                              (traces ? std::string(kBvhGlsl) + kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
+                              (s.specular ? kSpecularGlsl : "");
   s.shadingProgram =
       linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}}, "shading", true, specularHeader);
   s.lookupProgram = linkProgram({{GL_COMPUTE_SHADER, kLookupCompute}}, "lookup", true);
   if (epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
     s.multisampleProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}},
                                        "multi-sample shading", true,
-                                       (s.specular ? specularHeader : int64) + "#define MULTISAMPLE\n");
+                                       (s.specular ? specularHeader : int64 + specularHeader) + "#define MULTISAMPLE\n");
   glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
   for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {
     if (program == 0) continue;
+    if (s.highlights) {
+      glProgramUniform1ui(program, glGetUniformLocation(program, "highlightLightCount"), GLuint(highlightLightRecords.size()));
+      glProgramUniform1i(program, glGetUniformLocation(program, "shadowsPassThinGlass"), scene.hasThinGlass() ? 1 : 0);
+    }
     glProgramUniform3f(program, glGetUniformLocation(program, "background"), s.background.x, s.background.y,
                        s.background.z);
     glProgramUniform1i(program, glGetUniformLocation(program, "hasEnvironmentMap"), environmentMap != nullptr ? 1 : 0);

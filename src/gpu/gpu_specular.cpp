@@ -69,20 +69,11 @@ std::string specularGlslConstants() {
 // (bsdf.cpp: sample, sampleSmoothDielectric, thinSheetReflectanceTransmittance,
 // fresnelDielectricTransmittance, refractDirection; bsdf.h fresnelSchlick) and
 // offsetRayOrigin (accel.h) — statement for statement; then the fast renderer's chain.
-const char* const kSpecularGlsl = R"glsl(
+const char* const kSurfaceGlsl = R"glsl(
 struct SpecularMaterial { vec4 colour; vec4 iface; vec4 absorption; vec4 emission; };
 layout(std430, binding = SPECULAR_MATERIALS_BINDING) readonly buffer SpecularMaterials { SpecularMaterial specularMaterials[]; };
 layout(std430, binding = TRIANGLE_MATERIALS_BINDING) readonly buffer TriangleMaterials { uint triangleMaterials[]; };
 
-uint64_t specularRayHash(vec3 o, vec3 d) {
-  uint64_t h = 0x5350454355UL;
-  h = hashCombine(h, uint64_t(floatBitsToUint(o.x)));
-  h = hashCombine(h, uint64_t(floatBitsToUint(o.y)));
-  h = hashCombine(h, uint64_t(floatBitsToUint(o.z)));
-  h = hashCombine(h, uint64_t(floatBitsToUint(d.x)));
-  h = hashCombine(h, uint64_t(floatBitsToUint(d.y)));
-  return hashCombine(h, uint64_t(floatBitsToUint(d.z)));
-}
 float luminanceOf(vec3 c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 float transmittedShare(float a, float b) { return 4.0 * a * b / ((a + b) * (a + b)); }
 float fresnelDielectricTransmittance(float cosTheta, float eta) {
@@ -97,6 +88,60 @@ float fresnelDielectricTransmittance(float cosTheta, float eta) {
   return 0.5 * (transmittedShare(eta * cosTheta, cosT) + transmittedShare(cosTheta, eta * cosT));
 }
 float fresnelDielectric(float cosTheta, float eta) { return 1.0 - fresnelDielectricTransmittance(cosTheta, eta); }
+void thinSheetReflectanceTransmittance(SpecularMaterial m, float cosTheta, out vec3 reflectance, out vec3 transmittance) {
+  float R = fresnelDielectric(abs(cosTheta), m.iface.x), T = fresnelDielectricTransmittance(abs(cosTheta), m.iface.x);
+  reflectance = vec3(1.0);
+  transmittance = vec3(0.0);
+  if (!(T > 0.0)) return;
+  vec3 t = m.colour.rgb;
+  vec3 denom = vec3(1.0) - R * R * t * t;
+  reflectance = vec3(R) + T * T * R * t * t / denom;
+  transmittance = T * T * t / denom;
+}
+// surfaceAt (scene.cpp): the point from the barycentrics (b1, b2), the unit winding normal,
+// the interpolated shading normal on its side (interpolatedNormal).
+void surfaceAt(uint triangle, vec2 uv, out vec3 position, out vec3 geometricNormal, out vec3 shadingNormal) {
+  uvec4 tri = triangles[triangle];
+  vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
+  float b1 = uv.x, b2 = uv.y, b0 = 1.0 - b1 - b2;
+  position = b0 * p0 + b1 * p1 + b2 * p2;
+  geometricNormal = normalize(cross(p1 - p0, p2 - p0));
+  shadingNormal = geometricNormal;
+  if (normals[tri.x].w != 0.0) {
+    vec3 n = b0 * normals[tri.x].xyz + b1 * normals[tri.y].xyz + b2 * normals[tri.z].xyz;
+    float len = length(n);
+    if (len > 1e-6 && !isinf(len) && !isnan(len)) {
+      shadingNormal = n / len;
+      if (dot(shadingNormal, geometricNormal) < 0.0) shadingNormal = -shadingNormal;
+    }
+  }
+}
+// Frame::fromNormal (core/math.h): the tangents s, t of unit normal n.
+void frameFromNormal(vec3 n, out vec3 s, out vec3 t) {
+  float sign = (floatBitsToUint(n.z) >> 31) != 0u ? -1.0 : 1.0;  // copysign(1, n.z)
+  float a = -1.0 / (sign + n.z);
+  float b = n.x * n.y * a;
+  s = vec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  t = vec3(b, sign + n.y * n.y * a, -n.y);
+}
+// offsetRayOrigin (accel.h).
+vec3 offsetRayOrigin(vec3 position, vec3 geometricNormal, vec3 direction) {
+  float scale = 1.0 + max(abs(position.x), max(abs(position.y), abs(position.z)));
+  float offset = 2e-5 * scale;
+  return position + (dot(direction, geometricNormal) >= 0.0 ? offset : -offset) * geometricNormal;
+}
+)glsl";
+
+const char* const kSpecularGlsl = R"glsl(
+uint64_t specularRayHash(vec3 o, vec3 d) {
+  uint64_t h = 0x5350454355UL;
+  h = hashCombine(h, uint64_t(floatBitsToUint(o.x)));
+  h = hashCombine(h, uint64_t(floatBitsToUint(o.y)));
+  h = hashCombine(h, uint64_t(floatBitsToUint(o.z)));
+  h = hashCombine(h, uint64_t(floatBitsToUint(d.x)));
+  h = hashCombine(h, uint64_t(floatBitsToUint(d.y)));
+  return hashCombine(h, uint64_t(floatBitsToUint(d.z)));
+}
 // The sample in the local frame: false when the BSDF returns nothing.
 bool sampleSpecular(SpecularMaterial m, vec3 wo, float u, out vec3 wi, out vec3 weight) {
   uint kind = floatBitsToUint(m.colour.w);
@@ -113,16 +158,8 @@ bool sampleSpecular(SpecularMaterial m, vec3 wo, float u, out vec3 wi, out vec3 
   if (!(wo.z != 0.0) || any(isinf(wo)) || any(isnan(wo))) return false;
   float ior = m.iface.x;
   if (m.iface.y != 0.0) {
-    // thinSheetReflectanceTransmittance
-    float cosTheta = abs(wo.z);
-    float R = fresnelDielectric(cosTheta, ior), T = fresnelDielectricTransmittance(cosTheta, ior);
-    vec3 r = vec3(1.0), t = vec3(0.0);
-    if (T > 0.0) {
-      vec3 tr = m.colour.rgb;
-      vec3 denom = vec3(1.0) - R * R * tr * tr;
-      r = vec3(R) + T * T * R * tr * tr / denom;
-      t = T * T * tr / denom;
-    }
+    vec3 r, t;
+    thinSheetReflectanceTransmittance(m, wo.z, r, t);
     float lr = max(0.0, luminanceOf(r)), lt = max(0.0, luminanceOf(t));
     if (!(lr + lt > 0.0)) return false;
     float pR = lr / (lr + lt);
@@ -158,21 +195,8 @@ bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv
   nextOrigin = vec3(0.0);
   nextDirection = vec3(0.0);
   weight = vec3(0.0);
-  // surfaceAt: the point from the barycentrics, the winding normal, the interpolated normal.
-  uvec4 tri = triangles[triangle];
-  vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
-  float b1 = uv.x, b2 = uv.y, b0 = 1.0 - b1 - b2;
-  vec3 position = b0 * p0 + b1 * p1 + b2 * p2;
-  vec3 geometricNormal = normalize(cross(p1 - p0, p2 - p0));
-  vec3 shadingNormal = geometricNormal;
-  if (normals[tri.x].w != 0.0) {
-    vec3 n = b0 * normals[tri.x].xyz + b1 * normals[tri.y].xyz + b2 * normals[tri.z].xyz;
-    float len = length(n);
-    if (len > 1e-6 && !isinf(len) && !isnan(len)) {
-      shadingNormal = n / len;
-      if (dot(shadingNormal, geometricNormal) < 0.0) shadingNormal = -shadingNormal;
-    }
-  }
+  vec3 position, geometricNormal, shadingNormal;
+  surfaceAt(triangle, uv, position, geometricNormal, shadingNormal);
   SpecularMaterial m = specularMaterials[triangleMaterials[triangle]];
   vec3 wo = -direction;
   float cosWoGeometric = dot(geometricNormal, wo);
@@ -185,11 +209,8 @@ bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv
   bool turn = cosWoGeometric < 0.0 && !glass;
   vec3 g = turn ? -geometricNormal : geometricNormal;
   vec3 n = turn ? -shadingNormal : shadingNormal;
-  float sign = (floatBitsToUint(n.z) >> 31) != 0u ? -1.0 : 1.0;  // copysign(1, n.z)
-  float a = -1.0 / (sign + n.z);
-  float b = n.x * n.y * a;
-  vec3 s = vec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-  vec3 tt = vec3(b, sign + n.y * n.y * a, -n.y);
+  vec3 s, tt;
+  frameFromNormal(n, s, tt);
   vec3 woLocal = vec3(dot(wo, s), dot(wo, tt), dot(wo, n));
   // usableSide for wo, the sample, usableSide for wi.
   float cosWo = dot(wo, g);
@@ -201,10 +222,7 @@ bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv
   vec3 wi = wiLocal.x * s + wiLocal.y * tt + wiLocal.z * n;
   float cosWi = dot(wi, g);
   if (!(glass ? cosWi * wiLocal.z > 0.0 : cosWi > 0.0)) return false;
-  // offsetRayOrigin
-  float scale = 1.0 + max(abs(position.x), max(abs(position.y), abs(position.z)));
-  float offset = 2e-5 * scale;
-  nextOrigin = position + (dot(wi, g) >= 0.0 ? offset : -offset) * g;
+  nextOrigin = offsetRayOrigin(position, g, wi);
   nextDirection = wi;
   weight = sampleWeight * attenuation;
   if (step >= kSpecularRouletteStep) {
@@ -233,8 +251,13 @@ vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv,
     hitNormals(tri, uv, normalAtHit, shadingNormal);
     uint record = viewedRecord(tri.w, -direction, normalAtHit);
     if (record == kNoRecord) return radiance;  // inside a closed smooth mesh: nothing seen
-    if (charts[record].info.y != kSpecular)
-      return radiance + throughput * lookupRadiance(tri.w, origin + t * direction, -direction, normalAtHit, shadingNormal);
+    if (charts[record].info.y != kSpecular) {
+      radiance += throughput * lookupRadiance(tri.w, origin + t * direction, -direction, normalAtHit, shadingNormal);
+#ifdef HIGHLIGHTS
+      radiance += throughput * punctualHighlights(record, triangle, uv, -direction);
+#endif
+      return radiance;
+    }
   }
 }
 )glsl";

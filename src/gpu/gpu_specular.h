@@ -58,12 +58,18 @@ inline constexpr uint32_t kSpecularMaterialsBinding = 18, kTriangleMaterialsBind
 /// kSpecularGlsl's programs).
 std::string specularGlslConstants();
 
+/// GLSL shared by the chains and the punctual highlights (gpu_highlights.h): the blocks
+/// SpecularMaterials (SPECULAR_MATERIALS_BINDING, per material) and TriangleMaterials
+/// (TRIANGLE_MATERIALS_BINDING, per triangle), surfaceAt, frameFromNormal (Frame::fromNormal),
+/// offsetRayOrigin, fresnelDielectric and thinSheetReflectanceTransmittance. Needs the shading
+/// pass's geometry blocks before it.
+extern const char* const kSurfaceGlsl;
+
 /// GLSL: vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv,
 /// uint mirrorDepth) — the radiance along a camera ray whose closest hit is (t, triangle, uv)
-/// on a specular record, without the camera weight. Needs kBvhGlsl, the shading pass's
-/// geometry blocks, hitNormals, lookupRadiance, environmentRadiance and the 64-bit hash
-/// (hashCombine) before it; reads the blocks SpecularMaterials (SPECULAR_MATERIALS_BINDING,
-/// per material) and TriangleMaterials (TRIANGLE_MATERIALS_BINDING, per triangle).
+/// on a specular record, without the camera weight. Needs kBvhGlsl, kSurfaceGlsl, hitNormals,
+/// lookupRadiance, environmentRadiance, punctualHighlights (gpu_highlights.h) and the 64-bit
+/// hash (hashCombine) before it.
 extern const char* const kSpecularGlsl;
 
 }  // namespace pl
