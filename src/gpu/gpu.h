@@ -27,16 +27,18 @@
 // chartShadingNormalAt), the triangle → chart map, the sun masks (one uint each; the masked
 // lights are uniforms) and the environment map's texels (RGBA). So GPU memory is 16 bytes per
 // value + 128 per chart + 32 per vertex + 28 per triangle + 4 per sun mask + 16 per
-// environment texel + (with mirrors or glass) the BVH's 32 per node and 4 per triangle and
-// the chains' 64 per material and 4 per triangle + the frame's targets (radiance 16 bytes per
+// environment texel + (with mirrors, glass or punctual highlights) the BVH's 32 per node and
+// 4 per triangle, 64 per material and 4 per triangle for the chains and shadow rays, and 64 per
+// delta light and 48 per material for the highlights + the frame's targets (radiance 16 bytes per
 // pixel; id and depth 8 bytes per pixel, or per texel of the finer multi-sample visibility
 // pass).
 //
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
 // picture): mirror-like glossy lobes (specular charts of a glossy model), albedo textures and
-// vertex colours, normal maps, alpha masks, punctual highlights, GGX diffuse
-// bases; and of the render settings, thin lenses.
+// vertex colours, normal maps, alpha masks, GGX diffuse bases, punctual highlights on glTF
+// materials; and of the render settings, thin lenses. Punctual highlights on glossy charts are
+// evaluated per pixel with a shadow ray through the BVH (gpu_highlights.h).
 //
 // Several samples per pixel: the shading pass loops over the pixel's samples at the CPU
 // renderers' jittered film points (Pcg32::forKey in 64-bit GLSL integers,
