@@ -8,6 +8,8 @@
 #include <cmath>
 #include <limits>
 
+#include "scene/scene.h"
+
 namespace pl {
 namespace {
 
@@ -122,6 +124,19 @@ float enterNode(const BvhNode& node, const Vec3& origin, const Vec3& inverseDire
 }
 
 }  // namespace
+
+void flattenSceneTriangles(const Scene& scene, std::vector<Vec3>& positions, std::vector<UVec3>& triangles,
+                           std::vector<std::pair<uint32_t, uint32_t>>* meshTriangle) {
+  for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    const uint32_t first = uint32_t(positions.size());
+    positions.insert(positions.end(), mesh.positions.begin(), mesh.positions.end());
+    for (uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      triangles.push_back(mesh.triangles[t] + UVec3(first));
+      if (meshTriangle != nullptr) meshTriangle->emplace_back(m, t);
+    }
+  }
+}
 
 GpuBvh buildGpuBvh(const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles) {
   Builder builder{positions, triangles, {}, {}, {}};

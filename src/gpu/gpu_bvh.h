@@ -19,11 +19,14 @@
 // agree with Embree's to float rounding (a few ulp), not bit for bit.
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/math.h"
 
 namespace pl {
+
+struct Scene;
 
 inline constexpr uint32_t kBvhLeafTriangles = 4;
 
@@ -41,6 +44,12 @@ struct GpuBvh {
   std::vector<BvhNode> nodes;   ///< nodes[0] is the root (an empty leaf when there are no triangles)
   std::vector<uint32_t> order;  ///< triangle indices in leaf order
 };
+
+/// Every mesh's vertices and triangles of `scene` in one array each, in scene order, the
+/// triangles' indices into `positions`: the triangle array the GPU renderer draws and builds
+/// the BVH over. `meshTriangle`, when given, gets each triangle's (mesh, triangle in the mesh).
+void flattenSceneTriangles(const Scene& scene, std::vector<Vec3>& positions, std::vector<UVec3>& triangles,
+                           std::vector<std::pair<uint32_t, uint32_t>>* meshTriangle = nullptr);
 
 /// Builds the hierarchy over triangles (p[v[0]], p[v[1]], p[v[2]]) for every v in
 /// `triangles`, triangle i of the result being triangles[i]. Degenerate and non-finite

@@ -139,14 +139,7 @@ TEST(GpuBvh, CornellBoxMatchesEmbree) {
   std::vector<Vec3> positions;
   std::vector<UVec3> triangles;
   std::vector<std::pair<uint32_t, uint32_t>> meshTriangle;
-  for (uint32_t m = 0; m < scene.meshes.size(); ++m) {
-    const uint32_t first = uint32_t(positions.size());
-    positions.insert(positions.end(), scene.meshes[m].positions.begin(), scene.meshes[m].positions.end());
-    for (uint32_t t = 0; t < scene.meshes[m].triangles.size(); ++t) {
-      triangles.push_back(scene.meshes[m].triangles[t] + UVec3(first));
-      meshTriangle.emplace_back(m, t);
-    }
-  }
+  flattenSceneTriangles(scene, positions, triangles, &meshTriangle);
   const GpuBvh bvh = buildGpuBvh(positions, triangles);
   expectWellFormed(bvh, positions, triangles);
   Vec3 lo, hi;

@@ -603,6 +603,29 @@ std::string currentDeviceName() {
                      reinterpret_cast<const char*>(glGetString(GL_VERSION)));
 }
 
+/// Runs compute program `program` (64-wide groups, uniform `count`) on `count` queries, `input`
+/// bound at kQueriesBinding, and returns the resultFloats floats per query it writes at
+/// kResultsBinding (GpuRenderer::lookup, GpuRenderer::intersect). `what` names it in errors.
+std::vector<float> runQueries(GLuint program, const std::vector<float>& input, size_t count, size_t resultFloats,
+                              const char* what) {
+  GLuint buffers[2];
+  glCreateBuffers(2, buffers);
+  const size_t resultBytes = count * resultFloats * sizeof(float);
+  glNamedBufferStorage(buffers[0], GLsizeiptr(std::max<size_t>(input.size() * sizeof(float), 16)), input.empty() ? nullptr : input.data(), 0);
+  glNamedBufferStorage(buffers[1], GLsizeiptr(std::max<size_t>(resultBytes, 16)), nullptr, GL_MAP_READ_BIT);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kQueriesBinding, buffers[0]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kResultsBinding, buffers[1]);
+  glUseProgram(program);
+  glProgramUniform1ui(program, glGetUniformLocation(program, "count"), GLuint(count));
+  glDispatchCompute(GLuint((count + 63) / 64), 1, 1);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  std::vector<float> output(count * resultFloats);
+  if (count > 0) glGetNamedBufferSubData(buffers[1], 0, GLsizeiptr(resultBytes), output.data());
+  glDeleteBuffers(2, buffers);
+  checkGl(what);
+  return output;
+}
+
 void setCameraUniforms(GLuint program, const Camera& camera) {
   auto vec3 = [&](const char* name, const Vec3& v) { glProgramUniform3f(program, glGetUniformLocation(program, name), v.x, v.y, v.z); };
   vec3("eye", camera.eye());
@@ -723,11 +746,7 @@ struct GpuRenderer::State {
     if (bvhUploaded) return;
     std::vector<Vec3> points;
     std::vector<UVec3> tris;
-    for (const Mesh& mesh : scene.meshes) {
-      const uint32_t first = uint32_t(points.size());
-      points.insert(points.end(), mesh.positions.begin(), mesh.positions.end());
-      for (const UVec3& t : mesh.triangles) tris.push_back(t + UVec3(first));
-    }
+    flattenSceneTriangles(scene, points, tris);
     const GpuBvh bvh = buildGpuBvh(points, tris);
     glCreateBuffers(2, rayBuffers);
     glNamedBufferStorage(rayBuffers[0], GLsizeiptr(bvh.nodes.size() * sizeof(BvhNode)), bvh.nodes.data(), 0);
@@ -1014,21 +1033,8 @@ std::vector<Rgb> GpuRenderer::lookup(const std::vector<LookupQuery>& queries) {
     input.insert(input.end(), {q.position.x, q.position.y, q.position.z, chart, q.towardsViewer.x, q.towardsViewer.y,
                                q.towardsViewer.z, 0.0f});
   }
-  GLuint buffers[2];
-  glCreateBuffers(2, buffers);
   const size_t count = queries.size();
-  glNamedBufferStorage(buffers[0], GLsizeiptr(std::max<size_t>(input.size() * sizeof(float), 16)), input.empty() ? nullptr : input.data(), 0);
-  glNamedBufferStorage(buffers[1], GLsizeiptr(std::max<size_t>(count * 16, 16)), nullptr, GL_MAP_READ_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kQueriesBinding, buffers[0]);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kResultsBinding, buffers[1]);
-  glUseProgram(s.lookupProgram);
-  glProgramUniform1ui(s.lookupProgram, glGetUniformLocation(s.lookupProgram, "count"), GLuint(count));
-  glDispatchCompute(GLuint((count + 63) / 64), 1, 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  std::vector<float> output(count * 4);
-  if (count > 0) glGetNamedBufferSubData(buffers[1], 0, GLsizeiptr(output.size() * sizeof(float)), output.data());
-  glDeleteBuffers(2, buffers);
-  checkGl("the lookup queries");
+  const std::vector<float> output = runQueries(s.lookupProgram, input, count, 4, "the lookup queries");
   std::vector<Rgb> result(count);
   for (size_t i = 0; i < count; ++i) result[i] = Rgb(output[4 * i], output[4 * i + 1], output[4 * i + 2]);
   return result;
@@ -1046,20 +1052,7 @@ std::vector<BvhHit> GpuRenderer::intersect(const std::vector<Ray>& rays, std::ve
   for (const Ray& r : rays)
     input.insert(input.end(), {r.origin.x, r.origin.y, r.origin.z, r.tMin, r.direction.x, r.direction.y, r.direction.z, r.tMax});
   const size_t count = rays.size();
-  GLuint buffers[2];
-  glCreateBuffers(2, buffers);
-  glNamedBufferStorage(buffers[0], GLsizeiptr(std::max<size_t>(input.size() * sizeof(float), 16)), input.empty() ? nullptr : input.data(), 0);
-  glNamedBufferStorage(buffers[1], GLsizeiptr(std::max<size_t>(count * 32, 16)), nullptr, GL_MAP_READ_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kQueriesBinding, buffers[0]);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kResultsBinding, buffers[1]);
-  glUseProgram(s.intersectProgram);
-  glProgramUniform1ui(s.intersectProgram, glGetUniformLocation(s.intersectProgram, "count"), GLuint(count));
-  glDispatchCompute(GLuint((count + 63) / 64), 1, 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  std::vector<float> output(count * 8);
-  if (count > 0) glGetNamedBufferSubData(buffers[1], 0, GLsizeiptr(output.size() * sizeof(float)), output.data());
-  glDeleteBuffers(2, buffers);
-  checkGl("the ray queries");
+  const std::vector<float> output = runQueries(s.intersectProgram, input, count, 8, "the ray queries");
   std::vector<BvhHit> hits(count);
   if (occluded != nullptr) occluded->assign(count, 0);
   for (size_t i = 0; i < count; ++i) {
