@@ -894,19 +894,19 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   // With specular charts or highlights the shading passes carry the BVH traversal, the
   // highlights and the chains after their main.
   const std::string int64 = "#extension GL_ARB_gpu_shader_int64 : require\n";
-  const std::string specularHeader = (s.specular ? int64 + "#define SPECULAR\n" : "") +
+  const std::string raysHeader = (s.specular ? int64 + "#define SPECULAR\n" : "") +
                                      (s.highlights ? "#define HIGHLIGHTS\n" + highlightGlslConstants() : "") +
                                      (traces ? bvhGlslConstants() + specularGlslConstants() : "");
   const std::string shading = std::string(kGeometryGlsl) + kShadingFragment +
                               (traces ? std::string(kBvhGlsl) + kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
                               (s.specular ? kSpecularGlsl : "");
   s.shadingProgram =
-      linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}}, "shading", true, specularHeader);
+      linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}}, "shading", true, raysHeader);
   s.lookupProgram = linkProgram({{GL_COMPUTE_SHADER, kLookupCompute}}, "lookup", true);
   if (epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
     s.multisampleProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}},
                                        "multi-sample shading", true,
-                                       (s.specular ? specularHeader : int64 + specularHeader) + "#define MULTISAMPLE\n");
+                                       (s.specular ? raysHeader : int64 + raysHeader) + "#define MULTISAMPLE\n");
   glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
   for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {
     if (program == 0) continue;
