@@ -14,7 +14,9 @@
 //      the CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
 //      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes) in a fragment shader,
 //      times the camera weight (cos⁴θ with vignetting). A miss sees the environment (the
-//      constant and the map: EnvironmentMap::radiance, bilinear in the lat-long image).
+//      constant and the map: EnvironmentMap::radiance, bilinear in the lat-long image). A hit
+//      on a mirror or glass record follows the chain of reflected and refracted rays, traced
+//      through a BVH on the GPU, as the CPU renderers do (gpu_specular.h, gpu_bvh.h).
 // The result is radiance (W·sr⁻¹·m⁻², camera weight included, no exposure), read back into an
 // Image exactly where FastRenderer::render writes it; exposure and tone mapping are then the
 // same CPU code for both renderers (jobs/ ViewSettings::writeImage).
@@ -25,14 +27,18 @@
 // chartShadingNormalAt), the triangle → chart map, the sun masks (one uint each; the masked
 // lights are uniforms) and the environment map's texels (RGBA). So GPU memory is 16 bytes per
 // value + 128 per chart + 32 per vertex + 28 per triangle + 4 per sun mask + 16 per
-// environment texel + the frame's targets (radiance 16 bytes per pixel; id
-// and depth 8 bytes per pixel, or per texel of the finer multi-sample visibility pass).
+// environment texel + (with mirrors, glass or punctual highlights) the BVH's 32 per node and
+// 4 per triangle, 64 per material and 4 per triangle for the chains and shadow rays, and 64 per
+// delta light and 48 per material for the highlights + the frame's targets (radiance 16 bytes per
+// pixel; id and depth 8 bytes per pixel, or per texel of the finer multi-sample visibility
+// pass).
 //
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
-// picture): mirrors and glass (specular charts), albedo textures and vertex colours, normal
-// maps, alpha masks, punctual highlights, rough glass, GGX diffuse bases; and of the render
-// settings, thin lenses.
+// picture): mirror-like glossy lobes (specular charts of a glossy model), albedo textures and
+// vertex colours, normal maps, alpha masks, GGX diffuse bases, punctual highlights on glTF
+// materials; and of the render settings, thin lenses. Punctual highlights on glossy charts are
+// evaluated per pixel with a shadow ray through the BVH (gpu_highlights.h).
 //
 // Several samples per pixel: the shading pass loops over the pixel's samples at the CPU
 // renderers' jittered film points (Pcg32::forKey in 64-bit GLSL integers,
@@ -47,6 +53,7 @@
 #include <string>
 #include <vector>
 
+#include "gpu/gpu_bvh.h"
 #include "image/image.h"
 #include "lightfield/lightfield.h"
 #include "lightfield/render_settings.h"
@@ -56,7 +63,7 @@ namespace pl {
 class Camera;
 
 /// The first feature of `lightField` the GPU renderer does not draw yet, as a phrase for a
-/// message ("mirrors and glass (specular charts)", …); empty when it draws all of it.
+/// message ("alpha masks", …); empty when it draws all of it.
 std::string gpuUnsupportedFeature(const LightField& lightField);
 
 /// The first of `settings` (for `camera`) the GPU renderer does not support yet, whatever the
@@ -122,6 +129,12 @@ class GpuRenderer {
   /// exitantRadiance(lightField, chart, position, towardsViewer, uv) gives on the CPU (planar
   /// charts; curved ones are read around the chart normal here).
   std::vector<Rgb> lookup(const std::vector<LookupQuery>& queries);
+
+  /// The closest hits of `rays` in (tMin, tMax) by the BVH traversal the shading pass traces
+  /// mirrors and glass with (gpu_bvh.h bvhIntersect), run in a compute shader; triangle is
+  /// the index in the scene's meshes' triangles in order (mesh 0's first). `occluded`, when
+  /// given, gets bvhOccluded's answer per ray (1: blocked).
+  std::vector<BvhHit> intersect(const std::vector<Ray>& rays, std::vector<uint8_t>* occluded = nullptr);
 
   /// The GL_RENDERER and GL_VERSION strings of the context (e.g. "llvmpipe (LLVM 15.0.6, 256
   /// bits)", "4.5 (Core Profile) Mesa 22.3.6").

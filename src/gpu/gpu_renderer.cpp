@@ -12,6 +12,9 @@
 #include "env/env.h"
 #include "gpu/egl_context.h"
 #include "gpu/gpu.h"
+#include "gpu/gpu_bvh.h"
+#include "gpu/gpu_highlights.h"
+#include "gpu/gpu_specular.h"
 #include "lightfield/lookup.h"
 
 namespace pl {
@@ -221,13 +224,19 @@ vec3 toLocalAround(ChartRecord c, vec3 n, vec3 w) {
 // chartNormalAt's normal there (the record's side), shadingNormal interpolatedNormal's (the
 // front's; a curved glossy chart's map is read around it, chartShadingNormalAt). viewedChart,
 // then exitantRadianceLanes.
-vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, vec3 shadingNormal) {
-  ChartRecord c = charts[chart];
-  uint flags = c.info.z;
+// viewedChart: the record seen, kNoRecord behind a one-sided curved record.
+const uint kNoRecord = 0xffffffffu;
+uint viewedRecord(uint chart, vec3 towardsViewer, vec3 normalAtHit) {
+  uint flags = charts[chart].info.z;
   float side = dot(towardsViewer, normalAtHit);
-  if ((flags & kFlagCurved) != 0u && (flags & kFlagTwoSided) == 0u && side < 0.0) return vec3(0.0);
-  if ((flags & kFlagTwoSided) != 0u && (flags & kFlagBack) == 0u && side < 0.0) c = charts[chart + 1u];
-  flags = c.info.z;
+  if ((flags & kFlagCurved) != 0u && (flags & kFlagTwoSided) == 0u && side < 0.0) return kNoRecord;
+  return (flags & kFlagTwoSided) != 0u && (flags & kFlagBack) == 0u && side < 0.0 ? chart + 1u : chart;
+}
+vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, vec3 shadingNormal) {
+  uint record = viewedRecord(chart, towardsViewer, normalAtHit);
+  if (record == kNoRecord) return vec3(0.0);
+  ChartRecord c = charts[record];
+  uint flags = c.info.z;
   if (c.info.y == kSpecular) return vec3(0.0);
   vec3 d = p - c.origin.xyz;
   vec2 grid = vec2(dot(d, c.axisU.xyz) * c.origin.w - 0.5, dot(d, c.axisV.xyz) * c.origin.w - 0.5);
@@ -275,10 +284,13 @@ void main() {
   gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
 }
 )glsl";
-constexpr const char* kShadingFragment = R"glsl(
+// The geometry as the shading pass and the BVH traversal (gpu_bvh.h) read it.
+constexpr const char* kGeometryGlsl = R"glsl(
 layout(std430, binding = POSITIONS_BINDING) readonly buffer Positions { vec4 positions[]; };
 layout(std430, binding = TRIANGLES_BINDING) readonly buffer Triangles { uvec4 triangles[]; };
 layout(std430, binding = NORMALS_BINDING) readonly buffer Normals { vec4 normals[]; };  // w = 0: none
+)glsl";
+constexpr const char* kShadingFragment = R"glsl(
 layout(binding = 0) uniform usampler2D ids;
 uniform vec3 eye, forward, right, up, background;
 uniform float tanHalfFovY, aspect;
@@ -317,6 +329,52 @@ vec3 environmentRadiance(vec3 d) {
   vec3 bottom = (1.0 - ax) * envTexel(x0, y1) + ax * envTexel(x1, y1);
   return background + envScale * ((1.0 - ay) * top + ay * bottom);
 }
+
+#if defined(MULTISAMPLE) || defined(SPECULAR)
+// mix64 and hashCombine (core/rng.h) in 64-bit integers (GL_ARB_gpu_shader_int64).
+uint64_t mix64(uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9UL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebUL;
+  x ^= x >> 31;
+  return x;
+}
+uint64_t hashCombine(uint64_t a, uint64_t b) { return mix64(a ^ (mix64(b) + 0x9e3779b97f4a7c15UL)); }
+#endif
+
+// chartNormalAt's normal (the front record's side: the chart normal, on a curved chart the
+// triangle's) and interpolatedNormal's (a curved glossy chart's map is read around it,
+// chartShadingNormalAt) at barycentrics uv = (b1, b2) of triangle `tri`.
+void hitNormals(uvec4 tri, vec2 uv, out vec3 normalAtHit, out vec3 shadingNormal) {
+  ChartRecord c = charts[tri.w];
+  normalAtHit = c.normal.xyz;
+  shadingNormal = c.normal.xyz;
+  if ((c.info.z & kFlagCurved) == 0u) return;
+  vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
+  vec3 n = cross(p1 - p0, p2 - p0);
+  // triangleNormal, then interpolatedNormal (scene.h).
+  float length2 = dot(n, n);
+  normalAtHit = length2 > 0.0 ? n / sqrt(length2) : vec3(0.0);
+  shadingNormal = normalAtHit;
+  if (normals[tri.x].w == 0.0) return;
+  vec3 interpolated = (1.0 - uv.x - uv.y) * normals[tri.x].xyz + uv.x * normals[tri.y].xyz + uv.y * normals[tri.z].xyz;
+  float len = length(interpolated);
+  if (len > 1e-6 && !isinf(len) && !isnan(len)) {
+    shadingNormal = interpolated / len;
+    if (dot(shadingNormal, normalAtHit) < 0.0) shadingNormal = -shadingNormal;
+  }
+}
+
+#ifdef SPECULAR
+uniform uint mirrorDepth;  // effectiveMirrorDepth
+// gpu_specular.h (its chunk follows this shader's main).
+vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv, uint mirrorDepth);
+#endif
+#ifdef HIGHLIGHTS
+// gpu_highlights.h (its chunk follows this shader's main).
+vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer);
+#endif
 
 // The camera weight times the radiance along the camera ray through film point `film` (pixel
 // units, Camera::generateRay's pinhole). `jittered`: the film point is anywhere in its pixel,
@@ -368,43 +426,33 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
   vec3 n = cross(p1 - p0, p2 - p0);
   if (isinf(t)) t = dot(p0 - eye, n) / dot(direction, n);
   vec3 p = eye + t * direction;
-  ChartRecord c = charts[tri.w];
-  vec3 normalAtHit = c.normal.xyz, shadingNormal = c.normal.xyz;
-  if ((c.info.z & kFlagCurved) != 0u) {
-    // triangleNormal, then interpolatedNormal (scene.h) at the hit's barycentrics (b1, b2).
-    float length2 = dot(n, n);
-    normalAtHit = length2 > 0.0 ? n / sqrt(length2) : vec3(0.0);
-    shadingNormal = normalAtHit;
-    if (normals[tri.x].w != 0.0) {
-      vec3 e1 = p1 - p0, e2 = p2 - p0, v = p - p0;
-      float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), v1 = dot(v, e1), v2 = dot(v, e2);
-      float denominator = d11 * d22 - d12 * d12;
-      float b1 = (d22 * v1 - d12 * v2) / denominator, b2 = (d11 * v2 - d12 * v1) / denominator;
-      vec3 interpolated = (1.0 - b1 - b2) * normals[tri.x].xyz + b1 * normals[tri.y].xyz + b2 * normals[tri.z].xyz;
-      float len = length(interpolated);
-      if (len > 1e-6 && !isinf(len) && !isnan(len)) {
-        shadingNormal = interpolated / len;
-        if (dot(shadingNormal, normalAtHit) < 0.0) shadingNormal = -shadingNormal;
-      }
-    }
-  }
+  // The hit's barycentrics (b1, b2), from the point.
+  vec3 e1 = p1 - p0, e2 = p2 - p0, v = p - p0;
+  float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), v1 = dot(v, e1), v2 = dot(v, e2);
+  float denominator = d11 * d22 - d12 * d12;
+  vec2 uv = vec2((d22 * v1 - d12 * v2) / denominator, (d11 * v2 - d12 * v1) / denominator);
+  vec3 normalAtHit, shadingNormal;
+  hitNormals(tri, uv, normalAtHit, shadingNormal);
+#if defined(SPECULAR) || defined(HIGHLIGHTS)
+  uint record = viewedRecord(tri.w, -direction, normalAtHit);
+#endif
+#ifdef SPECULAR
+  if (record != kNoRecord && charts[record].info.y == kSpecular)
+    return weight * specularChain(eye, direction, t, id - 1u, uv, mirrorDepth);
+#endif
+#ifdef HIGHLIGHTS
+  if (record != kNoRecord)
+    return weight * (lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal) +
+                     punctualHighlights(record, id - 1u, uv, -direction));
+#endif
   return weight * lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal);
 }
 
 #ifdef MULTISAMPLE
-// Pcg32::forKey, mix64 and hashCombine (core/rng.h) in 64-bit integers
-// (GL_ARB_gpu_shader_int64): the CPU renderers' sample positions.
+// Pcg32::forKey (core/rng.h) in 64-bit integers (GL_ARB_gpu_shader_int64): the CPU
+// renderers' sample positions.
 uniform uvec2 seed;  // (low, high) 32 bits
 uniform int spp;
-uint64_t mix64(uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9UL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebUL;
-  x ^= x >> 31;
-  return x;
-}
-uint64_t hashCombine(uint64_t a, uint64_t b) { return mix64(a ^ (mix64(b) + 0x9e3779b97f4a7c15UL)); }
 struct Pcg32 { uint64_t state, inc; };
 uint pcgNext(inout Pcg32 rng) {
   uint64_t old = rng.state;
@@ -462,6 +510,27 @@ void main() {
 }
 )glsl";
 
+// The BVH traversal on rays (GpuRenderer::intersect).
+constexpr const char* kIntersectCompute = R"glsl(
+layout(local_size_x = 64) in;
+struct TraceRay { vec4 origin; vec4 direction; };  // origin.w: tMin, direction.w: tMax
+layout(std430, binding = QUERIES_BINDING) readonly buffer Rays { TraceRay rays[]; };
+// Per ray: (t, triangle as uint bits, u, v), then (occluded, 0, 0, 0).
+layout(std430, binding = RESULTS_BINDING) writeonly buffer Hits { vec4 hits[]; };
+uniform uint count;
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  float t;
+  uint triangle;
+  vec2 uv;
+  TraceRay r = rays[i];
+  bvhIntersect(r.origin.xyz, r.direction.xyz, r.origin.w, r.direction.w, t, triangle, uv);
+  hits[2u * i] = vec4(t, uintBitsToFloat(triangle), uv);
+  hits[2u * i + 1u] = vec4(bvhOccluded(r.origin.xyz, r.direction.xyz, r.origin.w, r.direction.w) ? 1.0 : 0.0, 0.0, 0.0, 0.0);
+}
+)glsl";
+
 const char* glErrorName(GLenum error) {
   switch (error) {
     case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
@@ -507,9 +576,9 @@ GLuint compileShader(GLenum type, const std::string& source, const char* name) {
 
 /// A program of the given stages, each source prefixed by the version line, `header`
 /// (extensions, defines), the generated constants and, where `lookup`, the lookup functions.
-GLuint linkProgram(std::initializer_list<std::pair<GLenum, const char*>> stages, const char* name, bool lookup,
-                   const char* header = "") {
-  const std::string prefix = "#version 450 core\n" + std::string(header) + glslConstants() + (lookup ? kLookupGlsl : "");
+GLuint linkProgram(std::initializer_list<std::pair<GLenum, std::string>> stages, const char* name, bool lookup,
+                   const std::string& header = "") {
+  const std::string prefix = "#version 450 core\n" + header + glslConstants() + (lookup ? kLookupGlsl : "");
   const GLuint program = glCreateProgram();
   std::vector<GLuint> shaders;
   for (const auto& [type, source] : stages) {
@@ -534,6 +603,29 @@ std::string currentDeviceName() {
                      reinterpret_cast<const char*>(glGetString(GL_VERSION)));
 }
 
+/// Runs compute program `program` (64-wide groups, uniform `count`) on `count` queries, `input`
+/// bound at kQueriesBinding, and returns the resultFloats floats per query it writes at
+/// kResultsBinding (GpuRenderer::lookup, GpuRenderer::intersect). `what` names it in errors.
+std::vector<float> runQueries(GLuint program, const std::vector<float>& input, size_t count, size_t resultFloats,
+                              const char* what) {
+  GLuint buffers[2];
+  glCreateBuffers(2, buffers);
+  const size_t resultBytes = count * resultFloats * sizeof(float);
+  glNamedBufferStorage(buffers[0], GLsizeiptr(std::max<size_t>(input.size() * sizeof(float), 16)), input.empty() ? nullptr : input.data(), 0);
+  glNamedBufferStorage(buffers[1], GLsizeiptr(std::max<size_t>(resultBytes, 16)), nullptr, GL_MAP_READ_BIT);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kQueriesBinding, buffers[0]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kResultsBinding, buffers[1]);
+  glUseProgram(program);
+  glProgramUniform1ui(program, glGetUniformLocation(program, "count"), GLuint(count));
+  glDispatchCompute(GLuint((count + 63) / 64), 1, 1);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  std::vector<float> output(count * resultFloats);
+  if (count > 0) glGetNamedBufferSubData(buffers[1], 0, GLsizeiptr(resultBytes), output.data());
+  glDeleteBuffers(2, buffers);
+  checkGl(what);
+  return output;
+}
+
 void setCameraUniforms(GLuint program, const Camera& camera) {
   auto vec3 = [&](const char* name, const Vec3& v) { glProgramUniform3f(program, glGetUniformLocation(program, name), v.x, v.y, v.z); };
   vec3("eye", camera.eye());
@@ -550,20 +642,14 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
   const Scene& scene = lf.scene;
   for (const Material& m : scene.materials)
     if (m.isMasked()) return "alpha masks";
-  // PunctualHighlights::active() without its shadow-ray machinery: a bake with punctual
-  // highlights, a delta light, and a glossy chart to show them.
-  const bool glossy = std::any_of(lf.charts.begin(), lf.charts.end(), [](const Chart& c) { return c.kind == ChartKind::Glossy; });
-  if (lf.settings.punctualHighlights && glossy)
-    for (const Light& light : scene.lights)
-      if (isDeltaLight(light)) return "punctual highlights (point, spot and directional lights on glossy charts)";
+  if (std::string specular = gpuUnsupportedSpecular(lf); !specular.empty()) return specular;
+  if (std::string highlights = gpuUnsupportedHighlights(lf); !highlights.empty()) return highlights;
   const SunLights sun = sunLightsOf(lf);
   for (uint32_t i = 0; i < lf.charts.size(); ++i) {
     const Chart& c = lf.charts[i];
-    if (c.kind == ChartKind::Specular) return "mirrors and glass (specular charts)";
     const ChartShading shading = chartShading(lf, i, sun);
     if (shading.texturedAlbedo) return "albedo textures, metallic-roughness textures and vertex colours";
     if (shading.normalMapped || c.directionalIrradiance) return "normal maps";
-    if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) return "rough glass";
     if (shading.texturedEmission) return "emission textures";
     // The shader takes a glossy chart's diffuse part as Blinn-Phong's, k(μ) = 1; GGX-like
     // models (GgxBsdf, GltfPbrBsdf) couple it to the lobe's albedo.
@@ -587,6 +673,14 @@ struct GpuRenderer::State {
   GLuint buffers[8] = {};  // values, charts, positions, triangles, indices, normals, sun masks, environment map
   GLuint vertexArray = 0, emptyVertexArray = 0;
   GLuint visibilityProgram = 0, shadingProgram = 0, lookupProgram = 0;
+  /// The BVH (gpu_bvh.h: nodes, order), the materials of the specular chains and shadow rays
+  /// (gpu_specular.h: per material, per triangle) and the highlights' lights and models
+  /// (gpu_highlights.h); the BVH is built with the first program that traces rays.
+  GLuint rayBuffers[6] = {};
+  bool bvhUploaded = false;
+  GLuint intersectProgram = 0;  ///< GpuRenderer::intersect's, made on its first call
+  bool specular = false;        ///< the light field has specular charts: the shading passes trace their chains
+  bool highlights = false;      ///< gpuHighlightsActive: the shading passes add punctual highlights
   /// The shading pass with several jittered samples per pixel; 0 where the driver lacks
   /// GL_ARB_gpu_shader_int64 (the sample positions' 64-bit hash).
   GLuint multisampleProgram = 0;
@@ -601,6 +695,8 @@ struct GpuRenderer::State {
   ~State() {
     context.makeCurrent();
     glDeleteBuffers(8, buffers);
+    glDeleteBuffers(6, rayBuffers);
+    glDeleteProgram(intersectProgram);
     glDeleteVertexArrays(1, &vertexArray);
     glDeleteVertexArrays(1, &emptyVertexArray);
     glDeleteProgram(visibilityProgram);
@@ -644,6 +740,23 @@ struct GpuRenderer::State {
     width = w;
     height = h;
     idScale = scale;
+  }
+  /// Builds the BVH over the scene's triangles (the order of `triangles` above) and uploads it.
+  void uploadBvh(const Scene& scene) {
+    if (bvhUploaded) return;
+    std::vector<Vec3> points;
+    std::vector<UVec3> tris;
+    flattenSceneTriangles(scene, points, tris);
+    const GpuBvh bvh = buildGpuBvh(points, tris);
+    glCreateBuffers(2, rayBuffers);
+    glNamedBufferStorage(rayBuffers[0], GLsizeiptr(bvh.nodes.size() * sizeof(BvhNode)), bvh.nodes.data(), 0);
+    glNamedBufferStorage(rayBuffers[1], GLsizeiptr(std::max<size_t>(bvh.order.size() * sizeof(uint32_t), 16)),
+                         bvh.order.empty() ? nullptr : bvh.order.data(), 0);
+    bufferBytes += bvh.nodes.size() * sizeof(BvhNode) + std::max<size_t>(bvh.order.size() * sizeof(uint32_t), 16);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBvhNodesBinding, rayBuffers[0]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBvhOrderBinding, rayBuffers[1]);
+    checkGl("uploading the BVH (out of GPU memory?)");
+    bvhUploaded = true;
   }
   uint64_t targetBytes() const {
     return uint64_t(width) * uint64_t(height) * (16 + uint64_t(idScale) * uint64_t(idScale) * (4 + 4));
@@ -736,6 +849,37 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   }
   upload(s.buffers[7], envTexels.data(), envTexels.size() * sizeof(float));
   checkGl("uploading the light field (out of GPU memory?)");
+  // Mirrors and glass, punctual highlights: the BVH their rays are traced through, the
+  // materials they follow or pass (thin glass), the highlights' lights and models.
+  s.specular = hasSpecularCharts(lightField);
+  s.highlights = gpuHighlightsActive(lightField);
+  if (s.specular && !epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
+    fail("GPU renderer: this light field has mirrors or glass, which need GL_ARB_gpu_shader_int64 (this driver, {}, "
+         "lacks it; render it with --renderer cpu)",
+         currentDeviceName());
+  const bool traces = s.specular || s.highlights;
+  if (traces) {
+    s.uploadBvh(scene);
+    const std::vector<SpecularMaterialGpu> materials = specularMaterials(scene);
+    std::vector<uint32_t> triangleMaterials;
+    for (const Mesh& mesh : scene.meshes) triangleMaterials.insert(triangleMaterials.end(), mesh.materials.begin(), mesh.materials.end());
+    glCreateBuffers(2, s.rayBuffers + 2);
+    upload(s.rayBuffers[2], materials.data(), materials.size() * sizeof(SpecularMaterialGpu));
+    upload(s.rayBuffers[3], triangleMaterials.data(), triangleMaterials.size() * sizeof(uint32_t));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSpecularMaterialsBinding, s.rayBuffers[2]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTriangleMaterialsBinding, s.rayBuffers[3]);
+    checkGl("uploading the materials of mirrors and glass");
+  }
+  const std::vector<HighlightLightGpu> highlightLightRecords = s.highlights ? highlightLights(scene) : std::vector<HighlightLightGpu>{};
+  if (s.highlights) {
+    const std::vector<HighlightModelGpu> models = highlightModels(scene);
+    glCreateBuffers(2, s.rayBuffers + 4);
+    upload(s.rayBuffers[4], highlightLightRecords.data(), highlightLightRecords.size() * sizeof(HighlightLightGpu));
+    upload(s.rayBuffers[5], models.data(), models.size() * sizeof(HighlightModelGpu));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kHighlightLightsBinding, s.rayBuffers[4]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kHighlightModelsBinding, s.rayBuffers[5]);
+    checkGl("uploading the punctual lights");
+  }
 
   glCreateVertexArrays(1, &s.vertexArray);
   glVertexArrayVertexBuffer(s.vertexArray, 0, s.buffers[2], 0, 4 * sizeof(float));
@@ -747,15 +891,29 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
 
   s.visibilityProgram =
       linkProgram({{GL_VERTEX_SHADER, kVisibilityVertex}, {GL_FRAGMENT_SHADER, kVisibilityFragment}}, "visibility", false);
-  s.shadingProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, kShadingFragment}}, "shading", true);
+  // With specular charts or highlights the shading passes carry the BVH traversal, the
+  // highlights and the chains after their main.
+  const std::string int64 = "#extension GL_ARB_gpu_shader_int64 : require\n";
+  const std::string raysHeader = (s.specular ? int64 + "#define SPECULAR\n" : "") +
+                                     (s.highlights ? "#define HIGHLIGHTS\n" + highlightGlslConstants() : "") +
+                                     (traces ? bvhGlslConstants() + specularGlslConstants() : "");
+  const std::string shading = std::string(kGeometryGlsl) + kShadingFragment +
+                              (traces ? std::string(kBvhGlsl) + kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
+                              (s.specular ? kSpecularGlsl : "");
+  s.shadingProgram =
+      linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}}, "shading", true, raysHeader);
   s.lookupProgram = linkProgram({{GL_COMPUTE_SHADER, kLookupCompute}}, "lookup", true);
   if (epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
-    s.multisampleProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, kShadingFragment}},
+    s.multisampleProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}},
                                        "multi-sample shading", true,
-                                       "#extension GL_ARB_gpu_shader_int64 : require\n#define MULTISAMPLE\n");
+                                       (s.specular ? raysHeader : int64 + raysHeader) + "#define MULTISAMPLE\n");
   glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
   for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {
     if (program == 0) continue;
+    if (s.highlights) {
+      glProgramUniform1ui(program, glGetUniformLocation(program, "highlightLightCount"), GLuint(highlightLightRecords.size()));
+      glProgramUniform1i(program, glGetUniformLocation(program, "shadowsPassThinGlass"), scene.hasThinGlass() ? 1 : 0);
+    }
     glProgramUniform3f(program, glGetUniformLocation(program, "background"), s.background.x, s.background.y,
                        s.background.z);
     glProgramUniform1i(program, glGetUniformLocation(program, "hasEnvironmentMap"), environmentMap != nullptr ? 1 : 0);
@@ -841,6 +999,9 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   glProgramUniform2i(program, glGetUniformLocation(program, "size"), camera.width(), camera.height());
   glProgramUniform1i(program, glGetUniformLocation(program, "idScale"), idScale);
   glProgramUniform1i(program, glGetUniformLocation(program, "vignetting"), camera.vignetting() ? 1 : 0);
+  if (s.specular)
+    glProgramUniform1ui(program, glGetUniformLocation(program, "mirrorDepth"),
+                        effectiveMirrorDepth(settings, lightField_.settings.mirrorDepth));
   if (spp > 1) {
     glProgramUniform1i(program, glGetUniformLocation(program, "spp"), spp);
     glProgramUniform2ui(program, glGetUniformLocation(program, "seed"), GLuint(settings.seed & 0xffffffffu),
@@ -872,24 +1033,35 @@ std::vector<Rgb> GpuRenderer::lookup(const std::vector<LookupQuery>& queries) {
     input.insert(input.end(), {q.position.x, q.position.y, q.position.z, chart, q.towardsViewer.x, q.towardsViewer.y,
                                q.towardsViewer.z, 0.0f});
   }
-  GLuint buffers[2];
-  glCreateBuffers(2, buffers);
   const size_t count = queries.size();
-  glNamedBufferStorage(buffers[0], GLsizeiptr(std::max<size_t>(input.size() * sizeof(float), 16)), input.empty() ? nullptr : input.data(), 0);
-  glNamedBufferStorage(buffers[1], GLsizeiptr(std::max<size_t>(count * 16, 16)), nullptr, GL_MAP_READ_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kQueriesBinding, buffers[0]);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kResultsBinding, buffers[1]);
-  glUseProgram(s.lookupProgram);
-  glProgramUniform1ui(s.lookupProgram, glGetUniformLocation(s.lookupProgram, "count"), GLuint(count));
-  glDispatchCompute(GLuint((count + 63) / 64), 1, 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  std::vector<float> output(count * 4);
-  if (count > 0) glGetNamedBufferSubData(buffers[1], 0, GLsizeiptr(output.size() * sizeof(float)), output.data());
-  glDeleteBuffers(2, buffers);
-  checkGl("the lookup queries");
+  const std::vector<float> output = runQueries(s.lookupProgram, input, count, 4, "the lookup queries");
   std::vector<Rgb> result(count);
   for (size_t i = 0; i < count; ++i) result[i] = Rgb(output[4 * i], output[4 * i + 1], output[4 * i + 2]);
   return result;
+}
+
+std::vector<BvhHit> GpuRenderer::intersect(const std::vector<Ray>& rays, std::vector<uint8_t>* occluded) {
+  State& s = *state_;
+  s.context.makeCurrent();
+  s.uploadBvh(lightField_.scene);
+  if (s.intersectProgram == 0)
+    s.intersectProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kGeometryGlsl) + kBvhGlsl + kIntersectCompute}},
+                                     "intersect", false, bvhGlslConstants());
+  std::vector<float> input;
+  input.reserve(rays.size() * 8);
+  for (const Ray& r : rays)
+    input.insert(input.end(), {r.origin.x, r.origin.y, r.origin.z, r.tMin, r.direction.x, r.direction.y, r.direction.z, r.tMax});
+  const size_t count = rays.size();
+  const std::vector<float> output = runQueries(s.intersectProgram, input, count, 8, "the ray queries");
+  std::vector<BvhHit> hits(count);
+  if (occluded != nullptr) occluded->assign(count, 0);
+  for (size_t i = 0; i < count; ++i) {
+    hits[i].t = output[8 * i];
+    std::memcpy(&hits[i].triangle, &output[8 * i + 1], sizeof(uint32_t));
+    hits[i].barycentrics = Vec2(output[8 * i + 2], output[8 * i + 3]);
+    if (occluded != nullptr) (*occluded)[i] = output[8 * i + 4] != 0.0f ? 1 : 0;
+  }
+  return hits;
 }
 
 std::string GpuRenderer::deviceName() const {

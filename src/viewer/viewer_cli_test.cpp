@@ -166,10 +166,9 @@ TEST_F(ViewerCliTest, GpuScreenshotUnderXvfbEqualsGpuRender) {
   EXPECT_EQ(differingPixels(path("render.png"), path("view.png")), 0);
 }
 
-/// The light field of McGuire's mirror box (a chart the GPU renderer does not draw yet).
+/// A light field with mirror-like lobes (a chart the GPU renderer does not draw yet).
 void writeMirrorLightField(const std::string& file) {
-  writeLightField(file, test_support::randomLightField(
-                            loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/CornellBox-Mirror.obj"), 5));
+  writeLightField(file, test_support::randomLightField(test_support::mirrorLikeCornellBox(), 5));
 }
 
 /// The lines of `text` that contain `word`.
@@ -220,10 +219,11 @@ TEST_F(ViewerCliTest, FallsBackToTheCpuRendererWithOneWarningLine) {
   std::string out, errors;
   ASSERT_EQ(run("view " + path("mirror.plf") + " --frames 1" + size, &out, &errors), 0) << errors;
   EXPECT_EQ(linesWith(errors, "warning"), 1) << errors;
-  EXPECT_NE(errors.find("view uses the CPU renderer: the GPU renderer does not draw mirrors and glass"), std::string::npos)
+  EXPECT_NE(errors.find("view uses the CPU renderer: the GPU renderer does not draw mirror-like glossy lobes"),
+            std::string::npos)
       << errors;
   EXPECT_NE(run("view " + path("mirror.plf") + " --renderer gpu --frames 1" + size, nullptr, &errors), 0);
-  EXPECT_NE(errors.find("mirrors and glass"), std::string::npos) << errors;
+  EXPECT_NE(errors.find("mirror-like glossy lobes"), std::string::npos) << errors;
   EXPECT_NE(errors.find("--renderer cpu"), std::string::npos) << errors;
   // Settings it does not support yet (a thin lens) likewise.
   ASSERT_EQ(run("view " + path("cornell.plf") + " --aperture 2.8 --frames 1" + size, nullptr, &errors), 0) << errors;

@@ -6,6 +6,7 @@
 #include "bake/parameterisation.h"
 #include "core/rng.h"
 #include "lightfield/lightfield.h"
+#include "scene/scene.h"
 
 namespace pl::test_support {
 
@@ -24,6 +25,17 @@ inline LightField randomLightField(Scene scene, uint64_t seed) {
   lf.scene = std::move(scene);
   lf.scene.finalize();  // the move keeps the Embree padding, but be explicit
   return lf;
+}
+
+/// The built-in Cornell box with every non-emissive material a GGX metal too sharp for a
+/// glossy map (α 2e-3): its charts are mirror-like specular records (bake/parameterisation.h
+/// isMirrorLike), which the CPU renderers follow by sampling the lobe and the GPU renderer
+/// does not draw yet.
+inline Scene mirrorLikeCornellBox() {
+  Scene scene = makeCornellBox();
+  for (Material& m : scene.materials)
+    if (!m.isEmissive()) m.bsdf = GgxBsdf{Rgb(0.0f), Rgb(0.9f), 2e-3f};
+  return scene;
 }
 
 }  // namespace pl::test_support

@@ -1,0 +1,81 @@
+#pragma once
+// The GPU renderer's ray-casting structure: a bounding-volume hierarchy built on the CPU over
+// the renderer's triangle array (every mesh's triangles in scene order, global vertex
+// indices: GpuRenderer's upload), uploaded as two shader storage buffers and traversed by
+// the GLSL functions of kBvhGlsl — the rays of mirror and glass chains and the shadow rays of
+// punctual highlights, which rasterisation cannot answer.
+//
+// Build: binned SAH (16 bins on the centroids along the longest centroid axis; a node
+// becomes a leaf at ≤ kBvhLeafTriangles triangles, or when no split is cheaper than the leaf,
+// traversal cost 1 against intersection cost 1 per triangle, up to 8 triangles; and at depth
+// 48 whatever it holds, so that the traversal's stack cannot overflow). Nodes are in depth-first order,
+// the two children of an inner node adjacent.
+//
+// Traversal (GLSL, kBvhGlsl): a stack of 64 node indices, the nearer child first (by the slab
+// test's entry distance), closest hit (bvhIntersect) or any hit (bvhOccluded) in (tMin, tMax).
+// The triangle test is Möller–Trumbore with inclusive edges (u ≥ 0, v ≥ 0, u + v ≤ 1), so a
+// ray through a shared edge hits one of the two triangles (both, the nearer kept), and
+// barycentrics (u, v) as Embree reports them. It is not Embree's arithmetic: t and (u, v)
+// agree with Embree's to float rounding (a few ulp), not bit for bit.
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/math.h"
+
+namespace pl {
+
+struct Scene;
+
+inline constexpr uint32_t kBvhLeafTriangles = 4;
+
+/// One node as the shaders read it (std430: two 16-byte rows). Inner node: count == 0 and
+/// its children at `first` and `first + 1`. Leaf: triangles order[first … first + count).
+struct BvhNode {
+  float lower[3];
+  uint32_t first;
+  float upper[3];
+  uint32_t count;
+};
+static_assert(sizeof(BvhNode) == 32);
+
+struct GpuBvh {
+  std::vector<BvhNode> nodes;   ///< nodes[0] is the root (an empty leaf when there are no triangles)
+  std::vector<uint32_t> order;  ///< triangle indices in leaf order
+};
+
+/// Every mesh's vertices and triangles of `scene` in one array each, in scene order, the
+/// triangles' indices into `positions`: the triangle array the GPU renderer draws and builds
+/// the BVH over. `meshTriangle`, when given, gets each triangle's (mesh, triangle in the mesh).
+void flattenSceneTriangles(const Scene& scene, std::vector<Vec3>& positions, std::vector<UVec3>& triangles,
+                           std::vector<std::pair<uint32_t, uint32_t>>* meshTriangle = nullptr);
+
+/// Builds the hierarchy over triangles (p[v[0]], p[v[1]], p[v[2]]) for every v in
+/// `triangles`, triangle i of the result being triangles[i]. Degenerate and non-finite
+/// triangles are kept (they never report a hit).
+GpuBvh buildGpuBvh(const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles);
+
+/// The closest hit of `ray` in (ray.tMin, ray.tMax) by the traversal kBvhGlsl runs, on the
+/// CPU (the build's unit test); triangle = kNone (0xffffffff) for a miss.
+struct BvhHit {
+  float t = kInfinity;
+  uint32_t triangle = 0xffffffffu;
+  Vec2 barycentrics{0.0f};
+};
+BvhHit intersectGpuBvh(const GpuBvh& bvh, const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles,
+                       const Ray& ray);
+
+/// The storage-buffer bindings of the nodes and the order (above the renderer's own).
+inline constexpr uint32_t kBvhNodesBinding = 16, kBvhOrderBinding = 17;
+/// GLSL #defines of BVH_NODES_BINDING and BVH_ORDER_BINDING (prefixed to kBvhGlsl's programs).
+std::string bvhGlslConstants();
+
+/// GLSL: bvhIntersect(origin, direction, tMin, tMax, out t, out triangle, out barycentrics)
+/// and bvhOccluded(origin, direction, tMin, tMax), over the storage blocks BvhNodes
+/// (binding BVH_NODES_BINDING) and BvhOrder (BVH_ORDER_BINDING). Needs the shading pass's
+/// `positions` (vec4 per vertex) and `triangles` (uvec4: vertex indices, chart) blocks declared
+/// before it. Triangle indices are into `triangles`.
+extern const char* const kBvhGlsl;
+
+}  // namespace pl

@@ -1,0 +1,217 @@
+// Punctual lights' highlights in the GPU renderer (gpu_highlights.h).
+#include "gpu/gpu_highlights.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "bsdf/bsdf.h"
+#include "light/lights.h"
+#include "scene/scene.h"
+
+namespace pl {
+
+bool gpuHighlightsActive(const LightField& lf) {
+  if (!lf.settings.punctualHighlights) return false;
+  const bool glossy = std::any_of(lf.charts.begin(), lf.charts.end(), [](const Chart& c) { return c.kind == ChartKind::Glossy; });
+  return glossy && std::any_of(lf.scene.lights.begin(), lf.scene.lights.end(), [](const Light& l) { return isDeltaLight(l); });
+}
+
+std::string gpuUnsupportedHighlights(const LightField& lf) {
+  if (!gpuHighlightsActive(lf)) return {};
+  for (const Chart& c : lf.charts) {
+    if (c.kind != ChartKind::Glossy) continue;
+    const Bsdf& model = lf.scene.materials[c.material].bsdf;
+    if (isRoughGlassChart(c, model) || std::holds_alternative<BlinnPhongBsdf>(model)) continue;
+    const auto* ggx = std::get_if<GgxBsdf>(&model);
+    if (ggx == nullptr) return "punctual highlights on glTF PBR materials";
+    if (!isBlack(ggx->diffuse) && !c.diffuseValue) return "punctual highlights on GGX materials with a diffuse base";
+  }
+  return {};
+}
+
+std::vector<HighlightLightGpu> highlightLights(const Scene& scene) {
+  std::vector<HighlightLightGpu> result;
+  for (const Light& light : scene.lights) {
+    if (!isDeltaLight(light)) continue;
+    HighlightLightGpu g{};
+    uint32_t kind = kHighlightPoint;
+    Vec3 position(0.0f), axis(0.0f);
+    Rgb intensity(0.0f);
+    if (const auto* point = std::get_if<PointLight>(&light)) {
+      position = point->position, intensity = point->intensity;
+    } else if (const auto* spot = std::get_if<SpotLight>(&light)) {
+      kind = kHighlightSpot;
+      position = spot->position, intensity = spot->intensity, axis = spot->axis;
+      g.cone[0] = spot->cosInner, g.cone[1] = spot->cosOuter;
+    } else if (const auto* sun = std::get_if<DirectionalLight>(&light)) {
+      kind = kHighlightDirectional;
+      position = -sun->travel(), intensity = sun->irradiance;  // DirectionalLight::sample's wi
+    }
+    for (int k = 0; k < 3; ++k) g.position[k] = position[k], g.intensity[k] = intensity[k], g.axis[k] = axis[k];
+    std::memcpy(&g.position[3], &kind, sizeof(float));
+    result.push_back(g);
+  }
+  return result;
+}
+
+std::vector<HighlightModelGpu> highlightModels(const Scene& scene) {
+  std::vector<HighlightModelGpu> result(scene.materials.size());
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    HighlightModelGpu& g = result[i];
+    uint32_t kind = kHighlightNoModel;
+    const Bsdf& model = scene.materials[i].bsdf;
+    if (const auto* phong = std::get_if<BlinnPhongBsdf>(&model)) {
+      kind = kHighlightBlinnPhong;
+      const float n = std::max(0.0f, phong->exponent);
+      for (int k = 0; k < 3; ++k) g.diffuse[k] = phong->diffuse[k], g.lobe[k] = phong->specular[k];
+      g.lobe[3] = n;
+      g.extra[0] = blinnPhongNormalization(n);
+    } else if (const auto* ggx = std::get_if<GgxBsdf>(&model)) {
+      kind = kHighlightGgx;
+      for (int k = 0; k < 3; ++k) g.lobe[k] = ggx->f0[k];
+      g.lobe[3] = std::clamp(ggx->alpha, kGgxMinAlpha, 1.0f);  // bsdf.cpp clampAlpha
+    }
+    std::memcpy(&g.diffuse[3], &kind, sizeof(float));
+  }
+  return result;
+}
+
+std::string highlightGlslConstants() {
+  return fmt::format(
+      "const uint kHighlightPoint = {}u, kHighlightSpot = {}u, kHighlightDirectional = {}u;\n"
+      "const uint kHighlightNoModel = {}u, kHighlightBlinnPhong = {}u, kHighlightGgx = {}u;\n"
+      "#define HIGHLIGHT_LIGHTS_BINDING {}\n#define HIGHLIGHT_MODELS_BINDING {}\n",
+      kHighlightPoint, kHighlightSpot, kHighlightDirectional, kHighlightNoModel, kHighlightBlinnPhong, kHighlightGgx,
+      kHighlightLightsBinding, kHighlightModelsBinding);
+}
+
+// PunctualHighlights::radiance (lookup.cpp) with what it calls — scatteringFrame and
+// usableSide (scene.cpp) of a reflecting model, sampleLight of the delta lights
+// (lights.cpp incidentFromPoint, SpotLight::sample, DirectionalLight::sample), eval of
+// Blinn-Phong and GGX (bsdf.cpp evalBlinnPhong, ggxSpecular, ggxD, ggxLambda),
+// shadowRayTowards (light.cpp) and ShadowRays::transmittance — statement for statement.
+const char* const kHighlightsGlsl = R"glsl(
+struct HighlightLight { vec4 position; vec4 intensity; vec4 axis; vec4 cone; };
+layout(std430, binding = HIGHLIGHT_LIGHTS_BINDING) readonly buffer HighlightLights { HighlightLight highlightLights[]; };
+struct HighlightModel { vec4 diffuse; vec4 lobe; vec4 extra; };
+layout(std430, binding = HIGHLIGHT_MODELS_BINDING) readonly buffer HighlightModels { HighlightModel highlightModels[]; };
+uniform uint highlightLightCount;
+uniform bool shadowsPassThinGlass;
+
+float ggxD(float alpha, vec3 h) {
+  float a2 = alpha * alpha;
+  float c2 = h.z * h.z;
+  float d = c2 * (a2 - 1.0) + 1.0;
+  return a2 / (3.14159265358979 * d * d);
+}
+float ggxLambda(float alpha, vec3 w) {
+  float c2 = w.z * w.z;
+  if (c2 <= 0.0) return 1.0 / 0.0;
+  float tan2 = max(0.0, 1.0 - c2) / c2;
+  return 0.5 * (sqrt(1.0 + alpha * alpha * tan2) - 1.0);
+}
+// eval of the chart's model in the local frame (withDiffuse: Blinn-Phong's diffuse part too).
+vec3 evalHighlightModel(HighlightModel m, bool withDiffuse, vec3 wo, vec3 wi) {
+  if (!(wo.z > 0.0 && wi.z > 0.0)) return vec3(0.0);
+  uint kind = floatBitsToUint(m.diffuse.w);
+  vec3 h = normalize(wo + wi);
+  if (kind == kHighlightBlinnPhong) {
+    vec3 diffuse = withDiffuse ? m.diffuse.rgb : vec3(0.0);
+    return diffuse * 0.318309886183791 + m.lobe.rgb * (m.extra.x * pow(max(0.0, h.z), m.lobe.w));
+  }
+  if (kind != kHighlightGgx) return vec3(0.0);
+  float alpha = m.lobe.w;
+  float g2 = 1.0 / (1.0 + ggxLambda(alpha, wo) + ggxLambda(alpha, wi));
+  float c = clamp(1.0 - dot(wo, h), 0.0, 1.0), c2 = c * c;
+  vec3 fresnel = m.lobe.rgb + (vec3(1.0) - m.lobe.rgb) * (c2 * c2 * c);
+  return fresnel * (ggxD(alpha, h) * g2 / (4.0 * wo.z * wi.z));
+}
+// ShadowRays::transmittance of the ray (origin, direction) over (0, tMax).
+vec3 shadowTransmittance(vec3 origin, vec3 direction, float tMax) {
+  if (!shadowsPassThinGlass) return bvhOccluded(origin, direction, 0.0, tMax) ? vec3(0.0) : vec3(1.0);
+  vec3 transmittance = vec3(1.0);
+  vec3 start = origin;
+  float tEnd = tMax;
+  for (;;) {
+    float t;
+    uint triangle;
+    vec2 uv;
+    if (!bvhIntersect(origin, direction, 0.0, tMax, t, triangle, uv)) return transmittance;
+    vec3 position, geometricNormal, shadingNormal;
+    surfaceAt(triangle, uv, position, geometricNormal, shadingNormal);
+    SpecularMaterial m = specularMaterials[triangleMaterials[triangle]];
+    if (floatBitsToUint(m.colour.w) != kSpecularGlass || m.iface.y == 0.0) return vec3(0.0);
+    vec3 reflectance, straight;
+    thinSheetReflectanceTransmittance(m, dot(shadingNormal, direction), reflectance, straight);
+    transmittance *= straight;
+    if (all(equal(transmittance, vec3(0.0)))) return transmittance;
+    // Continue from just past the sheet; the remaining length is measured from the start.
+    origin = offsetRayOrigin(position, geometricNormal, direction);
+    tMax = isinf(tEnd) ? tEnd : tEnd - dot(origin - start, direction);
+    if (!(tMax > 0.0)) return transmittance;
+  }
+}
+vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer) {
+  if (highlightLightCount == 0u || charts[record].info.y != kGlossy) return vec3(0.0);
+  HighlightModel model = highlightModels[triangleMaterials[triangle]];
+  if (floatBitsToUint(model.diffuse.w) == kHighlightNoModel) return vec3(0.0);  // rough glass keeps them in its maps
+  bool withDiffuse = (charts[record].info.z & kFlagDiffuseValue) == 0u;
+  vec3 position, geometricNormal, shadingNormal;
+  surfaceAt(triangle, uv, position, geometricNormal, shadingNormal);
+  // scatteringFrame of a reflecting model: both normals turned to the viewer's side.
+  bool turn = dot(geometricNormal, towardsViewer) < 0.0;
+  vec3 g = turn ? -geometricNormal : geometricNormal, n = turn ? -shadingNormal : shadingNormal;
+  vec3 s, t;
+  frameFromNormal(n, s, t);
+  vec3 wo = vec3(dot(towardsViewer, s), dot(towardsViewer, t), dot(towardsViewer, n));
+  if (!(dot(towardsViewer, g) > 0.0)) return vec3(0.0);
+  vec3 sum = vec3(0.0);
+  for (uint l = 0u; l < highlightLightCount; ++l) {
+    HighlightLight light = highlightLights[l];
+    uint kind = floatBitsToUint(light.position.w);
+    vec3 wi = light.position.xyz, incident = light.intensity.rgb;
+    bool finite = kind != kHighlightDirectional;
+    if (finite) {
+      vec3 toLight = light.position.xyz - position;
+      float distanceSquared = dot(toLight, toLight);
+      if (!(distanceSquared > 0.0)) continue;
+      wi = toLight / sqrt(distanceSquared);
+      float falloff = 1.0;
+      if (kind == kHighlightSpot) {
+        float c = dot(light.axis.xyz, -wi), cosInner = light.cone.x, cosOuter = light.cone.y;
+        if (cosInner <= cosOuter) {
+          falloff = c >= cosInner ? 1.0 : 0.0;
+        } else {
+          float x = clamp((c - cosOuter) / (cosInner - cosOuter), 0.0, 1.0);
+          falloff = x * x * (3.0 - 2.0 * x);
+        }
+      }
+      if (!(falloff > 0.0)) continue;
+      incident = light.intensity.rgb * (falloff / distanceSquared);
+    }
+    vec3 wiLocal = vec3(dot(wi, s), dot(wi, t), dot(wi, n));
+    if (!(dot(wi, g) > 0.0)) continue;
+    vec3 f = evalHighlightModel(model, withDiffuse, wo, wiLocal);
+    float cosIn = abs(wiLocal.z);
+    if (all(equal(f, vec3(0.0))) || !(cosIn > 0.0) || all(equal(incident, vec3(0.0)))) continue;
+    // shadowRayTowards: to the light's position, or unbounded along wi at infinity.
+    vec3 origin = offsetRayOrigin(position, g, wi);
+    vec3 direction = wi;
+    float tMax = 1.0 / 0.0;
+    if (finite) {
+      vec3 toTarget = light.position.xyz - origin;
+      float distance = length(toTarget);
+      if (!(distance > 0.0)) continue;
+      direction = toTarget / distance;
+      tMax = distance;
+    }
+    vec3 visible = shadowTransmittance(origin, direction, tMax);
+    if (any(notEqual(visible, vec3(0.0)))) sum += visible * f * cosIn * incident;
+  }
+  return sum;
+}
+)glsl";
+
+}  // namespace pl

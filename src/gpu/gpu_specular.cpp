@@ -1,0 +1,265 @@
+// Mirrors and smooth glass in the GPU renderer (gpu_specular.h).
+#include "gpu/gpu_specular.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "bsdf/bsdf.h"
+#include "lightfield/lookup.h"
+#include "scene/scene.h"
+
+namespace pl {
+
+bool hasSpecularCharts(const LightField& lf) {
+  return std::any_of(lf.charts.begin(), lf.charts.end(), [](const Chart& c) { return c.kind == ChartKind::Specular; });
+}
+
+std::string gpuUnsupportedSpecular(const LightField& lf) {
+  const Scene& scene = lf.scene;
+  for (const Chart& c : lf.charts) {
+    if (c.kind != ChartKind::Specular) continue;
+    const Material& m = scene.materials[c.material];
+    if (!isDelta(m.bsdf) && !std::holds_alternative<DielectricBsdf>(m.bsdf))
+      return "mirror-like glossy lobes (specular charts of a Blinn-Phong or GGX material)";
+    if (m.normalTexture >= 0) return "normal maps on mirrors and glass";
+    if (m.emissionTexture >= 0) return "emission textures on mirrors and glass";
+  }
+  return {};
+}
+
+std::vector<SpecularMaterialGpu> specularMaterials(const Scene& scene) {
+  std::vector<SpecularMaterialGpu> result(scene.materials.size());
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    SpecularMaterialGpu& g = result[i];
+    uint32_t kind = kSpecularOther;
+    if (const auto* mirror = std::get_if<MirrorBsdf>(&m.bsdf)) {
+      kind = kSpecularMirror;
+      g.colour[0] = mirror->reflectance.r, g.colour[1] = mirror->reflectance.g, g.colour[2] = mirror->reflectance.b;
+      g.dielectric[2] = mirror->fresnel ? 1.0f : 0.0f;
+    } else if (const auto* glass = std::get_if<DielectricBsdf>(&m.bsdf)) {
+      // followSpecular follows every glass as smooth (a rough one is a glossy chart).
+      kind = kSpecularGlass;
+      g.colour[0] = glass->transmittance.r, g.colour[1] = glass->transmittance.g, g.colour[2] = glass->transmittance.b;
+      g.dielectric[0] = glass->ior;
+      g.dielectric[1] = glass->thin ? 1.0f : 0.0f;
+    }
+    std::memcpy(&g.colour[3], &kind, sizeof(float));
+    const Rgb sigma = interiorAbsorption(m.bsdf);
+    g.absorption[0] = sigma.r, g.absorption[1] = sigma.g, g.absorption[2] = sigma.b;
+    g.emission[0] = m.emission.r, g.emission[1] = m.emission.g, g.emission[2] = m.emission.b;
+    g.emission[3] = m.twoSidedEmission ? 1.0f : 0.0f;
+  }
+  return result;
+}
+
+std::string specularGlslConstants() {
+  return fmt::format("const uint kSpecularOther = {}u, kSpecularMirror = {}u, kSpecularGlass = {}u;\n"
+                     "const uint kSpecularRouletteStep = {}u;\n"
+                     "#define SPECULAR_MATERIALS_BINDING {}\n#define TRIANGLE_MATERIALS_BINDING {}\n",
+                     kSpecularOther, kSpecularMirror, kSpecularGlass, kSpecularRouletteStep, kSpecularMaterialsBinding,
+                     kTriangleMaterialsBinding);
+}
+
+// followSpecular (lookup.cpp) with what it calls — surfaceAt's normals and point (scene.cpp),
+// interiorTransmittance and emittedRadiance (scene.h), scatteringFrame, usableSide and scatter
+// (scene.cpp), Frame::fromNormal (core/math.h), the mirror's and smooth glass's sample
+// (bsdf.cpp: sample, sampleSmoothDielectric, thinSheetReflectanceTransmittance,
+// fresnelDielectricTransmittance, refractDirection; bsdf.h fresnelSchlick) and
+// offsetRayOrigin (accel.h) — statement for statement; then the fast renderer's chain.
+const char* const kSurfaceGlsl = R"glsl(
+struct SpecularMaterial { vec4 colour; vec4 iface; vec4 absorption; vec4 emission; };
+layout(std430, binding = SPECULAR_MATERIALS_BINDING) readonly buffer SpecularMaterials { SpecularMaterial specularMaterials[]; };
+layout(std430, binding = TRIANGLE_MATERIALS_BINDING) readonly buffer TriangleMaterials { uint triangleMaterials[]; };
+
+float luminanceOf(vec3 c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+float transmittedShare(float a, float b) { return 4.0 * a * b / ((a + b) * (a + b)); }
+float fresnelDielectricTransmittance(float cosTheta, float eta) {
+  cosTheta = clamp(cosTheta, -1.0, 1.0);
+  if (cosTheta < 0.0) {
+    eta = 1.0 / eta;
+    cosTheta = -cosTheta;
+  }
+  float sin2T = (1.0 - cosTheta * cosTheta) / (eta * eta);
+  if (sin2T >= 1.0) return 0.0;
+  float cosT = sqrt(max(0.0, 1.0 - sin2T));
+  return 0.5 * (transmittedShare(eta * cosTheta, cosT) + transmittedShare(cosTheta, eta * cosT));
+}
+float fresnelDielectric(float cosTheta, float eta) { return 1.0 - fresnelDielectricTransmittance(cosTheta, eta); }
+void thinSheetReflectanceTransmittance(SpecularMaterial m, float cosTheta, out vec3 reflectance, out vec3 transmittance) {
+  float R = fresnelDielectric(abs(cosTheta), m.iface.x), T = fresnelDielectricTransmittance(abs(cosTheta), m.iface.x);
+  reflectance = vec3(1.0);
+  transmittance = vec3(0.0);
+  if (!(T > 0.0)) return;
+  vec3 t = m.colour.rgb;
+  vec3 denom = vec3(1.0) - R * R * t * t;
+  reflectance = vec3(R) + T * T * R * t * t / denom;
+  transmittance = T * T * t / denom;
+}
+// surfaceAt (scene.cpp): the point from the barycentrics (b1, b2), the unit winding normal,
+// the interpolated shading normal on its side (interpolatedNormal).
+void surfaceAt(uint triangle, vec2 uv, out vec3 position, out vec3 geometricNormal, out vec3 shadingNormal) {
+  uvec4 tri = triangles[triangle];
+  vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
+  float b1 = uv.x, b2 = uv.y, b0 = 1.0 - b1 - b2;
+  position = b0 * p0 + b1 * p1 + b2 * p2;
+  geometricNormal = normalize(cross(p1 - p0, p2 - p0));
+  shadingNormal = geometricNormal;
+  if (normals[tri.x].w != 0.0) {
+    vec3 n = b0 * normals[tri.x].xyz + b1 * normals[tri.y].xyz + b2 * normals[tri.z].xyz;
+    float len = length(n);
+    if (len > 1e-6 && !isinf(len) && !isnan(len)) {
+      shadingNormal = n / len;
+      if (dot(shadingNormal, geometricNormal) < 0.0) shadingNormal = -shadingNormal;
+    }
+  }
+}
+// Frame::fromNormal (core/math.h): the tangents s, t of unit normal n.
+void frameFromNormal(vec3 n, out vec3 s, out vec3 t) {
+  float sign = (floatBitsToUint(n.z) >> 31) != 0u ? -1.0 : 1.0;  // copysign(1, n.z)
+  float a = -1.0 / (sign + n.z);
+  float b = n.x * n.y * a;
+  s = vec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  t = vec3(b, sign + n.y * n.y * a, -n.y);
+}
+// offsetRayOrigin (accel.h).
+vec3 offsetRayOrigin(vec3 position, vec3 geometricNormal, vec3 direction) {
+  float scale = 1.0 + max(abs(position.x), max(abs(position.y), abs(position.z)));
+  float offset = 2e-5 * scale;
+  return position + (dot(direction, geometricNormal) >= 0.0 ? offset : -offset) * geometricNormal;
+}
+)glsl";
+
+const char* const kSpecularGlsl = R"glsl(
+uint64_t specularRayHash(vec3 o, vec3 d) {
+  uint64_t h = 0x5350454355UL;
+  h = hashCombine(h, uint64_t(floatBitsToUint(o.x)));
+  h = hashCombine(h, uint64_t(floatBitsToUint(o.y)));
+  h = hashCombine(h, uint64_t(floatBitsToUint(o.z)));
+  h = hashCombine(h, uint64_t(floatBitsToUint(d.x)));
+  h = hashCombine(h, uint64_t(floatBitsToUint(d.y)));
+  return hashCombine(h, uint64_t(floatBitsToUint(d.z)));
+}
+// The sample in the local frame: false when the BSDF returns nothing.
+bool sampleSpecular(SpecularMaterial m, vec3 wo, float u, out vec3 wi, out vec3 weight) {
+  uint kind = floatBitsToUint(m.colour.w);
+  wi = vec3(0.0);
+  weight = vec3(0.0);
+  if (kind == kSpecularMirror) {
+    if (!(wo.z > 0.0)) return false;
+    wi = vec3(-wo.x, -wo.y, wo.z);
+    float f = clamp(1.0 - wo.z, 0.0, 1.0), f2 = f * f;
+    weight = m.iface.z != 0.0 ? m.colour.rgb + (vec3(1.0) - m.colour.rgb) * (f2 * f2 * f) : m.colour.rgb;
+    return true;
+  }
+  if (kind != kSpecularGlass) return false;
+  if (!(wo.z != 0.0) || any(isinf(wo)) || any(isnan(wo))) return false;
+  float ior = m.iface.x;
+  if (m.iface.y != 0.0) {
+    vec3 r, t;
+    thinSheetReflectanceTransmittance(m, wo.z, r, t);
+    float lr = max(0.0, luminanceOf(r)), lt = max(0.0, luminanceOf(t));
+    if (!(lr + lt > 0.0)) return false;
+    float pR = lr / (lr + lt);
+    if (u < pR) {
+      wi = vec3(-wo.x, -wo.y, wo.z);
+      weight = r / pR;
+    } else {
+      wi = -wo;
+      weight = t / (1.0 - pR);
+    }
+    return true;
+  }
+  float F = fresnelDielectric(wo.z, ior);
+  if (u < F) {
+    wi = vec3(-wo.x, -wo.y, wo.z);
+    weight = vec3(1.0);
+    return true;
+  }
+  float etap = wo.z > 0.0 ? ior : 1.0 / ior;
+  vec3 n = vec3(0.0, 0.0, wo.z > 0.0 ? 1.0 : -1.0);
+  // refractDirection
+  float cosI = dot(n, wo);
+  float sin2T = max(0.0, 1.0 - cosI * cosI) / (etap * etap);
+  if (sin2T >= 1.0) return false;
+  float cosT = sqrt(1.0 - sin2T);
+  wi = -wo / etap + (cosI / etap - cosT) * n;
+  weight = m.colour.rgb / (etap * etap);
+  return true;
+}
+// followSpecular at the hit (t, triangle, uv) of the ray (origin, direction).
+bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv, uint step, uint stepLimit,
+                    out vec3 emitted, out vec3 nextOrigin, out vec3 nextDirection, out vec3 weight) {
+  nextOrigin = vec3(0.0);
+  nextDirection = vec3(0.0);
+  weight = vec3(0.0);
+  vec3 position, geometricNormal, shadingNormal;
+  surfaceAt(triangle, uv, position, geometricNormal, shadingNormal);
+  SpecularMaterial m = specularMaterials[triangleMaterials[triangle]];
+  vec3 wo = -direction;
+  float cosWoGeometric = dot(geometricNormal, wo);
+  vec3 attenuation = vec3(1.0);
+  if (cosWoGeometric < 0.0 && any(notEqual(m.absorption.rgb, vec3(0.0)))) attenuation = exp(-m.absorption.rgb * t);
+  emitted = (cosWoGeometric > 0.0 || m.emission.w != 0.0 ? m.emission.rgb : vec3(0.0)) * attenuation;
+  if (step >= stepLimit) return false;
+  // scatteringFrame: a reflecting model's frame turned to wo's side, glass's never.
+  bool glass = floatBitsToUint(m.colour.w) == kSpecularGlass;
+  bool turn = cosWoGeometric < 0.0 && !glass;
+  vec3 g = turn ? -geometricNormal : geometricNormal;
+  vec3 n = turn ? -shadingNormal : shadingNormal;
+  vec3 s, tt;
+  frameFromNormal(n, s, tt);
+  vec3 woLocal = vec3(dot(wo, s), dot(wo, tt), dot(wo, n));
+  // usableSide for wo, the sample, usableSide for wi.
+  float cosWo = dot(wo, g);
+  if (!(glass ? cosWo * woLocal.z > 0.0 : cosWo > 0.0)) return false;
+  uint64_t hash = specularRayHash(origin, direction);
+  float branchU = float(uint(hash >> 40)) * exp2(-24.0);
+  vec3 wiLocal, sampleWeight;
+  if (!sampleSpecular(m, woLocal, branchU, wiLocal, sampleWeight)) return false;
+  vec3 wi = wiLocal.x * s + wiLocal.y * tt + wiLocal.z * n;
+  float cosWi = dot(wi, g);
+  if (!(glass ? cosWi * wiLocal.z > 0.0 : cosWi > 0.0)) return false;
+  nextOrigin = offsetRayOrigin(position, g, wi);
+  nextDirection = wi;
+  weight = sampleWeight * attenuation;
+  if (step >= kSpecularRouletteStep) {
+    float survival = min(1.0, max(weight.r, max(weight.g, weight.b)));
+    float rouletteU = float(uint((hash >> 16) & 0xffffffUL)) * exp2(-24.0);
+    if (!(rouletteU < survival)) return false;
+    weight /= survival;
+  }
+  return true;
+}
+// The fast renderer's chain (realtime.h step 3) from a camera ray's hit on a specular record.
+vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv, uint mirrorDepth) {
+  vec3 radiance = vec3(0.0), throughput = vec3(1.0);
+  for (uint step = 0u;; ++step) {
+    vec3 emitted, nextOrigin, nextDirection, weight;
+    bool more = followSpecular(origin, direction, t, triangle, uv, step, mirrorDepth, emitted, nextOrigin, nextDirection, weight);
+    radiance += throughput * emitted;
+    if (!more) return radiance;
+    throughput *= weight;
+    origin = nextOrigin;
+    direction = nextDirection;
+    if (!bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, uv))
+      return radiance + throughput * environmentRadiance(direction);
+    uvec4 tri = triangles[triangle];
+    vec3 normalAtHit, shadingNormal;
+    hitNormals(tri, uv, normalAtHit, shadingNormal);
+    uint record = viewedRecord(tri.w, -direction, normalAtHit);
+    if (record == kNoRecord) return radiance;  // inside a closed smooth mesh: nothing seen
+    if (charts[record].info.y != kSpecular) {
+      radiance += throughput * lookupRadiance(tri.w, origin + t * direction, -direction, normalAtHit, shadingNormal);
+#ifdef HIGHLIGHTS
+      radiance += throughput * punctualHighlights(record, triangle, uv, -direction);
+#endif
+      return radiance;
+    }
+  }
+}
+)glsl";
+
+}  // namespace pl
