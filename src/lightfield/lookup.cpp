@@ -260,7 +260,7 @@ MirrorLikeLights::MirrorLikeLights(const LightField& lf, const Accel& accel) : l
   });
   if (!mirrorLike) return;
   LightSampler sampler(lf.scene);
-  if (sampler.emissiveTriangleCount() == 0 && !sampler.hasEnvironment()) return;
+  if (sampler.emissiveTriangleCount() == 0 && !sampler.hasEnvironment() && !sampler.hasSphereLights()) return;
   sampler_.emplace(std::move(sampler));
   shadows_.emplace(lf.scene, accel);
 }
@@ -277,7 +277,7 @@ Rgb MirrorLikeLights::radiance(uint32_t chart, const Ray& ray, const RayHit& hit
   if (!usableSide(wo, scattering.woLocal, scattering.geometricNormal, bsdf)) return Rgb(0.0f);
   uint64_t rays = 0;  // no renderer reports them
   return nextEventEstimate(*sampler_, *shadows_, surface.position, scattering, bsdf, nextEventU(ray, sample),
-                           NextEvent::MisFindableOnly, rays);
+                           NextEvent::MisExceptDelta, rays);
 }
 
 float MirrorLikeLights::emissionWeight(const Ray& ray, const RayHit& hit, const LobeChain& chain) const {
@@ -289,6 +289,16 @@ float MirrorLikeLights::emissionWeight(const Ray& ray, const RayHit& hit, const 
 float MirrorLikeLights::environmentWeight(const Vec3& direction, const LobeChain& chain) const {
   if (!sampler_ || !(chain.pdf > 0.0f) || !sampler_->hasEnvironment()) return 1.0f;
   return powerHeuristic(chain.pdf, sampler_->environmentPdf(direction));
+}
+
+Rgb MirrorLikeLights::sphereEmission(const Ray& ray, float tHit, const LobeChain& chain) const {
+  if (!sampler_ || !(chain.pdf > 0.0f) || !sampler_->hasSphereLights()) return Rgb(0.0f);
+  Ray segment = ray;
+  segment.tMax = tHit;
+  // The lobe's vertex: chain.distance back along the ray (straight passes of thin sheets).
+  const std::optional<LightSampler::SphereCrossing> sphere =
+      sampler_->sphereLightAlong(segment, ray.origin - chain.distance * ray.direction);
+  return sphere ? sphere->radiance * powerHeuristic(chain.pdf, sphere->pdf) : Rgb(0.0f);
 }
 
 Rgb MirrorLikeLights::overcountedEmission(const Ray& ray, const RayHit& hit, const LobeChain& chain) const {

@@ -689,10 +689,14 @@ class PunctualHighlights {
 /// ray), weighted by the power heuristic against the lobe's density, and the emission the
 /// lobe's sampled ray then finds — on an emitter's chart, a mirror-like or mirror chart, or the
 /// sky — is weighted by the power heuristic the other way (emissionWeight,
-/// environmentWeight). The scene's lights (point, spot, directional, sphere), which no
-/// sampled ray finds, are not sampled here: PunctualHighlights adds the delta ones. Inactive
-/// (nothing added, every weight 1) without mirror-like charts or without emissive triangles
-/// and a lit sky.
+/// environmentWeight). Sphere lights, which are no geometry, are sampled here too and found
+/// by the lobe's sampled rays as they pass through them (sphereEmission), the two weighted by
+/// the power heuristic as for the emissive surfaces (the path tracer counts their light sample
+/// in full and no ray finds them, an estimator equal in the mean, but a sharp lobe is then
+/// found by its light samples alone, as fireflies); a sample that chooses a point, spot or
+/// directional light counts 0 (NextEvent::MisExceptDelta): PunctualHighlights adds those.
+/// Inactive (nothing added, every weight 1) without mirror-like charts or without emissive
+/// triangles, a lit sky and sphere lights.
 class MirrorLikeLights {
  public:
   /// lf and accel must outlive it.
@@ -707,6 +711,12 @@ class MirrorLikeLights {
   float emissionWeight(const Ray& ray, const RayHit& hit, const LobeChain& chain) const;
   /// The same for the sky that `direction` (unit) leaves the scene in.
   float environmentWeight(const Vec3& direction, const LobeChain& chain) const;
+  /// The MIS-weighted emission of the sphere light that `ray`, continued along `chain`, enters
+  /// before `tHit` (its hit's distance, kInfinity when it leaves the scene): 0 when chain.pdf
+  /// is 0 (a camera ray or a delta step: the camera and mirrors show no sphere, as in the path
+  /// tracer), else Le times the power heuristic of the lobe's density against the light
+  /// sample's from the lobe's vertex.
+  Rgb sphereEmission(const Ray& ray, float tHit, const LobeChain& chain) const;
   /// The part of the emission a lookup at `hit` counts that next-event estimation at the
   /// chain's mirror-like hit counted already: (1 − emissionWeight) · Le there, towards the
   /// viewer, its emission texture included (0 when chain.pdf is 0 or inactive).

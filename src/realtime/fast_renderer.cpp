@@ -348,6 +348,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const Rgb throughput = s.mirrorThroughput[i];
       const float distance = s.mirrorDistance[i] + hit.t;  // the reference's running sum (render.cpp)
       const LobeChain& chain = s.mirrorChain[i];
+      s.radiance[slot] += throughput * lobeLights_.sphereEmission(ray, hit.hit() ? hit.t : kInfinity, chain);  // render.cpp's order
       if (!hit.hit()) {
         s.radiance[slot] +=
             throughput * lobeLights_.environmentWeight(ray.direction, chain) * backgroundRadiance(scene.environment, ray.direction);

@@ -36,6 +36,7 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, const PunctualHigh
   const Scene& scene = lf.scene;
   Rgb result(0.0f);
   for (uint32_t reflections = firstReflection;; ++reflections) {
+    result += throughput * lobeLights.sphereEmission(ray, hit.hit() ? hit.t : kInfinity, chain);  // after a lobe
     if (!hit.hit())
       return result + throughput * lobeLights.environmentWeight(ray.direction, chain) *
                           backgroundRadiance(scene.environment, ray.direction);
