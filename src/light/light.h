@@ -144,6 +144,8 @@ class LightSampler {
   /// the ray enters none.
   std::optional<SphereCrossing> sphereLightAlong(const Ray& ray, const Vec3& receiver) const;
   bool hasSphereLights() const { return !sphereEntries_.empty(); }
+  /// The emissive triangles' power, Σ π·A·Y(mean Le)·(2 if two-sided) (W, luminance).
+  double emissiveTrianglePower() const { return triangleDistribution_.total(); }
 
   /// A point on the emissive triangles alone, chosen with probability ∝ their power and then
   /// uniformly by area (the bake's area-light shadow rays). Requires emissiveTriangleCount() > 0.
