@@ -234,6 +234,7 @@ def on_white(material):
 
 LIGHT_OFF = {"light": lambert(WHITE)}
 POINT = {"type": "point", "position": [278, 450, 279.6], "intensity": 1.5e5}
+SPHERE = {"type": "sphere", "position": [278, 420, 500], "radius": 30, "intensity": 1.5e5}
 SPOT_NARROW = {"type": "spot", "position": [278, 540, 279.6], "direction": [122, -540, -159.6],
                "intensity": 2e7, "inner_angle": 3, "outer_angle": 6}
 SPOT_WIDE = {"type": "spot", "position": [278, 540, 279.6], "direction": [0, -1, 0],
@@ -298,6 +299,9 @@ CASES = [
     case("point", "a point light (1.5e5 W/sr at y = 450), area light off", LIGHT_OFF, lights=[POINT]),
     case("point-ggx-0.2", "the point light on GGX dielectric roughness 0.2 (issue 31's first row)",
          {**LIGHT_OFF, **on_white(ggx(0.2))}, lights=[POINT]),
+    case("sphere-mirror", "a sphere light (radius 30 mm, 1.5e5 W/sr, 59 mm before the back wall), area light off, "
+         "reflected in the GGX metal ceiling (roughness 0.05), seen there and through the mirror back wall (0.9)",
+         {**LIGHT_OFF, "backWall": {"type": "mirror", "reflectance": 0.9}, "ceiling": ggx(0.05, True)}, lights=[SPHERE]),
     case("spot-narrow", "a narrow spot (3 deg / 6 deg) on the floor, area light off", LIGHT_OFF, lights=[SPOT_NARROW]),
     case("spot-wide", "a wide spot (25 deg / 40 deg) straight down, area light off", LIGHT_OFF, lights=[SPOT_WIDE]),
     case("directional", "a sun (3 W/m^2) through the open front, area light off", LIGHT_OFF, lights=[SUN_FRONT]),

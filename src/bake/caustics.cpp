@@ -1,4 +1,4 @@
-// Caustics: photons from the emissive triangles through specular chains (see caustics.h).
+// Caustics: photons from the emissive triangles and sphere lights through specular chains (see caustics.h).
 #include "bake/caustics.h"
 
 #include <algorithm>
@@ -68,12 +68,13 @@ Rgb fluxWeight(const Scene& scene, const Chart& chart, const Vec3& frontNormal, 
 struct PhotonState {
   uint32_t photon;  ///< index within the block (deposit order)
   Rgb flux;         ///< W
+  bool sphere = false;  ///< from a sphere light
 };
 
 }  // namespace
 
 bool shootsCaustics(const Parameterisation& param, const LightSampler& lights, const BakeSettings& settings) {
-  return settings.causticPhotons > 0 && lights.emissiveTriangleCount() > 0 &&
+  return settings.causticPhotons > 0 && (lights.emissiveTriangleCount() > 0 || lights.hasSphereLights()) &&
          std::any_of(param.charts.begin(), param.charts.end(), [](const Chart& c) { return c.kind == ChartKind::Specular; });
 }
 
@@ -89,7 +90,22 @@ CausticPhotons traceCausticPhotons(const Scene& scene, const Accel& accel, const
   const uint64_t seedHash = mix64(settings.seed ^ 0xca05ca05ca05ca05ULL);
   const uint32_t pointSeed = uint32_t(seedHash), directionSeed = uint32_t(seedHash >> 32);
   const uint32_t shuffleSeed = uint32_t(mix64(seedHash + 1)), sideSeed = uint32_t(mix64(seedHash + 2));
-  const float invPhotons = 1.0f / float(photons);
+  // Sphere lights shoot their share of the photons by power (luminance), after the emissive
+  // triangles' (photon indices trianglePhotons … photons − 1), each sphere chosen ∝ its power.
+  std::vector<const SphereLight*> spheres;
+  std::vector<float> spherePowers;
+  for (const Light& light : scene.lights)
+    if (const auto* sphere = std::get_if<SphereLight>(&light); sphere && sphere->power(0.0f) > 0.0f) {
+      spheres.push_back(sphere);
+      spherePowers.push_back(sphere->power(0.0f));
+    }
+  const Distribution1D sphereChoice(spherePowers);
+  const double trianglePower = lights.emissiveTrianglePower();
+  const uint64_t spherePhotons =
+      spheres.empty() ? 0 : uint64_t(double(photons) * sphereChoice.total() / (sphereChoice.total() + trianglePower) + 0.5);
+  const uint64_t trianglePhotons = photons - spherePhotons;
+  const float invTrianglePhotons = trianglePhotons > 0 ? 1.0f / float(trianglePhotons) : 0.0f;
+  const float invSpherePhotons = spherePhotons > 0 ? 1.0f / float(spherePhotons) : 0.0f;
 
   std::vector<std::vector<std::pair<uint32_t, CausticDeposit>>> blockDeposits(blocks);
   std::atomic<uint64_t> rayCount{0}, landedCount{0};
@@ -107,6 +123,20 @@ CausticPhotons traceCausticPhotons(const Scene& scene, const Accel& accel, const
       const uint32_t shuffled = reverseBits32(owenScrambleReversed(reverseBits32(index), shuffleSeed));
       const Vec2 uDirection(fixedToUnit(scrambledSobol(shuffled, 0, directionSeed)),
                             fixedToUnit(scrambledSobol(shuffled, 1, directionSeed)));
+      if (first + p >= trianglePhotons) {
+        // A sphere light's photon: a point uniform on the sphere (area 4πr²), a cosine-distributed
+        // direction about its outward normal; flux π·Le·4πr²/(P(sphere)·N) = 4π·I/(P(sphere)·N).
+        float remapped = 0.0f;
+        const size_t chosen = sphereChoice.sample(uPoint.x, &remapped);
+        const SphereLight& sphere = *spheres[chosen];
+        const Vec3 normal = sampleUniformSphere(Vec2(remapped, uPoint.y));
+        const Vec3 dir = glm::normalize(Frame::fromNormal(normal).toWorld(sampleCosineHemisphere(uDirection)));
+        const Rgb flux = sphere.intensity * (4.0f * kPi * invSpherePhotons / sphereChoice.probability(chosen));
+        if (isBlack(flux)) continue;
+        rays.push_back(Ray{offsetRayOrigin(sphere.position + sphere.radius * normal, normal, dir), dir, 0.0f, kInfinity});
+        states.push_back({uint32_t(p), flux, true});
+        continue;
+      }
       const EmitterPoint e = lights.sampleEmitterPoint(uPoint);
       if (!e.triangle || !(e.areaPdf > 0.0f)) continue;
       const EmissiveTriangle& tri = *e.triangle;
@@ -116,7 +146,7 @@ CausticPhotons traceCausticPhotons(const Scene& scene, const Accel& accel, const
       const Vec3 dir = glm::normalize(Frame::fromNormal(normal).toWorld(sampleCosineHemisphere(uDirection)));
       const float sideProbability = tri.twoSided ? 0.5f : 1.0f;
       const Rgb flux =
-          tri.Le(glm::dot(dir, tri.normal)) * e.modulation * (kPi * invPhotons / (e.areaPdf * sideProbability));
+          tri.Le(glm::dot(dir, tri.normal)) * e.modulation * (kPi * invTrianglePhotons / (e.areaPdf * sideProbability));
       if (isBlack(flux)) continue;
       rays.push_back(Ray{offsetRayOrigin(e.point, tri.normal, dir), dir, 0.0f, kInfinity});
       states.push_back({uint32_t(p), flux});
@@ -137,13 +167,17 @@ CausticPhotons traceCausticPhotons(const Scene& scene, const Accel& accel, const
             facingChart(param.charts.data(), param.triangleChart[hit.mesh][hit.triangle], -ray.direction, mesh, hit.triangle);
         const Chart& c = param.charts[chartIndex];
         if (c.kind == ChartKind::Specular) {
+          // A sphere light's light reaches a surface through a specular chain in the path
+          // tracer only when the chain's vertex nearest the light is a lobe (next-event
+          // estimation there): through a mirror or glass first it is in neither (caustics.h).
+          if (states[r].sphere && depth == 0 && !isMirrorLikeRecord(c, scene.materials[c.material].bsdf)) continue;
           Rgb emitted, weight;
           Ray next;
           if (!followSpecular(scene, ray, hit, depth, settings.mirrorDepth, emitted, next, weight)) continue;
           const Rgb flux = states[r].flux * fluxWeight(scene, c, triangleNormal(mesh, hit.triangle), ray, next, weight);
           if (isBlack(flux)) continue;
           nextRays.push_back(next);
-          nextStates.push_back({states[r].photon, flux});
+          nextStates.push_back({states[r].photon, flux, states[r].sphere});
           continue;
         }
         // Not specular: direct light at the first hit (shadow rays and gather count it); after

@@ -11,7 +11,10 @@
 // rays and gather (MIS), the sky through chains by the gather, glossy tixels gather emitters
 // through chains themselves, and the scene's lights (point, spot, directional, sphere), which
 // no gather ray finds, reach tixels by shadow rays only (through thin glass) — their light
-// through mirrors and solid glass is not in the light field.
+// through mirrors and solid glass is not in the light field, nor in the path tracer. Sphere
+// lights shoot photons too, but only those whose first hit is a mirror-like lobe count (the
+// path tracer finds that light by next-event estimation at the lobe; they take the photons'
+// share of the spheres' power, after the triangles' photon indices).
 //
 // Photons: N photons (BakeSettings::causticPhotons) from the emissive triangles, by the light
 // sampler (light/light.h sampleEmitterPoint: a triangle ∝ power, a point uniform by area) and a

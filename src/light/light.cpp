@@ -92,6 +92,7 @@ LightSampler::LightSampler(const Scene& scene) : scene_(&scene) {
   for (const Light& light : scene.lights) {
     const float power = lightPower(light, sceneRadius);
     if (!(power > 0.0f)) continue;
+    if (std::holds_alternative<SphereLight>(light)) sphereEntries_.push_back(static_cast<uint32_t>(entries_.size()));
     entries_.push_back({Kind::SceneLight, static_cast<uint32_t>(sceneLights_.size())});
     sceneLights_.push_back(light);
     weights.push_back(selectionWeight(power));
@@ -177,6 +178,7 @@ std::optional<LightSample> LightSampler::sampleEntry(const Entry& entry, float s
       s.incident = in->incident;
       s.pdf = selectProbability * in->pdf;  // a delta light's pdf is 1: the selection alone
       s.nextEventOnly = true;
+      s.delta = isDeltaLight(light);
       s.infinite = isAtInfinity(light);
       s.target = in->target;
       break;
@@ -192,6 +194,24 @@ float LightSampler::emitterPdf(uint32_t mesh, uint32_t triangle, float distance,
   if (entry < 0 || !(cosLight > 0.0f)) return 0.0f;
   const EmissiveTriangle& e = triangles_[entries_[static_cast<size_t>(entry)].index];
   return all_.probability(static_cast<size_t>(entry)) * distance * distance / (cosLight * e.area);
+}
+
+std::optional<LightSampler::SphereCrossing> LightSampler::sphereLightAlong(const Ray& ray, const Vec3& receiver) const {
+  std::optional<SphereCrossing> nearest;
+  float nearestT = ray.tMax;
+  for (const uint32_t entry : sphereEntries_) {
+    const SphereLight& sphere = std::get<SphereLight>(sceneLights_[entries_[entry].index]);
+    // The near root of |o + t·d − c|² = r²: t = b − √(b² − |c − o|² + r²), b = d·(c − o).
+    const Vec3 toCentre = sphere.position - ray.origin;
+    const float b = glm::dot(toCentre, ray.direction), r2 = sphere.radius * sphere.radius;
+    const float discriminant = b * b - (glm::dot(toCentre, toCentre) - r2);
+    if (!(discriminant >= 0.0f)) continue;
+    const float t = b - std::sqrt(discriminant);
+    if (!(t > ray.tMin && t < nearestT)) continue;  // behind, past the hit, or the origin inside it
+    nearestT = t;
+    nearest = SphereCrossing{sphere.intensity / (kPi * r2), all_.probability(entry) * sphere.pdf(receiver, ray.direction)};
+  }
+  return nearest;
 }
 
 float LightSampler::environmentPdf(const Vec3& dir) const {
@@ -216,7 +236,7 @@ float LightSampler::emitterAreaPdf(uint32_t mesh, uint32_t triangle) const {
 Rgb nextEventEstimate(const LightSampler& lights, const ShadowRays& shadows, const Vec3& position,
                       const ScatteringFrame& scattering, const Bsdf& bsdf, Vec2 u, NextEvent mode, uint64_t& rays) {
   const std::optional<LightSample> light = lights.sample(position, u, /*nextEventOnly=*/mode == NextEvent::SceneLightsOnly);
-  if (!light || (mode == NextEvent::MisFindableOnly && light->nextEventOnly)) return Rgb(0.0f);
+  if (!light || (mode == NextEvent::MisExceptDelta && light->delta)) return Rgb(0.0f);
   const Vec3& wi = light->wi;  // towards the light, world space
   const auto& [geometricNormal, frame, woLocal] = scattering;
 
@@ -237,8 +257,10 @@ Rgb nextEventEstimate(const LightSampler& lights, const ShadowRays& shadows, con
   if (isBlack(visible)) return Rgb(0.0f);
 
   const Rgb unweighted = visible * f * cosIn * light->incident / light->pdf;
-  const bool mis = mode == NextEvent::Mis || mode == NextEvent::MisFindableOnly;
-  if (light->nextEventOnly || !mis) return unweighted;
+  const bool mis = mode == NextEvent::Mis || mode == NextEvent::MisExceptDelta;
+  // Scene lights no BSDF-sampled ray finds count in full; sphere lights, which the caller of
+  // MisExceptDelta finds along its BSDF samples, are MIS-weighted as emitters are.
+  if (!mis || (light->nextEventOnly && mode != NextEvent::MisExceptDelta)) return unweighted;
   return unweighted * powerHeuristic(light->pdf, pdf(bsdf, woLocal, wiLocal));
 }
 

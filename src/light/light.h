@@ -92,6 +92,7 @@ struct LightSample {
   /// A scene light (lights.h): no BSDF-sampled ray can find it, so next-event estimation
   /// counts it with full weight (no MIS).
   bool nextEventOnly = false;
+  bool delta = false;  ///< a point, spot or directional light (lights.h isDeltaLight)
   bool infinite = false;  ///< a light at infinity or the environment: the shadow ray is unbounded
   Vec3 target{0.0f};      ///< finite lights: the point the shadow ray ends at
 };
@@ -131,6 +132,21 @@ class LightSampler {
   /// The density sample() has for direction `dir` (unit, towards the sky) on the environment.
   float environmentPdf(const Vec3& dir) const;
 
+  /// A sphere light that `ray` (unit direction) enters between ray.tMin and ray.tMax.
+  struct SphereCrossing {
+    Rgb radiance{0.0f};  ///< its surface radiance Le = I/(π r²)
+    float pdf = 0.0f;    ///< the density sample() has for ray.direction from `receiver`
+  };
+  /// The nearest sphere light along `ray` (sphere lights are no geometry: a caller that
+  /// samples directions at `receiver` and follows them finds them this way), with the density
+  /// sample() has for that direction at `receiver` (the scattering vertex the direction was
+  /// sampled at; ray.origin unless a thin sheet was passed straight on the way). Nullopt when
+  /// the ray enters none.
+  std::optional<SphereCrossing> sphereLightAlong(const Ray& ray, const Vec3& receiver) const;
+  bool hasSphereLights() const { return !sphereEntries_.empty(); }
+  /// The emissive triangles' power, Σ π·A·Y(mean Le)·(2 if two-sided) (W, luminance).
+  double emissiveTrianglePower() const { return triangleDistribution_.total(); }
+
   /// A point on the emissive triangles alone, chosen with probability ∝ their power and then
   /// uniformly by area (the bake's area-light shadow rays). Requires emissiveTriangleCount() > 0.
   EmitterPoint sampleEmitterPoint(Vec2 u) const;
@@ -162,6 +178,7 @@ class LightSampler {
   std::vector<int32_t> entryOfTriangle_;    ///< entry of each global triangle, or −1
   std::vector<float> areaPdf_;  ///< sampleEmitterPoint's area density, per triangles_ entry
   int32_t environmentEntry_ = -1;
+  std::vector<uint32_t> sphereEntries_;  ///< the entries that are sphere lights
 };
 
 // ---- Next-event estimation ---------------------------------------------------------------
@@ -176,10 +193,12 @@ enum class NextEvent : uint8_t {
   /// The scene lights alone, full weight (the BSDF-only strategy: the lights no BSDF-sampled
   /// ray finds).
   SceneLightsOnly,
-  /// The lights BSDF sampling can find (emissive triangles, the environment), MIS-weighted:
-  /// a sample that chooses a scene light counts 0, for a caller that adds those another way
-  /// (the light-field renderers at mirror-like lobes, lightfield/lookup.h MirrorLikeLights).
-  MisFindableOnly,
+  /// Every light but the delta ones, MIS-weighted, sphere lights too (a caller that follows
+  /// the BSDF's sample finds them with LightSampler::sphereLightAlong): a sample that chooses a
+  /// point, spot or directional light counts 0, for a caller that adds those another way (the
+  /// light-field renderers at mirror-like lobes, lightfield/lookup.h MirrorLikeLights and
+  /// PunctualHighlights).
+  MisExceptDelta,
 };
 
 /// One next-event sample at a non-delta scattering vertex `position` (a ScatteringFrame and

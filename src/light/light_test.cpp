@@ -105,6 +105,36 @@ TEST(LightSampler, SampleDensitiesMatchTheLookedUpDensities) {
   EXPECT_EQ(lights.emitterPdf(0, 4, 1.0f, 1.0f), 0.0f);
 }
 
+// A sphere light, no geometry, is found along a ray by sphereLightAlong with the density the
+// sampler gives the same direction (the renderers' MIS at mirror-like lobes relies on it): for
+// every sampled direction towards it, the crossing's density is the sample's, its radiance
+// I/(πr²); a ray that stops short of the sphere, or misses it, finds none.
+TEST(LightSampler, SphereLightsAreFoundAlongRaysWithTheirSampleDensity) {
+  Scene s = mixedLights();
+  s.lights.push_back(createLight("sphere", {{"position", Vec3(0.3f, 1.5f, 0.2f)}, {"radius", 0.25f},
+                                            {"intensity", Rgb(3.0f)}}, "test"));
+  s.finalize();
+  const LightSampler lights(s);
+  ASSERT_TRUE(lights.hasSphereLights());
+  const Vec3 receiver(0.2f, 0.01f, -0.3f);
+  Pcg32 rng(3, 4);
+  int spheres = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const std::optional<LightSample> l = lights.sample(receiver, Vec2(rng.uniform(), rng.uniform()));
+    if (!l || !l->nextEventOnly) continue;
+    if (l->delta) continue;  // the point light
+    ++spheres;
+    const Ray ray{receiver, l->wi, 0.0f, kInfinity};
+    const std::optional<LightSampler::SphereCrossing> crossing = lights.sphereLightAlong(ray, receiver);
+    ASSERT_TRUE(crossing);
+    EXPECT_NEAR(crossing->pdf, l->pdf, 1e-4f * l->pdf);
+    EXPECT_EQ(crossing->radiance, Rgb(3.0f) / (kPi * 0.25f * 0.25f));
+    EXPECT_FALSE(lights.sphereLightAlong(Ray{receiver, l->wi, 0.0f, 0.5f * glm::length(l->target - receiver)}, receiver));
+  }
+  EXPECT_GT(spheres, 50);
+  EXPECT_FALSE(lights.sphereLightAlong(Ray{receiver, Vec3(0.0f, -1.0f, 0.0f), 0.0f, kInfinity}, receiver));
+}
+
 // Irradiance under the corner of a parallel rectangle emitter of radiance Le, w × l at height
 // h: E = π·Le·F with the form factor F = 1/(2π)·[a/√(1+a²)·atan(b/√(1+a²)) +
 // b/√(1+b²)·atan(a/√(1+b²))], a = w/h, b = l/h. The light estimator Σ Le·cos θ/pdf over

@@ -58,18 +58,29 @@ float specularBranchU(const Ray& ray) { return float(specularRayHash(ray) >> 40)
 
 float specularRouletteU(const Ray& ray) { return float((specularRayHash(ray) >> 16) & 0xffffffULL) * 0x1p-24f; }
 
-Vec2 specularLobeU(const Ray& ray) {
-  const uint64_t h = hashCombine(specularRayHash(ray), 0x4c4f4245ULL);
+namespace {
+
+/// Two uniform numbers in [0, 1) from a hash of the ray's bits and `salt`, sample k > 0 of a
+/// split hashed in too (sample 0 keeps the numbers unsplit rays always had).
+Vec2 rayHashU2(const Ray& ray, uint64_t salt, uint32_t sample) {
+  uint64_t h = hashCombine(specularRayHash(ray), salt);
+  if (sample > 0) h = hashCombine(h, sample);
   return Vec2(float(h >> 40) * 0x1p-24f, float((h >> 16) & 0xffffffULL) * 0x1p-24f);
 }
 
-Vec2 nextEventU(const Ray& ray) {
-  const uint64_t h = hashCombine(specularRayHash(ray), 0x4e45454cULL);
-  return Vec2(float(h >> 40) * 0x1p-24f, float((h >> 16) & 0xffffffULL) * 0x1p-24f);
+}  // namespace
+
+Vec2 specularLobeU(const Ray& ray, uint32_t sample) { return rayHashU2(ray, 0x4c4f4245ULL, sample); }
+
+Vec2 nextEventU(const Ray& ray, uint32_t sample) { return rayHashU2(ray, 0x4e45454cULL, sample); }
+
+uint32_t firstHitLobeSamples(const LightField& lf, uint32_t chart) {
+  const Chart& c = lf.charts[chart];
+  return isMirrorLikeRecord(c, lf.scene.materials[c.material].bsdf) ? kFirstHitLobeSamples : 1;
 }
 
 bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint32_t step, uint32_t stepLimit,
-                    Rgb& emitted, Ray& next, Rgb& weight, SpecularStep* sampled) {
+                    Rgb& emitted, Ray& next, Rgb& weight, SpecularStep* sampled, uint32_t lobeSample) {
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
   const Material& material = scene.materials[surface.material];
   const Vec3 wo = -ray.direction;
@@ -88,7 +99,7 @@ bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint3
   // delta lobe's branch, or (a mirror-like lobe, bake/parameterisation.h isMirrorLike) a
   // direction importance-sampled from the lobe, weighted f·cos θ/pdf.
   const bool lobe = !isDelta(bsdf);
-  const std::optional<Scattered> bs = scatter(scattering, bsdf, lobe ? specularLobeU(ray) : Vec2(specularBranchU(ray), 0.5f));
+  const std::optional<Scattered> bs = scatter(scattering, bsdf, lobe ? specularLobeU(ray, lobeSample) : Vec2(specularBranchU(ray), 0.5f));
   if (!bs || (!lobe && !bs->sample.delta)) return false;
   next = Ray{offsetRayOrigin(surface.position, scattering.geometricNormal, bs->wi), bs->wi, 0.0f, kInfinity};
   weight = bs->sample.weight * attenuation;
@@ -191,15 +202,9 @@ Rgb exitantRadiance(const LightField& lf, const RayHit& hit, const Vec3& worldPo
                          mappedNormal, albedo);
 }
 
-namespace {
-
-/// A specular chart record of a glossy model: a mirror-like lobe (bake/parameterisation.h
-/// isMirrorLike), not a mirror or glass.
 bool isMirrorLikeRecord(const Chart& c, const Bsdf& model) {
   return c.kind == ChartKind::Specular && !isDelta(model) && !hasTransmission(model);
 }
-
-}  // namespace
 
 PunctualHighlights::PunctualHighlights(const LightField& lf, const Accel& accel)
     : lf_(lf), glossyCharts_(lf.settings.punctualHighlights) {
@@ -255,12 +260,12 @@ MirrorLikeLights::MirrorLikeLights(const LightField& lf, const Accel& accel) : l
   });
   if (!mirrorLike) return;
   LightSampler sampler(lf.scene);
-  if (sampler.emissiveTriangleCount() == 0 && !sampler.hasEnvironment()) return;
+  if (sampler.emissiveTriangleCount() == 0 && !sampler.hasEnvironment() && !sampler.hasSphereLights()) return;
   sampler_.emplace(std::move(sampler));
   shadows_.emplace(lf.scene, accel);
 }
 
-Rgb MirrorLikeLights::radiance(uint32_t chart, const Ray& ray, const RayHit& hit) const {
+Rgb MirrorLikeLights::radiance(uint32_t chart, const Ray& ray, const RayHit& hit, uint32_t sample) const {
   const Scene& scene = lf_.scene;
   const Chart& c = lf_.charts[chart];
   if (!sampler_ || !isMirrorLikeRecord(c, scene.materials[c.material].bsdf)) return Rgb(0.0f);
@@ -271,8 +276,8 @@ Rgb MirrorLikeLights::radiance(uint32_t chart, const Ray& ray, const RayHit& hit
   const ScatteringFrame scattering = scatteringFrame(surface, wo, bsdf);
   if (!usableSide(wo, scattering.woLocal, scattering.geometricNormal, bsdf)) return Rgb(0.0f);
   uint64_t rays = 0;  // no renderer reports them
-  return nextEventEstimate(*sampler_, *shadows_, surface.position, scattering, bsdf, nextEventU(ray),
-                           NextEvent::MisFindableOnly, rays);
+  return nextEventEstimate(*sampler_, *shadows_, surface.position, scattering, bsdf, nextEventU(ray, sample),
+                           NextEvent::MisExceptDelta, rays);
 }
 
 float MirrorLikeLights::emissionWeight(const Ray& ray, const RayHit& hit, const LobeChain& chain) const {
@@ -284,6 +289,16 @@ float MirrorLikeLights::emissionWeight(const Ray& ray, const RayHit& hit, const 
 float MirrorLikeLights::environmentWeight(const Vec3& direction, const LobeChain& chain) const {
   if (!sampler_ || !(chain.pdf > 0.0f) || !sampler_->hasEnvironment()) return 1.0f;
   return powerHeuristic(chain.pdf, sampler_->environmentPdf(direction));
+}
+
+Rgb MirrorLikeLights::sphereEmission(const Ray& ray, float tHit, const LobeChain& chain) const {
+  if (!sampler_ || !(chain.pdf > 0.0f) || !sampler_->hasSphereLights()) return Rgb(0.0f);
+  Ray segment = ray;
+  segment.tMax = tHit;
+  // The lobe's vertex: chain.distance back along the ray (straight passes of thin sheets).
+  const std::optional<LightSampler::SphereCrossing> sphere =
+      sampler_->sphereLightAlong(segment, ray.origin - chain.distance * ray.direction);
+  return sphere ? sphere->radiance * powerHeuristic(chain.pdf, sphere->pdf) : Rgb(0.0f);
 }
 
 Rgb MirrorLikeLights::overcountedEmission(const Ray& ray, const RayHit& hit, const LobeChain& chain) const {

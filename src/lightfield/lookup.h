@@ -250,9 +250,11 @@ inline float albedoLodAt(const Scene& scene, uint32_t material, uint32_t mesh, u
 /// Returns false when the chain ends here (step limit, roulette, no delta lobe, a direction
 /// on the wrong side of the geometric surface at grazing angles). `sampled`, when given, gets
 /// how `next` was chosen (SpecularStep), for the renderers' MIS at mirror-like lobes.
+/// `lobeSample` k > 0 draws a mirror-like lobe's direction with specularLobeU(ray, k) instead:
+/// the k-th of several independent samples at one hit (firstHitLobeSamples).
 struct SpecularStep;
 bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint32_t step, uint32_t stepLimit,
-                    Rgb& emitted, Ray& next, Rgb& weight, SpecularStep* sampled = nullptr);
+                    Rgb& emitted, Ray& next, Rgb& weight, SpecularStep* sampled = nullptr, uint32_t lobeSample = 0);
 
 /// How one followSpecular step chose its continued ray.
 struct SpecularStep {
@@ -277,6 +279,21 @@ struct LobeChain {
   }
 };
 
+/// A specular chart record of a glossy model: a mirror-like lobe (bake/parameterisation.h
+/// isMirrorLike), not a mirror or glass.
+bool isMirrorLikeRecord(const Chart& c, const Bsdf& model);
+
+/// Splitting at a view ray's first hit when it is a mirror-like lobe. A traced lobe's noise is
+/// that of the path tracer's chains of reflections: rare, bright samples (a sample in one
+/// lobe's tail that finds the lamp's reflection in the next metal surface, and so on down the
+/// chain). At that first hit the renderers take kFirstHitLobeSamples independent lobe samples
+/// (followSpecular's lobeSample k), each with its own light sample (MirrorLikeLights,
+/// nextEventU(ray, k)), each of weight 1/kFirstHitLobeSamples and followed to its chain's end:
+/// the pixels that see such a lobe get that many chains per camera sample, the others none
+/// more (unlike more samples per pixel). 1 elsewhere (mirrors, glass, later hits).
+inline constexpr uint32_t kFirstHitLobeSamples = 8;
+uint32_t firstHitLobeSamples(const LightField& lf, uint32_t chart);
+
 /// The chain step from which followSpecular plays Russian roulette on the branch weight.
 inline constexpr uint32_t kSpecularRouletteStep = 8;
 
@@ -284,16 +301,18 @@ inline constexpr uint32_t kSpecularRouletteStep = 8;
 float specularBranchU(const Ray& ray);
 
 /// The two uniform numbers in [0, 1) with which followSpecular samples a mirror-like lobe for
-/// `ray` (a second hash of its bits: independent of the branch and the roulette).
-Vec2 specularLobeU(const Ray& ray);
+/// `ray` (a second hash of its bits: independent of the branch and the roulette); sample k > 0
+/// of a split (firstHitLobeSamples) hashes k in too.
+Vec2 specularLobeU(const Ray& ray, uint32_t sample = 0);
 
 /// The uniform number in [0, 1) that followSpecular plays its roulette with for `ray`
 /// (other bits of the same hash as specularBranchU: independent of the branch).
 float specularRouletteU(const Ray& ray);
 
 /// The two uniform numbers in [0, 1) of the light sample MirrorLikeLights takes at the hit of
-/// `ray` (a third hash of its bits: independent of the lobe's own sample there).
-Vec2 nextEventU(const Ray& ray);
+/// `ray` (a third hash of its bits: independent of the lobe's own sample there); sample k > 0
+/// of a split hashes k in too.
+Vec2 nextEventU(const Ray& ray, uint32_t sample = 0);
 
 struct SunLights;
 
@@ -670,24 +689,34 @@ class PunctualHighlights {
 /// ray), weighted by the power heuristic against the lobe's density, and the emission the
 /// lobe's sampled ray then finds — on an emitter's chart, a mirror-like or mirror chart, or the
 /// sky — is weighted by the power heuristic the other way (emissionWeight,
-/// environmentWeight). The scene's lights (point, spot, directional, sphere), which no
-/// sampled ray finds, are not sampled here: PunctualHighlights adds the delta ones. Inactive
-/// (nothing added, every weight 1) without mirror-like charts or without emissive triangles
-/// and a lit sky.
+/// environmentWeight). Sphere lights, which are no geometry, are sampled here too and found
+/// by the lobe's sampled rays as they pass through them (sphereEmission), the two weighted by
+/// the power heuristic as for the emissive surfaces (the path tracer counts their light sample
+/// in full and no ray finds them, an estimator equal in the mean, but a sharp lobe is then
+/// found by its light samples alone, as fireflies); a sample that chooses a point, spot or
+/// directional light counts 0 (NextEvent::MisExceptDelta): PunctualHighlights adds those.
+/// Inactive (nothing added, every weight 1) without mirror-like charts or without emissive
+/// triangles, a lit sky and sphere lights.
 class MirrorLikeLights {
  public:
   /// lf and accel must outlive it.
   MirrorLikeLights(const LightField& lf, const Accel& accel);
   bool active() const { return sampler_.has_value(); }
   /// The MIS-weighted light sample at record `chart` (any record of the hit triangle's chart)
-  /// where `ray` hits it at `hit`; 0 unless it is mirror-like.
-  Rgb radiance(uint32_t chart, const Ray& ray, const RayHit& hit) const;
+  /// where `ray` hits it at `hit`; 0 unless it is mirror-like. `sample`: nextEventU's.
+  Rgb radiance(uint32_t chart, const Ray& ray, const RayHit& hit, uint32_t sample = 0) const;
   /// The weight of the emission that `ray`, continued along `chain`, finds at `hit`: the power
   /// heuristic of the lobe's density against the light sampler's for that point of the
   /// emitter (1 when chain.pdf is 0 or inactive).
   float emissionWeight(const Ray& ray, const RayHit& hit, const LobeChain& chain) const;
   /// The same for the sky that `direction` (unit) leaves the scene in.
   float environmentWeight(const Vec3& direction, const LobeChain& chain) const;
+  /// The MIS-weighted emission of the sphere light that `ray`, continued along `chain`, enters
+  /// before `tHit` (its hit's distance, kInfinity when it leaves the scene): 0 when chain.pdf
+  /// is 0 (a camera ray or a delta step: the camera and mirrors show no sphere, as in the path
+  /// tracer), else Le times the power heuristic of the lobe's density against the light
+  /// sample's from the lobe's vertex.
+  Rgb sphereEmission(const Ray& ray, float tHit, const LobeChain& chain) const;
   /// The part of the emission a lookup at `hit` counts that next-event estimation at the
   /// chain's mirror-like hit counted already: (1 − emissionWeight) · Le there, towards the
   /// viewer, its emission texture included (0 when chain.pdf is 0 or inactive).

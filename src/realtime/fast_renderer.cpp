@@ -297,18 +297,27 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
         }
         radiance = f4Rgb(lanes);
       } else {
-        Ray reflected;
-        Rgb reflectance;
-        SpecularStep step;
-        const bool more = followSpecular(scene, ray, hit, 0, mirrorDepth, radiance, reflected, reflectance, &step);
-        if (highlights_.active()) radiance += highlights_.radiance(chart, hit, -ray.direction);  // mirror-like lobes
-        if (lobeLights_.active()) radiance += lobeLights_.radiance(chart, ray, hit);
-        if (more) {
-          s.mirrorRays.push_back(reflected);
-          s.mirrorSlot.push_back(uint32_t(i));
-          s.mirrorThroughput.push_back(reflectance);
-          s.mirrorDistance.push_back(hit.t);
-          s.mirrorChain.push_back(LobeChain{}.after(step, hit.t));
+        // The view ray's first hit: several lobe samples on a mirror-like lobe
+        // (firstHitLobeSamples), in the reference renderer's order of sums (render.cpp).
+        const uint32_t samples = firstHitLobeSamples(lightField_, chart);
+        const float share = 1.0f / float(samples);
+        for (uint32_t k = 0; k < samples; ++k) {
+          Ray reflected;
+          Rgb reflectance, emitted;
+          SpecularStep step;
+          const bool more = followSpecular(scene, ray, hit, 0, mirrorDepth, emitted, reflected, reflectance, &step, k);
+          if (k == 0) {
+            radiance = emitted;
+            if (highlights_.active()) radiance += highlights_.radiance(chart, hit, -ray.direction);  // mirror-like lobes
+          }
+          if (lobeLights_.active()) radiance += share * lobeLights_.radiance(chart, ray, hit, k);
+          if (more) {
+            s.mirrorRays.push_back(reflected);
+            s.mirrorSlot.push_back(uint32_t(i));
+            s.mirrorThroughput.push_back(share * reflectance);
+            s.mirrorDistance.push_back(hit.t);
+            s.mirrorChain.push_back(LobeChain{}.after(step, hit.t));
+          }
         }
       }
     }
@@ -317,7 +326,10 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
     ++i;
   }
   // The samples whose pixels the reflections below complete (one sample per pixel).
-  if (spp == 1) s.reflectedSamples.assign(s.mirrorSlot.begin(), s.mirrorSlot.end());
+  if (spp == 1) {
+    s.reflectedSamples.assign(s.mirrorSlot.begin(), s.mirrorSlot.end());  // a split's rays are adjacent
+    s.reflectedSamples.erase(std::unique(s.reflectedSamples.begin(), s.reflectedSamples.end()), s.reflectedSamples.end());
+  }
 
   // 3. Reflection wavefronts, intersected as packets (a planar mirror keeps them coherent).
   for (uint32_t reflections = 1; !s.mirrorRays.empty(); ++reflections) {
@@ -336,6 +348,7 @@ void FastRenderer::renderTile(const Camera& camera, int spp, uint32_t mirrorDept
       const Rgb throughput = s.mirrorThroughput[i];
       const float distance = s.mirrorDistance[i] + hit.t;  // the reference's running sum (render.cpp)
       const LobeChain& chain = s.mirrorChain[i];
+      s.radiance[slot] += throughput * lobeLights_.sphereEmission(ray, hit.hit() ? hit.t : kInfinity, chain);  // render.cpp's order
       if (!hit.hit()) {
         s.radiance[slot] +=
             throughput * lobeLights_.environmentWeight(ray.direction, chain) * backgroundRadiance(scene.environment, ray.direction);

@@ -39,10 +39,12 @@ Scene metalBox() {
   return scene;
 }
 
-// Measured (48 × 48, draft, 16 samples per pixel vs 256 spp): LF/PT 0.9843, relMSE 0.0409.
-// With the lobe's own samples alone (as before MirrorLikeLights) the lamp's reflections are
-// fireflies: the conformance case of the same box, tests/conformance ggx-m-0.2, had relMSE
-// 0.257 then. Bounds: the ratio within 0.03, relMSE 1.5 × the measured.
+// Measured (48 × 48, draft, 16 samples per pixel vs 256 spp): LF/PT 0.9777, relMSE 0.0201;
+// without the split at the first hit (lookup.h firstHitLobeSamples: one lobe sample there)
+// 0.9843, 0.0409, which the bound fails. With the lobe's own samples alone (as before
+// MirrorLikeLights) the lamp's reflections are fireflies: the conformance case of the same
+// box, tests/conformance ggx-m-0.2, had relMSE 0.257 then. Bounds: the ratio within 0.03,
+// relMSE 1.5 × the measured.
 TEST_F(MirrorLikeLightsTest, LampReflectionsInMirrorLikeMetalMatchThePathTracer) {
   const Scene scene = metalBox();
   const Camera camera(scene.cameras.front(), 48, 48);
@@ -57,10 +59,11 @@ TEST_F(MirrorLikeLightsTest, LampReflectionsInMirrorLikeMetalMatchThePathTracer)
   std::printf("area light in mirror-like GGX metal r 0.2: LF/PT %.4f relMSE %.5f\n", with.meanLuminanceRatio,
               with.relMseAverage);
   EXPECT_NEAR(with.meanLuminanceRatio, 1.0, 0.03);
-  EXPECT_LT(with.relMseAverage, 0.061);
+  EXPECT_LT(with.relMseAverage, 0.030);
 
-  // The fast renderer samples the same lights with the same numbers (one and four samples per
-  // pixel): only the hit points' rounding differs, a missing or doubled term would be above 1e-2.
+  // The fast renderer samples the same lights and splits the same first hits with the same
+  // numbers (one and four samples per pixel): only the hit points' rounding and the order of
+  // sums differ, a missing or doubled term would be above 1e-2.
   for (int spp : {1, 4}) {
     const ImageComparison same = test_support::fastAgainstReferenceRenderer(lf, accel, camera, spp);
     std::printf("fast vs reference renderer, %d spp: relMSE %.3g, mean ratio %.7f\n", spp, same.relMseAverage,

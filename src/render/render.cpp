@@ -25,14 +25,18 @@ namespace {
 /// (`throughput`); the first non-specular chart ends it with the light-field lookup, its
 /// albedo texture read at the level of the ray cone (coneSpread × the chain's length so far,
 /// textureConeSpread). At mirror-like lobes the emitters are sampled too (MirrorLikeLights),
-/// and the emission the lobe's sampled ray finds is weighted against that (`chain`).
+/// and the emission the lobe's sampled ray finds is weighted against that (`chain`). A view
+/// ray's first hit on a mirror-like lobe is split (firstHitLobeSamples): each sample's chain is
+/// this function again from reflection 1 on, `throughput`, `distance` and `chain` the state it
+/// begins with.
 Rgb radianceFromHit(const LightField& lf, const Accel& accel, const PunctualHighlights& highlights,
-                    const MirrorLikeLights& lobeLights, Ray ray, RayHit hit, uint32_t mirrorDepth, float coneSpread) {
+                    const MirrorLikeLights& lobeLights, Ray ray, RayHit hit, uint32_t mirrorDepth, float coneSpread,
+                    Rgb throughput = Rgb(1.0f), float distance = 0.0f, LobeChain chain = {},
+                    uint32_t firstReflection = 0) {
   const Scene& scene = lf.scene;
-  Rgb throughput(1.0f), result(0.0f);
-  float distance = 0.0f;  // along the chain, scene units
-  LobeChain chain;
-  for (uint32_t reflections = 0;; ++reflections) {
+  Rgb result(0.0f);
+  for (uint32_t reflections = firstReflection;; ++reflections) {
+    result += throughput * lobeLights.sphereEmission(ray, hit.hit() ? hit.t : kInfinity, chain);  // after a lobe
     if (!hit.hit())
       return result + throughput * lobeLights.environmentWeight(ray.direction, chain) *
                           backgroundRadiance(scene.environment, ray.direction);
@@ -60,6 +64,24 @@ Rgb radianceFromHit(const LightField& lf, const Accel& accel, const PunctualHigh
     const uint32_t record = lf.triangleChart[hit.mesh][hit.triangle];
     if (highlights.active())  // a mirror-like lobe's (lightfield/lookup.h PunctualHighlights)
       result += throughput * highlights.radiance(record, hit, -ray.direction);
+    const uint32_t samples = reflections == 0 ? firstHitLobeSamples(lf, record) : 1;
+    if (samples > 1) {
+      // The view ray's first hit on a mirror-like lobe: every sample's light sample, then every
+      // sample's chain (the fast renderer's order).
+      const float share = 1.0f / float(samples);
+      for (uint32_t k = 0; k < samples; ++k) result += throughput * (share * lobeLights.radiance(record, ray, hit, k));
+      for (uint32_t k = 0; k < samples; ++k) {
+        Rgb unused;
+        if (k == 0 ? !more
+                   : !followSpecular(scene, ray, hit, reflections, mirrorDepth, unused, reflected, reflectance, &step, k))
+          continue;
+        RayHit next;
+        accel.intersect(reflected, next);
+        result += radianceFromHit(lf, accel, highlights, lobeLights, reflected, next, mirrorDepth, coneSpread,
+                                  throughput * (share * reflectance), distance, chain.after(step, hit.t), reflections + 1);
+      }
+      return result;
+    }
     if (lobeLights.active()) result += throughput * lobeLights.radiance(record, ray, hit);
     if (!more) return result;
     throughput *= reflectance;
