@@ -41,20 +41,16 @@ uint64_t tixelUnder(const Chart& c, const Vec3& p) {
   return c.firstTixel + uint64_t(j) * c.resU + i;
 }
 
-/// The covered area of tixel g (scene units²): at least one footprint sub-sample's (1/16 of
-/// the tixel), so that a walk leaving through a sliver the coverage estimate missed does not
-/// divide by zero.
-float coveredArea(const Parameterisation& param, uint64_t g) {
-  const Chart& c = param.charts[param.tixelChart[g]];
-  return std::max(param.coverage[g], 1.0f / 16.0f) * c.tixelSize * c.tixelSize;
-}
-
 /// The walks entering chart record `ci` (its front record: the outside of the closed mesh),
 /// merged per (entry, exit) pair and truncated per entry tixel (kSubsurfaceDroppedFraction).
+/// Adds the area each walk stands for to its entry tixel's in `surfaceArea` (indexed from
+/// c.firstTixel): the surface area under each tixel, which on a curved chart is larger than
+/// the tixel's square covers in the chart's plane.
 std::vector<Contribution> chartWalks(const Scene& scene, const Accel& accel, const Parameterisation& param, uint32_t ci,
-                                     uint32_t walksPerTixel, uint64_t seed, uint64_t& walks, uint64_t& exited,
-                                     uint64_t& rays, uint64_t& dropped) {
+                                     uint32_t walksPerTixel, uint64_t seed, std::vector<double>& surfaceArea, uint64_t& walks,
+                                     uint64_t& exited, uint64_t& rays, uint64_t& dropped) {
   const Chart& c = param.charts[ci];
+  surfaceArea.assign(c.tixelCount(), 0.0);
   std::vector<Contribution> out;
   const float tixelArea = c.tixelSize * c.tixelSize;
   for (const auto& [mesh, triangle] : param.chartTriangles[ci]) {
@@ -79,6 +75,7 @@ std::vector<Contribution> chartWalks(const Scene& scene, const Accel& accel, con
       const std::optional<SubsurfaceMedium> medium = subsurfaceMedium(bsdf);
       if (!medium) continue;
       ++walks;
+      surfaceArea[tixelUnder(c, entry.position) - c.firstTixel] += share;
       // The light comes from the outside: the winding normal's side (the chart's front).
       const ScatteringFrame frame = scatteringFrame(entry, entry.geometricNormal, bsdf);
       const std::optional<WalkExit> exit =
@@ -147,10 +144,11 @@ SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& acce
 
   // The walks, per chart in parallel, gathered in chart order (deterministic).
   std::vector<std::vector<Contribution>> perChart(charts.size());
+  std::vector<std::vector<double>> areas(charts.size());
   std::vector<uint64_t> walks(charts.size()), exited(charts.size()), rays(charts.size()), dropped(charts.size());
   parallelFor(charts.size(), [&](uint64_t k) {
-    perChart[k] = chartWalks(scene, accel, param, charts[k], std::max(1u, walksPerTixel), seed, walks[k], exited[k],
-                             rays[k], dropped[k]);
+    perChart[k] = chartWalks(scene, accel, param, charts[k], std::max(1u, walksPerTixel), seed, areas[k], walks[k],
+                             exited[k], rays[k], dropped[k]);
   });
   for (size_t k = 0; k < charts.size(); ++k) {
     op.walks += walks[k];
@@ -163,8 +161,19 @@ SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& acce
   const auto rowOf = [&](uint64_t g) {
     return uint64_t(std::lower_bound(op.rowTixel.begin(), op.rowTixel.end(), g) - op.rowTixel.begin());
   };
+  // A_j: the surface area the entry walks found under tixel j; where they found none (a back
+  // record, or a sliver between their points) one footprint sub-sample's share of the tixel,
+  // so that a walk leaving there does not divide by zero.
   op.area.resize(op.rowTixel.size());
-  for (size_t r = 0; r < op.rowTixel.size(); ++r) op.area[r] = coveredArea(param, op.rowTixel[r]);
+  for (size_t r = 0; r < op.rowTixel.size(); ++r) {
+    const Chart& c = param.charts[param.tixelChart[op.rowTixel[r]]];
+    op.area[r] = std::max(param.coverage[op.rowTixel[r]], 1.0f / 16.0f) * c.tixelSize * c.tixelSize;
+  }
+  for (size_t k = 0; k < charts.size(); ++k) {
+    const Chart& c = param.charts[charts[k]];
+    for (uint64_t local = 0; local < c.tixelCount(); ++local)
+      if (areas[k][local] > 0.0) op.area[rowOf(c.firstTixel + local)] = float(areas[k][local]);
+  }
   op.rowStart.assign(op.rowTixel.size() + 1, 0);
   for (const auto& list : perChart)
     for (const Contribution& x : list) ++op.rowStart[rowOf(x.exit) + 1];

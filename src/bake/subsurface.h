@@ -10,8 +10,9 @@
 // path tracer's own (trace/subsurface_walk.h) — entering at points spread area-uniformly over
 // the triangles of every subsurface chart, about `walksPerTixel` per tixel area: a walk
 // entering at a point of tixel i, which stands for the area a = (triangle area / its walks),
-// and leaving at a point of tixel j with weight w adds w·a / A_j to K[j ← i], A_j the covered
-// area of tixel j (coverage × tixel size², at least one footprint sub-sample's). The exitance
+// and leaving at a point of tixel j with weight w adds w·a / A_j to K[j ← i], A_j the surface
+// area under tixel j (the sum of the a of the walks entering there: on a curved chart more
+// than its square in the chart's plane; one footprint sub-sample's where none entered). The exitance
 // of tixel j is then M_j = Σ_i K[j ← i]·E_i, and its radiance M_j / π. The fraction of the
 // light entering tixel i that leaves through tixel j is S[i → j] = K[j ← i]·A_j / A_i; per
 // channel Σ_j S[i → j] ≤ 1 (up to the walks' noise): the light the medium does not absorb.
@@ -41,7 +42,7 @@ struct SubsurfaceOperator {
   std::vector<uint64_t> rowStart;   ///< row r's entries are [rowStart[r], rowStart[r + 1])
   std::vector<uint64_t> entryTixel; ///< per entry: the entry tixel i
   std::vector<Rgb> weight;          ///< per entry: K[j ← i] (exitance per irradiance)
-  std::vector<float> area;          ///< per row: the covered area A_j (scene units²)
+  std::vector<float> area;          ///< per row: the surface area A_j under the tixel (scene units²)
   uint64_t walks = 0, exited = 0;   ///< walks started, walks that left the medium
   uint64_t rays = 0;                ///< rays the walks traced
   uint64_t dropped = 0;             ///< entries dropped by the truncation
