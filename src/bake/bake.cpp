@@ -15,6 +15,7 @@
 #include "bake/parameterisation.h"
 #include "bake/propagation.h"
 #include "bake/shard.h"
+#include "bake/subsurface.h"
 #include "bake/visibility.h"
 #include "distributed/communicator.h"
 
@@ -177,9 +178,10 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
   note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s (first shot {:.2f} s, {} shadow rays)",
                    prop.iterations, prop.residual, prop.seconds, prop.firstShotSeconds, prop.shadowRays));
   if (prop.subsurfaceWalks > 0)
-    note(fmt::format("subsurface: {} walks ({} rays) in {:.2f} s (of the first shot), operator {} entries, {:.1f} MB",
-                     prop.subsurfaceWalks, prop.subsurfaceRays, prop.subsurfaceSeconds, prop.subsurfaceEntries,
-                     prop.subsurfaceBytes / 1e6));
+    note(fmt::format("subsurface: {} tixels, {} walks ({} rays) in {:.2f} s (of the first shot), operator {} entries, "
+                     "{:.1f} MB",
+                     prop.subsurfaceTixels, prop.subsurfaceWalks, prop.subsurfaceRays, prop.subsurfaceSeconds,
+                     prop.subsurfaceEntries, prop.subsurfaceBytes / 1e6));
   if (prop.causticPhotons > 0)
     note(fmt::format("caustics: {} photons, {} reached a diffuse surface through mirrors or glass, {:.2f} s (of the first shot)",
                      prop.causticPhotons, prop.causticPhotonsLanded, prop.causticSeconds));
@@ -289,7 +291,8 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   if (options.checkMemory) {
     // Traced ahead on a sample of the held tixels: how many bytes the field will take.
     const double bytesPerTixel = estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
-    options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel));
+    options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel) +
+                        subsurfaceOperatorBytesEstimate(lf.scene, param, settings.subsurfaceWalks));
   }
 
   // 2. Visibility field and 3. propagation.

@@ -1513,6 +1513,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   const uint64_t bytesBefore = comm.bytesReceived();
   if (ranks > 1 && !state.ops->subsurface.empty()) requireBakeableMaterials(scene, ranks);
   result.subsurfaceSeconds = state.ops->subsurface.seconds;
+  result.subsurfaceTixels = state.ops->subsurface.rowTixel.size();
   result.subsurfaceWalks = state.ops->subsurface.walks;
   result.subsurfaceRays = state.ops->subsurface.rays;
   result.subsurfaceEntries = state.ops->subsurface.entries();

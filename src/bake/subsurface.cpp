@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <variant>
 
 #include "accel/accel.h"
 #include "bake/parameterisation.h"
@@ -83,8 +82,7 @@ std::vector<Contribution> chartWalks(const Scene& scene, const Accel& accel, con
       if (!exit) continue;
       const uint32_t exitChart = param.triangleChart[exit->surface.mesh][exit->surface.triangle];
       const Chart& e = param.charts[exitChart];
-      if (e.kind != ChartKind::Diffuse || !std::holds_alternative<SubsurfaceBsdf>(scene.materials[e.material].bsdf))
-        continue;
+      if (!isSubsurfaceChart(scene, e)) continue;
       ++exited;
       out.push_back({tixelUnder(e, exit->surface.position), tixelUnder(c, entry.position), exit->weight * share});
     }
@@ -128,6 +126,15 @@ std::vector<Contribution> chartWalks(const Scene& scene, const Accel& accel, con
 
 }  // namespace
 
+uint64_t subsurfaceOperatorBytesEstimate(const Scene& scene, const Parameterisation& param, uint32_t walksPerTixel) {
+  uint64_t tixels = 0;
+  for (const Chart& c : param.charts)
+    if (isSubsurfaceChart(scene, c)) tixels += c.tixelCount();
+  constexpr uint64_t kEntryBytes = sizeof(uint64_t) + sizeof(Rgb);
+  return tixels * (uint64_t(std::max(1u, walksPerTixel)) * (sizeof(Contribution) + kEntryBytes) + 3 * sizeof(uint64_t) +
+                   sizeof(float) + sizeof(Rgb));
+}
+
 SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                            uint32_t walksPerTixel, uint64_t seed) {
   const auto start = std::chrono::steady_clock::now();
@@ -135,7 +142,7 @@ SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& acce
   std::vector<uint32_t> charts;
   for (uint32_t ci = 0; ci < param.charts.size(); ++ci) {
     const Chart& c = param.charts[ci];
-    if (c.kind != ChartKind::Diffuse || !std::holds_alternative<SubsurfaceBsdf>(scene.materials[c.material].bsdf)) continue;
+    if (!isSubsurfaceChart(scene, c)) continue;
     for (uint64_t g = c.firstTixel; g < c.firstTixel + c.tixelCount(); ++g) op.rowTixel.push_back(g);
     if (!c.isBack) charts.push_back(ci);  // walks enter from the outside only
   }

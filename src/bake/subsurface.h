@@ -59,6 +59,11 @@ struct SubsurfaceOperator {
 SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                            uint32_t walksPerTixel, uint64_t seed);
 
+/// An upper bound on the bytes buildSubsurfaceOperator allocates for `param` (0 without
+/// subsurface charts): every walk kept as its own entry, and its contribution record alive
+/// beside the compressed rows (what the memory guard, bake.h BakeOptions::checkMemory, adds).
+uint64_t subsurfaceOperatorBytesEstimate(const Scene& scene, const Parameterisation& param, uint32_t walksPerTixel);
+
 /// exitance[r] = Σ K[rowTixel[r] ← i]·irradiance[i] for every row r; `irradiance` by global
 /// tixel index (entries of non-subsurface tixels are never read).
 void applySubsurfaceOperator(const SubsurfaceOperator& op, const std::vector<Rgb>& irradiance, std::vector<Rgb>& exitance);
