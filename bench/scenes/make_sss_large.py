@@ -13,7 +13,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from make_sss_cornell import MTL, WALLS, icosphere  # noqa: E402
+from make_sss_cornell import MTL, WALLS, icosphere, write_obj  # noqa: E402
 
 MARBLE = {"type": "subsurface", "albedo": [0.83, 0.79, 0.75], "radius": [0.2, 0.15, 0.1]}
 
@@ -25,15 +25,8 @@ def main():
     os.makedirs(out, exist_ok=True)
     objects = [(name, quad, [(0, 1, 2), (0, 2, 3)]) for name, quad in WALLS]
     objects.append(("marble", *icosphere((0.0, 0.76, -0.1), 0.75, 5)))
-    lines = ["# Written by bench/scenes/make_sss_large.py", "mtllib sss-large.mtl"]
-    base = 1
-    for name, points, faces in objects:
-        lines += [f"o {name}", f"usemtl {name}"]
-        lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in points]
-        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in faces]
-        base += len(points)
-    with open(os.path.join(out, "sss-large.obj"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    write_obj(os.path.join(out, "sss-large.obj"), ["# Written by bench/scenes/make_sss_large.py", "mtllib sss-large.mtl"],
+              objects)
     with open(os.path.join(out, "sss-large.mtl"), "w") as f:
         for name, body in {**MTL, "marble": "Kd 0.5 0.5 0.5"}.items():
             f.write(f"newmtl {name}\n{body}\n\n")
