@@ -61,7 +61,7 @@ double slabReflectance(double alpha) {
 // on at most what enters it (per channel, up to 4 standard errors of its 1024 walks: ≤ 1.06),
 // and the mean over the top face's interior tixels (more than a tixel, 10 radii, from the
 // edges) is the semi-infinite medium's reflectance within 0.01 (its noise over 16 × 1024 walks
-// is ≤ 0.003; measured 0.2968, 0.5991, 0.7958 against 0.2985, 0.6046, 0.7954), so the slab's
+// is ≤ 0.003; measured 0.2970, 0.5993, 0.7961 against 0.2985, 0.6046, 0.7954), so the slab's
 // albedo.
 TEST_F(SubsurfaceBakeTest, OperatorConservesEnergy) {
   const SubsurfaceBsdf model{Rgb(0.3f, 0.6f, 0.8f), Rgb(0.05f)};
@@ -117,8 +117,8 @@ Rgb tracedUnderside(const Scene& scene, float x, float y, float z, uint64_t key)
 // A thin slab (2 × 0.05 × 2, radius 0.1: half a radius thick) under a sun straight above: its
 // underside, which no light reaches directly, glows with the light that crossed it. In the
 // light field (its bottom chart's radiance at the centre and at four points around it) as in
-// the path tracer within 5 %. Measured: +0.5 % at 1024 walks per tixel area, +1 % at 4096;
-// at 256 walks seeds move it by ±3 % (a bottom tixel sees the walks of a few top tixels only);
+// the path tracer within 5 %. Measured: +0.3 % at 1024 walks per tixel area; at 256 walks the
+// runs tried were 2–3 % off either way (a bottom tixel sees the walks of a few top tixels only);
 // the trace's 2^14 paths per point ≈ 1 %.
 TEST_F(SubsurfaceBakeTest, ThinSlabGlowsOnItsFarSide) {
   const SubsurfaceBsdf model{Rgb(0.8f, 0.6f, 0.9f), Rgb(0.1f)};
