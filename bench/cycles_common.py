@@ -58,7 +58,8 @@ def configure_cycles(scene, out_path, spp, seed, width, height, threads):
     cycles.caustics_refractive = True
     for bounces in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces", "volume_bounces",
                     "transparent_max_bounces"):
-        setattr(cycles, bounces, 1024)
+        # CYCLES_MAX_BOUNCES: a lower limit for a depth-limited comparison (bench/sss_vs_cycles.sh MAX_DEPTH).
+        setattr(cycles, bounces, int(os.environ.get("CYCLES_MAX_BOUNCES", "1024")))
     cycles.min_light_bounces = 0
     cycles.min_transparent_bounces = 0
 

@@ -26,6 +26,13 @@
 # --variance`), Cycles' mean and their ratio (target: within 3 %). WORKDIR/side_by_side.png:
 # plenoptic (left) and Cycles (right), tone-mapped together (`plenoptic tonemap`, Reinhard).
 #
+# MAX_DEPTH=D limits both renderers to D scattering events (plenoptic `--max-depth D`, Cycles
+# max_bounces D − 1: its bounces do not count the first hit); MAX_DEPTH=1 is direct light only,
+# where no path has a diffuse surface before a subsurface one. STANDINS=SCENE also traces SCENE
+# with plenoptic (e.g. bench/scenes/sss-cornell-standins.json: the objects Lambertian of the
+# colours Cycles' SSS nodes get) and adds its column: what Cycles shows wherever it renders the
+# objects as Lambertian.
+#
 # Usage: bench/sss_vs_cycles.sh [PLENOPTIC] [WORKDIR]
 #   PLENOPTIC  default build/plenoptic; WORKDIR default out/sss_vs_cycles
 # Environment: SCENE (default bench/scenes/sss-cornell.json), WIDTH (256), HEIGHT (256),
@@ -47,8 +54,16 @@ mkdir -p "$work"
 echo "Blender: $("$blender" --version 2> /dev/null | head -1); $threads threads; ${width}x${height}; $spp spp" >&2
 
 echo "== plenoptic trace, $spp spp" >&2
+depth=${MAX_DEPTH:--1}
+if [ "$depth" != -1 ]; then export CYCLES_MAX_BOUNCES=$((depth - 1)); fi
 "$plenoptic" --quiet --threads "$threads" --seed 1 trace "$scene" -o "$work/pt.pfm" --variance "$work/pt_var.pfm" \
-  --spp "$spp" --width "$width" --height "$height" --camera main --stats "$work/pt.json"
+  --spp "$spp" --width "$width" --height "$height" --camera main --stats "$work/pt.json" --max-depth "$depth"
+rm -f "$work/standins.pfm"
+if [ -n "${STANDINS:-}" ]; then
+  echo "== plenoptic trace of $STANDINS, $spp spp" >&2
+  "$plenoptic" --quiet --threads "$threads" --seed 1 trace "$STANDINS" -o "$work/standins.pfm" \
+    --spp "$spp" --width "$width" --height "$height" --camera main --max-depth "$depth"
+fi
 echo "== Cycles, $spp spp" >&2
 "$blender" --background --factory-startup --python "$here/sss_vs_cycles_blender.py" -- "$scene" "$work/cy.exr" \
   "$spp" 1 "$width" "$height" "$threads" > "$work/cy.log" 2>&1 || { cat "$work/cy.log" >&2; exit 1; }
@@ -75,6 +90,7 @@ def image(name):
 
 
 pt, var, cy, ids = image("pt"), image("pt_var"), image("cy"), image("cy.ids")
+standins = image("standins") if os.path.exists(os.path.join(work, "standins.pfm")) else None
 colours = json.load(open(os.path.join(work, "cy.ids.json")))
 regions, walls = [], np.zeros(ids.shape[:2], bool)
 for name, colour in sorted(colours.items()):
@@ -89,15 +105,20 @@ stats = json.load(open(os.path.join(work, "pt.json")))
 print(f"Scene {os.path.basename(scene)}, {ids.shape[1]}x{ids.shape[0]}, both renderers {spp} spp "
       f"(plenoptic trace {stats.get('seconds', float('nan')):.1f} s):")
 print()
-print("| region | pixels | plenoptic Y (± s.e.) | Cycles Y | Cycles / plenoptic |")
-print("|---|---:|---:|---:|---:|")
+extra = " plenoptic, stand-ins Y | Cycles / stand-ins |" if standins is not None else ""
+print("| region | pixels | plenoptic Y (± s.e.) | Cycles Y | Cycles / plenoptic |" + extra)
+print("|---|---:|---:|---:|---:|" + ("---:|---:|" if standins is not None else ""))
 for name, mask in regions:
     n = int(mask.sum())
     if n == 0:  # e.g. no walls in the furnace
         continue
     y_pt, y_cy = float((pt[mask] @ weights).mean()), float((cy[mask] @ weights).mean())
     se = float(np.sqrt((var[mask] @ (weights ** 2)).sum()) / n)  # pixels independent
-    print(f"| {name} | {n} | {y_pt:.4f} ± {se:.4f} | {y_cy:.4f} | {y_cy / y_pt:.4f} |")
+    row = f"| {name} | {n} | {y_pt:.4f} ± {se:.4f} | {y_cy:.4f} | {y_cy / y_pt:.4f} |"
+    if standins is not None:
+        y_st = float((standins[mask] @ weights).mean())
+        row += f" {y_st:.4f} | {y_cy / y_st:.4f} |"
+    print(row)
 print()
 print("Y = mean luminance (Rec. 709) of linear radiance over the region's pixels.")
 side = np.concatenate([pt, cy], axis=1).astype("<f4")

@@ -84,6 +84,19 @@ def box(centre, size, degrees):
     return points, faces
 
 
+def write_obj(path, header, objects):
+    """An OBJ of `objects` (name, points, faces; each its own object and material) after `header`."""
+    lines = list(header)
+    base = 1
+    for name, points, faces in objects:
+        lines += [f"o {name}", f"usemtl {name}"]
+        lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in points]
+        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in faces]
+        base += len(points)
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
 def main():
     objects = [(name, quad, [(0, 1, 2), (0, 2, 3)]) for name, quad in WALLS]
     objects.append(("sphere", *icosphere((-0.42, 0.36, 0.25), 0.35, 3)))
@@ -92,16 +105,10 @@ def main():
     # each pixel is one walk's albedo (no transport between objects).
     for stem, kept, extra in (("sss-cornell", objects, {}),
                               ("sss-furnace", objects[-2:], {"environment": {"color": 1}})):
-        lines = ["# Written by bench/scenes/make_sss_cornell.py: McGuire's CornellBox-Original walls",
-                 f"# (public domain) with a subsurface sphere and slab ({stem}.json)", "mtllib sss-cornell.mtl"]
-        base = 1
-        for name, points, faces in kept:
-            lines += [f"o {name}", f"usemtl {name}"]
-            lines += [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in points]
-            lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in faces]
-            base += len(points)
-        with open(os.path.join(HERE, stem + ".obj"), "w") as f:
-            f.write("\n".join(lines) + "\n")
+        write_obj(os.path.join(HERE, stem + ".obj"),
+                  ["# Written by bench/scenes/make_sss_cornell.py: McGuire's CornellBox-Original walls",
+                   f"# (public domain) with a subsurface sphere and slab ({stem}.json)", "mtllib sss-cornell.mtl"],
+                  kept)
         scene = {
             "meshes": [{"file": stem + ".obj"}],
             "materials": SUBSURFACE,

@@ -102,6 +102,9 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
                       "Override the preset: photons shot from emissive surfaces through mirrors and glass onto diffuse "
                       "surfaces (caustics; 0 = none, the gather finds that light; see docs/user-guide.md)")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 32));
+  command->add_option("--subsurface-walks", options->subsurfaceWalks,
+                      "Override the preset: random walks per tixel area that carry light through subsurface objects")
+      ->check(CLI::Range(1u, 65536u));
   command->add_option("--tolerance", options->tolerance,
                       "Override the preset: relative change of total power at which iteration stops")
       ->check(CLI::Range(1e-9f, 1.0f));

@@ -15,6 +15,7 @@
 #include "bake/parameterisation.h"
 #include "bake/propagation.h"
 #include "bake/shard.h"
+#include "bake/subsurface.h"
 #include "bake/visibility.h"
 #include "distributed/communicator.h"
 
@@ -34,6 +35,7 @@ BakeSettings bakePreset(const std::string& name) {
   s.areaLightSamples = preset->areaLightSamples;
   s.tolerance = preset->tolerance;
   s.causticPhotons = preset->causticPhotons;
+  s.subsurfaceWalks = preset->subsurfaceWalks;
   s.maxTixelsPerChartSide = 16384;
   s.maxIterations = 200;
   s.mirrorDepth = 256;
@@ -175,6 +177,11 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
   const PropagationResult& prop = t.propagation;
   note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s (first shot {:.2f} s, {} shadow rays)",
                    prop.iterations, prop.residual, prop.seconds, prop.firstShotSeconds, prop.shadowRays));
+  if (prop.subsurfaceWalks > 0)
+    note(fmt::format("subsurface: {} tixels, {} walks ({} rays) in {:.2f} s (of the first shot), operator {} entries, "
+                     "{:.1f} MB",
+                     prop.subsurfaceTixels, prop.subsurfaceWalks, prop.subsurfaceRays, prop.subsurfaceSeconds,
+                     prop.subsurfaceEntries, prop.subsurfaceBytes / 1e6));
   if (prop.causticPhotons > 0)
     note(fmt::format("caustics: {} photons, {} reached a diffuse surface through mirrors or glass, {:.2f} s (of the first shot)",
                      prop.causticPhotons, prop.causticPhotonsLanded, prop.causticSeconds));
@@ -246,25 +253,26 @@ BakeStats bakeStats(const Parameterisation& param, const Transport& t, const Dis
 
 }  // namespace
 
-void requireBakeableMaterials(const Scene& scene) {
+void requireBakeableMaterials(const Scene& scene, int ranks) {
+  if (ranks <= 1) return;
   std::vector<uint8_t> used(scene.materials.size(), 0);
   for (const Mesh& mesh : scene.meshes)
     for (const uint32_t m : mesh.materials) used[m] = 1;
   for (size_t m = 0; m < scene.materials.size(); ++m)
     if (used[m] && subsurfaceMedium(scene.materials[m].bsdf))
-      fail("{}: material '{}' is subsurface, which the light-field bake does not model (light would leave "
-           "where it entered, not through the object); render the scene with `plenoptic trace`",
-           scene.sourcePath, scene.materials[m].name);
+      fail("{}: material '{}' is subsurface, which a distributed bake ({} ranks) does not support (its light "
+           "crosses the object between the ranks' shares); bake the scene in one process",
+           scene.sourcePath, scene.materials[m].name, ranks);
 }
 
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options) {
-  requireBakeableMaterials(scene);
+  SingleProcess single;
+  Communicator& comm = options.communicator ? *options.communicator : single;
+  requireBakeableMaterials(scene, comm.size());
   const auto start = std::chrono::steady_clock::now();
   const Note note = [&](const std::string& text) {
     if (options.log) options.log(text);
   };
-  SingleProcess single;
-  Communicator& comm = options.communicator ? *options.communicator : single;
   LightField lf;
   lf.scene = std::move(scene);
   lf.settings = settings;
@@ -283,7 +291,8 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   if (options.checkMemory) {
     // Traced ahead on a sample of the held tixels: how many bytes the field will take.
     const double bytesPerTixel = estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
-    options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel));
+    options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel) +
+                        subsurfaceOperatorBytesEstimate(lf.scene, param, settings.subsurfaceWalks));
   }
 
   // 2. Visibility field and 3. propagation.

@@ -31,14 +31,16 @@ struct BakePresetValues {
   /// Photons of the caustic pass (caustics.h), shot only when the scene has an emissive
   /// surface and a mirror or smooth glass.
   uint64_t causticPhotons;
+  /// Random walks per tixel area of the subsurface operator (subsurface.h).
+  uint32_t subsurfaceWalks;
 };
 /// The presets: the one list of their names and values (bakePreset, bakePresetNames, and
 /// through them the jobs, the command line and Python; docs/user-guide.md's table shows it).
 inline constexpr BakePresetValues kBakePresets[] = {
-    // name     across  gather  glossy  area rays  tolerance  caustic photons
-    {"draft",    20.0f,  144,    8,      16,        5e-3f,     uint64_t(1) << 20},
-    {"default",  40.0f,  256,    16,     32,        1e-3f,     uint64_t(1) << 22},
-    {"high",     60.0f,  576,    24,     64,        2e-4f,     uint64_t(1) << 24},
+    // name     across  gather  glossy  area rays  tolerance  caustic photons       subsurface walks
+    {"draft",    20.0f,  144,    8,      16,        5e-3f,     uint64_t(1) << 20,    128},
+    {"default",  40.0f,  256,    16,     32,        1e-3f,     uint64_t(1) << 22,    256},
+    {"high",     60.0f,  576,    24,     64,        2e-4f,     uint64_t(1) << 24,    1024},
 };
 
 /// The settings of a named preset; throws pl::Error listing the names for an unknown one.
@@ -106,11 +108,11 @@ uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings
 /// evenly, but what they see varies from chart to chart.
 inline constexpr double kVisibilityEstimateMargin = 1.15;
 
-/// Throws pl::Error naming the file and the material when a triangle of the scene has a
-/// material the bake does not model: subsurface scattering (bsdf.h SubsurfaceBsdf), whose light
-/// leaves the object away from where it entered — only the path tracer renders it. bake()
-/// calls it first, before any ray is traced or anything written.
-void requireBakeableMaterials(const Scene& scene);
+/// Throws pl::Error naming the file and the material when a bake over `ranks` processes cannot
+/// bake the scene's materials: a distributed bake (ranks > 1) of a scene with a subsurface
+/// material (bsdf.h SubsurfaceBsdf), whose operator (subsurface.h) joins tixels of every rank's
+/// share and is not exchanged. bake() calls it first, before any ray is traced or anything written.
+void requireBakeableMaterials(const Scene& scene, int ranks);
 
 /// Bakes `scene` (moved into the result). Throws pl::Error on failures, among them a scene
 /// requireBakeableMaterials refuses.

@@ -91,6 +91,23 @@ TEST_F(BakeCli, CausticPhotonsAreABakeOption) {
   EXPECT_FALSE(fs::exists(path("x.plf")));
 }
 
+// A subsurface scene bakes (the bake says what its operator took), --subsurface-walks N
+// overrides the preset's walks per tixel area (recorded in the bake settings), and values
+// outside [1, 65536] are refused before anything is written.
+TEST_F(BakeCli, BakesSubsurfaceScenesWithSubsurfaceWalks) {
+  std::string out, err;
+  const std::string scene = std::string(PLENOPTIC_TEST_DATA_DIR) + "/../../bench/scenes/sss-cornell.json";
+  const std::string common = "bake \"" + scene + "\" --preset draft --tixels-across 8 --directions 16 -o \"";
+  ASSERT_EQ(run(common + path("preset.plf") + "\" --quiet", &out, &err), 0) << err;
+  EXPECT_EQ(readLightField(path("preset.plf")).settings.subsurfaceWalks, 128u);
+  ASSERT_EQ(run(common + path("n.plf") + "\" --subsurface-walks 8", &out, &err), 0) << err;
+  EXPECT_NE(err.find("subsurface: "), std::string::npos) << err;
+  EXPECT_EQ(readLightField(path("n.plf")).settings.subsurfaceWalks, 8u);
+  EXPECT_EQ(run(common + path("x.plf") + "\" --subsurface-walks 0", &out, &err), 2);
+  EXPECT_NE(err.find("--subsurface-walks"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("x.plf")));
+}
+
 // --glossy-res N caps the glossy maps at N² texels instead of the preset's (recorded in the
 // bake settings); values outside [2, 256] are refused before anything is written.
 TEST_F(BakeCli, GlossyResOverridesThePresetsCap) {

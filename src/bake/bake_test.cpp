@@ -130,21 +130,6 @@ TEST_F(BakeTest, WhiteFurnaceWithAreaLightSampling) {
   checkFurnace(0.9f, 16, 0.05f);
 }
 
-// The bake does not model subsurface scattering: a scene using it is refused before any ray
-// is traced, naming the file, the material and the path tracer that renders it. An unused
-// subsurface material does not matter.
-TEST_F(BakeTest, RefusesSubsurfaceMaterials) {
-  Material wall;
-  wall.name = "wall";
-  wall.emission = Rgb(0.1f);
-  Material marble;
-  marble.name = "marble";
-  marble.bsdf = SubsurfaceBsdf{Rgb(0.8f), Rgb(0.2f)};
-  expectError([&] { bake(makeClosedBox(3.0f, wall, marble, 2), smallSettings()); },
-              {"furnace box", "'marble'", "subsurface", "plenoptic trace"});
-  EXPECT_NO_THROW(requireBakeableMaterials(makeClosedBox(3.0f, wall, marble)));
-}
-
 TEST_F(BakeTest, MirrorFurnace) {
   // One wall is an ideal mirror of reflectance 1: it shows the uniform furnace field, so the
   // diffuse walls still converge to Le/(1−a). Exercises the mirror chains of the visibility

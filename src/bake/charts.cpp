@@ -257,8 +257,9 @@ Chart frameChart(const Scene& scene, const TriangleList& list, bool grewCurved, 
   c.diffuseValue = c.kind == ChartKind::Glossy && !isBlack(diffuseAlbedo(bsdf));
   // A normal-mapped diffuse material, or glossy one with a diffuse part, keeps irradiances
   // about tilted normals (lightfield.h "Normal-mapped diffuse charts").
-  c.directionalIrradiance =
-      (c.kind == ChartKind::Diffuse || c.diffuseValue) && scene.materials[c.material].normalTexture >= 0;
+  // (Not a subsurface chart: its light leaves at the boundary diffusely, whatever the normal.)
+  c.directionalIrradiance = (c.kind == ChartKind::Diffuse || c.diffuseValue) &&
+                            scene.materials[c.material].normalTexture >= 0 && !isSubsurfaceChart(scene, c);
   const double nLen = glm::length(normalSum);
   const Vec3 n = nLen > 0.0 ? Vec3(normalSum / nLen) : Vec3(0.0f, 0.0f, 1.0f);
   c.normal = n;

@@ -541,7 +541,9 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       p.gatherPoint[g] = point;
       if (c.curved) p.gatherNormal[g] = normal;
       if (c.directionalIrradiance) p.transportTiltWeights[g] = transportTiltWeights(c, normal, mappedNormals.data(), inside);
-      if (c.kind == ChartKind::Diffuse && !p.sunMaskLights.empty())
+      if (isSubsurfaceChart(scene, c) && !p.sunMaskLights.empty())
+        p.sunMask[g].fill(SunMask(0));  // the first shot's shadow rays take the masked lights
+      else if (c.kind == ChartKind::Diffuse && !p.sunMaskLights.empty())
         p.sunMask[g] = tixelSunMasks(scene, accel, c, r, local, i, j, point, normal, p.sunMaskLights);
 
       if (emitterTextured && !r.tris.empty()) {
@@ -599,7 +601,7 @@ void recomputeSunMasks(const Scene& scene, const Accel& accel, Parameterisation&
   const std::vector<uint32_t> light{p.sunMaskLights[slot]};
   parallelFor(p.charts.size(), [&](uint64_t ci) {
     const Chart& c = p.charts[ci];
-    if (c.kind != ChartKind::Diffuse) return;
+    if (c.kind != ChartKind::Diffuse || isSubsurfaceChart(scene, c)) return;  // (their masks stay empty)
     const ChartRaster r = rasteriseChart(scene, c, p.chartTriangles[ci]);
     // What fillChartTixels did: each tixel's masks at its gather point and normal, then the
     // wholly buried tixels' from their nearest unburied neighbour (the same breadth-first order).

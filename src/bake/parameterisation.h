@@ -75,6 +75,7 @@
 #include <cstdint>
 #include <utility>
 #include <array>
+#include <variant>
 #include <vector>
 
 namespace pl {
@@ -143,6 +144,14 @@ struct Parameterisation {
 inline bool texturedEmitter(const Scene& scene, const Chart& c) {
   const Material& m = scene.materials[c.material];
   return m.emissionTexture >= 0 && m.isEmissive();
+}
+
+/// Whether chart c is a subsurface chart (bake/subsurface.h): a diffuse chart of a subsurface
+/// material (bsdf.h SubsurfaceBsdf), whose light leaves through the object's other tixels. Its
+/// stored value is M/ρ̄ (lightfield.h "What is stored per chart kind"), it keeps no tilted
+/// irradiances, and its sun masks are empty: the masked lights' light goes through the object.
+inline bool isSubsurfaceChart(const Scene& scene, const Chart& c) {
+  return c.kind == ChartKind::Diffuse && std::holds_alternative<SubsurfaceBsdf>(scene.materials[c.material].bsdf);
 }
 
 /// Whether chart c's tixels keep their own lobe f0 (Parameterisation::specularF0): a glossy

@@ -11,8 +11,10 @@
 #include <variant>
 
 #include "accel/accel.h"
+#include "bake/bake.h"
 #include "bake/caustics.h"
 #include "bake/shard.h"
+#include "bake/subsurface.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/timing.h"
@@ -475,6 +477,12 @@ struct TransportState::Operators {
   /// jitter sub-cell j at [k·kGatherJitterSide² + j] — its share of each tilted irradiance in
   /// the gather frame, π/n · max(0, b_i·ω)/cos θ · tiltFactor.
   std::vector<std::vector<std::array<Rgb, kTiltedNormals>>> tiltShares;
+  /// Subsurface charts (subsurface.h; all empty when there is none): the operator, per chart
+  /// whether it is one, and per tixel the irradiance a subsurface tixel gathered at its last
+  /// update (its own value is the operator's product of these: applySubsurface).
+  SubsurfaceOperator subsurface;
+  std::vector<uint8_t> subsurfaceChart;
+  std::vector<Rgb> subsurfaceIrradiance;
 };
 
 namespace {
@@ -675,6 +683,12 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
     punctualGlossy.assign(param.valueCount, Rgb(0.0f));
   change.assign(tixels, 0.0f);
   batchStart = propagationBatches(param);
+  ops->subsurface = buildSubsurfaceOperator(scene, accel, param, settings.subsurfaceWalks, settings.seed);
+  if (!ops->subsurface.empty()) {
+    ops->subsurfaceChart.resize(param.charts.size());
+    for (size_t ci = 0; ci < param.charts.size(); ++ci) ops->subsurfaceChart[ci] = isSubsurfaceChart(scene, param.charts[ci]);
+    ops->subsurfaceIrradiance.assign(tixels, Rgb(0.0f));
+  }
   ops->tiltShares.resize(scene.materials.size());
   for (const Chart& c : param.charts) {
     std::vector<std::array<Rgb, kTiltedNormals>>& shares = ops->tiltShares[c.material];
@@ -832,7 +846,8 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         const Light& light = sceneLights[li];
         // A masked light on a diffuse tixel: its footprint's mean visibility, no ray
         // (lightfield.h "Sun masks"; sunMaskedIrradiance, which the bake takes back out).
-        if (maskSlot[li] >= 0 && c.kind == ChartKind::Diffuse) {
+        // (Not on a subsurface chart, whose light goes through the object: shadow rays.)
+        if (maskSlot[li] >= 0 && c.kind == ChartKind::Diffuse && !isSubsurfaceChart(scene, c)) {
           const Rgb masked = sunMaskedIrradiance(param, light, g, size_t(maskSlot[li]));
           direct[valueBase(g, c)] += masked;
           if (c.directionalIrradiance)
@@ -1088,9 +1103,45 @@ void finishFirstShot(TransportState& state) {
   state.ops->glassFirstShot->addTransmission(state.param, state.ops->glossy, state.direct);
 }
 
+namespace {
+
+/// Subsurface charts (subsurface.h): every subsurface tixel j's value from the irradiance the
+/// subsurface tixels gathered at their last update, M_j = Σ_i K[j ← i]·E_i, stored as M_j / ρ̄_j
+/// (0 in a channel where the transport albedo ρ̄_j is 0) so that its transport quad, ρ̄·value/π,
+/// and the renderers' albedo·value/π show M_j/π; with its change. The transport of the
+/// subsurface charts is refreshed when `refresh` (beginIteration refreshes every tixel's).
+void applySubsurface(TransportState& state, bool refresh) {
+  TransportState::Operators& ops = *state.ops;
+  if (ops.subsurface.empty()) return;
+  const Parameterisation& param = state.param;
+  std::vector<Rgb> exitance;
+  applySubsurfaceOperator(ops.subsurface, ops.subsurfaceIrradiance, exitance);
+  parallelForRange(exitance.size(), 1024, [&](uint64_t r0, uint64_t r1) {
+    for (uint64_t r = r0; r < r1; ++r) {
+      const uint64_t g = ops.subsurface.rowTixel[r];
+      const Chart& c = param.charts[param.tixelChart[g]];
+      const Rgb albedo = param.transportAlbedo[g];
+      Rgb& value = state.current[valueBase(g, c)];
+      const Rgb before = value;
+      for (int k = 0; k < 3; ++k) value[k] = albedo[k] > 0.0f ? exitance[r][k] / albedo[k] : 0.0f;
+      state.change[g] = exitanceChange(state, &before, &value, g, c);
+    }
+  });
+  if (!refresh) return;
+  for (size_t ci = 0; ci < param.charts.size(); ++ci)
+    if (ops.subsurfaceChart[ci])
+      updateTransport(state, param.charts[ci].firstTixel, param.charts[ci].firstTixel + param.charts[ci].tixelCount());
+}
+
+}  // namespace
+
 void beginIteration(TransportState& state) {
   requireFiniteValues(state.scene, state.param, state.direct, "in the first shot (direct light)");
   state.current = state.direct;
+  // Subsurface tixels: what leaves them of the first shot's light entering the object.
+  for (const uint64_t g : state.ops->subsurface.rowTixel)
+    state.ops->subsurfaceIrradiance[g] = state.direct[valueBase(g, state.param.charts[state.param.tixelChart[g]])];
+  applySubsurface(state, false);
   state.ops->quads.assign(state.param.tixelCount + 1, TransportQuad{});
   updateTransport(state, 0, state.param.tixelCount);
 }
@@ -1160,7 +1211,7 @@ Rgb slowPathRadiance(const TransportState& state, VisibilityEntry e, const Visib
 
 void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t begin, uint64_t end, float omega) {
   const Parameterisation& param = state.param;
-  const TransportState::Operators& ops = *state.ops;
+  TransportState::Operators& ops = *state.ops;
   const std::vector<GlossyMaterial>& glossy = ops.glossy;
   const uint32_t n = state.n;
   const std::vector<Rgb>& direct = state.direct;
@@ -1184,7 +1235,10 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
                          : gatherTixel<false>(entries, n, ops.quads.data(), ops.quads.size(), extras, nullptr, slowPath);
       const uint64_t vb = valueBase(g, c);
       auto relax = [&](const Rgb& before, const Rgb& update) { return glm::max(Rgb(0.0f), before + omega * (update - before)); };
-      if (c.kind == ChartKind::Diffuse) {
+      if (c.kind == ChartKind::Diffuse && !ops.subsurfaceChart.empty() && ops.subsurfaceChart[param.tixelChart[g]]) {
+        // A subsurface tixel: its irradiance enters the object (applySubsurface, after the batches).
+        ops.subsurfaceIrradiance[g] = direct[vb] + f4Rgb(sum) * (kPi / float(n));
+      } else if (c.kind == ChartKind::Diffuse) {
         const Rgb before = current[vb];
         current[vb] = relax(before, direct[vb] + f4Rgb(sum) * (kPi / float(n)));
         if (c.directionalIrradiance) {
@@ -1392,6 +1446,9 @@ void iterateOnce(TransportState& state, const VisibilityShard& vis, const ShardP
     }
     result.repeatedSeconds += secondsSince(repeatedStart);
   }
+  // Subsurface tixels: the light that entered them this iteration leaves through the object.
+  // (One process only: propagate refuses a distributed bake of subsurface charts.)
+  applySubsurface(state, true);
 }
 
 /// The iteration, from the first shot to convergence (StoppingRule) or maxIterations.
@@ -1454,6 +1511,13 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
          plan.ranks, plan.batches(), ranks, state.batchStart.size() - 1);
   ValueExchange exchange(param, plan, comm);
   const uint64_t bytesBefore = comm.bytesReceived();
+  if (ranks > 1 && !state.ops->subsurface.empty()) requireBakeableMaterials(scene, ranks);
+  result.subsurfaceSeconds = state.ops->subsurface.seconds;
+  result.subsurfaceTixels = state.ops->subsurface.rowTixel.size();
+  result.subsurfaceWalks = state.ops->subsurface.walks;
+  result.subsurfaceRays = state.ops->subsurface.rays;
+  result.subsurfaceEntries = state.ops->subsurface.entries();
+  result.subsurfaceBytes = state.ops->subsurface.bytes();
 
   double waitSeconds = 0.0;
   const VisibilityShard& vis = shootFirstShot(state, plan, rank, visibility, exchange, waitSeconds);

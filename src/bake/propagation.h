@@ -72,6 +72,10 @@ struct PropagationResult {
   double repeatedSeconds = 0.0;
   uint64_t causticPhotons = 0, causticPhotonsLanded = 0;  ///< the caustic pass's (caustics.h)
   double causticSeconds = 0.0;                            ///< of firstShotSeconds
+  /// The subsurface operator (subsurface.h; all 0 without subsurface charts): its build time
+  /// (of firstShotSeconds), tixels, walks, their rays, its entries and bytes.
+  double subsurfaceSeconds = 0.0;
+  uint64_t subsurfaceTixels = 0, subsurfaceWalks = 0, subsurfaceRays = 0, subsurfaceEntries = 0, subsurfaceBytes = 0;
 };
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,

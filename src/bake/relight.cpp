@@ -99,6 +99,11 @@ struct Relighter::Impl {
 
   Impl(const LightField& lf, VisibilitySource source, std::optional<Parameterisation> given, Note note)
       : log(std::move(note)), scene(lf.scene), settings(lf.settings), stats(lf.stats) {
+    for (const Chart& c : lf.charts)
+      if (isSubsurfaceChart(lf.scene, c))
+        fail("{}: cannot relight: material '{}' is subsurface, whose light the relighting does not carry through "
+             "the object; re-bake the edited scene: {}",
+             lf.scene.sourcePath, lf.scene.materials[c.material].name, rebakeCommand(lf.scene, lf.settings));
     const auto start = std::chrono::steady_clock::now();
     scene.finalize();  // a copied scene lacks the vertex padding the BVH shares (scene.h)
     accel = std::make_unique<Accel>(scene);

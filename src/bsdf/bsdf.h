@@ -253,7 +253,7 @@ GltfPbrBsdf gltfPbrFromInputs(const GltfPbrInputs& in);
 /// As a BSDF — eval/pdf/sample, what anything without a random walk sees — it is Lambertian of
 /// albedo A, the reflectance the mapping gives a thick slab (where light leaves close to where
 /// it entered); the path tracer replaces it by the walk through the medium (trace.h), and the
-/// light-field bake refuses it (bake.h requireBakeableMaterials).
+/// light-field bake by an operator between tixels built from the same walk (bake/subsurface.h).
 struct SubsurfaceBsdf {
   Rgb albedo{0.8f};  ///< A in [0, 1): the multiple-scattering albedo of a thick slab
   Rgb radius{1.0f};  ///< d > 0 (scene units): the distance light travels inside, per channel

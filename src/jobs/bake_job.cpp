@@ -86,6 +86,7 @@ BakeSettings BakeJob::settings() const {
   settings.sunMasks = options_.sunMasks;
   settings.punctualHighlights = options_.punctualHighlights;
   if (options_.causticPhotons >= 0) settings.causticPhotons = uint64_t(options_.causticPhotons);
+  if (options_.subsurfaceWalks > 0) settings.subsurfaceWalks = options_.subsurfaceWalks;
   if (options_.tolerance > 0.0f) settings.tolerance = options_.tolerance;
   settings.seed = options_.seed;
   return settings;

@@ -161,6 +161,7 @@ struct BakeJobOptions {
   bool sunMasks = true;  ///< BakeSettings::sunMasks (`--sun-masks`)
   bool punctualHighlights = true;  ///< BakeSettings::punctualHighlights (`--punctual-highlights`)
   int64_t causticPhotons = -1;  ///< BakeSettings::causticPhotons (`--caustic-photons`); −1 = the preset's, 0 = no caustic pass
+  uint32_t subsurfaceWalks = 0;  ///< BakeSettings::subsurfaceWalks (`--subsurface-walks`); 0 = the preset's
   bool reuseVisibility = false;
   /// The most memory the bake may plan to use (`--max-memory`, parseMemorySize): the memory
   /// guard refuses a bake whose estimate exceeds it, as one that exceeds the available memory;

@@ -27,6 +27,7 @@ void fields(Settings& s, Visit&& visit) {
   visit("sun_masks", s.sunMasks);
   visit("punctual_highlights", s.punctualHighlights);
   visit("caustic_photons", s.causticPhotons);
+  visit("subsurface_walks", s.subsurfaceWalks);
 }
 
 template <typename Stats, typename Visit>

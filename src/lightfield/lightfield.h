@@ -30,6 +30,11 @@
 //             Le + albedo(uv)·E/π, with the albedo texture read by the renderers at the mip
 //             level of the view ray's cone (lookup.h albedoTextureLod; the bake's transport
 //             albedo is a full-resolution average over each tixel's footprint).
+//             A subsurface chart (bake/subsurface.h) is a diffuse chart whose light enters
+//             the object and leaves elsewhere: it stores M/ρ̄, M the exitance (W·m⁻²) the
+//             subsurface operator sends out of the tixel and ρ̄ its transport albedo, so that
+//             the same formula shows M/π (the albedo texture modulating it about ρ̄); its
+//             sun masks are empty (the masked lights' light went through the object).
 //   Glossy    dirRes² values per tixel: exitant radiance Lo (W·sr⁻¹·m⁻², emission included).
 //             When the material has a diffuse part (diffuseValue: Blinn-Phong's or GGX's base
 //             with a non-black diffuse albedo) the maps hold only the rest (the specular lobe
@@ -235,6 +240,9 @@ struct BakeSettings {
   /// mirrors and glass onto diffuse tixels, whose gather then leaves that light out; 0 = none
   /// (the gather finds it, as in files written before them). `bake --caustic-photons N`.
   uint64_t causticPhotons = 0;
+  /// Subsurface charts (bake/subsurface.h): random walks per tixel area that estimate the
+  /// operator carrying light through subsurface objects. Older files: the default (unused).
+  uint32_t subsurfaceWalks = 256;
 };
 
 struct BakeStats {

@@ -14,7 +14,7 @@
 //
 // Subsurface scattering (bsdf.h SubsurfaceBsdf). A path meeting a subsurface material enters
 // it — cosine-distributed about the inward normal, weight 1: the boundary is diffuse and
-// index-matched — and random-walks through the homogeneous medium (subsurfaceWalk below) until
+// index-matched — and random-walks through the homogeneous medium (trace/subsurface_walk.h) until
 // it meets the mesh again. There it leaves as from a Lambertian surface of albedo 1: next-event
 // estimation and the next direction are those of LambertBsdf{1} at the exit point, and the walk
 // with its entry and exit counts as one scattering event (one depth). Light arriving at the
@@ -43,6 +43,7 @@
 #include "core/sampling.h"
 #include "light/light.h"
 #include "scene/scene.h"
+#include "trace/subsurface_walk.h"
 #include "trace/trace.h"
 
 namespace pl {
@@ -82,30 +83,12 @@ uint32_t bounceDimension(int depth, BounceDimension which) {
   return kFirstBounceDimension + kDimensionsPerBounce * uint32_t(depth) + which;
 }
 
-/// A random walk (subsurfaceWalk) takes at most kMaxWalkSteps scattering events; a walk that
-/// has not left by then is absorbed. Its throughput is then below α^kMaxWalkSteps ≤ 0.011 for
-/// the largest α the mapping gives (A → 1: α = 1 − e^−6.8), and walks that long are rare (in a
-/// half-space the chance of leaving after n steps falls as n^−3/2): what is lost is below 1e-5
-/// of the light. It bounds the work of a walk whose throughput stays high, and fixes the walk's
-/// sampler dimensions: walk step k at path depth d draws from walkDimension(d, k), a block of
-/// kDimensionsPerWalkStep per step (step 0: the entry direction), far above the bounces' own.
-constexpr uint32_t kMaxWalkSteps = 4096;
-constexpr uint32_t kDimensionsPerWalkStep = 5;
+/// A random walk (trace/subsurface_walk.h) at path depth d draws from walkDimension(d), a block
+/// of kWalkDimensions per depth far above the bounces' own.
 constexpr uint32_t kFirstWalkDimension = 1u << 24;
-enum WalkDimension : uint32_t { kWalkChannel = 0, kWalkDistance = 1, kWalkDirection = 2, kWalkRoulette = 4 };
-uint32_t walkDimension(int depth, uint32_t step, WalkDimension which) {
-  return kFirstWalkDimension + (uint32_t(depth) * (kMaxWalkSteps + 1) + step) * kDimensionsPerWalkStep + which;
-}
-static_assert(uint64_t(kFirstWalkDimension) + uint64_t(kSafetyDepth + 1) * (kMaxWalkSteps + 1) * kDimensionsPerWalkStep <
-                  (uint64_t(1) << 32),
+uint32_t walkDimension(int depth) { return kFirstWalkDimension + uint32_t(uint64_t(depth) * kWalkDimensions); }
+static_assert(uint64_t(kFirstWalkDimension) + uint64_t(kSafetyDepth + 1) * kWalkDimensions < (uint64_t(1) << 32),
               "walk dimensions fit in 32 bits");
-
-/// Where a random walk left the medium.
-struct WalkExit {
-  SurfaceHit surface;  ///< the exit point on the mesh
-  Vec3 direction;      ///< the walk's last direction (it crosses the surface outwards)
-  Rgb weight;          ///< the walk's throughput, entry to exit
-};
 
 /// Running sums of one pixel's samples in double precision.
 struct PixelAccumulator {
@@ -153,9 +136,6 @@ struct PathTracer::Impl {
 
   Rgb directLight(const ScatteringFrame& scattering, const Vec3& position, const Bsdf& bsdf,
                   const TraceSettings& settings, int depth, Sampler& sampler, Counters& counters) const;
-  std::optional<WalkExit> subsurfaceWalk(const Vec3& position, const ScatteringFrame& entry,
-                                         const SubsurfaceMedium& medium, const Rgb& throughput, int depth,
-                                         Sampler& sampler, Counters& counters) const;
   Rgb radiance(Ray ray, Sampler& sampler, const TraceSettings& settings, Counters& counters) const;
   void tracePixel(const Camera& camera, const ZSobolLayout& layout, const TraceSettings& settings, int x, int y,
                   PixelAccumulator& acc, Counters& counters) const;
@@ -171,93 +151,6 @@ Rgb PathTracer::Impl::directLight(const ScatteringFrame& scattering, const Vec3&
                          : settings.strategy == TraceStrategy::BsdfOnly ? NextEvent::SceneLightsOnly
                                                                         : NextEvent::LightOnly;
   return nextEventEstimate(lights, shadows, position, scattering, bsdf, u, mode, counters.rays);
-}
-
-// A random walk through a subsurface medium, from an entry point at `position` (its frame
-// turned to the outside, where the path came from) to the point where it leaves the mesh.
-//
-// Hero channel with spectral MIS (the one-sample balance heuristic over the channels, as in
-// Cycles; Wilkie et al. 2014, "Hero Wavelength Spectral Sampling"): one path serves all three
-// channels, whose media differ, instead of a walk per channel that would split the path. At each
-// step a channel c is chosen with probability p_c ∝ the path's throughput in it (β · walk weight)
-// and a free-flight distance t drawn from σt_c e^(−σt_c t). The distance's density is then the
-// mixture p(t) = Σ_j p_j σt_j e^(−σt_j t), and channel k's weight is multiplied by
-//   α_k σt_k e^(−σt_k t) / p(t)                          at a scattering event (t before the
-//                                                        boundary: σs = α σt, then the phase),
-//   e^(−σt_k t_b) / Σ_j p_j e^(−σt_j t_b)                 when the boundary comes first at t_b
-// (the probability of flying past t_b in channel k over the mixture's). Each channel's estimate
-// is unbiased whichever channel was drawn, and none is drawn where it carries nothing.
-// The phase function is isotropic: a uniform direction on the sphere, weight 1.
-//
-// Only surfaces of subsurface materials bound the medium: the walk passes through any other
-// surface inside the mesh (as Cycles' walk sees only its own object). Russian roulette inside:
-// once the path's throughput has fallen below 1, a step continues with probability √(max
-// channel) (as the path's own roulette, without its 0.95 cap, which would end the long walks of
-// high albedos for no loss of theirs); see kMaxWalkSteps for the cap on steps.
-std::optional<WalkExit> PathTracer::Impl::subsurfaceWalk(const Vec3& position, const ScatteringFrame& entry,
-                                                         const SubsurfaceMedium& medium, const Rgb& throughput,
-                                                         int depth, Sampler& sampler, Counters& counters) const {
-  sampler.setDimension(walkDimension(depth, 0, kWalkDirection));
-  const Vec3 local = sampleCosineHemisphere(sampler.get2D());
-  Vec3 direction = entry.frame.toWorld(Vec3(local.x, local.y, -local.z));
-  if (!(glm::dot(direction, entry.geometricNormal) < 0.0f)) return std::nullopt;  // grazing, or a bent normal
-  Vec3 origin = offsetRayOrigin(position, entry.geometricNormal, direction);
-  Rgb weight(1.0f);
-  for (uint32_t step = 1; step <= kMaxWalkSteps; ++step) {
-    // Channel choice ∝ the path's throughput in each channel.
-    const Rgb carried = throughput * weight;
-    const float total = carried.r + carried.g + carried.b;
-    if (!(total > 0.0f) || !std::isfinite(total)) return std::nullopt;
-    const Rgb channelPdf = carried / total;
-    sampler.setDimension(walkDimension(depth, step, kWalkChannel));
-    const float uChannel = sampler.get1D() * total;
-    const int channel = uChannel < carried.r ? 0 : uChannel < carried.r + carried.g ? 1 : 2;
-    sampler.setDimension(walkDimension(depth, step, kWalkDistance));
-    const float distance = -std::log1p(-sampler.get1D()) / medium.sigmaT[channel];
-
-    // The boundary within that distance: the first subsurface surface (others are passed).
-    Ray ray{origin, direction, 0.0f, distance};
-    float travelled = 0.0f;
-    std::optional<RayHit> boundary;
-    for (;;) {
-      RayHit hit;
-      ++counters.rays;
-      if (!accel.intersect(ray, hit)) break;
-      const uint32_t material = scene.meshes[hit.mesh].materials[hit.triangle];
-      if (subsurfaceMedium(scene.materials[material].bsdf)) {
-        hit.t += travelled;
-        boundary = hit;
-        break;
-      }
-      const SurfaceHit passed = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
-      ray.origin = offsetRayOrigin(passed.position, passed.geometricNormal, direction);
-      travelled += hit.t;
-      ray.tMax = distance - travelled;
-      if (!(ray.tMax > 0.0f)) break;
-    }
-
-    if (boundary) {
-      const Rgb transmittance = glm::exp(-medium.sigmaT * boundary->t);
-      weight *= transmittance / glm::dot(channelPdf, transmittance);
-      if (!isFinite(weight)) return std::nullopt;
-      return WalkExit{surfaceAt(scene, boundary->mesh, boundary->triangle, boundary->barycentrics), direction, weight};
-    }
-    const Rgb density = medium.sigmaT * glm::exp(-medium.sigmaT * distance);
-    weight *= medium.alpha * density / glm::dot(channelPdf, density);
-    if (!isFinite(weight)) return std::nullopt;
-    origin += distance * direction;
-    sampler.setDimension(walkDimension(depth, step, kWalkDirection));
-    direction = sampleUniformSphere(sampler.get2D());
-
-    const float carriedMax = maxComponent(throughput * weight);
-    if (carriedMax < 1.0f) {
-      const float q = std::sqrt(carriedMax);
-      sampler.setDimension(walkDimension(depth, step, kWalkRoulette));
-      if (!(sampler.get1D() < q)) return std::nullopt;
-      weight /= q;
-    }
-  }
-  return std::nullopt;
 }
 
 Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& settings, Counters& counters) const {
@@ -327,7 +220,7 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
       // Through the medium to where the walk leaves it; the exit point then scatters as a
       // white Lambertian on the mesh's outside (the side the walk's last direction points to).
       const std::optional<WalkExit> exit =
-          subsurfaceWalk(position, scattering, *medium, throughput, depth, sampler, counters);
+          subsurfaceWalk(scene, accel, position, scattering, *medium, throughput, sampler, walkDimension(depth), counters.rays);
       if (!exit) break;
       throughput *= exit->weight;
       bsdf = LambertBsdf{Rgb(1.0f)};
