@@ -72,6 +72,15 @@ struct BakeOptions {
   std::string visibilityPath;
   /// Reuse visibilityPath when it exists and its hash matches this scene and settings.
   bool reuseVisibility = false;
+  /// Resume from the scratch files that an interrupted bake left beside visibilityPath
+  /// (resume.h: the partial field, the propagation checkpoint) when they match this bake;
+  /// false: trace and propagate afresh (`bake --fresh`). Nothing is saved or resumed without
+  /// a visibilityPath.
+  bool resume = true;
+  /// Remove the propagation checkpoint when the bake returns (false: the caller removes it
+  /// with removePropagationCheckpoint once it has written the light field, so that a bake
+  /// killed while writing it resumes at once).
+  bool removeCheckpoint = true;
   /// Receives one-line notes for the user (reuse decisions, rates). May be empty.
   std::function<void(const std::string&)> log;
   /// Called once the parameterisation is known, before the visibility field and the values
@@ -111,6 +120,10 @@ inline constexpr double kVisibilityEstimateMargin = 1.15;
 /// leaves the object away from where it entered — only the path tracer renders it. bake()
 /// calls it first, before any ray is traced or anything written.
 void requireBakeableMaterials(const Scene& scene);
+
+/// Removes the propagation checkpoint (resume.h) of a bake with these options (every rank's
+/// own, for a distributed bake), if there is one.
+void removePropagationCheckpoint(const BakeOptions& options);
 
 /// Bakes `scene` (moved into the result). Throws pl::Error on failures, among them a scene
 /// requireBakeableMaterials refuses.

@@ -27,6 +27,7 @@
 namespace pl {
 
 class Accel;
+class VisibilityJournal;
 
 /// Tixels [begin, end) (global tixel indices).
 struct TixelRange {
@@ -122,9 +123,11 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 /// Traces the tixels of `ranges` only (sorted, disjoint), stored one range after another: a
 /// rank's shard, whose hash is visibilityShardHash. Every tixel's entries are the same as in
 /// the whole field (a tixel's rays depend only on the tixel, the seed and the scene).
+/// With a journal (resume.h), the blocks it restores are not traced again, and every block
+/// traced is appended to it as it finishes; field.rays counts the rays traced in this call.
 VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                        const BakeSettings& settings, const std::vector<TixelRange>& ranges,
-                                       bool showProgress = true);
+                                       bool showProgress = true, VisibilityJournal* journal = nullptr);
 
 /// Rays a visibility memory estimate traces (estimateVisibilityBytesPerTixel): a few
 /// hundredths of a second, against the minutes of a field that needs an estimate.
