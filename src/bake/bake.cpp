@@ -132,6 +132,18 @@ struct Transport {
   PropagationResult propagation;
 };
 
+/// What the propagation may spend on holding the visibility field decoded, 8 bytes per entry
+/// (VisibilityShard::holdDecoded: the gather then skips decoding each tixel in every
+/// iteration): a quarter of the memory available beyond the bake's estimate, and no more than
+/// maxMemory leaves beside the estimate. The memory guard's estimate stays the compact field's.
+uint64_t decodedFieldBudget(uint64_t estimate, const BakeOptions& options) {
+  const std::optional<uint64_t> available = availableMemoryBytes();
+  if (!available || *available <= estimate) return 0;
+  uint64_t budget = (*available - estimate) / 4;
+  if (options.maxMemory > 0) budget = std::min(budget, options.maxMemory > estimate ? options.maxMemory - estimate : 0);
+  return budget;
+}
+
 /// The checkpoint of an interrupted propagation of this bake (resume.h), read into `checkpoint`
 /// with this rank's field when both match it and every rank has them at the same iteration
 /// (collective: every rank calls it). Says why not when a checkpoint was there.
@@ -172,7 +184,8 @@ bool resumableCheckpoint(const std::string& visibilityPath, uint64_t shardHash, 
 /// an interrupted bake resumes (resume.h), from a checkpoint before anything else.
 Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const BakeSettings& settings, const BakeOptions& options, Communicator& comm,
-                            const ShardPlan& plan, const std::vector<TixelRange>& held, uint64_t hash, const Note& note) {
+                            const ShardPlan& plan, const std::vector<TixelRange>& held, uint64_t hash, uint64_t decodedBudget,
+                            const Note& note) {
   const std::string visibilityPath = shardVisibilityPath(options.visibilityPath, comm.rank(), comm.size());
   const uint64_t shardHash = visibilityShardHash(hash, held, param.tixelCount);
   Transport t;
@@ -193,6 +206,7 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
       if (resumableCheckpoint(visibilityPath, shardHash, key, param, held, comm, checkpoint, t.visibility, note)) {
         resume.from = &checkpoint;
         t.reused = true;
+        t.visibility.holdDecoded(decodedBudget);
       }
     } else {
       std::error_code ec;
@@ -210,6 +224,7 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
                      f.seconds > 0 ? f.rays / f.seconds * 1e-6 : 0.0, f.bytes() / 1e6));
     if (!visibilityPath.empty()) writeVisibility(visibilityPath, f);
     if (journal) journal->finish();
+    t.visibility.holdDecoded(decodedBudget);
   };
   if (resume.from) {
     t.propagation = propagate(scene, accel, param, [&]() -> const VisibilityShard& { return t.visibility; }, settings,
@@ -221,7 +236,10 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
       const auto readStart = std::chrono::steady_clock::now();
       VisibilityField field;
       const bool ok = readVisibility(visibilityPath, shardHash, field, &why, param.tixelCount);
-      if (ok) t.visibility = VisibilityShard::of(std::move(field), held);
+      if (ok) {
+        t.visibility = VisibilityShard::of(std::move(field), held);
+        t.visibility.holdDecoded(decodedBudget);
+      }
       readSeconds = secondsSince(readStart);
       return ok;
     });
@@ -358,14 +376,14 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   noteParameterisation(note, param, setupSeconds, tixelSetup, comm.size());
   const ShardPlan plan = planShards(lf.scene, param, settings, comm.size());
   const RankShare share = rankShare(lf.scene, param, plan, comm.rank(), note);
-  if (options.checkMemory) {
-    // Traced ahead on a sample of the held tixels: how many bytes the field will take.
-    const double bytesPerTixel = estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
-    options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel));
-  }
+  // Traced ahead on a sample of the held tixels: how many bytes the field will take.
+  const double bytesPerTixel = estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
+  const uint64_t estimate = bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel);
+  if (options.checkMemory) options.checkMemory(estimate);
 
   // 2. Visibility field and 3. propagation.
-  Transport transport = traceAndPropagate(lf.scene, accel, param, settings, options, comm, plan, share.held, hash, note);
+  Transport transport = traceAndPropagate(lf.scene, accel, param, settings, options, comm, plan, share.held, hash,
+                                          decodedFieldBudget(estimate, options), note);
   DistributedBakeStats distributed =
       gatherDistributedStats(comm, plan, share, setupSeconds, tixelSetup, transport, note);
 

@@ -87,6 +87,10 @@ struct BakeOptions {
   /// are allocated, with bakeMemoryEstimate() of this bake; may throw to refuse it (the
   /// command line calls requireMemory, core/memory.h). May be empty.
   std::function<void(uint64_t bytes)> checkMemory;
+  /// The most memory the bake may plan to use (`--max-memory`; 0 = the available memory
+  /// alone): bounds, beside the estimate, what the propagation may spend on holding the
+  /// visibility field decoded (VisibilityShard::holdDecoded; checkMemory does the refusing).
+  uint64_t maxMemory = 0;
   /// The ranks of a distributed bake (distributed/communicator.h); null = one process. Every
   /// rank calls bake() with the same scene and settings (refused otherwise, before any ray is
   /// traced); each traces and saves its shard of the visibility field (visibilityPath becomes

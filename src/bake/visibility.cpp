@@ -206,6 +206,19 @@ VisibilityShard VisibilityShard::of(VisibilityField field, std::vector<TixelRang
   return shard;
 }
 
+bool VisibilityShard::holdDecoded(uint64_t budget) {
+  const uint64_t bytes = field.entryCount() * sizeof(VisibilityEntry);
+  if (!decoded.empty()) return true;
+  if (field.tixelCount == 0 || bytes > budget) return false;
+  const uint32_t n = field.directionsPerTixel();
+  std::vector<VisibilityEntry> all(field.entryCount());
+  parallelForRange(field.tixelCount, 256, [&](uint64_t t0, uint64_t t1) {
+    for (uint64_t t = t0; t < t1; ++t) field.decode(t, all.data() + t * n);
+  });
+  decoded = FieldArray<VisibilityEntry>(std::move(all));
+  return true;
+}
+
 bool VisibilityShard::holds(uint64_t begin, uint64_t end) const {
   if (begin >= end) return true;
   for (const TixelRange& r : ranges) {

@@ -44,6 +44,10 @@ struct VisibilityShard {
   VisibilityField field;
   std::vector<TixelRange> ranges;
   std::vector<uint64_t> localStart;  ///< per range: field index of its first tixel
+  /// Every held tixel's entries decoded (8 bytes each, in field order), when the bake can
+  /// afford them (holdDecoded): the gather then reads them instead of decoding each tixel in
+  /// every iteration. Empty: decoded on the fly.
+  FieldArray<VisibilityEntry> decoded;
 
   /// The whole field as a shard of one range (shares the storage).
   static VisibilityShard whole(const VisibilityField& field);
@@ -61,11 +65,16 @@ struct VisibilityShard {
     }
     return localStart[lo] + (g - ranges[lo].begin);
   }
-  /// Tixel g's N entries, decoded into `scratch` (room for N), which it returns.
+  /// Tixel g's N entries: decoded into `scratch` (room for N), which it returns, or where
+  /// `decoded` holds them.
   const VisibilityEntry* entries(uint64_t g, VisibilityEntry* scratch) const {
+    if (!decoded.empty()) return decoded.data() + local(g) * field.directionsPerTixel();
     field.decode(local(g), scratch);
     return scratch;
   }
+  /// Decodes every entry into `decoded` (in parallel) when they take at most `budget` bytes
+  /// (8 per entry); returns whether it did. The entries are the same either way.
+  bool holdDecoded(uint64_t budget);
   /// Tixel g's first extra record.
   const VisibilityExtra* extras(uint64_t g) const { return field.extras.data() + field.extraOffset[local(g)]; }
 };

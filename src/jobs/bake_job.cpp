@@ -139,6 +139,7 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
     requireMemory(bytes, "bake (visibility field and light-field values)",
                   "lower --preset, --tixels-across or --directions", limit);
   };
+  bakeOptions.maxMemory = options_.maxMemory;
   bakeOptions.communicator = options_.communicator;
   DistributedBakeStats distributed;
   bakeOptions.distributedStats = &distributed;
