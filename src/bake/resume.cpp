@@ -17,7 +17,6 @@
 #include "core/file_io.h"
 #include "core/hash.h"
 #include "lightfield/lightfield.h"
-#include "plf/codec_backends.h"
 #include "plf/plf_file.h"
 
 namespace pl {
@@ -26,9 +25,11 @@ namespace {
 constexpr char kJournalMagic[8] = {'P', 'L', 'V', 'P', 'A', 'R', 'T', '\n'};
 constexpr uint32_t kJournalVersion = 1;
 constexpr size_t kJournalHeaderBytes = 48;
-constexpr size_t kRecordHeaderBytes = 32;
-/// zstd level of the journal's records: the fastest, as they are written while tracing.
-constexpr int kJournalZstdLevel = 1;
+constexpr size_t kRecordHeaderBytes = 24;
+/// Records are written in batches of about this many bytes (one `write` each): a killed bake
+/// loses at most one batch besides the blocks in flight, and the tracing threads do not meet
+/// in a system call per block.
+constexpr size_t kJournalWriteBytes = size_t(1) << 20;
 
 constexpr char kCheckpointMagic[8] = {'P', 'L', 'P', 'C', 'K', 'P', 'T', '\n'};
 constexpr uint32_t kCheckpointVersion = 1;
@@ -127,7 +128,14 @@ VisibilityJournal::VisibilityJournal(std::string path, bool resume, std::functio
     : path_(std::move(path)), resume_(resume), log_(std::move(log)), stopAfter_(testStopAfter("PLENOPTIC_TEST_STOP_AFTER_BLOCKS")) {}
 
 VisibilityJournal::~VisibilityJournal() {
-  if (fd_ >= 0) ::close(fd_);
+  // Unwinding (an error, Ctrl-C in Python): what is pending is saved too, if it can be.
+  if (fd_ >= 0) {
+    try {
+      writeAll(fd_, pending_, path_);
+    } catch (const Error&) {
+    }
+    ::close(fd_);
+  }
 }
 
 std::vector<uint8_t> VisibilityJournal::open(uint64_t hash, uint32_t gridSide, const std::vector<uint64_t>& blockTixels,
@@ -157,21 +165,12 @@ std::vector<uint8_t> VisibilityJournal::open(uint64_t hash, uint32_t gridSide, c
                        path_));
     } else {
       size_t at = kJournalHeaderBytes;
-      std::vector<unsigned char> content;
       while (bytes.size() - at >= kRecordHeaderBytes) {
-        const uint64_t block = getValue<uint64_t>(bytes, at), stored = getValue<uint64_t>(bytes, at + 8),
-                       contentBytes = getValue<uint64_t>(bytes, at + 16), check = getValue<uint64_t>(bytes, at + 24);
-        if (block >= blockTixels.size() || stored > bytes.size() - at - kRecordHeaderBytes ||
-            contentBytes > (uint64_t(1) << 32))
-          break;
-        const std::span<const unsigned char> frame = bytes.subspan(at + kRecordHeaderBytes, stored);
-        if (xxh64(frame.data(), frame.size(), xxh64(bytes.data() + at, 24)) != check) break;
-        content.resize(contentBytes);
-        try {
-          detail::zstdDecompressInto(frame, content, path_);
-        } catch (const Error&) {
-          break;
-        }
+        const uint64_t block = getValue<uint64_t>(bytes, at), contentBytes = getValue<uint64_t>(bytes, at + 8),
+                       check = getValue<uint64_t>(bytes, at + 16);
+        if (block >= blockTixels.size() || contentBytes > bytes.size() - at - kRecordHeaderBytes) break;
+        const std::span<const unsigned char> content = bytes.subspan(at + kRecordHeaderBytes, contentBytes);
+        if (xxh64(content.data(), content.size(), xxh64(bytes.data() + at, 16)) != check) break;
         if (!done[block]) {
           if (!restoreBlock(content, blockTixels[block], firstTixel[block], n, targetTixels, runs[block], extras[block]))
             break;
@@ -179,7 +178,7 @@ std::vector<uint8_t> VisibilityJournal::open(uint64_t hash, uint32_t gridSide, c
           ++restoredBlocks_;
           restoredTixels_ += blockTixels[block];
         }
-        at += kRecordHeaderBytes + stored;
+        at += kRecordHeaderBytes + contentBytes;
       }
       validBytes = at;
       std::string dropped;
@@ -205,29 +204,36 @@ std::vector<uint8_t> VisibilityJournal::open(uint64_t hash, uint32_t gridSide, c
 }
 
 void VisibilityJournal::append(uint64_t block, const EncodedRun& run, const BlockExtras& extras) {
-  std::vector<unsigned char> content;
-  content.reserve(8 + extras.size() * (8 + sizeof(VisibilityExtra)) + run.tixelBytes.size() * 4 + run.bytes.size());
-  putValue(content, uint64_t(extras.size()));
-  for (const auto& [entry, extra] : extras) {
-    putValue(content, entry);
-    putValue(content, extra);
-  }
-  put(content, run.tixelBytes.data(), run.tixelBytes.size() * sizeof(uint32_t));
-  put(content, run.bytes.data(), run.bytes.size());
-  const std::vector<unsigned char> frame = detail::zstdCompress(content, kJournalZstdLevel);
+  // The record: its header (the checksum patched in last), then the block's content.
   std::vector<unsigned char> record;
-  record.reserve(kRecordHeaderBytes + frame.size());
+  record.reserve(kRecordHeaderBytes + 8 + extras.size() * (8 + sizeof(VisibilityExtra)) + run.tixelBytes.size() * 4 +
+                 run.bytes.size());
   putValue(record, block);
-  putValue(record, uint64_t(frame.size()));
-  putValue(record, uint64_t(content.size()));
-  putValue(record, xxh64(frame.data(), frame.size(), xxh64(record.data(), 24)));
-  put(record, frame.data(), frame.size());
+  putValue(record, uint64_t(0));  // the content's size, below
+  putValue(record, uint64_t(0));  // the checksum, below
+  putValue(record, uint64_t(extras.size()));
+  for (const auto& [entry, extra] : extras) {
+    putValue(record, entry);
+    putValue(record, extra);
+  }
+  put(record, run.tixelBytes.data(), run.tixelBytes.size() * sizeof(uint32_t));
+  put(record, run.bytes.data(), run.bytes.size());
+  const uint64_t contentBytes = record.size() - kRecordHeaderBytes;
+  std::memcpy(record.data() + 8, &contentBytes, 8);
+  const uint64_t check = xxh64(record.data() + kRecordHeaderBytes, contentBytes, xxh64(record.data(), 16));
+  std::memcpy(record.data() + 16, &check, 8);
   const std::lock_guard lock(mutex_);
-  writeAll(fd_, record, path_);
-  if (stopAfter_ > 0 && ++appended_ == stopAfter_) std::_Exit(kExitFailure);  // the test hook: "killed" here
+  pending_.insert(pending_.end(), record.begin(), record.end());
+  const bool stop = stopAfter_ > 0 && ++appended_ == stopAfter_;
+  if (pending_.size() >= kJournalWriteBytes || stop) {
+    writeAll(fd_, pending_, path_);
+    pending_.clear();
+  }
+  if (stop) std::_Exit(kExitFailure);  // the test hook: "killed" here, with K blocks saved
 }
 
 void VisibilityJournal::finish() {
+  pending_.clear();
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
   std::error_code ec;

@@ -3,10 +3,11 @@
 // files beside the visibility field X.plv keep a long bake's work while it runs:
 //
 //   X.plv.partial     the visibility field as it is traced: a journal of finished blocks, each
-//                     its own checksummed record appended as the block finishes, so that a
-//                     bake killed while tracing loses only the blocks in flight (a torn or
-//                     corrupt tail is detected by its checksum and dropped). Removed once the
-//                     complete X.plv is written.
+//                     its own checksummed record, appended as the blocks finish (a MiB of
+//                     records per write), so that a bake killed while tracing loses only the
+//                     blocks in flight and the last unwritten MiB (a torn or corrupt tail is
+//                     detected by its checksum and dropped). Removed once the complete X.plv
+//                     is written.
 //   X.plv.checkpoint  the propagation's state after its last finished iteration (the first
 //                     shot and the iterate), replaced atomically after every iteration, so a
 //                     bake killed while propagating resumes at the next iteration. Removed
@@ -22,11 +23,12 @@
 // Journal layout (little-endian):
 //   header   magic "PLVPART\n", u32 kJournalVersion, u32 gridSide, u64 field hash, u64 block
 //            count, u64 XXH64 of the blocks' tixel counts, u64 XXH64 of the 40 bytes before it
-//   records  until the end of the file, in the order the blocks finished:
-//            u64 block, u64 stored bytes S, u64 content bytes, u64 XXH64 of the 24 bytes before
-//            it and the S bytes after it; then S bytes, a zstd frame of the content: u64 extra
-//            count X, X × (u64 field entry index, 24-byte VisibilityExtra), the block's tixels'
-//            encoded sizes (u32 each), their encodings (plv_file.h "Compact entries").
+//   records  until the end of the file, in the order the blocks finished: u64 block, u64
+//            content bytes C, u64 XXH64 of the C bytes after it (seeded with the XXH64 of the
+//            record's first 16 bytes); then the content, uncompressed (zstd would cost the
+//            tracing threads more than the few bytes it saves; the .plv is compressed): u64
+//            extra count X, X × (u64 field entry index, 24-byte VisibilityExtra), the block's
+//            tixels' encoded sizes (u32 each), their encodings (plv_file.h "Compact entries").
 // Checkpoint layout: magic "PLPCKPT\n", u32 version, u32 converged flag, u64 key, u32 iterations,
 // u32 0, f64 × 4 (StoppingRule state: previous power, previous L1 change, ω; residual),
 // u64 × 3 (shadow rays, caustic photons shot, landed), u64 value count V, u64 punctual count P,
@@ -86,6 +88,7 @@ class VisibilityJournal {
   std::function<void(const std::string&)> log_;
   int fd_ = -1;
   std::mutex mutex_;
+  std::vector<unsigned char> pending_;  ///< records not yet written (written a MiB at a time)
   uint64_t appended_ = 0, stopAfter_ = 0;  ///< stopAfter_: the test hook's K (0: none)
   uint64_t restoredBlocks_ = 0, restoredTixels_ = 0;
 };
