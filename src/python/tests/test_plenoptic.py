@@ -190,6 +190,16 @@ def test_editing_emission_and_rebaking_with_the_reused_visibility_equals_a_full_
     assert np.array_equal(reused.render(width=32, height=24), full.render(width=32, height=24))
 
 
+def test_a_finished_bake_leaves_no_resume_files_and_fresh_starts_over(tmp_path):
+    scene = plenoptic.load_scene("cornell")
+    visibility = str(tmp_path / "cornell.plv")
+    first = plenoptic.bake(scene, preset="draft", visibility=visibility)
+    # The journal of the trace and the propagation checkpoint are gone once the bake is done.
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cornell.plv"]
+    again = plenoptic.bake(scene, preset="draft", visibility=visibility, fresh=True)
+    assert np.array_equal(first.render(width=32, height=24), again.render(width=32, height=24))
+
+
 def test_relight_equals_a_fresh_bake_of_the_edited_scene():
     scene = plenoptic.load_scene("cornell")
     lf = plenoptic.bake(scene, preset="draft")
