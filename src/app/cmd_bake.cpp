@@ -73,6 +73,9 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--reuse-visibility", options->reuseVisibility,
                     "Reuse the saved visibility field if geometry, parameterisation and settings are unchanged "
                     "(checked by hash); otherwise recompute it and say why");
+  command->add_flag("--fresh", options->fresh,
+                    "Start afresh: ignore the partial visibility field and propagation checkpoint that an interrupted "
+                    "bake left beside the .plv (by default a matching one is resumed)");
   command->add_option("--visibility", options->visibilityPath,
                       "Where the visibility field is saved/looked for (default: OUT with extension .plv)");
   command

@@ -4,8 +4,11 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <future>
+#include <optional>
 
 #include "accel/accel.h"
 #include "core/error.h"
@@ -14,6 +17,7 @@
 #include "core/timing.h"
 #include "bake/parameterisation.h"
 #include "bake/propagation.h"
+#include "bake/resume.h"
 #include "bake/shard.h"
 #include "bake/subsurface.h"
 #include "bake/visibility.h"
@@ -130,30 +134,114 @@ struct Transport {
   PropagationResult propagation;
 };
 
+/// What the propagation may spend on holding the visibility field decoded, 8 bytes per entry
+/// (VisibilityShard::holdDecoded: the gather then skips decoding each tixel in every
+/// iteration): a quarter of the memory available beyond the bake's estimate, and no more than
+/// maxMemory leaves beside the estimate. The memory guard's estimate stays the compact field's.
+uint64_t decodedFieldBudget(uint64_t estimate, const BakeOptions& options) {
+  const std::optional<uint64_t> available = availableMemoryBytes();
+  if (!available || *available <= estimate) return 0;
+  uint64_t budget = (*available - estimate) / 4;
+  if (options.maxMemory > 0) budget = std::min(budget, options.maxMemory > estimate ? options.maxMemory - estimate : 0);
+  return budget;
+}
+
+/// The checkpoint of an interrupted propagation of this bake (resume.h), read into `checkpoint`
+/// with this rank's field when both match it and every rank has them at the same iteration
+/// (collective: every rank calls it). Says why not when a checkpoint was there.
+bool resumableCheckpoint(const std::string& visibilityPath, uint64_t shardHash, uint64_t key, const Parameterisation& param,
+                         const std::vector<TixelRange>& held, Communicator& comm, PropagationCheckpoint& checkpoint,
+                         VisibilityShard& visibility, const Note& note) {
+  const std::string path = propagationCheckpointPath(visibilityPath);
+  std::error_code ec;
+  const bool present = std::filesystem::exists(path, ec);
+  std::string why;
+  bool ok = readPropagationCheckpoint(path, key, param.valueCount, checkpoint, &why);
+  VisibilityField field;
+  if (ok && !readVisibility(visibilityPath, shardHash, field, &why, param.tixelCount)) ok = false;
+  // Every rank must start from the same iteration (the checkpoints of ranks killed at
+  // different moments may differ by one).
+  const uint64_t mine = ok ? uint64_t(checkpoint.progress.iterations) + 1 : 0;
+  for (uint64_t theirs : comm.allgather(mine))
+    if (theirs != mine) {
+      ok = false;
+      if (why.empty()) why = "the ranks' checkpoints are of different iterations";
+    }
+  if (!ok) {
+    if (present) note(fmt::format("propagation: not resuming from {}, because {}", path, why));
+    return false;
+  }
+  visibility = VisibilityShard::of(std::move(field), held);
+  note(fmt::format("propagation: resuming the interrupted bake from {} after iteration {}{} (visibility field read "
+                   "from {})",
+                   path, checkpoint.progress.iterations, checkpoint.progress.converged ? " (converged)" : "",
+                   visibilityPath));
+  return true;
+}
+
 /// Reads the saved field when asked to and it matches `hash`, else traces (and saves) it; and
 /// propagates. A saved field is read on its own thread while propagation starts with the
 /// shadow rays of the first shot, which do not need it; propagation waits for it after them.
+/// With a visibility path, the trace is journalled and the propagation checkpointed so that
+/// an interrupted bake resumes (resume.h), from a checkpoint before anything else.
 Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const BakeSettings& settings, const BakeOptions& options, Communicator& comm,
-                            const ShardPlan& plan, const std::vector<TixelRange>& held, uint64_t hash, const Note& note) {
+                            const ShardPlan& plan, const std::vector<TixelRange>& held, uint64_t hash, uint64_t decodedBudget,
+                            const Note& note) {
   const std::string visibilityPath = shardVisibilityPath(options.visibilityPath, comm.rank(), comm.size());
   const uint64_t shardHash = visibilityShardHash(hash, held, param.tixelCount);
   Transport t;
+  PropagationResume resume;
+  PropagationCheckpoint checkpoint;
+  if (!visibilityPath.empty()) {
+    const std::string checkpointPath = propagationCheckpointPath(visibilityPath);
+    const uint64_t key = propagationKey(shardHash, scene, settings);
+    const uint64_t stopAfter = testStopAfter("PLENOPTIC_TEST_STOP_AFTER_ITERATIONS");
+    resume.save = [checkpointPath, key, stopAfter, saved = uint64_t(0)](const PropagationProgress& at,
+                                                                        const TransportState& state) mutable {
+      PropagationProgress progress = at;
+      progress.key = key;
+      writePropagationCheckpoint(checkpointPath, progress, state.direct, state.punctualGlossy, state.current);
+      if (stopAfter > 0 && ++saved == stopAfter) std::_Exit(kExitFailure);  // the test hook: "killed" here
+    };
+    if (options.resume) {
+      if (resumableCheckpoint(visibilityPath, shardHash, key, param, held, comm, checkpoint, t.visibility, note)) {
+        resume.from = &checkpoint;
+        t.reused = true;
+        t.visibility.holdDecoded(decodedBudget);
+      }
+    } else {
+      std::error_code ec;
+      if (std::filesystem::exists(checkpointPath, ec))
+        note(fmt::format("propagation: ignoring the checkpoint {} (--fresh)", checkpointPath));
+      comm.allgather(uint64_t(0));  // (resumableCheckpoint's collective, which every rank calls)
+    }
+  }
   auto computeAndSave = [&] {
-    t.visibility = computeVisibilityShard(scene, accel, param, settings, held);
+    std::optional<VisibilityJournal> journal;
+    if (!visibilityPath.empty()) journal.emplace(partialVisibilityPath(visibilityPath), options.resume, note);
+    t.visibility = computeVisibilityShard(scene, accel, param, settings, held, true, journal ? &*journal : nullptr);
     const VisibilityField& f = t.visibility.field;
     note(fmt::format("visibility: {} rays in {:.2f} s ({:.1f} Mrays/s), {:.1f} MB", f.rays, f.seconds,
                      f.seconds > 0 ? f.rays / f.seconds * 1e-6 : 0.0, f.bytes() / 1e6));
     if (!visibilityPath.empty()) writeVisibility(visibilityPath, f);
+    if (journal) journal->finish();
+    t.visibility.holdDecoded(decodedBudget);
   };
-  if (options.reuseVisibility && !visibilityPath.empty()) {
+  if (resume.from) {
+    t.propagation = propagate(scene, accel, param, [&]() -> const VisibilityShard& { return t.visibility; }, settings,
+                              comm, plan, resume);
+  } else if (options.reuseVisibility && !visibilityPath.empty()) {
     std::string why;
     double readSeconds = 0.0;
     std::future<bool> read = std::async(std::launch::async, [&] {
       const auto readStart = std::chrono::steady_clock::now();
       VisibilityField field;
       const bool ok = readVisibility(visibilityPath, shardHash, field, &why, param.tixelCount);
-      if (ok) t.visibility = VisibilityShard::of(std::move(field), held);
+      if (ok) {
+        t.visibility = VisibilityShard::of(std::move(field), held);
+        t.visibility.holdDecoded(decodedBudget);
+      }
       readSeconds = secondsSince(readStart);
       return ok;
     });
@@ -168,11 +256,11 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
         computeAndSave();
       }
       return t.visibility;
-    }, settings, comm, plan);
+    }, settings, comm, plan, resume);
   } else {
     computeAndSave();
     t.propagation = propagate(scene, accel, param, [&]() -> const VisibilityShard& { return t.visibility; }, settings,
-                              comm, plan);
+                              comm, plan, resume);
   }
   const PropagationResult& prop = t.propagation;
   note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s (first shot {:.2f} s, {} shadow rays)",
@@ -265,6 +353,14 @@ void requireBakeableMaterials(const Scene& scene, int ranks) {
            scene.sourcePath, scene.materials[m].name, ranks);
 }
 
+void removePropagationCheckpoint(const BakeOptions& options) {
+  if (options.visibilityPath.empty()) return;
+  const int rank = options.communicator ? options.communicator->rank() : 0;
+  const int ranks = options.communicator ? options.communicator->size() : 1;
+  std::error_code ec;
+  std::filesystem::remove(propagationCheckpointPath(shardVisibilityPath(options.visibilityPath, rank, ranks)), ec);
+}
+
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options) {
   SingleProcess single;
   Communicator& comm = options.communicator ? *options.communicator : single;
@@ -288,15 +384,16 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   noteParameterisation(note, param, setupSeconds, tixelSetup, comm.size());
   const ShardPlan plan = planShards(lf.scene, param, settings, comm.size());
   const RankShare share = rankShare(lf.scene, param, plan, comm.rank(), note);
-  if (options.checkMemory) {
-    // Traced ahead on a sample of the held tixels: how many bytes the field will take.
-    const double bytesPerTixel = estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
-    options.checkMemory(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel) +
-                        subsurfaceOperatorBytesEstimate(lf.scene, param, settings.subsurfaceWalks));
-  }
+  // Traced ahead on a sample of the held tixels: how many bytes the field will take.
+  const double bytesPerTixel = estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
+  const uint64_t estimate =
+      bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel) +
+      subsurfaceOperatorBytesEstimate(lf.scene, param, settings.subsurfaceWalks);
+  if (options.checkMemory) options.checkMemory(estimate);
 
   // 2. Visibility field and 3. propagation.
-  Transport transport = traceAndPropagate(lf.scene, accel, param, settings, options, comm, plan, share.held, hash, note);
+  Transport transport = traceAndPropagate(lf.scene, accel, param, settings, options, comm, plan, share.held, hash,
+                                          decodedFieldBudget(estimate, options), note);
   DistributedBakeStats distributed =
       gatherDistributedStats(comm, plan, share, setupSeconds, tixelSetup, transport, note);
 
@@ -307,6 +404,7 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   if (options.distributedStats) *options.distributedStats = std::move(distributed);
   if (options.keepParameterisation) *options.keepParameterisation = std::move(param);
   if (options.keepVisibility) *options.keepVisibility = std::move(transport.visibility);
+  if (options.removeCheckpoint) removePropagationCheckpoint(options);
   return lf;
 }
 

@@ -74,12 +74,25 @@ struct BakeOptions {
   std::string visibilityPath;
   /// Reuse visibilityPath when it exists and its hash matches this scene and settings.
   bool reuseVisibility = false;
+  /// Resume from the scratch files that an interrupted bake left beside visibilityPath
+  /// (resume.h: the partial field, the propagation checkpoint) when they match this bake;
+  /// false: trace and propagate afresh (`bake --fresh`). Nothing is saved or resumed without
+  /// a visibilityPath.
+  bool resume = true;
+  /// Remove the propagation checkpoint when the bake returns (false: the caller removes it
+  /// with removePropagationCheckpoint once it has written the light field, so that a bake
+  /// killed while writing it resumes at once).
+  bool removeCheckpoint = true;
   /// Receives one-line notes for the user (reuse decisions, rates). May be empty.
   std::function<void(const std::string&)> log;
   /// Called once the parameterisation is known, before the visibility field and the values
   /// are allocated, with bakeMemoryEstimate() of this bake; may throw to refuse it (the
   /// command line calls requireMemory, core/memory.h). May be empty.
   std::function<void(uint64_t bytes)> checkMemory;
+  /// The most memory the bake may plan to use (`--max-memory`; 0 = the available memory
+  /// alone): bounds, beside the estimate, what the propagation may spend on holding the
+  /// visibility field decoded (VisibilityShard::holdDecoded; checkMemory does the refusing).
+  uint64_t maxMemory = 0;
   /// The ranks of a distributed bake (distributed/communicator.h); null = one process. Every
   /// rank calls bake() with the same scene and settings (refused otherwise, before any ray is
   /// traced); each traces and saves its shard of the visibility field (visibilityPath becomes
@@ -113,6 +126,10 @@ inline constexpr double kVisibilityEstimateMargin = 1.15;
 /// material (bsdf.h SubsurfaceBsdf), whose operator (subsurface.h) joins tixels of every rank's
 /// share and is not exchanged. bake() calls it first, before any ray is traced or anything written.
 void requireBakeableMaterials(const Scene& scene, int ranks);
+
+/// Removes the propagation checkpoint (resume.h) of a bake with these options (every rank's
+/// own, for a distributed bake), if there is one.
+void removePropagationCheckpoint(const BakeOptions& options);
 
 /// Bakes `scene` (moved into the result). Throws pl::Error on failures, among them a scene
 /// requireBakeableMaterials refuses.

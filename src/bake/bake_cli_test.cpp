@@ -1,7 +1,12 @@
 // Runs `plenoptic bake` end to end (PLENOPTIC_BINARY): the .plf and .plv it writes, --stats,
 // --reuse-visibility, and how it refuses bad input.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -171,6 +176,112 @@ TEST_F(BakeCli, InfoShowsAVisibilityFieldsBytesPerEntry) {
   fs::resize_file(plv, fs::file_size(plv) - 3);
   EXPECT_EQ(run("info \"" + plv + "\"", &out, &err), 1);
   EXPECT_NE(err.find("v.plv: corrupt or truncated visibility field"), std::string::npos) << err;
+}
+
+// The light field of a .plf, bit for bit (VALS).
+bool sameValues(const std::string& a, const std::string& b) {
+  const LightField x = readLightField(a), y = readLightField(b);
+  return x.values.size() == y.values.size() &&
+         std::memcmp(x.values.data(), y.values.data(), x.values.size() * sizeof(Rgb)) == 0;
+}
+
+// A bake stopped after a few traced blocks, or after a few iterations (the test hooks end the
+// process at once, as a kill would), resumes automatically where it stopped, says so, and
+// writes the uninterrupted bake's light field; the scratch files go once it is written.
+// --fresh ignores them; other settings are not resumed, and the reason is given.
+TEST_F(BakeCli, ResumesABakeStoppedWhileTracingOrPropagating) {
+  std::string out, err;
+  const std::string settings = " --preset draft --tixels-across 12 --directions 64";
+  ASSERT_EQ(run("bake cornell -o \"" + path("ref.plf") + "\"" + settings + " --quiet", &out, &err), 0) << err;
+  const std::string plf = path("a.plf"), plv = path("a.plv");
+  const std::string partial = plv + ".partial", checkpoint = plv + ".checkpoint";
+  const std::string bake = "bake cornell -o \"" + plf + "\"" + settings;
+  auto stopped = [&](const std::string& hook, const std::string& extra = "") {
+    return cli_test::runPlenoptic(bake + extra + " --quiet", dir_, &out, &err, hook);
+  };
+
+  // Stopped while tracing: only the partial field is left; the next bake resumes it.
+  EXPECT_EQ(stopped("PLENOPTIC_TEST_STOP_AFTER_BLOCKS=3"), 1) << err;
+  EXPECT_FALSE(fs::exists(plf));
+  EXPECT_FALSE(fs::exists(plv));
+  EXPECT_TRUE(fs::exists(partial));
+  ASSERT_EQ(run(bake, &out, &err), 0) << err;
+  EXPECT_NE(err.find("visibility: resuming the interrupted trace in " + partial + ": "), std::string::npos) << err;
+  EXPECT_TRUE(sameValues(plf, path("ref.plf")));
+  EXPECT_FALSE(fs::exists(partial));
+  EXPECT_FALSE(fs::exists(checkpoint));
+
+  // Stopped while propagating: the field is complete, the checkpoint holds iteration 2.
+  fs::remove(plf);
+  EXPECT_EQ(stopped("PLENOPTIC_TEST_STOP_AFTER_ITERATIONS=2"), 1) << err;
+  EXPECT_FALSE(fs::exists(plf));
+  EXPECT_TRUE(fs::exists(checkpoint));
+  ASSERT_EQ(run(bake, &out, &err), 0) << err;
+  EXPECT_NE(err.find("propagation: resuming the interrupted bake from " + checkpoint + " after iteration 2"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(err.find("visibility: "), std::string::npos) << err;  // nothing traced
+  EXPECT_TRUE(sameValues(plf, path("ref.plf")));
+  EXPECT_FALSE(fs::exists(checkpoint));
+
+  // --fresh: the checkpoint is ignored (and said so), the bake is the same.
+  EXPECT_EQ(stopped("PLENOPTIC_TEST_STOP_AFTER_ITERATIONS=1"), 1) << err;
+  ASSERT_EQ(run(bake + " --fresh", &out, &err), 0) << err;
+  EXPECT_NE(err.find("propagation: ignoring the checkpoint " + checkpoint + " (--fresh)"), std::string::npos) << err;
+  EXPECT_TRUE(sameValues(plf, path("ref.plf")));
+  EXPECT_FALSE(fs::exists(checkpoint));
+
+  // Other settings: neither the partial field nor the checkpoint is resumed, and the log says why.
+  EXPECT_EQ(stopped("PLENOPTIC_TEST_STOP_AFTER_BLOCKS=2", " --visibility \"" + path("b.plv") + "\""), 1) << err;
+  const std::string otherDirections = "bake cornell -o \"" + plf + "\" --preset draft --tixels-across 12 --directions 100";
+  ASSERT_EQ(run(otherDirections + " --visibility \"" + path("b.plv") + "\"", &out, &err), 0) << err;
+  EXPECT_NE(err.find("visibility: tracing afresh, because " + path("b.plv") + ".partial was traced for different "
+                     "geometry, parameterisation or settings"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(stopped("PLENOPTIC_TEST_STOP_AFTER_ITERATIONS=1"), 1) << err;
+  ASSERT_EQ(run(bake + " --tolerance 0.01", &out, &err), 0) << err;
+  EXPECT_NE(err.find("propagation: not resuming from " + checkpoint + ", because"), std::string::npos) << err;
+  EXPECT_NE(err.find("another scene, other settings"), std::string::npos) << err;
+}
+
+// A real SIGKILL (fork + exec, killed once the bake has saved some of its work, while it
+// traces or propagates): the next bake resumes and writes the uninterrupted light field.
+TEST_F(BakeCli, ResumesAfterSigkill) {
+  std::string out, err;
+  const std::string settings = " --preset draft --tixels-across 20 --directions 144";
+  ASSERT_EQ(run("bake cornell -o \"" + path("ref.plf") + "\"" + settings + " --quiet", &out, &err), 0) << err;
+  const std::string plf = path("k.plf"), partial = path("k.plv.partial"), checkpoint = path("k.plv.checkpoint");
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 1);
+    ::dup2(null, 2);
+    ::execl(PLENOPTIC_BINARY, "plenoptic", "bake", "cornell", "-o", plf.c_str(), "--preset", "draft", "--tixels-across",
+            "20", "--directions", "144", "--quiet", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int status = 0;
+  bool killed = false;
+  for (int polls = 0; polls < 120000 && !killed; ++polls) {
+    std::error_code ec;
+    if ((fs::exists(partial, ec) && fs::file_size(partial, ec) > 20000) || fs::exists(checkpoint, ec)) {
+      killed = ::kill(pid, SIGKILL) == 0;
+      break;
+    }
+    if (::waitpid(pid, &status, WNOHANG) == pid) break;  // finished before any work was saved
+    ::usleep(500);
+  }
+  if (killed) {
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFSIGNALED(status) || WIFEXITED(status));
+  }
+  ASSERT_TRUE(killed) << "the bake ended before it could be killed";
+  EXPECT_FALSE(fs::exists(plf));
+  ASSERT_EQ(run("bake cornell -o \"" + plf + "\"" + settings, &out, &err), 0) << err;
+  EXPECT_NE(err.find("resuming the interrupted"), std::string::npos) << err;
+  EXPECT_TRUE(sameValues(plf, path("ref.plf")));
 }
 
 TEST_F(BakeCli, MaxMemoryCapsTheMemoryGuard) {

@@ -1451,9 +1451,10 @@ void iterateOnce(TransportState& state, const VisibilityShard& vis, const ShardP
   applySubsurface(state, true);
 }
 
-/// The iteration, from the first shot to convergence (StoppingRule) or maxIterations.
+/// The iteration, from the first shot (or a checkpoint's iterate: resume.from) to convergence
+/// (StoppingRule) or maxIterations, handing its state to resume.save after every iteration.
 void iterate(TransportState& state, const VisibilityShard& vis, const ShardPlan& plan, int rank, ValueExchange& exchange,
-             PropagationResult& result) {
+             const PropagationResume& resume, PropagationResult& result) {
   const Scene& scene = state.scene;
   const Parameterisation& param = state.param;
   const BakeSettings& settings = state.settings;
@@ -1463,8 +1464,23 @@ void iterate(TransportState& state, const VisibilityShard& vis, const ShardPlan&
   // the tixels other ranks updated.
   const bool keepPrevious = keepsPreviousValues(param) || plan.ranks > 1;
   StoppingRule stopping(transportPower(state, state.current), settings.tolerance);
+  PropagationProgress at;
+  at.shadowRays = state.shadowRays.load();
+  at.causticPhotons = state.causticPhotons;
+  at.causticPhotonsLanded = state.causticPhotonsLanded;
+  if (resume.from) {
+    // After a full iteration every transport quad is its tixel's function of current
+    // (updateTransport), so the iterate alone gives the state the next iteration starts from.
+    at = resume.from->progress;
+    state.current = resume.from->current;
+    updateTransport(state, 0, param.tixelCount);
+    stopping = StoppingRule(at, settings.tolerance);
+    result.iterations = at.iterations;
+    result.residual = at.residual;
+  }
   Progress progress("propagation", settings.maxIterations);
-  for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
+  progress.advance(at.iterations);
+  for (uint32_t iteration = at.iterations + 1; iteration <= settings.maxIterations && !at.converged; ++iteration) {
     iterateOnce(state, vis, plan, rank, stopping.omega(), exchange, keepPrevious, result);
     const auto repeatedStart = std::chrono::steady_clock::now();
     const double power = transportPower(state, state.current);
@@ -1476,12 +1492,14 @@ void iterate(TransportState& state, const VisibilityShard& vis, const ShardPlan&
     const double changed = transportChange(state);
     result.repeatedSeconds += secondsSince(repeatedStart);
     progress.advance(1);
-    if (stopping.converged(iteration, power, changed, result)) {
-      // Converged: the iterations left are not needed, so the bar completes.
-      progress.advance(settings.maxIterations - iteration);
-      break;
-    }
+    at.converged = stopping.converged(iteration, power, changed, result);
+    at.iterations = iteration;
+    at.residual = result.residual;
+    stopping.save(at);
+    if (resume.save) resume.save(at, state);
   }
+  // Converged (or resumed converged): the iterations left are not needed, so the bar completes.
+  progress.advance(settings.maxIterations - std::min(settings.maxIterations, at.iterations));
   progress.finish();
 }
 
@@ -1501,7 +1519,7 @@ void iterateTransport(TransportState& state, const VisibilityShard& vis, float o
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const std::function<const VisibilityShard&()>& visibility, const BakeSettings& settings,
-                            Communicator& comm, const ShardPlan& plan) {
+                            Communicator& comm, const ShardPlan& plan, const PropagationResume& resume) {
   const auto start = std::chrono::steady_clock::now();
   PropagationResult result;
   TransportState state(scene, accel, param, settings);
@@ -1520,9 +1538,22 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   result.subsurfaceBytes = state.ops->subsurface.bytes();
 
   double waitSeconds = 0.0;
-  const VisibilityShard& vis = shootFirstShot(state, plan, rank, visibility, exchange, waitSeconds);
+  const VisibilityShard* vis = nullptr;
+  if (resume.from) {
+    // The checkpoint holds the first shot (every rank's: the direct values were exchanged).
+    const auto waitStart = std::chrono::steady_clock::now();
+    vis = &visibility();
+    waitSeconds = secondsSince(waitStart);
+    state.direct = resume.from->direct;
+    state.punctualGlossy = resume.from->punctualGlossy;
+    state.shadowRays = resume.from->progress.shadowRays;
+    state.causticPhotons = resume.from->progress.causticPhotons;
+    state.causticPhotonsLanded = resume.from->progress.causticPhotonsLanded;
+  } else {
+    vis = &shootFirstShot(state, plan, rank, visibility, exchange, waitSeconds);
+  }
   result.firstShotSeconds = secondsSince(start) - waitSeconds;
-  iterate(state, vis, plan, rank, exchange, result);
+  iterate(state, *vis, plan, rank, exchange, resume, result);
   finishTransport(state);
 
   result.values = std::move(state.current);

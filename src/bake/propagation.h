@@ -40,6 +40,7 @@
 // drops below the tolerance and so does the error this leaves, estimated from the L1 change
 // of the values and its measured rate of convergence (see the .cpp), or at maxIterations.
 #include "bake/parameterisation.h"
+#include "bake/resume.h"
 #include "bake/visibility.h"
 
 #include <atomic>
@@ -83,6 +84,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
 
 class Communicator;
 struct ShardPlan;
+struct TransportState;
 
 /// The same, with the visibility field supplied late: `visibility` is called once, after the
 /// shadow rays of the first shot (which do not need the field), so that reading a saved field
@@ -90,6 +92,16 @@ struct ShardPlan;
 /// The time spent inside `visibility` is excluded from `seconds` and `firstShotSeconds`.
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const std::function<const VisibilityField&()>& visibility, const BakeSettings& settings);
+
+/// Saving and resuming the iteration (resume.h; docs/design.md, Resuming an interrupted bake).
+struct PropagationResume {
+  /// Start after this checkpoint's iterations, from its first shot and iterate, instead of
+  /// shooting the first shot (the visibility field is still obtained). Null: from the start.
+  const PropagationCheckpoint* from = nullptr;
+  /// Called after every iteration (the last included) with where the propagation stands and
+  /// its state, whose direct, punctualGlossy and current arrays a checkpoint keeps. May be empty.
+  std::function<void(const PropagationProgress&, const TransportState&)> save;
+};
 
 /// One rank of a distributed propagation (shard.h): this rank (comm.rank() of plan.ranks)
 /// shoots the first shot of its own tixels, gathers through its shard of the field and updates
@@ -100,7 +112,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
 /// Only rank 0 should show progress bars (Progress::setEnabled).
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const std::function<const VisibilityShard&()>& visibility, const BakeSettings& settings,
-                            Communicator& comm, const ShardPlan& plan);
+                            Communicator& comm, const ShardPlan& plan, const PropagationResume& resume = {});
 
 /// Batches of whole charts in tixel order, each ≥ 2048 tixels (and at most ~16000 of them):
 /// batch b is tixels [result[b], result[b + 1]).
@@ -229,6 +241,15 @@ inline constexpr float kOverRelaxation = 1.2f;
 class StoppingRule {
  public:
   StoppingRule(double startPower, float tolerance) : previousPower_(startPower), tolerance_(tolerance) {}
+  /// The rule as it stood after the iterations of `at` (a resumed propagation, resume.h).
+  StoppingRule(const PropagationProgress& at, float tolerance)
+      : previousPower_(at.previousPower), previousL1Change_(at.previousL1Change), tolerance_(tolerance), omega_(at.omega) {}
+  /// Its state, for a checkpoint: previous power and L1 change, and ω (into `at`).
+  void save(PropagationProgress& at) const {
+    at.previousPower = previousPower_;
+    at.previousL1Change = previousL1Change_;
+    at.omega = omega_;
+  }
 
   /// After iteration `iteration` (from 1) with total power `power` and L1 change `changed`
   /// (transportPower, transportChange): sets result.iterations and result.residual, and

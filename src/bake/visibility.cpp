@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "accel/accel.h"
+#include "bake/resume.h"
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/memory.h"
@@ -205,6 +206,19 @@ VisibilityShard VisibilityShard::of(VisibilityField field, std::vector<TixelRang
   return shard;
 }
 
+bool VisibilityShard::holdDecoded(uint64_t budget) {
+  const uint64_t bytes = field.entryCount() * sizeof(VisibilityEntry);
+  if (!decoded.empty()) return true;
+  if (field.tixelCount == 0 || bytes > budget) return false;
+  const uint32_t n = field.directionsPerTixel();
+  std::vector<VisibilityEntry> all(field.entryCount());
+  parallelForRange(field.tixelCount, 256, [&](uint64_t t0, uint64_t t1) {
+    for (uint64_t t = t0; t < t1; ++t) field.decode(t, all.data() + t * n);
+  });
+  decoded = FieldArray<VisibilityEntry>(std::move(all));
+  return true;
+}
+
 bool VisibilityShard::holds(uint64_t begin, uint64_t end) const {
   if (begin >= end) return true;
   for (const TixelRange& r : ranges) {
@@ -234,7 +248,7 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 
 VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                        const BakeSettings& settings, const std::vector<TixelRange>& ranges,
-                                       bool showProgress) {
+                                       bool showProgress, VisibilityJournal* journal) {
   const auto start = std::chrono::steady_clock::now();
   VisibilityField field;
   field.gridSide = gatherGridSide(settings.gatherDirections);
@@ -268,10 +282,17 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     }
   }
   const uint64_t blockCount = blockList.size();
-  std::vector<std::vector<std::pair<uint64_t, VisibilityExtra>>> blockExtras(blockCount);
+  std::vector<BlockExtras> blockExtras(blockCount);
   // Each block's entries are traced into a buffer of its own and encoded (plv_file.h, "Compact
   // entries") as soon as it is done: the field is never held at 8 bytes per entry.
   std::vector<EncodedRun> blockEntries(blockCount);
+  // Blocks an interrupted bake already traced (resume.h), restored from its journal.
+  std::vector<uint8_t> restored(blockCount, 0);
+  if (journal) {
+    std::vector<uint64_t> blockTixels(blockCount);
+    for (uint64_t b = 0; b < blockCount; ++b) blockTixels[b] = blockList[b].t1 - blockList[b].t0;
+    restored = journal->open(field.hash, field.gridSide, blockTixels, param.tixelCount, blockEntries, blockExtras);
+  }
   std::atomic<uint64_t> rayCount{0};
   std::optional<Progress> progress;
   if (showProgress) progress.emplace("visibility", heldTixels);
@@ -283,6 +304,10 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
   };
   parallelFor(blockCount, [&](uint64_t block) {
     const uint64_t t0 = blockList[block].t0, t1 = blockList[block].t1, localBase = blockList[block].local;
+    if (restored[block]) {
+      if (progress) progress->advance(t1 - t0);
+      return;
+    }
     std::vector<Ray> rays, nextRays;
     std::vector<RayHit> hits;
     std::vector<PathState> states, nextStates;
@@ -378,6 +403,7 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     run.bytes.reserve((t1 - t0) * maxEncodedTixelBytes(n));
     for (uint64_t g = t0; g < t1; ++g) run.add(entries.data() + (g - t0) * n, n);
     run.bytes.shrink_to_fit();
+    if (journal) journal->append(block, run, extras);
     if (progress) progress->advance(t1 - t0);
   });
   if (progress) progress->finish();

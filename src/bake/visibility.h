@@ -27,6 +27,7 @@
 namespace pl {
 
 class Accel;
+class VisibilityJournal;
 
 /// Tixels [begin, end) (global tixel indices).
 struct TixelRange {
@@ -43,6 +44,10 @@ struct VisibilityShard {
   VisibilityField field;
   std::vector<TixelRange> ranges;
   std::vector<uint64_t> localStart;  ///< per range: field index of its first tixel
+  /// Every held tixel's entries decoded (8 bytes each, in field order), when the bake can
+  /// afford them (holdDecoded): the gather then reads them instead of decoding each tixel in
+  /// every iteration. Empty: decoded on the fly.
+  FieldArray<VisibilityEntry> decoded;
 
   /// The whole field as a shard of one range (shares the storage).
   static VisibilityShard whole(const VisibilityField& field);
@@ -60,11 +65,16 @@ struct VisibilityShard {
     }
     return localStart[lo] + (g - ranges[lo].begin);
   }
-  /// Tixel g's N entries, decoded into `scratch` (room for N), which it returns.
+  /// Tixel g's N entries: decoded into `scratch` (room for N), which it returns, or where
+  /// `decoded` holds them.
   const VisibilityEntry* entries(uint64_t g, VisibilityEntry* scratch) const {
+    if (!decoded.empty()) return decoded.data() + local(g) * field.directionsPerTixel();
     field.decode(local(g), scratch);
     return scratch;
   }
+  /// Decodes every entry into `decoded` (in parallel) when they take at most `budget` bytes
+  /// (8 per entry); returns whether it did. The entries are the same either way.
+  bool holdDecoded(uint64_t budget);
   /// Tixel g's first extra record.
   const VisibilityExtra* extras(uint64_t g) const { return field.extras.data() + field.extraOffset[local(g)]; }
 };
@@ -122,9 +132,11 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 /// Traces the tixels of `ranges` only (sorted, disjoint), stored one range after another: a
 /// rank's shard, whose hash is visibilityShardHash. Every tixel's entries are the same as in
 /// the whole field (a tixel's rays depend only on the tixel, the seed and the scene).
+/// With a journal (resume.h), the blocks it restores are not traced again, and every block
+/// traced is appended to it as it finishes; field.rays counts the rays traced in this call.
 VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                        const BakeSettings& settings, const std::vector<TixelRange>& ranges,
-                                       bool showProgress = true);
+                                       bool showProgress = true, VisibilityJournal* journal = nullptr);
 
 /// Rays a visibility memory estimate traces (estimateVisibilityBytesPerTixel): a few
 /// hundredths of a second, against the minutes of a field that needs an estimate.

@@ -131,11 +131,16 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
   BakeOptions bakeOptions;
   bakeOptions.visibilityPath = visibilityPath_;
   bakeOptions.reuseVisibility = options_.reuseVisibility;
+  bakeOptions.resume = !options_.fresh;
+  // The propagation checkpoint goes once the .plf is written (below): a bake killed while
+  // writing it resumes with nothing left to propagate.
+  bakeOptions.removeCheckpoint = false;
   bakeOptions.log = options_.log;
   bakeOptions.checkMemory = [limit = options_.maxMemory](uint64_t bytes) {
     requireMemory(bytes, "bake (visibility field and light-field values)",
                   "lower --preset, --tixels-across or --directions", limit);
   };
+  bakeOptions.maxMemory = options_.maxMemory;
   bakeOptions.communicator = options_.communicator;
   DistributedBakeStats distributed;
   bakeOptions.distributedStats = &distributed;
@@ -151,6 +156,7 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
     writeLightField(options_.output, lf, parseValuesCodec(options_.compress));
     stats.fileBytes = std::filesystem::file_size(options_.output);
   }
+  removePropagationCheckpoint(bakeOptions);
   stats.seconds = loadSeconds + secondsSince(start);
   stats.loadSeconds = loadSeconds;
   stats.scene = options_.sceneName;

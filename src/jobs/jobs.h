@@ -163,6 +163,8 @@ struct BakeJobOptions {
   int64_t causticPhotons = -1;  ///< BakeSettings::causticPhotons (`--caustic-photons`); −1 = the preset's, 0 = no caustic pass
   uint32_t subsurfaceWalks = 0;  ///< BakeSettings::subsurfaceWalks (`--subsurface-walks`); 0 = the preset's
   bool reuseVisibility = false;
+  /// Ignore what an interrupted bake left to resume from (`--fresh`; BakeOptions::resume).
+  bool fresh = false;
   /// The most memory the bake may plan to use (`--max-memory`, parseMemorySize): the memory
   /// guard refuses a bake whose estimate exceeds it, as one that exceeds the available memory;
   /// 0 = the available memory alone.

@@ -1158,4 +1158,6 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
   return info;
 }
 
+std::vector<unsigned char> encodeSceneSection(const Scene& scene) { return encodeScene(scene); }
+
 }  // namespace pl

@@ -171,4 +171,9 @@ LightField readLightField(const std::string& path);
 /// the other sections are recomputed in bounded chunks when verifyChecksums is set.
 PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums = true);
 
+/// The scene section's bytes (SCNE) for `scene`: everything a light field keeps of it —
+/// geometry, materials, textures, lights, environment. A bake hashes them to tell whether a
+/// saved propagation state is this scene's (bake/resume.h).
+std::vector<unsigned char> encodeSceneSection(const Scene& scene);
+
 }  // namespace pl

@@ -196,7 +196,7 @@ void bindLightField(py::module_& m) {
       "bake",
       [](const Scene& scene, const std::string& preset, uint64_t seed, int threads, std::optional<std::string> visibility,
          bool reuseVisibility, bool sunMasks, bool punctualHighlights, std::optional<int64_t> causticPhotons,
-         std::optional<std::string> maxMemory, bool keepVisibility) {
+         std::optional<std::string> maxMemory, bool keepVisibility, bool fresh) {
         BakeJobOptions options;
         if (maxMemory) options.maxMemory = parseMemorySize(*maxMemory, "max_memory");
         auto relight = std::make_shared<RelightSource>();
@@ -219,6 +219,7 @@ void bindLightField(py::module_& m) {
         options.threads = threads;
         if (visibility) options.visibilityPath = *visibility;
         options.reuseVisibility = reuseVisibility;
+        options.fresh = fresh;
         const BakeJob job(std::move(options));
         BakeJobResult result = runInterruptible([&] {
           // The bake keeps its scene (in the light field); a copy must be finalized again to
@@ -236,14 +237,15 @@ void bindLightField(py::module_& m) {
       py::arg("scene"), py::arg("preset") = "default", py::arg("seed") = 0, py::arg("threads") = 0,
       py::arg("visibility") = py::none(), py::arg("reuse_visibility") = false, py::arg("sun_masks") = true,
       py::arg("punctual_highlights") = true, py::arg("caustic_photons") = py::none(), py::arg("max_memory") = py::none(),
-      py::arg("keep_visibility") = true,
+      py::arg("keep_visibility") = true, py::arg("fresh") = false,
       "Bakes `scene`'s light field (what `plenoptic bake` does). visibility: a .plv path where the visibility field\n"
       "is saved; with reuse_visibility=True it is read back when the geometry and settings match (so a bake after\n"
       "editing only lights or emission re-runs the propagation alone). sun_masks=False: `--sun-masks off`;\n"
       "punctual_highlights=False: `--punctual-highlights off`; caustic_photons=N: `--caustic-photons N` (None:\n"
       "the preset's); max_memory=\"12G\": `--max-memory 12G` (the bake is refused, before it starts, when its\n"
       "memory estimate exceeds it). keep_visibility=True keeps the visibility field in memory for LightField.relight\n"
-      "(False frees it).");
+      "(False frees it). With a visibility path, a bake that was interrupted resumes from what it saved there\n"
+      "(docs/user-guide.md, Resuming an interrupted bake); fresh=True: `--fresh` (start afresh).");
 
   m.def(
       "load_light_field",

@@ -190,6 +190,16 @@ def test_editing_emission_and_rebaking_with_the_reused_visibility_equals_a_full_
     assert np.array_equal(reused.render(width=32, height=24), full.render(width=32, height=24))
 
 
+def test_a_finished_bake_leaves_no_resume_files_and_fresh_starts_over(tmp_path):
+    scene = plenoptic.load_scene("cornell")
+    visibility = str(tmp_path / "cornell.plv")
+    first = plenoptic.bake(scene, preset="draft", visibility=visibility)
+    # The journal of the trace and the propagation checkpoint are gone once the bake is done.
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cornell.plv"]
+    again = plenoptic.bake(scene, preset="draft", visibility=visibility, fresh=True)
+    assert np.array_equal(first.render(width=32, height=24), again.render(width=32, height=24))
+
+
 def test_relight_equals_a_fresh_bake_of_the_edited_scene():
     scene = plenoptic.load_scene("cornell")
     lf = plenoptic.bake(scene, preset="draft")
@@ -763,4 +773,6 @@ def test_ctrl_c_interrupts_a_bake_leaving_the_old_visibility_file_untouched(tmp_
     lines = run_interrupted("plenoptic.bake(scene, preset='high', visibility='field.plv')", tmp_path)
     assert lines[:2] == ["KeyboardInterrupt", "next call (8, 8, 3)"]
     assert plv.read_bytes() == b"the previous file"
-    assert sorted(os.listdir(tmp_path)) == ["field.plv"]  # no temporary left behind
+    # No temporary left behind; the journal of the blocks traced so far stays, for the next
+    # bake to resume from (when the interrupt came while tracing).
+    assert sorted(os.listdir(tmp_path)) in (["field.plv"], ["field.plv", "field.plv.partial"])
