@@ -1074,6 +1074,37 @@ TEST_F(PlfFileTest, RoundTripKeepsEmissionTextures) {
   }
 }
 
+// Vertex alphas (glTF COLOR_0's alpha) come back through the VALP block, alone after the
+// settings or after the other blocks; they make their materials masked again on load, and an
+// alpha outside [0, 1] in the block is refused naming the mesh.
+TEST_F(PlfFileTest, RoundTripKeepsVertexAlphas) {
+  LightField original = makeTestLightField();
+  Scene& s = original.scene;
+  const std::string plainPath = file("plain.plf");
+  writeLightField(plainPath, original);
+  const uint64_t plainScene = sections(readBytes(plainPath))[0].size;
+  s.meshes[0].alphas = {0.0f, 0.25f, 1.0f, 0.5f};
+  for (const bool others : {false, true}) {
+    SCOPED_TRACE(others ? "after SDTL, TXMP and EMTX" : "alone");
+    if (others) {
+      s.materials[3].albedoMapping.offset = Vec2(0.5f, 0.0f);
+      s.materials[0].emissionTexture = 1;
+      s.materials[0].emission = Rgb(1.0f);
+    }
+    const std::string path = file("alphas.plf");
+    writeLightField(path, original);
+    const LightField copy = readLightField(path);
+    EXPECT_EQ(copy.scene.meshes[0].alphas, s.meshes[0].alphas);
+    EXPECT_TRUE(copy.scene.meshes[1].alphas.empty());
+    for (const uint32_t m : copy.scene.meshes[0].materials) EXPECT_TRUE(copy.scene.materials[m].isMasked());
+    EXPECT_EQ(copy.scene.materials[0].emissionTexture, others ? 1 : -1);
+    // The block ends with mesh 0's last alpha (0.5f, its high byte 12 − 3 bytes before the
+    // end) and mesh 1's empty count: 0x7f there makes it 1.7e38.
+    expectRefusedWithSceneByte(path, plainScene, 9, 0x7f, "alphas_bad.plf",
+                               {"scene section", "mesh", "vertex alpha 3", "outside [0, 1]"});
+  }
+}
+
 // --- Sun masks (SMSK, version 3) -----------------------------------------------------------
 
 // makeTestLightField's scene has one directional light (lights[2]) and no thin glass, so
