@@ -230,6 +230,12 @@ class PlfFileTest : public test_support::TempDirTest {
   /// The valid file at `path`, whose scene section must be larger than `plainSceneSize` (an
   /// optional block is there), with the byte `fromEnd` bytes before the end of that section set
   /// to `value` and re-signed, written as `name`: the reader must refuse it with `fragments`.
+  /// The SCNE section's size in `lf` written as it is (plain.plf): the layout a scene without
+  /// an optional block has, for expectRefusedWithSceneByte.
+  uint64_t sceneSectionSize(const LightField& lf) const {
+    writeLightField(file("plain.plf"), lf);
+    return sections(readBytes(file("plain.plf")))[0].size;
+  }
   void expectRefusedWithSceneByte(const std::string& path, uint64_t plainSceneSize, uint64_t fromEnd, uint8_t value,
                                   const std::string& name, const std::vector<std::string>& fragments) const {
     auto bytes = readBytes(path);
@@ -999,9 +1005,7 @@ TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {
 TEST_F(PlfFileTest, RoundTripKeepsTexturing) {
   LightField original = makeTestLightField();
   Scene& s = original.scene;
-  const std::string plainPath = file("plain.plf");
-  writeLightField(plainPath, original);
-  const uint64_t plainScene = sections(readBytes(plainPath))[0].size;
+  const uint64_t plainScene = sceneSectionSize(original);
   Mesh& quad = s.meshes[0];
   quad.uvs1 = {{0.5f, 0}, {1, 0.25f}, {1, 1}, {0, 0.5f}};
   quad.colors = {{1, 0.5f, 0.25f}, {0, 1, 1}, {0.5f, 0.5f, 0.5f}, {1, 1, 1}};
@@ -1047,9 +1051,7 @@ TEST_F(PlfFileTest, RoundTripKeepsTexturing) {
 TEST_F(PlfFileTest, RoundTripKeepsEmissionTextures) {
   LightField original = makeTestLightField();
   Scene& s = original.scene;
-  const std::string plainPath = file("plain.plf");
-  writeLightField(plainPath, original);
-  const uint64_t plainScene = sections(readBytes(plainPath))[0].size;
+  const uint64_t plainScene = sceneSectionSize(original);
   Material& lamp = s.materials[0];
   lamp.emission = Rgb(3.0f, 2.0f, 1.0f);
   lamp.emissionTexture = 1;
@@ -1080,9 +1082,7 @@ TEST_F(PlfFileTest, RoundTripKeepsEmissionTextures) {
 TEST_F(PlfFileTest, RoundTripKeepsVertexAlphas) {
   LightField original = makeTestLightField();
   Scene& s = original.scene;
-  const std::string plainPath = file("plain.plf");
-  writeLightField(plainPath, original);
-  const uint64_t plainScene = sections(readBytes(plainPath))[0].size;
+  const uint64_t plainScene = sceneSectionSize(original);
   s.meshes[0].alphas = {0.0f, 0.25f, 1.0f, 0.5f};
   for (const bool others : {false, true}) {
     SCOPED_TRACE(others ? "after SDTL, TXMP and EMTX" : "alone");

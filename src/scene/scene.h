@@ -85,9 +85,10 @@ struct Material {
   /// emissionMapping, at full resolution (emissionModulation).
   int emissionTexture = -1;
   /// Alpha mask (cut-out): coverage α = alphaFactor × (alphaTexture's coverage at uv, or 1
-  /// without one) × the mesh's vertex alpha (Mesh::alphas, 1 without). Where α < alphaCutoff the surface is not there at all: ray casting (Accel)
-  /// skips the hit, so every renderer, shadow ray and the bake see through it. alphaTexture is
-  /// an index into Scene::textures (decoded as ImageDecode::Coverage) or -1.
+  /// without one) × the mesh's vertex alpha (Mesh::alphas, 1 without). Where α < alphaCutoff
+  /// the surface is not there at all: ray casting (Accel) skips the hit, so every renderer,
+  /// shadow ray and the bake see through it. alphaTexture is an index into Scene::textures
+  /// (decoded as ImageDecode::Coverage) or -1.
   int alphaTexture = -1;
   float alphaFactor = 1.0f;
   float alphaCutoff = 0.5f;
