@@ -455,5 +455,21 @@ TEST(Accel, AlphaFactorWithoutTextureRemovesOrKeepsTheWholeMaterial) {
   }
 }
 
+// Vertex alphas (glTF COLOR_0's alpha) alone cut the quad where their interpolation is below
+// the cutoff: alpha = y here, so rays at y < 0.5 reach the floor.
+TEST(Accel, VertexAlphaCutsWhereItsInterpolationIsBelowTheCutoff) {
+  Scene scene = makeMaskedQuads(0.5f);
+  scene.materials[0].alphaTexture = -1;
+  scene.meshes[0].alphas = {0.0f, 0.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+  markVertexColoredMaterials(scene);
+  ASSERT_TRUE(scene.materials[0].isMasked());
+  const Accel accel(scene);
+  for (const float y : {0.1f, 0.4f, 0.6f, 0.9f}) {
+    RayHit hit;
+    ASSERT_TRUE(accel.intersect(Ray{Vec3(0.45f, y, 2.0f), Vec3(0, 0, -1), 0.0f, kInfinity}, hit));
+    EXPECT_EQ(hit.mesh, y >= 0.5f ? 0u : 1u) << "y " << y;
+  }
+}
+
 }  // namespace
 }  // namespace pl

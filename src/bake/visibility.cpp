@@ -120,6 +120,8 @@ uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const
       for (int k = 0; k < 3; ++k) h.value(mesh.positions[t[k]]);
     }
     h.update(mesh.materials.data(), mesh.materials.size() * sizeof(uint32_t));
+    // Vertex alphas cut an alpha mask like its texture (meshes without them hash as before).
+    if (!mesh.alphas.empty()) h.update(mesh.alphas.data(), mesh.alphas.size() * sizeof(float));
   }
   for (const Material& m : scene.materials) {
     h.value(uint8_t(chartKindOf(m.bsdf, settings)));

@@ -163,6 +163,8 @@ constexpr uint32_t kSurfaceDetailTag = 0x4c544453u;
 constexpr uint32_t kTexturingTag = 0x504d5854u;
 /// Opens SCNE's optional emission-texture block ("EMTX", version ≥ 5; plf_file.h).
 constexpr uint32_t kEmissionTextureTag = 0x58544d45u;
+/// Opens SCNE's optional vertex-alpha block ("VALP", version ≥ 6; plf_file.h).
+constexpr uint32_t kVertexAlphaTag = 0x504c4156u;
 
 /// Whether a scene needs the texturing block: a second uv set, vertex colours, a texture
 /// mapping other than TEXCOORD_0 as it is, a metallic-roughness texture or a sampling other
@@ -310,6 +312,11 @@ std::vector<unsigned char> encodeScene(const Scene& scene) {
       putMapping(w, m.emissionMapping);
     }
   }
+  // Vertex alphas: only when some mesh has them, so other files keep their layout.
+  if (std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) { return !m.alphas.empty(); })) {
+    w.put(kVertexAlphaTag);
+    for (const Mesh& m : scene.meshes) w.putArray(m.alphas);
+  }
   return std::move(w.bytes());
 }
 
@@ -410,13 +417,23 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
   const bool hasCamera = r.get<uint8_t>() != 0;
   std::string camera = r.getString();
   if (hasCamera) scene.settings.camera = std::move(camera);
-  // The optional blocks, in this order: SDTL, TXMP (version ≥ 5), EMTX (version ≥ 5).
-  const bool version5 = version >= 5;
-  uint32_t tag = r.remaining() > 0 ? r.get<uint32_t>() : 0;
-  if (tag != 0 && tag != kSurfaceDetailTag && !((tag == kTexturingTag || tag == kEmissionTextureTag) && version5))
-    r.corrupt("unexpected bytes after the scene's settings");
+  // The optional blocks, each at most once, in this order and from the version given:
+  // SDTL, TXMP (5), EMTX (5), VALP (6). nextTag reads the next one's tag (0 at the end).
+  constexpr std::pair<uint32_t, uint32_t> kBlocks[] = {
+      {kSurfaceDetailTag, 1}, {kTexturingTag, 5}, {kEmissionTextureTag, 5}, {kVertexAlphaTag, 6}};
+  size_t blocksPast = 0;
+  auto nextTag = [&](const char* after) -> uint32_t {
+    if (r.remaining() == 0) return 0;
+    const uint32_t tag = r.get<uint32_t>();
+    for (size_t b = blocksPast; b < std::size(kBlocks); ++b)
+      if (tag == kBlocks[b].first && version >= kBlocks[b].second) {
+        blocksPast = b + 1;
+        return tag;
+      }
+    r.corrupt(fmt::format("unexpected bytes after {}", after));
+  };
+  uint32_t tag = nextTag("the scene's settings");
   if (tag == kSurfaceDetailTag) {
-    tag = 0;
     for (Material& m : scene.materials) {
       m.alphaTexture = r.get<int32_t>();
       m.alphaFactor = r.get<float>();
@@ -430,11 +447,7 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
         r.corrupt(fmt::format("texture '{}' has unknown decoding {}", t.path, decode));
       t.decode = ImageDecode(decode);
     }
-    if (r.remaining() > 0) {
-      tag = r.get<uint32_t>();
-      if (!((tag == kTexturingTag || tag == kEmissionTextureTag) && version5))
-        r.corrupt("unexpected bytes after the surface-detail block");
-    }
+    tag = nextTag("the surface-detail block");
   }
   if (tag == kTexturingTag) {
     for (Mesh& m : scene.meshes) {
@@ -459,11 +472,7 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
         r.corrupt(fmt::format("texture '{}' has unknown sampling {} {} {} {}", t.path, wrapU, wrapV, nearest, mipmaps));
       t.sampling = TextureSampling{TextureWrap(wrapU), TextureWrap(wrapV), nearest != 0, mipmaps != 0};
     }
-    tag = 0;
-    if (r.remaining() > 0) {
-      tag = r.get<uint32_t>();
-      if (tag != kEmissionTextureTag) r.corrupt("unexpected bytes after the texturing block");
-    }
+    tag = nextTag("the texturing block");
   }
   if (tag == kEmissionTextureTag) {
     for (Material& m : scene.materials) {
@@ -472,7 +481,10 @@ Scene decodeScene(std::span<const unsigned char> bytes, const std::string& path,
       if (const std::string problem = mappingProblem(m); !problem.empty())
         r.corrupt(fmt::format("material '{}': {}", m.name, problem));
     }
+    tag = nextTag("the emission-texture block");
   }
+  if (tag == kVertexAlphaTag)
+    for (Mesh& m : scene.meshes) m.alphas = r.getArray<float>("vertex alphas");
   r.expectEnd();
   if (textures == TextureDecoding::Decode)
     for (Texture& t : scene.textures) {

@@ -51,6 +51,9 @@
 //         block: u32 tag "EMTX"; per material i32 emissionTexture (−1: none) and its
 //         TextureMapping. Without it no material has one (files written before emission
 //         textures read unchanged; a reader from before them refuses a file with the block).
+//         Then (version ≥ 6), only when a mesh has vertex alphas (Mesh::alphas), a
+//         vertex-alpha block: u32 tag "VALP"; per mesh u64 count + f32 alphas. Without it no
+//         mesh has them (likewise: older files read unchanged, older readers refuse it).
 //   CHRT  the charts: u64 count, then fixed 85-byte records (see encodeCharts in plf_file.cpp).
 //         The kind byte's bit 4 (version ≥ 4) marks a glossy chart whose tixels keep their
 //         diffuse irradiance after their map (Chart::diffuseValue, lightfield.h); bit 3

@@ -230,6 +230,12 @@ class PlfFileTest : public test_support::TempDirTest {
   /// The valid file at `path`, whose scene section must be larger than `plainSceneSize` (an
   /// optional block is there), with the byte `fromEnd` bytes before the end of that section set
   /// to `value` and re-signed, written as `name`: the reader must refuse it with `fragments`.
+  /// The SCNE section's size in `lf` written as it is (plain.plf): the layout a scene without
+  /// an optional block has, for expectRefusedWithSceneByte.
+  uint64_t sceneSectionSize(const LightField& lf) const {
+    writeLightField(file("plain.plf"), lf);
+    return sections(readBytes(file("plain.plf")))[0].size;
+  }
   void expectRefusedWithSceneByte(const std::string& path, uint64_t plainSceneSize, uint64_t fromEnd, uint8_t value,
                                   const std::string& name, const std::vector<std::string>& fragments) const {
     auto bytes = readBytes(path);
@@ -999,9 +1005,7 @@ TEST_F(PlfFileTest, RoundTripKeepsAlphaMasksNormalMapsAndTextureDecodings) {
 TEST_F(PlfFileTest, RoundTripKeepsTexturing) {
   LightField original = makeTestLightField();
   Scene& s = original.scene;
-  const std::string plainPath = file("plain.plf");
-  writeLightField(plainPath, original);
-  const uint64_t plainScene = sections(readBytes(plainPath))[0].size;
+  const uint64_t plainScene = sceneSectionSize(original);
   Mesh& quad = s.meshes[0];
   quad.uvs1 = {{0.5f, 0}, {1, 0.25f}, {1, 1}, {0, 0.5f}};
   quad.colors = {{1, 0.5f, 0.25f}, {0, 1, 1}, {0.5f, 0.5f, 0.5f}, {1, 1, 1}};
@@ -1047,9 +1051,7 @@ TEST_F(PlfFileTest, RoundTripKeepsTexturing) {
 TEST_F(PlfFileTest, RoundTripKeepsEmissionTextures) {
   LightField original = makeTestLightField();
   Scene& s = original.scene;
-  const std::string plainPath = file("plain.plf");
-  writeLightField(plainPath, original);
-  const uint64_t plainScene = sections(readBytes(plainPath))[0].size;
+  const uint64_t plainScene = sceneSectionSize(original);
   Material& lamp = s.materials[0];
   lamp.emission = Rgb(3.0f, 2.0f, 1.0f);
   lamp.emissionTexture = 1;
@@ -1071,6 +1073,35 @@ TEST_F(PlfFileTest, RoundTripKeepsEmissionTextures) {
     // The block ends with the last material's i32 texture, u8 uv set, 6 floats: uv set 7.
     expectRefusedWithSceneByte(path, plainScene, 25, 7, "emission_bad.plf",
                                {"scene section", "the emission texture reads uv set 7"});
+  }
+}
+
+// Vertex alphas (glTF COLOR_0's alpha) come back through the VALP block, alone after the
+// settings or after the other blocks; they make their materials masked again on load, and an
+// alpha outside [0, 1] in the block is refused naming the mesh.
+TEST_F(PlfFileTest, RoundTripKeepsVertexAlphas) {
+  LightField original = makeTestLightField();
+  Scene& s = original.scene;
+  const uint64_t plainScene = sceneSectionSize(original);
+  s.meshes[0].alphas = {0.0f, 0.25f, 1.0f, 0.5f};
+  for (const bool others : {false, true}) {
+    SCOPED_TRACE(others ? "after SDTL, TXMP and EMTX" : "alone");
+    if (others) {
+      s.materials[3].albedoMapping.offset = Vec2(0.5f, 0.0f);
+      s.materials[0].emissionTexture = 1;
+      s.materials[0].emission = Rgb(1.0f);
+    }
+    const std::string path = file("alphas.plf");
+    writeLightField(path, original);
+    const LightField copy = readLightField(path);
+    EXPECT_EQ(copy.scene.meshes[0].alphas, s.meshes[0].alphas);
+    EXPECT_TRUE(copy.scene.meshes[1].alphas.empty());
+    for (const uint32_t m : copy.scene.meshes[0].materials) EXPECT_TRUE(copy.scene.materials[m].isMasked());
+    EXPECT_EQ(copy.scene.materials[0].emissionTexture, others ? 1 : -1);
+    // The block ends with mesh 0's last alpha (0.5f, its high byte 12 − 3 bytes before the
+    // end) and mesh 1's empty count: 0x7f there makes it 1.7e38.
+    expectRefusedWithSceneByte(path, plainScene, 9, 0x7f, "alphas_bad.plf",
+                               {"scene section", "mesh", "vertex alpha 3", "outside [0, 1]"});
   }
 }
 

@@ -83,6 +83,24 @@ std::vector<unsigned char> dracoQuad(int& positionId, int& uvId) {
   return {buffer.data(), buffer.data() + buffer.size()};
 }
 
+/// A .glb of `json` and `bin`: header, JSON chunk, BIN chunk, each chunk padded to 4 bytes.
+std::vector<unsigned char> glbBytes(std::string json, std::vector<unsigned char> bin) {
+  while (json.size() % 4 != 0) json += ' ';
+  while (bin.size() % 4 != 0) bin.push_back(0);
+  std::vector<unsigned char> glb;
+  auto u32 = [&](uint32_t v) { glb.insert(glb.end(), reinterpret_cast<unsigned char*>(&v), reinterpret_cast<unsigned char*>(&v) + 4); };
+  glb.insert(glb.end(), {'g', 'l', 'T', 'F'});
+  u32(2);
+  u32(uint32_t(12 + 8 + json.size() + 8 + bin.size()));
+  u32(uint32_t(json.size()));
+  glb.insert(glb.end(), {'J', 'S', 'O', 'N'});
+  glb.insert(glb.end(), json.begin(), json.end());
+  u32(uint32_t(bin.size()));
+  glb.insert(glb.end(), {'B', 'I', 'N', '\0'});
+  glb.insert(glb.end(), bin.begin(), bin.end());
+  return glb;
+}
+
 /// The Draco quad as draco.gltf (the stream in draco.bin), or with `binary` as draco.glb (the
 /// stream in its binary chunk). Its index accessor has no buffer view, as exporters write it.
 std::string dracoGltf(const fs::path& dir, const std::vector<unsigned char>& bytes, int positionId, int uvId,
@@ -104,21 +122,7 @@ std::string dracoGltf(const fs::path& dir, const std::vector<unsigned char>& byt
     std::ofstream(dir / "draco.gltf", std::ios::binary) << text;
     return (dir / "draco.gltf").string();
   }
-  // GLB: header, JSON chunk, BIN chunk, each chunk padded to 4 bytes.
-  while (text.size() % 4 != 0) text += ' ';
-  std::vector<unsigned char> bin = bytes;
-  while (bin.size() % 4 != 0) bin.push_back(0);
-  std::vector<unsigned char> glb;
-  auto u32 = [&](uint32_t v) { glb.insert(glb.end(), reinterpret_cast<unsigned char*>(&v), reinterpret_cast<unsigned char*>(&v) + 4); };
-  glb.insert(glb.end(), {'g', 'l', 'T', 'F'});
-  u32(2);
-  u32(uint32_t(12 + 8 + text.size() + 8 + bin.size()));
-  u32(uint32_t(text.size()));
-  glb.insert(glb.end(), {'J', 'S', 'O', 'N'});
-  glb.insert(glb.end(), text.begin(), text.end());
-  u32(uint32_t(bin.size()));
-  glb.insert(glb.end(), {'B', 'I', 'N', '\0'});
-  glb.insert(glb.end(), bin.begin(), bin.end());
+  const std::vector<unsigned char> glb = glbBytes(text, bytes);
   writeBytes(dir / "draco.glb", glb);
   return (dir / "draco.glb").string();
 }
@@ -139,9 +143,16 @@ TEST(GltfCompression, DracoQuadLoadsAndADamagedBufferIsRefused) {
   expectError([&] { loadScene(dracoGltf(dir, bytes, positionId, 17)); }, {"draco.gltf", "mesh 'squashed'", "attribute 17"});
 }
 
+/// How meshoptGltf stores the compressed streams and the fallback buffer.
+enum class MeshoptLayout {
+  Files,     ///< meshopt.gltf: streams in meshopt.bin, a zero fallback in fallback.bin
+  Gltfpack,  ///< meshopt.glb as gltfpack writes it: streams in the binary chunk, a fallback
+             ///< buffer without uri declared larger than that chunk
+};
+
 /// The quad with EXT_meshopt_compression views: vertices (stride 12) and indices (TRIANGLES,
-/// stride 2), the compressed streams in meshopt.bin, a zero fallback buffer beside them.
-std::string meshoptGltf(const fs::path& dir, bool damage) {
+/// stride 2), compressed; where they and the fallback are, `layout` says.
+std::string meshoptGltf(const fs::path& dir, bool damage, MeshoptLayout layout = MeshoptLayout::Files) {
   std::vector<unsigned char> vertices(meshopt_encodeVertexBufferBound(4, 12));
   vertices.resize(meshopt_encodeVertexBuffer(vertices.data(), vertices.size(), kPositions, 4, 12));
   std::vector<unsigned char> uvs(meshopt_encodeVertexBufferBound(4, 8));
@@ -152,13 +163,20 @@ std::string meshoptGltf(const fs::path& dir, bool damage) {
   std::vector<unsigned char> all = vertices;
   all.insert(all.end(), uvs.begin(), uvs.end());
   all.insert(all.end(), indices.begin(), indices.end());
-  writeBytes(dir / "meshopt.bin", all);
-  writeBytes(dir / "fallback.bin", std::vector<unsigned char>(92, 0));
+  const bool glb = layout == MeshoptLayout::Gltfpack;
+  // gltfpack's fallback holds the views uncompressed (92 bytes here) and has no data; 4096
+  // bytes makes it larger than the binary chunk, as it is for a real mesh.
+  const std::string fallbackLength = glb ? "4096" : "92";
+  const std::string streams = glb ? "" : R"(, "uri": "meshopt.bin")", fallback = glb ? "" : R"(, "uri": "fallback.bin")";
+  if (!glb) {
+    writeBytes(dir / "meshopt.bin", all);
+    writeBytes(dir / "fallback.bin", std::vector<unsigned char>(92, 0));
+  }
   const size_t v = vertices.size(), u = uvs.size(), i = indices.size();
   const std::string text = R"({"asset": {"version": "2.0"},
     "extensionsUsed": ["EXT_meshopt_compression"], "extensionsRequired": ["EXT_meshopt_compression"],
-    "buffers": [{"byteLength": )" + std::to_string(all.size()) + R"(, "uri": "meshopt.bin"},
-                {"byteLength": 92, "uri": "fallback.bin", "extensions": {"EXT_meshopt_compression": {"fallback": true}}}],
+    "buffers": [{"byteLength": )" + std::to_string(all.size()) + streams + R"(},
+                {"byteLength": )" + fallbackLength + fallback + R"(, "extensions": {"EXT_meshopt_compression": {"fallback": true}}}],
     "bufferViews": [
       {"buffer": 1, "byteOffset": 0, "byteLength": 48, "byteStride": 12, "extensions": {"EXT_meshopt_compression":
         {"buffer": 0, "byteOffset": 0, "byteLength": )" + std::to_string(v) + R"(, "byteStride": 12, "count": 4, "mode": "ATTRIBUTES"}}},
@@ -173,6 +191,11 @@ std::string meshoptGltf(const fs::path& dir, bool damage) {
                   {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}],
     "meshes": [{"name": "packed", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2}]}],
     "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]})";
+  if (glb) {
+    EXPECT_LT(all.size(), 4096u);
+    writeBytes(dir / "meshopt.glb", glbBytes(text, all));
+    return (dir / "meshopt.glb").string();
+  }
   std::ofstream(dir / "meshopt.gltf", std::ios::binary) << text;
   return (dir / "meshopt.gltf").string();
 }
@@ -181,6 +204,17 @@ TEST(GltfCompression, MeshoptQuadLoadsAndADamagedStreamIsRefused) {
   const fs::path dir = scratch("meshopt");
   expectQuad(loadScene(meshoptGltf(dir, false)));
   expectError([&] { loadScene(meshoptGltf(dir, true)); }, {"meshopt.gltf", "buffer view 0", "EXT_meshopt_compression"});
+}
+
+// gltfpack's .glb: the fallback buffer has no data and a byteLength larger than the binary
+// chunk, which tinygltf alone refuses. The fuzzing seed seed-meshopt-fallback.glb is this
+// file (written by this test to its scratch folder, copied), so it is checked here too.
+TEST(GltfCompression, MeshoptGlbWithAFallbackLargerThanItsBinaryChunkLoads) {
+  const fs::path dir = scratch("meshopt_glb");
+  expectQuad(loadScene(meshoptGltf(dir, false, MeshoptLayout::Gltfpack)));
+  expectQuad(loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/fuzz/gltf/seed-meshopt-fallback.glb"));
+  expectError([&] { loadScene(meshoptGltf(dir, true, MeshoptLayout::Gltfpack)); },
+              {"meshopt.glb", "buffer view 0", "EXT_meshopt_compression"});
 }
 
 }  // namespace

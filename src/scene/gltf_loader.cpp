@@ -46,7 +46,8 @@
 //    attenuationColor c and attenuationDistance d give the absorption σa = −ln(c)/d.
 //    transmissionTexture, thicknessTexture and a baseColorTexture on it are ignored (warning).
 //  * alphaMode MASK → alpha mask: coverage = baseColorFactor.a × the baseColorTexture's alpha
-//    channel (1 when its image has none), cut at alphaCutoff (default 0.5). BLEND is read as
+//    channel (1 when its image has none) × COLOR_0's alpha (Mesh::alphas; 1 for RGB colours),
+//    cut at alphaCutoff (default 0.5). BLEND is read as
 //    MASK with cutoff 0.5 (warning): ray casting has no partial coverage. OPAQUE (the
 //    default) ignores alpha.
 //  * normalTexture → tangent-space normal map (raw values, no sRGB decoding; +x = +u,
@@ -866,24 +867,37 @@ void addPrimitive(GltfContext& ctx, const tinygltf::Primitive& primitive, const 
     std::vector<Vec2>& target = set == 0 ? mesh.uvs : mesh.uvs1;
     for (size_t v = 0; v < vertexCount; ++v) target.push_back(Vec2(uvs[2 * v], 1.0f - uvs[2 * v + 1]));
   }
-  // COLOR_0 (RGB or RGBA, linear; alpha not read) multiplies the base colour. All white is
-  // the same as none, which keeps the material's albedo constant (exporters often write it).
+  // COLOR_0 (RGB or RGBA, linear) multiplies the base colour, and its alpha the base colour's
+  // alpha: the coverage of an alpha-masked material (alphaMode MASK or BLEND; OPAQUE ignores
+  // alpha). All white is the same as none, which keeps the material's albedo constant
+  // (exporters often write it); all-opaque alphas likewise.
   if (const int colorAccessor = attribute("COLOR_0"); colorAccessor >= 0) {
     const int components = componentsOf(colorAccessor);
     const std::vector<float> colors = floatsOf(colorAccessor, components, "COLOR_0");
     if (colors.size() / size_t(components) != vertexCount)
       fail("{}: mesh '{}': COLOR_0 and POSITION counts differ", ctx.path, name);
-    bool clamped = false, white = true;
+    const std::string alphaMode = primitive.material >= 0 ? ctx.model.materials[size_t(primitive.material)].alphaMode : "";
+    const bool masked = components == 4 && (alphaMode == "MASK" || alphaMode == "BLEND");
+    bool clamped = false, white = true, opaque = true;
     for (size_t v = 0; v < vertexCount; ++v) {
-      const Rgb c(colors[size_t(components) * v], colors[size_t(components) * v + 1], colors[size_t(components) * v + 2]);
+      const float* value = &colors[size_t(components) * v];
+      const Rgb c(value[0], value[1], value[2]);
       const Rgb kept = glm::clamp(c, 0.0f, 1.0f);
-      if (!isFinite(c)) fail("{}: mesh '{}': COLOR_0 {} is not finite", ctx.path, name, v);
+      if (!isFinite(c) || (components == 4 && !std::isfinite(value[3])))
+        fail("{}: mesh '{}': COLOR_0 {} is not finite", ctx.path, name, v);
       clamped = clamped || kept != c;
       white = white && kept == Rgb(1.0f);
       mesh.colors.push_back(kept);
+      if (masked) {
+        const float alpha = std::clamp(value[3], 0.0f, 1.0f);
+        clamped = clamped || alpha != value[3];
+        opaque = opaque && alpha == 1.0f;
+        mesh.alphas.push_back(alpha);
+      }
     }
     if (clamped) spdlog::warn("{}: mesh '{}': COLOR_0 values outside [0, 1] clamped", ctx.path, name);
     if (white) mesh.colors.clear();
+    if (opaque) mesh.alphas.clear();
   }
 
   std::vector<uint32_t> indices;
@@ -1015,32 +1029,12 @@ bool keepEncodedImage(tinygltf::Image* image, const int imageIndex, std::string*
 }
 
 /// tinygltf refuses an index accessor without a buffer view, which is what an exporter writes
-/// for a KHR_draco_mesh_compression primitive (its indices are in the Draco stream). So when a
-/// file mentions the extension, such accessors get their primitive's Draco buffer view before
-/// tinygltf parses the JSON; their data is never read (decodeDracoPrimitive replaces it). Returns
-/// the file's bytes so patched (a .glb with its JSON chunk rebuilt), or "" when nothing needs it
-/// (then tinygltf reads the file itself, and reports whatever is wrong with it).
-std::string dracoPatchedFile(const std::string& path, bool binary) {
-  // The JSON alone first (a .glb's first chunk): the binary chunk is read only when patching.
-  std::ifstream in(path, std::ios::binary);
-  std::string header(binary ? 20 : 0, '\0'), text;
-  uint32_t jsonLength = 0;
-  if (binary) {
-    if (!in.read(header.data(), 20) || header.compare(0, 4, "glTF") != 0 || header.compare(16, 4, "JSON") != 0) return "";
-    std::memcpy(&jsonLength, header.data() + 12, 4);
-    std::error_code ec;
-    const uintmax_t size = std::filesystem::file_size(path, ec);
-    if (ec || jsonLength > size - 20) return "";  // a lying length: tinygltf reports the file
-    text.resize(jsonLength);
-    if (!in.read(text.data(), std::streamsize(jsonLength))) return "";
-  } else {
-    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  if (text.find(kDraco) == std::string::npos) return "";
-  nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array() || !doc.contains("accessors") ||
-      !doc["accessors"].is_array())
-    return "";
+/// for a KHR_draco_mesh_compression primitive (its indices are in the Draco stream). So such
+/// accessors get their primitive's Draco buffer view; their data is never read
+/// (decodeDracoPrimitive replaces it). Returns whether it changed `doc`.
+bool patchDracoIndices(nlohmann::json& doc) {
+  if (!doc.contains("meshes") || !doc["meshes"].is_array() || !doc.contains("accessors") || !doc["accessors"].is_array())
+    return false;
   nlohmann::json& accessors = doc["accessors"];
   bool patched = false;
   for (nlohmann::json& mesh : doc["meshes"]) {
@@ -1057,7 +1051,57 @@ std::string dracoPatchedFile(const std::string& path, bool binary) {
       patched = true;
     }
   }
-  if (!patched) return "";
+  return patched;
+}
+
+/// An EXT_meshopt_compression fallback buffer (its extension says "fallback": true) may have
+/// no data at all: no `uri`, only a byteLength, the size of the uncompressed views it stands
+/// for. tinygltf refuses that — in a .gltf for the missing uri, in a .glb (what gltfpack
+/// writes) because the byteLength is larger than the binary chunk, which holds the compressed
+/// data. The fallback is never read where meshopt decodes (decodeMeshoptViews points every
+/// view at its decoded bytes), so in a build with meshopt each such buffer becomes a 3-byte
+/// data URI. Returns whether it changed `doc`.
+bool patchMeshoptFallbacks(nlohmann::json& doc) {
+  if (!meshoptSupported() || !doc.contains("buffers") || !doc["buffers"].is_array()) return false;
+  bool patched = false;
+  for (nlohmann::json& buffer : doc["buffers"]) {
+    if (!buffer.is_object() || buffer.contains("uri")) continue;
+    const auto extensions = buffer.find("extensions");
+    if (extensions == buffer.end() || !extensions->is_object() || !extensions->contains(kMeshopt)) continue;
+    const nlohmann::json& meshopt = (*extensions)[kMeshopt];
+    if (!meshopt.is_object() || !meshopt.contains("fallback") || meshopt["fallback"] != true) continue;
+    buffer["uri"] = "data:application/octet-stream;base64,AAAA";
+    buffer["byteLength"] = 3;
+    patched = true;
+  }
+  return patched;
+}
+
+/// The glTF file's bytes as tinygltf should read them (patchDracoIndices, patchMeshoptFallbacks;
+/// a .glb with its JSON chunk rebuilt), or "" when nothing needs patching (then tinygltf reads
+/// the file itself, and reports whatever is wrong with it).
+std::string patchedFile(const std::string& path, bool binary) {
+  // The JSON alone first (a .glb's first chunk): the binary chunk is read only when patching.
+  std::ifstream in(path, std::ios::binary);
+  std::string header(binary ? 20 : 0, '\0'), text;
+  uint32_t jsonLength = 0;
+  if (binary) {
+    if (!in.read(header.data(), 20) || header.compare(0, 4, "glTF") != 0 || header.compare(16, 4, "JSON") != 0) return "";
+    std::memcpy(&jsonLength, header.data() + 12, 4);
+    std::error_code ec;
+    const uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec || jsonLength > size - 20) return "";  // a lying length: tinygltf reports the file
+    text.resize(jsonLength);
+    if (!in.read(text.data(), std::streamsize(jsonLength))) return "";
+  } else {
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  if (text.find(kDraco) == std::string::npos && text.find(kMeshopt) == std::string::npos) return "";
+  nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (!doc.is_object()) return "";
+  const bool draco = patchDracoIndices(doc);
+  const bool meshopt = patchMeshoptFallbacks(doc);
+  if (!draco && !meshopt) return "";
   std::string json = doc.dump();
   if (!binary) return json;
   const std::string rest((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -1084,7 +1128,7 @@ Scene loadGltf(const std::string& path) {
   bool ok = false;
   try {
     const bool binary = extension == ".glb";
-    if (const std::string patched = dracoPatchedFile(path, binary); !patched.empty()) {
+    if (const std::string patched = patchedFile(path, binary); !patched.empty()) {
       const std::string baseDir = std::filesystem::path(path).parent_path().string();
       ok = binary ? loader.LoadBinaryFromMemory(&model, &error, &warning, reinterpret_cast<const unsigned char*>(patched.data()),
                                                 unsigned(patched.size()), baseDir)

@@ -60,7 +60,8 @@ fs::path scratch(const std::string& name) {
     for (int x = 0; x < kSide; ++x)
       for (int c = 0; c < 3; ++c) png.rgb.push_back(texelByte(x, y, c));
   writePng((dir / "tex.png").string(), png);
-  // Buffer: POSITION (4 × vec3), TEXCOORD_0, TEXCOORD_1 (= TEXCOORD_0 / 2), COLOR_0 (vec3), indices.
+  // Buffer: POSITION (4 × vec3), TEXCOORD_0, TEXCOORD_1 (= TEXCOORD_0 / 2), COLOR_0 (vec3),
+  // indices, COLOR_0 (vec4: white, alpha = y).
   std::vector<float> floats;
   const float xy[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
   for (const auto& p : xy) floats.insert(floats.end(), {p[0], p[1], 0.0f});
@@ -71,6 +72,9 @@ fs::path scratch(const std::string& name) {
   std::ofstream bin(dir / "quad.bin", std::ios::binary);
   bin.write(reinterpret_cast<const char*>(floats.data()), std::streamsize(floats.size() * 4));
   bin.write(reinterpret_cast<const char*>(indices), sizeof(indices));
+  std::vector<float> rgba;
+  for (const auto& p : xy) rgba.insert(rgba.end(), {1.0f, 1.0f, 1.0f, p[1]});
+  bin.write(reinterpret_cast<const char*>(rgba.data()), std::streamsize(rgba.size() * 4));
   return dir;
 }
 
@@ -79,15 +83,16 @@ fs::path scratch(const std::string& name) {
 std::string writeQuad(const fs::path& dir, const std::string& material, const std::string& attributes = "",
                       const std::string& top = "", const std::string& sampler = "{}") {
   const std::string text = R"({"asset": {"version": "2.0"}, )" + top + R"(
-    "buffers": [{"byteLength": 172, "uri": "quad.bin"}],
+    "buffers": [{"byteLength": 236, "uri": "quad.bin"}],
     "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32},
                     {"buffer": 0, "byteOffset": 80, "byteLength": 32}, {"buffer": 0, "byteOffset": 112, "byteLength": 48},
-                    {"buffer": 0, "byteOffset": 160, "byteLength": 12}],
+                    {"buffer": 0, "byteOffset": 160, "byteLength": 12}, {"buffer": 0, "byteOffset": 172, "byteLength": 64}],
     "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]},
                   {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
                   {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
                   {"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC3"},
-                  {"bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+                  {"bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR"},
+                  {"bufferView": 5, "componentType": 5126, "count": 4, "type": "VEC4"}],
     "images": [{"uri": "tex.png"}], "samplers": [)" + sampler + R"(],
     "textures": [{"source": 0, "sampler": 0}],
     "materials": [)" + material + R"(],
@@ -226,6 +231,29 @@ TEST(GltfTexturing, VertexColorScalesTheAlbedo) {
   const SurfaceHit hit = surfaceAt(coloured, 0, 1, Vec2(0.3f, 0.4f));
   EXPECT_VEC3_NEAR(diffuseAlbedo(bsdfAt(coloured, hit)), Rgb(0.8f * 0.5f, 0.6f * 1.0f, 0.4f * 0.25f), kTight);
   EXPECT_VEC3_NEAR(diffuseAlbedo(bsdfAt(plain, hit)), Rgb(0.8f, 0.6f, 0.4f), kTight);
+}
+
+// COLOR_0's alpha multiplies the base colour's alpha: an alpha-masked material's coverage
+// (alpha = y on the quad here, × baseColorFactor.a); OPAQUE ignores it, as it does alpha.
+TEST(GltfTexturing, VertexAlphaMultipliesTheMaskCoverage) {
+  const fs::path dir = scratch("color0_alpha");
+  auto coverage = [](const Scene& scene, float x, float y) {
+    return x >= y ? coverageAt(scene, 0, 0, Vec2(x - y, y)) : coverageAt(scene, 0, 1, Vec2(x, y - x));
+  };
+  const Scene masked = loadScene(writeQuad(
+      dir, R"({"alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.8]}})", R"(, "COLOR_0": 5)"));
+  ASSERT_TRUE(masked.materials[0].isMasked());
+  EXPECT_FALSE(masked.materials[0].vertexColored);  // white: the albedo stays constant
+  for (const Vec2 p : {Vec2(0.6f, 0.3f), Vec2(0.2f, 0.7f), Vec2(0.9f, 0.9f)})
+    EXPECT_NEAR(coverage(masked, p.x, p.y), 0.8f * p.y, kTight) << p.x << "," << p.y;
+  const Scene opaque = loadScene(writeQuad(dir, R"({"pbrMetallicRoughness": {}})", R"(, "COLOR_0": 5)"));
+  EXPECT_FALSE(opaque.materials[0].isMasked());
+  EXPECT_TRUE(opaque.meshes[0].alphas.empty());
+  // RGB colours have no alpha: a MASK material keeps its factor's coverage.
+  const Scene rgb = loadScene(writeQuad(
+      dir, R"({"alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.8]}})", R"(, "COLOR_0": 3)"));
+  EXPECT_TRUE(rgb.meshes[0].alphas.empty());
+  EXPECT_NEAR(coverage(rgb, 0.6f, 0.3f), 0.8f, kTight);
 }
 
 // A metallicRoughnessTexture sets the model at each hit: B × metallicFactor is the metalness,

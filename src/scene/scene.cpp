@@ -67,11 +67,13 @@ std::string mappingProblem(const Material& material) {
 }
 
 void markVertexColoredMaterials(Scene& scene) {
-  for (Material& material : scene.materials) material.vertexColored = false;
+  for (Material& material : scene.materials) material.vertexColored = material.vertexAlpha = false;
   for (const Mesh& mesh : scene.meshes)
-    if (!mesh.colors.empty())
-      for (const uint32_t material : mesh.materials)
-        if (material < scene.materials.size()) scene.materials[material].vertexColored = true;
+    for (const uint32_t material : mesh.materials)
+      if (material < scene.materials.size()) {
+        scene.materials[material].vertexColored |= !mesh.colors.empty();
+        scene.materials[material].vertexAlpha |= !mesh.alphas.empty();
+      }
 }
 
 size_t openSubsurfaceEdges(const Scene& scene, const Mesh& mesh) {
@@ -180,6 +182,11 @@ void checkScene(const Scene& scene) {
       if (!isFinite(mesh.colors[v]) || glm::any(glm::lessThan(mesh.colors[v], Rgb(0.0f))) ||
           maxComponent(mesh.colors[v]) > 1.0f)
         fail("{}: mesh '{}': vertex colour {} is {}, outside [0, 1]", src, mesh.name, v, vecString(mesh.colors[v]));
+    if (!mesh.alphas.empty() && mesh.alphas.size() != vertexCount)
+      fail("{}: mesh '{}' has {} vertex alphas for {} vertices", src, mesh.name, mesh.alphas.size(), vertexCount);
+    for (size_t v = 0; v < mesh.alphas.size(); ++v)
+      if (!(mesh.alphas[v] >= 0.0f && mesh.alphas[v] <= 1.0f))
+        fail("{}: mesh '{}': vertex alpha {} is {}, outside [0, 1]", src, mesh.name, v, mesh.alphas[v]);
     if (mesh.materials.size() != mesh.triangles.size())
       fail("{}: mesh '{}' has {} material indices for {} triangles", src, mesh.name, mesh.materials.size(),
            mesh.triangles.size());
@@ -394,10 +401,16 @@ Vec3 normalMapped(const Vec3& n, const Vec3& geometricNormal, const Vec3 (&p)[3]
 float coverageAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, Vec2 barycentrics) {
   const Mesh& mesh = scene.meshes[meshIndex];
   const Material& material = scene.materials[mesh.materials[triangle]];
-  if (material.alphaTexture < 0) return material.alphaFactor;
+  float coverage = material.alphaFactor;
+  if (!mesh.alphas.empty()) {
+    const float b1 = barycentrics.x, b2 = barycentrics.y, b0 = 1.0f - b1 - b2;
+    const UVec3 tri = mesh.triangles[triangle];
+    coverage *= b0 * mesh.alphas[tri.x] + b1 * mesh.alphas[tri.y] + b2 * mesh.alphas[tri.z];
+  }
   // Only uv is needed (this runs per candidate hit inside Embree's traversal).
-  return material.alphaFactor *
-         scene.textures[size_t(material.alphaTexture)].sample(uvAt(mesh, triangle, barycentrics, material.alphaMapping)).r;
+  if (material.alphaTexture >= 0)
+    coverage *= scene.textures[size_t(material.alphaTexture)].sample(uvAt(mesh, triangle, barycentrics, material.alphaMapping)).r;
+  return coverage;
 }
 
 AlbedoPoint albedoPointAt(const Scene& scene, uint32_t meshIndex, uint32_t triangle, Vec2 barycentrics) {

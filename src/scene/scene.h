@@ -85,9 +85,10 @@ struct Material {
   /// emissionMapping, at full resolution (emissionModulation).
   int emissionTexture = -1;
   /// Alpha mask (cut-out): coverage α = alphaFactor × (alphaTexture's coverage at uv, or 1
-  /// without one). Where α < alphaCutoff the surface is not there at all: ray casting (Accel)
-  /// skips the hit, so every renderer, shadow ray and the bake see through it. alphaTexture is
-  /// an index into Scene::textures (decoded as ImageDecode::Coverage) or -1.
+  /// without one) × the mesh's vertex alpha (Mesh::alphas, 1 without). Where α < alphaCutoff
+  /// the surface is not there at all: ray casting (Accel) skips the hit, so every renderer,
+  /// shadow ray and the bake see through it. alphaTexture is an index into Scene::textures
+  /// (decoded as ImageDecode::Coverage) or -1.
   int alphaTexture = -1;
   float alphaFactor = 1.0f;
   float alphaCutoff = 0.5f;
@@ -110,6 +111,9 @@ struct Material {
   /// so that its albedo varies over a surface even without a texture. Scene::finalize and the
   /// .plf reader set it (markVertexColoredMaterials).
   bool vertexColored = false;
+  /// Derived, not stored: whether a mesh with vertex alphas (Mesh::alphas) uses the material,
+  /// so that its coverage varies over a surface even without a texture (the same setters).
+  bool vertexAlpha = false;
 
   bool isEmissive() const { return !isBlack(emission); }
   /// Whether the diffuse albedo varies over the surface (a texture or vertex colours): the
@@ -119,7 +123,7 @@ struct Material {
   /// texture): materialModelAt is then needed per point.
   bool modelVaries() const { return albedoVaries() || metallicRoughness.texture >= 0; }
   /// Whether some of the surface may be cut away (the Accel filters hits on it).
-  bool isMasked() const { return alphaTexture >= 0 || alphaFactor < alphaCutoff; }
+  bool isMasked() const { return alphaTexture >= 0 || alphaFactor < alphaCutoff || vertexAlpha; }
 };
 
 /// The sidedness rule for emission, written once for the path tracer, the bake and the
@@ -157,6 +161,10 @@ struct Mesh {
   /// Linear RGB vertex colours (glTF COLOR_0), empty or one per vertex in [0, 1]: they
   /// multiply the diffuse albedo (albedoModulation), interpolated over each triangle.
   std::vector<Rgb> colors;
+  /// Vertex alphas (glTF COLOR_0's alpha on an alpha-masked material), empty or one per vertex
+  /// in [0, 1]: they multiply the alpha mask's coverage (coverageAt), interpolated over each
+  /// triangle. The glTF loader keeps them only where they can cut something away.
+  std::vector<float> alphas;
   std::vector<UVec3> triangles;
   std::vector<uint32_t> materials;  ///< one per triangle, index into Scene::materials
 };
@@ -369,11 +377,12 @@ std::string mappingProblem(const Material& material);
 /// means); otherwise the model with its diffuse albedo × albedoModulation(p).
 Bsdf materialModelAt(const Scene& scene, const Material& material, const AlbedoPoint& p);
 
-/// Sets Material::vertexColored from the meshes (Scene::finalize and the .plf reader call it).
+/// Sets Material::vertexColored and vertexAlpha from the meshes (Scene::finalize and the .plf
+/// reader call it).
 void markVertexColoredMaterials(Scene& scene);
 
 /// The alpha mask's coverage at barycentrics (b1, b2) of a triangle: alphaFactor × texture
-/// coverage at the interpolated uv (1 for unmasked materials). The Accel's hit filter.
+/// coverage at the interpolated uv × the interpolated vertex alpha. The Accel's hit filter.
 float coverageAt(const Scene& scene, uint32_t mesh, uint32_t triangle, Vec2 barycentrics);
 
 /// The sidedness rule for scattering, written once for the path tracer, the bake's specular
