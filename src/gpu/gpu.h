@@ -6,7 +6,9 @@
 // A frame is two passes:
 //   1. visibility: every triangle of the scene rasterised once with a reversed-Z float depth
 //      buffer, writing its triangle id (+1; 0 = nothing) per pixel — the primary hit of the
-//      ray through the pixel centre, as the CPU renderer's one sample per pixel;
+//      ray through the pixel centre, as the CPU renderer's one sample per pixel; an
+//      alpha-masked triangle is discarded where that ray meets it at a coverage below its
+//      cutoff (coverageAt), as the ray caster's hit filter does;
 //   2. shading: per pixel, the camera ray of Camera::generateRay through the pixel centre,
 //      intersected with the triangles of that pixel and its 8 neighbours (the rasteriser snaps
 //      vertices to a sub-pixel grid, which can hand a centre near an edge the triangle across
@@ -14,7 +16,11 @@
 //      the CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
 //      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes) in a fragment shader,
 //      times the camera weight (cos⁴θ with vignetting). A miss sees the environment (the
-//      constant and the map: EnvironmentMap::radiance, bilinear in the lat-long image).
+//      constant and the map: EnvironmentMap::radiance, bilinear in the lat-long image). On a
+//      chart whose albedo varies, the albedo texture is read at the CPU renderer's mip level
+//      (albedoTextureLod: ray cones of textureConeSpread × t) exactly as Texture::sampleLod
+//      reads it (wrap modes, nearest, trilinear between levels), times the vertex colour; an
+//      emission texture is read at full resolution (emissionModulation).
 // The result is radiance (W·sr⁻¹·m⁻², camera weight included, no exposure), read back into an
 // Image exactly where FastRenderer::render writes it; exposure and tone mapping are then the
 // same CPU code for both renderers (jobs/ ViewSettings::writeImage).
@@ -23,16 +29,24 @@
 // copy), its chart records with their precomputed shading (ChartShading), the vertex positions
 // and normals (a curved glossy chart's map is read around the interpolated normal,
 // chartShadingNormalAt), the triangle → chart map, the sun masks (one uint each; the masked
-// lights are uniforms) and the environment map's texels (RGBA). So GPU memory is 16 bytes per
-// value + 128 per chart + 32 per vertex + 28 per triangle + 4 per sun mask + 16 per
-// environment texel + the frame's targets (radiance 16 bytes per pixel; id
-// and depth 8 bytes per pixel, or per texel of the finer multi-sample visibility pass).
+// lights are uniforms), the environment map's texels (RGBA) and the surface detail
+// (gpu_surface_detail.h: the textures the shader reads — 4 bytes per texel of an 8-bit level
+// as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 128 bytes per
+// material, and where a chart or mask needs uvs, 32 bytes per vertex and 4 per triangle). So
+// GPU memory is 16 bytes per value + 128 per chart + 32 per vertex + 28 per triangle + 4 per
+// sun mask + 16 per environment texel + the surface detail + the frame's targets (radiance 16
+// bytes per pixel; id and depth 8 bytes per pixel, or per texel of the finer multi-sample
+// visibility pass). A light field whose buffers exceed the GPU memory available
+// (gpu_memory.h: the driver's query, GL_NVX_gpu_memory_info or GL_ATI_meminfo; the
+// PLENOPTIC_GPU_MEMORY variable; 4 GiB where neither says) is refused before anything is
+// uploaded, with the sizes, and so is one with a buffer larger than the driver's largest
+// storage block.
 //
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
-// picture): mirrors and glass (specular charts), albedo textures and vertex colours, normal
-// maps, alpha masks, punctual highlights, rough glass, GGX diffuse bases; and of the render
-// settings, thin lenses.
+// picture): mirrors and glass (specular charts), normal maps, metallic-roughness textures,
+// albedo textures on non-Lambertian diffuse charts, punctual highlights, rough glass, GGX
+// diffuse bases; and of the render settings, thin lenses.
 //
 // Several samples per pixel: the shading pass loops over the pixel's samples at the CPU
 // renderers' jittered film points (Pcg32::forKey in 64-bit GLSL integers,
@@ -86,8 +100,9 @@ class GpuRenderer {
  public:
   /// Creates the headless context (EGL: Mesa's surfaceless platform, else the default display
   /// with a 1×1 pbuffer), compiles the shaders and uploads the light field. Throws pl::Error
-  /// naming the EGL or GL error when no OpenGL 4.5 core context can be had, and naming the
-  /// feature (gpuUnsupportedFeature) for a light field it cannot draw. `lightField` must
+  /// naming the EGL or GL error when no OpenGL 4.5 core context can be had, naming the
+  /// feature (gpuUnsupportedFeature) for a light field it cannot draw, and giving the sizes
+  /// for one that does not fit the GPU memory. `lightField` must
   /// outlive the renderer. The context belongs to the renderer: use it from one thread.
   explicit GpuRenderer(const LightField& lightField);
   ~GpuRenderer();

@@ -12,13 +12,16 @@
 #include "env/env.h"
 #include "gpu/egl_context.h"
 #include "gpu/gpu.h"
+#include "gpu/gpu_memory.h"
+#include "gpu/gpu_surface_detail.h"
 #include "lightfield/lookup.h"
 
 namespace pl {
 namespace {
 
-// Chart record flags (ChartGpu::info.z). The GLSL constants are generated from these
-// (glslConstants), so the shader and the upload cannot disagree.
+// Chart record flags (ChartGpu::info.z; gpu_surface_detail.h adds its own from 128 up). The
+// GLSL constants are generated from these (glslConstants), so the shader and the upload cannot
+// disagree.
 constexpr uint32_t kFlagTwoSided = 1u, kFlagBack = 2u, kFlagCurved = 4u, kFlagDiffuseValue = 8u, kFlagEmissive = 16u,
                    kFlagTwoSidedEmission = 32u, kFlagSunMasks = 64u;
 
@@ -29,7 +32,7 @@ struct ChartGpu {
   uint32_t grid[4];       ///< resU, resV, dirRes, firstValue
   uint32_t info[4];       ///< valuesPerTixel, kind (ChartKind), flags, firstTixel (its sun masks)
   float emission[4];      ///< ChartShading::emission
-  float albedoOverPi[4];  ///< ChartShading::albedoOverPi
+  float albedoOverPi[4];  ///< ChartShading::albedoOverPi; with kFlagTexturedAlbedo the base albedo (texturedAlbedoBase)
 };
 static_assert(sizeof(ChartGpu) == 128);
 
@@ -54,7 +57,7 @@ int multiSampleIdScale(int width, int height) {
 // Shader storage bindings.
 constexpr GLuint kValuesBinding = 0, kChartsBinding = 1, kPositionsBinding = 2, kTrianglesBinding = 3,
                  kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7,
-                 kEnvironmentBinding = 8;
+                 kEnvironmentBinding = 8, kSurfaceDetailBinding = 12;
 
 std::string glslConstants() {
   return fmt::format(
@@ -220,8 +223,9 @@ vec3 toLocalAround(ChartRecord c, vec3 n, vec3 w) {
 // triangle maps to chart record `chart` (triangleChart's front record): normalAtHit is
 // chartNormalAt's normal there (the record's side), shadingNormal interpolatedNormal's (the
 // front's; a curved glossy chart's map is read around it, chartShadingNormalAt). viewedChart,
-// then exitantRadianceLanes.
-vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, vec3 shadingNormal) {
+// then exitantRadianceLanes. detail: the albedo modulation and emission texel at the hit
+// (surfaceDetailAt), read on charts whose albedo or emission is textured.
+vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, vec3 shadingNormal, SurfaceDetail detail) {
   ChartRecord c = charts[chart];
   uint flags = c.info.z;
   float side = dot(towardsViewer, normalAtHit);
@@ -234,19 +238,24 @@ vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, ve
   float cosTheta = (flags & kFlagCurved) != 0u ? 1.0 : dot(towardsViewer, c.normal.xyz);
   bool emits = cosTheta > 0.0 || (flags & kFlagTwoSidedEmission) != 0u;
   vec3 emission = (flags & kFlagEmissive) != 0u && emits ? c.emission.rgb : vec3(0.0);
+  if ((flags & kFlagTexturedEmission) != 0u) emission *= detail.emission;
   if (!(cosTheta >= 0.0)) return emission;
   // lookupNormalAt: the chart normal, or on a curved chart the interpolated one (chartShadingNormalAt).
   vec3 lookupNormal = (flags & kFlagBack) != 0u ? -shadingNormal : shadingNormal;
   if (c.info.y == kDiffuse) {
     vec3 irradiance = interpolateLanes(c, grid, vec2(0.0));
     if ((flags & kFlagSunMasks) != 0u) irradiance += sunIrradianceAt(c, grid, lookupNormal);
-    return emission + c.albedoOverPi.rgb * irradiance;
+    // diffuseAlbedoAt: the base albedo × the modulation, over π.
+    vec3 albedoOverPi = (flags & kFlagTexturedAlbedo) != 0u ? c.albedoOverPi.rgb * detail.albedo * kInvPi : c.albedoOverPi.rgb;
+    return emission + albedoOverPi * irradiance;
   }
   vec3 local = toLocalAround(c, lookupNormal, towardsViewer);
   vec3 mapped = interpolateLanes(c, grid, directionToParaboloid(local));
   if ((flags & kFlagDiffuseValue) == 0u) return mapped;
   float k = local.z > 0.0 ? 1.0 : 0.0;  // diffuseDirectionalFactor of Blinn-Phong
-  return mapped + c.albedoOverPi.rgb * k * diffuseValueOverTixels(c, grid);
+  // glossyDiffuseAlbedoAt: the model's diffuse albedo × the modulation.
+  vec3 albedoOverPi = (flags & kFlagTexturedAlbedo) != 0u ? c.albedoOverPi.rgb * detail.albedo * kInvPi : c.albedoOverPi.rgb;
+  return mapped + albedoOverPi * k * diffuseValueOverTixels(c, grid);
 }
 )glsl";
 
@@ -262,9 +271,40 @@ void main() {
   gl_Position = vec4(dot(v, right) / (tanHalfFovY * aspect), -dot(v, up) / tanHalfFovY, near, z);
 }
 )glsl";
+// The fragment stages' view of the scene: its triangles, the camera and film size, and the
+// ray through a film point (Camera::generateRay's pinhole).
+constexpr const char* kFrameGlsl = R"glsl(
+layout(std430, binding = POSITIONS_BINDING) readonly buffer Positions { vec4 positions[]; };
+layout(std430, binding = TRIANGLES_BINDING) readonly buffer Triangles { uvec4 triangles[]; };
+uniform vec3 eye, forward, right, up;
+uniform float tanHalfFovY, aspect;
+uniform ivec2 size;
+uniform int idScale;  // the ids are at idScale × the image's resolution
+uniform bool anyMasked;  // some material is alpha-masked (maskedMaterial)
+// The vector from the eye to film point `film` (pixel units) on the image plane at unit distance.
+vec3 cameraToFilm(vec2 film) {
+  float sx = (2.0 * film.x / float(size.x) - 1.0) * tanHalfFovY * aspect;
+  float sy = (1.0 - 2.0 * film.y / float(size.y)) * tanHalfFovY;
+  return forward + sx * right + sy * up;
+}
+)glsl";
+// An alpha-masked triangle (anyMasked: the scene has some) is cut away where the ray through
+// the texel centre meets it at a coverage below its cutoff (coverageAt), as the ray caster's
+// hit filter does: the surface behind it is seen there.
 constexpr const char* kVisibilityFragment = R"glsl(
 out uint id;
-void main() { id = uint(gl_PrimitiveID) + 1u; }
+void main() {
+  uint triangle = uint(gl_PrimitiveID);
+  if (anyMasked && maskedMaterial(triangle)) {
+    vec3 direction = normalize(cameraToFilm(gl_FragCoord.xy / float(idScale)));
+    uvec4 tri = triangles[triangle];
+    vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
+    vec3 n = cross(p1 - p0, p2 - p0);
+    vec3 p = eye + (dot(p0 - eye, n) / dot(direction, n)) * direction;
+    if (masked(triangle, tri.xyz, hitBarycentrics(p0, p1, p2, p))) discard;
+  }
+  id = triangle + 1u;
+}
 )glsl";
 
 // Pass 2: per pixel, the camera ray through its centre (Camera::generateRay), the hit on the
@@ -276,15 +316,11 @@ void main() {
 }
 )glsl";
 constexpr const char* kShadingFragment = R"glsl(
-layout(std430, binding = POSITIONS_BINDING) readonly buffer Positions { vec4 positions[]; };
-layout(std430, binding = TRIANGLES_BINDING) readonly buffer Triangles { uvec4 triangles[]; };
 layout(std430, binding = NORMALS_BINDING) readonly buffer Normals { vec4 normals[]; };  // w = 0: none
 layout(binding = 0) uniform usampler2D ids;
-uniform vec3 eye, forward, right, up, background;
-uniform float tanHalfFovY, aspect;
-uniform ivec2 size;
-uniform int idScale;  // the ids are at idScale × the image's resolution
+uniform vec3 background;
 uniform bool vignetting;
+uniform float coneSpread;  // textureConeSpread: a sample's ray cone is coneSpread × t wide at t
 out vec4 color;
 
 // Environment::radiance (scene.h): the constant plus, where the scene has one, its map —
@@ -322,9 +358,7 @@ vec3 environmentRadiance(vec3 d) {
 // units, Camera::generateRay's pinhole). `jittered`: the film point is anywhere in its pixel,
 // not the centre (see the miss rule below).
 vec3 sampleRadiance(vec2 film, bool jittered) {
-  float sx = (2.0 * film.x / float(size.x) - 1.0) * tanHalfFovY * aspect;
-  float sy = (1.0 - 2.0 * film.y / float(size.y)) * tanHalfFovY;
-  vec3 toFilm = forward + sx * right + sy * up;
+  vec3 toFilm = cameraToFilm(film);
   float invLength = 1.0 / length(toFilm);
   float weight = 1.0;
   if (vignetting) weight = invLength * invLength * invLength * invLength;  // cos^4
@@ -356,7 +390,8 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
       vec3 r = cross(s, e1);
       float v = dot(direction, r) / det;
       float hit = dot(e2, r) / det;
-      if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit > 0.0 && hit < t) {
+      if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit > 0.0 && hit < t &&
+          !(anyMasked && masked(candidate - 1u, tri.xyz, vec2(u, v)))) {
         t = hit;
         id = candidate;
       }
@@ -369,6 +404,7 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
   if (isinf(t)) t = dot(p0 - eye, n) / dot(direction, n);
   vec3 p = eye + t * direction;
   ChartRecord c = charts[tri.w];
+  vec2 b = hitBarycentrics(p0, p1, p2, p);
   vec3 normalAtHit = c.normal.xyz, shadingNormal = c.normal.xyz;
   if ((c.info.z & kFlagCurved) != 0u) {
     // triangleNormal, then interpolatedNormal (scene.h) at the hit's barycentrics (b1, b2).
@@ -376,10 +412,7 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
     normalAtHit = length2 > 0.0 ? n / sqrt(length2) : vec3(0.0);
     shadingNormal = normalAtHit;
     if (normals[tri.x].w != 0.0) {
-      vec3 e1 = p1 - p0, e2 = p2 - p0, v = p - p0;
-      float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), v1 = dot(v, e1), v2 = dot(v, e2);
-      float denominator = d11 * d22 - d12 * d12;
-      float b1 = (d22 * v1 - d12 * v2) / denominator, b2 = (d11 * v2 - d12 * v1) / denominator;
+      float b1 = b.x, b2 = b.y;
       vec3 interpolated = (1.0 - b1 - b2) * normals[tri.x].xyz + b1 * normals[tri.y].xyz + b2 * normals[tri.z].xyz;
       float len = length(interpolated);
       if (len > 1e-6 && !isinf(len) && !isnan(len)) {
@@ -388,7 +421,8 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
       }
     }
   }
-  return weight * lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal);
+  SurfaceDetail detail = surfaceDetailAt(id - 1u, tri.xyz, p0, p1, p2, b, c.info.z, direction, coneSpread * t);
+  return weight * lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal, detail);
 }
 
 #ifdef MULTISAMPLE
@@ -458,7 +492,8 @@ void main() {
   if (i >= count) return;
   uint chart = floatBitsToUint(queries[i].position.w);
   vec3 normal = charts[chart].normal.xyz;
-  results[i] = vec4(lookupRadiance(chart, queries[i].position.xyz, queries[i].towardsViewer.xyz, normal, normal), 0.0);
+  results[i] = vec4(lookupRadiance(chart, queries[i].position.xyz, queries[i].towardsViewer.xyz, normal, normal,
+                                   noSurfaceDetail()), 0.0);
 }
 )glsl";
 
@@ -509,11 +544,17 @@ GLuint compileShader(GLenum type, const std::string& source, const char* name) {
 /// (extensions, defines), the generated constants and, where `lookup`, the lookup functions.
 GLuint linkProgram(std::initializer_list<std::pair<GLenum, const char*>> stages, const char* name, bool lookup,
                    const char* header = "") {
-  const std::string prefix = "#version 450 core\n" + std::string(header) + glslConstants() + (lookup ? kLookupGlsl : "");
+  const std::string prefix = "#version 450 core\n" + std::string(header) + glslConstants();
+  // The surface detail (its buffer and functions) for the fragment and compute stages, the
+  // triangles and the camera for the fragment stages.
+  const std::string detail = gpu::surfaceDetailGlsl(kSurfaceDetailBinding);
   const GLuint program = glCreateProgram();
   std::vector<GLuint> shaders;
   for (const auto& [type, source] : stages) {
-    shaders.push_back(compileShader(type, prefix + source, name));
+    const std::string text = type == GL_VERTEX_SHADER ? prefix + source
+                                                      : prefix + detail + (type == GL_FRAGMENT_SHADER ? kFrameGlsl : "") +
+                                                            (lookup ? kLookupGlsl : "") + source;
+    shaders.push_back(compileShader(type, text, name));
     glAttachShader(program, shaders.back());
   }
   glLinkProgram(program);
@@ -548,8 +589,6 @@ void setCameraUniforms(GLuint program, const Camera& camera) {
 
 std::string gpuUnsupportedFeature(const LightField& lf) {
   const Scene& scene = lf.scene;
-  for (const Material& m : scene.materials)
-    if (m.isMasked()) return "alpha masks";
   // PunctualHighlights::active() without its shadow-ray machinery: a bake with punctual
   // highlights, a delta light, and a glossy chart to show them.
   const bool glossy = std::any_of(lf.charts.begin(), lf.charts.end(), [](const Chart& c) { return c.kind == ChartKind::Glossy; });
@@ -561,10 +600,9 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
     const Chart& c = lf.charts[i];
     if (c.kind == ChartKind::Specular) return "mirrors and glass (specular charts)";
     const ChartShading shading = chartShading(lf, i, sun);
-    if (shading.texturedAlbedo) return "albedo textures, metallic-roughness textures and vertex colours";
+    if (std::string detail = gpu::surfaceDetailUnsupported(lf, c, shading); !detail.empty()) return detail;
     if (shading.normalMapped || c.directionalIrradiance) return "normal maps";
     if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) return "rough glass";
-    if (shading.texturedEmission) return "emission textures";
     // The shader takes a glossy chart's diffuse part as Blinn-Phong's, k(μ) = 1; GGX-like
     // models (GgxBsdf, GltfPbrBsdf) couple it to the lobe's albedo.
     const Bsdf& model = scene.materials[c.material].bsdf;
@@ -584,7 +622,9 @@ std::string gpuUnsupportedSetting(const RenderSettings& /*settings*/, const Came
 
 struct GpuRenderer::State {
   gpu::EglContext context;
-  GLuint buffers[8] = {};  // values, charts, positions, triangles, indices, normals, sun masks, environment map
+  // values, charts, positions, triangles, indices, normals, sun masks, environment map, surface detail
+  static constexpr GLsizei kBufferCount = 9;
+  GLuint buffers[kBufferCount] = {};
   GLuint vertexArray = 0, emptyVertexArray = 0;
   GLuint visibilityProgram = 0, shadingProgram = 0, lookupProgram = 0;
   /// The shading pass with several jittered samples per pixel; 0 where the driver lacks
@@ -600,7 +640,7 @@ struct GpuRenderer::State {
 
   ~State() {
     context.makeCurrent();
-    glDeleteBuffers(8, buffers);
+    glDeleteBuffers(kBufferCount, buffers);
     glDeleteVertexArrays(1, &vertexArray);
     glDeleteVertexArrays(1, &emptyVertexArray);
     glDeleteProgram(visibilityProgram);
@@ -677,12 +717,18 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                   (c.sides == 2 ? kFlagTwoSided : 0u) | (c.isBack ? kFlagBack : 0u) | (c.curved ? kFlagCurved : 0u) |
                       (c.diffuseValue ? kFlagDiffuseValue : 0u) | (shading.emissive ? kFlagEmissive : 0u) |
                       (shading.twoSidedEmission ? kFlagTwoSidedEmission : 0u) |
-                      (shading.sunMasks != nullptr ? kFlagSunMasks : 0u),
+                      (shading.sunMasks != nullptr ? kFlagSunMasks : 0u) |
+                      (shading.needsUv && shading.texturedAlbedo ? gpu::kFlagTexturedAlbedo : 0u) |
+                      (shading.texturedEmission ? gpu::kFlagTexturedEmission : 0u),
                   uint32_t(c.firstTixel)},
                  {},
                  {}};
     std::memcpy(g.emission, shading.emission.v, sizeof(g.emission));
     std::memcpy(g.albedoOverPi, shading.albedoOverPi.v, sizeof(g.albedoOverPi));
+    if (shading.needsUv && shading.texturedAlbedo) {
+      const Rgb base = gpu::texturedAlbedoBase(scene, c);
+      std::memcpy(g.albedoOverPi, &base, sizeof(Rgb));
+    }
   }
   // The geometry: every mesh's positions in one array, triangles with global vertex indices
   // (so gl_PrimitiveID of the one draw call is the triangle's index here) and their charts.
@@ -712,21 +758,8 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   if (!positions.empty()) s.near = std::max(1e-6f * glm::length(upper - lower), std::numeric_limits<float>::min());
   s.indexCount = GLsizei(indices.size());
 
-  glCreateBuffers(8, s.buffers);
-  auto upload = [&](GLuint buffer, const void* data, size_t bytes) {
-    // A zero-sized buffer cannot be bound to a storage block: 16 bytes stand in.
-    glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), bytes > 0 ? data : nullptr, GL_DYNAMIC_STORAGE_BIT);
-    s.bufferBytes += std::max<size_t>(bytes, 16);
-  };
-  upload(s.buffers[0], values.data(), values.size() * sizeof(float));
-  upload(s.buffers[1], charts.data(), charts.size() * sizeof(ChartGpu));
-  upload(s.buffers[2], positions.data(), positions.size() * sizeof(float));
-  upload(s.buffers[3], triangles.data(), triangles.size() * sizeof(TriangleGpu));
-  upload(s.buffers[4], indices.data(), indices.size() * sizeof(uint32_t));
-  upload(s.buffers[5], normals.data(), normals.size() * sizeof(float));
   const std::vector<uint32_t> sunMasks(lightField.sunMasks.begin(), lightField.sunMasks.end());
-  upload(s.buffers[6], sunMasks.data(), sunMasks.size() * sizeof(uint32_t));
-  // The environment map's lat-long texels as RGBA (none: a 16-byte stand-in).
+  // The environment map's lat-long texels as RGBA.
   const EnvironmentMap* environmentMap = scene.environment.map.get();
   std::vector<float> envTexels;
   if (environmentMap != nullptr) {
@@ -734,7 +767,34 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
     envTexels.resize(image.pixels.size() * 4, 0.0f);
     for (size_t i = 0; i < image.pixels.size(); ++i) std::memcpy(&envTexels[4 * i], &image.pixels[i], sizeof(Rgb));
   }
-  upload(s.buffers[7], envTexels.data(), envTexels.size() * sizeof(float));
+  const std::vector<uint32_t> detail = gpu::surfaceDetailWords(lightField);
+  // The buffers, in State::buffers' order, and what each holds (for the memory check's
+  // message). A zero-sized buffer cannot be bound to a storage block: 16 bytes stand in.
+  struct Upload {
+    const char* what;
+    const void* data;
+    size_t bytes;
+  };
+  const Upload uploads[State::kBufferCount] = {
+      {"values", values.data(), values.size() * sizeof(float)},
+      {"chart records", charts.data(), charts.size() * sizeof(ChartGpu)},
+      {"vertex positions", positions.data(), positions.size() * sizeof(float)},
+      {"triangles", triangles.data(), triangles.size() * sizeof(TriangleGpu)},
+      {"vertex indices", indices.data(), indices.size() * sizeof(uint32_t)},
+      {"vertex normals", normals.data(), normals.size() * sizeof(float)},
+      {"sun masks", sunMasks.data(), sunMasks.size() * sizeof(uint32_t)},
+      {"environment map", envTexels.data(), envTexels.size() * sizeof(float)},
+      {"textures, uvs and vertex colours", detail.data(), detail.size() * sizeof(uint32_t)}};
+  std::vector<std::pair<std::string, uint64_t>> sizes;
+  for (const Upload& u : uploads) sizes.emplace_back(u.what, std::max<size_t>(u.bytes, 16));
+  gpu::checkGpuMemory(sizes);
+  glCreateBuffers(State::kBufferCount, s.buffers);
+  for (GLsizei i = 0; i < State::kBufferCount; ++i) {
+    const Upload& u = uploads[i];
+    glNamedBufferStorage(s.buffers[i], GLsizeiptr(std::max<size_t>(u.bytes, 16)), u.bytes > 0 ? u.data : nullptr,
+                         GL_DYNAMIC_STORAGE_BIT);
+    s.bufferBytes += std::max<size_t>(u.bytes, 16);
+  }
   checkGl("uploading the light field (out of GPU memory?)");
 
   glCreateVertexArrays(1, &s.vertexArray);
@@ -754,6 +814,9 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                        "multi-sample shading", true,
                                        "#extension GL_ARB_gpu_shader_int64 : require\n#define MULTISAMPLE\n");
   glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
+  const bool anyMasked = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.isMasked(); });
+  for (GLuint program : {s.visibilityProgram, s.shadingProgram, s.multisampleProgram})
+    if (program != 0) glProgramUniform1i(program, glGetUniformLocation(program, "anyMasked"), anyMasked ? 1 : 0);
   for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {
     if (program == 0) continue;
     glProgramUniform3f(program, glGetUniformLocation(program, "background"), s.background.x, s.background.y,
@@ -775,6 +838,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kNormalsBinding, s.buffers[5]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSunMasksBinding, s.buffers[6]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kEnvironmentBinding, s.buffers[7]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSurfaceDetailBinding, s.buffers[8]);
   for (GLuint program : {s.shadingProgram, s.lookupProgram, s.multisampleProgram}) {
     if (program == 0) continue;
     glProgramUniform1ui(program, glGetUniformLocation(program, "sunCount"), sun.count);
@@ -799,6 +863,8 @@ void GpuRenderer::drawVisibility(const Camera& camera, int idScale) {
   s.context.makeCurrent();
   s.ensureTargets(camera.width(), camera.height(), idScale);
   setCameraUniforms(s.visibilityProgram, camera);
+  glProgramUniform2i(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "size"), camera.width(), camera.height());
+  glProgramUniform1i(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "idScale"), idScale);
   glBindFramebuffer(GL_FRAMEBUFFER, s.visibilityFramebuffer);
   glViewport(0, 0, camera.width() * idScale, camera.height() * idScale);
   const GLuint noTriangle = 0;
@@ -841,6 +907,8 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   glProgramUniform2i(program, glGetUniformLocation(program, "size"), camera.width(), camera.height());
   glProgramUniform1i(program, glGetUniformLocation(program, "idScale"), idScale);
   glProgramUniform1i(program, glGetUniformLocation(program, "vignetting"), camera.vignetting() ? 1 : 0);
+  glProgramUniform1f(program, glGetUniformLocation(program, "coneSpread"),
+                     textureConeSpread(settings, camera.pixelSpread(), spp));
   if (spp > 1) {
     glProgramUniform1i(program, glGetUniformLocation(program, "spp"), spp);
     glProgramUniform2ui(program, glGetUniformLocation(program, "seed"), GLuint(settings.seed & 0xffffffffu),

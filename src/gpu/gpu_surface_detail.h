@@ -1,0 +1,55 @@
+#pragma once
+// The GPU renderer's surface detail (internal to src/gpu): what the shading pass reads per
+// pixel besides the light field — albedo textures with their mip levels, vertex colours,
+// emission textures and alpha masks — uploaded as one storage buffer of 32-bit words, with the
+// GLSL that reads it (the C++ of scene/texture.h, scene/scene.h uvAt/vertexColorAt/coverageAt
+// and lightfield/lookup.h albedoTextureLod, statement for statement).
+//
+// The buffer (uint detail[]): a header of section offsets (words), then
+//   textures:  8 words each — first level (into the level table), level count (level 0 and its
+//              mips), sampling flags (wrap u | wrap v << 2 | nearest << 4 | mipmaps << 5 |
+//              default sampling << 6), the mean texel (3 floats), 2 unused;
+//   levels:    4 words each — width, height, first texel word, palette word (kNone: the texels
+//              are 3 floats each; else one word per texel, palette indices r | g << 8 | b << 16,
+//              into 3 × 256 floats: the CPU's packed texels, Texture::packed, unblocked);
+//   materials: kMaterialWords each — albedo, emission and alpha textures (kNone: none), alpha
+//              factor and cutoff, then the albedo, emission and alpha TextureMappings (8 words
+//              each: uv set, whether default, linear[0][0], [0][1], [1][0], [1][1], offset);
+//   vertices:  8 words each (all meshes' vertices in the renderer's order) — uv set 0 (2
+//              floats), uv set 1 (2), vertex colour (3), flags (has uvs | has uvs1 << 1 | has
+//              colours << 2);
+//   triangles: 1 word each — the triangle's material.
+// Textures are uploaded only where a chart the GPU draws reads them, vertices and triangles
+// only where some chart or mask needs a uv: a scene without either costs the header alone.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "lightfield/lightfield.h"
+#include "lightfield/lookup.h"
+
+namespace pl::gpu {
+
+/// Chart record flags (the shaders' ChartRecord info.z) that the surface detail adds to
+/// gpu_renderer.cpp's: the diffuse albedo varies (albedoOverPi then holds the material's base
+/// albedo, times the modulation per pixel), the emission is textured.
+inline constexpr uint32_t kFlagTexturedAlbedo = 128u, kFlagTexturedEmission = 256u;
+
+/// The first surface-detail feature of chart record `chart` the GPU renderer does not draw, as
+/// a phrase for gpuUnsupportedFeature; empty when it draws it.
+std::string surfaceDetailUnsupported(const LightField& lf, const Chart& chart, const ChartShading& shading);
+
+/// The base albedo the shader multiplies by the per-pixel modulation on a chart whose albedo
+/// varies (kFlagTexturedAlbedo): the Lambertian albedo of a diffuse chart (diffuseAlbedoAt's
+/// rule), the model's diffuse albedo of a glossy one with Ẽ (glossyDiffuseAlbedoAt's).
+Rgb texturedAlbedoBase(const Scene& scene, const Chart& chart);
+
+/// The words of the surface-detail buffer of `lf` (layout above).
+std::vector<uint32_t> surfaceDetailWords(const LightField& lf);
+
+/// The GLSL constants and functions (the buffer at binding `binding`): sampleTexture,
+/// sampleTextureLod, surfaceDetailAt (the albedo modulation and emission texel of a hit) and
+/// coverageAt (the alpha mask). Needs the chart flag constants (kFlagTexturedAlbedo, …).
+std::string surfaceDetailGlsl(unsigned binding);
+
+}  // namespace pl::gpu
