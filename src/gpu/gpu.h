@@ -44,7 +44,7 @@
 //
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
-// picture): mirrors and glass (specular charts), normal maps, metallic-roughness textures,
+// picture): mirrors and glass (specular charts), metallic-roughness textures,
 // albedo textures on non-Lambertian diffuse charts, punctual highlights, rough glass, GGX
 // diffuse bases; and of the render settings, thin lenses.
 //

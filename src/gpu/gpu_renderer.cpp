@@ -151,15 +151,17 @@ vec3 interpolateLanes(ChartRecord c, vec2 grid, vec2 st) {
   return sum;
 }
 // The glossy charts' diffuse irradiance, bilinear over the tixels (after each tixel's map).
-vec3 diffuseValueOverTixels(ChartRecord c, vec2 grid) {
+// bilinearOverTixels of the value `offset` after each tixel's first (its map: the diffuse
+// irradiance at dirRes², a tilted irradiance after it).
+vec3 tixelValueOverTixels(ChartRecord c, vec2 grid, uint offset) {
   LinearTap tu = linearTap(grid.x, c.grid.x), tv = linearTap(grid.y, c.grid.y);
-  uint map = c.grid.z * c.grid.z;
-  vec3 lower = (1.0 - tu.f) * (1.0 - tv.f) * values[valueIndex(c, tu.i0, tv.i0, 0u, 0u) + map].rgb +
-               tu.f * (1.0 - tv.f) * values[valueIndex(c, tu.i1, tv.i0, 0u, 0u) + map].rgb;
-  vec3 upper = (1.0 - tu.f) * tv.f * values[valueIndex(c, tu.i0, tv.i1, 0u, 0u) + map].rgb +
-               tu.f * tv.f * values[valueIndex(c, tu.i1, tv.i1, 0u, 0u) + map].rgb;
+  vec3 lower = (1.0 - tu.f) * (1.0 - tv.f) * values[valueIndex(c, tu.i0, tv.i0, 0u, 0u) + offset].rgb +
+               tu.f * (1.0 - tv.f) * values[valueIndex(c, tu.i1, tv.i0, 0u, 0u) + offset].rgb;
+  vec3 upper = (1.0 - tu.f) * tv.f * values[valueIndex(c, tu.i0, tv.i1, 0u, 0u) + offset].rgb +
+               tu.f * tv.f * values[valueIndex(c, tu.i1, tv.i1, 0u, 0u) + offset].rgb;
   return lower + upper;
 }
+vec3 diffuseValueOverTixels(ChartRecord c, vec2 grid) { return tixelValueOverTixels(c, grid, c.grid.z * c.grid.z); }
 // sunVisibility (lightfield.h): light l's mask bilinear between the four nearest sub-samples.
 void sunAxis(float g, uint res, out uint s0, out uint s1, out float f) {
   uint side = uint(kSunMaskSide);
@@ -190,12 +192,13 @@ float sunVisibility(ChartRecord c, uint light, vec2 grid) {
   return (1.0 - fv) * ((1.0 - fu) * sunBit(c, light, u0, v0) + fu * sunBit(c, light, u1, v0)) +
          fv * ((1.0 - fu) * sunBit(c, light, u0, v1) + fu * sunBit(c, light, u1, v1));
 }
-// sunIrradianceLanes (lookup.h) without a normal map: n' = n.
-vec3 sunIrradianceAt(ChartRecord c, vec2 grid, vec3 normal) {
+// sunIrradianceLanes (lookup.h): the masked lights above the surface's normal n, on its
+// mapped normal n' (n itself without a normal map).
+vec3 sunIrradianceAt(ChartRecord c, vec2 grid, vec3 normal, vec3 mappedNormal) {
   vec3 sum = vec3(0.0);
   for (uint l = 0u; l < sunCount; ++l) {
     if (!(dot(normal, sunTowards[l]) > 0.0)) continue;
-    float cosTheta = dot(normal, sunTowards[l]);
+    float cosTheta = dot(mappedNormal, sunTowards[l]);
     if (!(cosTheta > 0.0)) continue;
     float lit = sunVisibility(c, l, grid);
     if (lit > 0.0) sum += sunIrradiance[l] * (cosTheta * lit);
@@ -219,6 +222,27 @@ vec3 toLocalAround(ChartRecord c, vec3 n, vec3 w) {
   vec3 t = vec3(b, sign + n.y * n.y * a, -n.y);
   return vec3(dot(w, s), dot(w, t), dot(w, n));
 }
+// mappedNormalIrradiance (lookup.h) with tiltWeights (lightfield.h): the irradiance about the
+// mapped normal (localMapped: in the tilt frame) from the irradiance about the chart normal
+// and the tilted irradiances, bilinear over the tixels; clamped at 0.
+vec3 mappedNormalIrradiance(ChartRecord c, vec2 grid, vec3 irradiance, vec3 localMapped) {
+  float share = (1.0 - localMapped.z) * (1.0 / (1.0 - kNormalTiltCosine));
+  float gradient = 2.0 / (3.0 * kNormalTiltSine);
+  vec3 total = (1.0 - share) * irradiance;
+  uint first = c.grid.z * c.grid.z + ((c.info.z & kFlagDiffuseValue) != 0u ? 1u : 0u);
+  for (uint k = 0u; k < kTiltedNormals; ++k) {
+    float w = share * (1.0 / float(kTiltedNormals)) + gradient * (kTiltAcross[k].x * localMapped.x + kTiltAcross[k].y * localMapped.y);
+    total += w * tixelValueOverTixels(c, grid, first + k);
+  }
+  return max(total, vec3(0.0));
+}
+// normalMappedLookupDirection (lookup.cpp).
+vec3 normalMappedLookupDirection(vec3 mapNormal, vec3 shadingNormal, vec3 wo) {
+  if (!(dot(wo, mapNormal) > 0.0)) return wo;
+  vec3 mirrored = 2.0 * dot(wo, shadingNormal) * shadingNormal - wo;
+  vec3 d = 2.0 * dot(mirrored, mapNormal) * mapNormal - mirrored;
+  return dot(d, mapNormal) > 0.0 ? normalize(d) : wo;
+}
 // The radiance towards the viewer (unit towardsViewer) at world point p of the surface whose
 // triangle maps to chart record `chart` (triangleChart's front record): normalAtHit is
 // chartNormalAt's normal there (the record's side), shadingNormal interpolatedNormal's (the
@@ -240,22 +264,41 @@ vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, ve
   vec3 emission = (flags & kFlagEmissive) != 0u && emits ? c.emission.rgb : vec3(0.0);
   if ((flags & kFlagTexturedEmission) != 0u) emission *= detail.emission;
   if (!(cosTheta >= 0.0)) return emission;
-  // lookupNormalAt: the chart normal, or on a curved chart the interpolated one (chartShadingNormalAt).
+  // lookupNormalAt: the chart normal, or on a curved chart the interpolated one (chartShadingNormalAt);
+  // lookupInputs' mapped normal, turned to the record's side.
   vec3 lookupNormal = (flags & kFlagBack) != 0u ? -shadingNormal : shadingNormal;
+  bool normalMapped = (flags & kFlagNormalMapped) != 0u;
+  vec3 mappedNormal = !normalMapped ? lookupNormal : (flags & kFlagBack) != 0u ? -detail.normal : detail.normal;
   if (c.info.y == kDiffuse) {
     vec3 irradiance = interpolateLanes(c, grid, vec2(0.0));
-    if ((flags & kFlagSunMasks) != 0u) irradiance += sunIrradianceAt(c, grid, lookupNormal);
+    if ((flags & kFlagDirectionalIrradiance) != 0u) {
+      // The Lambertian lobe reflects only towards viewers above the mapped normal.
+      if (!(dot(towardsViewer, mappedNormal) > 0.0)) return emission;
+      irradiance = mappedNormalIrradiance(c, grid, irradiance, toLocalAround(c, lookupNormal, mappedNormal));
+    }
+    if ((flags & kFlagSunMasks) != 0u) irradiance += sunIrradianceAt(c, grid, lookupNormal, mappedNormal);
     // diffuseAlbedoAt: the base albedo × the modulation, over π.
     vec3 albedoOverPi = (flags & kFlagTexturedAlbedo) != 0u ? c.albedoOverPi.rgb * detail.albedo * kInvPi : c.albedoOverPi.rgb;
     return emission + albedoOverPi * irradiance;
   }
-  vec3 local = toLocalAround(c, lookupNormal, towardsViewer);
+  // A normal-mapped glossy chart: nothing reflected towards viewers below the mapped normal, and
+  // the map read in the direction the normal map bends the view to.
+  vec3 lookupDirection = towardsViewer;
+  if (normalMapped) {
+    if (!(dot(towardsViewer, mappedNormal) > 0.0)) return (flags & kFlagEmissive) != 0u && emits ? c.emission.rgb : vec3(0.0);
+    lookupDirection = normalMappedLookupDirection(lookupNormal, mappedNormal, towardsViewer);
+  }
+  vec3 local = toLocalAround(c, lookupNormal, lookupDirection);
   vec3 mapped = interpolateLanes(c, grid, directionToParaboloid(local));
   if ((flags & kFlagDiffuseValue) == 0u) return mapped;
-  float k = local.z > 0.0 ? 1.0 : 0.0;  // diffuseDirectionalFactor of Blinn-Phong
+  vec3 diffuseIrradiance = diffuseValueOverTixels(c, grid);
+  if ((flags & kFlagDirectionalIrradiance) != 0u)
+    diffuseIrradiance = mappedNormalIrradiance(c, grid, diffuseIrradiance, toLocalAround(c, lookupNormal, mappedNormal));
+  // diffuseDirectionalFactor of Blinn-Phong at μo (against the mapped normal on a normal-mapped chart).
+  float k = (normalMapped ? dot(towardsViewer, mappedNormal) : local.z) > 0.0 ? 1.0 : 0.0;
   // glossyDiffuseAlbedoAt: the model's diffuse albedo × the modulation.
   vec3 albedoOverPi = (flags & kFlagTexturedAlbedo) != 0u ? c.albedoOverPi.rgb * detail.albedo * kInvPi : c.albedoOverPi.rgb;
-  return mapped + albedoOverPi * k * diffuseValueOverTixels(c, grid);
+  return mapped + albedoOverPi * k * diffuseIrradiance;
 }
 )glsl";
 
@@ -276,6 +319,7 @@ void main() {
 constexpr const char* kFrameGlsl = R"glsl(
 layout(std430, binding = POSITIONS_BINDING) readonly buffer Positions { vec4 positions[]; };
 layout(std430, binding = TRIANGLES_BINDING) readonly buffer Triangles { uvec4 triangles[]; };
+layout(std430, binding = NORMALS_BINDING) readonly buffer Normals { vec4 normals[]; };  // w = 0: none
 uniform vec3 eye, forward, right, up;
 uniform float tanHalfFovY, aspect;
 uniform ivec2 size;
@@ -286,6 +330,17 @@ vec3 cameraToFilm(vec2 film) {
   float sx = (2.0 * film.x / float(size.x) - 1.0) * tanHalfFovY * aspect;
   float sy = (1.0 - 2.0 * film.y / float(size.y)) * tanHalfFovY;
   return forward + sx * right + sy * up;
+}
+// interpolatedNormal (scene.h) at barycentrics b of the triangle with vertices v and unit
+// geometric normal `geometric`: the vertex normals interpolated, turned to its side.
+vec3 interpolatedNormalAt(uvec3 v, vec2 b, vec3 geometric) {
+  if (normals[v.x].w == 0.0) return geometric;
+  float b1 = b.x, b2 = b.y;
+  vec3 interpolated = (1.0 - b1 - b2) * normals[v.x].xyz + b1 * normals[v.y].xyz + b2 * normals[v.z].xyz;
+  float len = length(interpolated);
+  if (!(len > 1e-6 && !isinf(len) && !isnan(len))) return geometric;
+  vec3 shading = interpolated / len;
+  return dot(shading, geometric) < 0.0 ? -shading : shading;
 }
 )glsl";
 // An alpha-masked triangle (anyMasked: the scene has some) is cut away where the ray through
@@ -316,7 +371,6 @@ void main() {
 }
 )glsl";
 constexpr const char* kShadingFragment = R"glsl(
-layout(std430, binding = NORMALS_BINDING) readonly buffer Normals { vec4 normals[]; };  // w = 0: none
 layout(binding = 0) uniform usampler2D ids;
 uniform vec3 background;
 uniform bool vignetting;
@@ -405,23 +459,15 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
   vec3 p = eye + t * direction;
   ChartRecord c = charts[tri.w];
   vec2 b = hitBarycentrics(p0, p1, p2, p);
-  vec3 normalAtHit = c.normal.xyz, shadingNormal = c.normal.xyz;
-  if ((c.info.z & kFlagCurved) != 0u) {
-    // triangleNormal, then interpolatedNormal (scene.h) at the hit's barycentrics (b1, b2).
-    float length2 = dot(n, n);
-    normalAtHit = length2 > 0.0 ? n / sqrt(length2) : vec3(0.0);
-    shadingNormal = normalAtHit;
-    if (normals[tri.x].w != 0.0) {
-      float b1 = b.x, b2 = b.y;
-      vec3 interpolated = (1.0 - b1 - b2) * normals[tri.x].xyz + b1 * normals[tri.y].xyz + b2 * normals[tri.z].xyz;
-      float len = length(interpolated);
-      if (len > 1e-6 && !isinf(len) && !isnan(len)) {
-        shadingNormal = interpolated / len;
-        if (dot(shadingNormal, normalAtHit) < 0.0) shadingNormal = -shadingNormal;
-      }
-    }
-  }
-  SurfaceDetail detail = surfaceDetailAt(id - 1u, tri.xyz, p0, p1, p2, b, c.info.z, direction, coneSpread * t);
+  // triangleNormal, then on a curved or normal-mapped chart interpolatedNormal (scene.h) at the
+  // hit's barycentrics.
+  float length2 = dot(n, n);
+  vec3 geometric = length2 > 0.0 ? n / sqrt(length2) : vec3(0.0);
+  bool curved = (c.info.z & kFlagCurved) != 0u;
+  vec3 interpolated = curved || (c.info.z & kFlagNormalMapped) != 0u ? interpolatedNormalAt(tri.xyz, b, geometric) : geometric;
+  vec3 normalAtHit = curved ? geometric : c.normal.xyz, shadingNormal = curved ? interpolated : c.normal.xyz;
+  SurfaceDetail detail =
+      surfaceDetailAt(id - 1u, tri.xyz, p0, p1, p2, b, c.info, direction, coneSpread * t, geometric, interpolated);
   return weight * lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal, detail);
 }
 
@@ -493,7 +539,7 @@ void main() {
   uint chart = floatBitsToUint(queries[i].position.w);
   vec3 normal = charts[chart].normal.xyz;
   results[i] = vec4(lookupRadiance(chart, queries[i].position.xyz, queries[i].towardsViewer.xyz, normal, normal,
-                                   noSurfaceDetail()), 0.0);
+                                   noSurfaceDetail(normal)), 0.0);
 }
 )glsl";
 
@@ -552,7 +598,7 @@ GLuint linkProgram(std::initializer_list<std::pair<GLenum, const char*>> stages,
   std::vector<GLuint> shaders;
   for (const auto& [type, source] : stages) {
     const std::string text = type == GL_VERTEX_SHADER ? prefix + source
-                                                      : prefix + detail + (type == GL_FRAGMENT_SHADER ? kFrameGlsl : "") +
+                                                      : prefix + (type == GL_FRAGMENT_SHADER ? kFrameGlsl : "") + detail +
                                                             (lookup ? kLookupGlsl : "") + source;
     shaders.push_back(compileShader(type, text, name));
     glAttachShader(program, shaders.back());
@@ -601,7 +647,6 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
     if (c.kind == ChartKind::Specular) return "mirrors and glass (specular charts)";
     const ChartShading shading = chartShading(lf, i, sun);
     if (std::string detail = gpu::surfaceDetailUnsupported(lf, c, shading); !detail.empty()) return detail;
-    if (shading.normalMapped || c.directionalIrradiance) return "normal maps";
     if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) return "rough glass";
     // The shader takes a glossy chart's diffuse part as Blinn-Phong's, k(μ) = 1; GGX-like
     // models (GgxBsdf, GltfPbrBsdf) couple it to the lobe's albedo.
@@ -719,7 +764,9 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                       (shading.twoSidedEmission ? kFlagTwoSidedEmission : 0u) |
                       (shading.sunMasks != nullptr ? kFlagSunMasks : 0u) |
                       (shading.needsUv && shading.texturedAlbedo ? gpu::kFlagTexturedAlbedo : 0u) |
-                      (shading.texturedEmission ? gpu::kFlagTexturedEmission : 0u),
+                      (shading.texturedEmission ? gpu::kFlagTexturedEmission : 0u) |
+                      (shading.normalMapped ? gpu::kFlagNormalMapped : 0u) |
+                      (c.directionalIrradiance ? gpu::kFlagDirectionalIrradiance : 0u),
                   uint32_t(c.firstTixel)},
                  {},
                  {}};

@@ -14,11 +14,12 @@ namespace {
 
 constexpr uint32_t kNone = 0xffffffffu;
 constexpr uint32_t kHeaderWords = 8, kTextureWords = 8, kLevelWords = 4, kMappingWords = 8, kVertexWords = 8;
-// Material record: albedo, emission and alpha textures, alpha factor, cutoff, 3 unused, then
-// the albedo, emission and alpha mappings.
+// Material record: albedo, emission, alpha and normal textures, alpha factor, cutoff, normal
+// scale, 1 unused, then the albedo, emission, alpha and normal mappings.
 constexpr uint32_t kMaterialAlbedoMapping = 8, kMaterialEmissionMapping = kMaterialAlbedoMapping + kMappingWords,
                    kMaterialAlphaMapping = kMaterialEmissionMapping + kMappingWords,
-                   kMaterialWords = kMaterialAlphaMapping + kMappingWords;
+                   kMaterialNormalMapping = kMaterialAlphaMapping + kMappingWords,
+                   kMaterialWords = kMaterialNormalMapping + kMappingWords;
 // Texture sampling flags.
 constexpr uint32_t kNearestBit = 16u, kMipmapsBit = 32u, kDefaultSamplingBit = 64u;
 
@@ -68,6 +69,10 @@ std::vector<uint32_t> surfaceDetailWords(const LightField& lf) {
     needsUv = needsUv || shading.needsUv;
     if (shading.needsUv && shading.texturedAlbedo) need(m.albedoTexture, TextureUse::AllLevels);
     if (shading.texturedEmission) need(m.emissionTexture, TextureUse::Level0);
+    if (shading.normalMapped) {
+      needsUv = true;
+      need(m.normalTexture, TextureUse::Level0);
+    }
   }
   for (const Material& m : scene.materials)
     if (m.isMasked()) {
@@ -110,10 +115,11 @@ std::vector<uint32_t> surfaceDetailWords(const LightField& lf) {
   for (const Material& m : scene.materials) {
     auto index = [](int texture) { return texture >= 0 ? uint32_t(texture) : kNone; };
     words.insert(words.end(), {index(m.albedoTexture), index(m.emissionTexture), index(m.alphaTexture),
-                               bits(m.alphaFactor), bits(m.alphaCutoff), 0u, 0u, 0u});
+                               index(m.normalTexture), bits(m.alphaFactor), bits(m.alphaCutoff), bits(m.normalScale), 0u});
     appendMapping(words, m.albedoMapping);
     appendMapping(words, m.emissionMapping);
     appendMapping(words, m.alphaMapping);
+    appendMapping(words, m.normalMapping);
   }
   // Vertices and triangles, in the renderer's order (meshes one after another).
   words[3] = uint32_t(words.size());
@@ -155,13 +161,18 @@ std::string surfaceDetailGlsl(unsigned binding) {
   return fmt::format(
              "#define SURFACE_DETAIL_BINDING {}\nconst uint kTextureWords = {}u, kLevelWords = {}u, kVertexWords = {}u, "
              "kMaterialWords = {}u, kMaterialAlbedoMapping = {}u, kMaterialEmissionMapping = {}u, kMaterialAlphaMapping = "
-             "{}u;\nconst uint kRepeat = {}u, kClampToEdge = {}u, kMirroredRepeat = {}u, kNearestBit = {}u, kMipmapsBit = "
+             "{}u, kMaterialNormalMapping = {}u;\nconst uint kRepeat = {}u, kClampToEdge = {}u, kMirroredRepeat = {}u, kNearestBit = {}u, kMipmapsBit = "
              "{}u, kDefaultSamplingBit = {}u;\nconst uint kFlagTexturedAlbedo = {}u, kFlagTexturedEmission = {}u;\n"
-             "const float kInvPi = {:.9g};\n",
+             "const float kInvPi = {:.9g};\nconst uint kFlagNormalMapped = {}u, kFlagDirectionalIrradiance = {}u;\n"
+             "const uint kTiltedNormals = {}u;\nconst float kNormalTiltCosine = {:.9g}, kNormalTiltSine = {:.9g};\n"
+             "const vec2 kTiltAcross[{}] = vec2[{}](vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}));\n",
              binding, kTextureWords, kLevelWords, kVertexWords, kMaterialWords, kMaterialAlbedoMapping,
-             kMaterialEmissionMapping, kMaterialAlphaMapping, unsigned(TextureWrap::Repeat),
+             kMaterialEmissionMapping, kMaterialAlphaMapping, kMaterialNormalMapping, unsigned(TextureWrap::Repeat),
              unsigned(TextureWrap::ClampToEdge), unsigned(TextureWrap::MirroredRepeat), kNearestBit, kMipmapsBit,
-             kDefaultSamplingBit, kFlagTexturedAlbedo, kFlagTexturedEmission, kInvPi) +
+             kDefaultSamplingBit, kFlagTexturedAlbedo, kFlagTexturedEmission, kInvPi, kFlagNormalMapped,
+             kFlagDirectionalIrradiance, kTiltedNormals, kNormalTiltCosine, kNormalTiltSine, kTiltedNormals, kTiltedNormals,
+             kTiltAcross[0][0], kTiltAcross[0][1], kTiltAcross[1][0], kTiltAcross[1][1], kTiltAcross[2][0],
+             kTiltAcross[2][1]) +
          R"glsl(
 layout(std430, binding = SURFACE_DETAIL_BINDING) readonly buffer SurfaceDetailWords { uint detail[]; };
 const uint kNone = 0xffffffffu;
@@ -291,6 +302,13 @@ vec2 vertexUv(uint vertex, uint set) {
   return vec2(detailFloat(i), detailFloat(i + 1u));
 }
 bool hasUvSet(uint vertex, uint set) { return (detail[detail[3] + kVertexWords * vertex + 7u] & (set == 1u ? 2u : 1u)) != 0u; }
+// TextureMapping::apply: linear · uv + offset (linear column-major, as glm's Mat2).
+vec2 applyMapping(uint mapping, vec2 uv) {
+  if (detail[mapping + 1u] != 0u) return uv;
+  return vec2(detailFloat(mapping + 2u) * uv.x + detailFloat(mapping + 4u) * uv.y,
+              detailFloat(mapping + 3u) * uv.x + detailFloat(mapping + 5u) * uv.y) +
+         vec2(detailFloat(mapping + 6u), detailFloat(mapping + 7u));
+}
 vec2 mappedUv(uint mapping, uvec3 v, vec2 b) {
   uint set = detail[mapping];
   vec2 uv = b;
@@ -298,11 +316,7 @@ vec2 mappedUv(uint mapping, uvec3 v, vec2 b) {
     float b1 = b.x, b2 = b.y, b0 = 1.0 - b1 - b2;
     uv = b0 * vertexUv(v.x, set) + b1 * vertexUv(v.y, set) + b2 * vertexUv(v.z, set);
   }
-  if (detail[mapping + 1u] != 0u) return uv;
-  // linear · uv + offset, linear column-major as glm's Mat2.
-  return vec2(detailFloat(mapping + 2u) * uv.x + detailFloat(mapping + 4u) * uv.y,
-              detailFloat(mapping + 3u) * uv.x + detailFloat(mapping + 5u) * uv.y) +
-         vec2(detailFloat(mapping + 6u), detailFloat(mapping + 7u));
+  return applyMapping(mapping, uv);
 }
 // vertexColorAt (scene.h).
 vec3 vertexColorAt(uvec3 v, vec2 b) {
@@ -338,29 +352,65 @@ float albedoTextureLod(uint texture, uint mapping, uvec3 v, vec3 p0, vec3 p1, ve
   return 0.5 * approximateLog2(texelsSquared);
 }
 
-// What a lookup needs of its hit besides the position and normals: the albedo modulation
-// (albedoModulation: the albedo texture at the cone's mip level × the vertex colour) on a
-// kFlagTexturedAlbedo chart, the emission texel (emissionModulation) on a
-// kFlagTexturedEmission one; 1 elsewhere.
-struct SurfaceDetail { vec3 albedo, emission; };
-SurfaceDetail noSurfaceDetail() { return SurfaceDetail(vec3(1.0), vec3(1.0)); }
-// albedoPointAt and albedoModulation for a hit at barycentrics b of triangle `triangle`
-// (vertices v at p0, p1, p2) of a chart with flags `chartFlags`, seen along `direction` with a
-// ray cone coneWidth wide there (0: full resolution).
-SurfaceDetail surfaceDetailAt(uint triangle, uvec3 v, vec3 p0, vec3 p1, vec3 p2, vec2 b, uint chartFlags, vec3 direction,
-                              float coneWidth) {
-  SurfaceDetail d = noSurfaceDetail();
-  if ((chartFlags & (kFlagTexturedAlbedo | kFlagTexturedEmission)) == 0u) return d;
+// normalMapped (scene.cpp): shading normal n perturbed by the normal-map texel in the tangent
+// frame of the triangle p0 p1 p2 with (mapped) uvs uv0 uv1 uv2; n where there is no frame or
+// the result would fall behind the geometric normal ng.
+vec3 normalMapped(vec3 n, vec3 ng, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1, vec2 uv2, vec3 texel, float scale) {
+  vec3 e1 = p1 - p0, e2 = p2 - p0;
+  vec2 d1 = uv1 - uv0, d2 = uv2 - uv0;
+  float det = d1.x * d2.y - d1.y * d2.x;
+  if (!(abs(det) > 1e-12)) return n;
+  vec3 dpdu = (e1 * d2.y - e2 * d1.y) / det;
+  vec3 dpdv = (e2 * d1.x - e1 * d2.x) / det;
+  vec3 t = dpdu - n * dot(n, dpdu);
+  float tLength = length(t);
+  if (!(tLength > 0.0) || isinf(tLength) || isnan(tLength)) return n;
+  t /= tLength;
+  vec3 b = dot(cross(n, t), dpdv) < 0.0 ? -cross(n, t) : cross(n, t);
+  vec3 m = vec3(scale * (2.0 * texel.r - 1.0), scale * (2.0 * texel.g - 1.0), 2.0 * texel.b - 1.0);
+  vec3 mapped = m.x * t + m.y * b + m.z * n;
+  float len = length(mapped);
+  if (!(len > 0.0) || isinf(len) || isnan(len)) return n;
+  vec3 result = mapped / len;
+  return dot(result, ng) > 0.01 ? result : n;
+}
+
+// What a lookup needs of its hit besides the position and the normals it is read around: the
+// albedo modulation (albedoModulation: the albedo texture at the cone's mip level × the vertex
+// colour) on a kFlagTexturedAlbedo chart, the emission texel (emissionModulation) on a
+// kFlagTexturedEmission one, 1 elsewhere; the mapped normal (surfaceAt's shading normal, on the
+// front's side) on a kFlagNormalMapped chart.
+struct SurfaceDetail { vec3 albedo, emission, normal; };
+SurfaceDetail noSurfaceDetail(vec3 normal) { return SurfaceDetail(vec3(1.0), vec3(1.0), normal); }
+// albedoPointAt, albedoModulation and surfaceAt's shading normal for a hit at barycentrics b
+// of triangle `triangle` (vertices v at p0, p1, p2; unit geometric normal `geometric`, the
+// interpolated normal `interpolated`) of a chart record with info `chartInfo` (kind, flags),
+// seen along `direction` with a ray cone coneWidth wide there (0: full resolution).
+SurfaceDetail surfaceDetailAt(uint triangle, uvec3 v, vec3 p0, vec3 p1, vec3 p2, vec2 b, uvec4 chartInfo, vec3 direction,
+                              float coneWidth, vec3 geometric, vec3 interpolated) {
+  uint flags = chartInfo.z;
+  SurfaceDetail d = noSurfaceDetail(interpolated);
+  if ((flags & (kFlagTexturedAlbedo | kFlagTexturedEmission | kFlagNormalMapped)) == 0u) return d;
   uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
-  if ((chartFlags & kFlagTexturedAlbedo) != 0u) {
+  bool glossyMapped = (flags & kFlagNormalMapped) != 0u && chartInfo.y == kGlossy;
+  if ((flags & kFlagTexturedAlbedo) != 0u) {
     d.albedo = vertexColorAt(v, b);
     uint texture = detail[m];
     if (texture != kNone) {
-      float lod = albedoTextureLod(texture, m + kMaterialAlbedoMapping, v, p0, p1, p2, direction, coneWidth);
+      // A normal-mapped glossy chart reads its albedo at full resolution (lookupInputs).
+      float lod = glossyMapped ? 0.0 : albedoTextureLod(texture, m + kMaterialAlbedoMapping, v, p0, p1, p2, direction, coneWidth);
       d.albedo = sampleTextureLod(texture, mappedUv(m + kMaterialAlbedoMapping, v, b), lod) * d.albedo;
     }
   }
-  if ((chartFlags & kFlagTexturedEmission) != 0u) d.emission = sampleTexture(detail[m + 1u], mappedUv(m + kMaterialEmissionMapping, v, b));
+  if ((flags & kFlagTexturedEmission) != 0u) d.emission = sampleTexture(detail[m + 1u], mappedUv(m + kMaterialEmissionMapping, v, b));
+  // surfaceAt: the normal map where its uv set exists, in the frame of the mapped vertex uvs.
+  uint normalMapping = m + kMaterialNormalMapping, set = detail[normalMapping];
+  if ((flags & kFlagNormalMapped) != 0u && hasUvSet(v.x, set)) {
+    vec3 texel = sampleTexture(detail[m + 3u], mappedUv(normalMapping, v, b));
+    d.normal = normalMapped(interpolated, geometric, p0, p1, p2, applyMapping(normalMapping, vertexUv(v.x, set)),
+                            applyMapping(normalMapping, vertexUv(v.y, set)), applyMapping(normalMapping, vertexUv(v.z, set)),
+                            texel, detailFloat(m + 6u));
+  }
   return d;
 }
 // The barycentrics (b1, b2) of point p in the plane of the triangle p0 p1 p2.
@@ -373,13 +423,13 @@ vec2 hitBarycentrics(vec3 p0, vec3 p1, vec3 p2, vec3 p) {
 // Whether triangle `triangle`'s material is alpha-masked at all (Material::isMasked).
 bool maskedMaterial(uint triangle) {
   uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
-  return detail[m + 2u] != kNone || detailFloat(m + 3u) < detailFloat(m + 4u);
+  return detail[m + 2u] != kNone || detailFloat(m + 4u) < detailFloat(m + 5u);
 }
 // coverageAt (scene.h): the alpha mask's coverage at barycentrics b of triangle `triangle`
 // (vertices v); below the material's cutoff the surface is not there (masked() says so).
 bool masked(uint triangle, uvec3 v, vec2 b) {
   uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
-  float factor = detailFloat(m + 3u), cutoff = detailFloat(m + 4u);
+  float factor = detailFloat(m + 4u), cutoff = detailFloat(m + 5u);
   uint texture = detail[m + 2u];
   float coverage = texture == kNone ? factor : factor * sampleTexture(texture, mappedUv(m + kMaterialAlphaMapping, v, b)).r;
   return coverage < cutoff;

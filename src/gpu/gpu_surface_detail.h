@@ -1,9 +1,9 @@
 #pragma once
 // The GPU renderer's surface detail (internal to src/gpu): what the shading pass reads per
 // pixel besides the light field — albedo textures with their mip levels, vertex colours,
-// emission textures and alpha masks — uploaded as one storage buffer of 32-bit words, with the
-// GLSL that reads it (the C++ of scene/texture.h, scene/scene.h uvAt/vertexColorAt/coverageAt
-// and lightfield/lookup.h albedoTextureLod, statement for statement).
+// emission textures, alpha masks and normal maps — uploaded as one storage buffer of 32-bit words, with the
+// GLSL that reads it (the C++ of scene/texture.h, scene/scene.h uvAt/vertexColorAt/coverageAt/
+// surfaceAt/normalMapped and lightfield/lookup.h albedoTextureLod, statement for statement).
 //
 // The buffer (uint detail[]): a header of section offsets (words), then
 //   textures:  8 words each — first level (into the level table), level count (level 0 and its
@@ -12,9 +12,10 @@
 //   levels:    4 words each — width, height, first texel word, palette word (kNone: the texels
 //              are 3 floats each; else one word per texel, palette indices r | g << 8 | b << 16,
 //              into 3 × 256 floats: the CPU's packed texels, Texture::packed, unblocked);
-//   materials: kMaterialWords each — albedo, emission and alpha textures (kNone: none), alpha
-//              factor and cutoff, then the albedo, emission and alpha TextureMappings (8 words
-//              each: uv set, whether default, linear[0][0], [0][1], [1][0], [1][1], offset);
+//   materials: 40 words each — albedo, emission, alpha and normal textures (kNone: none), alpha
+//              factor and cutoff, normal scale, 1 unused, then the albedo, emission, alpha and
+//              normal TextureMappings (8 words each: uv set, whether default, linear[0][0],
+//              [0][1], [1][0], [1][1], offset);
 //   vertices:  8 words each (all meshes' vertices in the renderer's order) — uv set 0 (2
 //              floats), uv set 1 (2), vertex colour (3), flags (has uvs | has uvs1 << 1 | has
 //              colours << 2);
@@ -32,8 +33,11 @@ namespace pl::gpu {
 
 /// Chart record flags (the shaders' ChartRecord info.z) that the surface detail adds to
 /// gpu_renderer.cpp's: the diffuse albedo varies (albedoOverPi then holds the material's base
-/// albedo, times the modulation per pixel), the emission is textured.
-inline constexpr uint32_t kFlagTexturedAlbedo = 128u, kFlagTexturedEmission = 256u;
+/// albedo, times the modulation per pixel), the emission is textured, the chart is
+/// normal-mapped (ChartShading::normalMapped: the lookup takes the mapped normal), it keeps
+/// tilted irradiances (Chart::directionalIrradiance).
+inline constexpr uint32_t kFlagTexturedAlbedo = 128u, kFlagTexturedEmission = 256u, kFlagNormalMapped = 512u,
+                          kFlagDirectionalIrradiance = 1024u;
 
 /// The first surface-detail feature of chart record `chart` the GPU renderer does not draw, as
 /// a phrase for gpuUnsupportedFeature; empty when it draws it.
@@ -48,8 +52,8 @@ Rgb texturedAlbedoBase(const Scene& scene, const Chart& chart);
 std::vector<uint32_t> surfaceDetailWords(const LightField& lf);
 
 /// The GLSL constants and functions (the buffer at binding `binding`): sampleTexture,
-/// sampleTextureLod, surfaceDetailAt (the albedo modulation and emission texel of a hit) and
-/// coverageAt (the alpha mask). Needs the chart flag constants (kFlagTexturedAlbedo, …).
+/// sampleTextureLod, surfaceDetailAt (the albedo modulation, emission texel and mapped normal
+/// of a hit) and masked (the alpha mask). Needs glslConstants' chart kinds.
 std::string surfaceDetailGlsl(unsigned binding);
 
 }  // namespace pl::gpu

@@ -321,6 +321,40 @@ TEST_F(GpuRendererTest, MatchesFastRendererWithSunMasks) {
   }
 }
 
+/// `scene` with planar uvs and a bumpy normal map (random tilts up to ±0.4 in x and y,
+/// scaled by 0.8) on every material that does not emit, and albedo textures as
+/// withSurfaceDetail's on the Lambertian ones.
+Scene withNormalMaps(Scene scene) {
+  scene = withSurfaceDetail(std::move(scene), true);
+  Texture bumps = test_support::randomTexture(9, 7, false, 5);
+  bumps.decode = ImageDecode::Data;
+  for (Rgb& texel : bumps.image.pixels) texel = Rgb(0.1f + 0.8f * texel.r, 0.1f + 0.8f * texel.g, 1.0f);
+  scene.textures.push_back(bumps);
+  for (Material& m : scene.materials)
+    if (!m.isEmissive()) {
+      m.normalTexture = int(scene.textures.size()) - 1;
+      m.normalScale = 0.8f;
+    }
+  return scene;
+}
+
+// Normal maps: diffuse charts with tilted irradiances (directionalIrradiance) and sun masks lit
+// on the mapped normal, glossy maps read in the direction the normal map bends the view to,
+// and the glossy charts' diffuse part about the mapped normal.
+TEST_F(GpuRendererTest, MatchesFastRendererWithNormalMaps) {
+  for (const std::string& file : {std::string("CornellBox-Original.obj"), std::string("CornellBox-Glossy.obj")}) {
+    SCOPED_TRACE(file);
+    const LightField lf = withRandomSunMasks(randomLightField(withNormalMaps(loadScene(kMcGuire + file)), 41), 42);
+    ASSERT_EQ(gpuUnsupportedFeature(lf), "");
+    ASSERT_GT(std::count_if(lf.charts.begin(), lf.charts.end(), [](const Chart& c) { return c.directionalIrradiance; }), 0);
+    GpuRenderer gpu(lf);
+    RenderSettings four;
+    four.samplesPerPixel = 4;
+    expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 64, 48);
+    expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 64, 48, false, four);
+  }
+}
+
 // The shader's lookup (the function the shading pass calls) against exitantRadiance on random
 // points and directions over every chart: both sides of each record, points off the grid
 // (clamped), grazing and below-horizon directions.
