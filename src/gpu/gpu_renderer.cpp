@@ -28,7 +28,8 @@ constexpr uint32_t kFlagTwoSided = 1u, kFlagBack = 2u, kFlagCurved = 4u, kFlagDi
 /// One chart record as the shaders read it (std430: eight 16-byte rows).
 struct ChartGpu {
   float origin[4];        ///< xyz: Chart::origin; w: 1 / tixelSize (ChartShading::inverseTixelSize)
-  float axisU[4], axisV[4], normal[4];
+  float axisU[4];         ///< xyz: Chart::axisU; w: the material's k(μ) table (word, as float bits; diffuseFactor)
+  float axisV[4], normal[4];
   uint32_t grid[4];       ///< resU, resV, dirRes, firstValue
   uint32_t info[4];       ///< valuesPerTixel, kind (ChartKind), flags, firstTixel (its sun masks)
   float emission[4];      ///< ChartShading::emission
@@ -294,8 +295,8 @@ vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, ve
   vec3 diffuseIrradiance = diffuseValueOverTixels(c, grid);
   if ((flags & kFlagDirectionalIrradiance) != 0u)
     diffuseIrradiance = mappedNormalIrradiance(c, grid, diffuseIrradiance, toLocalAround(c, lookupNormal, mappedNormal));
-  // diffuseDirectionalFactor of Blinn-Phong at μo (against the mapped normal on a normal-mapped chart).
-  float k = (normalMapped ? dot(towardsViewer, mappedNormal) : local.z) > 0.0 ? 1.0 : 0.0;
+  // diffuseDirectionalFactor at μo (against the mapped normal on a normal-mapped chart).
+  vec3 k = diffuseFactor(floatBitsToUint(c.axisU.w), normalMapped ? dot(towardsViewer, mappedNormal) : local.z);
   // glossyDiffuseAlbedoAt: the model's diffuse albedo × the modulation.
   vec3 albedoOverPi = (flags & kFlagTexturedAlbedo) != 0u ? c.albedoOverPi.rgb * detail.albedo * kInvPi : c.albedoOverPi.rgb;
   return mapped + albedoOverPi * k * diffuseIrradiance;
@@ -648,12 +649,6 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
     const ChartShading shading = chartShading(lf, i, sun);
     if (std::string detail = gpu::surfaceDetailUnsupported(lf, c, shading); !detail.empty()) return detail;
     if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) return "rough glass";
-    // The shader takes a glossy chart's diffuse part as Blinn-Phong's, k(μ) = 1; GGX-like
-    // models (GgxBsdf, GltfPbrBsdf) couple it to the lobe's albedo.
-    const Bsdf& model = scene.materials[c.material].bsdf;
-    if (c.diffuseValue && (diffuseDirectionalFactor(model, 0.25f) != Rgb(1.0f) ||
-                           diffuseDirectionalFactor(model, 1.0f) != Rgb(1.0f)))
-      return "GGX materials with a diffuse base";
   }
   if (lf.values.size() >= std::numeric_limits<uint32_t>::max() || lf.sunMasks.size() >= std::numeric_limits<uint32_t>::max())
     return "more than 2^32 light-field values";
@@ -748,6 +743,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   std::vector<float> values(lightField.values.size() * 4, 0.0f);
   for (size_t i = 0; i < lightField.values.size(); ++i) std::memcpy(&values[4 * i], &lightField.values[i], sizeof(Rgb));
   const SunLights sun = sunLightsOf(lightField);
+  const gpu::SurfaceDetailBuffer detail = gpu::surfaceDetailBuffer(lightField);
   std::vector<ChartGpu> charts(lightField.charts.size());
   for (uint32_t i = 0; i < charts.size(); ++i) {
     const Chart& c = lightField.charts[i];
@@ -772,6 +768,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                  {}};
     std::memcpy(g.emission, shading.emission.v, sizeof(g.emission));
     std::memcpy(g.albedoOverPi, shading.albedoOverPi.v, sizeof(g.albedoOverPi));
+    std::memcpy(&g.axisU[3], &detail.diffuseFactorTable[c.material], sizeof(float));
     if (shading.needsUv && shading.texturedAlbedo) {
       const Rgb base = gpu::texturedAlbedoBase(scene, c);
       std::memcpy(g.albedoOverPi, &base, sizeof(Rgb));
@@ -814,7 +811,6 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
     envTexels.resize(image.pixels.size() * 4, 0.0f);
     for (size_t i = 0; i < image.pixels.size(); ++i) std::memcpy(&envTexels[4 * i], &image.pixels[i], sizeof(Rgb));
   }
-  const std::vector<uint32_t> detail = gpu::surfaceDetailWords(lightField);
   // The buffers, in State::buffers' order, and what each holds (for the memory check's
   // message). A zero-sized buffer cannot be bound to a storage block: 16 bytes stand in.
   struct Upload {
@@ -831,7 +827,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
       {"vertex normals", normals.data(), normals.size() * sizeof(float)},
       {"sun masks", sunMasks.data(), sunMasks.size() * sizeof(uint32_t)},
       {"environment map", envTexels.data(), envTexels.size() * sizeof(float)},
-      {"textures, uvs and vertex colours", detail.data(), detail.size() * sizeof(uint32_t)}};
+      {"textures, uvs and vertex colours", detail.words.data(), detail.words.size() * sizeof(uint32_t)}};
   std::vector<std::pair<std::string, uint64_t>> sizes;
   for (const Upload& u : uploads) sizes.emplace_back(u.what, std::max<size_t>(u.bytes, 16));
   gpu::checkGpuMemory(sizes);

@@ -12,7 +12,7 @@
 namespace pl::gpu {
 namespace {
 
-constexpr uint32_t kNone = 0xffffffffu;
+constexpr uint32_t kNone = kNoWord;
 constexpr uint32_t kHeaderWords = 8, kTextureWords = 8, kLevelWords = 4, kMappingWords = 8, kVertexWords = 8;
 // Material record: albedo, emission, alpha and normal textures, alpha factor, cutoff, normal
 // scale, 1 unused, then the albedo, emission, alpha and normal mappings.
@@ -40,6 +40,11 @@ std::string surfaceDetailUnsupported(const LightField& lf, const Chart& chart, c
   const Material& material = lf.scene.materials[chart.material];
   if (material.metallicRoughness.texture >= 0 && (chart.kind == ChartKind::Diffuse || chart.diffuseValue))
     return "metallic-roughness textures";
+  // k(μ) of the diffuse part tabulated at diffuseFactorNodes (exact only where it is linear
+  // between them).
+  const Bsdf& model = material.bsdf;
+  if (chart.diffuseValue && !std::holds_alternative<BlinnPhongBsdf>(model) && !diffuseFactorIsPiecewiseLinear(model))
+    return "glTF materials with a clear coat or sheen over a diffuse base";
   // diffuseAlbedoAt multiplies a Lambertian albedo by the modulation; another model's
   // directional albedo at normal incidence is not linear in it.
   if (shading.texturedAlbedo && chart.kind == ChartKind::Diffuse && !std::holds_alternative<LambertBsdf>(material.bsdf))
@@ -54,7 +59,7 @@ Rgb texturedAlbedoBase(const Scene& scene, const Chart& chart) {
   return diffuseAlbedo(model);
 }
 
-std::vector<uint32_t> surfaceDetailWords(const LightField& lf) {
+SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
   const Scene& scene = lf.scene;
   // Which textures the shader reads, and whether any lookup or mask needs a hit's uv.
   std::vector<TextureUse> use(scene.textures.size(), TextureUse::None);
@@ -62,11 +67,15 @@ std::vector<uint32_t> surfaceDetailWords(const LightField& lf) {
     if (texture >= 0 && use[size_t(texture)] < u) use[size_t(texture)] = u;
   };
   bool needsUv = false;
+  std::vector<bool> needsFactor(scene.materials.size(), false);
   const SunLights sun = sunLightsOf(lf);
   for (uint32_t i = 0; i < lf.charts.size(); ++i) {
     const ChartShading shading = chartShading(lf, i, sun);
     const Material& m = scene.materials[lf.charts[i].material];
     needsUv = needsUv || shading.needsUv;
+    const Bsdf& model = m.bsdf;
+    if (lf.charts[i].diffuseValue && !std::holds_alternative<BlinnPhongBsdf>(model) && diffuseFactorIsPiecewiseLinear(model))
+      needsFactor[lf.charts[i].material] = true;
     if (shading.needsUv && shading.texturedAlbedo) need(m.albedoTexture, TextureUse::AllLevels);
     if (shading.texturedEmission) need(m.emissionTexture, TextureUse::Level0);
     if (shading.normalMapped) {
@@ -137,6 +146,23 @@ std::vector<uint32_t> surfaceDetailWords(const LightField& lf) {
   words[4] = uint32_t(words.size());
   if (needsUv)
     for (const Mesh& mesh : scene.meshes) words.insert(words.end(), mesh.materials.begin(), mesh.materials.end());
+  // The nodes of k(μ), and its tables. Node 0 is μ = 0, where diffuseDirectionalFactor is 0
+  // (nothing below the horizon) but its interpolation from the right is not: k there is
+  // extrapolated from the first segment's line (its end and midpoint).
+  const std::vector<float>& nodes = diffuseFactorNodes();
+  words[5] = uint32_t(words.size());
+  for (float mu : nodes) words.push_back(bits(mu));
+  std::vector<uint32_t> factorTables(scene.materials.size(), kNone);
+  for (size_t m = 0; m < scene.materials.size(); ++m) {
+    if (!needsFactor[m]) continue;
+    factorTables[m] = uint32_t(words.size());
+    const Bsdf& model = scene.materials[m].bsdf;
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      const Rgb k = i > 0 ? diffuseDirectionalFactor(model, nodes[i])
+                          : 2.0f * diffuseDirectionalFactor(model, 0.5f * nodes[1]) - diffuseDirectionalFactor(model, nodes[1]);
+      words.insert(words.end(), {bits(k.r), bits(k.g), bits(k.b)});
+    }
+  }
   // The texels: a level's packed texels (4×4 blocks of palette indices, Texture::PackedBlock)
   // and its palette where it has them, else 3 floats per texel.
   for (size_t l = 0; l < levels.size(); ++l) {
@@ -154,7 +180,7 @@ std::vector<uint32_t> surfaceDetailWords(const LightField& lf) {
       for (const Rgb& texel : level.image->pixels) words.insert(words.end(), {bits(texel.r), bits(texel.g), bits(texel.b)});
     }
   }
-  return words;
+  return {std::move(words), std::move(factorTables)};
 }
 
 std::string surfaceDetailGlsl(unsigned binding) {
@@ -165,14 +191,15 @@ std::string surfaceDetailGlsl(unsigned binding) {
              "{}u, kDefaultSamplingBit = {}u;\nconst uint kFlagTexturedAlbedo = {}u, kFlagTexturedEmission = {}u;\n"
              "const float kInvPi = {:.9g};\nconst uint kFlagNormalMapped = {}u, kFlagDirectionalIrradiance = {}u;\n"
              "const uint kTiltedNormals = {}u;\nconst float kNormalTiltCosine = {:.9g}, kNormalTiltSine = {:.9g};\n"
-             "const vec2 kTiltAcross[{}] = vec2[{}](vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}));\n",
+             "const vec2 kTiltAcross[{}] = vec2[{}](vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}));\n"
+             "const int kDiffuseFactorNodes = {};\n",
              binding, kTextureWords, kLevelWords, kVertexWords, kMaterialWords, kMaterialAlbedoMapping,
              kMaterialEmissionMapping, kMaterialAlphaMapping, kMaterialNormalMapping, unsigned(TextureWrap::Repeat),
              unsigned(TextureWrap::ClampToEdge), unsigned(TextureWrap::MirroredRepeat), kNearestBit, kMipmapsBit,
              kDefaultSamplingBit, kFlagTexturedAlbedo, kFlagTexturedEmission, kInvPi, kFlagNormalMapped,
              kFlagDirectionalIrradiance, kTiltedNormals, kNormalTiltCosine, kNormalTiltSine, kTiltedNormals, kTiltedNormals,
              kTiltAcross[0][0], kTiltAcross[0][1], kTiltAcross[1][0], kTiltAcross[1][1], kTiltAcross[2][0],
-             kTiltAcross[2][1]) +
+             kTiltAcross[2][1], diffuseFactorNodes().size()) +
          R"glsl(
 layout(std430, binding = SURFACE_DETAIL_BINDING) readonly buffer SurfaceDetailWords { uint detail[]; };
 const uint kNone = 0xffffffffu;
@@ -424,6 +451,19 @@ vec2 hitBarycentrics(vec3 p0, vec3 p1, vec3 p2, vec3 p) {
 bool maskedMaterial(uint triangle) {
   uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
   return detail[m + 2u] != kNone || detailFloat(m + 4u) < detailFloat(m + 5u);
+}
+// diffuseDirectionalFactor (bsdf.h) of a material whose k(μ) is tabulated at word `table`
+// (kNone: k = 1, Lambert and Blinn-Phong), interpolated between the nodes as the GGX albedo
+// table's lookup (locate) does.
+vec3 diffuseFactor(uint table, float cosTheta) {
+  if (!(cosTheta > 0.0)) return vec3(0.0);
+  if (table == kNone) return vec3(1.0);
+  float mu = min(cosTheta, 1.0);
+  int i0 = clamp(int(sqrt(mu) * float(kDiffuseFactorNodes - 1)), 0, kDiffuseFactorNodes - 2);
+  float a = detailFloat(detail[5] + uint(i0)), b = detailFloat(detail[5] + uint(i0) + 1u);
+  float t = clamp((mu - a) / (b - a), 0.0, 1.0);
+  vec3 k0 = detailRgb(table + 3u * uint(i0)), k1 = detailRgb(table + 3u * uint(i0) + 3u);
+  return k0 + t * (k1 - k0);
 }
 // coverageAt (scene.h): the alpha mask's coverage at barycentrics b of triangle `triangle`
 // (vertices v); below the material's cutoff the surface is not there (masked() says so).

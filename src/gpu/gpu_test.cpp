@@ -355,6 +355,41 @@ TEST_F(GpuRendererTest, MatchesFastRendererWithNormalMaps) {
   }
 }
 
+/// `scene` with every material that does not emit made GGX-like with a diffuse base: GgxBsdf
+/// (rough, then less rough with a metal-like f0) and GltfPbrBsdf without layers, in turn.
+Scene withGgxDiffuseBases(Scene scene) {
+  int next = 0;
+  for (Material& m : scene.materials) {
+    if (m.isEmissive()) continue;
+    const Rgb rho = diffuseAlbedo(m.bsdf);
+    m.tixelDensity = 0.15f;  // coarse tixels: their maps stay a few MiB
+    switch (next++ % 3) {
+      case 0: m.bsdf = GgxBsdf{rho, Rgb(0.04f), 0.6f}; break;
+      case 1: m.bsdf = GgxBsdf{0.5f * rho, Rgb(0.5f, 0.4f, 0.3f), 0.4f}; break;
+      default: m.bsdf = GltfPbrBsdf{.diffuse = rho, .alpha = 0.5f}; break;
+    }
+  }
+  return scene;
+}
+
+// GGX materials with a diffuse base: the diffuse part ρ/π · k(μo) · Ẽ with k from the lobe's
+// albedo table, plain and normal-mapped, at one and four samples per pixel.
+TEST_F(GpuRendererTest, MatchesFastRendererWithGgxDiffuseBases) {
+  for (const bool bumpy : {false, true}) {
+    SCOPED_TRACE(bumpy ? "normal-mapped" : "plain");
+    Scene scene = withGgxDiffuseBases(loadScene(kMcGuire + "CornellBox-Original.obj"));
+    const LightField lf = randomLightField(bumpy ? withNormalMaps(std::move(scene)) : std::move(scene), 43);
+    ASSERT_EQ(gpuUnsupportedFeature(lf), "");
+    ASSERT_GT(std::count_if(lf.charts.begin(), lf.charts.end(), [](const Chart& c) { return c.diffuseValue; }), 0);
+    ASSERT_LT(lf.values.size(), 1u << 20);
+    GpuRenderer gpu(lf);
+    RenderSettings four;
+    four.samplesPerPixel = 4;
+    expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 64, 48);
+    expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 64, 48, false, four);
+  }
+}
+
 // The shader's lookup (the function the shading pass calls) against exitantRadiance on random
 // points and directions over every chart: both sides of each record, points off the grid
 // (clamped), grazing and below-horizon directions.
@@ -407,12 +442,12 @@ TEST_F(GpuRendererTest, RefusesWhatItDoesNotDrawYet) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("mirrors and glass"), std::string::npos) << e.what();
   }
-  // Glossy charts whose diffuse share follows the lobe (the glTF layered model's) need a
-  // per-pixel term the shader does not have yet.
+  // Glossy charts whose diffuse share follows a clear coat's albedo as well as the lobe's: k(μ)
+  // is then not linear between the GGX table's nodes.
   Scene layered = makeCornellBox();
   for (Material& m : layered.materials)
-    if (!m.isEmissive()) m.bsdf = GltfPbrBsdf{};
-  EXPECT_EQ(gpuUnsupportedFeature(randomLightField(layered, 8)), "GGX materials with a diffuse base");
+    if (!m.isEmissive()) m.bsdf = GltfPbrBsdf{.clearcoat = 0.5f};
+  EXPECT_EQ(gpuUnsupportedFeature(randomLightField(layered, 8)), "glTF materials with a clear coat or sheen over a diffuse base");
   const LightField box = randomLightField(makeCornellBox(), 6);
   EXPECT_EQ(gpuUnsupportedFeature(box), "");
   GpuRenderer gpu(box);
@@ -433,12 +468,13 @@ TEST_F(GpuRendererTest, GpuMemoryIsTheLightFieldAndOneFrame) {
   GpuRenderer gpu(lf);
   Image image;
   gpu.render(Camera(firstCamera(lf.scene), 64, 48), RenderSettings{}, image);
-  // Values as 16-byte RGBA, 128 bytes per chart record, the geometry, 128 bytes per material
-  // after a 32-byte header (no textures, uvs or masks here), and 24 bytes per pixel.
+  // Values as 16-byte RGBA, 128 bytes per chart record, the geometry, 160 bytes per material
+  // and 160 of k nodes after a 32-byte header (no textures, uvs or masks here), and 24 bytes
+  // per pixel.
   uint64_t geometry = 0;
   for (const Mesh& m : lf.scene.meshes) geometry += m.positions.size() * 32 + m.triangles.size() * 28;
   const uint64_t expected = lf.values.size() * 16 + lf.charts.size() * 128 + geometry + 32 +
-                            lf.scene.materials.size() * 128 + 64 * 48 * 24;
+                            lf.scene.materials.size() * 160 + 160 + 64 * 48 * 24;
   EXPECT_LE(gpu.gpuBytes(), expected + 8 * 16);  // 16-byte stand-ins for empty buffers
   EXPECT_GE(gpu.gpuBytes(), expected);
   EXPECT_NE(gpu.deviceName().find("OpenGL 4.5"), std::string::npos) << gpu.deviceName();
