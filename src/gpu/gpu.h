@@ -77,6 +77,13 @@ std::string gpuUnsupportedFeature(const LightField& lightField);
 /// driver; empty if none (GpuRenderer::unsupportedSetting adds what this driver lacks).
 std::string gpuUnsupportedSetting(const RenderSettings& settings, const Camera& camera);
 
+/// The bytes the CPU renderers hold of `lightField` once decoded: its values (12 bytes each),
+/// chart records, triangle → chart map and sun masks, its scene's geometry (positions,
+/// normals, uvs, vertex colours, triangles and their materials) and textures (every level's
+/// float texels and packed ones, Texture::mips). What GpuRenderer::gpuBytes is measured
+/// against (docs/benchmarks.md).
+uint64_t lightFieldMemoryBytes(const LightField& lightField);
+
 /// Whether a headless OpenGL 4.5 core context can be created here; `why` gets the EGL/GL
 /// error when not.
 bool gpuAvailable(std::string* why = nullptr);
@@ -143,6 +150,9 @@ class GpuRenderer {
   std::string deviceName() const;
   /// Bytes of GPU buffers and textures this renderer holds (the light field's and the frame's).
   uint64_t gpuBytes() const;
+  /// Of gpuBytes, the light field's buffers alone (uploaded once; the rest is the frame's
+  /// targets, which follow the image size).
+  uint64_t lightFieldGpuBytes() const;
 
  private:
   struct State;

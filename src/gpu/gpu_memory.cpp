@@ -7,6 +7,27 @@
 #include <cstdlib>
 
 #include "core/error.h"
+#include "gpu/gpu.h"
+
+namespace pl {
+
+uint64_t lightFieldMemoryBytes(const LightField& lf) {
+  uint64_t bytes = lf.values.size() * sizeof(Rgb) + lf.charts.size() * sizeof(Chart) + lf.sunMasks.size() * sizeof(SunMask);
+  for (const std::vector<uint32_t>& charts : lf.triangleChart) bytes += charts.size() * sizeof(uint32_t);
+  for (const Mesh& m : lf.scene.meshes)
+    bytes += (m.positions.size() + m.normals.size() + m.colors.size()) * sizeof(Vec3) + (m.uvs.size() + m.uvs1.size()) * sizeof(Vec2) +
+             m.triangles.size() * sizeof(UVec3) + m.materials.size() * sizeof(uint32_t);
+  auto level = [](const Image& image, const std::vector<Texture::PackedBlock>& packed, const std::vector<float>& palette) {
+    return image.pixels.size() * sizeof(Rgb) + packed.size() * sizeof(Texture::PackedBlock) + palette.size() * sizeof(float);
+  };
+  for (const Texture& t : lf.scene.textures) {
+    bytes += level(t.image, t.packed, t.palette);
+    for (const Texture::Level& l : t.mips) bytes += level(l.image, l.packed, l.palette);
+  }
+  return bytes;
+}
+
+}  // namespace pl
 
 namespace pl::gpu {
 namespace {

@@ -332,6 +332,16 @@ vec3 cameraToFilm(vec2 film) {
   float sy = (1.0 - 2.0 * film.y / float(size.y)) * tanHalfFovY;
   return forward + sx * right + sy * up;
 }
+// The ray from the eye along unit `direction` against the triangle with vertices v
+// (Möller–Trumbore, no bounds test): (t, b1, b2), the barycentrics of where it meets the plane.
+vec3 rayTriangle(vec3 direction, uvec3 v) {
+  vec3 p0 = positions[v.x].xyz, e1 = positions[v.y].xyz - p0, e2 = positions[v.z].xyz - p0;
+  vec3 q = cross(direction, e2);
+  float det = dot(e1, q);
+  vec3 s = eye - p0;
+  vec3 r = cross(s, e1);
+  return vec3(dot(e2, r), dot(s, q), dot(direction, r)) / det;
+}
 // interpolatedNormal (scene.h) at barycentrics b of the triangle with vertices v and unit
 // geometric normal `geometric`: the vertex normals interpolated, turned to its side.
 vec3 interpolatedNormalAt(uvec3 v, vec2 b, vec3 geometric) {
@@ -352,12 +362,8 @@ out uint id;
 void main() {
   uint triangle = uint(gl_PrimitiveID);
   if (anyMasked && maskedMaterial(triangle)) {
-    vec3 direction = normalize(cameraToFilm(gl_FragCoord.xy / float(idScale)));
-    uvec4 tri = triangles[triangle];
-    vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
-    vec3 n = cross(p1 - p0, p2 - p0);
-    vec3 p = eye + (dot(p0 - eye, n) / dot(direction, n)) * direction;
-    if (masked(triangle, tri.xyz, hitBarycentrics(p0, p1, p2, p))) discard;
+    uvec3 v = triangles[triangle].xyz;
+    if (masked(triangle, v, rayTriangle(normalize(cameraToFilm(gl_FragCoord.xy / float(idScale))), v).yz)) discard;
   }
   id = triangle + 1u;
 }
@@ -436,18 +442,11 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
       if (candidate == 0u) besideBackground = true;
       if (candidate == 0u || candidate == id) continue;
       uvec4 tri = triangles[candidate - 1u];
-      vec3 p0 = positions[tri.x].xyz, e1 = positions[tri.y].xyz - p0, e2 = positions[tri.z].xyz - p0;
-      vec3 q = cross(direction, e2);
-      float det = dot(e1, q);
-      if (det == 0.0) continue;
-      vec3 s = eye - p0;
-      float u = dot(s, q) / det;
-      vec3 r = cross(s, e1);
-      float v = dot(direction, r) / det;
-      float hit = dot(e2, r) / det;
-      if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit > 0.0 && hit < t &&
+      vec3 hit = rayTriangle(direction, tri.xyz);  // (t, b1, b2)
+      float u = hit.y, v = hit.z;
+      if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit.x > 0.0 && hit.x < t &&
           !(anyMasked && masked(candidate - 1u, tri.xyz, vec2(u, v)))) {
-        t = hit;
+        t = hit.x;
         id = candidate;
       }
     }
@@ -456,10 +455,13 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
   uvec4 tri = triangles[id - 1u];
   vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
   vec3 n = cross(p1 - p0, p2 - p0);
+  // The hit's barycentrics (Möller–Trumbore's, as the ray caster's), on the triangle's plane
+  // where the ray passes beside it.
+  vec3 hit = rayTriangle(direction, tri.xyz);
   if (isinf(t)) t = dot(p0 - eye, n) / dot(direction, n);
   vec3 p = eye + t * direction;
   ChartRecord c = charts[tri.w];
-  vec2 b = hitBarycentrics(p0, p1, p2, p);
+  vec2 b = hit.yz;
   // triangleNormal, then on a curved or normal-mapped chart interpolatedNormal (scene.h) at the
   // hit's barycentrics.
   float length2 = dot(n, n);
@@ -1009,6 +1011,8 @@ std::string GpuRenderer::deviceName() const {
 }
 
 uint64_t GpuRenderer::gpuBytes() const { return state_->bufferBytes + state_->targetBytes(); }
+
+uint64_t GpuRenderer::lightFieldGpuBytes() const { return state_->bufferBytes; }
 
 bool gpuAvailable(std::string* why) {
   const GpuProbe probe = probeGpu();

@@ -440,13 +440,6 @@ SurfaceDetail surfaceDetailAt(uint triangle, uvec3 v, vec3 p0, vec3 p1, vec3 p2,
   }
   return d;
 }
-// The barycentrics (b1, b2) of point p in the plane of the triangle p0 p1 p2.
-vec2 hitBarycentrics(vec3 p0, vec3 p1, vec3 p2, vec3 p) {
-  vec3 e1 = p1 - p0, e2 = p2 - p0, v = p - p0;
-  float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), v1 = dot(v, e1), v2 = dot(v, e2);
-  float denominator = d11 * d22 - d12 * d12;
-  return vec2((d22 * v1 - d12 * v2) / denominator, (d11 * v2 - d12 * v1) / denominator);
-}
 // Whether triangle `triangle`'s material is alpha-masked at all (Material::isMasked).
 bool maskedMaterial(uint triangle) {
   uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
