@@ -20,7 +20,9 @@
 //      chart whose albedo varies, the albedo texture is read at the CPU renderer's mip level
 //      (albedoTextureLod: ray cones of textureConeSpread × t) exactly as Texture::sampleLod
 //      reads it (wrap modes, nearest, trilinear between levels), times the vertex colour; an
-//      emission texture is read at full resolution (emissionModulation).
+//      emission texture is read at full resolution (emissionModulation); on a normal-mapped
+//      chart the mapped normal (surfaceAt) bends the glossy lookup and selects the tilted
+//      irradiances; a GGX-like diffuse base takes k(μ) from its table (gpu_surface_detail.h).
 // The result is radiance (W·sr⁻¹·m⁻², camera weight included, no exposure), read back into an
 // Image exactly where FastRenderer::render writes it; exposure and tone mapping are then the
 // same CPU code for both renderers (jobs/ ViewSettings::writeImage).
@@ -142,7 +144,8 @@ class GpuRenderer {
   };
   /// The shading pass's lookup function run on each query in a compute shader: the radiance
   /// exitantRadiance(lightField, chart, position, towardsViewer, uv) gives on the CPU (planar
-  /// charts; curved ones are read around the chart normal here).
+  /// charts; curved ones are read around the chart normal here; no surface detail: the albedo
+  /// modulation and emission texel 1, the chart normal as the mapped normal).
   std::vector<Rgb> lookup(const std::vector<LookupQuery>& queries);
 
   /// The GL_RENDERER and GL_VERSION strings of the context (e.g. "llvmpipe (LLVM 15.0.6, 256

@@ -248,8 +248,9 @@ vec3 normalMappedLookupDirection(vec3 mapNormal, vec3 shadingNormal, vec3 wo) {
 // triangle maps to chart record `chart` (triangleChart's front record): normalAtHit is
 // chartNormalAt's normal there (the record's side), shadingNormal interpolatedNormal's (the
 // front's; a curved glossy chart's map is read around it, chartShadingNormalAt). viewedChart,
-// then exitantRadianceLanes. detail: the albedo modulation and emission texel at the hit
-// (surfaceDetailAt), read on charts whose albedo or emission is textured.
+// then exitantRadianceLanes. detail: the albedo modulation, emission texel and mapped normal at
+// the hit (surfaceDetailAt), read on charts whose albedo or emission is textured or whose
+// material is normal-mapped.
 vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, vec3 shadingNormal, SurfaceDetail detail) {
   ChartRecord c = charts[chart];
   uint flags = c.info.z;
