@@ -29,6 +29,12 @@ uint32_t bits(float f) { return std::bit_cast<uint32_t>(f); }
 /// at full resolution, Texture::sample) or every level (albedo textures: sampleLod).
 enum class TextureUse : uint8_t { None, Level0, AllLevels };
 
+/// Whether diffuseDirectionalFactor (bsdf.h) of `model` is not simply 1 above the horizon: the
+/// GGX-like models', whose k(μ) follows the lobe's albedo.
+bool variesWithAngle(const Bsdf& model) {
+  return std::holds_alternative<GgxBsdf>(model) || std::holds_alternative<GltfPbrBsdf>(model);
+}
+
 void appendMapping(std::vector<uint32_t>& words, const TextureMapping& m) {
   words.insert(words.end(), {uint32_t(m.uvSet), m.isDefault() ? 1u : 0u, bits(m.linear[0][0]), bits(m.linear[0][1]),
                              bits(m.linear[1][0]), bits(m.linear[1][1]), bits(m.offset.x), bits(m.offset.y)});
@@ -43,7 +49,7 @@ std::string surfaceDetailUnsupported(const LightField& lf, const Chart& chart, c
   // k(μ) of the diffuse part tabulated at diffuseFactorNodes (exact only where it is linear
   // between them).
   const Bsdf& model = material.bsdf;
-  if (chart.diffuseValue && !std::holds_alternative<BlinnPhongBsdf>(model) && !diffuseFactorIsPiecewiseLinear(model))
+  if (chart.diffuseValue && variesWithAngle(model) && !diffuseFactorIsPiecewiseLinear(model))
     return "glTF materials with a clear coat or sheen over a diffuse base";
   // diffuseAlbedoAt multiplies a Lambertian albedo by the modulation; another model's
   // directional albedo at normal incidence is not linear in it.
@@ -74,7 +80,7 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
     const Material& m = scene.materials[lf.charts[i].material];
     needsUv = needsUv || shading.needsUv;
     const Bsdf& model = m.bsdf;
-    if (lf.charts[i].diffuseValue && !std::holds_alternative<BlinnPhongBsdf>(model) && diffuseFactorIsPiecewiseLinear(model))
+    if (lf.charts[i].diffuseValue && variesWithAngle(model) && diffuseFactorIsPiecewiseLinear(model))
       needsFactor[lf.charts[i].material] = true;
     if (shading.needsUv && shading.texturedAlbedo) need(m.albedoTexture, TextureUse::AllLevels);
     if (shading.texturedEmission) need(m.emissionTexture, TextureUse::Level0);
