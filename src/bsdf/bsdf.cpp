@@ -182,6 +182,8 @@ class GgxAlbedoTable {
     static const GgxAlbedoTable table;  // thread-safe one-time initialisation
     return table;
   }
+  /// The μ of the nodes (diffuseFactorNodes).
+  const std::array<float, kMuNodes>& muNodes() const { return mu_; }
 
   /// E₀, E₅ at (μ, α), and the matching cosine-weighted means Ē₀, Ē₅ at α.
   struct Lookup {
@@ -1224,6 +1226,17 @@ Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta) {
   if (const auto* ggx = std::get_if<GgxBsdf>(&bsdf)) return ggxDiffuseFactor(*ggx, mu);
   if (const auto* pbr = std::get_if<GltfPbrBsdf>(&bsdf)) return pbrDiffuseShape(*pbr, pbrAlbedos(*pbr, mu)) * pbrDiffuseNorm(*pbr);
   return Rgb(1.0f);
+}
+
+const std::vector<float>& diffuseFactorNodes() {
+  static const std::vector<float> nodes(GgxAlbedoTable::get().muNodes().begin(), GgxAlbedoTable::get().muNodes().end());
+  return nodes;
+}
+
+bool diffuseFactorIsPiecewiseLinear(const Bsdf& bsdf) {
+  if (std::holds_alternative<GgxBsdf>(bsdf)) return true;  // (1 − E(μ)) / √(1 − Ē): E linear in each node's segment
+  const auto* pbr = std::get_if<GltfPbrBsdf>(&bsdf);
+  return pbr != nullptr && !(pbr->clearcoat > 0.0f) && !(sheenWeight(*pbr) > 0.0f);
 }
 
 const char* modelName(const Bsdf& bsdf) {

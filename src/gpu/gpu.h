@@ -6,7 +6,9 @@
 // A frame is two passes:
 //   1. visibility: every triangle of the scene rasterised once with a reversed-Z float depth
 //      buffer, writing its triangle id (+1; 0 = nothing) per pixel — the primary hit of the
-//      ray through the pixel centre, as the CPU renderer's one sample per pixel;
+//      ray through the pixel centre, as the CPU renderer's one sample per pixel; an
+//      alpha-masked triangle is discarded where that ray meets it at a coverage below its
+//      cutoff (coverageAt), as the ray caster's hit filter does;
 //   2. shading: per pixel, the camera ray of Camera::generateRay through the pixel centre,
 //      intersected with the triangles of that pixel and its 8 neighbours (the rasteriser snaps
 //      vertices to a sub-pixel grid, which can hand a centre near an edge the triangle across
@@ -14,9 +16,15 @@
 //      the CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
 //      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes) in a fragment shader,
 //      times the camera weight (cos⁴θ with vignetting). A miss sees the environment (the
-//      constant and the map: EnvironmentMap::radiance, bilinear in the lat-long image). A hit
-//      on a mirror or glass record follows the chain of reflected and refracted rays, traced
-//      through a BVH on the GPU, as the CPU renderers do (gpu_specular.h, gpu_bvh.h).
+//      constant and the map: EnvironmentMap::radiance, bilinear in the lat-long image). On a
+//      chart whose albedo varies, the albedo texture is read at the CPU renderer's mip level
+//      (albedoTextureLod: ray cones of textureConeSpread × t) exactly as Texture::sampleLod
+//      reads it (wrap modes, nearest, trilinear between levels), times the vertex colour; an
+//      emission texture is read at full resolution (emissionModulation); on a normal-mapped
+//      chart the mapped normal (surfaceAt) bends the glossy lookup and selects the tilted
+//      irradiances; a GGX-like diffuse base takes k(μ) from its table (gpu_surface_detail.h).
+//      A hit on a mirror or glass record follows the chain of reflected and refracted rays,
+//      traced through a BVH on the GPU, as the CPU renderers do (gpu_specular.h, gpu_bvh.h).
 // The result is radiance (W·sr⁻¹·m⁻², camera weight included, no exposure), read back into an
 // Image exactly where FastRenderer::render writes it; exposure and tone mapping are then the
 // same CPU code for both renderers (jobs/ ViewSettings::writeImage).
@@ -25,20 +33,29 @@
 // copy), its chart records with their precomputed shading (ChartShading), the vertex positions
 // and normals (a curved glossy chart's map is read around the interpolated normal,
 // chartShadingNormalAt), the triangle → chart map, the sun masks (one uint each; the masked
-// lights are uniforms) and the environment map's texels (RGBA). So GPU memory is 16 bytes per
-// value + 128 per chart + 32 per vertex + 28 per triangle + 4 per sun mask + 16 per
-// environment texel + (with mirrors, glass or punctual highlights) the BVH's 32 per node and
-// 4 per triangle, 64 per material and 4 per triangle for the chains and shadow rays, and 64 per
-// delta light and 48 per material for the highlights + the frame's targets (radiance 16 bytes per
-// pixel; id and depth 8 bytes per pixel, or per texel of the finer multi-sample visibility
-// pass).
+// lights are uniforms), the environment map's texels (RGBA) and the surface detail
+// (gpu_surface_detail.h: the textures the shader reads — 4 bytes per texel of an 8-bit level
+// as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 128 bytes per
+// material, and where a chart or mask needs uvs, 32 bytes per vertex and 4 per triangle). So
+// GPU memory is 16 bytes per value + 128 per chart + 32 per vertex + 28 per triangle + 4 per
+// sun mask + 16 per environment texel + the surface detail + (with mirrors, glass or punctual
+// highlights) the BVH's 32 per node and 4 per triangle, 64 per material and 4 per triangle for
+// the chains and shadow rays, and 64 per delta light and 48 per material for the highlights +
+// the frame's targets (radiance 16 bytes per pixel; id and depth 8 bytes per pixel, or per
+// texel of the finer multi-sample visibility pass). A light field whose buffers exceed the GPU
+// memory available (gpu_memory.h: the driver's query, GL_NVX_gpu_memory_info or
+// GL_ATI_meminfo; the PLENOPTIC_GPU_MEMORY variable; 4 GiB where neither says) is refused
+// before anything is uploaded, with the sizes, and so is one with a buffer larger than the
+// driver's largest storage block.
 //
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
-// picture): mirror-like glossy lobes (specular charts of a glossy model), albedo textures and
-// vertex colours, normal maps, alpha masks, GGX diffuse bases, punctual highlights on glTF
-// materials; and of the render settings, thin lenses. Punctual highlights on glossy charts are
-// evaluated per pixel with a shadow ray through the BVH (gpu_highlights.h).
+// picture): mirror-like glossy lobes (specular charts of a glossy model), metallic-roughness
+// textures, albedo textures on non-Lambertian diffuse charts, punctual highlights on glTF
+// materials, mirrors, glass or punctual highlights beside textured, normal-mapped or
+// alpha-masked surfaces (the traced rays read no surface detail and cut no masks); and of the
+// render settings, thin lenses. Punctual highlights on glossy charts are evaluated per pixel
+// with a shadow ray through the BVH (gpu_highlights.h).
 //
 // Several samples per pixel: the shading pass loops over the pixel's samples at the CPU
 // renderers' jittered film points (Pcg32::forKey in 64-bit GLSL integers,
@@ -70,6 +87,13 @@ std::string gpuUnsupportedFeature(const LightField& lightField);
 /// driver; empty if none (GpuRenderer::unsupportedSetting adds what this driver lacks).
 std::string gpuUnsupportedSetting(const RenderSettings& settings, const Camera& camera);
 
+/// The bytes the CPU renderers hold of `lightField` once decoded: its values (12 bytes each),
+/// chart records, triangle → chart map and sun masks, its scene's geometry (positions,
+/// normals, uvs, vertex colours, triangles and their materials) and textures (every level's
+/// float texels and packed ones, Texture::mips). What GpuRenderer::gpuBytes is measured
+/// against (docs/benchmarks.md).
+uint64_t lightFieldMemoryBytes(const LightField& lightField);
+
 /// Whether a headless OpenGL 4.5 core context can be created here; `why` gets the EGL/GL
 /// error when not.
 bool gpuAvailable(std::string* why = nullptr);
@@ -93,8 +117,9 @@ class GpuRenderer {
  public:
   /// Creates the headless context (EGL: Mesa's surfaceless platform, else the default display
   /// with a 1×1 pbuffer), compiles the shaders and uploads the light field. Throws pl::Error
-  /// naming the EGL or GL error when no OpenGL 4.5 core context can be had, and naming the
-  /// feature (gpuUnsupportedFeature) for a light field it cannot draw. `lightField` must
+  /// naming the EGL or GL error when no OpenGL 4.5 core context can be had, naming the
+  /// feature (gpuUnsupportedFeature) for a light field it cannot draw, and giving the sizes
+  /// for one that does not fit the GPU memory. `lightField` must
   /// outlive the renderer. The context belongs to the renderer: use it from one thread.
   explicit GpuRenderer(const LightField& lightField);
   ~GpuRenderer();
@@ -127,7 +152,8 @@ class GpuRenderer {
   };
   /// The shading pass's lookup function run on each query in a compute shader: the radiance
   /// exitantRadiance(lightField, chart, position, towardsViewer, uv) gives on the CPU (planar
-  /// charts; curved ones are read around the chart normal here).
+  /// charts; curved ones are read around the chart normal here; no surface detail: the albedo
+  /// modulation and emission texel 1, the chart normal as the mapped normal).
   std::vector<Rgb> lookup(const std::vector<LookupQuery>& queries);
 
   /// The closest hits of `rays` in (tMin, tMax) by the BVH traversal the shading pass traces
@@ -141,6 +167,9 @@ class GpuRenderer {
   std::string deviceName() const;
   /// Bytes of GPU buffers and textures this renderer holds (the light field's and the frame's).
   uint64_t gpuBytes() const;
+  /// Of gpuBytes, the light field's buffers alone (uploaded once; the rest is the frame's
+  /// targets, which follow the image size).
+  uint64_t lightFieldGpuBytes() const;
 
  private:
   struct State;

@@ -15,24 +15,28 @@
 #include "gpu/gpu_bvh.h"
 #include "gpu/gpu_highlights.h"
 #include "gpu/gpu_specular.h"
+#include "gpu/gpu_memory.h"
+#include "gpu/gpu_surface_detail.h"
 #include "lightfield/lookup.h"
 
 namespace pl {
 namespace {
 
-// Chart record flags (ChartGpu::info.z). The GLSL constants are generated from these
-// (glslConstants), so the shader and the upload cannot disagree.
+// Chart record flags (ChartGpu::info.z; gpu_surface_detail.h adds its own from 128 up). The
+// GLSL constants are generated from these (glslConstants), so the shader and the upload cannot
+// disagree.
 constexpr uint32_t kFlagTwoSided = 1u, kFlagBack = 2u, kFlagCurved = 4u, kFlagDiffuseValue = 8u, kFlagEmissive = 16u,
                    kFlagTwoSidedEmission = 32u, kFlagSunMasks = 64u;
 
 /// One chart record as the shaders read it (std430: eight 16-byte rows).
 struct ChartGpu {
   float origin[4];        ///< xyz: Chart::origin; w: 1 / tixelSize (ChartShading::inverseTixelSize)
-  float axisU[4], axisV[4], normal[4];
+  float axisU[4];         ///< xyz: Chart::axisU; w: the material's k(μ) table (word, as float bits; diffuseFactor)
+  float axisV[4], normal[4];
   uint32_t grid[4];       ///< resU, resV, dirRes, firstValue
   uint32_t info[4];       ///< valuesPerTixel, kind (ChartKind), flags, firstTixel (its sun masks)
   float emission[4];      ///< ChartShading::emission
-  float albedoOverPi[4];  ///< ChartShading::albedoOverPi
+  float albedoOverPi[4];  ///< ChartShading::albedoOverPi; with kFlagTexturedAlbedo the base albedo (texturedAlbedoBase)
 };
 static_assert(sizeof(ChartGpu) == 128);
 
@@ -57,7 +61,7 @@ int multiSampleIdScale(int width, int height) {
 // Shader storage bindings.
 constexpr GLuint kValuesBinding = 0, kChartsBinding = 1, kPositionsBinding = 2, kTrianglesBinding = 3,
                  kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7,
-                 kEnvironmentBinding = 8;
+                 kEnvironmentBinding = 8, kSurfaceDetailBinding = 12;
 
 std::string glslConstants() {
   return fmt::format(
@@ -151,15 +155,17 @@ vec3 interpolateLanes(ChartRecord c, vec2 grid, vec2 st) {
   return sum;
 }
 // The glossy charts' diffuse irradiance, bilinear over the tixels (after each tixel's map).
-vec3 diffuseValueOverTixels(ChartRecord c, vec2 grid) {
+// bilinearOverTixels of the value `offset` after each tixel's first (its map: the diffuse
+// irradiance at dirRes², a tilted irradiance after it).
+vec3 tixelValueOverTixels(ChartRecord c, vec2 grid, uint offset) {
   LinearTap tu = linearTap(grid.x, c.grid.x), tv = linearTap(grid.y, c.grid.y);
-  uint map = c.grid.z * c.grid.z;
-  vec3 lower = (1.0 - tu.f) * (1.0 - tv.f) * values[valueIndex(c, tu.i0, tv.i0, 0u, 0u) + map].rgb +
-               tu.f * (1.0 - tv.f) * values[valueIndex(c, tu.i1, tv.i0, 0u, 0u) + map].rgb;
-  vec3 upper = (1.0 - tu.f) * tv.f * values[valueIndex(c, tu.i0, tv.i1, 0u, 0u) + map].rgb +
-               tu.f * tv.f * values[valueIndex(c, tu.i1, tv.i1, 0u, 0u) + map].rgb;
+  vec3 lower = (1.0 - tu.f) * (1.0 - tv.f) * values[valueIndex(c, tu.i0, tv.i0, 0u, 0u) + offset].rgb +
+               tu.f * (1.0 - tv.f) * values[valueIndex(c, tu.i1, tv.i0, 0u, 0u) + offset].rgb;
+  vec3 upper = (1.0 - tu.f) * tv.f * values[valueIndex(c, tu.i0, tv.i1, 0u, 0u) + offset].rgb +
+               tu.f * tv.f * values[valueIndex(c, tu.i1, tv.i1, 0u, 0u) + offset].rgb;
   return lower + upper;
 }
+vec3 diffuseValueOverTixels(ChartRecord c, vec2 grid) { return tixelValueOverTixels(c, grid, c.grid.z * c.grid.z); }
 // sunVisibility (lightfield.h): light l's mask bilinear between the four nearest sub-samples.
 void sunAxis(float g, uint res, out uint s0, out uint s1, out float f) {
   uint side = uint(kSunMaskSide);
@@ -190,12 +196,13 @@ float sunVisibility(ChartRecord c, uint light, vec2 grid) {
   return (1.0 - fv) * ((1.0 - fu) * sunBit(c, light, u0, v0) + fu * sunBit(c, light, u1, v0)) +
          fv * ((1.0 - fu) * sunBit(c, light, u0, v1) + fu * sunBit(c, light, u1, v1));
 }
-// sunIrradianceLanes (lookup.h) without a normal map: n' = n.
-vec3 sunIrradianceAt(ChartRecord c, vec2 grid, vec3 normal) {
+// sunIrradianceLanes (lookup.h): the masked lights above the surface's normal n, on its
+// mapped normal n' (n itself without a normal map).
+vec3 sunIrradianceAt(ChartRecord c, vec2 grid, vec3 normal, vec3 mappedNormal) {
   vec3 sum = vec3(0.0);
   for (uint l = 0u; l < sunCount; ++l) {
     if (!(dot(normal, sunTowards[l]) > 0.0)) continue;
-    float cosTheta = dot(normal, sunTowards[l]);
+    float cosTheta = dot(mappedNormal, sunTowards[l]);
     if (!(cosTheta > 0.0)) continue;
     float lit = sunVisibility(c, l, grid);
     if (lit > 0.0) sum += sunIrradiance[l] * (cosTheta * lit);
@@ -219,11 +226,34 @@ vec3 toLocalAround(ChartRecord c, vec3 n, vec3 w) {
   vec3 t = vec3(b, sign + n.y * n.y * a, -n.y);
   return vec3(dot(w, s), dot(w, t), dot(w, n));
 }
+// mappedNormalIrradiance (lookup.h) with tiltWeights (lightfield.h): the irradiance about the
+// mapped normal (localMapped: in the tilt frame) from the irradiance about the chart normal
+// and the tilted irradiances, bilinear over the tixels; clamped at 0.
+vec3 mappedNormalIrradiance(ChartRecord c, vec2 grid, vec3 irradiance, vec3 localMapped) {
+  float share = (1.0 - localMapped.z) * (1.0 / (1.0 - kNormalTiltCosine));
+  float gradient = 2.0 / (3.0 * kNormalTiltSine);
+  vec3 total = (1.0 - share) * irradiance;
+  uint first = c.grid.z * c.grid.z + ((c.info.z & kFlagDiffuseValue) != 0u ? 1u : 0u);
+  for (uint k = 0u; k < kTiltedNormals; ++k) {
+    float w = share * (1.0 / float(kTiltedNormals)) + gradient * (kTiltAcross[k].x * localMapped.x + kTiltAcross[k].y * localMapped.y);
+    total += w * tixelValueOverTixels(c, grid, first + k);
+  }
+  return max(total, vec3(0.0));
+}
+// normalMappedLookupDirection (lookup.cpp).
+vec3 normalMappedLookupDirection(vec3 mapNormal, vec3 shadingNormal, vec3 wo) {
+  if (!(dot(wo, mapNormal) > 0.0)) return wo;
+  vec3 mirrored = 2.0 * dot(wo, shadingNormal) * shadingNormal - wo;
+  vec3 d = 2.0 * dot(mirrored, mapNormal) * mapNormal - mirrored;
+  return dot(d, mapNormal) > 0.0 ? normalize(d) : wo;
+}
 // The radiance towards the viewer (unit towardsViewer) at world point p of the surface whose
 // triangle maps to chart record `chart` (triangleChart's front record): normalAtHit is
 // chartNormalAt's normal there (the record's side), shadingNormal interpolatedNormal's (the
 // front's; a curved glossy chart's map is read around it, chartShadingNormalAt). viewedChart,
-// then exitantRadianceLanes.
+// then exitantRadianceLanes. detail: the albedo modulation, emission texel and mapped normal at
+// the hit (surfaceDetailAt), read on charts whose albedo or emission is textured or whose
+// material is normal-mapped.
 // viewedChart: the record seen, kNoRecord behind a one-sided curved record.
 const uint kNoRecord = 0xffffffffu;
 uint viewedRecord(uint chart, vec3 towardsViewer, vec3 normalAtHit) {
@@ -232,7 +262,7 @@ uint viewedRecord(uint chart, vec3 towardsViewer, vec3 normalAtHit) {
   if ((flags & kFlagCurved) != 0u && (flags & kFlagTwoSided) == 0u && side < 0.0) return kNoRecord;
   return (flags & kFlagTwoSided) != 0u && (flags & kFlagBack) == 0u && side < 0.0 ? chart + 1u : chart;
 }
-vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, vec3 shadingNormal) {
+vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, vec3 shadingNormal, SurfaceDetail detail) {
   uint record = viewedRecord(chart, towardsViewer, normalAtHit);
   if (record == kNoRecord) return vec3(0.0);
   ChartRecord c = charts[record];
@@ -243,19 +273,49 @@ vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, ve
   float cosTheta = (flags & kFlagCurved) != 0u ? 1.0 : dot(towardsViewer, c.normal.xyz);
   bool emits = cosTheta > 0.0 || (flags & kFlagTwoSidedEmission) != 0u;
   vec3 emission = (flags & kFlagEmissive) != 0u && emits ? c.emission.rgb : vec3(0.0);
+  if ((flags & kFlagTexturedEmission) != 0u) emission *= detail.emission;
   if (!(cosTheta >= 0.0)) return emission;
-  // lookupNormalAt: the chart normal, or on a curved chart the interpolated one (chartShadingNormalAt).
+  // lookupNormalAt: the chart normal, or on a curved chart the interpolated one (chartShadingNormalAt);
+  // lookupInputs' mapped normal, turned to the record's side.
   vec3 lookupNormal = (flags & kFlagBack) != 0u ? -shadingNormal : shadingNormal;
+  bool normalMapped = (flags & kFlagNormalMapped) != 0u;
+  vec3 mappedNormal = !normalMapped ? lookupNormal : (flags & kFlagBack) != 0u ? -detail.normal : detail.normal;
   if (c.info.y == kDiffuse) {
     vec3 irradiance = interpolateLanes(c, grid, vec2(0.0));
-    if ((flags & kFlagSunMasks) != 0u) irradiance += sunIrradianceAt(c, grid, lookupNormal);
-    return emission + c.albedoOverPi.rgb * irradiance;
+    if ((flags & kFlagDirectionalIrradiance) != 0u) {
+      // The Lambertian lobe reflects only towards viewers above the mapped normal.
+      if (!(dot(towardsViewer, mappedNormal) > 0.0)) return emission;
+      irradiance = mappedNormalIrradiance(c, grid, irradiance, toLocalAround(c, lookupNormal, mappedNormal));
+    }
+    if ((flags & kFlagSunMasks) != 0u) irradiance += sunIrradianceAt(c, grid, lookupNormal, mappedNormal);
+    // diffuseAlbedoAt: the base albedo × the modulation, over π.
+    vec3 albedoOverPi = (flags & kFlagTexturedAlbedo) != 0u ? c.albedoOverPi.rgb * detail.albedo * kInvPi : c.albedoOverPi.rgb;
+    return emission + albedoOverPi * irradiance;
   }
-  vec3 local = toLocalAround(c, lookupNormal, towardsViewer);
+  // A normal-mapped glossy chart: nothing reflected towards viewers below the mapped normal, and
+  // the map read in the direction the normal map bends the view to.
+  vec3 lookupDirection = towardsViewer;
+  if (normalMapped) {
+    if (!(dot(towardsViewer, mappedNormal) > 0.0)) return (flags & kFlagEmissive) != 0u && emits ? c.emission.rgb : vec3(0.0);
+    lookupDirection = normalMappedLookupDirection(lookupNormal, mappedNormal, towardsViewer);
+  }
+  vec3 local = toLocalAround(c, lookupNormal, lookupDirection);
   vec3 mapped = interpolateLanes(c, grid, directionToParaboloid(local));
   if ((flags & kFlagDiffuseValue) == 0u) return mapped;
-  float k = local.z > 0.0 ? 1.0 : 0.0;  // diffuseDirectionalFactor of Blinn-Phong
-  return mapped + c.albedoOverPi.rgb * k * diffuseValueOverTixels(c, grid);
+  vec3 diffuseIrradiance = diffuseValueOverTixels(c, grid);
+  if ((flags & kFlagDirectionalIrradiance) != 0u)
+    diffuseIrradiance = mappedNormalIrradiance(c, grid, diffuseIrradiance, toLocalAround(c, lookupNormal, mappedNormal));
+  // diffuseDirectionalFactor at μo (against the mapped normal on a normal-mapped chart).
+  vec3 k = diffuseFactor(floatBitsToUint(c.axisU.w), normalMapped ? dot(towardsViewer, mappedNormal) : local.z);
+  // glossyDiffuseAlbedoAt: the model's diffuse albedo × the modulation.
+  vec3 albedoOverPi = (flags & kFlagTexturedAlbedo) != 0u ? c.albedoOverPi.rgb * detail.albedo * kInvPi : c.albedoOverPi.rgb;
+  return mapped + albedoOverPi * k * diffuseIrradiance;
+}
+// The radiance at a hit of a reflected or refracted ray (gpu_specular.h): no surface detail —
+// gpuUnsupportedFeature refuses mirrors, glass and punctual highlights beside textured,
+// normal-mapped or alpha-masked surfaces, whose detail those rays would need.
+vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, vec3 shadingNormal) {
+  return lookupRadiance(chart, p, towardsViewer, normalAtHit, shadingNormal, noSurfaceDetail(shadingNormal));
 }
 )glsl";
 
@@ -271,9 +331,61 @@ void main() {
   gl_Position = vec4(dot(v, right) / (tanHalfFovY * aspect), -dot(v, up) / tanHalfFovY, near, z);
 }
 )glsl";
+// The geometry as the fragment stages and the BVH traversal (gpu_bvh.h) read it.
+constexpr const char* kGeometryGlsl = R"glsl(
+layout(std430, binding = POSITIONS_BINDING) readonly buffer Positions { vec4 positions[]; };
+layout(std430, binding = TRIANGLES_BINDING) readonly buffer Triangles { uvec4 triangles[]; };
+layout(std430, binding = NORMALS_BINDING) readonly buffer Normals { vec4 normals[]; };  // w = 0: none
+)glsl";
+// The fragment stages' view of the scene beside its geometry: the camera and film size, and the
+// ray through a film point (Camera::generateRay's pinhole).
+constexpr const char* kFrameGlsl = R"glsl(
+uniform vec3 eye, forward, right, up;
+uniform float tanHalfFovY, aspect;
+uniform ivec2 size;
+uniform int idScale;  // the ids are at idScale × the image's resolution
+uniform bool anyMasked;  // some material is alpha-masked (maskedMaterial)
+// The vector from the eye to film point `film` (pixel units) on the image plane at unit distance.
+vec3 cameraToFilm(vec2 film) {
+  float sx = (2.0 * film.x / float(size.x) - 1.0) * tanHalfFovY * aspect;
+  float sy = (1.0 - 2.0 * film.y / float(size.y)) * tanHalfFovY;
+  return forward + sx * right + sy * up;
+}
+// The ray from the eye along unit `direction` against the triangle with vertices v
+// (Möller–Trumbore, no bounds test): (t, b1, b2), the barycentrics of where it meets the plane.
+vec3 rayTriangle(vec3 direction, uvec3 v) {
+  vec3 p0 = positions[v.x].xyz, e1 = positions[v.y].xyz - p0, e2 = positions[v.z].xyz - p0;
+  vec3 q = cross(direction, e2);
+  float det = dot(e1, q);
+  vec3 s = eye - p0;
+  vec3 r = cross(s, e1);
+  return vec3(dot(e2, r), dot(s, q), dot(direction, r)) / det;
+}
+// interpolatedNormal (scene.h) at barycentrics b of the triangle with vertices v and unit
+// geometric normal `geometric`: the vertex normals interpolated, turned to its side.
+vec3 interpolatedNormalAt(uvec3 v, vec2 b, vec3 geometric) {
+  if (normals[v.x].w == 0.0) return geometric;
+  float b1 = b.x, b2 = b.y;
+  vec3 interpolated = (1.0 - b1 - b2) * normals[v.x].xyz + b1 * normals[v.y].xyz + b2 * normals[v.z].xyz;
+  float len = length(interpolated);
+  if (!(len > 1e-6 && !isinf(len) && !isnan(len))) return geometric;
+  vec3 shading = interpolated / len;
+  return dot(shading, geometric) < 0.0 ? -shading : shading;
+}
+)glsl";
+// An alpha-masked triangle (anyMasked: the scene has some) is cut away where the ray through
+// the texel centre meets it at a coverage below its cutoff (coverageAt), as the ray caster's
+// hit filter does: the surface behind it is seen there.
 constexpr const char* kVisibilityFragment = R"glsl(
 out uint id;
-void main() { id = uint(gl_PrimitiveID) + 1u; }
+void main() {
+  uint triangle = uint(gl_PrimitiveID);
+  if (anyMasked && maskedMaterial(triangle)) {
+    uvec3 v = triangles[triangle].xyz;
+    if (masked(triangle, v, rayTriangle(normalize(cameraToFilm(gl_FragCoord.xy / float(idScale))), v).yz)) discard;
+  }
+  id = triangle + 1u;
+}
 )glsl";
 
 // Pass 2: per pixel, the camera ray through its centre (Camera::generateRay), the hit on the
@@ -284,19 +396,11 @@ void main() {
   gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
 }
 )glsl";
-// The geometry as the shading pass and the BVH traversal (gpu_bvh.h) read it.
-constexpr const char* kGeometryGlsl = R"glsl(
-layout(std430, binding = POSITIONS_BINDING) readonly buffer Positions { vec4 positions[]; };
-layout(std430, binding = TRIANGLES_BINDING) readonly buffer Triangles { uvec4 triangles[]; };
-layout(std430, binding = NORMALS_BINDING) readonly buffer Normals { vec4 normals[]; };  // w = 0: none
-)glsl";
 constexpr const char* kShadingFragment = R"glsl(
 layout(binding = 0) uniform usampler2D ids;
-uniform vec3 eye, forward, right, up, background;
-uniform float tanHalfFovY, aspect;
-uniform ivec2 size;
-uniform int idScale;  // the ids are at idScale × the image's resolution
+uniform vec3 background;
 uniform bool vignetting;
+uniform float coneSpread;  // textureConeSpread: a sample's ray cone is coneSpread × t wide at t
 out vec4 color;
 
 // Environment::radiance (scene.h): the constant plus, where the scene has one, its map —
@@ -380,9 +484,7 @@ vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer)
 // units, Camera::generateRay's pinhole). `jittered`: the film point is anywhere in its pixel,
 // not the centre (see the miss rule below).
 vec3 sampleRadiance(vec2 film, bool jittered) {
-  float sx = (2.0 * film.x / float(size.x) - 1.0) * tanHalfFovY * aspect;
-  float sy = (1.0 - 2.0 * film.y / float(size.y)) * tanHalfFovY;
-  vec3 toFilm = forward + sx * right + sy * up;
+  vec3 toFilm = cameraToFilm(film);
   float invLength = 1.0 / length(toFilm);
   float weight = 1.0;
   if (vignetting) weight = invLength * invLength * invLength * invLength;  // cos^4
@@ -405,17 +507,11 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
       if (candidate == 0u) besideBackground = true;
       if (candidate == 0u || candidate == id) continue;
       uvec4 tri = triangles[candidate - 1u];
-      vec3 p0 = positions[tri.x].xyz, e1 = positions[tri.y].xyz - p0, e2 = positions[tri.z].xyz - p0;
-      vec3 q = cross(direction, e2);
-      float det = dot(e1, q);
-      if (det == 0.0) continue;
-      vec3 s = eye - p0;
-      float u = dot(s, q) / det;
-      vec3 r = cross(s, e1);
-      float v = dot(direction, r) / det;
-      float hit = dot(e2, r) / det;
-      if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit > 0.0 && hit < t) {
-        t = hit;
+      vec3 hit = rayTriangle(direction, tri.xyz);  // (t, b1, b2)
+      float u = hit.y, v = hit.z;
+      if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit.x > 0.0 && hit.x < t &&
+          !(anyMasked && masked(candidate - 1u, tri.xyz, vec2(u, v)))) {
+        t = hit.x;
         id = candidate;
       }
     }
@@ -424,28 +520,34 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
   uvec4 tri = triangles[id - 1u];
   vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
   vec3 n = cross(p1 - p0, p2 - p0);
+  // The hit's barycentrics (Möller–Trumbore's, as the ray caster's), on the triangle's plane
+  // where the ray passes beside it.
+  vec3 hit = rayTriangle(direction, tri.xyz);
   if (isinf(t)) t = dot(p0 - eye, n) / dot(direction, n);
   vec3 p = eye + t * direction;
-  // The hit's barycentrics (b1, b2), from the point.
-  vec3 e1 = p1 - p0, e2 = p2 - p0, v = p - p0;
-  float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), v1 = dot(v, e1), v2 = dot(v, e2);
-  float denominator = d11 * d22 - d12 * d12;
-  vec2 uv = vec2((d22 * v1 - d12 * v2) / denominator, (d11 * v2 - d12 * v1) / denominator);
-  vec3 normalAtHit, shadingNormal;
-  hitNormals(tri, uv, normalAtHit, shadingNormal);
+  ChartRecord c = charts[tri.w];
+  vec2 b = hit.yz;
+  // triangleNormal, then on a curved or normal-mapped chart interpolatedNormal (scene.h) at the
+  // hit's barycentrics.
+  float length2 = dot(n, n);
+  vec3 geometric = length2 > 0.0 ? n / sqrt(length2) : vec3(0.0);
+  bool curved = (c.info.z & kFlagCurved) != 0u;
+  vec3 interpolated = curved || (c.info.z & kFlagNormalMapped) != 0u ? interpolatedNormalAt(tri.xyz, b, geometric) : geometric;
+  vec3 normalAtHit = curved ? geometric : c.normal.xyz, shadingNormal = curved ? interpolated : c.normal.xyz;
 #if defined(SPECULAR) || defined(HIGHLIGHTS)
   uint record = viewedRecord(tri.w, -direction, normalAtHit);
 #endif
 #ifdef SPECULAR
   if (record != kNoRecord && charts[record].info.y == kSpecular)
-    return weight * specularChain(eye, direction, t, id - 1u, uv, mirrorDepth);
+    return weight * specularChain(eye, direction, t, id - 1u, b, mirrorDepth);
 #endif
+  SurfaceDetail detail =
+      surfaceDetailAt(id - 1u, tri.xyz, p0, p1, p2, b, c.info, direction, coneSpread * t, geometric, interpolated);
+  vec3 radiance = lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal, detail);
 #ifdef HIGHLIGHTS
-  if (record != kNoRecord)
-    return weight * (lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal) +
-                     punctualHighlights(record, id - 1u, uv, -direction));
+  if (record != kNoRecord) radiance += punctualHighlights(record, id - 1u, b, -direction);
 #endif
-  return weight * lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal);
+  return weight * radiance;
 }
 
 #ifdef MULTISAMPLE
@@ -506,7 +608,8 @@ void main() {
   if (i >= count) return;
   uint chart = floatBitsToUint(queries[i].position.w);
   vec3 normal = charts[chart].normal.xyz;
-  results[i] = vec4(lookupRadiance(chart, queries[i].position.xyz, queries[i].towardsViewer.xyz, normal, normal), 0.0);
+  results[i] = vec4(lookupRadiance(chart, queries[i].position.xyz, queries[i].towardsViewer.xyz, normal, normal,
+                                   noSurfaceDetail(normal)), 0.0);
 }
 )glsl";
 
@@ -578,11 +681,17 @@ GLuint compileShader(GLenum type, const std::string& source, const char* name) {
 /// (extensions, defines), the generated constants and, where `lookup`, the lookup functions.
 GLuint linkProgram(std::initializer_list<std::pair<GLenum, std::string>> stages, const char* name, bool lookup,
                    const std::string& header = "") {
-  const std::string prefix = "#version 450 core\n" + header + glslConstants() + (lookup ? kLookupGlsl : "");
+  const std::string prefix = "#version 450 core\n" + header + glslConstants();
+  // The surface detail (its buffer and functions) for the fragment and compute stages, the
+  // triangles and the camera for the fragment stages.
+  const std::string detail = gpu::surfaceDetailGlsl(kSurfaceDetailBinding);
   const GLuint program = glCreateProgram();
   std::vector<GLuint> shaders;
   for (const auto& [type, source] : stages) {
-    shaders.push_back(compileShader(type, prefix + source, name));
+    const std::string text = type == GL_VERTEX_SHADER ? prefix + source
+                                                      : prefix + (type == GL_FRAGMENT_SHADER ? std::string(kGeometryGlsl) + kFrameGlsl : "") + detail +
+                                                            (lookup ? kLookupGlsl : "") + source;
+    shaders.push_back(compileShader(type, text, name));
     glAttachShader(program, shaders.back());
   }
   glLinkProgram(program);
@@ -640,23 +749,22 @@ void setCameraUniforms(GLuint program, const Camera& camera) {
 
 std::string gpuUnsupportedFeature(const LightField& lf) {
   const Scene& scene = lf.scene;
-  for (const Material& m : scene.materials)
-    if (m.isMasked()) return "alpha masks";
   if (std::string specular = gpuUnsupportedSpecular(lf); !specular.empty()) return specular;
   if (std::string highlights = gpuUnsupportedHighlights(lf); !highlights.empty()) return highlights;
+  // The reflected, refracted and shadow rays (gpu_specular.h, gpu_highlights.h) neither cut
+  // alpha masks nor read the surface detail at their hits.
+  const bool tracesRays = hasSpecularCharts(lf) || gpuHighlightsActive(lf);
+  const char* const tracedBesideDetail =
+      "mirrors, glass or punctual highlights beside textured, normal-mapped or alpha-masked surfaces";
+  if (tracesRays && std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.isMasked(); }))
+    return tracedBesideDetail;
   const SunLights sun = sunLightsOf(lf);
   for (uint32_t i = 0; i < lf.charts.size(); ++i) {
     const Chart& c = lf.charts[i];
     const ChartShading shading = chartShading(lf, i, sun);
-    if (shading.texturedAlbedo) return "albedo textures, metallic-roughness textures and vertex colours";
-    if (shading.normalMapped || c.directionalIrradiance) return "normal maps";
-    if (shading.texturedEmission) return "emission textures";
-    // The shader takes a glossy chart's diffuse part as Blinn-Phong's, k(μ) = 1; GGX-like
-    // models (GgxBsdf, GltfPbrBsdf) couple it to the lobe's albedo.
-    const Bsdf& model = scene.materials[c.material].bsdf;
-    if (c.diffuseValue && (diffuseDirectionalFactor(model, 0.25f) != Rgb(1.0f) ||
-                           diffuseDirectionalFactor(model, 1.0f) != Rgb(1.0f)))
-      return "GGX materials with a diffuse base";
+    if (std::string detail = gpu::surfaceDetailUnsupported(lf, c, shading); !detail.empty()) return detail;
+    if (tracesRays && (shading.texturedAlbedo || shading.texturedEmission || shading.normalMapped || c.directionalIrradiance))
+      return tracedBesideDetail;
   }
   if (lf.values.size() >= std::numeric_limits<uint32_t>::max() || lf.sunMasks.size() >= std::numeric_limits<uint32_t>::max())
     return "more than 2^32 light-field values";
@@ -670,7 +778,9 @@ std::string gpuUnsupportedSetting(const RenderSettings& /*settings*/, const Came
 
 struct GpuRenderer::State {
   gpu::EglContext context;
-  GLuint buffers[8] = {};  // values, charts, positions, triangles, indices, normals, sun masks, environment map
+  // values, charts, positions, triangles, indices, normals, sun masks, environment map, surface detail
+  static constexpr GLsizei kBufferCount = 9;
+  GLuint buffers[kBufferCount] = {};
   GLuint vertexArray = 0, emptyVertexArray = 0;
   GLuint visibilityProgram = 0, shadingProgram = 0, lookupProgram = 0;
   /// The BVH (gpu_bvh.h: nodes, order), the materials of the specular chains and shadow rays
@@ -694,7 +804,7 @@ struct GpuRenderer::State {
 
   ~State() {
     context.makeCurrent();
-    glDeleteBuffers(8, buffers);
+    glDeleteBuffers(kBufferCount, buffers);
     glDeleteBuffers(6, rayBuffers);
     glDeleteProgram(intersectProgram);
     glDeleteVertexArrays(1, &vertexArray);
@@ -776,6 +886,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   std::vector<float> values(lightField.values.size() * 4, 0.0f);
   for (size_t i = 0; i < lightField.values.size(); ++i) std::memcpy(&values[4 * i], &lightField.values[i], sizeof(Rgb));
   const SunLights sun = sunLightsOf(lightField);
+  const gpu::SurfaceDetailBuffer detail = gpu::surfaceDetailBuffer(lightField);
   std::vector<ChartGpu> charts(lightField.charts.size());
   for (uint32_t i = 0; i < charts.size(); ++i) {
     const Chart& c = lightField.charts[i];
@@ -790,12 +901,21 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                   (c.sides == 2 ? kFlagTwoSided : 0u) | (c.isBack ? kFlagBack : 0u) | (c.curved ? kFlagCurved : 0u) |
                       (c.diffuseValue ? kFlagDiffuseValue : 0u) | (shading.emissive ? kFlagEmissive : 0u) |
                       (shading.twoSidedEmission ? kFlagTwoSidedEmission : 0u) |
-                      (shading.sunMasks != nullptr ? kFlagSunMasks : 0u),
+                      (shading.sunMasks != nullptr ? kFlagSunMasks : 0u) |
+                      (shading.needsUv && shading.texturedAlbedo ? gpu::kFlagTexturedAlbedo : 0u) |
+                      (shading.texturedEmission ? gpu::kFlagTexturedEmission : 0u) |
+                      (shading.normalMapped ? gpu::kFlagNormalMapped : 0u) |
+                      (c.directionalIrradiance ? gpu::kFlagDirectionalIrradiance : 0u),
                   uint32_t(c.firstTixel)},
                  {},
                  {}};
     std::memcpy(g.emission, shading.emission.v, sizeof(g.emission));
     std::memcpy(g.albedoOverPi, shading.albedoOverPi.v, sizeof(g.albedoOverPi));
+    std::memcpy(&g.axisU[3], &detail.diffuseFactorTable[c.material], sizeof(float));
+    if (shading.needsUv && shading.texturedAlbedo) {
+      const Rgb base = gpu::texturedAlbedoBase(scene, c);
+      std::memcpy(g.albedoOverPi, &base, sizeof(Rgb));
+    }
   }
   // The geometry: every mesh's positions in one array, triangles with global vertex indices
   // (so gl_PrimitiveID of the one draw call is the triangle's index here) and their charts.
@@ -825,21 +945,8 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   if (!positions.empty()) s.near = std::max(1e-6f * glm::length(upper - lower), std::numeric_limits<float>::min());
   s.indexCount = GLsizei(indices.size());
 
-  glCreateBuffers(8, s.buffers);
-  auto upload = [&](GLuint buffer, const void* data, size_t bytes) {
-    // A zero-sized buffer cannot be bound to a storage block: 16 bytes stand in.
-    glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), bytes > 0 ? data : nullptr, GL_DYNAMIC_STORAGE_BIT);
-    s.bufferBytes += std::max<size_t>(bytes, 16);
-  };
-  upload(s.buffers[0], values.data(), values.size() * sizeof(float));
-  upload(s.buffers[1], charts.data(), charts.size() * sizeof(ChartGpu));
-  upload(s.buffers[2], positions.data(), positions.size() * sizeof(float));
-  upload(s.buffers[3], triangles.data(), triangles.size() * sizeof(TriangleGpu));
-  upload(s.buffers[4], indices.data(), indices.size() * sizeof(uint32_t));
-  upload(s.buffers[5], normals.data(), normals.size() * sizeof(float));
   const std::vector<uint32_t> sunMasks(lightField.sunMasks.begin(), lightField.sunMasks.end());
-  upload(s.buffers[6], sunMasks.data(), sunMasks.size() * sizeof(uint32_t));
-  // The environment map's lat-long texels as RGBA (none: a 16-byte stand-in).
+  // The environment map's lat-long texels as RGBA.
   const EnvironmentMap* environmentMap = scene.environment.map.get();
   std::vector<float> envTexels;
   if (environmentMap != nullptr) {
@@ -847,17 +954,51 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
     envTexels.resize(image.pixels.size() * 4, 0.0f);
     for (size_t i = 0; i < image.pixels.size(); ++i) std::memcpy(&envTexels[4 * i], &image.pixels[i], sizeof(Rgb));
   }
-  upload(s.buffers[7], envTexels.data(), envTexels.size() * sizeof(float));
+  // The buffers, in State::buffers' order, and what each holds (for the memory check's
+  // message). A zero-sized buffer cannot be bound to a storage block: 16 bytes stand in.
+  struct Upload {
+    const char* what;
+    const void* data;
+    size_t bytes;
+  };
+  const Upload uploads[State::kBufferCount] = {
+      {"values", values.data(), values.size() * sizeof(float)},
+      {"chart records", charts.data(), charts.size() * sizeof(ChartGpu)},
+      {"vertex positions", positions.data(), positions.size() * sizeof(float)},
+      {"triangles", triangles.data(), triangles.size() * sizeof(TriangleGpu)},
+      {"vertex indices", indices.data(), indices.size() * sizeof(uint32_t)},
+      {"vertex normals", normals.data(), normals.size() * sizeof(float)},
+      {"sun masks", sunMasks.data(), sunMasks.size() * sizeof(uint32_t)},
+      {"environment map", envTexels.data(), envTexels.size() * sizeof(float)},
+      {"textures, uvs and vertex colours", detail.words.data(), detail.words.size() * sizeof(uint32_t)}};
+  std::vector<std::pair<std::string, uint64_t>> sizes;
+  for (const Upload& u : uploads) sizes.emplace_back(u.what, std::max<size_t>(u.bytes, 16));
+  // Mirrors, glass and punctual highlights add the BVH (at most 2n − 1 nodes over n triangles,
+  // and their order), the triangles' materials and the materials and lights they read.
+  s.specular = hasSpecularCharts(lightField);
+  s.highlights = gpuHighlightsActive(lightField);
+  const bool traces = s.specular || s.highlights;
+  if (traces) {
+    const uint64_t triangleCount = triangles.size();
+    sizes.emplace_back("BVH (bound)", std::max<uint64_t>((2 * triangleCount) * sizeof(BvhNode) + 4 * triangleCount, 16));
+    sizes.emplace_back("materials of the traced rays", std::max<uint64_t>(scene.materials.size() * sizeof(SpecularMaterialGpu) +
+                                                                               4 * triangleCount, 16));
+  }
+  gpu::checkGpuMemory(sizes);
+  glCreateBuffers(State::kBufferCount, s.buffers);
+  for (GLsizei i = 0; i < State::kBufferCount; ++i) {
+    const Upload& u = uploads[i];
+    glNamedBufferStorage(s.buffers[i], GLsizeiptr(std::max<size_t>(u.bytes, 16)), u.bytes > 0 ? u.data : nullptr,
+                         GL_DYNAMIC_STORAGE_BIT);
+    s.bufferBytes += std::max<size_t>(u.bytes, 16);
+  }
   checkGl("uploading the light field (out of GPU memory?)");
   // Mirrors and glass, punctual highlights: the BVH their rays are traced through, the
   // materials they follow or pass (thin glass), the highlights' lights and models.
-  s.specular = hasSpecularCharts(lightField);
-  s.highlights = gpuHighlightsActive(lightField);
   if (s.specular && !epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
     fail("GPU renderer: this light field has mirrors or glass, which need GL_ARB_gpu_shader_int64 (this driver, {}, "
          "lacks it; render it with --renderer cpu)",
          currentDeviceName());
-  const bool traces = s.specular || s.highlights;
   if (traces) {
     s.uploadBvh(scene);
     const std::vector<SpecularMaterialGpu> materials = specularMaterials(scene);
@@ -897,7 +1038,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   const std::string raysHeader = (s.specular ? int64 + "#define SPECULAR\n" : "") +
                                      (s.highlights ? "#define HIGHLIGHTS\n" + highlightGlslConstants() : "") +
                                      (traces ? bvhGlslConstants() + specularGlslConstants() : "");
-  const std::string shading = std::string(kGeometryGlsl) + kShadingFragment +
+  const std::string shading = std::string(kShadingFragment) +
                               (traces ? std::string(kBvhGlsl) + kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
                               (s.specular ? kSpecularGlsl : "");
   s.shadingProgram =
@@ -908,6 +1049,9 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                        "multi-sample shading", true,
                                        (s.specular ? raysHeader : int64 + raysHeader) + "#define MULTISAMPLE\n");
   glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
+  const bool anyMasked = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.isMasked(); });
+  for (GLuint program : {s.visibilityProgram, s.shadingProgram, s.multisampleProgram})
+    if (program != 0) glProgramUniform1i(program, glGetUniformLocation(program, "anyMasked"), anyMasked ? 1 : 0);
   for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {
     if (program == 0) continue;
     if (s.highlights) {
@@ -933,6 +1077,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kNormalsBinding, s.buffers[5]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSunMasksBinding, s.buffers[6]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kEnvironmentBinding, s.buffers[7]);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSurfaceDetailBinding, s.buffers[8]);
   for (GLuint program : {s.shadingProgram, s.lookupProgram, s.multisampleProgram}) {
     if (program == 0) continue;
     glProgramUniform1ui(program, glGetUniformLocation(program, "sunCount"), sun.count);
@@ -957,6 +1102,8 @@ void GpuRenderer::drawVisibility(const Camera& camera, int idScale) {
   s.context.makeCurrent();
   s.ensureTargets(camera.width(), camera.height(), idScale);
   setCameraUniforms(s.visibilityProgram, camera);
+  glProgramUniform2i(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "size"), camera.width(), camera.height());
+  glProgramUniform1i(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "idScale"), idScale);
   glBindFramebuffer(GL_FRAMEBUFFER, s.visibilityFramebuffer);
   glViewport(0, 0, camera.width() * idScale, camera.height() * idScale);
   const GLuint noTriangle = 0;
@@ -1002,6 +1149,8 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   if (s.specular)
     glProgramUniform1ui(program, glGetUniformLocation(program, "mirrorDepth"),
                         effectiveMirrorDepth(settings, lightField_.settings.mirrorDepth));
+  glProgramUniform1f(program, glGetUniformLocation(program, "coneSpread"),
+                     textureConeSpread(settings, camera.pixelSpread(), spp));
   if (spp > 1) {
     glProgramUniform1i(program, glGetUniformLocation(program, "spp"), spp);
     glProgramUniform2ui(program, glGetUniformLocation(program, "seed"), GLuint(settings.seed & 0xffffffffu),
@@ -1070,6 +1219,8 @@ std::string GpuRenderer::deviceName() const {
 }
 
 uint64_t GpuRenderer::gpuBytes() const { return state_->bufferBytes + state_->targetBytes(); }
+
+uint64_t GpuRenderer::lightFieldGpuBytes() const { return state_->bufferBytes; }
 
 bool gpuAvailable(std::string* why) {
   const GpuProbe probe = probeGpu();

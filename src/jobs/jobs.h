@@ -247,6 +247,10 @@ struct RenderJobOptions {
 struct RenderJobStats {
   std::string input, output, camera, renderer, path;
   std::string device;  ///< the GPU renderer's GL_RENDERER and GL_VERSION; empty for the CPU ones
+  /// The GPU renderer's GPU memory (GpuRenderer::gpuBytes), the light field's part of it
+  /// (lightFieldGpuBytes) and the decoded light field and textures it holds there
+  /// (lightFieldMemoryBytes); 0 for the CPU renderers.
+  uint64_t gpuBytes = 0, gpuLightFieldBytes = 0, lightFieldBytes = 0;
   int width = 0, height = 0, spp = 0, threads = 0, frames = 0;  ///< spp: camera samples per pixel used
   uint32_t mirrorDepth = 0;
   double msPerFrameMedian = 0, msPerFrameMin = 0, msPerFrameMax = 0, fps = 0;

@@ -36,6 +36,11 @@ std::string RenderJobStats::toJson() const {
   json["threads"] = threads;
   json["renderer"] = renderer;
   if (!device.empty()) json["device"] = device;
+  if (gpuBytes > 0) {
+    json["gpu_bytes"] = gpuBytes;
+    json["gpu_light_field_bytes"] = gpuLightFieldBytes;
+    json["light_field_bytes"] = lightFieldBytes;
+  }
   if (!path.empty()) json["path"] = path;
   json["frames"] = frames;
   json["ms_per_frame_median"] = msPerFrameMedian;
@@ -221,7 +226,12 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   stats.mirrorDepth = effectiveMirrorDepth(settings, lightField.settings.mirrorDepth);
   stats.threads = pool.threads();
   stats.renderer = o.reference ? "reference" : gpuRenderer ? "gpu" : "fast";
-  if (gpuRenderer) stats.device = gpuRenderer->deviceName();
+  if (gpuRenderer) {
+    stats.device = gpuRenderer->deviceName();
+    stats.gpuBytes = gpuRenderer->gpuBytes();
+    stats.gpuLightFieldBytes = gpuRenderer->lightFieldGpuBytes();
+    stats.lightFieldBytes = lightFieldMemoryBytes(lightField);
+  }
   stats.path = o.pathFile;
   stats.frames = frames;
   stats.msPerFrameMedian = median(frameMs);

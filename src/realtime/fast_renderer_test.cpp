@@ -23,6 +23,7 @@
 #include "render/render.h"
 #include "support/glossy_spheres.h"
 #include "support/random_light_field.h"
+#include "support/random_texture.h"
 
 namespace pl {
 namespace {
@@ -224,16 +225,7 @@ TEST_F(FastRendererTest, MatchesReferenceOnBuiltInCornellBox) {
 /// `scene` with a width × height texture of random texels (8-bit values when eightBit, else
 /// any floats in [0, 1)) multiplying every Lambertian material's albedo.
 Scene withRandomAlbedoTexture(Scene scene, int width, int height, bool eightBit, uint64_t seed) {
-  Texture texture;
-  texture.path = eightBit ? "random-8-bit" : "random-float";
-  texture.image = Image(width, height);
-  Pcg32 rng(seed, 1);
-  auto value = [&] { return eightBit ? float(rng.next() >> 24) / 255.0f : rng.uniform(); };
-  for (Rgb& texel : texture.image.pixels) {
-    const float r = value(), g = value(), b = value();
-    texel = Rgb(r, g, b);
-  }
-  scene.textures.push_back(texture);
+  scene.textures.push_back(test_support::randomTexture(width, height, eightBit, seed));
   int textured = 0;
   for (Material& m : scene.materials)
     if (std::holds_alternative<LambertBsdf>(m.bsdf)) m.albedoTexture = int(scene.textures.size()) - 1, ++textured;

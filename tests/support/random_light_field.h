@@ -10,12 +10,12 @@
 
 namespace pl::test_support {
 
-/// A light field over `scene` with the default preset's charts and *random* values in
-/// [0, 4): a harsher test of the 16-neighbour lookup than a smooth bake (every tixel and
-/// direction texel differs from its neighbours), and fast (no propagation).
-inline LightField randomLightField(Scene scene, uint64_t seed) {
+/// A light field over `scene` with the charts of `settings` (the default preset's unless given)
+/// and *random* values in [0, 4): a harsher test of the 16-neighbour lookup than a smooth bake
+/// (every tixel and direction texel differs from its neighbours), and fast (no propagation).
+inline LightField randomLightField(Scene scene, uint64_t seed, const BakeSettings& settings = BakeSettings{}) {
   LightField lf;
-  lf.settings = BakeSettings{};
+  lf.settings = settings;
   Parameterisation param = buildParameterisation(scene, lf.settings);
   lf.charts = std::move(param.charts);
   lf.triangleChart = std::move(param.triangleChart);

@@ -1,0 +1,479 @@
+// The GPU renderer's surface detail (gpu_surface_detail.h): the buffer and its GLSL.
+#include "gpu/gpu_surface_detail.h"
+
+#include <fmt/format.h>
+
+#include <bit>
+#include <limits>
+#include <variant>
+
+#include "bsdf/bsdf.h"
+
+namespace pl::gpu {
+namespace {
+
+constexpr uint32_t kNone = kNoWord;
+constexpr uint32_t kHeaderWords = 8, kTextureWords = 8, kLevelWords = 4, kMappingWords = 8, kVertexWords = 8;
+// Material record: albedo, emission, alpha and normal textures, alpha factor, cutoff, normal
+// scale, 1 unused, then the albedo, emission, alpha and normal mappings.
+constexpr uint32_t kMaterialAlbedoMapping = 8, kMaterialEmissionMapping = kMaterialAlbedoMapping + kMappingWords,
+                   kMaterialAlphaMapping = kMaterialEmissionMapping + kMappingWords,
+                   kMaterialNormalMapping = kMaterialAlphaMapping + kMappingWords,
+                   kMaterialWords = kMaterialNormalMapping + kMappingWords;
+// Texture sampling flags.
+constexpr uint32_t kNearestBit = 16u, kMipmapsBit = 32u, kDefaultSamplingBit = 64u;
+
+uint32_t bits(float f) { return std::bit_cast<uint32_t>(f); }
+
+/// What the GPU reads of each texture: nothing, level 0 (emission textures, alpha masks: read
+/// at full resolution, Texture::sample) or every level (albedo textures: sampleLod).
+enum class TextureUse : uint8_t { None, Level0, AllLevels };
+
+/// Whether diffuseDirectionalFactor (bsdf.h) of `model` is not simply 1 above the horizon: the
+/// GGX-like models', whose k(μ) follows the lobe's albedo.
+bool variesWithAngle(const Bsdf& model) {
+  return std::holds_alternative<GgxBsdf>(model) || std::holds_alternative<GltfPbrBsdf>(model);
+}
+
+void appendMapping(std::vector<uint32_t>& words, const TextureMapping& m) {
+  words.insert(words.end(), {uint32_t(m.uvSet), m.isDefault() ? 1u : 0u, bits(m.linear[0][0]), bits(m.linear[0][1]),
+                             bits(m.linear[1][0]), bits(m.linear[1][1]), bits(m.offset.x), bits(m.offset.y)});
+}
+
+}  // namespace
+
+std::string surfaceDetailUnsupported(const LightField& lf, const Chart& chart, const ChartShading& shading) {
+  const Material& material = lf.scene.materials[chart.material];
+  if (material.metallicRoughness.texture >= 0 && (chart.kind == ChartKind::Diffuse || chart.diffuseValue))
+    return "metallic-roughness textures";
+  // k(μ) of the diffuse part tabulated at diffuseFactorNodes (exact only where it is linear
+  // between them).
+  const Bsdf& model = material.bsdf;
+  if (chart.diffuseValue && variesWithAngle(model) && !diffuseFactorIsPiecewiseLinear(model))
+    return "glTF materials with a clear coat or sheen over a diffuse base";
+  // diffuseAlbedoAt multiplies a Lambertian albedo by the modulation; another model's
+  // directional albedo at normal incidence is not linear in it.
+  if (shading.texturedAlbedo && chart.kind == ChartKind::Diffuse && !std::holds_alternative<LambertBsdf>(material.bsdf))
+    return "albedo textures on non-Lambertian diffuse charts";
+  return {};
+}
+
+Rgb texturedAlbedoBase(const Scene& scene, const Chart& chart) {
+  const Bsdf& model = scene.materials[chart.material].bsdf;
+  if (const auto* lambert = std::get_if<LambertBsdf>(&model); lambert != nullptr && chart.kind == ChartKind::Diffuse)
+    return lambert->albedo;
+  return diffuseAlbedo(model);
+}
+
+SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
+  const Scene& scene = lf.scene;
+  // Which textures the shader reads, and whether any lookup or mask needs a hit's uv.
+  std::vector<TextureUse> use(scene.textures.size(), TextureUse::None);
+  auto need = [&](int texture, TextureUse u) {
+    if (texture >= 0 && use[size_t(texture)] < u) use[size_t(texture)] = u;
+  };
+  bool needsUv = false;
+  std::vector<bool> needsFactor(scene.materials.size(), false);
+  const SunLights sun = sunLightsOf(lf);
+  for (uint32_t i = 0; i < lf.charts.size(); ++i) {
+    const ChartShading shading = chartShading(lf, i, sun);
+    const Material& m = scene.materials[lf.charts[i].material];
+    needsUv = needsUv || shading.needsUv;
+    const Bsdf& model = m.bsdf;
+    if (lf.charts[i].diffuseValue && variesWithAngle(model) && diffuseFactorIsPiecewiseLinear(model))
+      needsFactor[lf.charts[i].material] = true;
+    if (shading.needsUv && shading.texturedAlbedo) need(m.albedoTexture, TextureUse::AllLevels);
+    if (shading.texturedEmission) need(m.emissionTexture, TextureUse::Level0);
+    if (shading.normalMapped) {
+      needsUv = true;
+      need(m.normalTexture, TextureUse::Level0);
+    }
+  }
+  for (const Material& m : scene.materials)
+    if (m.isMasked()) {
+      needsUv = true;
+      need(m.alphaTexture, TextureUse::Level0);
+    }
+
+  std::vector<uint32_t> words(kHeaderWords, 0u);
+  // Textures and their level table; the texels go after the tables (their offsets are filled
+  // in once the tables' sizes are known).
+  struct LevelSource {
+    const Image* image;
+    const std::vector<Texture::PackedBlock>* packed;
+    const std::vector<float>* palette;
+  };
+  std::vector<LevelSource> levels;
+  std::vector<uint32_t> textureTable;
+  for (size_t t = 0; t < scene.textures.size(); ++t) {
+    const Texture& texture = scene.textures[t];
+    const TextureSampling& s = texture.sampling;
+    const uint32_t count = use[t] == TextureUse::None ? 0u : use[t] == TextureUse::Level0 ? 1u : uint32_t(1 + texture.mips.size());
+    textureTable.insert(textureTable.end(),
+                        {uint32_t(levels.size()), count,
+                         uint32_t(s.wrapU) | uint32_t(s.wrapV) << 2 | (s.nearest ? kNearestBit : 0u) |
+                             (s.mipmaps ? kMipmapsBit : 0u) | (s.isDefault() ? kDefaultSamplingBit : 0u),
+                         bits(texture.average.r), bits(texture.average.g), bits(texture.average.b), 0u, 0u});
+    if (count > 0) levels.push_back({&texture.image, &texture.packed, &texture.palette});
+    for (uint32_t l = 1; l < count; ++l) {
+      const Texture::Level& level = texture.mips[l - 1];
+      levels.push_back({&level.image, &level.packed, &level.palette});
+    }
+  }
+  words[0] = uint32_t(words.size());
+  words.insert(words.end(), textureTable.begin(), textureTable.end());
+  words[1] = uint32_t(words.size());
+  const size_t levelTable = words.size();
+  words.resize(words.size() + levels.size() * kLevelWords, 0u);
+  // Materials.
+  words[2] = uint32_t(words.size());
+  for (const Material& m : scene.materials) {
+    auto index = [](int texture) { return texture >= 0 ? uint32_t(texture) : kNone; };
+    words.insert(words.end(), {index(m.albedoTexture), index(m.emissionTexture), index(m.alphaTexture),
+                               index(m.normalTexture), bits(m.alphaFactor), bits(m.alphaCutoff), bits(m.normalScale), 0u});
+    appendMapping(words, m.albedoMapping);
+    appendMapping(words, m.emissionMapping);
+    appendMapping(words, m.alphaMapping);
+    appendMapping(words, m.normalMapping);
+  }
+  // Vertices and triangles, in the renderer's order (meshes one after another).
+  words[3] = uint32_t(words.size());
+  if (needsUv) {
+    for (const Mesh& mesh : scene.meshes) {
+      const uint32_t flags = (mesh.uvs.empty() ? 0u : 1u) | (mesh.uvs1.empty() ? 0u : 2u) | (mesh.colors.empty() ? 0u : 4u);
+      for (size_t v = 0; v < mesh.positions.size(); ++v) {
+        const Vec2 uv0 = mesh.uvs.empty() ? Vec2(0.0f) : mesh.uvs[v], uv1 = mesh.uvs1.empty() ? Vec2(0.0f) : mesh.uvs1[v];
+        const Rgb colour = mesh.colors.empty() ? Rgb(1.0f) : mesh.colors[v];
+        words.insert(words.end(), {bits(uv0.x), bits(uv0.y), bits(uv1.x), bits(uv1.y), bits(colour.r), bits(colour.g),
+                                   bits(colour.b), flags});
+      }
+    }
+  }
+  words[4] = uint32_t(words.size());
+  if (needsUv)
+    for (const Mesh& mesh : scene.meshes) words.insert(words.end(), mesh.materials.begin(), mesh.materials.end());
+  // The nodes of k(μ), and its tables. Node 0 is μ = 0, where diffuseDirectionalFactor is 0
+  // (nothing below the horizon) but its interpolation from the right is not: k there is
+  // extrapolated from the first segment's line (its end and midpoint).
+  const std::vector<float>& nodes = diffuseFactorNodes();
+  words[5] = uint32_t(words.size());
+  for (float mu : nodes) words.push_back(bits(mu));
+  std::vector<uint32_t> factorTables(scene.materials.size(), kNone);
+  for (size_t m = 0; m < scene.materials.size(); ++m) {
+    if (!needsFactor[m]) continue;
+    factorTables[m] = uint32_t(words.size());
+    const Bsdf& model = scene.materials[m].bsdf;
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      const Rgb k = i > 0 ? diffuseDirectionalFactor(model, nodes[i])
+                          : 2.0f * diffuseDirectionalFactor(model, 0.5f * nodes[1]) - diffuseDirectionalFactor(model, nodes[1]);
+      words.insert(words.end(), {bits(k.r), bits(k.g), bits(k.b)});
+    }
+  }
+  // The texels: a level's packed texels (4×4 blocks of palette indices, Texture::PackedBlock)
+  // and its palette where it has them, else 3 floats per texel.
+  for (size_t l = 0; l < levels.size(); ++l) {
+    const LevelSource& level = levels[l];
+    uint32_t* record = &words[levelTable + l * kLevelWords];
+    record[0] = uint32_t(level.image->width);
+    record[1] = uint32_t(level.image->height);
+    record[2] = uint32_t(words.size());
+    record[3] = kNone;
+    if (!level.packed->empty()) {
+      for (const Texture::PackedBlock& block : *level.packed) words.insert(words.end(), block.texels, block.texels + 16);
+      words[levelTable + l * kLevelWords + 3] = uint32_t(words.size());
+      for (float v : *level.palette) words.push_back(bits(v));
+    } else {
+      for (const Rgb& texel : level.image->pixels) words.insert(words.end(), {bits(texel.r), bits(texel.g), bits(texel.b)});
+    }
+  }
+  return {std::move(words), std::move(factorTables)};
+}
+
+std::string surfaceDetailGlsl(unsigned binding) {
+  return fmt::format(
+             "#define SURFACE_DETAIL_BINDING {}\nconst uint kTextureWords = {}u, kLevelWords = {}u, kVertexWords = {}u, "
+             "kMaterialWords = {}u, kMaterialAlbedoMapping = {}u, kMaterialEmissionMapping = {}u, kMaterialAlphaMapping = "
+             "{}u, kMaterialNormalMapping = {}u;\nconst uint kRepeat = {}u, kClampToEdge = {}u, kMirroredRepeat = {}u, kNearestBit = {}u, kMipmapsBit = "
+             "{}u, kDefaultSamplingBit = {}u;\nconst uint kFlagTexturedAlbedo = {}u, kFlagTexturedEmission = {}u;\n"
+             "const float kInvPi = {:.9g};\nconst uint kFlagNormalMapped = {}u, kFlagDirectionalIrradiance = {}u;\n"
+             "const uint kTiltedNormals = {}u;\nconst float kNormalTiltCosine = {:.9g}, kNormalTiltSine = {:.9g};\n"
+             "const vec2 kTiltAcross[{}] = vec2[{}](vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}));\n"
+             "const int kDiffuseFactorNodes = {};\n",
+             binding, kTextureWords, kLevelWords, kVertexWords, kMaterialWords, kMaterialAlbedoMapping,
+             kMaterialEmissionMapping, kMaterialAlphaMapping, kMaterialNormalMapping, unsigned(TextureWrap::Repeat),
+             unsigned(TextureWrap::ClampToEdge), unsigned(TextureWrap::MirroredRepeat), kNearestBit, kMipmapsBit,
+             kDefaultSamplingBit, kFlagTexturedAlbedo, kFlagTexturedEmission, kInvPi, kFlagNormalMapped,
+             kFlagDirectionalIrradiance, kTiltedNormals, kNormalTiltCosine, kNormalTiltSine, kTiltedNormals, kTiltedNormals,
+             kTiltAcross[0][0], kTiltAcross[0][1], kTiltAcross[1][0], kTiltAcross[1][1], kTiltAcross[2][0],
+             kTiltAcross[2][1], diffuseFactorNodes().size()) +
+         R"glsl(
+layout(std430, binding = SURFACE_DETAIL_BINDING) readonly buffer SurfaceDetailWords { uint detail[]; };
+const uint kNone = 0xffffffffu;
+float detailFloat(uint i) { return uintBitsToFloat(detail[i]); }
+vec3 detailRgb(uint i) { return vec3(detailFloat(i), detailFloat(i + 1u), detailFloat(i + 2u)); }
+
+// repeatIndex and wrapIndex (texture.cpp): texel index i (a whole number) of an axis of n
+// texels, wrapped. (GLSL's % is undefined for negative operands: the C++ remainder's
+// negative case is written out.)
+int repeatIndex(float i, int n) {
+  if (i >= 0.0 && i < float(n)) return int(i);
+  if (abs(i) < 1073741824.0) {
+    int k = int(i);
+    return k >= 0 ? k % n : n - 1 - ((-k - 1) % n);
+  }
+  float m = i - float(n) * floor(i / float(n));  // fmod's non-negative remainder, for huge coordinates
+  int k = int(m);
+  return k >= n ? 0 : max(k, 0);
+}
+int wrapIndex(float i, int n, uint wrap) {
+  if (wrap == kClampToEdge) return i <= 0.0 ? 0 : i >= float(n - 1) ? n - 1 : int(i);
+  if (wrap == kMirroredRepeat) {
+    int m = repeatIndex(i, 2 * n);
+    return m < n ? m : 2 * n - 1 - m;
+  }
+  return repeatIndex(i, n);
+}
+
+// BilinearFootprint: the 2×2 texels a bilinear read blends and their weights.
+struct Footprint { int x0, x1, y0, y1; float fx, fy; };
+ivec2 levelSize(uint level) {
+  uint record = detail[1] + kLevelWords * level;
+  return ivec2(int(detail[record]), int(detail[record + 1u]));
+}
+// sampledFootprint (texture.cpp; bilinearFootprint is its repeat, bilinear case): false for a
+// non-finite uv.
+bool sampledFootprint(ivec2 size, vec2 uv, uint wrapU, uint wrapV, bool nearest, out Footprint f) {
+  float half_ = nearest ? 0.0 : 0.5;
+  float x = uv.x * float(size.x) - half_;
+  float y = (1.0 - uv.y) * float(size.y) - half_;
+  f = Footprint(0, 0, 0, 0, 0.0, 0.0);
+  if (isnan(x) || isinf(x) || isnan(y) || isinf(y)) return false;
+  float x0f = floor(x), y0f = floor(y);
+  f.fx = nearest ? 0.0 : x - x0f;
+  f.fy = nearest ? 0.0 : y - y0f;
+  float step_ = nearest ? 0.0 : 1.0;
+  f.x0 = wrapIndex(x0f, size.x, wrapU);
+  f.x1 = wrapIndex(x0f + step_, size.x, wrapU);
+  f.y0 = wrapIndex(y0f, size.y, wrapV);
+  f.y1 = wrapIndex(y0f + step_, size.y, wrapV);
+  return true;
+}
+// reducedFootprint (texture.cpp): a uv already reduced to [0, 1)².
+void reducedAxis(float x, int n, out int i0, out int i1, out float fraction) {
+  int below = int(x + 1.0) - 1;  // floor(x) for x >= -1
+  fraction = x - float(below);
+  i0 = below < 0 ? n - 1 : below;
+  i1 = below + 1 >= n ? 0 : below + 1;
+}
+Footprint reducedFootprint(ivec2 size, vec2 uv) {
+  Footprint f;
+  reducedAxis(uv.x * float(size.x) - 0.5, size.x, f.x0, f.x1, f.fx);
+  reducedAxis((1.0 - uv.y) * float(size.y) - 0.5, size.y, f.y0, f.y1, f.fy);
+  return f;
+}
+// Texel (x, y) of a level (row 0 = the image's top): its packed palette indices (packedTexel's
+// 4×4 blocks) or its 3 floats.
+vec3 levelTexel(uint level, int x, int y) {
+  uint record = detail[1] + kLevelWords * level;
+  uint width = detail[record], texels = detail[record + 2u], palette = detail[record + 3u];
+  if (palette == kNone) return detailRgb(texels + 3u * (uint(y) * width + uint(x)));
+  uint blocksPerRow = (width + 3u) / 4u;
+  uint p = detail[texels + 16u * ((uint(y) >> 2) * blocksPerRow + (uint(x) >> 2)) + (uint(y) & 3u) * 4u + (uint(x) & 3u)];
+  return vec3(detailFloat(palette + (p & 0xffu)), detailFloat(palette + ((p >> 8) & 0xffu)),
+              detailFloat(palette + ((p >> 16) & 0xffu)));
+}
+// sampleLevel's blend.
+vec3 bilinearLevel(uint level, Footprint f) {
+  vec3 top = (1.0 - f.fx) * levelTexel(level, f.x0, f.y0) + f.fx * levelTexel(level, f.x1, f.y0);
+  vec3 bottom = (1.0 - f.fx) * levelTexel(level, f.x0, f.y1) + f.fx * levelTexel(level, f.x1, f.y1);
+  return (1.0 - f.fy) * top + f.fy * bottom;
+}
+// Texture::sample: level 0, bilinear (or nearest), wrapped as the texture's sampling says; its
+// mean texel for a non-finite uv.
+vec3 sampleTexture(uint texture, vec2 uv) {
+  uint record = detail[0] + kTextureWords * texture;
+  uint level0 = detail[record], flags = detail[record + 2u];
+  Footprint f;
+  if (!sampledFootprint(levelSize(level0), uv, flags & 3u, (flags >> 2) & 3u, (flags & kNearestBit) != 0u, f))
+    return detailRgb(record + 3u);
+  return bilinearLevel(level0, f);
+}
+// Texture::sampleLod: trilinear between levels floor(lod) and floor(lod) + 1; lod <= 0 or NaN
+// is sampleTexture.
+vec3 sampleTextureLod(uint texture, vec2 uv, float lod) {
+  uint record = detail[0] + kTextureWords * texture;
+  uint level0 = detail[record], levels = detail[record + 1u], flags = detail[record + 2u];
+  if (!(lod > 0.0) || levels <= 1u || (flags & kMipmapsBit) == 0u) return sampleTexture(texture, uv);
+  float clamped = min(lod, float(levels - 1u));
+  uint fine = uint(clamped);
+  float f = clamped - float(fine);
+  vec3 a, b;
+  if ((flags & kDefaultSamplingBit) == 0u) {
+    Footprint footprint;
+    if (!sampledFootprint(levelSize(level0 + fine), uv, flags & 3u, (flags >> 2) & 3u, false, footprint))
+      return detailRgb(record + 3u);
+    a = bilinearLevel(level0 + fine, footprint);
+    if (f == 0.0) return a;
+    sampledFootprint(levelSize(level0 + fine + 1u), uv, flags & 3u, (flags >> 2) & 3u, false, footprint);
+    b = bilinearLevel(level0 + fine + 1u, footprint);
+    return (1.0 - f) * a + f * b;
+  }
+  uv -= floor(uv);
+  if (!(uv.x < 1.0)) uv.x = 0.0;
+  if (!(uv.y < 1.0)) uv.y = 0.0;
+  if (!(uv.x >= 0.0 && uv.y >= 0.0)) return detailRgb(record + 3u);
+  a = bilinearLevel(level0 + fine, reducedFootprint(levelSize(level0 + fine), uv));
+  if (f == 0.0) return a;
+  b = bilinearLevel(level0 + fine + 1u, reducedFootprint(levelSize(level0 + fine + 1u), uv));
+  return (1.0 - f) * a + f * b;
+}
+
+// uvAt with a TextureMapping (scene.h) at barycentrics b of the triangle with vertices v: the
+// slot's uv set interpolated (the barycentrics for a mesh without it), then its transform.
+vec2 vertexUv(uint vertex, uint set) {
+  uint i = detail[3] + kVertexWords * vertex + 2u * set;
+  return vec2(detailFloat(i), detailFloat(i + 1u));
+}
+bool hasUvSet(uint vertex, uint set) { return (detail[detail[3] + kVertexWords * vertex + 7u] & (set == 1u ? 2u : 1u)) != 0u; }
+// TextureMapping::apply: linear · uv + offset (linear column-major, as glm's Mat2).
+vec2 applyMapping(uint mapping, vec2 uv) {
+  if (detail[mapping + 1u] != 0u) return uv;
+  return vec2(detailFloat(mapping + 2u) * uv.x + detailFloat(mapping + 4u) * uv.y,
+              detailFloat(mapping + 3u) * uv.x + detailFloat(mapping + 5u) * uv.y) +
+         vec2(detailFloat(mapping + 6u), detailFloat(mapping + 7u));
+}
+vec2 mappedUv(uint mapping, uvec3 v, vec2 b) {
+  uint set = detail[mapping];
+  vec2 uv = b;
+  if (hasUvSet(v.x, set)) {
+    float b1 = b.x, b2 = b.y, b0 = 1.0 - b1 - b2;
+    uv = b0 * vertexUv(v.x, set) + b1 * vertexUv(v.y, set) + b2 * vertexUv(v.z, set);
+  }
+  return applyMapping(mapping, uv);
+}
+// vertexColorAt (scene.h).
+vec3 vertexColorAt(uvec3 v, vec2 b) {
+  uint x = detail[3] + kVertexWords * v.x;
+  if ((detail[x + 7u] & 4u) == 0u) return vec3(1.0);
+  float b1 = b.x, b2 = b.y, b0 = 1.0 - b1 - b2;
+  return b0 * detailRgb(x + 4u) + b1 * detailRgb(detail[3] + kVertexWords * v.y + 4u) +
+         b2 * detailRgb(detail[3] + kVertexWords * v.z + 4u);
+}
+// approximateLog2 (core/math.h).
+float approximateLog2(float x) {
+  if (!(x > 0.0)) return -1.0 / 0.0;
+  uint xBits = floatBitsToUint(x);
+  float t = uintBitsToFloat((xBits & 0x007fffffu) | 0x3f800000u) - 1.0;
+  return float(int(xBits >> 23) - 127) + t + 0.347 * t * (1.0 - t);
+}
+// albedoTextureLod (lookup.h): the mip level of a ray cone coneWidth wide arriving along
+// `direction` at the triangle (vertices v at p0, p1, p2) through mapping `mapping`.
+float albedoTextureLod(uint texture, uint mapping, uvec3 v, vec3 p0, vec3 p1, vec3 p2, vec3 direction, float coneWidth) {
+  if (!(coneWidth > 0.0)) return 0.0;
+  vec3 c = cross(p1 - p0, p2 - p0);
+  float uvCross = 1.0;
+  uint set = detail[mapping];
+  if (hasUvSet(v.x, set)) {
+    vec2 a = vertexUv(v.y, set) - vertexUv(v.x, set), b = vertexUv(v.z, set) - vertexUv(v.x, set);
+    uvCross = abs(a.x * b.y - a.y * b.x);
+  }
+  if (detail[mapping + 1u] == 0u)
+    uvCross *= abs(detailFloat(mapping + 2u) * detailFloat(mapping + 5u) - detailFloat(mapping + 4u) * detailFloat(mapping + 3u));
+  float cosArea = abs(dot(direction, c));
+  ivec2 size = levelSize(detail[detail[0] + kTextureWords * texture]);
+  float texelsSquared = float(size.x) * float(size.y) * uvCross * (coneWidth * coneWidth) / cosArea;
+  return 0.5 * approximateLog2(texelsSquared);
+}
+
+// normalMapped (scene.cpp): shading normal n perturbed by the normal-map texel in the tangent
+// frame of the triangle p0 p1 p2 with (mapped) uvs uv0 uv1 uv2; n where there is no frame or
+// the result would fall behind the geometric normal ng.
+vec3 normalMapped(vec3 n, vec3 ng, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1, vec2 uv2, vec3 texel, float scale) {
+  vec3 e1 = p1 - p0, e2 = p2 - p0;
+  vec2 d1 = uv1 - uv0, d2 = uv2 - uv0;
+  float det = d1.x * d2.y - d1.y * d2.x;
+  if (!(abs(det) > 1e-12)) return n;
+  vec3 dpdu = (e1 * d2.y - e2 * d1.y) / det;
+  vec3 dpdv = (e2 * d1.x - e1 * d2.x) / det;
+  vec3 t = dpdu - n * dot(n, dpdu);
+  float tLength = length(t);
+  if (!(tLength > 0.0) || isinf(tLength) || isnan(tLength)) return n;
+  t /= tLength;
+  vec3 b = dot(cross(n, t), dpdv) < 0.0 ? -cross(n, t) : cross(n, t);
+  vec3 m = vec3(scale * (2.0 * texel.r - 1.0), scale * (2.0 * texel.g - 1.0), 2.0 * texel.b - 1.0);
+  vec3 mapped = m.x * t + m.y * b + m.z * n;
+  float len = length(mapped);
+  if (!(len > 0.0) || isinf(len) || isnan(len)) return n;
+  vec3 result = mapped / len;
+  return dot(result, ng) > 0.01 ? result : n;
+}
+
+// What a lookup needs of its hit besides the position and the normals it is read around: the
+// albedo modulation (albedoModulation: the albedo texture at the cone's mip level × the vertex
+// colour) on a kFlagTexturedAlbedo chart, the emission texel (emissionModulation) on a
+// kFlagTexturedEmission one, 1 elsewhere; the mapped normal (surfaceAt's shading normal, on the
+// front's side) on a kFlagNormalMapped chart.
+struct SurfaceDetail { vec3 albedo, emission, normal; };
+SurfaceDetail noSurfaceDetail(vec3 normal) { return SurfaceDetail(vec3(1.0), vec3(1.0), normal); }
+// albedoPointAt, albedoModulation and surfaceAt's shading normal for a hit at barycentrics b
+// of triangle `triangle` (vertices v at p0, p1, p2; unit geometric normal `geometric`, the
+// interpolated normal `interpolated`) of a chart record with info `chartInfo` (kind, flags),
+// seen along `direction` with a ray cone coneWidth wide there (0: full resolution).
+SurfaceDetail surfaceDetailAt(uint triangle, uvec3 v, vec3 p0, vec3 p1, vec3 p2, vec2 b, uvec4 chartInfo, vec3 direction,
+                              float coneWidth, vec3 geometric, vec3 interpolated) {
+  uint flags = chartInfo.z;
+  SurfaceDetail d = noSurfaceDetail(interpolated);
+  if ((flags & (kFlagTexturedAlbedo | kFlagTexturedEmission | kFlagNormalMapped)) == 0u) return d;
+  uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
+  bool glossyMapped = (flags & kFlagNormalMapped) != 0u && chartInfo.y == kGlossy;
+  if ((flags & kFlagTexturedAlbedo) != 0u) {
+    d.albedo = vertexColorAt(v, b);
+    uint texture = detail[m];
+    if (texture != kNone) {
+      // A normal-mapped glossy chart reads its albedo at full resolution (lookupInputs).
+      float lod = glossyMapped ? 0.0 : albedoTextureLod(texture, m + kMaterialAlbedoMapping, v, p0, p1, p2, direction, coneWidth);
+      d.albedo = sampleTextureLod(texture, mappedUv(m + kMaterialAlbedoMapping, v, b), lod) * d.albedo;
+    }
+  }
+  if ((flags & kFlagTexturedEmission) != 0u) d.emission = sampleTexture(detail[m + 1u], mappedUv(m + kMaterialEmissionMapping, v, b));
+  // surfaceAt: the normal map where its uv set exists, in the frame of the mapped vertex uvs.
+  uint normalMapping = m + kMaterialNormalMapping, set = detail[normalMapping];
+  if ((flags & kFlagNormalMapped) != 0u && hasUvSet(v.x, set)) {
+    vec3 texel = sampleTexture(detail[m + 3u], mappedUv(normalMapping, v, b));
+    d.normal = normalMapped(interpolated, geometric, p0, p1, p2, applyMapping(normalMapping, vertexUv(v.x, set)),
+                            applyMapping(normalMapping, vertexUv(v.y, set)), applyMapping(normalMapping, vertexUv(v.z, set)),
+                            texel, detailFloat(m + 6u));
+  }
+  return d;
+}
+// Whether triangle `triangle`'s material is alpha-masked at all (Material::isMasked).
+bool maskedMaterial(uint triangle) {
+  uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
+  return detail[m + 2u] != kNone || detailFloat(m + 4u) < detailFloat(m + 5u);
+}
+// diffuseDirectionalFactor (bsdf.h) of a material whose k(μ) is tabulated at word `table`
+// (kNone: k = 1, Lambert and Blinn-Phong), interpolated between the nodes as the GGX albedo
+// table's lookup (locate) does.
+vec3 diffuseFactor(uint table, float cosTheta) {
+  if (!(cosTheta > 0.0)) return vec3(0.0);
+  if (table == kNone) return vec3(1.0);
+  float mu = min(cosTheta, 1.0);
+  int i0 = clamp(int(sqrt(mu) * float(kDiffuseFactorNodes - 1)), 0, kDiffuseFactorNodes - 2);
+  float a = detailFloat(detail[5] + uint(i0)), b = detailFloat(detail[5] + uint(i0) + 1u);
+  float t = clamp((mu - a) / (b - a), 0.0, 1.0);
+  vec3 k0 = detailRgb(table + 3u * uint(i0)), k1 = detailRgb(table + 3u * uint(i0) + 3u);
+  return k0 + t * (k1 - k0);
+}
+// coverageAt (scene.h): the alpha mask's coverage at barycentrics b of triangle `triangle`
+// (vertices v); below the material's cutoff the surface is not there (masked() says so).
+bool masked(uint triangle, uvec3 v, vec2 b) {
+  uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
+  float factor = detailFloat(m + 4u), cutoff = detailFloat(m + 5u);
+  uint texture = detail[m + 2u];
+  float coverage = texture == kNone ? factor : factor * sampleTexture(texture, mappedUv(m + kMaterialAlphaMapping, v, b)).r;
+  return coverage < cutoff;
+}
+)glsl";
+}
+
+}  // namespace pl::gpu

@@ -1,0 +1,74 @@
+#pragma once
+// The GPU renderer's surface detail (internal to src/gpu): what the shading pass reads per
+// pixel besides the light field — albedo textures with their mip levels, vertex colours,
+// emission textures, alpha masks, normal maps and the diffuse factor k(μ) of GGX-like models —
+// uploaded as one storage buffer of 32-bit words, with the GLSL that reads it (the C++ of scene/texture.h, scene/scene.h uvAt/vertexColorAt/coverageAt/
+// surfaceAt/normalMapped and lightfield/lookup.h albedoTextureLod, statement for statement).
+//
+// The buffer (uint detail[]): a header of 8 words — the offsets (in words) of the textures,
+// levels, materials, vertices, triangles and k nodes below — then
+//   textures:  8 words each — first level (into the level table), level count (level 0 and its
+//              mips), sampling flags (wrap u | wrap v << 2 | nearest << 4 | mipmaps << 5 |
+//              default sampling << 6), the mean texel (3 floats), 2 unused;
+//   levels:    4 words each — width, height, first texel word, palette word (kNoWord: the
+//              texels are 3 floats each; else they are the CPU's packed texels as they are,
+//              Texture::packed's 4×4 blocks of palette indices r | g << 8 | b << 16, one word
+//              each, and the palette its ≤ 256 floats);
+//   materials: 40 words each — albedo, emission, alpha and normal textures (kNoWord: none), alpha
+//              factor and cutoff, normal scale, 1 unused, then the albedo, emission, alpha and
+//              normal TextureMappings (8 words each: uv set, whether default, linear[0][0],
+//              [0][1], [1][0], [1][1], offset);
+//   vertices:  8 words each (all meshes' vertices in the renderer's order) — uv set 0 (2
+//              floats), uv set 1 (2), vertex colour (3), flags (has uvs | has uvs1 << 1 | has
+//              colours << 2);
+//   triangles: 1 word each — the triangle's material;
+//   k nodes:   the μ of diffuseFactorNodes (bsdf.h), then per material whose glossy charts
+//              keep a diffuse part and whose k(μ) is not 1, k at those nodes (3 floats each):
+//              the diffuse part's directional factor, interpolated linearly as the CPU's is;
+//   texels:    the levels' texels and palettes.
+// Textures are uploaded only where a chart the GPU draws reads them, vertices and triangles
+// only where some chart or mask needs a uv: a scene without either costs the header, 160
+// bytes per material and 160 bytes of k nodes.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "lightfield/lightfield.h"
+#include "lightfield/lookup.h"
+
+namespace pl::gpu {
+
+/// Chart record flags (the shaders' ChartRecord info.z) that the surface detail adds to
+/// gpu_renderer.cpp's: the diffuse albedo varies (albedoOverPi then holds the material's base
+/// albedo, times the modulation per pixel), the emission is textured, the chart is
+/// normal-mapped (ChartShading::normalMapped: the lookup takes the mapped normal), it keeps
+/// tilted irradiances (Chart::directionalIrradiance).
+inline constexpr uint32_t kFlagTexturedAlbedo = 128u, kFlagTexturedEmission = 256u, kFlagNormalMapped = 512u,
+                          kFlagDirectionalIrradiance = 1024u;
+
+/// The first surface-detail feature of chart record `chart` the GPU renderer does not draw, as
+/// a phrase for gpuUnsupportedFeature; empty when it draws it.
+std::string surfaceDetailUnsupported(const LightField& lf, const Chart& chart, const ChartShading& shading);
+
+/// The base albedo the shader multiplies by the per-pixel modulation on a chart whose albedo
+/// varies (kFlagTexturedAlbedo): the Lambertian albedo of a diffuse chart (diffuseAlbedoAt's
+/// rule), the model's diffuse albedo of a glossy one with Ẽ (glossyDiffuseAlbedoAt's).
+Rgb texturedAlbedoBase(const Scene& scene, const Chart& chart);
+
+/// The surface-detail buffer of `lf` (layout above), and per material the word offset of its
+/// k(μ) table (diffuseFactorNodes: 3 floats per node), kNone where k is 1 (Lambert,
+/// Blinn-Phong) or no glossy chart with a diffuse part needs it.
+struct SurfaceDetailBuffer {
+  std::vector<uint32_t> words;
+  std::vector<uint32_t> diffuseFactorTable;
+};
+SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf);
+/// The word that stands for "none" in the buffer.
+inline constexpr uint32_t kNoWord = 0xffffffffu;
+
+/// The GLSL constants and functions (the buffer at binding `binding`): sampleTexture,
+/// sampleTextureLod, surfaceDetailAt (the albedo modulation, emission texel and mapped normal
+/// of a hit) and masked (the alpha mask). Needs glslConstants' chart kinds.
+std::string surfaceDetailGlsl(unsigned binding);
+
+}  // namespace pl::gpu
