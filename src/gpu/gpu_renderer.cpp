@@ -985,13 +985,12 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                                                                4 * triangleCount, 16));
   }
   gpu::checkGpuMemory(sizes);
+  auto upload = [&](GLuint buffer, const void* data, size_t bytes) {
+    glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), bytes > 0 ? data : nullptr, GL_DYNAMIC_STORAGE_BIT);
+    s.bufferBytes += std::max<size_t>(bytes, 16);
+  };
   glCreateBuffers(State::kBufferCount, s.buffers);
-  for (GLsizei i = 0; i < State::kBufferCount; ++i) {
-    const Upload& u = uploads[i];
-    glNamedBufferStorage(s.buffers[i], GLsizeiptr(std::max<size_t>(u.bytes, 16)), u.bytes > 0 ? u.data : nullptr,
-                         GL_DYNAMIC_STORAGE_BIT);
-    s.bufferBytes += std::max<size_t>(u.bytes, 16);
-  }
+  for (GLsizei i = 0; i < State::kBufferCount; ++i) upload(s.buffers[i], uploads[i].data, uploads[i].bytes);
   checkGl("uploading the light field (out of GPU memory?)");
   // Mirrors and glass, punctual highlights: the BVH their rays are traced through, the
   // materials they follow or pass (thin glass), the highlights' lights and models.
