@@ -25,6 +25,7 @@
 #include "scene/scene.h"
 #include "support/box_mesh.h"
 #include "support/expect_error.h"
+#include "support/light_field_difference.h"
 #include "trace/trace.h"
 
 namespace pl {
@@ -150,17 +151,7 @@ TEST_F(SubsurfaceBakeTest, ThinSlabGlowsOnItsFarSide) {
   }
 }
 
-/// Σ|Y(a − b)| / Σ Y(b) over the values: the relative L1 difference of two light fields (as
-/// relight_test.cpp).
-double relativeDifference(const LightField& a, const LightField& b) {
-  EXPECT_EQ(a.values.size(), b.values.size());
-  double diff = 0.0, total = 0.0;
-  for (size_t v = 0; v < a.values.size() && v < b.values.size(); ++v) {
-    diff += std::abs(double(luminance(a.values[v] - b.values[v])));
-    total += std::abs(double(luminance(b.values[v])));
-  }
-  return total > 0.0 ? diff / total : diff;
-}
+using test_support::relativeDifference;
 
 uint32_t materialIndex(const Scene& scene, const std::string& name) {
   for (uint32_t m = 0; m < scene.materials.size(); ++m)
