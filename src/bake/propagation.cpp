@@ -1135,6 +1135,21 @@ void applySubsurface(TransportState& state, bool refresh) {
 
 }  // namespace
 
+void subsurfaceDirectChange(const TransportState& state, std::vector<Rgb>& delta) {
+  const TransportState::Operators& ops = *state.ops;
+  if (ops.subsurface.empty()) return;
+  const Parameterisation& param = state.param;
+  std::vector<Rgb> entering(param.tixelCount, Rgb(0.0f)), leaving;
+  for (const uint64_t g : ops.subsurface.rowTixel) entering[g] = delta[valueBase(g, param.charts[param.tixelChart[g]])];
+  applySubsurfaceOperator(ops.subsurface, entering, leaving);
+  for (size_t r = 0; r < leaving.size(); ++r) {
+    const uint64_t g = ops.subsurface.rowTixel[r];
+    const Rgb albedo = param.transportAlbedo[g];
+    Rgb& value = delta[valueBase(g, param.charts[param.tixelChart[g]])];
+    for (int k = 0; k < 3; ++k) value[k] = albedo[k] > 0.0f ? leaving[r][k] / albedo[k] : 0.0f;
+  }
+}
+
 void beginIteration(TransportState& state) {
   requireFiniteValues(state.scene, state.param, state.direct, "in the first shot (direct light)");
   state.current = state.direct;

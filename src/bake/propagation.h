@@ -217,6 +217,11 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
 void recomputeChange(TransportState& state, const std::vector<Rgb>& before, uint64_t begin, uint64_t end);
 /// Refreshes the transport (the bilinear interpolants of ρ̄E/π) of tixels [begin, end) from current.
 void updateTransport(TransportState& state, uint64_t begin, uint64_t end);
+/// A change `delta` of the first shot (per value, as state.direct) made the change of the values
+/// it causes at once, for a relighting's warm start: on subsurface tixels the change of the
+/// irradiance entering them leaves through the object, K·delta/ρ̄ (applySubsurface's
+/// convention); every other value keeps its delta. Nothing without subsurface charts.
+void subsurfaceDirectChange(const TransportState& state, std::vector<Rgb>& delta);
 /// Σ area × exitance luminance of `values` (W): the total outgoing power the stopping rule watches.
 double transportPower(const TransportState& state, const std::vector<Rgb>& values);
 /// Σ area × state.change (W): the L1 change of the last iteration.

@@ -99,11 +99,6 @@ struct Relighter::Impl {
 
   Impl(const LightField& lf, VisibilitySource source, std::optional<Parameterisation> given, Note note)
       : log(std::move(note)), scene(lf.scene), settings(lf.settings), stats(lf.stats) {
-    for (const Chart& c : lf.charts)
-      if (isSubsurfaceChart(lf.scene, c))
-        fail("{}: cannot relight: material '{}' is subsurface, whose light the relighting does not carry through "
-             "the object; re-bake the edited scene: {}",
-             lf.scene.sourcePath, lf.scene.materials[c.material].name, rebakeCommand(lf.scene, lf.settings));
     const auto start = std::chrono::steady_clock::now();
     scene.finalize();  // a copied scene lacks the vertex padding the BVH shares (scene.h)
     accel = std::make_unique<Accel>(scene);
@@ -249,6 +244,8 @@ struct Relighter::Impl {
       if (c.kind == ChartKind::Specular) return;
       const uint64_t v0 = c.firstValue, v1 = c.firstValue + c.tixelCount() * c.valuesPerTixel();
       if (c.kind == ChartKind::Diffuse) {
+        // (A subsurface chart has no sun masks: its first shot traced the masked lights too.)
+        if (isSubsurfaceChart(scene, c)) return;
         for (uint32_t l = 0; l < scene.lights.size(); ++l) {
           if (!masked[l]) continue;
           const Rgb e = lightEmission(scene.lights[l]);
@@ -340,10 +337,19 @@ struct Relighter::Impl {
     material.emission = emission;
   }
 
+  /// The subsurface operator (bake/subsurface.h) was built by random walks for the material's
+  /// albedo and radius: changing them needs new walks, which the relighting does not trace.
+  [[noreturn]] void refuseSubsurfaceEdit(const Material& material) const {
+    refuse(fmt::format("material '{}' is subsurface, and its albedo and radius shape the light carried through the "
+                       "object, whose random walks the bake traced",
+                       material.name));
+  }
+
   void setAlbedo(uint32_t m, const Rgb& albedo) {
     requireMaterial(m);
     Material& material = scene.materials[m];
     auto* lambert = std::get_if<LambertBsdf>(&material.bsdf);
+    if (subsurfaceMedium(material.bsdf)) refuseSubsurfaceEdit(material);
     if (!lambert)
       refuse(fmt::format("material '{}' is not Lambertian: only a Lambertian albedo can change without re-baking",
                          material.name));
@@ -368,6 +374,8 @@ struct Relighter::Impl {
     for (uint32_t m = 0; m < scene.materials.size(); ++m) {
       const Material &a = scene.materials[m], &b = edited.materials[m];
       const bool lambert = std::holds_alternative<LambertBsdf>(a.bsdf) && std::holds_alternative<LambertBsdf>(b.bsdf);
+      if (!lambert && modelHash(a.bsdf) != modelHash(b.bsdf) && subsurfaceMedium(a.bsdf) && subsurfaceMedium(b.bsdf))
+        refuseSubsurfaceEdit(a);
       if (!lambert && modelHash(a.bsdf) != modelHash(b.bsdf))
         refuse(fmt::format("material '{}' changed its model or its parameters", a.name));
       if (a.emissionTexture != b.emissionTexture || a.twoSidedEmission != b.twoSidedEmission ||
@@ -517,9 +525,15 @@ struct Relighter::Impl {
         for (uint64_t v = v0; v < v1; ++v) current[v] *= f;
       });
     } else {
+      // current + the change of the first shot, which on subsurface tixels leaves through the object.
+      Values delta(current.size());
       const Values& before = state->direct;
       parallelForRange(current.size(), 4096, [&](uint64_t v0, uint64_t v1) {
-        for (uint64_t v = v0; v < v1; ++v) current[v] = glm::max(Rgb(0.0f), current[v] + direct[v] - before[v]);
+        for (uint64_t v = v0; v < v1; ++v) delta[v] = direct[v] - before[v];
+      });
+      subsurfaceDirectChange(*state, delta);
+      parallelForRange(current.size(), 4096, [&](uint64_t v0, uint64_t v1) {
+        for (uint64_t v = v0; v < v1; ++v) current[v] = glm::max(Rgb(0.0f), current[v] + delta[v]);
       });
     }
     state->direct = std::move(direct);

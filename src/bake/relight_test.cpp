@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "light/lights.h"
+#include "support/light_field_difference.h"
 #include "support/quad_mesh.h"
 
 namespace pl {
@@ -45,16 +46,7 @@ Relighter bakeForRelight(const Scene& scene, const BakeSettings& settings, Light
   return relighter;
 }
 
-/// Σ|Y(a − b)| / Σ Y(b) over the values: the relative L1 difference of two light fields.
-double relativeDifference(const LightField& a, const LightField& b) {
-  EXPECT_EQ(a.values.size(), b.values.size());
-  double diff = 0.0, total = 0.0;
-  for (size_t v = 0; v < a.values.size() && v < b.values.size(); ++v) {
-    diff += std::abs(double(luminance(a.values[v] - b.values[v])));
-    total += std::abs(double(luminance(b.values[v])));
-  }
-  return total > 0.0 ? diff / total : diff;
-}
+using test_support::relativeDifference;
 
 /// The relit field against a fresh bake of the relighter's scene: the same within the
 /// tolerance's order (both stop when their remaining error is below it), and the same sun masks.

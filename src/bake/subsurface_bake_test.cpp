@@ -3,13 +3,15 @@
 //    interior tixels of a thick slab's face send on what a semi-infinite medium reflects
 //    (van de Hulst's formula, which the path tracer's walk matches: trace/subsurface_test.cpp);
 //  * a thin slab lit from above glows underneath, as bright as the path tracer shows it;
-//  * relighting and distributed bakes refuse subsurface scenes with a clear message.
+//  * relighting a subsurface scene's lights equals a fresh bake; edits of a subsurface material
+//    and distributed bakes are refused with a clear message.
 // Deterministic (fixed seeds); tolerances from the estimates' noise, stated per test.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 
 #include "accel/accel.h"
 #include "bake/bake.h"
@@ -23,6 +25,7 @@
 #include "scene/scene.h"
 #include "support/box_mesh.h"
 #include "support/expect_error.h"
+#include "support/light_field_difference.h"
 #include "trace/trace.h"
 
 namespace pl {
@@ -148,22 +151,81 @@ TEST_F(SubsurfaceBakeTest, ThinSlabGlowsOnItsFarSide) {
   }
 }
 
-// Relighting carries no light through subsurface objects: a light field with one is refused,
-// naming the file, the material and the command that re-bakes it.
-TEST_F(SubsurfaceBakeTest, RelightingRefusesSubsurfaceScenes) {
-  const Scene scene = subsurfaceBox(SubsurfaceBsdf{Rgb(0.8f), Rgb(0.1f)}, Vec3(-1.0f), Vec3(1.0f));
+using test_support::relativeDifference;
+
+uint32_t materialIndex(const Scene& scene, const std::string& name) {
+  for (uint32_t m = 0; m < scene.materials.size(); ++m)
+    if (scene.materials[m].name == name) return m;
+  ADD_FAILURE() << "no material " << name;
+  return 0;
+}
+
+// Relighting carries light through subsurface objects: on the repository's subsurface test
+// scene (bench/scenes/sss-cornell.json, a wax sphere and a thin slab) with a point light added,
+// small tixels and few walks, the ceiling light recoloured, then the point light moved and
+// recoloured, each give a fresh bake of the changed scene within relight_test's bound (5× the
+// bake's tolerance in relative L1: both stop when their remaining error is below it; the fresh
+// bake traces the same subsurface walks, which do not depend on the lights). Edits of a
+// subsurface material's albedo or radius change its walks: refused by name with the re-bake
+// command, and the relighter still works after a refusal.
+TEST_F(SubsurfaceBakeTest, RelightingEqualsFreshBakes) {
+  Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/../../bench/scenes/sss-cornell.json");
+  scene.lights.push_back(
+      createLight("point", {{"position", Vec3(0.5f, 1.5f, 0.5f)}, {"intensity", Vec3(1.0f)}}, "test light"));
+  scene.finalize();
   BakeSettings settings = bakePreset("draft");
-  settings.tixelsPerUnit = 2.0f;
-  settings.gatherDirections = 16;
-  settings.subsurfaceWalks = 4;
+  settings.tixelsAcrossScene = 8.0f;
+  settings.gatherDirections = 32;
+  settings.areaLightSamples = 4;
+  settings.subsurfaceWalks = 16;
+  settings.tolerance = 1e-4f;
+  settings.maxIterations = 400;
   Parameterisation param;
   VisibilityShard visibility;
   BakeOptions options;
   options.keepParameterisation = &param;
   options.keepVisibility = &visibility;
-  const LightField lf = bake(scene, settings, options);
-  test_support::expectError([&] { Relighter(lf, std::move(visibility), std::move(param)); },
-                            {"subsurface box", "cannot relight", "'wax'", "subsurface", "plenoptic bake"});
+  const LightField baked = bake(scene, settings, options);
+  uint64_t subsurfaceTixels = 0;
+  for (const Chart& c : baked.charts)
+    if (isSubsurfaceChart(baked.scene, c)) subsurfaceTixels += c.tixelCount();
+  ASSERT_GT(subsurfaceTixels, 0u);
+  Relighter relighter(baked, std::move(visibility), std::move(param));
+  auto expectFreshBake = [&](const char* step) {
+    const LightField relit = relighter.lightField();
+    const LightField fresh = bake(relighter.scene(), settings);
+    const double d = relativeDifference(relit, fresh), moved = relativeDifference(baked, fresh);
+    std::printf("%s: relit against fresh %.2e, baked against fresh %.3f\n", step, d, moved);
+    EXPECT_LT(d, 5.0 * settings.tolerance) << step;
+    EXPECT_GT(moved, 0.05) << step << ": the change should show";
+  };
+
+  // 1. The ceiling light recoloured: its first shot scaled.
+  const uint32_t light = materialIndex(relighter.scene(), "light");
+  relighter.setEmission(light, relighter.scene().materials[light].emission * Rgb(0.5f, 1.0f, 2.0f));
+  RelightStats stats = relighter.relight();
+  EXPECT_TRUE(stats.converged);
+  expectFreshBake("ceiling light recoloured");
+
+  // 2. The point light moved (beside the slab) and recoloured: its first shot traced again.
+  Light moved = relighter.scene().lights[0];
+  std::get<PointLight>(moved).position = Vec3(-0.4f, 0.6f, 0.6f);
+  setLightEmission(moved, Rgb(0.5f, 1.5f, 1.0f));
+  relighter.setLight(0, moved);
+  stats = relighter.relight();
+  EXPECT_EQ(stats.lightsShot, 1u);
+  EXPECT_TRUE(stats.converged);
+  expectFreshBake("point light moved");
+
+  // 3. A subsurface material's albedo or radius: refused, the relighter unchanged.
+  const uint32_t sphere = materialIndex(relighter.scene(), "sphere");
+  test_support::expectError([&] { relighter.setAlbedo(sphere, Rgb(0.5f)); },
+                            {"sss-cornell.json", "cannot relight", "'sphere'", "subsurface", "plenoptic bake"});
+  Scene edited = relighter.scene();
+  std::get<SubsurfaceBsdf>(edited.materials[materialIndex(edited, "slab")].bsdf).radius = Rgb(0.2f);
+  test_support::expectError([&] { relighter.setScene(edited); },
+                            {"sss-cornell.json", "cannot relight", "'slab'", "subsurface", "plenoptic bake"});
+  EXPECT_FALSE(relighter.pending());
 }
 
 /// Two ranks whose collectives must never be reached: the refusal comes first.

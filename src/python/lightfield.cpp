@@ -196,7 +196,7 @@ void bindLightField(py::module_& m) {
       "bake",
       [](const Scene& scene, const std::string& preset, uint64_t seed, int threads, std::optional<std::string> visibility,
          bool reuseVisibility, bool sunMasks, bool punctualHighlights, std::optional<int64_t> causticPhotons,
-         std::optional<std::string> maxMemory, bool keepVisibility, bool fresh) {
+         std::optional<std::string> maxMemory, bool keepVisibility, bool fresh, std::optional<int64_t> subsurfaceWalks) {
         BakeJobOptions options;
         if (maxMemory) options.maxMemory = parseMemorySize(*maxMemory, "max_memory");
         auto relight = std::make_shared<RelightSource>();
@@ -212,6 +212,11 @@ void bindLightField(py::module_& m) {
           if (*causticPhotons < 0 || *causticPhotons > (int64_t(1) << 32))
             throw py::value_error(fmt::format("caustic_photons must be in [0, 2^32] (got {})", *causticPhotons));
           options.causticPhotons = *causticPhotons;
+        }
+        if (subsurfaceWalks) {
+          if (*subsurfaceWalks < 1 || *subsurfaceWalks > 65536)  // `--subsurface-walks`'s range
+            throw py::value_error(fmt::format("subsurface_walks must be in [1, 65536] (got {})", *subsurfaceWalks));
+          options.subsurfaceWalks = uint32_t(*subsurfaceWalks);
         }
         options.sceneName = scene.sourcePath;
         options.preset = preset;
@@ -237,7 +242,7 @@ void bindLightField(py::module_& m) {
       py::arg("scene"), py::arg("preset") = "default", py::arg("seed") = 0, py::arg("threads") = 0,
       py::arg("visibility") = py::none(), py::arg("reuse_visibility") = false, py::arg("sun_masks") = true,
       py::arg("punctual_highlights") = true, py::arg("caustic_photons") = py::none(), py::arg("max_memory") = py::none(),
-      py::arg("keep_visibility") = true, py::arg("fresh") = false,
+      py::arg("keep_visibility") = true, py::arg("fresh") = false, py::arg("subsurface_walks") = py::none(),
       "Bakes `scene`'s light field (what `plenoptic bake` does). visibility: a .plv path where the visibility field\n"
       "is saved; with reuse_visibility=True it is read back when the geometry and settings match (so a bake after\n"
       "editing only lights or emission re-runs the propagation alone). sun_masks=False: `--sun-masks off`;\n"
@@ -245,7 +250,8 @@ void bindLightField(py::module_& m) {
       "the preset's); max_memory=\"12G\": `--max-memory 12G` (the bake is refused, before it starts, when its\n"
       "memory estimate exceeds it). keep_visibility=True keeps the visibility field in memory for LightField.relight\n"
       "(False frees it). With a visibility path, a bake that was interrupted resumes from what it saved there\n"
-      "(docs/user-guide.md, Resuming an interrupted bake); fresh=True: `--fresh` (start afresh).");
+      "(docs/user-guide.md, Resuming an interrupted bake); fresh=True: `--fresh` (start afresh). subsurface_walks=N:\n"
+      "`--subsurface-walks N` (random walks per tixel area through subsurface objects; None: the preset's).");
 
   m.def(
       "load_light_field",

@@ -177,6 +177,20 @@ def test_caustic_photons_is_a_bake_option():
         plenoptic.bake(scene, preset="draft", caustic_photons=-1)
 
 
+def test_subsurface_walks_is_a_bake_option(tmp_path):
+    # The repository's subsurface furnace (a sphere and a slab under a white sky): the walks per
+    # tixel area are recorded in the saved light field's settings (META), as `--subsurface-walks`
+    # records them; out of [1, 65536] raises before anything is baked.
+    scene = plenoptic.load_scene(os.path.join(DATA, "..", "..", "bench", "scenes", "sss-furnace.json"))
+    path = str(tmp_path / "walks.plf")
+    plenoptic.bake(scene, preset="draft", subsurface_walks=3).save(path)
+    with open(path, "rb") as f:
+        assert re.search(rb'"subsurface_walks":\s*3\b', f.read())
+    for bad in (0, 65537):
+        with pytest.raises(ValueError, match="subsurface_walks"):
+            plenoptic.bake(scene, preset="draft", subsurface_walks=bad)
+
+
 def test_editing_emission_and_rebaking_with_the_reused_visibility_equals_a_full_bake(tmp_path):
     scene = plenoptic.load_scene("cornell")
     visibility = str(tmp_path / "cornell.plv")
