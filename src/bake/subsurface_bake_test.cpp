@@ -101,8 +101,10 @@ TEST_F(SubsurfaceBakeTest, OperatorConservesEnergy) {
     // …which is the albedo itself within the mapping's accuracy (0.01 for A ≤ 0.8).
     EXPECT_NEAR(interior[ch], model.albedo[ch], 0.02) << "channel " << ch;
   }
-  // The truncation's bound: nothing it dropped shows in these sums (they include only what is kept).
-  EXPECT_LT(double(op.dropped), 0.5 * double(op.entries()));
+  // The sums above hold only what the truncation kept (kSubsurfaceDroppedFraction of each entry
+  // tixel's light at most is dropped): it must have dropped something here for them to show
+  // that its loss stays within their tolerance.
+  EXPECT_GT(op.dropped, 0u);
 }
 
 /// The path tracer's radiance leaving the slab's underside at (x, y, z), seen from below.
