@@ -111,17 +111,11 @@ Agreement compareWithPathTracer(const Scene& scene, const BakeSettings& settings
 
   Agreement result;
   result.image = compareImages(image, reference);
-  double lfSum = 0.0, ptSum = 0.0;
-  int count = 0;
-  const std::vector<RayHit> hits = test_support::pixelCentreHits(accel, camera);
-  for (size_t i = 0; i < hits.size(); ++i) {
-    if (!hits[i].hit() || hits[i].mesh != 1) continue;
-    lfSum += luminance(image.pixels[i]);
-    ptSum += luminance(reference.pixels[i]);
-    ++count;
-  }
+  const test_support::RegionRatio ball = test_support::regionLuminanceRatio(
+      image, reference, test_support::pixelCentreHits(accel, camera), [](const RayHit& hit) { return hit.mesh == 1; });
+  const int count = ball.pixels;
   EXPECT_GT(count, 50);
-  result.ball = ptSum > 0.0 ? lfSum / ptSum : 0.0;
+  result.ball = ball.ratio;
   const ImageComparison& c = result.image;
   std::printf("rough glass LF vs PT: mean ratio %.4f %.4f %.4f, relMSE %.4f, ball (%d pixels) %.4f\n", c.meanRatio[0],
               c.meanRatio[1], c.meanRatio[2], c.relMseAverage, count, result.ball);

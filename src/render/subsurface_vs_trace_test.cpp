@@ -39,16 +39,12 @@ TEST(SubsurfaceVsPathTracer, CornellBoxWithSphereAndSlabAgreesInMean) {
   const Accel accel(scene);
   const std::vector<RayHit> hits = test_support::pixelCentreHits(accel, camera);
   auto meanRatio = [&](const std::function<bool(const Material&)>& keep, int& pixels) {
-    double field = 0.0, traced = 0.0;
-    pixels = 0;
-    for (size_t p = 0; p < hits.size(); ++p) {
-      if (!hits[p].hit()) continue;
-      if (!keep(scene.materials[scene.meshes[hits[p].mesh].materials[hits[p].triangle]])) continue;
-      field += luminance(run.image.pixels[p]);
-      traced += luminance(run.reference.pixels[p]);
-      ++pixels;
-    }
-    return field / traced;
+    const test_support::RegionRatio region =
+        test_support::regionLuminanceRatio(run.image, run.reference, hits, [&](const RayHit& hit) {
+          return keep(scene.materials[scene.meshes[hit.mesh].materials[hit.triangle]]);
+        });
+    pixels = region.pixels;
+    return region.ratio;
   };
   int pixels = 0;
   const double image = meanRatio([](const Material& m) { return !m.isEmissive(); }, pixels);

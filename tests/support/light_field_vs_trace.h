@@ -10,6 +10,7 @@
 #include "scene/scene.h"
 #include "trace/trace.h"
 
+#include <functional>
 #include <vector>
 
 namespace pl::test_support {
@@ -48,6 +49,27 @@ inline std::vector<RayHit> pixelCentreHits(const Accel& accel, const Camera& cam
       accel.intersect(camera.generateRay(Vec2(float(x) + 0.5f, float(y) + 0.5f), Vec2(0.5f)).ray,
                       hits[size_t(y) * size_t(camera.width()) + size_t(x)]);
   return hits;
+}
+
+/// The ratio of `image`'s to `reference`'s mean luminance over the pixels whose centre ray hits
+/// a surface `keep(hit)` accepts (hits: pixelCentreHits), and how many pixels that is (0 when
+/// none: the ratio is then 0).
+struct RegionRatio {
+  double ratio = 0.0;
+  int pixels = 0;
+};
+inline RegionRatio regionLuminanceRatio(const Image& image, const Image& reference, const std::vector<RayHit>& hits,
+                                        const std::function<bool(const RayHit&)>& keep) {
+  double imageSum = 0.0, referenceSum = 0.0;
+  RegionRatio region;
+  for (size_t i = 0; i < hits.size(); ++i) {
+    if (!hits[i].hit() || !keep(hits[i])) continue;
+    imageSum += luminance(image.pixels[i]);
+    referenceSum += luminance(reference.pixels[i]);
+    ++region.pixels;
+  }
+  region.ratio = referenceSum > 0.0 ? imageSum / referenceSum : 0.0;
+  return region;
 }
 
 }  // namespace pl::test_support
