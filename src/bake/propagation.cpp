@@ -292,26 +292,43 @@ constexpr uint32_t kPrefetchDistance = 16;
 /// Σ_k L_k over one tixel's n visibility entries, in gather order k = 0 … n−1 (also writing
 /// each L_k to incoming when KeepIncoming). Entries without an extra record that hit a front
 /// side are direct views of diffuse tixels (a mirror-free path to a glossy chart always has
-/// one) or escaped, and are looked up in the quads (quadCount − 1 is an all-zero quad for the
-/// escaped ones); the others go through slowPath(entry, extra), which returns their radiance.
-/// Back-side entries without an extra bring nothing.
+/// one), looked up in the quads; entries with an extra record go through slowPath(entry,
+/// extra), which returns their radiance; escaped entries and back sides without an extra bring
+/// nothing. `extraCount` is the tixel's number of extra records, `scratch` room for that many
+/// values. Prefetches read quad quadCount − 1 (all zero) for the escaped entries.
+///
+/// The entries with an extra record are evaluated first, into `scratch`, so that the loop that
+/// sums makes no call; the values and the order of the additions are those of evaluating each
+/// entry in turn, so the sum is the same to the bit.
 template <bool KeepIncoming, typename SlowPath>
 F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* quads, uint64_t quadCount,
-               const VisibilityExtra* extras, Lanes4* incoming, SlowPath&& slowPath) {
+               const VisibilityExtra* extras, uint64_t extraCount, Lanes4* scratch, Lanes4* incoming, SlowPath&& slowPath) {
+  if (extraCount > 0) {
+    const VisibilityExtra* extra = extras;
+    Lanes4* out = scratch;
+    for (uint32_t k = 0; k < n; ++k)
+      if (entries[k].hasExtra()) *out++ = lanes4(slowPath(entries[k], extra++));
+  }
+  const Lanes4* slow = scratch;
   F4 sum = f4Zero();
   for (uint32_t k = 0; k < n; ++k) {
     if (k + kPrefetchDistance < n)
       __builtin_prefetch(quads + std::min<uint64_t>(entries[k + kPrefetchDistance].tixel(), quadCount - 1));
     const VisibilityEntry e = entries[k];
-    if ((e.target & (VisibilityEntry::kBackSide | VisibilityEntry::kHasExtra)) == 0) {
-      // An escaped entry (tixel() = kEscape, above every index) reads the all-zero last quad.
-      const F4 L = lookupQuad(quads[std::min<uint64_t>(e.tixel(), quadCount - 1)], e);
+    // The flags are the target's top bits, so one comparison finds the direct views of a
+    // front side: below kEscape, with neither flag.
+    if (e.target < VisibilityEntry::kEscape) {
+      const F4 L = lookupQuad(quads[e.tixel()], e);
+      sum = f4Add(sum, L);
+      if constexpr (KeepIncoming) incoming[k] = lanes4(L);
+    } else if (e.hasExtra()) {
+      const F4 L = f4Load((slow++)->v);  // slowPath's radiance
       sum = f4Add(sum, L);
       if constexpr (KeepIncoming) incoming[k] = lanes4(L);
     } else {
-      const Rgb L = slowPath(e, e.hasExtra() ? extras++ : nullptr);
-      sum = f4Add(sum, f4FromRgb(L));
-      if constexpr (KeepIncoming) incoming[k] = lanes4(L);
+      // Escaped, or a back side without an extra: nothing arrives (as slowPathRadiance says),
+      // and adding +0 would leave the sum as it is (it starts at +0, so it is never −0).
+      if constexpr (KeepIncoming) incoming[k] = Lanes4{};
     }
   }
   return sum;
@@ -1234,7 +1251,7 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
   std::vector<Rgb>& current = state.current;
   std::vector<float>& change = state.change;
   parallelForRange(end - begin, 16, [&](uint64_t t0, uint64_t t1) {
-    std::vector<Lanes4> incoming(n), twinIncoming;
+    std::vector<Lanes4> incoming(n), twinIncoming, slowValues(n);
     std::vector<VisibilityEntry> decoded(n);
     std::vector<uint8_t> subCells;
     for (uint64_t g = begin + t0; g < begin + t1; ++g) {
@@ -1245,9 +1262,12 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
       };
       const VisibilityEntry* entries = vis.entries(g, decoded.data());
       const VisibilityExtra* extras = vis.extras(g);
+      const uint64_t extraCount = vis.extraCount(g);
       const F4 sum = c.kind == ChartKind::Glossy || c.directionalIrradiance
-                         ? gatherTixel<true>(entries, n, ops.quads.data(), ops.quads.size(), extras, incoming.data(), slowPath)
-                         : gatherTixel<false>(entries, n, ops.quads.data(), ops.quads.size(), extras, nullptr, slowPath);
+                         ? gatherTixel<true>(entries, n, ops.quads.data(), ops.quads.size(), extras, extraCount,
+                                             slowValues.data(), incoming.data(), slowPath)
+                         : gatherTixel<false>(entries, n, ops.quads.data(), ops.quads.size(), extras, extraCount,
+                                              slowValues.data(), nullptr, slowPath);
       const uint64_t vb = valueBase(g, c);
       auto relax = [&](const Rgb& before, const Rgb& update) { return glm::max(Rgb(0.0f), before + omega * (update - before)); };
       if (c.kind == ChartKind::Diffuse && !ops.subsurfaceChart.empty() && ops.subsurfaceChart[param.tixelChart[g]]) {
@@ -1273,8 +1293,9 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
           // Rough glass: plus the transmission of what the twin record gathers now.
           const uint64_t twin = twinTixel(param, g);
           twinIncoming.resize(n);
-          const F4 twinSum = gatherTixel<true>(vis.entries(twin, decoded.data()), n, ops.quads.data(), ops.quads.size(), vis.extras(twin),
-                                               twinIncoming.data(), slowPath);
+          const F4 twinSum = gatherTixel<true>(vis.entries(twin, decoded.data()), n, ops.quads.data(), ops.quads.size(),
+                                               vis.extras(twin), vis.extraCount(twin), slowValues.data(), twinIncoming.data(),
+                                               slowPath);
           gm.transmission[c.isBack ? 1 : 0].apply(twinIncoming.data(), twinSum, out);
         }
         const Rgb* before = previousValues.data() + vb;

@@ -77,6 +77,11 @@ struct VisibilityShard {
   bool holdDecoded(uint64_t budget);
   /// Tixel g's first extra record.
   const VisibilityExtra* extras(uint64_t g) const { return field.extras.data() + field.extraOffset[local(g)]; }
+  /// How many extra records tixel g has.
+  uint64_t extraCount(uint64_t g) const {
+    const uint64_t t = local(g);
+    return field.extraOffset[t + 1] - field.extraOffset[t];
+  }
 };
 
 /// The hash a shard's .plv carries: the whole field's (visibilityHash) for one range holding
