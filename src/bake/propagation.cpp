@@ -299,9 +299,11 @@ constexpr uint32_t kPrefetchDistance = 16;
 ///
 /// The entries with an extra record are evaluated first, into `scratch`, so that the loop that
 /// sums makes no call; the values and the order of the additions are those of evaluating each
-/// entry in turn, so the sum is the same to the bit.
+/// entry in turn, so the sum is the same to the bit. Not inlined: inside gatherIteration's
+/// loop, where values live across calls, the compiler kept `sum` in memory, which chained the
+/// additions through a store and a reload each.
 template <bool KeepIncoming, typename SlowPath>
-F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* quads, uint64_t quadCount,
+[[gnu::noinline]] F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* quads, uint64_t quadCount,
                const VisibilityExtra* extras, uint64_t extraCount, Lanes4* scratch, Lanes4* incoming, SlowPath&& slowPath) {
   if (extraCount > 0) {
     const VisibilityExtra* extra = extras;
