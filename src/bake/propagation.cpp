@@ -313,9 +313,7 @@ template <bool KeepIncoming, typename SlowPath>
   }
   const Lanes4* slow = scratch;
   F4 sum = f4Zero();
-  for (uint32_t k = 0; k < n; ++k) {
-    if (k + kPrefetchDistance < n)
-      __builtin_prefetch(quads + std::min<uint64_t>(entries[k + kPrefetchDistance].tixel(), quadCount - 1));
+  auto add = [&](uint32_t k) [[gnu::always_inline]] {
     const VisibilityEntry e = entries[k];
     // The flags are the target's top bits, so one comparison finds the direct views of a
     // front side: below kEscape, with neither flag.
@@ -332,7 +330,15 @@ template <bool KeepIncoming, typename SlowPath>
       // and adding +0 would leave the sum as it is (it starts at +0, so it is never −0).
       if constexpr (KeepIncoming) incoming[k] = Lanes4{};
     }
+  };
+  // The entries kPrefetchDistance ahead exist up to n − kPrefetchDistance: two loops, so that
+  // neither tests for it.
+  const uint32_t prefetched = n > kPrefetchDistance ? n - kPrefetchDistance : 0;
+  for (uint32_t k = 0; k < prefetched; ++k) {
+    __builtin_prefetch(quads + std::min<uint64_t>(entries[k + kPrefetchDistance].tixel(), quadCount - 1));
+    add(k);
   }
+  for (uint32_t k = prefetched; k < n; ++k) add(k);
   return sum;
 }
 
