@@ -1394,7 +1394,8 @@ class ValueExchange {
     }
     std::vector<Rgb> packed(packedTixel_.size());
     const int rank = comm_.rank();
-    for (uint64_t k = packedStart_[size_t(rank)]; k < packedStart_[size_t(rank) + 1]; ++k) packed[k] = irradiance[packedTixel_[k]];
+    for (uint64_t k = packedStart_[size_t(rank)]; k < packedStart_[size_t(rank) + 1]; ++k)
+      packed[k] = irradiance[packedTixel_[k]];
     for (int r = 0; r < ranks; ++r) {
       displacement_[size_t(r)] = packedStart_[size_t(r)] * sizeof(Rgb);
       count_[size_t(r)] = (packedStart_[size_t(r) + 1] - packedStart_[size_t(r)]) * sizeof(Rgb);
@@ -1569,13 +1570,13 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
                             Communicator& comm, const ShardPlan& plan, const PropagationResume& resume) {
   const auto start = std::chrono::steady_clock::now();
   PropagationResult result;
+  const uint64_t bytesBefore = comm.bytesReceived();  // the subsurface walks' exchange included
   TransportState state(scene, accel, param, settings, &comm);
   const int rank = comm.rank(), ranks = comm.size();
   if (plan.ranks != ranks || plan.batchStart != state.batchStart)
     fail("{}: the shard plan ({} ranks, {} batches) does not fit this propagation ({} ranks, {} batches)", scene.sourcePath,
          plan.ranks, plan.batches(), ranks, state.batchStart.size() - 1);
   ValueExchange exchange(param, plan, comm);
-  const uint64_t bytesBefore = comm.bytesReceived();
   result.subsurfaceSeconds = state.ops->subsurface.seconds;
   result.subsurfaceTixels = state.ops->subsurface.rowTixel.size();
   result.subsurfaceWalks = state.ops->subsurface.walks;

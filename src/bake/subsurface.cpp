@@ -8,6 +8,7 @@
 
 #include "accel/accel.h"
 #include "bake/parameterisation.h"
+#include "bake/shard.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "core/sampler.h"
@@ -161,14 +162,7 @@ std::vector<uint32_t> walkSplit(const Scene& scene, const Parameterisation& para
     }
     prefix[k + 1] = prefix[k] + walks;
   }
-  std::vector<uint32_t> split{0};
-  for (int r = 1; r < ranks; ++r) {
-    const double target = prefix.back() * double(r) / double(ranks);
-    const size_t at = size_t(std::lower_bound(prefix.begin(), prefix.end(), target) - prefix.begin());
-    split.push_back(std::max(split.back(), uint32_t(std::min(at, charts.size()))));
-  }
-  split.push_back(uint32_t(charts.size()));
-  return split;
+  return splitByCost(prefix, ranks);
 }
 
 // A record's walks as bytes: walks, exited, rays, dropped, the contribution count (uint64
