@@ -31,7 +31,10 @@
 # where no path has a diffuse surface before a subsurface one. STANDINS=SCENE also traces SCENE
 # with plenoptic (e.g. bench/scenes/sss-cornell-standins.json: the objects Lambertian of the
 # colours Cycles' SSS nodes get) and adds its column: what Cycles shows wherever it renders the
-# objects as Lambertian.
+# objects as Lambertian. SHORTCUT=1 also traces the scene with `--subsurface-after-diffuse
+# lambert` (Cycles' own shortcut: the subsurface materials shaded as Lambertian of their albedo
+# once a path has bounced off a diffuse surface) and adds its column: plenoptic rendering what
+# Cycles renders, so that the ratio isolates everything but the shortcut.
 #
 # Usage: bench/sss_vs_cycles.sh [PLENOPTIC] [WORKDIR]
 #   PLENOPTIC  default build/plenoptic; WORKDIR default out/sss_vs_cycles
@@ -58,7 +61,12 @@ depth=${MAX_DEPTH:--1}
 if [ "$depth" != -1 ]; then export CYCLES_MAX_BOUNCES=$((depth - 1)); fi
 "$plenoptic" --quiet --threads "$threads" --seed 1 trace "$scene" -o "$work/pt.pfm" --variance "$work/pt_var.pfm" \
   --spp "$spp" --width "$width" --height "$height" --camera main --stats "$work/pt.json" --max-depth "$depth"
-rm -f "$work/standins.pfm"
+rm -f "$work/standins.pfm" "$work/shortcut.pfm"
+if [ -n "${SHORTCUT:-}" ]; then
+  echo "== plenoptic trace with --subsurface-after-diffuse lambert, $spp spp" >&2
+  "$plenoptic" --quiet --threads "$threads" --seed 1 trace "$scene" -o "$work/shortcut.pfm" --subsurface-after-diffuse lambert \
+    --spp "$spp" --width "$width" --height "$height" --camera main --max-depth "$depth"
+fi
 if [ -n "${STANDINS:-}" ]; then
   echo "== plenoptic trace of $STANDINS, $spp spp" >&2
   "$plenoptic" --quiet --threads "$threads" --seed 1 trace "$STANDINS" -o "$work/standins.pfm" \
@@ -90,7 +98,10 @@ def image(name):
 
 
 pt, var, cy, ids = image("pt"), image("pt_var"), image("cy"), image("cy.ids")
-standins = image("standins") if os.path.exists(os.path.join(work, "standins.pfm")) else None
+# The optional columns: (heading, image) of each extra plenoptic trace that was made.
+extras = [(heading, image(name)) for name, heading in (("shortcut", "plenoptic with Cycles' shortcut"),
+                                                       ("standins", "plenoptic, stand-ins"))
+          if os.path.exists(os.path.join(work, name + ".pfm"))]
 colours = json.load(open(os.path.join(work, "cy.ids.json")))
 regions, walls = [], np.zeros(ids.shape[:2], bool)
 for name, colour in sorted(colours.items()):
@@ -105,9 +116,9 @@ stats = json.load(open(os.path.join(work, "pt.json")))
 print(f"Scene {os.path.basename(scene)}, {ids.shape[1]}x{ids.shape[0]}, both renderers {spp} spp "
       f"(plenoptic trace {stats.get('seconds', float('nan')):.1f} s):")
 print()
-extra = " plenoptic, stand-ins Y | Cycles / stand-ins |" if standins is not None else ""
+extra = "".join(f" {heading} Y | Cycles / it |" for heading, _ in extras)
 print("| region | pixels | plenoptic Y (± s.e.) | Cycles Y | Cycles / plenoptic |" + extra)
-print("|---|---:|---:|---:|---:|" + ("---:|---:|" if standins is not None else ""))
+print("|---|---:|---:|---:|---:|" + "---:|---:|" * len(extras))
 for name, mask in regions:
     n = int(mask.sum())
     if n == 0:  # e.g. no walls in the furnace
@@ -115,9 +126,9 @@ for name, mask in regions:
     y_pt, y_cy = float((pt[mask] @ weights).mean()), float((cy[mask] @ weights).mean())
     se = float(np.sqrt((var[mask] @ (weights ** 2)).sum()) / n)  # pixels independent
     row = f"| {name} | {n} | {y_pt:.4f} ± {se:.4f} | {y_cy:.4f} | {y_cy / y_pt:.4f} |"
-    if standins is not None:
-        y_st = float((standins[mask] @ weights).mean())
-        row += f" {y_st:.4f} | {y_cy / y_st:.4f} |"
+    for _, other in extras:
+        y_other = float((other[mask] @ weights).mean())
+        row += f" {y_other:.4f} | {y_cy / y_other:.4f} |"
     print(row)
 print()
 print("Y = mean luminance (Rec. 709) of linear radiance over the region's pixels.")

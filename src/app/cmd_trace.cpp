@@ -98,6 +98,14 @@ void addTraceCommand(CLI::App& app, const GlobalOptions& global) {
           "(PCG32 streams; exact per-pixel variance estimates)")
       ->check(CLI::IsMember({"independent", "sobol"}))
       ->default_str(samplerName(job.trace.sampler));
+  command
+      ->add_option_function<std::string>(
+          "--subsurface-after-diffuse",
+          [&job](const std::string& s) { job.trace.subsurfaceLambertAfterDiffuse = s == "lambert"; },
+          "Subsurface materials met after a Lambertian bounce: walk (default; the medium every time) or "
+          "lambert (shaded as Lambertian of their albedo, as Blender Cycles does; for comparisons, biased)")
+      ->check(CLI::IsMember({"walk", "lambert"}))
+      ->default_str("walk");
   command->add_option("--stats", job.statsPath, "Write timings and counts as JSON");
   command->add_option("--variance", job.variancePath,
                       "Also write the per-pixel variance of the mean (.exr/.hdr/.pfm; radiance², no exposure)");

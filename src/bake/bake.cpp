@@ -266,10 +266,11 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
   note(fmt::format("propagation: {} iterations, residual {:.2e}, {:.2f} s (first shot {:.2f} s, {} shadow rays)",
                    prop.iterations, prop.residual, prop.seconds, prop.firstShotSeconds, prop.shadowRays));
   if (prop.subsurfaceWalks > 0)
-    note(fmt::format("subsurface: {} tixels, {} walks ({} rays) in {:.2f} s (of the first shot), operator {} entries, "
+    note(fmt::format("subsurface: {} tixels, {} walks{} ({} rays) in {:.2f} s (of the first shot), operator {} entries, "
                      "{:.1f} MB",
-                     prop.subsurfaceTixels, prop.subsurfaceWalks, prop.subsurfaceRays, prop.subsurfaceSeconds,
-                     prop.subsurfaceEntries, prop.subsurfaceBytes / 1e6));
+                     prop.subsurfaceTixels, prop.subsurfaceWalks,
+                     comm.size() > 1 ? fmt::format(", {} of them on rank {}", prop.subsurfaceWalkedHere, comm.rank()) : "",
+                     prop.subsurfaceRays, prop.subsurfaceSeconds, prop.subsurfaceEntries, prop.subsurfaceBytes / 1e6));
   if (prop.causticPhotons > 0)
     note(fmt::format("caustics: {} photons, {} reached a diffuse surface through mirrors or glass, {:.2f} s (of the first shot)",
                      prop.causticPhotons, prop.causticPhotonsLanded, prop.causticSeconds));
@@ -341,18 +342,6 @@ BakeStats bakeStats(const Parameterisation& param, const Transport& t, const Dis
 
 }  // namespace
 
-void requireBakeableMaterials(const Scene& scene, int ranks) {
-  if (ranks <= 1) return;
-  std::vector<uint8_t> used(scene.materials.size(), 0);
-  for (const Mesh& mesh : scene.meshes)
-    for (const uint32_t m : mesh.materials) used[m] = 1;
-  for (size_t m = 0; m < scene.materials.size(); ++m)
-    if (used[m] && subsurfaceMedium(scene.materials[m].bsdf))
-      fail("{}: material '{}' is subsurface, which a distributed bake ({} ranks) does not support (its light "
-           "crosses the object between the ranks' shares); bake the scene in one process",
-           scene.sourcePath, scene.materials[m].name, ranks);
-}
-
 void removePropagationCheckpoint(const BakeOptions& options) {
   if (options.visibilityPath.empty()) return;
   const int rank = options.communicator ? options.communicator->rank() : 0;
@@ -364,7 +353,6 @@ void removePropagationCheckpoint(const BakeOptions& options) {
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options) {
   SingleProcess single;
   Communicator& comm = options.communicator ? *options.communicator : single;
-  requireBakeableMaterials(scene, comm.size());
   const auto start = std::chrono::steady_clock::now();
   const Note note = [&](const std::string& text) {
     if (options.log) options.log(text);
@@ -388,7 +376,7 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   const double bytesPerTixel = estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
   const uint64_t estimate =
       bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel) +
-      subsurfaceOperatorBytesEstimate(lf.scene, param, settings.subsurfaceWalks);
+      subsurfaceOperatorBytesEstimate(lf.scene, param, settings.subsurfaceWalks, comm.size());
   if (options.checkMemory) options.checkMemory(estimate);
 
   // 2. Visibility field and 3. propagation.

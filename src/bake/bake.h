@@ -121,18 +121,11 @@ uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings
 /// evenly, but what they see varies from chart to chart.
 inline constexpr double kVisibilityEstimateMargin = 1.15;
 
-/// Throws pl::Error naming the file and the material when a bake over `ranks` processes cannot
-/// bake the scene's materials: a distributed bake (ranks > 1) of a scene with a subsurface
-/// material (bsdf.h SubsurfaceBsdf), whose operator (subsurface.h) joins tixels of every rank's
-/// share and is not exchanged. bake() calls it first, before any ray is traced or anything written.
-void requireBakeableMaterials(const Scene& scene, int ranks);
-
 /// Removes the propagation checkpoint (resume.h) of a bake with these options (every rank's
 /// own, for a distributed bake), if there is one.
 void removePropagationCheckpoint(const BakeOptions& options);
 
-/// Bakes `scene` (moved into the result). Throws pl::Error on failures, among them a scene
-/// requireBakeableMaterials refuses.
+/// Bakes `scene` (moved into the result). Throws pl::Error on failures.
 LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& options = {});
 
 }  // namespace pl

@@ -651,7 +651,7 @@ void addTiltedGather(const TransportState& state, const Chart& c, uint64_t g, co
 }  // namespace
 
 TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const Parameterisation& paramIn,
-                               const BakeSettings& settingsIn)
+                               const BakeSettings& settingsIn, Communicator* comm)
     : scene(sceneIn), accel(accelIn), param(paramIn), settings(settingsIn), ops(std::make_unique<Operators>()) {
   // The gather grid follows from the settings (the field's hash covers them); the field itself
   // is first needed after the shadow rays of the first shot.
@@ -709,7 +709,9 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
     punctualGlossy.assign(param.valueCount, Rgb(0.0f));
   change.assign(tixels, 0.0f);
   batchStart = propagationBatches(param);
-  ops->subsurface = buildSubsurfaceOperator(scene, accel, param, settings.subsurfaceWalks, settings.seed);
+  SingleProcess single;
+  ops->subsurface =
+      buildSubsurfaceOperator(scene, accel, param, settings.subsurfaceWalks, settings.seed, comm ? *comm : single);
   if (!ops->subsurface.empty()) {
     ops->subsurfaceChart.resize(param.charts.size());
     for (size_t ci = 0; ci < param.charts.size(); ++ci) ops->subsurfaceChart[ci] = isSubsurfaceChart(scene, param.charts[ci]);
@@ -1403,6 +1405,35 @@ class ValueExchange {
   void all(std::vector<Rgb>& values) {
     for (size_t b = 0; b < plan_.batches(); ++b) batch(values, b);
   }
+  /// Exchanges the irradiance (tixel-indexed) that the subsurface tixels `rows` (ascending)
+  /// gathered, each on the rank that owns it: every rank's rows packed into one run of a
+  /// buffer, one collective per call.
+  void subsurface(const std::vector<uint64_t>& rows, std::vector<Rgb>& irradiance) {
+    const int ranks = comm_.size();
+    if (ranks == 1 || rows.empty()) return;
+    const auto start = std::chrono::steady_clock::now();
+    if (packedStart_.empty()) {
+      // Rank r's rows, in tixel order, are packed[packedStart_[r], packedStart_[r + 1]).
+      packedStart_.push_back(0);
+      for (int r = 0; r < ranks; ++r) {
+        for (const TixelRange& owned : plan_.owned(r))
+          for (auto it = std::lower_bound(rows.begin(), rows.end(), owned.begin); it != rows.end() && *it < owned.end; ++it)
+            packedTixel_.push_back(*it);
+        packedStart_.push_back(packedTixel_.size());
+      }
+    }
+    std::vector<Rgb> packed(packedTixel_.size());
+    const int rank = comm_.rank();
+    for (uint64_t k = packedStart_[size_t(rank)]; k < packedStart_[size_t(rank) + 1]; ++k)
+      packed[k] = irradiance[packedTixel_[k]];
+    for (int r = 0; r < ranks; ++r) {
+      displacement_[size_t(r)] = packedStart_[size_t(r)] * sizeof(Rgb);
+      count_[size_t(r)] = (packedStart_[size_t(r) + 1] - packedStart_[size_t(r)]) * sizeof(Rgb);
+    }
+    comm_.allgatherv(packed.data(), displacement_, count_);
+    for (uint64_t k = 0; k < packed.size(); ++k) irradiance[packedTixel_[k]] = packed[k];
+    seconds_ += secondsSince(start);
+  }
   /// Time spent inside the exchanges (waiting for the slowest rank included).
   double seconds() const { return seconds_; }
 
@@ -1411,6 +1442,7 @@ class ValueExchange {
   const ShardPlan& plan_;
   Communicator& comm_;
   std::vector<uint64_t> displacement_, count_;
+  std::vector<uint64_t> packedTixel_, packedStart_;  ///< the subsurface rows by owning rank (subsurface())
   double seconds_ = 0.0;
 };
 
@@ -1491,8 +1523,9 @@ void iterateOnce(TransportState& state, const VisibilityShard& vis, const ShardP
     }
     result.repeatedSeconds += secondsSince(repeatedStart);
   }
-  // Subsurface tixels: the light that entered them this iteration leaves through the object.
-  // (One process only: propagate refuses a distributed bake of subsurface charts.)
+  // Subsurface tixels: the light that entered them this iteration (gathered by their owners,
+  // exchanged) leaves through the object; every rank applies the whole operator.
+  exchange.subsurface(state.ops->subsurface.rowTixel, state.ops->subsurfaceIrradiance);
   applySubsurface(state, true);
 }
 
@@ -1567,17 +1600,17 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
                             Communicator& comm, const ShardPlan& plan, const PropagationResume& resume) {
   const auto start = std::chrono::steady_clock::now();
   PropagationResult result;
-  TransportState state(scene, accel, param, settings);
+  const uint64_t bytesBefore = comm.bytesReceived();  // the subsurface walks' exchange included
+  TransportState state(scene, accel, param, settings, &comm);
   const int rank = comm.rank(), ranks = comm.size();
   if (plan.ranks != ranks || plan.batchStart != state.batchStart)
     fail("{}: the shard plan ({} ranks, {} batches) does not fit this propagation ({} ranks, {} batches)", scene.sourcePath,
          plan.ranks, plan.batches(), ranks, state.batchStart.size() - 1);
   ValueExchange exchange(param, plan, comm);
-  const uint64_t bytesBefore = comm.bytesReceived();
-  if (ranks > 1 && !state.ops->subsurface.empty()) requireBakeableMaterials(scene, ranks);
   result.subsurfaceSeconds = state.ops->subsurface.seconds;
   result.subsurfaceTixels = state.ops->subsurface.rowTixel.size();
   result.subsurfaceWalks = state.ops->subsurface.walks;
+  result.subsurfaceWalkedHere = state.ops->subsurface.walkedHere;
   result.subsurfaceRays = state.ops->subsurface.rays;
   result.subsurfaceEntries = state.ops->subsurface.entries();
   result.subsurfaceBytes = state.ops->subsurface.bytes();

@@ -74,9 +74,11 @@ struct PropagationResult {
   uint64_t causticPhotons = 0, causticPhotonsLanded = 0;  ///< the caustic pass's (caustics.h)
   double causticSeconds = 0.0;                            ///< of firstShotSeconds
   /// The subsurface operator (subsurface.h; all 0 without subsurface charts): its build time
-  /// (of firstShotSeconds), tixels, walks, their rays, its entries and bytes.
+  /// (of firstShotSeconds, its exchange included), tixels, walks (every rank's, and this
+  /// rank's share), their rays, its entries and bytes.
   double subsurfaceSeconds = 0.0;
-  uint64_t subsurfaceTixels = 0, subsurfaceWalks = 0, subsurfaceRays = 0, subsurfaceEntries = 0, subsurfaceBytes = 0;
+  uint64_t subsurfaceTixels = 0, subsurfaceWalks = 0, subsurfaceWalkedHere = 0, subsurfaceRays = 0, subsurfaceEntries = 0,
+           subsurfaceBytes = 0;
 };
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
@@ -129,9 +131,11 @@ std::vector<uint64_t> propagationBatches(const Parameterisation& param);
 
 /// What the stages share. Values are in LightField::values layout.
 struct TransportState {
-  /// Builds the glossy operators, the light sampler and the batches; `direct` all zero. The
-  /// scene, accel and parameterisation must outlive the state.
-  TransportState(const Scene& scene, const Accel& accel, const Parameterisation& param, const BakeSettings& settings);
+  /// Builds the glossy operators, the light sampler, the batches and the subsurface operator
+  /// (subsurface.h; its walks split between the ranks of `comm` when given, which makes this a
+  /// collective); `direct` all zero. The scene, accel and parameterisation must outlive the state.
+  TransportState(const Scene& scene, const Accel& accel, const Parameterisation& param, const BakeSettings& settings,
+                 Communicator* comm = nullptr);
   ~TransportState();
   TransportState(const TransportState&) = delete;
   TransportState& operator=(const TransportState&) = delete;

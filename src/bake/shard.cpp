@@ -128,14 +128,19 @@ std::vector<uint32_t> tixelSetupSplit(const Parameterisation& param, int ranks) 
     const double perTixel = c.kind == ChartKind::Specular ? 0.25 : 1.0;
     prefix[ci + 1] = prefix[ci] + 1.0 + perTixel * double(c.tixelCount());
   }
+  return splitByCost(prefix, ranks);
+}
+
+std::vector<uint32_t> splitByCost(const std::vector<double>& prefix, int ranks) {
+  const size_t items = prefix.size() - 1;
   std::vector<uint32_t> split{0};
   for (int r = 1; r < ranks; ++r) {
-    // The first record at which the running cost reaches r/ranks of the total.
+    // The first item at which the running cost reaches r/ranks of the total.
     const double target = prefix.back() * double(r) / double(ranks);
     const size_t at = size_t(std::lower_bound(prefix.begin(), prefix.end(), target) - prefix.begin());
-    split.push_back(std::max(split.back(), uint32_t(std::min(at, records))));
+    split.push_back(std::max(split.back(), uint32_t(std::min(at, items))));
   }
-  split.push_back(uint32_t(records));
+  split.push_back(uint32_t(items));
   return split;
 }
 

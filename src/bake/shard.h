@@ -59,6 +59,12 @@ std::vector<TixelRange> visibilityRanges(const Scene& scene, const Parameterisat
 /// 1/4) plus one. Deterministic: every rank computes the same split.
 std::vector<uint32_t> tixelSetupSplit(const Parameterisation& param, int ranks);
 
+/// Items 0 … n − 1 of cumulative cost `prefix` (n + 1 entries, prefix[0] = 0, non-decreasing)
+/// split into `ranks` contiguous runs of about equal cost: ranks + 1 boundaries, run r being
+/// [result[r], result[r + 1]), each boundary the first item at which the running cost reaches
+/// r/ranks of the total.
+std::vector<uint32_t> splitByCost(const std::vector<double>& prefix, int ranks);
+
 /// What fillTixelsDistributed measured on this rank.
 struct TixelSetupTiming {
   double seconds = 0.0;          ///< filling this rank's records (its share of the divisible work)

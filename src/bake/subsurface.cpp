@@ -4,14 +4,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 #include "accel/accel.h"
 #include "bake/parameterisation.h"
+#include "bake/shard.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "core/sampler.h"
 #include "core/sampling.h"
 #include "core/timing.h"
+#include "distributed/communicator.h"
 #include "scene/scene.h"
 #include "trace/subsurface_walk.h"
 
@@ -40,24 +43,41 @@ uint64_t tixelUnder(const Chart& c, const Vec3& p) {
   return c.firstTixel + uint64_t(j) * c.resU + i;
 }
 
+/// The walks of one triangle of area `area` on a chart of tixel area `tixelArea`: about
+/// walksPerTixel per tixel area, at least one.
+uint32_t triangleWalks(float area, uint32_t walksPerTixel, float tixelArea) {
+  return std::max(1u, uint32_t(std::ceil(float(walksPerTixel) * area / tixelArea)));
+}
+
+float triangleArea(const Mesh& m, uint32_t triangle) {
+  const UVec3& t = m.triangles[triangle];
+  return 0.5f * glm::length(glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]));
+}
+
+/// What the walks entering one chart record gave (chartWalks).
+struct ChartWalks {
+  std::vector<Contribution> contributions;  ///< merged per (entry, exit) and truncated
+  std::vector<double> area;                 ///< per tixel of the chart: the surface area its walks stand for
+  uint64_t walks = 0, exited = 0, rays = 0, dropped = 0;
+};
+
 /// The walks entering chart record `ci` (its front record: the outside of the closed mesh),
-/// merged per (entry, exit) pair and truncated per entry tixel (kSubsurfaceDroppedFraction).
-/// Adds the area each walk stands for to its entry tixel's in `surfaceArea` (indexed from
-/// c.firstTixel): the surface area under each tixel, which on a curved chart is larger than
-/// the tixel's square covers in the chart's plane.
-std::vector<Contribution> chartWalks(const Scene& scene, const Accel& accel, const Parameterisation& param, uint32_t ci,
-                                     uint32_t walksPerTixel, uint64_t seed, std::vector<double>& surfaceArea, uint64_t& walks,
-                                     uint64_t& exited, uint64_t& rays, uint64_t& dropped) {
+/// merged per (entry, exit) pair and truncated per entry tixel (kSubsurfaceDroppedFraction),
+/// with the area each walk stands for added to its entry tixel's (indexed from c.firstTixel):
+/// the surface area under each tixel, which on a curved chart is larger than the tixel's
+/// square covers in the chart's plane. Depends only on the chart and the seed.
+ChartWalks chartWalks(const Scene& scene, const Accel& accel, const Parameterisation& param, uint32_t ci,
+                      uint32_t walksPerTixel, uint64_t seed) {
   const Chart& c = param.charts[ci];
-  surfaceArea.assign(c.tixelCount(), 0.0);
+  ChartWalks result;
+  result.area.assign(c.tixelCount(), 0.0);
   std::vector<Contribution> out;
   const float tixelArea = c.tixelSize * c.tixelSize;
   for (const auto& [mesh, triangle] : param.chartTriangles[ci]) {
     const Mesh& m = scene.meshes[mesh];
-    const UVec3& t = m.triangles[triangle];
-    const float area = 0.5f * glm::length(glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]));
+    const float area = triangleArea(m, triangle);
     if (!(area > 0.0f)) continue;
-    const uint32_t count = std::max(1u, uint32_t(std::ceil(float(walksPerTixel) * area / tixelArea)));
+    const uint32_t count = triangleWalks(area, walksPerTixel, tixelArea);
     const float share = area / float(count);  // the area each walk stands for
     const uint64_t key = (uint64_t(mesh) << 32) | triangle;
     // Entry points: a Hammersley set over the triangle (Heitz's low-distortion map), shifted
@@ -73,17 +93,17 @@ std::vector<Contribution> chartWalks(const Scene& scene, const Accel& accel, con
       const Bsdf bsdf = bsdfAt(scene, entry);  // a textured albedo: the entry point's medium
       const std::optional<SubsurfaceMedium> medium = subsurfaceMedium(bsdf);
       if (!medium) continue;
-      ++walks;
-      surfaceArea[tixelUnder(c, entry.position) - c.firstTixel] += share;
+      ++result.walks;
+      result.area[tixelUnder(c, entry.position) - c.firstTixel] += share;
       // The light comes from the outside: the winding normal's side (the chart's front).
       const ScatteringFrame frame = scatteringFrame(entry, entry.geometricNormal, bsdf);
       const std::optional<WalkExit> exit =
-          subsurfaceWalk(scene, accel, entry.position, frame, *medium, Rgb(1.0f), sampler, 0, rays);
+          subsurfaceWalk(scene, accel, entry.position, frame, *medium, Rgb(1.0f), sampler, 0, result.rays);
       if (!exit) continue;
       const uint32_t exitChart = param.triangleChart[exit->surface.mesh][exit->surface.triangle];
       const Chart& e = param.charts[exitChart];
       if (!isSubsurfaceChart(scene, e)) continue;
-      ++exited;
+      ++result.exited;
       out.push_back({tixelUnder(e, exit->surface.position), tixelUnder(c, entry.position), exit->weight * share});
     }
   }
@@ -99,7 +119,7 @@ std::vector<Contribution> chartWalks(const Scene& scene, const Accel& accel, con
     else
       merged.push_back(x);
   }
-  std::vector<Contribution> kept;
+  std::vector<Contribution>& kept = result.contributions;
   kept.reserve(merged.size());
   for (size_t begin = 0; begin < merged.size();) {
     size_t end = begin;
@@ -115,28 +135,119 @@ std::vector<Contribution> chartWalks(const Scene& scene, const Accel& accel, con
       droppedSum += luminance(merged[k].power);
       if (droppedSum > kSubsurfaceDroppedFraction * total) break;
       drop[k - begin] = 1;
-      ++dropped;
+      ++result.dropped;
     }
     for (size_t k = begin; k < end; ++k)
       if (!drop[k - begin]) kept.push_back(merged[k]);
     begin = end;
   }
-  return kept;
+  return result;
+}
+
+// ---- Distributed: the walking records split between the ranks, their results exchanged ----
+
+/// The split of the walking records `charts` between `ranks`: ranks + 1 boundaries into
+/// `charts`, rank r walking [result[r], result[r + 1]), contiguous runs of about equal walk
+/// counts (a walk's rays vary with the medium, but every rank gets a slice of each object
+/// only where an object spans several records). Deterministic: every rank computes the same.
+std::vector<uint32_t> walkSplit(const Scene& scene, const Parameterisation& param, const std::vector<uint32_t>& charts,
+                                uint32_t walksPerTixel, int ranks) {
+  std::vector<double> prefix(charts.size() + 1, 0.0);
+  for (size_t k = 0; k < charts.size(); ++k) {
+    const Chart& c = param.charts[charts[k]];
+    double walks = 0.0;
+    for (const auto& [mesh, triangle] : param.chartTriangles[charts[k]]) {
+      const float area = triangleArea(scene.meshes[mesh], triangle);
+      if (area > 0.0f) walks += triangleWalks(area, walksPerTixel, c.tixelSize * c.tixelSize);
+    }
+    prefix[k + 1] = prefix[k] + walks;
+  }
+  return splitByCost(prefix, ranks);
+}
+
+// A record's walks as bytes: walks, exited, rays, dropped, the contribution count (uint64
+// each), the per-tixel areas (double), the contributions. Ranks run the same build, so the
+// structs' layout is the same on every rank.
+void appendBytes(std::vector<unsigned char>& out, const void* data, size_t bytes) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  out.insert(out.end(), p, p + bytes);
+}
+void appendChartWalks(std::vector<unsigned char>& out, const ChartWalks& w) {
+  const uint64_t header[5] = {w.walks, w.exited, w.rays, w.dropped, uint64_t(w.contributions.size())};
+  appendBytes(out, header, sizeof(header));
+  appendBytes(out, w.area.data(), w.area.size() * sizeof(double));
+  appendBytes(out, w.contributions.data(), w.contributions.size() * sizeof(Contribution));
+}
+ChartWalks readChartWalks(const unsigned char*& at, uint64_t tixels) {
+  ChartWalks w;
+  uint64_t header[5];
+  std::memcpy(header, at, sizeof(header));
+  at += sizeof(header);
+  w.walks = header[0], w.exited = header[1], w.rays = header[2], w.dropped = header[3];
+  w.area.resize(tixels);
+  std::memcpy(w.area.data(), at, tixels * sizeof(double));
+  at += tixels * sizeof(double);
+  w.contributions.resize(header[4]);
+  std::memcpy(w.contributions.data(), at, header[4] * sizeof(Contribution));
+  at += header[4] * sizeof(Contribution);
+  return w;
+}
+
+/// Every rank's records of `split` into `perChart` on every rank: each rank's serialised
+/// records are one contiguous run of a byte buffer, exchanged in place (in windows of at most
+/// windowBytes, as shard.h fillTixelsDistributed, so that no collective spans more than an MPI
+/// int addresses).
+void exchangeChartWalks(const Parameterisation& param, const std::vector<uint32_t>& charts, const std::vector<uint32_t>& split,
+                        Communicator& comm, std::vector<ChartWalks>& perChart, uint64_t windowBytes = uint64_t(1) << 30) {
+  const int rank = comm.rank(), ranks = comm.size();
+  std::vector<unsigned char> local;
+  for (uint32_t k = split[size_t(rank)]; k < split[size_t(rank) + 1]; ++k) appendChartWalks(local, perChart[k]);
+  const std::vector<uint64_t> sizes = comm.allgather(local.size());
+  std::vector<uint64_t> start(static_cast<size_t>(ranks) + 1, 0);
+  for (int r = 0; r < ranks; ++r) start[size_t(r) + 1] = start[size_t(r)] + sizes[size_t(r)];
+  std::vector<unsigned char> all(start.back());
+  std::copy(local.begin(), local.end(), all.begin() + std::ptrdiff_t(start[size_t(rank)]));
+  local = {};
+  std::vector<uint64_t> displacement(static_cast<size_t>(ranks)), count(static_cast<size_t>(ranks));
+  for (uint64_t w0 = 0; w0 < all.size(); w0 += windowBytes) {
+    const uint64_t w1 = std::min<uint64_t>(all.size(), w0 + windowBytes);
+    for (int r = 0; r < ranks; ++r) {
+      const uint64_t b0 = std::clamp(start[size_t(r)], w0, w1), b1 = std::clamp(start[size_t(r) + 1], w0, w1);
+      displacement[size_t(r)] = b0;
+      count[size_t(r)] = b1 - b0;
+    }
+    comm.allgatherv(all.data(), displacement, count);
+  }
+  for (int r = 0; r < ranks; ++r) {
+    if (r == rank) continue;
+    const unsigned char* at = all.data() + start[size_t(r)];
+    for (uint32_t k = split[size_t(r)]; k < split[size_t(r) + 1]; ++k)
+      perChart[k] = readChartWalks(at, param.charts[charts[k]].tixelCount());
+  }
 }
 
 }  // namespace
 
-uint64_t subsurfaceOperatorBytesEstimate(const Scene& scene, const Parameterisation& param, uint32_t walksPerTixel) {
+uint64_t subsurfaceOperatorBytesEstimate(const Scene& scene, const Parameterisation& param, uint32_t walksPerTixel,
+                                          int ranks) {
   uint64_t tixels = 0;
   for (const Chart& c : param.charts)
     if (isSubsurfaceChart(scene, c)) tixels += c.tixelCount();
+  // Per walk: its contribution record, its entry in the rows and, over several ranks, its
+  // bytes in the exchange buffer.
   constexpr uint64_t kEntryBytes = sizeof(uint64_t) + sizeof(Rgb);
-  return tixels * (uint64_t(std::max(1u, walksPerTixel)) * (sizeof(Contribution) + kEntryBytes) + 3 * sizeof(uint64_t) +
-                   sizeof(float) + sizeof(Rgb));
+  const uint64_t perWalk = sizeof(Contribution) + kEntryBytes + (ranks > 1 ? sizeof(Contribution) : 0);
+  return tixels * (uint64_t(std::max(1u, walksPerTixel)) * perWalk + 3 * sizeof(uint64_t) + sizeof(float) + sizeof(Rgb));
 }
 
 SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                            uint32_t walksPerTixel, uint64_t seed) {
+  SingleProcess single;
+  return buildSubsurfaceOperator(scene, accel, param, walksPerTixel, seed, single);
+}
+
+SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                           uint32_t walksPerTixel, uint64_t seed, Communicator& comm) {
   const auto start = std::chrono::steady_clock::now();
   SubsurfaceOperator op;
   std::vector<uint32_t> charts;
@@ -149,19 +260,23 @@ SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& acce
   if (op.rowTixel.empty()) return op;
   std::sort(op.rowTixel.begin(), op.rowTixel.end());
 
-  // The walks, per chart in parallel, gathered in chart order (deterministic).
-  std::vector<std::vector<Contribution>> perChart(charts.size());
-  std::vector<std::vector<double>> areas(charts.size());
-  std::vector<uint64_t> walks(charts.size()), exited(charts.size()), rays(charts.size()), dropped(charts.size());
-  parallelFor(charts.size(), [&](uint64_t k) {
-    perChart[k] = chartWalks(scene, accel, param, charts[k], std::max(1u, walksPerTixel), seed, areas[k], walks[k],
-                             exited[k], rays[k], dropped[k]);
+  // The walks, per chart in parallel, this rank's records of the split (every record for one
+  // rank), then every rank's exchanged: each record's result depends only on the record, so
+  // every rank ends with the one-process results, in chart order (deterministic).
+  walksPerTixel = std::max(1u, walksPerTixel);
+  const std::vector<uint32_t> split = walkSplit(scene, param, charts, walksPerTixel, comm.size());
+  const uint32_t first = split[size_t(comm.rank())], last = split[size_t(comm.rank()) + 1];
+  std::vector<ChartWalks> perChart(charts.size());
+  parallelFor(last - first, [&](uint64_t k) {
+    perChart[first + k] = chartWalks(scene, accel, param, charts[first + k], walksPerTixel, seed);
   });
-  for (size_t k = 0; k < charts.size(); ++k) {
-    op.walks += walks[k];
-    op.exited += exited[k];
-    op.rays += rays[k];
-    op.dropped += dropped[k];
+  for (uint32_t k = first; k < last; ++k) op.walkedHere += perChart[k].walks;
+  if (comm.size() > 1) exchangeChartWalks(param, charts, split, comm, perChart);
+  for (const ChartWalks& w : perChart) {
+    op.walks += w.walks;
+    op.exited += w.exited;
+    op.rays += w.rays;
+    op.dropped += w.dropped;
   }
 
   // Compressed by exit tixel: count, prefix sums, fill (entries in chart, then entry order).
@@ -179,17 +294,17 @@ SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& acce
   for (size_t k = 0; k < charts.size(); ++k) {
     const Chart& c = param.charts[charts[k]];
     for (uint64_t local = 0; local < c.tixelCount(); ++local)
-      if (areas[k][local] > 0.0) op.area[rowOf(c.firstTixel + local)] = float(areas[k][local]);
+      if (perChart[k].area[local] > 0.0) op.area[rowOf(c.firstTixel + local)] = float(perChart[k].area[local]);
   }
   op.rowStart.assign(op.rowTixel.size() + 1, 0);
-  for (const auto& list : perChart)
-    for (const Contribution& x : list) ++op.rowStart[rowOf(x.exit) + 1];
+  for (const ChartWalks& w : perChart)
+    for (const Contribution& x : w.contributions) ++op.rowStart[rowOf(x.exit) + 1];
   for (size_t r = 0; r < op.rowTixel.size(); ++r) op.rowStart[r + 1] += op.rowStart[r];
   op.entryTixel.resize(op.rowStart.back());
   op.weight.resize(op.rowStart.back());
   std::vector<uint64_t> fill(op.rowStart.begin(), op.rowStart.end() - 1);
-  for (const auto& list : perChart)
-    for (const Contribution& x : list) {
+  for (const ChartWalks& w : perChart)
+    for (const Contribution& x : w.contributions) {
       const uint64_t r = rowOf(x.exit);
       op.entryTixel[fill[r]] = x.entry;
       op.weight[fill[r]] = x.power / op.area[r];  // K[j ← i] = Σ w·a / A_j

@@ -18,8 +18,9 @@
 // channel Σ_j S[i → j] ≤ 1 (up to the walks' noise): the light the medium does not absorb.
 //
 // Stored compressed by exit tixel (CSR rows, one per subsurface tixel) for the propagation's
-// gather-style product; never written to a file (the bake rebuilds it; relighting and
-// distributed bakes refuse subsurface scenes, bake.h requireBakeableScene). Per entry tixel the
+// gather-style product; never written to a file (the bake rebuilds it). A distributed bake
+// (shard.h) splits the walks between its ranks by entry record and exchanges their results, so
+// that every rank holds the whole operator, the one process's bit for bit. Per entry tixel the
 // smallest entries are dropped while their sum stays below kSubsurfaceDroppedFraction of the
 // light leaving that tixel's entries (luminance): the energy bound of the truncation.
 #include <cstdint>
@@ -30,6 +31,7 @@
 namespace pl {
 
 class Accel;
+class Communicator;
 struct Scene;
 struct Parameterisation;
 
@@ -44,6 +46,7 @@ struct SubsurfaceOperator {
   std::vector<Rgb> weight;          ///< per entry: K[j ← i] (exitance per irradiance)
   std::vector<float> area;          ///< per row: the surface area A_j under the tixel (scene units²)
   uint64_t walks = 0, exited = 0;   ///< walks started, walks that left the medium
+  uint64_t walkedHere = 0;          ///< walks this rank started (its share of `walks`)
   uint64_t rays = 0;                ///< rays the walks traced
   uint64_t dropped = 0;             ///< entries dropped by the truncation
   double seconds = 0.0;             ///< time to build it
@@ -58,11 +61,21 @@ struct SubsurfaceOperator {
 /// about `walksPerTixel` walks per tixel area; deterministic for a given seed.
 SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                            uint32_t walksPerTixel, uint64_t seed);
+/// The same over the ranks of `comm` (a collective: every rank calls it): the walking records
+/// (the subsurface charts' front records) are split into contiguous runs of about equal walk
+/// counts, each rank walks its run, and the runs' merged, truncated walks are exchanged (one
+/// allgather of their sizes, then in-place allgathervs of the bytes), so that every rank
+/// returns the one-process operator bit for bit (each record's walks depend only on the record
+/// and the seed); walkedHere counts this rank's walks.
+SubsurfaceOperator buildSubsurfaceOperator(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                           uint32_t walksPerTixel, uint64_t seed, Communicator& comm);
 
 /// An upper bound on the bytes buildSubsurfaceOperator allocates for `param` (0 without
-/// subsurface charts): every walk kept as its own entry, and its contribution record alive
-/// beside the compressed rows (what the memory guard, bake.h BakeOptions::checkMemory, adds).
-uint64_t subsurfaceOperatorBytesEstimate(const Scene& scene, const Parameterisation& param, uint32_t walksPerTixel);
+/// subsurface charts) on each of `ranks` ranks: every walk kept as its own entry, and its
+/// contribution record alive beside the compressed rows (plus, over several ranks, its bytes
+/// in the exchange buffer): what the memory guard, bake.h BakeOptions::checkMemory, adds.
+uint64_t subsurfaceOperatorBytesEstimate(const Scene& scene, const Parameterisation& param, uint32_t walksPerTixel,
+                                         int ranks = 1);
 
 /// exitance[r] = Σ K[rowTixel[r] ← i]·irradiance[i] for every row r; `irradiance` by global
 /// tixel index (entries of non-subsurface tixels are never read).

@@ -4,13 +4,13 @@
 //    (van de Hulst's formula, which the path tracer's walk matches: trace/subsurface_test.cpp);
 //  * a thin slab lit from above glows underneath, as bright as the path tracer shows it;
 //  * relighting a subsurface scene's lights equals a fresh bake; edits of a subsurface material
-//    and distributed bakes are refused with a clear message.
+//    are refused with a clear message.
+// (Distributed bakes of subsurface scenes: shard_test and distributed_bake_test.)
 // Deterministic (fixed seeds); tolerances from the estimates' noise, stated per test.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
-#include <stdexcept>
 #include <string>
 
 #include "accel/accel.h"
@@ -19,7 +19,6 @@
 #include "bake/relight.h"
 #include "bake/subsurface.h"
 #include "core/progress.h"
-#include "distributed/communicator.h"
 #include "light/lights.h"
 #include "lightfield/lookup.h"
 #include "scene/scene.h"
@@ -228,37 +227,6 @@ TEST_F(SubsurfaceBakeTest, RelightingEqualsFreshBakes) {
   test_support::expectError([&] { relighter.setScene(edited); },
                             {"sss-cornell.json", "cannot relight", "'slab'", "subsurface", "plenoptic bake"});
   EXPECT_FALSE(relighter.pending());
-}
-
-/// Two ranks whose collectives must never be reached: the refusal comes first.
-class TwoRanks final : public Communicator {
- public:
-  int rank() const override { return 0; }
-  int size() const override { return 2; }
-  void allgatherv(void*, const std::vector<uint64_t>&, const std::vector<uint64_t>&) override { unreachable(); }
-  std::vector<uint64_t> allgather(uint64_t) override { unreachable(); }
-  void barrier() override { unreachable(); }
-  [[noreturn]] void abort(int) override { unreachable(); }
-  std::string name() const override { return "two ranks"; }
-
- private:
-  [[noreturn]] static void unreachable() { throw std::logic_error("a collective was called before the refusal"); }
-};
-
-// A distributed bake of a scene with a subsurface material is refused before any ray is traced
-// (no collective is called), naming the file and the material; one process bakes it, and an
-// unused subsurface material does not matter.
-TEST_F(SubsurfaceBakeTest, DistributedBakeRefusesSubsurfaceScenes) {
-  Scene scene = subsurfaceBox(SubsurfaceBsdf{Rgb(0.8f), Rgb(0.1f)}, Vec3(-1.0f), Vec3(1.0f));
-  TwoRanks ranks;
-  BakeOptions options;
-  options.communicator = &ranks;
-  test_support::expectError([&] { bake(scene, bakePreset("draft"), options); },
-                            {"subsurface box", "'wax'", "subsurface", "distributed", "one process"});
-  EXPECT_NO_THROW(requireBakeableMaterials(scene, 1));
-  scene.materials.push_back(scene.materials[0]);
-  scene.materials[0].bsdf = LambertBsdf{};
-  EXPECT_NO_THROW(requireBakeableMaterials(scene, 2));
 }
 
 }  // namespace

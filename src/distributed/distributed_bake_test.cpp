@@ -1,9 +1,10 @@
 // The distributed bake end to end (issue #16): `mpirun -np N plenoptic bake` on this machine
 // (PLENOPTIC_BINARY, --oversubscribe so that 3 ranks run on 2 cores). Checks that the light
 // field is the single-process one bit for bit for 2 and 3 ranks (the built-in Cornell box,
-// and McGuire's glossy box for the glossy charts' paths), that each rank saves and reuses its
-// own .plv shard, that a rank with a different scene file is refused before any work, and
-// that a failing rank ends the job with a non-zero status and no .plf (the old one intact).
+// McGuire's glossy box for the glossy charts' paths, a subsurface scene for its operator),
+// that each rank saves and reuses its own .plv shard, that a rank with a different scene file
+// is refused before any work, and that a failing rank ends the job with a non-zero status and
+// no .plf (the old one intact).
 // Skipped, saying so, when mpirun is missing or this build has no MPI.
 #include <gtest/gtest.h>
 
@@ -110,6 +111,17 @@ TEST_F(DistributedBake, GlossyChartsSameBits) {
   ASSERT_EQ(run("bake " + scene + " -o " + quoted(path("one.plf")) + " " + bakeArgs, nullptr, &err), 0) << err;
   ASSERT_EQ(runRanks(3, "bake " + scene + " -o " + quoted(path("three.plf")) + " " + bakeArgs, &err), 0) << err;
   expectSameValues(path("one.plf"), path("three.plf"));
+}
+
+TEST_F(DistributedBake, SubsurfaceSameBits) {
+  // Subsurface charts: the operator's walks split between the ranks and exchanged, and the
+  // irradiance entering each object exchanged every iteration.
+  const std::string scene = quoted(std::string(PLENOPTIC_TEST_DATA_DIR) + "/../../bench/scenes/sss-cornell.json");
+  const std::string bakeArgs = "--preset draft --tixels-across 8 --directions 16";
+  std::string err;
+  ASSERT_EQ(run("bake " + scene + " -o " + quoted(path("one.plf")) + " " + bakeArgs, nullptr, &err), 0) << err;
+  ASSERT_EQ(runRanks(2, "bake " + scene + " -o " + quoted(path("two.plf")) + " " + bakeArgs, &err), 0) << err;
+  expectSameValues(path("one.plf"), path("two.plf"));
 }
 
 TEST_F(DistributedBake, RankWithDifferentSceneIsRefused) {

@@ -114,6 +114,7 @@ struct TraceJobOptions {
 /// What `plenoptic trace --stats` writes.
 struct TraceJobStats {
   std::string scene, output, camera, strategy, sampler;
+  std::string subsurfaceAfterDiffuse;  ///< "walk" or "lambert" (TraceSettings::subsurfaceLambertAfterDiffuse)
   int width = 0, height = 0, spp = 0, maxDepth = 0, threads = 0;
   uint64_t seed = 0;
   TraceStats trace;  ///< timings and counts of the render

@@ -22,6 +22,7 @@ std::string TraceJobStats::toJson() const {
   json["max_depth"] = maxDepth;
   json["strategy"] = strategy;
   json["sampler"] = sampler;
+  json["subsurface_after_diffuse"] = subsurfaceAfterDiffuse;
   json["seed"] = seed;
   json["threads"] = threads;
   json["seconds"] = trace.seconds;
@@ -102,6 +103,7 @@ TraceJobResult TraceJob::run(const Scene& scene) const {
   stats.maxDepth = settings.maxDepth;
   stats.strategy = strategyName(settings.strategy);
   stats.sampler = samplerName(settings.sampler);
+  stats.subsurfaceAfterDiffuse = settings.subsurfaceLambertAfterDiffuse ? "lambert" : "walk";
   stats.seed = settings.seed;
   stats.threads = pool.threads();
   stats.trace = traced.stats;

@@ -18,7 +18,11 @@
 // it meets the mesh again. There it leaves as from a Lambertian surface of albedo 1: next-event
 // estimation and the next direction are those of LambertBsdf{1} at the exit point, and the walk
 // with its entry and exit counts as one scattering event (one depth). Light arriving at the
-// entry point is not reflected there: all of it goes through the medium.
+// entry point is not reflected there: all of it goes through the medium. With
+// TraceSettings::subsurfaceLambertAfterDiffuse (a comparison with Cycles) a path that has
+// bounced off a Lambertian surface — a Lambertian material, a subsurface exit, or a subsurface
+// material already so shaded — shades subsurface materials as the SubsurfaceBsdf's BSDF,
+// Lambertian of albedo A, without a walk.
 //
 // Light selection, the points sampled on lights, their densities and what blocks a shadow ray
 // are light/light.h's (LightSampler, ShadowRays): the bake's first shot uses the same ones.
@@ -168,6 +172,8 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
   // interfaces (bsdf.h), which Russian roulette must not mistake for absorption (pbrt-v4's
   // etaScale). After entering glass the throughput is 1/η² of what it will be on leaving.
   float etaScale = 1.0f;
+  // Whether the path has bounced off a Lambertian surface (subsurfaceLambertAfterDiffuse).
+  bool diffuseAncestor = false;
   const bool useMis = settings.strategy == TraceStrategy::Mis;
   const bool bsdfOnly = settings.strategy == TraceStrategy::BsdfOnly;
 
@@ -216,7 +222,8 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
     ScatteringFrame scattering = scatteringFrame(surface, wo, bsdf);
     if (!usableSide(wo, scattering.woLocal, scattering.geometricNormal, bsdf)) break;
     Vec3 position = surface.position;
-    if (const std::optional<SubsurfaceMedium> medium = subsurfaceMedium(bsdf)) {
+    const std::optional<SubsurfaceMedium> medium = subsurfaceMedium(bsdf);
+    if (medium && !(settings.subsurfaceLambertAfterDiffuse && diffuseAncestor)) {
       // Through the medium to where the walk leaves it; the exit point then scatters as a
       // white Lambertian on the mesh's outside (the side the walk's last direction points to).
       const std::optional<WalkExit> exit =
@@ -241,6 +248,8 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
     if (!scattered) break;
     const BsdfSample& s = scattered->sample;
     const Vec3 wi = scattered->wi;
+    diffuseAncestor =
+        diffuseAncestor || std::holds_alternative<LambertBsdf>(bsdf) || std::holds_alternative<SubsurfaceBsdf>(bsdf);
     throughput *= s.weight;
     if (isBlack(throughput)) break;
     if (const auto* glass = std::get_if<DielectricBsdf>(&bsdf); glass && !glass->thin && woLocal.z * s.wi.z < 0.0f) {

@@ -6,7 +6,9 @@
 //    channel's medium gives (the channels do not leak into each other);
 //  * no energy is created: under light of radiance 1 nothing leaves more than 1, and a nearly
 //    white object (A → 1) that absorbs little leaves nearly all of it;
-//  * the loader's closed-mesh check finds holes and only holes.
+//  * the loader's closed-mesh check finds holes and only holes;
+//  * the Cycles comparison option (TraceSettings::subsurfaceLambertAfterDiffuse) shades a
+//    subsurface object as Lambertian of its albedo after a diffuse bounce, and only then.
 // Deterministic (fixed seeds, the independent sampler), tolerances from the estimates' own
 // standard errors.
 #include <gtest/gtest.h>
@@ -168,6 +170,74 @@ TEST_F(SubsurfaceTest, OpenMeshesAreFound) {
   // Triangles of other materials do not count: a Lambertian mesh is never "open" here.
   holed.materials[0].bsdf = LambertBsdf{};
   EXPECT_EQ(openSubsurfaceEdges(holed, holed.meshes[0]), 0u);
+}
+
+/// A thin subsurface slab (4 × 0.1 × 4, radius 0.3: light crosses it) floating at y = 1 over a
+/// Lambertian floor of albedo 0.5, under a white sky of radiance 1; or the same with the slab
+/// a LambertBsdf of the slab's albedo.
+struct SlabOverFloor {
+  Scene scene;
+  std::unique_ptr<Accel> accel;
+  std::unique_ptr<PathTracer> tracer;
+
+  explicit SlabOverFloor(const Bsdf& slab) {
+    scene.materials.push_back(Material{});
+    scene.materials[0].name = "slab";
+    scene.materials[0].bsdf = slab;
+    scene.materials.push_back(Material{});
+    scene.materials[1].name = "floor";
+    scene.materials[1].bsdf = LambertBsdf{Rgb(0.5f)};
+    Mesh mesh;
+    mesh.name = "objects";
+    test_support::addBox(mesh, Vec3(-2.0f, 1.0f, -2.0f), Vec3(2.0f, 1.1f, 2.0f), 0);
+    test_support::addBox(mesh, Vec3(-20.0f, -1.0f, -20.0f), Vec3(20.0f, 0.0f, 20.0f), 1);
+    scene.meshes.push_back(std::move(mesh));
+    scene.environment.constant = Rgb(1.0f);
+    scene.sourcePath = "test scene";
+    scene.finalize();
+    accel = std::make_unique<Accel>(scene);
+    tracer = std::make_unique<PathTracer>(scene, *accel);
+  }
+  RadianceEstimate seen(const Ray& ray, bool lambertAfterDiffuse, int maxDepth, uint64_t key) const {
+    TraceSettings settings;
+    settings.spp = 1 << 17;
+    settings.seed = 5;
+    settings.sampler = SamplerKind::Independent;
+    settings.maxDepth = maxDepth;
+    settings.subsurfaceLambertAfterDiffuse = lambertAfterDiffuse;
+    return tracer->estimateRadiance(ray, settings, key);
+  }
+};
+
+/// |a − b| in every channel within 4 standard errors of the difference (and those small enough
+/// to tell a difference of 0.012), or beyond them when `same` is false.
+void expectSame(const RadianceEstimate& a, const RadianceEstimate& b, bool same, const char* what) {
+  for (int c = 0; c < 3; ++c) {
+    const double sigma = std::sqrt(a.varianceOfMean[c] + b.varianceOfMean[c]);
+    EXPECT_LT(sigma, 0.003) << what << ": too noisy to tell";
+    if (same)
+      EXPECT_NEAR(a.mean[c], b.mean[c], 4.0 * sigma) << what << ", channel " << c;
+    else
+      EXPECT_GT(std::abs(a.mean[c] - b.mean[c]), 4.0 * sigma) << what << ", channel " << c;
+  }
+}
+
+// The Cycles comparison option. The floor under the slab, seen from the camera: every path that
+// reaches the slab has bounced off the floor, so with the option it sees what a Lambertian slab
+// of albedo A gives, and without it the sky's light crossing the slab (brighter: A = 0.5, but
+// the thin slab passes more than it reflects). The slab itself seen from the camera with direct
+// light only (no diffuse bounce before it) walks with or without the option.
+TEST_F(SubsurfaceTest, LambertAfterDiffuseOptionShadesLikeCycles) {
+  const SubsurfaceBsdf model{Rgb(0.5f, 0.7f, 0.9f), Rgb(0.3f)};
+  const SlabOverFloor walked(model), lambert(LambertBsdf{model.albedo});
+  const Ray toFloor{Vec3(0.3f, 0.6f, 0.2f), glm::normalize(Vec3(0.2f, -1.0f, 0.1f)), 0.0f, kInfinity};
+  const RadianceEstimate standIn = lambert.seen(toFloor, false, kUnboundedDepth, 1);
+  expectSame(walked.seen(toFloor, true, kUnboundedDepth, 2), standIn, true, "floor, option");
+  expectSame(walked.seen(toFloor, false, kUnboundedDepth, 3), standIn, false, "floor, walks");
+  const Ray toSlab{Vec3(0.2f, 3.0f, 0.4f), glm::normalize(Vec3(0.3f, -1.0f, 0.0f)), 0.0f, kInfinity};
+  const RadianceEstimate slabWalks = walked.seen(toSlab, false, 1, 4);
+  expectSame(walked.seen(toSlab, true, 1, 5), slabWalks, true, "slab, direct light, option");
+  expectSame(lambert.seen(toSlab, false, 1, 6), slabWalks, false, "slab, direct light, stand-in");
 }
 
 }  // namespace

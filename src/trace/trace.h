@@ -84,6 +84,13 @@ struct TraceSettings {
   /// samples; Independent is the plain PCG32 stream, whose per-pixel variance estimates are
   /// exact (tests that need independent samples for their statistics ask for it).
   SamplerKind sampler = SamplerKind::Sobol;
+  /// A comparison option, off by default: subsurface materials met after a Lambertian bounce
+  /// (off a Lambertian material, or out of a subsurface walk) are shaded as Lambertian of their
+  /// albedo A instead of walking the medium — the shortcut Blender Cycles takes (a closure under
+  /// PATH_RAY_DIFFUSE_ANCESTOR gets radius 0, which turns it into a diffuse BSDF of its colour),
+  /// so that bench/sss_vs_cycles.sh can render what Cycles renders. Biased: it drops the light
+  /// that crosses an object after the first diffuse bounce. (`trace --subsurface-after-diffuse`.)
+  bool subsurfaceLambertAfterDiffuse = false;
   int tileSize = 16;           ///< square tiles, rendered in parallel
   bool showProgress = true;    ///< progress bar with ETA on stderr (still subject to --quiet)
 };

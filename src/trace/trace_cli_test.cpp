@@ -42,6 +42,7 @@ TEST_F(TraceCliTest, WritesImageAndStats) {
   EXPECT_EQ(json.at("height").get<int>(), 24);
   EXPECT_EQ(json.at("nan_samples").get<int>(), 0);
   EXPECT_EQ(json.at("sampler").get<std::string>(), "sobol");  // the default
+  EXPECT_EQ(json.at("subsurface_after_diffuse").get<std::string>(), "walk");  // the default
   EXPECT_GE(json.at("threads").get<int>(), 1);
   EXPECT_GT(json.at("seconds").get<double>(), 0.0);
   // paths/s is consistent with the counts it is derived from. 1e-3 of 3072 paths: the JSON
