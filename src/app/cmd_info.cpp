@@ -200,6 +200,7 @@ void printVisibility(const std::string& path, bool json) {
       j["entry_bytes_per_entry"] = double(v.entryBytes) / entries;
       j["memory_bytes"] = v.heldBytes;
       j["memory_bytes_per_entry"] = double(v.heldBytes) / entries;
+      j["fraction_bits"] = v.fractionBits;
     }
     fmt::print("{}\n", j.dump(2));
     return;
@@ -213,6 +214,9 @@ void printVisibility(const std::string& path, bool json) {
   fmt::print("field        {} tixels × {} gather directions = {} entries, {} extra records, hash {:016x}\n", v.tixelCount,
              uint64_t(v.gridSide) * v.gridSide, v.entryCount, v.extraCount, v.hash);
   fmt::print("on disk      {} ({:.2f} bytes per entry)\n", humanBytes(v.fileBytes), double(v.fileBytes) / entries);
+  if (v.fractionBits > 0)
+    fmt::print("fractions    {} bits each ({})\n", v.fractionBits,
+               v.fractionBits == kExactFractionBits ? "exact, as traced" : "compact, quantised");
   fmt::print("in memory    {} ({:.2f} bytes per entry; the encoded entries alone {:.2f})\n", humanBytes(v.heldBytes),
              double(v.heldBytes) / entries, double(v.entryBytes) / entries);
 }

@@ -110,9 +110,14 @@ uint32_t gatherCellOf(const Vec3& local, uint32_t gridSide) {
   return a + b * gridSide;
 }
 
+uint32_t visibilityFractionBits(const BakeSettings& settings) {
+  return settings.exactVisibility ? kExactFractionBits : kCompactFractionBits;
+}
+
 uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings) {
   Fnv1a64 h;
   h.value(kPlvVersion);
+  h.value(visibilityFractionBits(settings));
   h.value(uint64_t(scene.meshes.size()));
   for (const Mesh& mesh : scene.meshes) {
     h.value(uint64_t(mesh.triangles.size()));
@@ -262,6 +267,7 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     fail("{}: {} tixels exceed the visibility field's limit of {}", scene.sourcePath, param.tixelCount,
          VisibilityEntry::kIndexMask - 1);
   const uint32_t n = field.directionsPerTixel();
+  const uint32_t fractionBits = visibilityFractionBits(settings);
   std::vector<Vec3> directionTable(size_t(n) * kJitterCount);  // [cell][sub-cell]
   for (uint32_t k = 0; k < n; ++k)
     for (uint32_t j = 0; j < kJitterCount; ++j) directionTable[size_t(k) * kJitterCount + j] = cellDirection(k, j, field.gridSide, settings.seed);
@@ -403,7 +409,7 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     std::sort(extras.begin(), extras.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     EncodedRun& run = blockEntries[block];
     run.bytes.reserve((t1 - t0) * maxEncodedTixelBytes(n));
-    for (uint64_t g = t0; g < t1; ++g) run.add(entries.data() + (g - t0) * n, n);
+    for (uint64_t g = t0; g < t1; ++g) run.add(entries.data() + (g - t0) * n, n, fractionBits);
     run.bytes.shrink_to_fit();
     if (journal) journal->append(block, run, extras);
     if (progress) progress->advance(t1 - t0);

@@ -124,10 +124,15 @@ Vec3 gatherCellDirection(uint32_t k, uint32_t subCell, uint32_t gridSide, uint64
 uint32_t gatherCellOf(const Vec3& local, uint32_t gridSide);
 
 
+/// Bits per fraction of the field's entries (plf/plv_file.h "Compact entries"):
+/// kExactFractionBits when settings.exactVisibility, else kCompactFractionBits.
+uint32_t visibilityFractionBits(const BakeSettings& settings);
+
 /// Hash of everything the visibility field depends on: vertex positions, triangles and their
 /// materials' *transport class* (chart kind, and mirror parameters, which the field's
 /// throughputs contain — not diffuse albedo or emission), the parameterisation (charts,
-/// gather points) and the settings that shape it (gather directions, mirror depth, seed).
+/// gather points) and the settings that shape it (gather directions, mirror depth, seed,
+/// fraction precision).
 /// FNV-1a (core/hash.h Fnv1a64): the value is stored in every .plv header.
 uint64_t visibilityHash(const Scene& scene, const Parameterisation& param, const BakeSettings& settings);
 

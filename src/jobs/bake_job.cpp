@@ -85,6 +85,7 @@ BakeSettings BakeJob::settings() const {
   if (options_.lightSamples > 0) settings.areaLightSamples = options_.lightSamples;
   settings.sunMasks = options_.sunMasks;
   settings.punctualHighlights = options_.punctualHighlights;
+  settings.exactVisibility = options_.exactVisibility;
   if (options_.causticPhotons >= 0) settings.causticPhotons = uint64_t(options_.causticPhotons);
   if (options_.subsurfaceWalks > 0) settings.subsurfaceWalks = options_.subsurfaceWalks;
   if (options_.tolerance > 0.0f) settings.tolerance = options_.tolerance;

@@ -161,6 +161,7 @@ struct BakeJobOptions {
   float tolerance = 0.0f;
   bool sunMasks = true;  ///< BakeSettings::sunMasks (`--sun-masks`)
   bool punctualHighlights = true;  ///< BakeSettings::punctualHighlights (`--punctual-highlights`)
+  bool exactVisibility = false;    ///< BakeSettings::exactVisibility (`--visibility-precision exact`)
   int64_t causticPhotons = -1;  ///< BakeSettings::causticPhotons (`--caustic-photons`); −1 = the preset's, 0 = no caustic pass
   uint32_t subsurfaceWalks = 0;  ///< BakeSettings::subsurfaceWalks (`--subsurface-walks`); 0 = the preset's
   bool reuseVisibility = false;

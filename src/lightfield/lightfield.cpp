@@ -28,6 +28,7 @@ void fields(Settings& s, Visit&& visit) {
   visit("punctual_highlights", s.punctualHighlights);
   visit("caustic_photons", s.causticPhotons);
   visit("subsurface_walks", s.subsurfaceWalks);
+  visit("exact_visibility", s.exactVisibility);
 }
 
 template <typename Stats, typename Visit>
@@ -71,6 +72,7 @@ void fromJson(const nlohmann::json& json, BakeSettings& settings) {
   settings.sunMasks = false;            // writers before sun masks (.plf version ≤ 2) baked without them
   settings.punctualHighlights = false;  // writers before punctual highlights kept them in the glossy maps
   settings.causticPhotons = 0;          // writers before the caustic pass left caustics to the gather
+  settings.exactVisibility = true;      // writers before the compact fractions kept them whole
   read(json, settings);
 }
 

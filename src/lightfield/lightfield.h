@@ -243,6 +243,9 @@ struct BakeSettings {
   /// Subsurface charts (bake/subsurface.h): random walks per tixel area that estimate the
   /// operator carrying light through subsurface objects. Older files: the default (unused).
   uint32_t subsurfaceWalks = 256;
+  /// The visibility field's bilinear fractions kept whole (plf/plv_file.h "Compact entries"):
+  /// `bake --visibility-precision exact`; false: quantised (compact), the default.
+  bool exactVisibility = false;
 };
 
 struct BakeStats {

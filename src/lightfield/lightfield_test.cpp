@@ -33,6 +33,7 @@ TEST(BakeJsonSchema, SettingsAndStatsRoundTripAndOldFilesMeanNoSunMasksOrHighlig
   old.erase("sun_masks");
   old.erase("punctual_highlights");
   old.erase("caustic_photons");
+  old.erase("exact_visibility");
   old.erase("seed");
   old["a_key_from_a_newer_writer"] = 1;
   BakeSettings fromOld;
@@ -41,6 +42,7 @@ TEST(BakeJsonSchema, SettingsAndStatsRoundTripAndOldFilesMeanNoSunMasksOrHighlig
   EXPECT_FALSE(fromOld.sunMasks);
   EXPECT_FALSE(fromOld.punctualHighlights);
   EXPECT_EQ(fromOld.causticPhotons, 0u);  // caustics gathered
+  EXPECT_TRUE(fromOld.exactVisibility);    // fractions kept whole
   EXPECT_EQ(fromOld.seed, 5u);
 
   BakeStats stats;

@@ -217,7 +217,7 @@ PlvLayout readPlvLayout(const std::string& path, std::span<const unsigned char> 
   for (uint64_t b = 0; b <= blocks; ++b) {
     const uint64_t tixels = b < blocks ? std::min(tixelCount - b * perBlock, perBlock) : 0;
     if (b < blocks) {
-      const uint64_t least = tixels * (sizeof(uint32_t) + kTagBytes(uint32_t(n)));
+      const uint64_t least = tixels * (sizeof(uint32_t) + kTixelHeaderBytes(uint32_t(n)));
       const uint64_t most = tixels * (sizeof(uint32_t) + maxEncodedTixelBytes(uint32_t(n)));
       if (contentSizes[b] < least || contentSizes[b] > most)
         fail("{}: corrupt visibility field: block {} of {} tixels declares {} bytes (between {} and {})", path, b,
@@ -256,6 +256,11 @@ VisibilityFileInfo readVisibilityInfo(const std::string& path) {
     const PlvLayout l = readPlvLayout(path, bytes, h);
     info.entryBytes = l.blockEntryStart[l.blocks];
     info.heldBytes = heldBytes(h, info.entryBytes);
+    if (l.blocks > 0) {  // the first tixel's precision, from the first block (the bake writes one for all)
+      std::vector<unsigned char> raw(l.contentSizes[0]);
+      detail::zstdDecompressInto(bytes.subspan(l.frameOffset[0], l.frameSizes[0]), raw, fmt::format("{}: visibility block 0", path));
+      info.fractionBits = raw[std::min(h.tixelCount, l.perBlock) * sizeof(uint32_t)];
+    }
   }
   return info;
 }

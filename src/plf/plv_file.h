@@ -3,7 +3,7 @@
 // field so that a bake whose geometry, parameterisation and settings are unchanged reuses it
 // (bake/visibility.h traces it and says what its directions are; bake/bake.h decides reuse).
 //
-// .plv layout (version 4; little-endian; written by writeVisibility, validated by readVisibility):
+// .plv layout (version 5; little-endian; written by writeVisibility, validated by readVisibility):
 //   header, 56 bytes:
 //   magic        8 bytes  "PLVIS\0\r\n"
 //   version      u32      kPlvVersion
@@ -22,8 +22,9 @@
 //   contentSizes u64 × (B + 1): the bytes each frame decompresses to
 // An entry block's content: its tixels' encoded sizes (u32 each), then their encodings, in
 // tixel order (the compact entries below, as held in memory), so reading it back gives the same
-// entries bit for bit. Version 3 held the raw 8-byte entries split into planes, version 2 the
-// raw entries: an older field is traced again, like a stale one.
+// entries bit for bit. Version 4 had no fraction precision per tixel (always exact), version 3
+// held the raw 8-byte entries split into planes, version 2 the raw entries: an older field is
+// traced again, like a stale one.
 //
 // Entries (8 bytes decoded; tixel-major: entry k of tixel g; held encoded, "Compact entries"):
 //   target  bits 0–29: global index of the tixel at the lower-left of the 2×2 bilinear
@@ -39,6 +40,7 @@
 //               that leaves the scene after mirrors, the octahedral encoding of its final
 //               world direction (to look the environment up)
 //   viaMirror   whether the path went through at least one mirror
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -52,7 +54,7 @@ namespace pl {
 
 /// The .plv format version this program reads and writes (visibilityHash includes it, so a
 /// field of another version is traced again).
-inline constexpr uint32_t kPlvVersion = 4;  // 2: multi-jittered gather directions; 3: compressed blocks; 4: compact entries
+inline constexpr uint32_t kPlvVersion = 5;  // 2: multi-jittered gather directions; 3: compressed blocks; 4: compact entries; 5: quantised fractions
 /// Largest gather grid side m a field may have (gatherDirections ≤ 65 536); a .plv declaring
 /// more is corrupt.
 inline constexpr uint32_t kMaxGatherGridSide = 256;
@@ -107,49 +109,107 @@ class FieldArray {
 
 // ---- Compact entries ----------------------------------------------------------------------
 // In memory (and in the .plv, under zstd) a tixel's N entries are encoded one after another,
-// losslessly, so that the field takes a few bytes per entry instead of 8; the gather decodes
-// each tixel's entries into a small buffer as it reaches it (docs/design.md, Visibility field,
-// has the measurements behind this choice). A tixel's encoding:
+// so that the field takes a few bytes per entry instead of 8; the gather decodes each tixel's
+// entries into a small buffer as it reaches it (docs/design.md, Visibility field, has the
+// measurements behind this choice). The fractions are kept either whole (16 bits, "exact": the
+// entries decode bit for bit as traced) or quantised to F ≤ 8 bits each ("compact", the
+// default: `bake --visibility-precision`); the tixel index and the flags are always exact.
+// A tixel's encoding:
+//   bits     1 byte: F, the bits per fraction (16: exact; 1–8: quantised)
 //   tags     ⌈N/4⌉ bytes: a 2-bit tag per entry, entry k in bits 2(k mod 4) of byte k/4
-//   payload  per entry in order, by tag:
+//   payload  per entry in order, by tag; exact (F = 16):
 //     kTagEscape   (0) nothing: target = kEscape, fu = fv = 0 (nothing seen, no extra record)
 //     kTagNear     (1) i8 delta, fu, fv (u16 each): no flags, tixel = previous + delta
 //     kTagFar      (2) i16 delta, fu, fv: likewise
 //     kTagGeneral  (3) LEB128 varint of zigzag(delta)·4 + (target >> 30), then fu, fv: any
 //                      entry (flags set, escapes with an extra record, long jumps)
+//   quantised (F ≤ 8), with levels qu = round(fu·(2^F − 1)/65535) and likewise qv:
+//     kTagEscape   (0) nothing, as above (an escape whose levels are 0)
+//     kTagNear     (1) nearHitBytes(F) bytes, a little-endian integer: qu in bits [0, F), qv in
+//                      [F, 2F), the signed delta in the bits above (at least 4 of them)
+//     kTagFar      (2) one byte more: the same with a delta 8 bits wider
+//     kTagGeneral  (3) the varint as above, then ⌈2F/8⌉ bytes: qu | qv << F
+//   and the fractions decode to fractionLevel(q, F) = round(q·65535/(2^F − 1)): 0 and 65535
+//   (a fraction at a chart's last row or column, or at a tixel's far edge) stay exact.
 // "previous" is the tixel index of the tixel's last earlier entry that saw a tixel (escapes
 // leave it unchanged), 0 before the first. The delta is taken on the 30-bit index field.
-// Neighbouring gather directions mostly see the same chart a few tixels apart, so most entries
-// take 5 or 6 bytes; the fractions (4 bytes) keep every bit, so the gather — and the light
-// field — are exactly as with 8-byte entries.
+// Neighbouring gather directions mostly see the same chart a few tixels apart, so most exact
+// entries take 5 or 6 bytes and most quantised ones 2 or 3.
 inline constexpr uint32_t kTagEscape = 0, kTagNear = 1, kTagFar = 2, kTagGeneral = 3;
-/// Bytes of a tixel's tag plane.
+/// Bits per fraction of the exact encoding, and of the compact one (docs/design.md, Visibility
+/// field: the coarsest that keeps the light field within relMSE 1e-5 of the exact one, with margin).
+inline constexpr uint32_t kExactFractionBits = 16, kCompactFractionBits = 4;
+/// Whether a tixel's encoding may declare `bits` bits per fraction.
+constexpr bool validFractionBits(uint32_t bits) { return (bits >= 1 && bits <= 8) || bits == kExactFractionBits; }
+/// The level of a 16-bit fraction (× 65535) at `bits` ≤ 8 bits: round(f·(2^bits − 1)/65535).
+constexpr uint32_t quantiseFraction(uint16_t f, uint32_t bits) {
+  return (uint32_t(f) * ((1u << bits) - 1) + 32767u) / 65535u;
+}
+/// The 16-bit fraction that level q of `bits` ≤ 8 bits decodes to: round(q·65535/(2^bits − 1)).
+constexpr uint16_t fractionLevel(uint32_t q, uint32_t bits) {
+  const uint32_t top = (1u << bits) - 1;
+  return uint16_t((2 * q * 65535u + top) / (2 * top));
+}
+/// fractionLevel tabulated: kFractionLevels[bits][q] for bits 1–8 (row 0 unused).
+inline constexpr auto kFractionLevels = [] {
+  std::array<std::array<uint16_t, 256>, 9> table{};
+  for (uint32_t bits = 1; bits <= 8; ++bits)
+    for (uint32_t q = 0; q < (1u << bits); ++q) table[bits][q] = fractionLevel(q, bits);
+  return table;
+}();
+/// Bytes of a quantised near hit at `bits` per fraction (a far hit takes one more): the
+/// fractions and at least 4 bits of delta.
+constexpr uint32_t nearHitBytes(uint32_t bits) { return (2 * bits + 4 + 7) / 8; }
+/// Bytes of a tixel's tag plane, and of everything before its payload (the bits byte and tags).
 constexpr uint64_t kTagBytes(uint32_t n) { return (uint64_t(n) + 3) / 4; }
-/// Most bytes one entry's payload may take (kTagGeneral: a 5-byte varint and the fractions).
+constexpr uint64_t kTixelHeaderBytes(uint32_t n) { return 1 + kTagBytes(n); }
+/// Most bytes one entry's payload may take (kTagGeneral, exact: a 5-byte varint and the fractions).
 inline constexpr uint64_t kMaxEntryPayloadBytes = 9;
 /// Most bytes n entries may take encoded (the buffer encodeTixelEntries needs).
-constexpr uint64_t maxEncodedTixelBytes(uint32_t n) { return kTagBytes(n) + uint64_t(n) * kMaxEntryPayloadBytes; }
+constexpr uint64_t maxEncodedTixelBytes(uint32_t n) { return kTixelHeaderBytes(n) + uint64_t(n) * kMaxEntryPayloadBytes; }
 
-/// Encodes n entries (any values) into out (maxEncodedTixelBytes(n) bytes); returns the bytes used.
-size_t encodeTixelEntries(const VisibilityEntry* entries, uint32_t n, unsigned char* out);
+/// Encodes n entries (any values) into out (maxEncodedTixelBytes(n) bytes) with `fractionBits`
+/// per fraction (validFractionBits); returns the bytes used.
+size_t encodeTixelEntries(const VisibilityEntry* entries, uint32_t n, uint32_t fractionBits, unsigned char* out);
 
 /// Zero bytes that follow a field's last encoded tixel, so that the unchecked decoder may read a
 /// whole 8-byte word wherever an entry starts.
 inline constexpr size_t kEntryBytesPadding = 8;
 
-/// Decodes n entries encoded by encodeTixelEntries from in[0, size) into out. Checked: returns
-/// the bytes consumed, or 0 when the bytes run out, decode to an index outside [0, kEscape] or
-/// take a form the encoder never writes (a corrupt file). Unchecked (the gather's, on a field
-/// that the checked decoder accepted): size is ignored, and kEntryBytesPadding bytes past the
-/// tixel's encoding must be readable; the result is the same.
+namespace detail {
+
+/// The general form's varint at `at` (advanced past it): the entry's index, from `previous`,
+/// and flags. Checked: false when the bytes run out before `end` or the varint is too long.
 template <bool Checked>
-inline size_t decodeTixelEntries(const unsigned char* in, size_t size, uint32_t n, VisibilityEntry* out) {
-  if (Checked && size < kTagBytes(n)) return 0;
-  const unsigned char* at = in + kTagBytes(n);
+inline bool readGeneralTarget(const unsigned char*& at, const unsigned char* end, int64_t previous, int64_t& index,
+                              uint32_t& flags) {
+  uint64_t v = 0;
+  for (int shift = 0;; shift += 7) {
+    if (Checked && (at == end || shift > 28)) return false;  // ≤ 33 bits: zigzag(delta)·4 + flags
+    const uint8_t byte = *at++;
+    v |= uint64_t(byte & 0x7f) << shift;
+    if ((byte & 0x80) == 0) break;
+  }
+  flags = uint32_t(v & 3u) << 30;
+  index = previous + (int64_t(v >> 3) ^ -int64_t((v >> 2) & 1));  // un-zigzag of v >> 2
+  return true;
+}
+
+/// Whether a decoded index may stand with its tag (checked decoding): within [0, kEscape], and
+/// kEscape only in the general form.
+inline bool validIndex(int64_t index, uint32_t tag) {
+  return index >= 0 && index <= int64_t(VisibilityEntry::kIndexMask) &&
+         (tag == kTagGeneral || index != int64_t(VisibilityEntry::kEscape));
+}
+
+template <bool Checked>
+inline size_t decodeExact(const unsigned char* in, size_t size, uint32_t n, VisibilityEntry* out) {
+  const unsigned char* const tags = in + 1;
+  const unsigned char* at = in + kTixelHeaderBytes(n);
   [[maybe_unused]] const unsigned char* const end = in + size;
   int64_t previous = 0;
   for (uint32_t k = 0; k < n; ++k) {
-    const uint32_t tag = (in[k / 4] >> (2 * (k % 4))) & 3u;
+    const uint32_t tag = (tags[k / 4] >> (2 * (k % 4))) & 3u;
     if constexpr (!Checked) {
       if (tag != kTagGeneral) [[likely]] {
         // Without branches, as the mix of these three tags is unpredictable: the next 8 bytes
@@ -185,20 +245,10 @@ inline size_t decodeTixelEntries(const unsigned char* in, size_t size, uint32_t 
       std::memcpy(&d, at, 2);
       index = previous + d;
       at += 2;
-    } else {
-      uint64_t v = 0;
-      for (int shift = 0;; shift += 7) {
-        if (Checked && (at == end || shift > 28)) return 0;  // ≤ 33 bits: zigzag(delta)·4 + flags
-        const uint8_t byte = *at++;
-        v |= uint64_t(byte & 0x7f) << shift;
-        if ((byte & 0x80) == 0) break;
-      }
-      flags = uint32_t(v & 3u) << 30;
-      index = previous + (int64_t(v >> 3) ^ -int64_t((v >> 2) & 1));  // un-zigzag of v >> 2
-    }
-    if (Checked && (index < 0 || index > int64_t(VisibilityEntry::kIndexMask) || end - at < 4 ||
-                    (tag != kTagGeneral && index == int64_t(VisibilityEntry::kEscape))))
+    } else if (!readGeneralTarget<Checked>(at, end, previous, index, flags)) {
       return 0;
+    }
+    if (Checked && (!validIndex(index, tag) || end - at < 4)) return 0;
     VisibilityEntry e;
     e.target = uint32_t(index) | flags;
     std::memcpy(&e.fu, at, 2);
@@ -210,14 +260,93 @@ inline size_t decodeTixelEntries(const unsigned char* in, size_t size, uint32_t 
   return size_t(at - in);
 }
 
+template <bool Checked>
+inline size_t decodeQuantised(const unsigned char* in, size_t size, uint32_t n, uint32_t bits, VisibilityEntry* out) {
+  const unsigned char* const tags = in + 1;
+  const unsigned char* at = in + kTixelHeaderBytes(n);
+  [[maybe_unused]] const unsigned char* const end = in + size;
+  const uint16_t* const level = kFractionLevels[bits].data();
+  const uint64_t mask = (uint64_t(1) << bits) - 1;
+  const uint64_t nearBytes = nearHitBytes(bits), farBytes = nearBytes + 1, fractionBytes = (2 * bits + 7) / 8;
+  int64_t previous = 0;
+  for (uint32_t k = 0; k < n; ++k) {
+    const uint32_t tag = (tags[k / 4] >> (2 * (k % 4))) & 3u;
+    if constexpr (!Checked) {
+      if (tag != kTagGeneral) [[likely]] {
+        // Branch-free as in decodeExact: the entry's integer is the low `length` bytes of the
+        // next 8 (none for an escape); shifting it to the top and back sign-extends the delta.
+        uint64_t word;
+        std::memcpy(&word, at, 8);
+        const uint64_t near = 0 - uint64_t(tag == kTagNear), far = 0 - uint64_t(tag == kTagFar);
+        const uint64_t hit = near | far;
+        const uint64_t length = (nearBytes & near) | (farBytes & far);
+        const uint32_t top = uint32_t(64 - 8 * length) & 63u;
+        previous += int64_t(uint64_t(int64_t(word << top) >> (top + 2 * bits)) & hit);
+        const uint64_t packed = ((uint64_t(uint32_t(previous)) | (uint64_t(level[word & mask]) << 32) |
+                                  (uint64_t(level[(word >> bits) & mask]) << 48)) & hit) |
+                                (uint64_t(VisibilityEntry::kEscape) & ~hit);
+        std::memcpy(static_cast<void*>(&out[k]), &packed, 8);
+        at += length;
+        continue;
+      }
+    }
+    if (tag == kTagEscape) {
+      out[k] = VisibilityEntry{};
+      continue;
+    }
+    int64_t index;
+    uint32_t flags = 0;
+    uint64_t word = 0;
+    if (tag != kTagGeneral) {
+      const uint64_t length = tag == kTagNear ? nearBytes : farBytes;
+      if (Checked && uint64_t(end - at) < length) return 0;
+      std::memcpy(&word, at, length);  // little-endian, as the whole format
+      at += length;
+      const uint32_t top = uint32_t(64 - 8 * length);
+      index = previous + (int64_t(word << top) >> (top + 2 * bits));
+    } else {
+      if (!readGeneralTarget<Checked>(at, end, previous, index, flags)) return 0;
+      if (Checked && uint64_t(end - at) < fractionBytes) return 0;
+      std::memcpy(&word, at, fractionBytes);
+      at += fractionBytes;
+      if (Checked && (word >> (2 * bits)) != 0) return 0;  // bits the encoder leaves 0
+    }
+    if (Checked && !validIndex(index, tag)) return 0;
+    VisibilityEntry e;
+    e.target = uint32_t(index) | flags;
+    e.fu = level[word & mask];
+    e.fv = level[(word >> bits) & mask];
+    if (index != int64_t(VisibilityEntry::kEscape)) previous = index;
+    out[k] = e;
+  }
+  return size_t(at - in);
+}
+
+}  // namespace detail
+
+/// Decodes n entries encoded by encodeTixelEntries from in[0, size) into out. Checked: returns
+/// the bytes consumed, or 0 when the bytes run out, declare a fraction precision that is not
+/// valid, decode to an index outside [0, kEscape] or take a form the encoder never writes (a
+/// corrupt file). Unchecked (the gather's, on a field that the checked decoder accepted): size
+/// is ignored, and kEntryBytesPadding bytes past the tixel's encoding must be readable; the
+/// result is the same.
+template <bool Checked>
+inline size_t decodeTixelEntries(const unsigned char* in, size_t size, uint32_t n, VisibilityEntry* out) {
+  if (Checked && size < kTixelHeaderBytes(n)) return 0;
+  const uint32_t bits = in[0];
+  if (bits == kExactFractionBits) return detail::decodeExact<Checked>(in, size, n, out);
+  if (Checked && !validFractionBits(bits)) return 0;
+  return detail::decodeQuantised<Checked>(in, size, n, bits, out);
+}
+
 /// A run of consecutive tixels' encoded entries: a bake encodes its field a run at a time, in
 /// parallel, and assembleEntries joins the runs.
 struct EncodedRun {
   std::vector<unsigned char> bytes;
   std::vector<uint32_t> tixelBytes;  ///< per tixel of the run, in order: its encoding's size
 
-  /// Appends the encoding of one tixel's n entries.
-  void add(const VisibilityEntry* entries, uint32_t n);
+  /// Appends the encoding of one tixel's n entries, with `fractionBits` per fraction.
+  void add(const VisibilityEntry* entries, uint32_t n, uint32_t fractionBits);
 };
 
 struct VisibilityField {
@@ -240,8 +369,8 @@ struct VisibilityField {
   /// Every entry, tixel-major (tests and tools; the bake decodes a tixel at a time).
   std::vector<VisibilityEntry> decodeAll() const;
   /// Encodes tixelCount · N entries (tixel-major) as the field's entries (gridSide and
-  /// tixelCount set before).
-  void setEntries(const VisibilityEntry* entries);
+  /// tixelCount set before), with `fractionBits` per fraction ("Compact entries").
+  void setEntries(const VisibilityEntry* entries, uint32_t fractionBits = kExactFractionBits);
   /// Sets the field's entries to `runs` in order (their tixels must total tixelCount), freeing
   /// each run as it is copied, so that the runs and the field are not held twice.
   void assembleEntries(std::vector<EncodedRun>& runs);
@@ -266,6 +395,7 @@ struct VisibilityFileInfo {
   uint64_t fileBytes = 0;
   uint64_t entryBytes = 0;  ///< the encoded entries (0 for an older version, which is not read further)
   uint64_t heldBytes = 0;   ///< what the field takes in memory once read (VisibilityField::bytes; 0: older version)
+  uint32_t fractionBits = 0;  ///< bits per fraction of its first tixel ("Compact entries"; 0: older version or no tixels)
 };
 /// Reads a .plv's header and, for the current version, checks its payload checksum and frame
 /// table (without decoding the entries). Throws pl::Error naming the file when it is not a .plv

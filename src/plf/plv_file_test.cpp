@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <cstring>
 #include <limits>
@@ -34,18 +35,36 @@ VisibilityField tinyField(const VisibilityExtra& extra) {
   return field;
 }
 
-/// Encodes n entries, decodes them checked and unchecked, and compares bit for bit; returns the
-/// encoded size.
-size_t roundTrip(const std::vector<VisibilityEntry>& entries) {
+/// The fraction precisions a tixel's encoding may take: the exact one and every quantised
+/// width (kCompactFractionBits among them).
+const std::vector<uint32_t> kEveryFractionBits = {kExactFractionBits, 1, 2, 3, 4, 5, 6, 7, 8};
+
+/// What an entry decodes to at `bits` per fraction: itself (exact), or with its fractions
+/// quantised.
+VisibilityEntry expected(VisibilityEntry e, uint32_t bits) {
+  if (bits == kExactFractionBits) return e;
+  e.fu = fractionLevel(quantiseFraction(e.fu, bits), bits);
+  e.fv = fractionLevel(quantiseFraction(e.fv, bits), bits);
+  return e;
+}
+
+/// Encodes n entries with `bits` per fraction, decodes them checked and unchecked, and compares
+/// bit for bit with what they must decode to; encodes the decoded entries again and checks the
+/// bytes are the same (quantising is idempotent). Returns the encoded size.
+size_t roundTrip(const std::vector<VisibilityEntry>& entries, uint32_t bits = kExactFractionBits) {
   const uint32_t n = uint32_t(entries.size());
   std::vector<unsigned char> bytes(maxEncodedTixelBytes(n) + kEntryBytesPadding);
-  const size_t size = encodeTixelEntries(entries.data(), n, bytes.data());
+  const size_t size = encodeTixelEntries(entries.data(), n, bits, bytes.data());
   EXPECT_LE(size, maxEncodedTixelBytes(n));
-  std::vector<VisibilityEntry> checked(n), fast(n);
-  EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), size, n, checked.data()), size);
-  EXPECT_EQ(decodeTixelEntries<false>(bytes.data(), 0, n, fast.data()), size);
-  EXPECT_EQ(std::memcmp(checked.data(), entries.data(), n * sizeof(VisibilityEntry)), 0);
-  EXPECT_EQ(std::memcmp(fast.data(), entries.data(), n * sizeof(VisibilityEntry)), 0);
+  std::vector<VisibilityEntry> want(n), checked(n), fast(n);
+  for (uint32_t k = 0; k < n; ++k) want[k] = expected(entries[k], bits);
+  EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), size, n, checked.data()), size) << bits;
+  EXPECT_EQ(decodeTixelEntries<false>(bytes.data(), 0, n, fast.data()), size) << bits;
+  EXPECT_EQ(std::memcmp(checked.data(), want.data(), n * sizeof(VisibilityEntry)), 0) << bits;
+  EXPECT_EQ(std::memcmp(fast.data(), want.data(), n * sizeof(VisibilityEntry)), 0) << bits;
+  std::vector<unsigned char> again(maxEncodedTixelBytes(n));
+  EXPECT_EQ(encodeTixelEntries(checked.data(), n, bits, again.data()), size) << bits;
+  EXPECT_EQ(std::memcmp(again.data(), bytes.data(), size), 0) << bits;
   // Every shorter prefix is refused by the checked decoder (it never reads past `size`).
   for (size_t cut = 0; cut < size; ++cut) EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), cut, n, checked.data()), 0u) << cut;
   return size;
@@ -62,29 +81,33 @@ VisibilityEntry entry(uint32_t target, uint16_t fu = 0, uint16_t fv = 0) {
 }
 
 TEST(VisibilityCodec, AllMissesTakeTheTagsOnly) {
-  const std::vector<VisibilityEntry> misses(256);
-  EXPECT_EQ(roundTrip(misses), kTagBytes(256));
-  // Escapes that carry flags or fractions are kept exactly (general form).
-  std::vector<VisibilityEntry> odd(7, entry(VisibilityEntry::kEscape | VisibilityEntry::kHasExtra));
-  odd[3] = entry(VisibilityEntry::kEscape, 1, 65535);
-  odd[5] = entry(VisibilityEntry::kEscape | VisibilityEntry::kBackSide | VisibilityEntry::kHasExtra, 7, 9);
-  roundTrip(odd);
+  for (uint32_t bits : kEveryFractionBits) {
+    const std::vector<VisibilityEntry> misses(256);
+    EXPECT_EQ(roundTrip(misses, bits), kTixelHeaderBytes(256));
+    // Escapes that carry flags or fractions are kept (general form).
+    std::vector<VisibilityEntry> odd(7, entry(VisibilityEntry::kEscape | VisibilityEntry::kHasExtra));
+    odd[3] = entry(VisibilityEntry::kEscape, 1, 65535);
+    odd[5] = entry(VisibilityEntry::kEscape | VisibilityEntry::kBackSide | VisibilityEntry::kHasExtra, 7, 9);
+    roundTrip(odd, bits);
+  }
 }
 
 TEST(VisibilityCodec, EveryEntryADifferentFarTixel) {
-  std::mt19937_64 rng(7);
-  std::vector<VisibilityEntry> far(576);
-  for (VisibilityEntry& e : far) {
-    const uint32_t flags = uint32_t(rng() & 3) << 30;
-    e = entry(uint32_t(rng() % VisibilityEntry::kEscape) | flags, uint16_t(rng()), uint16_t(rng()));
+  for (uint32_t bits : kEveryFractionBits) {
+    std::mt19937_64 rng(7);
+    std::vector<VisibilityEntry> far(576);
+    for (VisibilityEntry& e : far) {
+      const uint32_t flags = uint32_t(rng() & 3) << 30;
+      e = entry(uint32_t(rng() % VisibilityEntry::kEscape) | flags, uint16_t(rng()), uint16_t(rng()));
+    }
+    const size_t size = roundTrip(far, bits);
+    EXPECT_LE(size, kTixelHeaderBytes(576) + 576 * kMaxEntryPayloadBytes);
+    // Alternating between the smallest and the largest index: the longest deltas both ways.
+    std::vector<VisibilityEntry> swing(64);
+    for (size_t k = 0; k < swing.size(); ++k)
+      swing[k] = entry(k % 2 ? VisibilityEntry::kIndexMask - 1 : 0, uint16_t(k), 65535);
+    roundTrip(swing, bits);
   }
-  const size_t size = roundTrip(far);
-  EXPECT_LE(size, kTagBytes(576) + 576 * kMaxEntryPayloadBytes);
-  // Alternating between the smallest and the largest index: the longest deltas both ways.
-  std::vector<VisibilityEntry> swing(64);
-  for (size_t k = 0; k < swing.size(); ++k)
-    swing[k] = entry(k % 2 ? VisibilityEntry::kIndexMask - 1 : 0, uint16_t(k), 65535);
-  roundTrip(swing);
 }
 
 TEST(VisibilityCodec, TheLargestTixelIndexAndEveryFlag) {
@@ -94,51 +117,127 @@ TEST(VisibilityCodec, TheLargestTixelIndexAndEveryFlag) {
                          VisibilityEntry::kBackSide | VisibilityEntry::kHasExtra})
     for (uint32_t index : {largest, largest - 1, 0u, largest, largest - 200, largest - 40000})
       entries.push_back(entry(index | flags, 65535, 0));
-  roundTrip(entries);
+  for (uint32_t bits : kEveryFractionBits) roundTrip(entries, bits);
+}
+
+TEST(VisibilityCodec, DeltasAtTheEdgesOfEachForm) {
+  // Per precision, deltas just inside and just outside the near and far forms' ranges, both
+  // signs, from a middle index (so that none leaves [0, kEscape)).
+  for (uint32_t bits : kEveryFractionBits) {
+    const int64_t nearBits = bits == kExactFractionBits ? 8 : int64_t(8 * nearHitBytes(bits) - 2 * bits);
+    std::vector<VisibilityEntry> entries;
+    int64_t at = int64_t(1) << 28;
+    entries.push_back(entry(uint32_t(at), 1, 2));
+    for (int64_t width : {nearBits, nearBits + 8}) {
+      const int64_t half = int64_t(1) << (width - 1);
+      for (int64_t delta : {half - 1, half, -half, -half - 1, int64_t(0), int64_t(1), int64_t(-1)}) {
+        at += delta;
+        entries.push_back(entry(uint32_t(at), uint16_t(at * 7919), uint16_t(at * 104729)));
+      }
+    }
+    roundTrip(entries, bits);
+  }
+}
+
+TEST(VisibilityCodec, QuantisedFractionsKeepTheEdgesAndStayWithinHalfALevel) {
+  for (uint32_t bits = 1; bits <= 8; ++bits) {
+    const uint32_t top = (1u << bits) - 1;
+    EXPECT_EQ(quantiseFraction(0, bits), 0u);
+    EXPECT_EQ(quantiseFraction(65535, bits), top);
+    EXPECT_EQ(fractionLevel(0, bits), 0u);
+    EXPECT_EQ(fractionLevel(top, bits), 65535u);
+    // Half a level of 65535/top, plus the 16-bit rounding of the level itself.
+    const double bound = 0.5 * 65535.0 / top + 0.5;
+    uint32_t previous = 0;
+    for (uint32_t f = 0; f <= 65535; ++f) {
+      const uint32_t q = quantiseFraction(uint16_t(f), bits);
+      ASSERT_LE(q, top);
+      ASSERT_GE(q, previous);  // monotone
+      previous = q;
+      ASSERT_LE(std::abs(double(fractionLevel(q, bits)) - double(f)), bound) << bits << " " << f;
+      ASSERT_EQ(kFractionLevels[bits][q], fractionLevel(q, bits));
+      ASSERT_EQ(quantiseFraction(fractionLevel(q, bits), bits), q);  // idempotent
+    }
+  }
+  // The fractions' edges in a tixel: 0 and 65535 decode exactly at every precision.
+  std::vector<VisibilityEntry> edges;
+  for (uint16_t fu : {0, 1, 65534, 65535})
+    for (uint16_t fv : {0, 1, 65534, 65535}) edges.push_back(entry(uint32_t(40 + edges.size()), fu, fv));
+  for (uint32_t bits : kEveryFractionBits) {
+    roundTrip(edges, bits);
+    EXPECT_EQ(expected(edges[0], bits).fu, 0u);
+    EXPECT_EQ(expected(edges.back(), bits).fv, 65535u);
+  }
 }
 
 TEST(VisibilityCodec, NeighbouringHitsTakeFewBytes) {
-  // One tixel (grid 1) and a smooth pattern: deltas within ±127 take 1 + 4 bytes and the tag.
-  roundTrip({entry(12345, 3, 4)});
+  // One tixel (grid 1) and a smooth pattern.
+  for (uint32_t bits : kEveryFractionBits) roundTrip({entry(12345, 3, 4)}, bits);
   std::vector<VisibilityEntry> smooth(256);
   for (size_t k = 0; k < smooth.size(); ++k) smooth[k] = entry(uint32_t(1000 + 3 * k + (k % 16) * 4), uint16_t(k * 97), uint16_t(k * 31));
-  const size_t size = roundTrip(smooth);
-  EXPECT_LE(size, kTagBytes(256) + 8 + 255 * 5);  // the first delta (1000) takes 2 bytes
+  // Exact: deltas within ±127 take 1 + 4 bytes and the tag; the first (1000) takes 2 + 4.
+  EXPECT_LE(roundTrip(smooth), kTixelHeaderBytes(256) + 6 + 255 * 5);
+  // 8 bits: 1 + 2 bytes, the first 2 + 2; 4 bits (the default): 2 bytes, the first 3.
+  EXPECT_LE(roundTrip(smooth, 8), kTixelHeaderBytes(256) + 4 + 255 * 3);
+  EXPECT_LE(roundTrip(smooth, 4), kTixelHeaderBytes(256) + 3 + 255 * 2);
 }
 
 TEST(VisibilityCodec, CorruptEncodingsAreRefused) {
   std::vector<unsigned char> bytes(maxEncodedTixelBytes(4));
   VisibilityEntry out[4];
+  // A fraction precision that no encoder writes.
+  for (uint8_t bits : {0, 9, 15, 17, 255}) {
+    std::fill(bytes.begin(), bytes.end(), 0);
+    bytes[0] = bits;
+    EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), bytes.size(), 1, out), 0u) << int(bits);
+  }
   // A negative index: tag near (1) with delta −1 from 0.
-  bytes[0] = 1;
-  bytes[1] = 0xff;
-  EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), 6, 1, out), 0u);
+  std::fill(bytes.begin(), bytes.end(), 0);
+  bytes[0] = kExactFractionBits;
+  bytes[1] = 1;
+  bytes[2] = 0xff;
+  EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), 7, 1, out), 0u);
+  // The same quantised: a near hit of 8-bit fractions whose delta byte is −1.
+  bytes[0] = 8;
+  bytes[2] = 0;
+  bytes[3] = 0;
+  bytes[4] = 0xff;
+  EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), 5, 1, out), 0u);
   // A varint that never ends.
   std::fill(bytes.begin(), bytes.end(), 0xff);
-  bytes[0] = 3;
+  bytes[0] = kExactFractionBits;
+  bytes[1] = 3;
   EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), bytes.size(), 1, out), 0u);
+  auto putVarint = [&](uint64_t v, size_t at) {
+    while (v >= 0x80) {
+      bytes[at++] = uint8_t(v | 0x80);
+      v >>= 7;
+    }
+    bytes[at++] = uint8_t(v);
+    return at;
+  };
   // An index past kEscape: general form, delta 2^30 from 0.
   std::fill(bytes.begin(), bytes.end(), 0);
-  bytes[0] = 3;
-  uint64_t v = zigzag(int64_t(1) << 30) << 2;
-  size_t at = 1;
-  while (v >= 0x80) {
-    bytes[at++] = uint8_t(v | 0x80);
-    v >>= 7;
-  }
-  bytes[at++] = uint8_t(v);
+  bytes[0] = kExactFractionBits;
+  bytes[1] = 3;
+  size_t at = putVarint(zigzag(int64_t(1) << 30) << 2, 2);
   EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), at + 4, 1, out), 0u);
+  // A quantised general form whose fraction bytes set bits above the two levels (6 bits each:
+  // bit 12 of the 2 bytes), which the encoder leaves 0.
+  std::fill(bytes.begin(), bytes.end(), 0);
+  bytes[0] = 6;
+  bytes[1] = 3;
+  at = putVarint(zigzag(5) << 2, 2);
+  bytes[at + 1] = 0x10;
+  EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), at + 2, 1, out), 0u);
+  bytes[at + 1] = 0x0f;  // within the levels: accepted
+  EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), at + 2, 1, out), at + 2);
   // kEscape reached by a short delta (the encoder writes escapes with a tag of their own or in
   // the general form): refused, as the fast decoder would read it otherwise.
   std::fill(bytes.begin(), bytes.end(), 0);
-  bytes[0] = 3 | (1 << 2);  // entry 0 general, entry 1 near
-  v = zigzag(int64_t(VisibilityEntry::kEscape) - 1) << 2;
-  at = 1;
-  while (v >= 0x80) {
-    bytes[at++] = uint8_t(v | 0x80);
-    v >>= 7;
-  }
-  bytes[at++] = uint8_t(v);
+  bytes[0] = kExactFractionBits;
+  bytes[1] = 3 | (1 << 2);  // entry 0 general, entry 1 near
+  at = putVarint(zigzag(int64_t(VisibilityEntry::kEscape) - 1) << 2, 2);
   at += 4;
   bytes[at++] = 1;  // delta +1: kEscape
   EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), at + 4, 2, out), 0u);

@@ -16,36 +16,51 @@ constexpr uint32_t kFlagBits = VisibilityEntry::kBackSide | VisibilityEntry::kHa
 
 inline uint64_t zigzag(int64_t d) { return (uint64_t(d) << 1) ^ uint64_t(d >> 63); }
 
-inline unsigned char* putFractions(unsigned char* out, const VisibilityEntry& e) {
-  std::memcpy(out, &e.fu, 2);
-  std::memcpy(out + 2, &e.fv, 2);
-  return out + 4;
+/// The n low bytes of v, little-endian.
+inline unsigned char* putBytes(unsigned char* out, uint64_t v, uint64_t n) {
+  std::memcpy(out, &v, n);
+  return out + n;
+}
+
+/// Whether delta fits a signed integer of `bits` bits.
+inline bool fits(int64_t delta, uint64_t bits) {
+  const int64_t half = int64_t(1) << (bits - 1);
+  return delta >= -half && delta < half;
 }
 
 }  // namespace
 
-size_t encodeTixelEntries(const VisibilityEntry* entries, uint32_t n, unsigned char* out) {
-  unsigned char* tags = out;
+size_t encodeTixelEntries(const VisibilityEntry* entries, uint32_t n, uint32_t fractionBits, unsigned char* out) {
+  if (!validFractionBits(fractionBits)) fail("visibility field: {} bits per fraction (1 to 8, or 16)", fractionBits);
+  const bool exact = fractionBits == kExactFractionBits;
+  // The fractions' bits as stored, and the widths of a near and a far hit's delta (layout in
+  // plv_file.h).
+  const uint64_t fractionWidth = exact ? 32 : 2 * fractionBits;
+  const uint64_t nearBits = exact ? 8 : 8 * nearHitBytes(fractionBits) - fractionWidth, farBits = nearBits + 8;
+  out[0] = uint8_t(fractionBits);
+  unsigned char* tags = out + 1;
   std::memset(tags, 0, kTagBytes(n));
-  unsigned char* at = out + kTagBytes(n);
+  unsigned char* at = out + kTixelHeaderBytes(n);
   int64_t previous = 0;  // index of the last entry that saw a tixel
   for (uint32_t k = 0; k < n; ++k) {
     const VisibilityEntry& e = entries[k];
+    // The fractions as stored: whole (exact), or their levels, packed qu | qv << F.
+    const uint64_t fractions = exact ? uint64_t(e.fu) | uint64_t(e.fv) << 16
+                                     : quantiseFraction(e.fu, fractionBits) |
+                                           uint64_t(quantiseFraction(e.fv, fractionBits)) << fractionBits;
     uint32_t tag;
-    if (e.target == VisibilityEntry::kEscape && e.fu == 0 && e.fv == 0) {
+    if (e.target == VisibilityEntry::kEscape && fractions == 0) {
       tag = kTagEscape;
     } else {
       const int64_t index = e.tixel();
       const int64_t delta = index - previous;
-      if ((e.target & kFlagBits) == 0 && !e.escaped() && delta >= INT8_MIN && delta <= INT8_MAX) {
-        tag = kTagNear;
-        const int8_t d = int8_t(delta);
-        std::memcpy(at++, &d, 1);
-      } else if ((e.target & kFlagBits) == 0 && !e.escaped() && delta >= INT16_MIN && delta <= INT16_MAX) {
-        tag = kTagFar;
-        const int16_t d = int16_t(delta);
-        std::memcpy(at, &d, 2);
-        at += 2;
+      const bool plain = (e.target & kFlagBits) == 0 && !e.escaped();
+      if (plain && fits(delta, farBits)) {
+        tag = fits(delta, nearBits) ? kTagNear : kTagFar;
+        const uint64_t deltaBits = tag == kTagNear ? nearBits : farBits;
+        const uint64_t d = uint64_t(delta) & ((uint64_t(1) << deltaBits) - 1);
+        if (exact) at = putBytes(putBytes(at, d, deltaBits / 8), fractions, 4);
+        else at = putBytes(at, fractions | d << fractionWidth, (fractionWidth + deltaBits) / 8);
       } else {
         tag = kTagGeneral;
         uint64_t v = (zigzag(delta) << 2) | (e.target >> 30);
@@ -54,8 +69,8 @@ size_t encodeTixelEntries(const VisibilityEntry* entries, uint32_t n, unsigned c
           v >>= 7;
         }
         *at++ = uint8_t(v);
+        at = putBytes(at, fractions, (fractionWidth + 7) / 8);
       }
-      at = putFractions(at, e);
       if (!e.escaped()) previous = index;
     }
     tags[k / 4] |= uint8_t(tag << (2 * (k % 4)));
@@ -63,10 +78,10 @@ size_t encodeTixelEntries(const VisibilityEntry* entries, uint32_t n, unsigned c
   return size_t(at - out);
 }
 
-void EncodedRun::add(const VisibilityEntry* entries, uint32_t n) {
+void EncodedRun::add(const VisibilityEntry* entries, uint32_t n, uint32_t fractionBits) {
   const size_t at = bytes.size();
   bytes.resize(at + maxEncodedTixelBytes(n));
-  const size_t used = encodeTixelEntries(entries, n, bytes.data() + at);
+  const size_t used = encodeTixelEntries(entries, n, fractionBits, bytes.data() + at);
   bytes.resize(at + used);
   tixelBytes.push_back(uint32_t(used));
 }
@@ -104,13 +119,13 @@ void VisibilityField::assembleEntries(std::vector<EncodedRun>& runs) {
   entryOffset = FieldArray<uint64_t>(std::move(offsets));
 }
 
-void VisibilityField::setEntries(const VisibilityEntry* entries) {
+void VisibilityField::setEntries(const VisibilityEntry* entries, uint32_t fractionBits) {
   const uint32_t n = directionsPerTixel();
   constexpr uint64_t kTixelsPerRun = 1024;
   std::vector<EncodedRun> runs((tixelCount + kTixelsPerRun - 1) / kTixelsPerRun);
   parallelFor(runs.size(), [&](uint64_t r) {
     const uint64_t t1 = std::min(tixelCount, (r + 1) * kTixelsPerRun);
-    for (uint64_t t = r * kTixelsPerRun; t < t1; ++t) runs[r].add(entries + t * n, n);
+    for (uint64_t t = r * kTixelsPerRun; t < t1; ++t) runs[r].add(entries + t * n, n, fractionBits);
   });
   assembleEntries(runs);
 }

@@ -196,7 +196,8 @@ void bindLightField(py::module_& m) {
       "bake",
       [](const Scene& scene, const std::string& preset, uint64_t seed, int threads, std::optional<std::string> visibility,
          bool reuseVisibility, bool sunMasks, bool punctualHighlights, std::optional<int64_t> causticPhotons,
-         std::optional<std::string> maxMemory, bool keepVisibility, bool fresh, std::optional<int64_t> subsurfaceWalks) {
+         std::optional<std::string> maxMemory, bool keepVisibility, bool fresh, std::optional<int64_t> subsurfaceWalks,
+         const std::string& visibilityPrecision) {
         BakeJobOptions options;
         if (maxMemory) options.maxMemory = parseMemorySize(*maxMemory, "max_memory");
         auto relight = std::make_shared<RelightSource>();
@@ -208,6 +209,9 @@ void bindLightField(py::module_& m) {
         }
         options.sunMasks = sunMasks;
         options.punctualHighlights = punctualHighlights;
+        if (visibilityPrecision != "compact" && visibilityPrecision != "exact")
+          throw py::value_error(fmt::format("visibility_precision must be 'compact' or 'exact' (got '{}')", visibilityPrecision));
+        options.exactVisibility = visibilityPrecision == "exact";
         if (causticPhotons) {
           if (*causticPhotons < 0 || *causticPhotons > (int64_t(1) << 32))
             throw py::value_error(fmt::format("caustic_photons must be in [0, 2^32] (got {})", *causticPhotons));
@@ -243,6 +247,7 @@ void bindLightField(py::module_& m) {
       py::arg("visibility") = py::none(), py::arg("reuse_visibility") = false, py::arg("sun_masks") = true,
       py::arg("punctual_highlights") = true, py::arg("caustic_photons") = py::none(), py::arg("max_memory") = py::none(),
       py::arg("keep_visibility") = true, py::arg("fresh") = false, py::arg("subsurface_walks") = py::none(),
+      py::arg("visibility_precision") = "compact",
       "Bakes `scene`'s light field (what `plenoptic bake` does). visibility: a .plv path where the visibility field\n"
       "is saved; with reuse_visibility=True it is read back when the geometry and settings match (so a bake after\n"
       "editing only lights or emission re-runs the propagation alone). sun_masks=False: `--sun-masks off`;\n"
@@ -251,7 +256,8 @@ void bindLightField(py::module_& m) {
       "memory estimate exceeds it). keep_visibility=True keeps the visibility field in memory for LightField.relight\n"
       "(False frees it). With a visibility path, a bake that was interrupted resumes from what it saved there\n"
       "(docs/user-guide.md, Resuming an interrupted bake); fresh=True: `--fresh` (start afresh). subsurface_walks=N:\n"
-      "`--subsurface-walks N` (random walks per tixel area through subsurface objects; None: the preset's).");
+      "`--subsurface-walks N` (random walks per tixel area through subsurface objects; None: the preset's).\n"
+      "visibility_precision=\"exact\": `--visibility-precision exact` (the visibility field's fractions kept whole).");
 
   m.def(
       "load_light_field",

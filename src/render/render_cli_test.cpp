@@ -246,8 +246,8 @@ TEST_F(RenderCliTest, RefusesBadInputWithoutWritingAnything) {
 // quad-v5.plf by the version-5 writer (SCNE's texturing block, which the untextured quad does
 // not get, and a chart bit for normal-mapped diffuse charts, which it has not either),
 // quad-v6.plf by the version-6 writer (the glTF model's dielectric Fresnel; the quad's
-// material is Lambertian; rewritten when META's settings gained "subsurface_walks", a key
-// readers of version 6 ignore or default). They
+// material is Lambertian; rewritten when META's settings gained "subsurface_walks" and then
+// "exact_visibility", keys readers of version 6 ignore or default). They
 // pin the format: a change of the byte layout without a new version number
 // fails here, and files of the older version must still read. Regenerate the current one
 // deliberately (after bumping kPlfVersion and keeping a reader for old files) with
