@@ -160,9 +160,10 @@ struct Relighter::Impl {
     const std::string setupPath = tixelSetupPathFor(visibilityPath);
     std::string why;
     std::error_code ec;
-    if (!std::filesystem::exists(visibilityPath, ec))
-      why = fmt::format("{} does not exist", visibilityPath);
-    else if (lf.sunMaskLightCount != param.sunMaskLights.size())
+    if (!std::filesystem::exists(visibilityPath, ec))  // (before minutes of filling the tixels)
+      fail("{}: relighting needs the visibility field {} that was baked with this light field, but {} does not exist",
+           scene.sourcePath, visibilityPath, visibilityPath);
+    if (lf.sunMaskLightCount != param.sunMaskLights.size())
       why = "the light field's sun masks do not match its charts";
     else if (readTixelSetup(setupPath, readVisibilityInfo(visibilityPath).hash, lf.sunMasks, param, &why))
       return true;

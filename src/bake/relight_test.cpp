@@ -398,6 +398,8 @@ TEST_F(RelightFileTest, LoadedLightFieldRelightsAsRightAfterTheBake) {
   bytes[bytes.size() / 2] = char(bytes[bytes.size() / 2] ^ 0x10);
   std::ofstream(path("sun.plt"), std::ios::binary | std::ios::trunc) << bytes;
   test_support::expectError([&] { Relighter broken(loaded, path("sun.plv")); }, {"sun.plt", "corrupt"});
+  // No .plv: said at once, naming it.
+  test_support::expectError([&] { Relighter none(loaded, path("none.plv")); }, {"none.plv", "does not exist"});
 }
 
 }  // namespace
