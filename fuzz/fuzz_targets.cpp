@@ -17,6 +17,7 @@
 #include "core/hash.h"
 #include "image/image.h"
 #include "plf/plf_file.h"
+#include "plf/plt_file.h"
 #include "plf/plv_file.h"
 #include "scene/scene.h"
 
@@ -165,6 +166,26 @@ void runPlvFixed(std::span<const uint8_t> input) {
   runPlv(bytes);
 }
 
+// .plt header (plf/plt_file.h): magic 8, version 4, array count 4, hash 8 at 16, tixel count,
+// payloadHash 8 at 32, reserved; payload from 48.
+constexpr size_t kPltHashOffset = 16, kPltPayloadHashOffset = 32, kPltHeaderBytes = 48;
+
+void runPlt(std::span<const uint8_t> input) {
+  // The expected hash is the file's own, so the reader goes past the staleness check.
+  const uint64_t expected = input.size() >= kPltHashOffset + 8 ? loadU64(input.data() + kPltHashOffset) : 0;
+  TixelSetupFile file;
+  std::string why;
+  readTixelSetupFile(putFile("setup.plt", input), expected, file, &why);
+}
+
+/// .plt with the payload checksum recomputed over the mutated payload.
+void runPltFixed(std::span<const uint8_t> input) {
+  std::vector<uint8_t> bytes(input.begin(), input.end());
+  if (bytes.size() >= kPltHeaderBytes)
+    storeU64(bytes.data() + kPltPayloadHashOffset, xxh64(bytes.data() + kPltHeaderBytes, bytes.size() - kPltHeaderBytes));
+  runPlt(bytes);
+}
+
 constexpr FuzzTarget kTargets[] = {
     {"obj", "Wavefront OBJ + MTL scene (loadScene)", runObj},
     {"gltf", "glTF 2.0 scene, .gltf or .glb by the magic (loadScene)", runGltf},
@@ -176,6 +197,8 @@ constexpr FuzzTarget kTargets[] = {
     {"plf_fixed", "light field .plf with checksums recomputed after mutation", runPlfFixed},
     {"plv", "visibility field .plv (readVisibility)", runPlv},
     {"plv_fixed", "visibility field .plv with the payload checksum recomputed after mutation", runPlvFixed},
+    {"plt", "tixel-setup file .plt (readTixelSetupFile)", runPlt},
+    {"plt_fixed", "tixel-setup file .plt with the payload checksum recomputed after mutation", runPltFixed},
 };
 
 }  // namespace

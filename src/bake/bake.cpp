@@ -385,6 +385,16 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   DistributedBakeStats distributed =
       gatherDistributedStats(comm, plan, share, setupSeconds, tixelSetup, transport, note);
 
+  // The tixel setup beside the visibility field, so that relighting the saved light field
+  // does not fill the tixels again (relight.h). One process only: a distributed bake's field is
+  // saved in shards, which relighting does not read.
+  if (comm.size() == 1 && !options.visibilityPath.empty()) {
+    const auto writeStart = std::chrono::steady_clock::now();
+    const std::string path = tixelSetupPathFor(options.visibilityPath);
+    writeTixelSetup(path, param, hash);
+    note(fmt::format("tixel setup: {} ({:.1f} MB) in {:.2f} s", path, double(std::filesystem::file_size(path)) / 1e6,
+                     secondsSince(writeStart)));
+  }
   storeLightField(lf, param, std::move(transport.propagation.values));
   lf.stats = bakeStats(param, transport, distributed);
   lf.stats.seconds = secondsSince(start);

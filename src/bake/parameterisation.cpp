@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <deque>
+#include <filesystem>
+#include <type_traits>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -13,6 +16,7 @@
 #include "core/sampling.h"
 #include "light/emitters.h"
 #include "lightfield/lookup.h"
+#include "plf/plt_file.h"
 
 namespace pl {
 
@@ -627,6 +631,64 @@ void fillTixels(const Scene& scene, const Accel& accel, Parameterisation& p, uin
     const uint64_t ci = firstRecord + k;
     fillChartTixels(scene, accel, p.charts[ci], p.chartTriangles[ci], p);
   });
+}
+
+std::string tixelSetupPathFor(const std::string& visibilityPath) {
+  return std::filesystem::path(visibilityPath).replace_extension(".plt").string();
+}
+
+namespace {
+
+std::array<char, 4> tixelSetupTag(const char* name) { return {name[0], name[1], name[2], name[3]}; }
+
+}  // namespace
+
+void writeTixelSetup(const std::string& path, const Parameterisation& p, uint64_t hash) {
+  std::vector<TixelSetupView> views;
+  forEachTixelSetupArray(p, [&](const char* tag, const auto& array) {
+    using Element = typename std::decay_t<decltype(array)>::value_type;
+    static_assert(std::is_standard_layout_v<Element> && std::is_trivially_destructible_v<Element>);  // stored as its bytes
+    views.push_back({tixelSetupTag(tag), uint32_t(sizeof(Element)), uint64_t(array.size()), array.data()});
+  });
+  writeTixelSetupFile(path, hash, p.tixelCount, views);
+}
+
+bool readTixelSetup(const std::string& path, uint64_t hash, const std::vector<SunMask>& sunMasks, Parameterisation& p,
+                    std::string* why) {
+  TixelSetupFile file;
+  if (!readTixelSetupFile(path, hash, file, why)) return false;
+  const size_t lightCount = p.sunMaskLights.size();
+  if (file.tixelCount != p.tixelCount)
+    fail("{}: the tixel setup has {} tixels, the light field's charts {}", path, file.tixelCount, p.tixelCount);
+  if (sunMasks.size() != p.tixelCount * lightCount)
+    fail("{}: the light field holds {} sun masks, its charts need {} ({} masked lights)", path, sunMasks.size(),
+         p.tixelCount * lightCount, lightCount);
+  // Every array as fillTixels allocates it for these charts: the same tags, element sizes and
+  // counts in the same order, checked before any is taken.
+  size_t index = 0;
+  forEachTixelSetupArray(p, [&](const char* tag, const auto& array) {
+    using Element = typename std::decay_t<decltype(array)>::value_type;
+    const TixelSetupArray* a = index < file.arrays.size() ? &file.arrays[index] : nullptr;
+    if (!a || a->tag != tixelSetupTag(tag) || a->elementBytes != sizeof(Element) || a->count != array.size())
+      fail("{}: the tixel setup does not fit the light field's charts: array {} of {} elements of {} bytes expected, "
+           "the file has {}",
+           path, tag, array.size(), sizeof(Element),
+           a ? fmt::format("{} of {} elements of {} bytes", std::string(a->tag.data(), 4), a->count, a->elementBytes)
+             : std::string("no more arrays"));
+    ++index;
+  });
+  if (index != file.arrays.size())
+    fail("{}: the tixel setup does not fit the light field's charts: {} arrays, expected {}", path, file.arrays.size(),
+         index);
+  index = 0;
+  forEachTixelSetupArray(p, [&](const char*, auto& array) {
+    if (!array.empty()) std::memcpy(static_cast<void*>(array.data()), file.arrays[index].bytes.data(), file.arrays[index].bytes.size());
+    std::vector<unsigned char>().swap(file.arrays[index].bytes);
+    ++index;
+  });
+  for (uint64_t g = 0; g < p.tixelCount && lightCount > 0; ++g)
+    std::copy_n(sunMasks.begin() + int64_t(g * lightCount), lightCount, p.sunMask[g].begin());
+  return true;
 }
 
 }  // namespace pl

@@ -73,6 +73,7 @@
 #include "scene/scene.h"
 
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <array>
 #include <variant>
@@ -139,6 +140,24 @@ struct Parameterisation {
   std::vector<Rgb> emissionModulation;
   std::vector<std::pair<uint32_t, uint32_t>> emitterTriangle;
 };
+
+/// Calls f(tag, array) for each per-tixel array that fillTixels fills (the tixel setup), sun
+/// masks excepted (the light field stores those; they follow its lights): tag is the array's
+/// four-character name in the .plt file (plf/plt_file.h), array a
+/// std::vector<Element> of tixelCount trivially copyable elements, or empty when no chart
+/// uses it. Element types and the order are part of that file's format.
+template <typename P, typename F>
+void forEachTixelSetupArray(P& p, F&& f) {
+  f("GPNT", p.gatherPoint);
+  f("GNRM", p.gatherNormal);
+  f("TILT", p.transportTiltWeights);
+  f("COVR", p.coverage);
+  f("BORR", p.borrowedPoint);
+  f("ALBD", p.transportAlbedo);
+  f("SPF0", p.specularF0);
+  f("EMOD", p.emissionModulation);
+  f("EMTR", p.emitterTriangle);
+}
 
 /// Whether chart c is a textured emitter (Parameterisation::emissionModulation holds its tixels).
 inline bool texturedEmitter(const Scene& scene, const Chart& c) {
@@ -254,5 +273,19 @@ void fillTixels(const Scene& scene, const Accel& accel, Parameterisation& p, uin
 void recomputeSunMasks(const Scene& scene, const Accel& accel, Parameterisation& p, size_t slot);
 /// The same, building its own Accel for the scene scale.
 Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& settings);
+
+/// Where a bake whose visibility field is `visibilityPath` (X.plv) saves its tixel setup: X.plt.
+std::string tixelSetupPathFor(const std::string& visibilityPath);
+/// Saves p's tixel setup (forEachTixelSetupArray) as a .plt file (plf/plt_file.h) for the bake
+/// whose visibility field has hash `hash` (visibilityHash).
+void writeTixelSetup(const std::string& path, const Parameterisation& p, uint64_t hash);
+/// Fills the tixel setup of p (from buildCharts of the baked scene and settings) from the .plt
+/// at `path`, and its sun masks from `sunMasks` (LightField::sunMasks, sunMaskLightCount =
+/// p.sunMaskLights.size() per tixel) — what fillTixels would give, bit for bit. Returns false
+/// and sets *why when the file is absent, of another version, or was written for a visibility
+/// field other than `hash`'s (p unchanged); throws pl::Error naming the file when it is corrupt
+/// or its arrays do not fit p's charts.
+bool readTixelSetup(const std::string& path, uint64_t hash, const std::vector<SunMask>& sunMasks, Parameterisation& p,
+                    std::string* why);
 
 }  // namespace pl

@@ -16,6 +16,7 @@
 #include "core/parallel.h"
 #include "core/timing.h"
 #include "light/lights.h"
+#include "plf/plv_file.h"
 
 namespace pl {
 
@@ -102,10 +103,16 @@ struct Relighter::Impl {
     const auto start = std::chrono::steady_clock::now();
     scene.finalize();  // a copied scene lacks the vertex padding the BVH shares (scene.h)
     accel = std::make_unique<Accel>(scene);
-    param = given ? std::move(*given) : buildParameterisation(scene, *accel, settings);
+    const std::string* path = std::get_if<std::string>(&source);
+    if (given) {
+      param = std::move(*given);
+    } else {
+      param = buildCharts(scene, *accel, settings);
+      if (!path || !readSavedTixelSetup(*path, lf)) fillTixels(scene, *accel, param, 0, uint32_t(param.charts.size()));
+    }
     const double setupSeconds = secondsSince(start);
     const uint64_t hash = visibilityHash(scene, param, settings);
-    if (const std::string* path = std::get_if<std::string>(&source)) {
+    if (path) {
       VisibilityField field;
       std::string why;
       if (!readVisibility(*path, hash, field, &why, param.tixelCount))
@@ -144,6 +151,27 @@ struct Relighter::Impl {
       log(fmt::format("relight: ready ({} lights, {} tixels): BVH and parameterisation {:.2f} s, first shot by source "
                       "{:.2f} s",
                       scene.lights.size(), param.tixelCount, setupSeconds, shotSeconds));
+  }
+
+  /// The tixel setup saved beside the .plv at `visibilityPath` (parameterisation.h
+  /// readTixelSetup) into param, whose charts buildCharts made: false, with a note saying why,
+  /// when there is none that belongs to that .plv (the caller fills the tixels again).
+  bool readSavedTixelSetup(const std::string& visibilityPath, const LightField& lf) {
+    const std::string setupPath = tixelSetupPathFor(visibilityPath);
+    std::string why;
+    std::error_code ec;
+    if (!std::filesystem::exists(visibilityPath, ec))  // (before minutes of filling the tixels)
+      fail("{}: relighting needs the visibility field {} that was baked with this light field, but {} does not exist",
+           scene.sourcePath, visibilityPath, visibilityPath);
+    if (lf.sunMaskLightCount != param.sunMaskLights.size())
+      why = "the light field's sun masks do not match its charts";
+    else if (readTixelSetup(setupPath, readVisibilityInfo(visibilityPath).hash, lf.sunMasks, param, &why))
+      return true;
+    if (log)
+      log(fmt::format("relight: filling the tixels again (buried-point probes, footprints, sun masks), because {}; "
+                      "a bake writes {} beside its .plv",
+                      why, setupPath));
+    return false;
   }
 
   void snapshot() {

@@ -89,7 +89,11 @@ class Relighter {
   Relighter(const LightField& lightField, VisibilityShard visibility, Parameterisation param,
             const std::function<void(const std::string&)>& log = {});
   /// The same with the visibility field read from `visibilityPath` (a .plv); pl::Error naming
-  /// it when it is missing or was traced for another scene or settings.
+  /// it when it is missing or was traced for another scene or settings. The parameterisation's
+  /// charts are rebuilt (buildCharts: about a second on Crytek Sponza) and its tixel setup read
+  /// from the .plt the bake wrote beside the .plv (parameterisation.h readTixelSetup), or, when
+  /// there is none for this .plv, filled again (fillTixels: minutes on a large scene; `log`
+  /// says why).
   Relighter(const LightField& lightField, const std::string& visibilityPath,
             const std::function<void(const std::string&)>& log = {});
   ~Relighter();

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "bake/bake.h"
@@ -12,8 +15,12 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "light/lights.h"
+#include "plf/plf_file.h"
+#include "plf/plv_file.h"
+#include "support/expect_error.h"
 #include "support/light_field_difference.h"
 #include "support/quad_mesh.h"
+#include "support/temp_dir_test.h"
 
 namespace pl {
 namespace {
@@ -301,6 +308,98 @@ TEST_F(RelightTest, RefusesAVisibilityFieldOfAnotherScene) {
   bake(makeCornellBox(), settings, options);
   const LightField other = bake(sunScene(sunAt(40.0f, 0.0f)), settings);
   EXPECT_THROW(Relighter(other, std::move(visibility)), Error);
+}
+
+// Relighting a light field loaded from its files (.plf, .plv and the .plt the bake writes
+// beside them) without filling the tixels again: the same parameterisation bit for bit, so the
+// same relit light field bit for bit as relighting right after the bake.
+class RelightFileTest : public test_support::TempDirTest {
+ protected:
+  void SetUp() override {
+    TempDirTest::SetUp();
+    Progress::setEnabled(false);
+  }
+};
+
+/// Every tixel-setup array byte for byte, and the sun masks of the masked lights.
+void expectSameTixelSetup(const Parameterisation& a, const Parameterisation& b) {
+  ASSERT_EQ(a.tixelCount, b.tixelCount);
+  ASSERT_EQ(a.charts.size(), b.charts.size());
+  std::vector<std::pair<const void*, size_t>> arrays;
+  forEachTixelSetupArray(a, [&](const char*, const auto& array) {
+    arrays.emplace_back(array.data(), array.size() * sizeof(array[0]));
+  });
+  size_t index = 0;
+  forEachTixelSetupArray(b, [&](const char* tag, const auto& array) {
+    const size_t bytes = array.size() * sizeof(array[0]);
+    ASSERT_EQ(bytes, arrays[index].second) << tag;
+    EXPECT_TRUE(bytes == 0 || std::memcmp(array.data(), arrays[index].first, bytes) == 0) << tag;
+    ++index;
+  });
+  ASSERT_EQ(a.sunMaskLights, b.sunMaskLights);
+  for (uint64_t g = 0; g < a.tixelCount; ++g)
+    for (size_t slot = 0; slot < a.sunMaskLights.size(); ++slot)
+      ASSERT_EQ(a.sunMask[g][slot], b.sunMask[g][slot]) << "tixel " << g;
+}
+
+TEST_F(RelightFileTest, LoadedLightFieldRelightsAsRightAfterTheBake) {
+  const BakeSettings settings = testSettings(16.0f);
+  Parameterisation param;
+  VisibilityShard visibility;
+  BakeOptions options;
+  options.keepParameterisation = &param;
+  options.keepVisibility = &visibility;
+  options.visibilityPath = path("sun.plv");
+  const LightField baked = bake(sunScene(sunAt(40.0f, 20.0f)), settings, options);
+  writeLightField(path("sun.plf"), baked);
+  ASSERT_TRUE(std::filesystem::exists(path("sun.plt")));
+  const LightField loaded = readLightField(path("sun.plf"));
+
+  std::vector<std::string> notes;
+  const auto note = [&](const std::string& text) { notes.push_back(text); };
+  auto filledAgain = [&] {
+    for (const std::string& n : notes)
+      if (n.find("filling the tixels again") != std::string::npos) return n;
+    return std::string();
+  };
+  Relighter fromFiles(loaded, path("sun.plv"), note);
+  EXPECT_EQ(filledAgain(), "");
+  expectSameTixelSetup(fromFiles.parameterisation(), param);
+
+  // The sun turned 10°: the same light field, bit for bit.
+  const Parameterisation original = param;
+  Relighter inMemory(baked, std::move(visibility), std::move(param));
+  Light sun = baked.scene.lights[0];
+  std::get<DirectionalLight>(sun).direction = sunAt(40.0f, 30.0f);
+  inMemory.setLight(0, sun);
+  fromFiles.setLight(0, sun);
+  const RelightStats a = inMemory.relight(), b = fromFiles.relight();
+  EXPECT_EQ(a.iterations, b.iterations);
+  const LightField relitA = inMemory.lightField(), relitB = fromFiles.lightField();
+  EXPECT_TRUE(relitA.values == relitB.values);
+  EXPECT_EQ(relitA.sunMasks, relitB.sunMasks);
+  expectSameTixelSetup(fromFiles.parameterisation(), inMemory.parameterisation());
+
+  // Files without a .plt (written before it, or deleted), or with one of another bake: the
+  // tixels are filled again, with a note, to the same parameterisation.
+  std::filesystem::copy_file(path("sun.plt"), path("kept.plt"));
+  std::filesystem::remove(path("sun.plt"));
+  notes.clear();
+  const Relighter withoutSetup(loaded, path("sun.plv"), note);
+  EXPECT_NE(filledAgain().find("sun.plt does not exist"), std::string::npos) << filledAgain();
+  expectSameTixelSetup(withoutSetup.parameterisation(), original);
+  writeTixelSetup(path("sun.plt"), withoutSetup.parameterisation(), 42);
+  notes.clear();
+  const Relighter otherBake(loaded, path("sun.plv"), note);
+  EXPECT_NE(filledAgain().find("another bake"), std::string::npos) << filledAgain();
+
+  // A damaged .plt: an error naming it.
+  std::string bytes = test_support::readFileText(path("kept.plt"));
+  bytes[bytes.size() / 2] = char(bytes[bytes.size() / 2] ^ 0x10);
+  std::ofstream(path("sun.plt"), std::ios::binary | std::ios::trunc) << bytes;
+  test_support::expectError([&] { Relighter broken(loaded, path("sun.plv")); }, {"sun.plt", "corrupt"});
+  // No .plv: said at once, naming it.
+  test_support::expectError([&] { Relighter none(loaded, path("none.plv")); }, {"none.plv", "does not exist"});
 }
 
 }  // namespace
