@@ -34,8 +34,8 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, const AlbedoPoint& p)
 
 Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, const AlbedoPoint& p) {
   const Material& m = scene.materials[material];
-  // With a metallic-roughness texture: the point's model's diffuse albedo (its k(μ) stays the
-  // material model's, which the stored Ẽ was gathered with).
+  // With a metallic-roughness texture: the point's model's diffuse albedo (the renderers take
+  // its k(μo) too, glossyDiffuseReflectanceAt).
   if (m.metallicRoughness.texture >= 0) return diffuseAlbedo(materialModelAt(scene, m, p));
   const Rgb rho = diffuseAlbedo(m.bsdf);
   return m.albedoVaries() ? rho * albedoModulation(scene, m, p) : rho;

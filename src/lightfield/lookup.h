@@ -663,8 +663,8 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
 ///   Σ_l f(wo, wi_l) · E_l · |cos θ_l| · T_l
 /// with f the chart's model without its diffuse part when the chart keeps Ẽ (Chart::
 /// diffuseValue; the model the maps hold otherwise) — with a metallic-roughness texture the
-/// hit point's own model (materialModelAt), as in the path tracer — in the scattering frame of the shading
-/// normal at the hit (normal map included), E_l the light's irradiance normal to wi_l and T_l
+/// hit point's own model (materialModelAt), as in the path tracer — in the scattering frame
+/// of the shading normal at the hit (normal map included), E_l the light's irradiance normal to wi_l and T_l
 /// its shadow ray's transmittance (ShadowRays) — the path tracer's next-event estimation of
 /// that light, term for term. Both renderers add it to their lookups. Mirror-like charts
 /// (Specular records of a glossy model, bake/parameterisation.h isMirrorLike), which no
