@@ -252,7 +252,7 @@ Chart frameChart(const Scene& scene, const TriangleList& list, bool grewCurved, 
   c.material = firstMaterial;
   const Bsdf& bsdf = scene.materials[firstMaterial].bsdf;
   c.kind = chartKindOf(bsdf, settings);
-  c.dirRes = directionalResolution(bsdf, settings);
+  c.dirRes = chartDirectionalResolution(scene, c, settings);
   // A glossy model with a diffuse part keeps that part's irradiance per tixel (lightfield.h).
   c.diffuseValue = c.kind == ChartKind::Glossy && !isBlack(diffuseAlbedo(bsdf));
   // A normal-mapped diffuse material, or glossy one with a diffuse part, keeps irradiances
@@ -442,6 +442,8 @@ void layOutTixels(const Scene& scene, const BakeSettings& settings, Parameterisa
   p.transportAlbedo.resize(p.tixelCount);
   if (std::any_of(p.charts.begin(), p.charts.end(), [&](const Chart& c) { return perTixelSpecularF0(scene, c); }))
     p.specularF0.resize(p.tixelCount);
+  if (std::any_of(p.charts.begin(), p.charts.end(), [&](const Chart& c) { return perTixelLobeWidth(scene, c); }))
+    p.lobeAlpha.resize(p.tixelCount);
   if (std::any_of(p.charts.begin(), p.charts.end(), [&](const Chart& c) { return texturedEmitter(scene, c); })) {
     p.emissionModulation.assign(p.tixelCount, Rgb(1.0f));
     p.emitterTriangle.resize(p.tixelCount);

@@ -81,6 +81,61 @@ uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings) {
   return std::min(wanted, isStrongNarrowLobe(bsdf, settings) ? kStrongNarrowLobeCapFactor * cap : cap);
 }
 
+uint32_t chartDirectionalResolution(const Scene& scene, const Chart& c, const BakeSettings& settings) {
+  const Bsdf& bsdf = scene.materials[c.material].bsdf;
+  const uint32_t res = directionalResolution(bsdf, settings);
+  if (c.kind != ChartKind::Glossy || !perTixelLobeWidth(scene, c)) return res;
+  const uint32_t cap = std::max<uint32_t>(2, settings.glossyDirRes);
+  const float finest = lobeAlphaRange(scene, scene.materials[c.material]).first;
+  return std::max(res, std::min(cap, lobeMapResolution(reflectedLobeWidth(withGgxLobeAlpha(bsdf, finest)))));
+}
+
+float ggxLobeAlpha(const Bsdf& bsdf) {
+  if (const auto* ggx = std::get_if<GgxBsdf>(&bsdf)) return ggx->alpha;
+  if (const auto* pbr = std::get_if<GltfPbrBsdf>(&bsdf)) return pbr->alpha;
+  return 0.0f;
+}
+
+Bsdf withGgxLobeAlpha(const Bsdf& bsdf, float alpha) {
+  Bsdf b = bsdf;
+  if (auto* ggx = std::get_if<GgxBsdf>(&b)) ggx->alpha = alpha;
+  if (auto* pbr = std::get_if<GltfPbrBsdf>(&b)) pbr->alpha = alpha;
+  return b;
+}
+
+std::pair<float, float> lobeAlphaRange(const Scene& scene, const Material& material) {
+  const MetallicRoughnessMap& mr = material.metallicRoughness;
+  if (mr.texture < 0) return {ggxLobeAlpha(material.bsdf), ggxLobeAlpha(material.bsdf)};
+  float lo = kInfinity, hi = 0.0f;
+  for (const Rgb& t : scene.textures[size_t(mr.texture)].image.pixels) {
+    const float alpha = ggxAlphaFromRoughness(std::clamp(mr.roughness * t.g, 0.0f, 1.0f));
+    lo = std::min(lo, alpha);
+    hi = std::max(hi, alpha);
+  }
+  return lo <= hi ? std::pair{lo, hi} : std::pair{ggxLobeAlpha(material.bsdf), ggxLobeAlpha(material.bsdf)};
+}
+
+std::vector<float> lobeAlphaBins(const Scene& scene, const Material& material, uint32_t dirRes) {
+  // One texel of an R-texel map spans ≈ 4/R radians (lobeMapResolution): a lobe of that FWHM
+  // has θh = 1/R, and GGX θh = atan(α·√(√2 − 1)) (bsdf.h lobeHalfWidth).
+  const float texelAlpha = std::tan(1.0f / float(std::max<uint32_t>(dirRes, 2))) / std::sqrt(std::sqrt(2.0f) - 1.0f);
+  auto [lo, hi] = lobeAlphaRange(scene, material);
+  lo = std::max(lo, texelAlpha);
+  hi = std::max(hi, lo);
+  const uint32_t count = std::min<uint32_t>(
+      kMaxLobeBins, 1 + uint32_t(std::ceil(std::log(hi / lo) / std::log(kLobeBinRatio) - 1e-4f)));
+  std::vector<float> bins(count, lo);
+  for (uint32_t i = 1; i < count; ++i) bins[i] = lo * std::pow(hi / lo, float(i) / float(count - 1));
+  return bins;
+}
+
+uint32_t nearestLobeBin(const std::vector<float>& bins, float alpha) {
+  // The first bin whose geometric midpoint with the next is above α.
+  uint32_t i = 0;
+  while (i + 1 < bins.size() && alpha * alpha > bins[i] * bins[i + 1]) ++i;
+  return i;
+}
+
 bool isStrongNarrowLobe(const Bsdf& bsdf, const BakeSettings& settings) {
   if (isDelta(bsdf) || isDiffuse(bsdf) || hasTransmission(bsdf)) return false;
   // Narrower than two thirds of a texel at the cap (a texel spans ≈ 4/R radians, so the lobe
@@ -450,6 +505,12 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
     return specularF0(materialModelAt(scene, material, albedoPointAt(scene, r.tris[tri].mesh, r.tris[tri].triangle,
                                                                        Vec2(bary[1], bary[2]))));
   };
+  // Per-tixel lobe widths: the point models' GGX α, averaged like the f0.
+  const bool tixelAlpha = perTixelLobeWidth(scene, c);
+  auto alphaOn = [&](uint32_t tri, const std::array<float, 3>& bary) {
+    return ggxLobeAlpha(materialModelAt(scene, material, albedoPointAt(scene, r.tris[tri].mesh, r.tris[tri].triangle,
+                                                                        Vec2(bary[1], bary[2]))));
+  };
   // A textured emitter's mean emission texture over each footprint, at full resolution.
   const bool emitterTextured = texturedEmitter(scene, c);
   auto emissionOn = [&](uint32_t tri, const std::array<float, 3>& bary) {
@@ -467,6 +528,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
       // Footprint: coverage and mean albedo over the sub-samples inside the polygon.
       int inside = 0;
       Rgb albedoSum(0.0f), emissionSum(0.0f), f0Sum(0.0f);
+      float alphaSum = 0.0f;
       // directionalIrradiance: the mapped normals (world, the record's side) at the samples.
       std::array<Vec3, kFootprintSamples * kFootprintSamples> mappedNormals;
       std::array<std::pair<float, FootprintSample>, kFootprintSamples * kFootprintSamples> insideSamples;
@@ -480,6 +542,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
           ++inside;
           if (textured) albedoSum += albedoOn(s.tri, s.bary);
           if (tixelF0) f0Sum += f0On(s.tri, s.bary);
+          if (tixelAlpha) alphaSum += alphaOn(s.tri, s.bary);
           if (emitterTextured) emissionSum += emissionOn(s.tri, s.bary);
           if (c.directionalIrradiance) {
             const SurfaceHit hit = surfaceAt(scene, r.tris[s.tri].mesh, r.tris[s.tri].triangle, Vec2(s.bary[1], s.bary[2]));
@@ -555,6 +618,7 @@ void fillChartTixels(const Scene& scene, const Accel& accel, const Chart& c,
         p.emitterTriangle[g] = {r.tris[s.tri].mesh, r.tris[s.tri].triangle};
       }
       if (tixelF0 && !r.tris.empty()) p.specularF0[g] = inside > 0 ? f0Sum / float(inside) : f0On(s.tri, s.bary);
+      if (tixelAlpha && !r.tris.empty()) p.lobeAlpha[g] = inside > 0 ? alphaSum / float(inside) : alphaOn(s.tri, s.bary);
       if (hasAlbedo) {
         if (!textured) {
           p.transportAlbedo[g] = constantAlbedo;

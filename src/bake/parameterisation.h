@@ -127,6 +127,11 @@ struct Parameterisation {
   /// models' lobe f0 (bsdf.h specularF0 of scene.h materialModelAt), which the bake's glossy
   /// maps take in place of the material model's (propagation.cpp GlossyMaterial).
   std::vector<Rgb> specularF0;
+  /// Glossy charts with per-tixel lobe widths (perTixelLobeWidth; empty when no chart has
+  /// them, other entries never read): the mean over the tixel's footprint of the point models'
+  /// GGX α (roughness² of the metallic-roughness texture × factor), which picks the tixel's
+  /// lobe among its material's α bins (lobeAlphaBins; propagation.cpp GlossyMaterial).
+  std::vector<float> lobeAlpha;
   /// Sun masks (lightfield.h "Sun masks"): the scene lights masked (sunMaskLights, or none
   /// when BakeSettings::sunMasks is off) and per tixel one mask per masked light (slots past
   /// their count unused; every bit set on glossy and specular charts).
@@ -179,6 +184,35 @@ inline bool perTixelSpecularF0(const Scene& scene, const Chart& c) {
   return c.kind == ChartKind::Glossy && scene.materials[c.material].metallicRoughness.texture >= 0;
 }
 
+/// The GGX α of model `bsdf` (GgxBsdf, GltfPbrBsdf: a glTF metallic-roughness model's), 0 for
+/// a model without one; and the model with its α replaced.
+float ggxLobeAlpha(const Bsdf& bsdf);
+Bsdf withGgxLobeAlpha(const Bsdf& bsdf, float alpha);
+
+/// Whether chart c's tixels take their own lobe width (Parameterisation::lobeAlpha): a chart
+/// with its own lobe f0 (perTixelSpecularF0) whose model has a GGX α and transmits nothing.
+inline bool perTixelLobeWidth(const Scene& scene, const Chart& c) {
+  const Bsdf& bsdf = scene.materials[c.material].bsdf;
+  return perTixelSpecularF0(scene, c) && ggxLobeAlpha(bsdf) > 0.0f && !hasTransmission(bsdf);
+}
+
+/// The GGX α of a metallic-roughness texel of `material`: ggxAlphaFromRoughness(roughness
+/// factor × G), as materialModelAt makes it. lobeAlphaRange: its least and greatest over the
+/// texture's texels (the material's finest and widest lobes).
+std::pair<float, float> lobeAlphaRange(const Scene& scene, const Material& material);
+
+/// Neighbouring α bins are at most this ratio apart (a tixel's α within ±12 % of its bin's).
+inline constexpr float kLobeBinRatio = 1.25f;
+/// At most this many α bins per material (each costs the bake one or two glossy operators).
+inline constexpr uint32_t kMaxLobeBins = 16;
+/// The α bins of a material with per-tixel lobe widths on charts of map resolution dirRes:
+/// geometric from the texture's least α to its greatest (lobeAlphaRange), at most
+/// kLobeBinRatio apart, with α below one map texel's lobe (FWHM 4/dirRes radians: GGX
+/// α = tan(1/dirRes)/√(√2 − 1)) raised to it — the map holds all narrower lobes alike.
+std::vector<float> lobeAlphaBins(const Scene& scene, const Material& material, uint32_t dirRes);
+/// The bin (index into `bins`, ascending) nearest α, by ratio.
+uint32_t nearestLobeBin(const std::vector<float>& bins, float alpha);
+
 /// The radiance tixel `tixel` of chart record c emits towards a direction with cosine
 /// cosTheta against the record's normal: chartEmittedRadiance (lightfield.h) times the tixel's
 /// mean emission texture on a textured emitter. The bake's gather and glossy emission.
@@ -221,6 +255,10 @@ bool mayGrowCurvedCharts(const Material& material, const BakeSettings& settings)
 /// of its lobe, capped by settings.glossyDirRes, or by kStrongNarrowLobeCapFactor × that for
 /// a strong narrow lobe, isStrongNarrowLobe).
 uint32_t directionalResolution(const Bsdf& bsdf, const BakeSettings& settings);
+/// A glossy chart's map resolution: directionalResolution of the material's model, or with
+/// per-tixel lobe widths (perTixelLobeWidth) at least lobeMapResolution of its finest lobe
+/// (lobeAlphaRange), capped by settings.glossyDirRes.
+uint32_t chartDirectionalResolution(const Scene& scene, const Chart& c, const BakeSettings& settings);
 /// A glossy lobe is narrow when lobeMapResolution asks for more than this many times the
 /// preset's cap: narrower than two thirds of a texel of the capped map.
 inline constexpr uint32_t kStrongNarrowLobeTexels = 6;

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 #include <string>
 #include <utility>
@@ -353,6 +354,43 @@ TEST(Parameterisation, StrongNarrowLobesGetTwiceTheCap) {
   EXPECT_FALSE(isStrongNarrowLobe(DielectricBsdf{1.5f, Rgb(1.0f), 0.0025f}, settings));
   EXPECT_FALSE(isStrongNarrowLobe(MirrorBsdf{}, settings));
   EXPECT_FALSE(isStrongNarrowLobe(LambertBsdf{}, settings));
+}
+
+// Per-tixel lobe widths (lobeAlphaBins): the α bins of a metallic-roughness texture whose
+// roughness runs 0.1 → 1 span its α range geometrically, neighbours at most kLobeBinRatio
+// apart, from one map texel's lobe (α below it raised to it) up to α = 1; a tixel takes the
+// bin nearest its α by ratio.
+TEST(Parameterisation, LobeAlphaBinsSpanTheTextureFromOneMapTexel) {
+  Scene scene;
+  Texture ramp;
+  ramp.decode = ImageDecode::Data;
+  ramp.image = Image(2, 1);
+  ramp.image.at(0, 0) = Rgb(0.0f, 0.1f, 1.0f);
+  ramp.image.at(1, 0) = Rgb(0.0f, 1.0f, 1.0f);
+  scene.textures.push_back(ramp);
+  Material metal;
+  metal.bsdf = gltfMetallicRoughnessModel(Rgb(0.8f), 1.0f, 0.7f);
+  metal.metallicRoughness = {0, TextureMapping{}, Rgb(0.8f), 1.0f, 1.0f};
+  const auto [least, greatest] = lobeAlphaRange(scene, metal);
+  EXPECT_FLOAT_EQ(least, ggxAlphaFromRoughness(0.1f));
+  EXPECT_FLOAT_EQ(greatest, 1.0f);
+  for (uint32_t dirRes : {8u, 16u}) {
+    const std::vector<float> bins = lobeAlphaBins(scene, metal, dirRes);
+    const float texelAlpha = std::tan(1.0f / float(dirRes)) / std::sqrt(std::sqrt(2.0f) - 1.0f);
+    ASSERT_GE(bins.size(), 2u);
+    EXPECT_LE(bins.size(), kMaxLobeBins);
+    EXPECT_NEAR(bins.front(), texelAlpha, 1e-6f);
+    EXPECT_NEAR(bins.back(), 1.0f, 1e-5f);
+    for (size_t i = 1; i < bins.size(); ++i) EXPECT_LE(bins[i] / bins[i - 1], kLobeBinRatio * 1.0001f);
+    // Bins more than needed would cost operators: one fewer would be too far apart.
+    EXPECT_GT(std::pow(1.0f / texelAlpha, 1.0f / float(bins.size() - 2)), kLobeBinRatio);
+    EXPECT_EQ(nearestLobeBin(bins, 0.001f), 0u);
+    EXPECT_EQ(nearestLobeBin(bins, 2.0f), bins.size() - 1);
+    for (uint32_t i = 0; i < bins.size(); ++i) {
+      EXPECT_EQ(nearestLobeBin(bins, bins[i] * 1.05f), i);
+      EXPECT_EQ(nearestLobeBin(bins, bins[i] / 1.05f), i);
+    }
+  }
 }
 
 TEST(Parameterisation, MapResolutionFollowsTheLobeWidth) {

@@ -164,6 +164,20 @@ struct GlossyMaterial {
   // of the model depends on it — so that a tixel of f0 f reflects op·L + f ⊙ (f0Slope·L).
   bool tixelF0 = false;
   SparseOperator f0Slope;
+  /// The lobe's model: the material's, or a bin's (below) with the bin's α. The first shot
+  /// evaluates it (its diffuse part's k(μ) too).
+  Bsdf model;
+  // Per-tixel lobe widths (perTixelLobeWidth): the material's α bins (lobeAlphaBins,
+  // ascending) and per bin the operators above built for the material's model with the bin's
+  // α (outputs, centres and projectedSolidAngle stay the material's). A tixel takes the bin
+  // nearest its Parameterisation::lobeAlpha (lobeAt); the material's own operators are then
+  // not built.
+  std::vector<float> binAlpha;
+  std::vector<GlossyMaterial> bins;
+  /// The operators of tixel g's lobe: its bin's, or the material's.
+  const GlossyMaterial& lobeAt(const Parameterisation& param, uint64_t g) const {
+    return bins.empty() ? *this : bins[nearestLobeBin(binAlpha, param.lobeAlpha[g])];
+  }
   /// out[c] += Lo(c), the chart's reflection of incoming radiance (and its sum) at tixel g.
   void reflect(const Chart& c, const Parameterisation& param, uint64_t g, const Lanes4* incoming, F4 incomingSum,
                Rgb* out) const {
@@ -420,6 +434,30 @@ void addDiffusePart(GlossyMaterial& g, const Bsdf& bsdf, uint32_t gridSide) {
   g.diffuseExitance = total * kInvPi;
 }
 
+/// g's operators for one lobe of model `bsdf` on glossy chart c (GlossyMaterial): the
+/// reflection (with the per-tixel f0 slope where the tixels keep their own f0), the diffuse
+/// part's weights, and a narrow lobe's cell-constant BSDF.
+void buildGlossyLobe(GlossyMaterial& g, const Scene& scene, const Chart& c, const Bsdf& bsdf, uint32_t gridSide) {
+  const uint32_t n = gridSide * gridSide;
+  g.dirRes = c.dirRes;
+  g.model = bsdf;
+  if (c.diffuseValue) addDiffusePart(g, bsdf, gridSide);
+  const Bsdf& mapped = g.diffuse ? g.specular : bsdf;
+  g.tixelF0 = perTixelSpecularF0(scene, c) && !isNarrowLobe(mapped, gridSide) && !hasTransmission(mapped);
+  std::vector<Rgb> dense = glossyOperator(g.tixelF0 ? withSpecularF0(mapped, Rgb(0.0f)) : mapped, c.dirRes, gridSide);
+  g.op = SparseOperator::fromDense(dense, c.dirRes * c.dirRes, n);
+  if (g.tixelF0) {
+    std::vector<Rgb> slope = glossyOperator(withSpecularF0(mapped, Rgb(1.0f)), c.dirRes, gridSide);
+    for (size_t e = 0; e < slope.size(); ++e) slope[e] -= dense[e];
+    g.f0Slope = SparseOperator::fromDense(slope, c.dirRes * c.dirRes, n);
+  }
+  if (isNarrowLobe(mapped, gridSide)) {
+    for (Rgb& w : dense) w *= float(n) * kInvPi;
+    g.cellBsdf = std::move(dense);
+    g.gridSide = gridSide;
+  }
+}
+
 }  // namespace
 
 bool isNarrowLobe(const Bsdf& bsdf, uint32_t gridSide) {
@@ -543,7 +581,8 @@ double exitance(const TransportState& state, const Rgb* values, uint64_t g, cons
   const GlossyMaterial& gm = state.ops->glossy[c.material];
   for (uint32_t t = 0; t < c.directionTexels(); ++t) sum += double(luminance(values[t])) * gm.projectedSolidAngle[t];
   if (c.diffuseValue)
-    sum += double(luminance(state.param.transportAlbedo[g] * values[c.directionTexels()] * gm.diffuseExitance));
+    sum += double(luminance(state.param.transportAlbedo[g] * values[c.directionTexels()] *
+                            gm.lobeAt(state.param, g).diffuseExitance));
   return sum;
 }
 // |change| of that exitance from `before` to `after`, texel by texel (so that changes of
@@ -555,7 +594,7 @@ float exitanceChange(const TransportState& state, const Rgb* before, const Rgb* 
   for (uint32_t t = 0; t < c.directionTexels(); ++t) sum += std::abs(luminance(after[t] - before[t])) * gm.projectedSolidAngle[t];
   if (c.diffuseValue) {
     const uint64_t d = c.directionTexels();
-    sum += std::abs(luminance(state.param.transportAlbedo[g] * (after[d] - before[d]) * gm.diffuseExitance));
+    sum += std::abs(luminance(state.param.transportAlbedo[g] * (after[d] - before[d]) * gm.lobeAt(state.param, g).diffuseExitance));
   }
   return sum;
 }
@@ -578,12 +617,16 @@ Rgb transportIrradiance(const Parameterisation& param, const Chart& c, uint64_t 
 /// tixels (ρ̄ the transport albedo, Ẽ transportIrradiance's; as the diffuse quads interpolate ρ̄·E).
 Rgb glossyDiffuseRadiance(const TransportState& state, const Rgb* values, const Chart& c, Vec2 grid, Vec2 st) {
   const std::vector<Rgb>& albedo = state.param.transportAlbedo;
+  const float cosine = paraboloidToDirection(st).z;
+  const GlossyMaterial& gm = state.ops->glossy[c.material];
+  const bool perTixel = !gm.bins.empty();  // per-tixel lobe widths: each tixel's k(μo) its own lobe's
   const F4 e = bilinearOverTixels(c, grid, [&](uint32_t i, uint32_t j) {
     const uint64_t tixel = c.firstTixel + uint64_t(j) * c.resU + i;
-    return f4FromRgb(albedo[tixel] * transportIrradiance(state.param, c, tixel, &values[c.diffuseValueIndex(i, j)]));
+    const Rgb radiance = albedo[tixel] * transportIrradiance(state.param, c, tixel, &values[c.diffuseValueIndex(i, j)]);
+    return f4FromRgb(perTixel ? radiance * diffuseDirectionalFactor(gm.lobeAt(state.param, tixel).model, cosine) : radiance);
   });
-  const Bsdf& bsdf = state.scene.materials[c.material].bsdf;
-  return f4Rgb(e) * kInvPi * diffuseDirectionalFactor(bsdf, paraboloidToDirection(st).z);
+  const Rgb factor = perTixel ? Rgb(1.0f) : diffuseDirectionalFactor(state.scene.materials[c.material].bsdf, cosine);
+  return f4Rgb(e) * kInvPi * factor;
 }
 
 /// The weight of light arriving at cos θ = `cosine` to tilted normal b_k in chart c's tilted
@@ -664,22 +707,16 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   for (const Chart& c : param.charts) {
     if (c.kind != ChartKind::Glossy || glossy[c.material].dirRes != 0) continue;
     GlossyMaterial& g = glossy[c.material];
-    g.dirRes = c.dirRes;
     const Bsdf& bsdf = scene.materials[c.material].bsdf;
-    if (c.diffuseValue) addDiffusePart(g, bsdf, gridSide);
-    const Bsdf& mapped = g.diffuse ? g.specular : bsdf;
-    g.tixelF0 = perTixelSpecularF0(scene, c) && !isNarrowLobe(mapped, gridSide) && !hasTransmission(mapped);
-    std::vector<Rgb> dense = glossyOperator(g.tixelF0 ? withSpecularF0(mapped, Rgb(0.0f)) : mapped, c.dirRes, gridSide);
-    g.op = SparseOperator::fromDense(dense, c.dirRes * c.dirRes, n);
-    if (g.tixelF0) {
-      std::vector<Rgb> slope = glossyOperator(withSpecularF0(mapped, Rgb(1.0f)), c.dirRes, gridSide);
-      for (size_t e = 0; e < slope.size(); ++e) slope[e] -= dense[e];
-      g.f0Slope = SparseOperator::fromDense(slope, c.dirRes * c.dirRes, n);
-    }
-    if (isNarrowLobe(mapped, gridSide)) {
-      for (Rgb& w : dense) w *= float(n) * kInvPi;
-      g.cellBsdf = std::move(dense);
-      g.gridSide = gridSide;
+    if (perTixelLobeWidth(scene, c)) {
+      g.dirRes = c.dirRes;
+      g.model = bsdf;
+      g.binAlpha = lobeAlphaBins(scene, scene.materials[c.material], c.dirRes);
+      g.bins.resize(g.binAlpha.size());
+      for (size_t b = 0; b < g.bins.size(); ++b)
+        buildGlossyLobe(g.bins[b], scene, c, withGgxLobeAlpha(bsdf, g.binAlpha[b]), gridSide);
+    } else {
+      buildGlossyLobe(g, scene, c, bsdf, gridSide);
     }
     if (isRoughGlassChart(c, scene.materials[c.material].bsdf)) addGlassOperators(g, scene.materials[c.material].bsdf, gridSide);
     const std::vector<float>& omega = paraboloidTexelSolidAngles(c.dirRes);
@@ -958,29 +995,31 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
         direct[vb] += p.irradiance;
         if (c.directionalIrradiance) addTiltedIrradiance(scene, param, c, p.tixel, p.wi, p.irradiance, &direct[vb + 1]);
       } else {
-        const GlossyMaterial& gm = glossy[c.material];
-        const Bsdf& bsdf = scene.materials[c.material].bsdf;
+        const GlossyMaterial& gm = glossy[c.material];  // its texel directions
+        const GlossyMaterial& lobe = gm.lobeAt(param, p.tixel);
+        const Bsdf& bsdf = lobe.model;
         const Chart* glass = isRoughGlassChart(c, bsdf) ? &c : nullptr;
         const Vec3 wiLocal = tixelFrame(param, c, p.tixel).toLocal(p.wi);  // the map's frame (a curved chart's own)
         // Delta lights: the BSDF averaged over each output texel (a delta light would
         // otherwise alias between texel centres). Area-light samples are many per tixel and
         // already spread over the emitter: the texel-centre value suffices and costs 9× less.
         // The maps get the model without its diffuse part when the tixel keeps that part's Ẽ.
-        const Bsdf mapped = gm.mappedAt(gm.diffuse ? gm.specular : bsdf, param, p.tixel);
+        const Bsdf mapped = lobe.mappedAt(lobe.diffuse ? lobe.specular : bsdf, param, p.tixel);
         // A delta light's highlight on a reflecting glossy chart is also noted apart, to be
         // taken out of the stored maps at the end (punctualGlossy).
         const bool highlight = !p.areaSample && !glass && !punctualGlossy.empty();
-        const Rgb* cellBsdf =
-            gm.cellBsdf.empty() || !(wiLocal.z > 0.0f) ? nullptr : gm.cellBsdf.data() + gatherCellOf(wiLocal, gm.gridSide);
+        const Rgb* cellBsdf = lobe.cellBsdf.empty() || !(wiLocal.z > 0.0f)
+                                  ? nullptr
+                                  : lobe.cellBsdf.data() + gatherCellOf(wiLocal, lobe.gridSide);
         for (uint32_t t = 0; t < c.directionTexels(); ++t) {
-          const Rgb reflected = (cellBsdf                ? cellBsdf[size_t(t) * gm.gridSide * gm.gridSide]
+          const Rgb reflected = (cellBsdf                ? cellBsdf[size_t(t) * lobe.gridSide * lobe.gridSide]
                                  : p.areaSample ? recordEval(mapped, glass, gm.centres[t], wiLocal)
                                                 : texelAverageBsdf(mapped, gm.outputs[t], wiLocal, glass)) *
                                 p.irradiance;
           direct[vb + t] += reflected;
           if (highlight) punctualGlossy[vb + t] += reflected;
         }
-        if (gm.diffuse) direct[vb + c.directionTexels()] += diffuseDirectionalFactor(bsdf, wiLocal.z) * p.irradiance;
+        if (lobe.diffuse) direct[vb + c.directionTexels()] += diffuseDirectionalFactor(bsdf, wiLocal.z) * p.irradiance;
         if (c.directionalIrradiance)
           addTiltedIrradiance(scene, param, c, p.tixel, p.wi, p.irradiance, &direct[vb + c.directionTexels() + 1]);
       }
@@ -1100,8 +1139,9 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
         direct[vb] += sum * (kPi / float(n));
         if (c.directionalIrradiance) addTiltedGather(state, c, g, incoming.data(), subCells, &direct[vb + 1]);
       } else {
-        glossy[c.material].reflect(c, param, g, incoming.data(), f4FromRgb(sum), direct.data() + vb);
-        glossy[c.material].addDiffuse(c, incoming.data(), direct.data() + vb);
+        const GlossyMaterial& gm = glossy[c.material].lobeAt(param, g);
+        gm.reflect(c, param, g, incoming.data(), f4FromRgb(sum), direct.data() + vb);
+        gm.addDiffuse(c, incoming.data(), direct.data() + vb);
         if (c.directionalIrradiance)
           addTiltedGather(state, c, g, incoming.data(), subCells, direct.data() + vb + c.directionTexels() + 1);
       }
@@ -1296,7 +1336,7 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
       } else {
         Rgb* out = current.data() + vb;
         std::copy_n(direct.data() + vb, c.valuesPerTixel(), out);
-        const GlossyMaterial& gm = glossy[c.material];
+        const GlossyMaterial& gm = glossy[c.material].lobeAt(param, g);
         gm.reflect(c, param, g, incoming.data(), sum, out);
         gm.addDiffuse(c, incoming.data(), out);
         if (c.directionalIrradiance) addTiltedGather(state, c, g, incoming.data(), subCells, out + c.directionTexels() + 1);

@@ -178,6 +178,7 @@ TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, P
   exchange(param.coverage);
   exchange(param.transportAlbedo);
   if (!param.specularF0.empty()) exchange(param.specularF0);
+  if (!param.lobeAlpha.empty()) exchange(param.lobeAlpha);
   exchange(param.sunMask);
   exchange(param.borrowedPoint);
   timing.exchangeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - filled).count();

@@ -34,11 +34,16 @@ Rgb diffuseAlbedoAt(const Scene& scene, uint32_t material, const AlbedoPoint& p)
 
 Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, const AlbedoPoint& p) {
   const Material& m = scene.materials[material];
-  // With a metallic-roughness texture: the point's model's diffuse albedo (its k(μ) stays the
-  // material model's, which the stored Ẽ was gathered with).
+  // With a metallic-roughness texture: the point's model's diffuse albedo (the renderers take
+  // its k(μo) too, glossyDiffuseReflectanceAt).
   if (m.metallicRoughness.texture >= 0) return diffuseAlbedo(materialModelAt(scene, m, p));
   const Rgb rho = diffuseAlbedo(m.bsdf);
   return m.albedoVaries() ? rho * albedoModulation(scene, m, p) : rho;
+}
+
+Rgb glossyDiffuseReflectanceAt(const Scene& scene, uint32_t material, const AlbedoPoint& p, float cosViewer) {
+  const Bsdf model = materialModelAt(scene, scene.materials[material], p);
+  return diffuseAlbedo(model) * diffuseDirectionalFactor(model, cosViewer) * kInvPi;
 }
 
 namespace {
@@ -228,8 +233,16 @@ Rgb PunctualHighlights::radiance(uint32_t chart, const RayHit& hit, const Vec3& 
   // A specular chart's only when mirror-like (a mirror's are 0).
   if (c.kind == ChartKind::Specular ? !isMirrorLikeRecord(c, model) : !glossyCharts_) return Rgb(0.0f);
   if (isRoughGlassChart(c, model)) return Rgb(0.0f);  // rough glass keeps them in its maps
-  // The model the maps hold (the bake's first shot: without the diffuse part when Ẽ keeps it).
-  const Bsdf& bsdf = c.diffuseValue ? withoutDiffuse_[c.material] : model;
+  // The model the maps hold (the bake's first shot: without the diffuse part when Ẽ keeps it);
+  // with a metallic-roughness texture the point's own, as the path tracer's bsdfAt makes it.
+  const bool perPoint = scene.materials[c.material].metallicRoughness.texture >= 0;
+  Bsdf pointModel;
+  if (perPoint) {
+    pointModel = materialModelAt(scene, scene.materials[c.material],
+                                 albedoPointAt(scene, hit.mesh, hit.triangle, hit.barycentrics));
+    if (c.diffuseValue) pointModel = withDiffuseAlbedo(pointModel, Rgb(0.0f));
+  }
+  const Bsdf& bsdf = perPoint ? pointModel : c.diffuseValue ? withoutDiffuse_[c.material] : model;
   const SurfaceHit surface = surfaceAt(scene, hit.mesh, hit.triangle, hit.barycentrics);
   const ScatteringFrame scattering = scatteringFrame(surface, towardsViewer, bsdf);  // the sidedness rule (scene.h)
   const auto& [geometricNormal, frame, woLocal] = scattering;

@@ -168,6 +168,10 @@ inline constexpr float kFullResolution = 0.0f;
 /// whose diffuse term is ρ/π · k(μo) · k(μi). With a metallic-roughness texture the diffuse
 /// albedo is baseColor × modulation × (1 − metalness) at the point (MetallicRoughnessMap).
 Rgb glossyDiffuseAlbedoAt(const Scene& scene, uint32_t material, const AlbedoPoint& p);
+/// A glossy chart's diffuse part per unit Ẽ at albedo point p towards a viewer at cosine μo, for
+/// a material with a metallic-roughness texture: ρ(p)/π · k(μo) of the point's model
+/// (materialModelAt), its k of the point's own roughness as in the path tracer.
+Rgb glossyDiffuseReflectanceAt(const Scene& scene, uint32_t material, const AlbedoPoint& p, float cosViewer);
 
 /// The mip level a light-field renderer reads an albedo texture at, by ray cones
 /// (Akenine-Möller et al., "Texture Level of Detail Strategies for Real-Time Ray Tracing",
@@ -530,11 +534,13 @@ inline F4 exitantRadianceLanes(const Scene& scene, const Chart& c, const ChartSh
   F4 irradiance = bilinearOverTixels(c, grid, [&](uint32_t i, uint32_t j) { return load(c.diffuseValueIndex(i, j)); });
   if (c.directionalIrradiance)
     irradiance = mappedNormalIrradiance(load, c, grid, irradiance, tiltFrameAround(c, lookupNormal).toLocal(mappedNormal));
+  // k(μo), μo against the mapped normal on a normal-mapped chart (the path tracer's shading frame).
+  const float cosViewer = shading.normalMapped ? glm::dot(worldDirectionTowardsViewer, mappedNormal) : local.z;
+  if (shading.texturedAlbedo && scene.materials[c.material].metallicRoughness.texture >= 0)
+    return f4Add(mapped, f4Mul(f4FromRgb(glossyDiffuseReflectanceAt(scene, c.material, albedo, cosViewer)), irradiance));
   const F4 albedoOverPi = shading.texturedAlbedo
                               ? f4Mul(f4FromRgb(glossyDiffuseAlbedoAt(scene, c.material, albedo)), f4Splat(kInvPi))
                               : f4Load(shading.albedoOverPi.v);
-  // k(μo), μo against the mapped normal on a normal-mapped chart (the path tracer's shading frame).
-  const float cosViewer = shading.normalMapped ? glm::dot(worldDirectionTowardsViewer, mappedNormal) : local.z;
   const F4 factor = f4FromRgb(diffuseDirectionalFactor(scene.materials[c.material].bsdf, cosViewer));
   return f4Add(mapped, f4Mul(f4Mul(albedoOverPi, factor), irradiance));
 }
@@ -656,8 +662,9 @@ inline void exitantRadianceDiffuse4(const Scene& scene, const Chart& c, const Ch
 /// highlights"): at a hit on a reflecting glossy chart record,
 ///   Σ_l f(wo, wi_l) · E_l · |cos θ_l| · T_l
 /// with f the chart's model without its diffuse part when the chart keeps Ẽ (Chart::
-/// diffuseValue; the model the maps hold otherwise), in the scattering frame of the shading
-/// normal at the hit (normal map included), E_l the light's irradiance normal to wi_l and T_l
+/// diffuseValue; the model the maps hold otherwise) — with a metallic-roughness texture the
+/// hit point's own model (materialModelAt), as in the path tracer — in the scattering frame
+/// of the shading normal at the hit (normal map included), E_l the light's irradiance normal to wi_l and T_l
 /// its shadow ray's transmittance (ShadowRays) — the path tracer's next-event estimation of
 /// that light, term for term. Both renderers add it to their lookups. Mirror-like charts
 /// (Specular records of a glossy model, bake/parameterisation.h isMirrorLike), which no

@@ -1,8 +1,8 @@
 #pragma once
 // Compressed glTF meshes, each codec behind its own file with its library: Draco
 // (KHR_draco_mesh_compression, gltf_draco.cpp, libdraco) and meshoptimizer
-// (EXT_meshopt_compression, gltf_meshopt.cpp, libmeshoptimizer). Both libraries are optional
-// at configure time; a build without one refuses such files with "built without … support".
+// (EXT_meshopt_compression and KHR_meshopt_compression, gltf_meshopt.cpp, libmeshoptimizer).
+// Both libraries are optional at configure time; a build without one refuses such files with "built without … support".
 // Internal to the scene module (gltf_loader.cpp is the only caller).
 #include <cstddef>
 #include <cstdint>
@@ -33,11 +33,15 @@ struct DracoPrimitive {
 DracoPrimitive decodeDraco(std::span<const unsigned char> bytes, const std::map<std::string, int>& attributes,
                            const std::map<std::string, int>& components, const std::string& label);
 
-/// EXT_meshopt_compression's parameters of one buffer view.
+/// The parameters of one buffer view compressed by EXT_meshopt_compression or its ratified
+/// successor KHR_meshopt_compression (`extension` names which, for messages). The KHR one adds
+/// the attribute codec's version 1 (header byte 0xa1) and the COLOR filter (YCoCg); a build
+/// whose meshoptimizer predates them (0.23 and 0.25) refuses them by name.
 struct MeshoptView {
+  std::string extension;  ///< "EXT_meshopt_compression" or "KHR_meshopt_compression"
   size_t count = 0, byteStride = 0;
   std::string mode;    ///< "ATTRIBUTES", "TRIANGLES" or "INDICES"
-  std::string filter;  ///< "NONE", "OCTAHEDRAL", "QUATERNION" or "EXPONENTIAL"
+  std::string filter;  ///< "NONE", "OCTAHEDRAL", "QUATERNION", "EXPONENTIAL" or (KHR) "COLOR"
 };
 
 /// Decodes one compressed buffer view into count × byteStride bytes. Throws pl::Error starting

@@ -150,9 +150,20 @@ enum class MeshoptLayout {
              ///< buffer without uri declared larger than that chunk
 };
 
-/// The quad with EXT_meshopt_compression views: vertices (stride 12) and indices (TRIANGLES,
-/// stride 2), compressed; where they and the fallback are, `layout` says.
-std::string meshoptGltf(const fs::path& dir, bool damage, MeshoptLayout layout = MeshoptLayout::Files) {
+/// What meshoptGltf varies beyond the layout: the extension, the attribute streams' first
+/// byte (the codec version: 0xa0 as the encoder writes it, or another), the uv view's filter,
+/// and whether the vertex view names both extensions.
+struct MeshoptVariant {
+  std::string extension = "EXT_meshopt_compression";
+  int attributeHeader = -1;  ///< −1: as encoded
+  std::string uvFilter = "NONE";
+  bool bothExtensions = false;
+};
+
+/// The quad with meshopt-compressed views (`variant.extension`): vertices (stride 12), uvs
+/// (stride 8) and indices (TRIANGLES, stride 2); where they and the fallback are, `layout` says.
+std::string meshoptGltf(const fs::path& dir, bool damage, MeshoptLayout layout = MeshoptLayout::Files,
+                        const MeshoptVariant& variant = {}) {
   std::vector<unsigned char> vertices(meshopt_encodeVertexBufferBound(4, 12));
   vertices.resize(meshopt_encodeVertexBuffer(vertices.data(), vertices.size(), kPositions, 4, 12));
   std::vector<unsigned char> uvs(meshopt_encodeVertexBufferBound(4, 8));
@@ -160,6 +171,10 @@ std::string meshoptGltf(const fs::path& dir, bool damage, MeshoptLayout layout =
   std::vector<unsigned char> indices(meshopt_encodeIndexBufferBound(6, 4));
   indices.resize(meshopt_encodeIndexBuffer(indices.data(), indices.size(), kIndices, 6));
   if (damage) vertices.resize(vertices.size() / 2);
+  if (variant.attributeHeader >= 0) vertices[0] = uvs[0] = (unsigned char)(variant.attributeHeader);
+  const std::string& ext = variant.extension;
+  const std::string other = variant.bothExtensions ? R"(, "KHR_meshopt_compression": {"buffer": 0, "byteLength": 1,
+        "byteStride": 12, "count": 4, "mode": "ATTRIBUTES"})" : "";
   std::vector<unsigned char> all = vertices;
   all.insert(all.end(), uvs.begin(), uvs.end());
   all.insert(all.end(), indices.begin(), indices.end());
@@ -174,16 +189,16 @@ std::string meshoptGltf(const fs::path& dir, bool damage, MeshoptLayout layout =
   }
   const size_t v = vertices.size(), u = uvs.size(), i = indices.size();
   const std::string text = R"({"asset": {"version": "2.0"},
-    "extensionsUsed": ["EXT_meshopt_compression"], "extensionsRequired": ["EXT_meshopt_compression"],
+    "extensionsUsed": [")" + ext + R"("], "extensionsRequired": [")" + ext + R"("],
     "buffers": [{"byteLength": )" + std::to_string(all.size()) + streams + R"(},
-                {"byteLength": )" + fallbackLength + fallback + R"(, "extensions": {"EXT_meshopt_compression": {"fallback": true}}}],
+                {"byteLength": )" + fallbackLength + fallback + R"(, "extensions": {")" + ext + R"(": {"fallback": true}}}],
     "bufferViews": [
-      {"buffer": 1, "byteOffset": 0, "byteLength": 48, "byteStride": 12, "extensions": {"EXT_meshopt_compression":
-        {"buffer": 0, "byteOffset": 0, "byteLength": )" + std::to_string(v) + R"(, "byteStride": 12, "count": 4, "mode": "ATTRIBUTES"}}},
-      {"buffer": 1, "byteOffset": 48, "byteLength": 32, "byteStride": 8, "extensions": {"EXT_meshopt_compression":
+      {"buffer": 1, "byteOffset": 0, "byteLength": 48, "byteStride": 12, "extensions": {")" + ext + R"(":
+        {"buffer": 0, "byteOffset": 0, "byteLength": )" + std::to_string(v) + R"(, "byteStride": 12, "count": 4, "mode": "ATTRIBUTES"})" + other + R"(}},
+      {"buffer": 1, "byteOffset": 48, "byteLength": 32, "byteStride": 8, "extensions": {")" + ext + R"(":
         {"buffer": 0, "byteOffset": )" + std::to_string(v) + R"(, "byteLength": )" + std::to_string(u) +
-                           R"(, "byteStride": 8, "count": 4, "mode": "ATTRIBUTES"}}},
-      {"buffer": 1, "byteOffset": 80, "byteLength": 12, "extensions": {"EXT_meshopt_compression":
+                           R"(, "byteStride": 8, "count": 4, "mode": "ATTRIBUTES", "filter": ")" + variant.uvFilter + R"("}}},
+      {"buffer": 1, "byteOffset": 80, "byteLength": 12, "extensions": {")" + ext + R"(":
         {"buffer": 0, "byteOffset": )" + std::to_string(v + u) + R"(, "byteLength": )" + std::to_string(i) +
                            R"(, "byteStride": 2, "count": 6, "mode": "TRIANGLES"}}}],
     "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0,0,0], "max": [2,1,0]},
@@ -215,6 +230,46 @@ TEST(GltfCompression, MeshoptGlbWithAFallbackLargerThanItsBinaryChunkLoads) {
   expectQuad(loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/fuzz/gltf/seed-meshopt-fallback.glb"));
   expectError([&] { loadScene(meshoptGltf(dir, true, MeshoptLayout::Gltfpack)); },
               {"meshopt.glb", "buffer view 0", "EXT_meshopt_compression"});
+}
+
+// KHR_meshopt_compression, the ratified successor: the same views decode (its attribute codec
+// version 0 is EXT_meshopt_compression's bitstream), with the fallback as gltfpack writes it too.
+TEST(GltfCompression, KhrMeshoptQuadLoads) {
+  const fs::path dir = scratch("meshopt_khr");
+  const MeshoptVariant khr{.extension = "KHR_meshopt_compression"};
+  expectQuad(loadScene(meshoptGltf(dir, false, MeshoptLayout::Files, khr)));
+  expectQuad(loadScene(meshoptGltf(dir, false, MeshoptLayout::Gltfpack, khr)));
+  expectError([&] { loadScene(meshoptGltf(dir, true, MeshoptLayout::Files, khr)); },
+              {"meshopt.gltf", "buffer view 0", "KHR_meshopt_compression", "does not decode"});
+}
+
+// What the KHR extension adds beyond this build's meshoptimizer is refused by name: attribute
+// codec version 1 (0.23 decodes it) and the COLOR filter (0.25). The EXT extension has neither:
+// a version 1 stream or a COLOR filter there is an error of the file.
+TEST(GltfCompression, MeshoptModesOutsideTheExtensionOrTheLibraryAreRefusedByName) {
+  const fs::path dir = scratch("meshopt_modes");
+  const MeshoptVariant extV1{.attributeHeader = 0xa1};
+  expectError([&] { loadScene(meshoptGltf(dir, false, MeshoptLayout::Files, extV1)); },
+              {"meshopt.gltf", "buffer view 0", "version 1", "KHR_meshopt_compression's, not EXT_meshopt_compression's"});
+  const MeshoptVariant extColor{.uvFilter = "COLOR"};
+  expectError([&] { loadScene(meshoptGltf(dir, false, MeshoptLayout::Files, extColor)); },
+              {"meshopt.gltf", "buffer view 1", "unknown EXT_meshopt_compression filter 'COLOR'"});
+#if MESHOPTIMIZER_VERSION < 230
+  const MeshoptVariant khrV1{.extension = "KHR_meshopt_compression", .attributeHeader = 0xa1};
+  expectError([&] { loadScene(meshoptGltf(dir, false, MeshoptLayout::Files, khrV1)); },
+              {"meshopt.gltf", "buffer view 0", "KHR_meshopt_compression attribute codec version 1", "not supported"});
+#endif
+#if MESHOPTIMIZER_VERSION < 250
+  const MeshoptVariant khrColor{.extension = "KHR_meshopt_compression", .uvFilter = "COLOR"};
+  expectError([&] { loadScene(meshoptGltf(dir, false, MeshoptLayout::Files, khrColor)); },
+              {"meshopt.gltf", "buffer view 1", "KHR_meshopt_compression filter COLOR is not supported"});
+#endif
+  const MeshoptVariant unknown{.extension = "KHR_meshopt_compression", .uvFilter = "SPECTRAL"};
+  expectError([&] { loadScene(meshoptGltf(dir, false, MeshoptLayout::Files, unknown)); },
+              {"meshopt.gltf", "buffer view 1", "unknown KHR_meshopt_compression filter 'SPECTRAL'"});
+  const MeshoptVariant both{.bothExtensions = true};
+  expectError([&] { loadScene(meshoptGltf(dir, false, MeshoptLayout::Files, both)); },
+              {"meshopt.gltf", "buffer view 0", "both EXT_meshopt_compression and KHR_meshopt_compression"});
 }
 
 }  // namespace

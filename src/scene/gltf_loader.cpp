@@ -8,7 +8,8 @@
 //  * Triangle primitives (mode 4) with POSITION, optional NORMAL, TEXCOORD_0, TEXCOORD_1
 //    (kept only where a material reads it) and COLOR_0 (float, or normalised unsigned
 //    byte/short; with KHR_mesh_quantization also signed and unnormalised integers), indexed or
-//    not, KHR_draco_mesh_compression- or EXT_meshopt_compression-compressed or plain
+//    not, KHR_draco_mesh_compression-, EXT_meshopt_compression- or KHR_meshopt_compression-
+//    compressed or plain
 //    (gltf_compression.h). Other modes: warning, skipped. A texture slot reading a TEXCOORD set
 //    the primitive lacks is an error naming the mesh and the material.
 //  * Metallic-roughness materials → bsdf.h gltfMetallicRoughnessModel: the spec's
@@ -77,6 +78,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cstring>
 #include <filesystem>
@@ -97,9 +99,13 @@ constexpr double kLumensPerWatt = 683.0;
 
 constexpr const char* kDraco = "KHR_draco_mesh_compression";
 constexpr const char* kMeshopt = "EXT_meshopt_compression";
+/// The ratified successor of EXT_meshopt_compression: the same JSON, plus an attribute codec
+/// version and a filter (gltf_compression.h MeshoptView).
+constexpr const char* kMeshoptKhr = "KHR_meshopt_compression";
+constexpr std::array<const char*, 2> kMeshoptExtensions = {kMeshopt, kMeshoptKhr};
 
 /// The extensions this loader reads (docs/scenes.md): a file that requires another is refused.
-/// KHR_draco_mesh_compression and EXT_meshopt_compression join them where the build has their
+/// KHR_draco_mesh_compression, EXT_ and KHR_meshopt_compression join them where the build has their
 /// decoders (gltf_compression.h); a build without one refuses a file that requires it with the
 /// decoder's "built without … support", and reads the uncompressed fallback of one that only
 /// uses it.
@@ -111,7 +117,7 @@ const std::set<std::string>& supportedExtensions() {
                                    "KHR_materials_transmission", "KHR_materials_volume",
                                    "KHR_mesh_quantization",     "KHR_texture_transform"};
     if (dracoSupported()) names.insert(kDraco);
-    if (meshoptSupported()) names.insert(kMeshopt);
+    if (meshoptSupported()) names.insert(kMeshoptExtensions.begin(), kMeshoptExtensions.end());
     return names;
   }();
   return kSupported;
@@ -122,7 +128,7 @@ const std::set<std::string>& supportedExtensions() {
 void checkExtensions(const std::string& path, const tinygltf::Model& model) {
   const std::set<std::string>& supported = supportedExtensions();
   for (const std::string& name : model.extensionsRequired)
-    if (!supported.contains(name) && name != kDraco && name != kMeshopt)
+    if (!supported.contains(name) && name != kDraco && name != kMeshopt && name != kMeshoptKhr)
       fail("{}: the file requires the glTF extension '{}', which plenoptic does not support (supported: {})", path,
            name, fmt::join(supported, ", "));
   std::vector<std::string> ignored;
@@ -750,18 +756,25 @@ DracoPrimitive decodeDracoPrimitive(const GltfContext& ctx, const tinygltf::Valu
   return decoded;
 }
 
-/// Decodes every EXT_meshopt_compression buffer view into a buffer of its own and points the
-/// view at it, so that the accessors read plain data (gltf_compression.h). Without meshopt in
-/// the build the views keep their uncompressed fallback, unless the file requires the
-/// extension (then decodeMeshopt refuses).
+/// Decodes every EXT_meshopt_compression or KHR_meshopt_compression buffer view into a buffer
+/// of its own and points the view at it, so that the accessors read plain data
+/// (gltf_compression.h). Without meshopt in the build the views keep their uncompressed
+/// fallback, unless the file requires the extension (then decodeMeshopt refuses). A view may
+/// use one of the two, not both (the KHR extension's exclusion).
 void decodeMeshoptViews(const std::string& path, tinygltf::Model& model) {
-  const bool required = std::find(model.extensionsRequired.begin(), model.extensionsRequired.end(), kMeshopt) !=
-                        model.extensionsRequired.end();
+  auto required = [&](const char* name) {
+    return std::find(model.extensionsRequired.begin(), model.extensionsRequired.end(), name) !=
+           model.extensionsRequired.end();
+  };
   for (size_t v = 0; v < model.bufferViews.size(); ++v) {
-    auto it = model.bufferViews[v].extensions.find(kMeshopt);
-    if (it == model.bufferViews[v].extensions.end() || !(meshoptSupported() || required)) continue;
+    const auto& extensions = model.bufferViews[v].extensions;
+    if (extensions.contains(kMeshopt) && extensions.contains(kMeshoptKhr))
+      fail("{}: buffer view {} uses both {} and {}; a view may use one of them", path, v, kMeshopt, kMeshoptKhr);
+    const char* name = extensions.contains(kMeshoptKhr) ? kMeshoptKhr : kMeshopt;
+    auto it = extensions.find(name);
+    if (it == extensions.end() || !(meshoptSupported() || required(name))) continue;
     const tinygltf::Value& e = it->second;
-    const std::string label = fmt::format("{}: buffer view {} ({})", path, v, kMeshopt);
+    const std::string label = fmt::format("{}: buffer view {} ({})", path, v, name);
     auto integer = [&](const char* key, bool needed) -> size_t {
       if (!e.Has(key)) {
         if (needed) fail("{} lacks {}", label, key);
@@ -772,6 +785,7 @@ void decodeMeshoptViews(const std::string& path, tinygltf::Model& model) {
     };
     const size_t buffer = integer("buffer", true), offset = integer("byteOffset", false), length = integer("byteLength", true);
     MeshoptView view;
+    view.extension = name;
     view.byteStride = integer("byteStride", true);
     view.count = integer("count", true);
     view.mode = e.Has("mode") && e.Get("mode").IsString() ? e.Get("mode").Get<std::string>() : "";
@@ -1054,9 +1068,9 @@ bool patchDracoIndices(nlohmann::json& doc) {
   return patched;
 }
 
-/// An EXT_meshopt_compression fallback buffer (its extension says "fallback": true) may have
-/// no data at all: no `uri`, only a byteLength, the size of the uncompressed views it stands
-/// for. tinygltf refuses that — in a .gltf for the missing uri, in a .glb (what gltfpack
+/// An EXT_meshopt_compression or KHR_meshopt_compression fallback buffer (its extension says
+/// "fallback": true) may have no data at all: no `uri`, only a byteLength, the size of the
+/// uncompressed views it stands for. tinygltf refuses that — in a .gltf for the missing uri, in a .glb (what gltfpack
 /// writes) because the byteLength is larger than the binary chunk, which holds the compressed
 /// data. The fallback is never read where meshopt decodes (decodeMeshoptViews points every
 /// view at its decoded bytes), so in a build with meshopt each such buffer becomes a 3-byte
@@ -1067,9 +1081,13 @@ bool patchMeshoptFallbacks(nlohmann::json& doc) {
   for (nlohmann::json& buffer : doc["buffers"]) {
     if (!buffer.is_object() || buffer.contains("uri")) continue;
     const auto extensions = buffer.find("extensions");
-    if (extensions == buffer.end() || !extensions->is_object() || !extensions->contains(kMeshopt)) continue;
-    const nlohmann::json& meshopt = (*extensions)[kMeshopt];
-    if (!meshopt.is_object() || !meshopt.contains("fallback") || meshopt["fallback"] != true) continue;
+    if (extensions == buffer.end() || !extensions->is_object()) continue;
+    const bool fallback = std::any_of(kMeshoptExtensions.begin(), kMeshoptExtensions.end(), [&](const char* name) {
+      const auto meshopt = extensions->find(name);
+      return meshopt != extensions->end() && meshopt->is_object() && meshopt->contains("fallback") &&
+             (*meshopt)["fallback"] == true;
+    });
+    if (!fallback) continue;
     buffer["uri"] = "data:application/octet-stream;base64,AAAA";
     buffer["byteLength"] = 3;
     patched = true;
@@ -1096,7 +1114,9 @@ std::string patchedFile(const std::string& path, bool binary) {
   } else {
     text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
-  if (text.find(kDraco) == std::string::npos && text.find(kMeshopt) == std::string::npos) return "";
+  if (text.find(kDraco) == std::string::npos && text.find(kMeshopt) == std::string::npos &&
+      text.find(kMeshoptKhr) == std::string::npos)
+    return "";
   nlohmann::json doc = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (!doc.is_object()) return "";
   const bool draco = patchDracoIndices(doc);
