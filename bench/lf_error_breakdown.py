@@ -12,32 +12,21 @@ pixels within one pixel of where the reference's luminance exceeds --bright (def
 lamp of radiance 1 and its images) — and over the rest, and the N pixels (default 8) that carry
 most of the relMSE. Needs NumPy (Debian's python3-numpy)."""
 import argparse
+import os
+import sys
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from pfm import read_pfm_sized  # noqa: E402
 
 REC709 = np.array([0.2126, 0.7152, 0.0722])
 
 
-def read_pfm(path):
+def read_image(path):
     """A colour PFM as an (h, w, 3) float64 array, top row first."""
-    with open(path, "rb") as f:
-        data = f.read()
-    parts, pos = [], 0
-    while len(parts) < 4:  # "PF", width, height, scale
-        while data[pos:pos + 1].isspace():
-            pos += 1
-        start = pos
-        while not data[pos:pos + 1].isspace():
-            pos += 1
-        parts.append(data[start:pos].decode())
-    pos += 1
-    if parts[0] != "PF":
-        raise SystemExit(f"{path}: not a colour PFM")
-    w, h, scale = int(parts[1]), int(parts[2]), float(parts[3])
-    pixels = np.frombuffer(data[pos:pos + 12 * w * h], dtype="<f4" if scale < 0 else ">f4")
-    if pixels.size != 3 * w * h:
-        raise SystemExit(f"{path}: truncated ({pixels.size} of {3 * w * h} values)")
-    return pixels.reshape(h, w, 3)[::-1].astype(np.float64)
+    w, h, values = read_pfm_sized(path)
+    return np.array(values, dtype=np.float64).reshape(h, w, 3)[::-1]
 
 
 def main():
@@ -48,7 +37,7 @@ def main():
     ap.add_argument("--bright", type=float, default=0.2)
     ap.add_argument("--top", type=int, default=8)
     a = ap.parse_args()
-    lf, ref, var = read_pfm(a.lf), read_pfm(a.ref), read_pfm(a.refvar)
+    lf, ref, var = read_image(a.lf), read_image(a.ref), read_image(a.refvar)
     if lf.shape != ref.shape or var.shape != ref.shape:
         raise SystemExit(f"sizes differ: {lf.shape[1::-1]}, {ref.shape[1::-1]}, {var.shape[1::-1]}")
     ly, ry = lf @ REC709, ref @ REC709
