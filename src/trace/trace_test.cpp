@@ -501,6 +501,16 @@ TEST_F(TraceTest, SphereLightAboveLambertianPlaneIsThePointLightAtItsCentre) {
   }
 }
 
+/// A render of `camera` with `strategy`, `spp` samples per pixel and at most `maxDepth`
+/// scattering events (the default seed).
+TraceResult renderWith(const PathTracer& tracer, const Camera& camera, TraceStrategy strategy, int spp, int maxDepth) {
+  TraceSettings settings;
+  settings.spp = spp;
+  settings.maxDepth = maxDepth;
+  settings.strategy = strategy;
+  return tracer.render(camera, settings);
+}
+
 // A small sphere light reflected in sharp GGX metal (α = 0.0025, roughness 0.05), seen through
 // a thin tinted sheet: next-event estimation alone finds the reflection only when its point on
 // the sphere falls inside the narrow lobe, as rare bright samples; MIS also follows the
@@ -532,11 +542,7 @@ TEST_F(TraceTest, SphereLightInASharpLobeIsFoundByBsdfSamplingToo) {
   const TraceStrategy strategies[2] = {TraceStrategy::Mis, TraceStrategy::NeeOnly};
   double variance[2] = {0.0, 0.0}, mean = 0.0;
   for (int k = 0; k < 2; ++k) {
-    TraceSettings settings;
-    settings.spp = 512;
-    settings.maxDepth = 2;  // metal, sheet, sphere: the direct light through the sheet
-    settings.strategy = strategies[k];
-    results[k] = tracer.render(camera, settings);
+    results[k] = renderWith(tracer, camera, strategies[k], 512, 2);  // metal, sheet, sphere
     for (const Rgb& v : results[k].variance.pixels) variance[k] += v.r;
   }
   for (const Rgb& p : results[0].radiance.pixels) mean += p.r;
@@ -675,13 +681,8 @@ TEST_F(TraceTest, StrategiesAgreeThroughThinGlass) {
   const Camera camera(lookAt({0.0f, 0.9f, -0.6f}, {0, 0, 0}, {0, 1, 0}, 50.0f), 8, 8);
   TraceResult results[3];
   const TraceStrategy strategies[3] = {TraceStrategy::Mis, TraceStrategy::NeeOnly, TraceStrategy::BsdfOnly};
-  for (int k = 0; k < 3; ++k) {
-    TraceSettings settings;
-    settings.spp = 2048;
-    settings.maxDepth = 2;  // floor, sheet, light: the direct light through the sheet
-    settings.strategy = strategies[k];
-    results[k] = tracer.render(camera, settings);
-  }
+  for (int k = 0; k < 3; ++k)
+    results[k] = renderWith(tracer, camera, strategies[k], 2048, 2);  // floor, sheet, light: the direct light
   double mean = 0.0;
   for (const Rgb& p : results[0].radiance.pixels) mean += p.b;
   EXPECT_GT(mean / 64.0, 0.02) << "light must reach the floor through the sheet";  // measured 0.046
