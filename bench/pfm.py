@@ -6,6 +6,11 @@ import sys
 def read_pfm(path):
     """Colour PFM ('PF'): header lines, then float32 rows bottom to top. Returns the flat
     tuple of r, g, b values (row order as stored; irrelevant for image-wide sums)."""
+    return read_pfm_sized(path)[2]
+
+
+def read_pfm_sized(path):
+    """read_pfm's (width, height, values): the rows bottom to top, as stored."""
     with open(path, "rb") as f:
         data = f.read()
     parts, pos = [], 0
@@ -21,4 +26,6 @@ def read_pfm(path):
         sys.exit(f"{path}: not a colour PFM")
     w, h, scale = int(parts[1]), int(parts[2]), float(parts[3])
     fmt = ("<" if scale < 0 else ">") + "f" * (3 * w * h)
-    return struct.unpack(fmt, data[pos:pos + 12 * w * h])
+    if len(data) - pos < 12 * w * h:
+        sys.exit(f"{path}: truncated ({len(data) - pos} bytes of pixels, {12 * w * h} expected)")
+    return w, h, struct.unpack(fmt, data[pos:pos + 12 * w * h])

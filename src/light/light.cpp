@@ -258,9 +258,10 @@ Rgb nextEventEstimate(const LightSampler& lights, const ShadowRays& shadows, con
 
   const Rgb unweighted = visible * f * cosIn * light->incident / light->pdf;
   const bool mis = mode == NextEvent::Mis || mode == NextEvent::MisExceptDelta;
-  // Scene lights no BSDF-sampled ray finds count in full; sphere lights, which the caller of
-  // MisExceptDelta finds along its BSDF samples, are MIS-weighted as emitters are.
-  if (!mis || (light->nextEventOnly && mode != NextEvent::MisExceptDelta)) return unweighted;
+  // Delta lights, which no BSDF-sampled ray finds, count in full; sphere lights, which the
+  // callers of Mis and MisExceptDelta find along their BSDF samples (sphereLightAlong), are
+  // MIS-weighted as emitters are.
+  if (!mis || light->delta) return unweighted;
   return unweighted * powerHeuristic(light->pdf, pdf(bsdf, woLocal, wiLocal));
 }
 

@@ -89,8 +89,8 @@ struct LightSample {
                        ///< irradiance on a surface normal to wi (W·m⁻²)
   float pdf = 0.0f;    ///< solid-angle density of wi including the light's selection
                        ///< probability; for delta lights the selection probability alone
-  /// A scene light (lights.h): no BSDF-sampled ray can find it, so next-event estimation
-  /// counts it with full weight (no MIS).
+  /// A scene light (lights.h): no geometry, so a BSDF-sampled ray finds it only by asking
+  /// (sphereLightAlong, sphere lights) or never (the delta lights).
   bool nextEventOnly = false;
   bool delta = false;  ///< a point, spot or directional light (lights.h isDeltaLight)
   bool infinite = false;  ///< a light at infinity or the environment: the shadow ray is unbounded
@@ -186,7 +186,9 @@ class LightSampler {
 /// Which lights a next-event estimate samples, and how it weights them.
 enum class NextEvent : uint8_t {
   /// Every light, MIS-weighted (power heuristic) against the BSDF's density where BSDF
-  /// sampling could find the light too (the path tracer's default strategy).
+  /// sampling could find the light too: emissive triangles, the environment and sphere lights
+  /// (the caller finds them along its BSDF samples with LightSampler::sphereLightAlong); the
+  /// delta lights in full (the path tracer's default strategy).
   Mis,
   /// Every light, full weight (the path tracer's light-only strategy).
   LightOnly,

@@ -15,9 +15,12 @@
 //    wi has solid-angle density pdf (sr⁻¹) and `incident` is the radiance arriving along it.
 //    Either way incident·max(0, n·wi)/pdf, times the shadow ray's transmittance, estimates the
 //    irradiance on a surface of normal n (exactly, for a delta light).
-//  * None of these lights is geometry: camera rays and BSDF-sampled rays never hit them. Only
-//    shadow rays find them, so the path tracer counts them by next-event estimation alone,
-//    with no MIS weight, and the light field holds their light where it lands on surfaces.
+//  * None of these lights is geometry: camera rays and rays after mirrors never see them and
+//    nothing is shadowed by them. Shadow rays find them; a BSDF-sampled ray from a non-delta
+//    vertex finds a sphere light by asking (light.h LightSampler::sphereLightAlong), so the
+//    path tracer MIS-weights sphere lights between the two and counts the delta lights by
+//    next-event estimation alone, and the light field holds their light where it lands on
+//    surfaces.
 //  * power(R) is the selection weight of the light samplers (light/light.h): an estimate of
 //    the emitted flux's luminance, R the radius of the scene's bounding sphere (for lights at
 //    infinity).

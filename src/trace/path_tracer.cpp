@@ -8,8 +8,14 @@
 //                                         w_light = p_light² / (p_bsdf² + p_light²)
 // (Veach's power heuristic, β = 2). Both pdfs are solid-angle densities at x_k of the same
 // direction: p_light includes the probability of selecting that light. The scene's lights
-// (light/lights.h: point, spot, …) are no geometry and can only be reached by NEE (weight 1);
-// delta BSDF bounces (mirrors) can only be followed by BSDF sampling, so emission seen right
+// (light/lights.h: point, spot, …) are no geometry. The delta ones (point, spot, directional)
+// can only be reached by NEE (weight 1). Sphere lights are MIS-weighted as emissive triangles
+// are: a BSDF-sampled ray leaving a non-delta vertex that passes through one before its hit
+// (LightSampler::sphereLightAlong) adds β_k · Le · w_bsdf and goes on through it, since a
+// sphere light occludes nothing — without it a narrow lobe (sharp GGX) would find a small
+// sphere only by NEE, as rare huge f/p_light fireflies. Camera rays and rays after delta
+// bounces do not see sphere lights (lights.h: the camera and mirrors do not see the sphere).
+// Delta BSDF bounces (mirrors) can only be followed by BSDF sampling, so emission seen right
 // after one counts fully, as does emission seen by the camera ray.
 //
 // Subsurface scattering (bsdf.h SubsurfaceBsdf). A path meeting a subsurface material enters
@@ -181,7 +187,17 @@ Rgb PathTracer::Impl::radiance(Ray ray, Sampler& sampler, const TraceSettings& s
   for (int depth = 0;; ++depth) {
     RayHit hit;
     ++counters.rays;
-    if (!accel.intersect(ray, hit)) {
+    const bool found = accel.intersect(ray, hit);
+    if (useMis && !countEmissionFully && lights.hasSphereLights()) {
+      // A sphere light between the vertex and the hit (or the sky), weighted against NEE's
+      // density for the direction at the vertex that sampled it (distanceBefore back along the
+      // ray, past any thin sheets crossed straight).
+      Ray segment = ray;
+      segment.tMax = found ? hit.t : kInfinity;
+      if (const auto sphere = lights.sphereLightAlong(segment, ray.origin - distanceBefore * ray.direction))
+        result += throughput * sphere->radiance * powerHeuristic(previousBsdfPdf, sphere->pdf);
+    }
+    if (!found) {
       if (lights.hasEnvironment()) {
         const Rgb le = lights.environment().radiance(ray.direction);
         if (countEmissionFully) {
