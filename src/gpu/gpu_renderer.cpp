@@ -870,9 +870,11 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   const SunLights sun = sunLightsOf(lightField);
   const gpu::SurfaceDetailBuffer detail = gpu::surfaceDetailBuffer(lightField);
   std::vector<ChartGpu> charts(lightField.charts.size());
+  bool chartDetail = false;  // some chart reads surface detail (textures, normal maps)
   for (uint32_t i = 0; i < charts.size(); ++i) {
     const Chart& c = lightField.charts[i];
     const ChartShading shading = chartShading(lightField, i, sun);
+    chartDetail = chartDetail || (shading.needsUv && shading.texturedAlbedo) || shading.texturedEmission || shading.normalMapped;
     ChartGpu& g = charts[i];
     g = ChartGpu{{c.origin.x, c.origin.y, c.origin.z, shading.inverseTixelSize},
                  {c.axisU.x, c.axisU.y, c.axisU.z, 0.0f},
@@ -1016,9 +1018,15 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   // With specular charts or highlights the shading passes carry the BVH traversal, the
   // highlights and the chains after their main.
   const std::string int64 = "#extension GL_ARB_gpu_shader_int64 : require\n";
+  const bool anyMasked = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.isMasked(); });
+  // The traversal cuts masks and a chain's end reads surface detail only where the scene has
+  // some: the code inlined in the loops makes the program far longer to compile (llvmpipe:
+  // tens of seconds).
   const std::string raysHeader = (s.specular ? int64 + "#define SPECULAR\n" : "") +
                                      (s.highlights ? "#define HIGHLIGHTS\n" + highlightGlslConstants() : "") +
-                                     (traces ? bvhGlslConstants() + specularGlslConstants() + "#define BVH_ALPHA_MASKS\n" : "") +
+                                     (traces ? bvhGlslConstants() + specularGlslConstants() : "") +
+                                     (traces && anyMasked ? "#define BVH_ALPHA_MASKS\n" : "") +
+                                     (chartDetail ? "#define CHAIN_SURFACE_DETAIL\n" : "") +
                                      (gpu::tracedSurfaceDetail(lightField) ? "#define TRACED_DETAIL\n" : "");
   const std::string shading = std::string(kShadingFragment) +
                               (traces ? std::string(kBvhGlsl) + kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
@@ -1031,7 +1039,6 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                        "multi-sample shading", true,
                                        (s.specular ? raysHeader : int64 + raysHeader) + "#define MULTISAMPLE\n");
   glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
-  const bool anyMasked = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.isMasked(); });
   for (GLuint program : {s.visibilityProgram, s.shadingProgram, s.multisampleProgram})
     if (program != 0) glProgramUniform1i(program, glGetUniformLocation(program, "anyMasked"), anyMasked ? 1 : 0);
   for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {

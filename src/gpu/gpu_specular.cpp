@@ -264,7 +264,11 @@ vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv,
     uint record = viewedRecord(tri.w, -direction, normalAtHit);
     if (record == kNoRecord) return radiance;  // inside a closed smooth mesh: nothing seen
     if (charts[record].info.y != kSpecular) {
+#ifdef CHAIN_SURFACE_DETAIL
       SurfaceDetail detail = hitSurfaceDetail(triangle, uv, direction, coneSpread * distance);
+#else
+      SurfaceDetail detail = noSurfaceDetail(shadingNormal);  // no chart reads any
+#endif
       radiance += throughput * lookupRadiance(tri.w, origin + t * direction, -direction, normalAtHit, shadingNormal, detail);
 #ifdef HIGHLIGHTS
       radiance += throughput * punctualHighlights(record, triangle, uv, -direction);

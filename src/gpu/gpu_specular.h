@@ -25,7 +25,7 @@
 // glass bends surfaceAt's shading normal and an emission texture modulates its emission
 // (TRACED_DETAIL, gpu_surface_detail.h tracedSurfaceDetail); the lookup at the chain's end
 // reads the surface detail there (hitSurfaceDetail, the ray cone coneSpread × the chain's
-// summed length).
+// summed length; compiled in, CHAIN_SURFACE_DETAIL, where some chart reads surface detail).
 #include <cstdint>
 #include <string>
 #include <vector>
