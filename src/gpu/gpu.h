@@ -36,7 +36,7 @@
 // lights are uniforms), the environment map's texels (RGBA) and the surface detail
 // (gpu_surface_detail.h: the textures the shader reads — 4 bytes per texel of an 8-bit level
 // as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 128 bytes per
-// material, and where a chart or mask needs uvs, 32 bytes per vertex and 4 per triangle). So
+// material, and where a chart, mask or traced hit needs uvs, 36 bytes per vertex and 4 per triangle). So
 // GPU memory is 16 bytes per value + 128 per chart + 32 per vertex + 28 per triangle + 4 per
 // sun mask + 16 per environment texel + the surface detail + (with mirrors, glass or punctual
 // highlights) the BVH's 32 per node and 4 per triangle, 64 per material and 4 per triangle for
@@ -52,10 +52,13 @@
 // the constructor refuses such a light field with that name rather than draw a different
 // picture): mirror-like glossy lobes (specular charts of a glossy model), metallic-roughness
 // textures, albedo textures on non-Lambertian diffuse charts, punctual highlights on glTF
-// materials, mirrors, glass or punctual highlights beside textured, normal-mapped or
-// alpha-masked surfaces (the traced rays read no surface detail and cut no masks); and of the
-// render settings, thin lenses. Punctual highlights on glossy charts are evaluated per pixel
-// with a shadow ray through the BVH (gpu_highlights.h).
+// materials, albedo textures or vertex colours on mirrors and glass; and of the render
+// settings, thin lenses. Punctual highlights on glossy charts are evaluated per pixel with a
+// shadow ray through the BVH (gpu_highlights.h). The traced rays read the surface detail at
+// their hits as the camera rays do: they cut alpha masks (gpu_bvh.h BVH_ALPHA_MASKS), the
+// lookup at a chain's end reads the albedo texture at the mip level of the chain's ray cone
+// (textureConeSpread × the summed length), and surfaceAt bends a mirror's, glass's or
+// highlight's normal by its normal map (gpu_surface_detail.h tracedSurfaceDetail).
 //
 // Several samples per pixel: the shading pass loops over the pixel's samples at the CPU
 // renderers' jittered film points (Pcg32::forKey in 64-bit GLSL integers,

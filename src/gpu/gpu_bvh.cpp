@@ -245,6 +245,17 @@ float bvhTriangle(uint triangle, vec3 origin, vec3 direction, float tMin, float 
   uv = vec2(u, v);
   return u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > tMin && t < tMax ? t : kNoEntry;
 }
+// The ray caster's alpha-mask hit filter (accel_embree.cpp alphaMaskFilter): a candidate hit
+// on an alpha-masked triangle where its coverage is below the cutoff (coverageAt) is no hit and
+// traversal goes on past it. With BVH_ALPHA_MASKS the program has the surface detail
+// (gpu_surface_detail.h masked, maskedMaterial) and the uniform anyMasked before this chunk.
+bool bvhCutAway(uint triangle, vec2 uv) {
+#ifdef BVH_ALPHA_MASKS
+  return anyMasked && maskedMaterial(triangle) && masked(triangle, triangles[triangle].xyz, uv);
+#else
+  return false;
+#endif
+}
 // The closest hit in (tMin, tMax): true and its distance, triangle and barycentrics.
 bool bvhIntersect(vec3 origin, vec3 direction, float tMin, float tMax, out float t, out uint triangle, out vec2 uv) {
   vec3 inverse = bvhInverse(direction);
@@ -268,7 +279,7 @@ bool bvhIntersect(vec3 origin, vec3 direction, float tMin, float tMax, out float
     for (uint i = first; i < first + count; ++i) {
       vec2 hitUv;
       float hit = bvhTriangle(bvhOrder[i], origin, direction, tMin, t, hitUv);
-      if (hit < t) {
+      if (hit < t && !bvhCutAway(bvhOrder[i], hitUv)) {
         t = hit;
         triangle = bvhOrder[i];
         uv = hitUv;
@@ -297,7 +308,7 @@ bool bvhOccluded(vec3 origin, vec3 direction, float tMin, float tMax) {
     }
     for (uint i = first; i < first + count; ++i) {
       vec2 uv;
-      if (bvhTriangle(bvhOrder[i], origin, direction, tMin, tMax, uv) < kNoEntry) return true;
+      if (bvhTriangle(bvhOrder[i], origin, direction, tMin, tMax, uv) < kNoEntry && !bvhCutAway(bvhOrder[i], uv)) return true;
     }
   }
   return false;

@@ -16,7 +16,9 @@
 // The triangle test is Möller–Trumbore with inclusive edges (u ≥ 0, v ≥ 0, u + v ≤ 1), so a
 // ray through a shared edge hits one of the two triangles (both, the nearer kept), and
 // barycentrics (u, v) as Embree reports them. It is not Embree's arithmetic: t and (u, v)
-// agree with Embree's to float rounding (a few ulp), not bit for bit.
+// agree with Embree's to float rounding (a few ulp), not bit for bit. In a program compiled
+// with BVH_ALPHA_MASKS (the shading passes of a scene with alpha masks) both cut alpha masks as the ray caster's hit filter
+// does: a candidate hit where the coverage is below the cutoff is passed over (bvhCutAway).
 #include <cstdint>
 #include <string>
 #include <utility>

@@ -311,12 +311,6 @@ vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, ve
   vec3 albedoOverPi = (flags & kFlagTexturedAlbedo) != 0u ? c.albedoOverPi.rgb * detail.albedo * kInvPi : c.albedoOverPi.rgb;
   return mapped + albedoOverPi * k * diffuseIrradiance;
 }
-// The radiance at a hit of a reflected or refracted ray (gpu_specular.h): no surface detail —
-// gpuUnsupportedFeature refuses mirrors, glass and punctual highlights beside textured,
-// normal-mapped or alpha-masked surfaces, whose detail those rays would need.
-vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, vec3 shadingNormal) {
-  return lookupRadiance(chart, p, towardsViewer, normalAtHit, shadingNormal, noSurfaceDetail(shadingNormal));
-}
 )glsl";
 
 // Pass 1: the triangles' ids at the pixel centres, nearest first (reversed Z: depth = near / z).
@@ -447,6 +441,16 @@ uint64_t mix64(uint64_t x) {
 uint64_t hashCombine(uint64_t a, uint64_t b) { return mix64(a ^ (mix64(b) + 0x9e3779b97f4a7c15UL)); }
 #endif
 
+// triangleNormal (scene.h: the unit geometric normal of `tri`, 0 for a degenerate one) and, on
+// a curved or normal-mapped chart (`chartFlags`), interpolatedNormal at barycentrics b (the
+// geometric normal elsewhere, where nothing reads it).
+void triangleNormalsAt(uvec4 tri, vec2 b, uint chartFlags, out vec3 geometric, out vec3 interpolated) {
+  vec3 p0 = positions[tri.x].xyz;
+  vec3 n = cross(positions[tri.y].xyz - p0, positions[tri.z].xyz - p0);
+  float length2 = dot(n, n);
+  geometric = length2 > 0.0 ? n / sqrt(length2) : vec3(0.0);
+  interpolated = (chartFlags & (kFlagCurved | kFlagNormalMapped)) != 0u ? interpolatedNormalAt(tri.xyz, b, geometric) : geometric;
+}
 // chartNormalAt's normal (the front record's side: the chart normal, on a curved chart the
 // triangle's) and interpolatedNormal's (a curved glossy chart's map is read around it,
 // chartShadingNormalAt) at barycentrics uv = (b1, b2) of triangle `tri`.
@@ -454,20 +458,17 @@ void hitNormals(uvec4 tri, vec2 uv, out vec3 normalAtHit, out vec3 shadingNormal
   ChartRecord c = charts[tri.w];
   normalAtHit = c.normal.xyz;
   shadingNormal = c.normal.xyz;
-  if ((c.info.z & kFlagCurved) == 0u) return;
-  vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
-  vec3 n = cross(p1 - p0, p2 - p0);
-  // triangleNormal, then interpolatedNormal (scene.h).
-  float length2 = dot(n, n);
-  normalAtHit = length2 > 0.0 ? n / sqrt(length2) : vec3(0.0);
-  shadingNormal = normalAtHit;
-  if (normals[tri.x].w == 0.0) return;
-  vec3 interpolated = (1.0 - uv.x - uv.y) * normals[tri.x].xyz + uv.x * normals[tri.y].xyz + uv.y * normals[tri.z].xyz;
-  float len = length(interpolated);
-  if (len > 1e-6 && !isinf(len) && !isnan(len)) {
-    shadingNormal = interpolated / len;
-    if (dot(shadingNormal, normalAtHit) < 0.0) shadingNormal = -shadingNormal;
-  }
+  if ((c.info.z & kFlagCurved) != 0u) triangleNormalsAt(tri, uv, c.info.z, normalAtHit, shadingNormal);
+}
+// surfaceDetailAt for a ray along `direction` hitting `triangle` at barycentrics b, its ray cone
+// coneWidth wide there.
+SurfaceDetail hitSurfaceDetail(uint triangle, vec2 b, vec3 direction, float coneWidth) {
+  uvec4 tri = triangles[triangle];
+  uvec4 info = charts[tri.w].info;
+  vec3 geometric, interpolated;
+  triangleNormalsAt(tri, b, info.z, geometric, interpolated);
+  return surfaceDetailAt(triangle, tri.xyz, positions[tri.x].xyz, positions[tri.y].xyz, positions[tri.z].xyz, b, info,
+                         direction, coneWidth, geometric, interpolated);
 }
 
 #ifdef SPECULAR
@@ -525,15 +526,9 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
   vec3 hit = rayTriangle(direction, tri.xyz);
   if (isinf(t)) t = dot(p0 - eye, n) / dot(direction, n);
   vec3 p = eye + t * direction;
-  ChartRecord c = charts[tri.w];
   vec2 b = hit.yz;
-  // triangleNormal, then on a curved or normal-mapped chart interpolatedNormal (scene.h) at the
-  // hit's barycentrics.
-  float length2 = dot(n, n);
-  vec3 geometric = length2 > 0.0 ? n / sqrt(length2) : vec3(0.0);
-  bool curved = (c.info.z & kFlagCurved) != 0u;
-  vec3 interpolated = curved || (c.info.z & kFlagNormalMapped) != 0u ? interpolatedNormalAt(tri.xyz, b, geometric) : geometric;
-  vec3 normalAtHit = curved ? geometric : c.normal.xyz, shadingNormal = curved ? interpolated : c.normal.xyz;
+  vec3 normalAtHit, shadingNormal;
+  hitNormals(tri, b, normalAtHit, shadingNormal);
 #if defined(SPECULAR) || defined(HIGHLIGHTS)
   uint record = viewedRecord(tri.w, -direction, normalAtHit);
 #endif
@@ -541,8 +536,7 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
   if (record != kNoRecord && charts[record].info.y == kSpecular)
     return weight * specularChain(eye, direction, t, id - 1u, b, mirrorDepth);
 #endif
-  SurfaceDetail detail =
-      surfaceDetailAt(id - 1u, tri.xyz, p0, p1, p2, b, c.info, direction, coneSpread * t, geometric, interpolated);
+  SurfaceDetail detail = hitSurfaceDetail(id - 1u, b, direction, coneSpread * t);
   vec3 radiance = lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal, detail);
 #ifdef HIGHLIGHTS
   if (record != kNoRecord) radiance += punctualHighlights(record, id - 1u, b, -direction);
@@ -748,24 +742,12 @@ void setCameraUniforms(GLuint program, const Camera& camera) {
 }  // namespace
 
 std::string gpuUnsupportedFeature(const LightField& lf) {
-  const Scene& scene = lf.scene;
   if (std::string specular = gpuUnsupportedSpecular(lf); !specular.empty()) return specular;
   if (std::string highlights = gpuUnsupportedHighlights(lf); !highlights.empty()) return highlights;
-  // The reflected, refracted and shadow rays (gpu_specular.h, gpu_highlights.h) neither cut
-  // alpha masks nor read the surface detail at their hits.
-  const bool tracesRays = hasSpecularCharts(lf) || gpuHighlightsActive(lf);
-  const char* const tracedBesideDetail =
-      "mirrors, glass or punctual highlights beside textured, normal-mapped or alpha-masked surfaces";
-  if (tracesRays && std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.isMasked(); }))
-    return tracedBesideDetail;
   const SunLights sun = sunLightsOf(lf);
-  for (uint32_t i = 0; i < lf.charts.size(); ++i) {
-    const Chart& c = lf.charts[i];
-    const ChartShading shading = chartShading(lf, i, sun);
-    if (std::string detail = gpu::surfaceDetailUnsupported(lf, c, shading); !detail.empty()) return detail;
-    if (tracesRays && (shading.texturedAlbedo || shading.texturedEmission || shading.normalMapped || c.directionalIrradiance))
-      return tracedBesideDetail;
-  }
+  for (uint32_t i = 0; i < lf.charts.size(); ++i)
+    if (std::string detail = gpu::surfaceDetailUnsupported(lf, lf.charts[i], chartShading(lf, i, sun)); !detail.empty())
+      return detail;
   if (lf.values.size() >= std::numeric_limits<uint32_t>::max() || lf.sunMasks.size() >= std::numeric_limits<uint32_t>::max())
     return "more than 2^32 light-field values";
   return {};
@@ -888,9 +870,11 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   const SunLights sun = sunLightsOf(lightField);
   const gpu::SurfaceDetailBuffer detail = gpu::surfaceDetailBuffer(lightField);
   std::vector<ChartGpu> charts(lightField.charts.size());
+  bool chartDetail = false;  // some chart reads surface detail (textures, normal maps)
   for (uint32_t i = 0; i < charts.size(); ++i) {
     const Chart& c = lightField.charts[i];
     const ChartShading shading = chartShading(lightField, i, sun);
+    chartDetail = chartDetail || (shading.needsUv && shading.texturedAlbedo) || shading.texturedEmission || shading.normalMapped;
     ChartGpu& g = charts[i];
     g = ChartGpu{{c.origin.x, c.origin.y, c.origin.z, shading.inverseTixelSize},
                  {c.axisU.x, c.axisU.y, c.axisU.z, 0.0f},
@@ -1034,9 +1018,16 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   // With specular charts or highlights the shading passes carry the BVH traversal, the
   // highlights and the chains after their main.
   const std::string int64 = "#extension GL_ARB_gpu_shader_int64 : require\n";
+  const bool anyMasked = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.isMasked(); });
+  // The traversal cuts masks and a chain's end reads surface detail only where the scene has
+  // some: the code inlined in the loops makes the program far longer to compile (llvmpipe:
+  // tens of seconds).
   const std::string raysHeader = (s.specular ? int64 + "#define SPECULAR\n" : "") +
                                      (s.highlights ? "#define HIGHLIGHTS\n" + highlightGlslConstants() : "") +
-                                     (traces ? bvhGlslConstants() + specularGlslConstants() : "");
+                                     (traces ? bvhGlslConstants() + specularGlslConstants() : "") +
+                                     (traces && anyMasked ? "#define BVH_ALPHA_MASKS\n" : "") +
+                                     (chartDetail ? "#define CHAIN_SURFACE_DETAIL\n" : "") +
+                                     (gpu::tracedSurfaceDetail(lightField) ? "#define TRACED_DETAIL\n" : "");
   const std::string shading = std::string(kShadingFragment) +
                               (traces ? std::string(kBvhGlsl) + kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
                               (s.specular ? kSpecularGlsl : "");
@@ -1048,7 +1039,6 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                        "multi-sample shading", true,
                                        (s.specular ? raysHeader : int64 + raysHeader) + "#define MULTISAMPLE\n");
   glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
-  const bool anyMasked = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.isMasked(); });
   for (GLuint program : {s.visibilityProgram, s.shadingProgram, s.multisampleProgram})
     if (program != 0) glProgramUniform1i(program, glGetUniformLocation(program, "anyMasked"), anyMasked ? 1 : 0);
   for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {

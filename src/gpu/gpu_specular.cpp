@@ -23,8 +23,8 @@ std::string gpuUnsupportedSpecular(const LightField& lf) {
     const Material& m = scene.materials[c.material];
     if (!isDelta(m.bsdf) && !std::holds_alternative<DielectricBsdf>(m.bsdf))
       return "mirror-like glossy lobes (specular charts of a Blinn-Phong or GGX material)";
-    if (m.normalTexture >= 0) return "normal maps on mirrors and glass";
-    if (m.emissionTexture >= 0) return "emission textures on mirrors and glass";
+    // materialModelAt: the reflectance or transmittance would vary over the surface.
+    if (m.modelVaries()) return "albedo textures or vertex colours on mirrors and glass";
   }
   return {};
 }
@@ -99,7 +99,8 @@ void thinSheetReflectanceTransmittance(SpecularMaterial m, float cosTheta, out v
   transmittance = T * T * t / denom;
 }
 // surfaceAt (scene.cpp): the point from the barycentrics (b1, b2), the unit winding normal,
-// the interpolated shading normal on its side (interpolatedNormal).
+// the interpolated shading normal on its side (interpolatedNormal), bent by the material's
+// normal map (TRACED_DETAIL: gpu_surface_detail.h tracedSurfaceDetail).
 void surfaceAt(uint triangle, vec2 uv, out vec3 position, out vec3 geometricNormal, out vec3 shadingNormal) {
   uvec4 tri = triangles[triangle];
   vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
@@ -115,6 +116,9 @@ void surfaceAt(uint triangle, vec2 uv, out vec3 position, out vec3 geometricNorm
       if (dot(shadingNormal, geometricNormal) < 0.0) shadingNormal = -shadingNormal;
     }
   }
+#ifdef TRACED_DETAIL
+  shadingNormal = mappedNormalAt(materialRecord(triangle), tri.xyz, p0, p1, p2, uv, geometricNormal, shadingNormal);
+#endif
 }
 // Frame::fromNormal (core/math.h): the tangents s, t of unit normal n.
 void frameFromNormal(vec3 n, out vec3 s, out vec3 t) {
@@ -202,7 +206,11 @@ bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv
   float cosWoGeometric = dot(geometricNormal, wo);
   vec3 attenuation = vec3(1.0);
   if (cosWoGeometric < 0.0 && any(notEqual(m.absorption.rgb, vec3(0.0)))) attenuation = exp(-m.absorption.rgb * t);
-  emitted = (cosWoGeometric > 0.0 || m.emission.w != 0.0 ? m.emission.rgb : vec3(0.0)) * attenuation;
+  vec3 emission = cosWoGeometric > 0.0 || m.emission.w != 0.0 ? m.emission.rgb : vec3(0.0);
+#ifdef TRACED_DETAIL
+  emission *= emissionTexelAt(materialRecord(triangle), triangles[triangle].xyz, uv);  // emissionModulation
+#endif
+  emitted = emission * attenuation;
   if (step >= stepLimit) return false;
   // scatteringFrame: a reflecting model's frame turned to wo's side, glass's never.
   bool glass = floatBitsToUint(m.colour.w) == kSpecularGlass;
@@ -234,8 +242,11 @@ bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv
   return true;
 }
 // The fast renderer's chain (realtime.h step 3) from a camera ray's hit on a specular record.
+// The lookup at its end reads the surface detail there with a ray cone coneSpread × the
+// chain's length (the camera ray's t and each traced ray's, summed as the CPU renderer does).
 vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv, uint mirrorDepth) {
   vec3 radiance = vec3(0.0), throughput = vec3(1.0);
+  float distance = t;
   for (uint step = 0u;; ++step) {
     vec3 emitted, nextOrigin, nextDirection, weight;
     bool more = followSpecular(origin, direction, t, triangle, uv, step, mirrorDepth, emitted, nextOrigin, nextDirection, weight);
@@ -246,13 +257,19 @@ vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv,
     direction = nextDirection;
     if (!bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, uv))
       return radiance + throughput * environmentRadiance(direction);
+    distance += t;
     uvec4 tri = triangles[triangle];
     vec3 normalAtHit, shadingNormal;
     hitNormals(tri, uv, normalAtHit, shadingNormal);
     uint record = viewedRecord(tri.w, -direction, normalAtHit);
     if (record == kNoRecord) return radiance;  // inside a closed smooth mesh: nothing seen
     if (charts[record].info.y != kSpecular) {
-      radiance += throughput * lookupRadiance(tri.w, origin + t * direction, -direction, normalAtHit, shadingNormal);
+#ifdef CHAIN_SURFACE_DETAIL
+      SurfaceDetail detail = hitSurfaceDetail(triangle, uv, direction, coneSpread * distance);
+#else
+      SurfaceDetail detail = noSurfaceDetail(shadingNormal);  // no chart reads any
+#endif
+      radiance += throughput * lookupRadiance(tri.w, origin + t * direction, -direction, normalAtHit, shadingNormal, detail);
 #ifdef HIGHLIGHTS
       radiance += throughput * punctualHighlights(record, triangle, uv, -direction);
 #endif

@@ -20,7 +20,12 @@
 //
 // What it does not follow (gpuUnsupportedSpecular names it): mirror-like glossy lobes
 // (specular records of a Blinn-Phong or GGX model: their lobe sampling and the emitters'
-// next-event estimation there), and normal maps or emission textures on a mirror or glass.
+// next-event estimation there), and albedo textures or vertex colours on a mirror or glass
+// (materialModelAt would vary its reflectance or transmittance). A normal map on a mirror or
+// glass bends surfaceAt's shading normal and an emission texture modulates its emission
+// (TRACED_DETAIL, gpu_surface_detail.h tracedSurfaceDetail); the lookup at the chain's end
+// reads the surface detail there (hitSurfaceDetail, the ray cone coneSpread × the chain's
+// summed length; compiled in, CHAIN_SURFACE_DETAIL, where some chart reads surface detail).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -62,14 +67,14 @@ std::string specularGlslConstants();
 /// SpecularMaterials (SPECULAR_MATERIALS_BINDING, per material) and TriangleMaterials
 /// (TRIANGLE_MATERIALS_BINDING, per triangle), surfaceAt, frameFromNormal (Frame::fromNormal),
 /// offsetRayOrigin, fresnelDielectric and thinSheetReflectanceTransmittance. Needs the shading
-/// pass's geometry blocks before it.
+/// pass's geometry blocks and the surface detail (gpu_surface_detail.h) before it.
 extern const char* const kSurfaceGlsl;
 
 /// GLSL: vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv,
 /// uint mirrorDepth) — the radiance along a camera ray whose closest hit is (t, triangle, uv)
 /// on a specular record, without the camera weight. Needs kBvhGlsl, kSurfaceGlsl, hitNormals,
-/// lookupRadiance, environmentRadiance, punctualHighlights (gpu_highlights.h) and the 64-bit
-/// hash (hashCombine) before it.
+/// hitSurfaceDetail and the uniform coneSpread, lookupRadiance, environmentRadiance,
+/// punctualHighlights (gpu_highlights.h) and the 64-bit hash (hashCombine) before it.
 extern const char* const kSpecularGlsl;
 
 }  // namespace pl

@@ -3,19 +3,22 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 #include <limits>
 #include <variant>
 
 #include "bsdf/bsdf.h"
+#include "gpu/gpu_highlights.h"
+#include "gpu/gpu_specular.h"
 
 namespace pl::gpu {
 namespace {
 
 constexpr uint32_t kNone = kNoWord;
-constexpr uint32_t kHeaderWords = 8, kTextureWords = 8, kLevelWords = 4, kMappingWords = 8, kVertexWords = 8;
+constexpr uint32_t kHeaderWords = 8, kTextureWords = 8, kLevelWords = 4, kMappingWords = 8, kVertexWords = 9;
 // Material record: albedo, emission, alpha and normal textures, alpha factor, cutoff, normal
-// scale, 1 unused, then the albedo, emission, alpha and normal mappings.
+// scale, vertex alphas (1: some mesh of the material has them), then the albedo, emission, alpha and normal mappings.
 constexpr uint32_t kMaterialAlbedoMapping = 8, kMaterialEmissionMapping = kMaterialAlbedoMapping + kMappingWords,
                    kMaterialAlphaMapping = kMaterialEmissionMapping + kMappingWords,
                    kMaterialNormalMapping = kMaterialAlphaMapping + kMappingWords,
@@ -58,6 +61,12 @@ std::string surfaceDetailUnsupported(const LightField& lf, const Chart& chart, c
   return {};
 }
 
+bool tracedSurfaceDetail(const LightField& lf) {
+  if (!hasSpecularCharts(lf) && !gpuHighlightsActive(lf)) return false;
+  return std::any_of(lf.scene.materials.begin(), lf.scene.materials.end(),
+                     [](const Material& m) { return m.normalTexture >= 0 || m.emissionTexture >= 0; });
+}
+
 Rgb texturedAlbedoBase(const Scene& scene, const Chart& chart) {
   const Bsdf& model = scene.materials[chart.material].bsdf;
   if (const auto* lambert = std::get_if<LambertBsdf>(&model); lambert != nullptr && chart.kind == ChartKind::Diffuse)
@@ -87,6 +96,13 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
     if (shading.normalMapped) {
       needsUv = true;
       need(m.normalTexture, TextureUse::Level0);
+    }
+  }
+  if (tracedSurfaceDetail(lf)) {
+    needsUv = true;
+    for (const Material& m : scene.materials) {
+      need(m.normalTexture, TextureUse::Level0);
+      need(m.emissionTexture, TextureUse::Level0);
     }
   }
   for (const Material& m : scene.materials)
@@ -130,7 +146,8 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
   for (const Material& m : scene.materials) {
     auto index = [](int texture) { return texture >= 0 ? uint32_t(texture) : kNone; };
     words.insert(words.end(), {index(m.albedoTexture), index(m.emissionTexture), index(m.alphaTexture),
-                               index(m.normalTexture), bits(m.alphaFactor), bits(m.alphaCutoff), bits(m.normalScale), 0u});
+                               index(m.normalTexture), bits(m.alphaFactor), bits(m.alphaCutoff), bits(m.normalScale),
+                               m.vertexAlpha ? 1u : 0u});
     appendMapping(words, m.albedoMapping);
     appendMapping(words, m.emissionMapping);
     appendMapping(words, m.alphaMapping);
@@ -140,12 +157,14 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
   words[3] = uint32_t(words.size());
   if (needsUv) {
     for (const Mesh& mesh : scene.meshes) {
-      const uint32_t flags = (mesh.uvs.empty() ? 0u : 1u) | (mesh.uvs1.empty() ? 0u : 2u) | (mesh.colors.empty() ? 0u : 4u);
+      const uint32_t flags = (mesh.uvs.empty() ? 0u : 1u) | (mesh.uvs1.empty() ? 0u : 2u) | (mesh.colors.empty() ? 0u : 4u) |
+                             (mesh.alphas.empty() ? 0u : 8u);
       for (size_t v = 0; v < mesh.positions.size(); ++v) {
         const Vec2 uv0 = mesh.uvs.empty() ? Vec2(0.0f) : mesh.uvs[v], uv1 = mesh.uvs1.empty() ? Vec2(0.0f) : mesh.uvs1[v];
         const Rgb colour = mesh.colors.empty() ? Rgb(1.0f) : mesh.colors[v];
+        const float alpha = mesh.alphas.empty() ? 1.0f : mesh.alphas[v];
         words.insert(words.end(), {bits(uv0.x), bits(uv0.y), bits(uv1.x), bits(uv1.y), bits(colour.r), bits(colour.g),
-                                   bits(colour.b), flags});
+                                   bits(colour.b), flags, bits(alpha)});
       }
     }
   }
@@ -408,6 +427,26 @@ vec3 normalMapped(vec3 n, vec3 ng, vec3 p0, vec3 p1, vec3 p2, vec2 uv0, vec2 uv1
   return dot(result, ng) > 0.01 ? result : n;
 }
 
+// surfaceAt's shading normal (scene.cpp) at barycentrics b of a triangle (vertices v at p0, p1,
+// p2; unit geometric normal `geometric`, the interpolated normal `interpolated`) of material
+// record m whose normal texture is uploaded: the normal map where its uv set exists, in the
+// frame of the mapped vertex uvs; `interpolated` elsewhere.
+vec3 mappedNormalAt(uint m, uvec3 v, vec3 p0, vec3 p1, vec3 p2, vec2 b, vec3 geometric, vec3 interpolated) {
+  uint normalMapping = m + kMaterialNormalMapping, set = detail[normalMapping];
+  if (detail[m + 3u] == kNone || !hasUvSet(v.x, set)) return interpolated;
+  vec3 texel = sampleTexture(detail[m + 3u], mappedUv(normalMapping, v, b));
+  return normalMapped(interpolated, geometric, p0, p1, p2, applyMapping(normalMapping, vertexUv(v.x, set)),
+                      applyMapping(normalMapping, vertexUv(v.y, set)), applyMapping(normalMapping, vertexUv(v.z, set)),
+                      texel, detailFloat(m + 6u));
+}
+// The material record of triangle `triangle` (needs the triangle table: a uv is needed).
+uint materialRecord(uint triangle) { return detail[2] + kMaterialWords * detail[detail[4] + triangle]; }
+// emissionModulation (scene.h) at barycentrics b of a triangle (vertices v) of material record
+// m whose emission texture is uploaded: the texel at full resolution, 1 without a texture.
+vec3 emissionTexelAt(uint m, uvec3 v, vec2 b) {
+  return detail[m + 1u] == kNone ? vec3(1.0) : sampleTexture(detail[m + 1u], mappedUv(m + kMaterialEmissionMapping, v, b));
+}
+
 // What a lookup needs of its hit besides the position and the normals it is read around: the
 // albedo modulation (albedoModulation: the albedo texture at the cone's mip level × the vertex
 // colour) on a kFlagTexturedAlbedo chart, the emission texel (emissionModulation) on a
@@ -424,7 +463,7 @@ SurfaceDetail surfaceDetailAt(uint triangle, uvec3 v, vec3 p0, vec3 p1, vec3 p2,
   uint flags = chartInfo.z;
   SurfaceDetail d = noSurfaceDetail(interpolated);
   if ((flags & (kFlagTexturedAlbedo | kFlagTexturedEmission | kFlagNormalMapped)) == 0u) return d;
-  uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
+  uint m = materialRecord(triangle);
   bool glossyMapped = (flags & kFlagNormalMapped) != 0u && chartInfo.y == kGlossy;
   if ((flags & kFlagTexturedAlbedo) != 0u) {
     d.albedo = vertexColorAt(v, b);
@@ -435,21 +474,14 @@ SurfaceDetail surfaceDetailAt(uint triangle, uvec3 v, vec3 p0, vec3 p1, vec3 p2,
       d.albedo = sampleTextureLod(texture, mappedUv(m + kMaterialAlbedoMapping, v, b), lod) * d.albedo;
     }
   }
-  if ((flags & kFlagTexturedEmission) != 0u) d.emission = sampleTexture(detail[m + 1u], mappedUv(m + kMaterialEmissionMapping, v, b));
-  // surfaceAt: the normal map where its uv set exists, in the frame of the mapped vertex uvs.
-  uint normalMapping = m + kMaterialNormalMapping, set = detail[normalMapping];
-  if ((flags & kFlagNormalMapped) != 0u && hasUvSet(v.x, set)) {
-    vec3 texel = sampleTexture(detail[m + 3u], mappedUv(normalMapping, v, b));
-    d.normal = normalMapped(interpolated, geometric, p0, p1, p2, applyMapping(normalMapping, vertexUv(v.x, set)),
-                            applyMapping(normalMapping, vertexUv(v.y, set)), applyMapping(normalMapping, vertexUv(v.z, set)),
-                            texel, detailFloat(m + 6u));
-  }
+  if ((flags & kFlagTexturedEmission) != 0u) d.emission = emissionTexelAt(m, v, b);
+  if ((flags & kFlagNormalMapped) != 0u) d.normal = mappedNormalAt(m, v, p0, p1, p2, b, geometric, interpolated);
   return d;
 }
 // Whether triangle `triangle`'s material is alpha-masked at all (Material::isMasked).
 bool maskedMaterial(uint triangle) {
-  uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
-  return detail[m + 2u] != kNone || detailFloat(m + 4u) < detailFloat(m + 5u);
+  uint m = materialRecord(triangle);
+  return detail[m + 2u] != kNone || detailFloat(m + 4u) < detailFloat(m + 5u) || (detail[m + 7u] & 1u) != 0u;
 }
 // diffuseDirectionalFactor (bsdf.h) of a material whose k(μ) is tabulated at word `table`
 // (kNone: k = 1, Lambert and Blinn-Phong), interpolated between the nodes as the GGX albedo
@@ -467,10 +499,16 @@ vec3 diffuseFactor(uint table, float cosTheta) {
 // coverageAt (scene.h): the alpha mask's coverage at barycentrics b of triangle `triangle`
 // (vertices v); below the material's cutoff the surface is not there (masked() says so).
 bool masked(uint triangle, uvec3 v, vec2 b) {
-  uint m = detail[2] + kMaterialWords * detail[detail[4] + triangle];
-  float factor = detailFloat(m + 4u), cutoff = detailFloat(m + 5u);
+  uint m = materialRecord(triangle);
+  float coverage = detailFloat(m + 4u), cutoff = detailFloat(m + 5u);
+  uint x = detail[3] + kVertexWords * v.x;
+  if ((detail[x + 7u] & 8u) != 0u) {  // the mesh's vertex alphas, interpolated
+    float b1 = b.x, b2 = b.y, b0 = 1.0 - b1 - b2;
+    coverage *= b0 * detailFloat(x + 8u) + b1 * detailFloat(detail[3] + kVertexWords * v.y + 8u) +
+                b2 * detailFloat(detail[3] + kVertexWords * v.z + 8u);
+  }
   uint texture = detail[m + 2u];
-  float coverage = texture == kNone ? factor : factor * sampleTexture(texture, mappedUv(m + kMaterialAlphaMapping, v, b)).r;
+  if (texture != kNone) coverage *= sampleTexture(texture, mappedUv(m + kMaterialAlphaMapping, v, b)).r;
   return coverage < cutoff;
 }
 )glsl";

@@ -15,19 +15,20 @@
 //              Texture::packed's 4×4 blocks of palette indices r | g << 8 | b << 16, one word
 //              each, and the palette its ≤ 256 floats);
 //   materials: 40 words each — albedo, emission, alpha and normal textures (kNoWord: none), alpha
-//              factor and cutoff, normal scale, 1 unused, then the albedo, emission, alpha and
-//              normal TextureMappings (8 words each: uv set, whether default, linear[0][0],
-//              [0][1], [1][0], [1][1], offset);
-//   vertices:  8 words each (all meshes' vertices in the renderer's order) — uv set 0 (2
+//              factor and cutoff, normal scale, vertex alphas (1: Material::vertexAlpha), then
+//              the albedo, emission, alpha and normal TextureMappings (8 words each: uv set,
+//              whether default, linear[0][0], [0][1], [1][0], [1][1], offset);
+//   vertices:  9 words each (all meshes' vertices in the renderer's order) — uv set 0 (2
 //              floats), uv set 1 (2), vertex colour (3), flags (has uvs | has uvs1 << 1 | has
-//              colours << 2);
+//              colours << 2 | has alphas << 3), vertex alpha (the coverage factor, coverageAt);
 //   triangles: 1 word each — the triangle's material;
 //   k nodes:   the μ of diffuseFactorNodes (bsdf.h), then per material whose glossy charts
 //              keep a diffuse part and whose k(μ) is not 1, k at those nodes (3 floats each):
 //              the diffuse part's directional factor, interpolated linearly as the CPU's is;
 //   texels:    the levels' texels and palettes.
-// Textures are uploaded only where a chart the GPU draws reads them, vertices and triangles
-// only where some chart or mask needs a uv: a scene without either costs the header, 160
+// Textures are uploaded only where a chart the GPU draws or a traced ray's hit
+// (tracedSurfaceDetail) reads them, vertices and triangles only where some chart, mask or
+// traced hit needs a uv: a scene without either costs the header, 160
 // bytes per material and 160 bytes of k nodes.
 #include <cstdint>
 #include <string>
@@ -50,6 +51,15 @@ inline constexpr uint32_t kFlagTexturedAlbedo = 128u, kFlagTexturedEmission = 25
 /// a phrase for gpuUnsupportedFeature; empty when it draws it.
 std::string surfaceDetailUnsupported(const LightField& lf, const Chart& chart, const ChartShading& shading);
 
+/// Whether the rays the GPU traces for `lf` (mirror and glass chains, the shadow rays of
+/// punctual highlights) meet surfaces whose surfaceAt reads a texture: a normal map (the
+/// shading normal a mirror reflects about, a highlight is evaluated around, a thin sheet's
+/// straight transmittance takes its cosine from) or an emission texture (a mirror's or glass's
+/// own emission, emissionModulation). The buffer then holds every material's normal and
+/// emission textures and the uvs of every vertex, and the shading passes are compiled with
+/// TRACED_DETAIL (gpu_specular.h surfaceAt and followSpecular read them).
+bool tracedSurfaceDetail(const LightField& lf);
+
 /// The base albedo the shader multiplies by the per-pixel modulation on a chart whose albedo
 /// varies (kFlagTexturedAlbedo): the Lambertian albedo of a diffuse chart (diffuseAlbedoAt's
 /// rule), the model's diffuse albedo of a glossy one with Ẽ (glossyDiffuseAlbedoAt's).
@@ -68,7 +78,9 @@ inline constexpr uint32_t kNoWord = 0xffffffffu;
 
 /// The GLSL constants and functions (the buffer at binding `binding`): sampleTexture,
 /// sampleTextureLod, surfaceDetailAt (the albedo modulation, emission texel and mapped normal
-/// of a hit) and masked (the alpha mask). Needs glslConstants' chart kinds.
+/// of a hit), mappedNormalAt and emissionTexelAt (surfaceAt's normal map and
+/// emissionModulation for one material record, materialRecord) and masked (the alpha mask).
+/// Needs glslConstants' chart kinds.
 std::string surfaceDetailGlsl(unsigned binding);
 
 }  // namespace pl::gpu

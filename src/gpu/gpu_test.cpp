@@ -23,6 +23,7 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "gpu/gpu_highlights.h"
 #include "image/compare.h"
 #include "lightfield/lookup.h"
 #include "plf/plf_file.h"
@@ -268,19 +269,28 @@ TEST_F(GpuRendererTest, MatchesFastRendererWithTexturesAndVertexColours) {
 
 // Alpha masks: the built-in box's blocks cut out by a random coverage texture (bilinear, cutoff
 // 0.5), so the floor and walls are seen through them; the albedo-textured walls behind.
-TEST_F(GpuRendererTest, MatchesFastRendererWithAlphaMasks) {
-  Scene scene = withSurfaceDetail(makeCornellBox(), true);
+/// `scene` with the meshes named in `meshes` given a masked copy of their first material: a
+/// random coverage texture (bilinear, 0 or 1 per texel, cutoff 0.5) cuts holes in them.
+Scene withAlphaMasks(Scene scene, const std::vector<std::string>& meshes) {
   Texture mask = test_support::randomTexture(6, 5, true, 9);
   mask.decode = ImageDecode::Coverage;
   for (Rgb& texel : mask.image.pixels) texel = Rgb(texel.r < 0.5f ? 0.0f : 1.0f);
   scene.textures.push_back(mask);
-  Material masked = scene.materials[0];
-  masked.name = "masked";
-  masked.alphaTexture = int(scene.textures.size()) - 1;
-  scene.materials.push_back(masked);
-  Mesh& blocks = scene.meshes[2];
-  ASSERT_EQ(blocks.name, "blocks");
-  std::fill(blocks.materials.begin(), blocks.materials.end(), uint32_t(scene.materials.size() - 1));
+  for (const std::string& name : meshes) {
+    const auto mesh = std::find_if(scene.meshes.begin(), scene.meshes.end(), [&](const Mesh& m) { return m.name == name; });
+    EXPECT_NE(mesh, scene.meshes.end()) << name;
+    if (mesh == scene.meshes.end()) continue;
+    Material masked = scene.materials[mesh->materials.front()];
+    masked.name += " masked";
+    masked.alphaTexture = int(scene.textures.size()) - 1;
+    scene.materials.push_back(masked);
+    std::fill(mesh->materials.begin(), mesh->materials.end(), uint32_t(scene.materials.size() - 1));
+  }
+  return scene;
+}
+
+TEST_F(GpuRendererTest, MatchesFastRendererWithAlphaMasks) {
+  Scene scene = withAlphaMasks(withSurfaceDetail(makeCornellBox(), true), {"blocks"});
   const LightField lf = randomLightField(std::move(scene), 33);
   ASSERT_EQ(gpuUnsupportedFeature(lf), "");
   GpuRenderer gpu(lf);
@@ -294,6 +304,17 @@ TEST_F(GpuRendererTest, MatchesFastRendererWithAlphaMasks) {
   gone.scene.materials.back().alphaFactor = 0.25f;
   GpuRenderer goneGpu(gone);
   expectSameAsFastRenderer(gone, goneGpu, firstCamera(gone.scene), 64, 48);
+  // Vertex alphas (glTF COLOR_0's alpha) multiply the coverage: random ones on the blocks.
+  Scene faded = withAlphaMasks(withSurfaceDetail(makeCornellBox(), true), {"blocks"});
+  Pcg32 rng(61, 2);
+  for (Mesh& mesh : faded.meshes)
+    if (mesh.name == "blocks")
+      for (size_t v = 0; v < mesh.positions.size(); ++v) mesh.alphas.push_back(rng.uniform());
+  faded.finalize();
+  const LightField fadedLf = randomLightField(std::move(faded), 34);
+  ASSERT_TRUE(fadedLf.scene.materials.back().vertexAlpha);
+  GpuRenderer fadedGpu(fadedLf);
+  expectSameAsFastRenderer(fadedLf, fadedGpu, firstCamera(fadedLf.scene), 64, 48);
 }
 
 // An emission texture on a diffuse emitter (the glTF emissive seed, made Lambertian).
@@ -606,30 +627,32 @@ TEST_F(GpuRendererTest, MatchesFastRendererOnRoughGlassBall) {
   expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 64, 48);
 }
 
+/// A point, a spot and a directional light added to `scene` (delta lights: punctual highlights).
+void addLights(Scene& scene) {
+  Vec3 lo, hi;
+  scene.bounds(lo, hi);
+  const Vec3 extent = hi - lo;
+  scene.lights.push_back(PointLight{lo + Vec3(0.3f, 0.8f, 0.6f) * extent, Rgb(0.4f, 0.3f, 0.2f) * glm::dot(extent, extent)});
+  SpotLight spot;
+  spot.position = lo + Vec3(0.7f, 0.9f, 0.4f) * extent;
+  spot.direction = Vec3(-0.2f, -1.0f, 0.1f);
+  spot.intensity = Rgb(0.2f, 0.3f, 0.5f) * glm::dot(extent, extent);
+  spot.innerAngle = 0.3f;
+  spot.outerAngle = 0.6f;
+  spot.prepare();
+  scene.lights.push_back(spot);
+  DirectionalLight sun;
+  sun.direction = Vec3(0.3f, -1.0f, -0.6f);
+  sun.irradiance = Rgb(2.0f);
+  scene.lights.push_back(sun);
+}
+
 // Punctual highlights (lookup.h PunctualHighlights): point, spot and directional lights'
 // direct glossy reflection evaluated per pixel with a shadow ray through the GPU BVH, on
 // McGuire's glossy box (Blinn-Phong, the diffuse part in Ẽ) and on GGX metal walls around a
 // glass ball and a thin glass sheet (the highlights seen through the glass, the sheet's
 // shadow its transmittance).
 TEST_F(GpuRendererTest, PunctualHighlightsMatchFastRenderer) {
-  auto addLights = [](Scene& scene) {
-    Vec3 lo, hi;
-    scene.bounds(lo, hi);
-    const Vec3 extent = hi - lo;
-    scene.lights.push_back(PointLight{lo + Vec3(0.3f, 0.8f, 0.6f) * extent, Rgb(0.4f, 0.3f, 0.2f) * glm::dot(extent, extent)});
-    SpotLight spot;
-    spot.position = lo + Vec3(0.7f, 0.9f, 0.4f) * extent;
-    spot.direction = Vec3(-0.2f, -1.0f, 0.1f);
-    spot.intensity = Rgb(0.2f, 0.3f, 0.5f) * glm::dot(extent, extent);
-    spot.innerAngle = 0.3f;
-    spot.outerAngle = 0.6f;
-    spot.prepare();
-    scene.lights.push_back(spot);
-    DirectionalLight sun;
-    sun.direction = Vec3(0.3f, -1.0f, -0.6f);
-    sun.irradiance = Rgb(2.0f);
-    scene.lights.push_back(sun);
-  };
   Scene glossy = loadScene(kMcGuire + "CornellBox-Glossy.obj");
   addLights(glossy);
   const LightField glossyLf = randomLightField(std::move(glossy), 25);
@@ -664,6 +687,65 @@ TEST_F(GpuRendererTest, PunctualHighlightsMatchFastRenderer) {
   GpuRenderer metalGpu(metalLf);
   expectSameAsFastRenderer(metalLf, metalGpu, firstCamera(metalLf.scene), 64, 64, false, {}, 0.01);
   expectSameAsFastRenderer(metalLf, metalGpu, insideCamera(metalLf.scene), 64, 48, false, {}, 0.01);
+}
+
+/// `scene` without vertex colours on its mirrors' and glass's meshes (the GPU renderer refuses
+/// a mirror or glass whose reflectance or transmittance varies).
+Scene withoutColouredSpecular(Scene scene) {
+  for (Mesh& mesh : scene.meshes) {
+    const Bsdf& model = scene.materials[mesh.materials.front()].bsdf;
+    if (isDelta(model) || std::holds_alternative<DielectricBsdf>(model)) mesh.colors.clear();
+  }
+  scene.finalize();
+  return scene;
+}
+
+// The traced rays read the surface detail at their hits as the CPU renderer's do: the mirror
+// box with albedo textures (their mip level from the chain's ray cone), vertex colours, normal
+// maps (on the mirror too: it reflects about the mapped normal) and alpha masks (cut by the
+// reflected rays as by the camera's), the mirror emitting through an emission texture; the
+// glossy box so, lit by delta lights whose highlights' shadow rays pass through the masks'
+// holes; the glass ball, cut by a mask, and the sheet beside textured walls. (No mask here lets a
+// ray reach a face lying on another, as a box's bottom on the floor: which of two coplanar
+// triangles rasterisation and the ray caster see is not the same, docs/limitations.md.)
+TEST_F(GpuRendererTest, TracedRaysReadSurfaceDetailAtTheirHits) {
+  Scene mirror = withAlphaMasks(withNormalMaps(loadScene(kMcGuire + "CornellBox-Mirror.obj")), {"leftWall", "backWall"});
+  for (Material& m : mirror.materials)
+    if (std::holds_alternative<MirrorBsdf>(m.bsdf)) {
+      m.emission = Rgb(0.2f, 0.3f, 0.1f);
+      m.emissionTexture = 3;
+    }
+  const LightField mirrorLf = randomLightField(withoutColouredSpecular(std::move(mirror)), 51);
+  ASSERT_EQ(gpuUnsupportedFeature(mirrorLf), "");
+  GpuRenderer mirrorGpu(mirrorLf);
+  RenderSettings three;
+  three.samplesPerPixel = 3;
+  expectSameAsFastRenderer(mirrorLf, mirrorGpu, firstCamera(mirrorLf.scene), 64, 64);
+  expectSameAsFastRenderer(mirrorLf, mirrorGpu, insideCamera(mirrorLf.scene), 64, 48, true, three);
+
+  Scene glossy = withAlphaMasks(withNormalMaps(loadScene(kMcGuire + "CornellBox-Glossy.obj")), {"sphere", "leftWall"});
+  addLights(glossy);
+  const LightField glossyLf = randomLightField(std::move(glossy), 52);
+  ASSERT_TRUE(gpuHighlightsActive(glossyLf));
+  ASSERT_EQ(gpuUnsupportedFeature(glossyLf), "");
+  GpuRenderer glossyGpu(glossyLf);
+  // (A pixel may differ where a shadow ray passes within rounding of an occluder's edge.)
+  expectSameAsFastRenderer(glossyLf, glossyGpu, firstCamera(glossyLf.scene), 48, 48, false, {}, 0.002);
+  expectSameAsFastRenderer(glossyLf, glossyGpu, insideCamera(glossyLf.scene), 48, 36, false, {}, 0.002);
+
+  const LightField glassLf =
+      randomLightField(withoutColouredSpecular(withAlphaMasks(withSurfaceDetail(glassBallBox(), true), {"ball"})), 53);
+  ASSERT_EQ(gpuUnsupportedFeature(glassLf), "");
+  GpuRenderer glassGpu(glassLf);
+  expectSameAsFastRenderer(glassLf, glassGpu, firstCamera(glassLf.scene), 64, 64, false, {}, 0.01);
+
+  // What the traced rays still cannot read: a mirror whose reflectance a texture modulates.
+  Scene textured = loadScene(kMcGuire + "CornellBox-Mirror.obj");
+  textured = withPlanarUvs(std::move(textured));
+  textured.textures.push_back(test_support::randomTexture(4, 4, true, 6));
+  for (Material& m : textured.materials)
+    if (std::holds_alternative<MirrorBsdf>(m.bsdf)) m.albedoTexture = 0;
+  EXPECT_EQ(gpuUnsupportedFeature(randomLightField(std::move(textured), 54)), "albedo textures or vertex colours on mirrors and glass");
 }
 
 TEST_F(GpuRendererTest, GpuMemoryIsTheLightFieldAndOneFrame) {
