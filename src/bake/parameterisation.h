@@ -160,6 +160,7 @@ void forEachTixelSetupArray(P& p, F&& f) {
   f("BORR", p.borrowedPoint);
   f("ALBD", p.transportAlbedo);
   f("SPF0", p.specularF0);
+  f("LOBA", p.lobeAlpha);
   f("EMOD", p.emissionModulation);
   f("EMTR", p.emitterTriangle);
 }

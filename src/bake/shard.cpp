@@ -173,14 +173,11 @@ TixelSetupTiming fillTixelsDistributed(const Scene& scene, const Accel& accel, P
       comm.allgatherv(array.data(), displacement, count);
     }
   };
-  exchange(param.gatherPoint);
-  exchange(param.gatherNormal);
-  exchange(param.coverage);
-  exchange(param.transportAlbedo);
-  if (!param.specularF0.empty()) exchange(param.specularF0);
-  if (!param.lobeAlpha.empty()) exchange(param.lobeAlpha);
+  // Every per-tixel array fillTixels fills (one list: forEachTixelSetupArray), and the sun masks.
+  forEachTixelSetupArray(param, [&](const char*, auto& array) {
+    if (!array.empty()) exchange(array);
+  });
   exchange(param.sunMask);
-  exchange(param.borrowedPoint);
   timing.exchangeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - filled).count();
   return timing;
 }

@@ -317,6 +317,51 @@ TEST(Shards, RanksFillTheOneProcessParameterisationBitForBit) {
   EXPECT_THROW(fillTixels(scene, accel, part, 2, 1), Error);
 }
 
+TEST_F(ShardFiles, RanksFillEveryTixelSetupArrayOfTheOneProcess) {
+  // Normal-mapped walls (tilt weights) and a textured lamp (emission means, emitting
+  // triangles): every array forEachTixelSetupArray names reaches every rank, not only the
+  // three the sphere box above uses.
+  namespace fs = std::filesystem;
+  for (const char* file : {"normal_tilt.png", "checker.png"})
+    fs::copy_file(std::string(PLENOPTIC_TEST_DATA_DIR) + "/scene/" + file, path(file));
+  const std::string json = path("detail.json");
+  std::ofstream(json) << R"({"meshes": [{"file": ")" << PLENOPTIC_TEST_DATA_DIR
+                      << R"(/cornell-mcguire/CornellBox-Original.obj"}], "materials": {)"
+                      << R"("backWall": {"type": "lambert", "albedo": 0.7, "normal_texture": "normal_tilt.png"},)"
+                      << R"("light": {"type": "lambert", "albedo": 0.78, "emission": [17, 12, 4], "emission_texture": "checker.png"}}})";
+  const Scene scene = loadScene(json);
+  const BakeSettings settings = smallSettings(16, 16);
+  const Accel accel(scene);
+  const Parameterisation one = buildParameterisation(scene, accel, settings);
+  ASSERT_FALSE(one.transportTiltWeights.empty());
+  ASSERT_FALSE(one.emissionModulation.empty());
+  ASSERT_FALSE(one.emitterTriangle.empty());
+  std::vector<Parameterisation> results(2);
+  ThreadRanks world(2);
+  world.run([&](Communicator& comm) {
+    Parameterisation p = buildCharts(scene, accel, settings);
+    fillTixelsDistributed(scene, accel, p, comm, uint64_t(1) << 30);
+    results[size_t(comm.rank())] = std::move(p);
+  });
+  for (int r = 0; r < 2; ++r) {
+    size_t index = 0;
+    forEachTixelSetupArray(one, [&](const char* tag, const auto& expected) {
+      using Array = std::decay_t<decltype(expected)>;
+      const Array* got = nullptr;
+      size_t at = 0;
+      forEachTixelSetupArray(results[size_t(r)], [&](const char*, const auto& array) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(array)>, Array>)
+          if (at == index) got = &array;
+        ++at;
+      });
+      ASSERT_NE(got, nullptr) << tag;
+      EXPECT_EQ(differingEntries(*got, expected), 0u) << "array " << tag << ", rank " << r;
+      ++index;
+    });
+    EXPECT_EQ(differingEntries(results[size_t(r)].sunMask, one.sunMask), 0u) << "rank " << r;
+  }
+}
+
 TEST(Shards, ShardFileNames) {
   EXPECT_EQ(shardVisibilityPath("out/a.plv", 0, 1), "out/a.plv");
   EXPECT_EQ(shardVisibilityPath("out/a.plv", 2, 3), "out/a.rank2-of-3.plv");
