@@ -22,8 +22,12 @@ std::string gpuUnsupportedHighlights(const LightField& lf) {
   if (!gpuHighlightsActive(lf)) return {};
   for (const Chart& c : lf.charts) {
     if (c.kind != ChartKind::Glossy) continue;
-    const Bsdf& model = lf.scene.materials[c.material].bsdf;
+    const Material& material = lf.scene.materials[c.material];
+    const Bsdf& model = material.bsdf;
     if (isRoughGlassChart(c, model) || std::holds_alternative<BlinnPhongBsdf>(model)) continue;
+    // The CPU renderers evaluate such a highlight with the texel's lobe width and f0
+    // (lookup.h); the GLSL reads the material's.
+    if (material.metallicRoughness.texture >= 0) return "punctual highlights on metallic-roughness-textured materials";
     const auto* ggx = std::get_if<GgxBsdf>(&model);
     if (ggx == nullptr) return "punctual highlights on glTF PBR materials";
     if (!isBlack(ggx->diffuse) && !c.diffuseValue) return "punctual highlights on GGX materials with a diffuse base";
