@@ -23,8 +23,10 @@
 #
 # Printed (and written to WORKDIR/sss_vs_cycles.md): per region (sphere, slab, walls, whole
 # image), mean luminance of plenoptic's path trace with its standard error (`trace
-# --variance`), Cycles' mean and their ratio (target: within 3 %). WORKDIR/side_by_side.png:
-# plenoptic (left) and Cycles (right), tone-mapped together (`plenoptic tonemap`, Reinhard).
+# --variance`), Cycles' mean and their ratio (target: within 3 %), and the light field's mean
+# and its ratio to the path trace (target: within 2 %; `bake --preset PRESET`, `render --spp
+# LF_SPP`). WORKDIR/side_by_side.png: plenoptic's path trace (left), its light field (middle)
+# and Cycles (right), tone-mapped together (`plenoptic tonemap`, Reinhard).
 #
 # MAX_DEPTH=D limits both renderers to D scattering events (plenoptic `--max-depth D`, Cycles
 # max_bounces D − 1: its bounces do not count the first hit); MAX_DEPTH=1 is direct light only,
@@ -39,7 +41,8 @@
 # Usage: bench/sss_vs_cycles.sh [PLENOPTIC] [WORKDIR]
 #   PLENOPTIC  default build/plenoptic; WORKDIR default out/sss_vs_cycles
 # Environment: SCENE (default bench/scenes/sss-cornell.json), WIDTH (256), HEIGHT (256),
-# SPP (both renderers, default 1024), THREADS (2), BLENDER (default blender).
+# SPP (both renderers, default 1024), THREADS (2), BLENDER (default blender), PRESET (the
+# light field's bake preset, default `default`), LF_SPP (its render's samples, default 16).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 plenoptic=${1:-build/plenoptic}
@@ -61,6 +64,10 @@ depth=${MAX_DEPTH:--1}
 if [ "$depth" != -1 ]; then export CYCLES_MAX_BOUNCES=$((depth - 1)); fi
 "$plenoptic" --quiet --threads "$threads" --seed 1 trace "$scene" -o "$work/pt.pfm" --variance "$work/pt_var.pfm" \
   --spp "$spp" --width "$width" --height "$height" --camera main --stats "$work/pt.json" --max-depth "$depth"
+echo "== plenoptic light field: bake --preset ${PRESET:-default}, render --spp ${LF_SPP:-16}" >&2
+"$plenoptic" --quiet --threads "$threads" --seed 1 bake "$scene" -o "$work/lf.plf" --preset "${PRESET:-default}" --fresh
+"$plenoptic" --quiet --threads "$threads" render "$work/lf.plf" -o "$work/lf.pfm" --spp "${LF_SPP:-16}" \
+  --width "$width" --height "$height" --camera main
 rm -f "$work/standins.pfm" "$work/shortcut.pfm"
 if [ -n "${SHORTCUT:-}" ]; then
   echo "== plenoptic trace with --subsurface-after-diffuse lambert, $spp spp" >&2
@@ -97,7 +104,7 @@ def image(name):
     return np.array(read_pfm(path), dtype=np.float64).reshape(h, w, 3)  # bottom row first, as both store
 
 
-pt, var, cy, ids = image("pt"), image("pt_var"), image("cy"), image("cy.ids")
+pt, var, lf, cy, ids = image("pt"), image("pt_var"), image("lf"), image("cy"), image("cy.ids")
 # The optional columns: (heading, image) of each extra plenoptic trace that was made.
 extras = [(heading, image(name)) for name, heading in (("shortcut", "plenoptic with Cycles' shortcut"),
                                                        ("standins", "plenoptic, stand-ins"))
@@ -117,25 +124,26 @@ print(f"Scene {os.path.basename(scene)}, {ids.shape[1]}x{ids.shape[0]}, both ren
       f"(plenoptic trace {stats.get('seconds', float('nan')):.1f} s):")
 print()
 extra = "".join(f" {heading} Y | Cycles / it |" for heading, _ in extras)
-print("| region | pixels | plenoptic Y (± s.e.) | Cycles Y | Cycles / plenoptic |" + extra)
-print("|---|---:|---:|---:|---:|" + "---:|---:|" * len(extras))
+print("| region | pixels | plenoptic Y (± s.e.) | Cycles Y | Cycles / plenoptic | light field / plenoptic |" + extra)
+print("|---|---:|---:|---:|---:|---:|" + "---:|---:|" * len(extras))
 for name, mask in regions:
     n = int(mask.sum())
     if n == 0:  # e.g. no walls in the furnace
         continue
     y_pt, y_cy = float((pt[mask] @ weights).mean()), float((cy[mask] @ weights).mean())
     se = float(np.sqrt((var[mask] @ (weights ** 2)).sum()) / n)  # pixels independent
-    row = f"| {name} | {n} | {y_pt:.4f} ± {se:.4f} | {y_cy:.4f} | {y_cy / y_pt:.4f} |"
+    y_lf = float((lf[mask] @ weights).mean())
+    row = f"| {name} | {n} | {y_pt:.4f} ± {se:.4f} | {y_cy:.4f} | {y_cy / y_pt:.4f} | {y_lf / y_pt:.4f} |"
     for _, other in extras:
         y_other = float((other[mask] @ weights).mean())
         row += f" {y_other:.4f} | {y_cy / y_other:.4f} |"
     print(row)
 print()
 print("Y = mean luminance (Rec. 709) of linear radiance over the region's pixels.")
-side = np.concatenate([pt, cy], axis=1).astype("<f4")
+side = np.concatenate([pt, lf, cy], axis=1).astype("<f4")
 with open(os.path.join(work, "side_by_side.pfm"), "wb") as f:
     f.write(f"PF\n{side.shape[1]} {side.shape[0]}\n-1.0\n".encode())
     f.write(side.tobytes())
 PY
 "$plenoptic" --quiet tonemap "$work/side_by_side.pfm" -o "$work/side_by_side.png"
-echo "Outputs in $work: pt.pfm (plenoptic), cy.pfm (Cycles), side_by_side.png, sss_vs_cycles.md" >&2
+echo "Outputs in $work: pt.pfm (plenoptic), lf.pfm (its light field), cy.pfm (Cycles), side_by_side.png, sss_vs_cycles.md" >&2
