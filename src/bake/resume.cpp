@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/byte_writer.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/hash.h"
@@ -37,15 +38,6 @@ constexpr size_t kCheckpointHeaderBytes = 8 + 4 + 4 + 8 + 4 + 4 + 4 * 8 + 3 * 8 
 
 std::string errnoText() { return std::strerror(errno); }
 
-/// Appends `size` bytes to a byte vector.
-void put(std::vector<unsigned char>& out, const void* data, size_t size) {
-  const auto* bytes = static_cast<const unsigned char*>(data);
-  out.insert(out.end(), bytes, bytes + size);
-}
-template <typename T>
-void putValue(std::vector<unsigned char>& out, const T& value) {
-  put(out, &value, sizeof(T));
-}
 template <typename T>
 T getValue(std::span<const unsigned char> bytes, size_t at) {
   T value;
@@ -65,13 +57,13 @@ void writeAll(int fd, std::span<const unsigned char> bytes, const std::string& p
 
 std::vector<unsigned char> journalHeader(uint32_t gridSide, uint64_t hash, const std::vector<uint64_t>& blockTixels) {
   std::vector<unsigned char> h;
-  put(h, kJournalMagic, 8);
-  putValue(h, kJournalVersion);
-  putValue(h, gridSide);
-  putValue(h, hash);
-  putValue(h, uint64_t(blockTixels.size()));
-  putValue(h, xxh64(blockTixels.data(), blockTixels.size() * sizeof(uint64_t)));
-  putValue(h, xxh64(h.data(), h.size()));
+  appendBytes(h, kJournalMagic, 8);
+  appendValue(h, kJournalVersion);
+  appendValue(h, gridSide);
+  appendValue(h, hash);
+  appendValue(h, uint64_t(blockTixels.size()));
+  appendValue(h, xxh64(blockTixels.data(), blockTixels.size() * sizeof(uint64_t)));
+  appendValue(h, xxh64(h.data(), h.size()));
   return h;
 }
 
@@ -208,16 +200,16 @@ void VisibilityJournal::append(uint64_t block, const EncodedRun& run, const Bloc
   std::vector<unsigned char> record;
   record.reserve(kRecordHeaderBytes + 8 + extras.size() * (8 + sizeof(VisibilityExtra)) + run.tixelBytes.size() * 4 +
                  run.bytes.size());
-  putValue(record, block);
-  putValue(record, uint64_t(0));  // the content's size, below
-  putValue(record, uint64_t(0));  // the checksum, below
-  putValue(record, uint64_t(extras.size()));
+  appendValue(record, block);
+  appendValue(record, uint64_t(0));  // the content's size, below
+  appendValue(record, uint64_t(0));  // the checksum, below
+  appendValue(record, uint64_t(extras.size()));
   for (const auto& [entry, extra] : extras) {
-    putValue(record, entry);
-    putValue(record, extra);
+    appendValue(record, entry);
+    appendValue(record, extra);
   }
-  put(record, run.tixelBytes.data(), run.tixelBytes.size() * sizeof(uint32_t));
-  put(record, run.bytes.data(), run.bytes.size());
+  appendBytes(record, run.tixelBytes.data(), run.tixelBytes.size() * sizeof(uint32_t));
+  appendBytes(record, run.bytes.data(), run.bytes.size());
   const uint64_t contentBytes = record.size() - kRecordHeaderBytes;
   std::memcpy(record.data() + 8, &contentBytes, 8);
   const uint64_t check = xxh64(record.data() + kRecordHeaderBytes, contentBytes, xxh64(record.data(), 16));
@@ -251,21 +243,21 @@ uint64_t propagationKey(uint64_t fieldHash, const Scene& scene, const BakeSettin
 void writePropagationCheckpoint(const std::string& path, const PropagationProgress& p, const std::vector<Rgb>& direct,
                                 const std::vector<Rgb>& punctualGlossy, const std::vector<Rgb>& current) {
   std::vector<unsigned char> header;
-  put(header, kCheckpointMagic, 8);
-  putValue(header, kCheckpointVersion);
-  putValue(header, uint32_t(p.converged ? 1 : 0));
-  putValue(header, p.key);
-  putValue(header, p.iterations);
-  putValue(header, uint32_t(0));
-  putValue(header, p.previousPower);
-  putValue(header, p.previousL1Change);
-  putValue(header, double(p.omega));
-  putValue(header, p.residual);
-  putValue(header, p.shadowRays);
-  putValue(header, p.causticPhotons);
-  putValue(header, p.causticPhotonsLanded);
-  putValue(header, uint64_t(current.size()));
-  putValue(header, uint64_t(punctualGlossy.size()));
+  appendBytes(header, kCheckpointMagic, 8);
+  appendValue(header, kCheckpointVersion);
+  appendValue(header, uint32_t(p.converged ? 1 : 0));
+  appendValue(header, p.key);
+  appendValue(header, p.iterations);
+  appendValue(header, uint32_t(0));
+  appendValue(header, p.previousPower);
+  appendValue(header, p.previousL1Change);
+  appendValue(header, double(p.omega));
+  appendValue(header, p.residual);
+  appendValue(header, p.shadowRays);
+  appendValue(header, p.causticPhotons);
+  appendValue(header, p.causticPhotonsLanded);
+  appendValue(header, uint64_t(current.size()));
+  appendValue(header, uint64_t(punctualGlossy.size()));
   writeFileAtomically(path, [&](const std::string& temp) {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
     if (!out) fail("cannot create the temporary file {}", temp);

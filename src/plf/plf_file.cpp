@@ -16,6 +16,7 @@
 #include <type_traits>
 
 #include "core/byte_reader.h"
+#include "core/byte_writer.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/hash.h"
@@ -57,32 +58,6 @@ static_assert(sizeof(SunMaskHeader) == 16 && std::is_trivially_copyable_v<SunMas
 static_assert(sizeof(SunMask) == 2, "SMSK stores 16-bit masks");
 
 uint64_t alignUp(uint64_t x) { return (x + kSectionAlignment - 1) / kSectionAlignment * kSectionAlignment; }
-
-/// Appends little-endian fields to a byte buffer.
-class ByteWriter {
- public:
-  template <typename T>
-  void put(const T& value) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    const auto* p = reinterpret_cast<const unsigned char*>(&value);
-    bytes_.insert(bytes_.end(), p, p + sizeof(T));
-  }
-  void putString(const std::string& s) {
-    put(uint32_t(s.size()));
-    bytes_.insert(bytes_.end(), s.begin(), s.end());
-  }
-  template <typename T>
-  void putArray(const std::vector<T>& v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    put(uint64_t(v.size()));
-    const auto* p = reinterpret_cast<const unsigned char*>(v.data());
-    bytes_.insert(bytes_.end(), p, p + v.size() * sizeof(T));
-  }
-  std::vector<unsigned char>& bytes() { return bytes_; }
-
- private:
-  std::vector<unsigned char> bytes_;
-};
 
 // --- Scene -------------------------------------------------------------------------------
 

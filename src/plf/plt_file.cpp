@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string_view>
 
+#include "core/byte_writer.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/hash.h"
@@ -23,14 +24,6 @@ constexpr size_t kPltHeaderBytes = 48, kPltEntryBytes = 32;
 /// zstd level of the arrays: float arrays gain little from higher levels.
 constexpr int kPltZstdLevel = 3;
 
-void putBytes(std::vector<unsigned char>& out, const void* data, size_t size) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  out.insert(out.end(), p, p + size);
-}
-template <typename T>
-void put(std::vector<unsigned char>& out, const T& value) {
-  putBytes(out, &value, sizeof(T));
-}
 template <typename T>
 T load(const unsigned char* at) {
   T value;
@@ -61,26 +54,26 @@ void writeTixelSetupFile(const std::string& path, uint64_t hash, uint64_t tixelC
   });
   std::vector<unsigned char> payload;
   for (size_t i = 0; i < arrays.size(); ++i) {
-    putBytes(payload, arrays[i].tag.data(), 4);
-    put(payload, arrays[i].elementBytes);
-    put(payload, arrays[i].count);
-    put(payload, uint64_t(frames[i].size()));
-    put(payload, uint64_t(0));
+    appendBytes(payload, arrays[i].tag.data(), 4);
+    appendValue(payload, arrays[i].elementBytes);
+    appendValue(payload, arrays[i].count);
+    appendValue(payload, uint64_t(frames[i].size()));
+    appendValue(payload, uint64_t(0));
   }
   for (std::vector<unsigned char>& frame : frames) {
-    putBytes(payload, frame.data(), frame.size());
+    appendBytes(payload, frame.data(), frame.size());
     std::vector<unsigned char>().swap(frame);
   }
   std::vector<unsigned char> file;
   file.reserve(kPltHeaderBytes + payload.size());
-  putBytes(file, kPltMagic, 8);
-  put(file, kPltVersion);
-  put(file, uint32_t(arrays.size()));
-  put(file, hash);
-  put(file, tixelCount);
-  put(file, xxh64(payload.data(), payload.size()));
-  put(file, uint64_t(0));
-  putBytes(file, payload.data(), payload.size());
+  appendBytes(file, kPltMagic, 8);
+  appendValue(file, kPltVersion);
+  appendValue(file, uint32_t(arrays.size()));
+  appendValue(file, hash);
+  appendValue(file, tixelCount);
+  appendValue(file, xxh64(payload.data(), payload.size()));
+  appendValue(file, uint64_t(0));
+  appendBytes(file, payload.data(), payload.size());
   writeFileAtomically(path, std::string_view(reinterpret_cast<const char*>(file.data()), file.size()));
 }
 
