@@ -4,11 +4,14 @@
 # holds timings) by their XXH64 checksums, and the .plv byte for byte when both builds write the
 # same .plv format version (else the .plf sections only: the light field is what must not change).
 #   bench/compare_bakes.sh NEW_PLENOPTIC OLD_PLENOPTIC SCENE [PRESET]
+# NEW_FLAGS: extra bake flags for the new build only, e.g. NEW_FLAGS="--visibility-precision
+# exact" against a build from before the compact fractions (whose fields were all exact).
 set -euo pipefail
 NEW=$1; OLD=$2; SCENE=$3; PRESET=${4:-draft}
 D=$(mktemp -d)
 trap 'rm -rf "$D"' EXIT
-"$NEW" bake "$SCENE" -o "$D/new.plf" --preset "$PRESET" --seed 5 --quiet >/dev/null
+# shellcheck disable=SC2086  # NEW_FLAGS is split into flags on purpose
+"$NEW" bake "$SCENE" -o "$D/new.plf" --preset "$PRESET" --seed 5 --quiet ${NEW_FLAGS:-} >/dev/null
 "$OLD" bake "$SCENE" -o "$D/old.plf" --preset "$PRESET" --seed 5 --quiet >/dev/null
 sums() {
   # The new build reads both files (it also reads the older build's format version).
