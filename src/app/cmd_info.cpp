@@ -37,6 +37,7 @@ std::string humanBytes(uint64_t bytes) {
 
 std::string_view encodingName(uint32_t encoding) {
   if (encoding == uint32_t(ValuesCodec::Raw)) return "raw";
+  if (encoding == kPlfSectionZstd) return "zstd";
   return isKnownValuesCodec(encoding) ? valuesCodecName(ValuesCodec(encoding)) : "unknown";
 }
 
@@ -159,8 +160,9 @@ void printHuman(const PlfInfo& info) {
              humanBytes(storage.storedBytes), storage.ratio);
   fmt::print("sections     id    encoding        offset        bytes  xxh64\n");
   for (const PlfSectionInfo& s : info.sections)
-    fmt::print("             {}  {:8} {:>13} {:>12}  {:016x}  ({})\n", s.id, encodingName(s.encoding), s.offset,
-               s.storedSize, s.checksum, humanBytes(s.storedSize));
+    fmt::print("             {}  {:8} {:>13} {:>12}  {:016x}  ({}{})\n", s.id, encodingName(s.encoding), s.offset,
+               s.storedSize, s.checksum, humanBytes(s.storedSize),
+               s.decodedSize == s.storedSize ? "" : " of " + humanBytes(s.decodedSize));
   const BakeSettings& bs = info.settings;
   fmt::print("bake settings  preset {}, ", bs.preset);
   if (bs.tixelsPerUnit > 0.0f)

@@ -180,7 +180,7 @@ TEST_F(BakeCli, InfoShowsAVisibilityFieldsBytesPerEntry) {
   EXPECT_NE(err.find("v.plv: corrupt or truncated visibility field"), std::string::npos) << err;
 }
 
-// The light field of a .plf, bit for bit (VALS).
+// The light field of a .plf, bit for bit (VALS; the bakes write float32 values, --compress none).
 bool sameValues(const std::string& a, const std::string& b) {
   const LightField x = readLightField(a), y = readLightField(b);
   return x.values.size() == y.values.size() &&
@@ -193,7 +193,7 @@ bool sameValues(const std::string& a, const std::string& b) {
 // --fresh ignores them; other settings are not resumed, and the reason is given.
 TEST_F(BakeCli, ResumesABakeStoppedWhileTracingOrPropagating) {
   std::string out, err;
-  const std::string settings = " --preset draft --tixels-across 12 --directions 64";
+  const std::string settings = " --preset draft --tixels-across 12 --directions 64 --compress none";
   ASSERT_EQ(run("bake cornell -o \"" + path("ref.plf") + "\"" + settings + " --quiet", &out, &err), 0) << err;
   const std::string plf = path("a.plf"), plv = path("a.plv");
   const std::string partial = plv + ".partial", checkpoint = plv + ".checkpoint";
@@ -251,7 +251,7 @@ TEST_F(BakeCli, ResumesABakeStoppedWhileTracingOrPropagating) {
 // traces or propagates): the next bake resumes and writes the uninterrupted light field.
 TEST_F(BakeCli, ResumesAfterSigkill) {
   std::string out, err;
-  const std::string settings = " --preset draft --tixels-across 20 --directions 144";
+  const std::string settings = " --preset draft --tixels-across 20 --directions 144 --compress none";
   ASSERT_EQ(run("bake cornell -o \"" + path("ref.plf") + "\"" + settings + " --quiet", &out, &err), 0) << err;
   const std::string plf = path("k.plf"), partial = path("k.plv.partial"), checkpoint = path("k.plv.checkpoint");
   const pid_t pid = ::fork();

@@ -48,7 +48,7 @@ class DistributedBake : public cli_test::CliTest {
   static std::string quoted(const std::string& p) { return "\"" + p + "\""; }
 };
 
-/// The values of two light fields are the same bits.
+/// The values of two light fields are the same bits (bakes with --compress none: float32 values).
 void expectSameValues(const std::string& a, const std::string& b) {
   const LightField x = readLightField(a), y = readLightField(b);
   ASSERT_EQ(x.charts.size(), y.charts.size());
@@ -62,7 +62,7 @@ void expectSameValues(const std::string& a, const std::string& b) {
 }
 
 TEST_F(DistributedBake, SameBitsForTwoAndThreeRanksAndReusesShards) {
-  const std::string bakeArgs = "--preset draft --tixels-across 12 --directions 64";
+  const std::string bakeArgs = "--preset draft --tixels-across 12 --directions 64 --compress none";
   std::string err;
   // 2 threads in one process: chunks of the parallel loops differ from the ranks' parts.
   ASSERT_EQ(run("bake cornell -o " + quoted(path("one.plf")) + " " + bakeArgs + " --threads 2", nullptr, &err), 0) << err;
@@ -106,7 +106,7 @@ TEST_F(DistributedBake, GlossyChartsSameBits) {
   // Glossy charts: the partial-batch rule of gatherIteration (glossy values of the batch read
   // at their previous values) and the paraboloid values in the exchange.
   const std::string scene = quoted(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/CornellBox-Glossy.obj");
-  const std::string bakeArgs = "--preset draft --tixels-across 10 --directions 36";
+  const std::string bakeArgs = "--preset draft --tixels-across 10 --directions 36 --compress none";
   std::string err;
   ASSERT_EQ(run("bake " + scene + " -o " + quoted(path("one.plf")) + " " + bakeArgs, nullptr, &err), 0) << err;
   ASSERT_EQ(runRanks(3, "bake " + scene + " -o " + quoted(path("three.plf")) + " " + bakeArgs, &err), 0) << err;
@@ -117,7 +117,7 @@ TEST_F(DistributedBake, SubsurfaceSameBits) {
   // Subsurface charts: the operator's walks split between the ranks and exchanged, and the
   // irradiance entering each object exchanged every iteration.
   const std::string scene = quoted(std::string(PLENOPTIC_TEST_DATA_DIR) + "/../../bench/scenes/sss-cornell.json");
-  const std::string bakeArgs = "--preset draft --tixels-across 8 --directions 16";
+  const std::string bakeArgs = "--preset draft --tixels-across 8 --directions 16 --compress none";
   std::string err;
   ASSERT_EQ(run("bake " + scene + " -o " + quoted(path("one.plf")) + " " + bakeArgs, nullptr, &err), 0) << err;
   ASSERT_EQ(runRanks(2, "bake " + scene + " -o " + quoted(path("two.plf")) + " " + bakeArgs, &err), 0) << err;

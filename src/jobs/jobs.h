@@ -26,6 +26,7 @@
 #include "image/tonemap.h"
 #include "lightfield/lightfield.h"
 #include "lightfield/render_settings.h"
+#include "plf/compression.h"
 #include "scene/scene.h"
 #include "trace/trace.h"
 
@@ -171,7 +172,7 @@ struct BakeJobOptions {
   /// guard refuses a bake whose estimate exceeds it, as one that exceeds the available memory;
   /// 0 = the available memory alone.
   uint64_t maxMemory = 0;
-  std::string compress = "none";  ///< none | lossless | bc1 | hdr (plf/compression.h)
+  std::string compress{valuesCodecName(kDefaultValuesCodec)};  ///< none | lossless | bc1 | hdr (plf/compression.h)
   uint64_t seed = 0;
   int threads = 0;  ///< 0 = all hardware threads
   /// One-line notes (reuse decisions, rates); empty = dropped.

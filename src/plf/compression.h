@@ -22,14 +22,16 @@
 //             BC1's quantisation: x = scale·(y/255)^γ. Negative components are stored as 0.
 //   hdr       lossy, keeps the dynamic range: every component x > 0 becomes a
 //             logarithmic code round((log2 x − log2Min)·stepsPerStop) + 1 (0 = zero),
-//             i.e. a relative error of at most 2^(1/(2·stepsPerStop)) − 1 (2.2% at the
-//             default 16 steps per stop), codes predicted with MED as in lossless, the
+//             i.e. a relative error of at most 2^(1/(2·stepsPerStop)) − 1 (0.54% at the
+//             default 64 steps per stop, 2.2% at 16), codes predicted with MED as in lossless, the
 //             green and blue prediction residuals taken relative to red's (the channels of
 //             a radiance change together), zig-zag, two byte planes, zstd.
 //             Chosen over shared-exponent RGB9E5 by measurement (bench/hdr_alternatives.py:
 //             RGB9E5 + zstd reaches 4–5:1 with up to 7.5% error on weak channels, these
-//             codes 12–15:1 at ≤ 2.2% on every channel; the default of 16 steps per stop
-//             keeps a render's relMSE near 1e-5, two orders under the 1e-3 target).
+//             codes 12–15:1 at ≤ 2.2% on every channel at 16 steps per stop). The default
+//             of 64 steps per stop, with hdr the default codec of a bake
+//             (kDefaultValuesCodec), keeps renders of Cornell and Sponza within a relMSE of
+//             1e-6 of the float values' (docs/benchmarks.md "Light-field compression").
 //
 // Layout ("images"): the values are visited as 2-D images so that neighbours in an image
 // are neighbours on a surface or on the hemisphere. A diffuse chart is one resU × resV image
@@ -62,6 +64,11 @@ namespace pl {
 
 enum class ValuesCodec : uint32_t { Raw = 0, Lossless = 1, Bc1 = 2, Hdr = 3 };
 
+/// How `bake` (and Python's LightField.save) store the values unless told otherwise: hdr at
+/// the default steps per stop below, and with it the other sections as zstd frames
+/// (plf_file.h kPlfSectionZstd). `--compress none` keeps float32 values bit for bit.
+inline constexpr ValuesCodec kDefaultValuesCodec = ValuesCodec::Hdr;
+
 /// "none", "lossless", "bc1", "hdr" (the --compress / --mode spellings).
 std::string_view valuesCodecName(ValuesCodec codec);
 /// The inverse of valuesCodecName ("raw" is accepted for none); anything else → pl::Error.
@@ -70,8 +77,8 @@ ValuesCodec parseValuesCodec(std::string_view name);
 bool isKnownValuesCodec(uint32_t code);
 
 struct ValuesCodecOptions {
-  int zstdLevel = 9;            ///< lossless and hdr; decoding speed does not depend on it
-  uint32_t hdrStepsPerStop = 16;  ///< hdr: logarithmic codes per factor of 2
+  int zstdLevel = 9;            ///< lossless, hdr and the zstd sections; decoding speed does not depend on it
+  uint32_t hdrStepsPerStop = 64;  ///< hdr: logarithmic codes per factor of 2 (max relative error 0.54%)
 };
 
 /// Encodes `values` (laid out by `charts`, see above). Raw returns the float bytes. Lossy

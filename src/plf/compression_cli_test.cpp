@@ -4,7 +4,10 @@
 // error (exit status 1, the file and section named), never a crash.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <utility>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -22,11 +25,12 @@ namespace fs = std::filesystem;
 
 class CompressCli : public cli_test::CliTest {
  protected:
-  /// A small Cornell-box bake (draft preset, coarse overrides keep it around a second).
+  /// A small Cornell-box bake (draft preset, coarse overrides keep it around a second);
+  /// `mode` empty: bake's default.
   void bake(const std::string& output, const std::string& mode) const {
     std::string err;
-    ASSERT_EQ(run("bake cornell -o \"" + output + "\" --preset draft --tixels-across 16 --directions 64 --compress " +
-                      mode + " --quiet",
+    ASSERT_EQ(run("bake cornell -o \"" + output + "\" --preset draft --tixels-across 16 --directions 64" +
+                      (mode.empty() ? "" : " --compress " + mode) + " --quiet",
                   nullptr, &err),
               0)
         << err;
@@ -81,6 +85,43 @@ TEST_F(CompressCli, BakeCompressInfoAndRenderEveryMode) {
               0)
         << err;
   }
+}
+
+// A bake writes hdr values (64 steps per stop) and zstd sections unless told otherwise: every
+// value within the codes' bound of the float32 bake's, zeros exact, and the renders within the
+// relMSE bound the default was chosen under (1e-5; measured about 1e-6 and below,
+// docs/benchmarks.md "Light-field compression").
+TEST_F(CompressCli, DefaultBakeIsHdrWithinItsBoundAndZstdSections) {
+  const std::string raw = path("raw.plf"), plain = path("default.plf");
+  bake(raw, "none");
+  bake(plain, "");
+  const PlfInfo info = readLightFieldInfo(plain);
+  for (const PlfSectionInfo& s : info.sections) {
+    const uint32_t expected = s.id == "VALS" ? uint32_t(kDefaultValuesCodec) : s.id == "META" ? 0u : kPlfSectionZstd;
+    EXPECT_EQ(s.encoding, expected) << s.id;
+  }
+  for (const PlfSectionInfo& s : readLightFieldInfo(raw).sections) EXPECT_EQ(s.encoding, 0u) << s.id;
+  EXPECT_LT(fs::file_size(plain) * 3, fs::file_size(raw));
+  const LightField a = readLightField(plain), b = readLightField(raw);
+  ASSERT_EQ(a.values.size(), b.values.size());
+  const double bound = std::exp2(1.0 / (2.0 * ValuesCodecOptions{}.hdrStepsPerStop)) - 1.0;
+  double worst = 0.0;
+  for (size_t i = 0; i < a.values.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const float x = (&b.values[i].r)[c], y = (&a.values[i].r)[c];
+      if (x == 0.0f) EXPECT_EQ(y, 0.0f);
+      else worst = std::max(worst, std::abs(double(y) - x) / std::abs(double(x)));
+    }
+  EXPECT_GT(worst, 0.0);
+  EXPECT_LE(worst, bound + 1e-6);
+  std::string err;
+  for (const auto& [file, image] : {std::pair{raw, path("raw.pfm")}, std::pair{plain, path("default.pfm")}})
+    ASSERT_EQ(run("render \"" + file + "\" -o \"" + image + "\" --width 64 --height 48 --spp 4 --quiet", nullptr, &err), 0)
+        << err;
+  EXPECT_EQ(run("compare \"" + path("default.pfm") + "\" \"" + path("raw.pfm") + "\" --max-relmse 1e-5 --quiet", nullptr,
+                &err),
+            0)
+      << err;
 }
 
 TEST_F(CompressCli, LosslessRoundTripsThroughTheProgramAndInPlace) {

@@ -20,6 +20,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/hash.h"
+#include "plf/codec_backends.h"
 #include "plf/compression.h"
 
 namespace pl {
@@ -56,6 +57,12 @@ struct SunMaskHeader {
 };
 static_assert(sizeof(SunMaskHeader) == 16 && std::is_trivially_copyable_v<SunMaskHeader>);
 static_assert(sizeof(SunMask) == 2, "SMSK stores 16-bit masks");
+
+static_assert(kPlfSectionZstd > uint32_t(ValuesCodec::Hdr), "a section's zstd encoding is no values codec");
+/// zstd's largest expansion: an RLE block, 3 header bytes and 1 byte, decodes to at most 128 KiB.
+/// A zstd section's decoded size beyond this many times its stored size is corruption, refused
+/// before anything is allocated for it.
+constexpr uint64_t kZstdMaxExpansion = 32768;
 
 uint64_t alignUp(uint64_t x) { return (x + kSectionAlignment - 1) / kSectionAlignment * kSectionAlignment; }
 
@@ -772,13 +779,17 @@ class PlfReader {
       if (found[kind] >= 0) fail("{}: section {} appears twice", path, id);
       found[kind] = int(i);
       const bool compressedValues = kind == kValues && e.encoding != uint32_t(ValuesCodec::Raw);
-      if (e.encoding != uint32_t(ValuesCodec::Raw) && !(kind == kValues && isKnownValuesCodec(e.encoding)))
+      const bool zstd = kind != kValues && e.encoding == kPlfSectionZstd;
+      if (e.encoding != uint32_t(ValuesCodec::Raw) && !(kind == kValues && isKnownValuesCodec(e.encoding)) && !zstd)
         fail("{}: section {} uses encoding {}, which this build does not know", path, id, e.encoding);
+      if (zstd && e.decodedSize / kZstdMaxExpansion > e.storedSize)
+        fail("{}: corrupt section table: zstd section {} of {} bytes cannot decode to {} bytes", path, id,
+             e.storedSize, e.decodedSize);
       if (compressedValues && e.decodedSize % sizeof(Rgb) != 0)
         fail("{}: corrupt section table: compressed section {} decodes to {} bytes, not a whole number of RGB "
              "float triplets",
              path, id, e.decodedSize);
-      if (!compressedValues && e.decodedSize != e.storedSize)
+      if (!compressedValues && !zstd && e.decodedSize != e.storedSize)
         fail("{}: section {} is raw but its decoded size {} differs from its stored size {}", path, id,
              e.decodedSize, e.storedSize);
       if (e.offset < previousEnd || e.storedSize > fileSize_ || e.offset > fileSize_ - e.storedSize)
@@ -821,6 +832,15 @@ class PlfReader {
     readInto(kind, bytes.data());
     return bytes;
   }
+  /// The section's decoded bytes (read(kind) unless it is zstd: decompressed, checked against
+  /// its decoded size and its frame's content checksum).
+  std::vector<unsigned char> decoded(int kind) const {
+    std::vector<unsigned char> stored = read(kind);
+    const SectionEntry& e = entry(kind);
+    if (e.encoding != kPlfSectionZstd) return stored;
+    return detail::zstdDecompress(stored, e.decodedSize,
+                                  fmt::format("{}: {} section ({})", path_, kSectionNames[kind], kSectionIds[kind]));
+  }
   /// Reads the section into memory the caller sized to storedSize, checksum verified.
   void readInto(int kind, void* destination) const {
     const SectionEntry& e = entry(kind);
@@ -845,9 +865,14 @@ class PlfReader {
   void peek(int kind, void* destination, uint64_t bytes) const {
     readAt(file_.fd, entry(kind).offset, destination, bytes, path_);
   }
-  /// Verifies a section's checksum reading it in bounded chunks.
+  /// Verifies a section's checksum reading it in bounded chunks; a zstd section is decoded
+  /// (it is small, and its frame's own checks see damage the checksum was re-signed over).
   void verify(int kind) const {
     const SectionEntry& e = entry(kind);
+    if (e.encoding == kPlfSectionZstd) {
+      (void)decoded(kind);
+      return;
+    }
     std::vector<unsigned char> chunk(std::min<uint64_t>(e.storedSize, 1u << 20));
     Xxh64Stream stream;
     for (uint64_t done = 0; done < e.storedSize;) {
@@ -909,22 +934,25 @@ uint64_t chartTixelCount(const std::vector<Chart>& charts) {
   return total;
 }
 
-/// Reads SMSK's header (without its checksum) and checks it against the section's size, the
-/// scene's masked lights (sunMaskLights) and the charts' tixels, so that nothing is allocated
-/// from an unchecked count. On a problem the section's checksum is verified first, so
-/// damaged bytes are reported as a checksum mismatch rather than as a bad field.
+/// Reads SMSK's header (of a raw section without its checksum; of a zstd one from `decoded`,
+/// the whole decoded section) and checks it against the section's decoded size, the scene's
+/// masked lights (sunMaskLights) and the charts' tixels, so that nothing is allocated from an
+/// unchecked count. On a problem the section's checksum is verified first, so damaged bytes
+/// are reported as a checksum mismatch rather than as a bad field.
 SunMaskHeader checkSunMaskHeader(const PlfReader& reader, const std::string& path, const Scene& scene,
-                                 const std::vector<Chart>& charts) {
+                                 const std::vector<Chart>& charts, std::span<const unsigned char> decoded) {
   const SectionEntry& e = reader.entry(kSunMasks);
   auto corrupt = [&](const std::string& problem) {
     reader.verify(kSunMasks);
     fail("{}: corrupt sun masks section (SMSK): {}", path, problem);
   };
   auto lights = [](uint64_t n) { return fmt::format("{} light{}", n, n == 1 ? "" : "s"); };
-  if (e.storedSize < sizeof(SunMaskHeader))
-    corrupt(fmt::format("{} bytes, fewer than its {}-byte header", e.storedSize, sizeof(SunMaskHeader)));
+  const uint64_t size = e.decodedSize;  // = storedSize when raw (PlfReader)
+  if (size < sizeof(SunMaskHeader))
+    corrupt(fmt::format("{} bytes, fewer than its {}-byte header", size, sizeof(SunMaskHeader)));
   SunMaskHeader h{};
-  reader.peek(kSunMasks, &h, sizeof(h));
+  if (e.encoding == kPlfSectionZstd) std::memcpy(&h, decoded.data(), sizeof(h));
+  else reader.peek(kSunMasks, &h, sizeof(h));
   if (h.reserved != 0) corrupt(fmt::format("reserved field is {}, not 0", h.reserved));
   if (h.lightCount < 1 || h.lightCount > kMaxSunMaskLights)
     corrupt(fmt::format("light count {} (must be 1 to {})", h.lightCount, kMaxSunMaskLights));
@@ -933,13 +961,13 @@ SunMaskHeader checkSunMaskHeader(const PlfReader& reader, const std::string& pat
     corrupt(fmt::format("masks of {} per tixel, but the scene has {} masked light{} (its first {} directional "
                         "lights, none when a material is thin glass)",
                         lights(h.lightCount), maskedLights, maskedLights == 1 ? "" : "s", kMaxSunMaskLights));
-  const uint64_t payload = e.storedSize - sizeof(SunMaskHeader);
+  const uint64_t payload = size - sizeof(SunMaskHeader);
   const uint64_t perTixel = uint64_t(h.lightCount) * sizeof(SunMask);
   if (payload % perTixel != 0 || h.tixelCount != payload / perTixel) {
     const bool fits = h.tixelCount <= (std::numeric_limits<uint64_t>::max() - sizeof(SunMaskHeader)) / perTixel;
     corrupt(fmt::format("the section has {} bytes, but its {}-byte header and the masks of {} tixels × {} × {} bytes "
                         "need {}",
-                        e.storedSize, sizeof(SunMaskHeader), h.tixelCount, lights(h.lightCount), sizeof(SunMask),
+                        size, sizeof(SunMaskHeader), h.tixelCount, lights(h.lightCount), sizeof(SunMask),
                         fits ? std::to_string(sizeof(SunMaskHeader) + h.tixelCount * perTixel)
                              : std::string("more than 2^64")));
   }
@@ -947,6 +975,13 @@ SunMaskHeader checkSunMaskHeader(const PlfReader& reader, const std::string& pat
   if (h.tixelCount != tixels)
     corrupt(fmt::format("masks for {} tixels, but the charts have {} tixels", h.tixelCount, tixels));
   return h;
+}
+
+/// SMSK decoded whole when it is zstd (for checkSunMaskHeader and the masks), else empty: a raw
+/// one is read straight into the light field.
+std::vector<unsigned char> decodedSunMasks(const PlfReader& reader) {
+  return reader.entry(kSunMasks).encoding == kPlfSectionZstd ? reader.decoded(kSunMasks)
+                                                             : std::vector<unsigned char>{};
 }
 
 }  // namespace
@@ -992,10 +1027,13 @@ void writeLightField(const std::string& path, const LightField& lf, ValuesCodec 
                                                 lf.sunMasks.size() * sizeof(SunMask)};
 
   // Each section's stored bytes: one or two parts (SMSK's header and its masks), in kind order;
-  // SMSK only when the light field has sun masks.
+  // SMSK only when the light field has sun masks. With compressed values every section but VALS
+  // and META (small, and readable as text) is stored as one zstd frame instead (kPlfSectionZstd).
   struct OutSection {
     int kind;
     std::span<const unsigned char> parts[2];
+    bool zstd = false;         ///< parts[0] is the zstd frame of decodedSize raw bytes
+    uint64_t decodedSize = 0;
     uint64_t size() const { return parts[0].size() + parts[1].size(); }
   };
   std::vector<OutSection> sections = {
@@ -1009,6 +1047,19 @@ void writeLightField(const std::string& path, const LightField& lf, ValuesCodec 
         {kSunMasks,
          {{reinterpret_cast<const unsigned char*>(&sunMaskHeader), sizeof(sunMaskHeader)}, sunMasks}});
   sections.push_back({kMeta, {meta, {}}});
+  std::vector<std::vector<unsigned char>> zstdFrames;
+  zstdFrames.reserve(sections.size());
+  if (valuesEncoding != ValuesCodec::Raw)
+    for (OutSection& section : sections) {
+      if (section.kind == kValues || section.kind == kMeta) continue;
+      std::vector<unsigned char> raw(section.parts[0].begin(), section.parts[0].end());
+      raw.insert(raw.end(), section.parts[1].begin(), section.parts[1].end());
+      zstdFrames.push_back(detail::zstdCompress(raw, codecOptions.zstdLevel));
+      section.zstd = true;
+      section.decodedSize = raw.size();
+      section.parts[0] = zstdFrames.back();
+      section.parts[1] = {};
+    }
 
   Header header{};
   std::memcpy(header.magic, kPlfMagic.data(), kPlfMagic.size());
@@ -1020,10 +1071,13 @@ void writeLightField(const std::string& path, const LightField& lf, ValuesCodec 
     const OutSection& section = sections[i];
     SectionEntry& e = table[i];
     std::memcpy(e.id, kSectionIds[section.kind], 4);
-    e.encoding = uint32_t(section.kind == kValues ? valuesEncoding : ValuesCodec::Raw);
+    e.encoding = section.kind == kValues ? uint32_t(valuesEncoding)
+                 : section.zstd ? kPlfSectionZstd
+                                : uint32_t(ValuesCodec::Raw);
     e.offset = offset;
     e.storedSize = e.decodedSize = section.size();
     if (section.kind == kValues) e.decodedSize = rawValues.size();
+    if (section.zstd) e.decodedSize = section.decodedSize;
     Xxh64Stream stream;
     for (const auto& part : section.parts)
       if (!part.empty()) stream.update(part.data(), part.size());
@@ -1063,9 +1117,9 @@ void writeLightField(const std::string& path, const LightField& lf, ValuesCodec 
 LightField readLightField(const std::string& path) {
   const PlfReader reader(path);
   LightField lf;
-  lf.scene = decodeScene(reader.read(kScene), path, reader.version());
-  lf.charts = decodeCharts(reader.read(kCharts), path, lf.scene.materials);
-  lf.triangleChart = decodeTriangleCharts(reader.read(kTriangleCharts), path, lf.scene, lf.charts);
+  lf.scene = decodeScene(reader.decoded(kScene), path, reader.version());
+  lf.charts = decodeCharts(reader.decoded(kCharts), path, lf.scene.materials);
+  lf.triangleChart = decodeTriangleCharts(reader.decoded(kTriangleCharts), path, lf.scene, lf.charts);
   const SectionEntry& values = reader.entry(kValues);
   const uint64_t valueBytes = values.decodedSize;
   if (valueBytes % sizeof(Rgb) != 0)
@@ -1083,15 +1137,20 @@ LightField readLightField(const std::string& path) {
   checkChartRanges(lf.charts, lf.values.size(), path);
   if (reader.has(kSunMasks)) {
     // Sizes checked against the section's (file-bounded) size before the masks are allocated.
-    const SunMaskHeader header = checkSunMaskHeader(reader, path, lf.scene, lf.charts);
-    lf.sunMasks.resize(header.tixelCount * header.lightCount);  // = (storedSize − 16) / 2
-    SunMaskHeader again{};
-    reader.readInto(kSunMasks, &again, sizeof(again), lf.sunMasks.data());
-    if (std::memcmp(&again, &header, sizeof(header)) != 0)
-      fail("{}: the sun masks section (SMSK) changed while being read", path);
+    const std::vector<unsigned char> decoded = decodedSunMasks(reader);
+    const SunMaskHeader header = checkSunMaskHeader(reader, path, lf.scene, lf.charts, decoded);
+    lf.sunMasks.resize(header.tixelCount * header.lightCount);  // = (decodedSize − 16) / 2
+    if (reader.entry(kSunMasks).encoding == kPlfSectionZstd) {
+      std::memcpy(lf.sunMasks.data(), decoded.data() + sizeof(header), lf.sunMasks.size() * sizeof(SunMask));
+    } else {
+      SunMaskHeader again{};
+      reader.readInto(kSunMasks, &again, sizeof(again), lf.sunMasks.data());
+      if (std::memcmp(&again, &header, sizeof(header)) != 0)
+        fail("{}: the sun masks section (SMSK) changed while being read", path);
+    }
     lf.sunMaskLightCount = header.lightCount;
   }  // else none: sunMaskLightCount 0, sunMasks empty (a file baked without them, or of version 1 or 2)
-  decodeMeta(reader.read(kMeta), path, lf.settings, lf.stats);
+  decodeMeta(reader.decoded(kMeta), path, lf.settings, lf.stats);
   return lf;
 }
 
@@ -1103,7 +1162,7 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
   info.fileBytes = reader.fileSize();
   info.sections = sectionInfos(reader);
 
-  const Scene scene = decodeScene(reader.read(kScene), path, reader.version(), TextureDecoding::Skip);
+  const Scene scene = decodeScene(reader.decoded(kScene), path, reader.version(), TextureDecoding::Skip);
   info.sceneSource = scene.sourcePath;
   info.meshes = scene.meshes.size();
   for (const Mesh& m : scene.meshes) {
@@ -1123,7 +1182,7 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
     info.environmentMapRotationDegrees = map->rotationDegrees();
   }
 
-  const std::vector<Chart> charts = decodeCharts(reader.read(kCharts), path, scene.materials);
+  const std::vector<Chart> charts = decodeCharts(reader.decoded(kCharts), path, scene.materials);
   info.charts = charts.size();
   for (const Chart& c : charts) {
     info.diffuseCharts += c.kind == ChartKind::Diffuse;
@@ -1134,8 +1193,9 @@ PlfInfo readLightFieldInfo(const std::string& path, bool verifyChecksums) {
     info.tixels += c.tixelCount();
   }
   info.values = reader.entry(kValues).decodedSize / sizeof(Rgb);
-  if (reader.has(kSunMasks)) info.sunMaskLights = checkSunMaskHeader(reader, path, scene, charts).lightCount;
-  decodeMeta(reader.read(kMeta), path, info.settings, info.stats);
+  if (reader.has(kSunMasks))
+    info.sunMaskLights = checkSunMaskHeader(reader, path, scene, charts, decodedSunMasks(reader)).lightCount;
+  decodeMeta(reader.decoded(kMeta), path, info.settings, info.stats);
   if (verifyChecksums) {
     reader.verify(kTriangleCharts);
     reader.verify(kValues);

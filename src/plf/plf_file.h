@@ -15,11 +15,13 @@
 //   offset 32  section table: sectionCount entries of 48 bytes
 //              id           4 bytes  four-character code, see Sections below
 //              encoding     u32      0 = raw; VALS may also be 1 = lossless, 2 = bc1, 3 = hdr
-//                                     (ValuesCodec numbers, plf/compression.h)
+//                                     (ValuesCodec numbers, plf/compression.h); every other
+//                                     section may be 4 = zstd (kPlfSectionZstd)
 //              offset       u64      from the start of the file, 64-byte aligned
 //              storedSize   u64      bytes in the file
 //              decodedSize  u64      bytes after decoding (= storedSize when raw; for a
-//                                     compressed VALS, 12 × the value count)
+//                                     compressed VALS, 12 × the value count; for zstd, the
+//                                     raw section's size)
 //              checksum     u64      XXH64 of the stored bytes (seed 0)
 //              reserved     u64      0
 //   sections, each at its offset, in table order, zero padding between them (checked).
@@ -119,8 +121,16 @@ inline constexpr std::array<char, 8> kPlfMagic = {'P', 'L', 'F', '\0', '\r', '\n
 
 // How a section's bytes are stored is a ValuesCodec number (plf/compression.h; a reader
 // refuses modes it does not know, naming the section). Every section may be Raw; only VALS
-// may use the value codecs. The checksum covers the stored (compressed) bytes; decoding
-// happens in readLightField, so every reader gets it.
+// may use the value codecs, and every section but VALS may be kPlfSectionZstd. The checksum
+// covers the stored (compressed) bytes; decoding happens in readLightField, so every reader
+// gets it.
+
+/// Section encoding 4 (any section but VALS): the raw section's bytes as exactly one zstd
+/// frame with its content size and content checksum; decodedSize is the raw size. Written
+/// for SCNE, CHRT, TRCH and SMSK whenever the values are compressed (writeLightField), never
+/// by `--compress none`, whose files stay readable by builds older than this encoding (which
+/// refuse a zstd section naming it and its encoding). Not a ValuesCodec: those are 0–3.
+inline constexpr uint32_t kPlfSectionZstd = 4;
 
 /// One entry of the section table, as stored.
 struct PlfSectionInfo {
@@ -158,11 +168,12 @@ struct PlfInfo {
 
 /// Writes the light field atomically: a temporary file beside `path` is written, fsynced
 /// and renamed over it; on any failure the temporary file is removed and pl::Error thrown.
-/// `valuesEncoding` selects how the VALS section is stored (compression.h).
+/// `valuesEncoding` selects how the VALS section is stored (compression.h); any codec but Raw
+/// also stores SCNE, CHRT, TRCH and SMSK as zstd frames (kPlfSectionZstd), Raw every section raw.
 void writeLightField(const std::string& path, const LightField& lightField,
                      ValuesCodec valuesEncoding = ValuesCodec::Raw);
 
-/// The same with the value codec's tuning (zstd level, hdr steps per stop).
+/// The same with the value codec's tuning (zstd level, also the other sections', hdr steps per stop).
 void writeLightField(const std::string& path, const LightField& lightField, ValuesCodec valuesEncoding,
                      const ValuesCodecOptions& codecOptions);
 

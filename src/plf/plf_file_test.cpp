@@ -1163,10 +1163,15 @@ TEST_F(PlfFileTest, SunMasksRoundTripWithEveryValuesEncoding) {
       EXPECT_EQ(info.sections[3].id, "VALS");
       EXPECT_EQ(info.sections[4].id, "SMSK");
       EXPECT_EQ(info.sections[5].id, "META");
-      EXPECT_EQ(info.sections[4].encoding, 0u);
-      EXPECT_EQ(info.sections[4].storedSize, 16u + 38u * lights * 2u);
-      EXPECT_EQ(info.sections[4].decodedSize, info.sections[4].storedSize);
+      EXPECT_EQ(info.sections[4].decodedSize, 16u + 38u * lights * 2u);
       EXPECT_EQ(info.sections[5].offset + info.sections[5].storedSize, info.fileBytes);
+      // Compressed values come with zstd'ed sun masks (ZstdSectionsRoundTrip…); raw ones below.
+      if (codec != ValuesCodec::Raw) {
+        EXPECT_EQ(info.sections[4].encoding, kPlfSectionZstd);
+        continue;
+      }
+      EXPECT_EQ(info.sections[4].encoding, 0u);
+      EXPECT_EQ(info.sections[4].storedSize, info.sections[4].decodedSize);
 
       // The section's bytes: L, reserved 0, T, then the masks as they are in memory.
       const auto bytes = readBytes(path);
@@ -1182,6 +1187,92 @@ TEST_F(PlfFileTest, SunMasksRoundTripWithEveryValuesEncoding) {
       EXPECT_EQ(
           std::memcmp(bytes.data() + smsk.offset + 16, original.sunMasks.data(), original.sunMasks.size() * 2), 0);
     }
+  }
+}
+
+// With compressed values, SCNE, CHRT, TRCH and SMSK are each one zstd frame (kPlfSectionZstd),
+// META and `--compress none` files raw; everything reads back as it was written, and damage
+// inside a frame (checksums re-signed, so zstd's own checks must catch it) or a decoded size
+// the frame does not hold is an error naming the file and the section.
+TEST_F(PlfFileTest, ZstdSectionsRoundTripAndDamageNamesTheSection) {
+  const LightField original = makeSunMaskedLightField();
+  const std::string path = file("zstd.plf");
+  writeLightField(path, original, ValuesCodec::Hdr);
+  const PlfInfo info = readLightFieldInfo(path);
+  ASSERT_EQ(info.sections.size(), 6u);
+  const std::pair<const char*, uint32_t> expected[] = {{"SCNE", kPlfSectionZstd}, {"CHRT", kPlfSectionZstd},
+                                                       {"TRCH", kPlfSectionZstd}, {"VALS", uint32_t(ValuesCodec::Hdr)},
+                                                       {"SMSK", kPlfSectionZstd}, {"META", 0u}};
+  for (size_t i = 0; i < 6; ++i) {
+    EXPECT_EQ(info.sections[i].id, expected[i].first);
+    EXPECT_EQ(info.sections[i].encoding, expected[i].second) << expected[i].first;
+  }
+  const LightField copy = readLightField(path);
+  EXPECT_EQ(encodeSceneSection(copy.scene), encodeSceneSection(original.scene));
+  ASSERT_EQ(copy.charts.size(), original.charts.size());
+  for (size_t i = 0; i < copy.charts.size(); ++i) {
+    EXPECT_EQ(copy.charts[i].resU, original.charts[i].resU);
+    EXPECT_EQ(copy.charts[i].firstValue, original.charts[i].firstValue);
+  }
+  EXPECT_EQ(copy.triangleChart, original.triangleChart);
+  EXPECT_EQ(copy.sunMasks, original.sunMasks);
+  // The raw sections decode to the same bytes as a `none` file's.
+  writeLightField(file("raw.plf"), original, ValuesCodec::Raw);
+  const PlfInfo rawInfo = readLightFieldInfo(file("raw.plf"));
+  for (size_t i = 0; i < 6; ++i) {
+    EXPECT_EQ(rawInfo.sections[i].encoding, 0u);
+    if (i != 3) { EXPECT_EQ(info.sections[i].decodedSize, rawInfo.sections[i].storedSize) << info.sections[i].id; }
+  }
+
+  const auto good = readBytes(path);
+  const std::pair<const char*, const char*> names[] = {
+      {"SCNE", "scene section (SCNE)"}, {"CHRT", "charts section (CHRT)"},
+      {"TRCH", "triangle charts section (TRCH)"}, {"SMSK", "sun masks section (SMSK)"}};
+  for (const auto& [id, name] : names) {
+    SCOPED_TRACE(id);
+    const int index = sectionIndex(good, id);
+    ASSERT_GE(index, 0);
+    const Section section = sections(good)[size_t(index)];
+    const uint64_t entryAt = kPlfHeaderSize + uint64_t(index) * kPlfSectionEntrySize;
+    {  // a byte flipped inside the frame's payload, re-signed
+      auto bad = good;
+      bad[section.offset + section.size / 2] ^= 0x5a;
+      resign(bad);
+      writeBytes(file("flip.plf"), bad);
+      expectRefused(file("flip.plf"), {name});
+    }
+    {  // not re-signed: the section checksum
+      auto bad = good;
+      bad[section.offset + section.size / 2] ^= 0x5a;
+      writeBytes(file("sum.plf"), bad);
+      expectRefused(file("sum.plf"), {"checksum mismatch"});
+    }
+    uint64_t decoded = 0;
+    std::memcpy(&decoded, good.data() + entryAt + 24, 8);
+    {  // a decoded size one byte more than the frame holds
+      auto bad = good;
+      const uint64_t more = decoded + 1;
+      std::memcpy(bad.data() + entryAt + 24, &more, 8);
+      resign(bad);
+      writeBytes(file("size.plf"), bad);
+      expectRefused(file("size.plf"), {name, "the zstd frame holds"});
+    }
+    {  // a decoded size no zstd frame of this size can hold: refused before any allocation
+      auto bad = good;
+      const uint64_t absurd = uint64_t(1) << 60;
+      std::memcpy(bad.data() + entryAt + 24, &absurd, 8);
+      resign(bad);
+      writeBytes(file("absurd.plf"), bad);
+      expectRefused(file("absurd.plf"), {"zstd section", id, "cannot decode"});
+    }
+  }
+  {  // zstd is no encoding of the values
+    auto bad = good;
+    const uint64_t entryAt = kPlfHeaderSize + uint64_t(sectionIndex(good, "VALS")) * kPlfSectionEntrySize;
+    std::memcpy(bad.data() + entryAt + 4, &kPlfSectionZstd, 4);
+    resign(bad);
+    writeBytes(file("vals.plf"), bad);
+    expectRefused(file("vals.plf"), {"section VALS uses encoding 4"});
   }
 }
 
