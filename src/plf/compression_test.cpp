@@ -455,7 +455,7 @@ TEST(CompressedPlf, FilesOfEarlierBuildsStillDecode) {
   ASSERT_EQ(lossless.values.size(), raw.values.size());
   EXPECT_EQ(std::memcmp(lossless.values.data(), raw.values.data(), rawBytes(raw.values)), 0);
   const LightField hdr = readLightField(dir + "hdr.plf");
-  // Written with the default 16 steps per stop: ≤ 2^(1/32) − 1 relative, + float32 rounding.
+  // Written at 16 steps per stop (the default then): ≤ 2^(1/32) − 1 relative, + float32 rounding.
   EXPECT_LE(measureValuesError(raw.values, hdr.values).maxRelative, std::exp2(1.0 / 32) - 1.0 + 1e-6);
   const LightField bc1 = readLightField(dir + "bc1.plf");
   // The same tone-mapped PSNR bound as for freshly encoded BC1 (Bc1KeepsToneMappedValues…).
