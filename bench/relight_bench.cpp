@@ -60,7 +60,7 @@ int run(int argc, char** argv) {
       const Accel accel(scene);
       const Parameterisation param = buildParameterisation(scene, accel, lf.settings);
       fillSeconds = secondsSince(start);
-      writeTixelSetup(tixelSetupPathFor(visibilityPathFor(plf)), param, readVisibilityInfo(visibilityPathFor(plf)).hash);
+      writeTixelSetup(tixelSetupPathFor(visibilityPathFor(plf)), scene, param, readVisibilityInfo(visibilityPathFor(plf)).hash);
       fmt::print(stderr, "relight_bench: parameterisation built in {:.2f} s and saved\n", fillSeconds);
     }
     start = std::chrono::steady_clock::now();
