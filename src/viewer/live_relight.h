@@ -55,11 +55,18 @@ struct RelightStatus {
   std::string message;      ///< the last refusal or error
 };
 
+/// How the background thread shares the cores with the renderer ("Cores" above).
+enum class RelightShare {
+  Idle,  ///< SCHED_IDLE (Linux; elsewhere nice +19): it runs only where no ordinary thread wants a core
+  Nice,  ///< nice +10 only: a small share of a core the renderer wants (for comparison: relight_bench --share)
+};
+
 class LiveRelight {
  public:
   /// Starts the background thread, which builds the Relighter from `lightField` and the .plv
   /// at visibilityPath (its errors go to status().message). lightField and accel must outlive it.
-  LiveRelight(const LightField& lightField, const Accel& accel, const std::string& visibilityPath);
+  LiveRelight(const LightField& lightField, const Accel& accel, const std::string& visibilityPath,
+              RelightShare share = RelightShare::Idle);
   ~LiveRelight();  ///< stops the worker (cancelling its set-up or iteration: core/cancel.h) and joins it
   LiveRelight(const LiveRelight&) = delete;
   LiveRelight& operator=(const LiveRelight&) = delete;
@@ -89,6 +96,7 @@ class LiveRelight {
   const LightField& original_;
   const Accel& accel_;
   const std::string visibilityPath_;
+  const RelightShare share_;
   // The wanted lighting (main thread writes, worker copies under mutex_).
   std::vector<Light> lights_;
   std::vector<Rgb> emission_;      ///< per material
