@@ -190,8 +190,8 @@ uint64_t decodedFieldBudget(uint64_t estimate, const BakeOptions& options) {
 /// when it is not this bake's), decoded as it is checked when the budget holds it decoded
 /// (VisibilityShard::holdDecoded's rule, without decoding it twice).
 bool readHeldField(const std::string& visibilityPath, uint64_t shardHash, const Parameterisation& param,
-                   const BakeSettings& settings, const std::vector<TixelRange>& held, uint64_t decodedBudget, VisibilityShard& visibility,
-                   std::string* why) {
+                   const BakeSettings& settings, const std::vector<TixelRange>& held, uint64_t decodedBudget,
+                   VisibilityShard& visibility, std::string* why) {
   uint64_t heldTixels = 0;
   for (const TixelRange& r : held) heldTixels += r.size();
   const uint64_t side = gatherGridSide(settings.gatherDirections);

@@ -332,7 +332,7 @@ std::vector<float> lightPlacement(const Light& light);
 /// meshes' normals, uv sets and vertex colours and every texture's texels and sampling; then
 /// per material what its charts' footprints read (model and parameters, texture slots and
 /// mappings, whether it emits); then per masked light (p.sunMaskLights) its type, index and
-/// placement (lights.h lightPlacement), which its sun masks follow.
+/// placement (lightPlacement), which its sun masks follow.
 std::vector<uint64_t> tixelSetupKeys(const Scene& scene, const Parameterisation& p);
 /// Fills the tixel setup of p (from buildCharts of the baked scene and settings) from the .plt
 /// at `path`, and its sun masks from `sunMasks` (LightField::sunMasks, sunMaskLightCount =
@@ -356,9 +356,9 @@ struct TixelSetupReuse {
 /// whose placement differs traced again — the result is fillTixels', bit for bit. Returns
 /// false and sets *why (p's per-tixel arrays then unspecified: the caller builds them again)
 /// when the file is absent, of another hash, for another number of tixels, without keys or
-/// sun masks (an older version), written for another number of materials or masked lights, or when the meshes' attributes
-/// or the textures changed (key 0) or a changed material needs other arrays; throws pl::Error
-/// naming the file when it is corrupt.
+/// sun masks (an older version), written for another number of materials or masked lights,
+/// or when the meshes' attributes or the textures changed (key 0) or a changed material needs
+/// other arrays; throws pl::Error naming the file when it is corrupt.
 bool reuseTixelSetup(const std::string& path, uint64_t hash, const Scene& scene, const Accel& accel, Parameterisation& p,
                      TixelSetupReuse& out, std::string* why);
 

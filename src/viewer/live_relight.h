@@ -12,10 +12,13 @@
 //   I / K          the sun 5° higher / lower (elevation within ±89°)
 //   M              select the next Lambertian material;  , / .  its albedo × 0.9 / × 1.1 (at most 1)
 //
-// Cores: the propagation runs on one thread of its own, in a one-thread task arena
-// (core/parallel.h runWithThreads) and at a lower scheduling priority (nice +10 on Linux):
-// the renderer keeps all the pool's threads and runs first, and the propagation takes the
-// time the frames leave; on two cores, one core's worth at most.
+// Cores: the propagation (and the relighter's set-up) runs on one thread of its own, in a
+// one-thread task arena (core/parallel.h runWithThreads), under Linux's SCHED_IDLE policy
+// (RelightShare::Idle; nice +19 where that is refused): the renderer keeps all the pool's
+// threads, and the propagation runs only on a core no ordinary thread wants — the frame's
+// serial parts, the waits for input when the view is still; on two cores, one core's worth
+// at most. Under nice +10 alone (RelightShare::Nice) it kept a share of a core the renderer
+// wanted (CFS weight 110 against 1024 per renderer thread), which a parallel frame waits for.
 //
 // Double buffering: two copies of the light field (made once; the scene's geometry and
 // textures are shared by neither, so each is a full copy); the worker writes the one not on
