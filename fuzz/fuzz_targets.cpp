@@ -167,7 +167,7 @@ void runPlvFixed(std::span<const uint8_t> input) {
 }
 
 // .plt header (plf/plt_file.h): magic 8, version 4, array count 4, hash 8 at 16, tixel count,
-// payloadHash 8 at 32, reserved; payload from 48.
+// payloadHash 8 at 32, key count 8; payload from 48.
 constexpr size_t kPltHashOffset = 16, kPltPayloadHashOffset = 32, kPltHeaderBytes = 48;
 
 void runPlt(std::span<const uint8_t> input) {

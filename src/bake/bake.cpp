@@ -127,6 +127,46 @@ RankShare rankShare(const Scene& scene, const Parameterisation& param, const Sha
   return share;
 }
 
+/// The header of the saved field at `visibilityPath` when `bake --reuse-visibility` may read it
+/// (present, of this version); nullopt otherwise (traced, as without the flag). A corrupt file
+/// throws pl::Error naming it.
+std::optional<VisibilityFileInfo> reusableVisibility(const std::string& visibilityPath) {
+  std::error_code ec;
+  if (visibilityPath.empty() || !std::filesystem::exists(visibilityPath, ec)) return std::nullopt;
+  VisibilityFileInfo info = readVisibilityInfo(visibilityPath);
+  if (info.version != kPlvVersion) return std::nullopt;
+  return info;
+}
+
+/// The tixel setup saved beside the field to reuse (parameterisation.h reuseTixelSetup) into
+/// param, from buildCharts: true when it belongs to this field and, after what the scene
+/// changed is recomputed, to this scene — when the field's hash then matches (else param's
+/// charts are built again: false, the caller fills the tixels). The .plt is then already right.
+bool reuseSavedTixelSetup(const Scene& scene, const Accel& accel, const BakeSettings& settings,
+                          const VisibilityFileInfo& field, const BakeOptions& options, Parameterisation& param,
+                          TixelSetupTiming& timing, const Note& note) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string path = tixelSetupPathFor(options.visibilityPath);
+  std::string why;
+  TixelSetupReuse reuse;
+  bool ok = reuseTixelSetup(path, field.hash, scene, accel, param, reuse, &why);
+  if (ok && visibilityHash(scene, param, settings) != field.hash) {
+    ok = false;
+    why = fmt::format("the visibility field {} was traced for other geometry or charts", options.visibilityPath);
+  }
+  if (!ok) {
+    note(fmt::format("tixel setup: filling the tixels, because {}", why));
+    param = buildCharts(scene, accel, settings);
+    return false;
+  }
+  timing.seconds = secondsSince(start);
+  note(fmt::format("tixel setup: reused {} ({} charts of changed materials filled again, sun masks of {} moved "
+                   "lights traced again) in {:.2f} s",
+                   path, reuse.chartsFilled, reuse.sunMasksTraced, timing.seconds));
+  if (!reuse.unchanged()) writeTixelSetup(path, scene, param, field.hash);
+  return true;
+}
+
 /// The visibility field (this rank's shard) and the propagation through it.
 struct Transport {
   VisibilityShard visibility;
@@ -144,6 +184,24 @@ uint64_t decodedFieldBudget(uint64_t estimate, const BakeOptions& options) {
   uint64_t budget = (*available - estimate) / 4;
   if (options.maxMemory > 0) budget = std::min(budget, options.maxMemory > estimate ? options.maxMemory - estimate : 0);
   return budget;
+}
+
+/// Reads the saved field of `held` into `visibility` (readVisibility's checks; false and *why
+/// when it is not this bake's), decoded as it is checked when the budget holds it decoded
+/// (VisibilityShard::holdDecoded's rule, without decoding it twice).
+bool readHeldField(const std::string& visibilityPath, uint64_t shardHash, const Parameterisation& param,
+                   const BakeSettings& settings, const std::vector<TixelRange>& held, uint64_t decodedBudget,
+                   VisibilityShard& visibility, std::string* why) {
+  uint64_t heldTixels = 0;
+  for (const TixelRange& r : held) heldTixels += r.size();
+  const uint64_t side = gatherGridSide(settings.gatherDirections);
+  const bool hold = heldTixels > 0 && heldTixels * side * side * sizeof(VisibilityEntry) <= decodedBudget;
+  VisibilityField field;
+  std::vector<VisibilityEntry> decoded;
+  if (!readVisibility(visibilityPath, shardHash, field, why, param.tixelCount, hold ? &decoded : nullptr)) return false;
+  visibility = VisibilityShard::of(std::move(field), held);
+  if (hold) visibility.decoded = FieldArray<VisibilityEntry>(std::move(decoded));
+  return true;
 }
 
 /// The checkpoint of an interrupted propagation of this bake (resume.h), read into `checkpoint`
@@ -236,12 +294,7 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
     double readSeconds = 0.0;
     std::future<bool> read = std::async(std::launch::async, [&] {
       const auto readStart = std::chrono::steady_clock::now();
-      VisibilityField field;
-      const bool ok = readVisibility(visibilityPath, shardHash, field, &why, param.tixelCount);
-      if (ok) {
-        t.visibility = VisibilityShard::of(std::move(field), held);
-        t.visibility.holdDecoded(decodedBudget);
-      }
+      const bool ok = readHeldField(visibilityPath, shardHash, param, settings, held, decodedBudget, t.visibility, &why);
       readSeconds = secondsSince(readStart);
       return ok;
     });
@@ -366,14 +419,24 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   const Accel accel(lf.scene);
   Parameterisation param = buildCharts(lf.scene, accel, settings);
   const double setupSeconds = secondsSince(start);
-  const TixelSetupTiming tixelSetup = fillTixelsDistributed(lf.scene, accel, param, comm);
+  // Reusing the field of one process: its tixel setup too, where it is still this scene's.
+  const std::optional<VisibilityFileInfo> reusable =
+      comm.size() == 1 && options.reuseVisibility ? reusableVisibility(options.visibilityPath) : std::nullopt;
+  TixelSetupTiming tixelSetup;
+  const bool setupReused = reusable && reuseSavedTixelSetup(lf.scene, accel, settings, *reusable, options, param,
+                                                            tixelSetup, note);
+  if (!setupReused) tixelSetup = fillTixelsDistributed(lf.scene, accel, param, comm);
   const uint64_t hash = visibilityHash(lf.scene, param, settings);
   requireSameBakeOnEveryRank(comm, hash, lf.scene);
   noteParameterisation(note, param, setupSeconds, tixelSetup, comm.size());
   const ShardPlan plan = planShards(lf.scene, param, settings, comm.size());
   const RankShare share = rankShare(lf.scene, param, plan, comm.rank(), note);
-  // Traced ahead on a sample of the held tixels: how many bytes the field will take.
-  const double bytesPerTixel = estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
+  // How many bytes the field will take: the saved field's, when it is this bake's, else traced
+  // ahead on a sample of the held tixels.
+  const double bytesPerTixel =
+      reusable && reusable->hash == hash && reusable->tixelCount == param.tixelCount && reusable->heldBytes > 0
+          ? double(reusable->heldBytes) / double(reusable->tixelCount)
+          : estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
   const uint64_t estimate =
       bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel) +
       subsurfaceOperatorBytesEstimate(lf.scene, param, settings.subsurfaceWalks, comm.size());
@@ -388,10 +451,10 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   // The tixel setup beside the visibility field, so that relighting the saved light field
   // does not fill the tixels again (relight.h). One process only: a distributed bake's field is
   // saved in shards, which relighting does not read.
-  if (comm.size() == 1 && !options.visibilityPath.empty()) {
+  if (comm.size() == 1 && !options.visibilityPath.empty() && !setupReused) {
     const auto writeStart = std::chrono::steady_clock::now();
     const std::string path = tixelSetupPathFor(options.visibilityPath);
-    writeTixelSetup(path, param, hash);
+    writeTixelSetup(path, lf.scene, param, hash);
     note(fmt::format("tixel setup: {} ({:.1f} MB) in {:.2f} s", path, double(std::filesystem::file_size(path)) / 1e6,
                      secondsSince(writeStart)));
   }

@@ -431,8 +431,11 @@ TEST_F(BakeTest, ReusedVisibilityAndChangedLightEqualsFullBake) {
       maxRel = std::max(maxRel, std::abs(double(reused.values[i][ch]) - full.values[i][ch]) / ref);
       changedFromFirst = std::max(changedFromFirst, std::abs(double(first.values[i][ch]) - full.values[i][ch]) / ref);
     }
-  // Same deterministic visibility field, same propagation: identical up to float round-off.
-  EXPECT_LT(maxRel, 1e-5);
+  // Same deterministic visibility field, the tixel setup taken from the .plt with the red
+  // wall's tixels filled again, same propagation: identical, bit for bit.
+  EXPECT_EQ(maxRel, 0.0);
+  EXPECT_NE(note.find("tixel setup: reused"), std::string::npos) << note;
+  EXPECT_EQ(note.find("(0 charts of changed materials"), std::string::npos) << note;
   EXPECT_GT(changedFromFirst, 0.1);  // and the change did change the light field
   std::filesystem::remove_all(dir);
 }

@@ -11,10 +11,12 @@
 #include <type_traits>
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "light/emitters.h"
+#include "light/lights.h"
 #include "lightfield/lookup.h"
 #include "plf/plt_file.h"
 
@@ -705,16 +707,144 @@ namespace {
 
 std::array<char, 4> tixelSetupTag(const char* name) { return {name[0], name[1], name[2], name[3]}; }
 
+/// The sun masks' array in a .plt (after forEachTixelSetupArray's).
+constexpr char kSunMaskTag[] = "SUNM";
+
+void hashMapping(Fnv1a64& h, const TextureMapping& m) {
+  h.value(m.uvSet);
+  h.value(m.linear);
+  h.value(m.offset);
+}
+
+template <typename T>
+void hashArray(Xxh64Stream& h, const std::vector<T>& v) {
+  const uint64_t size = v.size();
+  h.update(&size, sizeof(size));
+  h.update(v.data(), v.size() * sizeof(T));
+}
+
+/// The arrays of `file` that forEachTixelSetupArray(p) names, checked against p's shapes (the
+/// same tags, element sizes and counts in the same order, then at most the sun masks), copied
+/// into p; the sun masks' array, when present, is left in file. "" when they fit, else what
+/// does not (p unchanged).
+std::string takeTixelSetupArrays(TixelSetupFile& file, Parameterisation& p, const TixelSetupArray** sunMasks) {
+  *sunMasks = nullptr;
+  std::string problem;
+  size_t index = 0;
+  forEachTixelSetupArray(p, [&](const char* tag, const auto& array) {
+    using Element = typename std::decay_t<decltype(array)>::value_type;
+    const TixelSetupArray* a = index < file.arrays.size() ? &file.arrays[index] : nullptr;
+    if (problem.empty() && (!a || a->tag != tixelSetupTag(tag) || a->elementBytes != sizeof(Element) || a->count != array.size()))
+      problem = fmt::format("array {} of {} elements of {} bytes expected, the file has {}", tag, array.size(),
+                            sizeof(Element),
+                            a ? fmt::format("{} of {} elements of {} bytes", std::string(a->tag.data(), 4), a->count,
+                                            a->elementBytes)
+                              : std::string("no more arrays"));
+    ++index;
+  });
+  if (!problem.empty()) return problem;
+  if (index < file.arrays.size()) {
+    const TixelSetupArray& a = file.arrays[index];
+    if (a.tag != tixelSetupTag(kSunMaskTag) || a.elementBytes != sizeof(SunMaskSlots) || a.count != p.tixelCount ||
+        index + 1 != file.arrays.size())
+      return fmt::format("{} arrays, expected {} and the sun masks", file.arrays.size(), index);
+    *sunMasks = &a;
+  }
+  index = 0;
+  forEachTixelSetupArray(p, [&](const char*, auto& array) {
+    if (!array.empty()) std::memcpy(static_cast<void*>(array.data()), file.arrays[index].bytes.data(), file.arrays[index].bytes.size());
+    std::vector<unsigned char>().swap(file.arrays[index].bytes);
+    ++index;
+  });
+  return "";
+}
+
 }  // namespace
 
-void writeTixelSetup(const std::string& path, const Parameterisation& p, uint64_t hash) {
+uint64_t modelParameterHash(const Bsdf& bsdf) {
+  Fnv1a64 h;
+  h.value(uint32_t(bsdf.index()));
+  std::visit([&](const auto& b) { std::decay_t<decltype(b)>::parameters(b, [&](const auto& field) { h.value(field); }); },
+             bsdf);
+  return h.digest();
+}
+
+std::vector<float> lightPlacement(const Light& light) {
+  std::vector<float> out;
+  visitLightParameters(light, [&](const char*, LightParameterKind kind, const auto& field) {
+    if (kind == LightParameterKind::Emission) return;
+    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, float>) {
+      out.push_back(field);
+    } else {
+      out.insert(out.end(), {field.x, field.y, field.z});
+    }
+  });
+  return out;
+}
+
+std::vector<uint64_t> tixelSetupKeys(const Scene& scene, const Parameterisation& p) {
+  std::vector<uint64_t> keys;
+  // Every texture once (its texels are most of the bytes hashed), shared by the keys below.
+  std::vector<uint64_t> textureHash(scene.textures.size());
+  parallelFor(scene.textures.size(), [&](uint64_t i) {
+    const Texture& t = scene.textures[i];
+    Xxh64Stream h;
+    h.update(&t.image.width, sizeof(t.image.width));
+    h.update(&t.image.height, sizeof(t.image.height));
+    hashArray(h, t.image.pixels);
+    const uint32_t sampling = uint32_t(t.sampling.wrapU) | uint32_t(t.sampling.wrapV) << 8 | uint32_t(t.sampling.nearest) << 16;
+    h.update(&sampling, sizeof(sampling));
+    textureHash[i] = h.digest();
+  });
+  Xxh64Stream attributes;
+  for (const Mesh& mesh : scene.meshes) {
+    hashArray(attributes, mesh.normals);
+    hashArray(attributes, mesh.uvs);
+    hashArray(attributes, mesh.uvs1);
+    hashArray(attributes, mesh.colors);
+  }
+  hashArray(attributes, textureHash);
+  keys.push_back(attributes.digest());
+  for (const Material& m : scene.materials) {
+    Fnv1a64 h;
+    h.value(modelParameterHash(m.bsdf));
+    h.value(m.albedoTexture);
+    h.value(m.emissionTexture);
+    h.value(m.normalTexture);
+    h.value(m.normalScale);
+    h.value(m.metallicRoughness.texture);
+    h.value(m.metallicRoughness.baseColor);
+    h.value(m.metallicRoughness.metallic);
+    h.value(m.metallicRoughness.roughness);
+    for (const TextureMapping* mapping :
+         {&m.albedoMapping, &m.alphaMapping, &m.normalMapping, &m.emissionMapping, &m.metallicRoughness.mapping})
+      hashMapping(h, *mapping);
+    h.value(uint8_t(m.isEmissive()));  // (a textured emitter's footprint means; not the emission's value)
+    h.value(uint8_t(m.twoSidedEmission));
+    h.value(uint8_t(m.vertexColored));
+    h.value(m.tixelDensity);
+    keys.push_back(h.digest());
+  }
+  for (uint32_t l : p.sunMaskLights) {
+    Fnv1a64 h;
+    h.value(l);
+    h.value(uint32_t(scene.lights[l].index()));
+    for (float v : lightPlacement(scene.lights[l])) h.value(v);
+    keys.push_back(h.digest());
+  }
+  return keys;
+}
+
+void writeTixelSetup(const std::string& path, const Scene& scene, const Parameterisation& p, uint64_t hash) {
   std::vector<TixelSetupView> views;
   forEachTixelSetupArray(p, [&](const char* tag, const auto& array) {
     using Element = typename std::decay_t<decltype(array)>::value_type;
     static_assert(std::is_standard_layout_v<Element> && std::is_trivially_destructible_v<Element>);  // stored as its bytes
     views.push_back({tixelSetupTag(tag), uint32_t(sizeof(Element)), uint64_t(array.size()), array.data()});
   });
-  writeTixelSetupFile(path, hash, p.tixelCount, views);
+  views.push_back({tixelSetupTag(kSunMaskTag), uint32_t(sizeof(SunMaskSlots)), uint64_t(p.sunMask.size()), p.sunMask.data()});
+  const std::vector<uint64_t> keys = tixelSetupKeys(scene, p);
+  writeTixelSetupFile(path, hash, p.tixelCount, views, keys);
 }
 
 bool readTixelSetup(const std::string& path, uint64_t hash, const std::vector<SunMask>& sunMasks, Parameterisation& p,
@@ -727,31 +857,56 @@ bool readTixelSetup(const std::string& path, uint64_t hash, const std::vector<Su
   if (sunMasks.size() != p.tixelCount * lightCount)
     fail("{}: the light field holds {} sun masks, its charts need {} ({} masked lights)", path, sunMasks.size(),
          p.tixelCount * lightCount, lightCount);
-  // Every array as fillTixels allocates it for these charts: the same tags, element sizes and
-  // counts in the same order, checked before any is taken.
-  size_t index = 0;
-  forEachTixelSetupArray(p, [&](const char* tag, const auto& array) {
-    using Element = typename std::decay_t<decltype(array)>::value_type;
-    const TixelSetupArray* a = index < file.arrays.size() ? &file.arrays[index] : nullptr;
-    if (!a || a->tag != tixelSetupTag(tag) || a->elementBytes != sizeof(Element) || a->count != array.size())
-      fail("{}: the tixel setup does not fit the light field's charts: array {} of {} elements of {} bytes expected, "
-           "the file has {}",
-           path, tag, array.size(), sizeof(Element),
-           a ? fmt::format("{} of {} elements of {} bytes", std::string(a->tag.data(), 4), a->count, a->elementBytes)
-             : std::string("no more arrays"));
-    ++index;
-  });
-  if (index != file.arrays.size())
-    fail("{}: the tixel setup does not fit the light field's charts: {} arrays, expected {}", path, file.arrays.size(),
-         index);
-  index = 0;
-  forEachTixelSetupArray(p, [&](const char*, auto& array) {
-    if (!array.empty()) std::memcpy(static_cast<void*>(array.data()), file.arrays[index].bytes.data(), file.arrays[index].bytes.size());
-    std::vector<unsigned char>().swap(file.arrays[index].bytes);
-    ++index;
-  });
+  // The light field's sun masks follow its lights; the file's, the baked ones.
+  const TixelSetupArray* savedMasks = nullptr;
+  const std::string problem = takeTixelSetupArrays(file, p, &savedMasks);
+  if (!problem.empty()) fail("{}: the tixel setup does not fit the light field's charts: {}", path, problem);
   for (uint64_t g = 0; g < p.tixelCount && lightCount > 0; ++g)
     std::copy_n(sunMasks.begin() + int64_t(g * lightCount), lightCount, p.sunMask[g].begin());
+  return true;
+}
+
+bool reuseTixelSetup(const std::string& path, uint64_t hash, const Scene& scene, const Accel& accel, Parameterisation& p,
+                     TixelSetupReuse& out, std::string* why) {
+  auto reason = [&](std::string text) {
+    if (why) *why = std::move(text);
+    return false;
+  };
+  out = {};
+  TixelSetupFile file;
+  if (!readTixelSetupFile(path, hash, file, why)) return false;
+  if (file.tixelCount != p.tixelCount)
+    return reason(fmt::format("{} was written for {} tixels, these charts have {}", path, file.tixelCount, p.tixelCount));
+  const std::vector<uint64_t> keys = tixelSetupKeys(scene, p);
+  const size_t materials = scene.materials.size();
+  if (file.keys.empty()) return reason(fmt::format("{} was written without the keys of its inputs (an older version)", path));
+  if (file.keys.size() != keys.size())
+    return reason(fmt::format("{} was written for another number of materials or sun-masked lights", path));
+  if (file.keys[0] != keys[0])
+    return reason(fmt::format("the meshes' normals, uvs or vertex colours or the textures differ from {}'s", path));
+  std::vector<uint8_t> materialChanged(materials, 0);
+  for (size_t m = 0; m < materials; ++m) materialChanged[m] = file.keys[1 + m] != keys[1 + m];
+  const TixelSetupArray* savedMasks = nullptr;
+  const std::string problem = takeTixelSetupArrays(file, p, &savedMasks);
+  if (!problem.empty()) return reason(fmt::format("{} does not fit the charts: {}", path, problem));
+  if (!savedMasks) return reason(fmt::format("{} holds no sun masks (an older version)", path));
+  std::memcpy(static_cast<void*>(p.sunMask.data()), savedMasks->bytes.data(), savedMasks->bytes.size());
+  // What changed: the charts of a changed material, filled as fillTixels fills every record
+  // (a record's tixels depend only on the record), then the masks of a masked light that moved.
+  std::vector<uint32_t> refill;
+  for (uint32_t ci = 0; ci < p.charts.size(); ++ci)
+    if (materialChanged[p.charts[ci].material]) refill.push_back(ci);
+  parallelFor(refill.size(), [&](uint64_t k) {
+    const Chart& c = p.charts[refill[k]];
+    std::fill_n(p.borrowedPoint.begin() + int64_t(c.firstTixel), c.tixelCount(), uint8_t(0));  // (buildCharts' value)
+    fillChartTixels(scene, accel, p.charts[refill[k]], p.chartTriangles[refill[k]], p);
+  });
+  out.chartsFilled = uint32_t(refill.size());
+  for (size_t slot = 0; slot < p.sunMaskLights.size(); ++slot)
+    if (file.keys[1 + materials + slot] != keys[1 + materials + slot]) {
+      recomputeSunMasks(scene, accel, p, slot);
+      ++out.sunMasksTraced;
+    }
   return true;
 }
 

@@ -315,9 +315,25 @@ Parameterisation buildParameterisation(const Scene& scene, const BakeSettings& s
 
 /// Where a bake whose visibility field is `visibilityPath` (X.plv) saves its tixel setup: X.plt.
 std::string tixelSetupPathFor(const std::string& visibilityPath);
-/// Saves p's tixel setup (forEachTixelSetupArray) as a .plt file (plf/plt_file.h) for the bake
-/// whose visibility field has hash `hash` (visibilityHash).
-void writeTixelSetup(const std::string& path, const Parameterisation& p, uint64_t hash);
+/// Saves p's tixel setup (forEachTixelSetupArray), its sun masks (array SUNM, after them) and
+/// the keys of what they were computed from (tixelSetupKeys) as a .plt file (plf/plt_file.h)
+/// for the bake of `scene` whose visibility field has hash `hash` (visibilityHash).
+void writeTixelSetup(const std::string& path, const Scene& scene, const Parameterisation& p, uint64_t hash);
+/// FNV-1a of a material's model (its variant index) and every parameter (the parameters()
+/// hook): equal for the same model with the same parameters. What relighting and the tixel
+/// setup's keys compare materials by.
+uint64_t modelParameterHash(const Bsdf& bsdf);
+/// The parameters of a light other than its emission, in visitLightParameters order (a
+/// direction or position: three values): what moving or turning it changes, for relighting
+/// and the sun masks' keys.
+std::vector<float> lightPlacement(const Light& light);
+/// What the tixel setup of `scene` reads beyond the visibility field's inputs (visibilityHash,
+/// which covers the geometry, alpha masks and charts), as hashes, in this order: [0] the
+/// meshes' normals, uv sets and vertex colours and every texture's texels and sampling; then
+/// per material what its charts' footprints read (model and parameters, texture slots and
+/// mappings, whether it emits); then per masked light (p.sunMaskLights) its type, index and
+/// placement (lightPlacement), which its sun masks follow.
+std::vector<uint64_t> tixelSetupKeys(const Scene& scene, const Parameterisation& p);
 /// Fills the tixel setup of p (from buildCharts of the baked scene and settings) from the .plt
 /// at `path`, and its sun masks from `sunMasks` (LightField::sunMasks, sunMaskLightCount =
 /// p.sunMaskLights.size() per tixel) — what fillTixels would give, bit for bit. Returns false
@@ -326,5 +342,24 @@ void writeTixelSetup(const std::string& path, const Parameterisation& p, uint64_
 /// or its arrays do not fit p's charts.
 bool readTixelSetup(const std::string& path, uint64_t hash, const std::vector<SunMask>& sunMasks, Parameterisation& p,
                     std::string* why);
+
+/// What reuseTixelSetup took and what it computed again.
+struct TixelSetupReuse {
+  uint32_t chartsFilled = 0;    ///< chart records filled again (fillTixels) for a changed material
+  uint32_t sunMasksTraced = 0;  ///< masked lights whose masks were traced again (recomputeSunMasks)
+  bool unchanged() const { return chartsFilled == 0 && sunMasksTraced == 0; }
+};
+/// For a bake that reuses its visibility field: fills p (from buildCharts of `scene`) with the
+/// tixel setup and sun masks saved in the .plt at `path` by a bake of the same geometry (hash
+/// `hash`, the .plv's), recomputing only what `scene` changed since (tixelSetupKeys): the
+/// charts of a material whose key differs are filled again, the sun masks of a masked light
+/// whose placement differs traced again — the result is fillTixels', bit for bit. Returns
+/// false and sets *why (p's per-tixel arrays then unspecified: the caller builds them again)
+/// when the file is absent, of another hash, for another number of tixels, without keys or
+/// sun masks (an older version), written for another number of materials or masked lights,
+/// or when the meshes' attributes or the textures changed (key 0) or a changed material needs
+/// other arrays; throws pl::Error naming the file when it is corrupt.
+bool reuseTixelSetup(const std::string& path, uint64_t hash, const Scene& scene, const Accel& accel, Parameterisation& p,
+                     TixelSetupReuse& out, std::string* why);
 
 }  // namespace pl

@@ -34,30 +34,6 @@ std::string visibilityPathFor(const std::string& plfPath) {
 
 namespace {
 
-/// The parameters of a light other than its emission, in hook order: what moving or turning
-/// it changes.
-std::vector<float> lightPlacement(const Light& light) {
-  std::vector<float> out;
-  visitLightParameters(light, [&](const char*, LightParameterKind kind, const auto& field) {
-    if (kind == LightParameterKind::Emission) return;
-    if constexpr (std::is_same_v<std::decay_t<decltype(field)>, float>) {
-      out.push_back(field);
-    } else {
-      out.insert(out.end(), {field.x, field.y, field.z});
-    }
-  });
-  return out;
-}
-
-/// Hash of a material's model and all its parameters.
-uint64_t modelHash(const Bsdf& bsdf) {
-  Fnv1a64 h;
-  h.value(uint32_t(bsdf.index()));
-  std::visit([&](const auto& b) { std::decay_t<decltype(b)>::parameters(b, [&](const auto& field) { h.value(field); }); },
-             bsdf);
-  return h.digest();
-}
-
 bool sameEnvironment(const Environment& a, const Environment& b) { return a.constant == b.constant && a.map == b.map; }
 
 /// The per-channel factor k with after = k ⊙ before, when there is one: every channel of
@@ -402,9 +378,9 @@ struct Relighter::Impl {
     for (uint32_t m = 0; m < scene.materials.size(); ++m) {
       const Material &a = scene.materials[m], &b = edited.materials[m];
       const bool lambert = std::holds_alternative<LambertBsdf>(a.bsdf) && std::holds_alternative<LambertBsdf>(b.bsdf);
-      if (!lambert && modelHash(a.bsdf) != modelHash(b.bsdf) && subsurfaceMedium(a.bsdf) && subsurfaceMedium(b.bsdf))
+      if (!lambert && modelParameterHash(a.bsdf) != modelParameterHash(b.bsdf) && subsurfaceMedium(a.bsdf) && subsurfaceMedium(b.bsdf))
         refuseSubsurfaceEdit(a);
-      if (!lambert && modelHash(a.bsdf) != modelHash(b.bsdf))
+      if (!lambert && modelParameterHash(a.bsdf) != modelParameterHash(b.bsdf))
         refuse(fmt::format("material '{}' changed its model or its parameters", a.name));
       if (a.emissionTexture != b.emissionTexture || a.twoSidedEmission != b.twoSidedEmission ||
           a.albedoTexture != b.albedoTexture)

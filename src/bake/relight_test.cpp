@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 
 #include "bake/bake.h"
@@ -388,7 +389,7 @@ TEST_F(RelightFileTest, LoadedLightFieldRelightsAsRightAfterTheBake) {
   const Relighter withoutSetup(loaded, path("sun.plv"), note);
   EXPECT_NE(filledAgain().find("sun.plt does not exist"), std::string::npos) << filledAgain();
   expectSameTixelSetup(withoutSetup.parameterisation(), original);
-  writeTixelSetup(path("sun.plt"), withoutSetup.parameterisation(), 42);
+  writeTixelSetup(path("sun.plt"), withoutSetup.scene(), withoutSetup.parameterisation(), 42);
   notes.clear();
   const Relighter otherBake(loaded, path("sun.plv"), note);
   EXPECT_NE(filledAgain().find("another bake"), std::string::npos) << filledAgain();
@@ -400,6 +401,67 @@ TEST_F(RelightFileTest, LoadedLightFieldRelightsAsRightAfterTheBake) {
   test_support::expectError([&] { Relighter broken(loaded, path("sun.plv")); }, {"sun.plt", "corrupt"});
   // No .plv: said at once, naming it.
   test_support::expectError([&] { Relighter none(loaded, path("none.plv")); }, {"none.plv", "does not exist"});
+}
+
+// bake --reuse-visibility takes the tixel setup saved beside the field (.plt), recomputing
+// only what the edited scene changed: the light field is a full bake's of that scene, bit for
+// bit, whatever changed and whether the .plt is there, stale or another bake's.
+TEST_F(RelightFileTest, ReusedVisibilityTakesTheTixelSetupAndEqualsFullBakes) {
+  const BakeSettings settings = testSettings(16.0f);
+  const Scene original = sunScene(sunAt(40.0f, 20.0f));
+  BakeOptions save;
+  save.visibilityPath = path("s.plv");
+  bake(original, settings, save);
+  ASSERT_TRUE(std::filesystem::exists(path("s.plt")));
+  std::filesystem::copy_file(path("s.plt"), path("original.plt"));
+
+  struct Case {
+    const char* name;
+    std::function<void(Scene&)> edit;
+    const char* setupNote;  ///< what the tixel-setup note must say
+  };
+  const std::vector<Case> cases = {
+      {"light colour", [](Scene& s) { setLightEmission(s.lights[0], Rgb(4.0f, 3.0f, 2.0f)); },
+       "(0 charts of changed materials filled again, sun masks of 0 moved lights"},
+      {"light moved",
+       [](Scene& s) { std::get<DirectionalLight>(s.lights[0]).direction = sunAt(40.0f, 30.0f); },
+       "(0 charts of changed materials filled again, sun masks of 1 moved lights"},
+      {"albedo", [](Scene& s) { s.materials[0].bsdf = LambertBsdf{Rgb(0.2f, 0.5f, 0.7f)}; },
+       "charts of changed materials filled again, sun masks of 0 moved lights"},
+      {"no .plt", [&](Scene& s) {
+         setLightEmission(s.lights[0], Rgb(1.0f, 2.0f, 3.0f));
+         std::filesystem::remove(path("s.plt"));
+       },
+       "filling the tixels, because"},
+      {"another bake's .plt", [&](Scene& s) {
+         setLightEmission(s.lights[0], Rgb(1.0f, 2.0f, 3.0f));
+         writeTixelSetup(path("s.plt"), s, buildParameterisation(s, settings), 42);
+       },
+       "belongs to another bake"},
+  };
+  for (const Case& c : cases) {
+    std::filesystem::copy_file(path("original.plt"), path("s.plt"), std::filesystem::copy_options::overwrite_existing);
+    Scene edited = original;
+    c.edit(edited);
+    edited.finalize();
+    BakeOptions reuse;
+    reuse.visibilityPath = path("s.plv");
+    reuse.reuseVisibility = true;
+    std::string notes;
+    reuse.log = [&](const std::string& line) { notes += line + "\n"; };
+    const LightField reused = bake(edited, settings, reuse);
+    EXPECT_TRUE(reused.stats.reusedVisibility) << c.name << "\n" << notes;
+    EXPECT_NE(notes.find(c.setupNote), std::string::npos) << c.name << "\n" << notes;
+    const LightField full = bake(edited, settings);
+    EXPECT_TRUE(reused.values == full.values) << c.name;
+    EXPECT_EQ(reused.sunMasks, full.sunMasks) << c.name;
+    // The .plt left beside the field is the edited scene's: reused again with nothing to redo.
+    notes.clear();
+    const LightField again = bake(edited, settings, reuse);
+    EXPECT_NE(notes.find("(0 charts of changed materials filled again, sun masks of 0 moved lights"), std::string::npos)
+        << c.name << "\n" << notes;
+    EXPECT_TRUE(again.values == full.values) << c.name;
+  }
 }
 
 }  // namespace

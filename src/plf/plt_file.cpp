@@ -40,7 +40,8 @@ std::string tagName(const std::array<char, 4>& tag) {
 }  // namespace
 
 void writeTixelSetupFile(const std::string& path, uint64_t hash, uint64_t tixelCount,
-                         std::span<const TixelSetupView> arrays) {
+                         std::span<const TixelSetupView> arrays, std::span<const uint64_t> keys) {
+  if (keys.size() > kMaxTixelSetupKeys) fail("{}: {} tixel-setup keys (at most {})", path, keys.size(), kMaxTixelSetupKeys);
   if (arrays.size() > kMaxTixelSetupArrays) fail("{}: {} tixel-setup arrays (at most {})", path, arrays.size(), kMaxTixelSetupArrays);
   for (const TixelSetupView& a : arrays)
     if ((a.count != 0 && a.count != tixelCount) || a.elementBytes == 0 || a.elementBytes > kMaxTixelSetupElementBytes)
@@ -60,6 +61,7 @@ void writeTixelSetupFile(const std::string& path, uint64_t hash, uint64_t tixelC
     appendValue(payload, uint64_t(frames[i].size()));
     appendValue(payload, uint64_t(0));
   }
+  for (uint64_t key : keys) appendValue(payload, key);
   for (std::vector<unsigned char>& frame : frames) {
     appendBytes(payload, frame.data(), frame.size());
     std::vector<unsigned char>().swap(frame);
@@ -72,7 +74,7 @@ void writeTixelSetupFile(const std::string& path, uint64_t hash, uint64_t tixelC
   appendValue(file, hash);
   appendValue(file, tixelCount);
   appendValue(file, xxh64(payload.data(), payload.size()));
-  appendValue(file, uint64_t(0));
+  appendValue(file, uint64_t(keys.size()));
   appendBytes(file, payload.data(), payload.size());
   writeFileAtomically(path, std::string_view(reinterpret_cast<const char*>(file.data()), file.size()));
 }
@@ -91,8 +93,9 @@ bool readTixelSetupFile(const std::string& path, uint64_t expectedHash, TixelSet
     fail("{}: truncated tixel-setup file ({} bytes, the header needs {})", path, bytes.size(), kPltHeaderBytes);
   if (std::memcmp(bytes.data(), kPltMagic, 8) != 0) fail("{}: not a plenoptic tixel-setup file (bad magic)", path);
   const uint32_t version = load<uint32_t>(bytes.data() + 8);
-  if (version != kPltVersion)
-    return reason(fmt::format("{} has format version {} (this program reads version {})", path, version, kPltVersion));
+  if (version < kPltOldestVersion || version > kPltVersion)
+    return reason(fmt::format("{} has format version {} (this program reads versions {} to {})", path, version,
+                              kPltOldestVersion, kPltVersion));
   const uint32_t arrayCount = load<uint32_t>(bytes.data() + 12);
   const uint64_t hash = load<uint64_t>(bytes.data() + 16), tixelCount = load<uint64_t>(bytes.data() + 24);
   if (hash != expectedHash)
@@ -103,12 +106,19 @@ bool readTixelSetupFile(const std::string& path, uint64_t expectedHash, TixelSet
   if (arrayCount > kMaxTixelSetupArrays || uint64_t(arrayCount) * kPltEntryBytes > payload.size())
     fail("{}: corrupt tixel-setup file: {} arrays declared, at most {} fit", path, arrayCount,
          std::min<uint64_t>(kMaxTixelSetupArrays, payload.size() / kPltEntryBytes));
+  const uint64_t keyCount = load<uint64_t>(bytes.data() + 40);
+  const uint64_t tableBytes = uint64_t(arrayCount) * kPltEntryBytes;
+  if (keyCount > kMaxTixelSetupKeys || keyCount * sizeof(uint64_t) > payload.size() - tableBytes)
+    fail("{}: corrupt tixel-setup file: {} keys declared, at most {} fit", path, keyCount,
+         std::min<uint64_t>(kMaxTixelSetupKeys, (payload.size() - tableBytes) / sizeof(uint64_t)));
   // The table, every count and frame size checked before anything is allocated.
   TixelSetupFile result;
   result.hash = hash;
   result.tixelCount = tixelCount;
   result.arrays.resize(arrayCount);
-  std::vector<uint64_t> frameOffset(arrayCount + 1, uint64_t(arrayCount) * kPltEntryBytes), frameSize(arrayCount);
+  result.keys.resize(keyCount);
+  if (keyCount > 0) std::memcpy(result.keys.data(), payload.data() + tableBytes, keyCount * sizeof(uint64_t));
+  std::vector<uint64_t> frameOffset(arrayCount + 1, tableBytes + keyCount * sizeof(uint64_t)), frameSize(arrayCount);
   uint64_t decodedBytes = 0;
   for (uint32_t i = 0; i < arrayCount; ++i) {
     const unsigned char* entry = payload.data() + uint64_t(i) * kPltEntryBytes;

@@ -25,18 +25,19 @@ class PltFileTest : public test_support::TempDirTest {
   static constexpr uint64_t kTixels = 1000;
   std::vector<float> points = std::vector<float>(kTixels * 3);
   std::vector<uint8_t> flags = std::vector<uint8_t>(kTixels);
+  std::vector<uint64_t> keys = {7, 0xffffffffffffffffull, 42};
 
   PltFileTest() {
     for (uint64_t i = 0; i < points.size(); ++i) points[i] = float(i) * 0.25f - 17.0f;
     for (uint64_t i = 0; i < flags.size(); ++i) flags[i] = uint8_t(i % 7 == 0);
   }
 
-  /// Three arrays: points, an unused one, flags.
+  /// Three arrays: points, an unused one, flags; and three keys.
   std::string write(const std::string& name) {
     const std::vector<TixelSetupView> views = {{{'P', 'N', 'T', 'S'}, 12, kTixels, points.data()},
                                                {{'N', 'O', 'N', 'E'}, 4, 0, nullptr},
                                                {{'F', 'L', 'A', 'G'}, 1, kTixels, flags.data()}};
-    writeTixelSetupFile(path(name), kHash, kTixels, views);
+    writeTixelSetupFile(path(name), kHash, kTixels, views, keys);
     return path(name);
   }
 
@@ -71,7 +72,22 @@ TEST_F(PltFileTest, RoundTripKeepsEveryByte) {
   EXPECT_EQ(read.arrays[1].count, 0u);
   EXPECT_TRUE(read.arrays[1].bytes.empty());
   EXPECT_EQ(read.arrays[2].bytes, std::vector<unsigned char>(flags.begin(), flags.end()));
+  EXPECT_EQ(read.keys, keys);
   EXPECT_EQ(fileCount(), 1u);  // no temporary left
+}
+
+// A version 1 file (its key count was a reserved 0) reads as one without keys.
+TEST_F(PltFileTest, VersionOneReadsWithoutKeys) {
+  keys.clear();
+  const std::string file = write("a.plt");
+  std::vector<unsigned char> bytes = bytesOf(file);
+  bytes[8] = 1;
+  put(file, bytes);
+  TixelSetupFile read;
+  std::string why;
+  ASSERT_TRUE(readTixelSetupFile(file, kHash, read, &why)) << why;
+  EXPECT_TRUE(read.keys.empty());
+  EXPECT_EQ(read.arrays[2].bytes, std::vector<unsigned char>(flags.begin(), flags.end()));
 }
 
 TEST_F(PltFileTest, AbsentStaleOrOtherVersionIsNotAnError) {
@@ -83,10 +99,10 @@ TEST_F(PltFileTest, AbsentStaleOrOtherVersionIsNotAnError) {
   EXPECT_FALSE(readTixelSetupFile(file, kHash + 1, read, &why));
   EXPECT_NE(why.find("another bake"), std::string::npos) << why;
   std::vector<unsigned char> bytes = bytesOf(file);
-  bytes[8] = 2;  // version 2
+  bytes[8] = 3;  // version 3
   put(file, bytes);
   EXPECT_FALSE(readTixelSetupFile(file, kHash, read, &why));
-  EXPECT_NE(why.find("format version 2"), std::string::npos) << why;
+  EXPECT_NE(why.find("format version 3"), std::string::npos) << why;
 }
 
 TEST_F(PltFileTest, CorruptFilesAreRefusedNamingTheFile) {
@@ -114,6 +130,7 @@ TEST_F(PltFileTest, CorruptFilesAreRefusedNamingTheFile) {
     expectError([&] { readTixelSetupFile(file, kHash, read, &why); }, {"bad.plt", problem});
   };
   forged(12, 1000, 4, "arrays declared");                 // array count
+  forged(40, uint64_t(1) << 19, 8, "keys declared");      // key count
   forged(48 + 4, 0, 4, "elements of 0 bytes");             // element size
   forged(48 + 8, kTixels - 1, 8, "not 0 or the 1000 tixels");
   forged(48 + 16, 1u << 30, 8, "runs past the end");      // frame size

@@ -266,7 +266,7 @@ VisibilityFileInfo readVisibilityInfo(const std::string& path) {
 }
 
 bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
-                    uint64_t targetTixels) {
+                    uint64_t targetTixels, std::vector<VisibilityEntry>* decodedOut) {
   auto reason = [&](std::string text) {
     if (why) *why = std::move(text);
     return false;
@@ -301,6 +301,7 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   entryOffset[tixelCount] = entryBytesTotal;
   std::vector<uint64_t> flaggedPerTixel(tixelCount);
   const uint64_t targets = targetTixels > 0 ? targetTixels : tixelCount;
+  if (decodedOut) decodedOut->resize(tixelCount * n);
   // Blocks decode independently, in parallel; every tixel's encoding is decoded once, checked,
   // so that the gather may decode it unchecked and index without bounds checks.
   parallelFor(blocks, [&](uint64_t b) {
@@ -311,11 +312,12 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
     const unsigned char* encoded = raw.data() + (t1 - t0) * sizeof(uint32_t);
     const uint64_t encodedBytes = raw.size() - (t1 - t0) * sizeof(uint32_t);
     std::memcpy(entryBytes.data() + blockEntryStart[b], encoded, encodedBytes);
-    std::vector<VisibilityEntry> decoded(n);
+    std::vector<VisibilityEntry> scratch(decodedOut ? 0 : n);
     uint64_t used = 0;
     for (uint64_t g = t0; g < t1; ++g) {
       uint32_t size;
       std::memcpy(&size, raw.data() + (g - t0) * sizeof(uint32_t), sizeof(uint32_t));
+      const std::span<VisibilityEntry> decoded(decodedOut ? decodedOut->data() + g * n : scratch.data(), n);
       if (size > encodedBytes - used ||
           decodeTixelEntries<true>(encoded + used, size, uint32_t(n), decoded.data()) != size)
         fail("{}: corrupt visibility field: the entries of tixel {} do not decode", path, g);

@@ -409,8 +409,10 @@ VisibilityFileInfo readVisibilityInfo(const std::string& path);
 /// present but corrupt or truncated (header, payload checksum, every frame and every index are
 /// checked, every tixel's encoding decoded once, before it returns).
 /// targetTixels: how many tixels the entries may point at (0: the file's own tixel count; a
-/// shard's entries point at any tixel of the scene).
+/// shard's entries point at any tixel of the scene). decoded: when given, receives every
+/// tixel's entries decoded (directionsPerTixel each, in field order) as they are checked — what
+/// the bake's VisibilityShard::decoded holds — instead of a second decoding.
 bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
-                    uint64_t targetTixels = 0);
+                    uint64_t targetTixels = 0, std::vector<VisibilityEntry>* decoded = nullptr);
 
 }  // namespace pl

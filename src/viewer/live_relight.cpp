@@ -8,6 +8,8 @@
 #include <variant>
 
 #if defined(__linux__)
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -25,7 +27,7 @@ namespace {
 constexpr float kSunStepDegrees = 5.0f;
 constexpr float kMaxElevationDegrees = 89.0f;
 constexpr float kDimmer = 0.8f, kBrighter = 1.25f, kDarker = 0.9f, kLighter = 1.1f;
-constexpr int kBackgroundNice = 10;
+constexpr int kBackgroundNice = 10, kIdleNice = 19;
 
 /// The colours C cycles a source through (multiplying its baked emission).
 constexpr Rgb kColours[] = {Rgb(1.0f), Rgb(1.0f, 0.75f, 0.5f), Rgb(0.6f, 0.8f, 1.0f),
@@ -33,10 +35,16 @@ constexpr Rgb kColours[] = {Rgb(1.0f), Rgb(1.0f, 0.75f, 0.5f), Rgb(0.6f, 0.8f, 1
 constexpr const char* kColourNames[] = {"white", "warm", "cool", "red", "green", "blue"};
 constexpr uint32_t kColourCount = sizeof(kColours) / sizeof(kColours[0]);
 
-/// Lowers the calling thread's scheduling priority (Linux: a thread's nice value).
-void lowerThreadPriority() {
+/// Lowers the calling thread's priority (live_relight.h, "Cores"). Idle: Linux's SCHED_IDLE
+/// policy, which runs it only on a core no thread of normal priority wants (CFS weight 3
+/// against nice 0's 1024), or where that is refused nice +19; Nice: nice +10 (weight 110).
+void lowerThreadPriority(RelightShare share) {
 #if defined(__linux__)
-  setpriority(PRIO_PROCESS, id_t(syscall(SYS_gettid)), kBackgroundNice);
+  const sched_param none{};
+  if (share == RelightShare::Idle && pthread_setschedparam(pthread_self(), SCHED_IDLE, &none) == 0) return;
+  setpriority(PRIO_PROCESS, id_t(syscall(SYS_gettid)), share == RelightShare::Idle ? kIdleNice : kBackgroundNice);
+#else
+  (void)share;
 #endif
 }
 
@@ -53,8 +61,9 @@ Vec3 sunTravel(float azimuth, float elevation) {
 
 }  // namespace
 
-LiveRelight::LiveRelight(const LightField& lightField, const Accel& accel, const std::string& visibilityPath)
-    : original_(lightField), accel_(accel), visibilityPath_(visibilityPath) {
+LiveRelight::LiveRelight(const LightField& lightField, const Accel& accel, const std::string& visibilityPath,
+                         RelightShare share)
+    : original_(lightField), accel_(accel), visibilityPath_(visibilityPath), share_(share) {
   const Scene& scene = lightField.scene;
   lights_ = scene.lights;
   for (const Light& l : lights_) {
@@ -164,7 +173,7 @@ void LiveRelight::press(RelightKey key) {
 }
 
 void LiveRelight::work() {
-  lowerThreadPriority();
+  lowerThreadPriority(share_);
   try {
     runWithThreads(1, [&] {
       relighter_ = std::make_unique<Relighter>(original_, visibilityPath_);

@@ -12,10 +12,13 @@
 //   I / K          the sun 5° higher / lower (elevation within ±89°)
 //   M              select the next Lambertian material;  , / .  its albedo × 0.9 / × 1.1 (at most 1)
 //
-// Cores: the propagation runs on one thread of its own, in a one-thread task arena
-// (core/parallel.h runWithThreads) and at a lower scheduling priority (nice +10 on Linux):
-// the renderer keeps all the pool's threads and runs first, and the propagation takes the
-// time the frames leave; on two cores, one core's worth at most.
+// Cores: the propagation (and the relighter's set-up) runs on one thread of its own, in a
+// one-thread task arena (core/parallel.h runWithThreads), under Linux's SCHED_IDLE policy
+// (RelightShare::Idle; nice +19 where that is refused): the renderer keeps all the pool's
+// threads, and the propagation runs only on a core no ordinary thread wants — the frame's
+// serial parts, the waits for input when the view is still; on two cores, one core's worth
+// at most. Under nice +10 alone (RelightShare::Nice) it kept a share of a core the renderer
+// wanted (CFS weight 110 against 1024 per renderer thread), which a parallel frame waits for.
 //
 // Double buffering: two copies of the light field (made once; the scene's geometry and
 // textures are shared by neither, so each is a full copy); the worker writes the one not on
@@ -55,11 +58,18 @@ struct RelightStatus {
   std::string message;      ///< the last refusal or error
 };
 
+/// How the background thread shares the cores with the renderer ("Cores" above).
+enum class RelightShare {
+  Idle,  ///< SCHED_IDLE (Linux; elsewhere nice +19): it runs only where no ordinary thread wants a core
+  Nice,  ///< nice +10 only: a small share of a core the renderer wants (for comparison: relight_bench --share)
+};
+
 class LiveRelight {
  public:
   /// Starts the background thread, which builds the Relighter from `lightField` and the .plv
   /// at visibilityPath (its errors go to status().message). lightField and accel must outlive it.
-  LiveRelight(const LightField& lightField, const Accel& accel, const std::string& visibilityPath);
+  LiveRelight(const LightField& lightField, const Accel& accel, const std::string& visibilityPath,
+              RelightShare share = RelightShare::Idle);
   ~LiveRelight();  ///< stops the worker (cancelling its set-up or iteration: core/cancel.h) and joins it
   LiveRelight(const LiveRelight&) = delete;
   LiveRelight& operator=(const LiveRelight&) = delete;
@@ -89,6 +99,7 @@ class LiveRelight {
   const LightField& original_;
   const Accel& accel_;
   const std::string visibilityPath_;
+  const RelightShare share_;
   // The wanted lighting (main thread writes, worker copies under mutex_).
   std::vector<Light> lights_;
   std::vector<Rgb> emission_;      ///< per material
