@@ -590,8 +590,8 @@ struct TransportState::Operators {
   /// Normal-mapped charts (lightfield.h "Normal-mapped diffuse charts"), per material of a
   /// directionalIrradiance chart (empty for the others): per gather direction — cell k with
   /// jitter sub-cell j at [k·kGatherJitterSide² + j] — its share of each tilted irradiance in
-  /// the gather frame, π/n · max(0, b_i·ω)/cos θ · tiltFactor.
-  std::vector<std::vector<std::array<Rgb, kTiltedNormals>>> tiltShares;
+  /// the gather frame, π/n · max(0, b_i·ω)/cos θ · tiltFactor (lanes R, G, B and 0).
+  std::vector<std::vector<std::array<Lanes4, kTiltedNormals>>> tiltShares;
   /// Subsurface charts (subsurface.h; all empty when there is none): the operator, per chart
   /// whether it is one, and per tixel the irradiance a subsurface tixel gathered at its last
   /// update (its own value is the operator's product of these: applySubsurface).
@@ -716,12 +716,14 @@ void addTiltedGather(const TransportState& state, const Chart& c, uint64_t g, co
   const Parameterisation& param = state.param;
   const auto& shares = state.ops->tiltShares[c.material];
   gatherSubCells(g, state.gridSide, state.settings.seed, subCells);
-  Rgb sum[kTiltedNormals] = {Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
+  // Σ_k L_k · share_t, lane-wise (the colour channels; the fourth lane is unused).
+  F4 lanes[kTiltedNormals] = {f4Zero(), f4Zero(), f4Zero()};
   for (uint32_t k = 0; k < state.n; ++k) {
-    const Rgb L(incoming[k].v[0], incoming[k].v[1], incoming[k].v[2]);
-    const std::array<Rgb, kTiltedNormals>& share = shares[size_t(k) * kGatherJitterSide * kGatherJitterSide + subCells[k]];
-    for (uint32_t t = 0; t < kTiltedNormals; ++t) sum[t] += L * share[t];
+    const F4 L = f4Load(incoming[k].v);
+    const std::array<Lanes4, kTiltedNormals>& share = shares[size_t(k) * kGatherJitterSide * kGatherJitterSide + subCells[k]];
+    for (uint32_t t = 0; t < kTiltedNormals; ++t) lanes[t] = f4Add(lanes[t], f4Mul(L, f4Load(share[t].v)));
   }
+  Rgb sum[kTiltedNormals] = {f4Rgb(lanes[0]), f4Rgb(lanes[1]), f4Rgb(lanes[2])};
   if (c.curved) {
     const TixelFrame from = tixelFrame(param, c, g), to = tiltFrame(param, c, g);
     constexpr float kGradient = 2.0f / (3.0f * kNormalTiltSine);
@@ -807,7 +809,7 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   }
   ops->tiltShares.resize(scene.materials.size());
   for (const Chart& c : param.charts) {
-    std::vector<std::array<Rgb, kTiltedNormals>>& shares = ops->tiltShares[c.material];
+    std::vector<std::array<Lanes4, kTiltedNormals>>& shares = ops->tiltShares[c.material];
     if (!c.directionalIrradiance || !shares.empty()) continue;
     const Bsdf& bsdf = scene.materials[c.material].bsdf;
     constexpr uint32_t kJitters = kGatherJitterSide * kGatherJitterSide;
@@ -817,8 +819,8 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
         const Vec3 w = gatherCellDirection(k, j, gridSide, settings.seed);
         for (uint32_t t = 0; t < kTiltedNormals; ++t) {
           const float cosine = glm::dot(w, tiltedNormal(t));
-          shares[size_t(k) * kJitters + j][t] =
-              w.z > 0.0f ? Rgb(kPi / float(n) * std::max(0.0f, cosine) / w.z) * tiltFactor(c, bsdf, cosine) : Rgb(0.0f);
+          shares[size_t(k) * kJitters + j][t] = lanes4(
+              w.z > 0.0f ? Rgb(kPi / float(n) * std::max(0.0f, cosine) / w.z) * tiltFactor(c, bsdf, cosine) : Rgb(0.0f));
         }
       }
   }
