@@ -321,9 +321,8 @@ constexpr uint32_t kPrefetchDistance = 16;
 /// additions through a store and a reload each.
 template <bool KeepIncoming, typename SlowPath>
 [[gnu::noinline]] F4 gatherTixel(const VisibilityEntry* entries, const VisibilityEntry* ahead, uint32_t n,
-                                 const TransportQuad* quads,
-                                 uint64_t quadCount, const VisibilityExtra* extras, uint64_t extraCount, Lanes4* scratch,
-                                 Lanes4* incoming, SlowPath&& slowPath) {
+                                 const TransportQuad* quads, uint64_t quadCount, const VisibilityExtra* extras,
+                                 uint64_t extraCount, Lanes4* scratch, Lanes4* incoming, SlowPath&& slowPath) {
   if (extraCount > 0) {
     const VisibilityExtra* extra = extras;
     Lanes4* out = scratch;
