@@ -309,7 +309,10 @@ constexpr uint32_t kPrefetchDistance = 16;
 /// one), looked up in the quads; entries with an extra record go through slowPath(entry,
 /// extra), which returns their radiance; escaped entries and back sides without an extra bring
 /// nothing. `extraCount` is the tixel's number of extra records, `scratch` room for that many
-/// values. Prefetches read quad quadCount − 1 (all zero) for the escaped entries.
+/// values. `ahead`: the entries of the tixel gathered next (n of them), whose quads are
+/// prefetched one per entry gathered here, a whole tixel's gather before they are read; or
+/// nullptr, and the quads of this tixel's own entries kPrefetchDistance ahead are. Prefetches
+/// read quad quadCount − 1 (all zero) for the escaped entries.
 ///
 /// The entries with an extra record are evaluated first, into `scratch`, so that the loop that
 /// sums makes no call; the values and the order of the additions are those of evaluating each
@@ -317,9 +320,9 @@ constexpr uint32_t kPrefetchDistance = 16;
 /// loop, where values live across calls, the compiler kept `sum` in memory, which chained the
 /// additions through a store and a reload each.
 template <bool KeepIncoming, typename SlowPath>
-[[gnu::noinline]] F4 gatherTixel(const VisibilityEntry* entries, uint32_t n, const TransportQuad* quads,
-                                 uint64_t quadCount, const VisibilityExtra* extras, uint64_t extraCount, Lanes4* scratch,
-                                 Lanes4* incoming, SlowPath&& slowPath) {
+[[gnu::noinline]] F4 gatherTixel(const VisibilityEntry* entries, const VisibilityEntry* ahead, uint32_t n,
+                                 const TransportQuad* quads, uint64_t quadCount, const VisibilityExtra* extras,
+                                 uint64_t extraCount, Lanes4* scratch, Lanes4* incoming, SlowPath&& slowPath) {
   if (extraCount > 0) {
     const VisibilityExtra* extra = extras;
     Lanes4* out = scratch;
@@ -346,6 +349,13 @@ template <bool KeepIncoming, typename SlowPath>
       if constexpr (KeepIncoming) incoming[k] = Lanes4{};
     }
   };
+  if (ahead) {
+    for (uint32_t k = 0; k < n; ++k) {
+      __builtin_prefetch(quads + std::min<uint64_t>(ahead[k].tixel(), quadCount - 1));
+      add(k);
+    }
+    return sum;
+  }
   // The entries kPrefetchDistance ahead exist up to n − kPrefetchDistance: two loops, so that
   // neither tests for it.
   const uint32_t prefetched = n > kPrefetchDistance ? n - kPrefetchDistance : 0;
@@ -356,6 +366,46 @@ template <bool KeepIncoming, typename SlowPath>
   for (uint32_t k = prefetched; k < n; ++k) add(k);
   return sum;
 }
+
+/// A thread's walk over the entries of the tixels it gathers, in order, one tixel ahead: before
+/// it gathers a tixel it decodes the entries of the next (or finds them in the decoded field),
+/// so that gatherTixel prefetches the quads those will read while it works. Each quad so
+/// arrives a whole tixel's gather before it is read, where prefetching kPrefetchDistance entries
+/// ahead inside the tixel left every tixel's first entries and its short tixels waiting on
+/// memory (the quads are read at random and, on a large scene, mostly miss every cache).
+class EntryPipeline {
+ public:
+  EntryPipeline(const VisibilityShard& vis, uint32_t n)
+      : vis_(vis), n_(n), buffer_{std::vector<VisibilityEntry>(n), std::vector<VisibilityEntry>(n)} {}
+
+  /// Tixel g's entries: those ahead(g) prepared, else decoded now (and their quads prefetched
+  /// at once). Valid until the second ahead() after.
+  const VisibilityEntry* take(uint64_t g, const TransportQuad* quads, uint64_t quadCount) {
+    if (g == aheadTixel_) {
+      slot_ ^= 1;
+      aheadTixel_ = kNone;
+      return aheadEntries_;
+    }
+    const VisibilityEntry* entries = vis_.entries(g, buffer_[slot_].data());
+    for (uint32_t k = 0; k < n_; ++k) __builtin_prefetch(quads + std::min<uint64_t>(entries[k].tixel(), quadCount - 1));
+    return entries;
+  }
+  /// Prepares tixel g's entries, to be taken next (the buffer take() did not return); returns them.
+  const VisibilityEntry* ahead(uint64_t g) {
+    aheadTixel_ = g;
+    aheadEntries_ = vis_.entries(g, buffer_[slot_ ^ 1].data());
+    return aheadEntries_;
+  }
+
+ private:
+  static constexpr uint64_t kNone = ~uint64_t(0);
+  const VisibilityShard& vis_;
+  uint32_t n_;
+  std::vector<VisibilityEntry> buffer_[2];
+  uint32_t slot_ = 0;  ///< the buffer take() decodes into; ahead() uses the other
+  uint64_t aheadTixel_ = kNone;
+  const VisibilityEntry* aheadEntries_ = nullptr;
+};
 
 /// The scene's brightest emitter, for messages: "material 'NAME' (emission R G B)" or
 /// "point light I (intensity R G B)"; empty when nothing emits.
@@ -539,8 +589,8 @@ struct TransportState::Operators {
   /// Normal-mapped charts (lightfield.h "Normal-mapped diffuse charts"), per material of a
   /// directionalIrradiance chart (empty for the others): per gather direction — cell k with
   /// jitter sub-cell j at [k·kGatherJitterSide² + j] — its share of each tilted irradiance in
-  /// the gather frame, π/n · max(0, b_i·ω)/cos θ · tiltFactor.
-  std::vector<std::vector<std::array<Rgb, kTiltedNormals>>> tiltShares;
+  /// the gather frame, π/n · max(0, b_i·ω)/cos θ · tiltFactor (lanes R, G, B and 0).
+  std::vector<std::vector<std::array<Lanes4, kTiltedNormals>>> tiltShares;
   /// Subsurface charts (subsurface.h; all empty when there is none): the operator, per chart
   /// whether it is one, and per tixel the irradiance a subsurface tixel gathered at its last
   /// update (its own value is the operator's product of these: applySubsurface).
@@ -665,12 +715,14 @@ void addTiltedGather(const TransportState& state, const Chart& c, uint64_t g, co
   const Parameterisation& param = state.param;
   const auto& shares = state.ops->tiltShares[c.material];
   gatherSubCells(g, state.gridSide, state.settings.seed, subCells);
-  Rgb sum[kTiltedNormals] = {Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
+  // Σ_k L_k · share_t, lane-wise (the colour channels; the fourth lane is unused).
+  F4 lanes[kTiltedNormals] = {f4Zero(), f4Zero(), f4Zero()};
   for (uint32_t k = 0; k < state.n; ++k) {
-    const Rgb L(incoming[k].v[0], incoming[k].v[1], incoming[k].v[2]);
-    const std::array<Rgb, kTiltedNormals>& share = shares[size_t(k) * kGatherJitterSide * kGatherJitterSide + subCells[k]];
-    for (uint32_t t = 0; t < kTiltedNormals; ++t) sum[t] += L * share[t];
+    const F4 L = f4Load(incoming[k].v);
+    const std::array<Lanes4, kTiltedNormals>& share = shares[size_t(k) * kGatherJitterSide * kGatherJitterSide + subCells[k]];
+    for (uint32_t t = 0; t < kTiltedNormals; ++t) lanes[t] = f4Add(lanes[t], f4Mul(L, f4Load(share[t].v)));
   }
+  Rgb sum[kTiltedNormals] = {f4Rgb(lanes[0]), f4Rgb(lanes[1]), f4Rgb(lanes[2])};
   if (c.curved) {
     const TixelFrame from = tixelFrame(param, c, g), to = tiltFrame(param, c, g);
     constexpr float kGradient = 2.0f / (3.0f * kNormalTiltSine);
@@ -756,7 +808,7 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
   }
   ops->tiltShares.resize(scene.materials.size());
   for (const Chart& c : param.charts) {
-    std::vector<std::array<Rgb, kTiltedNormals>>& shares = ops->tiltShares[c.material];
+    std::vector<std::array<Lanes4, kTiltedNormals>>& shares = ops->tiltShares[c.material];
     if (!c.directionalIrradiance || !shares.empty()) continue;
     const Bsdf& bsdf = scene.materials[c.material].bsdf;
     constexpr uint32_t kJitters = kGatherJitterSide * kGatherJitterSide;
@@ -766,8 +818,8 @@ TransportState::TransportState(const Scene& sceneIn, const Accel& accelIn, const
         const Vec3 w = gatherCellDirection(k, j, gridSide, settings.seed);
         for (uint32_t t = 0; t < kTiltedNormals; ++t) {
           const float cosine = glm::dot(w, tiltedNormal(t));
-          shares[size_t(k) * kJitters + j][t] =
-              w.z > 0.0f ? Rgb(kPi / float(n) * std::max(0.0f, cosine) / w.z) * tiltFactor(c, bsdf, cosine) : Rgb(0.0f);
+          shares[size_t(k) * kJitters + j][t] = lanes4(
+              w.z > 0.0f ? Rgb(kPi / float(n) * std::max(0.0f, cosine) / w.z) * tiltFactor(c, bsdf, cosine) : Rgb(0.0f));
         }
       }
   }
@@ -1303,21 +1355,27 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
   std::vector<float>& change = state.change;
   parallelForRange(end - begin, 16, [&](uint64_t t0, uint64_t t1) {
     std::vector<Lanes4> incoming(n), twinIncoming, slowValues(n);
-    std::vector<VisibilityEntry> decoded(n);
+    std::vector<VisibilityEntry> twinDecoded;
+    EntryPipeline pipeline(vis, n);
     std::vector<uint8_t> subCells;
-    for (uint64_t g = begin + t0; g < begin + t1; ++g) {
+    const uint64_t g1 = begin + t1;
+    auto gathered = [&](uint64_t g) { return param.charts[param.tixelChart[g]].kind != ChartKind::Specular; };
+    for (uint64_t g = begin + t0; g < g1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
       auto slowPath = [&](VisibilityEntry e, const VisibilityExtra* extra) {
         return slowPathRadiance(state, e, extra, begin, end);
       };
-      const VisibilityEntry* entries = vis.entries(g, decoded.data());
+      const VisibilityEntry* entries = pipeline.take(g, ops.quads.data(), ops.quads.size());
+      uint64_t next = g + 1;
+      while (next < g1 && !gathered(next)) ++next;
+      const VisibilityEntry* ahead = next < g1 ? pipeline.ahead(next) : nullptr;
       const VisibilityExtra* extras = vis.extras(g);
       const uint64_t extraCount = vis.extraCount(g);
       const F4 sum = c.kind == ChartKind::Glossy || c.directionalIrradiance
-                         ? gatherTixel<true>(entries, n, ops.quads.data(), ops.quads.size(), extras, extraCount,
+                         ? gatherTixel<true>(entries, ahead, n, ops.quads.data(), ops.quads.size(), extras, extraCount,
                                              slowValues.data(), incoming.data(), slowPath)
-                         : gatherTixel<false>(entries, n, ops.quads.data(), ops.quads.size(), extras, extraCount,
+                         : gatherTixel<false>(entries, ahead, n, ops.quads.data(), ops.quads.size(), extras, extraCount,
                                               slowValues.data(), nullptr, slowPath);
       const uint64_t vb = valueBase(g, c);
       auto relax = [&](const Rgb& before, const Rgb& update) { return glm::max(Rgb(0.0f), before + omega * (update - before)); };
@@ -1344,9 +1402,10 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
           // Rough glass: plus the transmission of what the twin record gathers now.
           const uint64_t twin = twinTixel(param, g);
           twinIncoming.resize(n);
-          const F4 twinSum = gatherTixel<true>(vis.entries(twin, decoded.data()), n, ops.quads.data(), ops.quads.size(),
-                                               vis.extras(twin), vis.extraCount(twin), slowValues.data(), twinIncoming.data(),
-                                               slowPath);
+          twinDecoded.resize(n);
+          const F4 twinSum = gatherTixel<true>(vis.entries(twin, twinDecoded.data()), nullptr, n, ops.quads.data(),
+                                               ops.quads.size(), vis.extras(twin), vis.extraCount(twin),
+                                               slowValues.data(), twinIncoming.data(), slowPath);
           gm.transmission[c.isBack ? 1 : 0].apply(twinIncoming.data(), twinSum, out);
         }
         const Rgb* before = previousValues.data() + vb;

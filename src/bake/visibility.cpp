@@ -57,18 +57,6 @@ namespace {
 constexpr uint32_t kJitterSide = kGatherJitterSide;
 constexpr uint32_t kJitterCount = kJitterSide * kJitterSide;
 
-/// The random permutation of line `line` (a column when row == false) of a tixel's cells:
-/// order[rank] = index of the cell (along the line) with that rank.
-void linePermutation(uint64_t tixelSalt, uint32_t line, bool row, uint32_t gridSide, uint8_t* order) {
-  for (uint32_t i = 0; i < gridSide; ++i) order[i] = uint8_t(i);
-  const uint64_t lineSalt = tixelSalt ^ ((uint64_t(line) << 1 | uint64_t(row)) * 0x9e3779b97f4a7c15ULL);
-  for (uint32_t i = gridSide; i > 1; --i) {
-    // 32 random bits scaled to [0, i) (Lemire's multiply-shift; the bias is < i/2^32).
-    const uint32_t j = uint32_t((uint64_t(uint32_t(mix64(lineSalt + i))) * i) >> 32);
-    std::swap(order[i - 1], order[j]);
-  }
-}
-
 uint64_t tixelSalt(uint64_t tixel, uint64_t seed) { return hashCombine(tixel, seed ^ 0x5649534942494c59ULL); }
 
 }  // namespace
@@ -76,13 +64,37 @@ uint64_t tixelSalt(uint64_t tixel, uint64_t seed) { return hashCombine(tixel, se
 void gatherSubCells(uint64_t tixel, uint32_t gridSide, uint64_t seed, std::vector<uint8_t>& out) {
   out.assign(size_t(gridSide) * gridSide, 0);
   const uint64_t salt = tixelSalt(tixel, seed);
-  uint8_t order[kMaxGatherGridSide];
-  for (uint32_t line = 0; line < gridSide; ++line) {
-    linePermutation(salt, line, false, gridSide, order);  // column `line`: cells line + i·G
-    for (uint32_t rank = 0; rank < gridSide; ++rank) out[line + order[rank] * gridSide] += uint8_t(rank % kJitterSide);
-    linePermutation(salt, line, true, gridSide, order);  // row `line`: cells i + line·G
-    for (uint32_t rank = 0; rank < gridSide; ++rank)
-      out[order[rank] + line * gridSide] += uint8_t(kJitterSide * (rank % kJitterSide));
+  // Line q of the 2G lines is column q/2 (q even: cells q/2 + i·G) or row q/2 (q odd: cells
+  // i + (q/2)·G), permuted by a Fisher–Yates shuffle: order[rank] = the cell (along the line)
+  // with that rank, from order = identity by swapping order[i − 1] with order[j] for i = G … 2,
+  // j = 32 hashed bits of (line salt + i) scaled to [0, i) (Lemire's multiply-shift; the bias
+  // is < i/2^32). kLines lines are shuffled side by side, a step of each in turn: each
+  // shuffle's swaps wait on one another, those of different lines do not (the propagation
+  // calls this for every normal-mapped tixel in every iteration).
+  constexpr uint32_t kLines = 8;
+  uint8_t order[kLines][kMaxGatherGridSide];
+  uint64_t lineSalt[kLines];
+  const uint32_t lines = 2 * gridSide;
+  for (uint32_t q0 = 0; q0 < lines; q0 += kLines) {
+    const uint32_t count = std::min(kLines, lines - q0);
+    for (uint32_t l = 0; l < count; ++l) {
+      lineSalt[l] = salt ^ (uint64_t(q0 + l) * 0x9e3779b97f4a7c15ULL);
+      for (uint32_t i = 0; i < gridSide; ++i) order[l][i] = uint8_t(i);
+    }
+    for (uint32_t i = gridSide; i > 1; --i)
+      for (uint32_t l = 0; l < count; ++l) {
+        const uint32_t j = uint32_t((uint64_t(uint32_t(mix64(lineSalt[l] + i))) * i) >> 32);
+        std::swap(order[l][i - 1], order[l][j]);
+      }
+    // A column's cells take sub-column rank mod J, a row's sub-row rank mod J.
+    for (uint32_t l = 0; l < count; ++l) {
+      const uint32_t line = (q0 + l) / 2;
+      if ((q0 + l) % 2 == 0)
+        for (uint32_t rank = 0; rank < gridSide; ++rank) out[line + order[l][rank] * gridSide] += uint8_t(rank % kJitterSide);
+      else
+        for (uint32_t rank = 0; rank < gridSide; ++rank)
+          out[order[l][rank] + line * gridSide] += uint8_t(kJitterSide * (rank % kJitterSide));
+    }
   }
 }
 

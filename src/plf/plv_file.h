@@ -260,8 +260,24 @@ inline size_t decodeExact(const unsigned char* in, size_t size, uint32_t n, Visi
   return size_t(at - in);
 }
 
-template <bool Checked>
-inline size_t decodeQuantised(const unsigned char* in, size_t size, uint32_t n, uint32_t bits, VisibilityEntry* out) {
+/// kFractionLevels[F] of both fractions of a quantised entry at F = kCompactFractionBits, whose
+/// two levels fill one byte: entry q (qu | qv << F) holds fu | fv << 16, so that the default's
+/// decoder looks the pair up in one load.
+inline constexpr auto kCompactFractionPairs = [] {
+  constexpr uint32_t bits = kCompactFractionBits;
+  static_assert(2 * bits == 8);
+  std::array<uint32_t, 256> table{};
+  for (uint32_t q = 0; q < 256; ++q)
+    table[q] = uint32_t(kFractionLevels[bits][q & 15]) | uint32_t(kFractionLevels[bits][q >> bits]) << 16;
+  return table;
+}();
+
+/// FixedBits: 0, or the bits per fraction known at compile time (the default's, which the
+/// gather decodes with every length and mask a constant and the fractions looked up in pairs).
+template <bool Checked, uint32_t FixedBits = 0>
+inline size_t decodeQuantised(const unsigned char* in, size_t size, uint32_t n, uint32_t runtimeBits,
+                              VisibilityEntry* out) {
+  const uint32_t bits = FixedBits != 0 ? FixedBits : runtimeBits;
   const unsigned char* const tags = in + 1;
   const unsigned char* at = in + kTixelHeaderBytes(n);
   [[maybe_unused]] const unsigned char* const end = in + size;
@@ -282,8 +298,10 @@ inline size_t decodeQuantised(const unsigned char* in, size_t size, uint32_t n, 
         const uint64_t length = (nearBytes & near) | (farBytes & far);
         const uint32_t top = uint32_t(64 - 8 * length) & 63u;
         previous += int64_t(uint64_t(int64_t(word << top) >> (top + 2 * bits)) & hit);
-        const uint64_t packed = ((uint64_t(uint32_t(previous)) | (uint64_t(level[word & mask]) << 32) |
-                                  (uint64_t(level[(word >> bits) & mask]) << 48)) & hit) |
+        uint64_t fractions;
+        if constexpr (FixedBits == kCompactFractionBits) fractions = kCompactFractionPairs[word & 0xff];
+        else fractions = uint64_t(level[word & mask]) | (uint64_t(level[(word >> bits) & mask]) << 16);
+        const uint64_t packed = ((uint64_t(uint32_t(previous)) | (fractions << 32)) & hit) |
                                 (uint64_t(VisibilityEntry::kEscape) & ~hit);
         std::memcpy(static_cast<void*>(&out[k]), &packed, 8);
         at += length;
@@ -336,6 +354,8 @@ inline size_t decodeTixelEntries(const unsigned char* in, size_t size, uint32_t 
   const uint32_t bits = in[0];
   if (bits == kExactFractionBits) return detail::decodeExact<Checked>(in, size, n, out);
   if (Checked && !validFractionBits(bits)) return 0;
+  if (!Checked && bits == kCompactFractionBits)
+    return detail::decodeQuantised<false, kCompactFractionBits>(in, size, n, bits, out);
   return detail::decodeQuantised<Checked>(in, size, n, bits, out);
 }
 
