@@ -396,8 +396,8 @@ out uint id;
 void main() { id = kMarkedTexel; }
 )glsl";
 
-// Pass 2: per pixel, the camera ray through its centre (Camera::generateRay), the hit on the
-// visible triangle's plane, and the lookup.
+// Pass 2: per pixel, the camera ray through its centre (Camera::generateRay), its primary hit
+// (primaryHit: the id buffer's triangle, or the BVH's answer) and the lookup.
 constexpr const char* kShadingVertex = R"glsl(
 void main() {
   vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
