@@ -8,12 +8,17 @@
 //      buffer, writing its triangle id (+1; 0 = nothing) per pixel — the primary hit of the
 //      ray through the pixel centre, as the CPU renderer's one sample per pixel; an
 //      alpha-masked triangle is discarded where that ray meets it at a coverage below its
-//      cutoff (coverageAt), as the ray caster's hit filter does;
-//   2. shading: per pixel, the camera ray of Camera::generateRay through the pixel centre,
-//      intersected with the triangles of that pixel and its 8 neighbours (the rasteriser snaps
-//      vertices to a sub-pixel grid, which can hand a centre near an edge the triangle across
-//      it; the nearest hit is the ray caster's answer), the hit point origin + t·direction (as
-//      the CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
+//      cutoff (coverageAt), as the ray caster's hit filter does. Then every vertex is drawn as
+//      a one-pixel point that marks its pixel where it is nearer than the surface there;
+//   2. shading: per pixel, the camera ray of Camera::generateRay through the pixel centre. Its
+//      hit is the id buffer's triangle where that pixel and its 8 neighbours hold the same one,
+//      unmarked, and the ray hits it; elsewhere — an edge or silhouette nearby, or a marked
+//      vertex: a triangle smaller than a pixel, which the rasteriser's sub-pixel snapping can
+//      leave out of the id buffer though the ray through the centre hits it — the ray is cast
+//      through the BVH (gpu_bvh.h), as the CPU renderers cast theirs through Embree; so only a
+//      sliver narrower than a pixel passing between the 3×3 centres with its vertices
+//      elsewhere, or a tie between coplanar triangles, can make the two differ. Then the hit
+//      point origin + t·direction (as the CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
 //      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes) in a fragment shader,
 //      times the camera weight (cos⁴θ with vignetting). A miss sees the environment (the
 //      constant and the map: EnvironmentMap::radiance, bilinear in the lat-long image). On a
@@ -38,8 +43,8 @@
 // as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 128 bytes per
 // material, and where a chart, mask or traced hit needs uvs, 36 bytes per vertex and 4 per triangle). So
 // GPU memory is 16 bytes per value + 128 per chart + 32 per vertex + 28 per triangle + 4 per
-// sun mask + 16 per environment texel + the surface detail + (with mirrors, glass or punctual
-// highlights) the BVH's 32 per node and 4 per triangle, 64 per material and 4 per triangle for
+// sun mask + 16 per environment texel + the surface detail + the BVH's 32 per node and 4 per
+// triangle + (with mirrors, glass or punctual highlights) 64 per material and 4 per triangle for
 // the chains and shadow rays, and 64 per delta light and 48 per material for the highlights +
 // the frame's targets (radiance 16 bytes per pixel; id and depth 8 bytes per pixel, or per
 // texel of the finer multi-sample visibility pass). A light field whose buffers exceed the GPU
@@ -64,8 +69,8 @@
 // renderers' jittered film points (Pcg32::forKey in 64-bit GLSL integers,
 // GL_ARB_gpu_shader_int64); the visibility pass is then drawn at a finer resolution (16× per
 // axis on small images, 4× at 1920×1080: its targets stay within 256 MiB) and each jittered ray
-// looks for its triangle among those seen at the 3×3 of those finer texel centres around its
-// film point, so only a triangle that covers none of them (one seen almost edge-on) is missed.
+// takes the triangle of the 3×3 of those finer texels around its film point by the same rule
+// (one triangle, unmarked, hit by the ray), else it is cast through the BVH.
 //
 // The shader's lookup is checked against the C++ one (exitantRadiance) on random inputs by
 // GpuRenderer::lookup, which runs the very GLSL function the shading pass calls.

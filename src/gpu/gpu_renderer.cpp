@@ -47,9 +47,10 @@ struct TriangleGpu {
 };
 
 /// The visibility pass's resolution, per axis, relative to a width × height image's with
-/// several samples per pixel: a jittered ray looks for its triangle among those seen at the 3×3
-/// id texels around its film point, so a triangle that covers none of these finer texel centres
-/// (one seen almost edge-on) is missed. As fine as 16× while the id and depth targets stay
+/// several samples per pixel: a jittered ray takes the triangle of the 3×3 id texels around
+/// its film point where they agree (primaryHit), else it is cast through the BVH; finer texels
+/// agree on more of the image (fewer rays cast) and leave a thinner sliver able to pass
+/// between their centres unseen. As fine as 16× while the id and depth targets stay
 /// within kMaxIdTexels (8 bytes each: 256 MiB): 16× up to 256×192 pixels, 10× at 640×480,
 /// 4× at 1920×1080, never below 1×.
 constexpr uint64_t kMaxIdTexels = uint64_t(1) << 25;
@@ -339,6 +340,9 @@ uniform float tanHalfFovY, aspect;
 uniform ivec2 size;
 uniform int idScale;  // the ids are at idScale × the image's resolution
 uniform bool anyMasked;  // some material is alpha-masked (maskedMaterial)
+// An id texel the markers pass marked: a vertex lies there, nearer than the surface rasterised
+// (primaryHit casts the rays around it through the BVH).
+const uint kMarkedTexel = 0xffffffffu;
 // The vector from the eye to film point `film` (pixel units) on the image plane at unit distance.
 vec3 cameraToFilm(vec2 film) {
   float sx = (2.0 * film.x / float(size.x) - 1.0) * tanHalfFovY * aspect;
@@ -382,8 +386,18 @@ void main() {
 }
 )glsl";
 
-// Pass 2: per pixel, the camera ray through its centre (Camera::generateRay), the hit on the
-// visible triangle's plane, and the lookup.
+// Pass 1b, the markers: every vertex drawn as a one-texel point, depth-tested against pass 1's
+// depth without writing it, marks the texel it falls in where it is nearer than the surface
+// rasterised there. A triangle smaller than a texel may be left out of the ids by the
+// rasteriser's snapping (or lie between texel centres) though the ray through a texel centre
+// hits it; its vertices then mark the 3×3 around that centre, where primaryHit casts the rays.
+constexpr const char* kMarkerFragment = R"glsl(
+out uint id;
+void main() { id = kMarkedTexel; }
+)glsl";
+
+// Pass 2: per pixel, the camera ray through its centre (Camera::generateRay), its primary hit
+// (primaryHit: the id buffer's triangle, or the BVH's answer) and the lookup.
 constexpr const char* kShadingVertex = R"glsl(
 void main() {
   vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
@@ -481,52 +495,55 @@ vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv,
 vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer);
 #endif
 
+// The camera ray's primary hit: the ray from the eye along unit `direction` through film point
+// `film` (pixel units) — the ray caster's answer: true with its distance t, triangle and
+// barycentrics b, false on a miss. The id texels answer where they can be trusted: the texel
+// the film point falls in and its 8 neighbours hold one triangle (or all nothing), no vertex
+// marked there (kMarkedTexel), and the ray hits that triangle (Möller–Trumbore, edges
+// inclusive, not cut by an alpha mask). The film point lies within the square of those 9 texel
+// centres, all on that triangle; a nearer triangle would cover one of them or have a vertex
+// in front there, unless it is a sliver narrower than the texel spacing passing between them
+// with its vertices elsewhere (gpu.h). Everywhere else — an edge or silhouette in the 3×3, a
+// triangle smaller than a texel the rasteriser left out (its vertices mark its texels), a
+// jittered ray off its texel's triangle — the ray is cast through the BVH (gpu_bvh.h
+// bvhIntersect) as the CPU renderers cast theirs through Embree.
+bool primaryHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
+  ivec2 texel = ivec2(floor(film * float(idScale)));
+  ivec2 lastTexel = size * idScale - 1;
+  uint id = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
+  bool same = id != kMarkedTexel;
+  for (int dy = -1; dy <= 1 && same; ++dy)
+    for (int dx = -1; dx <= 1 && same; ++dx) same = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r == id;
+  const float far = 1.0 / 0.0;
+  if (same && id == 0u) {
+    t = far;
+    triangle = 0xffffffffu;
+    b = vec2(0.0);
+    return false;
+  }
+  if (same) {
+    t = bvhTriangle(id - 1u, eye, direction, 0.0, far, b);
+    triangle = id - 1u;
+    if (t < far && !bvhCutAway(triangle, b)) return true;
+  }
+  return bvhIntersect(eye, direction, 0.0, far, t, triangle, b);
+}
+
 // The camera weight times the radiance along the camera ray through film point `film` (pixel
-// units, Camera::generateRay's pinhole). `jittered`: the film point is anywhere in its pixel,
-// not the centre (see the miss rule below).
-vec3 sampleRadiance(vec2 film, bool jittered) {
+// units, Camera::generateRay's pinhole).
+vec3 sampleRadiance(vec2 film) {
   vec3 toFilm = cameraToFilm(film);
   float invLength = 1.0 / length(toFilm);
   float weight = 1.0;
   if (vignetting) weight = invLength * invLength * invLength * invLength;  // cos^4
   vec3 direction = toFilm * invLength;
-  // The visible triangle: rasterisation snaps vertices to a sub-pixel grid, so a texel centre
-  // within that snap of an edge may be given the triangle across it. The ray is tested against
-  // the triangles of the id texel the film point falls in and its 8 neighbours (Möller–Trumbore,
-  // edges inclusive) and the nearest it hits is taken — the ray caster's answer. If it hits
-  // none of them: through the pixel centre, the texel's own triangle's plane (a sliver no
-  // centre covers); through a jittered point, the environment where a neighbour sees it (past
-  // a silhouette), else the own triangle's plane too.
-  ivec2 texel = ivec2(floor(film * float(idScale)));
-  ivec2 lastTexel = size * idScale - 1;
-  uint id = 0u;
-  bool besideBackground = false;
-  float t = 1.0 / 0.0;
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      uint candidate = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r;
-      if (candidate == 0u) besideBackground = true;
-      if (candidate == 0u || candidate == id) continue;
-      uvec4 tri = triangles[candidate - 1u];
-      vec3 hit = rayTriangle(direction, tri.xyz);  // (t, b1, b2)
-      float u = hit.y, v = hit.z;
-      if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit.x > 0.0 && hit.x < t &&
-          !(anyMasked && masked(candidate - 1u, tri.xyz, vec2(u, v)))) {
-        t = hit.x;
-        id = candidate;
-      }
-    }
-  if (id == 0u && !(jittered && besideBackground)) id = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
-  if (id == 0u) return weight * environmentRadiance(direction);
-  uvec4 tri = triangles[id - 1u];
-  vec3 p0 = positions[tri.x].xyz, p1 = positions[tri.y].xyz, p2 = positions[tri.z].xyz;
-  vec3 n = cross(p1 - p0, p2 - p0);
-  // The hit's barycentrics (Möller–Trumbore's, as the ray caster's), on the triangle's plane
-  // where the ray passes beside it.
-  vec3 hit = rayTriangle(direction, tri.xyz);
-  if (isinf(t)) t = dot(p0 - eye, n) / dot(direction, n);
+  // The visible triangle (primaryHit), then the surface there.
+  float t;
+  uint triangle;
+  vec2 b;
+  if (!primaryHit(film, direction, t, triangle, b)) return weight * environmentRadiance(direction);
+  uvec4 tri = triangles[triangle];
   vec3 p = eye + t * direction;
-  vec2 b = hit.yz;
   vec3 normalAtHit, shadingNormal;
   hitNormals(tri, b, normalAtHit, shadingNormal);
 #if defined(SPECULAR) || defined(HIGHLIGHTS)
@@ -534,12 +551,12 @@ vec3 sampleRadiance(vec2 film, bool jittered) {
 #endif
 #ifdef SPECULAR
   if (record != kNoRecord && charts[record].info.y == kSpecular)
-    return weight * specularChain(eye, direction, t, id - 1u, b, mirrorDepth);
+    return weight * specularChain(eye, direction, t, triangle, b, mirrorDepth);
 #endif
-  SurfaceDetail detail = hitSurfaceDetail(id - 1u, b, direction, coneSpread * t);
+  SurfaceDetail detail = hitSurfaceDetail(triangle, b, direction, coneSpread * t);
   vec3 radiance = lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal, detail);
 #ifdef HIGHLIGHTS
-  if (record != kNoRecord) radiance += punctualHighlights(record, id - 1u, b, -direction);
+  if (record != kNoRecord) radiance += punctualHighlights(record, triangle, b, -direction);
 #endif
   return weight * radiance;
 }
@@ -578,14 +595,14 @@ void main() {
     Pcg32 rng = pcgForKey(index, uint64_t(k), seed64);
     float filmY = pcgUniform(rng);
     float filmX = pcgUniform(rng);
-    sum += sampleRadiance(vec2(float(pixel.x) + filmX, float(pixel.y) + filmY), true);
+    sum += sampleRadiance(vec2(float(pixel.x) + filmX, float(pixel.y) + filmY));
   }
   color = vec4(sum / float(spp), 1.0);
 }
 #else
 void main() {
   ivec2 pixel = ivec2(gl_FragCoord.xy);
-  color = vec4(sampleRadiance(vec2(pixel) + 0.5, false), 1.0);
+  color = vec4(sampleRadiance(vec2(pixel) + 0.5), 1.0);
 }
 #endif
 )glsl";
@@ -764,7 +781,7 @@ struct GpuRenderer::State {
   static constexpr GLsizei kBufferCount = 9;
   GLuint buffers[kBufferCount] = {};
   GLuint vertexArray = 0, emptyVertexArray = 0;
-  GLuint visibilityProgram = 0, shadingProgram = 0, lookupProgram = 0;
+  GLuint visibilityProgram = 0, markerProgram = 0, shadingProgram = 0, lookupProgram = 0;
   /// The BVH (gpu_bvh.h: nodes, order), the materials of the specular chains and shadow rays
   /// (gpu_specular.h: per material, per triangle) and the highlights' lights and models
   /// (gpu_highlights.h); the BVH is built with the first program that traces rays.
@@ -779,7 +796,7 @@ struct GpuRenderer::State {
   GLuint idTexture = 0, depthBuffer = 0, colorTexture = 0, visibilityFramebuffer = 0, shadingFramebuffer = 0;
   int width = 0, height = 0;
   int idScale = 1;  ///< the visibility targets are idScale·width × idScale·height
-  GLsizei indexCount = 0;
+  GLsizei indexCount = 0, vertexCount = 0;
   float near = 1e-6f;
   uint64_t bufferBytes = 0;
   Rgb background{0.0f};
@@ -792,6 +809,7 @@ struct GpuRenderer::State {
     glDeleteVertexArrays(1, &vertexArray);
     glDeleteVertexArrays(1, &emptyVertexArray);
     glDeleteProgram(visibilityProgram);
+    glDeleteProgram(markerProgram);
     glDeleteProgram(shadingProgram);
     glDeleteProgram(lookupProgram);
     glDeleteProgram(multisampleProgram);
@@ -928,6 +946,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   // so its precision does not depend on it; only what is nearer than it is cut away).
   if (!positions.empty()) s.near = std::max(1e-6f * glm::length(upper - lower), std::numeric_limits<float>::min());
   s.indexCount = GLsizei(indices.size());
+  s.vertexCount = GLsizei(positions.size() / 4);
 
   const std::vector<uint32_t> sunMasks(lightField.sunMasks.begin(), lightField.sunMasks.end());
   // The environment map's lat-long texels as RGBA.
@@ -957,14 +976,15 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
       {"textures, uvs and vertex colours", detail.words.data(), detail.words.size() * sizeof(uint32_t)}};
   std::vector<std::pair<std::string, uint64_t>> sizes;
   for (const Upload& u : uploads) sizes.emplace_back(u.what, std::max<size_t>(u.bytes, 16));
-  // Mirrors, glass and punctual highlights add the BVH (at most 2n − 1 nodes over n triangles,
-  // and their order), the triangles' materials and the materials and lights they read.
+  // The BVH the primary rays beside edges and the traced rays are cast through (at most 2n − 1
+  // nodes over n triangles, and their order); mirrors, glass and punctual highlights add the
+  // triangles' materials and the materials and lights they read.
   s.specular = hasSpecularCharts(lightField);
   s.highlights = gpuHighlightsActive(lightField);
   const bool traces = s.specular || s.highlights;
+  const uint64_t triangleCount = triangles.size();
+  sizes.emplace_back("BVH (bound)", std::max<uint64_t>((2 * triangleCount) * sizeof(BvhNode) + 4 * triangleCount, 16));
   if (traces) {
-    const uint64_t triangleCount = triangles.size();
-    sizes.emplace_back("BVH (bound)", std::max<uint64_t>((2 * triangleCount) * sizeof(BvhNode) + 4 * triangleCount, 16));
     sizes.emplace_back("materials of the traced rays", std::max<uint64_t>(scene.materials.size() * sizeof(SpecularMaterialGpu) +
                                                                                4 * triangleCount, 16));
   }
@@ -982,8 +1002,8 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
     fail("GPU renderer: this light field has mirrors or glass, which need GL_ARB_gpu_shader_int64 (this driver, {}, "
          "lacks it; render it with --renderer cpu)",
          currentDeviceName());
+  s.uploadBvh(scene);
   if (traces) {
-    s.uploadBvh(scene);
     const std::vector<SpecularMaterialGpu> materials = specularMaterials(scene);
     std::vector<uint32_t> triangleMaterials;
     for (const Mesh& mesh : scene.meshes) triangleMaterials.insert(triangleMaterials.end(), mesh.materials.begin(), mesh.materials.end());
@@ -1015,6 +1035,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
 
   s.visibilityProgram =
       linkProgram({{GL_VERTEX_SHADER, kVisibilityVertex}, {GL_FRAGMENT_SHADER, kVisibilityFragment}}, "visibility", false);
+  s.markerProgram = linkProgram({{GL_VERTEX_SHADER, kVisibilityVertex}, {GL_FRAGMENT_SHADER, kMarkerFragment}}, "markers", false);
   // With specular charts or highlights the shading passes carry the BVH traversal, the
   // highlights and the chains after their main.
   const std::string int64 = "#extension GL_ARB_gpu_shader_int64 : require\n";
@@ -1024,12 +1045,11 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   // tens of seconds).
   const std::string raysHeader = (s.specular ? int64 + "#define SPECULAR\n" : "") +
                                      (s.highlights ? "#define HIGHLIGHTS\n" + highlightGlslConstants() : "") +
-                                     (traces ? bvhGlslConstants() + specularGlslConstants() : "") +
-                                     (traces && anyMasked ? "#define BVH_ALPHA_MASKS\n" : "") +
+                                     bvhGlslConstants() + (traces ? specularGlslConstants() : "") +
+                                     (anyMasked ? "#define BVH_ALPHA_MASKS\n" : "") +
                                      (chartDetail ? "#define CHAIN_SURFACE_DETAIL\n" : "") +
                                      (gpu::tracedSurfaceDetail(lightField) ? "#define TRACED_DETAIL\n" : "");
-  const std::string shading = std::string(kShadingFragment) +
-                              (traces ? std::string(kBvhGlsl) + kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
+  const std::string shading = std::string(kBvhGlsl) + kShadingFragment + (traces ? kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
                               (s.specular ? kSpecularGlsl : "");
   s.shadingProgram =
       linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}}, "shading", true, raysHeader);
@@ -1038,7 +1058,8 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
     s.multisampleProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}},
                                        "multi-sample shading", true,
                                        (s.specular ? raysHeader : int64 + raysHeader) + "#define MULTISAMPLE\n");
-  glProgramUniform1f(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "near"), s.near);
+  for (GLuint program : {s.visibilityProgram, s.markerProgram})
+    glProgramUniform1f(program, glGetUniformLocation(program, "near"), s.near);
   for (GLuint program : {s.visibilityProgram, s.shadingProgram, s.multisampleProgram})
     if (program != 0) glProgramUniform1i(program, glGetUniformLocation(program, "anyMasked"), anyMasked ? 1 : 0);
   for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {
@@ -1105,6 +1126,12 @@ void GpuRenderer::drawVisibility(const Camera& camera, int idScale) {
   glUseProgram(s.visibilityProgram);
   glBindVertexArray(s.vertexArray);
   glDrawElements(GL_TRIANGLES, s.indexCount, GL_UNSIGNED_INT, nullptr);
+  // The markers (kMarkerFragment): the vertices as one-texel points, nearer than the surface.
+  setCameraUniforms(s.markerProgram, camera);
+  glDepthMask(GL_FALSE);
+  glUseProgram(s.markerProgram);
+  glDrawArrays(GL_POINTS, 0, s.vertexCount);
+  glDepthMask(GL_TRUE);
   glFinish();
   checkGl("the visibility pass");
 }

@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The GPU renderer on a graphics card, in one run: the frame rate of `render --renderer gpu`
+# on the built-in Cornell box and on Sponza at 1920×1080 (each camera), and the GPU-vs-CPU
+# comparison of bench/gpu_vs_cpu.sh on both light fields — so that minutes on a lent machine
+# go to measuring. It bakes what it is not given (draft preset: the box in seconds, Sponza in
+# a minute or two on 16 cores) and refuses to measure a software rasteriser (llvmpipe) unless
+# PLENOPTIC_ALLOW_SOFTWARE=1 (how it is checked on a machine without a graphics card).
+#   bench/gpu_device.sh [SPONZA]     SPONZA: a Sponza .plf, or the scene to bake it from
+#                                    (default /work/shared/scenes/sponza/sponza.json)
+#   PLENOPTIC=build/plenoptic (default) names the binary; FRAMES=200 frames per measurement;
+#   WIDTH=1920 HEIGHT=1080 the frame size; COMPARE_WIDTH=160 COMPARE_HEIGHT=120 the
+#   comparison's; OUT (a folder) keeps the light fields, the stats and the summary.
+# NVIDIA's EGL is found through its glvnd vendor file: __EGL_VENDOR_LIBRARY_FILENAMES is set to
+# /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json where that file exists.
+set -euo pipefail
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BIN=${PLENOPTIC:-$ROOT/build/plenoptic}
+SPONZA=${1:-/work/shared/scenes/sponza/sponza.json}
+FRAMES=${FRAMES:-200}; WIDTH=${WIDTH:-1920}; HEIGHT=${HEIGHT:-1080}
+COMPARE_WIDTH=${COMPARE_WIDTH:-160}; COMPARE_HEIGHT=${COMPARE_HEIGHT:-120}
+[ -x "$BIN" ] || { echo "gpu_device: $BIN is not built (make build, or set PLENOPTIC)" >&2; exit 1; }
+NVIDIA_EGL=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
+if [ -z "${__EGL_VENDOR_LIBRARY_FILENAMES:-}" ] && [ -f "$NVIDIA_EGL" ]; then
+  export __EGL_VENDOR_LIBRARY_FILENAMES=$NVIDIA_EGL
+fi
+if [ -n "${OUT:-}" ]; then D=$OUT; mkdir -p "$D"; else D=$(mktemp -d); trap 'rm -rf "$D"' EXIT; fi
+SUMMARY=$D/gpu_device.txt
+: > "$SUMMARY"
+say() { echo "$@" | tee -a "$SUMMARY"; }
+
+command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader |
+  sed 's/^/nvidia-smi: /' | tee -a "$SUMMARY" || true
+
+# The light fields: the built-in box always baked here, Sponza given or baked.
+"$BIN" bake cornell --preset draft -o "$D/cornell.plf" --quiet >/dev/null
+case "$SPONZA" in
+  *.plf) SPONZA_PLF=$SPONZA ;;
+  *)
+    [ -f "$SPONZA" ] || { echo "gpu_device: $SPONZA is absent (give a Sponza .plf or scene)" >&2; exit 1; }
+    SPONZA_PLF=$D/sponza.plf
+    start=$(date +%s)
+    "$BIN" bake "$SPONZA" --preset draft -o "$SPONZA_PLF" --quiet >/dev/null
+    say "Sponza draft bake: $(( $(date +%s) - start )) s"
+    ;;
+esac
+
+# One measurement: `render --renderer gpu` of FRAMES frames; prints the device and frame rate.
+measure() {  # name plf camera width height
+  local stats=$D/$1.json
+  "$BIN" render "$2" --camera "$3" -o "$D/$1.pfm" --renderer gpu --width "$4" --height "$5" --frames "$FRAMES" \
+    --stats "$stats" --quiet >/dev/null
+  python3 - "$1" "$stats" "${PLENOPTIC_ALLOW_SOFTWARE:-0}" <<'PY' | tee -a "$SUMMARY"
+import json, sys
+name, path, allow_software = sys.argv[1], sys.argv[2], sys.argv[3] == "1"
+s = json.load(open(path))
+if any(w in s["device"].lower() for w in ("llvmpipe", "softpipe", "software rasterizer")) and not allow_software:
+    sys.exit(f"gpu_device: {s['device']} is a software rasteriser, not a graphics card "
+             "(PLENOPTIC_ALLOW_SOFTWARE=1 measures it anyway)")
+print(f"{name} {s['width']}x{s['height']}: {s['fps']:.1f} fps ({s['ms_per_frame_median']:.3f} ms/frame median, "
+      f"min {s['ms_per_frame_min']:.3f}, read-back included; visibility pass {s['primary_ms_median']:.3f} ms), "
+      f"{s['frames']} frames, GPU memory {s['gpu_bytes'] / 2**20:.1f} MiB, on {s['device']}")
+PY
+}
+cameras() { "$BIN" info "$1" --json | python3 -c "import json,sys; print(' '.join(json.load(sys.stdin)['scene']['cameras']))"; }
+
+measure cornell "$D/cornell.plf" default "$WIDTH" "$HEIGHT"
+measure cornell-640x480 "$D/cornell.plf" default 640 480
+for camera in $(cameras "$SPONZA_PLF"); do
+  measure "sponza-$camera" "$SPONZA_PLF" "$camera" "$WIDTH" "$HEIGHT"
+done
+# The GPU renderer's picture against the CPU fast renderer's (bench/gpu_vs_cpu.sh).
+for plf in "$D/cornell.plf" "$SPONZA_PLF"; do
+  PLENOPTIC=$BIN "$ROOT/bench/gpu_vs_cpu.sh" "$plf" "$COMPARE_WIDTH" "$COMPARE_HEIGHT" 3 | tee -a "$SUMMARY"
+done
+echo "summary: $SUMMARY"
