@@ -10,12 +10,12 @@
 namespace pl {
 
 /// The GGX lobe behind a GGX-like model's highlights and its diffuse part's k(μ), for models
-/// without a clear coat or sheen (GgxBsdf; GltfPbrBsdf without layers): the diffuse albedo ρ,
+/// without a clear coat or sheen (GgxBsdf; GltfPbrBsdf without those layers): the diffuse albedo ρ,
 /// the lobe's α (clamped to [kGgxMinAlpha, 1], as eval clamps it) and its Fresnel ends f0,
 /// f90, and the Fresnel ends of the lobe whose directional albedo E(μ) the diffuse part gives
 /// up, k(μ) = (1 − E(μ)) / √(1 − Ē) — GgxBsdf's own lobe (f90 = 1), a glTF model's dielectric
 /// member. Then eval = ggx lobe + ρ/π · k(μo) · k(μi) exactly as bsdf.cpp evaluates it, with E
-/// from ggxAlbedoTables. nullopt for other models and for layered glTF models. The GPU
+/// from ggxAlbedoTables. nullopt for other models and for glTF models with a clear coat or sheen. The GPU
 /// renderer's copy of k and of the highlights (src/gpu) reads these.
 struct GgxLobeParameters {
   Rgb diffuse{0.0f};
@@ -35,6 +35,5 @@ struct GgxAlbedoTables {
   std::vector<float> mu, e0, e5, mean0, mean5;
 };
 const GgxAlbedoTables& ggxAlbedoTables();
-
 
 }  // namespace pl
