@@ -18,6 +18,7 @@
 
 #include "accel/accel.h"
 #include "bake/bake.h"
+#include "bsdf/ggx_lobe.h"
 #include "camera/camera.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -846,13 +847,15 @@ TEST_F(GpuRendererTest, GpuMemoryIsTheLightFieldAndOneFrame) {
   GpuRenderer gpu(lf);
   Image image;
   gpu.render(Camera(firstCamera(lf.scene), 64, 48), RenderSettings{}, image);
-  // Values as 16-byte RGBA, 128 bytes per chart record, the geometry, 160 bytes per material
-  // and 160 of k nodes after a 32-byte header (no textures, uvs or masks here), and 24 bytes
-  // per pixel.
+  // Values as 16-byte RGBA, 128 bytes per chart record, the geometry, 256 bytes per material
+  // and the GGX albedo tables after a 32-byte header (no textures, uvs or masks here), and 24
+  // bytes per pixel.
   uint64_t geometry = 0;
   for (const Mesh& m : lf.scene.meshes) geometry += m.positions.size() * 32 + m.triangles.size() * 28;
+  const GgxAlbedoTables& ggx = ggxAlbedoTables();
+  const uint64_t tables = 4 * (ggx.mu.size() + ggx.e0.size() + ggx.e5.size() + ggx.mean0.size() + ggx.mean5.size());
   const uint64_t expected = lf.values.size() * 16 + lf.charts.size() * 128 + geometry + 32 +
-                            lf.scene.materials.size() * 160 + 160 + 64 * 48 * 24;
+                            lf.scene.materials.size() * 256 + tables + 64 * 48 * 24;
   EXPECT_LE(gpu.gpuBytes(), expected + 8 * 16);  // 16-byte stand-ins for empty buffers
   EXPECT_GE(gpu.gpuBytes(), expected);
   EXPECT_NE(gpu.deviceName().find("OpenGL 4.5"), std::string::npos) << gpu.deviceName();
