@@ -1,6 +1,7 @@
 // Reflection models. The contract (local frame, eval without cosine, what sample returns)
 // is in bsdf.h; this file holds the formulas, their derivations and the sampling routines.
 #include "bsdf/bsdf.h"
+#include "bsdf/ggx_lobe.h"
 
 #include <array>
 #include <cmath>
@@ -182,8 +183,20 @@ class GgxAlbedoTable {
     static const GgxAlbedoTable table;  // thread-safe one-time initialisation
     return table;
   }
-  /// The μ of the nodes (diffuseFactorNodes).
-  const std::array<float, kMuNodes>& muNodes() const { return mu_; }
+  /// The tables as they are (ggxAlbedoTables).
+  GgxAlbedoTables tables() const {
+    GgxAlbedoTables t;
+    t.muNodes = kMuNodes;
+    t.roughNodes = kRoughNodes;
+    t.mu.assign(mu_.begin(), mu_.end());
+    for (int r = 0; r < kRoughNodes; ++r) {
+      t.e0.insert(t.e0.end(), e0_[r].begin(), e0_[r].end());
+      t.e5.insert(t.e5.end(), e5_[r].begin(), e5_[r].end());
+    }
+    t.mean0.assign(mean0_.begin(), mean0_.end());
+    t.mean5.assign(mean5_.begin(), mean5_.end());
+    return t;
+  }
 
   /// E₀, E₅ at (μ, α), and the matching cosine-weighted means Ē₀, Ē₅ at α.
   struct Lookup {
@@ -1228,15 +1241,21 @@ Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta) {
   return Rgb(1.0f);
 }
 
-const std::vector<float>& diffuseFactorNodes() {
-  static const std::vector<float> nodes(GgxAlbedoTable::get().muNodes().begin(), GgxAlbedoTable::get().muNodes().end());
-  return nodes;
+const std::vector<float>& diffuseFactorNodes() { return ggxAlbedoTables().mu; }
+
+bool diffuseFactorIsPiecewiseLinear(const Bsdf& bsdf) { return ggxLobeParameters(bsdf).has_value(); }
+
+std::optional<GgxLobeParameters> ggxLobeParameters(const Bsdf& bsdf) {
+  if (const auto* ggx = std::get_if<GgxBsdf>(&bsdf))
+    return GgxLobeParameters{ggx->diffuse, clampAlpha(ggx->alpha), ggx->f0, 1.0f, ggx->f0, 1.0f};
+  const auto* pbr = std::get_if<GltfPbrBsdf>(&bsdf);
+  if (pbr == nullptr || pbr->clearcoat > 0.0f || sheenWeight(*pbr) > 0.0f) return std::nullopt;
+  return GgxLobeParameters{pbr->diffuse, clampAlpha(pbr->alpha), pbr->f0, pbr->f90, pbr->dielectricF0, pbr->dielectricF90};
 }
 
-bool diffuseFactorIsPiecewiseLinear(const Bsdf& bsdf) {
-  if (std::holds_alternative<GgxBsdf>(bsdf)) return true;  // (1 − E(μ)) / √(1 − Ē): E linear in each node's segment
-  const auto* pbr = std::get_if<GltfPbrBsdf>(&bsdf);
-  return pbr != nullptr && !(pbr->clearcoat > 0.0f) && !(sheenWeight(*pbr) > 0.0f);
+const GgxAlbedoTables& ggxAlbedoTables() {
+  static const GgxAlbedoTables tables = GgxAlbedoTable::get().tables();
+  return tables;
 }
 
 const char* modelName(const Bsdf& bsdf) {

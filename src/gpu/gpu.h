@@ -40,12 +40,12 @@
 // chartShadingNormalAt), the triangle → chart map, the sun masks (one uint each; the masked
 // lights are uniforms), the environment map's texels (RGBA) and the surface detail
 // (gpu_surface_detail.h: the textures the shader reads — 4 bytes per texel of an 8-bit level
-// as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 128 bytes per
-// material, and where a chart, mask or traced hit needs uvs, 36 bytes per vertex and 4 per triangle). So
+// as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 256 bytes per
+// material, 7.8 KiB of GGX albedo tables, and where a chart, mask or traced hit needs uvs, 36 bytes per vertex and 4 per triangle). So
 // GPU memory is 16 bytes per value + 128 per chart + 32 per vertex + 28 per triangle + 4 per
 // sun mask + 16 per environment texel + the surface detail + the BVH's 32 per node and 4 per
 // triangle + (with mirrors, glass or punctual highlights) 64 per material and 4 per triangle for
-// the chains and shadow rays, and 64 per delta light and 48 per material for the highlights +
+// the chains and shadow rays, and 64 per delta light and 64 per material for the highlights +
 // the frame's targets (radiance 16 bytes per pixel; id and depth 8 bytes per pixel, or per
 // texel of the finer multi-sample visibility pass). A light field whose buffers exceed the GPU
 // memory available (gpu_memory.h: the driver's query, GL_NVX_gpu_memory_info or
@@ -55,11 +55,12 @@
 //
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
-// picture): mirror-like glossy lobes (specular charts of a glossy model), metallic-roughness
-// textures, albedo textures on non-Lambertian diffuse charts, punctual highlights on glTF
-// materials, albedo textures or vertex colours on mirrors and glass; and of the render
-// settings, thin lenses. Punctual highlights on glossy charts are evaluated per pixel with a
-// shadow ray through the BVH (gpu_highlights.h). The traced rays read the surface detail at
+// picture): mirror-like glossy lobes (specular charts of a glossy model), glTF materials with a
+// clear coat or sheen over a diffuse base (and their highlights), albedo textures or vertex
+// colours on mirrors and glass; and of the render settings, thin lenses. Punctual highlights
+// on glossy charts are evaluated per pixel with a shadow ray through the BVH
+// (gpu_highlights.h); a metallic-roughness texture gives each pixel its own model (its diffuse
+// part's ρ and k(μo), its highlights' lobe: gpu_surface_detail.h metallicRoughnessLobe). The traced rays read the surface detail at
 // their hits as the camera rays do: they cut alpha masks (gpu_bvh.h BVH_ALPHA_MASKS), the
 // lookup at a chain's end reads the albedo texture at the mip level of the chain's ray cone
 // (textureConeSpread × the summed length), and surfaceAt bends a mirror's, glass's or

@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 
 #include "bsdf/bsdf.h"
+#include "bsdf/ggx_lobe.h"
 #include "light/lights.h"
 #include "scene/scene.h"
 
@@ -25,12 +27,7 @@ std::string gpuUnsupportedHighlights(const LightField& lf) {
     const Material& material = lf.scene.materials[c.material];
     const Bsdf& model = material.bsdf;
     if (isRoughGlassChart(c, model) || std::holds_alternative<BlinnPhongBsdf>(model)) continue;
-    // The CPU renderers evaluate such a highlight with the texel's lobe width and f0
-    // (lookup.h); the GLSL reads the material's.
-    if (material.metallicRoughness.texture >= 0) return "punctual highlights on metallic-roughness-textured materials";
-    const auto* ggx = std::get_if<GgxBsdf>(&model);
-    if (ggx == nullptr) return "punctual highlights on glTF PBR materials";
-    if (!isBlack(ggx->diffuse) && !c.diffuseValue) return "punctual highlights on GGX materials with a diffuse base";
+    if (!ggxLobeParameters(model)) return "punctual highlights on glTF materials with a clear coat or sheen";
   }
   return {};
 }
@@ -72,10 +69,13 @@ std::vector<HighlightModelGpu> highlightModels(const Scene& scene) {
       for (int k = 0; k < 3; ++k) g.diffuse[k] = phong->diffuse[k], g.lobe[k] = phong->specular[k];
       g.lobe[3] = n;
       g.extra[0] = blinnPhongNormalization(n);
-    } else if (const auto* ggx = std::get_if<GgxBsdf>(&model)) {
+    } else if (const std::optional<GgxLobeParameters> ggx = ggxLobeParameters(model)) {
       kind = kHighlightGgx;
-      for (int k = 0; k < 3; ++k) g.lobe[k] = ggx->f0[k];
-      g.lobe[3] = std::clamp(ggx->alpha, kGgxMinAlpha, 1.0f);  // bsdf.cpp clampAlpha
+      for (int k = 0; k < 3; ++k) g.diffuse[k] = ggx->diffuse[k], g.lobe[k] = ggx->f0[k], g.diffuseF0[k] = ggx->diffuseF0[k];
+      g.lobe[3] = ggx->alpha;
+      g.extra[0] = ggx->f90;
+      g.extra[1] = ggx->diffuseF90;
+      g.extra[2] = scene.materials[i].metallicRoughness.texture >= 0 ? 1.0f : 0.0f;
     }
     std::memcpy(&g.diffuse[3], &kind, sizeof(float));
   }
@@ -94,12 +94,13 @@ std::string highlightGlslConstants() {
 // PunctualHighlights::radiance (lookup.cpp) with what it calls — scatteringFrame and
 // usableSide (scene.cpp) of a reflecting model, sampleLight of the delta lights
 // (lights.cpp incidentFromPoint, SpotLight::sample, DirectionalLight::sample), eval of
-// Blinn-Phong and GGX (bsdf.cpp evalBlinnPhong, ggxSpecular, ggxD, ggxLambda),
+// Blinn-Phong and the GGX-like models (bsdf.cpp evalBlinnPhong, evalGgx, evalGltfPbr without
+// layers, ggxSpecular, ggxD, ggxLambda), materialModelAt of a metallic-roughness texture,
 // shadowRayTowards (light.cpp) and ShadowRays::transmittance — statement for statement.
 const char* const kHighlightsGlsl = R"glsl(
 struct HighlightLight { vec4 position; vec4 intensity; vec4 axis; vec4 cone; };
 layout(std430, binding = HIGHLIGHT_LIGHTS_BINDING) readonly buffer HighlightLights { HighlightLight highlightLights[]; };
-struct HighlightModel { vec4 diffuse; vec4 lobe; vec4 extra; };
+struct HighlightModel { vec4 diffuse; vec4 lobe; vec4 extra; vec4 diffuseF0; };
 layout(std430, binding = HIGHLIGHT_MODELS_BINDING) readonly buffer HighlightModels { HighlightModel highlightModels[]; };
 uniform uint highlightLightCount;
 uniform bool shadowsPassThinGlass;
@@ -116,8 +117,9 @@ float ggxLambda(float alpha, vec3 w) {
   float tan2 = max(0.0, 1.0 - c2) / c2;
   return 0.5 * (sqrt(1.0 + alpha * alpha * tan2) - 1.0);
 }
-// eval of the chart's model in the local frame (withDiffuse: Blinn-Phong's diffuse part too).
-vec3 evalHighlightModel(HighlightModel m, bool withDiffuse, vec3 wo, vec3 wi) {
+// eval of the chart's model in the local frame: Blinn-Phong's (m), or the GGX-like `ggx`
+// (evalGgx, evalGltfPbr without layers); withDiffuse: the diffuse part too.
+vec3 evalHighlightModel(HighlightModel m, GgxLobe ggx, bool withDiffuse, vec3 wo, vec3 wi) {
   if (!(wo.z > 0.0 && wi.z > 0.0)) return vec3(0.0);
   uint kind = floatBitsToUint(m.diffuse.w);
   vec3 h = normalize(wo + wi);
@@ -126,11 +128,27 @@ vec3 evalHighlightModel(HighlightModel m, bool withDiffuse, vec3 wo, vec3 wi) {
     return diffuse * 0.318309886183791 + m.lobe.rgb * (m.extra.x * pow(max(0.0, h.z), m.lobe.w));
   }
   if (kind != kHighlightGgx) return vec3(0.0);
-  float alpha = m.lobe.w;
+  float alpha = ggx.alpha;
   float g2 = 1.0 / (1.0 + ggxLambda(alpha, wo) + ggxLambda(alpha, wi));
   float c = clamp(1.0 - dot(wo, h), 0.0, 1.0), c2 = c * c;
-  vec3 fresnel = m.lobe.rgb + (vec3(1.0) - m.lobe.rgb) * (c2 * c2 * c);
-  return fresnel * (ggxD(alpha, h) * g2 / (4.0 * wo.z * wi.z));
+  vec3 fresnel = ggx.f0 + (vec3(ggx.f90) - ggx.f0) * (c2 * c2 * c);
+  vec3 f = fresnel * (ggxD(alpha, h) * g2 / (4.0 * wo.z * wi.z));
+  if (withDiffuse && any(notEqual(ggx.diffuse, vec3(0.0))))
+    f += ggx.diffuse * kInvPi * ggxDiffuseFactor(alpha, ggx.diffuseF0, ggx.diffuseF90, wo.z) *
+         ggxDiffuseFactor(alpha, ggx.diffuseF0, ggx.diffuseF90, wi.z);
+  return f;
+}
+// The GGX-like model of material `material` at barycentrics uv of `triangle`: the material's
+// (highlightModels), or with a metallic-roughness texture the point's (materialModelAt at
+// albedoPointAt: the albedo texture at full resolution × the vertex colour, the texel).
+GgxLobe highlightLobe(HighlightModel m, uint material, uint triangle, vec2 uv) {
+  GgxLobe l = GgxLobe(m.diffuse.rgb, m.lobe.w, m.lobe.rgb, m.extra.x, m.diffuseF0.rgb, m.extra.y);
+  if (m.extra.z == 0.0) return l;
+  uint record = detail[2] + kMaterialWords * material;
+  uvec3 v = triangles[triangle].xyz;
+  vec3 modulation = vertexColorAt(v, uv);
+  if (detail[record] != kNone) modulation = sampleTexture(detail[record], mappedUv(record + kMaterialAlbedoMapping, v, uv)) * modulation;
+  return metallicRoughnessLobe(record, modulation, metallicRoughnessTexelAt(record, v, uv));
 }
 // ShadowRays::transmittance of the ray (origin, direction) over (0, tMax).
 vec3 shadowTransmittance(vec3 origin, vec3 direction, float tMax) {
@@ -159,9 +177,11 @@ vec3 shadowTransmittance(vec3 origin, vec3 direction, float tMax) {
 }
 vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer) {
   if (highlightLightCount == 0u || charts[record].info.y != kGlossy) return vec3(0.0);
-  HighlightModel model = highlightModels[triangleMaterials[triangle]];
+  uint material = triangleMaterials[triangle];
+  HighlightModel model = highlightModels[material];
   if (floatBitsToUint(model.diffuse.w) == kHighlightNoModel) return vec3(0.0);  // rough glass keeps them in its maps
   bool withDiffuse = (charts[record].info.z & kFlagDiffuseValue) == 0u;
+  GgxLobe ggx = highlightLobe(model, material, triangle, uv);
   vec3 position, geometricNormal, shadingNormal;
   surfaceAt(triangle, uv, position, geometricNormal, shadingNormal);
   // scatteringFrame of a reflecting model: both normals turned to the viewer's side.
@@ -197,7 +217,7 @@ vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer)
     }
     vec3 wiLocal = vec3(dot(wi, s), dot(wi, t), dot(wi, n));
     if (!(dot(wi, g) > 0.0)) continue;
-    vec3 f = evalHighlightModel(model, withDiffuse, wo, wiLocal);
+    vec3 f = evalHighlightModel(model, ggx, withDiffuse, wo, wiLocal);
     float cosIn = abs(wiLocal.z);
     if (all(equal(f, vec3(0.0))) || !(cosIn > 0.0) || all(equal(incident, vec3(0.0)))) continue;
     // shadowRayTowards: to the light's position, or unbounded along wi at infinity.

@@ -11,10 +11,13 @@
 // shadow ray's transmittance (ShadowRays: 0 when blocked, the straight transmittance of each
 // thin glass sheet crossed), traced through the GPU BVH (gpu_bvh.h).
 //
-// The models evaluated: Blinn-Phong (its diffuse part included on a chart without Ẽ) and GGX
-// without a diffuse part (ggxSpecular). gpuUnsupportedHighlights names what else a light field
-// with highlights has on its glossy charts (glTF layered models, GGX with a diffuse base on a
-// chart without Ẽ).
+// The models evaluated: Blinn-Phong and the GGX-like models of bsdf.h ggxLobeParameters (GGX,
+// glTF PBR without a clear coat or sheen: the lobe ggxSpecular and the diffuse part
+// ρ/π · k(μo) · k(μi) with k from the GGX tables), their diffuse part included on a chart
+// without Ẽ; with a metallic-roughness texture the hit point's own model (metallicRoughnessLobe
+// of the texel and the albedo modulation at full resolution, materialModelAt's point).
+// gpuUnsupportedHighlights names what else a light field with highlights has on its glossy
+// charts (glTF models with a clear coat or sheen).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -41,13 +44,15 @@ struct HighlightLightGpu {
 };
 static_assert(sizeof(HighlightLightGpu) == 64);
 
-/// One material's reflection model as kHighlightsGlsl evaluates it (std430: three rows).
+/// One material's reflection model as kHighlightsGlsl evaluates it (std430: four rows).
 struct HighlightModelGpu {
-  float diffuse[4];  ///< rgb: Blinn-Phong's diffuse albedo; w: kind (uint bits)
-  float lobe[4];     ///< rgb: Blinn-Phong's specular or GGX's f0; w: the exponent n or GGX's α (clamped)
-  float extra[4];    ///< x: Blinn-Phong's normalisation N(n) (blinnPhongNormalization)
+  float diffuse[4];    ///< rgb: the diffuse albedo ρ; w: kind (uint bits)
+  float lobe[4];       ///< rgb: Blinn-Phong's specular or GGX's f0; w: the exponent n or GGX's α (clamped)
+  float extra[4];      ///< x: Blinn-Phong's normalisation N(n) (blinnPhongNormalization) or GGX's f90; y: GGX's
+                       ///< diffuseF90; z: 1 where a metallic-roughness texture makes the model per point
+  float diffuseF0[4];  ///< rgb: GGX's diffuseF0 (GgxLobeParameters)
 };
-static_assert(sizeof(HighlightModelGpu) == 48);
+static_assert(sizeof(HighlightModelGpu) == 64);
 
 /// Kinds of HighlightLightGpu and HighlightModelGpu (GLSL constants of highlightGlslConstants).
 inline constexpr uint32_t kHighlightPoint = 0, kHighlightSpot = 1, kHighlightDirectional = 2;
@@ -55,7 +60,8 @@ inline constexpr uint32_t kHighlightNoModel = 0, kHighlightBlinnPhong = 1, kHigh
 
 /// The scene's delta lights, in its order.
 std::vector<HighlightLightGpu> highlightLights(const Scene& scene);
-/// Per material of the scene (kHighlightNoModel for what no glossy chart evaluates).
+/// Per material of the scene (kHighlightNoModel for what no glossy chart evaluates: rough glass,
+/// models with a clear coat or sheen).
 std::vector<HighlightModelGpu> highlightModels(const Scene& scene);
 
 /// The storage-buffer bindings of the lights and the models.

@@ -31,7 +31,7 @@ constexpr uint32_t kFlagTwoSided = 1u, kFlagBack = 2u, kFlagCurved = 4u, kFlagDi
 /// One chart record as the shaders read it (std430: eight 16-byte rows).
 struct ChartGpu {
   float origin[4];        ///< xyz: Chart::origin; w: 1 / tixelSize (ChartShading::inverseTixelSize)
-  float axisU[4];         ///< xyz: Chart::axisU; w: the material's k(μ) table (word, as float bits; diffuseFactor)
+  float axisU[4];         ///< xyz: Chart::axisU; w: the material's diffuse lobe record (word, as float bits; diffuseFactor)
   float axisV[4], normal[4];
   uint32_t grid[4];       ///< resU, resV, dirRes, firstValue
   uint32_t info[4];       ///< valuesPerTixel, kind (ChartKind), flags, firstTixel (its sun masks)
@@ -307,7 +307,13 @@ vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, ve
   if ((flags & kFlagDirectionalIrradiance) != 0u)
     diffuseIrradiance = mappedNormalIrradiance(c, grid, diffuseIrradiance, toLocalAround(c, lookupNormal, mappedNormal));
   // diffuseDirectionalFactor at μo (against the mapped normal on a normal-mapped chart).
-  vec3 k = diffuseFactor(floatBitsToUint(c.axisU.w), normalMapped ? dot(towardsViewer, mappedNormal) : local.z);
+  float cosViewer = normalMapped ? dot(towardsViewer, mappedNormal) : local.z;
+  // glossyDiffuseReflectanceAt: with a metallic-roughness texture the point's own model's ρ and k.
+  if ((flags & kFlagMetallicRoughness) != 0u) {
+    GgxLobe l = metallicRoughnessLobe(detail.material, detail.albedo, detail.metallicRoughness);
+    return mapped + l.diffuse * ggxDiffuseFactor(l.alpha, l.diffuseF0, l.diffuseF90, cosViewer) * kInvPi * diffuseIrradiance;
+  }
+  vec3 k = diffuseFactor(floatBitsToUint(c.axisU.w), cosViewer);
   // glossyDiffuseAlbedoAt: the model's diffuse albedo × the modulation.
   vec3 albedoOverPi = (flags & kFlagTexturedAlbedo) != 0u ? c.albedoOverPi.rgb * detail.albedo * kInvPi : c.albedoOverPi.rgb;
   return mapped + albedoOverPi * k * diffuseIrradiance;
@@ -907,13 +913,16 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                       (shading.needsUv && shading.texturedAlbedo ? gpu::kFlagTexturedAlbedo : 0u) |
                       (shading.texturedEmission ? gpu::kFlagTexturedEmission : 0u) |
                       (shading.normalMapped ? gpu::kFlagNormalMapped : 0u) |
-                      (c.directionalIrradiance ? gpu::kFlagDirectionalIrradiance : 0u),
+                      (c.directionalIrradiance ? gpu::kFlagDirectionalIrradiance : 0u) |
+                      (shading.needsUv && c.diffuseValue && scene.materials[c.material].metallicRoughness.texture >= 0
+                           ? gpu::kFlagMetallicRoughness
+                           : 0u),
                   uint32_t(c.firstTixel)},
                  {},
                  {}};
     std::memcpy(g.emission, shading.emission.v, sizeof(g.emission));
     std::memcpy(g.albedoOverPi, shading.albedoOverPi.v, sizeof(g.albedoOverPi));
-    std::memcpy(&g.axisU[3], &detail.diffuseFactorTable[c.material], sizeof(float));
+    std::memcpy(&g.axisU[3], &detail.diffuseLobe[c.material], sizeof(float));
     if (shading.needsUv && shading.texturedAlbedo) {
       const Rgb base = gpu::texturedAlbedoBase(scene, c);
       std::memcpy(g.albedoOverPi, &base, sizeof(Rgb));

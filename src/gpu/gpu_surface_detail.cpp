@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <bit>
 #include <limits>
+#include <optional>
 #include <variant>
 
 #include "bsdf/bsdf.h"
+#include "bsdf/ggx_lobe.h"
 #include "gpu/gpu_highlights.h"
 #include "gpu/gpu_specular.h"
 
@@ -17,12 +19,18 @@ namespace {
 
 constexpr uint32_t kNone = kNoWord;
 constexpr uint32_t kHeaderWords = 8, kTextureWords = 8, kLevelWords = 4, kMappingWords = 8, kVertexWords = 9;
-// Material record: albedo, emission, alpha and normal textures, alpha factor, cutoff, normal
-// scale, vertex alphas (1: some mesh of the material has them), then the albedo, emission, alpha and normal mappings.
+// Material record (gpu_surface_detail.h): albedo, emission, alpha and normal textures, alpha
+// factor, cutoff, normal scale, vertex alphas (1: some mesh of the material has them), then the
+// albedo, emission, alpha and normal mappings, the diffuse part's lobe (kDiffuseLobeWords), the
+// metallic-roughness record (kMetallicRoughnessWords) and its mapping.
+constexpr uint32_t kDiffuseLobeWords = 5, kMetallicRoughnessWords = 11;
 constexpr uint32_t kMaterialAlbedoMapping = 8, kMaterialEmissionMapping = kMaterialAlbedoMapping + kMappingWords,
                    kMaterialAlphaMapping = kMaterialEmissionMapping + kMappingWords,
                    kMaterialNormalMapping = kMaterialAlphaMapping + kMappingWords,
-                   kMaterialWords = kMaterialNormalMapping + kMappingWords;
+                   kMaterialDiffuseLobe = kMaterialNormalMapping + kMappingWords,
+                   kMaterialMetallicRoughness = kMaterialDiffuseLobe + kDiffuseLobeWords,
+                   kMaterialMetallicRoughnessMapping = kMaterialMetallicRoughness + kMetallicRoughnessWords,
+                   kMaterialWords = kMaterialMetallicRoughnessMapping + kMappingWords;
 // Texture sampling flags.
 constexpr uint32_t kNearestBit = 16u, kMipmapsBit = 32u, kDefaultSamplingBit = 64u;
 
@@ -43,21 +51,45 @@ void appendMapping(std::vector<uint32_t>& words, const TextureMapping& m) {
                              bits(m.linear[1][0]), bits(m.linear[1][1]), bits(m.offset.x), bits(m.offset.y)});
 }
 
+/// The metallic-roughness record of material `m` (kMetallicRoughnessWords, then its mapping):
+/// the texture (kNone: none), the factors materialModelAt multiplies the texel and the albedo
+/// modulation by — base colour (3), metallic, roughness — whether the model is glTF's layered
+/// one (gltfPbrFromInputs at every metalness) or gltfMetallicRoughnessModel's, and the
+/// dielectric member's Fresnel ends (3 + 1), which depend on neither the texel nor the
+/// modulation: gltfPbrFromInputs' of the material's own inputs (a layered model made without
+/// a point: PbrLayerMaps' factors and mean texels), of the defaults otherwise.
+void appendMetallicRoughness(std::vector<uint32_t>& words, const Material& m, const Scene& scene) {
+  const MetallicRoughnessMap& mr = m.metallicRoughness;
+  const bool layered = m.layers.layered;
+  Rgb base = mr.baseColor;
+  float metallic = mr.metallic, roughness = mr.roughness;
+  GltfPbrBsdf dielectric = gltfPbrFromInputs(GltfPbrInputs{});
+  if (layered) {
+    base = m.layers.factors.baseColor, metallic = m.layers.factors.metallic, roughness = m.layers.factors.roughness;
+    if (mr.texture >= 0) dielectric = std::get<GltfPbrBsdf>(materialModelAt(scene, m, AlbedoPoint{}));
+  }
+  words.insert(words.end(), {mr.texture >= 0 ? uint32_t(mr.texture) : kNone, bits(base.r), bits(base.g), bits(base.b),
+                             bits(metallic), bits(roughness), layered ? 1u : 0u, bits(dielectric.dielectricF0.r),
+                             bits(dielectric.dielectricF0.g), bits(dielectric.dielectricF0.b),
+                             bits(dielectric.dielectricF90)});
+  appendMapping(words, mr.mapping);
+}
+
 }  // namespace
 
 std::string surfaceDetailUnsupported(const LightField& lf, const Chart& chart, const ChartShading& shading) {
   const Material& material = lf.scene.materials[chart.material];
-  if (material.metallicRoughness.texture >= 0 && (chart.kind == ChartKind::Diffuse || chart.diffuseValue))
-    return "metallic-roughness textures";
-  // k(μ) of the diffuse part tabulated at diffuseFactorNodes (exact only where it is linear
-  // between them).
+  // k(μ) of the diffuse part from the GGX lobe's albedo tables (ggxLobeParameters): a clear
+  // coat's or sheen's albedo would multiply in other tables.
   const Bsdf& model = material.bsdf;
-  if (chart.diffuseValue && variesWithAngle(model) && !diffuseFactorIsPiecewiseLinear(model))
+  if (chart.diffuseValue && variesWithAngle(model) && !ggxLobeParameters(model))
     return "glTF materials with a clear coat or sheen over a diffuse base";
-  // diffuseAlbedoAt multiplies a Lambertian albedo by the modulation; another model's
-  // directional albedo at normal incidence is not linear in it.
-  if (shading.texturedAlbedo && chart.kind == ChartKind::Diffuse && !std::holds_alternative<LambertBsdf>(material.bsdf))
-    return "albedo textures on non-Lambertian diffuse charts";
+  // diffuseAlbedoAt multiplies a Lambertian or subsurface albedo by the modulation (albedo()
+  // of either is its albedo); another model's directional albedo at normal incidence is not
+  // linear in it. (Only those two models make diffuse charts: bake/parameterisation.h.)
+  if (shading.texturedAlbedo && chart.kind == ChartKind::Diffuse && !std::holds_alternative<LambertBsdf>(model) &&
+      !std::holds_alternative<SubsurfaceBsdf>(model))
+    return "albedo textures on diffuse charts of a model other than Lambert or subsurface";
   return {};
 }
 
@@ -89,9 +121,9 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
     const Material& m = scene.materials[lf.charts[i].material];
     needsUv = needsUv || shading.needsUv;
     const Bsdf& model = m.bsdf;
-    if (lf.charts[i].diffuseValue && variesWithAngle(model) && diffuseFactorIsPiecewiseLinear(model))
-      needsFactor[lf.charts[i].material] = true;
+    if (lf.charts[i].diffuseValue && variesWithAngle(model)) needsFactor[lf.charts[i].material] = true;
     if (shading.needsUv && shading.texturedAlbedo) need(m.albedoTexture, TextureUse::AllLevels);
+    if (shading.needsUv && lf.charts[i].diffuseValue) need(m.metallicRoughness.texture, TextureUse::Level0);
     if (shading.texturedEmission) need(m.emissionTexture, TextureUse::Level0);
     if (shading.normalMapped) {
       needsUv = true;
@@ -105,6 +137,15 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
       need(m.emissionTexture, TextureUse::Level0);
     }
   }
+  // A highlight on a metallic-roughness-textured material takes the point's model: the albedo
+  // and metallic-roughness textures at full resolution and the uvs (gpu_highlights.h).
+  if (gpuHighlightsActive(lf))
+    for (const Material& m : scene.materials)
+      if (m.metallicRoughness.texture >= 0) {
+        needsUv = true;
+        need(m.albedoTexture, TextureUse::Level0);
+        need(m.metallicRoughness.texture, TextureUse::Level0);
+      }
   for (const Material& m : scene.materials)
     if (m.isMasked()) {
       needsUv = true;
@@ -143,8 +184,11 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
   words.resize(words.size() + levels.size() * kLevelWords, 0u);
   // Materials.
   words[2] = uint32_t(words.size());
-  for (const Material& m : scene.materials) {
+  std::vector<uint32_t> diffuseLobes(scene.materials.size(), kNone);
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
     auto index = [](int texture) { return texture >= 0 ? uint32_t(texture) : kNone; };
+    const uint32_t record = uint32_t(words.size());
     words.insert(words.end(), {index(m.albedoTexture), index(m.emissionTexture), index(m.alphaTexture),
                                index(m.normalTexture), bits(m.alphaFactor), bits(m.alphaCutoff), bits(m.normalScale),
                                m.vertexAlpha ? 1u : 0u});
@@ -152,6 +196,12 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
     appendMapping(words, m.emissionMapping);
     appendMapping(words, m.alphaMapping);
     appendMapping(words, m.normalMapping);
+    // The diffuse part's lobe: α, the Fresnel ends of the lobe whose albedo it gives up.
+    const std::optional<GgxLobeParameters> lobe = ggxLobeParameters(m.bsdf);
+    if (needsFactor[i] && lobe) diffuseLobes[i] = record + kMaterialDiffuseLobe;
+    const GgxLobeParameters l = lobe.value_or(GgxLobeParameters{});
+    words.insert(words.end(), {bits(l.alpha), bits(l.diffuseF0.r), bits(l.diffuseF0.g), bits(l.diffuseF0.b), bits(l.diffuseF90)});
+    appendMetallicRoughness(words, m, scene);
   }
   // Vertices and triangles, in the renderer's order (meshes one after another).
   words[3] = uint32_t(words.size());
@@ -171,23 +221,11 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
   words[4] = uint32_t(words.size());
   if (needsUv)
     for (const Mesh& mesh : scene.meshes) words.insert(words.end(), mesh.materials.begin(), mesh.materials.end());
-  // The nodes of k(μ), and its tables. Node 0 is μ = 0, where diffuseDirectionalFactor is 0
-  // (nothing below the horizon) but its interpolation from the right is not: k there is
-  // extrapolated from the first segment's line (its end and midpoint).
-  const std::vector<float>& nodes = diffuseFactorNodes();
+  // The GGX lobe-albedo tables (ggxAlbedoTables): μ nodes, E₀, E₅, Ē₀, Ē₅.
+  const GgxAlbedoTables& tables = ggxAlbedoTables();
   words[5] = uint32_t(words.size());
-  for (float mu : nodes) words.push_back(bits(mu));
-  std::vector<uint32_t> factorTables(scene.materials.size(), kNone);
-  for (size_t m = 0; m < scene.materials.size(); ++m) {
-    if (!needsFactor[m]) continue;
-    factorTables[m] = uint32_t(words.size());
-    const Bsdf& model = scene.materials[m].bsdf;
-    for (size_t i = 0; i < nodes.size(); ++i) {
-      const Rgb k = i > 0 ? diffuseDirectionalFactor(model, nodes[i])
-                          : 2.0f * diffuseDirectionalFactor(model, 0.5f * nodes[1]) - diffuseDirectionalFactor(model, nodes[1]);
-      words.insert(words.end(), {bits(k.r), bits(k.g), bits(k.b)});
-    }
-  }
+  for (const std::vector<float>* table : {&tables.mu, &tables.e0, &tables.e5, &tables.mean0, &tables.mean5})
+    for (float v : *table) words.push_back(bits(v));
   // The texels: a level's packed texels (4×4 blocks of palette indices, Texture::PackedBlock)
   // and its palette where it has them, else 3 floats per texel.
   for (size_t l = 0; l < levels.size(); ++l) {
@@ -205,7 +243,7 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
       for (const Rgb& texel : level.image->pixels) words.insert(words.end(), {bits(texel.r), bits(texel.g), bits(texel.b)});
     }
   }
-  return {std::move(words), std::move(factorTables)};
+  return {std::move(words), std::move(diffuseLobes)};
 }
 
 std::string surfaceDetailGlsl(unsigned binding) {
@@ -217,14 +255,17 @@ std::string surfaceDetailGlsl(unsigned binding) {
              "const float kInvPi = {:.9g};\nconst uint kFlagNormalMapped = {}u, kFlagDirectionalIrradiance = {}u;\n"
              "const uint kTiltedNormals = {}u;\nconst float kNormalTiltCosine = {:.9g}, kNormalTiltSine = {:.9g};\n"
              "const vec2 kTiltAcross[{}] = vec2[{}](vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}));\n"
-             "const int kDiffuseFactorNodes = {};\n",
+             "const uint kMaterialDiffuseLobe = {}u, kMaterialMetallicRoughness = {}u, kMaterialMetallicRoughnessMapping = {}u;\n"
+             "const uint kFlagMetallicRoughness = {}u;\nconst int kGgxMuNodes = {}, kGgxRoughNodes = {};\n"
+             "const float kGgxMinAlpha = {:.9g};\n",
              binding, kTextureWords, kLevelWords, kVertexWords, kMaterialWords, kMaterialAlbedoMapping,
              kMaterialEmissionMapping, kMaterialAlphaMapping, kMaterialNormalMapping, unsigned(TextureWrap::Repeat),
              unsigned(TextureWrap::ClampToEdge), unsigned(TextureWrap::MirroredRepeat), kNearestBit, kMipmapsBit,
              kDefaultSamplingBit, kFlagTexturedAlbedo, kFlagTexturedEmission, kInvPi, kFlagNormalMapped,
              kFlagDirectionalIrradiance, kTiltedNormals, kNormalTiltCosine, kNormalTiltSine, kTiltedNormals, kTiltedNormals,
              kTiltAcross[0][0], kTiltAcross[0][1], kTiltAcross[1][0], kTiltAcross[1][1], kTiltAcross[2][0],
-             kTiltAcross[2][1], diffuseFactorNodes().size()) +
+             kTiltAcross[2][1], kMaterialDiffuseLobe, kMaterialMetallicRoughness, kMaterialMetallicRoughnessMapping,
+             kFlagMetallicRoughness, ggxAlbedoTables().muNodes, ggxAlbedoTables().roughNodes, kGgxMinAlpha) +
          R"glsl(
 layout(std430, binding = SURFACE_DETAIL_BINDING) readonly buffer SurfaceDetailWords { uint detail[]; };
 const uint kNone = 0xffffffffu;
@@ -447,13 +488,22 @@ vec3 emissionTexelAt(uint m, uvec3 v, vec2 b) {
   return detail[m + 1u] == kNone ? vec3(1.0) : sampleTexture(detail[m + 1u], mappedUv(m + kMaterialEmissionMapping, v, b));
 }
 
+// The metallic-roughness texel (materialModelAt: Texture::sample, full resolution) at
+// barycentrics b of a triangle (vertices v) of material record m, which has the texture.
+vec3 metallicRoughnessTexelAt(uint m, uvec3 v, vec2 b) {
+  return sampleTexture(detail[m + kMaterialMetallicRoughness], mappedUv(m + kMaterialMetallicRoughnessMapping, v, b));
+}
+
 // What a lookup needs of its hit besides the position and the normals it is read around: the
 // albedo modulation (albedoModulation: the albedo texture at the cone's mip level × the vertex
 // colour) on a kFlagTexturedAlbedo chart, the emission texel (emissionModulation) on a
 // kFlagTexturedEmission one, 1 elsewhere; the mapped normal (surfaceAt's shading normal, on the
 // front's side) on a kFlagNormalMapped chart.
-struct SurfaceDetail { vec3 albedo, emission, normal; };
-SurfaceDetail noSurfaceDetail(vec3 normal) { return SurfaceDetail(vec3(1.0), vec3(1.0), normal); }
+// On a kFlagMetallicRoughness chart also the metallic-roughness texel (materialModelAt's, at
+// full resolution) and the material record (metallicRoughnessLobe reads both); 1 and kNone
+// elsewhere.
+struct SurfaceDetail { vec3 albedo, emission, normal, metallicRoughness; uint material; };
+SurfaceDetail noSurfaceDetail(vec3 normal) { return SurfaceDetail(vec3(1.0), vec3(1.0), normal, vec3(1.0), kNone); }
 // albedoPointAt, albedoModulation and surfaceAt's shading normal for a hit at barycentrics b
 // of triangle `triangle` (vertices v at p0, p1, p2; unit geometric normal `geometric`, the
 // interpolated normal `interpolated`) of a chart record with info `chartInfo` (kind, flags),
@@ -475,6 +525,10 @@ SurfaceDetail surfaceDetailAt(uint triangle, uvec3 v, vec3 p0, vec3 p1, vec3 p2,
     }
   }
   if ((flags & kFlagTexturedEmission) != 0u) d.emission = emissionTexelAt(m, v, b);
+  if ((flags & kFlagMetallicRoughness) != 0u) {
+    d.metallicRoughness = metallicRoughnessTexelAt(m, v, b);
+    d.material = m;
+  }
   if ((flags & kFlagNormalMapped) != 0u) d.normal = mappedNormalAt(m, v, p0, p1, p2, b, geometric, interpolated);
   return d;
 }
@@ -483,18 +537,79 @@ bool maskedMaterial(uint triangle) {
   uint m = materialRecord(triangle);
   return detail[m + 2u] != kNone || detailFloat(m + 4u) < detailFloat(m + 5u) || (detail[m + 7u] & 1u) != 0u;
 }
-// diffuseDirectionalFactor (bsdf.h) of a material whose k(μ) is tabulated at word `table`
-// (kNone: k = 1, Lambert and Blinn-Phong), interpolated between the nodes as the GGX albedo
-// table's lookup (locate) does.
-vec3 diffuseFactor(uint table, float cosTheta) {
+// ggxLobeAlbedo (bsdf.cpp) from the tables at detail[5] (ggxAlbedoTables): the directional
+// albedo E at μ and the cosine-weighted mean Ē of the GGX lobe α with Schlick's Fresnel from f0
+// to f90 — GgxAlbedoTable::locate and lookup, statement for statement.
+void ggxLobeAlbedo(float alpha, vec3 f0, float f90, float mu, out vec3 at, out vec3 mean) {
+  const int muNodes = kGgxMuNodes, roughNodes = kGgxRoughNodes;
+  uint muTable = detail[5], e0 = muTable + uint(muNodes), e5 = e0 + uint(muNodes * roughNodes);
+  uint mean0 = e5 + uint(muNodes * roughNodes), mean5 = mean0 + uint(roughNodes);
+  float rMin = sqrt(kGgxMinAlpha);
+  float rPos = (sqrt(clamp(alpha, kGgxMinAlpha, 1.0)) - rMin) / (1.0 - rMin) * float(roughNodes - 1);
+  int r0 = clamp(int(rPos), 0, roughNodes - 2);
+  float tr = clamp(rPos - float(r0), 0.0, 1.0);
+  mu = clamp(mu, 0.0, 1.0);
+  int i0 = clamp(int(sqrt(mu) * float(muNodes - 1)), 0, muNodes - 2);
+  float mu0 = detailFloat(muTable + uint(i0)), mu1 = detailFloat(muTable + uint(i0) + 1u);
+  float tm = clamp((mu - mu0) / (mu1 - mu0), 0.0, 1.0);
+  uint row0 = uint(r0 * muNodes + i0), row1 = row0 + uint(muNodes);
+  float e00 = detailFloat(e0 + row0) + tm * (detailFloat(e0 + row0 + 1u) - detailFloat(e0 + row0));
+  float e01 = detailFloat(e0 + row1) + tm * (detailFloat(e0 + row1 + 1u) - detailFloat(e0 + row1));
+  float e50 = detailFloat(e5 + row0) + tm * (detailFloat(e5 + row0 + 1u) - detailFloat(e5 + row0));
+  float e51 = detailFloat(e5 + row1) + tm * (detailFloat(e5 + row1 + 1u) - detailFloat(e5 + row1));
+  float le0 = e00 + tr * (e01 - e00), le5 = e50 + tr * (e51 - e50);
+  float m0 = detailFloat(mean0 + uint(r0)), m5 = detailFloat(mean5 + uint(r0));
+  float lm0 = m0 + tr * (detailFloat(mean0 + uint(r0) + 1u) - m0), lm5 = m5 + tr * (detailFloat(mean5 + uint(r0) + 1u) - m5);
+  at = f0 * (le0 - le5) + vec3(f90 * le5);
+  mean = f0 * (lm0 - lm5) + vec3(f90 * lm5);
+}
+// ggxDiffuseFactor (bsdf.cpp): k(μ) = max(0, 1 − E(μ)) / √(1 − Ē) per channel (0 where Ē ≈ 1)
+// of the lobe α with Fresnel f0 → f90 that the diffuse part gives up (GgxLobeParameters'
+// diffuseF0, diffuseF90); 0 for μ ≤ 0 (diffuseDirectionalFactor).
+vec3 ggxDiffuseFactor(float alpha, vec3 f0, float f90, float cosTheta) {
   if (!(cosTheta > 0.0)) return vec3(0.0);
-  if (table == kNone) return vec3(1.0);
-  float mu = min(cosTheta, 1.0);
-  int i0 = clamp(int(sqrt(mu) * float(kDiffuseFactorNodes - 1)), 0, kDiffuseFactorNodes - 2);
-  float a = detailFloat(detail[5] + uint(i0)), b = detailFloat(detail[5] + uint(i0) + 1u);
-  float t = clamp((mu - a) / (b - a), 0.0, 1.0);
-  vec3 k0 = detailRgb(table + 3u * uint(i0)), k1 = detailRgb(table + 3u * uint(i0) + 3u);
-  return k0 + t * (k1 - k0);
+  vec3 at, mean;
+  ggxLobeAlbedo(alpha, f0, f90, min(cosTheta, 1.0), at, mean);
+  vec3 rest = vec3(1.0) - mean;
+  return mix(vec3(0.0), max(vec3(0.0), vec3(1.0) - at) / sqrt(max(rest, vec3(1e-6))), greaterThan(rest, vec3(1e-6)));
+}
+// diffuseDirectionalFactor (bsdf.h) of a material whose diffuse part's lobe record is at word
+// `lobe` (the material record's kMaterialDiffuseLobe: α, diffuseF0, diffuseF90), kNone where k
+// is 1 (Lambert, Blinn-Phong).
+vec3 diffuseFactor(uint lobe, float cosTheta) {
+  if (!(cosTheta > 0.0)) return vec3(0.0);
+  if (lobe == kNone) return vec3(1.0);
+  return ggxDiffuseFactor(detailFloat(lobe), detailRgb(lobe + 1u), detailFloat(lobe + 4u), cosTheta);
+}
+// A GGX-like model as GgxLobeParameters (bsdf.h) describes it.
+struct GgxLobe { vec3 diffuse; float alpha; vec3 f0; float f90; vec3 diffuseF0; float diffuseF90; };
+// materialModelAt (scene.cpp) of material record m, which has a metallic-roughness texture, at
+// a point whose albedo modulation is `modulation` and metallic-roughness texel `texel`:
+// gltfMetallicRoughnessModel (lobe.cpp: GgxBsdf at metalness 0 or 1) or, for glTF's layered
+// model and between, gltfPbrFromInputs with the record's dielectric Fresnel ends.
+GgxLobe metallicRoughnessLobe(uint m, vec3 modulation, vec3 texel) {
+  uint r = m + kMaterialMetallicRoughness;
+  vec3 baseColor = detailRgb(r + 1u) * modulation;
+  float metallic = clamp(detailFloat(r + 4u) * texel.b, 0.0, 1.0);
+  float roughness = clamp(detailFloat(r + 5u) * texel.g, 0.0, 1.0);
+  GgxLobe l;
+  l.alpha = max(roughness * roughness, kGgxMinAlpha);  // ggxAlphaFromRoughness
+  if (detail[r + 6u] == 0u && !(metallic > 0.0 && metallic < 1.0)) {
+    l.f0 = mix(vec3(0.04), baseColor, metallic);
+    l.diffuse = baseColor * (1.0 - metallic);
+    l.f90 = 1.0;
+    l.diffuseF0 = l.f0;
+    l.diffuseF90 = 1.0;
+    return l;
+  }
+  vec3 base = clamp(baseColor, 0.0, 1.0);
+  float specular = detailFloat(r + 10u);
+  l.diffuseF0 = detailRgb(r + 7u);
+  l.diffuseF90 = specular;
+  l.f0 = mix(l.diffuseF0, base, metallic);
+  l.f90 = specular + (1.0 - specular) * metallic;
+  l.diffuse = base * (1.0 - metallic);
+  return l;
 }
 // coverageAt (scene.h): the alpha mask's coverage at barycentrics b of triangle `triangle`
 // (vertices v); below the material's cutoff the surface is not there (masked() says so).

@@ -1,7 +1,8 @@
 #pragma once
 // The GPU renderer's surface detail (internal to src/gpu): what the shading pass reads per
 // pixel besides the light field — albedo textures with their mip levels, vertex colours,
-// emission textures, alpha masks, normal maps and the diffuse factor k(μ) of GGX-like models —
+// emission textures, alpha masks, normal maps, metallic-roughness textures and the diffuse
+// factor k(μ) of GGX-like models —
 // uploaded as one storage buffer of 32-bit words, with the GLSL that reads it (the C++ of scene/texture.h, scene/scene.h uvAt/vertexColorAt/coverageAt/
 // surfaceAt/normalMapped and lightfield/lookup.h albedoTextureLod, statement for statement).
 //
@@ -14,22 +15,27 @@
 //              texels are 3 floats each; else they are the CPU's packed texels as they are,
 //              Texture::packed's 4×4 blocks of palette indices r | g << 8 | b << 16, one word
 //              each, and the palette its ≤ 256 floats);
-//   materials: 40 words each — albedo, emission, alpha and normal textures (kNoWord: none), alpha
+//   materials: 64 words each — albedo, emission, alpha and normal textures (kNoWord: none), alpha
 //              factor and cutoff, normal scale, vertex alphas (1: Material::vertexAlpha), then
 //              the albedo, emission, alpha and normal TextureMappings (8 words each: uv set,
-//              whether default, linear[0][0], [0][1], [1][0], [1][1], offset);
+//              whether default, linear[0][0], [0][1], [1][0], [1][1], offset); the diffuse
+//              part's lobe (ggxLobeParameters: α, diffuseF0 (3), diffuseF90; k(μ) from the
+//              tables below); the metallic-roughness texture (kNoWord: none), the factors
+//              materialModelAt multiplies (base colour (3), metallic, roughness), whether the
+//              model is glTF's layered one, the dielectric member's Fresnel ends (3 + 1), and
+//              its TextureMapping;
 //   vertices:  9 words each (all meshes' vertices in the renderer's order) — uv set 0 (2
 //              floats), uv set 1 (2), vertex colour (3), flags (has uvs | has uvs1 << 1 | has
 //              colours << 2 | has alphas << 3), vertex alpha (the coverage factor, coverageAt);
 //   triangles: 1 word each — the triangle's material;
-//   k nodes:   the μ of diffuseFactorNodes (bsdf.h), then per material whose glossy charts
-//              keep a diffuse part and whose k(μ) is not 1, k at those nodes (3 floats each):
-//              the diffuse part's directional factor, interpolated linearly as the CPU's is;
+//   GGX:       the GGX lobe-albedo tables (bsdf.h ggxAlbedoTables: the μ nodes, E₀, E₅, Ē₀, Ē₅),
+//              from which k(μ) = (1 − E(μ)) / √(1 − Ē) of a diffuse part is computed as the
+//              CPU computes it, per material or per pixel (metallic-roughness textures);
 //   texels:    the levels' texels and palettes.
 // Textures are uploaded only where a chart the GPU draws or a traced ray's hit
 // (tracedSurfaceDetail) reads them, vertices and triangles only where some chart, mask or
-// traced hit needs a uv: a scene without either costs the header, 160
-// bytes per material and 160 bytes of k nodes.
+// traced hit needs a uv: a scene without either costs the header, 256
+// bytes per material and 7.8 KiB of GGX tables.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -43,9 +49,10 @@ namespace pl::gpu {
 /// gpu_renderer.cpp's: the diffuse albedo varies (albedoOverPi then holds the material's base
 /// albedo, times the modulation per pixel), the emission is textured, the chart is
 /// normal-mapped (ChartShading::normalMapped: the lookup takes the mapped normal), it keeps
-/// tilted irradiances (Chart::directionalIrradiance).
+/// tilted irradiances (Chart::directionalIrradiance), its diffuse part (Chart::diffuseValue) takes
+/// the model of each point of a metallic-roughness texture (lookup.h glossyDiffuseReflectanceAt).
 inline constexpr uint32_t kFlagTexturedAlbedo = 128u, kFlagTexturedEmission = 256u, kFlagNormalMapped = 512u,
-                          kFlagDirectionalIrradiance = 1024u;
+                          kFlagDirectionalIrradiance = 1024u, kFlagMetallicRoughness = 2048u;
 
 /// The first surface-detail feature of chart record `chart` the GPU renderer does not draw, as
 /// a phrase for gpuUnsupportedFeature; empty when it draws it.
@@ -66,11 +73,11 @@ bool tracedSurfaceDetail(const LightField& lf);
 Rgb texturedAlbedoBase(const Scene& scene, const Chart& chart);
 
 /// The surface-detail buffer of `lf` (layout above), and per material the word offset of its
-/// k(μ) table (diffuseFactorNodes: 3 floats per node), kNone where k is 1 (Lambert,
-/// Blinn-Phong) or no glossy chart with a diffuse part needs it.
+/// diffuse part's lobe record (α, diffuseF0, diffuseF90: the shader's k(μ)), kNoWord where k is
+/// 1 (Lambert, Blinn-Phong) or no glossy chart with a diffuse part needs it.
 struct SurfaceDetailBuffer {
   std::vector<uint32_t> words;
-  std::vector<uint32_t> diffuseFactorTable;
+  std::vector<uint32_t> diffuseLobe;
 };
 SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf);
 /// The word that stands for "none" in the buffer.
@@ -78,7 +85,8 @@ inline constexpr uint32_t kNoWord = 0xffffffffu;
 
 /// The GLSL constants and functions (the buffer at binding `binding`): sampleTexture,
 /// sampleTextureLod, surfaceDetailAt (the albedo modulation, emission texel and mapped normal
-/// of a hit), mappedNormalAt and emissionTexelAt (surfaceAt's normal map and
+/// of a hit), ggxLobeAlbedo, ggxDiffuseFactor and diffuseFactor (k(μ) from the GGX tables),
+/// metallicRoughnessLobe (a textured material's model at a point), mappedNormalAt and emissionTexelAt (surfaceAt's normal map and
 /// emissionModulation for one material record, materialRecord) and masked (the alpha mask).
 /// Needs glslConstants' chart kinds.
 std::string surfaceDetailGlsl(unsigned binding);
