@@ -111,8 +111,8 @@ TEST_F(GpuRendererTest, MatchesFastRendererOnCornellBox) {
   expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 48, 64, true);
 }
 
-// Several samples per pixel: the same jittered film points (Pcg32::forKey(pixel, k, seed)) as
-// the CPU renderer, averaged; a change of seed moves them.
+// Several samples per pixel: the same film points (pixelSample's ZSobol sequence) as the CPU
+// renderer, averaged; a change of seed moves them.
 TEST_F(GpuRendererTest, MultiSampleMatchesFastRenderer) {
   RenderSettings settings;
   settings.samplesPerPixel = 4;
