@@ -67,7 +67,7 @@
 // highlight's normal by its normal map (gpu_surface_detail.h tracedSurfaceDetail).
 //
 // Several samples per pixel: the shading pass loops over the pixel's samples at the CPU
-// renderers' jittered film points (Pcg32::forKey in 64-bit GLSL integers,
+// renderers' film points (pixelSample's ZSobol sequence in 64-bit GLSL integers,
 // GL_ARB_gpu_shader_int64); the visibility pass is then drawn at a finer resolution (16× per
 // axis on small images, 4× at 1920×1080: its targets stay within 256 MiB) and each jittered ray
 // takes the triangle of the 3×3 of those finer texels around its film point by the same rule
@@ -137,8 +137,8 @@ class GpuRenderer {
 
   /// Renders camera.width() × camera.height() pixels of radiance into `image` (resized only
   /// when its size differs), like FastRenderer::render: one ray through each pixel centre, or
-  /// with several samples per pixel the CPU renderers' jittered film points
-  /// (jitteredPixelSample, render_settings.h), averaged. Throws pl::Error for settings it does not
+  /// with several samples per pixel the CPU renderers' film points
+  /// (pixelSample, render_settings.h), averaged. Throws pl::Error for settings it does not
   /// support (checkSettings).
   void render(const Camera& camera, const RenderSettings& settings, Image& image);
 

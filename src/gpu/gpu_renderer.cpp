@@ -568,41 +568,58 @@ vec3 sampleRadiance(vec2 film) {
 }
 
 #ifdef MULTISAMPLE
-// Pcg32::forKey (core/rng.h) in 64-bit integers (GL_ARB_gpu_shader_int64): the CPU
-// renderers' sample positions.
-uniform uvec2 seed;  // (low, high) 32 bits
+// pixelSample (lightfield/render_settings.h): the ZSobol film points of core/sampler.h
+// (Sampler::sobol, dimension 0) in 64-bit integers (GL_ARB_gpu_shader_int64), line for line;
+// the layout's bit counts come from ZSobolLayout on the CPU.
+uniform uvec2 seed;  // (low, high) 32 bits: ZSobolLayout::seed
 uniform int spp;
-struct Pcg32 { uint64_t state, inc; };
-uint pcgNext(inout Pcg32 rng) {
-  uint64_t old = rng.state;
-  rng.state = old * 6364136223846793005UL + rng.inc;
-  uint xorshifted = uint(((old >> 18) ^ old) >> 27);
-  uint rot = uint(old >> 59);
-  return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
+uniform int log2Spp;    // ZSobolLayout::log2Spp
+uniform int indexBits;  // ZSobolLayout::indexBits
+uint owenScrambleReversed(uint v, uint scrambleSeed) {
+  v ^= v * 0x3d20adeau;
+  v += scrambleSeed;
+  v *= (scrambleSeed >> 16) | 1u;
+  v ^= v * 0x05526c56u;
+  v ^= v * 0x53a22864u;
+  return v;
 }
-Pcg32 pcgForKey(uint64_t a, uint64_t b, uint64_t c) {
-  Pcg32 rng;
-  uint64_t initState = hashCombine(hashCombine(a, b), c);
-  rng.state = 0UL;
-  rng.inc = (mix64(c + 0x632be59bd9b4e019UL) << 1) | 1UL;
-  pcgNext(rng);
-  rng.state += initState;
-  pcgNext(rng);
-  return rng;
+// reversedSobolPoint(index, 1): the second Sobol dimension's columns v₀ = 2^31,
+// v_k = v_{k−1} ⊕ (v_{k−1} >> 1), bit-reversed, XORed for the index's set bits.
+uint reversedSobolSecond(uint index) {
+  uint result = 0u, column = 0x80000000u;
+  for (; index != 0u; index >>= 1) {
+    if ((index & 1u) != 0u) result ^= bitfieldReverse(column);
+    column ^= column >> 1;
+  }
+  return result;
 }
-float pcgUniform(inout Pcg32 rng) { return float(pcgNext(rng) >> 8) * exp2(-24.0); }
+uint64_t mortonEncode2(uint x, uint y) {
+  uint64_t m = 0UL;
+  for (int bit = 0; bit < 16; ++bit)
+    m |= (uint64_t((x >> bit) & 1u) << (2 * bit)) | (uint64_t((y >> bit) & 1u) << (2 * bit + 1));
+  return m;
+}
+float fixedToUnit(uint v) { return float(v >> 8) * exp2(-24.0); }
+// Sampler::get2D of dimension 0 for the global index mortonIndex.
+vec2 zSobolFilm(uint64_t mortonIndex, uint64_t layoutSeed) {
+  uint64_t h = mix64((mortonIndex >> 32) ^ layoutSeed);  // dimensionHash(0)
+  uint index = 0u;                                       // shuffledIndex(h)
+  int bits = min(indexBits, 32);
+  if (bits > 0) {
+    int shift = 32 - bits;
+    uint shuffleSeed = uint((h * 0x9e3779b97f4a7c15UL) >> 32);
+    index = bitfieldReverse(owenScrambleReversed(bitfieldReverse(uint(mortonIndex) << shift), shuffleSeed)) >> shift;
+  }
+  return vec2(fixedToUnit(bitfieldReverse(owenScrambleReversed(index, uint(h >> 32)))),
+              fixedToUnit(bitfieldReverse(owenScrambleReversed(reversedSobolSecond(index), uint(h)))));
+}
 void main() {
   ivec2 pixel = ivec2(gl_FragCoord.xy);
-  uint64_t index = uint64_t(pixel.y) * uint64_t(size.x) + uint64_t(pixel.x);
   uint64_t seed64 = (uint64_t(seed.y) << 32) | uint64_t(seed.x);
+  uint64_t pixelIndex = mortonEncode2(uint(pixel.x), uint(pixel.y)) << log2Spp;
   vec3 sum = vec3(0.0);
-  for (int k = 0; k < spp; ++k) {
-    // jitteredPixelSample (render_settings.h): film y is drawn first.
-    Pcg32 rng = pcgForKey(index, uint64_t(k), seed64);
-    float filmY = pcgUniform(rng);
-    float filmX = pcgUniform(rng);
-    sum += sampleRadiance(vec2(float(pixel.x) + filmX, float(pixel.y) + filmY));
-  }
+  for (int k = 0; k < spp; ++k)
+    sum += sampleRadiance(vec2(pixel) + zSobolFilm(pixelIndex | uint64_t(k), seed64));
   color = vec4(sum / float(spp), 1.0);
 }
 #else
@@ -1160,7 +1177,7 @@ void GpuRenderer::checkSettings(const RenderSettings& settings, const Camera& ca
 
 void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) {
   checkSettings(settings, camera);
-  // One sample: the pixel centre; several: jitteredPixelSample's film points, whose triangles
+  // One sample: the pixel centre; several: pixelSample's film points, whose triangles
   // are looked for in a visibility pass at a finer resolution (multiSampleIdScale).
   const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
   const int idScale = spp > 1 ? multiSampleIdScale(camera.width(), camera.height()) : 1;
@@ -1177,7 +1194,10 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   glProgramUniform1f(program, glGetUniformLocation(program, "coneSpread"),
                      textureConeSpread(settings, camera.pixelSpread(), spp));
   if (spp > 1) {
+    const ZSobolLayout samples(camera.width(), camera.height(), spp, settings.seed);  // pixelSample
     glProgramUniform1i(program, glGetUniformLocation(program, "spp"), spp);
+    glProgramUniform1i(program, glGetUniformLocation(program, "log2Spp"), samples.log2Spp());
+    glProgramUniform1i(program, glGetUniformLocation(program, "indexBits"), samples.indexBits());
     glProgramUniform2ui(program, glGetUniformLocation(program, "seed"), GLuint(settings.seed & 0xffffffffu),
                         GLuint(settings.seed >> 32));
   }

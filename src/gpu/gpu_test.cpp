@@ -113,8 +113,8 @@ TEST_F(GpuRendererTest, MatchesFastRendererOnCornellBox) {
   expectSameAsFastRenderer(lf, gpu, insideCamera(lf.scene), 48, 64, true);
 }
 
-// Several samples per pixel: the same jittered film points (Pcg32::forKey(pixel, k, seed)) as
-// the CPU renderer, averaged; a change of seed moves them.
+// Several samples per pixel: the same film points (pixelSample's ZSobol sequence) as the CPU
+// renderer, averaged; a change of seed moves them.
 TEST_F(GpuRendererTest, MultiSampleMatchesFastRenderer) {
   RenderSettings settings;
   settings.samplesPerPixel = 4;
@@ -664,9 +664,11 @@ TEST_F(GpuRendererTest, MatchesFastRendererOnGlassBall) {
   RenderSettings one;
   one.mirrorDepth = 1;
   expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 48, 48, false, one, 0.002);
+  // Four samples a pixel are four chances for a branch drawn apart: 25 of the 2 304 pixels
+  // (1.1 %) with the stratified film points (pixelSample), mean ratio 1.0006, relMSE 0.0013.
   RenderSettings multi;
   multi.samplesPerPixel = 4;
-  expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 48, 48, false, multi, 0.01);
+  expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), 48, 48, false, multi, 0.015);
 }
 
 // Rough glass: a glossy chart on both sides (lightfield.h "Rough glass"), the ball's inside its

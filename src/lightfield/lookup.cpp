@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "core/rng.h"
+#include "core/sampler.h"
 
 namespace pl {
 
@@ -65,12 +66,21 @@ float specularRouletteU(const Ray& ray) { return float((specularRayHash(ray) >> 
 
 namespace {
 
-/// Two uniform numbers in [0, 1) from a hash of the ray's bits and `salt`, sample k > 0 of a
-/// split hashed in too (sample 0 keeps the numbers unsplit rays always had).
+/// Two uniform numbers in [0, 1) from a hash of the ray's bits and `salt`. Sample k > 0 of a
+/// split (firstHitLobeSamples) is point k of the 2-D Sobol sequence (a (0,2)-sequence, core/
+/// sampler.h) shifted by sample 0's numbers modulo 1 (a Cranley–Patterson rotation): every
+/// sample is uniform on its own, sample 0 keeps the numbers unsplit rays always had (the bake's
+/// and every later hit's), and the split's 2^j samples are stratified — one in each of the
+/// rotated elementary intervals of area 2^-j — instead of independent.
 Vec2 rayHashU2(const Ray& ray, uint64_t salt, uint32_t sample) {
-  uint64_t h = hashCombine(specularRayHash(ray), salt);
-  if (sample > 0) h = hashCombine(h, sample);
-  return Vec2(float(h >> 40) * 0x1p-24f, float((h >> 16) & 0xffffffULL) * 0x1p-24f);
+  const uint64_t h = hashCombine(specularRayHash(ray), salt);
+  // 24-bit fixed point: sample 0's numbers, then the rotation added modulo 2^24 (exact).
+  uint32_t x = uint32_t(h >> 40), y = uint32_t((h >> 16) & 0xffffffULL);
+  if (sample > 0) {
+    x = (x + (reverseBits32(reversedSobolPoint(sample, 0)) >> 8)) & 0xffffffu;
+    y = (y + (reverseBits32(reversedSobolPoint(sample, 1)) >> 8)) & 0xffffffu;
+  }
+  return Vec2(float(x) * 0x1p-24f, float(y) * 0x1p-24f);
 }
 
 }  // namespace

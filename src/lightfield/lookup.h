@@ -255,7 +255,7 @@ inline float albedoLodAt(const Scene& scene, uint32_t material, uint32_t mesh, u
 /// on the wrong side of the geometric surface at grazing angles). `sampled`, when given, gets
 /// how `next` was chosen (SpecularStep), for the renderers' MIS at mirror-like lobes.
 /// `lobeSample` k > 0 draws a mirror-like lobe's direction with specularLobeU(ray, k) instead:
-/// the k-th of several independent samples at one hit (firstHitLobeSamples).
+/// the k-th of several stratified samples at one hit (firstHitLobeSamples).
 struct SpecularStep;
 bool followSpecular(const Scene& scene, const Ray& ray, const RayHit& hit, uint32_t step, uint32_t stepLimit,
                     Rgb& emitted, Ray& next, Rgb& weight, SpecularStep* sampled = nullptr, uint32_t lobeSample = 0);
@@ -290,10 +290,10 @@ bool isMirrorLikeRecord(const Chart& c, const Bsdf& model);
 /// Splitting at a view ray's first hit when it is a mirror-like lobe. A traced lobe's noise is
 /// that of the path tracer's chains of reflections: rare, bright samples (a sample in one
 /// lobe's tail that finds the lamp's reflection in the next metal surface, and so on down the
-/// chain). At that first hit the renderers take kFirstHitLobeSamples independent lobe samples
-/// (followSpecular's lobeSample k), each with its own light sample (MirrorLikeLights,
-/// nextEventU(ray, k)), each of weight 1/kFirstHitLobeSamples and followed to its chain's end:
-/// the pixels that see such a lobe get that many chains per camera sample, the others none
+/// chain). At that first hit the renderers take kFirstHitLobeSamples stratified lobe samples
+/// (followSpecular's lobeSample k: specularLobeU), each with its own light sample, stratified
+/// too (MirrorLikeLights, nextEventU(ray, k)), each of weight 1/kFirstHitLobeSamples and
+/// followed to its chain's end: the pixels that see such a lobe get that many chains per camera sample, the others none
 /// more (unlike more samples per pixel). 1 elsewhere (mirrors, glass, later hits).
 inline constexpr uint32_t kFirstHitLobeSamples = 8;
 uint32_t firstHitLobeSamples(const LightField& lf, uint32_t chart);
@@ -306,7 +306,8 @@ float specularBranchU(const Ray& ray);
 
 /// The two uniform numbers in [0, 1) with which followSpecular samples a mirror-like lobe for
 /// `ray` (a second hash of its bits: independent of the branch and the roulette); sample k > 0
-/// of a split (firstHitLobeSamples) hashes k in too.
+/// of a split (firstHitLobeSamples) is point k of the 2-D Sobol sequence rotated by sample 0's
+/// numbers (lookup.cpp rayHashU2), so the split's samples are stratified over the lobe.
 Vec2 specularLobeU(const Ray& ray, uint32_t sample = 0);
 
 /// The uniform number in [0, 1) that followSpecular plays its roulette with for `ray`
@@ -315,7 +316,7 @@ float specularRouletteU(const Ray& ray);
 
 /// The two uniform numbers in [0, 1) of the light sample MirrorLikeLights takes at the hit of
 /// `ray` (a third hash of its bits: independent of the lobe's own sample there); sample k > 0
-/// of a split hashes k in too.
+/// of a split is stratified as specularLobeU's.
 Vec2 nextEventU(const Ray& ray, uint32_t sample = 0);
 
 struct SunLights;

@@ -10,6 +10,7 @@
 
 #include "core/rng.h"
 #include "lightfield/paraboloid.h"
+#include "lightfield/render_settings.h"
 #include "support/quad_mesh.h"
 
 namespace pl {
@@ -242,6 +243,65 @@ TEST(FollowSpecular, SamplesAMirrorLikeLobeWithoutBias) {
   const Rgb expected = albedo(ggx, wo);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(sum[k] / kRays, expected[k], 0.01f * expected[k]) << k;
   EXPECT_GT(glm::dot(glm::normalize(meanDirection), mirror), 0.9999f);
+}
+
+// The renderers' camera samples (render_settings.h pixelSample): a pixel's 16 film points lie
+// one in each quarter × quarter of the pixel, and its 16 lens points one in each quarter ×
+// quarter of the aperture; neighbouring pixels and another seed get other points.
+TEST(PixelSample, StratifiedOverThePixelAndTheLens) {
+  constexpr int kSide = 8, kSpp = 16;
+  const ZSobolLayout layout(kSide, kSide, kSpp, 3), reseeded(kSide, kSide, kSpp, 4);
+  for (int y = 0; y < kSide; ++y)
+    for (int x = 0; x < kSide; ++x) {
+      std::vector<int> filmCells(kSpp, 0), lensCells(kSpp, 0);
+      for (int k = 0; k < kSpp; ++k) {
+        Vec2 film, lens, otherFilm, otherLens, neighbourFilm, neighbourLens;
+        pixelSample(layout, x, y, k, film, lens);
+        const Vec2 f = film - Vec2(float(x), float(y));
+        ASSERT_TRUE(f.x >= 0.0f && f.x < 1.0f && f.y >= 0.0f && f.y < 1.0f) << f.x << " " << f.y;
+        ASSERT_TRUE(lens.x >= 0.0f && lens.x < 1.0f && lens.y >= 0.0f && lens.y < 1.0f);
+        ++filmCells[size_t(int(f.y * 4.0f) * 4 + int(f.x * 4.0f))];
+        ++lensCells[size_t(int(lens.y * 4.0f) * 4 + int(lens.x * 4.0f))];
+        pixelSample(reseeded, x, y, k, otherFilm, otherLens);
+        EXPECT_NE(film, otherFilm);
+        pixelSample(layout, (x + 1) % kSide, y, k, neighbourFilm, neighbourLens);
+        EXPECT_NE(f, neighbourFilm - Vec2(float((x + 1) % kSide), float(y)));
+      }
+      for (int c = 0; c < kSpp; ++c) {
+        EXPECT_EQ(filmCells[size_t(c)], 1) << "pixel " << x << "," << y << " film cell " << c;
+        EXPECT_EQ(lensCells[size_t(c)], 1) << "pixel " << x << "," << y << " lens cell " << c;
+      }
+    }
+}
+
+// The split at a first hit (firstHitLobeSamples): sample 0 is the unsplit ray's numbers, and
+// the kFirstHitLobeSamples samples are a rotated (0,3,2)-net — along each axis one in each
+// 1/8 of [0, 1) measured from sample 0's value, and one in each of the 2^j × 2^(3−j) cells so
+// measured — for the lobe's numbers and the light sample's alike.
+TEST(FollowSpecular, SplitLobeAndLightSamplesAreStratified) {
+  static_assert(kFirstHitLobeSamples == 8);
+  Pcg32 rng(5, 3);
+  for (int r = 0; r < 100; ++r) {
+    const Ray ray{Vec3(rng.uniform(), rng.uniform(), rng.uniform()),
+                  glm::normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, 1.0f)), 0.0f, kInfinity};
+    for (auto numbers : {specularLobeU, nextEventU}) {
+      const Vec2 first = numbers(ray, 0);
+      EXPECT_EQ(first, numbers(ray, 0));
+      for (int j = 0; j <= 3; ++j) {
+        std::vector<int> cells(8, 0);
+        for (uint32_t k = 0; k < kFirstHitLobeSamples; ++k) {
+          const Vec2 u = numbers(ray, k);
+          ASSERT_TRUE(u.x >= 0.0f && u.x < 1.0f && u.y >= 0.0f && u.y < 1.0f) << u.x << " " << u.y;
+          // The offsets from sample 0, modulo 1 (exact: multiples of 2^-24).
+          const float dx = u.x >= first.x ? u.x - first.x : u.x - first.x + 1.0f;
+          const float dy = u.y >= first.y ? u.y - first.y : u.y - first.y + 1.0f;
+          const int cx = int(dx * float(1 << j)), cy = int(dy * float(1 << (3 - j)));
+          ++cells[size_t(cx * (1 << (3 - j)) + cy)];
+        }
+        for (int c = 0; c < 8; ++c) EXPECT_EQ(cells[size_t(c)], 1) << "cells 2^" << j << " x 2^" << 3 - j;
+      }
+    }
+  }
 }
 
 TEST(Lookup, LinearTapClampsAndInterpolates) {

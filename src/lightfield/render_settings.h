@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/math.h"
 #include "core/rng.h"
+#include "core/sampler.h"
 
 namespace pl {
 
@@ -52,22 +53,24 @@ inline int effectiveSamplesPerPixel(const RenderSettings& settings, bool thinLen
   return settings.samplesPerPixel > 0 ? settings.samplesPerPixel : thinLens ? RenderSettings::kThinLensSamples : 1;
 }
 
-/// Sample k of pixel (x, y) — pixel index y·width + x — when a pixel has several samples: its
-/// film point (pixel units) and lens point (in [0, 1)²), drawn from Pcg32::forKey(pixel, k,
-/// seed) in the order film y, film x, lens y, lens x. (That order is the one GCC's
-/// right-to-left evaluation gave the constructor calls these draws were first written as, so
-/// images stay what they were; it is spelled out because C++ leaves the order of arguments
-/// unspecified, and the GPU renderer draws the same points.) The reference and the fast
-/// renderer take their samples from here; the GPU renderer's shader is a GLSL copy, checked
-/// against them by gpu_test.
-inline void jitteredPixelSample(int x, int y, uint64_t pixel, int k, uint64_t seed, Vec2& film, Vec2& lens) {
-  Pcg32 rng = Pcg32::forKey(pixel, uint64_t(k), seed);
-  const float filmY = rng.uniform();
-  const float filmX = rng.uniform();
-  const float lensY = rng.uniform();
-  const float lensX = rng.uniform();
-  film = Vec2(float(x) + filmX, float(y) + filmY);
-  lens = Vec2(lensX, lensY);
+/// The film and lens points of the light-field renderers' camera samples when a pixel has
+/// several: a ZSobol sequence (core/sampler.h) over the whole image — layout
+/// ZSobolLayout(width, height, spp, seed) — the film point from dimension 0 and the lens point
+/// from dimension 1, as the path tracer draws its own (trace/path_tracer.cpp kFilmDimension,
+/// kLensDimension). A pixel's 2^k samples are therefore stratified over its area and over the
+/// aperture (every elementary interval of area 2^-k holds one), so a 16-sample render of a
+/// small bright emitter — seen directly or through mirrors and glass, whose chains are a
+/// deterministic function of the film point — converges as the path tracer's does instead of
+/// with the 1/√n noise of independent points. pixelSample is sample k (< 2^layout.log2Spp())
+/// of pixel (x, y): film in pixel units, lens in [0, 1)². The reference and the fast renderer
+/// take their samples from here; the GPU renderer's shader is a GLSL copy (gpu_renderer.cpp
+/// "ZSobol"), checked against them by gpu_test.
+inline void pixelSample(const ZSobolLayout& layout, int x, int y, int k, Vec2& film, Vec2& lens) {
+  Sampler sampler = Sampler::sobol(layout, x, y, uint64_t(k));
+  sampler.setDimension(0);
+  film = Vec2(float(x), float(y)) + sampler.get2D();
+  sampler.setDimension(1);
+  lens = sampler.get2D();
 }
 
 /// The mirror-depth rule: settings.mirrorDepth when ≥ 0, else the bake's own

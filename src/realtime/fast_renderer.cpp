@@ -111,16 +111,16 @@ size_t FastRenderer::tileCameraRays(const Camera& camera, int spp, uint64_t seed
     flush();
     return n;
   }
+  const ZSobolLayout samples(width, camera.height(), spp, seed);  // pixelSample
   for (int by = y0; by < y1; by += 4)
     for (int bx = x0; bx < x1; bx += 4)
       for (int y = by; y < std::min(by + 4, y1); ++y)
         for (int x = bx; x < std::min(bx + 4, x1); ++x) {
-          const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
-          pixelIndex[p++] = uint32_t(pixel);
+          pixelIndex[p++] = uint32_t(uint64_t(y) * uint64_t(width) + uint64_t(x));
           for (int k = 0; k < spp; ++k) {
             // Exactly the reference's sample positions (render.cpp).
             Vec2 film, lens;
-            jitteredPixelSample(x, y, pixel, k, seed, film, lens);
+            pixelSample(samples, x, y, k, film, lens);
             if (pending == kBatch) flush();
             ::new (static_cast<void*>(batch + pending)) Camera::Sample(camera.generateRay(film, lens));
             ++pending;

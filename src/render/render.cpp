@@ -103,6 +103,7 @@ Image renderLightField(const LightField& lf, const Accel& accel, const Camera& c
   const int tile = settings.tileSize;
   const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
   Image image(width, height);
+  const ZSobolLayout samples(width, height, spp, settings.seed);  // pixelSample
   const PunctualHighlights highlights(lf, accel);
   const MirrorLikeLights lobeLights(lf, accel);
 
@@ -120,10 +121,9 @@ Image renderLightField(const LightField& lf, const Accel& accel, const Camera& c
       weights.clear();
       for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
-          const uint64_t pixel = uint64_t(y) * uint64_t(width) + uint64_t(x);
           for (int k = 0; k < spp; ++k) {
             Vec2 film(float(x) + 0.5f, float(y) + 0.5f), lens(0.5f);
-            if (spp > 1) jitteredPixelSample(x, y, pixel, k, settings.seed, film, lens);
+            if (spp > 1) pixelSample(samples, x, y, k, film, lens);
             const Camera::Sample cs = camera.generateRay(film, lens);
             rays.push_back(cs.ray);
             weights.push_back(cs.weight);

@@ -18,8 +18,8 @@
 // `trace` does, so both renderers' files are directly comparable.
 //
 // Sampling: with one sample per pixel the ray goes through the pixel centre (and the lens
-// centre); with N > 1 samples, sample k of pixel p uses the random stream
-// Pcg32::forKey(p, k, seed) for a jittered film position and a lens position, so an image
+// centre); with N > 1 samples, sample k of pixel (x, y) takes its film and lens positions from
+// pixelSample (render_settings.h: a ZSobol sequence, stratified per pixel), so an image
 // depends on the seed only, never on the thread count.
 #include <cstdint>
 
