@@ -1241,10 +1241,6 @@ Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta) {
   return Rgb(1.0f);
 }
 
-const std::vector<float>& diffuseFactorNodes() { return ggxAlbedoTables().mu; }
-
-bool diffuseFactorIsPiecewiseLinear(const Bsdf& bsdf) { return ggxLobeParameters(bsdf).has_value(); }
-
 std::optional<GgxLobeParameters> ggxLobeParameters(const Bsdf& bsdf) {
   if (const auto* ggx = std::get_if<GgxBsdf>(&bsdf))
     return GgxLobeParameters{ggx->diffuse, clampAlpha(ggx->alpha), ggx->f0, 1.0f, ggx->f0, 1.0f};

@@ -395,15 +395,6 @@ Bsdf withSpecularF0(const Bsdf& bsdf, const Rgb& f0);
 /// and evaluates ρ(uv)/π · k(μo) · Ẽ where it is seen, so that textures modulate it
 /// (lightfield.h "What is stored per chart kind").
 Rgb diffuseDirectionalFactor(const Bsdf& bsdf, float cosTheta);
-/// The μ (ascending, from 0 to 1) between which diffuseDirectionalFactor is linear in μ for the
-/// models diffuseFactorIsPiecewiseLinear accepts — the nodes of the GGX lobe-albedo table it
-/// interpolates — so that k tabulated there and interpolated linearly in μ (clamped to [0, 1])
-/// is the function itself up to rounding: the GPU renderer's k(μ).
-const std::vector<float>& diffuseFactorNodes();
-/// Whether the model's diffuseDirectionalFactor is linear between diffuseFactorNodes: GgxBsdf
-/// and GltfPbrBsdf without a clear coat or sheen (whose layers multiply in other tables).
-/// Lambert and Blinn-Phong (k = 1) are not asked.
-bool diffuseFactorIsPiecewiseLinear(const Bsdf& bsdf);
 /// A short name for messages and `info`: "lambert", "mirror", "blinn-phong", "ggx",
 /// "dielectric" (smooth), "rough-dielectric", "thin-dielectric", "gltf-pbr", "subsurface".
 const char* modelName(const Bsdf& bsdf);
