@@ -139,9 +139,16 @@ struct Relighter::Impl {
     if (!std::filesystem::exists(visibilityPath, ec))  // (before minutes of filling the tixels)
       fail("{}: relighting needs the visibility field {} that was baked with this light field, but {} does not exist",
            scene.sourcePath, visibilityPath, visibilityPath);
+    const uint64_t hash = readVisibilityInfo(visibilityPath).hash;
+    // First keyed against the light field's scene (parameterisation.h reuseTixelSetup): a .plt
+    // written for another light field of the same geometry, or one whose charts a warm-started
+    // bake marked (warm_start.h), gets the charts of each changed material filled again and the
+    // masks of each moved light traced again. Else taken as it is (a .plt without keys).
+    TixelSetupReuse reuse;
     if (lf.sunMaskLightCount != param.sunMaskLights.size())
       why = "the light field's sun masks do not match its charts";
-    else if (readTixelSetup(setupPath, readVisibilityInfo(visibilityPath).hash, lf.sunMasks, param, &why))
+    else if (reuseTixelSetup(setupPath, hash, scene, *accel, param, reuse, &why) ||
+             readTixelSetup(setupPath, hash, lf.sunMasks, param, &why))
       return true;
     if (log)
       log(fmt::format("relight: filling the tixels again (buried-point probes, footprints, sun masks), because {}; "

@@ -91,7 +91,9 @@ class Relighter {
   /// The same with the visibility field read from `visibilityPath` (a .plv); pl::Error naming
   /// it when it is missing or was traced for another scene or settings. The parameterisation's
   /// charts are rebuilt (buildCharts: about a second on Crytek Sponza) and its tixel setup read
-  /// from the .plt the bake wrote beside the .plv (parameterisation.h readTixelSetup), or, when
+  /// from the .plt the bake wrote beside the .plv, keyed against the light field's scene
+  /// (parameterisation.h reuseTixelSetup: a changed material's charts filled again, a moved
+  /// sun's masks traced again; a .plt without keys taken as it is, readTixelSetup), or, when
   /// there is none for this .plv, filled again (fillTixels: minutes on a large scene; `log`
   /// says why).
   Relighter(const LightField& lightField, const std::string& visibilityPath,
