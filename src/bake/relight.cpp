@@ -74,7 +74,8 @@ struct Relighter::Impl {
   /// The visibility field: in memory, or the path of its .plv.
   using VisibilitySource = std::variant<VisibilityShard, std::string>;
 
-  Impl(const LightField& lf, VisibilitySource source, std::optional<Parameterisation> given, Note note)
+  Impl(const LightField& lf, VisibilitySource source, std::optional<Parameterisation> given, Note note,
+       uint64_t decodedBudget = 0)
       : log(std::move(note)), scene(lf.scene), settings(lf.settings), stats(lf.stats) {
     const auto start = std::chrono::steady_clock::now();
     scene.finalize();  // a copied scene lacks the vertex padding the BVH shares (scene.h)
@@ -91,10 +92,14 @@ struct Relighter::Impl {
     if (path) {
       VisibilityField field;
       std::string why;
-      if (!readVisibility(*path, hash, field, &why, param.tixelCount))
+      const uint64_t side = gatherGridSide(settings.gatherDirections);
+      const bool hold = param.tixelCount > 0 && param.tixelCount * side * side * sizeof(VisibilityEntry) <= decodedBudget;
+      std::vector<VisibilityEntry> decoded;
+      if (!readVisibility(*path, hash, field, &why, param.tixelCount, hold ? &decoded : nullptr))
         fail("{}: relighting needs the visibility field {} that was baked with this light field, but {}",
              scene.sourcePath, *path, why);
       vis = VisibilityShard::of(std::move(field), {TixelRange{0, param.tixelCount}});
+      if (hold) vis.decoded = FieldArray<VisibilityEntry>(std::move(decoded));
     } else {
       vis = std::move(std::get<VisibilityShard>(source));
     }
@@ -598,8 +603,9 @@ Relighter::Relighter(const LightField& lightField, VisibilityShard visibility, c
     : impl_(std::make_unique<Impl>(lightField, std::move(visibility), std::nullopt, log)) {}
 Relighter::Relighter(const LightField& lightField, VisibilityShard visibility, Parameterisation param, const Note& log)
     : impl_(std::make_unique<Impl>(lightField, std::move(visibility), std::move(param), log)) {}
-Relighter::Relighter(const LightField& lightField, const std::string& visibilityPath, const Note& log)
-    : impl_(std::make_unique<Impl>(lightField, visibilityPath, std::nullopt, log)) {}
+Relighter::Relighter(const LightField& lightField, const std::string& visibilityPath, const Note& log,
+                     uint64_t decodedBudget)
+    : impl_(std::make_unique<Impl>(lightField, visibilityPath, std::nullopt, log, decodedBudget)) {}
 Relighter::~Relighter() = default;
 Relighter::Relighter(Relighter&&) noexcept = default;
 Relighter& Relighter::operator=(Relighter&&) noexcept = default;

@@ -95,9 +95,11 @@ class Relighter {
   /// (parameterisation.h reuseTixelSetup: a changed material's charts filled again, a moved
   /// sun's masks traced again; a .plt without keys taken as it is, readTixelSetup), or, when
   /// there is none for this .plv, filled again (fillTixels: minutes on a large scene; `log`
-  /// says why).
+  /// says why). The field is held decoded (VisibilityShard::decoded, decoded as it is checked:
+  /// every iteration's gather then reads it directly) when that takes at most `decodedBudget`
+  /// bytes (bake.h decodedFieldBudget); 0: kept compact.
   Relighter(const LightField& lightField, const std::string& visibilityPath,
-            const std::function<void(const std::string&)>& log = {});
+            const std::function<void(const std::string&)>& log = {}, uint64_t decodedBudget = 0);
   ~Relighter();
   Relighter(Relighter&&) noexcept;
   Relighter& operator=(Relighter&&) noexcept;

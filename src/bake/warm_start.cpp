@@ -49,14 +49,13 @@ LightField relightPrevious(Scene& scene, const BakeSettings& settings, const std
                               before.contains(key) ? before[key].dump() : "unset");
     fail("{} was baked with other settings: {}", previousPath, differ);
   }
-  if (options.checkMemory) {
-    // The Relighter holds what the bake holds (the visibility field counted at 8 bytes per
-    // entry: no sample measured here) and the first shot of every source (relight.h).
-    const uint64_t perSource = 2 * previous.values.size() * sizeof(Rgb);
-    options.checkMemory(bakeMemoryEstimate(previous.stats.tixels, previous.values.size(), settings) +
-                        (previous.scene.lights.size() + 1) * perSource);
-  }
-  Relighter relighter(previous, options.visibilityPath, options.log);
+  // The Relighter holds what the bake holds (the visibility field counted at 8 bytes per
+  // entry: no sample measured here) and the first shot of every source (relight.h).
+  const uint64_t perSource = 2 * previous.values.size() * sizeof(Rgb);
+  const uint64_t estimate = bakeMemoryEstimate(previous.stats.tixels, previous.values.size(), settings) +
+                            (previous.scene.lights.size() + 1) * perSource;
+  if (options.checkMemory) options.checkMemory(estimate);
+  Relighter relighter(previous, options.visibilityPath, options.log, decodedFieldBudget(estimate, options));
   // What setScene does not compare: the meshes' attributes and the textures' texels (key 0 of
   // the tixel setup), which the relit charts were filled from.
   const Parameterisation& param = relighter.parameterisation();
