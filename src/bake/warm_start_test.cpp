@@ -19,11 +19,17 @@
 #include "plf/plf_file.h"
 #include "render/render.h"
 #include "support/light_field_difference.h"
-#include "support/quad_mesh.h"
+#include "support/relight_scenes.h"
 #include "support/temp_dir_test.h"
 
 namespace pl {
 namespace {
+
+using test_support::cornellWithPointLight;
+using test_support::materialIndex;
+using test_support::relightTestSettings;
+using test_support::sunAt;
+using test_support::sunScene;
 
 class WarmStartTest : public test_support::TempDirTest {
  protected:
@@ -52,16 +58,6 @@ class WarmStartTest : public test_support::TempDirTest {
 
   std::string notes_;
 };
-
-BakeSettings testSettings(float tixelsAcross = 10.0f) {
-  BakeSettings s = bakePreset("draft");
-  s.tixelsAcrossScene = tixelsAcross;
-  s.gatherDirections = 64;
-  s.areaLightSamples = 8;
-  s.tolerance = 1e-4f;
-  s.maxIterations = 400;
-  return s;
-}
 
 Image renderAt(const LightField& lf, const CameraDesc& desc) {
   const Accel accel(lf.scene);
@@ -93,23 +89,8 @@ CameraDesc cornellCamera() {
   return desc;
 }
 
-uint32_t materialIndex(const Scene& scene, const std::string& name) {
-  for (uint32_t m = 0; m < scene.materials.size(); ++m)
-    if (scene.materials[m].name == name) return m;
-  ADD_FAILURE() << "no material " << name;
-  return 0;
-}
-
-Scene cornellWithPointLight() {
-  Scene scene = makeCornellBox();
-  scene.lights.push_back(createLight("point", {{"position", Vec3(278.0f, 400.0f, 200.0f)}, {"intensity", Vec3(2e4f)}},
-                                     "test light"));
-  scene.finalize();
-  return scene;
-}
-
 TEST_F(WarmStartTest, LightColourIntensityAndAlbedoEqualFreshBakes) {
-  const BakeSettings settings = testSettings();
+  const BakeSettings settings = relightTestSettings();
   const Scene original = cornellWithPointLight();
   bakePrevious(original, settings);
   struct Case {
@@ -137,31 +118,8 @@ TEST_F(WarmStartTest, LightColourIntensityAndAlbedoEqualFreshBakes) {
   }
 }
 
-/// An open scene under a grey sky: a floor, a wall standing on it and a sun.
-Scene sunScene(const Vec3& sunDirection) {
-  Scene scene;
-  scene.sourcePath = "sun test";
-  Material ground;
-  ground.name = "ground";
-  ground.bsdf = LambertBsdf{Rgb(0.6f)};
-  scene.materials.push_back(ground);
-  Mesh mesh;
-  test_support::addQuad(mesh, Vec3(0, 0, 0), Vec3(0, 0, 10), Vec3(10, 0, 10), Vec3(10, 0, 0), 0);
-  test_support::addQuad(mesh, Vec3(3, 0, 5), Vec3(7, 0, 5), Vec3(7, 3, 5), Vec3(3, 3, 5), 0);
-  scene.meshes.push_back(std::move(mesh));
-  scene.environment.constant = Rgb(0.2f, 0.3f, 0.5f);
-  scene.lights.push_back(createLight("directional", {{"direction", sunDirection}, {"irradiance", Vec3(3.0f)}}, "sun"));
-  scene.finalize();
-  return scene;
-}
-
-Vec3 sunAt(float elevationDegrees, float azimuthDegrees) {
-  const float e = elevationDegrees * kPi / 180.0f, a = azimuthDegrees * kPi / 180.0f;
-  return -Vec3(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
-}
-
 TEST_F(WarmStartTest, SunMovedEqualsAFreshBakeAndTheSetupLeftBehindStaysExact) {
-  const BakeSettings settings = testSettings(16.0f);
+  const BakeSettings settings = relightTestSettings(16.0f);
   bakePrevious(sunScene(sunAt(40.0f, 20.0f)), settings);
   CameraDesc camera;
   camera.eye = {5.0f, 6.0f, -6.0f};
@@ -199,7 +157,7 @@ TEST_F(WarmStartTest, SunMovedEqualsAFreshBakeAndTheSetupLeftBehindStaysExact) {
 }
 
 TEST_F(WarmStartTest, DeclinesWithTheReason) {
-  const BakeSettings settings = testSettings();
+  const BakeSettings settings = relightTestSettings();
   const Scene original = cornellWithPointLight();
   WarmStartOutcome outcome;
   auto declined = [&](const Scene& scene, const BakeSettings& s, const std::string& why, const std::string& previous = "") {
