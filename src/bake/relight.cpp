@@ -34,7 +34,16 @@ std::string visibilityPathFor(const std::string& plfPath) {
 
 namespace {
 
-bool sameEnvironment(const Environment& a, const Environment& b) { return a.constant == b.constant && a.map == b.map; }
+/// The same sky: the same map object, or maps of the same texels, scale and rotation (a scene
+/// loaded again, or read from a .plf, holds its own copy of an unchanged map).
+bool sameEnvironment(const Environment& a, const Environment& b) {
+  if (a.constant != b.constant) return false;
+  if (a.map == b.map) return true;
+  if (!a.map || !b.map) return false;
+  const Image &x = a.map->map().image, &y = b.map->map().image;
+  return a.map->scale() == b.map->scale() && a.map->rotationDegrees() == b.map->rotationDegrees() &&
+         x.width == y.width && x.height == y.height && x.pixels == y.pixels;
+}
 
 /// The per-channel factor k with after = k ⊙ before, when there is one: every channel of
 /// `before` positive (or both black: k unset, any factor fits).

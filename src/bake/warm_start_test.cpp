@@ -8,12 +8,14 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 
 #include "accel/accel.h"
 #include "bake/bake.h"
 #include "camera/camera.h"
 #include "core/progress.h"
+#include "env/env.h"
 #include "image/compare.h"
 #include "light/lights.h"
 #include "plf/plf_file.h"
@@ -154,6 +156,26 @@ TEST_F(WarmStartTest, SunMovedEqualsAFreshBakeAndTheSetupLeftBehindStaysExact) {
   const std::optional<LightField> twice = warm(again, settings, outcome);
   ASSERT_TRUE(twice) << outcome.reason;
   expectFreshBake(*twice, settings, camera, "then recoloured");
+}
+
+// The scene to bake holds its own copy of the sky (loaded again): an unchanged map is not a
+// changed environment, so only the recoloured sun is recombined, nothing is shot again.
+TEST_F(WarmStartTest, AnUnchangedSkyMapIsNotShotAgain) {
+  const BakeSettings settings = relightTestSettings(8.0f);
+  auto withSky = [](Scene scene) {
+    Image sky(16, 8);
+    for (int y = 0; y < sky.height; ++y)
+      for (int x = 0; x < sky.width; ++x) sky.at(x, y) = Rgb(0.1f + 0.05f * float(x % 4), 0.2f, 0.1f * float(y));
+    scene.environment.map = std::make_shared<const EnvironmentMap>(LatLongMap{std::move(sky)}, 0.8f, 30.0f);
+    return scene;
+  };
+  bakePrevious(withSky(sunScene(sunAt(40.0f, 20.0f))), settings);
+  Scene recoloured = withSky(sunScene(sunAt(40.0f, 20.0f)));
+  setLightEmission(recoloured.lights[0], Rgb(4.0f, 3.0f, 2.0f));
+  WarmStartOutcome outcome;
+  ASSERT_TRUE(warm(recoloured, settings, outcome)) << outcome.reason;
+  EXPECT_FALSE(outcome.relight.emittersShot);
+  EXPECT_EQ(outcome.relight.lightsShot, 0u);
 }
 
 TEST_F(WarmStartTest, DeclinesWithTheReason) {
