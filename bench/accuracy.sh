@@ -24,7 +24,7 @@
 #
 # Then the reuse-visibility check (issue 4, item 2): a JSON scene of McGuire's CornellBox-Original
 # with the light recoloured is baked twice — once reusing the visibility field saved by a bake of the
-# original colour (--reuse-visibility --visibility), once from scratch — and the two light
+# original colour (--reuse-visibility --no-warm-start --visibility: propagated from zero), once from scratch — and the two light
 # fields' renders are compared (relMSE ≈ 0 expected; the bake is deterministic for a seed).
 #
 # Usage: bench/accuracy.sh [PLENOPTIC] [WORKDIR]
@@ -106,7 +106,7 @@ reuse="$workdir/reuse"
 "$plenoptic" --quiet bake "$workdir/light_original.json" -o "$reuse.original.plf" --visibility "$reuse.plv" \
   --stats "$reuse.original.json" >&2
 "$plenoptic" --quiet bake "$workdir/light_recoloured.json" -o "$reuse.reused.plf" --visibility "$reuse.plv" \
-  --reuse-visibility --stats "$reuse.reused.json" >&2
+  --reuse-visibility --no-warm-start --stats "$reuse.reused.json" >&2
 "$plenoptic" --quiet bake "$workdir/light_recoloured.json" -o "$reuse.full.plf" --visibility "$reuse.full.plv" \
   --stats "$reuse.full.json" >&2
 for kind in reused full original; do

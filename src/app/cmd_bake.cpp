@@ -73,6 +73,13 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--reuse-visibility", options->reuseVisibility,
                     "Reuse the saved visibility field if geometry, parameterisation and settings are unchanged "
                     "(checked by hash); otherwise recompute it and say why");
+  command->add_option("--warm-start", options->warmStart,
+                      "With --reuse-visibility: the previous light field (.plf, baked with the reused .plv) to relight "
+                      "instead of propagating from zero, when the scene changed only in lights, emission, environment "
+                      "or Lambertian albedo (default: the one at -o, if any; implies --reuse-visibility)");
+  command->add_flag("--no-warm-start", options->noWarmStart,
+                    "With --reuse-visibility: always propagate from zero (the light field a full bake gives, bit for "
+                    "bit; a warm start is within the bake's tolerance of it)");
   command->add_flag("--fresh", options->fresh,
                     "Start afresh: ignore the partial visibility field and propagation checkpoint that an interrupted "
                     "bake left beside the .plv (by default a matching one is resumed)");

@@ -174,10 +174,8 @@ struct Transport {
   PropagationResult propagation;
 };
 
-/// What the propagation may spend on holding the visibility field decoded, 8 bytes per entry
-/// (VisibilityShard::holdDecoded: the gather then skips decoding each tixel in every
-/// iteration): a quarter of the memory available beyond the bake's estimate, and no more than
-/// maxMemory leaves beside the estimate. The memory guard's estimate stays the compact field's.
+}  // namespace
+
 uint64_t decodedFieldBudget(uint64_t estimate, const BakeOptions& options) {
   const std::optional<uint64_t> available = availableMemoryBytes();
   if (!available || *available <= estimate) return 0;
@@ -185,6 +183,8 @@ uint64_t decodedFieldBudget(uint64_t estimate, const BakeOptions& options) {
   if (options.maxMemory > 0) budget = std::min(budget, options.maxMemory > estimate ? options.maxMemory - estimate : 0);
   return budget;
 }
+
+namespace {
 
 /// Reads the saved field of `held` into `visibility` (readVisibility's checks; false and *why
 /// when it is not this bake's), decoded as it is checked when the budget holds it decoded

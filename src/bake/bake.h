@@ -121,6 +121,13 @@ uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings
 /// evenly, but what they see varies from chart to chart.
 inline constexpr double kVisibilityEstimateMargin = 1.15;
 
+/// What the propagation may spend on holding the visibility field decoded, 8 bytes per entry
+/// (VisibilityShard::holdDecoded: the gather then skips decoding each tixel in every
+/// iteration): a quarter of the memory available beyond the bake's estimate `estimate`, and no
+/// more than options.maxMemory leaves beside it. The memory guard's estimate stays the compact
+/// field's.
+uint64_t decodedFieldBudget(uint64_t estimate, const BakeOptions& options);
+
 /// Removes the propagation checkpoint (resume.h) of a bake with these options (every rank's
 /// own, for a distributed bake), if there is one.
 void removePropagationCheckpoint(const BakeOptions& options);

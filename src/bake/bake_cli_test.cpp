@@ -52,8 +52,9 @@ TEST_F(BakeCli, BakesWritesStatsAndReusesVisibility) {
   EXPECT_EQ(json["two_sided_charts"].get<uint64_t>(), 12u);
   EXPECT_EQ(lf.stats.tixels, json["tixels"].get<uint64_t>());
 
-  // Same scene and settings: the saved field is reused (and said so on stderr).
-  ASSERT_EQ(run(common + " --reuse-visibility --stats \"" + stats + "\"", &out, &err), 0) << err;
+  // Same scene and settings: the saved field is reused (and said so on stderr); propagated
+  // from zero, not warm-started from the .plf at -o (BakeCli.WarmStart...).
+  ASSERT_EQ(run(common + " --reuse-visibility --no-warm-start --stats \"" + stats + "\"", &out, &err), 0) << err;
   EXPECT_NE(err.find("reusing"), std::string::npos) << err;
   std::ifstream in2(stats);
   EXPECT_TRUE(nlohmann::json::parse(in2)["reused_visibility"].get<bool>());
@@ -125,6 +126,58 @@ TEST_F(BakeCli, GlossyResOverridesThePresetsCap) {
   EXPECT_EQ(run(common + path("x.plf") + "\" --glossy-res 1", &out, &err), 2);
   EXPECT_NE(err.find("--glossy-res"), std::string::npos) << err;
   EXPECT_FALSE(fs::exists(path("x.plf")));
+}
+
+// bake --reuse-visibility with the previous light field at -o: relit for what changed (said on
+// stderr and in --stats); what relighting does not serve, --no-warm-start and a damaged
+// --warm-start file fall back to propagating from zero, with the reason.
+TEST_F(BakeCli, WarmStartsFromThePreviousLightField) {
+  const std::string plf = path("box.plf"), scene = path("box.json"), stats = path("stats.json");
+  auto writeScene = [&](const std::string& red) {
+    std::ofstream(scene) << "{\"include_cornell\": true, \"materials\": {\"red\": " << red << "}}";
+  };
+  auto statsJson = [&] {
+    std::ifstream in(stats);
+    return nlohmann::json::parse(in);
+  };
+  const std::string bake = "bake \"" + scene + "\" -o \"" + plf + "\" --preset draft --tixels-across 12 --directions 64 --stats \"" + stats + "\"";
+  std::string out, err;
+  writeScene("{\"type\": \"lambert\", \"albedo\": [0.57, 0.043, 0.044]}");
+  ASSERT_EQ(run(bake, &out, &err), 0) << err;
+  EXPECT_FALSE(statsJson()["warm_start"].get<bool>());
+  EXPECT_NE(statsJson()["warm_start_reason"].get<std::string>().find("--reuse-visibility"), std::string::npos);
+
+  // The red wall's albedo changed: warm-started.
+  writeScene("{\"type\": \"lambert\", \"albedo\": [0.2, 0.5, 0.7]}");
+  ASSERT_EQ(run(bake + " --reuse-visibility", &out, &err), 0) << err;
+  EXPECT_NE(err.find("warm start: relit"), std::string::npos) << err;
+  nlohmann::json json = statsJson();
+  EXPECT_TRUE(json["warm_start"].get<bool>());
+  EXPECT_EQ(json["warm_start_reason"].get<std::string>(), "");
+  EXPECT_TRUE(json["reused_visibility"].get<bool>());
+  EXPECT_EQ(readLightField(plf).scene.materials[1].name, "red");
+
+  // --no-warm-start: propagated from zero.
+  ASSERT_EQ(run(bake + " --reuse-visibility --no-warm-start", &out, &err), 0) << err;
+  EXPECT_EQ(statsJson()["warm_start_reason"].get<std::string>(), "--no-warm-start");
+  EXPECT_NE(run(bake + " --warm-start \"" + plf + "\" --no-warm-start", &out, &err), 0);
+  EXPECT_NE(err.find("contradict"), std::string::npos) << err;
+
+  // A change relighting refuses: the wall turned glossy.
+  writeScene("{\"type\": \"ggx\", \"diffuse\": 0.5, \"f0\": 0.04, \"roughness\": 0.5}");
+  ASSERT_EQ(run(bake + " --reuse-visibility", &out, &err), 0) << err;
+  EXPECT_NE(err.find("warm start: not used, because"), std::string::npos) << err;
+  json = statsJson();
+  EXPECT_FALSE(json["warm_start"].get<bool>());
+  EXPECT_NE(json["warm_start_reason"].get<std::string>().find("cannot relight"), std::string::npos) << json.dump();
+
+  // A damaged previous light field named by --warm-start (which implies --reuse-visibility).
+  std::ofstream(path("damaged.plf"), std::ios::binary) << "PLF not really";
+  ASSERT_EQ(run(bake + " --warm-start \"" + path("damaged.plf") + "\"", &out, &err), 0) << err;
+  json = statsJson();
+  EXPECT_FALSE(json["warm_start"].get<bool>());
+  EXPECT_TRUE(json["reused_visibility"].get<bool>());
+  EXPECT_NE(json["warm_start_reason"].get<std::string>().find("damaged.plf"), std::string::npos) << json.dump();
 }
 
 TEST_F(BakeCli, RefusesBadInput) {

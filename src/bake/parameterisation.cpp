@@ -835,7 +835,8 @@ std::vector<uint64_t> tixelSetupKeys(const Scene& scene, const Parameterisation&
   return keys;
 }
 
-void writeTixelSetup(const std::string& path, const Scene& scene, const Parameterisation& p, uint64_t hash) {
+void writeTixelSetup(const std::string& path, const Scene& scene, const Parameterisation& p, uint64_t hash,
+                     const std::vector<uint32_t>& staleMaterials) {
   std::vector<TixelSetupView> views;
   forEachTixelSetupArray(p, [&](const char* tag, const auto& array) {
     using Element = typename std::decay_t<decltype(array)>::value_type;
@@ -843,7 +844,8 @@ void writeTixelSetup(const std::string& path, const Scene& scene, const Paramete
     views.push_back({tixelSetupTag(tag), uint32_t(sizeof(Element)), uint64_t(array.size()), array.data()});
   });
   views.push_back({tixelSetupTag(kSunMaskTag), uint32_t(sizeof(SunMaskSlots)), uint64_t(p.sunMask.size()), p.sunMask.data()});
-  const std::vector<uint64_t> keys = tixelSetupKeys(scene, p);
+  std::vector<uint64_t> keys = tixelSetupKeys(scene, p);
+  for (uint32_t m : staleMaterials) keys.at(1 + m) = 0;  // (keys: [0] attributes, then one per material)
   writeTixelSetupFile(path, hash, p.tixelCount, views, keys);
 }
 

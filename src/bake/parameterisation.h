@@ -318,7 +318,11 @@ std::string tixelSetupPathFor(const std::string& visibilityPath);
 /// Saves p's tixel setup (forEachTixelSetupArray), its sun masks (array SUNM, after them) and
 /// the keys of what they were computed from (tixelSetupKeys) as a .plt file (plf/plt_file.h)
 /// for the bake of `scene` whose visibility field has hash `hash` (visibilityHash).
-void writeTixelSetup(const std::string& path, const Scene& scene, const Parameterisation& p, uint64_t hash);
+/// `staleMaterials`: materials whose charts p holds other than fillTixels would fill them (a
+/// relit albedo, relight.h): their keys are written as 0, which no material hashes to, so
+/// that reuseTixelSetup fills their charts again.
+void writeTixelSetup(const std::string& path, const Scene& scene, const Parameterisation& p, uint64_t hash,
+                     const std::vector<uint32_t>& staleMaterials = {});
 /// FNV-1a of a material's model (its variant index) and every parameter (the parameters()
 /// hook): equal for the same model with the same parameters. What relighting and the tixel
 /// setup's keys compare materials by.

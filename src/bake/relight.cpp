@@ -34,7 +34,16 @@ std::string visibilityPathFor(const std::string& plfPath) {
 
 namespace {
 
-bool sameEnvironment(const Environment& a, const Environment& b) { return a.constant == b.constant && a.map == b.map; }
+/// The same sky: the same map object, or maps of the same texels, scale and rotation (a scene
+/// loaded again, or read from a .plf, holds its own copy of an unchanged map).
+bool sameEnvironment(const Environment& a, const Environment& b) {
+  if (a.constant != b.constant) return false;
+  if (a.map == b.map) return true;
+  if (!a.map || !b.map) return false;
+  const Image &x = a.map->map().image, &y = b.map->map().image;
+  return a.map->scale() == b.map->scale() && a.map->rotationDegrees() == b.map->rotationDegrees() &&
+         x.width == y.width && x.height == y.height && x.pixels == y.pixels;
+}
 
 /// The per-channel factor k with after = k ⊙ before, when there is one: every channel of
 /// `before` positive (or both black: k unset, any factor fits).
@@ -74,7 +83,8 @@ struct Relighter::Impl {
   /// The visibility field: in memory, or the path of its .plv.
   using VisibilitySource = std::variant<VisibilityShard, std::string>;
 
-  Impl(const LightField& lf, VisibilitySource source, std::optional<Parameterisation> given, Note note)
+  Impl(const LightField& lf, VisibilitySource source, std::optional<Parameterisation> given, Note note,
+       uint64_t decodedBudget = 0)
       : log(std::move(note)), scene(lf.scene), settings(lf.settings), stats(lf.stats) {
     const auto start = std::chrono::steady_clock::now();
     scene.finalize();  // a copied scene lacks the vertex padding the BVH shares (scene.h)
@@ -91,10 +101,14 @@ struct Relighter::Impl {
     if (path) {
       VisibilityField field;
       std::string why;
-      if (!readVisibility(*path, hash, field, &why, param.tixelCount))
+      const uint64_t side = gatherGridSide(settings.gatherDirections);
+      const bool hold = param.tixelCount > 0 && param.tixelCount * side * side * sizeof(VisibilityEntry) <= decodedBudget;
+      std::vector<VisibilityEntry> decoded;
+      if (!readVisibility(*path, hash, field, &why, param.tixelCount, hold ? &decoded : nullptr))
         fail("{}: relighting needs the visibility field {} that was baked with this light field, but {}",
              scene.sourcePath, *path, why);
       vis = VisibilityShard::of(std::move(field), {TixelRange{0, param.tixelCount}});
+      if (hold) vis.decoded = FieldArray<VisibilityEntry>(std::move(decoded));
     } else {
       vis = std::move(std::get<VisibilityShard>(source));
     }
@@ -139,9 +153,16 @@ struct Relighter::Impl {
     if (!std::filesystem::exists(visibilityPath, ec))  // (before minutes of filling the tixels)
       fail("{}: relighting needs the visibility field {} that was baked with this light field, but {} does not exist",
            scene.sourcePath, visibilityPath, visibilityPath);
+    const uint64_t hash = readVisibilityInfo(visibilityPath).hash;
+    // First keyed against the light field's scene (parameterisation.h reuseTixelSetup): a .plt
+    // written for another light field of the same geometry, or one whose charts a warm-started
+    // bake marked (warm_start.h), gets the charts of each changed material filled again and the
+    // masks of each moved light traced again. Else taken as it is (a .plt without keys).
+    TixelSetupReuse reuse;
     if (lf.sunMaskLightCount != param.sunMaskLights.size())
       why = "the light field's sun masks do not match its charts";
-    else if (readTixelSetup(setupPath, readVisibilityInfo(visibilityPath).hash, lf.sunMasks, param, &why))
+    else if (reuseTixelSetup(setupPath, hash, scene, *accel, param, reuse, &why) ||
+             readTixelSetup(setupPath, hash, lf.sunMasks, param, &why))
       return true;
     if (log)
       log(fmt::format("relight: filling the tixels again (buried-point probes, footprints, sun masks), because {}; "
@@ -591,8 +612,9 @@ Relighter::Relighter(const LightField& lightField, VisibilityShard visibility, c
     : impl_(std::make_unique<Impl>(lightField, std::move(visibility), std::nullopt, log)) {}
 Relighter::Relighter(const LightField& lightField, VisibilityShard visibility, Parameterisation param, const Note& log)
     : impl_(std::make_unique<Impl>(lightField, std::move(visibility), std::move(param), log)) {}
-Relighter::Relighter(const LightField& lightField, const std::string& visibilityPath, const Note& log)
-    : impl_(std::make_unique<Impl>(lightField, visibilityPath, std::nullopt, log)) {}
+Relighter::Relighter(const LightField& lightField, const std::string& visibilityPath, const Note& log,
+                     uint64_t decodedBudget)
+    : impl_(std::make_unique<Impl>(lightField, visibilityPath, std::nullopt, log, decodedBudget)) {}
 Relighter::~Relighter() = default;
 Relighter::Relighter(Relighter&&) noexcept = default;
 Relighter& Relighter::operator=(Relighter&&) noexcept = default;

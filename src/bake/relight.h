@@ -91,11 +91,15 @@ class Relighter {
   /// The same with the visibility field read from `visibilityPath` (a .plv); pl::Error naming
   /// it when it is missing or was traced for another scene or settings. The parameterisation's
   /// charts are rebuilt (buildCharts: about a second on Crytek Sponza) and its tixel setup read
-  /// from the .plt the bake wrote beside the .plv (parameterisation.h readTixelSetup), or, when
+  /// from the .plt the bake wrote beside the .plv, keyed against the light field's scene
+  /// (parameterisation.h reuseTixelSetup: a changed material's charts filled again, a moved
+  /// sun's masks traced again; a .plt without keys taken as it is, readTixelSetup), or, when
   /// there is none for this .plv, filled again (fillTixels: minutes on a large scene; `log`
-  /// says why).
+  /// says why). The field is held decoded (VisibilityShard::decoded, decoded as it is checked:
+  /// every iteration's gather then reads it directly) when that takes at most `decodedBudget`
+  /// bytes (bake.h decodedFieldBudget); 0: kept compact.
   Relighter(const LightField& lightField, const std::string& visibilityPath,
-            const std::function<void(const std::string&)>& log = {});
+            const std::function<void(const std::string&)>& log = {}, uint64_t decodedBudget = 0);
   ~Relighter();
   Relighter(Relighter&&) noexcept;
   Relighter& operator=(Relighter&&) noexcept;

@@ -20,26 +20,22 @@
 #include "plf/plv_file.h"
 #include "support/expect_error.h"
 #include "support/light_field_difference.h"
-#include "support/quad_mesh.h"
+#include "support/relight_scenes.h"
 #include "support/temp_dir_test.h"
 
 namespace pl {
 namespace {
 
+using test_support::cornellWithPointLight;
+using test_support::materialIndex;
+using test_support::relightTestSettings;
+using test_support::sunAt;
+using test_support::sunScene;
+
 class RelightTest : public ::testing::Test {
  protected:
   void SetUp() override { Progress::setEnabled(false); }
 };
-
-BakeSettings testSettings(float tixelsAcross = 10.0f) {
-  BakeSettings s = bakePreset("draft");
-  s.tixelsAcrossScene = tixelsAcross;
-  s.gatherDirections = 64;
-  s.areaLightSamples = 8;
-  s.tolerance = 1e-4f;
-  s.maxIterations = 400;
-  return s;
-}
 
 /// A bake with its parameterisation and visibility field kept, as a Relighter.
 Relighter bakeForRelight(const Scene& scene, const BakeSettings& settings, LightField* baked = nullptr) {
@@ -66,23 +62,8 @@ void expectFreshBake(const Relighter& relighter, const BakeSettings& settings, c
   EXPECT_EQ(relit.sunMaskLightCount, fresh.sunMaskLightCount) << step;
 }
 
-uint32_t materialIndex(const Scene& scene, const std::string& name) {
-  for (uint32_t m = 0; m < scene.materials.size(); ++m)
-    if (scene.materials[m].name == name) return m;
-  ADD_FAILURE() << "no material " << name;
-  return 0;
-}
-
-Scene cornellWithPointLight() {
-  Scene scene = makeCornellBox();
-  scene.lights.push_back(createLight("point", {{"position", Vec3(278.0f, 400.0f, 200.0f)}, {"intensity", Vec3(2e4f)}},
-                                     "test light"));
-  scene.finalize();
-  return scene;
-}
-
 TEST_F(RelightTest, CornellSequenceEqualsFreshBakes) {
-  const BakeSettings settings = testSettings();
+  const BakeSettings settings = relightTestSettings();
   Relighter relighter = bakeForRelight(cornellWithPointLight(), settings);
   const uint32_t light = materialIndex(relighter.scene(), "light");
   const uint32_t red = materialIndex(relighter.scene(), "red");
@@ -125,7 +106,7 @@ TEST_F(RelightTest, CornellSequenceEqualsFreshBakes) {
 // The built-in box's one light recoloured: the solution is scaled per channel, exactly
 // converged, without an iteration.
 TEST_F(RelightTest, RecolouringTheOnlyLightScalesTheSolution) {
-  const BakeSettings settings = testSettings();
+  const BakeSettings settings = relightTestSettings();
   LightField baked;
   Relighter relighter = bakeForRelight(makeCornellBox(), settings, &baked);
   const uint32_t light = materialIndex(relighter.scene(), "light");
@@ -152,7 +133,7 @@ TEST_F(RelightTest, GlossyBoxSequenceEqualsFreshBakes) {
   Scene scene = loadScene(std::string(PLENOPTIC_TEST_DATA_DIR) + "/cornell-mcguire/CornellBox-Glossy.obj");
   scene.lights.push_back(createLight("point", {{"position", Vec3(0.0f, 1.2f, 0.3f)}, {"intensity", Vec3(0.5f)}}, "test"));
   scene.finalize();
-  const BakeSettings settings = testSettings(8.0f);
+  const BakeSettings settings = relightTestSettings(8.0f);
   Relighter relighter = bakeForRelight(scene, settings);
   const uint32_t light = materialIndex(relighter.scene(), "light");
   relighter.setEmission(light, Rgb(0.5f, 0.8f, 1.5f));
@@ -171,31 +152,8 @@ TEST_F(RelightTest, GlossyBoxSequenceEqualsFreshBakes) {
   expectFreshBake(relighter, settings, "glossy: light moved, albedo");
 }
 
-/// An open scene under a grey sky: a floor, a wall standing on it and a sun.
-Scene sunScene(const Vec3& sunDirection) {
-  Scene scene;
-  scene.sourcePath = "sun test";
-  Material ground;
-  ground.name = "ground";
-  ground.bsdf = LambertBsdf{Rgb(0.6f)};
-  scene.materials.push_back(ground);
-  Mesh mesh;
-  test_support::addQuad(mesh, Vec3(0, 0, 0), Vec3(0, 0, 10), Vec3(10, 0, 10), Vec3(10, 0, 0), 0);
-  test_support::addQuad(mesh, Vec3(3, 0, 5), Vec3(7, 0, 5), Vec3(7, 3, 5), Vec3(3, 3, 5), 0);
-  scene.meshes.push_back(std::move(mesh));
-  scene.environment.constant = Rgb(0.2f, 0.3f, 0.5f);
-  scene.lights.push_back(createLight("directional", {{"direction", sunDirection}, {"irradiance", Vec3(3.0f)}}, "sun"));
-  scene.finalize();
-  return scene;
-}
-
-Vec3 sunAt(float elevationDegrees, float azimuthDegrees) {
-  const float e = elevationDegrees * kPi / 180.0f, a = azimuthDegrees * kPi / 180.0f;
-  return -Vec3(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
-}
-
 TEST_F(RelightTest, SunMovedRetracesItsMasksOnly) {
-  const BakeSettings settings = testSettings(16.0f);
+  const BakeSettings settings = relightTestSettings(16.0f);
   Relighter relighter = bakeForRelight(sunScene(sunAt(40.0f, 20.0f)), settings);
   ASSERT_EQ(relighter.parameterisation().sunMaskLights.size(), 1u);
   Light sun = relighter.scene().lights[0];
@@ -217,7 +175,7 @@ TEST_F(RelightTest, SunMovedRetracesItsMasksOnly) {
 
 // A small change starts near the solution: fewer iterations than a cold bake, the same field.
 TEST_F(RelightTest, WarmStartNeedsFewerIterationsThanColdStart) {
-  const BakeSettings settings = testSettings();
+  const BakeSettings settings = relightTestSettings();
   Relighter relighter = bakeForRelight(cornellWithPointLight(), settings);
   Light moved = relighter.scene().lights[0];
   std::get<PointLight>(moved).position += Vec3(20.0f, 0.0f, 0.0f);
@@ -232,7 +190,7 @@ TEST_F(RelightTest, WarmStartNeedsFewerIterationsThanColdStart) {
 // Iteration by iteration: the callback sees every iteration and may stop; the next relight()
 // goes on to the same result.
 TEST_F(RelightTest, CancelledRelightGoesOnLater) {
-  const BakeSettings settings = testSettings();
+  const BakeSettings settings = relightTestSettings();
   Relighter relighter = bakeForRelight(cornellWithPointLight(), settings);
   relighter.setAlbedo(materialIndex(relighter.scene(), "white"), Rgb(0.3f));
   const RelightStats first = relighter.relight([](const RelightProgress& p) { return p.iteration < 1; });
@@ -262,7 +220,7 @@ void expectRefused(const std::function<void()>& change, const std::string& what)
 }
 
 TEST_F(RelightTest, RefusesWhatTheFieldCannotServe) {
-  const BakeSettings settings = testSettings(6.0f);
+  const BakeSettings settings = relightTestSettings(6.0f);
   Relighter relighter = bakeForRelight(cornellWithPointLight(), settings);
   const Scene original = relighter.scene();
   expectRefused([&] { relighter.setLight(0, createLight("spot", {{"position", Vec3(278.0f, 400.0f, 200.0f)}}, "t")); },
@@ -300,7 +258,7 @@ TEST_F(RelightTest, RefusesWhatTheFieldCannotServe) {
 }
 
 TEST_F(RelightTest, RefusesAVisibilityFieldOfAnotherScene) {
-  const BakeSettings settings = testSettings(6.0f);
+  const BakeSettings settings = relightTestSettings(6.0f);
   Parameterisation param;
   VisibilityShard visibility;
   BakeOptions options;
@@ -344,7 +302,7 @@ void expectSameTixelSetup(const Parameterisation& a, const Parameterisation& b) 
 }
 
 TEST_F(RelightFileTest, LoadedLightFieldRelightsAsRightAfterTheBake) {
-  const BakeSettings settings = testSettings(16.0f);
+  const BakeSettings settings = relightTestSettings(16.0f);
   Parameterisation param;
   VisibilityShard visibility;
   BakeOptions options;
@@ -407,7 +365,7 @@ TEST_F(RelightFileTest, LoadedLightFieldRelightsAsRightAfterTheBake) {
 // only what the edited scene changed: the light field is a full bake's of that scene, bit for
 // bit, whatever changed and whether the .plt is there, stale or another bake's.
 TEST_F(RelightFileTest, ReusedVisibilityTakesTheTixelSetupAndEqualsFullBakes) {
-  const BakeSettings settings = testSettings(16.0f);
+  const BakeSettings settings = relightTestSettings(16.0f);
   const Scene original = sunScene(sunAt(40.0f, 20.0f));
   BakeOptions save;
   save.visibilityPath = path("s.plv");

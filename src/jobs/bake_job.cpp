@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <optional>
 #include <utility>
 
 #include "core/error.h"
@@ -14,6 +15,7 @@
 #include "bake/bake.h"
 #include "bake/shard.h"
 #include "bake/relight.h"
+#include "bake/warm_start.h"
 #include "distributed/communicator.h"
 #include "plf/compression.h"
 #include "plf/plf_file.h"
@@ -36,6 +38,8 @@ std::string BakeJobStats::toJson() const {
   json["two_sided_charts"] = twoSidedCharts;
   json["back_side_tixels"] = backSideTixels;
   json["sun_mask_lights"] = sunMaskLights;
+  json["warm_start"] = warmStart;
+  json["warm_start_reason"] = warmStartReason;
   json["curved_charts"] = curvedCharts;  // chart records (a two-sided curved chart counts twice)
   json["curved_tixels"] = curvedTixels;
   json["visibility_rays_per_second"] =
@@ -72,6 +76,10 @@ BakeJob::BakeJob(BakeJobOptions options) : options_(std::move(options)) {
     visibilityPath_ = visibilityPathFor(options_.output);
   if (!visibilityPath_.empty()) checkOutputPath(visibilityPath_, {".plv"}, "--visibility");
   if (!options_.statsPath.empty()) checkOutputPath(options_.statsPath, {}, "--stats");
+  if (!options_.warmStart.empty()) {
+    if (options_.noWarmStart) failUsage("bake: --warm-start and --no-warm-start contradict each other");
+    options_.reuseVisibility = true;
+  }
   checkDistinctOutputs({{"-o", options_.output}, {"--visibility", visibilityPath_}, {"--stats", options_.statsPath}});
   (void)bakePreset(options_.preset);          // an unknown preset names the known ones
   (void)parseValuesCodec(options_.compress);  // an unknown codec names the known ones
@@ -147,9 +155,22 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
   bakeOptions.distributedStats = &distributed;
   bakeOptions.keepParameterisation = options_.keepParameterisation;
   bakeOptions.keepVisibility = options_.keepVisibility;
-  BakeJobResult result{bake(std::move(scene), settings(), bakeOptions), {}};
+  WarmStartOutcome warm;
+  std::optional<LightField> warmed;
+  if (!options_.reuseVisibility) {
+    warm.reason = "the bake does not reuse its visibility field (--reuse-visibility)";
+  } else if (options_.noWarmStart) {
+    warm.reason = "--no-warm-start";
+  } else {
+    const std::string& previous = options_.warmStart.empty() ? options_.output : options_.warmStart;
+    if (previous.empty()) warm.reason = "there is no previous light field to start from (no output path)";
+    else warmed = warmStartBake(scene, settings(), previous, bakeOptions, warm);
+  }
+  BakeJobResult result{warmed ? std::move(*warmed) : bake(std::move(scene), settings(), bakeOptions), {}};
   const LightField& lf = result.lightField;
   BakeJobStats& stats = result.stats;
+  stats.warmStart = warm.used;
+  stats.warmStartReason = warm.reason;
   stats.distributed = distributed;
   // Every rank holds the whole light field; rank 0 alone writes it (atomically) and the stats.
   const bool writer = !options_.communicator || options_.communicator->rank() == 0;

@@ -166,6 +166,12 @@ struct BakeJobOptions {
   int64_t causticPhotons = -1;  ///< BakeSettings::causticPhotons (`--caustic-photons`); −1 = the preset's, 0 = no caustic pass
   uint32_t subsurfaceWalks = 0;  ///< BakeSettings::subsurfaceWalks (`--subsurface-walks`); 0 = the preset's
   bool reuseVisibility = false;
+  /// With reuseVisibility: the previous light field to warm-start from (`--warm-start`,
+  /// bake/warm_start.h); empty = the one at `output`, if any. Setting it implies reuseVisibility.
+  std::string warmStart;
+  /// With reuseVisibility: never warm-start, propagate from zero (`--no-warm-start`): the light
+  /// field a full bake would give, bit for bit.
+  bool noWarmStart = false;
   /// Ignore what an interrupted bake left to resume from (`--fresh`; BakeOptions::resume).
   bool fresh = false;
   /// The most memory the bake may plan to use (`--max-memory`, parseMemorySize): the memory
@@ -194,6 +200,8 @@ struct BakeJobStats {
   BakeStats bake;
   uint64_t charts = 0, twoSidedCharts = 0, backSideTixels = 0, curvedCharts = 0, curvedTixels = 0, fileBytes = 0;
   uint32_t sunMaskLights = 0;  ///< directional lights with sun masks (LightField::sunMaskLightCount)
+  bool warmStart = false;         ///< the previous light field was relit (bake/warm_start.h)
+  std::string warmStartReason;    ///< when not: why
   DistributedBakeStats distributed;
   std::string toJson() const;
 };
