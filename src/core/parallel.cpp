@@ -11,6 +11,7 @@
 #include <tbb/task_scheduler_observer.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
 #include <optional>
 
 namespace pl {
@@ -50,6 +51,11 @@ ThreadPool::ThreadPool(int threads) : impl_(std::make_unique<Impl>()) {
 }
 
 ThreadPool::~ThreadPool() = default;
+
+int poolThreads() {
+  return int(std::min<size_t>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+                              size_t(tbb::info::default_concurrency())));
+}
 
 void runWithThreads(int threads, const std::function<void()>& work) {
   ensureDenormalObserver();

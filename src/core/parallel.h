@@ -26,6 +26,10 @@ class ThreadPool {
   int threads_;
 };
 
+/// The number of threads a parallel loop may use now: the innermost ThreadPool's limit, else
+/// every hardware thread.
+int poolThreads();
+
 /// Sets FTZ/DAZ on the calling thread (the observer does it for TBB workers).
 void enableFlushDenormals();
 

@@ -7,14 +7,6 @@
 #include <cmath>
 #include <variant>
 
-#if defined(__linux__)
-#include <pthread.h>
-#include <sched.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-#endif
-
 #include "bake/relight.h"
 #include "core/cancel.h"
 #include "core/error.h"
@@ -27,26 +19,12 @@ namespace {
 constexpr float kSunStepDegrees = 5.0f;
 constexpr float kMaxElevationDegrees = 89.0f;
 constexpr float kDimmer = 0.8f, kBrighter = 1.25f, kDarker = 0.9f, kLighter = 1.1f;
-constexpr int kBackgroundNice = 10, kIdleNice = 19;
 
 /// The colours C cycles a source through (multiplying its baked emission).
 constexpr Rgb kColours[] = {Rgb(1.0f), Rgb(1.0f, 0.75f, 0.5f), Rgb(0.6f, 0.8f, 1.0f),
                             Rgb(1.0f, 0.2f, 0.2f), Rgb(0.2f, 1.0f, 0.2f), Rgb(0.3f, 0.3f, 1.0f)};
 constexpr const char* kColourNames[] = {"white", "warm", "cool", "red", "green", "blue"};
 constexpr uint32_t kColourCount = sizeof(kColours) / sizeof(kColours[0]);
-
-/// Lowers the calling thread's priority (live_relight.h, "Cores"). Idle: Linux's SCHED_IDLE
-/// policy, which runs it only on a core no thread of normal priority wants (CFS weight 3
-/// against nice 0's 1024), or where that is refused nice +19; Nice: nice +10 (weight 110).
-void lowerThreadPriority(RelightShare share) {
-#if defined(__linux__)
-  const sched_param none{};
-  if (share == RelightShare::Idle && pthread_setschedparam(pthread_self(), SCHED_IDLE, &none) == 0) return;
-  setpriority(PRIO_PROCESS, id_t(syscall(SYS_gettid)), share == RelightShare::Idle ? kIdleNice : kBackgroundNice);
-#else
-  (void)share;
-#endif
-}
 
 /// Azimuth and elevation (degrees; y up) of the direction towards a light travelling `travel`.
 void sunAngles(const Vec3& travel, float& azimuth, float& elevation) {
@@ -173,7 +151,7 @@ void LiveRelight::press(RelightKey key) {
 }
 
 void LiveRelight::work() {
-  lowerThreadPriority(share_);
+  applyRelightPriority(share_);
   try {
     runWithThreads(1, [&] {
       relighter_ = std::make_unique<Relighter>(original_, visibilityPath_);
@@ -274,6 +252,12 @@ const LightField& LiveRelight::lightField() const { return shown_ >= 0 ? buffers
 RelightStatus LiveRelight::status() const {
   const std::lock_guard lock(mutex_);
   return status_;
+}
+
+bool LiveRelight::busy() const {
+  const std::lock_guard lock(mutex_);
+  if (!status_.ready) return status_.message.empty();  // setting up, or off
+  return status_.running || pending_;
 }
 
 bool LiveRelight::showsNewest() const {

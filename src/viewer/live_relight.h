@@ -13,12 +13,9 @@
 //   M              select the next Lambertian material;  , / .  its albedo × 0.9 / × 1.1 (at most 1)
 //
 // Cores: the propagation (and the relighter's set-up) runs on one thread of its own, in a
-// one-thread task arena (core/parallel.h runWithThreads), under Linux's SCHED_IDLE policy
-// (RelightShare::Idle; nice +19 where that is refused): the renderer keeps all the pool's
-// threads, and the propagation runs only on a core no ordinary thread wants — the frame's
-// serial parts, the waits for input when the view is still; on two cores, one core's worth
-// at most. Under nice +10 alone (RelightShare::Nice) it kept a share of a core the renderer
-// wanted (CFS weight 110 against 1024 per renderer thread), which a parallel frame waits for.
+// one-thread task arena (core/parallel.h runWithThreads), at the priority of its RelightShare
+// (core_share.h: normal under Split, the viewer's, which gives the renderer the pool's
+// threads − 1 meanwhile; busy() tells the viewer when that applies).
 //
 // Double buffering: two copies of the light field (made once; the scene's geometry and
 // textures are shared by neither, so each is a full copy); the worker writes the one not on
@@ -34,6 +31,7 @@
 
 #include "lightfield/lightfield.h"
 #include "realtime/realtime.h"
+#include "viewer/core_share.h"
 
 namespace pl {
 
@@ -58,18 +56,12 @@ struct RelightStatus {
   std::string message;      ///< the last refusal or error
 };
 
-/// How the background thread shares the cores with the renderer ("Cores" above).
-enum class RelightShare {
-  Idle,  ///< SCHED_IDLE (Linux; elsewhere nice +19): it runs only where no ordinary thread wants a core
-  Nice,  ///< nice +10 only: a small share of a core the renderer wants (for comparison: relight_bench --share)
-};
-
 class LiveRelight {
  public:
   /// Starts the background thread, which builds the Relighter from `lightField` and the .plv
   /// at visibilityPath (its errors go to status().message). lightField and accel must outlive it.
   LiveRelight(const LightField& lightField, const Accel& accel, const std::string& visibilityPath,
-              RelightShare share = RelightShare::Idle);
+              RelightShare share = RelightShare::Split);
   ~LiveRelight();  ///< stops the worker (cancelling its set-up or iteration: core/cancel.h) and joins it
   LiveRelight(const LiveRelight&) = delete;
   LiveRelight& operator=(const LiveRelight&) = delete;
@@ -84,6 +76,9 @@ class LiveRelight {
   /// The light field on screen (the original until the first relit iteration).
   const LightField& lightField() const;
   RelightStatus status() const;
+  /// Whether the worker is setting up or relighting (a relight asked for counts at once), i.e.
+  /// uses its core: not after it converged, stopped, or was refused, nor when the set-up failed.
+  bool busy() const;
   /// Whether the screen shows the newest relit light field (one was published and taken).
   bool showsNewest() const;
   /// HUD lines: the selected source and material, and the propagation's state.

@@ -13,17 +13,20 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "accel/accel.h"
 #include "camera/camera.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/timing.h"
 #include "image/display.h"
 #include "image/frame_output.h"
 #include "gpu/gpu.h"
 #include "image/image.h"
 #include "realtime/realtime.h"
+#include "viewer/core_share.h"
 #include "viewer/fly_camera.h"
 #include "viewer/hud_text.h"
 #include "viewer/live_relight.h"
@@ -296,12 +299,11 @@ class ViewerSession {
         fly_(options.camera, speed_),
         renderer_(lightField, accel, options),
         window_(options.title, options.width, options.height, renderer_.gpu()),
-        scale_(renderer_.gpu() ? 0.0 : options.targetFps),
         toneMap_(options.toneMap),
         recorder_(options.recordInterval),
         start_(Clock::now()) {
     if (!options.visibilityPath.empty()) {
-      live_ = std::make_unique<LiveRelight>(lightField, accel, options.visibilityPath);
+      live_ = std::make_unique<LiveRelight>(lightField, accel, options.visibilityPath, kViewerShare);
       for (char c : options.relightKeys)
         live_->press(*relightKeyOfChar(c));
     }
@@ -365,6 +367,10 @@ class ViewerSession {
     window_.outputSize(width, height);
     const Clock::time_point renderStart = Clock::now();
     const bool relit = live_ && live_->update();
+    // The cores' share of this frame (core_share.h): while the relighter works and the CPU
+    // draws, one core is the relighter's and the frames hold kRelightTargetFps.
+    share_ = coreShare(kViewerShare, poolThreads(), live_ && live_->busy(),
+                       !renderer_.gpu() || (live_ && live_->renderer()), options_.targetFps);
     const double scale = renderFrame(width, height, relit);
     const bool rendered = scale > 0.0;
     if (rendered) renderMs_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
@@ -376,13 +382,15 @@ class ViewerSession {
     window_.present();
     // The frame-rate controller learns from frames at the settings' own samples per pixel.
     if (rendered && shown_ != Shown::Refined)
-      scale_.record(scale, std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
+      scales_(share_).record(scale, std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
     return rendered;
   }
 
   /// Counts a frame that rendered (the HUD's fps averages the last kTimingWindow of them);
   /// after one that did not (nothing left to refine) an interactive session waits for input.
   void endFrame(Clock::time_point frameStart, bool rendered) {
+    if (rendered && share_.minFrameSeconds > 0.0)
+      std::this_thread::sleep_until(frameStart + std::chrono::duration<double>(share_.minFrameSeconds));
     if (!rendered) {
       if (options_.frames == 0 && !options_.path) SDL_WaitEventTimeout(nullptr, kIdleWaitMs);
       return;
@@ -422,6 +430,9 @@ class ViewerSession {
 
  private:
   static constexpr int kIdleWaitMs = 50;
+  /// The viewer's core-sharing policy while relighting (core_share.h; docs/benchmarks.md
+  /// "Relighting" has the measurements that chose it).
+  static constexpr RelightShare kViewerShare = RelightShare::Split;
 
   double secondsAt(Clock::time_point t) const { return std::chrono::duration<double>(t - start_).count(); }
   /// The starting exposure with the +/− offset.
@@ -450,7 +461,7 @@ class ViewerSession {
     shownHeight_ = height;
     if (moved || shown_ == Shown::Scaled) {
       // The very first frame is at full resolution: the controller has no frame time yet.
-      const double scale = moved && !first ? scale_.scale(true) : 1.0;
+      const double scale = moved && !first ? scales_(share_).scale(true) : 1.0;
       int w = width, h = height;
       scaledSize(width, height, scale, w, h);
       draw(cameraAt(w, h), options_.render, frame_);
@@ -486,11 +497,13 @@ class ViewerSession {
   /// Renders with the relit light field's CPU renderer once live relighting has published one
   /// (the GPU renderer draws the baked light field only), else with the session's renderer.
   void draw(const Camera& camera, const RenderSettings& settings, Image& image) {
-    if (const FastRenderer* relit = live_ ? live_->renderer() : nullptr) {
-      relit->render(camera, settings, image);
-    } else {
-      renderer_.render(camera, settings, image);
-    }
+    drawWithShare(share_, [&] {
+      if (const FastRenderer* relit = live_ ? live_->renderer() : nullptr) {
+        relit->render(camera, settings, image);
+      } else {
+        renderer_.render(camera, settings, image);
+      }
+    });
   }
 
   /// The shown view at full resolution and the settings' samples per pixel: what `plenoptic
@@ -550,9 +563,12 @@ class ViewerSession {
     std::vector<std::string> lines = {
         fmt::format("{:.1f} FPS  {:.2f} MS/FRAME  (RENDER {:.2f} MS)  {}X{}", meanMs > 0 ? 1e3 / meanMs : 0.0, meanMs,
                     renderMs_.empty() ? 0.0 : renderMs_.back(), width, height),
-        fmt::format("{} RENDERER  SCALE {:.0f}% ({}X{})  {} SPP{}", renderer_.gpu() ? "GPU" : "CPU",
+        fmt::format("{} RENDERER  SCALE {:.0f}% ({}X{})  {} SPP{}{}", renderer_.gpu() && !(live_ && live_->renderer()) ? "GPU" : "CPU",
                     100.0 * double(frame_.width) / double(width), frame_.width, frame_.height, spp,
-                    !renderer_.gpu() && scale_.targetFps() > 0 ? fmt::format("  TARGET {:g} FPS", scale_.targetFps()) : ""),
+                    share_.targetFps > 0 ? fmt::format("  TARGET {:g} FPS", share_.targetFps) : "",
+                    share_.renderThreads > 0 ? fmt::format("  {} THREAD{} (RELIGHT 1)", share_.renderThreads,
+                                                           share_.renderThreads > 1 ? "S" : "")
+                                             : ""),
         fmt::format("EYE {:.3g} {:.3g} {:.3g}", eye.x, eye.y, eye.z),
         fmt::format("EXPOSURE {:+.1f} EV  TONEMAP {}{}", exposureEv_, toneMapOperatorName(toneMap_.op),
                     recorder_.recording() ? "  [REC]" : ""),
@@ -581,7 +597,8 @@ class ViewerSession {
   FrameRenderer renderer_;
   DisplayEncoder display_;
   Window window_;
-  RenderScaleController scale_;
+  ShareScale scales_;
+  CoreShare share_;  ///< the frame's (renderAndPresent)
   float exposureEv_ = 0.0f;  ///< the +/− offset on top of options.exposureScale
   ToneMapSettings toneMap_;
   Image frame_;         ///< what the window shows (radiance; scaled, base or refined)

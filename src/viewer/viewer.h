@@ -17,7 +17,8 @@
 // Frame rate: with the CPU renderer, while the camera moves each frame is rendered at the
 // reduced internal resolution RenderScaleController (render_scale.h) picks for the frame-rate
 // target and upscaled (bilinear) to the window (the GPU renderer draws every frame at full
-// resolution). When the camera stops, the frame is rendered at full resolution, then (both
+// resolution). While the live relighting works, the cores are shared by core_share.h (Split):
+// the CPU renderer on the pool's threads − 1 at kRelightTargetFps, the relighter on one core. When the camera stops, the frame is rendered at full resolution, then (both
 // renderers) refined with batches of jittered samples averaged up to kRefinedSamples per
 // pixel; then the loop waits for input. Screenshots are always the full-resolution frame at the --spp samples (what
 // `render` writes), rendered for the purpose when the window shows a scaled or refined one.
