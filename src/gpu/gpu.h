@@ -81,6 +81,7 @@
 
 #include "gpu/gpu_bvh.h"
 #include "image/image.h"
+#include "light/light.h"
 #include "lightfield/lightfield.h"
 #include "lightfield/render_settings.h"
 
@@ -170,6 +171,32 @@ class GpuRenderer {
   /// the index in the scene's meshes' triangles in order (mesh 0's first). `occluded`, when
   /// given, gets bvhOccluded's answer per ray (1: blocked).
   std::vector<BvhHit> intersect(const std::vector<Ray>& rays, std::vector<uint8_t>* occluded = nullptr);
+
+  /// One query of the light sampler's GLSL (gpu_lights.h), at `position` with the numbers `u`;
+  /// emitterPdf's arguments (triangle: the scene's index, mesh by mesh), environmentPdf's
+  /// direction and sphereLightAlong's ray (from origin along unit direction, in (0, tMax),
+  /// the receiver `position`).
+  struct LightQuery {
+    Vec3 position{0.0f};
+    Vec2 u{0.0f};
+    uint32_t triangle = 0;
+    float distance = 1.0f, cosLight = 1.0f;
+    Vec3 origin{0.0f}, direction{0.0f, 0.0f, 1.0f};
+    float tMax = kInfinity;
+  };
+  /// What the GLSL answers: LightSampler::sample (sampled: it returned a sample; delta: a delta
+  /// light, whose fields are unset), emitterPdf, environmentPdf and sphereLightAlong.
+  struct LightAnswer {
+    bool sampled = false;
+    LightSample sample;
+    float emitterPdf = 0.0f, environmentPdf = 0.0f;
+    bool sphere = false;  ///< sphereLightAlong found one
+    LightSampler::SphereCrossing crossing;
+  };
+  /// The light sampler's GLSL run on each query in a compute shader, with `sampler`'s tables
+  /// uploaded (a sampler of this renderer's scene). Throws pl::Error for lights it does not
+  /// sample (gpuUnsupportedLights).
+  std::vector<LightAnswer> sampleLights(const LightSampler& sampler, const std::vector<LightQuery>& queries);
 
   /// The GL_RENDERER and GL_VERSION strings of the context (e.g. "llvmpipe (LLVM 15.0.6, 256
   /// bits)", "4.5 (Core Profile) Mesa 22.3.6").

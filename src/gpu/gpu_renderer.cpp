@@ -14,6 +14,7 @@
 #include "gpu/gpu.h"
 #include "gpu/gpu_bvh.h"
 #include "gpu/gpu_highlights.h"
+#include "gpu/gpu_lights.h"
 #include "gpu/gpu_specular.h"
 #include "gpu/gpu_memory.h"
 #include "gpu/gpu_surface_detail.h"
@@ -668,6 +669,34 @@ void main() {
 }
 )glsl";
 
+// The light sampler on queries (GpuRenderer::sampleLights).
+constexpr const char* kLightsCompute = R"glsl(
+layout(local_size_x = 64) in;
+// position | u.x, u.y | triangle | distance | cosLight, origin | tMax, direction | 0
+struct LightQuery { vec4 position; vec4 pdfArguments; vec4 origin; vec4 direction; };
+layout(std430, binding = QUERIES_BINDING) readonly buffer Queries { LightQuery queries[]; };
+// Per query: (wi, sampled + 2·delta + 4·infinite), (incident, pdf), (target, emitterPdf),
+// (sphere radiance, sphere pdf), (environment pdf, sphere found, 0, 0).
+layout(std430, binding = RESULTS_BINDING) writeonly buffer Results { vec4 results[]; };
+uniform uint count;
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  LightQuery q = queries[i];
+  LightSampleGpu s;
+  bool sampled = lightSample(q.position.xyz, vec2(q.position.w, q.pdfArguments.x), s);
+  float flags = (sampled ? 1.0 : 0.0) + (s.delta ? 2.0 : 0.0) + (s.infinite ? 4.0 : 0.0);
+  results[5u * i] = vec4(s.wi, flags);
+  results[5u * i + 1u] = vec4(s.incident, s.pdf);
+  results[5u * i + 2u] = vec4(s.target, emitterPdf(floatBitsToUint(q.pdfArguments.y), q.pdfArguments.z, q.pdfArguments.w));
+  vec3 radiance;
+  float pdf;
+  bool sphere = sphereLightAlong(q.origin.xyz, q.direction.xyz, 0.0, q.origin.w, q.position.xyz, radiance, pdf);
+  results[5u * i + 3u] = vec4(radiance, pdf);
+  results[5u * i + 4u] = vec4(environmentLightPdf(q.direction.xyz), sphere ? 1.0 : 0.0, 0.0, 0.0);
+}
+)glsl";
+
 const char* glErrorName(GLenum error) {
   switch (error) {
     case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
@@ -811,6 +840,8 @@ struct GpuRenderer::State {
   GLuint rayBuffers[6] = {};
   bool bvhUploaded = false;
   GLuint intersectProgram = 0;  ///< GpuRenderer::intersect's, made on its first call
+  GLuint lightTable = 0;        ///< the light sampler's table (gpu_lights.h)
+  GLuint lightsProgram = 0;     ///< GpuRenderer::sampleLights's, made on its first call
   bool specular = false;        ///< the light field has specular charts: the shading passes trace their chains
   bool highlights = false;      ///< gpuHighlightsActive: the shading passes add punctual highlights
   /// The shading pass with several jittered samples per pixel; 0 where the driver lacks
@@ -829,6 +860,8 @@ struct GpuRenderer::State {
     glDeleteBuffers(kBufferCount, buffers);
     glDeleteBuffers(6, rayBuffers);
     glDeleteProgram(intersectProgram);
+    glDeleteProgram(lightsProgram);
+    glDeleteBuffers(1, &lightTable);
     glDeleteVertexArrays(1, &vertexArray);
     glDeleteVertexArrays(1, &emptyVertexArray);
     glDeleteProgram(visibilityProgram);
@@ -1256,6 +1289,51 @@ std::vector<BvhHit> GpuRenderer::intersect(const std::vector<Ray>& rays, std::ve
     if (occluded != nullptr) (*occluded)[i] = output[8 * i + 4] != 0.0f ? 1 : 0;
   }
   return hits;
+}
+
+std::vector<GpuRenderer::LightAnswer> GpuRenderer::sampleLights(const LightSampler& sampler,
+                                                                 const std::vector<LightQuery>& queries) {
+  if (const std::string unsupported = gpuUnsupportedLights(sampler); !unsupported.empty())
+    fail("GPU renderer: the light sampler does not sample {}", unsupported);
+  State& s = *state_;
+  s.context.makeCurrent();
+  const std::vector<uint32_t> table = gpuLightTable(sampler);
+  glDeleteBuffers(1, &s.lightTable);
+  glCreateBuffers(1, &s.lightTable);
+  glNamedBufferStorage(s.lightTable, GLsizeiptr(table.size() * sizeof(uint32_t)), table.data(), 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightTableBinding, s.lightTable);
+  if (s.lightsProgram == 0)
+    s.lightsProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kGeometryGlsl) + kSurfaceGlsl + kLightsGlsl + kLightsCompute}},
+                                  "light sampler", false, specularGlslConstants() + lightGlslConstants());
+  std::vector<float> input;
+  input.reserve(queries.size() * 16);
+  for (const LightQuery& q : queries) {
+    float triangle;
+    std::memcpy(&triangle, &q.triangle, sizeof(float));
+    input.insert(input.end(), {q.position.x, q.position.y, q.position.z, q.u.x, q.u.y, triangle, q.distance, q.cosLight,
+                               q.origin.x, q.origin.y, q.origin.z, q.tMax, q.direction.x, q.direction.y, q.direction.z, 0.0f});
+  }
+  const size_t count = queries.size();
+  const std::vector<float> output = runQueries(s.lightsProgram, input, count, 20, "the light sampler queries");
+  std::vector<LightAnswer> answers(count);
+  for (size_t i = 0; i < count; ++i) {
+    const float* r = &output[20 * i];
+    LightAnswer& a = answers[i];
+    const int flags = int(r[3]);
+    a.sampled = (flags & 1) != 0;
+    a.sample.delta = (flags & 2) != 0;
+    a.sample.infinite = (flags & 4) != 0;
+    a.sample.wi = Vec3(r[0], r[1], r[2]);
+    a.sample.incident = Rgb(r[4], r[5], r[6]);
+    a.sample.pdf = r[7];
+    a.sample.target = Vec3(r[8], r[9], r[10]);
+    a.emitterPdf = r[11];
+    a.crossing.radiance = Rgb(r[12], r[13], r[14]);
+    a.crossing.pdf = r[15];
+    a.environmentPdf = r[16];
+    a.sphere = r[17] != 0.0f;
+  }
+  return answers;
 }
 
 std::string GpuRenderer::deviceName() const {
