@@ -16,7 +16,8 @@
 //                  delta light, which the GLSL only reports as chosen)
 //   entry of triangle   LightSampler::entryOfTriangle, four a row (−1 as 0xffffffff)
 // So the GLSL chooses the same entry as the C++ for the same number (the binary search of
-// Distribution1D::sample on the same doubles) and stretches it the same way.
+// Distribution1D::sample on the same doubles: GLSL doubles are core since OpenGL 4.0) and
+// stretches it the same way.
 //
 // What the GLSL samples (kLightsGlsl lightSample): emissive triangles (uniform by area, Le by
 // the emission sidedness rule, an emission texture's texel where the shading pass has surface
