@@ -863,7 +863,7 @@ struct GpuRenderer::State {
   GLuint intersectProgram = 0;  ///< GpuRenderer::intersect's, made on its first call
   GLuint lightTable = 0;        ///< the light sampler's table (gpu_lights.h)
   GLuint lightsProgram = 0;     ///< GpuRenderer::sampleLights's, made on its first call
-  GLuint lobeModels = 0;        ///< GpuRenderer::sampleLobes's models (highlightModels)
+  GLuint lobeModels = 0;        ///< GpuRenderer::sampleLobes's models (highlightModels) without highlights
   GLuint lobesProgram = 0;      ///< GpuRenderer::sampleLobes's, made on its first call
   bool specular = false;        ///< the light field has specular charts: the shading passes trace their chains
   bool highlights = false;      ///< gpuHighlightsActive: the shading passes add punctual highlights
@@ -1367,17 +1367,19 @@ std::vector<GpuRenderer::LobeAnswer> GpuRenderer::sampleLobes(const std::vector<
   State& s = *state_;
   s.context.makeCurrent();
   if (s.lobesProgram == 0) {
-    const std::vector<HighlightModelGpu> models = highlightModels(lightField_.scene);
-    glCreateBuffers(1, &s.lobeModels);
-    glNamedBufferStorage(s.lobeModels, GLsizeiptr(std::max<size_t>(models.size() * sizeof(HighlightModelGpu), 16)),
-                         models.empty() ? nullptr : models.data(), 0);
-    s.uploadBvh(lightField_.scene);
+    // The highlights' model records: the renderer's own where it has highlights, else a copy.
+    if (!s.highlights) {
+      const std::vector<HighlightModelGpu> models = highlightModels(lightField_.scene);
+      glCreateBuffers(1, &s.lobeModels);
+      glNamedBufferStorage(s.lobeModels, GLsizeiptr(std::max<size_t>(models.size() * sizeof(HighlightModelGpu), 16)),
+                           models.empty() ? nullptr : models.data(), 0);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kHighlightModelsBinding, s.lobeModels);
+    }
     s.lobesProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + kGeometryGlsl + kBvhGlsl + kSurfaceGlsl +
                                                           kHighlightsGlsl + kMirrorLikeGlsl + kLobesCompute}},
                                  "mirror-like lobe", true,
                                  highlightGlslConstants() + bvhGlslConstants() + specularGlslConstants());
   }
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kHighlightModelsBinding, s.lobeModels);
   std::vector<float> input;
   input.reserve(queries.size() * 12);
   for (const LobeQuery& q : queries) {
