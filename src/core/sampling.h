@@ -111,6 +111,9 @@ class Distribution1D {
   double total() const { return total_; }
   /// Probability of bin i (sums to 1 over bins).
   float probability(size_t i) const { return pdf_[i]; }
+  /// The normalised cumulative sums sample() searches: size()+1 values from 0 to 1 (all 0 when
+  /// the weights are), in double (the GPU renderer's copy searches the same, gpu/gpu_lights.h).
+  std::span<const double> cdf() const { return cdf_; }
   /// Samples a bin; returns its index and rescales u to [0,1) within the bin in *remapped.
   size_t sample(float u, float* remapped = nullptr) const {
     const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), static_cast<double>(u));

@@ -75,12 +75,17 @@
 //
 // The shader's lookup is checked against the C++ one (exitantRadiance) on random inputs by
 // GpuRenderer::lookup, which runs the very GLSL function the shading pass calls.
+// The light sampler's GLSL (gpu_lights.h) is checked against LightSampler the same way by
+// GpuRenderer::sampleLights, and the mirror-like lobe's (gpu_mirror_like.h) by
+// GpuRenderer::sampleLobes.
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "bsdf/bsdf.h"
 #include "gpu/gpu_bvh.h"
 #include "image/image.h"
+#include "light/light.h"
 #include "lightfield/lightfield.h"
 #include "lightfield/render_settings.h"
 
@@ -170,6 +175,49 @@ class GpuRenderer {
   /// the index in the scene's meshes' triangles in order (mesh 0's first). `occluded`, when
   /// given, gets bvhOccluded's answer per ray (1: blocked).
   std::vector<BvhHit> intersect(const std::vector<Ray>& rays, std::vector<uint8_t>* occluded = nullptr);
+
+  /// One query of the light sampler's GLSL (gpu_lights.h), at `position` with the numbers `u`;
+  /// emitterPdf's arguments (triangle: the scene's index, mesh by mesh), environmentPdf's
+  /// direction and sphereLightAlong's ray (from origin along unit direction, in (0, tMax),
+  /// the receiver `position`).
+  struct LightQuery {
+    Vec3 position{0.0f};
+    Vec2 u{0.0f};
+    uint32_t triangle = 0;
+    float distance = 1.0f, cosLight = 1.0f;
+    Vec3 origin{0.0f}, direction{0.0f, 0.0f, 1.0f};
+    float tMax = kInfinity;
+  };
+  /// What the GLSL answers: LightSampler::sample (sampled: it returned a sample; delta: a delta
+  /// light, whose fields are unset), emitterPdf, environmentPdf and sphereLightAlong.
+  struct LightAnswer {
+    bool sampled = false;
+    LightSample sample;
+    float emitterPdf = 0.0f, environmentPdf = 0.0f;
+    bool sphere = false;  ///< sphereLightAlong found one
+    LightSampler::SphereCrossing crossing;
+  };
+  /// The light sampler's GLSL run on each query in a compute shader, with `sampler`'s tables
+  /// uploaded (a sampler of this renderer's scene). Throws pl::Error for lights it does not
+  /// sample (gpuUnsupportedLights).
+  std::vector<LightAnswer> sampleLights(const LightSampler& sampler, const std::vector<LightQuery>& queries);
+
+  /// One query of the mirror-like lobe's GLSL (gpu_mirror_like.h): material `material`'s model
+  /// sampled for local direction wo with the numbers u, and its density for wi.
+  struct LobeQuery {
+    uint32_t material = 0;
+    Vec3 wo{0.0f, 0.0f, 1.0f}, wi{0.0f, 0.0f, 1.0f};
+    Vec2 u{0.0f};
+  };
+  /// What the GLSL answers: sample(bsdf, wo, u) (sampled: it returned one; its wi, weight and
+  /// pdf) and pdf(bsdf, wo, wi) as wiPdf.
+  struct LobeAnswer {
+    bool sampled = false;
+    BsdfSample sample;
+    float wiPdf = 0.0f;
+  };
+  /// The mirror-like lobe's GLSL run on each query in a compute shader.
+  std::vector<LobeAnswer> sampleLobes(const std::vector<LobeQuery>& queries);
 
   /// The GL_RENDERER and GL_VERSION strings of the context (e.g. "llvmpipe (LLVM 15.0.6, 256
   /// bits)", "4.5 (Core Profile) Mesa 22.3.6").

@@ -14,6 +14,8 @@
 #include "gpu/gpu.h"
 #include "gpu/gpu_bvh.h"
 #include "gpu/gpu_highlights.h"
+#include "gpu/gpu_lights.h"
+#include "gpu/gpu_mirror_like.h"
 #include "gpu/gpu_specular.h"
 #include "gpu/gpu_memory.h"
 #include "gpu/gpu_surface_detail.h"
@@ -630,13 +632,17 @@ void main() {
 #endif
 )glsl";
 
+// What every query program (runQueries) begins with: 64-wide groups and the query count.
+constexpr const char* kQueryComputeHead = R"glsl(
+layout(local_size_x = 64) in;
+uniform uint count;
+)glsl";
+
 // The lookup on queries (GpuRenderer::lookup).
 constexpr const char* kLookupCompute = R"glsl(
-layout(local_size_x = 64) in;
 struct Query { vec4 position; vec4 towardsViewer; };  // position.w: the chart, as uint bits
 layout(std430, binding = QUERIES_BINDING) readonly buffer Queries { Query queries[]; };
 layout(std430, binding = RESULTS_BINDING) writeonly buffer Results { vec4 results[]; };
-uniform uint count;
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= count) return;
@@ -649,12 +655,10 @@ void main() {
 
 // The BVH traversal on rays (GpuRenderer::intersect).
 constexpr const char* kIntersectCompute = R"glsl(
-layout(local_size_x = 64) in;
 struct TraceRay { vec4 origin; vec4 direction; };  // origin.w: tMin, direction.w: tMax
 layout(std430, binding = QUERIES_BINDING) readonly buffer Rays { TraceRay rays[]; };
 // Per ray: (t, triangle as uint bits, u, v), then (occluded, 0, 0, 0).
 layout(std430, binding = RESULTS_BINDING) writeonly buffer Hits { vec4 hits[]; };
-uniform uint count;
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= count) return;
@@ -665,6 +669,52 @@ void main() {
   bvhIntersect(r.origin.xyz, r.direction.xyz, r.origin.w, r.direction.w, t, triangle, uv);
   hits[2u * i] = vec4(t, uintBitsToFloat(triangle), uv);
   hits[2u * i + 1u] = vec4(bvhOccluded(r.origin.xyz, r.direction.xyz, r.origin.w, r.direction.w) ? 1.0 : 0.0, 0.0, 0.0, 0.0);
+}
+)glsl";
+
+// The light sampler on queries (GpuRenderer::sampleLights).
+constexpr const char* kLightsCompute = R"glsl(
+// position | u.x, u.y | triangle | distance | cosLight, origin | tMax, direction | 0
+struct LightQuery { vec4 position; vec4 pdfArguments; vec4 origin; vec4 direction; };
+layout(std430, binding = QUERIES_BINDING) readonly buffer Queries { LightQuery queries[]; };
+// Per query: (wi, sampled + 2·delta + 4·infinite), (incident, pdf), (target, emitterPdf),
+// (sphere radiance, sphere pdf), (environment pdf, sphere found, 0, 0).
+layout(std430, binding = RESULTS_BINDING) writeonly buffer Results { vec4 results[]; };
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  LightQuery q = queries[i];
+  LightSampleGpu s;
+  bool sampled = lightSample(q.position.xyz, vec2(q.position.w, q.pdfArguments.x), s);
+  float flags = (sampled ? 1.0 : 0.0) + (s.delta ? 2.0 : 0.0) + (s.infinite ? 4.0 : 0.0);
+  results[5u * i] = vec4(s.wi, flags);
+  results[5u * i + 1u] = vec4(s.incident, s.pdf);
+  results[5u * i + 2u] = vec4(s.target, emitterPdf(floatBitsToUint(q.pdfArguments.y), q.pdfArguments.z, q.pdfArguments.w));
+  vec3 radiance;
+  float pdf;
+  bool sphere = sphereLightAlong(q.origin.xyz, q.direction.xyz, 0.0, q.origin.w, q.position.xyz, radiance, pdf);
+  results[5u * i + 3u] = vec4(radiance, pdf);
+  results[5u * i + 4u] = vec4(environmentLightPdf(q.direction.xyz), sphere ? 1.0 : 0.0, 0.0, 0.0);
+}
+)glsl";
+
+// The mirror-like lobe on queries (GpuRenderer::sampleLobes).
+constexpr const char* kLobesCompute = R"glsl(
+// Per query three rows: wo | material (uint bits), wi | 0, u | 0, 0.
+layout(std430, binding = QUERIES_BINDING) readonly buffer Queries { vec4 lobeQueries[]; };
+// Per query: (wi, sampled), (weight, pdf), (pdf of the query's wi, 0, 0, 0).
+layout(std430, binding = RESULTS_BINDING) writeonly buffer Results { vec4 results[]; };
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  vec4 a = lobeQueries[3u * i], b = lobeQueries[3u * i + 1u], c = lobeQueries[3u * i + 2u];
+  HighlightModel m = highlightModels[floatBitsToUint(a.w)];
+  vec3 wi, weight;
+  float pdf;
+  bool sampled = sampleMirrorLikeLobe(m, a.xyz, c.xy, wi, weight, pdf);
+  results[3u * i] = vec4(wi, sampled ? 1.0 : 0.0);
+  results[3u * i + 1u] = vec4(weight, pdf);
+  results[3u * i + 2u] = vec4(mirrorLikeLobePdf(m, a.xyz, b.xyz), 0.0, 0.0, 0.0);
 }
 )glsl";
 
@@ -811,6 +861,10 @@ struct GpuRenderer::State {
   GLuint rayBuffers[6] = {};
   bool bvhUploaded = false;
   GLuint intersectProgram = 0;  ///< GpuRenderer::intersect's, made on its first call
+  GLuint lightTable = 0;        ///< the light sampler's table (gpu_lights.h)
+  GLuint lightsProgram = 0;     ///< GpuRenderer::sampleLights's, made on its first call
+  GLuint lobeModels = 0;        ///< GpuRenderer::sampleLobes's models (highlightModels) without highlights
+  GLuint lobesProgram = 0;      ///< GpuRenderer::sampleLobes's, made on its first call
   bool specular = false;        ///< the light field has specular charts: the shading passes trace their chains
   bool highlights = false;      ///< gpuHighlightsActive: the shading passes add punctual highlights
   /// The shading pass with several jittered samples per pixel; 0 where the driver lacks
@@ -829,6 +883,10 @@ struct GpuRenderer::State {
     glDeleteBuffers(kBufferCount, buffers);
     glDeleteBuffers(6, rayBuffers);
     glDeleteProgram(intersectProgram);
+    glDeleteProgram(lightsProgram);
+    glDeleteBuffers(1, &lightTable);
+    glDeleteProgram(lobesProgram);
+    glDeleteBuffers(1, &lobeModels);
     glDeleteVertexArrays(1, &vertexArray);
     glDeleteVertexArrays(1, &emptyVertexArray);
     glDeleteProgram(visibilityProgram);
@@ -1079,7 +1137,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                               (s.specular ? kSpecularGlsl : "");
   s.shadingProgram =
       linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}}, "shading", true, raysHeader);
-  s.lookupProgram = linkProgram({{GL_COMPUTE_SHADER, kLookupCompute}}, "lookup", true);
+  s.lookupProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + kLookupCompute}}, "lookup", true);
   if (epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
     s.multisampleProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}},
                                        "multi-sample shading", true,
@@ -1239,8 +1297,9 @@ std::vector<BvhHit> GpuRenderer::intersect(const std::vector<Ray>& rays, std::ve
   s.context.makeCurrent();
   s.uploadBvh(lightField_.scene);
   if (s.intersectProgram == 0)
-    s.intersectProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kGeometryGlsl) + kBvhGlsl + kIntersectCompute}},
-                                     "intersect", false, bvhGlslConstants());
+    s.intersectProgram =
+        linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + kGeometryGlsl + kBvhGlsl + kIntersectCompute}},
+                    "intersect", false, bvhGlslConstants());
   std::vector<float> input;
   input.reserve(rays.size() * 8);
   for (const Ray& r : rays)
@@ -1256,6 +1315,90 @@ std::vector<BvhHit> GpuRenderer::intersect(const std::vector<Ray>& rays, std::ve
     if (occluded != nullptr) (*occluded)[i] = output[8 * i + 4] != 0.0f ? 1 : 0;
   }
   return hits;
+}
+
+std::vector<GpuRenderer::LightAnswer> GpuRenderer::sampleLights(const LightSampler& sampler,
+                                                                 const std::vector<LightQuery>& queries) {
+  if (const std::string unsupported = gpuUnsupportedLights(sampler); !unsupported.empty())
+    fail("GPU renderer: the light sampler does not sample {}", unsupported);
+  State& s = *state_;
+  s.context.makeCurrent();
+  const std::vector<uint32_t> table = gpuLightTable(sampler);
+  glDeleteBuffers(1, &s.lightTable);
+  glCreateBuffers(1, &s.lightTable);
+  glNamedBufferStorage(s.lightTable, GLsizeiptr(table.size() * sizeof(uint32_t)), table.data(), 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightTableBinding, s.lightTable);
+  if (s.lightsProgram == 0)
+    s.lightsProgram = linkProgram(
+        {{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + kGeometryGlsl + kSurfaceGlsl + kLightsGlsl + kLightsCompute}},
+        "light sampler", false, specularGlslConstants() + lightGlslConstants());
+  std::vector<float> input;
+  input.reserve(queries.size() * 16);
+  for (const LightQuery& q : queries) {
+    float triangle;
+    std::memcpy(&triangle, &q.triangle, sizeof(float));
+    input.insert(input.end(), {q.position.x, q.position.y, q.position.z, q.u.x, q.u.y, triangle, q.distance, q.cosLight,
+                               q.origin.x, q.origin.y, q.origin.z, q.tMax, q.direction.x, q.direction.y, q.direction.z, 0.0f});
+  }
+  const size_t count = queries.size();
+  const std::vector<float> output = runQueries(s.lightsProgram, input, count, 20, "the light sampler queries");
+  std::vector<LightAnswer> answers(count);
+  for (size_t i = 0; i < count; ++i) {
+    const float* r = &output[20 * i];
+    LightAnswer& a = answers[i];
+    const int flags = int(r[3]);
+    a.sampled = (flags & 1) != 0;
+    a.sample.delta = (flags & 2) != 0;
+    a.sample.infinite = (flags & 4) != 0;
+    a.sample.wi = Vec3(r[0], r[1], r[2]);
+    a.sample.incident = Rgb(r[4], r[5], r[6]);
+    a.sample.pdf = r[7];
+    a.sample.target = Vec3(r[8], r[9], r[10]);
+    a.emitterPdf = r[11];
+    a.crossing.radiance = Rgb(r[12], r[13], r[14]);
+    a.crossing.pdf = r[15];
+    a.environmentPdf = r[16];
+    a.sphere = r[17] != 0.0f;
+  }
+  return answers;
+}
+
+std::vector<GpuRenderer::LobeAnswer> GpuRenderer::sampleLobes(const std::vector<LobeQuery>& queries) {
+  State& s = *state_;
+  s.context.makeCurrent();
+  if (s.lobesProgram == 0) {
+    // The highlights' model records: the renderer's own where it has highlights, else a copy.
+    if (!s.highlights) {
+      const std::vector<HighlightModelGpu> models = highlightModels(lightField_.scene);
+      glCreateBuffers(1, &s.lobeModels);
+      glNamedBufferStorage(s.lobeModels, GLsizeiptr(std::max<size_t>(models.size() * sizeof(HighlightModelGpu), 16)),
+                           models.empty() ? nullptr : models.data(), 0);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kHighlightModelsBinding, s.lobeModels);
+    }
+    s.lobesProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + kGeometryGlsl + kBvhGlsl + kSurfaceGlsl +
+                                                          kHighlightsGlsl + kMirrorLikeGlsl + kLobesCompute}},
+                                 "mirror-like lobe", true,
+                                 highlightGlslConstants() + bvhGlslConstants() + specularGlslConstants());
+  }
+  std::vector<float> input;
+  input.reserve(queries.size() * 12);
+  for (const LobeQuery& q : queries) {
+    float material;
+    std::memcpy(&material, &q.material, sizeof(float));
+    input.insert(input.end(), {q.wo.x, q.wo.y, q.wo.z, material, q.wi.x, q.wi.y, q.wi.z, 0.0f, q.u.x, q.u.y, 0.0f, 0.0f});
+  }
+  const size_t count = queries.size();
+  const std::vector<float> output = runQueries(s.lobesProgram, input, count, 12, "the lobe queries");
+  std::vector<LobeAnswer> answers(count);
+  for (size_t i = 0; i < count; ++i) {
+    const float* r = &output[12 * i];
+    answers[i].sampled = r[3] != 0.0f;
+    answers[i].sample.wi = Vec3(r[0], r[1], r[2]);
+    answers[i].sample.weight = Rgb(r[4], r[5], r[6]);
+    answers[i].sample.pdf = r[7];
+    answers[i].wiPdf = r[8];
+  }
+  return answers;
 }
 
 std::string GpuRenderer::deviceName() const {

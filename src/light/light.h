@@ -30,6 +30,7 @@
 // of two triangles as over one rectangle — instead of over each emitter separately.
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "core/math.h"
@@ -147,6 +148,23 @@ class LightSampler {
   /// The emissive triangles' power, Σ π·A·Y(mean Le)·(2 if two-sided) (W, luminance).
   double emissiveTrianglePower() const { return triangleDistribution_.total(); }
 
+  /// The tables sample(), emitterPdf(), environmentPdf() and sphereLightAlong() read, as they
+  /// are (the GPU renderer uploads them: gpu/gpu_lights.h). Entries are in selection order:
+  /// the emissive triangles, then the scene lights, then the environment.
+  enum class Kind : uint8_t { Triangle, SceneLight, Environment };
+  struct Entry {
+    Kind kind;
+    uint32_t index;  ///< into emitterTriangles() or sceneLights()
+  };
+  std::span<const Entry> entries() const { return entries_; }
+  /// The selection over entries() (sample() without nextEventOnly).
+  const Distribution1D& selection() const { return all_; }
+  std::span<const EmissiveTriangle> emitterTriangles() const { return triangles_; }
+  /// Those of scene.lights with positive power.
+  std::span<const Light> sceneLights() const { return sceneLights_; }
+  /// The entry of each triangle of the scene (numbered mesh by mesh, in order), or −1.
+  std::span<const int32_t> entryOfTriangle() const { return entryOfTriangle_; }
+
   /// A point on the emissive triangles alone, chosen with probability ∝ their power and then
   /// uniformly by area (the bake's area-light shadow rays). Requires emissiveTriangleCount() > 0.
   EmitterPoint sampleEmitterPoint(Vec2 u) const;
@@ -156,11 +174,6 @@ class LightSampler {
   float emitterAreaPdf(uint32_t mesh, uint32_t triangle) const;
 
  private:
-  enum class Kind : uint8_t { Triangle, SceneLight, Environment };
-  struct Entry {
-    Kind kind;
-    uint32_t index;  ///< into triangles_ or sceneLights_
-  };
   std::optional<LightSample> sampleEntry(const Entry& entry, float selectProbability, const Vec3& position,
                                          Vec2 u) const;
   /// The emission texture at barycentrics b of e (1 when untextured).
