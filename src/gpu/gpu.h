@@ -40,8 +40,8 @@
 // chartShadingNormalAt), the triangle → chart map, the sun masks (one uint each; the masked
 // lights are uniforms), the environment map's texels (RGBA) and the surface detail
 // (gpu_surface_detail.h: the textures the shader reads — 4 bytes per texel of an 8-bit level
-// as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 256 bytes per
-// material, 7.8 KiB of GGX albedo tables, and where a chart, mask or traced hit needs uvs, 36 bytes per vertex and 4 per triangle). So
+// as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 292 bytes per
+// material, 10 KiB of GGX and sheen albedo tables, and where a chart, mask or traced hit needs uvs, 36 bytes per vertex and 4 per triangle). So
 // GPU memory is 16 bytes per value + 128 per chart + 32 per vertex + 28 per triangle + 4 per
 // sun mask + 16 per environment texel + the surface detail + the BVH's 32 per node and 4 per
 // triangle + (with mirrors, glass or punctual highlights) 64 per material and 4 per triangle for

@@ -989,19 +989,22 @@ TEST_F(GpuRendererTest, GpuMemoryIsTheLightFieldAndOneFrame) {
   GpuRenderer gpu(lf);
   Image image;
   gpu.render(Camera(firstCamera(lf.scene), 64, 48), RenderSettings{}, image);
-  // Values as 16-byte RGBA, 128 bytes per chart record, the geometry, 256 bytes per material
-  // and the GGX albedo tables after a 32-byte header (no textures, uvs or masks here), the BVH of
-  // the primary rays beside edges (32 bytes per node, 4 per triangle) and 24 bytes per pixel.
+  // Values as 16-byte RGBA, 128 bytes per chart record, the geometry, 292 bytes per material
+  // and the GGX and sheen albedo tables after a 32-byte header (no textures, uvs or masks here),
+  // the BVH of the primary rays beside edges (32 bytes per node, 4 per triangle) and 24 bytes
+  // per pixel.
   uint64_t geometry = 0;
   for (const Mesh& m : lf.scene.meshes) geometry += m.positions.size() * 32 + m.triangles.size() * 28;
   const GgxAlbedoTables& ggx = ggxAlbedoTables();
-  const uint64_t tables = 4 * (ggx.mu.size() + ggx.e0.size() + ggx.e5.size() + ggx.mean0.size() + ggx.mean5.size());
+  const SheenAlbedoTables& sheen = sheenAlbedoTables();
+  const uint64_t tables = 4 * (ggx.mu.size() + ggx.e0.size() + ggx.e5.size() + ggx.mean0.size() + ggx.mean5.size() +
+                               sheen.mu.size() + sheen.e.size() + sheen.scale.size());
   std::vector<Vec3> positions;
   std::vector<UVec3> triangles;
   flattenSceneTriangles(lf.scene, positions, triangles);
   const GpuBvh bvh = buildGpuBvh(positions, triangles);
   const uint64_t expected = lf.values.size() * 16 + lf.charts.size() * 128 + geometry + 32 +
-                            lf.scene.materials.size() * 256 + tables + bvh.nodes.size() * 32 +
+                            lf.scene.materials.size() * 292 + tables + bvh.nodes.size() * 32 +
                             bvh.order.size() * 4 + 64 * 48 * 24;
   EXPECT_LE(gpu.gpuBytes(), expected + 8 * 16);  // 16-byte stand-ins for empty buffers
   EXPECT_GE(gpu.gpuBytes(), expected);
