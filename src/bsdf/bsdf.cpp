@@ -417,9 +417,7 @@ std::optional<Vec3> sampleGgxDirection(const GgxBsdf& b, const Vec3& wo, Vec2 u)
 // Sampling: a mixture of the coat's and the base's visible-normal samplers, a uniform
 // hemisphere for the sheen (its lobe is broad, peaking at grazing) and the cosine hemisphere
 // for the diffuse, chosen with probabilities ∝ the terms' albedo estimates at wo above; pdf()
-// is the full mixture.
-
-constexpr float kCoatF0 = kClearcoatF0;  ///< the clearcoat's f0 (ior 1.5)
+// is the full mixture. The coat's f0 is kClearcoatF0 (ggx_lobe.h: ior 1.5).
 
 inline float sheenRoughness(float r) { return std::clamp(r, kSheenMinRoughness, 1.0f); }
 
@@ -534,7 +532,7 @@ struct PbrAlbedos {
 };
 PbrAlbedos pbrAlbedos(const GltfPbrBsdf& b, float mu) {
   PbrAlbedos a;
-  if (b.clearcoat > 0.0f) a.coat = GgxAlbedoTable::get().upperAlbedo(mu, b.clearcoatAlpha, kCoatF0, 1.0f);
+  if (b.clearcoat > 0.0f) a.coat = GgxAlbedoTable::get().upperAlbedo(mu, b.clearcoatAlpha, kClearcoatF0, 1.0f);
   if (sheenWeight(b) > 0.0f) a.sheen = SheenAlbedoTable::get().lookup(mu, b.sheenRoughness).albedo;
   a.base = ggxLobeAlbedo(b.alpha, b.f0, b.f90, mu).at;
   a.dielectric = b.dielectricF0 == b.f0 && b.dielectricF90 == b.f90
@@ -594,7 +592,7 @@ Rgb evalGltfPbr(const GltfPbrBsdf& b, const Vec3& wo, const Vec3& wi) {
   }
   if (b.clearcoat > 0.0f) {
     f *= 1.0f - b.clearcoat * std::max(o.coat, i.coat);
-    f += b.clearcoat * ggxSpecular(b.clearcoatAlpha, Rgb(kCoatF0), 1.0f, wo, wi);
+    f += b.clearcoat * ggxSpecular(b.clearcoatAlpha, Rgb(kClearcoatF0), 1.0f, wo, wi);
   }
   if (!isBlack(b.diffuse)) {
     const Rgb norm = pbrDiffuseNorm(b);

@@ -515,13 +515,13 @@ vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer)
 // jittered ray off its texel's triangle — the ray is cast through the BVH (gpu_bvh.h
 // bvhIntersect) as the CPU renderers cast theirs through Embree.
 bool primaryHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
-  const float far = 1.0 / 0.0;
   ivec2 texel = ivec2(floor(film * float(idScale)));
   ivec2 lastTexel = size * idScale - 1;
   uint id = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
   bool same = id != kMarkedTexel;
   for (int dy = -1; dy <= 1 && same; ++dy)
     for (int dx = -1; dx <= 1 && same; ++dx) same = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r == id;
+  const float far = 1.0 / 0.0;
   if (same && id == 0u) {
     t = far;
     triangle = 0xffffffffu;
