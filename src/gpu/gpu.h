@@ -56,8 +56,11 @@
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
 // picture): mirror-like glossy lobes (specular charts of a glossy model), glTF materials with a
-// clear coat or sheen over a diffuse base (and their highlights), albedo textures or vertex
-// colours on mirrors and glass. Punctual highlights
+// clear coat or sheen and a metallic-roughness texture (each point's k(μ) normalisation), albedo
+// textures on diffuse charts of a model other than Lambert or subsurface (which no bake makes),
+// glTF layered materials on mirrors and glass. A clear coat or sheen over a diffuse base takes
+// k(μ) from the GGX and sheen albedo tables (gpu_surface_detail.h); albedo textures and vertex
+// colours on mirrors and glass change nothing of them (materialModelAt). Punctual highlights
 // on glossy charts are evaluated per pixel with a shadow ray through the BVH
 // (gpu_highlights.h); a metallic-roughness texture gives each pixel its own model (its diffuse
 // part's ρ and k(μo), its highlights' lobe: gpu_surface_detail.h metallicRoughnessLobe). The traced rays read the surface detail at
