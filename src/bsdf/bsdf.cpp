@@ -417,9 +417,7 @@ std::optional<Vec3> sampleGgxDirection(const GgxBsdf& b, const Vec3& wo, Vec2 u)
 // Sampling: a mixture of the coat's and the base's visible-normal samplers, a uniform
 // hemisphere for the sheen (its lobe is broad, peaking at grazing) and the cosine hemisphere
 // for the diffuse, chosen with probabilities ∝ the terms' albedo estimates at wo above; pdf()
-// is the full mixture.
-
-constexpr float kCoatF0 = 0.04f;  ///< the clearcoat's f0 (ior 1.5)
+// is the full mixture. The coat's f0 is kClearcoatF0 (ggx_lobe.h: ior 1.5).
 
 inline float sheenRoughness(float r) { return std::clamp(r, kSheenMinRoughness, 1.0f); }
 
@@ -477,6 +475,16 @@ class SheenAlbedoTable {
     auto at = [&](int row) { return e_[row][i0] + tm * (e_[row][i0 + 1] - e_[row][i0]); };
     return {at(r0) + tr * (at(r0 + 1) - at(r0)), scale_[r0] + tr * (scale_[r0 + 1] - scale_[r0])};
   }
+  /// The table as the GPU renderer uploads it (ggx_lobe.h sheenAlbedoTables).
+  SheenAlbedoTables tables() const {
+    SheenAlbedoTables t;
+    t.muNodes = kMuNodes;
+    t.roughNodes = kRoughNodes;
+    t.mu.assign(mu_.begin(), mu_.end());
+    for (const auto& row : e_) t.e.insert(t.e.end(), row.begin(), row.end());
+    t.scale.assign(scale_.begin(), scale_.end());
+    return t;
+  }
 
  private:
   SheenAlbedoTable() {
@@ -524,7 +532,7 @@ struct PbrAlbedos {
 };
 PbrAlbedos pbrAlbedos(const GltfPbrBsdf& b, float mu) {
   PbrAlbedos a;
-  if (b.clearcoat > 0.0f) a.coat = GgxAlbedoTable::get().upperAlbedo(mu, b.clearcoatAlpha, kCoatF0, 1.0f);
+  if (b.clearcoat > 0.0f) a.coat = GgxAlbedoTable::get().upperAlbedo(mu, b.clearcoatAlpha, kClearcoatF0, 1.0f);
   if (sheenWeight(b) > 0.0f) a.sheen = SheenAlbedoTable::get().lookup(mu, b.sheenRoughness).albedo;
   a.base = ggxLobeAlbedo(b.alpha, b.f0, b.f90, mu).at;
   a.dielectric = b.dielectricF0 == b.f0 && b.dielectricF90 == b.f90
@@ -584,7 +592,7 @@ Rgb evalGltfPbr(const GltfPbrBsdf& b, const Vec3& wo, const Vec3& wi) {
   }
   if (b.clearcoat > 0.0f) {
     f *= 1.0f - b.clearcoat * std::max(o.coat, i.coat);
-    f += b.clearcoat * ggxSpecular(b.clearcoatAlpha, Rgb(kCoatF0), 1.0f, wo, wi);
+    f += b.clearcoat * ggxSpecular(b.clearcoatAlpha, Rgb(kClearcoatF0), 1.0f, wo, wi);
   }
   if (!isBlack(b.diffuse)) {
     const Rgb norm = pbrDiffuseNorm(b);
@@ -1245,8 +1253,21 @@ std::optional<GgxLobeParameters> ggxLobeParameters(const Bsdf& bsdf) {
   if (const auto* ggx = std::get_if<GgxBsdf>(&bsdf))
     return GgxLobeParameters{ggx->diffuse, clampAlpha(ggx->alpha), ggx->f0, 1.0f, ggx->f0, 1.0f};
   const auto* pbr = std::get_if<GltfPbrBsdf>(&bsdf);
-  if (pbr == nullptr || pbr->clearcoat > 0.0f || sheenWeight(*pbr) > 0.0f) return std::nullopt;
-  return GgxLobeParameters{pbr->diffuse, clampAlpha(pbr->alpha), pbr->f0, pbr->f90, pbr->dielectricF0, pbr->dielectricF90};
+  if (pbr == nullptr) return std::nullopt;
+  GgxLobeParameters p{pbr->diffuse, clampAlpha(pbr->alpha), pbr->f0, pbr->f90, pbr->dielectricF0, pbr->dielectricF90};
+  if (pbr->clearcoat > 0.0f || sheenWeight(*pbr) > 0.0f) {
+    p.clearcoat = pbr->clearcoat;
+    p.clearcoatAlpha = clampAlpha(pbr->clearcoatAlpha);
+    p.sheenColor = pbr->sheenColor;
+    p.sheenRoughness = sheenRoughness(pbr->sheenRoughness);
+    p.diffuseNorm = pbrDiffuseNorm(*pbr);
+  }
+  return p;
+}
+
+const SheenAlbedoTables& sheenAlbedoTables() {
+  static const SheenAlbedoTables tables = SheenAlbedoTable::get().tables();
+  return tables;
 }
 
 const GgxAlbedoTables& ggxAlbedoTables() {

@@ -40,8 +40,8 @@
 // chartShadingNormalAt), the triangle → chart map, the sun masks (one uint each; the masked
 // lights are uniforms), the environment map's texels (RGBA) and the surface detail
 // (gpu_surface_detail.h: the textures the shader reads — 4 bytes per texel of an 8-bit level
-// as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 256 bytes per
-// material, 7.8 KiB of GGX albedo tables, and where a chart, mask or traced hit needs uvs, 36 bytes per vertex and 4 per triangle). So
+// as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 292 bytes per
+// material, 10 KiB of GGX and sheen albedo tables, and where a chart, mask or traced hit needs uvs, 36 bytes per vertex and 4 per triangle). So
 // GPU memory is 16 bytes per value + 128 per chart + 32 per vertex + 28 per triangle + 4 per
 // sun mask + 16 per environment texel + the surface detail + the BVH's 32 per node and 4 per
 // triangle + (with mirrors, glass or punctual highlights) 64 per material and 4 per triangle for
@@ -56,8 +56,11 @@
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
 // picture): mirror-like glossy lobes (specular charts of a glossy model), glTF materials with a
-// clear coat or sheen over a diffuse base (and their highlights), albedo textures or vertex
-// colours on mirrors and glass; and of the render settings, thin lenses. Punctual highlights
+// clear coat or sheen and a metallic-roughness texture (each point's k(μ) normalisation), albedo
+// textures on diffuse charts of a model other than Lambert or subsurface (which no bake makes),
+// glTF layered materials on mirrors and glass. A clear coat or sheen over a diffuse base takes
+// k(μ) from the GGX and sheen albedo tables (gpu_surface_detail.h); albedo textures and vertex
+// colours on mirrors and glass change nothing of them (materialModelAt). Punctual highlights
 // on glossy charts are evaluated per pixel with a shadow ray through the BVH
 // (gpu_highlights.h); a metallic-roughness texture gives each pixel its own model (its diffuse
 // part's ρ and k(μo), its highlights' lobe: gpu_surface_detail.h metallicRoughnessLobe). The traced rays read the surface detail at
@@ -72,6 +75,11 @@
 // axis on small images, 4× at 1920×1080: its targets stay within 256 MiB) and each jittered ray
 // takes the triangle of the 3×3 of those finer texels around its film point by the same rule
 // (one triangle, unmarked, hit by the ray), else it is cast through the BVH.
+//
+// A thin lens (depth of field): each sample's lens point is the CPU renderers' (pixelSample's
+// second ZSobol dimension, mapped to the aperture by sampleConcentricDisk; the lens centre at
+// one sample per pixel) and its ray starts there, off the eye the id buffer is rasterised
+// from: every camera ray is cast through the BVH and the visibility pass is not drawn.
 //
 // The shader's lookup is checked against the C++ one (exitantRadiance) on random inputs by
 // GpuRenderer::lookup, which runs the very GLSL function the shading pass calls.
@@ -96,10 +104,6 @@ class Camera;
 /// The first feature of `lightField` the GPU renderer does not draw yet, as a phrase for a
 /// message ("alpha masks", …); empty when it draws all of it.
 std::string gpuUnsupportedFeature(const LightField& lightField);
-
-/// The first of `settings` (for `camera`) the GPU renderer does not support yet, whatever the
-/// driver; empty if none (GpuRenderer::unsupportedSetting adds what this driver lacks).
-std::string gpuUnsupportedSetting(const RenderSettings& settings, const Camera& camera);
 
 /// The bytes the CPU renderers hold of `lightField` once decoded: its values (12 bytes each),
 /// chart records, triangle → chart map and sun masks, its scene's geometry (positions,
@@ -141,14 +145,14 @@ class GpuRenderer {
   GpuRenderer& operator=(const GpuRenderer&) = delete;
 
   /// Renders camera.width() × camera.height() pixels of radiance into `image` (resized only
-  /// when its size differs), like FastRenderer::render: one ray through each pixel centre, or
-  /// with several samples per pixel the CPU renderers' film points
-  /// (pixelSample, render_settings.h), averaged. Throws pl::Error for settings it does not
+  /// when its size differs), like FastRenderer::render: one ray through each pixel centre (and
+  /// a thin lens's centre), or with several samples per pixel the CPU renderers' film and lens
+  /// points (pixelSample, render_settings.h), averaged. Throws pl::Error for settings it does not
   /// support (checkSettings).
   void render(const Camera& camera, const RenderSettings& settings, Image& image);
 
-  /// gpuUnsupportedSetting, and what this driver lacks for `settings` (several samples per
-  /// pixel need GL_ARB_gpu_shader_int64); empty when render() can draw them.
+  /// What this driver lacks for `settings` (several samples per pixel, a thin lens's default
+  /// among them, need GL_ARB_gpu_shader_int64); empty when render() can draw them.
   std::string unsupportedSetting(const RenderSettings& settings, const Camera& camera) const;
   /// checkRenderSettings, then throws pl::Error naming unsupportedSetting's answer, if any.
   void checkSettings(const RenderSettings& settings, const Camera& camera) const;

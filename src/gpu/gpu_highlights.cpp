@@ -20,18 +20,6 @@ bool gpuHighlightsActive(const LightField& lf) {
   return glossy && std::any_of(lf.scene.lights.begin(), lf.scene.lights.end(), [](const Light& l) { return isDeltaLight(l); });
 }
 
-std::string gpuUnsupportedHighlights(const LightField& lf) {
-  if (!gpuHighlightsActive(lf)) return {};
-  for (const Chart& c : lf.charts) {
-    if (c.kind != ChartKind::Glossy) continue;
-    const Material& material = lf.scene.materials[c.material];
-    const Bsdf& model = material.bsdf;
-    if (isRoughGlassChart(c, model) || std::holds_alternative<BlinnPhongBsdf>(model)) continue;
-    if (!ggxLobeParameters(model)) return "punctual highlights on glTF materials with a clear coat or sheen";
-  }
-  return {};
-}
-
 std::vector<HighlightLightGpu> highlightLights(const Scene& scene) {
   std::vector<HighlightLightGpu> result;
   for (const Light& light : scene.lights) {
@@ -94,8 +82,9 @@ std::string highlightGlslConstants() {
 // PunctualHighlights::radiance (lookup.cpp) with what it calls — scatteringFrame and
 // usableSide (scene.cpp) of a reflecting model, sampleLight of the delta lights
 // (lights.cpp incidentFromPoint, SpotLight::sample, DirectionalLight::sample), eval of
-// Blinn-Phong and the GGX-like models (bsdf.cpp evalBlinnPhong, evalGgx, evalGltfPbr without
-// layers, ggxSpecular, ggxD, ggxLambda), materialModelAt of a metallic-roughness texture,
+// Blinn-Phong and the GGX-like models (bsdf.cpp evalBlinnPhong, evalGgx, evalGltfPbr with its
+// clear coat and sheen, ggxSpecular, ggxD, ggxLambda, charlieD, charlieL, charlieLambda,
+// charlieLobe), materialModelAt of a metallic-roughness texture,
 // shadowRayTowards (light.cpp) and ShadowRays::transmittance — statement for statement.
 const char* const kHighlightsGlsl = R"glsl(
 struct HighlightLight { vec4 position; vec4 intensity; vec4 axis; vec4 cone; };
@@ -117,25 +106,71 @@ float ggxLambda(float alpha, vec3 w) {
   float tan2 = max(0.0, 1.0 - c2) / c2;
   return 0.5 * (sqrt(1.0 + alpha * alpha * tan2) - 1.0);
 }
-// eval of the chart's model in the local frame: Blinn-Phong's (m), or the GGX-like `ggx`
-// (evalGgx, evalGltfPbr without layers); withDiffuse: the diffuse part too.
-vec3 evalHighlightModel(HighlightModel m, GgxLobe ggx, bool withDiffuse, vec3 wo, vec3 wi) {
+// ggxSpecular (bsdf.cpp): the GGX lobe α (clamped) with Schlick's Fresnel f0 → f90.
+vec3 ggxSpecular(float alpha, vec3 f0, float f90, vec3 wo, vec3 wi) {
+  alpha = clamp(alpha, kGgxMinAlpha, 1.0);
+  vec3 h = normalize(wo + wi);
+  float g2 = 1.0 / (1.0 + ggxLambda(alpha, wo) + ggxLambda(alpha, wi));
+  float c = clamp(1.0 - dot(wo, h), 0.0, 1.0), c2 = c * c;
+  vec3 fresnel = f0 + (vec3(f90) - f0) * (c2 * c2 * c);
+  return fresnel * (ggxD(alpha, h) * g2 / (4.0 * wo.z * wi.z));
+}
+// The sheen's Charlie lobe D G / (4 cos θo cos θi) for roughness r (clamped): charlieD,
+// Estevez & Kulla's fit charlieL of ln Λ, charlieLambda, charlieLobe (bsdf.cpp).
+float charlieD(float r, float cosH) {
+  float invR = 1.0 / r;
+  float sin2 = max(0.0, 1.0 - cosH * cosH);
+  return (2.0 + invR) * pow(sin2, 0.5 * invR) * (0.5 * kInvPi);
+}
+float charlieL(float x, float r) {
+  float t = (1.0 - r) * (1.0 - r);
+  float a = mix(21.5473, 25.3245, t), b = mix(3.82987, 3.32435, t);
+  float c = mix(0.19823, 0.16801, t), d = mix(-1.97760, -1.27393, t);
+  float e = mix(-4.32054, -4.85967, t);
+  return a / (1.0 + b * pow(x, c)) + d * x + e;
+}
+float charlieLambda(float cosTheta, float r) {
+  return cosTheta < 0.5 ? exp(charlieL(cosTheta, r)) : exp(2.0 * charlieL(0.5, r) - charlieL(1.0 - cosTheta, r));
+}
+float charlieLobe(float r, vec3 wo, vec3 wi) {
+  vec3 h = normalize(wo + wi);
+  return charlieD(r, h.z) / ((1.0 + charlieLambda(wo.z, r) + charlieLambda(wi.z, r)) * 4.0 * wo.z * wi.z);
+}
+// eval of the chart's model in the local frame: Blinn-Phong's (m), or the GGX-like `ggx` under
+// `layers` (evalGgx; evalGltfPbr, its clear coat and sheen); withDiffuse: the diffuse part too.
+vec3 evalHighlightModel(HighlightModel m, GgxLobe ggx, PbrLayers layers, bool withDiffuse, vec3 wo, vec3 wi) {
   if (!(wo.z > 0.0 && wi.z > 0.0)) return vec3(0.0);
   uint kind = floatBitsToUint(m.diffuse.w);
-  vec3 h = normalize(wo + wi);
   if (kind == kHighlightBlinnPhong) {
+    vec3 h = normalize(wo + wi);
     vec3 diffuse = withDiffuse ? m.diffuse.rgb : vec3(0.0);
     return diffuse * 0.318309886183791 + m.lobe.rgb * (m.extra.x * pow(max(0.0, h.z), m.lobe.w));
   }
   if (kind != kHighlightGgx) return vec3(0.0);
-  float alpha = ggx.alpha;
-  float g2 = 1.0 / (1.0 + ggxLambda(alpha, wo) + ggxLambda(alpha, wi));
-  float c = clamp(1.0 - dot(wo, h), 0.0, 1.0), c2 = c * c;
-  vec3 fresnel = ggx.f0 + (vec3(ggx.f90) - ggx.f0) * (c2 * c2 * c);
-  vec3 f = fresnel * (ggxD(alpha, h) * g2 / (4.0 * wo.z * wi.z));
-  if (withDiffuse && any(notEqual(ggx.diffuse, vec3(0.0))))
-    f += ggx.diffuse * kInvPi * ggxDiffuseFactor(alpha, ggx.diffuseF0, ggx.diffuseF90, wo.z) *
-         ggxDiffuseFactor(alpha, ggx.diffuseF0, ggx.diffuseF90, wi.z);
+  vec3 f = ggxSpecular(ggx.alpha, ggx.f0, ggx.f90, wo, wi);
+  bool diffuse = withDiffuse && any(notEqual(ggx.diffuse, vec3(0.0)));
+  if (!hasLayers(layers)) {
+    if (diffuse)
+      f += ggx.diffuse * kInvPi * ggxDiffuseFactor(ggx.alpha, ggx.diffuseF0, ggx.diffuseF90, wo.z) *
+           ggxDiffuseFactor(ggx.alpha, ggx.diffuseF0, ggx.diffuseF90, wi.z);
+    return f;
+  }
+  // evalGltfPbr: the base lobe under the sheen, the sheen, both under the coat, the coat, and
+  // the diffuse part g(μo) g(μi) / Ḡ.
+  vec2 o = layerAlbedos(layers, wo.z), i = layerAlbedos(layers, wi.z);
+  float sheenWeight = max(0.0, max(layers.sheenColor.r, max(layers.sheenColor.g, layers.sheenColor.b)));
+  f *= 1.0 - sheenWeight * max(o.y, i.y);
+  if (sheenWeight > 0.0) {
+    float r = layers.sheenRoughness;
+    f += layers.sheenColor * (sheenAlbedo(0.0, r).y * charlieLobe(r, wo, wi));
+  }
+  if (layers.clearcoat > 0.0) {
+    f *= 1.0 - layers.clearcoat * max(o.x, i.x);
+    f += layers.clearcoat * ggxSpecular(layers.clearcoatAlpha, vec3(kClearcoatF0), 1.0, wo, wi);
+  }
+  if (diffuse)
+    f += ggx.diffuse * kInvPi * layeredDiffuseFactor(ggx.alpha, ggx.diffuseF0, ggx.diffuseF90, layers, wo.z) *
+         layeredDiffuseFactor(ggx.alpha, ggx.diffuseF0, ggx.diffuseF90, layers, wi.z);
   return f;
 }
 // The GGX-like model of material `material` at barycentrics uv of `triangle`: the material's
@@ -182,6 +217,7 @@ vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer)
   if (floatBitsToUint(model.diffuse.w) == kHighlightNoModel) return vec3(0.0);  // rough glass keeps them in its maps
   bool withDiffuse = (charts[record].info.z & kFlagDiffuseValue) == 0u;
   GgxLobe ggx = highlightLobe(model, material, triangle, uv);
+  PbrLayers layers = pbrLayersAt(detail[2] + kMaterialWords * material + kMaterialDiffuseLobe);
   vec3 position, geometricNormal, shadingNormal;
   surfaceAt(triangle, uv, position, geometricNormal, shadingNormal);
   // scatteringFrame of a reflecting model: both normals turned to the viewer's side.
@@ -217,7 +253,7 @@ vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer)
     }
     vec3 wiLocal = vec3(dot(wi, s), dot(wi, t), dot(wi, n));
     if (!(dot(wi, g) > 0.0)) continue;
-    vec3 f = evalHighlightModel(model, ggx, withDiffuse, wo, wiLocal);
+    vec3 f = evalHighlightModel(model, ggx, layers, withDiffuse, wo, wiLocal);
     float cosIn = abs(wiLocal.z);
     if (all(equal(f, vec3(0.0))) || !(cosIn > 0.0) || all(equal(incident, vec3(0.0)))) continue;
     // shadowRayTowards: to the light's position, or unbounded along wi at infinity.

@@ -12,12 +12,13 @@
 // thin glass sheet crossed), traced through the GPU BVH (gpu_bvh.h).
 //
 // The models evaluated: Blinn-Phong and the GGX-like models of bsdf.h ggxLobeParameters (GGX,
-// glTF PBR without a clear coat or sheen: the lobe ggxSpecular and the diffuse part
-// ρ/π · k(μo) · k(μi) with k from the GGX tables), their diffuse part included on a chart
-// without Ẽ; with a metallic-roughness texture the hit point's own model (metallicRoughnessLobe
-// of the texel and the albedo modulation at full resolution, materialModelAt's point).
-// gpuUnsupportedHighlights names what else a light field with highlights has on its glossy
-// charts (glTF models with a clear coat or sheen).
+// glTF PBR: the lobe ggxSpecular and the diffuse part ρ/π · k(μo) · k(μi) with k from the GGX
+// tables; a glTF model's sheen (the Charlie lobe, its albedo from the sheen table) and clear
+// coat over them, each scaling what lies below, and k of the diffuse part under them: read from
+// the material's surface-detail record, gpu_surface_detail.h), their diffuse part included on
+// a chart without Ẽ; with a metallic-roughness texture the hit point's own model
+// (metallicRoughnessLobe of the texel and the albedo modulation at full resolution,
+// materialModelAt's point; not with a clear coat or sheen: gpu_surface_detail.h refuses it).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -30,10 +31,6 @@ namespace pl {
 /// has glossy charts and its scene has delta lights (PunctualHighlights::active for the charts
 /// the GPU renderer draws).
 bool gpuHighlightsActive(const LightField& lf);
-
-/// The first feature of `lf`'s highlights the GPU renderer does not evaluate (see above), as a
-/// phrase for gpuUnsupportedFeature; empty when none (or no highlights).
-std::string gpuUnsupportedHighlights(const LightField& lf);
 
 /// One delta light as kHighlightsGlsl reads it (std430: four 16-byte rows).
 struct HighlightLightGpu {
@@ -60,8 +57,7 @@ inline constexpr uint32_t kHighlightNoModel = 0, kHighlightBlinnPhong = 1, kHigh
 
 /// The scene's delta lights, in its order.
 std::vector<HighlightLightGpu> highlightLights(const Scene& scene);
-/// Per material of the scene (kHighlightNoModel for what no glossy chart evaluates: rough glass,
-/// models with a clear coat or sheen).
+/// Per material of the scene (kHighlightNoModel for what no glossy chart evaluates: rough glass).
 std::vector<HighlightModelGpu> highlightModels(const Scene& scene);
 
 /// The storage-buffer bindings of the lights and the models.
@@ -73,7 +69,7 @@ std::string highlightGlslConstants();
 /// PunctualHighlights::radiance at barycentrics uv of `triangle`, seen as chart record
 /// `record` (viewedRecord) from unit direction towardsViewer; uniforms highlightLightCount and
 /// shadowsPassThinGlass (Scene::hasThinGlass). Needs kBvhGlsl, kSurfaceGlsl and the lookup's
-/// chart records before it.
+/// chart records and the surface detail's GLSL before it.
 extern const char* const kHighlightsGlsl;
 
 }  // namespace pl

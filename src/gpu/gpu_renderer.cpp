@@ -345,6 +345,7 @@ layout(std430, binding = NORMALS_BINDING) readonly buffer Normals { vec4 normals
 constexpr const char* kFrameGlsl = R"glsl(
 uniform vec3 eye, forward, right, up;
 uniform float tanHalfFovY, aspect;
+uniform float apertureRadius, focusDistance;  // Camera's thin lens (scene units; 0: a pinhole)
 uniform ivec2 size;
 uniform int idScale;  // the ids are at idScale × the image's resolution
 uniform bool anyMasked;  // some material is alpha-masked (maskedMaterial)
@@ -537,21 +538,48 @@ bool primaryHit(vec2 film, vec3 direction, out float t, out uint triangle, out v
   return bvhIntersect(eye, direction, 0.0, far, t, triangle, b);
 }
 
+// sampleConcentricDisk (core/sampling.h): u ∈ [0,1)² to the unit disk (Shirley–Chiu).
+vec2 sampleConcentricDisk(vec2 u) {
+  vec2 o = 2.0 * u - vec2(1.0);
+  if (o.x == 0.0 && o.y == 0.0) return vec2(0.0);
+  const float pi = 3.14159265358979;
+  float r, theta;
+  if (abs(o.x) > abs(o.y)) {
+    r = o.x;
+    theta = (pi / 4.0) * (o.y / o.x);
+  } else {
+    r = o.y;
+    theta = (pi / 2.0) - (pi / 4.0) * (o.x / o.y);
+  }
+  return r * vec2(cos(theta), sin(theta));
+}
+
 // The camera weight times the radiance along the camera ray through film point `film` (pixel
-// units, Camera::generateRay's pinhole).
-vec3 sampleRadiance(vec2 film) {
+// units) and lens point `lens` ∈ [0,1)² (Camera::generateRay; the lens point is unused by a
+// pinhole). A thin lens's ray starts off the eye, where the id buffer (rasterised from the
+// eye) says nothing: it is cast through the BVH.
+vec3 sampleRadiance(vec2 film, vec2 lens) {
   vec3 toFilm = cameraToFilm(film);
   float invLength = 1.0 / length(toFilm);
   float weight = 1.0;
-  if (vignetting) weight = invLength * invLength * invLength * invLength;  // cos^4
-  vec3 direction = toFilm * invLength;
+  if (vignetting) weight = invLength * invLength * invLength * invLength;  // cos^4 of the chief ray
+  vec3 origin = eye, direction = toFilm * invLength;
+  if (apertureRadius > 0.0) {
+    // Towards where the chief ray meets the plane of focus, from the lens point.
+    vec3 focusPoint = eye + toFilm * focusDistance;
+    vec2 disk = apertureRadius * sampleConcentricDisk(lens);
+    origin = eye + disk.x * right + disk.y * up;
+    direction = normalize(focusPoint - origin);
+  }
   // The visible triangle (primaryHit), then the surface there.
   float t;
   uint triangle;
   vec2 b;
-  if (!primaryHit(film, direction, t, triangle, b)) return weight * environmentRadiance(direction);
+  bool hit = apertureRadius > 0.0 ? bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, b)
+                                  : primaryHit(film, direction, t, triangle, b);
+  if (!hit) return weight * environmentRadiance(direction);
   uvec4 tri = triangles[triangle];
-  vec3 p = eye + t * direction;
+  vec3 p = origin + t * direction;
   vec3 normalAtHit, shadingNormal;
   hitNormals(tri, b, normalAtHit, shadingNormal);
 #if defined(SPECULAR) || defined(HIGHLIGHTS)
@@ -559,7 +587,7 @@ vec3 sampleRadiance(vec2 film) {
 #endif
 #ifdef SPECULAR
   if (record != kNoRecord && charts[record].info.y == kSpecular)
-    return weight * specularChain(eye, direction, t, triangle, b, mirrorDepth);
+    return weight * specularChain(origin, direction, t, triangle, b, mirrorDepth);
 #endif
   SurfaceDetail detail = hitSurfaceDetail(triangle, b, direction, coneSpread * t);
   vec3 radiance = lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal, detail);
@@ -602,9 +630,10 @@ uint64_t mortonEncode2(uint x, uint y) {
   return m;
 }
 float fixedToUnit(uint v) { return float(v >> 8) * exp2(-24.0); }
-// Sampler::get2D of dimension 0 for the global index mortonIndex.
-vec2 zSobolFilm(uint64_t mortonIndex, uint64_t layoutSeed) {
-  uint64_t h = mix64((mortonIndex >> 32) ^ layoutSeed);  // dimensionHash(0)
+// Sampler::get2D of dimension d for the global index mortonIndex: pixelSample's film point
+// (d = 0) and lens point (d = 1).
+vec2 zSobol2D(uint64_t mortonIndex, uint64_t layoutSeed, uint d) {
+  uint64_t h = mix64(((uint64_t(d) << 32) | (mortonIndex >> 32)) ^ layoutSeed);  // dimensionHash(d)
   uint index = 0u;                                       // shuffledIndex(h)
   int bits = min(indexBits, 32);
   if (bits > 0) {
@@ -620,14 +649,17 @@ void main() {
   uint64_t seed64 = (uint64_t(seed.y) << 32) | uint64_t(seed.x);
   uint64_t pixelIndex = mortonEncode2(uint(pixel.x), uint(pixel.y)) << log2Spp;
   vec3 sum = vec3(0.0);
-  for (int k = 0; k < spp; ++k)
-    sum += sampleRadiance(vec2(pixel) + zSobolFilm(pixelIndex | uint64_t(k), seed64));
+  for (int k = 0; k < spp; ++k) {
+    uint64_t index = pixelIndex | uint64_t(k);
+    vec2 lens = apertureRadius > 0.0 ? zSobol2D(index, seed64, 1u) : vec2(0.5);
+    sum += sampleRadiance(vec2(pixel) + zSobol2D(index, seed64, 0u), lens);
+  }
   color = vec4(sum / float(spp), 1.0);
 }
 #else
 void main() {
   ivec2 pixel = ivec2(gl_FragCoord.xy);
-  color = vec4(sampleRadiance(vec2(pixel) + 0.5), 1.0);
+  color = vec4(sampleRadiance(vec2(pixel) + 0.5, vec2(0.5)), 1.0);  // the pixel and lens centres
 }
 #endif
 )glsl";
@@ -827,24 +859,20 @@ void setCameraUniforms(GLuint program, const Camera& camera) {
   vec3("up", camera.up());
   glProgramUniform1f(program, glGetUniformLocation(program, "tanHalfFovY"), camera.tanHalfFovY());
   glProgramUniform1f(program, glGetUniformLocation(program, "aspect"), camera.aspect());
+  glProgramUniform1f(program, glGetUniformLocation(program, "apertureRadius"), camera.apertureRadius());
+  glProgramUniform1f(program, glGetUniformLocation(program, "focusDistance"), camera.focusDistance());
 }
 
 }  // namespace
 
 std::string gpuUnsupportedFeature(const LightField& lf) {
   if (std::string specular = gpuUnsupportedSpecular(lf); !specular.empty()) return specular;
-  if (std::string highlights = gpuUnsupportedHighlights(lf); !highlights.empty()) return highlights;
   const SunLights sun = sunLightsOf(lf);
   for (uint32_t i = 0; i < lf.charts.size(); ++i)
     if (std::string detail = gpu::surfaceDetailUnsupported(lf, lf.charts[i], chartShading(lf, i, sun)); !detail.empty())
       return detail;
   if (lf.values.size() >= std::numeric_limits<uint32_t>::max() || lf.sunMasks.size() >= std::numeric_limits<uint32_t>::max())
     return "more than 2^32 light-field values";
-  return {};
-}
-
-std::string gpuUnsupportedSetting(const RenderSettings& /*settings*/, const Camera& camera) {
-  if (camera.isThinLens()) return "thin-lens cameras (depth of field)";
   return {};
 }
 
@@ -1221,7 +1249,6 @@ void GpuRenderer::drawVisibility(const Camera& camera, int idScale) {
 }
 
 std::string GpuRenderer::unsupportedSetting(const RenderSettings& settings, const Camera& camera) const {
-  if (std::string missing = gpuUnsupportedSetting(settings, camera); !missing.empty()) return missing;
   if (effectiveSamplesPerPixel(settings, camera.isThinLens()) > 1 && state_->multisampleProgram == 0)
     return "more than one sample per pixel on this driver (it lacks GL_ARB_gpu_shader_int64)";
   return {};
@@ -1237,10 +1264,16 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   checkSettings(settings, camera);
   // One sample: the pixel centre; several: pixelSample's film points, whose triangles
   // are looked for in a visibility pass at a finer resolution (multiSampleIdScale).
+  // A thin lens's rays are all cast through the BVH: no visibility pass.
   const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
-  const int idScale = spp > 1 ? multiSampleIdScale(camera.width(), camera.height()) : 1;
-  drawVisibility(camera, idScale);
+  const int idScale = spp > 1 && !camera.isThinLens() ? multiSampleIdScale(camera.width(), camera.height()) : 1;
   State& s = *state_;
+  if (camera.isThinLens()) {
+    s.context.makeCurrent();
+    s.ensureTargets(camera.width(), camera.height(), idScale);
+  } else {
+    drawVisibility(camera, idScale);
+  }
   const GLuint program = spp > 1 ? s.multisampleProgram : s.shadingProgram;
   setCameraUniforms(program, camera);
   glProgramUniform2i(program, glGetUniformLocation(program, "size"), camera.width(), camera.height());

@@ -23,8 +23,10 @@ std::string gpuUnsupportedSpecular(const LightField& lf) {
     const Material& m = scene.materials[c.material];
     if (!isDelta(m.bsdf) && !std::holds_alternative<DielectricBsdf>(m.bsdf))
       return "mirror-like glossy lobes (specular charts of a Blinn-Phong or GGX material)";
-    // materialModelAt: the reflectance or transmittance would vary over the surface.
-    if (m.modelVaries()) return "albedo textures or vertex colours on mirrors and glass";
+    // An albedo texture or vertex colours leave a mirror's or glass's model as it is
+    // (materialModelAt: withDiffuseAlbedo of a model without a diffuse part), so the chains
+    // read none of them; only glTF's layered model would be made anew per point.
+    if (m.layers.layered && (m.layers.any() || m.modelVaries())) return "glTF layered materials on mirrors and glass";
   }
   return {};
 }

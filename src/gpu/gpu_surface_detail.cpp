@@ -23,7 +23,7 @@ constexpr uint32_t kHeaderWords = 8, kTextureWords = 8, kLevelWords = 4, kMappin
 // factor, cutoff, normal scale, vertex alphas (1: some mesh of the material has them), then the
 // albedo, emission, alpha and normal mappings, the diffuse part's lobe (kDiffuseLobeWords), the
 // metallic-roughness record (kMetallicRoughnessWords) and its mapping.
-constexpr uint32_t kDiffuseLobeWords = 5, kMetallicRoughnessWords = 11;
+constexpr uint32_t kDiffuseLobeWords = 14, kMetallicRoughnessWords = 11;
 constexpr uint32_t kMaterialAlbedoMapping = 8, kMaterialEmissionMapping = kMaterialAlbedoMapping + kMappingWords,
                    kMaterialAlphaMapping = kMaterialEmissionMapping + kMappingWords,
                    kMaterialNormalMapping = kMaterialAlphaMapping + kMappingWords,
@@ -79,11 +79,14 @@ void appendMetallicRoughness(std::vector<uint32_t>& words, const Material& m, co
 
 std::string surfaceDetailUnsupported(const LightField& lf, const Chart& chart, const ChartShading& shading) {
   const Material& material = lf.scene.materials[chart.material];
-  // k(μ) of the diffuse part from the GGX lobe's albedo tables (ggxLobeParameters): a clear
-  // coat's or sheen's albedo would multiply in other tables.
   const Bsdf& model = material.bsdf;
-  if (chart.diffuseValue && variesWithAngle(model) && !ggxLobeParameters(model))
-    return "glTF materials with a clear coat or sheen over a diffuse base";
+  // k(μ) of a clear coat's or sheen's diffuse base is normalised by a mean over μ (1/√Ḡ,
+  // ggxLobeParameters' diffuseNorm) made once per material: with a metallic-roughness texture
+  // each point's model (its diffuse part's k, its highlights) would need its own.
+  if (chart.kind == ChartKind::Glossy && material.metallicRoughness.texture >= 0)
+    if (const std::optional<GgxLobeParameters> lobe = ggxLobeParameters(model);
+        lobe && lobe->layered() && ((chart.diffuseValue && shading.needsUv) || gpuHighlightsActive(lf)))
+      return "glTF materials with a clear coat or sheen and a metallic-roughness texture";
   // diffuseAlbedoAt multiplies a Lambertian or subsurface albedo by the modulation (albedo()
   // of either is its albedo); another model's directional albedo at normal incidence is not
   // linear in it. (Only those two models make diffuse charts: bake/parameterisation.h.)
@@ -196,11 +199,15 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
     appendMapping(words, m.emissionMapping);
     appendMapping(words, m.alphaMapping);
     appendMapping(words, m.normalMapping);
-    // The diffuse part's lobe: α, the Fresnel ends of the lobe whose albedo it gives up.
+    // The diffuse part's lobe: α, the Fresnel ends of the lobe whose albedo it gives up, and
+    // the layers above it (ggxLobeParameters).
     const std::optional<GgxLobeParameters> lobe = ggxLobeParameters(m.bsdf);
     if (needsFactor[i] && lobe) diffuseLobes[i] = record + kMaterialDiffuseLobe;
     const GgxLobeParameters l = lobe.value_or(GgxLobeParameters{});
-    words.insert(words.end(), {bits(l.alpha), bits(l.diffuseF0.r), bits(l.diffuseF0.g), bits(l.diffuseF0.b), bits(l.diffuseF90)});
+    words.insert(words.end(), {bits(l.alpha), bits(l.diffuseF0.r), bits(l.diffuseF0.g), bits(l.diffuseF0.b), bits(l.diffuseF90),
+                               bits(l.clearcoat), bits(l.clearcoatAlpha), bits(l.sheenColor.r), bits(l.sheenColor.g),
+                               bits(l.sheenColor.b), bits(l.sheenRoughness), bits(l.diffuseNorm.r), bits(l.diffuseNorm.g),
+                               bits(l.diffuseNorm.b)});
     appendMetallicRoughness(words, m, scene);
   }
   // Vertices and triangles, in the renderer's order (meshes one after another).
@@ -225,6 +232,11 @@ SurfaceDetailBuffer surfaceDetailBuffer(const LightField& lf) {
   const GgxAlbedoTables& tables = ggxAlbedoTables();
   words[5] = uint32_t(words.size());
   for (const std::vector<float>* table : {&tables.mu, &tables.e0, &tables.e5, &tables.mean0, &tables.mean5})
+    for (float v : *table) words.push_back(bits(v));
+  // The sheen's albedo table (sheenAlbedoTables): μ nodes, E_s (scaled), the scales.
+  const SheenAlbedoTables& sheen = sheenAlbedoTables();
+  words[6] = uint32_t(words.size());
+  for (const std::vector<float>* table : {&sheen.mu, &sheen.e, &sheen.scale})
     for (float v : *table) words.push_back(bits(v));
   // The texels: a level's packed texels (4×4 blocks of palette indices, Texture::PackedBlock)
   // and its palette where it has them, else 3 floats per texel.
@@ -257,7 +269,8 @@ std::string surfaceDetailGlsl(unsigned binding) {
              "const vec2 kTiltAcross[{}] = vec2[{}](vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}), vec2({:.9g}, {:.9g}));\n"
              "const uint kMaterialDiffuseLobe = {}u, kMaterialMetallicRoughness = {}u, kMaterialMetallicRoughnessMapping = {}u;\n"
              "const uint kFlagMetallicRoughness = {}u;\nconst int kGgxMuNodes = {}, kGgxRoughNodes = {};\n"
-             "const float kGgxMinAlpha = {:.9g};\n",
+             "const float kGgxMinAlpha = {:.9g};\nconst int kSheenMuNodes = {}, kSheenRoughNodes = {};\n"
+             "const float kSheenMinRoughness = {:.9g}, kClearcoatF0 = {:.9g};\n",
              binding, kTextureWords, kLevelWords, kVertexWords, kMaterialWords, kMaterialAlbedoMapping,
              kMaterialEmissionMapping, kMaterialAlphaMapping, kMaterialNormalMapping, unsigned(TextureWrap::Repeat),
              unsigned(TextureWrap::ClampToEdge), unsigned(TextureWrap::MirroredRepeat), kNearestBit, kMipmapsBit,
@@ -265,7 +278,8 @@ std::string surfaceDetailGlsl(unsigned binding) {
              kFlagDirectionalIrradiance, kTiltedNormals, kNormalTiltCosine, kNormalTiltSine, kTiltedNormals, kTiltedNormals,
              kTiltAcross[0][0], kTiltAcross[0][1], kTiltAcross[1][0], kTiltAcross[1][1], kTiltAcross[2][0],
              kTiltAcross[2][1], kMaterialDiffuseLobe, kMaterialMetallicRoughness, kMaterialMetallicRoughnessMapping,
-             kFlagMetallicRoughness, ggxAlbedoTables().muNodes, ggxAlbedoTables().roughNodes, kGgxMinAlpha) +
+             kFlagMetallicRoughness, ggxAlbedoTables().muNodes, ggxAlbedoTables().roughNodes, kGgxMinAlpha,
+             sheenAlbedoTables().muNodes, sheenAlbedoTables().roughNodes, kSheenMinRoughness, kClearcoatF0) +
          R"glsl(
 layout(std430, binding = SURFACE_DETAIL_BINDING) readonly buffer SurfaceDetailWords { uint detail[]; };
 const uint kNone = 0xffffffffu;
@@ -537,21 +551,30 @@ bool maskedMaterial(uint triangle) {
   uint m = materialRecord(triangle);
   return detail[m + 2u] != kNone || detailFloat(m + 4u) < detailFloat(m + 5u) || (detail[m + 7u] & 1u) != 0u;
 }
-// ggxLobeAlbedo (bsdf.cpp) from the tables at detail[5] (ggxAlbedoTables): the directional
-// albedo E at μ and the cosine-weighted mean Ē of the GGX lobe α with Schlick's Fresnel from f0
-// to f90 — GgxAlbedoTable::locate and lookup, statement for statement.
+// GgxAlbedoTable::locate (bsdf.cpp) in the tables at detail[5] (ggxAlbedoTables): the
+// roughness row r0 of α and the weight tr of r0 + 1, the μ segment i0 and the weight tm of i0 + 1.
+void ggxLocate(float mu, float alpha, out int r0, out float tr, out int i0, out float tm) {
+  const int muNodes = kGgxMuNodes, roughNodes = kGgxRoughNodes;
+  uint muTable = detail[5];
+  float rMin = sqrt(kGgxMinAlpha);
+  float rPos = (sqrt(clamp(alpha, kGgxMinAlpha, 1.0)) - rMin) / (1.0 - rMin) * float(roughNodes - 1);
+  r0 = clamp(int(rPos), 0, roughNodes - 2);
+  tr = clamp(rPos - float(r0), 0.0, 1.0);
+  mu = clamp(mu, 0.0, 1.0);
+  i0 = clamp(int(sqrt(mu) * float(muNodes - 1)), 0, muNodes - 2);
+  float mu0 = detailFloat(muTable + uint(i0)), mu1 = detailFloat(muTable + uint(i0) + 1u);
+  tm = clamp((mu - mu0) / (mu1 - mu0), 0.0, 1.0);
+}
+// ggxLobeAlbedo (bsdf.cpp) from the tables at detail[5]: the directional albedo E at μ and the
+// cosine-weighted mean Ē of the GGX lobe α with Schlick's Fresnel from f0 to f90 —
+// GgxAlbedoTable::lookup, statement for statement.
 void ggxLobeAlbedo(float alpha, vec3 f0, float f90, float mu, out vec3 at, out vec3 mean) {
   const int muNodes = kGgxMuNodes, roughNodes = kGgxRoughNodes;
   uint muTable = detail[5], e0 = muTable + uint(muNodes), e5 = e0 + uint(muNodes * roughNodes);
   uint mean0 = e5 + uint(muNodes * roughNodes), mean5 = mean0 + uint(roughNodes);
-  float rMin = sqrt(kGgxMinAlpha);
-  float rPos = (sqrt(clamp(alpha, kGgxMinAlpha, 1.0)) - rMin) / (1.0 - rMin) * float(roughNodes - 1);
-  int r0 = clamp(int(rPos), 0, roughNodes - 2);
-  float tr = clamp(rPos - float(r0), 0.0, 1.0);
-  mu = clamp(mu, 0.0, 1.0);
-  int i0 = clamp(int(sqrt(mu) * float(muNodes - 1)), 0, muNodes - 2);
-  float mu0 = detailFloat(muTable + uint(i0)), mu1 = detailFloat(muTable + uint(i0) + 1u);
-  float tm = clamp((mu - mu0) / (mu1 - mu0), 0.0, 1.0);
+  int r0, i0;
+  float tr, tm;
+  ggxLocate(mu, alpha, r0, tr, i0, tm);
   uint row0 = uint(r0 * muNodes + i0), row1 = row0 + uint(muNodes);
   float e00 = detailFloat(e0 + row0) + tm * (detailFloat(e0 + row0 + 1u) - detailFloat(e0 + row0));
   float e01 = detailFloat(e0 + row1) + tm * (detailFloat(e0 + row1 + 1u) - detailFloat(e0 + row1));
@@ -573,13 +596,81 @@ vec3 ggxDiffuseFactor(float alpha, vec3 f0, float f90, float cosTheta) {
   vec3 rest = vec3(1.0) - mean;
   return mix(vec3(0.0), max(vec3(0.0), vec3(1.0) - at) / sqrt(max(rest, vec3(1e-6))), greaterThan(rest, vec3(1e-6)));
 }
+// GgxAlbedoTable::upperAlbedo (bsdf.cpp): the larger of the two roughness rows' albedos at μ
+// of the GGX lobe α with Schlick's Fresnel from f0 to f90 (the clear coat's E_c).
+float ggxUpperAlbedo(float mu, float alpha, float f0, float f90) {
+  const int muNodes = kGgxMuNodes, roughNodes = kGgxRoughNodes;
+  uint e0 = detail[5] + uint(muNodes), e5 = e0 + uint(muNodes * roughNodes);
+  int r0, i0;
+  float tr, tm;
+  ggxLocate(mu, alpha, r0, tr, i0, tm);
+  float rows[2];
+  for (int k = 0; k < 2; ++k) {
+    uint row = uint((r0 + k) * muNodes + i0);
+    float a0 = detailFloat(e0 + row) + tm * (detailFloat(e0 + row + 1u) - detailFloat(e0 + row));
+    float a5 = detailFloat(e5 + row) + tm * (detailFloat(e5 + row + 1u) - detailFloat(e5 + row));
+    rows[k] = f0 * (a0 - a5) + f90 * a5;
+  }
+  return max(rows[0], rows[1]);
+}
+// SheenAlbedoTable::lookup (bsdf.cpp) from the table at detail[6] (sheenAlbedoTables): the
+// Charlie lobe's scaled albedo E_s at μ (x) and the scale (y) for roughness r.
+vec2 sheenAlbedo(float mu, float r) {
+  const int muNodes = kSheenMuNodes, roughNodes = kSheenRoughNodes;
+  uint muTable = detail[6], e = muTable + uint(muNodes), scale = e + uint(muNodes * roughNodes);
+  float rPos = (clamp(r, kSheenMinRoughness, 1.0) - kSheenMinRoughness) / (1.0 - kSheenMinRoughness) * float(roughNodes - 1);
+  int r0 = clamp(int(rPos), 0, roughNodes - 2);
+  float tr = clamp(rPos - float(r0), 0.0, 1.0);
+  mu = clamp(mu, 0.0, 1.0);
+  int i0 = clamp(int(sqrt(mu) * float(muNodes - 1)), 0, muNodes - 2);
+  float mu0 = detailFloat(muTable + uint(i0)), mu1 = detailFloat(muTable + uint(i0) + 1u);
+  float tm = clamp((mu - mu0) / (mu1 - mu0), 0.0, 1.0);
+  uint row0 = e + uint(r0 * muNodes + i0), row1 = row0 + uint(muNodes);
+  float at0 = detailFloat(row0) + tm * (detailFloat(row0 + 1u) - detailFloat(row0));
+  float at1 = detailFloat(row1) + tm * (detailFloat(row1 + 1u) - detailFloat(row1));
+  float s0 = detailFloat(scale + uint(r0));
+  return vec2(at0 + tr * (at1 - at0), s0 + tr * (detailFloat(scale + uint(r0) + 1u) - s0));
+}
+// A glTF model's layers above its base (GgxLobeParameters: the coat's weight and α, the sheen's
+// colour and roughness, the diffuse part's 1/√Ḡ); all 0 without.
+struct PbrLayers { float clearcoat, clearcoatAlpha; vec3 sheenColor; float sheenRoughness; vec3 diffuseNorm; };
+// The layers of the lobe record at word `lobe` (after its α and Fresnel ends).
+PbrLayers pbrLayersAt(uint lobe) {
+  return PbrLayers(detailFloat(lobe + 5u), detailFloat(lobe + 6u), detailRgb(lobe + 7u), detailFloat(lobe + 10u),
+                   detailRgb(lobe + 11u));
+}
+bool hasLayers(PbrLayers l) { return l.clearcoat > 0.0 || max(l.sheenColor.r, max(l.sheenColor.g, l.sheenColor.b)) > 0.0; }
+// pbrAlbedos' coat and sheen (bsdf.cpp): E_c and E_s at μ, 0 for an absent layer.
+vec2 layerAlbedos(PbrLayers l, float mu) {
+  float sheenWeight = max(0.0, max(l.sheenColor.r, max(l.sheenColor.g, l.sheenColor.b)));
+  return vec2(l.clearcoat > 0.0 ? ggxUpperAlbedo(mu, l.clearcoatAlpha, kClearcoatF0, 1.0) : 0.0,
+              sheenWeight > 0.0 ? sheenAlbedo(mu, l.sheenRoughness).x : 0.0);
+}
+// pbrDiffuseShape (bsdf.cpp): g(μ) = (1 − E_d)(1 − w_s E_s)(1 − w_c E_c) per channel, ≥ 0, with
+// E_d the dielectric member's albedo at μ and (E_c, E_s) layerAlbedos'.
+vec3 pbrDiffuseShape(PbrLayers l, vec3 dielectricAlbedo, vec2 coatSheen) {
+  float sheenWeight = max(0.0, max(l.sheenColor.r, max(l.sheenColor.g, l.sheenColor.b)));
+  float layers = max(0.0, 1.0 - sheenWeight * coatSheen.y) * max(0.0, 1.0 - l.clearcoat * coatSheen.x);
+  return max(vec3(1.0) - dielectricAlbedo, vec3(0.0)) * layers;
+}
+// diffuseDirectionalFactor (bsdf.h) of a GGX-like model whose diffuse part gives up the lobe α
+// with Fresnel f0 → f90, under layers l: ggxDiffuseFactor without layers, g(μ) · diffuseNorm
+// with (GltfPbrBsdf: pbrDiffuseShape × pbrDiffuseNorm).
+vec3 layeredDiffuseFactor(float alpha, vec3 f0, float f90, PbrLayers l, float cosTheta) {
+  if (!hasLayers(l)) return ggxDiffuseFactor(alpha, f0, f90, cosTheta);
+  if (!(cosTheta > 0.0)) return vec3(0.0);
+  float mu = min(cosTheta, 1.0);
+  vec3 at, mean;
+  ggxLobeAlbedo(alpha, f0, f90, mu, at, mean);
+  return pbrDiffuseShape(l, at, layerAlbedos(l, mu)) * l.diffuseNorm;
+}
 // diffuseDirectionalFactor (bsdf.h) of a material whose diffuse part's lobe record is at word
-// `lobe` (the material record's kMaterialDiffuseLobe: α, diffuseF0, diffuseF90), kNone where k
-// is 1 (Lambert, Blinn-Phong).
+// `lobe` (the material record's kMaterialDiffuseLobe: α, diffuseF0, diffuseF90, the layers),
+// kNone where k is 1 (Lambert, Blinn-Phong).
 vec3 diffuseFactor(uint lobe, float cosTheta) {
   if (!(cosTheta > 0.0)) return vec3(0.0);
   if (lobe == kNone) return vec3(1.0);
-  return ggxDiffuseFactor(detailFloat(lobe), detailRgb(lobe + 1u), detailFloat(lobe + 4u), cosTheta);
+  return layeredDiffuseFactor(detailFloat(lobe), detailRgb(lobe + 1u), detailFloat(lobe + 4u), pbrLayersAt(lobe), cosTheta);
 }
 // A GGX-like model as GgxLobeParameters (bsdf.h) describes it.
 struct GgxLobe { vec3 diffuse; float alpha; vec3 f0; float f90; vec3 diffuseF0; float diffuseF90; };

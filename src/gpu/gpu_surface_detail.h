@@ -7,7 +7,7 @@
 // surfaceAt/normalMapped and lightfield/lookup.h albedoTextureLod, statement for statement).
 //
 // The buffer (uint detail[]): a header of 8 words — the offsets (in words) of the textures,
-// levels, materials, vertices, triangles and k nodes below — then
+// levels, materials, vertices, triangles, GGX and sheen tables below — then
 //   textures:  8 words each — first level (into the level table), level count (level 0 and its
 //              mips), sampling flags (wrap u | wrap v << 2 | nearest << 4 | mipmaps << 5 |
 //              default sampling << 6), the mean texel (3 floats), 2 unused;
@@ -15,12 +15,13 @@
 //              texels are 3 floats each; else they are the CPU's packed texels as they are,
 //              Texture::packed's 4×4 blocks of palette indices r | g << 8 | b << 16, one word
 //              each, and the palette its ≤ 256 floats);
-//   materials: 64 words each — albedo, emission, alpha and normal textures (kNoWord: none), alpha
+//   materials: 73 words each — albedo, emission, alpha and normal textures (kNoWord: none), alpha
 //              factor and cutoff, normal scale, vertex alphas (1: Material::vertexAlpha), then
 //              the albedo, emission, alpha and normal TextureMappings (8 words each: uv set,
 //              whether default, linear[0][0], [0][1], [1][0], [1][1], offset); the diffuse
-//              part's lobe (ggxLobeParameters: α, diffuseF0 (3), diffuseF90; k(μ) from the
-//              tables below); the metallic-roughness texture (kNoWord: none), the factors
+//              part's lobe (ggxLobeParameters: α, diffuseF0 (3), diffuseF90, then a glTF
+//              model's layers — clear coat weight and α, sheen colour (3) and roughness, 1/√Ḡ
+//              (3); k(μ) from the tables below); the metallic-roughness texture (kNoWord: none), the factors
 //              materialModelAt multiplies (base colour (3), metallic, roughness), whether the
 //              model is glTF's layered one, the dielectric member's Fresnel ends (3 + 1), and
 //              its TextureMapping;
@@ -31,11 +32,13 @@
 //   GGX:       the GGX lobe-albedo tables (bsdf.h ggxAlbedoTables: the μ nodes, E₀, E₅, Ē₀, Ē₅),
 //              from which k(μ) = (1 − E(μ)) / √(1 − Ē) of a diffuse part is computed as the
 //              CPU computes it, per material or per pixel (metallic-roughness textures);
+//   sheen:     the sheen's albedo table (ggx_lobe.h sheenAlbedoTables: the μ nodes, E_s, the
+//              scales), for the diffuse part under a sheen and the sheen's highlights;
 //   texels:    the levels' texels and palettes.
 // Textures are uploaded only where a chart the GPU draws or a traced ray's hit
 // (tracedSurfaceDetail) reads them, vertices and triangles only where some chart, mask or
-// traced hit needs a uv: a scene without either costs the header, 256
-// bytes per material and 7.8 KiB of GGX tables.
+// traced hit needs a uv: a scene without either costs the header, 292
+// bytes per material, 7.8 KiB of GGX tables and 2.2 KiB of the sheen's.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -86,6 +89,8 @@ inline constexpr uint32_t kNoWord = 0xffffffffu;
 /// The GLSL constants and functions (the buffer at binding `binding`): sampleTexture,
 /// sampleTextureLod, surfaceDetailAt (the albedo modulation, emission texel and mapped normal
 /// of a hit), ggxLobeAlbedo, ggxDiffuseFactor and diffuseFactor (k(μ) from the GGX tables),
+/// ggxUpperAlbedo, sheenAlbedo, pbrLayersAt and layeredDiffuseFactor (a glTF clear coat's and
+/// sheen's albedos and k(μ) of the diffuse part under them),
 /// metallicRoughnessLobe (a textured material's model at a point), mappedNormalAt and emissionTexelAt (surfaceAt's normal map and
 /// emissionModulation for one material record, materialRecord) and masked (the alpha mask).
 /// Needs glslConstants' chart kinds.

@@ -248,12 +248,8 @@ class FrameRenderer {
   std::string tryGpu(const LightField& lightField, const ViewerOptions& options) {
     const bool asked = options.renderer == ViewerRendererChoice::Gpu;
     const Camera camera(options.camera, options.width, options.height, options.vignetting, options.metresPerUnit);
-    std::string refused;
-    if (const std::string feature = gpuUnsupportedFeature(lightField); !feature.empty())
-      refused = fmt::format("the GPU renderer does not draw {} yet", feature);
-    else if (const std::string setting = gpuUnsupportedSetting(options.render, camera); !setting.empty())
-      refused = fmt::format("the GPU renderer does not support {} yet", setting);
-    if (!refused.empty()) {
+    if (const std::string feature = gpuUnsupportedFeature(lightField); !feature.empty()) {
+      const std::string refused = fmt::format("the GPU renderer does not draw {} yet", feature);
       if (asked) fail("view: {} (use --renderer cpu)", refused);
       return refused;
     }
