@@ -75,6 +75,7 @@ BakeJob::BakeJob(BakeJobOptions options) : options_(std::move(options)) {
   checkDistinctOutputs({{"-o", options_.output}, {"--visibility", visibilityPath_}, {"--stats", options_.statsPath}});
   (void)bakePreset(options_.preset);          // an unknown preset names the known ones
   (void)parseValuesCodec(options_.compress);  // an unknown codec names the known ones
+  (void)parseVisibilityMemory(options_.visibilityMemory, "--visibility-memory");
 }
 
 BakeSettings BakeJob::settings() const {
@@ -142,6 +143,7 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
                   "lower --preset, --tixels-across or --directions", limit);
   };
   bakeOptions.maxMemory = options_.maxMemory;
+  bakeOptions.visibilityMemory = parseVisibilityMemory(options_.visibilityMemory, "--visibility-memory");
   bakeOptions.communicator = options_.communicator;
   DistributedBakeStats distributed;
   bakeOptions.distributedStats = &distributed;
