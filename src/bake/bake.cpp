@@ -9,7 +9,6 @@
 #include <functional>
 #include <future>
 #include <optional>
-#include <thread>
 
 #include "accel/accel.h"
 #include "core/error.h"
@@ -67,8 +66,7 @@ uint64_t visibilityStreamBufferBytes(uint32_t gridSide) {
   // the sizes and the largest encodings.
   const uint32_t n = gridSide * gridSide;
   const uint64_t blockBytes = visibilityBlockTixels(n) * (sizeof(uint32_t) + maxEncodedTixelBytes(n));
-  const uint64_t threads = std::max(1u, std::thread::hardware_concurrency());
-  return threads * 6 * blockBytes;
+  return uint64_t(std::max(1, parallelThreads())) * 6 * blockBytes;
 }
 
 uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings, uint64_t visibilityTixels,

@@ -135,8 +135,9 @@ struct BakeOptions {
 /// (visibilityStreamBufferBytes).
 uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings, uint64_t visibilityTixels = 0,
                             double visibilityBytesPerTixel = 0.0, bool streamed = false);
-/// Bytes a streamed field's readers and writer hold: a few entry blocks per thread (the
-/// block each gather task reads, a rough-glass twin's, the frames written out of order).
+/// Bytes a streamed field's readers and writer hold: a few entry blocks per thread of the
+/// parallel loops (parallelThreads: the block each gather task reads, a rough-glass twin's, the
+/// frames written out of order).
 uint64_t visibilityStreamBufferBytes(uint32_t gridSide);
 /// Margin on a visibility field's size measured on a sample: the sample's tixels are spread
 /// evenly, but what they see varies from chart to chart.

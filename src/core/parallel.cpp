@@ -51,6 +51,8 @@ ThreadPool::ThreadPool(int threads) : impl_(std::make_unique<Impl>()) {
 
 ThreadPool::~ThreadPool() = default;
 
+int parallelThreads() { return tbb::this_task_arena::max_concurrency(); }
+
 void runWithThreads(int threads, const std::function<void()>& work) {
   ensureDenormalObserver();
   tbb::task_arena arena(threads > 0 ? threads : 1);

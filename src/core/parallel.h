@@ -34,6 +34,9 @@ void enableFlushDenormals();
 /// the pool: the viewer's background propagation on one thread beside the renderer's loops.
 void runWithThreads(int threads, const std::function<void()>& work);
 
+/// How many threads a parallel loop started now may run on (the ThreadPool's or arena's limit).
+int parallelThreads();
+
 /// Calls body(begin, end) on disjoint sub-ranges of [0, count), in parallel. grain is the
 /// smallest range handed to one task. Each sub-range starts with a cancellation point
 /// (core/cancel.h): once cancellation is requested, the loop stops and pl::Cancelled is thrown.
