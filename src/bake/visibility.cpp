@@ -582,7 +582,7 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
   if (writer) {
     if (!sink->complete()) fail("{}: the visibility field was not traced whole", streamTo);
     VisibilityFrames frames = writer->finish(extraOffset, extras);
-    field.stream = std::make_shared<const VisibilityBlockFile>(streamTo, field.gridSide, heldTixels, std::move(frames));
+    field.stream = std::make_shared<const VisibilityBlockFile>(streamTo, std::move(frames));
   } else {
     field.assembleEntries(blockEntries);
   }

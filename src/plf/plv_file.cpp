@@ -200,12 +200,10 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
   writer.finish({field.extraOffset.data(), field.extraOffset.size()}, {field.extras.data(), field.extras.size()});
 }
 
-VisibilityBlockFile::VisibilityBlockFile(std::string path, uint32_t gridSide, uint64_t tixelCount, VisibilityFrames frames)
-    : path_(std::move(path)), tixelCount_(tixelCount), frames_(std::move(frames)) {
-  (void)gridSide;
+VisibilityBlockFile::VisibilityBlockFile(std::string path, VisibilityFrames frames)
+    : path_(std::move(path)), frames_(std::move(frames)) {
   fd_ = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd_ < 0) fail("{}: cannot open the visibility field: {}", path_, std::strerror(errno));
-  for (uint64_t b = 0; b < frames_.blocks; ++b) largestContent_ = std::max(largestContent_, frames_.contentSizes[b]);
 }
 
 VisibilityBlockFile::~VisibilityBlockFile() {
@@ -475,7 +473,7 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   if (streamed) {
     VisibilityFrames frames{perBlock, blocks, {frameOffset.begin(), frameOffset.begin() + int64_t(blocks) + 1}, frameSizes,
                             contentSizes};
-    f.stream = std::make_shared<const VisibilityBlockFile>(path, h.gridSide, tixelCount, std::move(frames));
+    f.stream = std::make_shared<const VisibilityBlockFile>(path, std::move(frames));
   } else {
     f.entryBytes = FieldArray<unsigned char>(std::move(entryBytes));
     f.entryOffset = FieldArray<uint64_t>(std::move(entryOffset));

@@ -386,9 +386,9 @@ struct VisibilityFrames {
 /// into another, so that memory holds a block per reader instead of the field. Thread-safe.
 class VisibilityBlockFile {
  public:
-  /// The .plv at `path` of this grid side and frame layout (its writer's, or readVisibility's
-  /// checked one). Throws pl::Error naming the file when it cannot be opened.
-  VisibilityBlockFile(std::string path, uint32_t gridSide, uint64_t tixelCount, VisibilityFrames frames);
+  /// The .plv at `path`, whose frames lie as `frames` says (its writer's, or readVisibility's
+  /// checked table). Throws pl::Error naming the file when it cannot be opened.
+  VisibilityBlockFile(std::string path, VisibilityFrames frames);
   ~VisibilityBlockFile();
   VisibilityBlockFile(const VisibilityBlockFile&) = delete;
   VisibilityBlockFile& operator=(const VisibilityBlockFile&) = delete;
@@ -396,8 +396,6 @@ class VisibilityBlockFile {
   const std::string& path() const { return path_; }
   uint64_t perBlock() const { return frames_.perBlock; }
   uint64_t blocks() const { return frames_.blocks; }
-  /// Largest content of a block (bytes): what a reader's buffer grows to.
-  uint64_t largestContent() const { return largestContent_; }
   /// Reads block b into `content`: its tixels' encoded sizes (u32 each), then their encodings
   /// ("Compact entries"), then kEntryBytesPadding zero bytes (the unchecked decoder's); `frame`
   /// is scratch for the stored frame. Throws pl::Error naming the file when the read fails or
@@ -407,9 +405,7 @@ class VisibilityBlockFile {
  private:
   std::string path_;
   int fd_ = -1;
-  uint64_t tixelCount_ = 0;
   VisibilityFrames frames_;
-  uint64_t largestContent_ = 0;
 };
 
 struct VisibilityField {
