@@ -25,6 +25,7 @@ std::string BakeJobStats::toJson() const {
   // `seconds` is the whole job's here and the bake's is `bake_seconds`.
   nlohmann::json json = pl::toJson(bake);
   json["bake_seconds"] = bake.seconds;
+  json["visibility_memory"] = bake.visibilityMemory;  // a run's fact, not the light field's: not in META
   json["seconds"] = seconds;
   json["command"] = "bake";
   json["scene"] = scene;

@@ -44,7 +44,6 @@ void fields(Stats& s, Visit&& visit) {
   visit("visibility_rays", s.visibilityRays);
   visit("peak_rss_bytes", s.peakRssBytes);
   visit("reused_visibility", s.reusedVisibility);
-  visit("visibility_memory", s.visibilityMemory);
   visit("caustic_photons", s.causticPhotons);
   visit("caustic_photons_landed", s.causticPhotonsLanded);
   visit("caustic_seconds", s.causticSeconds);
