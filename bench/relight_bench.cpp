@@ -88,7 +88,7 @@ std::string runLive(const std::string& plf, const pl::LightField& lf, double sec
     const auto frameStart = Clock::now();
     if (live.update() && firstShown < 0.0) firstShown = secondsSince(relightStart);
     // As the viewer's frame: the share asked first, the relit light field drawn at the scale.
-    const CoreShare cs = coreShare(share, poolThreads(), live.busy(), true, targetFps);
+    const CoreShare cs = coreShare(share, parallelThreads(), live.busy(), true, targetFps);
     if (cs.renderThreads > 0) renderThreads = cs.renderThreads;
     RenderScaleController& controller = controllers(cs);
     const double scale = controller.scale(true);
@@ -114,7 +114,7 @@ std::string runLive(const std::string& plf, const pl::LightField& lf, double sec
       "\"beside_fps_p10\": {:.2f}, \"scale_median\": {:.4f}, \"scale_min\": {:.4f}, "
       "\"first_updated_frame_seconds\": {:.2f}, \"relighter_first_frame_seconds\": {:.2f}, \"iterations\": {}, "
       "\"converged\": {}, \"relight_seconds\": {:.2f}{}}}",
-      relightShareName(share), width, height, poolThreads(), renderThreads > 0 ? renderThreads : poolThreads(), targetFps,
+      relightShareName(share), width, height, parallelThreads(), renderThreads > 0 ? renderThreads : parallelThreads(), targetFps,
       setupSeconds, alone.size(), median(alone), 1000.0 / median(alone), beside.size(), median(beside),
       1000.0 / median(beside), 1000.0 / quantile(beside, 0.9), median(scales), quantile(scales, 0.0), firstShown,
       status.firstFrameSeconds, status.iteration, converged, relightSeconds,

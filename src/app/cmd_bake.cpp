@@ -91,6 +91,12 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
           "The most memory the bake may plan to use, e.g. 12G or 800M: a bake whose estimate exceeds it (or the "
           "available memory) is refused before it starts")
       ->type_name("SIZE");
+  command->add_option("--visibility-memory", options->visibilityMemory,
+                      "Where the propagation reads the visibility field: held (in memory), streamed (from the .plv, a "
+                      "block at a time: far less memory) or auto (streamed only when holding it does not fit the "
+                      "available memory or --max-memory; see docs/user-guide.md)")
+      ->check(CLI::IsMember({"auto", "held", "streamed"}))
+      ->capture_default_str();
   command->add_option("--stats", options->statsPath, "Write timings and counts as JSON");
   command->add_option("--compress", options->compress,
                       "How the values are stored: none (float32, bit for bit; every section raw), lossless (bit-exact), "

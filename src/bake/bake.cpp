@@ -46,19 +46,46 @@ BakeSettings bakePreset(const std::string& name) {
   return s;
 }
 
+const char* visibilityMemoryName(VisibilityMemory mode) {
+  switch (mode) {
+    case VisibilityMemory::held: return "held";
+    case VisibilityMemory::streamed: return "streamed";
+    default: return "auto";
+  }
+}
+
+VisibilityMemory parseVisibilityMemory(const std::string& text, const std::string& option) {
+  for (VisibilityMemory mode : {VisibilityMemory::automatic, VisibilityMemory::held, VisibilityMemory::streamed})
+    if (text == visibilityMemoryName(mode)) return mode;
+  throw UsageError(fmt::format("{}: unknown value '{}' (choose auto, held or streamed)", option, text));
+}
+
+uint64_t visibilityStreamBufferBytes(uint32_t gridSide) {
+  // Per thread: two readers (a gather task's and a rough-glass twin's), each a block's frame
+  // and content, and as many blocks again waiting in the writer; a block's content is at most
+  // the sizes and the largest encodings.
+  const uint32_t n = gridSide * gridSide;
+  const uint64_t blockBytes = visibilityBlockTixels(n) * (sizeof(uint32_t) + maxEncodedTixelBytes(n));
+  return uint64_t(std::max(1, parallelThreads())) * 6 * blockBytes;
+}
+
 uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings, uint64_t visibilityTixels,
-                            double visibilityBytesPerTixel) {
+                            double visibilityBytesPerTixel, bool streamed) {
   const uint64_t directions = uint64_t(gatherGridSide(settings.gatherDirections)) * gatherGridSide(settings.gatherDirections);
   const uint64_t held = visibilityTixels > 0 ? visibilityTixels : tixels;
   // Unmeasured: 8 bytes per entry (more than the encoding takes but for the rarest fields) and
-  // the two per-tixel offsets. Measured: the sample's figure with kVisibilityEstimateMargin.
-  const uint64_t visibility =
-      visibilityBytesPerTixel > 0.0
-          ? uint64_t(double(held) * visibilityBytesPerTixel * kVisibilityEstimateMargin)
-          : held * (directions * sizeof(VisibilityEntry) + 2 * sizeof(uint64_t));
+  // the two per-tixel offsets; streamed, the extra records' offsets and one record per tixel.
+  // Measured: the sample's figure with kVisibilityEstimateMargin.
+  const uint64_t unmeasured = streamed ? sizeof(uint64_t) + sizeof(VisibilityExtra)
+                                       : directions * sizeof(VisibilityEntry) + 2 * sizeof(uint64_t);
+  const uint64_t visibility = visibilityBytesPerTixel > 0.0
+                                  ? uint64_t(double(held) * visibilityBytesPerTixel * kVisibilityEstimateMargin)
+                                  : held * unmeasured;
   constexpr uint64_t kQuadBytes = 64, kChangeBytes = 4, kValueArrays = 3;
-  // Writing the .plv compresses it a batch of blocks at a time beside the field.
-  const uint64_t writeBuffers = visibilityWriteBufferBytes(gatherGridSide(settings.gatherDirections));
+  // Writing the .plv compresses it a batch of blocks at a time beside the field; a streamed
+  // field is read and written a few blocks per thread at a time.
+  const uint32_t side = gatherGridSide(settings.gatherDirections);
+  const uint64_t writeBuffers = streamed ? visibilityStreamBufferBytes(side) : visibilityWriteBufferBytes(side);
   // Sun masks: every slot in the parameterisation, then the light field's copy (at most as many).
   const uint64_t sunMasks = settings.sunMasks ? sizeof(SunMaskSlots) * 2 : 0;
   return visibility + writeBuffers + values * kValueArrays * sizeof(Rgb) + tixels * (kQuadBytes + kChangeBytes + sunMasks);
@@ -185,20 +212,47 @@ uint64_t decodedFieldBudget(uint64_t estimate, const BakeOptions& options) {
 }
 
 namespace {
+/// Whether this bake streams its visibility field (options.visibilityMemory): automatic streams
+/// when the estimate with the field held exceeds the memory available or options.maxMemory (and
+/// there is a .plv to stream from, `visibilityPath`). Says so when it streams.
+bool streamVisibility(const BakeOptions& options, const std::string& visibilityPath, uint64_t heldEstimate,
+                      uint64_t streamedEstimate, const Note& note) {
+  constexpr double kGiB = double(uint64_t(1) << 30);
+  if (options.visibilityMemory == VisibilityMemory::held) return false;
+  if (options.visibilityMemory == VisibilityMemory::streamed) {
+    if (visibilityPath.empty())
+      throw UsageError("--visibility-memory streamed: the field is streamed from its .plv, and this bake saves none");
+    note(fmt::format("visibility: streamed from {} (--visibility-memory streamed; estimated memory {:.2f} GiB, held "
+                     "{:.2f} GiB)",
+                     visibilityPath, streamedEstimate / kGiB, heldEstimate / kGiB));
+    return true;
+  }
+  if (visibilityPath.empty()) return false;
+  std::optional<uint64_t> limit = availableMemoryBytes();
+  if (options.maxMemory > 0) limit = std::min(limit.value_or(options.maxMemory), options.maxMemory);
+  if (!limit || heldEstimate <= *limit) return false;
+  note(fmt::format("visibility: streamed from {}, because holding it would take the bake to {:.2f} GiB, over the "
+                   "{:.2f} GiB {} (streamed: {:.2f} GiB)",
+                   visibilityPath, heldEstimate / kGiB, *limit / kGiB,
+                   options.maxMemory > 0 && *limit == options.maxMemory ? "of --max-memory" : "available",
+                   streamedEstimate / kGiB));
+  return true;
+}
 
 /// Reads the saved field of `held` into `visibility` (readVisibility's checks; false and *why
 /// when it is not this bake's), decoded as it is checked when the budget holds it decoded
 /// (VisibilityShard::holdDecoded's rule, without decoding it twice).
 bool readHeldField(const std::string& visibilityPath, uint64_t shardHash, const Parameterisation& param,
                    const BakeSettings& settings, const std::vector<TixelRange>& held, uint64_t decodedBudget,
-                   VisibilityShard& visibility, std::string* why) {
+                   bool streamed, VisibilityShard& visibility, std::string* why) {
   uint64_t heldTixels = 0;
   for (const TixelRange& r : held) heldTixels += r.size();
   const uint64_t side = gatherGridSide(settings.gatherDirections);
-  const bool hold = heldTixels > 0 && heldTixels * side * side * sizeof(VisibilityEntry) <= decodedBudget;
+  const bool hold = !streamed && heldTixels > 0 && heldTixels * side * side * sizeof(VisibilityEntry) <= decodedBudget;
   VisibilityField field;
   std::vector<VisibilityEntry> decoded;
-  if (!readVisibility(visibilityPath, shardHash, field, why, param.tixelCount, hold ? &decoded : nullptr)) return false;
+  if (!readVisibility(visibilityPath, shardHash, field, why, param.tixelCount, hold ? &decoded : nullptr, streamed))
+    return false;
   visibility = VisibilityShard::of(std::move(field), held);
   if (hold) visibility.decoded = FieldArray<VisibilityEntry>(std::move(decoded));
   return true;
@@ -208,15 +262,15 @@ bool readHeldField(const std::string& visibilityPath, uint64_t shardHash, const 
 /// with this rank's field when both match it and every rank has them at the same iteration
 /// (collective: every rank calls it). Says why not when a checkpoint was there.
 bool resumableCheckpoint(const std::string& visibilityPath, uint64_t shardHash, uint64_t key, const Parameterisation& param,
-                         const std::vector<TixelRange>& held, Communicator& comm, PropagationCheckpoint& checkpoint,
-                         VisibilityShard& visibility, const Note& note) {
+                         const std::vector<TixelRange>& held, bool streamed, Communicator& comm,
+                         PropagationCheckpoint& checkpoint, VisibilityShard& visibility, const Note& note) {
   const std::string path = propagationCheckpointPath(visibilityPath);
   std::error_code ec;
   const bool present = std::filesystem::exists(path, ec);
   std::string why;
   bool ok = readPropagationCheckpoint(path, key, param.valueCount, checkpoint, &why);
   VisibilityField field;
-  if (ok && !readVisibility(visibilityPath, shardHash, field, &why, param.tixelCount)) ok = false;
+  if (ok && !readVisibility(visibilityPath, shardHash, field, &why, param.tixelCount, nullptr, streamed)) ok = false;
   // Every rank must start from the same iteration (the checkpoints of ranks killed at
   // different moments may differ by one).
   const uint64_t mine = ok ? uint64_t(checkpoint.progress.iterations) + 1 : 0;
@@ -245,7 +299,7 @@ bool resumableCheckpoint(const std::string& visibilityPath, uint64_t shardHash, 
 Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const BakeSettings& settings, const BakeOptions& options, Communicator& comm,
                             const ShardPlan& plan, const std::vector<TixelRange>& held, uint64_t hash, uint64_t decodedBudget,
-                            const Note& note) {
+                            bool streamed, const Note& note) {
   const std::string visibilityPath = shardVisibilityPath(options.visibilityPath, comm.rank(), comm.size());
   const uint64_t shardHash = visibilityShardHash(hash, held, param.tixelCount);
   Transport t;
@@ -263,7 +317,7 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
       if (stopAfter > 0 && ++saved == stopAfter) std::_Exit(kExitFailure);  // the test hook: "killed" here
     };
     if (options.resume) {
-      if (resumableCheckpoint(visibilityPath, shardHash, key, param, held, comm, checkpoint, t.visibility, note)) {
+      if (resumableCheckpoint(visibilityPath, shardHash, key, param, held, streamed, comm, checkpoint, t.visibility, note)) {
         resume.from = &checkpoint;
         t.reused = true;
         t.visibility.holdDecoded(decodedBudget);
@@ -278,11 +332,14 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
   auto computeAndSave = [&] {
     std::optional<VisibilityJournal> journal;
     if (!visibilityPath.empty()) journal.emplace(partialVisibilityPath(visibilityPath), options.resume, note);
-    t.visibility = computeVisibilityShard(scene, accel, param, settings, held, true, journal ? &*journal : nullptr);
+    // Streamed: written to the .plv as it is traced (then read from it), never held.
+    t.visibility = computeVisibilityShard(scene, accel, param, settings, held, true, journal ? &*journal : nullptr,
+                                          streamed ? visibilityPath : std::string());
     const VisibilityField& f = t.visibility.field;
-    note(fmt::format("visibility: {} rays in {:.2f} s ({:.1f} Mrays/s), {:.1f} MB", f.rays, f.seconds,
-                     f.seconds > 0 ? f.rays / f.seconds * 1e-6 : 0.0, f.bytes() / 1e6));
-    if (!visibilityPath.empty()) writeVisibility(visibilityPath, f);
+    note(fmt::format("visibility: {} rays in {:.2f} s ({:.1f} Mrays/s), {:.1f} MB{}", f.rays, f.seconds,
+                     f.seconds > 0 ? f.rays / f.seconds * 1e-6 : 0.0, f.bytes() / 1e6,
+                     streamed ? fmt::format(" held, entries streamed to {}", visibilityPath) : ""));
+    if (!visibilityPath.empty() && !streamed) writeVisibility(visibilityPath, f);
     if (journal) journal->finish();
     t.visibility.holdDecoded(decodedBudget);
   };
@@ -294,7 +351,8 @@ Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parame
     double readSeconds = 0.0;
     std::future<bool> read = std::async(std::launch::async, [&] {
       const auto readStart = std::chrono::steady_clock::now();
-      const bool ok = readHeldField(visibilityPath, shardHash, param, settings, held, decodedBudget, t.visibility, &why);
+      const bool ok =
+          readHeldField(visibilityPath, shardHash, param, settings, held, decodedBudget, streamed, t.visibility, &why);
       readSeconds = secondsSince(readStart);
       return ok;
     });
@@ -387,6 +445,7 @@ BakeStats bakeStats(const Parameterisation& param, const Transport& t, const Dis
   stats.values = param.valueCount;
   stats.visibilityRays = totalRays;
   stats.reusedVisibility = t.reused;
+  stats.visibilityMemory = t.visibility.streamed() ? "streamed" : "held";
   stats.causticPhotons = t.propagation.causticPhotons;
   stats.causticPhotonsLanded = t.propagation.causticPhotonsLanded;
   stats.causticSeconds = t.propagation.causticSeconds;
@@ -433,18 +492,28 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   const RankShare share = rankShare(lf.scene, param, plan, comm.rank(), note);
   // How many bytes the field will take: the saved field's, when it is this bake's, else traced
   // ahead on a sample of the held tixels.
-  const double bytesPerTixel =
-      reusable && reusable->hash == hash && reusable->tixelCount == param.tixelCount && reusable->heldBytes > 0
-          ? double(reusable->heldBytes) / double(reusable->tixelCount)
-          : estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
-  const uint64_t estimate =
-      bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel) +
-      subsurfaceOperatorBytesEstimate(lf.scene, param, settings.subsurfaceWalks, comm.size());
+  VisibilityBytesPerTixel bytesPerTixel;
+  if (reusable && reusable->hash == hash && reusable->tixelCount == param.tixelCount && reusable->heldBytes > 0) {
+    const double tixels = double(reusable->tixelCount);
+    bytesPerTixel.held = double(reusable->heldBytes) / tixels;
+    bytesPerTixel.streamed = double(reusable->heldBytes - reusable->entryBytes - kEntryBytesPadding) / tixels - sizeof(uint64_t);
+  } else {
+    bytesPerTixel = estimateVisibilityBytesPerTixel(lf.scene, accel, param, settings, share.held);
+  }
+  const uint64_t subsurfaceBytes = subsurfaceOperatorBytesEstimate(lf.scene, param, settings.subsurfaceWalks, comm.size());
+  const uint64_t heldEstimate =
+      bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels, bytesPerTixel.held) + subsurfaceBytes;
+  const uint64_t streamedEstimate = bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, share.heldTixels,
+                                                       bytesPerTixel.streamed, true) +
+                                    subsurfaceBytes;
+  const bool streamed = streamVisibility(options, shardVisibilityPath(options.visibilityPath, comm.rank(), comm.size()),
+                                         heldEstimate, streamedEstimate, note);
+  const uint64_t estimate = streamed ? streamedEstimate : heldEstimate;
   if (options.checkMemory) options.checkMemory(estimate);
 
   // 2. Visibility field and 3. propagation.
   Transport transport = traceAndPropagate(lf.scene, accel, param, settings, options, comm, plan, share.held, hash,
-                                          decodedFieldBudget(estimate, options), note);
+                                          decodedFieldBudget(estimate, options), streamed, note);
   DistributedBakeStats distributed =
       gatherDistributedStats(comm, plan, share, setupSeconds, tixelSetup, transport, note);
 

@@ -69,6 +69,17 @@ struct DistributedBakeStats {
   double exchangeSeconds = 0.0;     ///< this rank's time inside the exchanges (waits included)
 };
 
+/// Where the propagation reads the visibility field from (docs/design.md, Visibility field).
+enum class VisibilityMemory {
+  automatic,  ///< held when the bake's estimate with it held fits the memory (and maxMemory), else streamed
+  held,       ///< in memory (compact entries)
+  streamed,   ///< from its .plv, a block at a time (needs a visibilityPath)
+};
+/// The name of a mode ("auto", "held", "streamed") and back; parseVisibilityMemory throws
+/// pl::UsageError naming `option` and the choices for anything else.
+const char* visibilityMemoryName(VisibilityMemory mode);
+VisibilityMemory parseVisibilityMemory(const std::string& text, const std::string& option);
+
 struct BakeOptions {
   /// Where the visibility field is saved (and looked for with reuseVisibility); empty = not saved.
   std::string visibilityPath;
@@ -93,6 +104,9 @@ struct BakeOptions {
   /// alone): bounds, beside the estimate, what the propagation may spend on holding the
   /// visibility field decoded (VisibilityShard::holdDecoded; checkMemory does the refusing).
   uint64_t maxMemory = 0;
+  /// Whether the visibility field is held in memory or streamed from its .plv (`bake
+  /// --visibility-memory`); automatic streams only when holding it does not fit.
+  VisibilityMemory visibilityMemory = VisibilityMemory::automatic;
   /// The ranks of a distributed bake (distributed/communicator.h); null = one process. Every
   /// rank calls bake() with the same scene and settings (refused otherwise, before any ray is
   /// traced); each traces and saves its shard of the visibility field (visibilityPath becomes
@@ -115,8 +129,16 @@ struct BakeOptions {
 /// per tixel. What the bake allocates after the check: the scene and the BVH, already resident
 /// then, are not in it.
 /// visibilityTixels: the tixels of the field this process holds (a rank's shard); 0 = all.
+/// streamed: the field is streamed (VisibilityMemory::streamed): visibilityBytesPerTixel is
+/// then what it holds of it (VisibilityBytesPerTixel::streamed; 0: 16 bytes, the extra records'
+/// offsets and a few records), and the readers' and the writer's block buffers are added
+/// (visibilityStreamBufferBytes).
 uint64_t bakeMemoryEstimate(uint64_t tixels, uint64_t values, const BakeSettings& settings, uint64_t visibilityTixels = 0,
-                            double visibilityBytesPerTixel = 0.0);
+                            double visibilityBytesPerTixel = 0.0, bool streamed = false);
+/// Bytes a streamed field's readers and writer hold: a few entry blocks per thread of the
+/// parallel loops (parallelThreads: the block each gather task reads, a rough-glass twin's, the
+/// frames written out of order).
+uint64_t visibilityStreamBufferBytes(uint32_t gridSide);
 /// Margin on a visibility field's size measured on a sample: the sample's tixels are spread
 /// evenly, but what they see varies from chart to chart.
 inline constexpr double kVisibilityEstimateMargin = 1.15;

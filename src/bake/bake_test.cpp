@@ -640,12 +640,19 @@ TEST_F(BakeTest, CornellBoxVisibilityFieldIsSane) {
   EXPECT_LT(fraction, 0.4);
   // The memory guard's figure, measured on a sample of tixels, is close to what the field holds
   // and well below 8 bytes per entry.
-  const double estimate = estimateVisibilityBytesPerTixel(scene, accel, param, settings, {TixelRange{0, param.tixelCount}});
+  const VisibilityBytesPerTixel perTixel =
+      estimateVisibilityBytesPerTixel(scene, accel, param, settings, {TixelRange{0, param.tixelCount}});
+  const double estimate = perTixel.held;
   const double held = double(field.bytes()) / double(field.tixelCount);
   EXPECT_NEAR(estimate / held, 1.0, 0.1) << estimate << " " << held;
   EXPECT_LT(held, 64 * 6.0);
   EXPECT_LT(bakeMemoryEstimate(param.tixelCount, param.valueCount, settings, 0, estimate),
             bakeMemoryEstimate(param.tixelCount, param.valueCount, settings));
+  // Streamed, the field holds its extra records and their offsets alone.
+  const double streamed = double(field.extraOffset.size() * sizeof(uint64_t) + field.extras.size() * sizeof(VisibilityExtra)) /
+                          double(field.tixelCount);
+  EXPECT_NEAR(perTixel.streamed / streamed, 1.0, 0.25) << perTixel.streamed << " " << streamed;
+  EXPECT_LT(perTixel.streamed, estimate / 4);
 }
 
 // The gather's sub-cells are multi-jittered: along each column of cells every sub-column is

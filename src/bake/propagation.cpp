@@ -375,8 +375,8 @@ template <bool KeepIncoming, typename SlowPath>
 /// memory (the quads are read at random and, on a large scene, mostly miss every cache).
 class EntryPipeline {
  public:
-  EntryPipeline(const VisibilityShard& vis, uint32_t n)
-      : vis_(vis), n_(n), buffer_{std::vector<VisibilityEntry>(n), std::vector<VisibilityEntry>(n)} {}
+  EntryPipeline(EntryReader& reader, uint32_t n)
+      : reader_(reader), n_(n), buffer_{std::vector<VisibilityEntry>(n), std::vector<VisibilityEntry>(n)} {}
 
   /// Tixel g's entries: those ahead(g) prepared, else decoded now (and their quads prefetched
   /// at once). Valid until the second ahead() after.
@@ -386,20 +386,20 @@ class EntryPipeline {
       aheadTixel_ = kNone;
       return aheadEntries_;
     }
-    const VisibilityEntry* entries = vis_.entries(g, buffer_[slot_].data());
+    const VisibilityEntry* entries = reader_.entries(g, buffer_[slot_].data());
     for (uint32_t k = 0; k < n_; ++k) __builtin_prefetch(quads + std::min<uint64_t>(entries[k].tixel(), quadCount - 1));
     return entries;
   }
   /// Prepares tixel g's entries, to be taken next (the buffer take() did not return); returns them.
   const VisibilityEntry* ahead(uint64_t g) {
     aheadTixel_ = g;
-    aheadEntries_ = vis_.entries(g, buffer_[slot_ ^ 1].data());
+    aheadEntries_ = reader_.entries(g, buffer_[slot_ ^ 1].data());
     return aheadEntries_;
   }
 
  private:
   static constexpr uint64_t kNone = ~uint64_t(0);
-  const VisibilityShard& vis_;
+  EntryReader& reader_;
   uint32_t n_;
   std::vector<VisibilityEntry> buffer_[2];
   uint32_t slot_ = 0;  ///< the buffer take() decodes into; ahead() uses the other
@@ -1119,15 +1119,14 @@ void gatherEmission(TransportState& state, const VisibilityShard& vis, uint64_t 
     std::fill_n(tixelEmits.begin() + int64_t(c.firstTixel), c.tixelCount(), bits);
   }
   tixelEmits[tixels] = environment.isBlack() ? 0 : 3;
-  parallelForRange(end - begin, 16, [&](uint64_t r0, uint64_t r1) {
-    const uint64_t t0 = begin + r0, t1 = begin + r1;
+  vis.forEachSpan(begin, end, 16, [&](uint64_t t0, uint64_t t1, EntryReader& reader) {
     std::vector<Lanes4> incoming(n);  // per gather cell, kept for glossy tixels
     std::vector<VisibilityEntry> decoded(n);
     std::vector<uint8_t> subCells;
     for (uint64_t g = t0; g < t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
-      const VisibilityEntry* entries = vis.entries(g, decoded.data());
+      const VisibilityEntry* entries = reader.entries(g, decoded.data());
       const VisibilityExtra* extras = vis.extras(g);
       uint64_t cursor = 0;
       const TixelFrame frame = tixelFrame(param, c, g);  // the gather rays' frame (visibility.cpp)
@@ -1353,14 +1352,14 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
   const std::vector<Rgb>& previousValues = state.previousValues;
   std::vector<Rgb>& current = state.current;
   std::vector<float>& change = state.change;
-  parallelForRange(end - begin, 16, [&](uint64_t t0, uint64_t t1) {
+  vis.forEachSpan(begin, end, 16, [&](uint64_t g0, uint64_t g1, EntryReader& reader) {
     std::vector<Lanes4> incoming(n), twinIncoming, slowValues(n);
     std::vector<VisibilityEntry> twinDecoded;
-    EntryPipeline pipeline(vis, n);
+    EntryPipeline pipeline(reader, n);
+    std::optional<EntryReader> twinReader;  // rough glass: the twin record's tixels, elsewhere in the field
     std::vector<uint8_t> subCells;
-    const uint64_t g1 = begin + t1;
     auto gathered = [&](uint64_t g) { return param.charts[param.tixelChart[g]].kind != ChartKind::Specular; };
-    for (uint64_t g = begin + t0; g < g1; ++g) {
+    for (uint64_t g = g0; g < g1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
       if (c.kind == ChartKind::Specular) continue;
       auto slowPath = [&](VisibilityEntry e, const VisibilityExtra* extra) {
@@ -1403,7 +1402,8 @@ void gatherIteration(TransportState& state, const VisibilityShard& vis, uint64_t
           const uint64_t twin = twinTixel(param, g);
           twinIncoming.resize(n);
           twinDecoded.resize(n);
-          const F4 twinSum = gatherTixel<true>(vis.entries(twin, twinDecoded.data()), nullptr, n, ops.quads.data(),
+          if (!twinReader) twinReader.emplace(vis);
+          const F4 twinSum = gatherTixel<true>(twinReader->entries(twin, twinDecoded.data()), nullptr, n, ops.quads.data(),
                                                ops.quads.size(), vis.extras(twin), vis.extraCount(twin),
                                                slowValues.data(), twinIncoming.data(), slowPath);
           gm.transmission[c.isBack ? 1 : 0].apply(twinIncoming.data(), twinSum, out);

@@ -94,8 +94,10 @@ class ThreadRanks {
 };
 
 /// Values of a one-process bake and of `ranks` simulated ranks (every rank's), compared bit for
-/// bit; returns every rank's result.
-std::vector<PropagationResult> expectRanksMatchOneProcess(const Scene& scene, const BakeSettings& settings, int ranks) {
+/// bit; returns every rank's result. streamDir: when given, each rank streams its shard of the
+/// field from a .plv there (computeVisibilityShard's streamTo) instead of holding it.
+std::vector<PropagationResult> expectRanksMatchOneProcess(const Scene& scene, const BakeSettings& settings, int ranks,
+                                                          const std::string& streamDir = "") {
   Progress::setEnabled(false);
   const Accel accel(scene);
   const Parameterisation param = buildParameterisation(scene, accel, settings);
@@ -106,7 +108,10 @@ std::vector<PropagationResult> expectRanksMatchOneProcess(const Scene& scene, co
   ThreadRanks world(ranks);
   world.run([&](Communicator& comm) {
     const std::vector<TixelRange> held = visibilityRanges(scene, param, plan, comm.rank());
-    const VisibilityShard shard = computeVisibilityShard(scene, accel, param, settings, held);
+    const std::string streamTo =
+        streamDir.empty() ? std::string() : fmt::format("{}/rank{}-of-{}.plv", streamDir, comm.rank(), ranks);
+    const VisibilityShard shard = computeVisibilityShard(scene, accel, param, settings, held, false, nullptr, streamTo);
+    EXPECT_EQ(shard.streamed(), !streamDir.empty());
     results[size_t(comm.rank())] =
         propagate(scene, accel, param, [&]() -> const VisibilityShard& { return shard; }, settings, comm, plan);
   });
@@ -400,6 +405,8 @@ TEST_F(ShardFiles, RanksGetTheOneProcessLightFieldWithRoughGlass) {
   }
   ASSERT_TRUE(twinElsewhere);
   expectRanksMatchOneProcess(scene, settings, 3);
+  // Each rank's shard streamed from its .plv (several ranges, twins read from other blocks): the same bits.
+  expectRanksMatchOneProcess(scene, settings, 3, dir_);
 }
 
 TEST(Shards, RanksGetTheOneProcessLightFieldWithSubsurface) {

@@ -5,6 +5,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <map>
+#include <mutex>
 #include <optional>
 
 #include "accel/accel.h"
@@ -228,7 +231,7 @@ VisibilityShard VisibilityShard::of(VisibilityField field, std::vector<TixelRang
 bool VisibilityShard::holdDecoded(uint64_t budget) {
   const uint64_t bytes = field.entryCount() * sizeof(VisibilityEntry);
   if (!decoded.empty()) return true;
-  if (field.tixelCount == 0 || bytes > budget) return false;
+  if (field.tixelCount == 0 || bytes > budget || streamed()) return false;
   const uint32_t n = field.directionsPerTixel();
   std::vector<VisibilityEntry> all(field.entryCount());
   parallelForRange(field.tixelCount, 256, [&](uint64_t t0, uint64_t t1) {
@@ -236,6 +239,56 @@ bool VisibilityShard::holdDecoded(uint64_t budget) {
   });
   decoded = FieldArray<VisibilityEntry>(std::move(all));
   return true;
+}
+
+void VisibilityShard::forEachSpan(uint64_t begin, uint64_t end, uint64_t grain,
+                                  const std::function<void(uint64_t, uint64_t, EntryReader&)>& body) const {
+  if (begin >= end) return;
+  if (!streamed()) {
+    parallelForRange(end - begin, grain, [&](uint64_t r0, uint64_t r1) {
+      EntryReader reader(*this);
+      body(begin + r0, begin + r1, reader);
+    });
+    return;
+  }
+  // The parts of [begin, end) in each held range (contiguous field indices), cut at the
+  // entry blocks' boundaries: spans[i] = (first tixel, end tixel) of one block each.
+  const uint64_t perBlock = field.stream->perBlock();
+  std::vector<TixelRange> spans;
+  for (const TixelRange& r : ranges) {
+    const uint64_t p0 = std::max(begin, r.begin), p1 = std::min(end, r.end);
+    for (uint64_t g = p0; g < p1;) {
+      const uint64_t t = local(g), blockEnd = (t / perBlock + 1) * perBlock;
+      const uint64_t g1 = std::min(p1, g + (blockEnd - t));
+      spans.push_back({g, g1});
+      g = g1;
+    }
+  }
+  // Consecutive blocks per task (each task's reader buffers allocated once), each read once.
+  parallelForRange(spans.size(), 1, [&](uint64_t i0, uint64_t i1) {
+    EntryReader reader(*this);
+    for (uint64_t i = i0; i < i1; ++i) body(spans[i].begin, spans[i].end, reader);
+  });
+}
+
+const VisibilityEntry* EntryReader::streamedEntries(uint64_t g, VisibilityEntry* scratch) {
+  const VisibilityBlockFile& file = *vis_.field.stream;
+  const uint64_t t = vis_.local(g), perBlock = file.perBlock(), b = t / perBlock;
+  if (b != block_) {
+    file.read(b, frame_, content_);
+    const uint64_t tixels = std::min(vis_.field.tixelCount - b * perBlock, perBlock);
+    // The block's content: the tixels' encoded sizes (u32), then the encodings.
+    offset_.resize(tixels + 1);
+    offset_[0] = tixels * sizeof(uint32_t);
+    for (uint64_t i = 0; i < tixels; ++i) {
+      uint32_t size;
+      std::memcpy(&size, content_.data() + i * sizeof(uint32_t), sizeof(uint32_t));
+      offset_[i + 1] = offset_[i] + size;
+    }
+    block_ = b;
+  }
+  decodeTixelEntries<false>(content_.data() + offset_[t - b * perBlock], 0, vis_.field.directionsPerTixel(), scratch);
+  return scratch;
 }
 
 bool VisibilityShard::holds(uint64_t begin, uint64_t end) const {
@@ -265,9 +318,79 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
   return computeVisibilityShard(scene, accel, param, settings, {TixelRange{0, param.tixelCount}}).field;
 }
 
+namespace {
+
+/// A streamed field's traced blocks (runs of consecutive tixels, in field order), handed over
+/// in any order as they finish, joined in field order into the entry blocks of its .plv and
+/// written (VisibilityWriter), each run freed once copied: memory holds only the runs that
+/// wait for an earlier one (the tracing takes its blocks in order, so a few per thread).
+class StreamedFieldSink {
+ public:
+  StreamedFieldSink(VisibilityWriter& writer, uint64_t tixelCount, uint64_t runCount)
+      : writer_(writer), tixelCount_(tixelCount), runCount_(runCount) {}
+
+  /// Run `index` (thread-safe, each once). Throws pl::Error when the .plv cannot be written.
+  void add(uint64_t index, EncodedRun run) {
+    std::vector<Block> ready;
+    {
+      const std::lock_guard lock(mutex_);
+      pending_.emplace(index, std::move(run));
+      for (auto it = pending_.begin(); it != pending_.end() && it->first == next_; it = pending_.erase(it), ++next_) {
+        const EncodedRun& r = it->second;
+        // The run's tixels, split at the entry blocks' boundaries.
+        uint64_t byte = 0;
+        for (uint64_t i = 0; i < r.tixelBytes.size();) {
+          const uint64_t room = blockTixels(block_.index) - block_.tixelBytes.size();
+          const uint64_t take = std::min<uint64_t>(room, r.tixelBytes.size() - i);
+          uint64_t bytes = 0;
+          for (uint64_t k = i; k < i + take; ++k) bytes += r.tixelBytes[k];
+          block_.tixelBytes.insert(block_.tixelBytes.end(), r.tixelBytes.begin() + int64_t(i),
+                                   r.tixelBytes.begin() + int64_t(i + take));
+          block_.encoded.insert(block_.encoded.end(), r.bytes.begin() + int64_t(byte),
+                                r.bytes.begin() + int64_t(byte + bytes));
+          i += take;
+          byte += bytes;
+          if (block_.tixelBytes.size() == blockTixels(block_.index)) {
+            const uint64_t nextIndex = block_.index + 1;
+            ready.push_back(std::move(block_));
+            block_ = Block{nextIndex, {}, {}};
+          }
+        }
+      }
+    }
+    // Compressed outside the lock; the writer puts the frames in order.
+    for (const Block& b : ready) {
+      uint64_t contentBytes = 0;
+      std::vector<unsigned char> frame = VisibilityWriter::frameBlock(b.tixelBytes, b.encoded, &contentBytes);
+      writer_.put(b.index, std::move(frame), contentBytes);
+    }
+  }
+  /// Whether every run was added.
+  bool complete() const { return next_ == runCount_; }
+
+ private:
+  struct Block {
+    uint64_t index = 0;
+    std::vector<uint32_t> tixelBytes;
+    std::vector<unsigned char> encoded;
+  };
+  uint64_t blockTixels(uint64_t b) const {
+    return std::min(writer_.perBlock(), tixelCount_ - std::min(tixelCount_, b * writer_.perBlock()));
+  }
+
+  VisibilityWriter& writer_;
+  uint64_t tixelCount_, runCount_;
+  std::mutex mutex_;
+  std::map<uint64_t, EncodedRun> pending_;  ///< runs waiting for an earlier one
+  uint64_t next_ = 0;                       ///< the next run to join
+  Block block_;                             ///< the entry block being joined
+};
+
+}  // namespace
+
 VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                        const BakeSettings& settings, const std::vector<TixelRange>& ranges,
-                                       bool showProgress, VisibilityJournal* journal) {
+                                       bool showProgress, VisibilityJournal* journal, const std::string& streamTo) {
   const auto start = std::chrono::steady_clock::now();
   VisibilityField field;
   field.gridSide = gatherGridSide(settings.gatherDirections);
@@ -313,6 +436,19 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     for (uint64_t b = 0; b < blockCount; ++b) blockTixels[b] = blockList[b].t1 - blockList[b].t0;
     restored = journal->open(field.hash, field.gridSide, blockTixels, param.tixelCount, blockEntries, blockExtras);
   }
+  // Streamed: the blocks go to the .plv as they finish (the restored ones first), not into memory.
+  std::optional<VisibilityWriter> writer;
+  std::optional<StreamedFieldSink> sink;
+  if (!streamTo.empty()) {
+    writer.emplace(streamTo, field.gridSide, field.hash, heldTixels);
+    sink.emplace(*writer, heldTixels, blockCount);
+    for (uint64_t b = 0; b < blockCount; ++b)
+      if (restored[b]) sink->add(b, std::move(blockEntries[b]));
+    std::vector<EncodedRun>().swap(blockEntries);
+  }
+  // The blocks are taken in order (a task takes the next untraced block, whichever index it
+  // was given), so that a streamed field's blocks finish nearly in order.
+  std::atomic<uint64_t> nextBlock{0};
   std::atomic<uint64_t> rayCount{0};
   std::optional<Progress> progress;
   if (showProgress) progress.emplace("visibility", heldTixels);
@@ -322,7 +458,8 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     Rgb throughput;
     bool viaMirror;
   };
-  parallelFor(blockCount, [&](uint64_t block) {
+  parallelFor(blockCount, [&](uint64_t) {
+    const uint64_t block = nextBlock++;
     const uint64_t t0 = blockList[block].t0, t1 = blockList[block].t1, localBase = blockList[block].local;
     if (restored[block]) {
       if (progress) progress->advance(t1 - t0);
@@ -419,11 +556,13 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
       std::swap(states, nextStates);
     }
     std::sort(extras.begin(), extras.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    EncodedRun& run = blockEntries[block];
+    EncodedRun run;
     run.bytes.reserve((t1 - t0) * maxEncodedTixelBytes(n));
     for (uint64_t g = t0; g < t1; ++g) run.add(entries.data() + (g - t0) * n, n, fractionBits);
     run.bytes.shrink_to_fit();
     if (journal) journal->append(block, run, extras);
+    if (sink) sink->add(block, std::move(run));
+    else blockEntries[block] = std::move(run);
     if (progress) progress->advance(t1 - t0);
   });
   if (progress) progress->finish();
@@ -440,7 +579,13 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
     for (const auto& item : list) extras.push_back(item.second);
     std::vector<std::pair<uint64_t, VisibilityExtra>>().swap(list);
   }
-  field.assembleEntries(blockEntries);
+  if (writer) {
+    if (!sink->complete()) fail("{}: the visibility field was not traced whole", streamTo);
+    VisibilityFrames frames = writer->finish(extraOffset, extras);
+    field.stream = std::make_shared<const VisibilityBlockFile>(streamTo, std::move(frames));
+  } else {
+    field.assembleEntries(blockEntries);
+  }
   field.extraOffset = FieldArray<uint64_t>(std::move(extraOffset));
   field.extras = FieldArray<VisibilityExtra>(std::move(extras));
   field.rays = rayCount.load();
@@ -448,11 +593,11 @@ VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, c
   return VisibilityShard::of(std::move(field), ranges);
 }
 
-double estimateVisibilityBytesPerTixel(const Scene& scene, const Accel& accel, const Parameterisation& param,
-                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges) {
+VisibilityBytesPerTixel estimateVisibilityBytesPerTixel(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                                        const BakeSettings& settings, const std::vector<TixelRange>& ranges) {
   uint64_t held = 0;
   for (const TixelRange& r : ranges) held += r.size();
-  if (held == 0) return 0.0;
+  if (held == 0) return {};
   const uint64_t n = uint64_t(gatherGridSide(settings.gatherDirections)) * gatherGridSide(settings.gatherDirections);
   const uint64_t count = std::clamp<uint64_t>(kVisibilitySampleRays / n, 1, held);
   // The middle tixel of each of `count` equal runs of the held tixels (in their order).
@@ -466,7 +611,10 @@ double estimateVisibilityBytesPerTixel(const Scene& scene, const Accel& accel, c
     if (sample.empty() || sample.back().end <= g) sample.push_back({g, g + 1});
   }
   const VisibilityShard traced = computeVisibilityShard(scene, accel, param, settings, sample, false);
-  return double(traced.field.bytes()) / double(traced.field.tixelCount);
+  const VisibilityField& f = traced.field;
+  const double tixels = double(f.tixelCount);
+  return {double(f.bytes()) / tixels,
+          double(f.extraOffset.size() * sizeof(uint64_t) + f.extras.size() * sizeof(VisibilityExtra)) / tixels};
 }
 
 }  // namespace pl

@@ -17,6 +17,7 @@
 // means) and its .plv file are plf/plv_file.h's.
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,7 @@
 namespace pl {
 
 class Accel;
+class EntryReader;
 class VisibilityJournal;
 
 /// Tixels [begin, end) (global tixel indices).
@@ -65,16 +67,26 @@ struct VisibilityShard {
     }
     return localStart[lo] + (g - ranges[lo].begin);
   }
-  /// Tixel g's N entries: decoded into `scratch` (room for N), which it returns, or where
-  /// `decoded` holds them.
+  /// Whether the field's entries are streamed from its .plv (VisibilityField::stream): then
+  /// only an EntryReader reads them, and entries() may not be called.
+  bool streamed() const { return field.stream != nullptr; }
+  /// Tixel g's N entries (held field): decoded into `scratch` (room for N), which it returns, or
+  /// where `decoded` holds them.
   const VisibilityEntry* entries(uint64_t g, VisibilityEntry* scratch) const {
     if (!decoded.empty()) return decoded.data() + local(g) * field.directionsPerTixel();
     field.decode(local(g), scratch);
     return scratch;
   }
   /// Decodes every entry into `decoded` (in parallel) when they take at most `budget` bytes
-  /// (8 per entry); returns whether it did. The entries are the same either way.
+  /// (8 per entry) and the field is held; returns whether it did. The entries are the same
+  /// either way.
   bool holdDecoded(uint64_t budget);
+  /// Calls body(t0, t1, reader) on disjoint sub-ranges [t0, t1) of the held tixels [begin, end)
+  /// (contiguous in one of `ranges`), in parallel, each with an EntryReader of its own task:
+  /// a held field in sub-ranges of at least `grain` tixels, a streamed one in whole entry
+  /// blocks of its .plv (their parts inside [begin, end)), so that each block is read once.
+  void forEachSpan(uint64_t begin, uint64_t end, uint64_t grain,
+                   const std::function<void(uint64_t, uint64_t, EntryReader&)>& body) const;
   /// Tixel g's first extra record.
   const VisibilityExtra* extras(uint64_t g) const { return field.extras.data() + field.extraOffset[local(g)]; }
   /// How many extra records tixel g has.
@@ -82,6 +94,28 @@ struct VisibilityShard {
     const uint64_t t = local(g);
     return field.extraOffset[t + 1] - field.extraOffset[t];
   }
+};
+
+/// A task's reader of a shard's entries, tixel by tixel (not shared between threads): a held
+/// field's are decoded from memory (VisibilityShard::entries); a streamed field's from the
+/// entry block of its .plv that holds the tixel, which the reader keeps (one block: the
+/// frame as read and its content) until a tixel of another block is asked for. The entries are
+/// the same either way.
+class EntryReader {
+ public:
+  explicit EntryReader(const VisibilityShard& vis) : vis_(vis) {}
+  /// Held tixel g's N entries, in `scratch` (room for N) or where the field holds them decoded.
+  const VisibilityEntry* entries(uint64_t g, VisibilityEntry* scratch) {
+    if (!vis_.field.stream) return vis_.entries(g, scratch);
+    return streamedEntries(g, scratch);
+  }
+
+ private:
+  const VisibilityEntry* streamedEntries(uint64_t g, VisibilityEntry* scratch);
+  const VisibilityShard& vis_;
+  uint64_t block_ = ~uint64_t(0);  ///< the block in content_
+  std::vector<unsigned char> frame_, content_;
+  std::vector<uint64_t> offset_;  ///< per tixel of the block + 1: where its encoding starts in content_
 };
 
 /// The hash a shard's .plv carries: the whole field's (visibilityHash) for one range holding
@@ -144,18 +178,27 @@ VisibilityField computeVisibility(const Scene& scene, const Accel& accel, const 
 /// the whole field (a tixel's rays depend only on the tixel, the seed and the scene).
 /// With a journal (resume.h), the blocks it restores are not traced again, and every block
 /// traced is appended to it as it finishes; field.rays counts the rays traced in this call.
+/// streamTo: empty, the field is held in memory (the caller saves it, writeVisibility); else
+/// the field is streamed (docs/design.md, Visibility field): each block traced is written to
+/// the .plv at streamTo (VisibilityWriter, in tixel order) and dropped, and the returned field
+/// reads its entries from there (VisibilityField::stream); the same file writeVisibility writes.
 VisibilityShard computeVisibilityShard(const Scene& scene, const Accel& accel, const Parameterisation& param,
                                        const BakeSettings& settings, const std::vector<TixelRange>& ranges,
-                                       bool showProgress = true, VisibilityJournal* journal = nullptr);
+                                       bool showProgress = true, VisibilityJournal* journal = nullptr,
+                                       const std::string& streamTo = "");
 
 /// Rays a visibility memory estimate traces (estimateVisibilityBytesPerTixel): a few
 /// hundredths of a second, against the minutes of a field that needs an estimate.
 inline constexpr uint64_t kVisibilitySampleRays = uint64_t(1) << 16;
-/// Bytes per tixel that the field of `ranges` (sorted, disjoint) will hold in memory — its
-/// encoded entries, offsets and extra records (VisibilityField::bytes) — measured on a sample
-/// of its tixels spread evenly over them (about kVisibilitySampleRays gather rays, at least one
-/// tixel), traced as the field would be: the encoding's size depends on what the rays see.
-double estimateVisibilityBytesPerTixel(const Scene& scene, const Accel& accel, const Parameterisation& param,
-                                       const BakeSettings& settings, const std::vector<TixelRange>& ranges);
+/// Bytes per tixel that the field of `ranges` (sorted, disjoint) will hold in memory.
+struct VisibilityBytesPerTixel {
+  double held = 0.0;      ///< held: its encoded entries, offsets and extra records (VisibilityField::bytes)
+  double streamed = 0.0;  ///< streamed: the extra records and their offsets alone
+};
+/// VisibilityBytesPerTixel measured on a sample of the tixels of `ranges` spread evenly over
+/// them (about kVisibilitySampleRays gather rays, at least one tixel), traced as the field
+/// would be: the encoding's size depends on what the rays see.
+VisibilityBytesPerTixel estimateVisibilityBytesPerTixel(const Scene& scene, const Accel& accel, const Parameterisation& param,
+                                                        const BakeSettings& settings, const std::vector<TixelRange>& ranges);
 
 }  // namespace pl

@@ -52,9 +52,10 @@ ThreadPool::ThreadPool(int threads) : impl_(std::make_unique<Impl>()) {
 
 ThreadPool::~ThreadPool() = default;
 
-int poolThreads() {
-  return int(std::min<size_t>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
-                              size_t(tbb::info::default_concurrency())));
+int parallelThreads() {
+  const size_t pool = std::min<size_t>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+                                       size_t(tbb::info::default_concurrency()));
+  return int(std::min<size_t>(pool, size_t(tbb::this_task_arena::max_concurrency())));
 }
 
 void runWithThreads(int threads, const std::function<void()>& work) {

@@ -26,10 +26,6 @@ class ThreadPool {
   int threads_;
 };
 
-/// The number of threads a parallel loop may use now: the innermost ThreadPool's limit, else
-/// every hardware thread.
-int poolThreads();
-
 /// Sets FTZ/DAZ on the calling thread (the observer does it for TBB workers).
 void enableFlushDenormals();
 
@@ -37,6 +33,10 @@ void enableFlushDenormals();
 /// thread among them (a task arena of its own), so that loops started by other threads keep
 /// the pool: the viewer's background propagation on one thread beside the renderer's loops.
 void runWithThreads(int threads, const std::function<void()>& work);
+
+/// How many threads a parallel loop started now may run on: the innermost ThreadPool's limit
+/// (else every hardware thread), and inside runWithThreads that arena's.
+int parallelThreads();
 
 /// Calls body(begin, end) on disjoint sub-ranges of [0, count), in parallel. grain is the
 /// smallest range handed to one task. Each sub-range starts with a cancellation point

@@ -27,6 +27,7 @@ std::string BakeJobStats::toJson() const {
   // `seconds` is the whole job's here and the bake's is `bake_seconds`.
   nlohmann::json json = pl::toJson(bake);
   json["bake_seconds"] = bake.seconds;
+  json["visibility_memory"] = bake.visibilityMemory;  // a run's fact, not the light field's: not in META
   json["seconds"] = seconds;
   json["command"] = "bake";
   json["scene"] = scene;
@@ -83,6 +84,7 @@ BakeJob::BakeJob(BakeJobOptions options) : options_(std::move(options)) {
   checkDistinctOutputs({{"-o", options_.output}, {"--visibility", visibilityPath_}, {"--stats", options_.statsPath}});
   (void)bakePreset(options_.preset);          // an unknown preset names the known ones
   (void)parseValuesCodec(options_.compress);  // an unknown codec names the known ones
+  (void)parseVisibilityMemory(options_.visibilityMemory, "--visibility-memory");
 }
 
 BakeSettings BakeJob::settings() const {
@@ -150,6 +152,7 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
                   "lower --preset, --tixels-across or --directions", limit);
   };
   bakeOptions.maxMemory = options_.maxMemory;
+  bakeOptions.visibilityMemory = parseVisibilityMemory(options_.visibilityMemory, "--visibility-memory");
   bakeOptions.communicator = options_.communicator;
   DistributedBakeStats distributed;
   bakeOptions.distributedStats = &distributed;

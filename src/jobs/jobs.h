@@ -178,6 +178,8 @@ struct BakeJobOptions {
   /// guard refuses a bake whose estimate exceeds it, as one that exceeds the available memory;
   /// 0 = the available memory alone.
   uint64_t maxMemory = 0;
+  /// `--visibility-memory auto|held|streamed` (BakeOptions::visibilityMemory, parseVisibilityMemory).
+  std::string visibilityMemory = "auto";
   std::string compress{valuesCodecName(kDefaultValuesCodec)};  ///< none | lossless | bc1 | hdr (plf/compression.h)
   uint64_t seed = 0;
   int threads = 0;  ///< 0 = all hardware threads

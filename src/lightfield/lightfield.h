@@ -257,6 +257,9 @@ struct BakeStats {
   uint64_t visibilityRays = 0;
   uint64_t peakRssBytes = 0;
   bool reusedVisibility = false;
+  /// How the propagation read the visibility field: "held" (in memory) or "streamed" (from
+  /// its .plv a block at a time; docs/design.md, Visibility field).
+  std::string visibilityMemory = "held";
   uint64_t causticPhotons = 0;       ///< photons shot by the caustic pass (0: none)
   uint64_t causticPhotonsLanded = 0; ///< of those, the ones that reached a diffuse tixel through mirrors or glass
   double causticSeconds = 0;         ///< of propagationSeconds, in the caustic pass

@@ -1,8 +1,14 @@
 // The .plv visibility-field file (layout in plv_file.h).
 #include "plf/plv_file.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <filesystem>
 #include <fstream>
 #include <span>
@@ -36,13 +42,18 @@ uint64_t tixelsPerBlock(uint32_t directionsPerTixel) {
   return std::max<uint64_t>(1, kBlockEntryBytes / (uint64_t(directionsPerTixel) * sizeof(VisibilityEntry)));
 }
 
-/// An entry block's frame content (see the layout in plv_file.h): the block's tixels' encoded
-/// sizes (u32 each), then their encodings. Its bytes, for tixels [t0, t1).
-uint64_t blockContentBytes(const VisibilityField& field, uint64_t t0, uint64_t t1) {
-  return (t1 - t0) * sizeof(uint32_t) + field.entryOffset[t1] - field.entryOffset[t0];
+/// The stored frame of an entry block's content, and back: the one place the entry blocks'
+/// frames are made and read.
+std::vector<unsigned char> compressEntryBlock(std::span<const unsigned char> content) {
+  return detail::zstdCompress(content, kPlvZstdLevel);
+}
+void decompressEntryBlock(std::span<const unsigned char> frame, std::span<unsigned char> content, const std::string& context) {
+  detail::zstdDecompressInto(frame, content, context);
 }
 
 }  // namespace
+
+uint64_t visibilityBlockTixels(uint32_t directionsPerTixel) { return tixelsPerBlock(directionsPerTixel); }
 
 uint64_t visibilityWriteBufferBytes(uint32_t gridSide) {
   // Per block of a batch: its compressed frame (at most the content plus zstd's small bound,
@@ -53,79 +64,166 @@ uint64_t visibilityWriteBufferBytes(uint32_t gridSide) {
   return kWriteBatchBlocks * 3 * blockBytes;
 }
 
+struct VisibilityWriter::Impl {
+  PendingFile file;
+  std::ofstream out;
+  Xxh64Stream payloadHash;
+  mutable std::mutex mutex;
+  uint64_t next = 0;       ///< the next block to write
+  uint64_t offset = 0;     ///< of the next frame in the file
+  uint64_t waiting = 0;    ///< bytes of the frames in `pending`
+  std::map<uint64_t, std::pair<std::vector<unsigned char>, uint64_t>> pending;  ///< block → (frame, content bytes)
+
+  explicit Impl(const std::string& path) : file(path) {}
+  void put(const void* data, size_t size) { out.write(static_cast<const char*>(data), std::streamsize(size)); }
+  void putPayload(const void* data, size_t size) {
+    put(data, size);
+    payloadHash.update(data, size);
+  }
+  void check() {
+    if (!out) fail("{}: cannot write: write failed (disk full?)", file.target());
+  }
+};
+
+VisibilityWriter::VisibilityWriter(const std::string& path, uint32_t gridSide, uint64_t hash, uint64_t tixelCount)
+    : impl_(std::make_unique<Impl>(path)) {
+  const uint32_t n = gridSide * gridSide;
+  frames_.perBlock = tixelsPerBlock(n);
+  frames_.blocks = (tixelCount + frames_.perBlock - 1) / frames_.perBlock;
+  frames_.frameOffset.assign(frames_.blocks + 1, 0);
+  frames_.frameSizes.assign(frames_.blocks + 1, 0);
+  frames_.contentSizes.assign(frames_.blocks + 1, 0);
+  Impl& w = *impl_;
+  w.out.open(w.file.temporaryPath(), std::ios::binary | std::ios::trunc);
+  if (!w.out) fail("{}: cannot write: cannot create the temporary file {}", path, w.file.temporaryPath());
+  const uint64_t entryCount = tixelCount * n, extraCountPlaceholder = 0, placeholder = 0;
+  w.put(kPlvMagic, 8);
+  w.put(&kPlvVersion, 4);
+  w.put(&gridSide, 4);
+  w.put(&hash, 8);
+  w.put(&tixelCount, 8);
+  w.put(&entryCount, 8);
+  w.put(&extraCountPlaceholder, 8);  // the extra records' count and the payload hash, written last
+  w.put(&placeholder, 8);
+  w.putPayload(&frames_.perBlock, 8);
+  w.offset = kPlvHeaderSize + 8;
+  w.check();
+}
+
+VisibilityWriter::~VisibilityWriter() = default;
+
+std::vector<unsigned char> VisibilityWriter::frameBlock(std::span<const uint32_t> tixelBytes,
+                                                        std::span<const unsigned char> encoded, uint64_t* contentBytes) {
+  std::vector<unsigned char> content(tixelBytes.size() * sizeof(uint32_t) + encoded.size());
+  if (!tixelBytes.empty()) std::memcpy(content.data(), tixelBytes.data(), tixelBytes.size() * sizeof(uint32_t));
+  if (!encoded.empty()) std::memcpy(content.data() + tixelBytes.size() * sizeof(uint32_t), encoded.data(), encoded.size());
+  if (contentBytes) *contentBytes = content.size();
+  return compressEntryBlock(content);
+}
+
+void VisibilityWriter::put(uint64_t b, std::vector<unsigned char> frame, uint64_t contentBytes) {
+  Impl& w = *impl_;
+  const std::lock_guard lock(w.mutex);
+  if (b >= frames_.blocks || b < w.next || w.pending.count(b))
+    fail("{}: visibility block {} handed over twice or out of range", w.file.target(), b);
+  w.waiting += frame.size();
+  w.pending.emplace(b, std::make_pair(std::move(frame), contentBytes));
+  // The blocks now contiguous with those written, in order.
+  for (auto it = w.pending.begin(); it != w.pending.end() && it->first == w.next; it = w.pending.erase(it)) {
+    const std::vector<unsigned char>& f = it->second.first;
+    w.putPayload(f.data(), f.size());
+    w.check();
+    frames_.frameOffset[w.next] = w.offset;
+    frames_.frameSizes[w.next] = f.size();
+    frames_.contentSizes[w.next] = it->second.second;
+    w.offset += f.size();
+    w.waiting -= f.size();
+    ++w.next;
+  }
+}
+
+uint64_t VisibilityWriter::waitingBytes() const {
+  const std::lock_guard lock(impl_->mutex);
+  return impl_->waiting;
+}
+
+VisibilityFrames VisibilityWriter::finish(std::span<const uint64_t> extraOffset, std::span<const VisibilityExtra> extras) {
+  Impl& w = *impl_;
+  if (w.next != frames_.blocks) fail("{}: {} of {} visibility blocks written", w.file.target(), w.next, frames_.blocks);
+  // The extra records' frame: offsets, then records.
+  std::vector<unsigned char> tail(extraOffset.size() * sizeof(uint64_t) + extras.size() * sizeof(VisibilityExtra));
+  if (!extraOffset.empty()) std::memcpy(tail.data(), extraOffset.data(), extraOffset.size() * sizeof(uint64_t));
+  if (!extras.empty())
+    std::memcpy(tail.data() + extraOffset.size() * sizeof(uint64_t), extras.data(), extras.size() * sizeof(VisibilityExtra));
+  const std::vector<unsigned char> tailFrame = detail::zstdCompress(tail, kPlvZstdLevel);
+  w.putPayload(tailFrame.data(), tailFrame.size());
+  const uint64_t b = frames_.blocks;
+  frames_.frameOffset[b] = w.offset;
+  frames_.frameSizes[b] = tailFrame.size();
+  frames_.contentSizes[b] = tail.size();
+  w.putPayload(frames_.frameSizes.data(), frames_.frameSizes.size() * sizeof(uint64_t));
+  w.putPayload(frames_.contentSizes.data(), frames_.contentSizes.size() * sizeof(uint64_t));
+  const uint64_t digest = w.payloadHash.digest(), extraCount = extras.size();
+  w.out.seekp(kPlvHeaderSize - 16);
+  w.put(&extraCount, 8);
+  w.put(&digest, 8);
+  w.out.flush();
+  w.check();
+  w.out.close();
+  w.check();
+  w.file.commit();
+  return frames_;
+}
+
 void writeVisibility(const std::string& path, const VisibilityField& field) {
-  const uint64_t n = field.directionsPerTixel();
-  const uint64_t perBlock = tixelsPerBlock(uint32_t(n));
-  const uint64_t blocks = (field.tixelCount + perBlock - 1) / perBlock;
-  const uint64_t entryCount = field.entryCount(), extraCount = field.extras.size();
+  VisibilityWriter writer(path, field.gridSide, field.hash, field.tixelCount);
+  const uint64_t perBlock = writer.perBlock(), blocks = writer.blocks();
+  // Entry blocks framed a batch at a time in parallel, handed over in order: memory stays
+  // bounded by one batch of frames whatever the field's size.
+  const uint64_t batch = kWriteBatchBlocks;
+  std::vector<std::vector<unsigned char>> frames(batch);
+  std::vector<uint64_t> contentBytes(batch);
+  Progress progress("visibility: writing", blocks);
+  for (uint64_t b0 = 0; b0 < blocks; b0 += batch) {
+    const uint64_t b1 = std::min(blocks, b0 + batch);
+    parallelFor(b1 - b0, [&](uint64_t i) {
+      const uint64_t t0 = (b0 + i) * perBlock, t1 = std::min(field.tixelCount, t0 + perBlock);
+      std::vector<uint32_t> sizes(t1 - t0);
+      for (uint64_t t = t0; t < t1; ++t) sizes[t - t0] = uint32_t(field.entryOffset[t + 1] - field.entryOffset[t]);
+      frames[i] = VisibilityWriter::frameBlock(
+          sizes, {field.entryBytes.data() + field.entryOffset[t0], field.entryOffset[t1] - field.entryOffset[t0]},
+          &contentBytes[i]);
+    });
+    for (uint64_t i = 0; i < b1 - b0; ++i) writer.put(b0 + i, std::move(frames[i]), contentBytes[i]);
+    progress.advance(b1 - b0);
+  }
+  writer.finish({field.extraOffset.data(), field.extraOffset.size()}, {field.extras.data(), field.extras.size()});
+}
 
-  writeFileAtomically(path, [&](const std::string& temp) {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) fail("cannot create the temporary file {}", temp);
-    Xxh64Stream payloadHash;
-    auto put = [&](const void* data, size_t size) { out.write(static_cast<const char*>(data), std::streamsize(size)); };
-    auto putPayload = [&](const void* data, size_t size) {
-      put(data, size);
-      payloadHash.update(data, size);
-    };
-    const uint64_t placeholder = 0;
-    put(kPlvMagic, 8);
-    put(&kPlvVersion, 4);
-    put(&field.gridSide, 4);
-    put(&field.hash, 8);
-    put(&field.tixelCount, 8);
-    put(&entryCount, 8);
-    put(&extraCount, 8);
-    put(&placeholder, 8);  // the payload hash, written last
-    putPayload(&perBlock, 8);
+VisibilityBlockFile::VisibilityBlockFile(std::string path, VisibilityFrames frames)
+    : path_(std::move(path)), frames_(std::move(frames)) {
+  fd_ = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd_ < 0) fail("{}: cannot open the visibility field: {}", path_, std::strerror(errno));
+}
 
-    // Entry blocks compressed a batch at a time in parallel, written in order: memory stays
-    // bounded by one batch of frames whatever the field's size.
-    std::vector<uint64_t> frameSizes, contentSizes;
-    frameSizes.reserve(blocks + 1);
-    contentSizes.reserve(blocks + 1);
-    const uint64_t batch = kWriteBatchBlocks;
-    std::vector<std::vector<unsigned char>> frames(batch);
-    Progress progress("visibility: writing", blocks);
-    for (uint64_t b0 = 0; b0 < blocks; b0 += batch) {
-      const uint64_t b1 = std::min(blocks, b0 + batch);
-      parallelFor(b1 - b0, [&](uint64_t i) {
-        const uint64_t t0 = (b0 + i) * perBlock, t1 = std::min(field.tixelCount, t0 + perBlock);
-        std::vector<unsigned char> raw(blockContentBytes(field, t0, t1));
-        for (uint64_t t = t0; t < t1; ++t) {
-          const uint32_t size = uint32_t(field.entryOffset[t + 1] - field.entryOffset[t]);
-          std::memcpy(raw.data() + (t - t0) * sizeof(uint32_t), &size, sizeof(uint32_t));
-        }
-        std::memcpy(raw.data() + (t1 - t0) * sizeof(uint32_t), field.entryBytes.data() + field.entryOffset[t0],
-                    field.entryOffset[t1] - field.entryOffset[t0]);
-        frames[i] = detail::zstdCompress(raw, kPlvZstdLevel);
-      });
-      for (uint64_t i = 0; i < b1 - b0; ++i) {
-        const uint64_t t0 = (b0 + i) * perBlock, t1 = std::min(field.tixelCount, t0 + perBlock);
-        putPayload(frames[i].data(), frames[i].size());
-        frameSizes.push_back(frames[i].size());
-        contentSizes.push_back(blockContentBytes(field, t0, t1));
-      }
-      progress.advance(b1 - b0);
-    }
-    // The extra records' frame: offsets, then records.
-    std::vector<unsigned char> tail(field.extraOffset.size() * sizeof(uint64_t) + extraCount * sizeof(VisibilityExtra));
-    if (!field.extraOffset.empty()) std::memcpy(tail.data(), field.extraOffset.data(), field.extraOffset.size() * sizeof(uint64_t));
-    if (extraCount > 0)
-      std::memcpy(tail.data() + field.extraOffset.size() * sizeof(uint64_t), field.extras.data(),
-                  extraCount * sizeof(VisibilityExtra));
-    const std::vector<unsigned char> tailFrame = detail::zstdCompress(tail, kPlvZstdLevel);
-    putPayload(tailFrame.data(), tailFrame.size());
-    frameSizes.push_back(tailFrame.size());
-    contentSizes.push_back(tail.size());
-    putPayload(frameSizes.data(), frameSizes.size() * sizeof(uint64_t));
-    putPayload(contentSizes.data(), contentSizes.size() * sizeof(uint64_t));
-    const uint64_t digest = payloadHash.digest();
-    out.seekp(kPlvHeaderSize - 8);
-    put(&digest, 8);
-    out.flush();
-    if (!out) fail("write failed (disk full?)");
-  });
+VisibilityBlockFile::~VisibilityBlockFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void VisibilityBlockFile::read(uint64_t b, std::vector<unsigned char>& frame, std::vector<unsigned char>& content) const {
+  if (b >= frames_.blocks) fail("{}: visibility block {} of {}", path_, b, frames_.blocks);
+  frame.resize(frames_.frameSizes[b]);
+  for (uint64_t done = 0; done < frame.size();) {
+    const ssize_t got = ::pread(fd_, frame.data() + done, frame.size() - done, off_t(frames_.frameOffset[b] + done));
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0)
+      fail("{}: cannot read visibility block {}: {}", path_, b, got < 0 ? std::strerror(errno) : "the file is truncated");
+    done += uint64_t(got);
+  }
+  const uint64_t size = frames_.contentSizes[b];
+  content.resize(size + kEntryBytesPadding);
+  std::memset(content.data() + size, 0, kEntryBytesPadding);
+  decompressEntryBlock(frame, {content.data(), size}, fmt::format("{}: visibility block {}", path_, b));
 }
 
 namespace {
@@ -258,7 +356,7 @@ VisibilityFileInfo readVisibilityInfo(const std::string& path) {
     info.heldBytes = heldBytes(h, info.entryBytes);
     if (l.blocks > 0) {  // the first tixel's precision, from the first block (the bake writes one for all)
       std::vector<unsigned char> raw(l.contentSizes[0]);
-      detail::zstdDecompressInto(bytes.subspan(l.frameOffset[0], l.frameSizes[0]), raw, fmt::format("{}: visibility block 0", path));
+      decompressEntryBlock(bytes.subspan(l.frameOffset[0], l.frameSizes[0]), raw, fmt::format("{}: visibility block 0", path));
       info.fractionBits = raw[std::min(h.tixelCount, l.perBlock) * sizeof(uint32_t)];
     }
   }
@@ -266,7 +364,7 @@ VisibilityFileInfo readVisibilityInfo(const std::string& path) {
 }
 
 bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
-                    uint64_t targetTixels, std::vector<VisibilityEntry>* decodedOut) {
+                    uint64_t targetTixels, std::vector<VisibilityEntry>* decodedOut, bool streamed) {
   auto reason = [&](std::string text) {
     if (why) *why = std::move(text);
     return false;
@@ -291,14 +389,20 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   const std::vector<uint64_t>& frameOffset = layout.frameOffset;
   const std::vector<uint64_t>& blockEntryStart = layout.blockEntryStart;
   const uint64_t entryBytesTotal = blockEntryStart[blocks];
-  requireMemory(heldBytes(h, entryBytesTotal), fmt::format("{}: the visibility field", path), "bake at a coarser --preset");
+  // Streamed: the entries stay in the file; only the extra records and their offsets are held.
+  const uint64_t keptEntryBytes = streamed ? 0 : entryBytesTotal;
+  requireMemory(heldBytes(h, keptEntryBytes) - (streamed ? (tixelCount + 1) * sizeof(uint64_t) : 0),
+                fmt::format("{}: the visibility field", path), "bake at a coarser --preset");
 
   std::vector<unsigned char> entryBytes;
-  entryBytes.reserve(entryBytesTotal + kEntryBytesPadding);
-  adviseHugePages(entryBytes.data(), entryBytesTotal + kEntryBytesPadding);
-  entryBytes.resize(entryBytesTotal + kEntryBytesPadding);
-  std::vector<uint64_t> entryOffset(tixelCount + 1, 0);
-  entryOffset[tixelCount] = entryBytesTotal;
+  std::vector<uint64_t> entryOffset;
+  if (!streamed) {
+    entryBytes.reserve(entryBytesTotal + kEntryBytesPadding);
+    adviseHugePages(entryBytes.data(), entryBytesTotal + kEntryBytesPadding);
+    entryBytes.resize(entryBytesTotal + kEntryBytesPadding);
+    entryOffset.assign(tixelCount + 1, 0);
+    entryOffset[tixelCount] = entryBytesTotal;
+  }
   std::vector<uint64_t> flaggedPerTixel(tixelCount);
   const uint64_t targets = targetTixels > 0 ? targetTixels : tixelCount;
   if (decodedOut) decodedOut->resize(tixelCount * n);
@@ -307,11 +411,10 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   parallelFor(blocks, [&](uint64_t b) {
     const uint64_t t0 = b * perBlock, t1 = std::min(tixelCount, t0 + perBlock);
     std::vector<unsigned char> raw(contentSizes[b]);
-    detail::zstdDecompressInto(bytes.subspan(frameOffset[b], frameSizes[b]), raw,
-                               fmt::format("{}: visibility block {}", path, b));
+    decompressEntryBlock(bytes.subspan(frameOffset[b], frameSizes[b]), raw, fmt::format("{}: visibility block {}", path, b));
     const unsigned char* encoded = raw.data() + (t1 - t0) * sizeof(uint32_t);
     const uint64_t encodedBytes = raw.size() - (t1 - t0) * sizeof(uint32_t);
-    std::memcpy(entryBytes.data() + blockEntryStart[b], encoded, encodedBytes);
+    if (!streamed) std::memcpy(entryBytes.data() + blockEntryStart[b], encoded, encodedBytes);
     std::vector<VisibilityEntry> scratch(decodedOut ? 0 : n);
     uint64_t used = 0;
     for (uint64_t g = t0; g < t1; ++g) {
@@ -321,7 +424,7 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
       if (size > encodedBytes - used ||
           decodeTixelEntries<true>(encoded + used, size, uint32_t(n), decoded.data()) != size)
         fail("{}: corrupt visibility field: the entries of tixel {} do not decode", path, g);
-      entryOffset[g] = blockEntryStart[b] + used;
+      if (!streamed) entryOffset[g] = blockEntryStart[b] + used;
       used += size;
       uint64_t flagged = 0;
       for (const VisibilityEntry& e : decoded) {
@@ -367,8 +470,14 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   f.gridSide = h.gridSide;
   f.tixelCount = tixelCount;
   f.hash = h.hash;
-  f.entryBytes = FieldArray<unsigned char>(std::move(entryBytes));
-  f.entryOffset = FieldArray<uint64_t>(std::move(entryOffset));
+  if (streamed) {
+    VisibilityFrames frames{perBlock, blocks, {frameOffset.begin(), frameOffset.begin() + int64_t(blocks) + 1}, frameSizes,
+                            contentSizes};
+    f.stream = std::make_shared<const VisibilityBlockFile>(path, std::move(frames));
+  } else {
+    f.entryBytes = FieldArray<unsigned char>(std::move(entryBytes));
+    f.entryOffset = FieldArray<uint64_t>(std::move(entryOffset));
+  }
   f.extraOffset = FieldArray<uint64_t>(std::move(extraOffset));
   f.extras = FieldArray<VisibilityExtra>(std::move(extras));
   field = std::move(f);

@@ -45,6 +45,7 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -369,6 +370,44 @@ struct EncodedRun {
   void add(const VisibilityEntry* entries, uint32_t n, uint32_t fractionBits);
 };
 
+/// Tixels per entry block of a .plv whose tixels have `directionsPerTixel` entries each: as many
+/// whole tixels as make about 512 KiB of decoded entries (64 Ki entries).
+uint64_t visibilityBlockTixels(uint32_t directionsPerTixel);
+
+/// Where a .plv's frames lie: B entry blocks of perBlock tixels (the last may hold fewer), then
+/// the extra records' frame; per frame, its offset in the file, stored and content bytes.
+struct VisibilityFrames {
+  uint64_t perBlock = 0, blocks = 0;
+  std::vector<uint64_t> frameOffset, frameSizes, contentSizes;  ///< B + 1 each
+};
+
+/// A .plv's entry blocks, read from the file one at a time (the streamed field, docs/design.md
+/// "Visibility field"): a block's frame is read (pread) into a caller's buffer and decompressed
+/// into another, so that memory holds a block per reader instead of the field. Thread-safe.
+class VisibilityBlockFile {
+ public:
+  /// The .plv at `path`, whose frames lie as `frames` says (its writer's, or readVisibility's
+  /// checked table). Throws pl::Error naming the file when it cannot be opened.
+  VisibilityBlockFile(std::string path, VisibilityFrames frames);
+  ~VisibilityBlockFile();
+  VisibilityBlockFile(const VisibilityBlockFile&) = delete;
+  VisibilityBlockFile& operator=(const VisibilityBlockFile&) = delete;
+
+  const std::string& path() const { return path_; }
+  uint64_t perBlock() const { return frames_.perBlock; }
+  uint64_t blocks() const { return frames_.blocks; }
+  /// Reads block b into `content`: its tixels' encoded sizes (u32 each), then their encodings
+  /// ("Compact entries"), then kEntryBytesPadding zero bytes (the unchecked decoder's); `frame`
+  /// is scratch for the stored frame. Throws pl::Error naming the file when the read fails or
+  /// the frame does not decompress to its declared size.
+  void read(uint64_t b, std::vector<unsigned char>& frame, std::vector<unsigned char>& content) const;
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  VisibilityFrames frames_;
+};
+
 struct VisibilityField {
   uint32_t gridSide = 0;          ///< m: N = m² gather directions per tixel
   uint64_t tixelCount = 0;
@@ -377,6 +416,9 @@ struct VisibilityField {
   FieldArray<uint64_t> entryOffset;       ///< tixelCount + 1: where tixel t's encoding starts
   FieldArray<uint64_t> extraOffset;       ///< tixelCount + 1
   FieldArray<VisibilityExtra> extras;
+  /// Set when the field is streamed: its entries stay in this .plv, read a block at a time by
+  /// the gathers (entryBytes and entryOffset are then empty, and decode() may not be called).
+  std::shared_ptr<const VisibilityBlockFile> stream;
   uint64_t rays = 0;              ///< rays traced to build it (gather + mirror continuations)
   double seconds = 0.0;
 
@@ -402,8 +444,42 @@ struct VisibilityField {
 };
 
 /// Writes the field atomically (temp + rename): zstd frames of blocks of tixels' encoded
-/// entries (format: above), with a progress bar.
+/// entries (format: above), with a progress bar. A held field only.
 void writeVisibility(const std::string& path, const VisibilityField& field);
+
+/// Writes a .plv a block at a time while its field is traced (a streamed field is never held
+/// whole): each entry block's frame is made by frameBlock on any thread and handed to put() in
+/// any order; put() writes the frames in block order as they become contiguous. finish()
+/// writes the extra records' frame and the frame table and moves the file over `path` (temp +
+/// rename: an unfinished writer leaves no .plv). The bytes are writeVisibility's.
+class VisibilityWriter {
+ public:
+  /// Throws pl::Error naming the file when it cannot be created.
+  VisibilityWriter(const std::string& path, uint32_t gridSide, uint64_t hash, uint64_t tixelCount);
+  ~VisibilityWriter();
+  VisibilityWriter(const VisibilityWriter&) = delete;
+  VisibilityWriter& operator=(const VisibilityWriter&) = delete;
+
+  uint64_t perBlock() const { return frames_.perBlock; }
+  uint64_t blocks() const { return frames_.blocks; }
+  /// The stored frame of an entry block of `tixelBytes.size()` tixels whose encodings, of those
+  /// sizes, are `encoded` one after another (thread-safe); *contentBytes receives its content's size.
+  static std::vector<unsigned char> frameBlock(std::span<const uint32_t> tixelBytes, std::span<const unsigned char> encoded,
+                                               uint64_t* contentBytes);
+  /// Hands over block b's frame (thread-safe, each block once, any order). Throws pl::Error
+  /// naming the file when a write fails.
+  void put(uint64_t b, std::vector<unsigned char> frame, uint64_t contentBytes);
+  /// Bytes of frames handed over but waiting for an earlier block.
+  uint64_t waitingBytes() const;
+  /// After every block was put: writes the extra records (extraOffset: tixelCount + 1), the
+  /// table and the checksum, and commits the file. Returns where its frames lie.
+  VisibilityFrames finish(std::span<const uint64_t> extraOffset, std::span<const VisibilityExtra> extras);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  VisibilityFrames frames_;
+};
 
 /// Bytes writeVisibility holds besides the field itself (one batch of blocks and frames).
 uint64_t visibilityWriteBufferBytes(uint32_t gridSide);
@@ -432,7 +508,9 @@ VisibilityFileInfo readVisibilityInfo(const std::string& path);
 /// shard's entries point at any tixel of the scene). decoded: when given, receives every
 /// tixel's entries decoded (directionsPerTixel each, in field order) as they are checked — what
 /// the bake's VisibilityShard::decoded holds — instead of a second decoding.
+/// streamed: the entries are checked but not kept; the field reads them from the file instead
+/// (VisibilityField::stream), and only its extra records are held.
 bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityField& field, std::string* why,
-                    uint64_t targetTixels = 0, std::vector<VisibilityEntry>* decoded = nullptr);
+                    uint64_t targetTixels = 0, std::vector<VisibilityEntry>* decoded = nullptr, bool streamed = false);
 
 }  // namespace pl

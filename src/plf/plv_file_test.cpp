@@ -9,6 +9,8 @@
 #include <cmath>
 #include <filesystem>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <string>
@@ -300,6 +302,89 @@ TEST(VisibilityFile, RecordsWithAbsurdContentsAreRefusedDespiteAValidChecksum) {
       EXPECT_NE(std::string(e.what()).find(c.problem), std::string::npos) << e.what();
     }
   }
+  std::filesystem::remove_all(dir);
+}
+
+// The streaming writer: entry blocks handed over in any order give writeVisibility's file byte
+// for byte, and the block file reads each block's content back (sizes, then encodings,
+// decoding to the entries); readVisibility's streamed form holds the extra records only.
+TEST(VisibilityFile, BlocksWrittenOutOfOrderAndReadBackOneAtATime) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_stream_test";
+  std::filesystem::create_directories(dir);
+  const std::string held = (dir / "held.plv").string(), streamed = (dir / "streamed.plv").string();
+  VisibilityField field;
+  field.gridSide = 16;  // 256 directions: 256 tixels per block
+  field.tixelCount = 1000;
+  field.hash = 7;
+  const uint32_t n = field.directionsPerTixel();
+  std::mt19937 random(3);
+  std::vector<VisibilityEntry> entries(field.tixelCount * n);
+  for (VisibilityEntry& e : entries)
+    e = random() % 4 ? entry(uint32_t(random() % field.tixelCount), uint16_t(random()), uint16_t(random())) : VisibilityEntry{};
+  field.setEntries(entries.data(), kCompactFractionBits);
+  field.extraOffset = FieldArray<uint64_t>(std::vector<uint64_t>(field.tixelCount + 1, 0));
+  writeVisibility(held, field);
+
+  VisibilityWriter writer(streamed, field.gridSide, field.hash, field.tixelCount);
+  ASSERT_EQ(writer.blocks(), 4u);
+  for (uint64_t b : {2u, 0u, 3u, 1u}) {
+    const uint64_t t0 = b * writer.perBlock(), t1 = std::min(field.tixelCount, t0 + writer.perBlock());
+    std::vector<uint32_t> sizes;
+    for (uint64_t t = t0; t < t1; ++t) sizes.push_back(uint32_t(field.entryOffset[t + 1] - field.entryOffset[t]));
+    uint64_t contentBytes = 0;
+    std::vector<unsigned char> frame = VisibilityWriter::frameBlock(
+        sizes, {field.entryBytes.data() + field.entryOffset[t0], field.entryOffset[t1] - field.entryOffset[t0]}, &contentBytes);
+    writer.put(b, std::move(frame), contentBytes);
+    EXPECT_EQ(writer.waitingBytes() > 0, b != 1);  // 2 and 3 wait for 1, the last handed over
+  }
+  EXPECT_THROW(writer.put(1, {}, 0), Error);  // each block once
+  const VisibilityFrames frames = writer.finish({field.extraOffset.data(), field.extraOffset.size()}, {});
+  auto bytes = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(bytes(streamed), bytes(held));
+
+  const VisibilityBlockFile file(streamed, frames);
+  std::vector<unsigned char> frame, content;
+  std::vector<VisibilityEntry> decoded(n);
+  for (uint64_t b = 0; b < file.blocks(); ++b) {
+    file.read(b, frame, content);
+    const uint64_t t0 = b * file.perBlock(), t1 = std::min(field.tixelCount, t0 + file.perBlock());
+    uint64_t at = (t1 - t0) * sizeof(uint32_t);
+    for (uint64_t t = t0; t < t1; ++t) {
+      uint32_t size;
+      std::memcpy(&size, content.data() + (t - t0) * sizeof(uint32_t), 4);
+      ASSERT_EQ(decodeTixelEntries<true>(content.data() + at, size, n, decoded.data()), size);
+      std::vector<VisibilityEntry> want(n);
+      field.decode(t, want.data());
+      ASSERT_EQ(std::memcmp(decoded.data(), want.data(), n * sizeof(VisibilityEntry)), 0) << "tixel " << t;
+      at += size;
+    }
+    EXPECT_EQ(at + kEntryBytesPadding, content.size());
+  }
+
+  VisibilityField read;
+  std::string why;
+  ASSERT_TRUE(readVisibility(held, 7, read, &why, 0, nullptr, true)) << why;
+  ASSERT_TRUE(read.stream);
+  EXPECT_TRUE(read.entryBytes.empty());
+  EXPECT_EQ(read.stream->blocks(), 4u);
+  EXPECT_EQ(read.extraOffset.size(), field.tixelCount + 1);
+  std::filesystem::remove_all(dir);
+}
+
+// An unfinished writer (an error, an interrupted bake) leaves no .plv.
+TEST(VisibilityFile, AnUnfinishedWriterLeavesNoFile) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_unfinished_test";
+  std::filesystem::create_directories(dir);
+  const std::string plv = (dir / "u.plv").string();
+  {
+    VisibilityWriter writer(plv, 2, 1, 10);
+    EXPECT_THROW(writer.finish({}, {}), Error);  // no block written
+  }
+  EXPECT_FALSE(std::filesystem::exists(plv));
+  EXPECT_TRUE(std::filesystem::is_empty(dir));  // nor its temporary
   std::filesystem::remove_all(dir);
 }
 

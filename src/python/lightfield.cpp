@@ -199,7 +199,7 @@ void bindLightField(py::module_& m) {
       [](const Scene& scene, const std::string& preset, uint64_t seed, int threads, std::optional<std::string> visibility,
          bool reuseVisibility, bool sunMasks, bool punctualHighlights, std::optional<int64_t> causticPhotons,
          std::optional<std::string> maxMemory, bool keepVisibility, bool fresh, std::optional<int64_t> subsurfaceWalks,
-         const std::string& visibilityPrecision) {
+         const std::string& visibilityPrecision, const std::string& visibilityMemory) {
         BakeJobOptions options;
         if (maxMemory) options.maxMemory = parseMemorySize(*maxMemory, "max_memory");
         auto relight = std::make_shared<RelightSource>();
@@ -214,6 +214,10 @@ void bindLightField(py::module_& m) {
         if (visibilityPrecision != "compact" && visibilityPrecision != "exact")
           throw py::value_error(fmt::format("visibility_precision must be 'compact' or 'exact' (got '{}')", visibilityPrecision));
         options.exactVisibility = visibilityPrecision == "exact";
+        if (visibilityMemory != "auto" && visibilityMemory != "held" && visibilityMemory != "streamed")
+          throw py::value_error(
+              fmt::format("visibility_memory must be 'auto', 'held' or 'streamed' (got '{}')", visibilityMemory));
+        options.visibilityMemory = visibilityMemory;
         if (causticPhotons) {
           if (*causticPhotons < 0 || *causticPhotons > (int64_t(1) << 32))
             throw py::value_error(fmt::format("caustic_photons must be in [0, 2^32] (got {})", *causticPhotons));
@@ -249,7 +253,7 @@ void bindLightField(py::module_& m) {
       py::arg("visibility") = py::none(), py::arg("reuse_visibility") = false, py::arg("sun_masks") = true,
       py::arg("punctual_highlights") = true, py::arg("caustic_photons") = py::none(), py::arg("max_memory") = py::none(),
       py::arg("keep_visibility") = true, py::arg("fresh") = false, py::arg("subsurface_walks") = py::none(),
-      py::arg("visibility_precision") = "compact",
+      py::arg("visibility_precision") = "compact", py::arg("visibility_memory") = "auto",
       "Bakes `scene`'s light field (what `plenoptic bake` does). visibility: a .plv path where the visibility field\n"
       "is saved; with reuse_visibility=True it is read back when the geometry and settings match (so a bake after\n"
       "editing only lights or emission re-runs the propagation alone). sun_masks=False: `--sun-masks off`;\n"
@@ -259,7 +263,9 @@ void bindLightField(py::module_& m) {
       "(False frees it). With a visibility path, a bake that was interrupted resumes from what it saved there\n"
       "(docs/user-guide.md, Resuming an interrupted bake); fresh=True: `--fresh` (start afresh). subsurface_walks=N:\n"
       "`--subsurface-walks N` (random walks per tixel area through subsurface objects; None: the preset's).\n"
-      "visibility_precision=\"exact\": `--visibility-precision exact` (the visibility field's fractions kept whole).");
+      "visibility_precision=\"exact\": `--visibility-precision exact` (the visibility field's fractions kept whole).\n"
+      "visibility_memory=\"streamed\": `--visibility-memory streamed` (the field read from its .plv a block at a time;\n"
+      "\"auto\" streams only when holding it does not fit; needs a visibility path).");
 
   m.def(
       "load_light_field",

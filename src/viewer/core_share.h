@@ -42,7 +42,7 @@ struct CoreShare {
   bool relighting = false; ///< the relighter's share applies (its own target and render-scale state)
 };
 
-/// The share of the next frame. poolThreads: the pool's thread count (poolThreads() of
+/// The share of the next frame. poolThreads: the pool's thread count (parallelThreads() of
 /// core/parallel.h); relighterBusy: the relighter is setting up or relighting (LiveRelight::
 /// busy); cpuDraws: the CPU renderer draws the frame; userTargetFps: --target-fps (0 = none).
 CoreShare coreShare(RelightShare share, int poolThreads, bool relighterBusy, bool cpuDraws, double userTargetFps);

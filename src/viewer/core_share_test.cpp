@@ -83,9 +83,9 @@ TEST(CoreShare, EachShareHasItsOwnFrameRateController) {
 
 TEST(CoreShare, TheRenderersThreadLimitIsTheArenas) {
   const ThreadPool pool(2);
-  EXPECT_EQ(poolThreads(), 2);
+  EXPECT_EQ(parallelThreads(), 2);
   // One render thread: every iteration of a parallel loop on the calling thread.
-  const CoreShare one = coreShare(RelightShare::Split, poolThreads(), true, true, 30.0);
+  const CoreShare one = coreShare(RelightShare::Split, parallelThreads(), true, true, 30.0);
   ASSERT_EQ(one.renderThreads, 1);
   std::mutex mutex;
   std::set<std::thread::id> threads;

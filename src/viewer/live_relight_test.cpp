@@ -101,7 +101,7 @@ TEST_F(LiveRelightTest, ConvergesToTheSameLightFieldWhileFramesAreDrawn) {
   for (int frame = 0; frame < 100000 && framesAfter < 3; ++frame) {
     live.update();
     const bool busy = live.busy();
-    const CoreShare share = coreShare(RelightShare::Split, poolThreads(), busy, true, 30.0);
+    const CoreShare share = coreShare(RelightShare::Split, parallelThreads(), busy, true, 30.0);
     EXPECT_EQ(share.renderThreads, busy ? 1 : 0);
     EXPECT_EQ(share.targetFps, busy ? kRelightTargetFps : 30.0);
     const FastRenderer& renderer = live.renderer() ? *live.renderer() : baked;

@@ -365,7 +365,7 @@ class ViewerSession {
     const bool relit = live_ && live_->update();
     // The cores' share of this frame (core_share.h): while the relighter works and the CPU
     // draws, one core is the relighter's and the frames hold kRelightTargetFps.
-    share_ = coreShare(kViewerShare, poolThreads(), live_ && live_->busy(),
+    share_ = coreShare(kViewerShare, parallelThreads(), live_ && live_->busy(),
                        !renderer_.gpu() || (live_ && live_->renderer()), options_.targetFps);
     const double scale = renderFrame(width, height, relit);
     const bool rendered = scale > 0.0;

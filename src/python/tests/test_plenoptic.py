@@ -137,6 +137,23 @@ def test_visibility_precision_is_a_bake_option(cornell, tmp_path):
         plenoptic.bake(cornell, preset="draft", visibility_precision="lossy")
 
 
+def test_visibility_memory_is_a_bake_option(cornell, tmp_path):
+    # Streamed from its .plv instead of held: the same light field bit for bit, and the kept
+    # (streamed) field relights as a held one does.
+    held = plenoptic.bake(cornell, preset="draft", visibility=str(tmp_path / "held.plv"), visibility_memory="held")
+    streamed = plenoptic.bake(cornell, preset="draft", visibility=str(tmp_path / "streamed.plv"),
+                              visibility_memory="streamed")
+    assert held.stats["visibility_memory"] == "held"
+    assert streamed.stats["visibility_memory"] == "streamed"
+    assert np.array_equal(held.render(width=32, height=32), streamed.render(width=32, height=32))
+    assert np.array_equal(held.relight(cornell).render(width=16, height=16),
+                          streamed.relight(cornell).render(width=16, height=16))
+    with pytest.raises(plenoptic.UsageError, match="streamed from its .plv, and this bake saves none"):
+        plenoptic.bake(cornell, preset="draft", visibility_memory="streamed")
+    with pytest.raises(ValueError, match="visibility_memory must be 'auto', 'held' or 'streamed'"):
+        plenoptic.bake(cornell, preset="draft", visibility_memory="sometimes")
+
+
 def test_sun_masks_are_a_bake_option(tmp_path):
     # A quad in the sun: with sun masks (the default) the directional light is stored as masks
     # and added back at render time, with sun_masks=False it stays in the values, as
