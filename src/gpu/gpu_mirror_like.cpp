@@ -76,7 +76,9 @@ bool sampleMirrorLikeLobe(HighlightModel m, vec3 wo, vec2 u, out vec3 wi, out ve
   wi = normalize(w);
   pdf = mirrorLikeLobePdf(m, wo, wi);
   if (!(pdf > 0.0)) return false;
-  weight = evalHighlightModel(m, mirrorLikeGgx(m), false, wo, wi) * (wi.z / pdf);
+  // No clear coat or sheen: mirror-like glTF PBR lobes are refused.
+  const PbrLayers noLayers = PbrLayers(0.0, 0.0, vec3(0.0), 0.0, vec3(0.0));
+  weight = evalHighlightModel(m, mirrorLikeGgx(m), noLayers, false, wo, wi) * (wi.z / pdf);
   return true;
 }
 )glsl";
