@@ -147,12 +147,16 @@ BakeJobResult BakeJob::runFrom(Scene scene, double loadSeconds) const {
   // writing it resumes with nothing left to propagate.
   bakeOptions.removeCheckpoint = false;
   bakeOptions.log = options_.log;
-  bakeOptions.checkMemory = [limit = options_.maxMemory](uint64_t bytes) {
-    requireMemory(bytes, "bake (visibility field and light-field values)",
-                  "lower --preset, --tixels-across or --directions", limit);
-  };
   bakeOptions.maxMemory = options_.maxMemory;
   bakeOptions.visibilityMemory = parseVisibilityMemory(options_.visibilityMemory, "--visibility-memory");
+  // A field forced to be held may still fit streamed: say so beside the other ways down.
+  const char* lower = bakeOptions.visibilityMemory == VisibilityMemory::held
+                          ? "lower --preset, --tixels-across or --directions, or let the visibility field stream from "
+                            "its .plv (--visibility-memory auto)"
+                          : "lower --preset, --tixels-across or --directions";
+  bakeOptions.checkMemory = [limit = options_.maxMemory, lower](uint64_t bytes) {
+    requireMemory(bytes, "bake (visibility field and light-field values)", lower, limit);
+  };
   bakeOptions.communicator = options_.communicator;
   DistributedBakeStats distributed;
   bakeOptions.distributedStats = &distributed;
