@@ -162,6 +162,11 @@ class GpuRenderer {
   /// resolution per axis (render() takes more than 1 for several samples per pixel).
   void drawVisibility(const Camera& camera, int idScale = 1);
 
+  /// The GPU's own time for the last render(), in milliseconds: from the start of its first pass
+  /// to the end of its shading pass by GL timestamp queries — what a frame costs the GPU, the
+  /// image's read-back into memory excluded (`render --stats` gpu_ms_median).
+  double lastGpuMilliseconds() const;
+
   /// One lookup query: the chart record as triangleChart gives it (facingChart turns it to the
   /// side the viewer is on), a world point and the unit direction towards the viewer.
   struct LookupQuery {

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <limits>
 
 #include "camera/camera.h"
@@ -311,7 +313,10 @@ vec3 lookupRadiance(uint chart, vec3 p, vec3 towardsViewer, vec3 normalAtHit, ve
   // diffuseDirectionalFactor at μo (against the mapped normal on a normal-mapped chart).
   float cosViewer = normalMapped ? dot(towardsViewer, mappedNormal) : local.z;
   // glossyDiffuseReflectanceAt: with a metallic-roughness texture the point's own model's ρ and k.
-  if ((flags & kFlagMetallicRoughness) != 0u) {
+  // (Only with a material record: a query without surface detail, as the lookup program's, has
+  // none — and NVIDIA's compiler, driver 580, crashes linking a program that inlines the lobe at
+  // the constant kNone record, so the test keeps the call out of that program altogether.)
+  if ((flags & kFlagMetallicRoughness) != 0u && detail.material != kNone) {
     GgxLobe l = metallicRoughnessLobe(detail.material, detail.albedo, detail.metallicRoughness);
     return mapped + l.diffuse * ggxDiffuseFactor(l.alpha, l.diffuseF0, l.diffuseF90, cosViewer) * kInvPi * diffuseIrradiance;
   }
@@ -778,7 +783,20 @@ std::string infoLog(GLuint object, GetLength getLength, GetLog getLog) {
   return log.c_str();
 }
 
+/// With PLENOPTIC_GPU_SHADER_DUMP=DIR, each shader's full text is written to DIR/NAME.STAGE
+/// before it is compiled (vert, frag, comp): what to attach to a driver bug report when a
+/// driver's compiler fails or crashes on one (docs/user-guide.md, "The GPU renderer").
+void dumpShaderSource(GLenum type, const std::string& source, const char* name) {
+  const char* dir = std::getenv("PLENOPTIC_GPU_SHADER_DUMP");
+  if (dir == nullptr || *dir == '\0') return;
+  const char* stage = type == GL_VERTEX_SHADER ? "vert" : type == GL_FRAGMENT_SHADER ? "frag" : "comp";
+  std::string fileName = name;
+  std::replace(fileName.begin(), fileName.end(), ' ', '_');
+  std::ofstream(fmt::format("{}/{}.{}", dir, fileName, stage)) << source;
+}
+
 GLuint compileShader(GLenum type, const std::string& source, const char* name) {
+  dumpShaderSource(type, source, name);
   const GLuint shader = glCreateShader(type);
   const char* text = source.c_str();
   glShaderSource(shader, 1, &text, nullptr);
@@ -898,6 +916,10 @@ struct GpuRenderer::State {
   /// The shading pass with several jittered samples per pixel; 0 where the driver lacks
   /// GL_ARB_gpu_shader_int64 (the sample positions' 64-bit hash).
   GLuint multisampleProgram = 0;
+  /// GL_TIMESTAMP queries at the start of a render()'s first pass and the end of its shading
+  /// pass, and the GPU time between them in the last render() (lastGpuMilliseconds).
+  GLuint timestampQueries[2] = {};
+  double lastGpuMilliseconds = 0.0;
   GLuint idTexture = 0, depthBuffer = 0, colorTexture = 0, visibilityFramebuffer = 0, shadingFramebuffer = 0;
   int width = 0, height = 0;
   int idScale = 1;  ///< the visibility targets are idScale·width × idScale·height
@@ -922,6 +944,7 @@ struct GpuRenderer::State {
     glDeleteProgram(shadingProgram);
     glDeleteProgram(lookupProgram);
     glDeleteProgram(multisampleProgram);
+    glDeleteQueries(2, timestampQueries);
     releaseTargets();
   }
   void releaseTargets() {
@@ -1268,8 +1291,10 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
   const int idScale = spp > 1 && !camera.isThinLens() ? multiSampleIdScale(camera.width(), camera.height()) : 1;
   State& s = *state_;
+  s.context.makeCurrent();
+  if (s.timestampQueries[0] == 0) glCreateQueries(GL_TIMESTAMP, 2, s.timestampQueries);
+  glQueryCounter(s.timestampQueries[0], GL_TIMESTAMP);
   if (camera.isThinLens()) {
-    s.context.makeCurrent();
     s.ensureTargets(camera.width(), camera.height(), idScale);
   } else {
     drawVisibility(camera, idScale);
@@ -1299,13 +1324,21 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   glBindTextureUnit(0, s.idTexture);
   glBindVertexArray(s.emptyVertexArray);
   glDrawArrays(GL_TRIANGLES, 0, 3);
+  glQueryCounter(s.timestampQueries[1], GL_TIMESTAMP);
   if (image.width != camera.width() || image.height != camera.height()) image = Image(camera.width(), camera.height());
   // GL row y is image row y (the projection flips film y): read straight into the pixels.
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glReadnPixels(0, 0, camera.width(), camera.height(), GL_RGB, GL_FLOAT, GLsizei(image.pixels.size() * sizeof(Rgb)),
                 image.pixels.data());
+  // (The read-back waited for the shading pass, so both timestamps are there.)
+  GLuint64 start = 0, end = 0;
+  glGetQueryObjectui64v(s.timestampQueries[0], GL_QUERY_RESULT, &start);
+  glGetQueryObjectui64v(s.timestampQueries[1], GL_QUERY_RESULT, &end);
+  s.lastGpuMilliseconds = end > start ? double(end - start) * 1e-6 : 0.0;
   checkGl("the shading pass");
 }
+
+double GpuRenderer::lastGpuMilliseconds() const { return state_->lastGpuMilliseconds; }
 
 std::vector<Rgb> GpuRenderer::lookup(const std::vector<LookupQuery>& queries) {
   State& s = *state_;

@@ -526,7 +526,7 @@ SurfaceDetail surfaceDetailAt(uint triangle, uvec3 v, vec3 p0, vec3 p1, vec3 p2,
                               float coneWidth, vec3 geometric, vec3 interpolated) {
   uint flags = chartInfo.z;
   SurfaceDetail d = noSurfaceDetail(interpolated);
-  if ((flags & (kFlagTexturedAlbedo | kFlagTexturedEmission | kFlagNormalMapped)) == 0u) return d;
+  if ((flags & (kFlagTexturedAlbedo | kFlagTexturedEmission | kFlagNormalMapped | kFlagMetallicRoughness)) == 0u) return d;
   uint m = materialRecord(triangle);
   bool glossyMapped = (flags & kFlagNormalMapped) != 0u && chartInfo.y == kGlossy;
   if ((flags & kFlagTexturedAlbedo) != 0u) {

@@ -1104,6 +1104,24 @@ class GpuRenderCliTest : public cli_test::CliTest {
   }
 };
 
+// PLENOPTIC_GPU_SHADER_DUMP=DIR writes each shader as compiled, for a driver bug report.
+TEST_F(GpuRenderCliTest, ShaderDumpWritesEachStage) {
+  const std::filesystem::path dir = path("shaders");
+  std::filesystem::create_directories(dir);
+  std::string err;
+  ::setenv("PLENOPTIC_GPU_SHADER_DUMP", dir.c_str(), 1);  // the child process inherits it
+  const int status = run("render " + path("box.plf") + " -o " + path("dump.exr") + " --width 16 --height 12 --renderer gpu",
+                         nullptr, &err);
+  ::unsetenv("PLENOPTIC_GPU_SHADER_DUMP");
+  ASSERT_EQ(status, 0) << err;
+  for (const char* name : {"visibility.vert", "visibility.frag", "shading.frag"}) {
+    SCOPED_TRACE(name);
+    const std::string text = cli_test::readFileText((dir / name).string());
+    EXPECT_EQ(text.rfind("#version 450 core\n", 0), 0u);
+    EXPECT_NE(text.find("void main()"), std::string::npos);
+  }
+}
+
 TEST_F(GpuRenderCliTest, RendersTheCpuPicture) {
   std::string err;
   const std::string size = " --width 64 --height 48";
@@ -1119,6 +1137,10 @@ TEST_F(GpuRenderCliTest, RendersTheCpuPicture) {
   EXPECT_EQ(json["renderer"], "gpu");
   EXPECT_NE(std::string(json["device"]).find("OpenGL 4.5"), std::string::npos) << json["device"];
   EXPECT_GT(double(json["primary_ms_median"]), 0.0);  // the rasterisation pass alone
+  // The GPU's own time of each frame (timestamp queries) lies inside the frame's wall time.
+  EXPECT_GT(double(json["gpu_ms_median"]), 0.0);
+  EXPECT_LE(double(json["gpu_ms_min"]), double(json["gpu_ms_median"]));
+  EXPECT_LE(double(json["gpu_ms_median"]), double(json["ms_per_frame_median"]));
   // A thin lens likewise (depth of field: its lens points are the CPU renderer's).
   const std::string lens = size + " --aperture 0.5 --spp 4";
   ASSERT_EQ(run("render " + path("box.plf") + " -o " + path("gpu-lens.exr") + lens + " --renderer gpu", nullptr, &err), 0) << err;

@@ -271,6 +271,7 @@ struct RenderJobStats {
   /// rasterisation pass, GpuRenderer::drawVisibility) on the same cameras, timed after the
   /// frames when stats are written for the fast or GPU renderer; 0 = not timed.
   double primaryMsMedian = 0, primaryMsMin = 0;
+  double gpuMsMedian = 0, gpuMsMin = 0;  ///< the GPU renderer: its own time per frame (GpuRenderer::lastGpuMilliseconds)
   double loadSeconds = 0, accelBuildSeconds = 0;
   uint64_t fileBytes = 0;
   /// A path with light keyframes: frames relit, iterations, and the time relighting took

@@ -47,6 +47,10 @@ std::string RenderJobStats::toJson() const {
   json["ms_per_frame_min"] = msPerFrameMin;
   json["ms_per_frame_max"] = msPerFrameMax;
   json["fps"] = fps;
+  if (gpuMsMedian > 0.0) {
+    json["gpu_ms_median"] = gpuMsMedian;
+    json["gpu_ms_min"] = gpuMsMin;
+  }
   if (primaryMsMedian > 0.0) {
     json["primary_ms_median"] = primaryMsMedian;
     json["primary_ms_min"] = primaryMsMin;
@@ -162,7 +166,7 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   settings.showProgress = o.frames == 1 && o.reference;
   RenderJobResult result;
   Image& image = result.image;
-  std::vector<double> frameMs, primaryMs;
+  std::vector<double> frameMs, primaryMs, gpuMs;
   // With --stats, the fast renderer's first pass alone (FastRenderer::castPrimaryRays) is
   // timed on every frame's camera after the last frame (interleaving it with the frames would
   // evict their light-field data from the caches and slow them down).
@@ -175,6 +179,7 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
       image = renderLightField(relit ? *relit : lightField, accel, frameCamera, settings);
     } else if (gpuRenderer) {
       gpuRenderer->render(frameCamera, settings, image);
+      gpuMs.push_back(gpuRenderer->lastGpuMilliseconds());
     } else {
       (relitRenderer ? *relitRenderer : fastRenderer).render(frameCamera, settings, image);
     }
@@ -238,6 +243,10 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   stats.msPerFrameMin = *std::min_element(frameMs.begin(), frameMs.end());
   stats.msPerFrameMax = *std::max_element(frameMs.begin(), frameMs.end());
   stats.fps = stats.msPerFrameMedian > 0.0 ? 1e3 / stats.msPerFrameMedian : 0.0;
+  if (!gpuMs.empty()) {
+    stats.gpuMsMedian = median(gpuMs);
+    stats.gpuMsMin = *std::min_element(gpuMs.begin(), gpuMs.end());
+  }
   if (!primaryMs.empty()) {
     stats.primaryMsMedian = median(primaryMs);
     stats.primaryMsMin = *std::min_element(primaryMs.begin(), primaryMs.end());
