@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "accel/accel.h"
+#include "bake/first_shot.h"
 #include "bake/propagation.h"
 #include "bake/shard.h"
 #include "core/error.h"
@@ -78,6 +79,7 @@ struct Relighter::Impl {
   Environment appliedEnvironment;
   std::vector<Light> bakedLights;      ///< the lights the parameterisation's sides were decided for
   std::vector<uint8_t> lightMoved;      ///< per light: its D_l must be traced again
+  bool firstShotRead = false;           ///< the first shot by source came from a .pls
   bool converged = true;                ///< the baked values are converged
 
   /// The visibility field: in memory, or the path of its .plv.
@@ -124,10 +126,16 @@ struct Relighter::Impl {
            param.charts.size(), param.sunMaskLights.size());
     state = std::make_unique<TransportState>(scene, *accel, param, settings);
     const auto shotStart = std::chrono::steady_clock::now();
-    lightDirect.resize(scene.lights.size());
-    lightPunctual.resize(scene.lights.size());
-    for (uint32_t l = 0; l < scene.lights.size(); ++l) shootLight(l);
-    shootEmitters();
+    // The first shot by source: read from the .pls beside the .plv when one was written for
+    // this light field (first_shot.h), else shot.
+    bool stored = false;
+    if (path) stored = firstShotRead = readStoredFirstShot(*path, hash);
+    if (!stored) {
+      lightDirect.resize(scene.lights.size());
+      lightPunctual.resize(scene.lights.size());
+      for (uint32_t l = 0; l < scene.lights.size(); ++l) shootLight(l);
+      shootEmitters();
+    }
     const double shotSeconds = secondsSince(shotStart);
     bakedLights = scene.lights;
     snapshot();
@@ -139,8 +147,46 @@ struct Relighter::Impl {
     lightMoved.assign(scene.lights.size(), 0);
     if (log)
       log(fmt::format("relight: ready ({} lights, {} tixels): BVH and parameterisation {:.2f} s, first shot by source "
-                      "{:.2f} s",
-                      scene.lights.size(), param.tixelCount, setupSeconds, shotSeconds));
+                      "{:.2f} s{}",
+                      scene.lights.size(), param.tixelCount, setupSeconds, shotSeconds,
+                      stored ? fmt::format(" (read from {})", firstShotPathFor(*path)) : std::string()));
+  }
+
+  /// The first shot by source from the .pls beside the .plv at `visibilityPath`, when one was
+  /// written for this light field (its key: first_shot.h). False, with a note saying why when
+  /// there is a file, when there is none that fits (the caller shoots).
+  bool readStoredFirstShot(const std::string& visibilityPath, uint64_t hash) {
+    const std::string shotPath = firstShotPathFor(visibilityPath);
+    FirstShotBySource shot;
+    std::string why;
+    std::error_code ec;
+    const bool exists = std::filesystem::exists(shotPath, ec);
+    if (!exists || !readFirstShot(shotPath, hash, firstShotKey(scene, param, settings, hash),
+                                  uint32_t(scene.lights.size()), param.valueCount, !state->punctualGlossy.empty(),
+                                  shot, &why)) {
+      if (exists && log) log(fmt::format("relight: shooting the first shot by source again, because {}", why));
+      return false;
+    }
+    lightDirect = std::move(shot.lightDirect);
+    lightPunctual = std::move(shot.lightPunctual);
+    lightPunctual.resize(scene.lights.size());
+    emitterDirect = std::move(shot.emitterDirect);
+    refreshEmitters(*state);  // the light sampler's powers, as shootEmitters leaves them
+    return true;
+  }
+
+  /// Writes the first shot by source of the applied scene (the last relight()) to `path`.
+  void saveFirstShot(const std::string& path) const {
+    if (pending()) fail("{}: the first shot by source is saved after relight(), with no edit pending", path);
+    Scene applied = scene;
+    applied.lights = appliedLights;
+    applied.materials = appliedMaterials;
+    applied.environment = appliedEnvironment;
+    FirstShotBySource shot;
+    shot.lightDirect = lightDirect;
+    if (!state->punctualGlossy.empty()) shot.lightPunctual = lightPunctual;
+    shot.emitterDirect = emitterDirect;
+    writeFirstShot(path, vis.field.hash, firstShotKey(applied, param, settings, vis.field.hash), shot);
   }
 
   /// The tixel setup saved beside the .plv at `visibilityPath` (parameterisation.h
@@ -635,6 +681,8 @@ void Relighter::setScene(const Scene& edited) { impl_->setScene(edited); }
 bool Relighter::pending() const { return impl_->pending(); }
 RelightStats Relighter::relight(const RelightCallback& onIteration) { return impl_->relight(onIteration); }
 void Relighter::update(LightField& lf) const { impl_->update(lf); }
+void Relighter::saveFirstShot(const std::string& path) const { impl_->saveFirstShot(path); }
+bool Relighter::firstShotRead() const { return impl_->firstShotRead; }
 
 LightField Relighter::lightField() const {
   LightField lf;
