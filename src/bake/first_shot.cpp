@@ -145,10 +145,12 @@ bool readFirstShot(const std::string& path, uint64_t visibilityHash, uint64_t ke
                           flags ? " with punctual parts" : "", lightCount, valueCount,
                           punctual ? " with punctual parts" : ""));
   const uint64_t arrays = arrayCount(lights, punctual);
-  // (values and lights equal the caller's, so this product cannot overflow for a light field in memory.)
-  if (size != kPlsHeaderBytes + arrays * values * sizeof(Rgb))
-    return no(fmt::format("{} is damaged ({} bytes, its header says {})", path, size,
-                          kPlsHeaderBytes + arrays * values * sizeof(Rgb)));
+  // The payload's size against the header's counts, divided rather than multiplied (no overflow).
+  const uint64_t payloadBytes = size - kPlsHeaderBytes, arrayBytes = values * sizeof(Rgb);
+  if (values > payloadBytes / sizeof(Rgb) || (arrayBytes > 0 && payloadBytes / arrayBytes != arrays) ||
+      (arrayBytes > 0 && payloadBytes % arrayBytes != 0) || (arrayBytes == 0 && payloadBytes != 0))
+    return no(fmt::format("{} is damaged ({} bytes after its header, which declares {} arrays of {} values)", path,
+                          payloadBytes, arrays, values));
   FirstShotBySource read;
   read.lightDirect.resize(lights);
   if (punctual) read.lightPunctual.resize(lights);

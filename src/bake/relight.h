@@ -97,7 +97,9 @@ class Relighter {
   /// there is none for this .plv, filled again (fillTixels: minutes on a large scene; `log`
   /// says why). The first shot by source is read from the .pls beside the .plv when one was
   /// written for this light field (bake/first_shot.h), else shot (`log` says why when a file
-  /// is there but does not fit). The field is held decoded (VisibilityShard::decoded, decoded as it is checked:
+  /// is there but does not fit); when it is read, the field itself is read (and checked) only
+  /// when a relight() first gathers through it — an iteration, or D_e shot again — its header
+  /// checked at once, so an edit that needs no iteration never decodes it. The field is held decoded (VisibilityShard::decoded, decoded as it is checked:
   /// every iteration's gather then reads it directly) when that takes at most `decodedBudget`
   /// bytes (bake.h decodedFieldBudget); 0: kept compact.
   Relighter(const LightField& lightField, const std::string& visibilityPath,
