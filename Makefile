@@ -7,7 +7,7 @@ CMAKE_FLAGS ?=
 PREFIX ?= /usr/local
 FUZZ_BUILD_DIR ?= build-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS ?= obj gltf json_scene camera_path hdr exr plf plf_fixed plv plv_fixed plt plt_fixed
+FUZZ_TARGETS ?= obj gltf json_scene camera_path hdr exr plf plf_fixed plv plv_fixed plt plt_fixed pls pls_fixed
 
 .PHONY: all bootstrap configure build python examples scenes test demo bench fuzz install clean
 

@@ -8,7 +8,8 @@
 #   nothing      the same scene again, warm-started
 #   light-cold   the light's colour changed, --no-warm-start (propagated from zero: bit-identical
 #                to a full bake)
-# Every re-bake starts from the same previous bake (its .plf, .plv and .plt copied back first).
+# Every re-bake starts from the same previous bake (its .plf, .plv, .plt and .pls, the first shot
+# by source, copied back first).
 # Prints one line per case: median user s, median wall s, and the share of the full bake's.
 # Usage: bench/rebake_share.sh [PLENOPTIC] [WORKDIR]   (default build/plenoptic, out/rebake_share)
 # Environment: PRESET (default "default"), REPEAT (default 3).
@@ -43,6 +44,7 @@ for ((i = 0; i < repeat; ++i)); do
       args=(original.json -o full.plf --fresh)
     else
       cp prev.plf box.plf && cp prev.plv box.plv && cp prev.plt box.plt
+      rm -f box.pls && if [[ -f prev.pls ]]; then cp prev.pls box.pls; fi
       args=("$c.json" -o box.plf --reuse-visibility)
       [[ $c == light-cold ]] && args+=(--no-warm-start)
     fi

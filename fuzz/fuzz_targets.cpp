@@ -16,6 +16,7 @@
 #include "core/file_io.h"
 #include "core/hash.h"
 #include "image/image.h"
+#include "bake/first_shot.h"
 #include "plf/plf_file.h"
 #include "plf/plt_file.h"
 #include "plf/plv_file.h"
@@ -186,6 +187,34 @@ void runPltFixed(std::span<const uint8_t> input) {
   runPlt(bytes);
 }
 
+// .pls header (bake/first_shot.h): magic 8, version 4, light count 4 at 12, hash 8 at 16, key 8
+// at 24, value count 8 at 32, flags 8 at 40, payloadHash 8 at 48; payload from 56.
+constexpr size_t kPlsPayloadHashOffset = 48, kPlsHeaderBytes = 56;
+
+void runPls(std::span<const uint8_t> input) {
+  // The expected hash, key and counts are the file's own, so the reader goes past the
+  // staleness checks (a relighting passes its light field's).
+  if (input.size() < kPlsHeaderBytes) {
+    FirstShotBySource shot;
+    readFirstShot(putFile("shot.pls", input), 0, 0, 0, 0, false, shot);
+    return;
+  }
+  uint32_t lights = 0;
+  std::memcpy(&lights, input.data() + 12, 4);
+  FirstShotBySource shot;
+  std::string why;
+  readFirstShot(putFile("shot.pls", input), loadU64(input.data() + 16), loadU64(input.data() + 24), lights,
+                loadU64(input.data() + 32), loadU64(input.data() + 40) == 1, shot, &why);
+}
+
+/// .pls with the payload checksum recomputed over the mutated payload.
+void runPlsFixed(std::span<const uint8_t> input) {
+  std::vector<uint8_t> bytes(input.begin(), input.end());
+  if (bytes.size() >= kPlsHeaderBytes)
+    storeU64(bytes.data() + kPlsPayloadHashOffset, xxh64(bytes.data() + kPlsHeaderBytes, bytes.size() - kPlsHeaderBytes));
+  runPls(bytes);
+}
+
 constexpr FuzzTarget kTargets[] = {
     {"obj", "Wavefront OBJ + MTL scene (loadScene)", runObj},
     {"gltf", "glTF 2.0 scene, .gltf or .glb by the magic (loadScene)", runGltf},
@@ -199,6 +228,8 @@ constexpr FuzzTarget kTargets[] = {
     {"plv_fixed", "visibility field .plv with the payload checksum recomputed after mutation", runPlvFixed},
     {"plt", "tixel-setup file .plt (readTixelSetupFile)", runPlt},
     {"plt_fixed", "tixel-setup file .plt with the payload checksum recomputed after mutation", runPltFixed},
+    {"pls", "first shot by source .pls (readFirstShot)", runPls},
+    {"pls_fixed", "first shot by source .pls with the payload checksum recomputed after mutation", runPlsFixed},
 };
 
 }  // namespace

@@ -386,7 +386,7 @@ TEST_F(AppCli, MemoryGuardRefusesWhatWouldNotFitWithTheEstimateAndTheFlag) {
       << err;
   std::vector<std::string> written = outputs();
   std::sort(written.begin(), written.end());
-  EXPECT_EQ(written, (std::vector<std::string>{"small.plf", "small.plt", "small.plv"}));
+  EXPECT_EQ(written, (std::vector<std::string>{"small.plf", "small.pls", "small.plt", "small.plv"}));
 }
 
 TEST_F(AppCli, InterruptedBakeRemovesItsTemporaryFilesAndSaysSo) {

@@ -15,6 +15,7 @@
 #include "core/memory.h"
 #include "core/parallel.h"
 #include "core/timing.h"
+#include "bake/first_shot.h"
 #include "bake/parameterisation.h"
 #include "bake/propagation.h"
 #include "bake/resume.h"
@@ -526,6 +527,23 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
     writeTixelSetup(path, lf.scene, param, hash);
     note(fmt::format("tixel setup: {} ({:.1f} MB) in {:.2f} s", path, double(std::filesystem::file_size(path)) / 1e6,
                      secondsSince(writeStart)));
+  }
+  // The first shot by source beside it (bake/first_shot.h), when the bake has it for free: a
+  // scene without scene lights, whose whole first shot is the emitters' and environment's D_e.
+  // A warm-started re-bake then reads it instead of shooting again. (With scene lights the bake
+  // shoots them together; the first warm-started re-bake writes the file.)
+  if (comm.size() == 1 && !options.visibilityPath.empty() && lf.scene.lights.empty() &&
+      transport.propagation.direct.size() == param.valueCount) {
+    const auto writeStart = std::chrono::steady_clock::now();
+    const std::string path = firstShotPathFor(options.visibilityPath);
+    FirstShotBySource shot;
+    shot.emitterDirect = std::move(transport.propagation.direct);
+    writeFirstShot(path, hash, firstShotKey(lf.scene, param, settings, hash), shot);
+    note(fmt::format("first shot by source: {} ({:.1f} MB) in {:.2f} s", path,
+                     double(std::filesystem::file_size(path)) / 1e6, secondsSince(writeStart)));
+  } else if (comm.size() == 1 && !options.visibilityPath.empty()) {
+    std::error_code ec;  // a stale one would be ignored by its key; removing it keeps the folder true
+    std::filesystem::remove(firstShotPathFor(options.visibilityPath), ec);
   }
   storeLightField(lf, param, std::move(transport.propagation.values));
   lf.stats = bakeStats(param, transport, distributed);

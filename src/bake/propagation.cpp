@@ -1734,6 +1734,7 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
   finishTransport(state);
 
   result.values = std::move(state.current);
+  result.direct = std::move(state.direct);
   result.shadowRays = comm.sum(state.shadowRays.load());
   result.causticPhotons = state.causticPhotons;
   result.causticPhotonsLanded = state.causticPhotonsLanded;

@@ -55,6 +55,7 @@ class Progress;
 
 struct PropagationResult {
   std::vector<Rgb> values;  ///< in LightField::values layout, emission included for glossy charts
+  std::vector<Rgb> direct;  ///< the first shot (this rank's view after the exchange), for bake/first_shot.h
   uint32_t iterations = 0;
   double residual = 0.0;    ///< relative change of total outgoing power at the last iteration
   double seconds = 0.0;

@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "accel/accel.h"
+#include "bake/first_shot.h"
 #include "bake/propagation.h"
 #include "bake/shard.h"
 #include "core/error.h"
@@ -78,6 +79,10 @@ struct Relighter::Impl {
   Environment appliedEnvironment;
   std::vector<Light> bakedLights;      ///< the lights the parameterisation's sides were decided for
   std::vector<uint8_t> lightMoved;      ///< per light: its D_l must be traced again
+  bool firstShotRead = false;           ///< the first shot by source came from a .pls
+  uint64_t visHash = 0;                 ///< the visibility field's hash (this light field's)
+  std::string unreadVisibility;         ///< the .plv whose reading waits until a gather needs it
+  uint64_t unreadBudget = 0;            ///< its decodedBudget
   bool converged = true;                ///< the baked values are converged
 
   /// The visibility field: in memory, or the path of its .plv.
@@ -98,21 +103,29 @@ struct Relighter::Impl {
     }
     const double setupSeconds = secondsSince(start);
     const uint64_t hash = visibilityHash(scene, param, settings);
-    if (path) {
-      VisibilityField field;
-      std::string why;
-      const uint64_t side = gatherGridSide(settings.gatherDirections);
-      const bool hold = param.tixelCount > 0 && param.tixelCount * side * side * sizeof(VisibilityEntry) <= decodedBudget;
-      std::vector<VisibilityEntry> decoded;
-      if (!readVisibility(*path, hash, field, &why, param.tixelCount, hold ? &decoded : nullptr))
-        fail("{}: relighting needs the visibility field {} that was baked with this light field, but {}",
-             scene.sourcePath, *path, why);
-      vis = VisibilityShard::of(std::move(field), {TixelRange{0, param.tixelCount}});
-      if (hold) vis.decoded = FieldArray<VisibilityEntry>(std::move(decoded));
+    visHash = hash;
+    state = std::make_unique<TransportState>(scene, *accel, param, settings);
+    // The first shot by source: read from the .pls beside the .plv when one was written for
+    // this light field (first_shot.h), else shot below. When it is read, the visibility field
+    // is read only once something needs it (a gather: an iteration, or D_e shot again), so a
+    // change that needs neither (a recolour that scales the solution, nothing changed) never
+    // decodes it; its header is checked now.
+    const bool stored = path && (firstShotRead = readStoredFirstShot(*path, hash));
+    if (stored) {
+      const VisibilityFileInfo info = readVisibilityInfo(*path);
+      if (info.hash != hash || info.tixelCount != param.tixelCount)
+        fail("{}: relighting needs the visibility field {} that was baked with this light field, but it was traced "
+             "for another scene or settings (hash {:016x}, {} tixels; this light field's {:016x}, {} tixels)",
+             scene.sourcePath, *path, info.hash, info.tixelCount, hash, param.tixelCount);
+      unreadVisibility = *path;
+      unreadBudget = decodedBudget;
+    } else if (path) {
+      readVisibilityField(*path, decodedBudget);
     } else {
       vis = std::move(std::get<VisibilityShard>(source));
     }
-    if (vis.ranges.size() != 1 || vis.ranges[0] != TixelRange{0, param.tixelCount} || vis.field.hash != hash)
+    if (unreadVisibility.empty() &&
+        (vis.ranges.size() != 1 || vis.ranges[0] != TixelRange{0, param.tixelCount} || vis.field.hash != hash))
       fail("{}: the visibility field in memory (hash {:016x}, {} tixels) was not traced for this light field (hash "
            "{:016x}, {} tixels): relighting needs the .plv baked with it",
            scene.sourcePath, vis.field.hash, vis.field.tixelCount, hash, param.tixelCount);
@@ -122,12 +135,13 @@ struct Relighter::Impl {
            "({} values, {} charts, {} sun-mask lights)",
            scene.sourcePath, lf.values.size(), lf.charts.size(), lf.sunMaskLightCount, param.valueCount,
            param.charts.size(), param.sunMaskLights.size());
-    state = std::make_unique<TransportState>(scene, *accel, param, settings);
     const auto shotStart = std::chrono::steady_clock::now();
-    lightDirect.resize(scene.lights.size());
-    lightPunctual.resize(scene.lights.size());
-    for (uint32_t l = 0; l < scene.lights.size(); ++l) shootLight(l);
-    shootEmitters();
+    if (!stored) {
+      lightDirect.resize(scene.lights.size());
+      lightPunctual.resize(scene.lights.size());
+      for (uint32_t l = 0; l < scene.lights.size(); ++l) shootLight(l);
+      shootEmitters();
+    }
     const double shotSeconds = secondsSince(shotStart);
     bakedLights = scene.lights;
     snapshot();
@@ -139,8 +153,69 @@ struct Relighter::Impl {
     lightMoved.assign(scene.lights.size(), 0);
     if (log)
       log(fmt::format("relight: ready ({} lights, {} tixels): BVH and parameterisation {:.2f} s, first shot by source "
-                      "{:.2f} s",
-                      scene.lights.size(), param.tixelCount, setupSeconds, shotSeconds));
+                      "{:.2f} s{}",
+                      scene.lights.size(), param.tixelCount, setupSeconds, shotSeconds,
+                      stored ? fmt::format(" (read from {})", firstShotPathFor(*path)) : std::string()));
+  }
+
+  /// Reads the visibility field at `path` into vis, decoded when that takes at most `budget`
+  /// bytes; pl::Error when it does not belong to this light field.
+  void readVisibilityField(const std::string& path, uint64_t budget) {
+    VisibilityField field;
+    std::string why;
+    const uint64_t side = gatherGridSide(settings.gatherDirections);
+    const bool hold = param.tixelCount > 0 && param.tixelCount * side * side * sizeof(VisibilityEntry) <= budget;
+    std::vector<VisibilityEntry> decoded;
+    if (!readVisibility(path, visHash, field, &why, param.tixelCount, hold ? &decoded : nullptr))
+      fail("{}: relighting needs the visibility field {} that was baked with this light field, but {}",
+           scene.sourcePath, path, why);
+    vis = VisibilityShard::of(std::move(field), {TixelRange{0, param.tixelCount}});
+    if (hold) vis.decoded = FieldArray<VisibilityEntry>(std::move(decoded));
+  }
+  /// The visibility field, read now if its reading was put off (see the constructor).
+  const VisibilityShard& visibility() {
+    if (!unreadVisibility.empty()) {
+      readVisibilityField(unreadVisibility, unreadBudget);
+      unreadVisibility.clear();
+    }
+    return vis;
+  }
+
+  /// The first shot by source from the .pls beside the .plv at `visibilityPath`, when one was
+  /// written for this light field (its key: first_shot.h). False, with a note saying why when
+  /// there is a file, when there is none that fits (the caller shoots).
+  bool readStoredFirstShot(const std::string& visibilityPath, uint64_t hash) {
+    const std::string shotPath = firstShotPathFor(visibilityPath);
+    FirstShotBySource shot;
+    std::string why;
+    std::error_code ec;
+    const bool exists = std::filesystem::exists(shotPath, ec);
+    if (!exists || !readFirstShot(shotPath, hash, firstShotKey(scene, param, settings, hash),
+                                  uint32_t(scene.lights.size()), param.valueCount, !state->punctualGlossy.empty(),
+                                  shot, &why)) {
+      if (exists && log) log(fmt::format("relight: shooting the first shot by source again, because {}", why));
+      return false;
+    }
+    lightDirect = std::move(shot.lightDirect);
+    lightPunctual = std::move(shot.lightPunctual);
+    lightPunctual.resize(scene.lights.size());
+    emitterDirect = std::move(shot.emitterDirect);
+    refreshEmitters(*state);  // the light sampler's powers, as shootEmitters leaves them
+    return true;
+  }
+
+  /// Writes the first shot by source of the applied scene (the last relight()) to `path`.
+  void saveFirstShot(const std::string& path) const {
+    if (pending()) fail("{}: the first shot by source is saved after relight(), with no edit pending", path);
+    Scene applied = scene;
+    applied.lights = appliedLights;
+    applied.materials = appliedMaterials;
+    applied.environment = appliedEnvironment;
+    FirstShotBySource shot;
+    shot.lightDirect = lightDirect;
+    if (!state->punctualGlossy.empty()) shot.lightPunctual = lightPunctual;
+    shot.emitterDirect = emitterDirect;
+    writeFirstShot(path, visHash, firstShotKey(applied, param, settings, visHash), shot);
   }
 
   /// The tixel setup saved beside the .plv at `visibilityPath` (parameterisation.h
@@ -236,7 +311,7 @@ struct Relighter::Impl {
     auto [direct, punctual] = shoot(sources);
     {
       const SwappedIn swapped(*state, direct, punctual);
-      gatherEmission(*state, vis, 0, param.tixelCount);
+      gatherEmission(*state, visibility(), 0, param.tixelCount);
       shootCaustics(*state);
       finishFirstShot(*state);
     }
@@ -392,7 +467,7 @@ struct Relighter::Impl {
     if (edited.lights.size() != scene.lights.size())
       refuse(fmt::format("the scene has {} lights, the light field {}: lights cannot be added or removed",
                          edited.lights.size(), scene.lights.size()));
-    if (edited.materials.size() != scene.materials.size() || visibilityHash(edited, param, settings) != vis.field.hash)
+    if (edited.materials.size() != scene.materials.size() || visibilityHash(edited, param, settings) != visHash)
       refuse("its geometry, its materials' kinds or their mirror and glass parameters changed");
     if (edited.environment.isBlack() != scene.environment.isBlack())
       refuse("the environment would turn black or stop being black, which decides the surfaces' back sides");
@@ -573,10 +648,11 @@ struct Relighter::Impl {
     if (onIteration && !onIteration({0, 0.0, converged, out.firstFrameSeconds})) out.cancelled = true;
     // 3. The bake's iteration and stopping rule.
     if (!converged && !out.cancelled) {
+      const VisibilityShard& field = visibility();
       StoppingRule stopping(transportPower(*state, current), settings.tolerance);
       PropagationResult result;
       for (uint32_t iteration = 1; iteration <= settings.maxIterations; ++iteration) {
-        iterateTransport(*state, vis, stopping.omega());
+        iterateTransport(*state, field, stopping.omega());
         const double power = transportPower(*state, current);
         if (!std::isfinite(power))
           fail("{}: light propagation overflowed in relighting iteration {}: the total power is not finite; scale the "
@@ -635,6 +711,8 @@ void Relighter::setScene(const Scene& edited) { impl_->setScene(edited); }
 bool Relighter::pending() const { return impl_->pending(); }
 RelightStats Relighter::relight(const RelightCallback& onIteration) { return impl_->relight(onIteration); }
 void Relighter::update(LightField& lf) const { impl_->update(lf); }
+void Relighter::saveFirstShot(const std::string& path) const { impl_->saveFirstShot(path); }
+bool Relighter::firstShotRead() const { return impl_->firstShotRead; }
 
 LightField Relighter::lightField() const {
   LightField lf;

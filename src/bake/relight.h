@@ -95,7 +95,11 @@ class Relighter {
   /// (parameterisation.h reuseTixelSetup: a changed material's charts filled again, a moved
   /// sun's masks traced again; a .plt without keys taken as it is, readTixelSetup), or, when
   /// there is none for this .plv, filled again (fillTixels: minutes on a large scene; `log`
-  /// says why). The field is held decoded (VisibilityShard::decoded, decoded as it is checked:
+  /// says why). The first shot by source is read from the .pls beside the .plv when one was
+  /// written for this light field (bake/first_shot.h), else shot (`log` says why when a file
+  /// is there but does not fit); when it is read, the field itself is read (and checked) only
+  /// when a relight() first gathers through it — an iteration, or D_e shot again — its header
+  /// checked at once, so an edit that needs no iteration never decodes it. The field is held decoded (VisibilityShard::decoded, decoded as it is checked:
   /// every iteration's gather then reads it directly) when that takes at most `decodedBudget`
   /// bytes (bake.h decodedFieldBudget); 0: kept compact.
   Relighter(const LightField& lightField, const std::string& visibilityPath,
@@ -131,6 +135,12 @@ class Relighter {
   /// Writes the current solution into `lf` (a light field of the same scene and
   /// parameterisation): values, sun masks, and the scene's lights, materials and environment.
   void update(LightField& lf) const;
+  /// Writes the first shot by source of the scene the last relight() applied (no edit pending)
+  /// as a .pls file (bake/first_shot.h), which a Relighter of the resulting light field reads
+  /// instead of shooting again. Throws pl::Error when edits are pending or it cannot write.
+  void saveFirstShot(const std::string& path) const;
+  /// Whether the constructor read the first shot by source from a .pls instead of shooting it.
+  bool firstShotRead() const;
   /// The current solution as a light field (a copy of the scene and charts).
   LightField lightField() const;
 

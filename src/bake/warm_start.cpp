@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "bake/first_shot.h"
 #include "bake/parameterisation.h"
 #include "bake/visibility.h"
 #include "core/cancel.h"
@@ -63,7 +64,17 @@ LightField relightPrevious(Scene& scene, const BakeSettings& settings, const std
     fail("the meshes' normals, uvs or vertex colours or the textures differ from {}'s", previousPath);
   relighter.setScene(scene);  // refuses, with the reason, what the field does not serve
   outcome.setupSeconds = secondsSince(start);
+  const bool sourcesChange = relighter.pending();
   outcome.relight = relighter.relight();
+  // The first shot by source of the new scene beside the .plv, for the next re-bake (first_shot.h):
+  // unless it is the one just read (nothing changed). A cache: a failure to write is a note.
+  if (!outcome.relight.cancelled && (sourcesChange || !relighter.firstShotRead())) {
+    try {
+      relighter.saveFirstShot(firstShotPathFor(options.visibilityPath));
+    } catch (const Error& e) {
+      if (options.log) options.log(fmt::format("warm start: the first shot by source was not saved: {}", e.what()));
+    }
+  }
   LightField lf = relighter.lightField();
   // The .plt beside the .plv now describes the relit parameterisation (what a Relighter of
   // the new light field reads); the charts it holds other than fillTixels would are marked.

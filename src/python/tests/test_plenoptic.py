@@ -242,7 +242,7 @@ def test_a_finished_bake_leaves_no_resume_files_and_fresh_starts_over(tmp_path):
     visibility = str(tmp_path / "cornell.plv")
     first = plenoptic.bake(scene, preset="draft", visibility=visibility)
     # The journal of the trace and the propagation checkpoint are gone once the bake is done.
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["cornell.plt", "cornell.plv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cornell.pls", "cornell.plt", "cornell.plv"]
     again = plenoptic.bake(scene, preset="draft", visibility=visibility, fresh=True)
     assert np.array_equal(first.render(width=32, height=24), again.render(width=32, height=24))
 
