@@ -28,7 +28,7 @@
 //      emission texture is read at full resolution (emissionModulation); on a normal-mapped
 //      chart the mapped normal (surfaceAt) bends the glossy lookup and selects the tilted
 //      irradiances; a GGX-like diffuse base takes k(μ) from its table (gpu_surface_detail.h).
-//      A hit on a mirror or glass record follows the chain of reflected and refracted rays,
+//      A hit on a mirror, glass or mirror-like record follows the chain of reflected, refracted and lobe-sampled rays,
 //      traced through a BVH on the GPU, as the CPU renderers do (gpu_specular.h, gpu_bvh.h).
 // The result is radiance (W·sr⁻¹·m⁻², camera weight included, no exposure), read back into an
 // Image exactly where FastRenderer::render writes it; exposure and tone mapping are then the
@@ -55,7 +55,8 @@
 //
 // What it does not render yet (gpuUnsupportedFeature names the first one a light field has;
 // the constructor refuses such a light field with that name rather than draw a different
-// picture): mirror-like glossy lobes (specular charts of a glossy model), glTF materials with a
+// picture): environment maps lighting mirror-like glossy lobes, mirror-like glTF PBR lobes or
+// ones with a metallic-roughness texture, glTF materials with a
 // clear coat or sheen and a metallic-roughness texture (each point's k(μ) normalisation), albedo
 // textures on diffuse charts of a model other than Lambert or subsurface (which no bake makes),
 // glTF layered materials on mirrors and glass. A clear coat or sheen over a diffuse base takes

@@ -92,6 +92,7 @@ layout(std430, binding = HIGHLIGHT_LIGHTS_BINDING) readonly buffer HighlightLigh
 struct HighlightModel { vec4 diffuse; vec4 lobe; vec4 extra; vec4 diffuseF0; };
 layout(std430, binding = HIGHLIGHT_MODELS_BINDING) readonly buffer HighlightModels { HighlightModel highlightModels[]; };
 uniform uint highlightLightCount;
+uniform bool glossyHighlights;  // gpuHighlightsActive: the glossy records' highlights too
 uniform bool shadowsPassThinGlass;
 
 float ggxD(float alpha, vec3 h) {
@@ -211,8 +212,14 @@ vec3 shadowTransmittance(vec3 origin, vec3 direction, float tMax) {
   }
 }
 vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer) {
-  if (highlightLightCount == 0u || charts[record].info.y != kGlossy) return vec3(0.0);
+  if (highlightLightCount == 0u) return vec3(0.0);
   uint material = triangleMaterials[triangle];
+  // A glossy record's when the bake kept them out of its maps; a specular record's only when
+  // mirror-like (a model that is neither mirror nor glass), whatever the setting.
+  uint kind = charts[record].info.y;
+  if (kind == kGlossy ? !glossyHighlights
+                      : kind != kSpecular || floatBitsToUint(specularMaterials[material].colour.w) != kSpecularOther)
+    return vec3(0.0);
   HighlightModel model = highlightModels[material];
   if (floatBitsToUint(model.diffuse.w) == kHighlightNoModel) return vec3(0.0);  // rough glass keeps them in its maps
   bool withDiffuse = (charts[record].info.z & kFlagDiffuseValue) == 0u;

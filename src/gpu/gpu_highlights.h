@@ -67,8 +67,9 @@ std::string highlightGlslConstants();
 
 /// GLSL: vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer) —
 /// PunctualHighlights::radiance at barycentrics uv of `triangle`, seen as chart record
-/// `record` (viewedRecord) from unit direction towardsViewer; uniforms highlightLightCount and
-/// shadowsPassThinGlass (Scene::hasThinGlass). Needs kBvhGlsl, kSurfaceGlsl and the lookup's
+/// `record` (viewedRecord) from unit direction towardsViewer — on a glossy record where
+/// glossyHighlights (gpuHighlightsActive), on a mirror-like specular record always; uniforms
+/// highlightLightCount, glossyHighlights and shadowsPassThinGlass (Scene::hasThinGlass). Needs kBvhGlsl, kSurfaceGlsl and the lookup's
 /// chart records and the surface detail's GLSL before it.
 extern const char* const kHighlightsGlsl;
 

@@ -8,11 +8,21 @@
 
 namespace pl {
 
+bool hasMirrorLikeCharts(const LightField& lf) {
+  for (const Chart& c : lf.charts)
+    if (isMirrorLikeRecord(c, lf.scene.materials[c.material].bsdf)) return true;
+  return false;
+}
+
 std::string gpuUnsupportedMirrorLike(const LightField& lf) {
   for (const Chart& c : lf.charts) {
-    const Bsdf& model = lf.scene.materials[c.material].bsdf;
-    if (isMirrorLikeRecord(c, model) && !std::holds_alternative<BlinnPhongBsdf>(model) && !std::holds_alternative<GgxBsdf>(model))
+    const Material& material = lf.scene.materials[c.material];
+    const Bsdf& model = material.bsdf;
+    if (!isMirrorLikeRecord(c, model)) continue;
+    if (!std::holds_alternative<BlinnPhongBsdf>(model) && !std::holds_alternative<GgxBsdf>(model))
       return "mirror-like glTF PBR lobes";
+    // The lobe is sampled from the material's model record, not each point's (materialModelAt).
+    if (material.metallicRoughness.texture >= 0) return "mirror-like lobes with a metallic-roughness texture";
   }
   return {};
 }

@@ -19,8 +19,11 @@
 
 namespace pl {
 
-/// The first mirror-like chart's model of `lf` that kMirrorLikeGlsl does not sample, as a
-/// phrase; empty if none.
+/// Whether `lf` has mirror-like chart records (lookup.h isMirrorLikeRecord).
+bool hasMirrorLikeCharts(const LightField& lf);
+
+/// The first mirror-like chart's model of `lf` that kMirrorLikeGlsl does not sample (glTF PBR,
+/// or one a metallic-roughness texture makes per point), as a phrase; empty if none.
 std::string gpuUnsupportedMirrorLike(const LightField& lf);
 
 /// GLSL, in the local frame of the shading normal (z up):

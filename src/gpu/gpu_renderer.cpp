@@ -468,6 +468,17 @@ uint64_t mix64(uint64_t x) {
 }
 uint64_t hashCombine(uint64_t a, uint64_t b) { return mix64(a ^ (mix64(b) + 0x9e3779b97f4a7c15UL)); }
 #endif
+// reversedSobolPoint(index, 1) (core/sampler.h): the second Sobol dimension's columns
+// v₀ = 2^31, v_k = v_{k−1} ⊕ (v_{k−1} >> 1), bit-reversed, XORed for the index's set bits — the
+// film points' (MULTISAMPLE) and the split lobe samples' (gpu_specular.h rayHashU2).
+uint reversedSobolSecond(uint index) {
+  uint result = 0u, column = 0x80000000u;
+  for (; index != 0u; index >>= 1) {
+    if ((index & 1u) != 0u) result ^= bitfieldReverse(column);
+    column ^= column >> 1;
+  }
+  return result;
+}
 
 // triangleNormal (scene.h: the unit geometric normal of `tri`, 0 for a degenerate one) and, on
 // a curved or normal-mapped chart (`chartFlags`), interpolatedNormal at barycentrics b (the
@@ -617,16 +628,6 @@ uint owenScrambleReversed(uint v, uint scrambleSeed) {
   v ^= v * 0x05526c56u;
   v ^= v * 0x53a22864u;
   return v;
-}
-// reversedSobolPoint(index, 1): the second Sobol dimension's columns v₀ = 2^31,
-// v_k = v_{k−1} ⊕ (v_{k−1} >> 1), bit-reversed, XORed for the index's set bits.
-uint reversedSobolSecond(uint index) {
-  uint result = 0u, column = 0x80000000u;
-  for (; index != 0u; index >>= 1) {
-    if ((index & 1u) != 0u) result ^= bitfieldReverse(column);
-    column ^= column >> 1;
-  }
-  return result;
 }
 uint64_t mortonEncode2(uint x, uint y) {
   uint64_t m = 0UL;
@@ -885,6 +886,9 @@ void setCameraUniforms(GLuint program, const Camera& camera) {
 
 std::string gpuUnsupportedFeature(const LightField& lf) {
   if (std::string specular = gpuUnsupportedSpecular(lf); !specular.empty()) return specular;
+  if (std::string lobe = gpuUnsupportedMirrorLike(lf); !lobe.empty()) return lobe;
+  if (hasMirrorLikeCharts(lf))  // the emitters sampled at mirror-like lobes (MirrorLikeLights)
+    if (std::string lights = gpuUnsupportedLights(LightSampler(lf.scene)); !lights.empty()) return lights;
   const SunLights sun = sunLightsOf(lf);
   for (uint32_t i = 0; i < lf.charts.size(); ++i)
     if (std::string detail = gpu::surfaceDetailUnsupported(lf, lf.charts[i], chartShading(lf, i, sun)); !detail.empty())
@@ -908,6 +912,7 @@ struct GpuRenderer::State {
   bool bvhUploaded = false;
   GLuint intersectProgram = 0;  ///< GpuRenderer::intersect's, made on its first call
   GLuint lightTable = 0;        ///< the light sampler's table (gpu_lights.h)
+  GLuint lobeLightTable = 0;    ///< the scene's light sampler's table, for mirror-like lobes (LOBE_LIGHTS)
   GLuint lightsProgram = 0;     ///< GpuRenderer::sampleLights's, made on its first call
   GLuint lobeModels = 0;        ///< GpuRenderer::sampleLobes's models (highlightModels) without highlights
   GLuint lobesProgram = 0;      ///< GpuRenderer::sampleLobes's, made on its first call
@@ -935,6 +940,7 @@ struct GpuRenderer::State {
     glDeleteProgram(intersectProgram);
     glDeleteProgram(lightsProgram);
     glDeleteBuffers(1, &lightTable);
+    glDeleteBuffers(1, &lobeLightTable);
     glDeleteProgram(lobesProgram);
     glDeleteBuffers(1, &lobeModels);
     glDeleteVertexArrays(1, &vertexArray);
@@ -1115,7 +1121,19 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   // nodes over n triangles, and their order); mirrors, glass and punctual highlights add the
   // triangles' materials and the materials and lights they read.
   s.specular = hasSpecularCharts(lightField);
-  s.highlights = gpuHighlightsActive(lightField);
+  // Mirror-like lobes: sampled with the highlights' model records, their delta lights'
+  // highlights added whatever the setting (PunctualHighlights), their emitters sampled from the
+  // scene's light sampler (MirrorLikeLights) when it has any.
+  const bool mirrorLike = hasMirrorLikeCharts(lightField);
+  const bool glossyHighlights = gpuHighlightsActive(lightField);
+  s.highlights = glossyHighlights || mirrorLike;
+  std::vector<uint32_t> lobeLightTable;
+  if (mirrorLike) {
+    const LightSampler sampler(scene);
+    if (sampler.emissiveTriangleCount() > 0 || sampler.hasEnvironment() || sampler.hasSphereLights())
+      lobeLightTable = gpuLightTable(sampler);
+  }
+  const bool lobeLights = !lobeLightTable.empty();
   const bool traces = s.specular || s.highlights;
   const uint64_t triangleCount = triangles.size();
   sizes.emplace_back("BVH (bound)", std::max<uint64_t>((2 * triangleCount) * sizeof(BvhNode) + 4 * triangleCount, 16));
@@ -1123,6 +1141,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
     sizes.emplace_back("materials of the traced rays", std::max<uint64_t>(scene.materials.size() * sizeof(SpecularMaterialGpu) +
                                                                                4 * triangleCount, 16));
   }
+  if (lobeLights) sizes.emplace_back("light sampler (mirror-like lobes)", lobeLightTable.size() * sizeof(uint32_t));
   gpu::checkGpuMemory(sizes);
   auto upload = [&](GLuint buffer, const void* data, size_t bytes) {
     glNamedBufferStorage(buffer, GLsizeiptr(std::max<size_t>(bytes, 16)), bytes > 0 ? data : nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -1159,6 +1178,12 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kHighlightModelsBinding, s.rayBuffers[5]);
     checkGl("uploading the punctual lights");
   }
+  if (lobeLights) {
+    glCreateBuffers(1, &s.lobeLightTable);
+    upload(s.lobeLightTable, lobeLightTable.data(), lobeLightTable.size() * sizeof(uint32_t));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightTableBinding, s.lobeLightTable);
+    checkGl("uploading the light sampler");
+  }
 
   glCreateVertexArrays(1, &s.vertexArray);
   glVertexArrayVertexBuffer(s.vertexArray, 0, s.buffers[2], 0, 4 * sizeof(float));
@@ -1183,8 +1208,11 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                      bvhGlslConstants() + (traces ? specularGlslConstants() : "") +
                                      (anyMasked ? "#define BVH_ALPHA_MASKS\n" : "") +
                                      (chartDetail ? "#define CHAIN_SURFACE_DETAIL\n" : "") +
-                                     (gpu::tracedSurfaceDetail(lightField) ? "#define TRACED_DETAIL\n" : "");
+                                     (gpu::tracedSurfaceDetail(lightField) ? "#define TRACED_DETAIL\n" : "") +
+                                     (mirrorLike ? "#define MIRROR_LIKE\n" : "") +
+                                     (lobeLights ? "#define LOBE_LIGHTS\n" + lightGlslConstants() : "");
   const std::string shading = std::string(kBvhGlsl) + kShadingFragment + (traces ? kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
+                              (lobeLights ? kLightsGlsl : "") + (mirrorLike ? kMirrorLikeGlsl : "") +
                               (s.specular ? kSpecularGlsl : "");
   s.shadingProgram =
       linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}}, "shading", true, raysHeader);
@@ -1201,6 +1229,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
     if (program == 0) continue;
     if (s.highlights) {
       glProgramUniform1ui(program, glGetUniformLocation(program, "highlightLightCount"), GLuint(highlightLightRecords.size()));
+      glProgramUniform1i(program, glGetUniformLocation(program, "glossyHighlights"), glossyHighlights ? 1 : 0);
       glProgramUniform1i(program, glGetUniformLocation(program, "shadowsPassThinGlass"), scene.hasThinGlass() ? 1 : 0);
     }
     glProgramUniform3f(program, glGetUniformLocation(program, "background"), s.background.x, s.background.y,
@@ -1408,6 +1437,7 @@ std::vector<GpuRenderer::LightAnswer> GpuRenderer::sampleLights(const LightSampl
   }
   const size_t count = queries.size();
   const std::vector<float> output = runQueries(s.lightsProgram, input, count, 20, "the light sampler queries");
+  if (s.lobeLightTable != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightTableBinding, s.lobeLightTable);
   std::vector<LightAnswer> answers(count);
   for (size_t i = 0; i < count; ++i) {
     const float* r = &output[20 * i];

@@ -21,8 +21,6 @@ std::string gpuUnsupportedSpecular(const LightField& lf) {
   for (const Chart& c : lf.charts) {
     if (c.kind != ChartKind::Specular) continue;
     const Material& m = scene.materials[c.material];
-    if (!isDelta(m.bsdf) && !std::holds_alternative<DielectricBsdf>(m.bsdf))
-      return "mirror-like glossy lobes (specular charts of a Blinn-Phong or GGX material)";
     // An albedo texture or vertex colours leave a mirror's or glass's model as it is
     // (materialModelAt: withDiffuseAlbedo of a model without a diffuse part), so the chains
     // read none of them; only glTF's layered model would be made anew per point.
@@ -59,9 +57,10 @@ std::vector<SpecularMaterialGpu> specularMaterials(const Scene& scene) {
 
 std::string specularGlslConstants() {
   return fmt::format("const uint kSpecularOther = {}u, kSpecularMirror = {}u, kSpecularGlass = {}u;\n"
-                     "const uint kSpecularRouletteStep = {}u;\n"
+                     "const uint kSpecularRouletteStep = {}u, kFirstHitLobeSamples = {}u;\n"
                      "#define SPECULAR_MATERIALS_BINDING {}\n#define TRIANGLE_MATERIALS_BINDING {}\n",
-                     kSpecularOther, kSpecularMirror, kSpecularGlass, kSpecularRouletteStep, kSpecularMaterialsBinding,
+                     kSpecularOther, kSpecularMirror, kSpecularGlass, kSpecularRouletteStep, kFirstHitLobeSamples,
+                     kSpecularMaterialsBinding,
                      kTriangleMaterialsBinding);
 }
 
@@ -148,6 +147,18 @@ uint64_t specularRayHash(vec3 o, vec3 d) {
   h = hashCombine(h, uint64_t(floatBitsToUint(d.y)));
   return hashCombine(h, uint64_t(floatBitsToUint(d.z)));
 }
+// rayHashU2 (lookup.cpp): two numbers in [0, 1) from the ray's hash and `salt`; sample k > 0 of
+// a split is Sobol point k rotated by sample 0's numbers (24-bit fixed point, modulo 2^24).
+// specularLobeU's salt is 0x4c4f4245, nextEventU's 0x4e45454c.
+vec2 rayHashU2(uint64_t rayHash, uint64_t salt, uint k) {
+  uint64_t h = hashCombine(rayHash, salt);
+  uint x = uint(h >> 40), y = uint((h >> 16) & 0xffffffUL);
+  if (k > 0u) {
+    x = (x + (bitfieldReverse(k) >> 8)) & 0xffffffu;  // reversedSobolPoint(k, 0) = k
+    y = (y + (bitfieldReverse(reversedSobolSecond(k)) >> 8)) & 0xffffffu;
+  }
+  return vec2(float(x) * exp2(-24.0), float(y) * exp2(-24.0));
+}
 // The sample in the local frame: false when the BSDF returns nothing.
 bool sampleSpecular(SpecularMaterial m, vec3 wo, float u, out vec3 wi, out vec3 weight) {
   uint kind = floatBitsToUint(m.colour.w);
@@ -195,12 +206,17 @@ bool sampleSpecular(SpecularMaterial m, vec3 wo, float u, out vec3 wi, out vec3 
   weight = m.colour.rgb / (etap * etap);
   return true;
 }
-// followSpecular at the hit (t, triangle, uv) of the ray (origin, direction).
-bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv, uint step, uint stepLimit,
-                    out vec3 emitted, out vec3 nextOrigin, out vec3 nextDirection, out vec3 weight) {
+// followSpecular at the hit (t, triangle, uv) of the ray (origin, direction); a mirror-like
+// lobe (kSpecularOther on a specular record) sampled with specularLobeU(ray, lobeSample).
+// lobePdf and straightThrough: SpecularStep's.
+bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv, uint step, uint stepLimit, uint lobeSample,
+                    out vec3 emitted, out vec3 nextOrigin, out vec3 nextDirection, out vec3 weight, out float lobePdf,
+                    out bool straightThrough) {
   nextOrigin = vec3(0.0);
   nextDirection = vec3(0.0);
   weight = vec3(0.0);
+  lobePdf = 0.0;
+  straightThrough = false;
   vec3 position, geometricNormal, shadingNormal;
   surfaceAt(triangle, uv, position, geometricNormal, shadingNormal);
   SpecularMaterial m = specularMaterials[triangleMaterials[triangle]];
@@ -215,7 +231,8 @@ bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv
   emitted = emission * attenuation;
   if (step >= stepLimit) return false;
   // scatteringFrame: a reflecting model's frame turned to wo's side, glass's never.
-  bool glass = floatBitsToUint(m.colour.w) == kSpecularGlass;
+  uint kind = floatBitsToUint(m.colour.w);
+  bool glass = kind == kSpecularGlass;
   bool turn = cosWoGeometric < 0.0 && !glass;
   vec3 g = turn ? -geometricNormal : geometricNormal;
   vec3 n = turn ? -shadingNormal : shadingNormal;
@@ -226,15 +243,25 @@ bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv
   float cosWo = dot(wo, g);
   if (!(glass ? cosWo * woLocal.z > 0.0 : cosWo > 0.0)) return false;
   uint64_t hash = specularRayHash(origin, direction);
-  float branchU = float(uint(hash >> 40)) * exp2(-24.0);
   vec3 wiLocal, sampleWeight;
-  if (!sampleSpecular(m, woLocal, branchU, wiLocal, sampleWeight)) return false;
+#ifdef MIRROR_LIKE
+  if (kind == kSpecularOther) {
+    if (!sampleMirrorLikeLobe(highlightModels[triangleMaterials[triangle]], woLocal, rayHashU2(hash, 0x4c4f4245UL, lobeSample),
+                              wiLocal, sampleWeight, lobePdf))
+      return false;
+  } else
+#endif
+  {
+    float branchU = float(uint(hash >> 40)) * exp2(-24.0);
+    if (!sampleSpecular(m, woLocal, branchU, wiLocal, sampleWeight)) return false;
+  }
   vec3 wi = wiLocal.x * s + wiLocal.y * tt + wiLocal.z * n;
   float cosWi = dot(wi, g);
   if (!(glass ? cosWi * wiLocal.z > 0.0 : cosWi > 0.0)) return false;
   nextOrigin = offsetRayOrigin(position, g, wi);
   nextDirection = wi;
   weight = sampleWeight * attenuation;
+  straightThrough = glass && m.iface.y != 0.0 && woLocal.z * wiLocal.z < 0.0;
   if (step >= kSpecularRouletteStep) {
     float survival = min(1.0, max(weight.r, max(weight.g, weight.b)));
     float rouletteU = float(uint((hash >> 16) & 0xffffffUL)) * exp2(-24.0);
@@ -243,22 +270,100 @@ bool followSpecular(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv
   }
   return true;
 }
-// The fast renderer's chain (realtime.h step 3) from a camera ray's hit on a specular record.
-// The lookup at its end reads the surface detail there with a ray cone coneSpread × the
-// chain's length (the camera ray's t and each traced ray's, summed as the CPU renderer does).
-vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv, uint mirrorDepth) {
-  vec3 radiance = vec3(0.0), throughput = vec3(1.0);
-  float distance = t;
-  for (uint step = 0u;; ++step) {
-    vec3 emitted, nextOrigin, nextDirection, weight;
-    bool more = followSpecular(origin, direction, t, triangle, uv, step, mirrorDepth, emitted, nextOrigin, nextDirection, weight);
-    radiance += throughput * emitted;
-    if (!more) return radiance;
-    throughput *= weight;
-    origin = nextOrigin;
-    direction = nextDirection;
-    if (!bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, uv))
-      return radiance + throughput * environmentRadiance(direction);
+#ifdef LOBE_LIGHTS
+// MirrorLikeLights (lookup.h) with nextEventEstimate (light.cpp, NextEvent::MisExceptDelta):
+// the light sample at a mirror-like hit and the power-heuristic weights of what the lobe's
+// sampled rays find. lobePdf 0 (a camera ray, a delta step): every weight 1, nothing added.
+const PbrLayers kNoLobeLayers = PbrLayers(0.0, 0.0, vec3(0.0), 0.0, vec3(0.0));
+vec3 lobeLightRadiance(vec3 origin, vec3 direction, uint triangle, vec2 uv, uint k) {
+  uint material = triangleMaterials[triangle];
+  if (floatBitsToUint(specularMaterials[material].colour.w) != kSpecularOther) return vec3(0.0);
+  HighlightModel model = highlightModels[material];
+  vec3 position, geometricNormal, shadingNormal;
+  surfaceAt(triangle, uv, position, geometricNormal, shadingNormal);
+  vec3 wo = -direction;
+  bool turn = dot(geometricNormal, wo) < 0.0;
+  vec3 g = turn ? -geometricNormal : geometricNormal, n = turn ? -shadingNormal : shadingNormal;
+  vec3 s, tt;
+  frameFromNormal(n, s, tt);
+  vec3 woLocal = vec3(dot(wo, s), dot(wo, tt), dot(wo, n));
+  if (!(dot(wo, g) > 0.0)) return vec3(0.0);
+  LightSampleGpu light;
+  if (!lightSample(position, rayHashU2(specularRayHash(origin, direction), 0x4e45454cUL, k), light) || light.delta)
+    return vec3(0.0);
+  vec3 wiLocal = vec3(dot(light.wi, s), dot(light.wi, tt), dot(light.wi, n));
+  if (!(dot(light.wi, g) > 0.0)) return vec3(0.0);
+  vec3 f = evalHighlightModel(model, mirrorLikeGgx(model), kNoLobeLayers, false, woLocal, wiLocal);
+  float cosIn = abs(wiLocal.z);
+  if (all(equal(f, vec3(0.0))) || !(cosIn > 0.0)) return vec3(0.0);
+  vec3 shadowOrigin = offsetRayOrigin(position, g, light.wi);
+  vec3 shadowDirection = light.wi;
+  float tMax = 1.0 / 0.0;
+  if (!light.infinite) {  // shadowRayTo
+    vec3 toTarget = light.target - shadowOrigin;
+    float distance = length(toTarget);
+    if (!(distance > 0.0)) return vec3(0.0);
+    shadowDirection = toTarget / distance;
+    tMax = distance;
+  }
+  vec3 visible = shadowTransmittance(shadowOrigin, shadowDirection, tMax);
+  if (all(equal(visible, vec3(0.0)))) return vec3(0.0);
+  return visible * f * cosIn * light.incident / light.pdf * powerHeuristic(light.pdf, mirrorLikeLobePdf(model, woLocal, wiLocal));
+}
+// emissionWeight: `distance` from the lobe's vertex to the hit on `triangle`.
+float lobeEmissionWeight(vec3 direction, uint triangle, float lobePdf, float distance) {
+  if (!(lobePdf > 0.0)) return 1.0;
+  uvec4 tri = triangles[triangle];
+  vec3 p0 = positions[tri.x].xyz;
+  vec3 normal = cross(positions[tri.y].xyz - p0, positions[tri.z].xyz - p0);
+  float length2 = dot(normal, normal);
+  normal = length2 > 0.0 ? normal / sqrt(length2) : vec3(0.0);  // triangleNormal
+  return powerHeuristic(lobePdf, emitterPdf(triangle, distance, abs(dot(normal, direction))));
+}
+float lobeEnvironmentWeight(vec3 direction, float lobePdf) {
+  return lobePdf > 0.0 ? powerHeuristic(lobePdf, environmentLightPdf(direction)) : 1.0;
+}
+vec3 lobeSphereEmission(vec3 origin, vec3 direction, float tHit, float lobePdf, float lobeDistance) {
+  vec3 radiance;
+  float pdf;
+  if (!(lobePdf > 0.0) || !sphereLightAlong(origin, direction, 0.0, tHit, origin - lobeDistance * direction, radiance, pdf))
+    return vec3(0.0);
+  return radiance * powerHeuristic(lobePdf, pdf);
+}
+// overcountedEmission at the hit (uv on `triangle`, `distance` from the lobe's vertex).
+vec3 lobeOvercountedEmission(vec3 direction, uint triangle, vec2 uv, float lobePdf, float distance) {
+  if (!(lobePdf > 0.0)) return vec3(0.0);
+  SpecularMaterial m = specularMaterials[triangleMaterials[triangle]];
+  uvec4 tri = triangles[triangle];
+  vec3 p0 = positions[tri.x].xyz;
+  float cosFront = -dot(cross(positions[tri.y].xyz - p0, positions[tri.z].xyz - p0), direction);
+  vec3 le = cosFront > 0.0 || m.emission.w != 0.0 ? m.emission.rgb : vec3(0.0);
+  if (all(equal(le, vec3(0.0)))) return vec3(0.0);
+#ifdef TRACED_DETAIL
+  le *= emissionTexelAt(materialRecord(triangle), tri.xyz, uv);
+#endif
+  return (1.0 - lobeEmissionWeight(direction, triangle, lobePdf, distance)) * le;
+}
+#endif
+// The fast renderer's chain (realtime.h step 3) of the ray (origin, direction) from its
+// `firstStep`-th specular step on: `hit` with (t, triangle, uv) its closest hit, `throughput`
+// its weight, `distance` the chain's length up to its origin (the lookup at its end reads the
+// surface detail with a ray cone coneSpread × the summed length, as the CPU renderer does),
+// lobePdf and lobeDistance the MIS state (LobeChain).
+vec3 followChain(vec3 origin, vec3 direction, bool hit, float t, uint triangle, vec2 uv, uint firstStep, uint stepLimit,
+                 vec3 throughput, float distance, float lobePdf, float lobeDistance) {
+  vec3 radiance = vec3(0.0);
+  for (uint step = firstStep;; ++step) {
+#ifdef LOBE_LIGHTS
+    radiance += throughput * lobeSphereEmission(origin, direction, hit ? t : 1.0 / 0.0, lobePdf, lobeDistance);
+#endif
+    if (!hit) {
+      vec3 sky = environmentRadiance(direction);
+#ifdef LOBE_LIGHTS
+      sky *= lobeEnvironmentWeight(direction, lobePdf);
+#endif
+      return radiance + throughput * sky;
+    }
     distance += t;
     uvec4 tri = triangles[triangle];
     vec3 normalAtHit, shadingNormal;
@@ -271,13 +376,82 @@ vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv,
 #else
       SurfaceDetail detail = noSurfaceDetail(shadingNormal);  // no chart reads any
 #endif
-      radiance += throughput * lookupRadiance(tri.w, origin + t * direction, -direction, normalAtHit, shadingNormal, detail);
+      vec3 seen = lookupRadiance(tri.w, origin + t * direction, -direction, normalAtHit, shadingNormal, detail);
+#ifdef LOBE_LIGHTS
+      seen -= lobeOvercountedEmission(direction, triangle, uv, lobePdf, lobeDistance + t);
+#endif
+      radiance += throughput * seen;
 #ifdef HIGHLIGHTS
       radiance += throughput * punctualHighlights(record, triangle, uv, -direction);
 #endif
       return radiance;
     }
+    vec3 emitted, nextOrigin, nextDirection, weight;
+    float stepPdf;
+    bool straight;
+    bool more = followSpecular(origin, direction, t, triangle, uv, step, stepLimit, 0u, emitted, nextOrigin, nextDirection,
+                               weight, stepPdf, straight);
+#ifdef LOBE_LIGHTS
+    emitted *= lobeEmissionWeight(direction, triangle, lobePdf, lobeDistance + t);
+#endif
+    radiance += throughput * emitted;
+#ifdef HIGHLIGHTS
+    radiance += throughput * punctualHighlights(record, triangle, uv, -direction);  // a mirror-like lobe's
+#endif
+#ifdef LOBE_LIGHTS
+    radiance += throughput * lobeLightRadiance(origin, direction, triangle, uv, 0u);
+#endif
+    if (!more) return radiance;
+    throughput *= weight;
+    if (straight) {
+      lobeDistance += t;
+    } else {
+      lobePdf = stepPdf;
+      lobeDistance = 0.0;
+    }
+    origin = nextOrigin;
+    direction = nextDirection;
+    hit = bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, uv);
   }
+}
+// The radiance along a camera ray whose closest hit (t, triangle, uv) is on a specular
+// record: its first specular step, split into kFirstHitLobeSamples stratified lobe samples on
+// a mirror-like lobe (firstHitLobeSamples), each with its own light sample and chain, each of
+// weight 1/kFirstHitLobeSamples — the fast renderer's first hit, term for term.
+vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv, uint mirrorDepth) {
+  uint samples = floatBitsToUint(specularMaterials[triangleMaterials[triangle]].colour.w) == kSpecularOther
+                     ? kFirstHitLobeSamples
+                     : 1u;
+  float share = 1.0 / float(samples);
+  vec3 radiance = vec3(0.0);
+  for (uint k = 0u; k < samples; ++k) {
+    vec3 emitted, nextOrigin, nextDirection, weight;
+    float stepPdf;
+    bool straight;
+    bool more = followSpecular(origin, direction, t, triangle, uv, 0u, mirrorDepth, k, emitted, nextOrigin, nextDirection,
+                               weight, stepPdf, straight);
+    if (k == 0u) {
+      radiance = emitted;
+#ifdef HIGHLIGHTS
+      uvec4 tri = triangles[triangle];
+      vec3 normalAtHit, shadingNormal;
+      hitNormals(tri, uv, normalAtHit, shadingNormal);
+      radiance += punctualHighlights(viewedRecord(tri.w, -direction, normalAtHit), triangle, uv, -direction);
+#endif
+    }
+#ifdef LOBE_LIGHTS
+    radiance += share * lobeLightRadiance(origin, direction, triangle, uv, k);
+#endif
+    if (!more) continue;
+    float nextT;
+    uint nextTriangle;
+    vec2 nextUv;
+    bool hit = bvhIntersect(nextOrigin, nextDirection, 0.0, 1.0 / 0.0, nextT, nextTriangle, nextUv);
+    // LobeChain{}.after(step, t): a straight pass keeps the camera ray's density (0).
+    radiance += followChain(nextOrigin, nextDirection, hit, nextT, nextTriangle, nextUv, 1u, mirrorDepth, share * weight, t,
+                            straight ? 0.0 : stepPdf, straight ? t : 0.0);
+  }
+  return radiance;
 }
 )glsl";
 

@@ -18,10 +18,14 @@
 // (hashCombine over the ray's six float bit patterns) in 64-bit GLSL integers, so it needs
 // GL_ARB_gpu_shader_int64.
 //
-// What it does not follow (gpuUnsupportedSpecular names it): mirror-like glossy lobes
-// (specular records of a Blinn-Phong or GGX model: their lobe sampling and the emitters'
-// next-event estimation there), and albedo textures or vertex colours on a mirror or glass
-// (materialModelAt would vary its reflectance or transmittance). A normal map on a mirror or
+// Mirror-like glossy lobes (specular records of a Blinn-Phong or GGX model, MIRROR_LIKE): the
+// lobe sampled with specularLobeU (gpu_mirror_like.h), kFirstHitLobeSamples stratified samples
+// at a camera ray's first hit, and (LOBE_LIGHTS, where the scene has emitters to sample) the
+// emitters' next-event estimation at each mirror-like hit with the chain's MIS state
+// (lookup.h MirrorLikeLights, LobeChain; the light sampler of gpu_lights.h); their delta
+// lights' highlights come from punctualHighlights (gpu_highlights.h).
+// What it does not follow (gpuUnsupportedSpecular names it): glTF layered materials on a
+// mirror or glass (materialModelAt would make the model anew per point). A normal map on a mirror or
 // glass bends surfaceAt's shading normal and an emission texture modulates its emission
 // (TRACED_DETAIL, gpu_surface_detail.h tracedSurfaceDetail); the lookup at the chain's end
 // reads the surface detail there (hitSurfaceDetail, the ray cone coneSpread × the chain's
@@ -74,7 +78,9 @@ extern const char* const kSurfaceGlsl;
 /// uint mirrorDepth) — the radiance along a camera ray whose closest hit is (t, triangle, uv)
 /// on a specular record, without the camera weight. Needs kBvhGlsl, kSurfaceGlsl, hitNormals,
 /// hitSurfaceDetail and the uniform coneSpread, lookupRadiance, environmentRadiance,
-/// punctualHighlights (gpu_highlights.h) and the 64-bit hash (hashCombine) before it.
+/// punctualHighlights (gpu_highlights.h), the 64-bit hash (hashCombine), reversedSobolSecond
+/// and, with MIRROR_LIKE, kHighlightsGlsl and kMirrorLikeGlsl, with LOBE_LIGHTS kLightsGlsl,
+/// before it.
 extern const char* const kSpecularGlsl;
 
 }  // namespace pl

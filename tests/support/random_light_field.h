@@ -29,8 +29,7 @@ inline LightField randomLightField(Scene scene, uint64_t seed, const BakeSetting
 
 /// The built-in Cornell box with every non-emissive material a GGX metal too sharp for a
 /// glossy map (α 2e-3): its charts are mirror-like specular records (bake/parameterisation.h
-/// isMirrorLike), which the CPU renderers follow by sampling the lobe and the GPU renderer
-/// does not draw yet.
+/// isMirrorLike), which the renderers follow by sampling the lobe.
 inline Scene mirrorLikeCornellBox() {
   Scene scene = makeCornellBox();
   for (Material& m : scene.materials)
