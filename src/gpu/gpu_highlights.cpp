@@ -225,14 +225,10 @@ vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer)
   bool withDiffuse = (charts[record].info.z & kFlagDiffuseValue) == 0u;
   GgxLobe ggx = highlightLobe(model, material, triangle, uv);
   PbrLayers layers = pbrLayersAt(detail[2] + kMaterialWords * material + kMaterialDiffuseLobe);
-  vec3 position, geometricNormal, shadingNormal;
-  surfaceAt(triangle, uv, position, geometricNormal, shadingNormal);
   // scatteringFrame of a reflecting model: both normals turned to the viewer's side.
-  bool turn = dot(geometricNormal, towardsViewer) < 0.0;
-  vec3 g = turn ? -geometricNormal : geometricNormal, n = turn ? -shadingNormal : shadingNormal;
-  vec3 s, t;
-  frameFromNormal(n, s, t);
-  vec3 wo = vec3(dot(towardsViewer, s), dot(towardsViewer, t), dot(towardsViewer, n));
+  ScatteringFrame frame = scatteringFrameAt(triangle, uv, towardsViewer);
+  vec3 position = frame.position, g = frame.g;
+  vec3 wo = toLocal(frame, towardsViewer);
   if (!(dot(towardsViewer, g) > 0.0)) return vec3(0.0);
   vec3 sum = vec3(0.0);
   for (uint l = 0u; l < highlightLightCount; ++l) {
@@ -258,7 +254,7 @@ vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer)
       if (!(falloff > 0.0)) continue;
       incident = light.intensity.rgb * (falloff / distanceSquared);
     }
-    vec3 wiLocal = vec3(dot(wi, s), dot(wi, t), dot(wi, n));
+    vec3 wiLocal = toLocal(frame, wi);
     if (!(dot(wi, g) > 0.0)) continue;
     vec3 f = evalHighlightModel(model, ggx, layers, withDiffuse, wo, wiLocal);
     float cosIn = abs(wiLocal.z);

@@ -129,6 +129,22 @@ void frameFromNormal(vec3 n, out vec3 s, out vec3 t) {
   s = vec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
   t = vec3(b, sign + n.y * n.y * a, -n.y);
 }
+// scatteringFrame (bsdf.h) of a reflecting model at barycentrics uv of `triangle`, seen from
+// unit world direction `towards`: surfaceAt's point, both normals turned to that side (g, n)
+// and n's tangents (s, t).
+struct ScatteringFrame { vec3 position, g, n, s, t; };
+ScatteringFrame scatteringFrameAt(uint triangle, vec2 uv, vec3 towards) {
+  ScatteringFrame f;
+  vec3 geometricNormal, shadingNormal;
+  surfaceAt(triangle, uv, f.position, geometricNormal, shadingNormal);
+  bool turn = dot(geometricNormal, towards) < 0.0;
+  f.g = turn ? -geometricNormal : geometricNormal;
+  f.n = turn ? -shadingNormal : shadingNormal;
+  frameFromNormal(f.n, f.s, f.t);
+  return f;
+}
+// World direction d in frame f's local coordinates (z along the shading normal).
+vec3 toLocal(ScatteringFrame f, vec3 d) { return vec3(dot(d, f.s), dot(d, f.t), dot(d, f.n)); }
 // offsetRayOrigin (accel.h).
 vec3 offsetRayOrigin(vec3 position, vec3 geometricNormal, vec3 direction) {
   float scale = 1.0 + max(abs(position.x), max(abs(position.y), abs(position.z)));
@@ -279,19 +295,15 @@ vec3 lobeLightRadiance(vec3 origin, vec3 direction, uint triangle, vec2 uv, uint
   uint material = triangleMaterials[triangle];
   if (floatBitsToUint(specularMaterials[material].colour.w) != kSpecularOther) return vec3(0.0);
   HighlightModel model = highlightModels[material];
-  vec3 position, geometricNormal, shadingNormal;
-  surfaceAt(triangle, uv, position, geometricNormal, shadingNormal);
   vec3 wo = -direction;
-  bool turn = dot(geometricNormal, wo) < 0.0;
-  vec3 g = turn ? -geometricNormal : geometricNormal, n = turn ? -shadingNormal : shadingNormal;
-  vec3 s, tt;
-  frameFromNormal(n, s, tt);
-  vec3 woLocal = vec3(dot(wo, s), dot(wo, tt), dot(wo, n));
+  ScatteringFrame frame = scatteringFrameAt(triangle, uv, wo);
+  vec3 position = frame.position, g = frame.g;
+  vec3 woLocal = toLocal(frame, wo);
   if (!(dot(wo, g) > 0.0)) return vec3(0.0);
   LightSampleGpu light;
   if (!lightSample(position, rayHashU2(specularRayHash(origin, direction), 0x4e45454cUL, k), light) || light.delta)
     return vec3(0.0);
-  vec3 wiLocal = vec3(dot(light.wi, s), dot(light.wi, tt), dot(light.wi, n));
+  vec3 wiLocal = toLocal(frame, light.wi);
   if (!(dot(light.wi, g) > 0.0)) return vec3(0.0);
   vec3 f = evalHighlightModel(model, mirrorLikeGgx(model), kNoLobeLayers, false, woLocal, wiLocal);
   float cosIn = abs(wiLocal.z);
