@@ -23,6 +23,7 @@
 #include "plf/plf_file.h"
 #include "support/cli_test_support.h"
 #include "support/random_light_field.h"
+#include "support/sky_map.h"
 #include "viewer/viewer.h"
 
 namespace pl {
@@ -167,8 +168,12 @@ TEST_F(ViewerCliTest, GpuScreenshotUnderXvfbEqualsGpuRender) {
 }
 
 /// A light field with mirror-like lobes (a chart the GPU renderer does not draw yet).
-void writeMirrorLightField(const std::string& file) {
-  writeLightField(file, test_support::randomLightField(test_support::mirrorLikeCornellBox(), 5));
+/// The mirror-like Cornell box lit by a sky map too: environment maps lighting mirror-like
+/// lobes are what the GPU renderer does not draw yet.
+void writeMapLitMirrorLightField(const std::string& file) {
+  Scene sky = test_support::mirrorLikeCornellBox();
+  sky.environment.map = std::make_shared<const EnvironmentMap>(test_support::skyWithSun(30.0f));
+  writeLightField(file, test_support::randomLightField(std::move(sky), 5));
 }
 
 /// The lines of `text` that contain `word`.
@@ -215,15 +220,16 @@ TEST_F(ViewerCliTest, FallsBackToTheCpuRendererWithOneWarningLine) {
     EXPECT_NE(errors.find(c.why), std::string::npos) << errors;
   }
   // A light field the GPU renderer does not draw yet: the warning names the feature.
-  writeMirrorLightField(path("mirror.plf"));
+  writeMapLitMirrorLightField(path("mirror.plf"));
   std::string out, errors;
   ASSERT_EQ(run("view " + path("mirror.plf") + " --frames 1" + size, &out, &errors), 0) << errors;
   EXPECT_EQ(linesWith(errors, "warning"), 1) << errors;
-  EXPECT_NE(errors.find("view uses the CPU renderer: the GPU renderer does not draw mirror-like glossy lobes"),
+  EXPECT_NE(errors.find("view uses the CPU renderer: the GPU renderer does not draw environment maps lighting "
+                        "mirror-like lobes"),
             std::string::npos)
       << errors;
   EXPECT_NE(run("view " + path("mirror.plf") + " --renderer gpu --frames 1" + size, nullptr, &errors), 0);
-  EXPECT_NE(errors.find("mirror-like glossy lobes"), std::string::npos) << errors;
+  EXPECT_NE(errors.find("environment maps lighting mirror-like lobes"), std::string::npos) << errors;
   EXPECT_NE(errors.find("--renderer cpu"), std::string::npos) << errors;
   // A thin lens is drawn by the GPU renderer too.
   ASSERT_EQ(run("view " + path("cornell.plf") + " --renderer gpu --aperture 2.8 --frames 1" + size, nullptr, &errors), 0)
