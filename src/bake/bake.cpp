@@ -300,11 +300,12 @@ bool resumableCheckpoint(const std::string& visibilityPath, uint64_t shardHash, 
 Transport traceAndPropagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const BakeSettings& settings, const BakeOptions& options, Communicator& comm,
                             const ShardPlan& plan, const std::vector<TixelRange>& held, uint64_t hash, uint64_t decodedBudget,
-                            bool streamed, const Note& note) {
+                            bool streamed, bool keepFirstShotBySource, const Note& note) {
   const std::string visibilityPath = shardVisibilityPath(options.visibilityPath, comm.rank(), comm.size());
   const uint64_t shardHash = visibilityShardHash(hash, held, param.tixelCount);
   Transport t;
-  PropagationResume resume;
+  PropagationOptions resume;
+  resume.keepFirstShotBySource = keepFirstShotBySource;
   PropagationCheckpoint checkpoint;
   if (!visibilityPath.empty()) {
     const std::string checkpointPath = propagationCheckpointPath(visibilityPath);
@@ -512,9 +513,19 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
   const uint64_t estimate = streamed ? streamedEstimate : heldEstimate;
   if (options.checkMemory) options.checkMemory(estimate);
 
-  // 2. Visibility field and 3. propagation.
+  // 2. Visibility field and 3. propagation. One process saving its field keeps the first shot
+  // by source for the .pls (below) when it fits the memory left beside the estimate: from the
+  // budget the decoded field would otherwise get.
+  uint64_t decodedBudget = decodedFieldBudget(estimate, options);
+  const uint64_t bySourceBytes =
+      (lf.scene.lights.size() * (settings.punctualHighlights ? 2 : 1) + 1) * param.valueCount * sizeof(Rgb);
+  const bool keepBySource = comm.size() == 1 && !options.visibilityPath.empty() && bySourceBytes <= decodedBudget;
+  if (keepBySource) decodedBudget -= bySourceBytes;
+  else if (comm.size() == 1 && !options.visibilityPath.empty() && !lf.scene.lights.empty())
+    note(fmt::format("first shot by source: not kept ({:.1f} MB would not fit beside the bake), so no {} is written",
+                     bySourceBytes / 1e6, firstShotPathFor(options.visibilityPath)));
   Transport transport = traceAndPropagate(lf.scene, accel, param, settings, options, comm, plan, share.held, hash,
-                                          decodedFieldBudget(estimate, options), streamed, note);
+                                          decodedBudget, streamed, keepBySource, note);
   DistributedBakeStats distributed =
       gatherDistributedStats(comm, plan, share, setupSeconds, tixelSetup, transport, note);
 
@@ -528,19 +539,22 @@ LightField bake(Scene scene, const BakeSettings& settings, const BakeOptions& op
     note(fmt::format("tixel setup: {} ({:.1f} MB) in {:.2f} s", path, double(std::filesystem::file_size(path)) / 1e6,
                      secondsSince(writeStart)));
   }
-  // The first shot by source beside it (bake/first_shot.h), when the bake has it for free: a
-  // scene without scene lights, whose whole first shot is the emitters' and environment's D_e.
-  // A warm-started re-bake then reads it instead of shooting again. (With scene lights the bake
-  // shoots them together; the first warm-started re-bake writes the file.)
-  if (comm.size() == 1 && !options.visibilityPath.empty() && lf.scene.lights.empty() &&
+  // The first shot by source beside it (bake/first_shot.h), so that a warm-started re-bake
+  // reads it instead of shooting again. A bake resumed from a propagation checkpoint has only
+  // the summed first shot: without scene lights that is the whole D_e, else there is no file.
+  std::optional<FirstShotBySource>& shot = transport.propagation.firstShotBySource;
+  if (!shot && comm.size() == 1 && !options.visibilityPath.empty() && lf.scene.lights.empty() &&
       transport.propagation.direct.size() == param.valueCount) {
+    shot.emplace();
+    shot->emitterDirect = std::move(transport.propagation.direct);
+  }
+  if (shot) {
     const auto writeStart = std::chrono::steady_clock::now();
     const std::string path = firstShotPathFor(options.visibilityPath);
-    FirstShotBySource shot;
-    shot.emitterDirect = std::move(transport.propagation.direct);
-    writeFirstShot(path, hash, firstShotKey(lf.scene, param, settings, hash), shot);
+    writeFirstShot(path, hash, firstShotKey(lf.scene, param, settings, hash), *shot);
     note(fmt::format("first shot by source: {} ({:.1f} MB) in {:.2f} s", path,
                      double(std::filesystem::file_size(path)) / 1e6, secondsSince(writeStart)));
+    shot.reset();
   } else if (comm.size() == 1 && !options.visibilityPath.empty()) {
     std::error_code ec;  // a stale one would be ignored by its key; removing it keeps the folder true
     std::filesystem::remove(firstShotPathFor(options.visibilityPath), ec);

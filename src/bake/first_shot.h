@@ -4,9 +4,10 @@
 // the first shot split by source (relight.h): D_l per scene light at unit emission (and its
 // punctual highlights on glossy charts), D_e of the emissive surfaces, the environment and the
 // caustics. Recomputing them is most of what a warm-started re-bake pays beyond reading its
-// files, so a bake writes them as X.pls beside X.plv when it has them for free (a scene without
-// scene lights: its whole first shot is D_e), and a warm-started re-bake writes the ones of the
-// scene it relit for — so the next re-bake reads them instead of shooting again.
+// files, so a bake, which shoots its first shot in this split (propagation.h
+// combineFirstShot), writes them as X.pls beside X.plv when they fit its memory, and a
+// warm-started re-bake writes the ones of the scene it relit for — so the next re-bake reads
+// them instead of shooting again.
 //
 // A file is used only for the light field it was written for: its key (firstShotKey) hashes
 // the visibility field's hash, the value count, the bake settings, the tixel setup's keys

@@ -143,17 +143,21 @@ TEST_F(FirstShotTest, ABakeWritesItAndTheRelighterReadsItToTheSameField) {
   EXPECT_EQ(notes.find("read from"), std::string::npos) << notes;
 }
 
-// A scene with a sun: the bake writes none (it shoots its sources together); the first
-// warm-started re-bake shoots and leaves the first shot of its new scene, which the next one
-// (from the relit light field, as `bake -o` leaves it) reads — to the field it would shoot.
-TEST_F(FirstShotTest, AWarmStartLeavesTheFirstShotOfItsSceneForTheNext) {
+// A scene with a sun: the bake shoots its first shot by source and writes it; a warm-started
+// re-bake for a moved sun reads the rest and shoots the sun alone — to the light field it
+// would relight to shooting everything (the bake's parts are a relight's bit for bit) — and
+// leaves the first shot of its new scene, which the next one (from the relit light field, as
+// `bake -o` leaves it) reads.
+TEST_F(FirstShotTest, ABakeWithASunAndEachWarmStartLeaveTheFirstShotOfTheirSceneForTheNext) {
   const BakeSettings settings = relightTestSettings(8.0f);
   BakeOptions options;
   options.visibilityPath = path("prev.plv");
-  writeLightField(path("prev.plf"), bake(sunScene(sunAt(40.0f, 20.0f)), settings, options));
-  EXPECT_FALSE(std::filesystem::exists(path("prev.pls")));
   std::string notes;
   options.log = [&](const std::string& line) { notes += line + "\n"; };
+  writeLightField(path("prev.plf"), bake(sunScene(sunAt(40.0f, 20.0f)), settings, options));
+  ASSERT_TRUE(std::filesystem::exists(path("prev.pls"))) << notes;
+  const std::string baked = path("baked.pls");
+  std::filesystem::copy_file(path("prev.pls"), baked);
   auto warm = [&](Scene edited) {
     notes.clear();
     edited.finalize();
@@ -164,6 +168,10 @@ TEST_F(FirstShotTest, AWarmStartLeavesTheFirstShotOfItsSceneForTheNext) {
   };
   Scene moved = sunScene(sunAt(40.0f, 30.0f));
   const LightField first = warm(moved);
+  EXPECT_NE(notes.find("(read from " + path("prev.pls") + ")"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("1 lights and 1 sun masks traced again"), std::string::npos) << notes;
+  std::filesystem::remove(path("prev.pls"));
+  EXPECT_TRUE(warm(moved).values == first.values);
   EXPECT_EQ(notes.find("read from"), std::string::npos) << notes;
   ASSERT_TRUE(std::filesystem::exists(path("prev.pls")));
   writeLightField(path("prev.plf"), first);
@@ -175,6 +183,21 @@ TEST_F(FirstShotTest, AWarmStartLeavesTheFirstShotOfItsSceneForTheNext) {
   const LightField shot = warm(recoloured);
   EXPECT_EQ(notes.find("read from"), std::string::npos) << notes;
   EXPECT_TRUE(second.values == shot.values);
+}
+
+// A bake's first shot is the sum of its parts by source, each light's at unit emission times
+// its emission: the same light field whether the bake keeps the parts (one process writing a
+// .pls) or not (no .plv), bit for bit.
+TEST_F(FirstShotTest, ABakeIsTheSameWhetherItKeepsTheFirstShotBySourceOrNot) {
+  const BakeSettings settings = relightTestSettings(8.0f);
+  Scene scene = sunScene(sunAt(40.0f, 20.0f));
+  setLightEmission(scene.lights[0], Rgb(5.0f, 2.5f, 1.0f));
+  BakeOptions kept;
+  kept.visibilityPath = path("kept.plv");
+  const LightField withFile = bake(scene, settings, kept);
+  ASSERT_TRUE(std::filesystem::exists(path("kept.pls")));
+  const LightField without = bake(scene, settings, BakeOptions{});
+  EXPECT_TRUE(withFile.values == without.values);
 }
 
 }  // namespace

@@ -923,7 +923,13 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
   const std::vector<GlossyMaterial>& glossy = ops.glossy;
   const LightSampler& lights = ops.lights;
   const uint32_t lightSamples = ops.lightSamples, n = state.n;
-  const std::vector<Light>& sceneLights = scene.lights;
+  // The lights as shot: each at unit emission for a first shot by source (its D_l).
+  std::vector<Light> unitLights;
+  if (sources.unitEmission) {
+    unitLights = scene.lights;
+    for (Light& light : unitLights) setLightEmission(light, Rgb(1.0f));
+  }
+  const std::vector<Light>& sceneLights = sources.unitEmission ? unitLights : scene.lights;
   const ShadowRays& shadows = *ops.shadows;
   // Per scene light: its sun-mask slot, or −1.
   std::vector<int> maskSlot(sceneLights.size());
@@ -1545,18 +1551,77 @@ class ValueExchange {
   double seconds_ = 0.0;
 };
 
+/// sum += weight ⊙ part, elementwise (the one step of combineFirstShot's sums).
+void addWeighted(std::vector<Rgb>& sum, const Rgb& weight, const std::vector<Rgb>& part) {
+  parallelForRange(sum.size(), 4096, [&](uint64_t v0, uint64_t v1) {
+    for (uint64_t v = v0; v < v1; ++v) sum[v] += weight * part[v];
+  });
+}
+
+}  // namespace
+
+std::vector<Rgb> combineFirstShot(const Scene& scene, const std::vector<std::vector<Rgb>>& perLight,
+                                  const std::vector<Rgb>& rest) {
+  uint64_t size = rest.size();
+  for (const std::vector<Rgb>& part : perLight) size = std::max<uint64_t>(size, part.size());
+  std::vector<Rgb> sum(size, Rgb(0.0f));
+  for (size_t l = 0; l < perLight.size() && l < scene.lights.size(); ++l) {
+    const Rgb emission = lightEmission(scene.lights[l]);
+    if (!perLight[l].empty() && !isBlack(emission)) addWeighted(sum, emission, perLight[l]);
+  }
+  if (!rest.empty())
+    parallelForRange(size, 4096, [&](uint64_t v0, uint64_t v1) {
+      for (uint64_t v = v0; v < v1; ++v) sum[v] += rest[v];
+    });
+  return sum;
+}
+
+namespace {
+
 /// The first shot of this rank's tixels: shadow rays, then (the visibility field obtained,
 /// its time returned in waitSeconds) the gathered emission, then the exchange of the direct
-/// values. Returns the visibility field.
+/// values. Returns the visibility field. The shadow rays are shot by source — each scene light
+/// on its own at unit emission (D_l), then the emissive surfaces — and the first shot is
+/// combineFirstShot's sum of the parts, so that it is the same whether or not `bySource` keeps
+/// them (one process keeps them for the .pls; bake/first_shot.h) and the same as a relight's.
 const VisibilityShard& shootFirstShot(TransportState& state, const ShardPlan& plan, int rank,
                                       const std::function<const VisibilityShard&()>& visibility,
-                                      ValueExchange& exchange, double& waitSeconds) {
+                                      ValueExchange& exchange, double& waitSeconds, FirstShotBySource* bySource) {
   const std::vector<TixelRange> own = plan.owned(rank);
   uint64_t ownTixels = 0;
   for (const TixelRange& r : own) ownTixels += r.size();
+  const Scene& scene = state.scene;
+  const uint64_t valueCount = state.param.valueCount;
+  const bool punctual = !state.punctualGlossy.empty();
+  // Σ_l E_l ⊙ D_l and its punctual part, in light order (combineFirstShot's first sum).
+  std::vector<Rgb> lightSum(valueCount, Rgb(0.0f)), punctualSum(punctual ? valueCount : 0, Rgb(0.0f));
   {
-    Progress progress("direct light", ownTixels);
-    for (const TixelRange& r : own) shootShadowRays(state, r.begin, r.end, &progress);
+    Progress progress("direct light", ownTixels * (scene.lights.size() + 1));
+    for (size_t l = 0; l < scene.lights.size(); ++l) {
+      std::vector<Rgb> direct(valueCount, Rgb(0.0f)), punctualPart(punctual ? valueCount : 0, Rgb(0.0f));
+      std::swap(state.direct, direct);
+      std::swap(state.punctualGlossy, punctualPart);
+      ShadowRaySources only;
+      only.lights.assign(scene.lights.size(), 0);
+      only.lights[l] = 1;
+      only.emitters = false;
+      only.unitEmission = true;
+      for (const TixelRange& r : own) shootShadowRays(state, r.begin, r.end, &progress, only);
+      std::swap(state.direct, direct);
+      std::swap(state.punctualGlossy, punctualPart);
+      const Rgb emission = lightEmission(scene.lights[l]);
+      if (!isBlack(emission)) {
+        addWeighted(lightSum, emission, direct);
+        if (punctual) addWeighted(punctualSum, emission, punctualPart);
+      }
+      if (bySource) {
+        bySource->lightDirect.push_back(std::move(direct));
+        if (punctual) bySource->lightPunctual.push_back(std::move(punctualPart));
+      }
+    }
+    ShadowRaySources emitters;
+    emitters.lights.assign(scene.lights.size(), 0);
+    for (const TixelRange& r : own) shootShadowRays(state, r.begin, r.end, &progress, emitters);
   }
   // From here on the visibility field is needed. Time spent obtaining it (waiting for a read
   // that overlapped the shadow rays, or tracing it) is not propagation time.
@@ -1571,6 +1636,13 @@ const VisibilityShard& shootFirstShot(TransportState& state, const ShardPlan& pl
     shootCaustics(state, &progress);
   }
   finishFirstShot(state);
+  // state.direct is D_e now: the first shot is Σ_l E_l ⊙ D_l + D_e.
+  if (bySource) bySource->emitterDirect = state.direct;
+  parallelForRange(valueCount, 4096, [&](uint64_t v0, uint64_t v1) {
+    for (uint64_t v = v0; v < v1; ++v) lightSum[v] += state.direct[v];
+  });
+  state.direct = std::move(lightSum);
+  if (punctual) state.punctualGlossy = std::move(punctualSum);
   exchange.all(state.direct);
   if (!state.punctualGlossy.empty()) exchange.all(state.punctualGlossy);
   return vis;
@@ -1631,7 +1703,7 @@ void iterateOnce(TransportState& state, const VisibilityShard& vis, const ShardP
 /// The iteration, from the first shot (or a checkpoint's iterate: resume.from) to convergence
 /// (StoppingRule) or maxIterations, handing its state to resume.save after every iteration.
 void iterate(TransportState& state, const VisibilityShard& vis, const ShardPlan& plan, int rank, ValueExchange& exchange,
-             const PropagationResume& resume, PropagationResult& result) {
+             const PropagationOptions& resume, PropagationResult& result) {
   const Scene& scene = state.scene;
   const Parameterisation& param = state.param;
   const BakeSettings& settings = state.settings;
@@ -1696,7 +1768,7 @@ void iterateTransport(TransportState& state, const VisibilityShard& vis, float o
 
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const std::function<const VisibilityShard&()>& visibility, const BakeSettings& settings,
-                            Communicator& comm, const ShardPlan& plan, const PropagationResume& resume) {
+                            Communicator& comm, const ShardPlan& plan, const PropagationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   PropagationResult result;
   const uint64_t bytesBefore = comm.bytesReceived();  // the subsurface walks' exchange included
@@ -1716,21 +1788,23 @@ PropagationResult propagate(const Scene& scene, const Accel& accel, const Parame
 
   double waitSeconds = 0.0;
   const VisibilityShard* vis = nullptr;
-  if (resume.from) {
+  if (options.from) {
     // The checkpoint holds the first shot (every rank's: the direct values were exchanged).
     const auto waitStart = std::chrono::steady_clock::now();
     vis = &visibility();
     waitSeconds = secondsSince(waitStart);
-    state.direct = resume.from->direct;
-    state.punctualGlossy = resume.from->punctualGlossy;
-    state.shadowRays = resume.from->progress.shadowRays;
-    state.causticPhotons = resume.from->progress.causticPhotons;
-    state.causticPhotonsLanded = resume.from->progress.causticPhotonsLanded;
+    state.direct = options.from->direct;
+    state.punctualGlossy = options.from->punctualGlossy;
+    state.shadowRays = options.from->progress.shadowRays;
+    state.causticPhotons = options.from->progress.causticPhotons;
+    state.causticPhotonsLanded = options.from->progress.causticPhotonsLanded;
   } else {
-    vis = &shootFirstShot(state, plan, rank, visibility, exchange, waitSeconds);
+    if (options.keepFirstShotBySource) result.firstShotBySource.emplace();
+    vis = &shootFirstShot(state, plan, rank, visibility, exchange, waitSeconds,
+                          result.firstShotBySource ? &*result.firstShotBySource : nullptr);
   }
   result.firstShotSeconds = secondsSince(start) - waitSeconds;
-  iterate(state, *vis, plan, rank, exchange, resume, result);
+  iterate(state, *vis, plan, rank, exchange, options, result);
   finishTransport(state);
 
   result.values = std::move(state.current);

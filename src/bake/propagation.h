@@ -39,6 +39,7 @@
 // It stops when the relative change of the total outgoing power Σ area·(exitant flux density)
 // drops below the tolerance and so does the error this leaves, estimated from the L1 change
 // of the values and its measured rate of convergence (see the .cpp), or at maxIterations.
+#include "bake/first_shot.h"
 #include "bake/parameterisation.h"
 #include "bake/resume.h"
 #include "bake/visibility.h"
@@ -46,6 +47,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace pl {
@@ -55,7 +57,10 @@ class Progress;
 
 struct PropagationResult {
   std::vector<Rgb> values;  ///< in LightField::values layout, emission included for glossy charts
-  std::vector<Rgb> direct;  ///< the first shot (this rank's view after the exchange), for bake/first_shot.h
+  std::vector<Rgb> direct;  ///< the first shot (this rank's view after the exchange)
+  /// The first shot by source (bake/first_shot.h), when PropagationOptions::keepFirstShotBySource
+  /// asked for it and the first shot was shot (not resumed from a checkpoint).
+  std::optional<FirstShotBySource> firstShotBySource;
   uint32_t iterations = 0;
   double residual = 0.0;    ///< relative change of total outgoing power at the last iteration
   double seconds = 0.0;
@@ -96,14 +101,19 @@ struct TransportState;
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const std::function<const VisibilityField&()>& visibility, const BakeSettings& settings);
 
-/// Saving and resuming the iteration (resume.h; docs/design.md, Resuming an interrupted bake).
-struct PropagationResume {
+/// What a propagation keeps and where it starts: saving and resuming the iteration (resume.h;
+/// docs/design.md, Resuming an interrupted bake) and the first shot by source.
+struct PropagationOptions {
   /// Start after this checkpoint's iterations, from its first shot and iterate, instead of
   /// shooting the first shot (the visibility field is still obtained). Null: from the start.
   const PropagationCheckpoint* from = nullptr;
   /// Called after every iteration (the last included) with where the propagation stands and
   /// its state, whose direct, punctualGlossy and current arrays a checkpoint keeps. May be empty.
   std::function<void(const PropagationProgress&, const TransportState&)> save;
+  /// Keep the first shot by source in PropagationResult::firstShotBySource (one process: the
+  /// arrays of this rank's tixels only otherwise). Each scene light's at unit emission and the
+  /// rest's: (lights × 2 + 1) × values × 12 bytes more at most.
+  bool keepFirstShotBySource = false;
 };
 
 /// One rank of a distributed propagation (shard.h): this rank (comm.rank() of plan.ranks)
@@ -115,7 +125,7 @@ struct PropagationResume {
 /// Only rank 0 should show progress bars (Progress::setEnabled).
 PropagationResult propagate(const Scene& scene, const Accel& accel, const Parameterisation& param,
                             const std::function<const VisibilityShard&()>& visibility, const BakeSettings& settings,
-                            Communicator& comm, const ShardPlan& plan, const PropagationResume& resume = {});
+                            Communicator& comm, const ShardPlan& plan, const PropagationOptions& options = {});
 
 /// Batches of whole charts in tixel order, each ≥ 2048 tixels (and at most ~16000 of them):
 /// batch b is tixels [result[b], result[b + 1]).
@@ -168,11 +178,19 @@ struct TransportState {
 };
 
 /// Which sources shootShadowRays shoots: by default every scene light and the emissive
-/// surfaces; relighting (relight.h) shoots each light on its own.
+/// surfaces; the first shot by source (shootFirstShot, relight.h) shoots each light on its own.
 struct ShadowRaySources {
   std::vector<uint8_t> lights;  ///< per scene light, whether it is shot; empty = every one
   bool emitters = true;         ///< the emissive surfaces' light samples
+  bool unitEmission = false;    ///< the lights shot as if their emission were 1 (D_l of relight.h)
 };
+
+/// The first shot from its parts by source: Σ_l E_l ⊙ perLight[l] over the scene lights in
+/// order (E_l = lightEmission; a black light or an empty array adds nothing), then + `rest`
+/// when not empty — the one order of these sums, so that a bake's first shot and a relight's
+/// of the same parts are equal bit for bit.
+std::vector<Rgb> combineFirstShot(const Scene& scene, const std::vector<std::vector<Rgb>>& perLight,
+                                  const std::vector<Rgb>& rest);
 
 /// First shot, shadow rays: the scene's lights and emissive surfaces seen from
 /// tixels [begin, end) are added to state.direct. Needs no visibility field. Advances

@@ -284,21 +284,12 @@ struct Relighter::Impl {
 
   /// D_l: light l's first shot at unit emission.
   void shootLight(uint32_t l) {
-    const Light saved = scene.lights[l];
-    pl::setLightEmission(scene.lights[l], Rgb(1.0f));
     ShadowRaySources sources;
     sources.lights.assign(scene.lights.size(), 0);
     sources.lights[l] = 1;
     sources.emitters = false;
-    std::pair<Values, Values> shot;
-    try {
-      shot = shoot(sources);
-    } catch (...) {
-      scene.lights[l] = saved;
-      throw;
-    }
-    auto& [direct, punctual] = shot;
-    scene.lights[l] = saved;
+    sources.unitEmission = true;
+    auto [direct, punctual] = shoot(sources);
     lightDirect[l] = std::move(direct);
     lightPunctual[l] = std::move(punctual);
   }
@@ -320,17 +311,11 @@ struct Relighter::Impl {
 
   /// Σ_l E_l ⊙ perLight[l] (+ `rest` when not empty), with the scene's current emissions.
   Values combine(const std::vector<Values>& perLight, const Values& rest) const {
-    Values out = rest.empty() ? Values(param.valueCount, Rgb(0.0f)) : rest;
-    std::vector<Rgb> emission;
-    for (const Light& light : scene.lights) emission.push_back(lightEmission(light));
-    parallelForRange(param.valueCount, 4096, [&](uint64_t v0, uint64_t v1) {
-      for (size_t l = 0; l < perLight.size(); ++l) {
-        if (perLight[l].empty() || isBlack(emission[l])) continue;
-        for (uint64_t v = v0; v < v1; ++v) out[v] += emission[l] * perLight[l][v];
-      }
-    });
+    Values out = combineFirstShot(scene, perLight, rest);
+    if (out.empty()) out.assign(param.valueCount, Rgb(0.0f));
     return out;
   }
+
 
   /// The iterate behind stored values (finishValues and removeSunMaskedDirect undone): the
   /// masked lights' first shot back on diffuse tixels, the glossy emission out, the punctual

@@ -163,7 +163,7 @@ TEST_F(ResumeTest, PropagationResumesFromACheckpoint) {
   const std::string file = path("box.plv.checkpoint");
   const uint64_t key = propagationKey(vis.field.hash, scene_, settings_);
   constexpr uint32_t kStopAfter = 2;
-  PropagationResume saving;
+  PropagationOptions saving;
   uint32_t saves = 0;
   saving.save = [&](const PropagationProgress& at, const TransportState& state) {
     ++saves;
@@ -182,7 +182,7 @@ TEST_F(ResumeTest, PropagationResumesFromACheckpoint) {
   ASSERT_TRUE(readPropagationCheckpoint(file, key, param_.valueCount, checkpoint, &why)) << why;
   EXPECT_EQ(checkpoint.progress.iterations, kStopAfter);
   EXPECT_FALSE(checkpoint.progress.converged);
-  PropagationResume resuming;
+  PropagationOptions resuming;
   resuming.from = &checkpoint;
   const PropagationResult resumed = propagate(scene_, accel_, param_, field, settings_, single, plan, resuming);
   EXPECT_EQ(resumed.iterations, full.iterations);
