@@ -256,9 +256,14 @@ void transformLight(Light& light, const Mat4& m) {
 }
 
 void normaliseLightDirections(Light& light) {
+  // A direction already unit to float precision (|d|² within 1e-6 of 1, as normalize leaves
+  // it) is kept bit for bit: normalising it again may move its last bits, so a scene finalized
+  // twice (a light field's, read and finalized by a relighter) would no longer be the scene
+  // that was baked (the .pls and .plt keys hash these bits).
   visitLightParameters(light, [](const char*, LightParameterKind kind, auto& field) {
     if constexpr (std::is_same_v<std::decay_t<decltype(field)>, Vec3>)
-      if (kind == LightParameterKind::Direction) field = glm::normalize(field);
+      if (kind == LightParameterKind::Direction && !(std::abs(glm::dot(field, field) - 1.0f) <= 1e-6f))
+        field = glm::normalize(field);
   });
   prepareLight(light);
 }

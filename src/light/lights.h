@@ -240,7 +240,8 @@ std::string lightProblem(const Light& light);
 /// Moves a light by the affine transform m: positions by m, directions by its linear part,
 /// lengths by the cube root of its |determinant| (exact for uniform scales).
 void transformLight(Light& light, const Mat4& m);
-/// Normalises every direction (Scene::finalize, after lightProblem found none zero).
+/// Normalises every direction (Scene::finalize, after lightProblem found none zero); one unit
+/// already to float precision is kept bit for bit, so that finalizing twice changes nothing.
 void normaliseLightDirections(Light& light);
 /// The light's Emission parameter (its intensity or irradiance), its name, and setting it.
 Rgb lightEmission(const Light& light);

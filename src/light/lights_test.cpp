@@ -109,6 +109,22 @@ TEST_F(LightsJson, EveryTypeLoadsFromAJsonScene) {
   }
 }
 
+// Finalizing twice changes no bit of a light: a light field's scene, read back and finalized
+// again (a relighter's), must still be the scene that was baked, whose lights the .pls and
+// .plt keys hash. Directions far from unit (here 1.07 and 3.1 long) are normalised once.
+TEST(Lights, NormalisingTwiceKeepsEveryBit) {
+  for (const Vec3 direction : {Vec3(0.25f, -1.0f, 0.3f), Vec3(-1.7f, 2.3f, 1.3f), Vec3(0.0f, -1.0f, 0.0f)}) {
+    Light once = createLight("directional", {{"direction", direction}, {"irradiance", 3.0f}}, "test");
+    normaliseLightDirections(once);
+    Light twice = once;
+    normaliseLightDirections(twice);
+    EXPECT_EQ(lightParameterFloats(once), lightParameterFloats(twice));
+    const Vec3 unit = std::get<DirectionalLight>(once).direction;
+    EXPECT_NEAR(glm::length(unit), 1.0f, 1e-6f);
+    EXPECT_NEAR(glm::dot(unit, glm::normalize(direction)), 1.0f, 1e-6f);
+  }
+}
+
 // A transform moves positions, turns directions and scales lengths, by the kind of each
 // parameter.
 TEST(Lights, TransformsMoveEachParameterByItsKind) {
