@@ -156,8 +156,6 @@ TEST_F(FirstShotTest, ABakeWithASunAndEachWarmStartLeaveTheFirstShotOfTheirScene
   options.log = [&](const std::string& line) { notes += line + "\n"; };
   writeLightField(path("prev.plf"), bake(sunScene(sunAt(40.0f, 20.0f)), settings, options));
   ASSERT_TRUE(std::filesystem::exists(path("prev.pls"))) << notes;
-  const std::string baked = path("baked.pls");
-  std::filesystem::copy_file(path("prev.pls"), baked);
   auto warm = [&](Scene edited) {
     notes.clear();
     edited.finalize();

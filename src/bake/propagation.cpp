@@ -931,9 +931,14 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
   }
   const std::vector<Light>& sceneLights = sources.unitEmission ? unitLights : scene.lights;
   const ShadowRays& shadows = *ops.shadows;
-  // Per scene light: its sun-mask slot, or −1.
+  // Per scene light: its sun-mask slot, or −1. And the lights shot (a first shot by source
+  // runs once per light: each pass loops over its own light only).
   std::vector<int> maskSlot(sceneLights.size());
-  for (size_t li = 0; li < sceneLights.size(); ++li) maskSlot[li] = sunMaskSlot(param, uint32_t(li));
+  std::vector<uint32_t> shotLights;
+  for (size_t li = 0; li < sceneLights.size(); ++li) {
+    maskSlot[li] = sunMaskSlot(param, uint32_t(li));
+    if (sources.lights.empty() || sources.lights[li]) shotLights.push_back(uint32_t(li));
+  }
   std::vector<Rgb>& direct = state.direct;
   std::vector<Rgb>& punctualGlossy = state.punctualGlossy;
   std::atomic<uint64_t>& shadowRays = state.shadowRays;
@@ -954,7 +959,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
     std::vector<Pending> seen;     // visibility already known (shadow rays through thin glass)
     uint64_t glassRays = 0;
     // At most one ray per delta light and area-light sample per tixel.
-    rays.reserve((t1 - t0) * (scene.lights.size() + lightSamples));
+    rays.reserve((t1 - t0) * (shotLights.size() + lightSamples));
     pending.reserve(rays.capacity());
     for (uint64_t g = t0; g < t1; ++g) {
       const Chart& c = param.charts[param.tixelChart[g]];
@@ -964,8 +969,7 @@ void shootShadowRays(TransportState& state, uint64_t begin, uint64_t end, Progre
       // Rough glass takes light from both sides: reflected from its own, transmitted from
       // the other (|cos θ|; the BSDF chooses, see the Pending loop below).
       const bool bothSides = isRoughGlassChart(c, scene.materials[c.material].bsdf);
-      for (size_t li = 0; li < sceneLights.size(); ++li) {
-        if (!sources.lights.empty() && !sources.lights[li]) continue;
+      for (const uint32_t li : shotLights) {
         const Light& light = sceneLights[li];
         // A masked light on a diffuse tixel: its footprint's mean visibility, no ray
         // (lightfield.h "Sun masks"; sunMaskedIrradiance, which the bake takes back out).
