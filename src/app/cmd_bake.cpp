@@ -141,8 +141,8 @@ void addBakeCommand(CLI::App& app, const GlobalOptions& global) {
   command
       ->add_option_function<std::string>(
           "--visibility-precision", [options](const std::string& s) { options->exactVisibility = s == "exact"; },
-          "The visibility field's bilinear fractions: compact (4 bits each: half the memory, light field within "
-          "relMSE 1e-9) or exact (16 bits, as traced; see docs/user-guide.md): compact|exact")
+          "The visibility field's bilinear fractions: compact (2 bits each: under half the memory, light field "
+          "within relMSE 1e-6) or exact (16 bits, as traced; see docs/user-guide.md): compact|exact")
       ->check(CLI::IsMember({"compact", "exact"}))
       ->default_str("compact");
   command->callback([options, &global] { runBakeCommand(*options, global); });

@@ -203,8 +203,8 @@ TEST_F(BakeCli, InfoShowsAVisibilityFieldsBytesPerEntry) {
   ASSERT_EQ(run("bake cornell -o \"" + path("v.plf") + "\" --preset draft --tixels-across 8 --directions 16 --quiet", &out, &err), 0)
       << err;
   ASSERT_EQ(run("info \"" + plv + "\"", &out, &err), 0) << err;
-  EXPECT_NE(out.find("plenoptic visibility field, format version 5"), std::string::npos) << out;
-  EXPECT_NE(out.find("fractions    4 bits each (compact, quantised)"), std::string::npos) << out;
+  EXPECT_NE(out.find("plenoptic visibility field, format version 6"), std::string::npos) << out;
+  EXPECT_NE(out.find("fractions    2 bits each (compact, quantised)"), std::string::npos) << out;
   EXPECT_NE(out.find("× 16 gather directions"), std::string::npos) << out;
   EXPECT_NE(out.find(" bytes per entry; the encoded entries alone "), std::string::npos) << out;
   ASSERT_EQ(run("info --json \"" + plv + "\"", &out, &err), 0) << err;
@@ -213,7 +213,7 @@ TEST_F(BakeCli, InfoShowsAVisibilityFieldsBytesPerEntry) {
   EXPECT_GT(j["memory_bytes_per_entry"].get<double>(), 0.25);  // at least the tags
   EXPECT_LT(j["memory_bytes_per_entry"].get<double>(), 8.0);
   EXPECT_EQ(j["entries"].get<uint64_t>(), j["tixels"].get<uint64_t>() * 16);
-  EXPECT_EQ(j["fraction_bits"], 4);  // the default, compact
+  EXPECT_EQ(j["fraction_bits"], 2);  // the default, compact
   // An older version is named as such; damage is an error naming the file.
   std::string bytes;
   {
@@ -226,7 +226,7 @@ TEST_F(BakeCli, InfoShowsAVisibilityFieldsBytesPerEntry) {
     o << bytes;
   }
   ASSERT_EQ(run("info \"" + path("old.plv") + "\"", &out, &err), 0) << err;
-  EXPECT_NE(out.find("format       older than this program's version 5: a bake traces the field again"), std::string::npos)
+  EXPECT_NE(out.find("format       older than this program's version 6: a bake traces the field again"), std::string::npos)
       << out;
   fs::resize_file(plv, fs::file_size(plv) - 3);
   EXPECT_EQ(run("info \"" + plv + "\"", &out, &err), 1);

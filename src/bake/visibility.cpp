@@ -271,24 +271,14 @@ void VisibilityShard::forEachSpan(uint64_t begin, uint64_t end, uint64_t grain,
   });
 }
 
-const VisibilityEntry* EntryReader::streamedEntries(uint64_t g, VisibilityEntry* scratch) {
+const VisibilityEntry* EntryReader::streamedEntries(uint64_t g, VisibilityEntry*) {
   const VisibilityBlockFile& file = *vis_.field.stream;
   const uint64_t t = vis_.local(g), perBlock = file.perBlock(), b = t / perBlock;
   if (b != block_) {
-    file.read(b, frame_, content_);
-    const uint64_t tixels = std::min(vis_.field.tixelCount - b * perBlock, perBlock);
-    // The block's content: the tixels' encoded sizes (u32), then the encodings.
-    offset_.resize(tixels + 1);
-    offset_[0] = tixels * sizeof(uint32_t);
-    for (uint64_t i = 0; i < tixels; ++i) {
-      uint32_t size;
-      std::memcpy(&size, content_.data() + i * sizeof(uint32_t), sizeof(uint32_t));
-      offset_[i + 1] = offset_[i] + size;
-    }
+    file.readEntries(b, frame_, stream_, entries_);
     block_ = b;
   }
-  decodeTixelEntries<false>(content_.data() + offset_[t - b * perBlock], 0, vis_.field.directionsPerTixel(), scratch);
-  return scratch;
+  return entries_.data() + (t - b * perBlock) * vis_.field.directionsPerTixel();
 }
 
 bool VisibilityShard::holds(uint64_t begin, uint64_t end) const {
@@ -361,7 +351,7 @@ class StreamedFieldSink {
     // Compressed outside the lock; the writer puts the frames in order.
     for (const Block& b : ready) {
       uint64_t contentBytes = 0;
-      std::vector<unsigned char> frame = VisibilityWriter::frameBlock(b.tixelBytes, b.encoded, &contentBytes);
+      std::vector<unsigned char> frame = VisibilityWriter::frameBlock(b.tixelBytes, b.encoded, writer_.directionsPerTixel(), &contentBytes);
       writer_.put(b.index, std::move(frame), contentBytes);
     }
   }

@@ -98,13 +98,13 @@ struct VisibilityShard {
 
 /// A task's reader of a shard's entries, tixel by tixel (not shared between threads): a held
 /// field's are decoded from memory (VisibilityShard::entries); a streamed field's from the
-/// entry block of its .plv that holds the tixel, which the reader keeps (one block: the
-/// frame as read and its content) until a tixel of another block is asked for. The entries are
-/// the same either way.
+/// entry block of its .plv that holds the tixel, which the reader decodes whole and keeps
+/// until a tixel of another block is asked for. The entries are the same either way.
 class EntryReader {
  public:
   explicit EntryReader(const VisibilityShard& vis) : vis_(vis) {}
-  /// Held tixel g's N entries, in `scratch` (room for N) or where the field holds them decoded.
+  /// Held tixel g's N entries, in `scratch` (room for N) or where the field or the reader holds
+  /// them decoded.
   const VisibilityEntry* entries(uint64_t g, VisibilityEntry* scratch) {
     if (!vis_.field.stream) return vis_.entries(g, scratch);
     return streamedEntries(g, scratch);
@@ -113,9 +113,9 @@ class EntryReader {
  private:
   const VisibilityEntry* streamedEntries(uint64_t g, VisibilityEntry* scratch);
   const VisibilityShard& vis_;
-  uint64_t block_ = ~uint64_t(0);  ///< the block in content_
-  std::vector<unsigned char> frame_, content_;
-  std::vector<uint64_t> offset_;  ///< per tixel of the block + 1: where its encoding starts in content_
+  uint64_t block_ = ~uint64_t(0);  ///< the block in entries_
+  std::vector<unsigned char> frame_, stream_;  ///< the block's stored frame, and its streams
+  std::vector<VisibilityEntry> entries_;       ///< the block's entries, tixel-major
 };
 
 /// The hash a shard's .plv carries: the whole field's (visibilityHash) for one range holding

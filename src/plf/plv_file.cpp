@@ -42,13 +42,226 @@ uint64_t tixelsPerBlock(uint32_t directionsPerTixel) {
   return std::max<uint64_t>(1, kBlockEntryBytes / (uint64_t(directionsPerTixel) * sizeof(VisibilityEntry)));
 }
 
-/// The stored frame of an entry block's content, and back: the one place the entry blocks'
-/// frames are made and read.
-std::vector<unsigned char> compressEntryBlock(std::span<const unsigned char> content) {
-  return detail::zstdCompress(content, kPlvZstdLevel);
+// ---- Stored entry blocks ------------------------------------------------------------------
+// A block's entries in byte streams, each its own zstd frame (layout in plv_file.h): the one
+// place the entry blocks' frames are made and read.
+
+enum PlvStream : uint32_t { kOpsStream, kNearStream, kFarLowStream, kFarHighStream, kTargetsStream, kFractionsStream };
+static_assert(kFractionsStream + 1 == kPlvStreams);
+constexpr uint8_t kOpEscape = 0, kOpNear = 1, kOpFar = 2, kOpGeneral = 3;
+constexpr uint32_t kFlagBits = VisibilityEntry::kBackSide | VisibilityEntry::kHasExtra;
+/// Bytes of a stored block's header: the bits byte, then the raw and stored sizes (u32 each).
+constexpr uint64_t kBlockHeaderBytes = 1 + 2 * kPlvStreams * sizeof(uint32_t);
+/// Zero bytes after each decompressed stream, so that the decoder may read a whole word.
+constexpr uint64_t kStreamPadding = 8;
+
+/// Bytes of an entry's fractions in the fractions stream at `bits` per fraction.
+constexpr uint32_t storedFractionBytes(uint32_t bits) { return bits == kExactFractionBits ? 4 : (2 * bits + 7) / 8; }
+
+/// The stored frame of `tixels` tixels' entries (n each, tixel-major) at `bits` per fraction.
+std::vector<unsigned char> encodeEntryBlock(const VisibilityEntry* entries, uint64_t tixels, uint32_t n, uint32_t bits) {
+  const uint64_t count = tixels * n;
+  const bool exact = bits == kExactFractionBits;
+  const uint32_t fractionBytes = storedFractionBytes(bits);
+  std::array<std::vector<unsigned char>, kPlvStreams> streams;
+  streams[kOpsStream].resize(count);
+  streams[kNearStream].reserve(count);
+  streams[kFractionsStream].reserve(count * fractionBytes);
+  auto put = [](std::vector<unsigned char>& stream, uint64_t value, uint32_t bytes) {
+    const size_t at = stream.size();
+    stream.resize(at + bytes);
+    std::memcpy(stream.data() + at, &value, bytes);  // little-endian, as the whole format
+  };
+  for (uint64_t t = 0; t < tixels; ++t) {
+    int64_t previous = 0;  // index of the tixel's last entry that saw a tixel
+    for (uint32_t k = 0; k < n; ++k) {
+      const VisibilityEntry& e = entries[t * n + k];
+      const uint64_t fractions = exact ? uint64_t(e.fu) | uint64_t(e.fv) << 16
+                                       : quantiseFraction(e.fu, bits) | uint64_t(quantiseFraction(e.fv, bits)) << bits;
+      uint8_t op = kOpEscape;
+      if (e.target != VisibilityEntry::kEscape || fractions != 0) {
+        const int64_t index = e.tixel(), delta = index - previous;
+        const bool plain = (e.target & kFlagBits) == 0 && !e.escaped();
+        if (plain && delta >= INT8_MIN && delta <= INT8_MAX) {
+          op = kOpNear;
+          streams[kNearStream].push_back(uint8_t(delta));
+        } else if (plain && delta >= INT16_MIN && delta <= INT16_MAX) {
+          op = kOpFar;
+          streams[kFarLowStream].push_back(uint8_t(delta));
+          streams[kFarHighStream].push_back(uint8_t(uint64_t(delta) >> 8));
+        } else {
+          op = kOpGeneral;
+          put(streams[kTargetsStream], e.target, 4);
+        }
+        put(streams[kFractionsStream], fractions, fractionBytes);
+        if (!e.escaped()) previous = index;
+      }
+      streams[kOpsStream][t * n + k] = op;
+    }
+  }
+  std::array<std::vector<unsigned char>, kPlvStreams> frames;
+  uint64_t total = kBlockHeaderBytes;
+  for (uint32_t i = 0; i < kPlvStreams; ++i) {
+    if (!streams[i].empty()) frames[i] = detail::zstdCompress(streams[i], kPlvZstdLevel);
+    total += frames[i].size();
+  }
+  std::vector<unsigned char> stored(total);
+  stored[0] = uint8_t(bits);
+  unsigned char* at = stored.data() + 1;
+  for (uint32_t i = 0; i < kPlvStreams; ++i, at += 4) {
+    const uint32_t raw = uint32_t(streams[i].size());
+    std::memcpy(at, &raw, 4);
+  }
+  for (uint32_t i = 0; i < kPlvStreams; ++i, at += 4) {
+    const uint32_t size = uint32_t(frames[i].size());
+    std::memcpy(at, &size, 4);
+  }
+  for (uint32_t i = 0; i < kPlvStreams; ++i) {
+    if (!frames[i].empty()) std::memcpy(at, frames[i].data(), frames[i].size());
+    at += frames[i].size();
+  }
+  return stored;
 }
-void decompressEntryBlock(std::span<const unsigned char> frame, std::span<unsigned char> content, const std::string& context) {
-  detail::zstdDecompressInto(frame, content, context);
+
+/// A stored entry block's header, checked against its tixels' entry count: the bits per
+/// fraction, each stream's raw bytes and where its frame lies in the block. Fails naming
+/// `context` on a block that cannot be one of `count` entries.
+struct EntryBlockHeader {
+  uint32_t bits = 0;
+  std::array<uint64_t, kPlvStreams> rawSizes{}, frameOffset{}, frameSizes{};
+};
+EntryBlockHeader readEntryBlockHeader(std::span<const unsigned char> stored, uint64_t count, const std::string& context) {
+  if (stored.size() < kBlockHeaderBytes) fail("{}: corrupt entry block: {} bytes, shorter than its header", context, stored.size());
+  EntryBlockHeader h;
+  h.bits = stored[0];
+  if (!validFractionBits(h.bits)) fail("{}: corrupt entry block: {} bits per fraction (1 to 8, or 16)", context, h.bits);
+  uint64_t offset = kBlockHeaderBytes;
+  for (uint32_t i = 0; i < kPlvStreams; ++i) {
+    uint32_t raw, size;
+    std::memcpy(&raw, stored.data() + 1 + 4 * i, 4);
+    std::memcpy(&size, stored.data() + 1 + 4 * (kPlvStreams + i), 4);
+    // Each stream holds at most one item per entry: 1 byte (ops, deltas), 4 (targets, fractions).
+    const uint64_t most = count * (i == kTargetsStream || i == kFractionsStream ? 4 : 1);
+    if (raw > most || (i == kOpsStream && raw != count) || (raw == 0) != (size == 0) || size > stored.size() - offset)
+      fail("{}: corrupt entry block: stream {} declares {} bytes in a frame of {} (the block holds {} entries in {} bytes)",
+           context, i, raw, size, count, stored.size());
+    h.rawSizes[i] = raw;
+    h.frameOffset[i] = offset;
+    h.frameSizes[i] = size;
+    offset += size;
+  }
+  if (offset != stored.size()) fail("{}: corrupt entry block: {} bytes after its streams", context, stored.size() - offset);
+  return h;
+}
+
+/// Checks a stored entry block of `count` entries without decoding it (its header and that each
+/// stream's frame declares its size).
+void checkEntryBlock(std::span<const unsigned char> stored, uint64_t count, const std::string& context) {
+  const EntryBlockHeader h = readEntryBlockHeader(stored, count, context);
+  for (uint32_t i = 0; i < kPlvStreams; ++i)
+    if (h.frameSizes[i] > 0)
+      detail::zstdCheckFrame(stored.subspan(h.frameOffset[i], h.frameSizes[i]), h.rawSizes[i],
+                             fmt::format("{} stream {}", context, i));
+}
+
+/// Decodes a stored entry block of `tixels` tixels of n entries into out (tixels · n entries,
+/// tixel-major), `scratch` holding its streams; returns its bits per fraction. Checked: fails
+/// naming `context` on any block the writer cannot have made (stream sizes that disagree with
+/// the ops, an op above 3, an index outside [0, kEscape), fraction bits the writer leaves 0).
+uint32_t decodeEntryBlock(std::span<const unsigned char> stored, uint64_t tixels, uint32_t n,
+                          std::vector<unsigned char>& scratch, VisibilityEntry* out, const std::string& context) {
+  const uint64_t count = tixels * n;
+  const EntryBlockHeader h = readEntryBlockHeader(stored, count, context);
+  std::array<const unsigned char*, kPlvStreams> stream{};
+  uint64_t scratchBytes = 0;
+  for (uint32_t i = 0; i < kPlvStreams; ++i) scratchBytes += h.rawSizes[i] + kStreamPadding;
+  scratch.resize(scratchBytes);
+  for (uint64_t i = 0, at = 0; i < kPlvStreams; ++i) {
+    unsigned char* into = scratch.data() + at;
+    if (h.frameSizes[i] > 0)
+      detail::zstdDecompressInto(stored.subspan(h.frameOffset[i], h.frameSizes[i]), {into, h.rawSizes[i]},
+                                 fmt::format("{} stream {}", context, i));
+    std::memset(into + h.rawSizes[i], 0, kStreamPadding);
+    stream[i] = into;
+    at += h.rawSizes[i] + kStreamPadding;
+  }
+  // The ops say how many items each other stream must hold: checked first, so that the loops
+  // below read within the streams without a check per entry.
+  const unsigned char* const op = stream[kOpsStream];
+  uint64_t invalid = 0, nears = 0, fars = 0, generals = 0;
+  for (uint64_t i = 0; i < count; ++i) {  // branch-free, so that it vectorises
+    const uint8_t o = op[i];
+    invalid += o > kOpGeneral;
+    nears += o == kOpNear;
+    fars += o == kOpFar;
+    generals += o == kOpGeneral;
+  }
+  if (invalid > 0) {
+    const uint64_t i = uint64_t(std::find_if(op, op + count, [](uint8_t o) { return o > kOpGeneral; }) - op);
+    fail("{}: corrupt entry block: op {} of entry {}", context, op[i], i);
+  }
+  const uint32_t bits = h.bits, fractionBytes = storedFractionBytes(bits);
+  if (h.rawSizes[kNearStream] != nears || h.rawSizes[kFarLowStream] != fars || h.rawSizes[kFarHighStream] != fars ||
+      h.rawSizes[kTargetsStream] != 4 * generals || h.rawSizes[kFractionsStream] != uint64_t(fractionBytes) * (nears + fars + generals))
+    fail("{}: corrupt entry block: its streams' sizes disagree with its ops", context);
+  const unsigned char *near = stream[kNearStream], *farLow = stream[kFarLowStream], *farHigh = stream[kFarHighStream];
+  const unsigned char *targets = stream[kTargetsStream], *fractions = stream[kFractionsStream];
+  const bool exact = bits == kExactFractionBits;
+  const uint64_t fractionMask = (uint64_t(1) << (8 * fractionBytes)) - 1;
+  // Bits of the stored fractions the writer leaves 0 (none for exact ones).
+  const uint64_t unusedBits = exact ? 0 : fractionMask & ~((uint64_t(1) << (2 * bits)) - 1);
+  // Both fractions' 16-bit values (fu | fv << 16) per stored fractions byte, for F ≤ 4: one load.
+  std::array<uint32_t, 256> pairs{};
+  if (fractionBytes == 1)
+    for (uint32_t q = 0; q < (1u << (2 * bits)); ++q)
+      pairs[q] = uint32_t(kFractionLevels[bits][q & ((1u << bits) - 1)]) | uint32_t(kFractionLevels[bits][q >> bits]) << 16;
+  auto levelsOf = [&](uint64_t f) -> uint64_t {  // fu | fv << 16
+    if (fractionBytes == 1) return pairs[f & 0xff];
+    if (exact) return f;
+    const uint64_t mask = (uint64_t(1) << bits) - 1;
+    return uint64_t(kFractionLevels[bits][f & mask]) | uint64_t(kFractionLevels[bits][(f >> bits) & mask]) << 16;
+  };
+  for (uint64_t t = 0; t < tixels; ++t) {
+    int64_t previous = 0;
+    uint64_t bad = 0;
+    for (uint64_t i = t * n; i < (t + 1) * n; ++i) {
+      const uint8_t o = op[i];
+      uint64_t f;
+      std::memcpy(&f, fractions, 8);
+      f &= fractionMask;
+      if (o == kOpGeneral) [[unlikely]] {
+        uint32_t target;
+        std::memcpy(&target, targets, 4);
+        targets += 4;
+        fractions += fractionBytes;
+        bad |= f & unusedBits;
+        VisibilityEntry e;
+        e.target = target;
+        const uint64_t levels = levelsOf(f);
+        e.fu = uint16_t(levels);
+        e.fv = uint16_t(levels >> 16);
+        if (!e.escaped()) previous = e.tixel();
+        out[i] = e;
+        continue;
+      }
+      // An escape, a near or a far hit, without branches (their mix is unpredictable): each
+      // stream's cursor moves by the entry's share of it, a mask selects the delta.
+      const uint64_t isNear = 0 - uint64_t(o == kOpNear), isFar = 0 - uint64_t(o == kOpFar), hit = isNear | isFar;
+      const int64_t nearDelta = int8_t(*near), farDelta = int16_t(uint16_t(*farLow) | uint16_t(*farHigh) << 8);
+      previous += int64_t((uint64_t(nearDelta) & isNear) | (uint64_t(farDelta) & isFar));
+      near += isNear & 1;
+      farLow += isFar & 1;
+      farHigh += isFar & 1;
+      fractions += fractionBytes & hit;
+      bad |= hit & ((uint64_t(previous) >= uint64_t(VisibilityEntry::kEscape)) | (f & unusedBits));
+      // The entry as one 8-byte word (target, then fu and fv: little-endian, one store).
+      const uint64_t packed = ((uint64_t(uint32_t(previous)) | (levelsOf(f) << 32)) & hit) |
+                              (uint64_t(VisibilityEntry::kEscape) & ~hit);
+      std::memcpy(static_cast<void*>(&out[i]), &packed, 8);
+    }
+    if (bad != 0) fail("{}: corrupt entry block: the entries of its tixel {} do not decode", context, t);
+  }
+  return bits;
 }
 
 }  // namespace
@@ -56,12 +269,14 @@ void decompressEntryBlock(std::span<const unsigned char> frame, std::span<unsign
 uint64_t visibilityBlockTixels(uint32_t directionsPerTixel) { return tixelsPerBlock(directionsPerTixel); }
 
 uint64_t visibilityWriteBufferBytes(uint32_t gridSide) {
-  // Per block of a batch: its compressed frame (at most the content plus zstd's small bound,
-  // counted as the content twice) while a worker also holds the content; the content is at most
-  // the sizes and the encoded entries, which take fewer than 8 bytes per entry.
+  // Per block of a batch: its content (the sizes and the encoded entries, fewer than 8 bytes
+  // per entry), counted three times as before the streams, and while it is framed its entries
+  // decoded (8 bytes each) and its streams (at most 12 bytes per entry: an op, a delta's bytes,
+  // a target and fractions) twice, raw and compressed.
   const uint32_t n = gridSide * gridSide;
   const uint64_t blockBytes = tixelsPerBlock(n) * (sizeof(uint32_t) + maxEncodedTixelBytes(n));
-  return kWriteBatchBlocks * 3 * blockBytes;
+  const uint64_t blockEntries = tixelsPerBlock(n) * n;
+  return kWriteBatchBlocks * (3 * blockBytes + blockEntries * (sizeof(VisibilityEntry) + 2 * 12));
 }
 
 struct VisibilityWriter::Impl {
@@ -89,6 +304,8 @@ VisibilityWriter::VisibilityWriter(const std::string& path, uint32_t gridSide, u
     : impl_(std::make_unique<Impl>(path)) {
   const uint32_t n = gridSide * gridSide;
   frames_.perBlock = tixelsPerBlock(n);
+  frames_.tixelCount = tixelCount;
+  frames_.directionsPerTixel = n;
   frames_.blocks = (tixelCount + frames_.perBlock - 1) / frames_.perBlock;
   frames_.frameOffset.assign(frames_.blocks + 1, 0);
   frames_.frameSizes.assign(frames_.blocks + 1, 0);
@@ -113,12 +330,26 @@ VisibilityWriter::VisibilityWriter(const std::string& path, uint32_t gridSide, u
 VisibilityWriter::~VisibilityWriter() = default;
 
 std::vector<unsigned char> VisibilityWriter::frameBlock(std::span<const uint32_t> tixelBytes,
-                                                        std::span<const unsigned char> encoded, uint64_t* contentBytes) {
-  std::vector<unsigned char> content(tixelBytes.size() * sizeof(uint32_t) + encoded.size());
-  if (!tixelBytes.empty()) std::memcpy(content.data(), tixelBytes.data(), tixelBytes.size() * sizeof(uint32_t));
-  if (!encoded.empty()) std::memcpy(content.data() + tixelBytes.size() * sizeof(uint32_t), encoded.data(), encoded.size());
-  if (contentBytes) *contentBytes = content.size();
-  return compressEntryBlock(content);
+                                                        std::span<const unsigned char> encoded, uint32_t directionsPerTixel,
+                                                        uint64_t* contentBytes) {
+  const uint64_t tixels = tixelBytes.size(), n = directionsPerTixel;
+  // The tixels' entries, decoded (checked: they are this program's own encodings, so a failure
+  // is a bug, not a damaged file), then stored in streams.
+  std::vector<VisibilityEntry> entries(tixels * n);
+  uint32_t bits = 0;
+  uint64_t used = 0;
+  for (uint64_t t = 0; t < tixels; ++t) {
+    const uint32_t size = tixelBytes[t];
+    if (size > encoded.size() - used || size == 0 ||
+        decodeTixelEntries<true>(encoded.data() + used, size, uint32_t(n), entries.data() + t * n) != size)
+      fail("visibility field: the encoding of tixel {} of a block does not decode", t);
+    if (t > 0 && encoded[used] != bits) fail("visibility field: tixels of one block with {} and {} bits per fraction", bits, encoded[used]);
+    bits = encoded[used];
+    used += size;
+  }
+  if (used != encoded.size()) fail("visibility field: {} bytes after a block's tixels", encoded.size() - used);
+  if (contentBytes) *contentBytes = tixels * sizeof(uint32_t) + encoded.size();
+  return encodeEntryBlock(entries.data(), tixels, uint32_t(n), tixels > 0 ? bits : kCompactFractionBits);
 }
 
 void VisibilityWriter::put(uint64_t b, std::vector<unsigned char> frame, uint64_t contentBytes) {
@@ -192,7 +423,7 @@ void writeVisibility(const std::string& path, const VisibilityField& field) {
       for (uint64_t t = t0; t < t1; ++t) sizes[t - t0] = uint32_t(field.entryOffset[t + 1] - field.entryOffset[t]);
       frames[i] = VisibilityWriter::frameBlock(
           sizes, {field.entryBytes.data() + field.entryOffset[t0], field.entryOffset[t1] - field.entryOffset[t0]},
-          &contentBytes[i]);
+          field.directionsPerTixel(), &contentBytes[i]);
     });
     for (uint64_t i = 0; i < b1 - b0; ++i) writer.put(b0 + i, std::move(frames[i]), contentBytes[i]);
     progress.advance(b1 - b0);
@@ -210,7 +441,8 @@ VisibilityBlockFile::~VisibilityBlockFile() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-void VisibilityBlockFile::read(uint64_t b, std::vector<unsigned char>& frame, std::vector<unsigned char>& content) const {
+void VisibilityBlockFile::readEntries(uint64_t b, std::vector<unsigned char>& frame, std::vector<unsigned char>& stream,
+                                      std::vector<VisibilityEntry>& entries) const {
   if (b >= frames_.blocks) fail("{}: visibility block {} of {}", path_, b, frames_.blocks);
   frame.resize(frames_.frameSizes[b]);
   for (uint64_t done = 0; done < frame.size();) {
@@ -220,10 +452,10 @@ void VisibilityBlockFile::read(uint64_t b, std::vector<unsigned char>& frame, st
       fail("{}: cannot read visibility block {}: {}", path_, b, got < 0 ? std::strerror(errno) : "the file is truncated");
     done += uint64_t(got);
   }
-  const uint64_t size = frames_.contentSizes[b];
-  content.resize(size + kEntryBytesPadding);
-  std::memset(content.data() + size, 0, kEntryBytesPadding);
-  decompressEntryBlock(frame, {content.data(), size}, fmt::format("{}: visibility block {}", path_, b));
+  const uint64_t tixels = std::min(frames_.tixelCount - b * frames_.perBlock, frames_.perBlock);
+  entries.resize(tixels * frames_.directionsPerTixel);
+  decodeEntryBlock(frame, tixels, frames_.directionsPerTixel, stream, entries.data(),
+                   fmt::format("{}: visibility block {}", path_, b));
 }
 
 namespace {
@@ -324,8 +556,11 @@ PlvLayout readPlvLayout(const std::string& path, std::span<const unsigned char> 
     } else if (contentSizes[b] != (tixelCount + 1) * sizeof(uint64_t) + extraCount * sizeof(VisibilityExtra)) {
       fail("{}: corrupt visibility field: the extra records' frame declares {} bytes", path, contentSizes[b]);
     }
-    detail::zstdCheckFrame(bytes.subspan(l.frameOffset[b], frameSizes[b]), contentSizes[b],
-                           fmt::format("{}: visibility frame {}", path, b));
+    if (b < blocks)
+      checkEntryBlock(bytes.subspan(l.frameOffset[b], frameSizes[b]), tixels * n, fmt::format("{}: visibility block {}", path, b));
+    else
+      detail::zstdCheckFrame(bytes.subspan(l.frameOffset[b], frameSizes[b]), contentSizes[b],
+                             fmt::format("{}: visibility extra records", path));
     l.frameOffset[b + 1] = l.frameOffset[b] + frameSizes[b];
   }
   return l;
@@ -354,11 +589,7 @@ VisibilityFileInfo readVisibilityInfo(const std::string& path) {
     const PlvLayout l = readPlvLayout(path, bytes, h);
     info.entryBytes = l.blockEntryStart[l.blocks];
     info.heldBytes = heldBytes(h, info.entryBytes);
-    if (l.blocks > 0) {  // the first tixel's precision, from the first block (the bake writes one for all)
-      std::vector<unsigned char> raw(l.contentSizes[0]);
-      decompressEntryBlock(bytes.subspan(l.frameOffset[0], l.frameSizes[0]), raw, fmt::format("{}: visibility block 0", path));
-      info.fractionBits = raw[std::min(h.tixelCount, l.perBlock) * sizeof(uint32_t)];
-    }
+    if (l.blocks > 0) info.fractionBits = bytes[l.frameOffset[0]];  // the first block's (the bake writes one for all)
   }
   return info;
 }
@@ -410,31 +641,37 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   // so that the gather may decode it unchecked and index without bounds checks.
   parallelFor(blocks, [&](uint64_t b) {
     const uint64_t t0 = b * perBlock, t1 = std::min(tixelCount, t0 + perBlock);
-    std::vector<unsigned char> raw(contentSizes[b]);
-    decompressEntryBlock(bytes.subspan(frameOffset[b], frameSizes[b]), raw, fmt::format("{}: visibility block {}", path, b));
-    const unsigned char* encoded = raw.data() + (t1 - t0) * sizeof(uint32_t);
-    const uint64_t encodedBytes = raw.size() - (t1 - t0) * sizeof(uint32_t);
-    if (!streamed) std::memcpy(entryBytes.data() + blockEntryStart[b], encoded, encodedBytes);
-    std::vector<VisibilityEntry> scratch(decodedOut ? 0 : n);
+    const std::string context = fmt::format("{}: visibility block {}", path, b);
+    std::vector<unsigned char> streams;
+    std::vector<VisibilityEntry> scratch(decodedOut ? 0 : (t1 - t0) * n);
+    VisibilityEntry* const decoded = decodedOut ? decodedOut->data() + t0 * n : scratch.data();
+    const uint32_t bits = decodeEntryBlock(bytes.subspan(frameOffset[b], frameSizes[b]), t1 - t0, uint32_t(n), streams,
+                                           decoded, context);
+    // Held: each tixel's compact encoding, into the block's part of the field's entry bytes,
+    // whose size the table declares.
+    const uint64_t encodedBytes = contentSizes[b] - (t1 - t0) * sizeof(uint32_t);
+    std::vector<unsigned char> encoding(streamed ? 0 : maxEncodedTixelBytes(uint32_t(n)));
     uint64_t used = 0;
     for (uint64_t g = t0; g < t1; ++g) {
-      uint32_t size;
-      std::memcpy(&size, raw.data() + (g - t0) * sizeof(uint32_t), sizeof(uint32_t));
-      const std::span<VisibilityEntry> decoded(decodedOut ? decodedOut->data() + g * n : scratch.data(), n);
-      if (size > encodedBytes - used ||
-          decodeTixelEntries<true>(encoded + used, size, uint32_t(n), decoded.data()) != size)
-        fail("{}: corrupt visibility field: the entries of tixel {} do not decode", path, g);
-      if (!streamed) entryOffset[g] = blockEntryStart[b] + used;
-      used += size;
+      const VisibilityEntry* const entries = decoded + (g - t0) * n;
+      if (!streamed) {
+        const size_t size = encodeTixelEntries(entries, uint32_t(n), bits, encoding.data());
+        if (size > encodedBytes - used)
+          fail("{}: corrupt visibility field: block {} holds more than the {} bytes its table declares", path, b, encodedBytes);
+        std::memcpy(entryBytes.data() + blockEntryStart[b] + used, encoding.data(), size);
+        entryOffset[g] = blockEntryStart[b] + used;
+        used += size;
+      }
       uint64_t flagged = 0;
-      for (const VisibilityEntry& e : decoded) {
+      for (uint64_t k = 0; k < n; ++k) {
+        const VisibilityEntry& e = entries[k];
         if (!e.escaped() && e.tixel() >= targets) fail("{}: an entry of tixel {} points outside the field", path, g);
         flagged += e.hasExtra() ? 1 : 0;
       }
       flaggedPerTixel[g] = flagged;
     }
-    if (used != encodedBytes)
-      fail("{}: corrupt visibility field: block {} holds {} bytes past its tixels", path, b, encodedBytes - used);
+    if (!streamed && used != encodedBytes)
+      fail("{}: corrupt visibility field: block {} holds {} bytes, its table declares {}", path, b, used, encodedBytes);
   });
   std::vector<uint64_t> extraOffset(tixelCount + 1);
   std::vector<VisibilityExtra> extras(extraCount);
@@ -471,8 +708,8 @@ bool readVisibility(const std::string& path, uint64_t expectedHash, VisibilityFi
   f.tixelCount = tixelCount;
   f.hash = h.hash;
   if (streamed) {
-    VisibilityFrames frames{perBlock, blocks, {frameOffset.begin(), frameOffset.begin() + int64_t(blocks) + 1}, frameSizes,
-                            contentSizes};
+    VisibilityFrames frames{perBlock,     blocks,     {frameOffset.begin(), frameOffset.begin() + int64_t(blocks) + 1},
+                            frameSizes,   contentSizes, tixelCount, uint32_t(n)};
     f.stream = std::make_shared<const VisibilityBlockFile>(path, std::move(frames));
   } else {
     f.entryBytes = FieldArray<unsigned char>(std::move(entryBytes));

@@ -3,7 +3,7 @@
 // field so that a bake whose geometry, parameterisation and settings are unchanged reuses it
 // (bake/visibility.h traces it and says what its directions are; bake/bake.h decides reuse).
 //
-// .plv layout (version 5; little-endian; written by writeVisibility, validated by readVisibility):
+// .plv layout (version 6; little-endian; written by writeVisibility, validated by readVisibility):
 //   header, 56 bytes:
 //   magic        8 bytes  "PLVIS\0\r\n"
 //   version      u32      kPlvVersion
@@ -16,15 +16,33 @@
 //   payload:
 //   tixelsPerBlock u64    tixels per entry block (≈ 64 Ki entries; the last block may hold
 //                         fewer): B = ⌈tixelCount / tixelsPerBlock⌉ blocks
-//   frames       B zstd frames of entry blocks, in tixel order, then one zstd frame of
-//                extraOffset (u64 × (tixelCount + 1)) followed by the extras (24 bytes each)
+//   frames       B entry blocks, in tixel order (below), then one zstd frame of extraOffset
+//                (u64 × (tixelCount + 1)) followed by the extras (24 bytes each)
 //   frameSizes   u64 × (B + 1): the stored bytes of each frame, in order
-//   contentSizes u64 × (B + 1): the bytes each frame decompresses to
-// An entry block's content: its tixels' encoded sizes (u32 each), then their encodings, in
-// tixel order (the compact entries below, as held in memory), so reading it back gives the same
-// entries bit for bit. Version 4 had no fraction precision per tixel (always exact), version 3
-// held the raw 8-byte entries split into planes, version 2 the raw entries: an older field is
-// traced again, like a stale one.
+//   contentSizes u64 × (B + 1): per entry block, the bytes of its content as held in memory —
+//                its tixels' encoded sizes (u32 each), then their compact encodings
+//                ("Compact entries" below); for the last frame, the bytes it decompresses to
+// A stored entry block keeps its entries in kPlvStreams byte streams, each its own zstd frame
+// (docs/design.md, Visibility field, "The .plv's bytes"):
+//   bits         u8       F, the bits per fraction of every tixel of the block
+//   rawSizes     u32 × kPlvStreams: each stream's bytes
+//   storedSizes  u32 × kPlvStreams: each stream's zstd frame's bytes (0: an empty stream, no frame)
+//   frames       the streams' zstd frames, in stream order
+// The streams hold the block's entries in tixel order, entry k of each tixel in turn; "previous"
+// is the tixel index of the tixel's last earlier entry that saw a tixel (0 before the first):
+//   ops          u8 per entry: 0 an escape (nothing seen, no extra record, fractions 0),
+//                1 a hit without flags at previous + an i8 delta, 2 likewise with an i16
+//                delta, 3 any other entry, its target (index and flags) whole
+//   near         i8 per op 1: the delta
+//   farLow       u8 per op 2: the delta's low byte
+//   farHigh      u8 per op 2: the delta's high byte
+//   targets      u32 per op 3: the target
+//   fractions    per op 1–3: qu | qv << F in ⌈2F/8⌉ bytes (F ≤ 8), or fu, fv (u16 each; F = 16)
+// Reading a block back and encoding its tixels gives the content the writer was handed, byte
+// for byte (the compact encoding is a function of the entries). Version 5 stored each block's
+// content as one zstd frame, version 4 had no fraction precision per tixel (always exact),
+// version 3 held the raw 8-byte entries split into planes, version 2 the raw entries: an
+// older field is traced again, like a stale one.
 //
 // Entries (8 bytes decoded; tixel-major: entry k of tixel g; held encoded, "Compact entries"):
 //   target  bits 0–29: global index of the tixel at the lower-left of the 2×2 bilinear
@@ -55,7 +73,9 @@ namespace pl {
 
 /// The .plv format version this program reads and writes (visibilityHash includes it, so a
 /// field of another version is traced again).
-inline constexpr uint32_t kPlvVersion = 5;  // 2: multi-jittered gather directions; 3: compressed blocks; 4: compact entries; 5: quantised fractions
+inline constexpr uint32_t kPlvVersion = 6;  // 2: multi-jittered gather directions; 3: compressed blocks; 4: compact entries; 5: quantised fractions; 6: entry blocks in streams
+/// Byte streams of a stored entry block (layout above).
+inline constexpr uint32_t kPlvStreams = 6;
 /// Largest gather grid side m a field may have (gatherDirections ≤ 65 536); a .plv declaring
 /// more is corrupt.
 inline constexpr uint32_t kMaxGatherGridSide = 256;
@@ -139,7 +159,7 @@ class FieldArray {
 inline constexpr uint32_t kTagEscape = 0, kTagNear = 1, kTagFar = 2, kTagGeneral = 3;
 /// Bits per fraction of the exact encoding, and of the compact one (docs/design.md, Visibility
 /// field: the coarsest that keeps the light field within relMSE 1e-5 of the exact one, with margin).
-inline constexpr uint32_t kExactFractionBits = 16, kCompactFractionBits = 4;
+inline constexpr uint32_t kExactFractionBits = 16, kCompactFractionBits = 2;
 /// Whether a tixel's encoding may declare `bits` bits per fraction.
 constexpr bool validFractionBits(uint32_t bits) { return (bits >= 1 && bits <= 8) || bits == kExactFractionBits; }
 /// The level of a 16-bit fraction (× 65535) at `bits` ≤ 8 bits: round(f·(2^bits − 1)/65535).
@@ -261,15 +281,16 @@ inline size_t decodeExact(const unsigned char* in, size_t size, uint32_t n, Visi
   return size_t(at - in);
 }
 
-/// kFractionLevels[F] of both fractions of a quantised entry at F = kCompactFractionBits, whose
-/// two levels fill one byte: entry q (qu | qv << F) holds fu | fv << 16, so that the default's
-/// decoder looks the pair up in one load.
+/// kFractionLevels[F] of both fractions of a quantised entry at F = kCompactFractionBits: entry
+/// q (qu | qv << F) holds fu | fv << 16, so that the default's decoder looks the pair up in one
+/// load.
+inline constexpr uint32_t kCompactFractionPairMask = (1u << (2 * kCompactFractionBits)) - 1;
 inline constexpr auto kCompactFractionPairs = [] {
-  constexpr uint32_t bits = kCompactFractionBits;
-  static_assert(2 * bits == 8);
-  std::array<uint32_t, 256> table{};
-  for (uint32_t q = 0; q < 256; ++q)
-    table[q] = uint32_t(kFractionLevels[bits][q & 15]) | uint32_t(kFractionLevels[bits][q >> bits]) << 16;
+  constexpr uint32_t bits = kCompactFractionBits, levels = 1u << bits;
+  static_assert(2 * bits <= 8);
+  std::array<uint32_t, kCompactFractionPairMask + 1> table{};
+  for (uint32_t q = 0; q <= kCompactFractionPairMask; ++q)
+    table[q] = uint32_t(kFractionLevels[bits][q % levels]) | uint32_t(kFractionLevels[bits][q / levels]) << 16;
   return table;
 }();
 
@@ -300,7 +321,7 @@ inline size_t decodeQuantised(const unsigned char* in, size_t size, uint32_t n, 
         const uint32_t top = uint32_t(64 - 8 * length) & 63u;
         previous += int64_t(uint64_t(int64_t(word << top) >> (top + 2 * bits)) & hit);
         uint64_t fractions;
-        if constexpr (FixedBits == kCompactFractionBits) fractions = kCompactFractionPairs[word & 0xff];
+        if constexpr (FixedBits == kCompactFractionBits) fractions = kCompactFractionPairs[word & kCompactFractionPairMask];
         else fractions = uint64_t(level[word & mask]) | (uint64_t(level[(word >> bits) & mask]) << 16);
         const uint64_t packed = ((uint64_t(uint32_t(previous)) | (fractions << 32)) & hit) |
                                 (uint64_t(VisibilityEntry::kEscape) & ~hit);
@@ -379,10 +400,12 @@ uint64_t visibilityBlockTixels(uint32_t directionsPerTixel);
 struct VisibilityFrames {
   uint64_t perBlock = 0, blocks = 0;
   std::vector<uint64_t> frameOffset, frameSizes, contentSizes;  ///< B + 1 each
+  uint64_t tixelCount = 0;
+  uint32_t directionsPerTixel = 0;
 };
 
 /// A .plv's entry blocks, read from the file one at a time (the streamed field, docs/design.md
-/// "Visibility field"): a block's frame is read (pread) into a caller's buffer and decompressed
+/// "Visibility field"): a block's frame is read (pread) into a caller's buffer and decoded
 /// into another, so that memory holds a block per reader instead of the field. Thread-safe.
 class VisibilityBlockFile {
  public:
@@ -396,11 +419,12 @@ class VisibilityBlockFile {
   const std::string& path() const { return path_; }
   uint64_t perBlock() const { return frames_.perBlock; }
   uint64_t blocks() const { return frames_.blocks; }
-  /// Reads block b into `content`: its tixels' encoded sizes (u32 each), then their encodings
-  /// ("Compact entries"), then kEntryBytesPadding zero bytes (the unchecked decoder's); `frame`
-  /// is scratch for the stored frame. Throws pl::Error naming the file when the read fails or
-  /// the frame does not decompress to its declared size.
-  void read(uint64_t b, std::vector<unsigned char>& frame, std::vector<unsigned char>& content) const;
+  uint64_t tixelCount() const { return frames_.tixelCount; }
+  /// Reads block b's entries into `entries` (its tixels' N entries each, tixel-major); `frame`
+  /// and `stream` are scratch for the stored frame and one decompressed stream. Throws
+  /// pl::Error naming the file when the read fails or the block does not decode.
+  void readEntries(uint64_t b, std::vector<unsigned char>& frame, std::vector<unsigned char>& stream,
+                   std::vector<VisibilityEntry>& entries) const;
 
  private:
   std::string path_;
@@ -462,10 +486,12 @@ class VisibilityWriter {
 
   uint64_t perBlock() const { return frames_.perBlock; }
   uint64_t blocks() const { return frames_.blocks; }
-  /// The stored frame of an entry block of `tixelBytes.size()` tixels whose encodings, of those
-  /// sizes, are `encoded` one after another (thread-safe); *contentBytes receives its content's size.
+  uint32_t directionsPerTixel() const { return frames_.directionsPerTixel; }
+  /// The stored frame of an entry block of `tixelBytes.size()` tixels of `directionsPerTixel`
+  /// entries whose encodings, of those sizes, are `encoded` one after another (thread-safe; every
+  /// tixel of the block must have one fraction precision); *contentBytes receives its content's size.
   static std::vector<unsigned char> frameBlock(std::span<const uint32_t> tixelBytes, std::span<const unsigned char> encoded,
-                                               uint64_t* contentBytes);
+                                               uint32_t directionsPerTixel, uint64_t* contentBytes);
   /// Hands over block b's frame (thread-safe, each block once, any order). Throws pl::Error
   /// naming the file when a write fails.
   void put(uint64_t b, std::vector<unsigned char> frame, uint64_t contentBytes);

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <cstring>
@@ -17,6 +18,8 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/hash.h"
+#include "plf/codec_backends.h"
 
 namespace pl {
 namespace {
@@ -179,7 +182,7 @@ TEST(VisibilityCodec, NeighbouringHitsTakeFewBytes) {
   for (size_t k = 0; k < smooth.size(); ++k) smooth[k] = entry(uint32_t(1000 + 3 * k + (k % 16) * 4), uint16_t(k * 97), uint16_t(k * 31));
   // Exact: deltas within ±127 take 1 + 4 bytes and the tag; the first (1000) takes 2 + 4.
   EXPECT_LE(roundTrip(smooth), kTixelHeaderBytes(256) + 6 + 255 * 5);
-  // 8 bits: 1 + 2 bytes, the first 2 + 2; 4 bits (the default): 2 bytes, the first 3.
+  // 8 bits: 1 + 2 bytes, the first 2 + 2; 4 bits: 2 bytes, the first 3.
   EXPECT_LE(roundTrip(smooth, 8), kTixelHeaderBytes(256) + 4 + 255 * 3);
   EXPECT_LE(roundTrip(smooth, 4), kTixelHeaderBytes(256) + 3 + 255 * 2);
 }
@@ -305,6 +308,97 @@ TEST(VisibilityFile, RecordsWithAbsurdContentsAreRefusedDespiteAValidChecksum) {
   std::filesystem::remove_all(dir);
 }
 
+/// A stored entry block made by hand (plv_file.h, "A stored entry block"): `bits`, then each
+/// stream's raw and stored sizes, then the streams' zstd frames; `rawSizes` overrides the
+/// declared raw sizes where given.
+std::vector<unsigned char> handMadeBlock(uint32_t bits, const std::array<std::vector<unsigned char>, kPlvStreams>& streams,
+                                         std::array<int64_t, kPlvStreams> rawSizes = {-1, -1, -1, -1, -1, -1}) {
+  std::vector<unsigned char> block{uint8_t(bits)};
+  std::array<std::vector<unsigned char>, kPlvStreams> frames;
+  auto put32 = [&](uint32_t v) { block.insert(block.end(), reinterpret_cast<unsigned char*>(&v), reinterpret_cast<unsigned char*>(&v) + 4); };
+  for (uint32_t i = 0; i < kPlvStreams; ++i) {
+    if (!streams[i].empty()) frames[i] = detail::zstdCompress(streams[i], 1);
+    put32(uint32_t(rawSizes[i] >= 0 ? rawSizes[i] : int64_t(streams[i].size())));
+  }
+  for (uint32_t i = 0; i < kPlvStreams; ++i) put32(uint32_t(frames[i].size()));
+  for (const auto& f : frames) block.insert(block.end(), f.begin(), f.end());
+  return block;
+}
+
+/// `file` (a .plv of one entry block) with that block replaced by `block`: the frame table and
+/// the payload checksum made to agree, so that only the block itself is wrong.
+std::string withEntryBlock(const std::string& file, const std::vector<unsigned char>& block) {
+  constexpr size_t kHeader = 56, kFramesAt = kHeader + 8;
+  uint64_t table[4];  // stored sizes of the block and the extra records' frame, then content sizes
+  std::memcpy(table, file.data() + file.size() - sizeof(table), sizeof(table));
+  const std::string extras = file.substr(kFramesAt + table[0], table[1]);
+  std::string out = file.substr(0, kFramesAt) + std::string(block.begin(), block.end()) + extras;
+  table[0] = block.size();
+  out.append(reinterpret_cast<const char*>(table), sizeof(table));
+  const uint64_t hash = xxh64(out.data() + kHeader, out.size() - kHeader);
+  std::memcpy(out.data() + 48, &hash, 8);
+  return out;
+}
+
+// The stored entry blocks' streams are checked as they are read: a block the writer cannot
+// have made is refused naming the file and the block, though every checksum and frame is valid.
+TEST(VisibilityFile, StoredEntryBlocksTheWriterCannotMakeAreRefused) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_streams_test";
+  std::filesystem::create_directories(dir);
+  const std::string plv = (dir / "crafted.plv").string();
+  VisibilityField field;  // one tixel, one direction, compact: a block of one entry
+  field.gridSide = 1;
+  field.tixelCount = 1;
+  field.hash = 5;
+  const VisibilityEntry seen = entry(0, 30000, 40000);
+  field.setEntries(&seen, kCompactFractionBits);
+  field.extraOffset = FieldArray<uint64_t>(std::vector<uint64_t>{0, 0});
+  writeVisibility(plv, field);
+  std::string written;
+  {
+    std::ifstream in(plv, std::ios::binary);
+    written.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  auto readWith = [&](const std::vector<unsigned char>& block, VisibilityField& read) {
+    std::ofstream(plv, std::ios::binary | std::ios::trunc) << withEntryBlock(written, block);
+    std::string why;
+    EXPECT_TRUE(readVisibility(plv, 5, read, &why)) << why;
+  };
+  using Streams = std::array<std::vector<unsigned char>, kPlvStreams>;  // ops, near, far low, far high, targets, fractions
+  const uint32_t bits = kCompactFractionBits;
+  const uint8_t levels = uint8_t(quantiseFraction(30000, bits) | quantiseFraction(40000, bits) << bits);
+  // The hand-made block of what was written reads back as written: the maker is right.
+  VisibilityField read;
+  readWith(handMadeBlock(bits, Streams{{{1}, {0}, {}, {}, {}, {levels}}}), read);
+  EXPECT_EQ(read.decodeAll()[0].target, 0u);
+  EXPECT_EQ(read.decodeAll()[0].fu, expected(seen, bits).fu);
+  EXPECT_EQ(read.decodeAll()[0].fv, expected(seen, bits).fv);
+
+  const struct {
+    std::vector<unsigned char> block;
+    const char* problem;
+  } cases[] = {
+      {handMadeBlock(9, Streams{{{1}, {0}, {}, {}, {}, {levels}}}), "9 bits per fraction"},
+      {handMadeBlock(bits, Streams{{{1}, {0}, {}, {}, {}, {levels}}}, {2, -1, -1, -1, -1, -1}), "stream 0 declares 2 bytes"},
+      {handMadeBlock(bits, Streams{{{4}, {0}, {}, {}, {}, {levels}}}), "op 4 of entry 0"},
+      {handMadeBlock(bits, Streams{{{1}, {}, {}, {}, {}, {levels}}}), "its streams' sizes disagree with its ops"},
+      {handMadeBlock(bits, Streams{{{2}, {}, {0xff}, {0xff}, {}, {levels}}}), "tixel 0 do not decode"},  // index −1
+      {handMadeBlock(bits, Streams{{{3}, {}, {}, {}, {0, 0, 0, 0}, {0x10}}}), "tixel 0 do not decode"},  // a bit above 2F
+  };
+  for (const auto& c : cases) {
+    std::ofstream(plv, std::ios::binary | std::ios::trunc) << withEntryBlock(written, c.block);
+    std::string why;
+    try {
+      readVisibility(plv, 5, read, &why);
+      ADD_FAILURE() << "accepted: " << c.problem;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("crafted.plv: visibility block 0"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.problem), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 // The streaming writer: entry blocks handed over in any order give writeVisibility's file byte
 // for byte, and the block file reads each block's content back (sizes, then encodings,
 // decoding to the entries); readVisibility's streamed form holds the extra records only.
@@ -333,7 +427,8 @@ TEST(VisibilityFile, BlocksWrittenOutOfOrderAndReadBackOneAtATime) {
     for (uint64_t t = t0; t < t1; ++t) sizes.push_back(uint32_t(field.entryOffset[t + 1] - field.entryOffset[t]));
     uint64_t contentBytes = 0;
     std::vector<unsigned char> frame = VisibilityWriter::frameBlock(
-        sizes, {field.entryBytes.data() + field.entryOffset[t0], field.entryOffset[t1] - field.entryOffset[t0]}, &contentBytes);
+        sizes, {field.entryBytes.data() + field.entryOffset[t0], field.entryOffset[t1] - field.entryOffset[t0]}, n,
+        &contentBytes);
     writer.put(b, std::move(frame), contentBytes);
     EXPECT_EQ(writer.waitingBytes() > 0, b != 1);  // 2 and 3 wait for 1, the last handed over
   }
@@ -346,22 +441,17 @@ TEST(VisibilityFile, BlocksWrittenOutOfOrderAndReadBackOneAtATime) {
   EXPECT_EQ(bytes(streamed), bytes(held));
 
   const VisibilityBlockFile file(streamed, frames);
-  std::vector<unsigned char> frame, content;
-  std::vector<VisibilityEntry> decoded(n);
+  std::vector<unsigned char> frame, stream;
+  std::vector<VisibilityEntry> decoded;
   for (uint64_t b = 0; b < file.blocks(); ++b) {
-    file.read(b, frame, content);
+    file.readEntries(b, frame, stream, decoded);
     const uint64_t t0 = b * file.perBlock(), t1 = std::min(field.tixelCount, t0 + file.perBlock());
-    uint64_t at = (t1 - t0) * sizeof(uint32_t);
+    ASSERT_EQ(decoded.size(), (t1 - t0) * n);
     for (uint64_t t = t0; t < t1; ++t) {
-      uint32_t size;
-      std::memcpy(&size, content.data() + (t - t0) * sizeof(uint32_t), 4);
-      ASSERT_EQ(decodeTixelEntries<true>(content.data() + at, size, n, decoded.data()), size);
       std::vector<VisibilityEntry> want(n);
       field.decode(t, want.data());
-      ASSERT_EQ(std::memcmp(decoded.data(), want.data(), n * sizeof(VisibilityEntry)), 0) << "tixel " << t;
-      at += size;
+      ASSERT_EQ(std::memcmp(decoded.data() + (t - t0) * n, want.data(), n * sizeof(VisibilityEntry)), 0) << "tixel " << t;
     }
-    EXPECT_EQ(at + kEntryBytesPadding, content.size());
   }
 
   VisibilityField read;

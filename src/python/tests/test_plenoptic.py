@@ -122,7 +122,7 @@ def test_max_memory_caps_the_bake_memory_guard(cornell):
 
 
 def test_visibility_precision_is_a_bake_option(cornell, tmp_path):
-    # The compact field (the default) keeps the gather's bilinear fractions to 4 bits each: a .plv
+    # The compact field (the default) keeps the gather's bilinear fractions to 2 bits each: a .plv
     # about half the size of the exact one, and the same light field to within a hair.
     images, sizes = {}, {}
     for precision in ("compact", "exact"):
