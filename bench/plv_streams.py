@@ -2,7 +2,7 @@
 """How much smaller would a .plv be with its entry blocks split into byte streams?
 
 Reads a sample of the entry blocks of a .plv (format version 5, fractions kept to 4 bits: the
-default), decompresses each (the `zstd` command), and compresses it again two ways at zstd
+default then; version 6 stores the blocks split into streams, docs/design.md "The .plv's bytes"), decompresses each (the `zstd` command), and compresses it again two ways at zstd
 levels 1 (what the bake writes), 3 and 6: whole, as the .plv stores it, and split into separate
 streams — the tixels' sizes, their precision bytes, the 2-bit tags, the fraction bytes, the
 near and far hits' deltas, and the general form's varints — each compressed on its own. Prints
@@ -31,7 +31,8 @@ def sampled_blocks(path, sample):
     with open(path, "rb") as f:
         magic, version, grid, _, tixels, _, _, _ = HEADER.unpack(f.read(HEADER.size))
         if magic != b"PLVIS\0\r\n" or version != 5:
-            sys.exit(f"{path}: not a version-5 .plv")
+            sys.exit(f"{path}: not a version-5 .plv (these scripts study the format before version 6, "
+                     "whose blocks are already split into streams: bake the field with a build before it)")
         per_block = struct.unpack("<Q", f.read(8))[0]
         blocks = (tixels + per_block - 1) // per_block
         f.seek(size - 2 * (blocks + 1) * 8)

@@ -10,12 +10,17 @@
 // alone), held_bytes_per_entry (everything the field holds: encodings, per-tixel offsets, extra
 // records), escaped (fraction of entries that see nothing). BM_Copy8 reads the same number of
 // 8-byte entries from a plain array (the layout before the compact one), for scale.
+// BM_StreamBlocks reads the field as a streamed bake's gather does: every entry block of its
+// .plv (written once to the temporary directory) read, decompressed and decoded from its byte
+// streams into 8-byte entries (VisibilityBlockFile::readEntries), from the page cache; counter
+// plv_bytes_per_entry: the file's bytes.
 // Run:  build/bench/visibility_bench
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -102,6 +107,33 @@ void BM_Copy8(benchmark::State& state, const std::string& name) {
   setCounters(state, f, escaped);
 }
 
+/// Reads every entry block of the field's .plv on one thread, as a streamed gather thread does.
+void BM_StreamBlocks(benchmark::State& state, const std::string& name) {
+  const pl::VisibilityField& f = field(name);
+  const std::string path = (std::filesystem::temp_directory_path() / ("plenoptic_visibility_bench_" + name + ".plv")).string();
+  pl::writeVisibility(path, f);
+  pl::VisibilityField streamed;
+  std::string why;
+  if (!pl::readVisibility(path, f.hash, streamed, &why, pl::VisibilityEntry::kIndexMask, nullptr, true)) {
+    fmt::print(stderr, "{}\n", why);
+    std::exit(1);
+  }
+  std::vector<unsigned char> frame, stream;
+  std::vector<pl::VisibilityEntry> entries;
+  uint64_t escaped = 0;
+  for (auto _ : state) {
+    escaped = 0;
+    for (uint64_t b = 0; b < streamed.stream->blocks(); ++b) {
+      streamed.stream->readEntries(b, frame, stream, entries);
+      for (const pl::VisibilityEntry& e : entries) escaped += e.escaped() ? 1 : 0;
+    }
+    benchmark::DoNotOptimize(escaped);
+  }
+  setCounters(state, f, escaped);
+  state.counters["plv_bytes_per_entry"] = double(std::filesystem::file_size(path)) / double(f.entryCount());
+  std::filesystem::remove(path);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -111,6 +143,7 @@ int main(int argc, char** argv) {
   for (const std::string& name : names) {
     benchmark::RegisterBenchmark(("BM_Decode/" + name).c_str(), BM_Decode, name)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("BM_Copy8/" + name).c_str(), BM_Copy8, name)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_StreamBlocks/" + name).c_str(), BM_StreamBlocks, name)->Unit(benchmark::kMillisecond);
   }
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
