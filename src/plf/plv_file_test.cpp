@@ -248,6 +248,20 @@ TEST(VisibilityCodec, CorruptEncodingsAreRefused) {
   EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), at + 4, 2, out), 0u);
 }
 
+/// Expects reading `plv` as a field of `hash` to throw a pl::Error whose message names `where`
+/// and `problem`.
+void expectRefused(const std::string& plv, uint64_t hash, const std::string& where, const std::string& problem) {
+  VisibilityField read;
+  std::string why;
+  try {
+    readVisibility(plv, hash, read, &why);
+    ADD_FAILURE() << "accepted: " << problem;
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
+  }
+}
+
 TEST(VisibilityFile, OneTixelFieldsRoundTrip) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_one_tixel_test";
   std::filesystem::create_directories(dir);
@@ -268,6 +282,65 @@ TEST(VisibilityFile, OneTixelFieldsRoundTrip) {
     const std::vector<VisibilityEntry> back = read.decodeAll();
     ASSERT_EQ(back.size(), entries.size());
     EXPECT_EQ(std::memcmp(back.data(), entries.data(), entries.size() * sizeof(VisibilityEntry)), 0);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// The stored streams (plv_file.h, "A stored entry block") at every precision, on tixels made
+// to reach each op's edges: all misses; escapes that carry a flag or fractions (op 3); deltas
+// just inside and outside the near (i8) and far (i16) ops, both signs; a flagged hit; the
+// field's smallest and largest index in turn. Written, read back held and streamed.
+TEST(VisibilityFile, EveryOpsEdgeRoundTripsThroughTheStreams) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_streams_test";
+  std::filesystem::create_directories(dir);
+  const std::string plv = (dir / "edges.plv").string();
+  VisibilityField field;
+  field.gridSide = 4;  // 16 entries per tixel
+  field.tixelCount = 70000;  // indices up to 69 999: deltas past ±32 768
+  field.hash = 11;
+  const uint32_t n = field.directionsPerTixel(), last = uint32_t(field.tixelCount - 1);
+  std::vector<VisibilityEntry> entries(field.tixelCount * n);  // tixel 0 and most others: all misses
+  VisibilityEntry* const odd = entries.data() + 1 * n;
+  odd[0] = entry(VisibilityEntry::kEscape | VisibilityEntry::kBackSide);
+  odd[1] = entry(VisibilityEntry::kEscape, 1, 65535);
+  odd[2] = entry(5 | VisibilityEntry::kBackSide, 65535, 0);
+  VisibilityEntry* const deltas = entries.data() + 2 * n;
+  int64_t at = 35000, k = 0;
+  deltas[k++] = entry(uint32_t(at), 1, 2);
+  for (int64_t delta : {127, 128, -128, -129, 32767, -32767, -32768, 32768, -32769, 0, 1, -1}) {
+    at += delta;
+    deltas[k] = entry(uint32_t(at), uint16_t(at * 7919), uint16_t(at * 104729));
+    ++k;
+  }
+  VisibilityEntry* const swing = entries.data() + 3 * n;
+  for (uint32_t i = 0; i < n; ++i) swing[i] = entry(i % 2 ? last : 0, uint16_t(i), 65535);
+  entries[(field.tixelCount - 1) * n] = entry(last, 65535, 65535);  // the last block's last tixel
+  for (uint32_t bits : kEveryFractionBits) {
+    field.setEntries(entries.data(), bits);
+    field.extraOffset = FieldArray<uint64_t>(std::vector<uint64_t>(field.tixelCount + 1, 0));
+    writeVisibility(plv, field);
+    std::vector<VisibilityEntry> want(entries.size());
+    for (size_t i = 0; i < entries.size(); ++i) want[i] = expected(entries[i], bits);
+    VisibilityField held;
+    std::string why;
+    ASSERT_TRUE(readVisibility(plv, 11, held, &why)) << bits << ": " << why;
+    const std::vector<VisibilityEntry> back = held.decodeAll();
+    ASSERT_EQ(back.size(), want.size());
+    EXPECT_EQ(std::memcmp(back.data(), want.data(), want.size() * sizeof(VisibilityEntry)), 0) << bits;
+    // The held field's bytes are the writer's, as the format promises.
+    EXPECT_EQ(held.entryOffset.size(), field.entryOffset.size());
+    EXPECT_EQ(std::memcmp(held.entryBytes.data(), field.entryBytes.data(), field.entryOffset[field.tixelCount]), 0) << bits;
+    VisibilityField streamed;
+    ASSERT_TRUE(readVisibility(plv, 11, streamed, &why, 0, nullptr, true)) << bits << ": " << why;
+    std::vector<unsigned char> frame, stream;
+    std::vector<VisibilityEntry> block;
+    for (uint64_t b = 0; b < streamed.stream->blocks(); ++b) {
+      streamed.stream->readEntries(b, frame, stream, block);
+      const uint64_t first = b * streamed.stream->perBlock() * n;
+      ASSERT_LE(first + block.size(), want.size());
+      EXPECT_EQ(std::memcmp(block.data(), want.data() + first, block.size() * sizeof(VisibilityEntry)), 0)
+          << bits << " block " << b;
+    }
   }
   std::filesystem::remove_all(dir);
 }
@@ -297,13 +370,7 @@ TEST(VisibilityFile, RecordsWithAbsurdContentsAreRefusedDespiteAValidChecksum) {
   };
   for (const auto& c : cases) {
     writeVisibility(plv, tinyField(c.extra));
-    try {
-      readVisibility(plv, 0x1234, read, &why);
-      ADD_FAILURE() << "accepted: " << c.problem;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("crafted.plv: extra record 0"), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(c.problem), std::string::npos) << e.what();
-    }
+    expectRefused(plv, 0x1234, "crafted.plv: extra record 0", c.problem);
   }
   std::filesystem::remove_all(dir);
 }
@@ -387,14 +454,7 @@ TEST(VisibilityFile, StoredEntryBlocksTheWriterCannotMakeAreRefused) {
   };
   for (const auto& c : cases) {
     std::ofstream(plv, std::ios::binary | std::ios::trunc) << withEntryBlock(written, c.block);
-    std::string why;
-    try {
-      readVisibility(plv, 5, read, &why);
-      ADD_FAILURE() << "accepted: " << c.problem;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("crafted.plv: visibility block 0"), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(c.problem), std::string::npos) << e.what();
-    }
+    expectRefused(plv, 5, "crafted.plv: visibility block 0", c.problem);
   }
   std::filesystem::remove_all(dir);
 }
