@@ -213,13 +213,10 @@ uint32_t decodeEntryBlock(std::span<const unsigned char> stored, uint64_t tixels
   // Both fractions' 16-bit values (fu | fv << 16) per stored fractions byte, for F ≤ 4: one load.
   std::array<uint32_t, 256> pairs{};
   if (fractionBytes == 1)
-    for (uint32_t q = 0; q < (1u << (2 * bits)); ++q)
-      pairs[q] = uint32_t(kFractionLevels[bits][q & ((1u << bits) - 1)]) | uint32_t(kFractionLevels[bits][q >> bits]) << 16;
+    for (uint32_t q = 0; q < (1u << (2 * bits)); ++q) pairs[q] = detail::fractionPair(bits, q);
   auto levelsOf = [&](uint64_t f) -> uint64_t {  // fu | fv << 16
     if (fractionBytes == 1) return pairs[f & 0xff];
-    if (exact) return f;
-    const uint64_t mask = (uint64_t(1) << bits) - 1;
-    return uint64_t(kFractionLevels[bits][f & mask]) | uint64_t(kFractionLevels[bits][(f >> bits) & mask]) << 16;
+    return exact ? f : detail::fractionPair(bits, f);
   };
   for (uint64_t t = 0; t < tixels; ++t) {
     int64_t previous = 0;

@@ -281,16 +281,19 @@ inline size_t decodeExact(const unsigned char* in, size_t size, uint32_t n, Visi
   return size_t(at - in);
 }
 
-/// kFractionLevels[F] of both fractions of a quantised entry at F = kCompactFractionBits: entry
-/// q (qu | qv << F) holds fu | fv << 16, so that the default's decoder looks the pair up in one
-/// load.
+/// Both fractions of a quantised entry's levels q = qu | qv << bits (bits ≤ 8), as 16-bit
+/// values: fu | fv << 16.
+constexpr uint32_t fractionPair(uint32_t bits, uint64_t q) {
+  const uint64_t mask = (uint64_t(1) << bits) - 1;
+  return uint32_t(kFractionLevels[bits][q & mask]) | uint32_t(kFractionLevels[bits][(q >> bits) & mask]) << 16;
+}
+/// fractionPair at F = kCompactFractionBits, tabulated over q, so that the default's decoder
+/// looks the pair up in one load.
 inline constexpr uint32_t kCompactFractionPairMask = (1u << (2 * kCompactFractionBits)) - 1;
 inline constexpr auto kCompactFractionPairs = [] {
-  constexpr uint32_t bits = kCompactFractionBits, levels = 1u << bits;
-  static_assert(2 * bits <= 8);
+  static_assert(2 * kCompactFractionBits <= 8);
   std::array<uint32_t, kCompactFractionPairMask + 1> table{};
-  for (uint32_t q = 0; q <= kCompactFractionPairMask; ++q)
-    table[q] = uint32_t(kFractionLevels[bits][q % levels]) | uint32_t(kFractionLevels[bits][q / levels]) << 16;
+  for (uint32_t q = 0; q <= kCompactFractionPairMask; ++q) table[q] = fractionPair(kCompactFractionBits, q);
   return table;
 }();
 
