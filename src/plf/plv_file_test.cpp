@@ -410,7 +410,7 @@ std::string withEntryBlock(const std::string& file, const std::vector<unsigned c
 // The stored entry blocks' streams are checked as they are read: a block the writer cannot
 // have made is refused naming the file and the block, though every checksum and frame is valid.
 TEST(VisibilityFile, StoredEntryBlocksTheWriterCannotMakeAreRefused) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_streams_test";
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_crafted_blocks_test";
   std::filesystem::create_directories(dir);
   const std::string plv = (dir / "crafted.plv").string();
   VisibilityField field;  // one tixel, one direction, compact: a block of one entry
