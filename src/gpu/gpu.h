@@ -46,8 +46,8 @@
 // sun mask + 16 per environment texel + the surface detail + the BVH's 32 per node and 4 per
 // triangle + (with mirrors, glass or punctual highlights) 64 per material and 4 per triangle for
 // the chains and shadow rays, and 64 per delta light and 64 per material for the highlights +
-// the frame's targets (radiance 16 bytes per pixel; id and depth 8 bytes per pixel, or per
-// texel of the finer multi-sample visibility pass). A light field whose buffers exceed the GPU
+// the frame's targets (radiance and the resolve pass's hits 16 bytes per pixel each; id and
+// depth 8 bytes per pixel, or per texel of the finer multi-sample visibility pass). A light field whose buffers exceed the GPU
 // memory available (gpu_memory.h: the driver's query, GL_NVX_gpu_memory_info or
 // GL_ATI_meminfo; the PLENOPTIC_GPU_MEMORY variable; 4 GiB where neither says) is refused
 // before anything is uploaded, with the sizes, and so is one with a buffer larger than the
@@ -132,6 +132,14 @@ GpuProbe probeGpu();
 /// (docs/benchmarks.md), so `view` takes the GPU renderer only when asked to.
 bool isSoftwareRasteriser(const std::string& glRenderer);
 
+/// The GPU's own time for a frame, pass by pass, in milliseconds (GL timestamp queries): the
+/// visibility pass (the triangle ids rasterised), the resolve pass (one sample per pixel: each
+/// pixel's camera ray cast — the id buffer's triangle or the BVH's), the shading pass (the
+/// lookup; with several samples per pixel their rays too), and all three.
+struct GpuPassMilliseconds {
+  double visibility = 0.0, resolve = 0.0, shading = 0.0, total = 0.0;
+};
+
 class GpuRenderer {
  public:
   /// Creates the headless context (EGL: Mesa's surfaceless platform, else the default display
@@ -167,6 +175,8 @@ class GpuRenderer {
   /// to the end of its shading pass by GL timestamp queries — what a frame costs the GPU, the
   /// image's read-back into memory excluded (`render --stats` gpu_ms_median).
   double lastGpuMilliseconds() const;
+  /// The same time pass by pass (`render --stats` gpu_visibility_ms_median, ...).
+  GpuPassMilliseconds lastGpuPasses() const;
 
   /// One lookup query: the chart record as triangleChart gives it (facingChart turns it to the
   /// side the viewer is on), a world point and the unit direction towards the viewer.

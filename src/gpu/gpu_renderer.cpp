@@ -67,6 +67,8 @@ int multiSampleIdScale(int width, int height) {
 constexpr GLuint kValuesBinding = 0, kChartsBinding = 1, kPositionsBinding = 2, kTrianglesBinding = 3,
                  kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7,
                  kEnvironmentBinding = 8, kSurfaceDetailBinding = 12;
+// Texture units: the visibility pass's ids, the resolve pass's hits; image unit of the hits.
+constexpr GLuint kIdsUnit = 0, kHitsUnit = 1, kHitsImageUnit = 0;
 
 std::string glslConstants() {
   return fmt::format(
@@ -75,11 +77,11 @@ std::string glslConstants() {
       "kFlagTwoSidedEmission = {}u, kFlagSunMasks = {}u;\nconst int kMaxSunMaskLights = {}, kSunMaskSide = {};\n"
       "#define VALUES_BINDING {}\n#define CHARTS_BINDING {}\n#define POSITIONS_BINDING {}\n#define TRIANGLES_BINDING {}\n"
       "#define QUERIES_BINDING {}\n#define RESULTS_BINDING {}\n#define NORMALS_BINDING {}\n#define SUN_MASKS_BINDING {}\n"
-      "#define ENVIRONMENT_BINDING {}\n",
+      "#define ENVIRONMENT_BINDING {}\n#define IDS_UNIT {}\n#define HITS_UNIT {}\n#define HITS_IMAGE_UNIT {}\n",
       unsigned(ChartKind::Diffuse), unsigned(ChartKind::Glossy), unsigned(ChartKind::Specular), kFlagTwoSided, kFlagBack,
       kFlagCurved, kFlagDiffuseValue, kFlagEmissive, kFlagTwoSidedEmission, kFlagSunMasks, kMaxSunMaskLights, kSunMaskSide,
       kValuesBinding, kChartsBinding, kPositionsBinding, kTrianglesBinding, kQueriesBinding, kResultsBinding, kNormalsBinding,
-      kSunMasksBinding, kEnvironmentBinding);
+      kSunMasksBinding, kEnvironmentBinding, kIdsUnit, kHitsUnit, kHitsImageUnit);
 }
 
 // The lookup of lightfield/lookup.h in GLSL, statement for statement (the names are the C++
@@ -363,6 +365,41 @@ vec3 cameraToFilm(vec2 film) {
   float sy = (1.0 - 2.0 * film.y / float(size.y)) * tanHalfFovY;
   return forward + sx * right + sy * up;
 }
+// sampleConcentricDisk (core/sampling.h): u ∈ [0,1)² to the unit disk (Shirley–Chiu).
+vec2 sampleConcentricDisk(vec2 u) {
+  vec2 o = 2.0 * u - vec2(1.0);
+  if (o.x == 0.0 && o.y == 0.0) return vec2(0.0);
+  const float pi = 3.14159265358979;
+  float r, theta;
+  if (abs(o.x) > abs(o.y)) {
+    r = o.x;
+    theta = (pi / 4.0) * (o.y / o.x);
+  } else {
+    r = o.y;
+    theta = (pi / 2.0) - (pi / 4.0) * (o.x / o.y);
+  }
+  return r * vec2(cos(theta), sin(theta));
+}
+uniform bool vignetting;
+// Camera::generateRay through film point `film` (pixel units) and lens point `lens` ∈ [0,1)²
+// (unused by a pinhole): the ray's origin and unit direction, and the camera weight (cos⁴ of
+// the chief ray with vignetting, else 1).
+float cameraRay(vec2 film, vec2 lens, out vec3 origin, out vec3 direction) {
+  vec3 toFilm = cameraToFilm(film);
+  float invLength = 1.0 / length(toFilm);
+  float weight = 1.0;
+  if (vignetting) weight = invLength * invLength * invLength * invLength;  // cos^4 of the chief ray
+  origin = eye;
+  direction = toFilm * invLength;
+  if (apertureRadius > 0.0) {
+    // Towards where the chief ray meets the plane of focus, from the lens point.
+    vec3 focusPoint = eye + toFilm * focusDistance;
+    vec2 disk = apertureRadius * sampleConcentricDisk(lens);
+    origin = eye + disk.x * right + disk.y * up;
+    direction = normalize(focusPoint - origin);
+  }
+  return weight;
+}
 // The ray from the eye along unit `direction` against the triangle with vertices v
 // (Möller–Trumbore, no bounds test): (t, b1, b2), the barycentrics of where it meets the plane.
 vec3 rayTriangle(vec3 direction, uvec3 v) {
@@ -410,8 +447,77 @@ out uint id;
 void main() { id = kMarkedTexel; }
 )glsl";
 
-// Pass 2: per pixel, the camera ray through its centre (Camera::generateRay), its primary hit
-// (primaryHit: the id buffer's triangle, or the BVH's answer) and the lookup.
+// The camera rays' hits (the resolve pass; the multi-sample shading pass per sample), after
+// kBvhGlsl: the id texels of the visibility pass and the BVH.
+constexpr const char* kPrimaryHitGlsl = R"glsl(
+layout(binding = IDS_UNIT) uniform usampler2D ids;
+const uint kNoTriangle = 0xffffffffu;  // a hit's triangle on a miss
+// The camera ray's primary hit: the ray from the eye along unit `direction` through film point
+// `film` (pixel units) — the ray caster's answer: true with its distance t, triangle and
+// barycentrics b, false on a miss. The id texels answer where they can be trusted: the texel
+// the film point falls in and its 8 neighbours hold one triangle (or all nothing), no vertex
+// marked there (kMarkedTexel), and the ray hits that triangle (Möller–Trumbore, edges
+// inclusive, not cut by an alpha mask). The film point lies within the square of those 9 texel
+// centres, all on that triangle; a nearer triangle would cover one of them or have a vertex
+// in front there, unless it is a sliver narrower than the texel spacing passing between them
+// with its vertices elsewhere (gpu.h). Everywhere else — an edge or silhouette in the 3×3, a
+// triangle smaller than a texel the rasteriser left out (its vertices mark its texels), a
+// jittered ray off its texel's triangle — the ray is cast through the BVH (gpu_bvh.h
+// bvhIntersect) as the CPU renderers cast theirs through Embree.
+bool primaryHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
+  ivec2 texel = ivec2(floor(film * float(idScale)));
+  ivec2 lastTexel = size * idScale - 1;
+  uint id = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
+  bool same = id != kMarkedTexel;
+  for (int dy = -1; dy <= 1 && same; ++dy)
+    for (int dx = -1; dx <= 1 && same; ++dx) same = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r == id;
+  const float far = 1.0 / 0.0;
+  if (same && id == 0u) {
+    t = far;
+    triangle = 0xffffffffu;
+    b = vec2(0.0);
+    return false;
+  }
+  if (same) {
+    t = bvhTriangle(id - 1u, eye, direction, 0.0, far, b);
+    triangle = id - 1u;
+    if (t < far && !bvhCutAway(triangle, b)) return true;
+  }
+  return bvhIntersect(eye, direction, 0.0, far, t, triangle, b);
+}
+
+// The camera ray's hit from `origin` along unit `direction` through film point `film`: a
+// pinhole's by primaryHit; a thin lens's rays start off the eye, where the id buffer
+// (rasterised from the eye) says nothing: they are cast through the BVH.
+bool cameraHit(vec2 film, vec3 origin, vec3 direction, out float t, out uint triangle, out vec2 b) {
+  return apertureRadius > 0.0 ? bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, b)
+                              : primaryHit(film, direction, t, triangle, b);
+}
+)glsl";
+
+// Pass 2, one sample per pixel: the camera ray through each pixel's centre and its hit
+// (cameraHit), stored as (t, triangle, b) bits for the shading pass — the ray casting apart
+// from the lookup, each program smaller than the two in one, and each timed on its own.
+constexpr const char* kResolveCompute = R"glsl(
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = HITS_IMAGE_UNIT, rgba32ui) uniform writeonly uimage2D hits;
+void main() {
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (pixel.x >= size.x || pixel.y >= size.y) return;
+  vec2 film = vec2(pixel) + 0.5;
+  vec3 origin, direction;
+  cameraRay(film, vec2(0.5), origin, direction);
+  float t;
+  uint triangle;
+  vec2 b;
+  bool hit = cameraHit(film, origin, direction, t, triangle, b);
+  imageStore(hits, pixel, uvec4(floatBitsToUint(t), hit ? triangle : kNoTriangle, floatBitsToUint(b)));
+}
+)glsl";
+
+// Pass 3: per pixel, the camera ray through its centre (Camera::generateRay), its hit (the
+// resolve pass's) and what is seen there (shadeHit); with several samples per pixel, each
+// sample's ray, hit (cameraHit) and shading in turn.
 constexpr const char* kShadingVertex = R"glsl(
 void main() {
   vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
@@ -419,9 +525,7 @@ void main() {
 }
 )glsl";
 constexpr const char* kShadingFragment = R"glsl(
-layout(binding = 0) uniform usampler2D ids;
 uniform vec3 background;
-uniform bool vignetting;
 uniform float coneSpread;  // textureConeSpread: a sample's ray cone is coneSpread × t wide at t
 out vec4 color;
 
@@ -520,80 +624,11 @@ vec3 specularChain(vec3 origin, vec3 direction, float t, uint triangle, vec2 uv,
 vec3 punctualHighlights(uint record, uint triangle, vec2 uv, vec3 towardsViewer);
 #endif
 
-// The camera ray's primary hit: the ray from the eye along unit `direction` through film point
-// `film` (pixel units) — the ray caster's answer: true with its distance t, triangle and
-// barycentrics b, false on a miss. The id texels answer where they can be trusted: the texel
-// the film point falls in and its 8 neighbours hold one triangle (or all nothing), no vertex
-// marked there (kMarkedTexel), and the ray hits that triangle (Möller–Trumbore, edges
-// inclusive, not cut by an alpha mask). The film point lies within the square of those 9 texel
-// centres, all on that triangle; a nearer triangle would cover one of them or have a vertex
-// in front there, unless it is a sliver narrower than the texel spacing passing between them
-// with its vertices elsewhere (gpu.h). Everywhere else — an edge or silhouette in the 3×3, a
-// triangle smaller than a texel the rasteriser left out (its vertices mark its texels), a
-// jittered ray off its texel's triangle — the ray is cast through the BVH (gpu_bvh.h
-// bvhIntersect) as the CPU renderers cast theirs through Embree.
-bool primaryHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
-  ivec2 texel = ivec2(floor(film * float(idScale)));
-  ivec2 lastTexel = size * idScale - 1;
-  uint id = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
-  bool same = id != kMarkedTexel;
-  for (int dy = -1; dy <= 1 && same; ++dy)
-    for (int dx = -1; dx <= 1 && same; ++dx) same = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r == id;
-  const float far = 1.0 / 0.0;
-  if (same && id == 0u) {
-    t = far;
-    triangle = 0xffffffffu;
-    b = vec2(0.0);
-    return false;
-  }
-  if (same) {
-    t = bvhTriangle(id - 1u, eye, direction, 0.0, far, b);
-    triangle = id - 1u;
-    if (t < far && !bvhCutAway(triangle, b)) return true;
-  }
-  return bvhIntersect(eye, direction, 0.0, far, t, triangle, b);
-}
-
-// sampleConcentricDisk (core/sampling.h): u ∈ [0,1)² to the unit disk (Shirley–Chiu).
-vec2 sampleConcentricDisk(vec2 u) {
-  vec2 o = 2.0 * u - vec2(1.0);
-  if (o.x == 0.0 && o.y == 0.0) return vec2(0.0);
-  const float pi = 3.14159265358979;
-  float r, theta;
-  if (abs(o.x) > abs(o.y)) {
-    r = o.x;
-    theta = (pi / 4.0) * (o.y / o.x);
-  } else {
-    r = o.y;
-    theta = (pi / 2.0) - (pi / 4.0) * (o.x / o.y);
-  }
-  return r * vec2(cos(theta), sin(theta));
-}
-
-// The camera weight times the radiance along the camera ray through film point `film` (pixel
-// units) and lens point `lens` ∈ [0,1)² (Camera::generateRay; the lens point is unused by a
-// pinhole). A thin lens's ray starts off the eye, where the id buffer (rasterised from the
-// eye) says nothing: it is cast through the BVH.
-vec3 sampleRadiance(vec2 film, vec2 lens) {
-  vec3 toFilm = cameraToFilm(film);
-  float invLength = 1.0 / length(toFilm);
-  float weight = 1.0;
-  if (vignetting) weight = invLength * invLength * invLength * invLength;  // cos^4 of the chief ray
-  vec3 origin = eye, direction = toFilm * invLength;
-  if (apertureRadius > 0.0) {
-    // Towards where the chief ray meets the plane of focus, from the lens point.
-    vec3 focusPoint = eye + toFilm * focusDistance;
-    vec2 disk = apertureRadius * sampleConcentricDisk(lens);
-    origin = eye + disk.x * right + disk.y * up;
-    direction = normalize(focusPoint - origin);
-  }
-  // The visible triangle (primaryHit), then the surface there.
-  float t;
-  uint triangle;
-  vec2 b;
-  bool hit = apertureRadius > 0.0 ? bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, b)
-                                  : primaryHit(film, direction, t, triangle, b);
-  if (!hit) return weight * environmentRadiance(direction);
+// The radiance along the camera ray from `origin` along unit `direction` that hits (`hit`)
+// triangle `triangle` at distance t and barycentrics b, or misses: the environment, or the
+// surface there — its lookup, a mirror's or glass's chain, the punctual highlights.
+vec3 shadeHit(vec3 origin, vec3 direction, bool hit, float t, uint triangle, vec2 b) {
+  if (!hit) return environmentRadiance(direction);
   uvec4 tri = triangles[triangle];
   vec3 p = origin + t * direction;
   vec3 normalAtHit, shadingNormal;
@@ -602,16 +637,29 @@ vec3 sampleRadiance(vec2 film, vec2 lens) {
   uint record = viewedRecord(tri.w, -direction, normalAtHit);
 #endif
 #ifdef SPECULAR
-  if (record != kNoRecord && charts[record].info.y == kSpecular)
-    return weight * specularChain(origin, direction, t, triangle, b, mirrorDepth);
+  if (record != kNoRecord && charts[record].info.y == kSpecular) return specularChain(origin, direction, t, triangle, b, mirrorDepth);
 #endif
   SurfaceDetail detail = hitSurfaceDetail(triangle, b, direction, coneSpread * t);
   vec3 radiance = lookupRadiance(tri.w, p, -direction, normalAtHit, shadingNormal, detail);
 #ifdef HIGHLIGHTS
   if (record != kNoRecord) radiance += punctualHighlights(record, triangle, b, -direction);
 #endif
-  return weight * radiance;
+  return radiance;
 }
+
+#ifdef MULTISAMPLE
+// The camera weight times the radiance along the camera ray through film point `film` (pixel
+// units) and lens point `lens` ∈ [0,1)²: cameraRay, cameraHit, shadeHit.
+vec3 sampleRadiance(vec2 film, vec2 lens) {
+  vec3 origin, direction;
+  float weight = cameraRay(film, lens, origin, direction);
+  float t;
+  uint triangle;
+  vec2 b;
+  bool hit = cameraHit(film, origin, direction, t, triangle, b);
+  return weight * shadeHit(origin, direction, hit, t, triangle, b);
+}
+#endif
 
 #ifdef MULTISAMPLE
 // pixelSample (lightfield/render_settings.h): the ZSobol film points of core/sampler.h
@@ -663,9 +711,14 @@ void main() {
   color = vec4(sum / float(spp), 1.0);
 }
 #else
+// One sample, at the pixel and lens centres: the camera ray's hit is the resolve pass's.
+layout(binding = HITS_UNIT) uniform usampler2D hits;
 void main() {
   ivec2 pixel = ivec2(gl_FragCoord.xy);
-  color = vec4(sampleRadiance(vec2(pixel) + 0.5, vec2(0.5)), 1.0);  // the pixel and lens centres
+  vec3 origin, direction;
+  float weight = cameraRay(vec2(pixel) + 0.5, vec2(0.5), origin, direction);
+  uvec4 h = texelFetch(hits, pixel, 0);
+  color = vec4(weight * shadeHit(origin, direction, h.y != kNoTriangle, uintBitsToFloat(h.x), h.y, uintBitsToFloat(h.zw)), 1.0);
 }
 #endif
 )glsl";
@@ -814,8 +867,9 @@ GLuint compileShader(GLenum type, const std::string& source, const char* name) {
 
 /// A program of the given stages, each source prefixed by the version line, `header`
 /// (extensions, defines), the generated constants and, where `lookup`, the lookup functions.
+/// Fragment stages (and compute stages where `computeFrame`) read the geometry and the camera.
 GLuint linkProgram(std::initializer_list<std::pair<GLenum, std::string>> stages, const char* name, bool lookup,
-                   const std::string& header = "") {
+                   const std::string& header = "", bool computeFrame = false) {
   const std::string prefix = "#version 450 core\n" + header + glslConstants();
   // The surface detail (its buffer and functions) for the fragment and compute stages, the
   // triangles and the camera for the fragment stages.
@@ -823,8 +877,9 @@ GLuint linkProgram(std::initializer_list<std::pair<GLenum, std::string>> stages,
   const GLuint program = glCreateProgram();
   std::vector<GLuint> shaders;
   for (const auto& [type, source] : stages) {
+    const bool frame = type == GL_FRAGMENT_SHADER || (type == GL_COMPUTE_SHADER && computeFrame);
     const std::string text = type == GL_VERTEX_SHADER ? prefix + source
-                                                      : prefix + (type == GL_FRAGMENT_SHADER ? std::string(kGeometryGlsl) + kFrameGlsl : "") + detail +
+                                                      : prefix + (frame ? std::string(kGeometryGlsl) + kFrameGlsl : "") + detail +
                                                             (lookup ? kLookupGlsl : "") + source;
     shaders.push_back(compileShader(type, text, name));
     glAttachShader(program, shaders.back());
@@ -904,7 +959,7 @@ struct GpuRenderer::State {
   static constexpr GLsizei kBufferCount = 9;
   GLuint buffers[kBufferCount] = {};
   GLuint vertexArray = 0, emptyVertexArray = 0;
-  GLuint visibilityProgram = 0, markerProgram = 0, shadingProgram = 0, lookupProgram = 0;
+  GLuint visibilityProgram = 0, markerProgram = 0, resolveProgram = 0, shadingProgram = 0, lookupProgram = 0;
   /// The BVH (gpu_bvh.h: nodes, order), the materials of the specular chains and shadow rays
   /// (gpu_specular.h: per material, per triangle) and the highlights' lights and models
   /// (gpu_highlights.h); the BVH is built with the first program that traces rays.
@@ -921,11 +976,15 @@ struct GpuRenderer::State {
   /// The shading pass with several jittered samples per pixel; 0 where the driver lacks
   /// GL_ARB_gpu_shader_int64 (the sample positions' 64-bit hash).
   GLuint multisampleProgram = 0;
-  /// GL_TIMESTAMP queries at the start of a render()'s first pass and the end of its shading
-  /// pass, and the GPU time between them in the last render() (lastGpuMilliseconds).
-  GLuint timestampQueries[2] = {};
-  double lastGpuMilliseconds = 0.0;
-  GLuint idTexture = 0, depthBuffer = 0, colorTexture = 0, visibilityFramebuffer = 0, shadingFramebuffer = 0;
+  /// GL_TIMESTAMP queries at the start of a render()'s first pass and at the end of its
+  /// visibility, resolve and shading passes, and the GPU times between them in the last
+  /// render() (lastGpuMilliseconds, lastGpuPasses).
+  static constexpr int kTimestamps = 4;
+  GLuint timestampQueries[kTimestamps] = {};
+  GpuPassMilliseconds lastPasses;
+  /// The frame's targets: the triangle ids and depth of the visibility pass, the camera rays'
+  /// hits of the resolve pass (one sample per pixel), the radiance of the shading pass.
+  GLuint idTexture = 0, depthBuffer = 0, hitsTexture = 0, colorTexture = 0, visibilityFramebuffer = 0, shadingFramebuffer = 0;
   int width = 0, height = 0;
   int idScale = 1;  ///< the visibility targets are idScale·width × idScale·height
   GLsizei indexCount = 0, vertexCount = 0;
@@ -947,23 +1006,25 @@ struct GpuRenderer::State {
     glDeleteVertexArrays(1, &emptyVertexArray);
     glDeleteProgram(visibilityProgram);
     glDeleteProgram(markerProgram);
+    glDeleteProgram(resolveProgram);
     glDeleteProgram(shadingProgram);
     glDeleteProgram(lookupProgram);
     glDeleteProgram(multisampleProgram);
-    glDeleteQueries(2, timestampQueries);
+    glDeleteQueries(kTimestamps, timestampQueries);
     releaseTargets();
   }
   void releaseTargets() {
     glDeleteFramebuffers(1, &visibilityFramebuffer);
     glDeleteFramebuffers(1, &shadingFramebuffer);
     glDeleteTextures(1, &idTexture);
+    glDeleteTextures(1, &hitsTexture);
     glDeleteTextures(1, &colorTexture);
     glDeleteRenderbuffers(1, &depthBuffer);
-    visibilityFramebuffer = shadingFramebuffer = idTexture = colorTexture = depthBuffer = 0;
+    visibilityFramebuffer = shadingFramebuffer = idTexture = hitsTexture = colorTexture = depthBuffer = 0;
     width = height = 0;
   }
-  /// The frame's targets: radiance at width × height, triangle ids and depth at scale·width ×
-  /// scale·height (re-made only when a size changes).
+  /// The frame's targets: hits and radiance at width × height, triangle ids and depth at
+  /// scale·width × scale·height (re-made only when a size changes).
   void ensureTargets(int w, int h, int scale) {
     if (w == width && h == height && scale == idScale) return;
     releaseTargets();
@@ -974,6 +1035,11 @@ struct GpuRenderer::State {
     glTextureParameteri(idTexture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glCreateRenderbuffers(1, &depthBuffer);
     glNamedRenderbufferStorage(depthBuffer, GL_DEPTH_COMPONENT32F, w * scale, h * scale);
+    // The hits: (t, triangle, b1, b2) as bits, read back exactly (texelFetch, no filtering).
+    glCreateTextures(GL_TEXTURE_2D, 1, &hitsTexture);
+    glTextureStorage2D(hitsTexture, 1, GL_RGBA32UI, w, h);
+    glTextureParameteri(hitsTexture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(hitsTexture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glCreateTextures(GL_TEXTURE_2D, 1, &colorTexture);
     glTextureStorage2D(colorTexture, 1, GL_RGBA32F, w, h);
     glCreateFramebuffers(1, &visibilityFramebuffer);
@@ -1006,8 +1072,35 @@ struct GpuRenderer::State {
     checkGl("uploading the BVH (out of GPU memory?)");
     bvhUploaded = true;
   }
+  /// Pass 1, queued (not waited for): the triangle ids at idScale × the camera's resolution,
+  /// then the vertex markers.
+  void queueVisibility(const Camera& camera, int scale) {
+    ensureTargets(camera.width(), camera.height(), scale);
+    setCameraUniforms(visibilityProgram, camera);
+    glProgramUniform2i(visibilityProgram, glGetUniformLocation(visibilityProgram, "size"), camera.width(), camera.height());
+    glProgramUniform1i(visibilityProgram, glGetUniformLocation(visibilityProgram, "idScale"), scale);
+    glBindFramebuffer(GL_FRAMEBUFFER, visibilityFramebuffer);
+    glViewport(0, 0, camera.width() * scale, camera.height() * scale);
+    const GLuint noTriangle = 0;
+    glClearNamedFramebufferuiv(visibilityFramebuffer, GL_COLOR, 0, &noTriangle);
+    const float farthest = 0.0f;
+    glClearNamedFramebufferfv(visibilityFramebuffer, GL_DEPTH, 0, &farthest);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(visibilityProgram);
+    glBindVertexArray(vertexArray);
+    glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+    // The markers (kMarkerFragment): the vertices as one-texel points, nearer than the surface.
+    setCameraUniforms(markerProgram, camera);
+    glDepthMask(GL_FALSE);
+    glUseProgram(markerProgram);
+    glDrawArrays(GL_POINTS, 0, vertexCount);
+    glDepthMask(GL_TRUE);
+    checkGl("the visibility pass");
+  }
   uint64_t targetBytes() const {
-    return uint64_t(width) * uint64_t(height) * (16 + uint64_t(idScale) * uint64_t(idScale) * (4 + 4));
+    return uint64_t(width) * uint64_t(height) * (16 + 16 + uint64_t(idScale) * uint64_t(idScale) * (4 + 4));
   }
 };
 
@@ -1211,11 +1304,14 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                      (gpu::tracedSurfaceDetail(lightField) ? "#define TRACED_DETAIL\n" : "") +
                                      (mirrorLike ? "#define MIRROR_LIKE\n" : "") +
                                      (lobeLights ? "#define LOBE_LIGHTS\n" + lightGlslConstants() : "");
-  const std::string shading = std::string(kBvhGlsl) + kShadingFragment + (traces ? kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
+  const std::string shading = std::string(kBvhGlsl) + kPrimaryHitGlsl + kShadingFragment + (traces ? kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
                               (lobeLights ? kLightsGlsl : "") + (mirrorLike ? kMirrorLikeGlsl : "") +
                               (s.specular ? kSpecularGlsl : "");
   s.shadingProgram =
       linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}}, "shading", true, raysHeader);
+  // The resolve pass casts rays only: the BVH, cut by alpha masks where the scene has some.
+  s.resolveProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kBvhGlsl) + kPrimaryHitGlsl + kResolveCompute}}, "resolve",
+                                 false, bvhGlslConstants() + (anyMasked ? "#define BVH_ALPHA_MASKS\n" : ""), true);
   s.lookupProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + kLookupCompute}}, "lookup", true);
   if (epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
     s.multisampleProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}},
@@ -1223,7 +1319,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                        (s.specular ? raysHeader : int64 + raysHeader) + "#define MULTISAMPLE\n");
   for (GLuint program : {s.visibilityProgram, s.markerProgram})
     glProgramUniform1f(program, glGetUniformLocation(program, "near"), s.near);
-  for (GLuint program : {s.visibilityProgram, s.shadingProgram, s.multisampleProgram})
+  for (GLuint program : {s.visibilityProgram, s.resolveProgram, s.shadingProgram, s.multisampleProgram})
     if (program != 0) glProgramUniform1i(program, glGetUniformLocation(program, "anyMasked"), anyMasked ? 1 : 0);
   for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {
     if (program == 0) continue;
@@ -1274,30 +1370,8 @@ GpuRenderer::~GpuRenderer() = default;
 void GpuRenderer::drawVisibility(const Camera& camera, int idScale) {
   State& s = *state_;
   s.context.makeCurrent();
-  s.ensureTargets(camera.width(), camera.height(), idScale);
-  setCameraUniforms(s.visibilityProgram, camera);
-  glProgramUniform2i(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "size"), camera.width(), camera.height());
-  glProgramUniform1i(s.visibilityProgram, glGetUniformLocation(s.visibilityProgram, "idScale"), idScale);
-  glBindFramebuffer(GL_FRAMEBUFFER, s.visibilityFramebuffer);
-  glViewport(0, 0, camera.width() * idScale, camera.height() * idScale);
-  const GLuint noTriangle = 0;
-  glClearNamedFramebufferuiv(s.visibilityFramebuffer, GL_COLOR, 0, &noTriangle);
-  const float farthest = 0.0f;
-  glClearNamedFramebufferfv(s.visibilityFramebuffer, GL_DEPTH, 0, &farthest);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_GREATER);
-  glDisable(GL_CULL_FACE);
-  glUseProgram(s.visibilityProgram);
-  glBindVertexArray(s.vertexArray);
-  glDrawElements(GL_TRIANGLES, s.indexCount, GL_UNSIGNED_INT, nullptr);
-  // The markers (kMarkerFragment): the vertices as one-texel points, nearer than the surface.
-  setCameraUniforms(s.markerProgram, camera);
-  glDepthMask(GL_FALSE);
-  glUseProgram(s.markerProgram);
-  glDrawArrays(GL_POINTS, 0, s.vertexCount);
-  glDepthMask(GL_TRUE);
+  s.queueVisibility(camera, idScale);
   glFinish();
-  checkGl("the visibility pass");
 }
 
 std::string GpuRenderer::unsupportedSetting(const RenderSettings& settings, const Camera& camera) const {
@@ -1314,25 +1388,41 @@ void GpuRenderer::checkSettings(const RenderSettings& settings, const Camera& ca
 
 void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) {
   checkSettings(settings, camera);
-  // One sample: the pixel centre; several: pixelSample's film points, whose triangles
-  // are looked for in a visibility pass at a finer resolution (multiSampleIdScale).
-  // A thin lens's rays are all cast through the BVH: no visibility pass.
+  // One sample: the pixel centre, its ray cast by the resolve pass; several: pixelSample's film
+  // points, whose triangles are looked for in a visibility pass at a finer resolution
+  // (multiSampleIdScale) by the shading pass itself. A thin lens's rays are all cast through the
+  // BVH: no visibility pass.
   const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
   const int idScale = spp > 1 && !camera.isThinLens() ? multiSampleIdScale(camera.width(), camera.height()) : 1;
   State& s = *state_;
   s.context.makeCurrent();
-  if (s.timestampQueries[0] == 0) glCreateQueries(GL_TIMESTAMP, 2, s.timestampQueries);
+  if (s.timestampQueries[0] == 0) glCreateQueries(GL_TIMESTAMP, State::kTimestamps, s.timestampQueries);
   glQueryCounter(s.timestampQueries[0], GL_TIMESTAMP);
   if (camera.isThinLens()) {
     s.ensureTargets(camera.width(), camera.height(), idScale);
   } else {
-    drawVisibility(camera, idScale);
+    s.queueVisibility(camera, idScale);
   }
+  glQueryCounter(s.timestampQueries[1], GL_TIMESTAMP);
+  auto setFrameUniforms = [&](GLuint program) {
+    setCameraUniforms(program, camera);
+    glProgramUniform2i(program, glGetUniformLocation(program, "size"), camera.width(), camera.height());
+    glProgramUniform1i(program, glGetUniformLocation(program, "idScale"), idScale);
+    glProgramUniform1i(program, glGetUniformLocation(program, "vignetting"), camera.vignetting() ? 1 : 0);
+  };
+  glBindTextureUnit(kIdsUnit, s.idTexture);
+  if (spp == 1) {
+    setFrameUniforms(s.resolveProgram);
+    glUseProgram(s.resolveProgram);
+    glBindImageTexture(kHitsImageUnit, s.hitsTexture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32UI);
+    glDispatchCompute(GLuint((camera.width() + 7) / 8), GLuint((camera.height() + 7) / 8), 1);
+    // The shading pass fetches the hits the dispatch stored.
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glBindTextureUnit(kHitsUnit, s.hitsTexture);
+  }
+  glQueryCounter(s.timestampQueries[2], GL_TIMESTAMP);
   const GLuint program = spp > 1 ? s.multisampleProgram : s.shadingProgram;
-  setCameraUniforms(program, camera);
-  glProgramUniform2i(program, glGetUniformLocation(program, "size"), camera.width(), camera.height());
-  glProgramUniform1i(program, glGetUniformLocation(program, "idScale"), idScale);
-  glProgramUniform1i(program, glGetUniformLocation(program, "vignetting"), camera.vignetting() ? 1 : 0);
+  setFrameUniforms(program);
   if (s.specular)
     glProgramUniform1ui(program, glGetUniformLocation(program, "mirrorDepth"),
                         effectiveMirrorDepth(settings, lightField_.settings.mirrorDepth));
@@ -1350,24 +1440,26 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   glViewport(0, 0, camera.width(), camera.height());
   glDisable(GL_DEPTH_TEST);
   glUseProgram(program);
-  glBindTextureUnit(0, s.idTexture);
   glBindVertexArray(s.emptyVertexArray);
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  glQueryCounter(s.timestampQueries[1], GL_TIMESTAMP);
+  glQueryCounter(s.timestampQueries[3], GL_TIMESTAMP);
   if (image.width != camera.width() || image.height != camera.height()) image = Image(camera.width(), camera.height());
   // GL row y is image row y (the projection flips film y): read straight into the pixels.
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glReadnPixels(0, 0, camera.width(), camera.height(), GL_RGB, GL_FLOAT, GLsizei(image.pixels.size() * sizeof(Rgb)),
                 image.pixels.data());
-  // (The read-back waited for the shading pass, so both timestamps are there.)
-  GLuint64 start = 0, end = 0;
-  glGetQueryObjectui64v(s.timestampQueries[0], GL_QUERY_RESULT, &start);
-  glGetQueryObjectui64v(s.timestampQueries[1], GL_QUERY_RESULT, &end);
-  s.lastGpuMilliseconds = end > start ? double(end - start) * 1e-6 : 0.0;
+  // (The read-back waited for the shading pass, so every timestamp is there.)
+  GLuint64 stamps[State::kTimestamps] = {};
+  for (int i = 0; i < State::kTimestamps; ++i) glGetQueryObjectui64v(s.timestampQueries[i], GL_QUERY_RESULT, &stamps[i]);
+  auto milliseconds = [&](int from, int to) { return stamps[to] > stamps[from] ? double(stamps[to] - stamps[from]) * 1e-6 : 0.0; };
+  s.lastPasses = {milliseconds(0, 1), milliseconds(1, 2), milliseconds(2, 3)};
+  s.lastPasses.total = milliseconds(0, 3);
   checkGl("the shading pass");
 }
 
-double GpuRenderer::lastGpuMilliseconds() const { return state_->lastGpuMilliseconds; }
+double GpuRenderer::lastGpuMilliseconds() const { return state_->lastPasses.total; }
+
+GpuPassMilliseconds GpuRenderer::lastGpuPasses() const { return state_->lastPasses; }
 
 std::vector<Rgb> GpuRenderer::lookup(const std::vector<LookupQuery>& queries) {
   State& s = *state_;

@@ -1036,8 +1036,8 @@ TEST_F(GpuRendererTest, GpuMemoryIsTheLightFieldAndOneFrame) {
   gpu.render(Camera(firstCamera(lf.scene), 64, 48), RenderSettings{}, image);
   // Values as 16-byte RGBA, 128 bytes per chart record, the geometry, 292 bytes per material
   // and the GGX and sheen albedo tables after a 32-byte header (no textures, uvs or masks here),
-  // the BVH of the primary rays beside edges (32 bytes per node, 4 per triangle) and 24 bytes
-  // per pixel.
+  // the BVH of the primary rays beside edges (32 bytes per node, 4 per triangle) and 40 bytes
+  // per pixel (radiance, hits, id and depth).
   uint64_t geometry = 0;
   for (const Mesh& m : lf.scene.meshes) geometry += m.positions.size() * 32 + m.triangles.size() * 28;
   const GgxAlbedoTables& ggx = ggxAlbedoTables();
@@ -1050,7 +1050,7 @@ TEST_F(GpuRendererTest, GpuMemoryIsTheLightFieldAndOneFrame) {
   const GpuBvh bvh = buildGpuBvh(positions, triangles);
   const uint64_t expected = lf.values.size() * 16 + lf.charts.size() * 128 + geometry + 32 +
                             lf.scene.materials.size() * 292 + tables + bvh.nodes.size() * 32 +
-                            bvh.order.size() * 4 + 64 * 48 * 24;
+                            bvh.order.size() * 4 + 64 * 48 * 40;
   EXPECT_LE(gpu.gpuBytes(), expected + 8 * 16);  // 16-byte stand-ins for empty buffers
   EXPECT_GE(gpu.gpuBytes(), expected);
   EXPECT_NE(gpu.deviceName().find("OpenGL 4.5"), std::string::npos) << gpu.deviceName();
@@ -1159,7 +1159,7 @@ TEST_F(GpuRenderCliTest, ShaderDumpWritesEachStage) {
                          nullptr, &err);
   ::unsetenv("PLENOPTIC_GPU_SHADER_DUMP");
   ASSERT_EQ(status, 0) << err;
-  for (const char* name : {"visibility.vert", "visibility.frag", "shading.frag"}) {
+  for (const char* name : {"visibility.vert", "visibility.frag", "resolve.comp", "shading.frag"}) {
     SCOPED_TRACE(name);
     const std::string text = cli_test::readFileText((dir / name).string());
     EXPECT_EQ(text.rfind("#version 450 core\n", 0), 0u);
@@ -1186,6 +1186,13 @@ TEST_F(GpuRenderCliTest, RendersTheCpuPicture) {
   EXPECT_GT(double(json["gpu_ms_median"]), 0.0);
   EXPECT_LE(double(json["gpu_ms_min"]), double(json["gpu_ms_median"]));
   EXPECT_LE(double(json["gpu_ms_median"]), double(json["ms_per_frame_median"]));
+  // Pass by pass: the three are the frame's GPU time (one frame, so the medians add up).
+  const double visibility = json["gpu_visibility_ms_median"], resolve = json["gpu_resolve_ms_median"],
+               shading = json["gpu_shading_ms_median"];
+  EXPECT_GT(visibility, 0.0);
+  EXPECT_GT(resolve, 0.0);
+  EXPECT_GT(shading, 0.0);
+  EXPECT_NEAR(visibility + resolve + shading, double(json["gpu_ms_median"]), 1e-6);
   // A thin lens likewise (depth of field: its lens points are the CPU renderer's).
   const std::string lens = size + " --aperture 0.5 --spp 4";
   ASSERT_EQ(run("render " + path("box.plf") + " -o " + path("gpu-lens.exr") + lens + " --renderer gpu", nullptr, &err), 0) << err;

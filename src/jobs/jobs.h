@@ -272,6 +272,8 @@ struct RenderJobStats {
   /// frames when stats are written for the fast or GPU renderer; 0 = not timed.
   double primaryMsMedian = 0, primaryMsMin = 0;
   double gpuMsMedian = 0, gpuMsMin = 0;  ///< the GPU renderer: its own time per frame (GpuRenderer::lastGpuMilliseconds)
+  /// The GPU renderer's passes' medians (GpuRenderer::lastGpuPasses).
+  double gpuVisibilityMsMedian = 0, gpuResolveMsMedian = 0, gpuShadingMsMedian = 0;
   double loadSeconds = 0, accelBuildSeconds = 0;
   uint64_t fileBytes = 0;
   /// A path with light keyframes: frames relit, iterations, and the time relighting took

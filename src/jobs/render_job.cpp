@@ -50,6 +50,9 @@ std::string RenderJobStats::toJson() const {
   if (gpuMsMedian > 0.0) {
     json["gpu_ms_median"] = gpuMsMedian;
     json["gpu_ms_min"] = gpuMsMin;
+    json["gpu_visibility_ms_median"] = gpuVisibilityMsMedian;
+    json["gpu_resolve_ms_median"] = gpuResolveMsMedian;
+    json["gpu_shading_ms_median"] = gpuShadingMsMedian;
   }
   if (primaryMsMedian > 0.0) {
     json["primary_ms_median"] = primaryMsMedian;
@@ -166,7 +169,7 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   settings.showProgress = o.frames == 1 && o.reference;
   RenderJobResult result;
   Image& image = result.image;
-  std::vector<double> frameMs, primaryMs, gpuMs;
+  std::vector<double> frameMs, primaryMs, gpuMs, gpuVisibilityMs, gpuResolveMs, gpuShadingMs;
   // With --stats, the fast renderer's first pass alone (FastRenderer::castPrimaryRays) is
   // timed on every frame's camera after the last frame (interleaving it with the frames would
   // evict their light-field data from the caches and slow them down).
@@ -179,7 +182,11 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
       image = renderLightField(relit ? *relit : lightField, accel, frameCamera, settings);
     } else if (gpuRenderer) {
       gpuRenderer->render(frameCamera, settings, image);
-      gpuMs.push_back(gpuRenderer->lastGpuMilliseconds());
+      const GpuPassMilliseconds passes = gpuRenderer->lastGpuPasses();
+      gpuMs.push_back(passes.total);
+      gpuVisibilityMs.push_back(passes.visibility);
+      gpuResolveMs.push_back(passes.resolve);
+      gpuShadingMs.push_back(passes.shading);
     } else {
       (relitRenderer ? *relitRenderer : fastRenderer).render(frameCamera, settings, image);
     }
@@ -246,6 +253,9 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   if (!gpuMs.empty()) {
     stats.gpuMsMedian = median(gpuMs);
     stats.gpuMsMin = *std::min_element(gpuMs.begin(), gpuMs.end());
+    stats.gpuVisibilityMsMedian = median(gpuVisibilityMs);
+    stats.gpuResolveMsMedian = median(gpuResolveMs);
+    stats.gpuShadingMsMedian = median(gpuShadingMs);
   }
   if (!primaryMs.empty()) {
     stats.primaryMsMedian = median(primaryMs);
