@@ -43,11 +43,12 @@
 // as the CPU packs it, 12 of a float one, every mip level of an albedo texture — 292 bytes per
 // material, 10 KiB of GGX and sheen albedo tables, and where a chart, mask or traced hit needs uvs, 36 bytes per vertex and 4 per triangle). So
 // GPU memory is 16 bytes per value + 128 per chart + 32 per vertex + 28 per triangle + 4 per
-// sun mask + 16 per environment texel + the surface detail + the BVH's 32 per node and 4 per
+// sun mask + 16 per environment texel + the surface detail + the BVH's 32 per node and 48 per
 // triangle + (with mirrors, glass or punctual highlights) 64 per material and 4 per triangle for
 // the chains and shadow rays, and 64 per delta light and 64 per material for the highlights +
-// the frame's targets (radiance and the resolve pass's hits 16 bytes per pixel each; id and
-// depth 8 bytes per pixel, or per texel of the finer multi-sample visibility pass). A light field whose buffers exceed the GPU
+// the frame's targets (radiance and the resolve pass's hits 16 bytes per pixel each, its queue
+// of rays to cast 4 and 16 in all; id and depth 8 bytes per pixel, or per texel of the finer
+// multi-sample visibility pass). A light field whose buffers exceed the GPU
 // memory available (gpu_memory.h: the driver's query, GL_NVX_gpu_memory_info or
 // GL_ATI_meminfo; the PLENOPTIC_GPU_MEMORY variable; 4 GiB where neither says) is refused
 // before anything is uploaded, with the sizes, and so is one with a buffer larger than the
@@ -177,6 +178,11 @@ class GpuRenderer {
   double lastGpuMilliseconds() const;
   /// The same time pass by pass (`render --stats` gpu_visibility_ms_median, ...).
   GpuPassMilliseconds lastGpuPasses() const;
+  /// The most pixels (width × height) render() draws on this driver: the resolve pass's queue
+  /// of rays to cast, 4 bytes per pixel, within its largest storage block
+  /// (GL_MAX_SHADER_STORAGE_BLOCK_SIZE: 128 MiB on llvmpipe, 33.5 M pixels). render() refuses a
+  /// larger image with the sizes.
+  uint64_t maxImagePixels() const;
 
   /// One lookup query: the chart record as triangleChart gives it (facingChart turns it to the
   /// side the viewer is on), a world point and the unit direction towards the viewer.

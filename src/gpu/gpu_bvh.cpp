@@ -158,35 +158,67 @@ GpuBvh buildGpuBvh(const std::vector<Vec3>& positions, const std::vector<UVec3>&
   builder.bvh.nodes.reserve(size_t(2) * n / kBvhLeafTriangles + 1);
   builder.bvh.nodes.resize(1);
   builder.build(0, 0, n, 0);
+  fillBvhTriangles(builder.bvh, positions, triangles);
   return std::move(builder.bvh);
 }
 
-BvhHit intersectGpuBvh(const GpuBvh& bvh, const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles,
-                       const Ray& ray) {
+void fillBvhTriangles(GpuBvh& bvh, const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles) {
+  const size_t n = bvh.order.size();
+  bvh.triangles.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const UVec3& v = triangles[bvh.order[i]];
+    const Vec3 p0 = positions[v[0]], e1 = positions[v[1]] - p0, e2 = positions[v[2]] - p0;
+    BvhTriangle& record = bvh.triangles[i];
+    for (int k = 0; k < 3; ++k) {
+      record.p0[k] = p0[k];
+      record.e1[k] = e1[k];
+      record.e2[k] = e2[k];
+    }
+    record.e1[3] = record.e2[3] = 0.0f;
+    record.triangle = bvh.order[i];
+  }
+}
+
+BvhHit intersectGpuBvh(const GpuBvh& bvh, const Ray& ray) {
   // kBvhGlsl's bvhIntersect, statement for statement.
   BvhHit hit;
   hit.t = ray.tMax;
   Vec3 inverse;
   for (int k = 0; k < 3; ++k)
     inverse[k] = 1.0f / (std::abs(ray.direction[k]) > 1e-20f ? ray.direction[k] : (ray.direction[k] >= 0.0f ? 1e-20f : -1e-20f));
+  // Each node with its entry distance: popped, it is skipped when a hit since lies nearer.
   uint32_t stack[64];
+  float stackEnter[64];
   int top = 0;
-  stack[top++] = 0;
+  const float rootEnter = enterNode(bvh.nodes[0], ray.origin, inverse, ray.tMin, hit.t);
+  if (rootEnter < kInfinity) {
+    stack[0] = 0;
+    stackEnter[0] = rootEnter;
+    top = 1;
+  }
   while (top > 0) {
-    const BvhNode& node = bvh.nodes[stack[--top]];
-    if (!(enterNode(node, ray.origin, inverse, ray.tMin, hit.t) < kInfinity)) continue;
+    --top;
+    if (!(stackEnter[top] <= hit.t)) continue;
+    const BvhNode& node = bvh.nodes[stack[top]];
     if (node.count == 0) {
       const float a = enterNode(bvh.nodes[node.first], ray.origin, inverse, ray.tMin, hit.t);
       const float b = enterNode(bvh.nodes[node.first + 1], ray.origin, inverse, ray.tMin, hit.t);
       // The nearer child on top; a missed child not pushed.
       const uint32_t nearer = a <= b ? node.first : node.first + 1, farther = a <= b ? node.first + 1 : node.first;
-      if (std::max(a, b) < kInfinity && top < 64) stack[top++] = farther;
-      if (std::min(a, b) < kInfinity && top < 64) stack[top++] = nearer;
+      if (std::max(a, b) < kInfinity && top < 64) {
+        stack[top] = farther;
+        stackEnter[top++] = std::max(a, b);
+      }
+      if (std::min(a, b) < kInfinity && top < 64) {
+        stack[top] = nearer;
+        stackEnter[top++] = std::min(a, b);
+      }
       continue;
     }
     for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-      const uint32_t t = bvh.order[i];
-      const Vec3 p0 = positions[triangles[t][0]], e1 = positions[triangles[t][1]] - p0, e2 = positions[triangles[t][2]] - p0;
+      const BvhTriangle& record = bvh.triangles[i];
+      const Vec3 p0(record.p0[0], record.p0[1], record.p0[2]), e1(record.e1[0], record.e1[1], record.e1[2]),
+          e2(record.e2[0], record.e2[1], record.e2[2]);
       const Vec3 q = glm::cross(ray.direction, e2);
       const float det = glm::dot(e1, q);
       if (det == 0.0f) continue;
@@ -197,7 +229,7 @@ BvhHit intersectGpuBvh(const GpuBvh& bvh, const std::vector<Vec3>& positions, co
       const float distance = glm::dot(e2, r) / det;
       if (u >= 0.0f && v >= 0.0f && u + v <= 1.0f && distance > ray.tMin && distance < hit.t) {
         hit.t = distance;
-        hit.triangle = t;
+        hit.triangle = record.triangle;
         hit.barycentrics = Vec2(u, v);
       }
     }
@@ -207,13 +239,15 @@ BvhHit intersectGpuBvh(const GpuBvh& bvh, const std::vector<Vec3>& positions, co
 }
 
 std::string bvhGlslConstants() {
-  return fmt::format("#define BVH_NODES_BINDING {}\n#define BVH_ORDER_BINDING {}\n", kBvhNodesBinding, kBvhOrderBinding);
+  return fmt::format("#define BVH_NODES_BINDING {}\n#define BVH_TRIANGLES_BINDING {}\n", kBvhNodesBinding, kBvhTrianglesBinding);
 }
 
 const char* const kBvhGlsl = R"glsl(
 struct BvhNode { vec4 lower; vec4 upper; };  // lower.w: first (uint bits), upper.w: count
 layout(std430, binding = BVH_NODES_BINDING) readonly buffer BvhNodes { BvhNode bvhNodes[]; };
-layout(std430, binding = BVH_ORDER_BINDING) readonly buffer BvhOrder { uint bvhOrder[]; };
+// BvhTriangle: p0 (w: the triangle's index, as uint bits), e1, e2.
+struct BvhTriangleRecord { vec4 p0; vec4 e1; vec4 e2; };
+layout(std430, binding = BVH_TRIANGLES_BINDING) readonly buffer BvhTriangles { BvhTriangleRecord bvhTriangles[]; };
 const float kNoEntry = 1.0 / 0.0;
 // The slab test: entry distance into node's box within (tMin, tMax), +inf on a miss.
 float bvhEnter(uint node, vec3 origin, vec3 inverseDirection, float tMin, float tMax) {
@@ -229,10 +263,9 @@ vec3 bvhInverse(vec3 d) {
   vec3 tiny = mix(vec3(-1e-20), vec3(1e-20), greaterThanEqual(d, vec3(0.0)));
   return 1.0 / mix(tiny, d, greaterThan(abs(d), vec3(1e-20)));
 }
-// Möller–Trumbore, edges inclusive: the distance along the ray, +inf on a miss; (u, v) as Embree's.
-float bvhTriangle(uint triangle, vec3 origin, vec3 direction, float tMin, float tMax, out vec2 uv) {
-  uvec4 tri = triangles[triangle];
-  vec3 p0 = positions[tri.x].xyz, e1 = positions[tri.y].xyz - p0, e2 = positions[tri.z].xyz - p0;
+// Möller–Trumbore, edges inclusive, on the triangle with first vertex p0 and edges e1, e2:
+// the distance along the ray, +inf on a miss; (u, v) as Embree's.
+float mollerTrumbore(vec3 p0, vec3 e1, vec3 e2, vec3 origin, vec3 direction, float tMin, float tMax, out vec2 uv) {
   vec3 q = cross(direction, e2);
   float det = dot(e1, q);
   uv = vec2(0.0);
@@ -244,6 +277,18 @@ float bvhTriangle(uint triangle, vec3 origin, vec3 direction, float tMin, float 
   float t = dot(e2, r) / det;
   uv = vec2(u, v);
   return u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > tMin && t < tMax ? t : kNoEntry;
+}
+// The same on triangle `triangle` of the triangle array.
+float bvhTriangle(uint triangle, vec3 origin, vec3 direction, float tMin, float tMax, out vec2 uv) {
+  uvec4 tri = triangles[triangle];
+  vec3 p0 = positions[tri.x].xyz;
+  return mollerTrumbore(p0, positions[tri.y].xyz - p0, positions[tri.z].xyz - p0, origin, direction, tMin, tMax, uv);
+}
+// The same on the leaf-order triangle i (BvhTriangles), its index in `triangle`.
+float bvhLeafTriangle(uint i, vec3 origin, vec3 direction, float tMin, float tMax, out vec2 uv, out uint triangle) {
+  BvhTriangleRecord r = bvhTriangles[i];
+  triangle = floatBitsToUint(r.p0.w);
+  return mollerTrumbore(r.p0.xyz, r.e1.xyz, r.e2.xyz, origin, direction, tMin, tMax, uv);
 }
 // The ray caster's alpha-mask hit filter (accel_embree.cpp alphaMaskFilter): a candidate hit
 // on an alpha-masked triangle where its coverage is below the cutoff (coverageAt) is no hit and
@@ -259,29 +304,44 @@ bool bvhCutAway(uint triangle, vec2 uv) {
 // The closest hit in (tMin, tMax): true and its distance, triangle and barycentrics.
 bool bvhIntersect(vec3 origin, vec3 direction, float tMin, float tMax, out float t, out uint triangle, out vec2 uv) {
   vec3 inverse = bvhInverse(direction);
+  // Each node with its entry distance: popped, it is skipped when a hit since lies nearer.
   uint stack[64];
+  float stackEnter[64];
   int top = 0;
-  stack[top++] = 0u;
   t = tMax;
   triangle = 0xffffffffu;
   uv = vec2(0.0);
+  float rootEnter = bvhEnter(0u, origin, inverse, tMin, t);
+  if (rootEnter < kNoEntry) {
+    stack[0] = 0u;
+    stackEnter[0] = rootEnter;
+    top = 1;
+  }
   while (top > 0) {
-    uint node = stack[--top];
-    if (!(bvhEnter(node, origin, inverse, tMin, t) < kNoEntry)) continue;
+    --top;
+    if (!(stackEnter[top] <= t)) continue;
+    uint node = stack[top];
     uint first = floatBitsToUint(bvhNodes[node].lower.w), count = floatBitsToUint(bvhNodes[node].upper.w);
     if (count == 0u) {
       float a = bvhEnter(first, origin, inverse, tMin, t), b = bvhEnter(first + 1u, origin, inverse, tMin, t);
       uint nearer = a <= b ? first : first + 1u, farther = a <= b ? first + 1u : first;
-      if (max(a, b) < kNoEntry && top < 64) stack[top++] = farther;
-      if (min(a, b) < kNoEntry && top < 64) stack[top++] = nearer;
+      if (max(a, b) < kNoEntry && top < 64) {
+        stack[top] = farther;
+        stackEnter[top++] = max(a, b);
+      }
+      if (min(a, b) < kNoEntry && top < 64) {
+        stack[top] = nearer;
+        stackEnter[top++] = min(a, b);
+      }
       continue;
     }
     for (uint i = first; i < first + count; ++i) {
       vec2 hitUv;
-      float hit = bvhTriangle(bvhOrder[i], origin, direction, tMin, t, hitUv);
-      if (hit < t && !bvhCutAway(bvhOrder[i], hitUv)) {
+      uint candidate;
+      float hit = bvhLeafTriangle(i, origin, direction, tMin, t, hitUv, candidate);
+      if (hit < t && !bvhCutAway(candidate, hitUv)) {
         t = hit;
-        triangle = bvhOrder[i];
+        triangle = candidate;
         uv = hitUv;
       }
     }
@@ -308,7 +368,8 @@ bool bvhOccluded(vec3 origin, vec3 direction, float tMin, float tMax) {
     }
     for (uint i = first; i < first + count; ++i) {
       vec2 uv;
-      if (bvhTriangle(bvhOrder[i], origin, direction, tMin, tMax, uv) < kNoEntry && !bvhCutAway(bvhOrder[i], uv)) return true;
+      uint candidate;
+      if (bvhLeafTriangle(i, origin, direction, tMin, tMax, uv, candidate) < kNoEntry && !bvhCutAway(candidate, uv)) return true;
     }
   }
   return false;

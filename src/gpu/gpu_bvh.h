@@ -1,7 +1,8 @@
 #pragma once
 // The GPU renderer's ray-casting structure: a bounding-volume hierarchy built on the CPU over
 // the renderer's triangle array (every mesh's triangles in scene order, global vertex
-// indices: GpuRenderer's upload), uploaded as two shader storage buffers and traversed by
+// indices: GpuRenderer's upload), uploaded as two shader storage buffers (the nodes; the
+// triangles in leaf order, each as its first vertex and two edges) and traversed by
 // the GLSL functions of kBvhGlsl — the rays of mirror and glass chains and the shadow rays of
 // punctual highlights, which rasterisation cannot answer.
 //
@@ -13,6 +14,10 @@
 //
 // Traversal (GLSL, kBvhGlsl): a stack of 64 node indices, the nearer child first (by the slab
 // test's entry distance), closest hit (bvhIntersect) or any hit (bvhOccluded) in (tMin, tMax).
+// The closest-hit stack keeps each node's entry distance beside it: a node popped is skipped
+// when a hit found since lies nearer than its entry — the slab test again against the nearer
+// hit, without reading the node's box again. A leaf's triangles are read in leaf order, one
+// 48-byte record each (no index into the triangle and vertex arrays on the way).
 // The triangle test is Möller–Trumbore with inclusive edges (u ≥ 0, v ≥ 0, u + v ≤ 1), so a
 // ray through a shared edge hits one of the two triangles (both, the nearer kept), and
 // barycentrics (u, v) as Embree reports them. It is not Embree's arithmetic: t and (u, v)
@@ -42,9 +47,20 @@ struct BvhNode {
 };
 static_assert(sizeof(BvhNode) == 32);
 
+/// One triangle as the traversal reads it (std430: three 16-byte rows): its first vertex p0,
+/// its edges e1 = p1 − p0 and e2 = p2 − p0 (as Möller–Trumbore computes them: the same float
+/// subtractions), and its index in the triangle array.
+struct BvhTriangle {
+  float p0[3];
+  uint32_t triangle;
+  float e1[4], e2[4];
+};
+static_assert(sizeof(BvhTriangle) == 48);
+
 struct GpuBvh {
-  std::vector<BvhNode> nodes;   ///< nodes[0] is the root (an empty leaf when there are no triangles)
-  std::vector<uint32_t> order;  ///< triangle indices in leaf order
+  std::vector<BvhNode> nodes;          ///< nodes[0] is the root (an empty leaf when there are no triangles)
+  std::vector<uint32_t> order;         ///< triangle indices in leaf order
+  std::vector<BvhTriangle> triangles;  ///< the triangles in leaf order (triangles[i].triangle == order[i])
 };
 
 /// Every mesh's vertices and triangles of `scene` in one array each, in scene order, the
@@ -57,6 +73,8 @@ void flattenSceneTriangles(const Scene& scene, std::vector<Vec3>& positions, std
 /// `triangles`, triangle i of the result being triangles[i]. Degenerate and non-finite
 /// triangles are kept (they never report a hit).
 GpuBvh buildGpuBvh(const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles);
+/// bvh.triangles from bvh.order (buildGpuBvh's last step).
+void fillBvhTriangles(GpuBvh& bvh, const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles);
 
 /// The closest hit of `ray` in (ray.tMin, ray.tMax) by the traversal kBvhGlsl runs, on the
 /// CPU (the build's unit test); triangle = kNone (0xffffffff) for a miss.
@@ -65,17 +83,16 @@ struct BvhHit {
   uint32_t triangle = 0xffffffffu;
   Vec2 barycentrics{0.0f};
 };
-BvhHit intersectGpuBvh(const GpuBvh& bvh, const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles,
-                       const Ray& ray);
+BvhHit intersectGpuBvh(const GpuBvh& bvh, const Ray& ray);
 
-/// The storage-buffer bindings of the nodes and the order (above the renderer's own).
-inline constexpr uint32_t kBvhNodesBinding = 16, kBvhOrderBinding = 17;
-/// GLSL #defines of BVH_NODES_BINDING and BVH_ORDER_BINDING (prefixed to kBvhGlsl's programs).
+/// The storage-buffer bindings of the nodes and the leaf-order triangles (above the renderer's own).
+inline constexpr uint32_t kBvhNodesBinding = 16, kBvhTrianglesBinding = 17;
+/// GLSL #defines of BVH_NODES_BINDING and BVH_TRIANGLES_BINDING (prefixed to kBvhGlsl's programs).
 std::string bvhGlslConstants();
 
 /// GLSL: bvhIntersect(origin, direction, tMin, tMax, out t, out triangle, out barycentrics)
 /// and bvhOccluded(origin, direction, tMin, tMax), over the storage blocks BvhNodes
-/// (binding BVH_NODES_BINDING) and BvhOrder (BVH_ORDER_BINDING). Needs the shading pass's
+/// (binding BVH_NODES_BINDING) and BvhTriangles (BVH_TRIANGLES_BINDING). Needs the shading pass's
 /// `positions` (vec4 per vertex) and `triangles` (uvec4: vertex indices, chart) blocks declared
 /// before it. Triangle indices are into `triangles`.
 extern const char* const kBvhGlsl;

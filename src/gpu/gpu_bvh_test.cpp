@@ -29,13 +29,15 @@ BvhHit bruteForce(const std::vector<Vec3>& positions, const std::vector<UVec3>& 
   GpuBvh flat;
   flat.nodes.push_back(BvhNode{{-1e30f, -1e30f, -1e30f}, 0, {1e30f, 1e30f, 1e30f}, uint32_t(triangles.size())});
   for (uint32_t t = 0; t < triangles.size(); ++t) flat.order.push_back(t);
-  return intersectGpuBvh(flat, positions, triangles, ray);
+  fillBvhTriangles(flat, positions, triangles);
+  return intersectGpuBvh(flat, ray);
 }
 
 /// Every node's box holds its children's or its triangles; every triangle is in one leaf; the
 /// depth stays within the traversal's stack.
 void expectWellFormed(const GpuBvh& bvh, const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles) {
   std::vector<int> seen(triangles.size(), 0);
+  ASSERT_EQ(bvh.triangles.size(), bvh.order.size());
   struct Item {
     uint32_t node;
     int depth;
@@ -66,6 +68,16 @@ void expectWellFormed(const GpuBvh& bvh, const std::vector<Vec3>& positions, con
     for (uint32_t i = node.first; i < node.first + node.count; ++i) {
       const uint32_t t = bvh.order[i];
       ++seen[t];
+      // The leaf-order record: this triangle's first vertex and edges.
+      const BvhTriangle& record = bvh.triangles[i];
+      EXPECT_EQ(record.triangle, t);
+      const Vec3 p0 = positions[triangles[t][0]], e1 = positions[triangles[t][1]] - p0, e2 = positions[triangles[t][2]] - p0;
+      for (int k = 0; k < 3; ++k) {
+        if (!isFinite(p0) || !isFinite(e1) || !isFinite(e2)) break;
+        EXPECT_EQ(record.p0[k], p0[k]);
+        EXPECT_EQ(record.e1[k], e1[k]);
+        EXPECT_EQ(record.e2[k], e2[k]);
+      }
       const Vec3 p[3] = {positions[triangles[t][0]], positions[triangles[t][1]], positions[triangles[t][2]]};
       if (!isFinite(p[0]) || !isFinite(p[1]) || !isFinite(p[2])) continue;  // in no box
       for (const Vec3& v : p) EXPECT_TRUE(inside(node, v));
@@ -90,7 +102,7 @@ TEST(GpuBvh, RandomSoupMatchesBruteForce) {
     ray.direction = glm::normalize(randomPoint(rng, 2.0f) - Vec3(1.0f));
     if (i % 4 == 0) ray.tMax = 0.5f;   // a bounded segment
     if (i % 7 == 0) ray.tMin = 0.2f;
-    const BvhHit expected = bruteForce(positions, triangles, ray), hit = intersectGpuBvh(bvh, positions, triangles, ray);
+    const BvhHit expected = bruteForce(positions, triangles, ray), hit = intersectGpuBvh(bvh, ray);
     ASSERT_EQ(hit.t, expected.t) << "ray " << i;
     if (hit.triangle != expected.triangle) continue;  // a tie at equal t (shared edge): either
     EXPECT_EQ(hit.barycentrics, expected.barycentrics);
@@ -120,17 +132,17 @@ TEST(GpuBvh, AxisAlignedRaysAndDegenerateInput) {
   for (int i = 0; i < 10; ++i)
     for (int j = 0; j < 10; ++j) {
       const Ray down{Vec3(i + 0.25f, j + 0.5f, 20.0f), Vec3(0.0f, 0.0f, -1.0f)};
-      const BvhHit hit = intersectGpuBvh(bvh, positions, triangles, down);
+      const BvhHit hit = intersectGpuBvh(bvh, down);
       ASSERT_NE(hit.triangle, 0xffffffffu);
       EXPECT_EQ(hit.triangle / 2, uint32_t(i * 10 + j));
       EXPECT_NEAR(hit.t, 20.0f - float(i + j) * 0.1f, 1e-5f);
     }
   const Ray sideways{Vec3(-1.0f, 0.5f, 0.0f), Vec3(1.0f, 0.0f, 0.0f)};  // in the plane of the first quad's row
-  EXPECT_EQ(intersectGpuBvh(bvh, positions, triangles, sideways).t, bruteForce(positions, triangles, sideways).t);
+  EXPECT_EQ(intersectGpuBvh(bvh, sideways).t, bruteForce(positions, triangles, sideways).t);
   // An empty scene: one empty leaf, nothing hit.
   const GpuBvh empty = buildGpuBvh({}, {});
   ASSERT_EQ(empty.nodes.size(), 1u);
-  EXPECT_EQ(intersectGpuBvh(empty, {}, {}, sideways).triangle, 0xffffffffu);
+  EXPECT_EQ(intersectGpuBvh(empty, sideways).triangle, 0xffffffffu);
 }
 
 TEST(GpuBvh, CornellBoxMatchesEmbree) {
@@ -152,7 +164,7 @@ TEST(GpuBvh, CornellBoxMatchesEmbree) {
     ray.direction = glm::normalize(randomPoint(rng, 2.0f) - Vec3(1.0f));
     RayHit expected;
     accel.intersect(ray, expected);
-    const BvhHit hit = intersectGpuBvh(bvh, positions, triangles, ray);
+    const BvhHit hit = intersectGpuBvh(bvh, ray);
     ASSERT_EQ(hit.triangle != 0xffffffffu, expected.hit()) << "ray " << i;
     if (!expected.hit()) continue;
     EXPECT_NEAR(hit.t, expected.t, 1e-4f * std::max(1.0f, expected.t)) << "ray " << i;

@@ -66,7 +66,7 @@ int multiSampleIdScale(int width, int height) {
 // Shader storage bindings.
 constexpr GLuint kValuesBinding = 0, kChartsBinding = 1, kPositionsBinding = 2, kTrianglesBinding = 3,
                  kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7,
-                 kEnvironmentBinding = 8, kSurfaceDetailBinding = 12;
+                 kEnvironmentBinding = 8, kRayQueueBinding = 9, kSurfaceDetailBinding = 12;
 // Texture units: the visibility pass's ids, the resolve pass's hits; image unit of the hits.
 constexpr GLuint kIdsUnit = 0, kHitsUnit = 1, kHitsImageUnit = 0;
 
@@ -77,11 +77,12 @@ std::string glslConstants() {
       "kFlagTwoSidedEmission = {}u, kFlagSunMasks = {}u;\nconst int kMaxSunMaskLights = {}, kSunMaskSide = {};\n"
       "#define VALUES_BINDING {}\n#define CHARTS_BINDING {}\n#define POSITIONS_BINDING {}\n#define TRIANGLES_BINDING {}\n"
       "#define QUERIES_BINDING {}\n#define RESULTS_BINDING {}\n#define NORMALS_BINDING {}\n#define SUN_MASKS_BINDING {}\n"
-      "#define ENVIRONMENT_BINDING {}\n#define IDS_UNIT {}\n#define HITS_UNIT {}\n#define HITS_IMAGE_UNIT {}\n",
+      "#define ENVIRONMENT_BINDING {}\n#define IDS_UNIT {}\n#define HITS_UNIT {}\n#define HITS_IMAGE_UNIT {}\n"
+      "#define RAY_QUEUE_BINDING {}\n",
       unsigned(ChartKind::Diffuse), unsigned(ChartKind::Glossy), unsigned(ChartKind::Specular), kFlagTwoSided, kFlagBack,
       kFlagCurved, kFlagDiffuseValue, kFlagEmissive, kFlagTwoSidedEmission, kFlagSunMasks, kMaxSunMaskLights, kSunMaskSide,
       kValuesBinding, kChartsBinding, kPositionsBinding, kTrianglesBinding, kQueriesBinding, kResultsBinding, kNormalsBinding,
-      kSunMasksBinding, kEnvironmentBinding, kIdsUnit, kHitsUnit, kHitsImageUnit);
+      kSunMasksBinding, kEnvironmentBinding, kIdsUnit, kHitsUnit, kHitsImageUnit, kRayQueueBinding);
 }
 
 // The lookup of lightfield/lookup.h in GLSL, statement for statement (the names are the C++
@@ -464,7 +465,10 @@ const uint kNoTriangle = 0xffffffffu;  // a hit's triangle on a miss
 // triangle smaller than a texel the rasteriser left out (its vertices mark its texels), a
 // jittered ray off its texel's triangle — the ray is cast through the BVH (gpu_bvh.h
 // bvhIntersect) as the CPU renderers cast theirs through Embree.
-bool primaryHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
+const int kIdsMiss = 0, kIdsHit = 1, kIdsUnsure = 2;
+// What the id texels say of that ray: kIdsMiss or kIdsHit (with t, triangle and b) where they
+// can be trusted, else kIdsUnsure (the ray is to be cast through the BVH).
+int idsHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
   ivec2 texel = ivec2(floor(film * float(idScale)));
   ivec2 lastTexel = size * idScale - 1;
   uint id = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
@@ -472,18 +476,21 @@ bool primaryHit(vec2 film, vec3 direction, out float t, out uint triangle, out v
   for (int dy = -1; dy <= 1 && same; ++dy)
     for (int dx = -1; dx <= 1 && same; ++dx) same = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r == id;
   const float far = 1.0 / 0.0;
-  if (same && id == 0u) {
-    t = far;
-    triangle = 0xffffffffu;
-    b = vec2(0.0);
-    return false;
-  }
+  t = far;
+  triangle = kNoTriangle;
+  b = vec2(0.0);
+  if (same && id == 0u) return kIdsMiss;
   if (same) {
     t = bvhTriangle(id - 1u, eye, direction, 0.0, far, b);
     triangle = id - 1u;
-    if (t < far && !bvhCutAway(triangle, b)) return true;
+    if (t < far && !bvhCutAway(triangle, b)) return kIdsHit;
   }
-  return bvhIntersect(eye, direction, 0.0, far, t, triangle, b);
+  return kIdsUnsure;
+}
+bool primaryHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
+  int answer = idsHit(film, direction, t, triangle, b);
+  if (answer != kIdsUnsure) return answer == kIdsHit;
+  return bvhIntersect(eye, direction, 0.0, 1.0 / 0.0, t, triangle, b);
 }
 
 // The camera ray's hit from `origin` along unit `direction` through film point `film`: a
@@ -497,10 +504,23 @@ bool cameraHit(vec2 film, vec3 origin, vec3 direction, out float t, out uint tri
 
 // Pass 2, one sample per pixel: the camera ray through each pixel's centre and its hit
 // (cameraHit), stored as (t, triangle, b) bits for the shading pass — the ray casting apart
-// from the lookup, each program smaller than the two in one, and each timed on its own.
+// from the lookup, each program smaller than the two in one, and each timed on its own. It
+// runs as two dispatches: the first answers the pixels the id texels can (idsHit) and queues
+// the others; the second, one thread per queued pixel, casts their rays through the BVH — so
+// the threads of a group traverse the BVH together rather than wait for one pixel of theirs
+// that does. The queue: a DispatchIndirectCommand (its x counting the 64-wide groups the
+// queued pixels take), their count, then the pixels (y · width + x).
 constexpr const char* kResolveCompute = R"glsl(
-layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = HITS_IMAGE_UNIT, rgba32ui) uniform writeonly uimage2D hits;
+layout(std430, binding = RAY_QUEUE_BINDING) buffer RayQueue {
+  uint queueGroups, queueGroupsY, queueGroupsZ, queueCount;
+  uint queuedPixels[];
+};
+void storeHit(ivec2 pixel, bool hit, float t, uint triangle, vec2 b) {
+  imageStore(hits, pixel, uvec4(floatBitsToUint(t), hit ? triangle : kNoTriangle, floatBitsToUint(b)));
+}
+#ifndef QUEUED_RAYS
+layout(local_size_x = 8, local_size_y = 8) in;
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (pixel.x >= size.x || pixel.y >= size.y) return;
@@ -510,9 +530,32 @@ void main() {
   float t;
   uint triangle;
   vec2 b;
-  bool hit = cameraHit(film, origin, direction, t, triangle, b);
-  imageStore(hits, pixel, uvec4(floatBitsToUint(t), hit ? triangle : kNoTriangle, floatBitsToUint(b)));
+  // A thin lens's rays start off the eye, where the id texels say nothing (cameraHit).
+  int answer = apertureRadius > 0.0 ? kIdsUnsure : idsHit(film, direction, t, triangle, b);
+  if (answer != kIdsUnsure) {
+    storeHit(pixel, answer == kIdsHit, t, triangle, b);
+    return;
+  }
+  uint slot = atomicAdd(queueCount, 1u);
+  queuedPixels[slot] = uint(pixel.y) * uint(size.x) + uint(pixel.x);
+  if (slot % 64u == 0u) atomicAdd(queueGroups, 1u);
 }
+#else
+layout(local_size_x = 64) in;
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= queueCount) return;
+  uint index = queuedPixels[i];
+  ivec2 pixel = ivec2(index % uint(size.x), index / uint(size.x));
+  vec3 origin, direction;
+  cameraRay(vec2(pixel) + 0.5, vec2(0.5), origin, direction);
+  float t;
+  uint triangle;
+  vec2 b;
+  bool hit = bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, b);
+  storeHit(pixel, hit, t, triangle, b);
+}
+#endif
 )glsl";
 
 // Pass 3: per pixel, the camera ray through its centre (Camera::generateRay), its hit (the
@@ -953,13 +996,18 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
   return {};
 }
 
+/// The ray queue's header (kResolveCompute): groups x, y, z to dispatch, and the count.
+constexpr uint64_t kRayQueueHeaderBytes = 16;
+
 struct GpuRenderer::State {
   gpu::EglContext context;
   // values, charts, positions, triangles, indices, normals, sun masks, environment map, surface detail
   static constexpr GLsizei kBufferCount = 9;
   GLuint buffers[kBufferCount] = {};
   GLuint vertexArray = 0, emptyVertexArray = 0;
-  GLuint visibilityProgram = 0, markerProgram = 0, resolveProgram = 0, shadingProgram = 0, lookupProgram = 0;
+  GLuint visibilityProgram = 0, markerProgram = 0, shadingProgram = 0, lookupProgram = 0;
+  /// The resolve pass's two programs: the id texels' answers and the queue, the queued rays.
+  GLuint resolveProgram = 0, queuedRaysProgram = 0;
   /// The BVH (gpu_bvh.h: nodes, order), the materials of the specular chains and shadow rays
   /// (gpu_specular.h: per material, per triangle) and the highlights' lights and models
   /// (gpu_highlights.h); the BVH is built with the first program that traces rays.
@@ -983,8 +1031,10 @@ struct GpuRenderer::State {
   GLuint timestampQueries[kTimestamps] = {};
   GpuPassMilliseconds lastPasses;
   /// The frame's targets: the triangle ids and depth of the visibility pass, the camera rays'
-  /// hits of the resolve pass (one sample per pixel), the radiance of the shading pass.
-  GLuint idTexture = 0, depthBuffer = 0, hitsTexture = 0, colorTexture = 0, visibilityFramebuffer = 0, shadingFramebuffer = 0;
+  /// hits and the queue of rays to cast of the resolve pass (one sample per pixel), the
+  /// radiance of the shading pass.
+  GLuint idTexture = 0, depthBuffer = 0, hitsTexture = 0, rayQueue = 0, colorTexture = 0, visibilityFramebuffer = 0,
+         shadingFramebuffer = 0;
   int width = 0, height = 0;
   int idScale = 1;  ///< the visibility targets are idScale·width × idScale·height
   GLsizei indexCount = 0, vertexCount = 0;
@@ -1007,6 +1057,7 @@ struct GpuRenderer::State {
     glDeleteProgram(visibilityProgram);
     glDeleteProgram(markerProgram);
     glDeleteProgram(resolveProgram);
+    glDeleteProgram(queuedRaysProgram);
     glDeleteProgram(shadingProgram);
     glDeleteProgram(lookupProgram);
     glDeleteProgram(multisampleProgram);
@@ -1018,15 +1069,21 @@ struct GpuRenderer::State {
     glDeleteFramebuffers(1, &shadingFramebuffer);
     glDeleteTextures(1, &idTexture);
     glDeleteTextures(1, &hitsTexture);
+    glDeleteBuffers(1, &rayQueue);
     glDeleteTextures(1, &colorTexture);
     glDeleteRenderbuffers(1, &depthBuffer);
-    visibilityFramebuffer = shadingFramebuffer = idTexture = hitsTexture = colorTexture = depthBuffer = 0;
+    visibilityFramebuffer = shadingFramebuffer = idTexture = hitsTexture = rayQueue = colorTexture = depthBuffer = 0;
     width = height = 0;
   }
-  /// The frame's targets: hits and radiance at width × height, triangle ids and depth at
-  /// scale·width × scale·height (re-made only when a size changes).
+  /// The frame's targets: hits, ray queue and radiance at width × height, triangle ids and
+  /// depth at scale·width × scale·height (re-made only when a size changes).
   void ensureTargets(int w, int h, int scale) {
     if (w == width && h == height && scale == idScale) return;
+    if (uint64_t(w) * uint64_t(h) > maxImagePixels())
+      fail("GPU renderer: a {}x{} image's queue of rays to cast takes {}, more than this driver's largest storage "
+           "buffer ({}, GL_MAX_SHADER_STORAGE_BLOCK_SIZE): render it smaller or with --renderer cpu",
+           w, h, gpu::formatBytes(kRayQueueHeaderBytes + 4 * uint64_t(w) * uint64_t(h)),
+           gpu::formatBytes(kRayQueueHeaderBytes + 4 * maxImagePixels()));
     releaseTargets();
     glCreateTextures(GL_TEXTURE_2D, 1, &idTexture);
     glTextureStorage2D(idTexture, 1, GL_R32UI, w * scale, h * scale);
@@ -1040,6 +1097,9 @@ struct GpuRenderer::State {
     glTextureStorage2D(hitsTexture, 1, GL_RGBA32UI, w, h);
     glTextureParameteri(hitsTexture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(hitsTexture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glCreateBuffers(1, &rayQueue);
+    glNamedBufferStorage(rayQueue, GLsizeiptr(kRayQueueHeaderBytes + 4 * uint64_t(w) * uint64_t(h)), nullptr,
+                         GL_DYNAMIC_STORAGE_BIT);
     glCreateTextures(GL_TEXTURE_2D, 1, &colorTexture);
     glTextureStorage2D(colorTexture, 1, GL_RGBA32F, w, h);
     glCreateFramebuffers(1, &visibilityFramebuffer);
@@ -1064,11 +1124,11 @@ struct GpuRenderer::State {
     const GpuBvh bvh = buildGpuBvh(points, tris);
     glCreateBuffers(2, rayBuffers);
     glNamedBufferStorage(rayBuffers[0], GLsizeiptr(bvh.nodes.size() * sizeof(BvhNode)), bvh.nodes.data(), 0);
-    glNamedBufferStorage(rayBuffers[1], GLsizeiptr(std::max<size_t>(bvh.order.size() * sizeof(uint32_t), 16)),
-                         bvh.order.empty() ? nullptr : bvh.order.data(), 0);
-    bufferBytes += bvh.nodes.size() * sizeof(BvhNode) + std::max<size_t>(bvh.order.size() * sizeof(uint32_t), 16);
+    glNamedBufferStorage(rayBuffers[1], GLsizeiptr(std::max<size_t>(bvh.triangles.size() * sizeof(BvhTriangle), 16)),
+                         bvh.triangles.empty() ? nullptr : bvh.triangles.data(), 0);
+    bufferBytes += bvh.nodes.size() * sizeof(BvhNode) + std::max<size_t>(bvh.triangles.size() * sizeof(BvhTriangle), 16);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBvhNodesBinding, rayBuffers[0]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBvhOrderBinding, rayBuffers[1]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBvhTrianglesBinding, rayBuffers[1]);
     checkGl("uploading the BVH (out of GPU memory?)");
     bvhUploaded = true;
   }
@@ -1099,8 +1159,15 @@ struct GpuRenderer::State {
     glDepthMask(GL_TRUE);
     checkGl("the visibility pass");
   }
+  /// The most pixels an image may have: its ray queue within the largest storage block.
+  uint64_t maxImagePixels() const {
+    GLint64 maxBlock = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
+    return maxBlock > int64_t(kRayQueueHeaderBytes) ? (uint64_t(maxBlock) - kRayQueueHeaderBytes) / 4
+                                                     : std::numeric_limits<uint64_t>::max();
+  }
   uint64_t targetBytes() const {
-    return uint64_t(width) * uint64_t(height) * (16 + 16 + uint64_t(idScale) * uint64_t(idScale) * (4 + 4));
+    return kRayQueueHeaderBytes + uint64_t(width) * uint64_t(height) * (16 + 16 + 4 + uint64_t(idScale) * uint64_t(idScale) * (4 + 4));
   }
 };
 
@@ -1229,7 +1296,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   const bool lobeLights = !lobeLightTable.empty();
   const bool traces = s.specular || s.highlights;
   const uint64_t triangleCount = triangles.size();
-  sizes.emplace_back("BVH (bound)", std::max<uint64_t>((2 * triangleCount) * sizeof(BvhNode) + 4 * triangleCount, 16));
+  sizes.emplace_back("BVH (bound)", std::max<uint64_t>((2 * triangleCount) * sizeof(BvhNode) + sizeof(BvhTriangle) * triangleCount, 16));
   if (traces) {
     sizes.emplace_back("materials of the traced rays", std::max<uint64_t>(scene.materials.size() * sizeof(SpecularMaterialGpu) +
                                                                                4 * triangleCount, 16));
@@ -1310,8 +1377,11 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   s.shadingProgram =
       linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}}, "shading", true, raysHeader);
   // The resolve pass casts rays only: the BVH, cut by alpha masks where the scene has some.
-  s.resolveProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kBvhGlsl) + kPrimaryHitGlsl + kResolveCompute}}, "resolve",
-                                 false, bvhGlslConstants() + (anyMasked ? "#define BVH_ALPHA_MASKS\n" : ""), true);
+  const std::string resolve = std::string(kBvhGlsl) + kPrimaryHitGlsl + kResolveCompute;
+  const std::string resolveHeader = bvhGlslConstants() + (anyMasked ? "#define BVH_ALPHA_MASKS\n" : "");
+  s.resolveProgram = linkProgram({{GL_COMPUTE_SHADER, resolve}}, "resolve", false, resolveHeader, true);
+  s.queuedRaysProgram =
+      linkProgram({{GL_COMPUTE_SHADER, resolve}}, "resolve queued rays", false, resolveHeader + "#define QUEUED_RAYS\n", true);
   s.lookupProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + kLookupCompute}}, "lookup", true);
   if (epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
     s.multisampleProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}},
@@ -1319,7 +1389,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                        (s.specular ? raysHeader : int64 + raysHeader) + "#define MULTISAMPLE\n");
   for (GLuint program : {s.visibilityProgram, s.markerProgram})
     glProgramUniform1f(program, glGetUniformLocation(program, "near"), s.near);
-  for (GLuint program : {s.visibilityProgram, s.resolveProgram, s.shadingProgram, s.multisampleProgram})
+  for (GLuint program : {s.visibilityProgram, s.resolveProgram, s.queuedRaysProgram, s.shadingProgram, s.multisampleProgram})
     if (program != 0) glProgramUniform1i(program, glGetUniformLocation(program, "anyMasked"), anyMasked ? 1 : 0);
   for (GLuint program : {s.shadingProgram, s.multisampleProgram}) {
     if (program == 0) continue;
@@ -1412,11 +1482,20 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   };
   glBindTextureUnit(kIdsUnit, s.idTexture);
   if (spp == 1) {
+    // The id texels' answers, the other pixels queued; then the queued pixels' rays.
+    const GLuint emptyQueue[4] = {0, 1, 1, 0};
+    glNamedBufferSubData(s.rayQueue, 0, sizeof(emptyQueue), emptyQueue);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRayQueueBinding, s.rayQueue);
+    glBindImageTexture(kHitsImageUnit, s.hitsTexture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32UI);
     setFrameUniforms(s.resolveProgram);
     glUseProgram(s.resolveProgram);
-    glBindImageTexture(kHitsImageUnit, s.hitsTexture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32UI);
     glDispatchCompute(GLuint((camera.width() + 7) / 8), GLuint((camera.height() + 7) / 8), 1);
-    // The shading pass fetches the hits the dispatch stored.
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+    setFrameUniforms(s.queuedRaysProgram);
+    glUseProgram(s.queuedRaysProgram);
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, s.rayQueue);
+    glDispatchComputeIndirect(0);
+    // The shading pass fetches the hits the dispatches stored.
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     glBindTextureUnit(kHitsUnit, s.hitsTexture);
   }
@@ -1458,6 +1537,11 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
 }
 
 double GpuRenderer::lastGpuMilliseconds() const { return state_->lastPasses.total; }
+
+uint64_t GpuRenderer::maxImagePixels() const {
+  state_->context.makeCurrent();
+  return state_->maxImagePixels();
+}
 
 GpuPassMilliseconds GpuRenderer::lastGpuPasses() const { return state_->lastPasses; }
 

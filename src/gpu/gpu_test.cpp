@@ -673,7 +673,7 @@ TEST_F(GpuRendererTest, BvhTraversalMatchesCpuAndEmbree) {
   ASSERT_EQ(hits.size(), rays.size());
   size_t sameAsCpu = 0, sameAsEmbree = 0, hitCount = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
-    const BvhHit cpu = intersectGpuBvh(bvh, positions, triangles, rays[i]);
+    const BvhHit cpu = intersectGpuBvh(bvh, rays[i]);
     RayHit embree;
     accel.intersect(rays[i], embree);
     EXPECT_EQ(hits[i].triangle != 0xffffffffu, embree.hit()) << "ray " << i;
@@ -1036,8 +1036,9 @@ TEST_F(GpuRendererTest, GpuMemoryIsTheLightFieldAndOneFrame) {
   gpu.render(Camera(firstCamera(lf.scene), 64, 48), RenderSettings{}, image);
   // Values as 16-byte RGBA, 128 bytes per chart record, the geometry, 292 bytes per material
   // and the GGX and sheen albedo tables after a 32-byte header (no textures, uvs or masks here),
-  // the BVH of the primary rays beside edges (32 bytes per node, 4 per triangle) and 40 bytes
-  // per pixel (radiance, hits, id and depth).
+  // the BVH of the primary rays beside edges (32 bytes per node, 48 per triangle) and 44 bytes
+  // per pixel (radiance, hits, the queue of rays to cast, id and depth) and the queue's
+  // 16-byte header.
   uint64_t geometry = 0;
   for (const Mesh& m : lf.scene.meshes) geometry += m.positions.size() * 32 + m.triangles.size() * 28;
   const GgxAlbedoTables& ggx = ggxAlbedoTables();
@@ -1050,7 +1051,7 @@ TEST_F(GpuRendererTest, GpuMemoryIsTheLightFieldAndOneFrame) {
   const GpuBvh bvh = buildGpuBvh(positions, triangles);
   const uint64_t expected = lf.values.size() * 16 + lf.charts.size() * 128 + geometry + 32 +
                             lf.scene.materials.size() * 292 + tables + bvh.nodes.size() * 32 +
-                            bvh.order.size() * 4 + 64 * 48 * 40;
+                            bvh.triangles.size() * 48 + 64 * 48 * 44 + 16;
   EXPECT_LE(gpu.gpuBytes(), expected + 8 * 16);  // 16-byte stand-ins for empty buffers
   EXPECT_GE(gpu.gpuBytes(), expected);
   EXPECT_NE(gpu.deviceName().find("OpenGL 4.5"), std::string::npos) << gpu.deviceName();
@@ -1105,6 +1106,34 @@ class ScopedEnvironment {
  private:
   const char* name_;
 };
+
+// An image whose resolve pass's ray queue (4 bytes per pixel) exceeds the driver's largest
+// storage block is refused with the sizes before any target is made, not drawn wrong; the
+// renderer goes on drawing smaller images.
+TEST_F(GpuRendererTest, RefusesAnImageWhoseRayQueueExceedsTheLargestStorageBlock) {
+  const LightField lf = randomLightField(makeCornellBox(), 41);
+  GpuRenderer gpu(lf);
+  const uint64_t most = gpu.maxImagePixels();
+  ASSERT_GT(most, uint64_t(1920) * 1080);
+  const int side = int(std::ceil(std::sqrt(double(most) + 1.0)));
+  if (side > 16384) GTEST_SKIP() << "this driver's largest storage block holds the queue of any image size";
+  const CameraDesc desc = firstCamera(lf.scene);
+  Image image;
+  try {
+    gpu.render(Camera(desc, side, side), RenderSettings{}, image);
+    ADD_FAILURE() << side << "x" << side << " was drawn";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    const std::string size = std::to_string(side) + "x" + std::to_string(side);
+    EXPECT_NE(message.find("a " + size + " image's queue of rays to cast takes"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("GL_MAX_SHADER_STORAGE_BLOCK_SIZE"), std::string::npos) << message;
+    EXPECT_NE(message.find("--renderer cpu"), std::string::npos) << message;
+  }
+  EXPECT_EQ(image.width, 0);  // nothing drawn
+  gpu.render(Camera(desc, 32, 24), RenderSettings{}, image);
+  EXPECT_EQ(image.width, 32);
+}
 
 // A light field that does not fit the GPU memory (here: PLENOPTIC_GPU_MEMORY set below it) is
 // refused before anything is uploaded, with the sizes and --renderer cpu suggested; a
