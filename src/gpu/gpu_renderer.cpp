@@ -653,8 +653,15 @@ SurfaceDetail hitSurfaceDetail(uint triangle, vec2 b, vec3 direction, float cone
   uvec4 info = charts[tri.w].info;
   vec3 geometric, interpolated;
   triangleNormalsAt(tri, b, info.z, geometric, interpolated);
+#ifndef PIXEL_DETAIL
+  // No chart record has a flag surfaceDetailAt reads: its first answer, for every pixel. (The
+  // code left out makes the program smaller: a GPU runs more of its threads at once, and a
+  // software rasteriser, which runs both sides of a branch, far less of it.)
+  return noSurfaceDetail(interpolated);
+#else
   return surfaceDetailAt(triangle, tri.xyz, positions[tri.x].xyz, positions[tri.y].xyz, positions[tri.z].xyz, b, info,
                          direction, coneWidth, geometric, interpolated);
+#endif
 }
 
 #ifdef SPECULAR
@@ -1187,6 +1194,11 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   const gpu::SurfaceDetailBuffer detail = gpu::surfaceDetailBuffer(lightField);
   std::vector<ChartGpu> charts(lightField.charts.size());
   bool chartDetail = false;  // some chart reads surface detail (textures, normal maps)
+  // Some chart record has a flag surfaceDetailAt reads per pixel (else it returns no detail
+  // for every pixel, and the shading passes are compiled without it: PIXEL_DETAIL).
+  constexpr uint32_t kPixelDetailFlags =
+      gpu::kFlagTexturedAlbedo | gpu::kFlagTexturedEmission | gpu::kFlagNormalMapped | gpu::kFlagMetallicRoughness;
+  bool pixelDetail = false;
   for (uint32_t i = 0; i < charts.size(); ++i) {
     const Chart& c = lightField.charts[i];
     const ChartShading shading = chartShading(lightField, i, sun);
@@ -1219,6 +1231,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
       const Rgb base = gpu::texturedAlbedoBase(scene, c);
       std::memcpy(g.albedoOverPi, &base, sizeof(Rgb));
     }
+    pixelDetail = pixelDetail || (g.info[2] & kPixelDetailFlags) != 0;
   }
   // The geometry: every mesh's positions in one array, triangles with global vertex indices
   // (so gl_PrimitiveID of the one draw call is the triangle's index here) and their charts.
@@ -1368,6 +1381,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                      bvhGlslConstants() + (traces ? specularGlslConstants() : "") +
                                      (anyMasked ? "#define BVH_ALPHA_MASKS\n" : "") +
                                      (chartDetail ? "#define CHAIN_SURFACE_DETAIL\n" : "") +
+                                     (pixelDetail ? "#define PIXEL_DETAIL\n" : "") +
                                      (gpu::tracedSurfaceDetail(lightField) ? "#define TRACED_DETAIL\n" : "") +
                                      (mirrorLike ? "#define MIRROR_LIKE\n" : "") +
                                      (lobeLights ? "#define LOBE_LIGHTS\n" + lightGlslConstants() : "");
