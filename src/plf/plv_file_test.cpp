@@ -20,6 +20,8 @@
 #include "core/error.h"
 #include "core/hash.h"
 #include "plf/codec_backends.h"
+#include "support/expect_error.h"
+#include "support/temp_dir_test.h"
 
 namespace pl {
 namespace {
@@ -248,24 +250,19 @@ TEST(VisibilityCodec, CorruptEncodingsAreRefused) {
   EXPECT_EQ(decodeTixelEntries<true>(bytes.data(), at + 4, 2, out), 0u);
 }
 
+/// Each test's own directory (TempDirTest: parallel ctest runs never share one).
+using VisibilityFile = test_support::TempDirTest;
+
 /// Expects reading `plv` as a field of `hash` to throw a pl::Error whose message names `where`
 /// and `problem`.
 void expectRefused(const std::string& plv, uint64_t hash, const std::string& where, const std::string& problem) {
   VisibilityField read;
   std::string why;
-  try {
-    readVisibility(plv, hash, read, &why);
-    ADD_FAILURE() << "accepted: " << problem;
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
-  }
+  test_support::expectError([&] { readVisibility(plv, hash, read, &why); }, {where, problem});
 }
 
-TEST(VisibilityFile, OneTixelFieldsRoundTrip) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_one_tixel_test";
-  std::filesystem::create_directories(dir);
-  const std::string plv = (dir / "one.plv").string();
+TEST_F(VisibilityFile, OneTixelFieldsRoundTrip) {
+  const std::string plv = path("one.plv");
   for (uint32_t gridSide : {1u, 3u, 16u}) {
     VisibilityField field;
     field.gridSide = gridSide;
@@ -283,17 +280,14 @@ TEST(VisibilityFile, OneTixelFieldsRoundTrip) {
     ASSERT_EQ(back.size(), entries.size());
     EXPECT_EQ(std::memcmp(back.data(), entries.data(), entries.size() * sizeof(VisibilityEntry)), 0);
   }
-  std::filesystem::remove_all(dir);
 }
 
 // The stored streams (plv_file.h, "A stored entry block") at every precision, on tixels made
 // to reach each op's edges: all misses; escapes that carry a flag or fractions (op 3); deltas
 // just inside and outside the near (i8) and far (i16) ops, both signs; a flagged hit; the
 // field's smallest and largest index in turn. Written, read back held and streamed.
-TEST(VisibilityFile, EveryOpsEdgeRoundTripsThroughTheStreams) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_streams_test";
-  std::filesystem::create_directories(dir);
-  const std::string plv = (dir / "edges.plv").string();
+TEST_F(VisibilityFile, EveryOpsEdgeRoundTripsThroughTheStreams) {
+  const std::string plv = path("edges.plv");
   VisibilityField field;
   field.gridSide = 4;  // 16 entries per tixel
   field.tixelCount = 70000;  // indices up to 69 999: deltas past ±32 768
@@ -342,13 +336,10 @@ TEST(VisibilityFile, EveryOpsEdgeRoundTripsThroughTheStreams) {
           << bits << " block " << b;
     }
   }
-  std::filesystem::remove_all(dir);
 }
 
-TEST(VisibilityFile, RecordsWithAbsurdContentsAreRefusedDespiteAValidChecksum) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_contents_test";
-  std::filesystem::create_directories(dir);
-  const std::string plv = (dir / "crafted.plv").string();
+TEST_F(VisibilityFile, RecordsWithAbsurdContentsAreRefusedDespiteAValidChecksum) {
+  const std::string plv = path("crafted.plv");
   VisibilityField read;
   std::string why;
   const VisibilityExtra sane{Rgb(0.9f, 0.5f, 0.0f), Vec2(-1.0f, 0.7f), 1};
@@ -372,7 +363,6 @@ TEST(VisibilityFile, RecordsWithAbsurdContentsAreRefusedDespiteAValidChecksum) {
     writeVisibility(plv, tinyField(c.extra));
     expectRefused(plv, 0x1234, "crafted.plv: extra record 0", c.problem);
   }
-  std::filesystem::remove_all(dir);
 }
 
 /// A stored entry block made by hand (plv_file.h, "A stored entry block"): `bits`, then each
@@ -409,10 +399,8 @@ std::string withEntryBlock(const std::string& file, const std::vector<unsigned c
 
 // The stored entry blocks' streams are checked as they are read: a block the writer cannot
 // have made is refused naming the file and the block, though every checksum and frame is valid.
-TEST(VisibilityFile, StoredEntryBlocksTheWriterCannotMakeAreRefused) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_crafted_blocks_test";
-  std::filesystem::create_directories(dir);
-  const std::string plv = (dir / "crafted.plv").string();
+TEST_F(VisibilityFile, StoredEntryBlocksTheWriterCannotMakeAreRefused) {
+  const std::string plv = path("crafted.plv");
   VisibilityField field;  // one tixel, one direction, compact: a block of one entry
   field.gridSide = 1;
   field.tixelCount = 1;
@@ -456,16 +444,13 @@ TEST(VisibilityFile, StoredEntryBlocksTheWriterCannotMakeAreRefused) {
     std::ofstream(plv, std::ios::binary | std::ios::trunc) << withEntryBlock(written, c.block);
     expectRefused(plv, 5, "crafted.plv: visibility block 0", c.problem);
   }
-  std::filesystem::remove_all(dir);
 }
 
 // The streaming writer: entry blocks handed over in any order give writeVisibility's file byte
 // for byte, and the block file reads each block's content back (sizes, then encodings,
 // decoding to the entries); readVisibility's streamed form holds the extra records only.
-TEST(VisibilityFile, BlocksWrittenOutOfOrderAndReadBackOneAtATime) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_stream_test";
-  std::filesystem::create_directories(dir);
-  const std::string held = (dir / "held.plv").string(), streamed = (dir / "streamed.plv").string();
+TEST_F(VisibilityFile, BlocksWrittenOutOfOrderAndReadBackOneAtATime) {
+  const std::string held = path("held.plv"), streamed = path("streamed.plv");
   VisibilityField field;
   field.gridSide = 16;  // 256 directions: 256 tixels per block
   field.tixelCount = 1000;
@@ -521,21 +506,17 @@ TEST(VisibilityFile, BlocksWrittenOutOfOrderAndReadBackOneAtATime) {
   EXPECT_TRUE(read.entryBytes.empty());
   EXPECT_EQ(read.stream->blocks(), 4u);
   EXPECT_EQ(read.extraOffset.size(), field.tixelCount + 1);
-  std::filesystem::remove_all(dir);
 }
 
 // An unfinished writer (an error, an interrupted bake) leaves no .plv.
-TEST(VisibilityFile, AnUnfinishedWriterLeavesNoFile) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "plenoptic_plv_unfinished_test";
-  std::filesystem::create_directories(dir);
-  const std::string plv = (dir / "u.plv").string();
+TEST_F(VisibilityFile, AnUnfinishedWriterLeavesNoFile) {
+  const std::string plv = path("u.plv");
   {
     VisibilityWriter writer(plv, 2, 1, 10);
     EXPECT_THROW(writer.finish({}, {}), Error);  // no block written
   }
   EXPECT_FALSE(std::filesystem::exists(plv));
-  EXPECT_TRUE(std::filesystem::is_empty(dir));  // nor its temporary
-  std::filesystem::remove_all(dir);
+  EXPECT_EQ(fileCount(), 0u);  // nor its temporary
 }
 
 }  // namespace
