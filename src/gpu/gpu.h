@@ -136,9 +136,10 @@ bool isSoftwareRasteriser(const std::string& glRenderer);
 /// The GPU's own time for a frame, pass by pass, in milliseconds (GL timestamp queries): the
 /// visibility pass (the triangle ids rasterised), the resolve pass (one sample per pixel: each
 /// pixel's camera ray cast — the id buffer's triangle or the BVH's), the shading pass (the
-/// lookup; with several samples per pixel their rays too), and all three.
+/// lookup; with several samples per pixel their rays too).
 struct GpuPassMilliseconds {
-  double visibility = 0.0, resolve = 0.0, shading = 0.0, total = 0.0;
+  double visibility = 0.0, resolve = 0.0, shading = 0.0;
+  double total() const { return visibility + resolve + shading; }
 };
 
 class GpuRenderer {

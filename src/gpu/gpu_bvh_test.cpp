@@ -72,12 +72,12 @@ void expectWellFormed(const GpuBvh& bvh, const std::vector<Vec3>& positions, con
       const BvhTriangle& record = bvh.triangles[i];
       EXPECT_EQ(record.triangle, t);
       const Vec3 p0 = positions[triangles[t][0]], e1 = positions[triangles[t][1]] - p0, e2 = positions[triangles[t][2]] - p0;
-      for (int k = 0; k < 3; ++k) {
-        if (!isFinite(p0) || !isFinite(e1) || !isFinite(e2)) break;
-        EXPECT_EQ(record.p0[k], p0[k]);
-        EXPECT_EQ(record.e1[k], e1[k]);
-        EXPECT_EQ(record.e2[k], e2[k]);
-      }
+      if (isFinite(p0) && isFinite(e1) && isFinite(e2))  // (NaN compares unequal to itself)
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_EQ(record.p0[k], p0[k]);
+          EXPECT_EQ(record.e1[k], e1[k]);
+          EXPECT_EQ(record.e2[k], e2[k]);
+        }
       const Vec3 p[3] = {positions[triangles[t][0]], positions[triangles[t][1]], positions[triangles[t][2]]};
       if (!isFinite(p[0]) || !isFinite(p[1]) || !isFinite(p[2])) continue;  // in no box
       for (const Vec3& v : p) EXPECT_TRUE(inside(node, v));

@@ -52,7 +52,7 @@ struct TriangleGpu {
 
 /// The visibility pass's resolution, per axis, relative to a width × height image's with
 /// several samples per pixel: a jittered ray takes the triangle of the 3×3 id texels around
-/// its film point where they agree (primaryHit), else it is cast through the BVH; finer texels
+/// its film point where they agree (idsHit), else it is cast through the BVH; finer texels
 /// agree on more of the image (fewer rays cast) and leave a thinner sliver able to pass
 /// between their centres unseen. As fine as 16× while the id and depth targets stay
 /// within kMaxIdTexels (8 bytes each: 256 MiB): 16× up to 256×192 pixels, 10× at 640×480,
@@ -358,7 +358,7 @@ uniform ivec2 size;
 uniform int idScale;  // the ids are at idScale × the image's resolution
 uniform bool anyMasked;  // some material is alpha-masked (maskedMaterial)
 // An id texel the markers pass marked: a vertex lies there, nearer than the surface rasterised
-// (primaryHit casts the rays around it through the BVH).
+// (cameraHit casts the rays around it through the BVH).
 const uint kMarkedTexel = 0xffffffffu;
 // The vector from the eye to film point `film` (pixel units) on the image plane at unit distance.
 vec3 cameraToFilm(vec2 film) {
@@ -442,7 +442,7 @@ void main() {
 // depth without writing it, marks the texel it falls in where it is nearer than the surface
 // rasterised there. A triangle smaller than a texel may be left out of the ids by the
 // rasteriser's snapping (or lie between texel centres) though the ray through a texel centre
-// hits it; its vertices then mark the 3×3 around that centre, where primaryHit casts the rays.
+// hits it; its vertices then mark the 3×3 around that centre, where cameraHit casts the rays.
 constexpr const char* kMarkerFragment = R"glsl(
 out uint id;
 void main() { id = kMarkedTexel; }
@@ -453,9 +453,8 @@ void main() { id = kMarkedTexel; }
 constexpr const char* kPrimaryHitGlsl = R"glsl(
 layout(binding = IDS_UNIT) uniform usampler2D ids;
 const uint kNoTriangle = 0xffffffffu;  // a hit's triangle on a miss
-// The camera ray's primary hit: the ray from the eye along unit `direction` through film point
-// `film` (pixel units) — the ray caster's answer: true with its distance t, triangle and
-// barycentrics b, false on a miss. The id texels answer where they can be trusted: the texel
+// The primary hit of the ray from the eye along unit `direction` through film point `film`
+// (pixel units), as the ray caster answers it. The id texels answer where they can be trusted: the texel
 // the film point falls in and its 8 neighbours hold one triangle (or all nothing), no vertex
 // marked there (kMarkedTexel), and the ray hits that triangle (Möller–Trumbore, edges
 // inclusive, not cut by an alpha mask). The film point lies within the square of those 9 texel
@@ -487,25 +486,32 @@ int idsHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b
   }
   return kIdsUnsure;
 }
-bool primaryHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
-  int answer = idsHit(film, direction, t, triangle, b);
-  if (answer != kIdsUnsure) return answer == kIdsHit;
-  return bvhIntersect(eye, direction, 0.0, 1.0 / 0.0, t, triangle, b);
+// What the id texels say of the camera ray through film point `film` along unit `direction`:
+// idsHit's answer for a pinhole; kIdsUnsure for a thin lens, whose rays start off the eye,
+// where the id buffer (rasterised from the eye) says nothing.
+int cameraIdsHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
+  if (apertureRadius > 0.0) {
+    t = 1.0 / 0.0;
+    triangle = kNoTriangle;
+    b = vec2(0.0);
+    return kIdsUnsure;
+  }
+  return idsHit(film, direction, t, triangle, b);
 }
 
-// The camera ray's hit from `origin` along unit `direction` through film point `film`: a
-// pinhole's by primaryHit; a thin lens's rays start off the eye, where the id buffer
-// (rasterised from the eye) says nothing: they are cast through the BVH.
+// The camera ray's hit from `origin` along unit `direction` through film point `film`: the id
+// texels' answer where they have one (cameraIdsHit), else the BVH's.
 bool cameraHit(vec2 film, vec3 origin, vec3 direction, out float t, out uint triangle, out vec2 b) {
-  return apertureRadius > 0.0 ? bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, b)
-                              : primaryHit(film, direction, t, triangle, b);
+  int answer = cameraIdsHit(film, direction, t, triangle, b);
+  if (answer != kIdsUnsure) return answer == kIdsHit;
+  return bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, b);
 }
 )glsl";
 
 // Pass 2, one sample per pixel: the camera ray through each pixel's centre and its hit
 // (cameraHit), stored as (t, triangle, b) bits for the shading pass — the ray casting apart
 // from the lookup, each program smaller than the two in one, and each timed on its own. It
-// runs as two dispatches: the first answers the pixels the id texels can (idsHit) and queues
+// runs as two dispatches: the first answers the pixels the id texels can (cameraIdsHit) and queues
 // the others; the second, one thread per queued pixel, casts their rays through the BVH — so
 // the threads of a group traverse the BVH together rather than wait for one pixel of theirs
 // that does. The queue: a DispatchIndirectCommand (its x counting the 64-wide groups the
@@ -530,8 +536,7 @@ void main() {
   float t;
   uint triangle;
   vec2 b;
-  // A thin lens's rays start off the eye, where the id texels say nothing (cameraHit).
-  int answer = apertureRadius > 0.0 ? kIdsUnsure : idsHit(film, direction, t, triangle, b);
+  int answer = cameraIdsHit(film, direction, t, triangle, b);
   if (answer != kIdsUnsure) {
     storeHit(pixel, answer == kIdsHit, t, triangle, b);
     return;
@@ -1193,7 +1198,6 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   const SunLights sun = sunLightsOf(lightField);
   const gpu::SurfaceDetailBuffer detail = gpu::surfaceDetailBuffer(lightField);
   std::vector<ChartGpu> charts(lightField.charts.size());
-  bool chartDetail = false;  // some chart reads surface detail (textures, normal maps)
   // Some chart record has a flag surfaceDetailAt reads per pixel (else it returns no detail
   // for every pixel, and the shading passes are compiled without it: PIXEL_DETAIL).
   constexpr uint32_t kPixelDetailFlags =
@@ -1202,7 +1206,6 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   for (uint32_t i = 0; i < charts.size(); ++i) {
     const Chart& c = lightField.charts[i];
     const ChartShading shading = chartShading(lightField, i, sun);
-    chartDetail = chartDetail || (shading.needsUv && shading.texturedAlbedo) || shading.texturedEmission || shading.normalMapped;
     ChartGpu& g = charts[i];
     g = ChartGpu{{c.origin.x, c.origin.y, c.origin.z, shading.inverseTixelSize},
                  {c.axisU.x, c.axisU.y, c.axisU.z, 0.0f},
@@ -1380,7 +1383,6 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                      (s.highlights ? "#define HIGHLIGHTS\n" + highlightGlslConstants() : "") +
                                      bvhGlslConstants() + (traces ? specularGlslConstants() : "") +
                                      (anyMasked ? "#define BVH_ALPHA_MASKS\n" : "") +
-                                     (chartDetail ? "#define CHAIN_SURFACE_DETAIL\n" : "") +
                                      (pixelDetail ? "#define PIXEL_DETAIL\n" : "") +
                                      (gpu::tracedSurfaceDetail(lightField) ? "#define TRACED_DETAIL\n" : "") +
                                      (mirrorLike ? "#define MIRROR_LIKE\n" : "") +
@@ -1546,11 +1548,10 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   for (int i = 0; i < State::kTimestamps; ++i) glGetQueryObjectui64v(s.timestampQueries[i], GL_QUERY_RESULT, &stamps[i]);
   auto milliseconds = [&](int from, int to) { return stamps[to] > stamps[from] ? double(stamps[to] - stamps[from]) * 1e-6 : 0.0; };
   s.lastPasses = {milliseconds(0, 1), milliseconds(1, 2), milliseconds(2, 3)};
-  s.lastPasses.total = milliseconds(0, 3);
   checkGl("the shading pass");
 }
 
-double GpuRenderer::lastGpuMilliseconds() const { return state_->lastPasses.total; }
+double GpuRenderer::lastGpuMilliseconds() const { return state_->lastPasses.total(); }
 
 uint64_t GpuRenderer::maxImagePixels() const {
   state_->context.makeCurrent();

@@ -383,11 +383,7 @@ vec3 followChain(vec3 origin, vec3 direction, bool hit, float t, uint triangle, 
     uint record = viewedRecord(tri.w, -direction, normalAtHit);
     if (record == kNoRecord) return radiance;  // inside a closed smooth mesh: nothing seen
     if (charts[record].info.y != kSpecular) {
-#ifdef CHAIN_SURFACE_DETAIL
       SurfaceDetail detail = hitSurfaceDetail(triangle, uv, direction, coneSpread * distance);
-#else
-      SurfaceDetail detail = noSurfaceDetail(shadingNormal);  // no chart reads any
-#endif
       vec3 seen = lookupRadiance(tri.w, origin + t * direction, -direction, normalAtHit, shadingNormal, detail);
 #ifdef LOBE_LIGHTS
       seen -= lobeOvercountedEmission(direction, triangle, uv, lobePdf, lobeDistance + t);

@@ -29,7 +29,7 @@
 // glass bends surfaceAt's shading normal and an emission texture modulates its emission
 // (TRACED_DETAIL, gpu_surface_detail.h tracedSurfaceDetail); the lookup at the chain's end
 // reads the surface detail there (hitSurfaceDetail, the ray cone coneSpread × the chain's
-// summed length; compiled in, CHAIN_SURFACE_DETAIL, where some chart reads surface detail).
+// summed length; none where no chart reads any: gpu_renderer.cpp PIXEL_DETAIL).
 #include <cstdint>
 #include <string>
 #include <vector>

@@ -1215,13 +1215,10 @@ TEST_F(GpuRenderCliTest, RendersTheCpuPicture) {
   EXPECT_GT(double(json["gpu_ms_median"]), 0.0);
   EXPECT_LE(double(json["gpu_ms_min"]), double(json["gpu_ms_median"]));
   EXPECT_LE(double(json["gpu_ms_median"]), double(json["ms_per_frame_median"]));
-  // Pass by pass: the three are the frame's GPU time (one frame, so the medians add up).
-  const double visibility = json["gpu_visibility_ms_median"], resolve = json["gpu_resolve_ms_median"],
-               shading = json["gpu_shading_ms_median"];
-  EXPECT_GT(visibility, 0.0);
-  EXPECT_GT(resolve, 0.0);
-  EXPECT_GT(shading, 0.0);
-  EXPECT_NEAR(visibility + resolve + shading, double(json["gpu_ms_median"]), 1e-6);
+  // Pass by pass: each pass of a one-sample frame ran and was timed.
+  EXPECT_GT(double(json["gpu_visibility_ms_median"]), 0.0);
+  EXPECT_GT(double(json["gpu_resolve_ms_median"]), 0.0);
+  EXPECT_GT(double(json["gpu_shading_ms_median"]), 0.0);
   // A thin lens likewise (depth of field: its lens points are the CPU renderer's).
   const std::string lens = size + " --aperture 0.5 --spp 4";
   ASSERT_EQ(run("render " + path("box.plf") + " -o " + path("gpu-lens.exr") + lens + " --renderer gpu", nullptr, &err), 0) << err;

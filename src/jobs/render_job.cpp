@@ -183,7 +183,7 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
     } else if (gpuRenderer) {
       gpuRenderer->render(frameCamera, settings, image);
       const GpuPassMilliseconds passes = gpuRenderer->lastGpuPasses();
-      gpuMs.push_back(passes.total);
+      gpuMs.push_back(passes.total());
       gpuVisibilityMs.push_back(passes.visibility);
       gpuResolveMs.push_back(passes.resolve);
       gpuShadingMs.push_back(passes.shading);
