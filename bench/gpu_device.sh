@@ -59,7 +59,8 @@ if any(w in s["device"].lower() for w in ("llvmpipe", "softpipe", "software rast
 print(f"{name} {s['width']}x{s['height']}: {s['fps']:.1f} fps ({s['ms_per_frame_median']:.3f} ms/frame median, "
       f"min {s['ms_per_frame_min']:.3f}, read-back included; GPU time alone {s.get('gpu_ms_median', 0):.3f} ms: "
       f"visibility {s.get('gpu_visibility_ms_median', 0):.3f}, resolve {s.get('gpu_resolve_ms_median', 0):.3f}, "
-      f"shading {s.get('gpu_shading_ms_median', 0):.3f} ms; visibility pass alone {s['primary_ms_median']:.3f} ms), "
+      f"shading {s.get('gpu_shading_ms_median', 0):.3f} ms; visibility pass alone {s['primary_ms_median']:.3f} ms; "
+      f"{100 * s.get('gpu_bvh_ray_share_median', 0):.1f} % of the camera rays cast through the BVH), "
       f"{s['frames']} frames, GPU memory {s['gpu_bytes'] / 2**20:.1f} MiB, on {s['device']}")
 PY
 }

@@ -89,6 +89,7 @@
 // GpuRenderer::sampleLights, and the mirror-like lobe's (gpu_mirror_like.h) by
 // GpuRenderer::sampleLobes.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -179,6 +180,11 @@ class GpuRenderer {
   double lastGpuMilliseconds() const;
   /// The same time pass by pass (`render --stats` gpu_visibility_ms_median, ...).
   GpuPassMilliseconds lastGpuPasses() const;
+  /// The share of the last render()'s pixels whose camera ray the resolve pass cast through
+  /// the BVH: those the id texels could not answer (edges, silhouettes, triangles smaller than a
+  /// pixel; every pixel of a thin lens) — `render --stats` gpu_bvh_ray_share_median. Empty
+  /// after a frame of several samples per pixel, whose rays are cast in the shading pass.
+  std::optional<double> lastBvhRayShare() const;
   /// The most pixels (width × height) render() draws on this driver: the resolve pass's queue
   /// of rays to cast, 4 bytes per pixel, within its largest storage block
   /// (GL_MAX_SHADER_STORAGE_BLOCK_SIZE: 128 MiB on llvmpipe, 33.5 M pixels). render() refuses a

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <optional>
 
 #include "camera/camera.h"
 #include "core/error.h"
@@ -1042,6 +1043,9 @@ struct GpuRenderer::State {
   static constexpr int kTimestamps = 4;
   GLuint timestampQueries[kTimestamps] = {};
   GpuPassMilliseconds lastPasses;
+  /// The last render()'s camera rays the resolve pass cast through the BVH (its queue's
+  /// count), over its pixels; empty after a frame of several samples (lastBvhRayShare).
+  std::optional<double> lastBvhRayShare;
   /// The frame's targets: the triangle ids and depth of the visibility pass, the camera rays'
   /// hits and the queue of rays to cast of the resolve pass (one sample per pixel), the
   /// radiance of the shading pass.
@@ -1548,6 +1552,12 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   for (int i = 0; i < State::kTimestamps; ++i) glGetQueryObjectui64v(s.timestampQueries[i], GL_QUERY_RESULT, &stamps[i]);
   auto milliseconds = [&](int from, int to) { return stamps[to] > stamps[from] ? double(stamps[to] - stamps[from]) * 1e-6 : 0.0; };
   s.lastPasses = {milliseconds(0, 1), milliseconds(1, 2), milliseconds(2, 3)};
+  s.lastBvhRayShare.reset();
+  if (spp == 1) {
+    GLuint queued = 0;  // the queue's count (kResolveCompute), after its header's three group counts
+    glGetNamedBufferSubData(s.rayQueue, 3 * sizeof(GLuint), sizeof(queued), &queued);
+    s.lastBvhRayShare = double(queued) / (double(camera.width()) * double(camera.height()));
+  }
   checkGl("the shading pass");
 }
 
@@ -1559,6 +1569,8 @@ uint64_t GpuRenderer::maxImagePixels() const {
 }
 
 GpuPassMilliseconds GpuRenderer::lastGpuPasses() const { return state_->lastPasses; }
+
+std::optional<double> GpuRenderer::lastBvhRayShare() const { return state_->lastBvhRayShare; }
 
 std::vector<Rgb> GpuRenderer::lookup(const std::vector<LookupQuery>& queries) {
   State& s = *state_;

@@ -1219,6 +1219,16 @@ TEST_F(GpuRenderCliTest, RendersTheCpuPicture) {
   EXPECT_GT(double(json["gpu_visibility_ms_median"]), 0.0);
   EXPECT_GT(double(json["gpu_resolve_ms_median"]), 0.0);
   EXPECT_GT(double(json["gpu_shading_ms_median"]), 0.0);
+  // The camera rays cast through the BVH: the box's edges and silhouettes, a minority of pixels.
+  EXPECT_GT(double(json["gpu_bvh_ray_share_median"]), 0.0);
+  EXPECT_LT(double(json["gpu_bvh_ray_share_median"]), 0.5);
+  // A thin lens casts every one (its rays start off the eye the ids were rasterised from).
+  ASSERT_EQ(run("render " + path("box.plf") + " -o " + path("gpu-lens1.exr") + size +
+                    " --aperture 0.5 --spp 1 --renderer gpu --stats " + path("gpu-lens1.json"),
+                nullptr, &err),
+            0)
+      << err;
+  EXPECT_EQ(double(nlohmann::json::parse(cli_test::readFileText(path("gpu-lens1.json")))["gpu_bvh_ray_share_median"]), 1.0);
   // A thin lens likewise (depth of field: its lens points are the CPU renderer's).
   const std::string lens = size + " --aperture 0.5 --spp 4";
   ASSERT_EQ(run("render " + path("box.plf") + " -o " + path("gpu-lens.exr") + lens + " --renderer gpu", nullptr, &err), 0) << err;

@@ -274,6 +274,9 @@ struct RenderJobStats {
   double gpuMsMedian = 0, gpuMsMin = 0;  ///< the GPU renderer: its own time per frame (GpuRenderer::lastGpuMilliseconds)
   /// The GPU renderer's passes' medians (GpuRenderer::lastGpuPasses).
   double gpuVisibilityMsMedian = 0, gpuResolveMsMedian = 0, gpuShadingMsMedian = 0;
+  /// The share of a frame's pixels whose camera ray was cast through the GPU's BVH
+  /// (GpuRenderer::lastBvhRayShare), median over the frames; -1: not counted (several samples).
+  double gpuBvhRayShareMedian = -1;
   double loadSeconds = 0, accelBuildSeconds = 0;
   uint64_t fileBytes = 0;
   /// A path with light keyframes: frames relit, iterations, and the time relighting took

@@ -53,6 +53,7 @@ std::string RenderJobStats::toJson() const {
     json["gpu_visibility_ms_median"] = gpuVisibilityMsMedian;
     json["gpu_resolve_ms_median"] = gpuResolveMsMedian;
     json["gpu_shading_ms_median"] = gpuShadingMsMedian;
+    if (gpuBvhRayShareMedian >= 0.0) json["gpu_bvh_ray_share_median"] = gpuBvhRayShareMedian;
   }
   if (primaryMsMedian > 0.0) {
     json["primary_ms_median"] = primaryMsMedian;
@@ -169,7 +170,7 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
   settings.showProgress = o.frames == 1 && o.reference;
   RenderJobResult result;
   Image& image = result.image;
-  std::vector<double> frameMs, primaryMs, gpuMs, gpuVisibilityMs, gpuResolveMs, gpuShadingMs;
+  std::vector<double> frameMs, primaryMs, gpuMs, gpuVisibilityMs, gpuResolveMs, gpuShadingMs, gpuBvhRayShare;
   // With --stats, the fast renderer's first pass alone (FastRenderer::castPrimaryRays) is
   // timed on every frame's camera after the last frame (interleaving it with the frames would
   // evict their light-field data from the caches and slow them down).
@@ -187,6 +188,7 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
       gpuVisibilityMs.push_back(passes.visibility);
       gpuResolveMs.push_back(passes.resolve);
       gpuShadingMs.push_back(passes.shading);
+      if (const std::optional<double> share = gpuRenderer->lastBvhRayShare()) gpuBvhRayShare.push_back(*share);
     } else {
       (relitRenderer ? *relitRenderer : fastRenderer).render(frameCamera, settings, image);
     }
@@ -256,6 +258,7 @@ RenderJobResult RenderJob::render(const LightField& lightField, double loadSecon
     stats.gpuVisibilityMsMedian = median(gpuVisibilityMs);
     stats.gpuResolveMsMedian = median(gpuResolveMs);
     stats.gpuShadingMsMedian = median(gpuShadingMs);
+    if (!gpuBvhRayShare.empty()) stats.gpuBvhRayShareMedian = median(gpuBvhRayShare);
   }
   if (!primaryMs.empty()) {
     stats.primaryMsMedian = median(primaryMs);
