@@ -3,23 +3,27 @@
 // renderer's picture (realtime/realtime.h) drawn by the graphics processor — or, on a machine
 // without one, by Mesa's llvmpipe software rasteriser, which is how the tests run it.
 //
-// A frame is two passes:
+// A frame is three passes:
 //   1. visibility: every triangle of the scene rasterised once with a reversed-Z float depth
 //      buffer, writing its triangle id (+1; 0 = nothing) per pixel — the primary hit of the
 //      ray through the pixel centre, as the CPU renderer's one sample per pixel; an
 //      alpha-masked triangle is discarded where that ray meets it at a coverage below its
 //      cutoff (coverageAt), as the ray caster's hit filter does. Then every vertex is drawn as
 //      a one-pixel point that marks its pixel where it is nearer than the surface there;
-//   2. shading: per pixel, the camera ray of Camera::generateRay through the pixel centre. Its
-//      hit is the id buffer's triangle where that pixel and its 8 neighbours hold the same one,
-//      unmarked, and the ray hits it; elsewhere — an edge or silhouette nearby, or a marked
-//      vertex: a triangle smaller than a pixel, which the rasteriser's sub-pixel snapping can
-//      leave out of the id buffer though the ray through the centre hits it — the ray is cast
+//   2. resolve (a compute shader): per pixel, the camera ray of Camera::generateRay through the
+//      pixel centre and its hit. Where that pixel and its 8 neighbours hold at most two ids,
+//      none marked, the ray is tested against those triangles (the nearer hit; a miss where
+//      it hits neither and one of the two is nothing); elsewhere — three surfaces or more
+//      nearby, a marked vertex (a triangle smaller than a pixel, which the rasteriser's
+//      sub-pixel snapping can leave out of the id buffer though the ray through the centre
+//      hits it), a ray hitting neither of two triangles — the pixel is queued and its ray cast
 //      through the BVH (gpu_bvh.h), as the CPU renderers cast theirs through Embree; so only a
 //      sliver narrower than a pixel passing between the 3×3 centres with its vertices
-//      elsewhere, or a tie between coplanar triangles, can make the two differ. Then the hit
-//      point origin + t·direction (as the CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
-//      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes) in a fragment shader,
+//      elsewhere, a triangle smaller than a pixel lying between the two with its vertices on
+//      their surface, or a tie between coplanar triangles, can make the two differ;
+//   3. shading, a fragment shader reading that hit: the hit point origin + t·direction (as the
+//      CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
+//      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes),
 //      times the camera weight (cos⁴θ with vignetting). A miss sees the environment (the
 //      constant and the map: EnvironmentMap::radiance, bilinear in the lat-long image). On a
 //      chart whose albedo varies, the albedo texture is read at the CPU renderer's mip level
@@ -75,8 +79,9 @@
 // renderers' film points (pixelSample's ZSobol sequence in 64-bit GLSL integers,
 // GL_ARB_gpu_shader_int64); the visibility pass is then drawn at a finer resolution (16× per
 // axis on small images, 4× at 1920×1080: its targets stay within 256 MiB) and each jittered ray
-// takes the triangle of the 3×3 of those finer texels around its film point by the same rule
-// (one triangle, unmarked, hit by the ray), else it is cast through the BVH.
+// takes its hit from the 3×3 of those finer texels around its film point by the same rule
+// (at most two ids, unmarked, one of them hit by the ray), else it is cast through the BVH —
+// in the shading pass itself, which then has no resolve pass before it.
 //
 // A thin lens (depth of field): each sample's lens point is the CPU renderers' (pixelSample's
 // second ZSobol dimension, mapped to the aperture by sampleConcentricDisk; the lens centre at

@@ -455,37 +455,59 @@ constexpr const char* kPrimaryHitGlsl = R"glsl(
 layout(binding = IDS_UNIT) uniform usampler2D ids;
 const uint kNoTriangle = 0xffffffffu;  // a hit's triangle on a miss
 // The primary hit of the ray from the eye along unit `direction` through film point `film`
-// (pixel units), as the ray caster answers it. The id texels answer where they can be trusted: the texel
-// the film point falls in and its 8 neighbours hold one triangle (or all nothing), no vertex
-// marked there (kMarkedTexel), and the ray hits that triangle (Möller–Trumbore, edges
-// inclusive, not cut by an alpha mask). The film point lies within the square of those 9 texel
-// centres, all on that triangle; a nearer triangle would cover one of them or have a vertex
-// in front there, unless it is a sliver narrower than the texel spacing passing between them
-// with its vertices elsewhere (gpu.h). Everywhere else — an edge or silhouette in the 3×3, a
-// triangle smaller than a texel the rasteriser left out (its vertices mark its texels), a
-// jittered ray off its texel's triangle — the ray is cast through the BVH (gpu_bvh.h
-// bvhIntersect) as the CPU renderers cast theirs through Embree.
+// (pixel units), as the ray caster answers it. The id texels answer where they can be trusted:
+// the texel the film point falls in and its 8 neighbours hold at most two ids (triangles, or
+// nothing), no vertex is marked there (kMarkedTexel), and the ray hits one of those triangles
+// (Möller–Trumbore, edges inclusive, not cut by an alpha mask; the nearer if it hits both) — or
+// hits neither while one of the two ids is nothing: a miss. The film point lies within the
+// square of those 9 texel centres; a nearer triangle missing from all of them would have a
+// vertex in front there (marked), unless it is a sliver narrower than the texel spacing passing
+// between them with its vertices elsewhere, or a triangle between the two, smaller than a
+// texel, whose vertices lie on their surface (gpu.h). Everywhere else — three surfaces or more
+// in the 3×3 (a corner, a strip of triangles smaller than a texel), a marked texel, a ray that
+// hits neither of two triangles — the ray is cast through the BVH (gpu_bvh.h bvhIntersect) as
+// the CPU renderers cast theirs through Embree.
 const int kIdsMiss = 0, kIdsHit = 1, kIdsUnsure = 2;
 // What the id texels say of that ray: kIdsMiss or kIdsHit (with t, triangle and b) where they
 // can be trusted, else kIdsUnsure (the ray is to be cast through the BVH).
 int idsHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
   ivec2 texel = ivec2(floor(film * float(idScale)));
   ivec2 lastTexel = size * idScale - 1;
-  uint id = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
-  bool same = id != kMarkedTexel;
-  for (int dy = -1; dy <= 1 && same; ++dy)
-    for (int dx = -1; dx <= 1 && same; ++dx) same = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r == id;
   const float far = 1.0 / 0.0;
   t = far;
   triangle = kNoTriangle;
   b = vec2(0.0);
-  if (same && id == 0u) return kIdsMiss;
-  if (same) {
-    t = bvhTriangle(id - 1u, eye, direction, 0.0, far, b);
-    triangle = id - 1u;
-    if (t < far && !bvhCutAway(triangle, b)) return kIdsHit;
+  // The 3×3 texels' ids (0: nothing; a triangle's index + 1): seen[0] the centre's, seen[1]
+  // another where there is one.
+  uint seen[2];
+  seen[0] = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
+  seen[1] = seen[0];
+  bool answerable = seen[0] != kMarkedTexel;
+  for (int dy = -1; dy <= 1 && answerable; ++dy)
+    for (int dx = -1; dx <= 1 && answerable; ++dx) {
+      uint id = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r;
+      if (id == seen[0] || id == seen[1]) continue;
+      if (id == kMarkedTexel || seen[1] != seen[0]) answerable = false;
+      else seen[1] = id;
+    }
+  if (!answerable) return kIdsUnsure;
+  bool nothingSeen = false;
+  for (int k = 0; k < 2; ++k) {
+    if (k == 1 && seen[1] == seen[0]) break;
+    if (seen[k] == 0u) {
+      nothingSeen = true;
+      continue;
+    }
+    vec2 hitB;
+    float hitT = bvhTriangle(seen[k] - 1u, eye, direction, 0.0, t, hitB);
+    if (hitT < t && !bvhCutAway(seen[k] - 1u, hitB)) {
+      t = hitT;
+      triangle = seen[k] - 1u;
+      b = hitB;
+    }
   }
-  return kIdsUnsure;
+  if (triangle != kNoTriangle) return kIdsHit;
+  return nothingSeen ? kIdsMiss : kIdsUnsure;
 }
 // What the id texels say of the camera ray through film point `film` along unit `direction`:
 // idsHit's answer for a pinhole; kIdsUnsure for a thin lens, whose rays start off the eye,

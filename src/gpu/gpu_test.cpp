@@ -1219,9 +1219,11 @@ TEST_F(GpuRenderCliTest, RendersTheCpuPicture) {
   EXPECT_GT(double(json["gpu_visibility_ms_median"]), 0.0);
   EXPECT_GT(double(json["gpu_resolve_ms_median"]), 0.0);
   EXPECT_GT(double(json["gpu_shading_ms_median"]), 0.0);
-  // The camera rays cast through the BVH: the box's edges and silhouettes, a minority of pixels.
+  // The camera rays cast through the BVH: near the box's corners and vertices, where three
+  // surfaces or more meet. An edge between two (walls, a block's silhouette) is answered by
+  // testing its two triangles; casting every edge pixel's ray would be 43 % of them here.
   EXPECT_GT(double(json["gpu_bvh_ray_share_median"]), 0.0);
-  EXPECT_LT(double(json["gpu_bvh_ray_share_median"]), 0.5);
+  EXPECT_LT(double(json["gpu_bvh_ray_share_median"]), 0.2);
   // A thin lens casts every one (its rays start off the eye the ids were rasterised from).
   ASSERT_EQ(run("render " + path("box.plf") + " -o " + path("gpu-lens1.exr") + size +
                     " --aperture 0.5 --spp 1 --renderer gpu --stats " + path("gpu-lens1.json"),
