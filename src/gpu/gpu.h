@@ -21,7 +21,7 @@
 //      sliver narrower than a pixel passing between the 3×3 centres with its vertices
 //      elsewhere, a triangle smaller than a pixel lying between the two with its vertices on
 //      their surface, or a tie between coplanar triangles, can make the two differ;
-//   3. shading, a fragment shader reading that hit: the hit point origin + t·direction (as the
+//   3. shading, a compute shader reading that hit: the hit point origin + t·direction (as the
 //      CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
 //      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes),
 //      times the camera weight (cos⁴θ with vignetting). A miss sees the environment (the

@@ -68,8 +68,8 @@ int multiSampleIdScale(int width, int height) {
 constexpr GLuint kValuesBinding = 0, kChartsBinding = 1, kPositionsBinding = 2, kTrianglesBinding = 3,
                  kQueriesBinding = 4, kResultsBinding = 5, kNormalsBinding = 6, kSunMasksBinding = 7,
                  kEnvironmentBinding = 8, kRayQueueBinding = 9, kSurfaceDetailBinding = 12;
-// Texture units: the visibility pass's ids, the resolve pass's hits; image unit of the hits.
-constexpr GLuint kIdsUnit = 0, kHitsUnit = 1, kHitsImageUnit = 0;
+// Texture units: the visibility pass's ids, the resolve pass's hits; image units: the hits, the radiance.
+constexpr GLuint kIdsUnit = 0, kHitsUnit = 1, kHitsImageUnit = 0, kRadianceImageUnit = 1;
 
 std::string glslConstants() {
   return fmt::format(
@@ -79,11 +79,11 @@ std::string glslConstants() {
       "#define VALUES_BINDING {}\n#define CHARTS_BINDING {}\n#define POSITIONS_BINDING {}\n#define TRIANGLES_BINDING {}\n"
       "#define QUERIES_BINDING {}\n#define RESULTS_BINDING {}\n#define NORMALS_BINDING {}\n#define SUN_MASKS_BINDING {}\n"
       "#define ENVIRONMENT_BINDING {}\n#define IDS_UNIT {}\n#define HITS_UNIT {}\n#define HITS_IMAGE_UNIT {}\n"
-      "#define RAY_QUEUE_BINDING {}\n",
+      "#define RAY_QUEUE_BINDING {}\n#define RADIANCE_IMAGE_UNIT {}\n",
       unsigned(ChartKind::Diffuse), unsigned(ChartKind::Glossy), unsigned(ChartKind::Specular), kFlagTwoSided, kFlagBack,
       kFlagCurved, kFlagDiffuseValue, kFlagEmissive, kFlagTwoSidedEmission, kFlagSunMasks, kMaxSunMaskLights, kSunMaskSide,
       kValuesBinding, kChartsBinding, kPositionsBinding, kTrianglesBinding, kQueriesBinding, kResultsBinding, kNormalsBinding,
-      kSunMasksBinding, kEnvironmentBinding, kIdsUnit, kHitsUnit, kHitsImageUnit, kRayQueueBinding);
+      kSunMasksBinding, kEnvironmentBinding, kIdsUnit, kHitsUnit, kHitsImageUnit, kRayQueueBinding, kRadianceImageUnit);
 }
 
 // The lookup of lightfield/lookup.h in GLSL, statement for statement (the names are the C++
@@ -586,19 +586,17 @@ void main() {
 #endif
 )glsl";
 
-// Pass 3: per pixel, the camera ray through its centre (Camera::generateRay), its hit (the
-// resolve pass's) and what is seen there (shadeHit); with several samples per pixel, each
-// sample's ray, hit (cameraHit) and shading in turn.
-constexpr const char* kShadingVertex = R"glsl(
-void main() {
-  vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-  gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
-}
-)glsl";
-constexpr const char* kShadingFragment = R"glsl(
+// Pass 3, a compute shader over the pixels (8×8 groups): per pixel, the camera ray through its
+// centre (Camera::generateRay), its hit (the resolve pass's) and what is seen there (shadeHit);
+// with several samples per pixel, each sample's ray, hit (cameraHit) and shading in turn. The
+// radiance is stored in an RGBA32F image. (A compute shader rather than a fragment shader over
+// a full-screen triangle: a GPU made for compute, as NVIDIA's Hopper, runs fragment shaders on
+// a few of its multiprocessors only, compute shaders on all of them.)
+constexpr const char* kShadingCompute = R"glsl(
+layout(local_size_x = 8, local_size_y = 8) in;
 uniform vec3 background;
 uniform float coneSpread;  // textureConeSpread: a sample's ray cone is coneSpread × t wide at t
-out vec4 color;
+layout(binding = RADIANCE_IMAGE_UNIT, rgba32f) uniform writeonly image2D radiance;
 
 // Environment::radiance (scene.h): the constant plus, where the scene has one, its map —
 // EnvironmentMap::radiance (env/env.h): rotated about +y (envRotation = cos, sin), looked up
@@ -777,7 +775,8 @@ vec2 zSobol2D(uint64_t mortonIndex, uint64_t layoutSeed, uint d) {
               fixedToUnit(bitfieldReverse(owenScrambleReversed(reversedSobolSecond(index), uint(h)))));
 }
 void main() {
-  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (pixel.x >= size.x || pixel.y >= size.y) return;
   uint64_t seed64 = (uint64_t(seed.y) << 32) | uint64_t(seed.x);
   uint64_t pixelIndex = mortonEncode2(uint(pixel.x), uint(pixel.y)) << log2Spp;
   vec3 sum = vec3(0.0);
@@ -786,17 +785,19 @@ void main() {
     vec2 lens = apertureRadius > 0.0 ? zSobol2D(index, seed64, 1u) : vec2(0.5);
     sum += sampleRadiance(vec2(pixel) + zSobol2D(index, seed64, 0u), lens);
   }
-  color = vec4(sum / float(spp), 1.0);
+  imageStore(radiance, pixel, vec4(sum / float(spp), 1.0));
 }
 #else
 // One sample, at the pixel and lens centres: the camera ray's hit is the resolve pass's.
 layout(binding = HITS_UNIT) uniform usampler2D hits;
 void main() {
-  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (pixel.x >= size.x || pixel.y >= size.y) return;
   vec3 origin, direction;
   float weight = cameraRay(vec2(pixel) + 0.5, vec2(0.5), origin, direction);
   uvec4 h = texelFetch(hits, pixel, 0);
-  color = vec4(weight * shadeHit(origin, direction, h.y != kNoTriangle, uintBitsToFloat(h.x), h.y, uintBitsToFloat(h.zw)), 1.0);
+  imageStore(radiance, pixel,
+             vec4(weight * shadeHit(origin, direction, h.y != kNoTriangle, uintBitsToFloat(h.x), h.y, uintBitsToFloat(h.zw)), 1.0));
 }
 #endif
 )glsl";
@@ -1039,7 +1040,7 @@ struct GpuRenderer::State {
   // values, charts, positions, triangles, indices, normals, sun masks, environment map, surface detail
   static constexpr GLsizei kBufferCount = 9;
   GLuint buffers[kBufferCount] = {};
-  GLuint vertexArray = 0, emptyVertexArray = 0;
+  GLuint vertexArray = 0;
   GLuint visibilityProgram = 0, markerProgram = 0, shadingProgram = 0, lookupProgram = 0;
   /// The resolve pass's two programs: the id texels' answers and the queue, the queued rays.
   GLuint resolveProgram = 0, queuedRaysProgram = 0;
@@ -1059,20 +1060,20 @@ struct GpuRenderer::State {
   /// The shading pass with several jittered samples per pixel; 0 where the driver lacks
   /// GL_ARB_gpu_shader_int64 (the sample positions' 64-bit hash).
   GLuint multisampleProgram = 0;
-  /// GL_TIMESTAMP queries at the start of a render()'s first pass and at the end of its
-  /// visibility, resolve and shading passes, and the GPU times between them in the last
+  /// GL_TIMESTAMP queries at the end of a render()'s visibility, resolve and shading passes
+  /// (its start is the GL's time when it begins), and the GPU times between them in the last
   /// render() (lastGpuMilliseconds, lastGpuPasses).
-  static constexpr int kTimestamps = 4;
-  GLuint timestampQueries[kTimestamps] = {};
+  static constexpr int kPassEnds = 3;
+  GLuint passEndQueries[kPassEnds] = {};
   GpuPassMilliseconds lastPasses;
   /// The last render()'s camera rays the resolve pass cast through the BVH (its queue's
   /// count), over its pixels; empty after a frame of several samples (lastBvhRayShare).
   std::optional<double> lastBvhRayShare;
   /// The frame's targets: the triangle ids and depth of the visibility pass, the camera rays'
   /// hits and the queue of rays to cast of the resolve pass (one sample per pixel), the
-  /// radiance of the shading pass.
-  GLuint idTexture = 0, depthBuffer = 0, hitsTexture = 0, rayQueue = 0, colorTexture = 0, visibilityFramebuffer = 0,
-         shadingFramebuffer = 0;
+  /// radiance image of the shading pass (read back through readbackFramebuffer).
+  GLuint idTexture = 0, depthBuffer = 0, hitsTexture = 0, rayQueue = 0, radianceTexture = 0, visibilityFramebuffer = 0,
+         readbackFramebuffer = 0;
   int width = 0, height = 0;
   int idScale = 1;  ///< the visibility targets are idScale·width × idScale·height
   GLsizei indexCount = 0, vertexCount = 0;
@@ -1091,7 +1092,6 @@ struct GpuRenderer::State {
     glDeleteProgram(lobesProgram);
     glDeleteBuffers(1, &lobeModels);
     glDeleteVertexArrays(1, &vertexArray);
-    glDeleteVertexArrays(1, &emptyVertexArray);
     glDeleteProgram(visibilityProgram);
     glDeleteProgram(markerProgram);
     glDeleteProgram(resolveProgram);
@@ -1099,18 +1099,18 @@ struct GpuRenderer::State {
     glDeleteProgram(shadingProgram);
     glDeleteProgram(lookupProgram);
     glDeleteProgram(multisampleProgram);
-    glDeleteQueries(kTimestamps, timestampQueries);
+    glDeleteQueries(kPassEnds, passEndQueries);
     releaseTargets();
   }
   void releaseTargets() {
     glDeleteFramebuffers(1, &visibilityFramebuffer);
-    glDeleteFramebuffers(1, &shadingFramebuffer);
+    glDeleteFramebuffers(1, &readbackFramebuffer);
     glDeleteTextures(1, &idTexture);
     glDeleteTextures(1, &hitsTexture);
     glDeleteBuffers(1, &rayQueue);
-    glDeleteTextures(1, &colorTexture);
+    glDeleteTextures(1, &radianceTexture);
     glDeleteRenderbuffers(1, &depthBuffer);
-    visibilityFramebuffer = shadingFramebuffer = idTexture = hitsTexture = rayQueue = colorTexture = depthBuffer = 0;
+    visibilityFramebuffer = readbackFramebuffer = idTexture = hitsTexture = rayQueue = radianceTexture = depthBuffer = 0;
     width = height = 0;
   }
   /// The frame's targets: hits, ray queue and radiance at width × height, triangle ids and
@@ -1138,14 +1138,14 @@ struct GpuRenderer::State {
     glCreateBuffers(1, &rayQueue);
     glNamedBufferStorage(rayQueue, GLsizeiptr(kRayQueueHeaderBytes + 4 * uint64_t(w) * uint64_t(h)), nullptr,
                          GL_DYNAMIC_STORAGE_BIT);
-    glCreateTextures(GL_TEXTURE_2D, 1, &colorTexture);
-    glTextureStorage2D(colorTexture, 1, GL_RGBA32F, w, h);
+    glCreateTextures(GL_TEXTURE_2D, 1, &radianceTexture);
+    glTextureStorage2D(radianceTexture, 1, GL_RGBA32F, w, h);
     glCreateFramebuffers(1, &visibilityFramebuffer);
     glNamedFramebufferTexture(visibilityFramebuffer, GL_COLOR_ATTACHMENT0, idTexture, 0);
     glNamedFramebufferRenderbuffer(visibilityFramebuffer, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depthBuffer);
-    glCreateFramebuffers(1, &shadingFramebuffer);
-    glNamedFramebufferTexture(shadingFramebuffer, GL_COLOR_ATTACHMENT0, colorTexture, 0);
-    for (GLuint fb : {visibilityFramebuffer, shadingFramebuffer})
+    glCreateFramebuffers(1, &readbackFramebuffer);
+    glNamedFramebufferTexture(readbackFramebuffer, GL_COLOR_ATTACHMENT0, radianceTexture, 0);
+    for (GLuint fb : {visibilityFramebuffer, readbackFramebuffer})
       if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         fail("GPU renderer: a {}x{} framebuffer is incomplete", w, h);
     checkGl("creating the frame's targets");
@@ -1393,7 +1393,6 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
   glEnableVertexArrayAttrib(s.vertexArray, 0);
   glVertexArrayAttribFormat(s.vertexArray, 0, 3, GL_FLOAT, GL_FALSE, 0);
   glVertexArrayAttribBinding(s.vertexArray, 0, 0);
-  glCreateVertexArrays(1, &s.emptyVertexArray);
 
   s.visibilityProgram =
       linkProgram({{GL_VERTEX_SHADER, kVisibilityVertex}, {GL_FRAGMENT_SHADER, kVisibilityFragment}}, "visibility", false);
@@ -1413,11 +1412,10 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
                                      (gpu::tracedSurfaceDetail(lightField) ? "#define TRACED_DETAIL\n" : "") +
                                      (mirrorLike ? "#define MIRROR_LIKE\n" : "") +
                                      (lobeLights ? "#define LOBE_LIGHTS\n" + lightGlslConstants() : "");
-  const std::string shading = std::string(kBvhGlsl) + kPrimaryHitGlsl + kShadingFragment + (traces ? kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
+  const std::string shading = std::string(kBvhGlsl) + kPrimaryHitGlsl + kShadingCompute + (traces ? kSurfaceGlsl : "") + (s.highlights ? kHighlightsGlsl : "") +
                               (lobeLights ? kLightsGlsl : "") + (mirrorLike ? kMirrorLikeGlsl : "") +
                               (s.specular ? kSpecularGlsl : "");
-  s.shadingProgram =
-      linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}}, "shading", true, raysHeader);
+  s.shadingProgram = linkProgram({{GL_COMPUTE_SHADER, shading}}, "shading", true, raysHeader, true);
   // The resolve pass casts rays only: the BVH, cut by alpha masks where the scene has some.
   const std::string resolve = std::string(kBvhGlsl) + kPrimaryHitGlsl + kResolveCompute;
   const std::string resolveHeader = bvhGlslConstants() + (anyMasked ? "#define BVH_ALPHA_MASKS\n" : "");
@@ -1426,9 +1424,8 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
       linkProgram({{GL_COMPUTE_SHADER, resolve}}, "resolve queued rays", false, resolveHeader + "#define QUEUED_RAYS\n", true);
   s.lookupProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + kLookupCompute}}, "lookup", true);
   if (epoxy_has_gl_extension("GL_ARB_gpu_shader_int64"))
-    s.multisampleProgram = linkProgram({{GL_VERTEX_SHADER, kShadingVertex}, {GL_FRAGMENT_SHADER, shading}},
-                                       "multi-sample shading", true,
-                                       (s.specular ? raysHeader : int64 + raysHeader) + "#define MULTISAMPLE\n");
+    s.multisampleProgram = linkProgram({{GL_COMPUTE_SHADER, shading}}, "multi-sample shading", true,
+                                       (s.specular ? raysHeader : int64 + raysHeader) + "#define MULTISAMPLE\n", true);
   for (GLuint program : {s.visibilityProgram, s.markerProgram})
     glProgramUniform1f(program, glGetUniformLocation(program, "near"), s.near);
   for (GLuint program : {s.visibilityProgram, s.resolveProgram, s.queuedRaysProgram, s.shadingProgram, s.multisampleProgram})
@@ -1508,14 +1505,20 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   const int idScale = spp > 1 && !camera.isThinLens() ? multiSampleIdScale(camera.width(), camera.height()) : 1;
   State& s = *state_;
   s.context.makeCurrent();
-  if (s.timestampQueries[0] == 0) glCreateQueries(GL_TIMESTAMP, State::kTimestamps, s.timestampQueries);
-  glQueryCounter(s.timestampQueries[0], GL_TIMESTAMP);
+  if (s.passEndQueries[0] == 0) glCreateQueries(GL_TIMESTAMP, State::kPassEnds, s.passEndQueries);
+  // The frame's start: the GL's time now, the GPU idle (the last frame was read back). Each
+  // pass's end is a timestamp query, flushed at once: Mesa's llvmpipe stamps a query when it
+  // runs the commands queued with it, so a query left queued behind a compute pass's
+  // would be stamped with the next pass's.
+  GLint64 frameStart = 0;
+  glGetInteger64v(GL_TIMESTAMP, &frameStart);
   if (camera.isThinLens()) {
     s.ensureTargets(camera.width(), camera.height(), idScale);
   } else {
     s.queueVisibility(camera, idScale);
   }
-  glQueryCounter(s.timestampQueries[1], GL_TIMESTAMP);
+  glQueryCounter(s.passEndQueries[0], GL_TIMESTAMP);
+  glFlush();
   auto setFrameUniforms = [&](GLuint program) {
     setCameraUniforms(program, camera);
     glProgramUniform2i(program, glGetUniformLocation(program, "size"), camera.width(), camera.height());
@@ -1541,7 +1544,8 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     glBindTextureUnit(kHitsUnit, s.hitsTexture);
   }
-  glQueryCounter(s.timestampQueries[2], GL_TIMESTAMP);
+  glQueryCounter(s.passEndQueries[1], GL_TIMESTAMP);
+  glFlush();
   const GLuint program = spp > 1 ? s.multisampleProgram : s.shadingProgram;
   setFrameUniforms(program);
   if (s.specular)
@@ -1557,21 +1561,22 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
     glProgramUniform2ui(program, glGetUniformLocation(program, "seed"), GLuint(settings.seed & 0xffffffffu),
                         GLuint(settings.seed >> 32));
   }
-  glBindFramebuffer(GL_FRAMEBUFFER, s.shadingFramebuffer);
-  glViewport(0, 0, camera.width(), camera.height());
-  glDisable(GL_DEPTH_TEST);
+  glBindImageTexture(kRadianceImageUnit, s.radianceTexture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glUseProgram(program);
-  glBindVertexArray(s.emptyVertexArray);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  glQueryCounter(s.timestampQueries[3], GL_TIMESTAMP);
+  glDispatchCompute(GLuint((camera.width() + 7) / 8), GLuint((camera.height() + 7) / 8), 1);
+  glQueryCounter(s.passEndQueries[2], GL_TIMESTAMP);
+  glFlush();
+  // The read-back reads the radiance image through the framebuffer it is attached to.
+  glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, s.readbackFramebuffer);
   if (image.width != camera.width() || image.height != camera.height()) image = Image(camera.width(), camera.height());
   // GL row y is image row y (the projection flips film y): read straight into the pixels.
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glReadnPixels(0, 0, camera.width(), camera.height(), GL_RGB, GL_FLOAT, GLsizei(image.pixels.size() * sizeof(Rgb)),
                 image.pixels.data());
   // (The read-back waited for the shading pass, so every timestamp is there.)
-  GLuint64 stamps[State::kTimestamps] = {};
-  for (int i = 0; i < State::kTimestamps; ++i) glGetQueryObjectui64v(s.timestampQueries[i], GL_QUERY_RESULT, &stamps[i]);
+  GLuint64 stamps[1 + State::kPassEnds] = {GLuint64(std::max<GLint64>(frameStart, 0))};
+  for (int i = 0; i < State::kPassEnds; ++i) glGetQueryObjectui64v(s.passEndQueries[i], GL_QUERY_RESULT, &stamps[1 + i]);
   auto milliseconds = [&](int from, int to) { return stamps[to] > stamps[from] ? double(stamps[to] - stamps[from]) * 1e-6 : 0.0; };
   s.lastPasses = {milliseconds(0, 1), milliseconds(1, 2), milliseconds(2, 3)};
   s.lastBvhRayShare.reset();

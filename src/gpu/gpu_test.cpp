@@ -1188,7 +1188,7 @@ TEST_F(GpuRenderCliTest, ShaderDumpWritesEachStage) {
                          nullptr, &err);
   ::unsetenv("PLENOPTIC_GPU_SHADER_DUMP");
   ASSERT_EQ(status, 0) << err;
-  for (const char* name : {"visibility.vert", "visibility.frag", "resolve.comp", "shading.frag"}) {
+  for (const char* name : {"visibility.vert", "visibility.frag", "resolve.comp", "shading.comp"}) {
     SCOPED_TRACE(name);
     const std::string text = cli_test::readFileText((dir / name).string());
     EXPECT_EQ(text.rfind("#version 450 core\n", 0), 0u);
