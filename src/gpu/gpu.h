@@ -13,14 +13,15 @@
 //   2. resolve (a compute shader): per pixel, the camera ray of Camera::generateRay through the
 //      pixel centre and its hit. Where that pixel and its 8 neighbours hold at most two ids,
 //      none marked, the ray is tested against those triangles (the nearer hit; a miss where
-//      it hits neither and one of the two is nothing); elsewhere — three surfaces or more
-//      nearby, a marked vertex (a triangle smaller than a pixel, which the rasteriser's
-//      sub-pixel snapping can leave out of the id buffer though the ray through the centre
-//      hits it), a ray hitting neither of two triangles — the pixel is queued and its ray cast
-//      through the BVH (gpu_bvh.h), as the CPU renderers cast theirs through Embree; so only a
-//      sliver narrower than a pixel passing between the 3×3 centres with its vertices
-//      elsewhere, a triangle smaller than a pixel lying between the two with its vertices on
-//      their surface, or a tie between coplanar triangles, can make the two differ;
+//      it hits neither and one of the two is nothing), and where they hold more triangles, all
+//      around one vertex, it takes the one of them it hits if it hits exactly one; elsewhere —
+//      other surfaces nearby, a marked vertex (a triangle smaller than a pixel, which the
+//      rasteriser's sub-pixel snapping can leave out of the id buffer though the ray through
+//      the centre hits it), a ray hitting none of the triangles — the pixel is queued and its
+//      ray cast through the BVH (gpu_bvh.h), as the CPU renderers cast theirs through Embree;
+//      so only a sliver narrower than a pixel passing between the 3×3 centres with its
+//      vertices elsewhere, a triangle smaller than a pixel whose vertices lie on the surfaces
+//      seen there, or a tie between coplanar triangles, can make the two differ;
 //   3. shading, a compute shader reading that hit: the hit point origin + t·direction (as the
 //      CPU renderer takes it), the chart record the viewer sees (viewedChart) and the
 //      16-neighbour lookup of lightfield/lookup.h (exitantRadianceLanes),

@@ -455,18 +455,24 @@ constexpr const char* kPrimaryHitGlsl = R"glsl(
 layout(binding = IDS_UNIT) uniform usampler2D ids;
 const uint kNoTriangle = 0xffffffffu;  // a hit's triangle on a miss
 // The primary hit of the ray from the eye along unit `direction` through film point `film`
-// (pixel units), as the ray caster answers it. The id texels answer where they can be trusted:
-// the texel the film point falls in and its 8 neighbours hold at most two ids (triangles, or
-// nothing), no vertex is marked there (kMarkedTexel), and the ray hits one of those triangles
-// (Möller–Trumbore, edges inclusive, not cut by an alpha mask; the nearer if it hits both) — or
-// hits neither while one of the two ids is nothing: a miss. The film point lies within the
-// square of those 9 texel centres; a nearer triangle missing from all of them would have a
-// vertex in front there (marked), unless it is a sliver narrower than the texel spacing passing
-// between them with its vertices elsewhere, or a triangle between the two, smaller than a
-// texel, whose vertices lie on their surface (gpu.h). Everywhere else — three surfaces or more
-// in the 3×3 (a corner, a strip of triangles smaller than a texel), a marked texel, a ray that
-// hits neither of two triangles — the ray is cast through the BVH (gpu_bvh.h bvhIntersect) as
-// the CPU renderers cast theirs through Embree.
+// (pixel units), as the ray caster answers it. The id texels answer where they can be trusted,
+// the texel the film point falls in and its 8 neighbours holding no marked vertex
+// (kMarkedTexel) and
+//   - at most two ids (triangles, or nothing): an edge, a silhouette or the inside of one
+//     triangle. The ray is tested against those triangles (Möller–Trumbore, edges inclusive,
+//     not cut by an alpha mask) and takes the nearer hit; hitting neither beside nothing, it
+//     misses;
+//   - or more triangles, all around one vertex (a fan: a mesh vertex in view), of which the ray
+//     hits exactly one, not cut by a mask.
+// The film point lies within the square of those 9 texel centres; a nearer triangle missing
+// from all of them would have a vertex in front there (marked), unless it is a sliver narrower
+// than the texel spacing passing between them with its vertices elsewhere, or a triangle
+// smaller than a texel whose vertices lie on the surfaces seen (between two triangles, or in a
+// fan folded over itself at a silhouette) (gpu.h). Everywhere else — a marked texel, three
+// surfaces or more not around one vertex (a corner, a strip of triangles smaller than a
+// texel), nothing beside a fan, a ray that hits none of the triangles or two of a fan — the ray
+// is cast through the BVH (gpu_bvh.h bvhIntersect) as the CPU renderers cast theirs through
+// Embree.
 const int kIdsMiss = 0, kIdsHit = 1, kIdsUnsure = 2;
 // What the id texels say of that ray: kIdsMiss or kIdsHit (with t, triangle and b) where they
 // can be trusted, else kIdsUnsure (the ray is to be cast through the BVH).
@@ -477,37 +483,69 @@ int idsHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b
   t = far;
   triangle = kNoTriangle;
   b = vec2(0.0);
-  // The 3×3 texels' ids (0: nothing; a triangle's index + 1): seen[0] the centre's, seen[1]
-  // another where there is one.
-  uint seen[2];
-  seen[0] = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r;
-  seen[1] = seen[0];
-  bool answerable = seen[0] != kMarkedTexel;
-  for (int dy = -1; dy <= 1 && answerable; ++dy)
-    for (int dx = -1; dx <= 1 && answerable; ++dx) {
+  // The 3×3 texels' ids (0: nothing; a triangle's index + 1): the centre's, another where
+  // there is one, and whether there are more.
+  uint centre = texelFetch(ids, clamp(texel, ivec2(0), lastTexel), 0).r, other = centre;
+  bool more = false;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
       uint id = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r;
-      if (id == seen[0] || id == seen[1]) continue;
-      if (id == kMarkedTexel || seen[1] != seen[0]) answerable = false;
-      else seen[1] = id;
+      if (id == kMarkedTexel) return kIdsUnsure;
+      if (id == centre || id == other) continue;
+      if (other == centre) other = id;
+      else more = true;
     }
-  if (!answerable) return kIdsUnsure;
-  bool nothingSeen = false;
-  for (int k = 0; k < 2; ++k) {
-    if (k == 1 && seen[1] == seen[0]) break;
-    if (seen[k] == 0u) {
-      nothingSeen = true;
-      continue;
+  if (!more) {
+    uint seen[2] = uint[2](centre, other);
+    for (int k = 0; k < (other == centre ? 1 : 2); ++k) {
+      if (seen[k] == 0u) continue;
+      vec2 hitB;
+      float hitT = bvhTriangle(seen[k] - 1u, eye, direction, 0.0, t, hitB);
+      if (hitT < t && !bvhCutAway(seen[k] - 1u, hitB)) {
+        t = hitT;
+        triangle = seen[k] - 1u;
+        b = hitB;
+      }
     }
-    vec2 hitB;
-    float hitT = bvhTriangle(seen[k] - 1u, eye, direction, 0.0, t, hitB);
-    if (hitT < t && !bvhCutAway(seen[k] - 1u, hitB)) {
-      t = hitT;
-      triangle = seen[k] - 1u;
-      b = hitB;
-    }
+    if (triangle != kNoTriangle) return kIdsHit;
+    return centre == 0u || other == 0u ? kIdsMiss : kIdsUnsure;
   }
-  if (triangle != kNoTriangle) return kIdsHit;
-  return nothingSeen ? kIdsMiss : kIdsUnsure;
+  // Three ids or more: all of them, distinct.
+  uint seen[9];
+  int count = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      uint id = texelFetch(ids, clamp(texel + ivec2(dx, dy), ivec2(0), lastTexel), 0).r;
+      if (id == 0u) return kIdsUnsure;  // nothing beside a fan: a silhouette's corner
+      bool known = false;
+      for (int k = 0; k < count; ++k) known = known || seen[k] == id;
+      if (!known) seen[count++] = id;
+    }
+  // A fan: some vertex of the first triangle is a vertex of every other one.
+  uvec3 first = triangles[seen[0] - 1u].xyz;
+  bvec3 aroundVertex = bvec3(true);
+  for (int k = 1; k < count; ++k) {
+    uvec3 v = triangles[seen[k] - 1u].xyz;
+    aroundVertex = bvec3(aroundVertex.x && any(equal(v, uvec3(first.x))), aroundVertex.y && any(equal(v, uvec3(first.y))),
+                         aroundVertex.z && any(equal(v, uvec3(first.z))));
+  }
+  if (!any(aroundVertex)) return kIdsUnsure;
+  int hits = 0;
+  for (int k = 0; k < count; ++k) {
+    vec2 hitB;
+    float hitT = bvhTriangle(seen[k] - 1u, eye, direction, 0.0, far, hitB);
+    if (!(hitT < far)) continue;
+    if (bvhCutAway(seen[k] - 1u, hitB)) return kIdsUnsure;  // what lies behind the mask's hole is not in the fan
+    ++hits;
+    t = hitT;
+    triangle = seen[k] - 1u;
+    b = hitB;
+  }
+  if (hits == 1) return kIdsHit;
+  t = far;
+  triangle = kNoTriangle;
+  b = vec2(0.0);
+  return kIdsUnsure;
 }
 // What the id texels say of the camera ray through film point `film` along unit `direction`:
 // idsHit's answer for a pinhole; kIdsUnsure for a thin lens, whose rays start off the eye,

@@ -196,6 +196,47 @@ TEST_F(GpuRendererTest, MatchesFastRendererOnSubPixelTriangles) {
   expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), width, height, false, four);
 }
 
+// A mesh of triangles about four pixels across filling the view: most pixels lie within a
+// pixel of an edge or a vertex, where the 3×3 id texels hold two triangles or a fan of
+// triangles around one vertex. The resolve pass answers those from the ids (the ray tested
+// against them) rather than casting them through the BVH — the same picture as the CPU
+// renderer, with a small share of the rays cast.
+TEST_F(GpuRendererTest, EdgesAndFansAreAnsweredFromTheIds) {
+  Scene scene = makeCornellBox();
+  const int width = 64, height = 48;
+  const Camera camera(firstCamera(scene), width, height);
+  const float depth = 300.0f;  // in front of the box's back wall, on a plane facing the eye
+  auto atFilm = [&](float x, float y) {
+    const float sx = (2.0f * x / float(width) - 1.0f) * camera.tanHalfFovY() * camera.aspect();
+    const float sy = (1.0f - 2.0f * y / float(height)) * camera.tanHalfFovY();
+    return camera.eye() + depth * (camera.forward() + sx * camera.right() + sy * camera.up());
+  };
+  Mesh grid;
+  grid.name = "grid";
+  const float spacing = 4.37f;  // pixels; no edge through a pixel centre
+  const int columns = int(float(width) / spacing) + 3, rows = int(float(height) / spacing) + 3;
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < columns; ++i) grid.positions.push_back(atFilm((float(i) - 1.0f) * spacing + 0.31f, (float(j) - 1.0f) * spacing + 0.23f));
+  const bool clockwise = glm::dot(glm::cross(grid.positions[1] - grid.positions[0], grid.positions[uint32_t(columns)] - grid.positions[0]),
+                                  camera.forward()) > 0.0f;
+  for (int j = 0; j + 1 < rows; ++j)
+    for (int i = 0; i + 1 < columns; ++i) {
+      const uint32_t a = uint32_t(j * columns + i), b = a + 1, c = a + uint32_t(columns), d = c + 1;
+      for (UVec3 t : {UVec3(a, b, d), UVec3(a, d, c)}) {  // every interior vertex in six triangles
+        grid.triangles.push_back(clockwise ? UVec3(t.x, t.z, t.y) : t);
+        grid.materials.push_back(0);
+      }
+    }
+  scene.meshes.push_back(std::move(grid));
+  scene.finalize();
+  const LightField lf = randomLightField(std::move(scene), 93);
+  GpuRenderer gpu(lf);
+  expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), width, height);
+  ASSERT_TRUE(gpu.lastBvhRayShare().has_value());
+  std::printf("camera rays cast through the BVH: %.1f %%\n", 100.0 * *gpu.lastBvhRayShare());
+  EXPECT_LT(*gpu.lastBvhRayShare(), 0.1);
+}
+
 // An environment map (rotated, scaled, over a constant) seen past the box, through the open
 // front and all around, with one and three samples per pixel.
 TEST_F(GpuRendererTest, EnvironmentMapBackgroundMatchesFastRenderer) {
@@ -1219,9 +1260,10 @@ TEST_F(GpuRenderCliTest, RendersTheCpuPicture) {
   EXPECT_GT(double(json["gpu_visibility_ms_median"]), 0.0);
   EXPECT_GT(double(json["gpu_resolve_ms_median"]), 0.0);
   EXPECT_GT(double(json["gpu_shading_ms_median"]), 0.0);
-  // The camera rays cast through the BVH: near the box's corners and vertices, where three
-  // surfaces or more meet. An edge between two (walls, a block's silhouette) is answered by
-  // testing its two triangles; casting every edge pixel's ray would be 43 % of them here.
+  // The camera rays cast through the BVH: near the box's corners, where three surfaces or
+  // more meet. An edge between two (walls, a block's silhouette) is answered by testing its
+  // two triangles, a fan around a vertex by testing its triangles; casting every edge
+  // pixel's ray would be 43 % of them here.
   EXPECT_GT(double(json["gpu_bvh_ray_share_median"]), 0.0);
   EXPECT_LT(double(json["gpu_bvh_ray_share_median"]), 0.2);
   // A thin lens casts every one (its rays start off the eye the ids were rasterised from).
