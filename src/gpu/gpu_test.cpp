@@ -146,6 +146,20 @@ TEST_F(GpuRendererTest, MultiSampleMatchesFastRenderer) {
   EXPECT_GT(compareImages(jittered, reseeded).relMseAverage, 1e-6);
 }
 
+/// The world point at film point `film` (pixel units) of `camera`, on the plane `depth` in
+/// front of its eye (along its forward axis).
+Vec3 filmPlanePoint(const Camera& camera, float depth, Vec2 film) {
+  const float sx = (2.0f * film.x / float(camera.width()) - 1.0f) * camera.tanHalfFovY() * camera.aspect();
+  const float sy = (1.0f - 2.0f * film.y / float(camera.height())) * camera.tanHalfFovY();
+  return camera.eye() + depth * (camera.forward() + sx * camera.right() + sy * camera.up());
+}
+/// Appends the triangle of `mesh`'s vertices v (material 0), wound to face `camera`.
+void addFacingTriangle(Mesh& mesh, const Camera& camera, UVec3 v) {
+  const Vec3 normal = glm::cross(mesh.positions[v.y] - mesh.positions[v.x], mesh.positions[v.z] - mesh.positions[v.x]);
+  mesh.triangles.push_back(glm::dot(normal, camera.forward()) < 0.0f ? v : UVec3(v.x, v.z, v.y));
+  mesh.materials.push_back(0);
+}
+
 // Triangles far smaller than a pixel, each with an edge a few thousandths of a pixel inside
 // a pixel centre: the rasteriser, which snaps vertices to a sub-pixel grid (1/256 pixel on
 // llvmpipe), may leave that centre out, and no other texel centre of the 3×3 around it holds
@@ -156,13 +170,6 @@ TEST_F(GpuRendererTest, MatchesFastRendererOnSubPixelTriangles) {
   Scene scene = makeCornellBox();
   const int width = 64, height = 48;
   const Camera camera(firstCamera(scene), width, height);
-  // The world point at film point (x, y) (pixel units) on the plane `depth` in front of the eye.
-  const float depth = 400.0f;
-  auto atFilm = [&](float x, float y) {
-    const float sx = (2.0f * x / float(width) - 1.0f) * camera.tanHalfFovY() * camera.aspect();
-    const float sy = (1.0f - 2.0f * y / float(height)) * camera.tanHalfFovY();
-    return camera.eye() + depth * (camera.forward() + sx * camera.right() + sy * camera.up());
-  };
   Mesh specks;
   specks.name = "specks";
   Pcg32 rng(91, 3);
@@ -179,12 +186,8 @@ TEST_F(GpuRendererTest, MatchesFastRendererOnSubPixelTriangles) {
       const Vec2 a = centre + offset * across - 0.1f * along, b = centre + offset * across + 0.1f * along,
                  c = centre - 0.25f * across;
       const uint32_t first = uint32_t(specks.positions.size());
-      for (const Vec2& p : {a, b, c}) specks.positions.push_back(atFilm(p.x, p.y));
-      const Vec3 normal = glm::cross(specks.positions[first + 1] - specks.positions[first],
-                                     specks.positions[first + 2] - specks.positions[first]);
-      specks.triangles.push_back(glm::dot(normal, camera.forward()) < 0.0f ? UVec3(first, first + 1, first + 2)
-                                                                           : UVec3(first, first + 2, first + 1));
-      specks.materials.push_back(0);
+      for (const Vec2& p : {a, b, c}) specks.positions.push_back(filmPlanePoint(camera, 400.0f, p));
+      addFacingTriangle(specks, camera, UVec3(first, first + 1, first + 2));
     }
   scene.meshes.push_back(std::move(specks));
   scene.finalize();
@@ -205,27 +208,18 @@ TEST_F(GpuRendererTest, EdgesAndFansAreAnsweredFromTheIds) {
   Scene scene = makeCornellBox();
   const int width = 64, height = 48;
   const Camera camera(firstCamera(scene), width, height);
-  const float depth = 300.0f;  // in front of the box's back wall, on a plane facing the eye
-  auto atFilm = [&](float x, float y) {
-    const float sx = (2.0f * x / float(width) - 1.0f) * camera.tanHalfFovY() * camera.aspect();
-    const float sy = (1.0f - 2.0f * y / float(height)) * camera.tanHalfFovY();
-    return camera.eye() + depth * (camera.forward() + sx * camera.right() + sy * camera.up());
-  };
   Mesh grid;
   grid.name = "grid";
   const float spacing = 4.37f;  // pixels; no edge through a pixel centre
   const int columns = int(float(width) / spacing) + 3, rows = int(float(height) / spacing) + 3;
   for (int j = 0; j < rows; ++j)
-    for (int i = 0; i < columns; ++i) grid.positions.push_back(atFilm((float(i) - 1.0f) * spacing + 0.31f, (float(j) - 1.0f) * spacing + 0.23f));
-  const bool clockwise = glm::dot(glm::cross(grid.positions[1] - grid.positions[0], grid.positions[uint32_t(columns)] - grid.positions[0]),
-                                  camera.forward()) > 0.0f;
+    for (int i = 0; i < columns; ++i)  // in front of the box, on a plane facing the eye
+      grid.positions.push_back(filmPlanePoint(camera, 300.0f, Vec2((float(i) - 1.0f) * spacing + 0.31f, (float(j) - 1.0f) * spacing + 0.23f)));
   for (int j = 0; j + 1 < rows; ++j)
     for (int i = 0; i + 1 < columns; ++i) {
       const uint32_t a = uint32_t(j * columns + i), b = a + 1, c = a + uint32_t(columns), d = c + 1;
-      for (UVec3 t : {UVec3(a, b, d), UVec3(a, d, c)}) {  // every interior vertex in six triangles
-        grid.triangles.push_back(clockwise ? UVec3(t.x, t.z, t.y) : t);
-        grid.materials.push_back(0);
-      }
+      addFacingTriangle(grid, camera, UVec3(a, b, d));  // every interior vertex in six triangles
+      addFacingTriangle(grid, camera, UVec3(a, d, c));
     }
   scene.meshes.push_back(std::move(grid));
   scene.finalize();
