@@ -180,11 +180,10 @@ class GpuRenderer {
   /// resolution per axis (render() takes more than 1 for several samples per pixel).
   void drawVisibility(const Camera& camera, int idScale = 1);
 
-  /// The GPU's own time for the last render(), in milliseconds: from the start of its first pass
-  /// to the end of its shading pass by GL timestamp queries — what a frame costs the GPU, the
-  /// image's read-back into memory excluded (`render --stats` gpu_ms_median).
-  double lastGpuMilliseconds() const;
-  /// The same time pass by pass (`render --stats` gpu_visibility_ms_median, ...).
+  /// The GPU's own time for the last render(), in milliseconds, pass by pass: from the start of
+  /// its first pass to the end of its shading pass by GL timestamp queries — what a frame costs
+  /// the GPU, the image's read-back into memory excluded (`render --stats` gpu_ms_median for
+  /// the total, gpu_visibility_ms_median, ... for the passes).
   GpuPassMilliseconds lastGpuPasses() const;
   /// The share of the last render()'s pixels whose camera ray the resolve pass cast through
   /// the BVH: those the id texels could not answer (edges, silhouettes, triangles smaller than a

@@ -42,14 +42,15 @@ struct Builder {
   const std::vector<UVec3>& triangles;
   std::vector<Box> bounds;     ///< per triangle (finite vertices only)
   std::vector<Vec3> centroid;  ///< per triangle
+  std::vector<uint32_t> order;  ///< triangle indices, leaf by leaf once built
   GpuBvh bvh;
 
   /// Makes node `index` over order[first, first + count), recursing into its children.
   void build(uint32_t index, uint32_t first, uint32_t count, int depth) {
     Box box, centroids;
     for (uint32_t i = first; i < first + count; ++i) {
-      box.grow(bounds[bvh.order[i]]);
-      centroids.grow(centroid[bvh.order[i]]);
+      box.grow(bounds[order[i]]);
+      centroids.grow(centroid[order[i]]);
     }
     BvhNode& node = bvh.nodes[index];
     for (int k = 0; k < 3; ++k) {
@@ -70,8 +71,8 @@ struct Builder {
     std::array<Box, kBins> binBox;
     std::array<uint32_t, kBins> binCount{};
     for (uint32_t i = first; i < first + count; ++i) {
-      const int b = binOf(bvh.order[i]);
-      binBox[b].grow(bounds[bvh.order[i]]);
+      const int b = binOf(order[i]);
+      binBox[b].grow(bounds[order[i]]);
       ++binCount[b];
     }
     std::array<float, kBins> leftCost{};
@@ -99,9 +100,9 @@ struct Builder {
     // against the leaf's `count` intersections.
     const float area = box.halfArea();
     if (bestPlane < 0 || (area > 0.0f && 1.0f + bestCost / area >= float(count) && count <= 2 * kBvhLeafTriangles)) return;
-    const auto middle = std::partition(bvh.order.begin() + first, bvh.order.begin() + first + count,
+    const auto middle = std::partition(order.begin() + first, order.begin() + first + count,
                                        [&](uint32_t t) { return binOf(t) < bestPlane; });
-    const uint32_t leftSize = uint32_t(middle - (bvh.order.begin() + first));
+    const uint32_t leftSize = uint32_t(middle - (order.begin() + first));
     const uint32_t children = uint32_t(bvh.nodes.size());
     bvh.nodes.resize(bvh.nodes.size() + 2);
     bvh.nodes[index].first = children;  // (`node` may dangle after the resize)
@@ -139,7 +140,7 @@ void flattenSceneTriangles(const Scene& scene, std::vector<Vec3>& positions, std
 }
 
 GpuBvh buildGpuBvh(const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles) {
-  Builder builder{positions, triangles, {}, {}, {}};
+  Builder builder{positions, triangles, {}, {}, {}, {}};
   const uint32_t n = uint32_t(triangles.size());
   builder.bounds.resize(n);
   builder.centroid.resize(n);
@@ -153,30 +154,31 @@ GpuBvh buildGpuBvh(const std::vector<Vec3>& positions, const std::vector<UVec3>&
     }
     if (!finite) b = Box{};  // never hit; kept out of the boxes
     builder.centroid[t] = b.empty() ? Vec3(0.0f) : 0.5f * (b.lower + b.upper);
-    builder.bvh.order.push_back(t);
+    builder.order.push_back(t);
   }
   builder.bvh.nodes.reserve(size_t(2) * n / kBvhLeafTriangles + 1);
   builder.bvh.nodes.resize(1);
   builder.build(0, 0, n, 0);
-  fillBvhTriangles(builder.bvh, positions, triangles);
+  builder.bvh.triangles = leafOrderTriangles(builder.order, positions, triangles);
   return std::move(builder.bvh);
 }
 
-void fillBvhTriangles(GpuBvh& bvh, const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles) {
-  const size_t n = bvh.order.size();
-  bvh.triangles.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    const UVec3& v = triangles[bvh.order[i]];
+std::vector<BvhTriangle> leafOrderTriangles(const std::vector<uint32_t>& order, const std::vector<Vec3>& positions,
+                                            const std::vector<UVec3>& triangles) {
+  std::vector<BvhTriangle> records(order.size());
+  for (size_t i = 0; i < order.size(); ++i) {
+    const UVec3& v = triangles[order[i]];
     const Vec3 p0 = positions[v[0]], e1 = positions[v[1]] - p0, e2 = positions[v[2]] - p0;
-    BvhTriangle& record = bvh.triangles[i];
+    BvhTriangle& record = records[i];
     for (int k = 0; k < 3; ++k) {
       record.p0[k] = p0[k];
       record.e1[k] = e1[k];
       record.e2[k] = e2[k];
     }
     record.e1[3] = record.e2[3] = 0.0f;
-    record.triangle = bvh.order[i];
+    record.triangle = order[i];
   }
+  return records;
 }
 
 BvhHit intersectGpuBvh(const GpuBvh& bvh, const Ray& ray) {

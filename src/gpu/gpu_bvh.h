@@ -59,8 +59,7 @@ static_assert(sizeof(BvhTriangle) == 48);
 
 struct GpuBvh {
   std::vector<BvhNode> nodes;          ///< nodes[0] is the root (an empty leaf when there are no triangles)
-  std::vector<uint32_t> order;         ///< triangle indices in leaf order
-  std::vector<BvhTriangle> triangles;  ///< the triangles in leaf order (triangles[i].triangle == order[i])
+  std::vector<BvhTriangle> triangles;  ///< the triangles in leaf order (a leaf holds triangles[first, first + count))
 };
 
 /// Every mesh's vertices and triangles of `scene` in one array each, in scene order, the
@@ -73,8 +72,9 @@ void flattenSceneTriangles(const Scene& scene, std::vector<Vec3>& positions, std
 /// `triangles`, triangle i of the result being triangles[i]. Degenerate and non-finite
 /// triangles are kept (they never report a hit).
 GpuBvh buildGpuBvh(const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles);
-/// bvh.triangles from bvh.order (buildGpuBvh's last step).
-void fillBvhTriangles(GpuBvh& bvh, const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles);
+/// The records of triangles order[0], order[1], … (buildGpuBvh's leaf order) of `triangles`.
+std::vector<BvhTriangle> leafOrderTriangles(const std::vector<uint32_t>& order, const std::vector<Vec3>& positions,
+                                            const std::vector<UVec3>& triangles);
 
 /// The closest hit of `ray` in (ray.tMin, ray.tMax) by the traversal kBvhGlsl runs, on the
 /// CPU (the build's unit test); triangle = kNone (0xffffffff) for a miss.

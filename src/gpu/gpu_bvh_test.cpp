@@ -28,8 +28,9 @@ void randomSoup(uint32_t n, Pcg32& rng, std::vector<Vec3>& positions, std::vecto
 BvhHit bruteForce(const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles, const Ray& ray) {
   GpuBvh flat;
   flat.nodes.push_back(BvhNode{{-1e30f, -1e30f, -1e30f}, 0, {1e30f, 1e30f, 1e30f}, uint32_t(triangles.size())});
-  for (uint32_t t = 0; t < triangles.size(); ++t) flat.order.push_back(t);
-  fillBvhTriangles(flat, positions, triangles);
+  std::vector<uint32_t> order(triangles.size());
+  for (uint32_t t = 0; t < triangles.size(); ++t) order[t] = t;
+  flat.triangles = leafOrderTriangles(order, positions, triangles);
   return intersectGpuBvh(flat, ray);
 }
 
@@ -37,7 +38,6 @@ BvhHit bruteForce(const std::vector<Vec3>& positions, const std::vector<UVec3>& 
 /// depth stays within the traversal's stack.
 void expectWellFormed(const GpuBvh& bvh, const std::vector<Vec3>& positions, const std::vector<UVec3>& triangles) {
   std::vector<int> seen(triangles.size(), 0);
-  ASSERT_EQ(bvh.triangles.size(), bvh.order.size());
   struct Item {
     uint32_t node;
     int depth;
@@ -66,11 +66,11 @@ void expectWellFormed(const GpuBvh& bvh, const std::vector<Vec3>& positions, con
       continue;
     }
     for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-      const uint32_t t = bvh.order[i];
-      ++seen[t];
-      // The leaf-order record: this triangle's first vertex and edges.
+      // The leaf-order record: its triangle's first vertex and edges.
       const BvhTriangle& record = bvh.triangles[i];
-      EXPECT_EQ(record.triangle, t);
+      const uint32_t t = record.triangle;
+      ASSERT_LT(t, triangles.size());
+      ++seen[t];
       const Vec3 p0 = positions[triangles[t][0]], e1 = positions[triangles[t][1]] - p0, e2 = positions[triangles[t][2]] - p0;
       if (isFinite(p0) && isFinite(e1) && isFinite(e2))  // (NaN compares unequal to itself)
         for (int k = 0; k < 3; ++k) {

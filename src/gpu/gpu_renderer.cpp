@@ -1100,7 +1100,7 @@ struct GpuRenderer::State {
   GLuint multisampleProgram = 0;
   /// GL_TIMESTAMP queries at the end of a render()'s visibility, resolve and shading passes
   /// (its start is the GL's time when it begins), and the GPU times between them in the last
-  /// render() (lastGpuMilliseconds, lastGpuPasses).
+  /// render() (lastGpuPasses).
   static constexpr int kPassEnds = 3;
   GLuint passEndQueries[kPassEnds] = {};
   GpuPassMilliseconds lastPasses;
@@ -1625,8 +1625,6 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   }
   checkGl("the shading pass");
 }
-
-double GpuRenderer::lastGpuMilliseconds() const { return state_->lastPasses.total(); }
 
 uint64_t GpuRenderer::maxImagePixels() const {
   state_->context.makeCurrent();

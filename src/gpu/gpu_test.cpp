@@ -227,6 +227,9 @@ TEST_F(GpuRendererTest, EdgesAndFansAreAnsweredFromTheIds) {
   GpuRenderer gpu(lf);
   expectSameAsFastRenderer(lf, gpu, firstCamera(lf.scene), width, height);
   ASSERT_TRUE(gpu.lastBvhRayShare().has_value());
+  // The grid casts none here (0 %); answering edges alone casts 68 % (every pixel within a
+  // pixel of a vertex). 10 % leaves room for vertices a driver marks in front of the plane
+  // they lie on (depth rounding), which are cast, and still fails if fans are not answered.
   std::printf("camera rays cast through the BVH: %.1f %%\n", 100.0 * *gpu.lastBvhRayShare());
   EXPECT_LT(*gpu.lastBvhRayShare(), 0.1);
 }

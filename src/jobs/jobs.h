@@ -271,7 +271,7 @@ struct RenderJobStats {
   /// rasterisation pass, GpuRenderer::drawVisibility) on the same cameras, timed after the
   /// frames when stats are written for the fast or GPU renderer; 0 = not timed.
   double primaryMsMedian = 0, primaryMsMin = 0;
-  double gpuMsMedian = 0, gpuMsMin = 0;  ///< the GPU renderer: its own time per frame (GpuRenderer::lastGpuMilliseconds)
+  double gpuMsMedian = 0, gpuMsMin = 0;  ///< the GPU renderer: its own time per frame (GpuRenderer::lastGpuPasses().total())
   /// The GPU renderer's passes' medians (GpuRenderer::lastGpuPasses).
   double gpuVisibilityMsMedian = 0, gpuResolveMsMedian = 0, gpuShadingMsMedian = 0;
   /// The share of a frame's pixels whose camera ray was cast through the GPU's BVH
