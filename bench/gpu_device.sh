@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The GPU renderer on a graphics card, in one run: the frame rate of `render --renderer gpu`
-# on the built-in Cornell box and on Sponza at 1920×1080 (each camera), and the GPU-vs-CPU
+# on the built-in Cornell box and on Sponza at 1920×1080 (each camera), the viewer's on the
+# box (`view --renderer gpu` flying a path, headless), and the GPU-vs-CPU
 # comparison of bench/gpu_vs_cpu.sh on both light fields — so that minutes on a lent machine
 # go to measuring. It bakes what it is not given (draft preset: the box in seconds, Sponza in
 # a minute or two on 16 cores) and refuses to measure a software rasteriser (llvmpipe) unless
@@ -71,6 +72,19 @@ measure cornell-640x480 "$D/cornell.plf" default 640 480
 for camera in $(cameras "$SPONZA_PLF"); do
   measure "sponza-$camera" "$SPONZA_PLF" "$camera" "$WIDTH" "$HEIGHT"
 done
+# The viewer's frames with the GPU renderer, on SDL's dummy video driver (no window): the box
+# flown along a path, so that every frame is drawn — the render, the display pass (tone mapping
+# on the GPU) and the read-back of its 8-bit pixels, the HUD and SDL's blit.
+python3 - "$D/box-walk.json" "$FRAMES" <<'PY'
+import json, sys
+frames = int(sys.argv[2])
+json.dump({"fps": 30, "keyframes": [
+    {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0]},
+    {"time": frames / 30, "eye": [200, 300, -500], "target": [300, 250, 300]}]}, open(sys.argv[1], "w"))
+PY
+viewed=$(SDL_VIDEODRIVER=dummy "$BIN" view "$D/cornell.plf" --renderer gpu --width "$WIDTH" --height "$HEIGHT" \
+  --path "$D/box-walk.json" 2>&1 | grep "frames rendered" || true)
+say "view cornell ${WIDTH}x${HEIGHT} (GPU renderer, display pass on the GPU): ${viewed#view: }"
 # The GPU renderer's picture against the CPU fast renderer's (bench/gpu_vs_cpu.sh).
 for plf in "$D/cornell.plf" "$SPONZA_PLF"; do
   PLENOPTIC=$BIN "$ROOT/bench/gpu_vs_cpu.sh" "$plf" "$COMPARE_WIDTH" "$COMPARE_HEIGHT" 3 | tee -a "$SUMMARY"

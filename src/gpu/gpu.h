@@ -37,7 +37,9 @@
 //      traced through a BVH on the GPU, as the CPU renderers do (gpu_specular.h, gpu_bvh.h).
 // The result is radiance (W·sr⁻¹·m⁻², camera weight included, no exposure), read back into an
 // Image exactly where FastRenderer::render writes it; exposure and tone mapping are then the
-// same CPU code for both renderers (jobs/ ViewSettings::writeImage).
+// same CPU code for both renderers (jobs/ ViewSettings::writeImage). The viewer instead has
+// the frame encoded into its window's 8-bit pixels on the GPU by DisplayEncoder's rule
+// (encodeDisplay, gpu_display.h) and reads back those.
 //
 // The light field is uploaded once: its values as 16-byte RGBA (the CPU renderer's padded
 // copy), its chart records with their precomputed shading (ChartShading), the vertex positions
@@ -53,7 +55,8 @@
 // the chains and shadow rays, and 64 per delta light and 64 per material for the highlights +
 // the frame's targets (radiance and the resolve pass's hits 16 bytes per pixel each, its queue
 // of rays to cast 4 and 16 in all; id and depth 8 bytes per pixel, or per texel of the finer
-// multi-sample visibility pass). A light field whose buffers exceed the GPU
+// multi-sample visibility pass; once the viewer's display pass has run, 4 more per pixel and
+// 16 per 16 pixels, and its 64 KiB sRGB table). A light field whose buffers exceed the GPU
 // memory available (gpu_memory.h: the driver's query, GL_NVX_gpu_memory_info or
 // GL_ATI_meminfo; the PLENOPTIC_GPU_MEMORY variable; 4 GiB where neither says) is refused
 // before anything is uploaded, with the sizes, and so is one with a buffer larger than the
@@ -109,6 +112,9 @@
 namespace pl {
 
 class Camera;
+class DisplayEncoder;
+struct ToneMapCurve;
+struct ToneMapSettings;
 
 /// The first feature of `lightField` the GPU renderer does not draw yet, as a phrase for a
 /// message ("alpha masks", …); empty when it draws all of it.
@@ -168,6 +174,24 @@ class GpuRenderer {
   /// points (pixelSample, render_settings.h), averaged. Throws pl::Error for settings it does not
   /// support (checkSettings).
   void render(const Camera& camera, const RenderSettings& settings, Image& image);
+  /// render() in two steps: draw() renders the frame and leaves its radiance on the GPU;
+  /// readRadiance() reads it back into `image` as render() does, or encodeDisplay() turns it
+  /// into the window's pixels there (the viewer's path). Either may be called several times
+  /// for one draw(), until the next draw() or render().
+  void draw(const Camera& camera, const RenderSettings& settings);
+  void readRadiance(Image& image);
+  /// The last draw()'s frame as display words, the same as `encoder.encode(radiance,
+  /// exposureScale, settings, pixels, pitchBytes)` on readRadiance()'s image (image/display.h):
+  /// the radiance subsample is read back and encoder.resolveCurve resolves the curve from it on
+  /// the CPU; the display pass (gpu_display.h) computes each pixel's word, 0xFFRRGGBB, on the
+  /// GPU and 4 bytes per pixel are read back into `pixels` (`pitchBytes` per row, the bytes
+  /// between rows left as they are) — instead of 12 of radiance and a tone-mapping pass on the
+  /// CPU.
+  void encodeDisplay(DisplayEncoder& encoder, float exposureScale, const ToneMapSettings& settings, uint32_t* pixels,
+                     int pitchBytes);
+  /// The display pass's GLSL (displayWord) on given exposed colours with `curve`: what
+  /// DisplayEncoder::word(curve, exposed) gives, one word each (gpu_test checks the two agree).
+  std::vector<uint32_t> displayWords(const ToneMapCurve& curve, const std::vector<Rgb>& exposed);
 
   /// What this driver lacks for `settings` (several samples per pixel, a thin lens's default
   /// among them, need GL_ARB_gpu_shader_int64); empty when render() can draw them.
@@ -180,12 +204,13 @@ class GpuRenderer {
   /// resolution per axis (render() takes more than 1 for several samples per pixel).
   void drawVisibility(const Camera& camera, int idScale = 1);
 
-  /// The GPU's own time for the last render(), in milliseconds, pass by pass: from the start of
-  /// its first pass to the end of its shading pass by GL timestamp queries — what a frame costs
-  /// the GPU, the image's read-back into memory excluded (`render --stats` gpu_ms_median for
-  /// the total, gpu_visibility_ms_median, ... for the passes).
+  /// The GPU's own time for the last frame read back (render(), or draw() then readRadiance()
+  /// or encodeDisplay()), in milliseconds, pass by pass: from the start of its first pass to
+  /// the end of its shading pass by GL timestamp queries — what a frame costs the GPU, the
+  /// read-back and the display pass excluded (`render --stats` gpu_ms_median for the total,
+  /// gpu_visibility_ms_median, ... for the passes).
   GpuPassMilliseconds lastGpuPasses() const;
-  /// The share of the last render()'s pixels whose camera ray the resolve pass cast through
+  /// The share of that frame's pixels whose camera ray the resolve pass cast through
   /// the BVH: those the id texels could not answer (edges, silhouettes, triangles smaller than a
   /// pixel; every pixel of a thin lens) — `render --stats` gpu_bvh_ray_share_median. Empty
   /// after a frame of several samples per pixel, whose rays are cast in the shading pass.

@@ -16,12 +16,14 @@
 #include "gpu/egl_context.h"
 #include "gpu/gpu.h"
 #include "gpu/gpu_bvh.h"
+#include "gpu/gpu_display.h"
 #include "gpu/gpu_highlights.h"
 #include "gpu/gpu_lights.h"
 #include "gpu/gpu_mirror_like.h"
 #include "gpu/gpu_specular.h"
 #include "gpu/gpu_memory.h"
 #include "gpu/gpu_surface_detail.h"
+#include "image/display.h"
 #include "lightfield/lookup.h"
 
 namespace pl {
@@ -1104,6 +1106,11 @@ struct GpuRenderer::State {
   static constexpr int kPassEnds = 3;
   GLuint passEndQueries[kPassEnds] = {};
   GpuPassMilliseconds lastPasses;
+  /// The last draw(): its targets hold a frame (frameDrawn, until they are re-made), its GL
+  /// start time, whether its statistics (lastPasses, lastBvhRayShare) are still to be read from
+  /// the queries (collectFrameStats) and whether it was one sample per pixel.
+  bool frameDrawn = false, statsPending = false, oneSample = false;
+  GLint64 frameStart = 0;
   /// The last render()'s camera rays the resolve pass cast through the BVH (its queue's
   /// count), over its pixels; empty after a frame of several samples (lastBvhRayShare).
   std::optional<double> lastBvhRayShare;
@@ -1112,6 +1119,10 @@ struct GpuRenderer::State {
   /// radiance image of the shading pass (read back through readbackFramebuffer).
   GLuint idTexture = 0, depthBuffer = 0, hitsTexture = 0, rayQueue = 0, radianceTexture = 0, visibilityFramebuffer = 0,
          readbackFramebuffer = 0;
+  /// The display pass (encodeDisplay; made on its first call): its programs and DisplayEncoder's
+  /// sRGB table, and the frame's words and radiance subsample (re-made with the targets).
+  GLuint displayStatisticsProgram = 0, displayEncodeProgram = 0, displayWordsProgram = 0, srgbTable = 0;
+  GLuint displayWords = 0, displayStatistics = 0;
   int width = 0, height = 0;
   int idScale = 1;  ///< the visibility targets are idScale·width × idScale·height
   GLsizei indexCount = 0, vertexCount = 0;
@@ -1137,6 +1148,10 @@ struct GpuRenderer::State {
     glDeleteProgram(shadingProgram);
     glDeleteProgram(lookupProgram);
     glDeleteProgram(multisampleProgram);
+    glDeleteProgram(displayStatisticsProgram);
+    glDeleteProgram(displayEncodeProgram);
+    glDeleteProgram(displayWordsProgram);
+    glDeleteBuffers(1, &srgbTable);
     glDeleteQueries(kPassEnds, passEndQueries);
     releaseTargets();
   }
@@ -1148,8 +1163,12 @@ struct GpuRenderer::State {
     glDeleteBuffers(1, &rayQueue);
     glDeleteTextures(1, &radianceTexture);
     glDeleteRenderbuffers(1, &depthBuffer);
+    glDeleteBuffers(1, &displayWords);
+    glDeleteBuffers(1, &displayStatistics);
     visibilityFramebuffer = readbackFramebuffer = idTexture = hitsTexture = rayQueue = radianceTexture = depthBuffer = 0;
+    displayWords = displayStatistics = 0;
     width = height = 0;
+    frameDrawn = false;
   }
   /// The frame's targets: hits, ray queue and radiance at width × height, triangle ids and
   /// depth at scale·width × scale·height (re-made only when a size changes).
@@ -1243,7 +1262,61 @@ struct GpuRenderer::State {
                                                      : std::numeric_limits<uint64_t>::max();
   }
   uint64_t targetBytes() const {
-    return kRayQueueHeaderBytes + uint64_t(width) * uint64_t(height) * (16 + 16 + 4 + uint64_t(idScale) * uint64_t(idScale) * (4 + 4));
+    return kRayQueueHeaderBytes + uint64_t(width) * uint64_t(height) * (16 + 16 + 4 + uint64_t(idScale) * uint64_t(idScale) * (4 + 4)) +
+           (displayWords != 0 ? displayBytes(width, height) : 0) + (srgbTable != 0 ? srgbTableBytes() : 0);
+  }
+  /// The display pass's frame buffers: 4 bytes per pixel of words, 16 per subsample pixel.
+  static uint64_t displayBytes(int w, int h) {
+    return 4 * uint64_t(w) * uint64_t(h) +
+           16 * uint64_t(DisplayEncoder::statisticsSize(w)) * uint64_t(DisplayEncoder::statisticsSize(h));
+  }
+  static uint64_t srgbTableBytes() { return 4 * uint64_t(DisplayEncoder::kSrgbTableSize); }
+  /// The display pass's sRGB table (DisplayEncoder's, one uint per entry), uploaded once.
+  void ensureSrgbTable(const DisplayEncoder& encoder) {
+    if (srgbTable != 0) return;
+    const std::vector<uint8_t>& table = encoder.srgbTable();
+    const std::vector<GLuint> words(table.begin(), table.end());
+    glCreateBuffers(1, &srgbTable);
+    glNamedBufferStorage(srgbTable, GLsizeiptr(words.size() * sizeof(GLuint)), words.data(), 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gpu::kSrgbTableBinding, srgbTable);
+  }
+  /// The statistics and encode programs and the frame's display buffers, made when missing.
+  void ensureDisplay(const DisplayEncoder& encoder) {
+    ensureSrgbTable(encoder);
+    const std::string constants = gpu::displayGlslConstants(kRadianceImageUnit);
+    if (displayStatisticsProgram == 0)
+      displayStatisticsProgram =
+          linkProgram({{GL_COMPUTE_SHADER, gpu::kDisplayStatisticsCompute}}, "display statistics", false, constants);
+    if (displayEncodeProgram == 0)
+      displayEncodeProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(gpu::kDisplayGlsl) + gpu::kDisplayEncodeCompute}},
+                                         "display", false, constants);
+    if (displayWords == 0) {
+      const int sw = DisplayEncoder::statisticsSize(width), sh = DisplayEncoder::statisticsSize(height);
+      glCreateBuffers(1, &displayWords);
+      glNamedBufferStorage(displayWords, GLsizeiptr(4 * uint64_t(width) * uint64_t(height)), nullptr, 0);
+      glCreateBuffers(1, &displayStatistics);
+      glNamedBufferStorage(displayStatistics, GLsizeiptr(16 * uint64_t(sw) * uint64_t(sh)), nullptr, 0);
+      checkGl("creating the display pass's buffers (out of GPU memory?)");
+    }
+  }
+  /// The last draw()'s pass times and BVH ray share from its queries (they wait for the frame),
+  /// once.
+  void collectFrameStats() {
+    if (!statsPending) return;
+    statsPending = false;
+    GLuint64 stamps[1 + kPassEnds] = {GLuint64(std::max<GLint64>(frameStart, 0))};
+    for (int i = 0; i < kPassEnds; ++i) glGetQueryObjectui64v(passEndQueries[i], GL_QUERY_RESULT, &stamps[1 + i]);
+    auto milliseconds = [&](int from, int to) { return stamps[to] > stamps[from] ? double(stamps[to] - stamps[from]) * 1e-6 : 0.0; };
+    lastPasses = {milliseconds(0, 1), milliseconds(1, 2), milliseconds(2, 3)};
+    lastBvhRayShare.reset();
+    if (oneSample) {
+      GLuint queued = 0;  // the queue's count (kResolveCompute), after its header's three group counts
+      glGetNamedBufferSubData(rayQueue, 3 * sizeof(GLuint), sizeof(queued), &queued);
+      lastBvhRayShare = double(queued) / (double(width) * double(height));
+    }
+  }
+  void requireFrame(const char* what) const {
+    if (!frameDrawn) fail("GPU renderer: {} without a frame drawn (GpuRenderer::draw first)", what);
   }
 };
 
@@ -1534,6 +1607,11 @@ void GpuRenderer::checkSettings(const RenderSettings& settings, const Camera& ca
 }
 
 void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, Image& image) {
+  draw(camera, settings);
+  readRadiance(image);
+}
+
+void GpuRenderer::draw(const Camera& camera, const RenderSettings& settings) {
   checkSettings(settings, camera);
   // One sample: the pixel centre, its ray cast by the resolve pass; several: pixelSample's film
   // points, whose triangles are looked for in a visibility pass at a finer resolution
@@ -1604,26 +1682,85 @@ void GpuRenderer::render(const Camera& camera, const RenderSettings& settings, I
   glDispatchCompute(GLuint((camera.width() + 7) / 8), GLuint((camera.height() + 7) / 8), 1);
   glQueryCounter(s.passEndQueries[2], GL_TIMESTAMP);
   glFlush();
+  checkGl("the shading pass");
+  s.frameDrawn = s.statsPending = true;
+  s.oneSample = spp == 1;
+  s.frameStart = frameStart;
+}
+
+void GpuRenderer::readRadiance(Image& image) {
+  State& s = *state_;
+  s.context.makeCurrent();
+  s.requireFrame("reading the radiance back");
   // The read-back reads the radiance image through the framebuffer it is attached to.
   glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, s.readbackFramebuffer);
-  if (image.width != camera.width() || image.height != camera.height()) image = Image(camera.width(), camera.height());
+  if (image.width != s.width || image.height != s.height) image = Image(s.width, s.height);
   // GL row y is image row y (the projection flips film y): read straight into the pixels.
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glReadnPixels(0, 0, camera.width(), camera.height(), GL_RGB, GL_FLOAT, GLsizei(image.pixels.size() * sizeof(Rgb)),
-                image.pixels.data());
-  // (The read-back waited for the shading pass, so every timestamp is there.)
-  GLuint64 stamps[1 + State::kPassEnds] = {GLuint64(std::max<GLint64>(frameStart, 0))};
-  for (int i = 0; i < State::kPassEnds; ++i) glGetQueryObjectui64v(s.passEndQueries[i], GL_QUERY_RESULT, &stamps[1 + i]);
-  auto milliseconds = [&](int from, int to) { return stamps[to] > stamps[from] ? double(stamps[to] - stamps[from]) * 1e-6 : 0.0; };
-  s.lastPasses = {milliseconds(0, 1), milliseconds(1, 2), milliseconds(2, 3)};
-  s.lastBvhRayShare.reset();
-  if (spp == 1) {
-    GLuint queued = 0;  // the queue's count (kResolveCompute), after its header's three group counts
-    glGetNamedBufferSubData(s.rayQueue, 3 * sizeof(GLuint), sizeof(queued), &queued);
-    s.lastBvhRayShare = double(queued) / (double(camera.width()) * double(camera.height()));
+  glReadnPixels(0, 0, s.width, s.height, GL_RGB, GL_FLOAT, GLsizei(image.pixels.size() * sizeof(Rgb)), image.pixels.data());
+  s.collectFrameStats();  // (the read-back waited for the shading pass: every timestamp is there)
+  checkGl("reading the frame back");
+}
+
+void GpuRenderer::encodeDisplay(DisplayEncoder& encoder, float exposureScale, const ToneMapSettings& settings,
+                                uint32_t* pixels, int pitchBytes) {
+  State& s = *state_;
+  s.context.makeCurrent();
+  s.requireFrame("encoding the display");
+  s.ensureDisplay(encoder);
+  const int w = s.width, h = s.height;
+  const int sw = DisplayEncoder::statisticsSize(w), sh = DisplayEncoder::statisticsSize(h);
+  // Both programs read the radiance image the shading pass stored.
+  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  glBindImageTexture(kRadianceImageUnit, s.radianceTexture, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gpu::kDisplayStatisticsBinding, s.displayStatistics);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gpu::kDisplayWordsBinding, s.displayWords);
+  glProgramUniform2i(s.displayStatisticsProgram, glGetUniformLocation(s.displayStatisticsProgram, "size"), w, h);
+  glUseProgram(s.displayStatisticsProgram);
+  glDispatchCompute(GLuint((sw + 7) / 8), GLuint((sh + 7) / 8), 1);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  std::vector<float> statistics(4 * size_t(sw) * size_t(sh));
+  glGetNamedBufferSubData(s.displayStatistics, 0, GLsizeiptr(statistics.size() * sizeof(float)), statistics.data());
+  Image subsample(sw, sh);
+  for (size_t i = 0; i < subsample.pixels.size(); ++i)
+    subsample.pixels[i] = Rgb(statistics[4 * i], statistics[4 * i + 1], statistics[4 * i + 2]);
+  const ToneMapCurve& curve = encoder.resolveCurve(subsample, exposureScale, settings);
+  const GLuint program = s.displayEncodeProgram;
+  gpu::setToneCurveUniforms(program, curve);
+  glProgramUniform2i(program, glGetUniformLocation(program, "size"), w, h);
+  glProgramUniform1f(program, glGetUniformLocation(program, "exposureScale"), exposureScale);
+  glUseProgram(program);
+  glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  const size_t rowBytes = 4 * size_t(w);
+  if (size_t(pitchBytes) == rowBytes) {
+    glGetNamedBufferSubData(s.displayWords, 0, GLsizeiptr(rowBytes * size_t(h)), pixels);
+  } else {
+    for (int y = 0; y < h; ++y)
+      glGetNamedBufferSubData(s.displayWords, GLintptr(rowBytes * size_t(y)), GLsizeiptr(rowBytes),
+                              reinterpret_cast<uint8_t*>(pixels) + size_t(y) * size_t(pitchBytes));
   }
-  checkGl("the shading pass");
+  s.collectFrameStats();
+  checkGl("the display pass");
+}
+
+std::vector<uint32_t> GpuRenderer::displayWords(const ToneMapCurve& curve, const std::vector<Rgb>& exposed) {
+  State& s = *state_;
+  s.context.makeCurrent();
+  s.ensureSrgbTable(DisplayEncoder());
+  if (s.displayWordsProgram == 0)
+    s.displayWordsProgram =
+        linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + gpu::kDisplayGlsl + gpu::kDisplayWordsCompute}},
+                    "display words", false, gpu::displayGlslConstants(kRadianceImageUnit));
+  gpu::setToneCurveUniforms(s.displayWordsProgram, curve);
+  std::vector<float> input;
+  input.reserve(exposed.size() * 4);
+  for (const Rgb& c : exposed) input.insert(input.end(), {c.r, c.g, c.b, 0.0f});
+  const std::vector<float> output = runQueries(s.displayWordsProgram, input, exposed.size(), 1, "the display queries");
+  std::vector<uint32_t> words(exposed.size());
+  std::memcpy(words.data(), output.data(), words.size() * sizeof(uint32_t));
+  return words;
 }
 
 uint64_t GpuRenderer::maxImagePixels() const {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -27,6 +28,8 @@
 #include "core/sampling.h"
 #include "gpu/gpu_highlights.h"
 #include "image/compare.h"
+#include "image/display.h"
+#include "image/tonemap.h"
 #include "lightfield/lookup.h"
 #include "plf/plf_file.h"
 #include "realtime/realtime.h"
@@ -572,6 +575,122 @@ TEST_F(GpuRendererTest, ShaderLookupMatchesCppLookup) {
       }
     }
     EXPECT_EQ(differing, 0) << file << ": worst difference " << worst;
+  }
+}
+
+/// How far apart two display words are: the largest difference of their 8-bit channels.
+int wordChannelDistance(uint32_t a, uint32_t b) {
+  int worst = 0;
+  for (int shift : {0, 8, 16, 24}) worst = std::max(worst, std::abs(int((a >> shift) & 255u) - int((b >> shift) & 255u)));
+  return worst;
+}
+
+// The display pass's GLSL (gpu_display.h) against DisplayEncoder::word on random exposed
+// colours, for each operator: dark and bright (10⁻⁸ … 10⁸), saturated, negative, zero and
+// non-finite ones. The words may differ only where a display value sits within float rounding
+// of a table step (the GPU's division is not IEEE-exact), and then by one level.
+TEST_F(GpuRendererTest, DisplayWordsMatchTheCpuEncoder) {
+  const LightField lf = randomLightField(makeCornellBox(), 1);
+  GpuRenderer gpu(lf);
+  const DisplayEncoder encoder;
+  Pcg32 rng(5, 9);
+  std::vector<Rgb> exposed;
+  for (int i = 0; i < 20000; ++i) {
+    auto logUniform = [&] { return std::exp2(-26.0f + 52.0f * rng.uniform()); };
+    switch (i % 5) {
+      case 0: exposed.push_back(Rgb(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0f); break;
+      case 1: exposed.push_back(Rgb(logUniform(), logUniform(), logUniform())); break;
+      case 2: exposed.push_back(Rgb(rng.uniform(), 0.0f, rng.uniform()) * 4.0f); break;  // saturated
+      case 3: exposed.push_back(Rgb(rng.uniform() - 0.5f, rng.uniform() - 0.3f, rng.uniform())); break;
+      default: exposed.push_back(Rgb(0.0f)); break;
+    }
+  }
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::nanf("");
+  for (const Rgb& c : {Rgb(nan, 0.5f, 0.5f), Rgb(0.5f, inf, 0.5f), Rgb(0.5f, 0.5f, -inf), Rgb(nan)}) exposed.push_back(c);
+  std::vector<ToneMapCurve> curves(5);
+  curves[0].luminanceScale = 0.37f;  // Reinhard with a key, no white point (eq. 3)
+  curves[1].luminanceScale = 1.9f;   // with a white point (eq. 4)
+  curves[1].whiteScaled = 2.5f;
+  curves[2].op = ToneMapOperator::Reinhard;  // no key: the luminance as it is
+  curves[3].op = ToneMapOperator::Linear;
+  curves[3].luminanceScale = 0.8f;
+  curves[4].op = ToneMapOperator::Clamp;
+  for (const ToneMapCurve& curve : curves) {
+    const std::vector<uint32_t> words = gpu.displayWords(curve, exposed);
+    ASSERT_EQ(words.size(), exposed.size());
+    int differing = 0, worst = 0;
+    for (size_t i = 0; i < exposed.size(); ++i) {
+      const uint32_t expected = encoder.word(curve, exposed[i]);
+      if (!isFinite(exposed[i])) {
+        EXPECT_EQ(words[i], DisplayEncoder::kNonFiniteWord) << i;
+        continue;
+      }
+      differing += words[i] != expected;
+      worst = std::max(worst, wordChannelDistance(words[i], expected));
+    }
+    EXPECT_LE(worst, 1) << toneMapOperatorName(curve.op);
+    EXPECT_LE(differing, int(exposed.size() / 1000)) << toneMapOperatorName(curve.op);
+    std::printf("%s: %d of %zu words differ (by one level)\n", toneMapOperatorName(curve.op), differing, exposed.size());
+  }
+}
+
+// The viewer's path: draw(), then encodeDisplay() — the frame's words made on the GPU — against
+// readRadiance() and DisplayEncoder::encode on the CPU, at an odd size (a subsample row and
+// column at the edge) and a padded pitch, for each operator and its statistics (the key from
+// the log-average, the automatic key from the percentiles, white points).
+TEST_F(GpuRendererTest, EncodeDisplayMatchesTheCpuEncoder) {
+  const LightField lf = randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 3);
+  GpuRenderer gpu(lf);
+  DisplayEncoder onGpu, onCpu;
+  std::vector<uint32_t> pixels;
+  EXPECT_THROW(gpu.encodeDisplay(onGpu, 1.0f, ToneMapSettings{}, pixels.data(), 4), Error);  // nothing drawn yet
+  ToneMapSettings autoKey;
+  autoKey.autoKey = true;
+  autoKey.white = 3.0f;
+  ToneMapSettings linear;
+  linear.op = ToneMapOperator::Linear;
+  linear.white = 0.5f;
+  ToneMapSettings clamp;
+  clamp.op = ToneMapOperator::Clamp;
+  for (auto [width, height] : {std::pair{67, 45}, std::pair{40, 30}}) {
+    const Camera camera(insideCamera(lf.scene), width, height);
+    gpu.draw(camera, RenderSettings{});
+    Image radiance;
+    gpu.readRadiance(radiance);
+    ASSERT_EQ(radiance.width, width);
+    const int pitchWords = width + 3;  // three words of padding per row, left alone
+    constexpr uint32_t kPadding = 0x12345678u;
+    // The display pass's GPU memory: its words (4 bytes per pixel), the radiance subsample (16
+    // per 16 pixels) and, the first time, the sRGB table (4 bytes per entry).
+    const uint64_t before = gpu.gpuBytes();
+    const bool first = width == 67;
+    const uint64_t subsample = uint64_t(DisplayEncoder::statisticsSize(width)) * uint64_t(DisplayEncoder::statisticsSize(height));
+    for (const ToneMapSettings& settings : {ToneMapSettings{}, autoKey, linear, clamp}) {
+      for (float exposure : {1.0f, 0.3f}) {
+        pixels.assign(size_t(pitchWords) * size_t(height), kPadding);
+        std::vector<uint32_t> expected = pixels;
+        gpu.encodeDisplay(onGpu, exposure, settings, pixels.data(), pitchWords * 4);
+        onCpu.encode(radiance, exposure, settings, expected.data(), pitchWords * 4);
+        EXPECT_EQ(onGpu.curve().luminanceScale, onCpu.curve().luminanceScale);
+        EXPECT_EQ(onGpu.curve().whiteScaled, onCpu.curve().whiteScaled);
+        int differing = 0, worst = 0;
+        for (int y = 0; y < height; ++y)
+          for (int x = 0; x < pitchWords; ++x) {
+            const size_t i = size_t(y) * size_t(pitchWords) + size_t(x);
+            if (x >= width) {
+              EXPECT_EQ(pixels[i], kPadding) << x << ", " << y;
+              continue;
+            }
+            differing += pixels[i] != expected[i];
+            worst = std::max(worst, wordChannelDistance(pixels[i], expected[i]));
+          }
+        EXPECT_LE(worst, 1) << toneMapOperatorName(settings.op);
+        EXPECT_LE(differing, width * height / 200) << toneMapOperatorName(settings.op);
+      }
+    }
+    EXPECT_GT(gpu.lastGpuPasses().total(), 0.0);
+    EXPECT_EQ(gpu.gpuBytes() - before,
+              4 * uint64_t(width * height) + 16 * subsample + (first ? 4 * DisplayEncoder::kSrgbTableSize : 0));
   }
 }
 

@@ -242,6 +242,14 @@ class FrameRenderer {
       cpu_->render(camera, settings, image);
     }
   }
+  /// The GPU renderer's frame kept on the GPU (GpuRenderer::draw): shown by encodeDisplay,
+  /// read back by readRadiance. Only with the GPU renderer.
+  void drawOnGpu(const Camera& camera, const RenderSettings& settings) { gpu_->draw(camera, settings); }
+  void readRadiance(Image& image) { gpu_->readRadiance(image); }
+  void encodeDisplay(DisplayEncoder& encoder, float exposureScale, const ToneMapSettings& settings, uint32_t* pixels,
+                     int pitchBytes) {
+    gpu_->encodeDisplay(encoder, exposureScale, settings, pixels, pitchBytes);
+  }
 
  private:
   /// Sets gpu_ when the GPU renderer can draw; returns why not (Automatic) or throws (Gpu).
@@ -369,11 +377,19 @@ class ViewerSession {
                        !renderer_.gpu() || (live_ && live_->renderer()), options_.targetFps);
     const double scale = renderFrame(width, height, relit);
     const bool rendered = scale > 0.0;
-    if (rendered) renderMs_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
-
+    auto renderDone = [&] { renderMs_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count()); };
     int pitch = 0;
-    uint32_t* pixels = window_.lockFrame(frame_.width, frame_.height, pitch);
-    display_.encode(frame_, exposureScale(), toneMap_, pixels, pitch);
+    if (frameOnGpu_) {
+      // The GPU's frame becomes the window's pixels there; its read-back waits for the frame,
+      // so the render time ends after it.
+      uint32_t* pixels = window_.lockFrame(frame_.width, frame_.height, pitch);
+      renderer_.encodeDisplay(display_, exposureScale(), toneMap_, pixels, pitch);
+      if (rendered) renderDone();
+    } else {
+      if (rendered) renderDone();
+      uint32_t* pixels = window_.lockFrame(frame_.width, frame_.height, pitch);
+      display_.encode(frame_, exposureScale(), toneMap_, pixels, pitch);
+    }
     drawHud(width, height, frameStart);
     window_.present();
     // The frame-rate controller learns from frames at the settings' own samples per pixel.
@@ -460,7 +476,7 @@ class ViewerSession {
       const double scale = moved && !first ? scales_(share_).scale(true) : 1.0;
       int w = width, h = height;
       scaledSize(width, height, scale, w, h);
-      draw(cameraAt(w, h), options_.render, frame_);
+      drawShown(cameraAt(w, h), options_.render);
       shown_ = scale < 1.0 ? Shown::Scaled : Shown::Base;
       batches_ = 0;
       return scale;
@@ -473,7 +489,7 @@ class ViewerSession {
     if (done + batchSpp > std::max(spp, ViewerOptions::kRefinedSamples) || !renderer_.multiSample(cameraAt(1, 1)))
       return 0.0;
     if (shown_ == Shown::Base) {
-      accumulation_ = baseIsBatch ? frame_ : Image(width, height);
+      accumulation_ = baseIsBatch ? shownRadiance() : Image(width, height);
       batches_ = baseIsBatch ? 1 : 0;
     }
     RenderSettings batch = options_.render;
@@ -490,9 +506,33 @@ class ViewerSession {
     return 1.0;
   }
 
+  /// Renders the view the window shows next: with the GPU renderer its frame stays on the GPU
+  /// (frameOnGpu_), where renderAndPresent turns it into the window's pixels; else into frame_.
+  void drawShown(const Camera& camera, const RenderSettings& settings) {
+    if (renderer_.gpu() && !(live_ && live_->renderer())) {
+      renderer_.drawOnGpu(camera, settings);
+      if (frame_.width != camera.width() || frame_.height != camera.height()) frame_ = Image(camera.width(), camera.height());
+      frameOnGpu_ = true;
+      return;
+    }
+    draw(camera, settings, frame_);
+  }
+
+  /// frame_, the shown view's radiance: read back first where it is still on the GPU.
+  const Image& shownRadiance() {
+    if (frameOnGpu_) {
+      renderer_.readRadiance(frame_);
+      frameOnGpu_ = false;
+    }
+    return frame_;
+  }
+
   /// Renders with the relit light field's CPU renderer once live relighting has published one
   /// (the GPU renderer draws the baked light field only), else with the session's renderer.
+  /// The shown frame, if still on the GPU, is read back first: the GPU renderer holds one.
   void draw(const Camera& camera, const RenderSettings& settings, Image& image) {
+    if (&image != &frame_) shownRadiance();
+    if (&image == &frame_) frameOnGpu_ = false;
     drawWithShare(share_, [&] {
       if (const FastRenderer* relit = live_ ? live_->renderer() : nullptr) {
         relit->render(camera, settings, image);
@@ -505,7 +545,7 @@ class ViewerSession {
   /// The shown view at full resolution and the settings' samples per pixel: what `plenoptic
   /// render` writes (rendered for the purpose when the window shows a scaled or refined frame).
   const Image& baseFrame() {
-    if (shown_ == Shown::Base) return frame_;
+    if (shown_ == Shown::Base) return shownRadiance();
     draw(cameraAt(shownWidth_, shownHeight_), options_.render, screenshot_);
     return screenshot_;
   }
@@ -597,7 +637,8 @@ class ViewerSession {
   CoreShare share_;  ///< the frame's (renderAndPresent)
   float exposureEv_ = 0.0f;  ///< the +/− offset on top of options.exposureScale
   ToneMapSettings toneMap_;
-  Image frame_;         ///< what the window shows (radiance; scaled, base or refined)
+  Image frame_;         ///< what the window shows (radiance; scaled, base or refined), its size
+  bool frameOnGpu_ = false;  ///< frame_'s pixels are the GPU renderer's last frame, not read back
   Image accumulation_;  ///< the sum of the refinement batches
   Image batchImage_, screenshot_;
   Shown shown_ = Shown::Nothing;

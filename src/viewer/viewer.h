@@ -8,11 +8,14 @@
 // renderer, with one warning line on stderr saying why (no EGL or GL 4.5 context, a software
 // rasteriser such as llvmpipe — slower than the CPU renderer, a shader that does not compile,
 // a feature the GPU renderer does not draw yet). Asked for explicitly, the GPU renderer
-// refuses with that error instead. Either way a frame is radiance in an Image that the CPU
-// encodes (exposure, tone mapping, sRGB) into the window: the GPU renderer's frame is read
-// back from its headless EGL context and blitted, as the CPU renderer's is (the window then
-// uses SDL's software renderer, so that no second OpenGL context competes for the thread), so
-// both show, and screenshot, exactly what `plenoptic render` writes.
+// refuses with that error instead. Either way a frame is radiance encoded (exposure, tone
+// mapping, sRGB) into the window's 8-bit pixels by one rule, DisplayEncoder's (image/display.h):
+// the CPU renderer's frame by the CPU; the GPU renderer's on the GPU, in its headless EGL
+// context (GpuRenderer::encodeDisplay: the curve resolved on the CPU from the frame's
+// subsample, each pixel's word computed there, 4 bytes per pixel read back instead of 12 of
+// radiance), then blitted (the window uses SDL's software renderer, so that no second OpenGL
+// context competes for the thread). Screenshots are the radiance read back and written as
+// `plenoptic render` writes it.
 //
 // Frame rate: with the CPU renderer, while the camera moves each frame is rendered at the
 // reduced internal resolution RenderScaleController (render_scale.h) picks for the frame-rate
@@ -96,7 +99,9 @@ struct ViewerOptions {
 struct ViewerResult {
   int frames = 0;
   double msPerFrameMedian = 0.0;  ///< render + display + present
-  double renderMsMedian = 0.0;    ///< the renderer alone (frames that rendered)
+  /// The renderer alone (frames that rendered); with the GPU renderer until its frame's pixels
+  /// are read back (its display pass included), the GPU working apart from the CPU until then.
+  double renderMsMedian = 0.0;
   std::string renderer;           ///< "gpu (DEVICE)" or "cpu"
   std::string fallback;           ///< why the CPU renderer was taken in Automatic mode; empty otherwise
   /// With relighting: frames drawn while the propagation ran, their median time, and the

@@ -1,0 +1,118 @@
+// The viewer's display pass on the GPU (gpu_display.h).
+#include "gpu/gpu_display.h"
+
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "image/display.h"
+
+namespace pl::gpu {
+
+std::string displayGlslConstants(uint32_t radianceImageUnit) {
+  return fmt::format(
+      "#define DISPLAY_WORDS_BINDING {}\n#define SRGB_TABLE_BINDING {}\n#define DISPLAY_STATISTICS_BINDING {}\n"
+      "#define DISPLAY_RADIANCE_UNIT {}\n"
+      "const uint kToneReinhard = {}u, kToneLinear = {}u, kToneClamp = {}u;\n"
+      "const float kSrgbTableLast = {:.1f};\nconst uint kNonFiniteWord = {}u;\nconst int kStatisticsStride = {};\n",
+      kDisplayWordsBinding, kSrgbTableBinding, kDisplayStatisticsBinding, radianceImageUnit,
+      unsigned(ToneMapOperator::Reinhard), unsigned(ToneMapOperator::Linear), unsigned(ToneMapOperator::Clamp),
+      double(DisplayEncoder::kSrgbTableSize - 1), DisplayEncoder::kNonFiniteWord, DisplayEncoder::kStatisticsStride);
+}
+
+// ToneMapCurve::apply and DisplayEncoder::word (tonemap.cpp, display.h), statement for
+// statement: rgbToYuv, the Reinhard curve (eq. 3, or eq. 4 with a white point), the scaled U
+// and V, yuvToRgb, clip01; linear; clamp. `precise` keeps the compiler from fusing a multiply
+// and an add the C++ rounds apart.
+const char* const kDisplayGlsl = R"glsl(
+uniform uint toneOperator;
+uniform float luminanceScale, whiteScaled;
+uniform bool whiteInfinite;  // whiteScaled = ∞: eq. 3
+layout(std430, binding = SRGB_TABLE_BINDING) readonly buffer SrgbTable { uint srgbTable[]; };
+
+float luminance709(vec3 c) {
+  precise float y = 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+  return y;
+}
+vec3 toneCurve(vec3 exposed) {
+  if (toneOperator == kToneReinhard) {
+    float y = luminance709(exposed);
+    precise float u = (exposed.b - y) / 1.8556, v = (exposed.r - y) / 1.5748;
+    if (!(y > 0.0)) return vec3(0.0);
+    precise float l = luminanceScale * y;
+    precise float ld = whiteInfinite ? l / (1.0 + l) : l * (1.0 + l / (whiteScaled * whiteScaled)) / (1.0 + l);
+    precise float s = ld / y;
+    precise float su = u * s, sv = v * s;
+    precise float r = ld + 1.5748 * sv;
+    precise float b = ld + 1.8556 * su;
+    precise float g = (ld - 0.2126 * r - 0.0722 * b) / 0.7152;
+    return clamp(vec3(r, g, b), vec3(0.0), vec3(1.0));
+  }
+  if (toneOperator == kToneLinear) {
+    precise vec3 scaled = exposed * luminanceScale;
+    return clamp(scaled, vec3(0.0), vec3(1.0));
+  }
+  vec3 c = max(exposed, vec3(0.0));
+  float m = max(c.r, max(c.g, c.b));
+  return m > 1.0 ? c / m : c;
+}
+bool nonFinite(vec3 c) { return any(isnan(c)) || any(isinf(c)); }
+uint tableLevel(float v) {
+  precise float index = clamp(v, 0.0, 1.0) * kSrgbTableLast + 0.5;
+  return srgbTable[uint(index)];
+}
+uint displayWord(vec3 exposed) {
+  if (nonFinite(exposed)) return kNonFiniteWord;
+  vec3 d = toneCurve(exposed);
+  if (nonFinite(d)) return kNonFiniteWord;
+  return 0xFF000000u | (tableLevel(d.r) << 16) | (tableLevel(d.g) << 8) | tableLevel(d.b);
+}
+)glsl";
+
+const char* const kDisplayStatisticsCompute = R"glsl(
+layout(local_size_x = 8, local_size_y = 8) in;
+uniform ivec2 size;
+layout(binding = DISPLAY_RADIANCE_UNIT, rgba32f) uniform readonly image2D radiance;
+layout(std430, binding = DISPLAY_STATISTICS_BINDING) writeonly buffer Statistics { vec4 statistics[]; };
+void main() {
+  ivec2 sub = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 subSize = (size + kStatisticsStride - 1) / kStatisticsStride;
+  if (sub.x >= subSize.x || sub.y >= subSize.y) return;
+  statistics[sub.y * subSize.x + sub.x] = vec4(imageLoad(radiance, sub * kStatisticsStride).rgb, 0.0);
+}
+)glsl";
+
+const char* const kDisplayEncodeCompute = R"glsl(
+layout(local_size_x = 8, local_size_y = 8) in;
+uniform ivec2 size;
+uniform float exposureScale;
+layout(binding = DISPLAY_RADIANCE_UNIT, rgba32f) uniform readonly image2D radiance;
+layout(std430, binding = DISPLAY_WORDS_BINDING) writeonly buffer Words { uint words[]; };
+void main() {
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (pixel.x >= size.x || pixel.y >= size.y) return;
+  precise vec3 exposed = imageLoad(radiance, pixel).rgb * exposureScale;
+  words[pixel.y * size.x + pixel.x] = displayWord(exposed);
+}
+)glsl";
+
+const char* const kDisplayWordsCompute = R"glsl(
+layout(std430, binding = QUERIES_BINDING) readonly buffer Queries { vec4 queries[]; };
+layout(std430, binding = RESULTS_BINDING) writeonly buffer Results { uint results[]; };
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= count) return;
+  results[i] = displayWord(queries[i].rgb);
+}
+)glsl";
+
+void setToneCurveUniforms(uint32_t program, const ToneMapCurve& curve) {
+  glProgramUniform1ui(program, glGetUniformLocation(program, "toneOperator"), unsigned(curve.op));
+  glProgramUniform1f(program, glGetUniformLocation(program, "luminanceScale"), curve.luminanceScale);
+  const bool infinite = std::isinf(curve.whiteScaled);
+  glProgramUniform1f(program, glGetUniformLocation(program, "whiteScaled"), infinite ? 1.0f : curve.whiteScaled);
+  glProgramUniform1i(program, glGetUniformLocation(program, "whiteInfinite"), infinite ? 1 : 0);
+}
+
+}  // namespace pl::gpu
