@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The GPU renderer on a graphics card, in one run: the frame rate of `render --renderer gpu`
-# on the built-in Cornell box and on Sponza at 1920×1080 (each camera), the viewer's on the
+# on the built-in Cornell box and on Sponza at 1920×1080 (each camera; rasterised ids, then
+# every camera ray through the BVH: PLENOPTIC_GPU_VISIBILITY=rays), the viewer's on the
 # box (`view --renderer gpu` flying a path, headless), and the GPU-vs-CPU
 # comparison of bench/gpu_vs_cpu.sh on both light fields — so that minutes on a lent machine
 # go to measuring. It bakes what it is not given (draft preset: the box in seconds, Sponza in
@@ -71,6 +72,13 @@ measure cornell "$D/cornell.plf" default "$WIDTH" "$HEIGHT"
 measure cornell-640x480 "$D/cornell.plf" default 640 480
 for camera in $(cameras "$SPONZA_PLF"); do
   measure "sponza-$camera" "$SPONZA_PLF" "$camera" "$WIDTH" "$HEIGHT"
+done
+# The same frames with every camera ray cast through the BVH and no rasterised ids
+# (PLENOPTIC_GPU_VISIBILITY=rays): whether the rasteriser or the ray casting is the cheaper
+# visibility on this card (on NVIDIA's Hopper, a compute GPU, few units rasterise).
+PLENOPTIC_GPU_VISIBILITY=rays measure cornell-rays "$D/cornell.plf" default "$WIDTH" "$HEIGHT"
+for camera in $(cameras "$SPONZA_PLF"); do
+  PLENOPTIC_GPU_VISIBILITY=rays measure "sponza-$camera-rays" "$SPONZA_PLF" "$camera" "$WIDTH" "$HEIGHT"
 done
 # The viewer's frames with the GPU renderer, on SDL's dummy video driver (no window): the box
 # flown along a path, so that every frame is drawn — the render, the display pass (tone mapping

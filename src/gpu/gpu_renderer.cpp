@@ -360,6 +360,8 @@ uniform float apertureRadius, focusDistance;  // Camera's thin lens (scene units
 uniform ivec2 size;
 uniform int idScale;  // the ids are at idScale × the image's resolution
 uniform bool anyMasked;  // some material is alpha-masked (maskedMaterial)
+// PLENOPTIC_GPU_VISIBILITY=rays: no visibility pass; every camera ray is cast through the BVH.
+uniform bool castAllRays;
 // An id texel the markers pass marked: a vertex lies there, nearer than the surface rasterised
 // (cameraHit casts the rays around it through the BVH).
 const uint kMarkedTexel = 0xffffffffu;
@@ -551,9 +553,10 @@ int idsHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b
 }
 // What the id texels say of the camera ray through film point `film` along unit `direction`:
 // idsHit's answer for a pinhole; kIdsUnsure for a thin lens, whose rays start off the eye,
-// where the id buffer (rasterised from the eye) says nothing.
+// where the id buffer (rasterised from the eye) says nothing, and where no ids were drawn
+// (castAllRays).
 int cameraIdsHit(vec2 film, vec3 direction, out float t, out uint triangle, out vec2 b) {
-  if (apertureRadius > 0.0) {
+  if (apertureRadius > 0.0 || castAllRays) {
     t = 1.0 / 0.0;
     triangle = kNoTriangle;
     b = vec2(0.0);
@@ -599,6 +602,10 @@ void main() {
   float t;
   uint triangle;
   vec2 b;
+  if (castAllRays) {  // every ray through the BVH, here, in 8×8 tiles of neighbouring rays
+    storeHit(pixel, bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, b), t, triangle, b);
+    return;
+  }
   int answer = cameraIdsHit(film, direction, t, triangle, b);
   if (answer != kIdsUnsure) {
     storeHit(pixel, answer == kIdsHit, t, triangle, b);
@@ -1072,6 +1079,23 @@ std::string gpuUnsupportedFeature(const LightField& lf) {
   return {};
 }
 
+namespace {
+
+/// How the camera rays find their first hits, from the environment variable
+/// PLENOPTIC_GPU_VISIBILITY: "raster" (unset: the default) rasterises the triangle ids and casts
+/// through the BVH only the rays they cannot answer; "rays" draws no ids and casts every camera
+/// ray through the BVH — the same hits (the ids only shortcut the ray casting), for measuring
+/// a GPU whose rasteriser is the smaller part of it (NVIDIA's Hopper: docs/benchmarks.md).
+bool castAllCameraRays() {
+  const char* value = std::getenv("PLENOPTIC_GPU_VISIBILITY");
+  const std::string mode = value != nullptr ? value : "";
+  if (mode.empty() || mode == "raster") return false;
+  if (mode == "rays") return true;
+  fail("GPU renderer: PLENOPTIC_GPU_VISIBILITY={} is not a visibility mode (use raster or rays)", mode);
+}
+
+}  // namespace
+
 /// The ray queue's header (kResolveCompute): groups x, y, z to dispatch, and the count.
 constexpr uint64_t kRayQueueHeaderBytes = 16;
 
@@ -1111,6 +1135,9 @@ struct GpuRenderer::State {
   /// the queries (collectFrameStats) and whether it was one sample per pixel.
   bool frameDrawn = false, statsPending = false, oneSample = false;
   GLint64 frameStart = 0;
+  /// PLENOPTIC_GPU_VISIBILITY=rays (castAllCameraRays): no visibility pass, every camera ray
+  /// cast through the BVH.
+  bool castAllRays = false;
   /// The last render()'s camera rays the resolve pass cast through the BVH (its queue's
   /// count), over its pixels; empty after a frame of several samples (lastBvhRayShare).
   std::optional<double> lastBvhRayShare;
@@ -1312,7 +1339,7 @@ struct GpuRenderer::State {
     if (oneSample) {
       GLuint queued = 0;  // the queue's count (kResolveCompute), after its header's three group counts
       glGetNamedBufferSubData(rayQueue, 3 * sizeof(GLuint), sizeof(queued), &queued);
-      lastBvhRayShare = double(queued) / (double(width) * double(height));
+      lastBvhRayShare = castAllRays ? 1.0 : double(queued) / (double(width) * double(height));
     }
   }
   void requireFrame(const char* what) const {
@@ -1326,6 +1353,7 @@ GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField)
          missing);
   state_ = std::make_unique<State>();
   State& s = *state_;
+  s.castAllRays = castAllCameraRays();
   const Scene& scene = lightField.scene;
   s.background = scene.environment.constant;
 
@@ -1618,7 +1646,8 @@ void GpuRenderer::draw(const Camera& camera, const RenderSettings& settings) {
   // (multiSampleIdScale) by the shading pass itself. A thin lens's rays are all cast through the
   // BVH: no visibility pass.
   const int spp = effectiveSamplesPerPixel(settings, camera.isThinLens());
-  const int idScale = spp > 1 && !camera.isThinLens() ? multiSampleIdScale(camera.width(), camera.height()) : 1;
+  const bool noIds = camera.isThinLens() || state_->castAllRays;
+  const int idScale = spp > 1 && !noIds ? multiSampleIdScale(camera.width(), camera.height()) : 1;
   State& s = *state_;
   s.context.makeCurrent();
   if (s.passEndQueries[0] == 0) glCreateQueries(GL_TIMESTAMP, State::kPassEnds, s.passEndQueries);
@@ -1628,7 +1657,7 @@ void GpuRenderer::draw(const Camera& camera, const RenderSettings& settings) {
   // would be stamped with the next pass's.
   GLint64 frameStart = 0;
   glGetInteger64v(GL_TIMESTAMP, &frameStart);
-  if (camera.isThinLens()) {
+  if (noIds) {
     s.ensureTargets(camera.width(), camera.height(), idScale);
   } else {
     s.queueVisibility(camera, idScale);
@@ -1640,6 +1669,7 @@ void GpuRenderer::draw(const Camera& camera, const RenderSettings& settings) {
     glProgramUniform2i(program, glGetUniformLocation(program, "size"), camera.width(), camera.height());
     glProgramUniform1i(program, glGetUniformLocation(program, "idScale"), idScale);
     glProgramUniform1i(program, glGetUniformLocation(program, "vignetting"), camera.vignetting() ? 1 : 0);
+    glProgramUniform1i(program, glGetUniformLocation(program, "castAllRays"), s.castAllRays ? 1 : 0);
   };
   glBindTextureUnit(kIdsUnit, s.idTexture);
   if (spp == 1) {

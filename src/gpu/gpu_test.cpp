@@ -1264,6 +1264,32 @@ class ScopedEnvironment {
   const char* name_;
 };
 
+// PLENOPTIC_GPU_VISIBILITY=rays: no rasterised ids, every camera ray cast through the BVH —
+// the CPU renderer's picture still, at one sample per pixel and several, with alpha masks cut
+// by the traversal; anything but raster or rays is refused by name.
+TEST_F(GpuRendererTest, CastingEveryCameraRayDrawsTheSamePicture) {
+  const ScopedEnvironment rays("PLENOPTIC_GPU_VISIBILITY", "rays");
+  const LightField glossy = randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 21);
+  GpuRenderer gpu(glossy);
+  expectSameAsFastRenderer(glossy, gpu, insideCamera(glossy.scene), 64, 48);
+  EXPECT_EQ(gpu.lastBvhRayShare(), std::optional<double>(1.0));
+  RenderSettings settings;
+  settings.samplesPerPixel = 4;
+  expectSameAsFastRenderer(glossy, gpu, firstCamera(glossy.scene), 48, 40, false, settings);
+  const LightField masked = randomLightField(withAlphaMasks(withSurfaceDetail(makeCornellBox(), true), {"blocks"}), 22);
+  GpuRenderer maskedGpu(masked);
+  expectSameAsFastRenderer(masked, maskedGpu, firstCamera(masked.scene), 64, 48);
+  const ScopedEnvironment bogus("PLENOPTIC_GPU_VISIBILITY", "compute");
+  try {
+    GpuRenderer refused(glossy);
+    ADD_FAILURE() << "PLENOPTIC_GPU_VISIBILITY=compute was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("PLENOPTIC_GPU_VISIBILITY=compute is not a visibility mode (use raster or rays)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // An image whose resolve pass's ray queue (4 bytes per pixel) exceeds the driver's largest
 // storage block is refused with the sizes before any target is made, not drawn wrong; the
 // renderer goes on drawing smaller images.
