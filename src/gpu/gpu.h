@@ -189,6 +189,10 @@ class GpuRenderer {
   /// CPU.
   void encodeDisplay(DisplayEncoder& encoder, float exposureScale, const ToneMapSettings& settings, uint32_t* pixels,
                      int pitchBytes);
+  /// Compiles the display pass's programs and uploads its table now rather than at the first
+  /// encodeDisplay: the viewer does it while it chooses its renderer, so that a driver that
+  /// fails on them is a reason to take the CPU renderer (pl::Error with the driver's log).
+  void prepareDisplay();
   /// The display pass's GLSL (displayWord) on given exposed colours with `curve`: what
   /// DisplayEncoder::word(curve, exposed) gives, one word each (gpu_test checks the two agree).
   std::vector<uint32_t> displayWords(const ToneMapCurve& curve, const std::vector<Rgb>& exposed);

@@ -1299,17 +1299,18 @@ struct GpuRenderer::State {
   }
   static uint64_t srgbTableBytes() { return 4 * uint64_t(DisplayEncoder::kSrgbTableSize); }
   /// The display pass's sRGB table (DisplayEncoder's, one uint per entry), uploaded once.
-  void ensureSrgbTable(const DisplayEncoder& encoder) {
+  void ensureSrgbTable() {
     if (srgbTable != 0) return;
+    const DisplayEncoder encoder;
     const std::vector<uint8_t>& table = encoder.srgbTable();
     const std::vector<GLuint> words(table.begin(), table.end());
     glCreateBuffers(1, &srgbTable);
     glNamedBufferStorage(srgbTable, GLsizeiptr(words.size() * sizeof(GLuint)), words.data(), 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gpu::kSrgbTableBinding, srgbTable);
   }
-  /// The statistics and encode programs and the frame's display buffers, made when missing.
-  void ensureDisplay(const DisplayEncoder& encoder) {
-    ensureSrgbTable(encoder);
+  /// The statistics and encode programs and the sRGB table, made when missing.
+  void ensureDisplayPrograms() {
+    ensureSrgbTable();
     const std::string constants = gpu::displayGlslConstants(kRadianceImageUnit);
     if (displayStatisticsProgram == 0)
       displayStatisticsProgram =
@@ -1317,6 +1318,10 @@ struct GpuRenderer::State {
     if (displayEncodeProgram == 0)
       displayEncodeProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(gpu::kDisplayGlsl) + gpu::kDisplayEncodeCompute}},
                                          "display", false, constants);
+  }
+  /// ensureDisplayPrograms, and the frame's display buffers, made when missing.
+  void ensureDisplay() {
+    ensureDisplayPrograms();
     if (displayWords == 0) {
       const int sw = DisplayEncoder::statisticsSize(width), sh = DisplayEncoder::statisticsSize(height);
       glCreateBuffers(1, &displayWords);
@@ -1738,7 +1743,7 @@ void GpuRenderer::encodeDisplay(DisplayEncoder& encoder, float exposureScale, co
   State& s = *state_;
   s.context.makeCurrent();
   s.requireFrame("encoding the display");
-  s.ensureDisplay(encoder);
+  s.ensureDisplay();
   const int w = s.width, h = s.height;
   const int sw = DisplayEncoder::statisticsSize(w), sh = DisplayEncoder::statisticsSize(h);
   // Both programs read the radiance image the shading pass stored.
@@ -1775,10 +1780,16 @@ void GpuRenderer::encodeDisplay(DisplayEncoder& encoder, float exposureScale, co
   checkGl("the display pass");
 }
 
+void GpuRenderer::prepareDisplay() {
+  state_->context.makeCurrent();
+  state_->ensureDisplayPrograms();
+  checkGl("preparing the display pass");
+}
+
 std::vector<uint32_t> GpuRenderer::displayWords(const ToneMapCurve& curve, const std::vector<Rgb>& exposed) {
   State& s = *state_;
   s.context.makeCurrent();
-  s.ensureSrgbTable(DisplayEncoder());
+  s.ensureSrgbTable();
   if (s.displayWordsProgram == 0)
     s.displayWordsProgram =
         linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + gpu::kDisplayGlsl + gpu::kDisplayWordsCompute}},

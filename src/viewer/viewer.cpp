@@ -272,6 +272,7 @@ class FrameRenderer {
     try {
       gpu_ = std::make_unique<GpuRenderer>(lightField);
       gpu_->checkSettings(options.render, camera);  // what this driver lacks
+      gpu_->prepareDisplay();                       // the display pass's shaders compile here
     } catch (const Error& e) {
       gpu_.reset();
       if (asked) throw;
