@@ -97,7 +97,13 @@ json.dump({"fps": 30, "keyframes": [
     {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0]},
     {"time": frames / 30, "eye": [200, 300, -500], "target": [300, 250, 300]}]}, open(sys.argv[1], "w"))
 PY
-viewed=$(SDL_VIDEODRIVER=dummy "$BIN" view "$D/cornell.plf" --renderer gpu --width "$WIDTH" --height "$HEIGHT" \
-  --path "$D/box-walk.json" 2>&1 | grep "frames rendered" || true)
-say "view cornell ${WIDTH}x${HEIGHT} (GPU renderer, display pass on the GPU): ${viewed#view: }"
+SDL_VIDEODRIVER=dummy "$BIN" view "$D/cornell.plf" --renderer gpu --width "$WIDTH" --height "$HEIGHT" \
+  --path "$D/box-walk.json" --stats "$D/view.json" --quiet >/dev/null 2>&1 || true
+python3 - "$D/view.json" <<'PY' | tee -a "$SUMMARY" || say "view: failed"
+import json, sys
+s = json.load(open(sys.argv[1]))
+print(f"view cornell {s['width']}x{s['height']} (GPU renderer, display pass on the GPU): {s['fps']:.1f} fps "
+      f"({s['ms_per_frame_median']:.3f} ms/frame median, render and read-back {s['render_ms_median']:.3f} ms), "
+      f"{s['frames']} frames, on {s.get('device', s['renderer'])}")
+PY
 echo "summary: $SUMMARY"

@@ -2,6 +2,8 @@
 // shared camera, exposure and tone-mapping flags, plus headless flags for tests and CI.
 #include <fmt/format.h>
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -12,6 +14,7 @@
 #include "bake/relight.h"
 #include "camera/camera_path.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "plf/plf_file.h"
 #include "viewer/viewer.h"
 
@@ -23,14 +26,39 @@ constexpr int kMaxFrames = 10000000;
 struct ViewCommandOptions {
   std::string input;      ///< .plf light field
   std::string pathFile;   ///< --path PATH.json: scripted camera
+  std::string statsPath;  ///< --stats S.json: the session's timings; empty = none
   ViewSettings view;      ///< window size, camera, exposure and tone mapping
   ViewerOptions viewer;   ///< the other flags are bound to its fields
 };
+
+/// The --stats JSON of a session (docs/user-guide.md#view), as `render --stats` names its fields.
+std::string viewStatsJson(const ViewerResult& result, const ViewerOptions& viewer) {
+  nlohmann::json json;
+  json["frames"] = result.frames;
+  json["width"] = viewer.width;
+  json["height"] = viewer.height;
+  json["ms_per_frame_median"] = result.msPerFrameMedian;
+  json["fps"] = result.msPerFrameMedian > 0.0 ? 1e3 / result.msPerFrameMedian : 0.0;
+  json["render_ms_median"] = result.renderMsMedian;
+  json["renderer"] = result.device.empty() ? "cpu" : "gpu";
+  if (!result.device.empty()) json["device"] = result.device;
+  if (!result.fallback.empty()) json["fallback"] = result.fallback;
+  if (!viewer.relightKeys.empty()) {
+    json["relight_iterations"] = result.relightIterations;
+    json["relight_converged"] = result.relightConverged;
+    json["relight_seconds"] = result.relightSeconds;
+    json["relight_first_frame_seconds"] = result.relightFirstFrameSeconds;
+    json["relight_frames"] = result.relightFrames;
+    json["relight_ms_per_frame_median"] = result.relightMsPerFrameMedian;
+  }
+  return json.dump(2) + "\n";
+}
 
 void runView(const ViewCommandOptions& options, const GlobalOptions& global) {
   Runtime runtime(global);
   const ViewSettings& view = options.view;
   if (!options.viewer.screenshotPath.empty()) ViewSettings::checkImageOutput(options.viewer.screenshotPath, "--screenshot");
+  if (!options.statsPath.empty()) checkOutputPath(options.statsPath, {}, "--stats");
   const LightField lightField = readLightField(options.input);
   const Accel accel(lightField.scene);
 
@@ -56,6 +84,7 @@ void runView(const ViewCommandOptions& options, const GlobalOptions& global) {
   fmt::print("view: {} frames rendered, median {:.2f} ms/frame (render {:.2f} ms), renderer {}{}\n", result.frames,
              result.msPerFrameMedian, result.renderMsMedian, result.renderer,
              viewer.screenshotPath.empty() ? "" : ", screenshot " + viewer.screenshotPath);
+  if (!options.statsPath.empty()) writeFileAtomically(options.statsPath, viewStatsJson(result, viewer));
   if (!viewer.relightKeys.empty())
     fmt::print("view: relit: {} iterations ({}), first frame {:.3f} s (sun masks {:.3f} s, first shot {:.3f} s), {:.3f} s "
                "in all; {} frames while propagating, median {:.2f} ms/frame{}\n",
@@ -81,6 +110,8 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--screenshot", viewer.screenshotPath,
                       "Write the last frame to this image (.png tone-mapped, .exr/.hdr/.pfm radiance) on exit");
   command->add_option("--path", options->pathFile, "Fly a camera path (JSON keyframes) instead of the keys");
+  command->add_option("--stats", options->statsPath,
+                      "Write JSON on exit: frames, ms_per_frame_median, fps, render_ms_median, renderer, device");
   command->add_option("--record", viewer.recordPath, "Where P (or R) saves the recorded camera path")
       ->capture_default_str();
   command->add_option("--speed", viewer.speed, "Movement speed in scene units per second (0 = automatic)")

@@ -218,7 +218,8 @@ class FrameRenderer {
   FrameRenderer(const LightField& lightField, const Accel& accel, const ViewerOptions& options) {
     if (options.renderer != ViewerRendererChoice::Cpu) fallback_ = tryGpu(lightField, options);
     if (gpu_) {
-      name_ = fmt::format("gpu ({})", gpu_->deviceName());
+      device_ = gpu_->deviceName();
+      name_ = fmt::format("gpu ({})", device_);
       return;
     }
     if (!fallback_.empty()) fmt::print(stderr, "plenoptic: warning: view uses the CPU renderer: {}\n", fallback_);
@@ -234,6 +235,7 @@ class FrameRenderer {
     return !gpu_ || gpu_->unsupportedSetting(two, camera).empty();
   }
   const std::string& name() const { return name_; }
+  const std::string& device() const { return device_; }
   const std::string& fallback() const { return fallback_; }
   void render(const Camera& camera, const RenderSettings& settings, Image& image) {
     if (gpu_) {
@@ -283,7 +285,7 @@ class FrameRenderer {
 
   std::unique_ptr<GpuRenderer> gpu_;
   std::unique_ptr<FastRenderer> cpu_;
-  std::string name_, fallback_;
+  std::string name_, device_, fallback_;
 };
 
 /// What the window shows (ViewerSession::renderFrame's states).
@@ -425,6 +427,7 @@ class ViewerSession {
     result.msPerFrameMedian = median(frameMs_);
     result.renderMsMedian = median(renderMs_);
     result.renderer = renderer_.name();
+    result.device = renderer_.device();
     result.fallback = renderer_.fallback();
     if (live_) {
       const RelightStatus status = live_->status();

@@ -103,6 +103,7 @@ struct ViewerResult {
   /// are read back (its display pass included), the GPU working apart from the CPU until then.
   double renderMsMedian = 0.0;
   std::string renderer;           ///< "gpu (DEVICE)" or "cpu"
+  std::string device;             ///< with the GPU renderer, DEVICE: GpuRenderer::deviceName
   std::string fallback;           ///< why the CPU renderer was taken in Automatic mode; empty otherwise
   /// With relighting: frames drawn while the propagation ran, their median time, and the
   /// last relight's times and state (seconds; live_relight.h RelightStatus).

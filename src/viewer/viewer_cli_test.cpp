@@ -4,6 +4,8 @@
 // renderer; the walk-through output of `render --path`; and the error paths.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -238,6 +240,36 @@ TEST_F(ViewerCliTest, FallsBackToTheCpuRendererWithOneWarningLine) {
   // The CPU renderer asked for: no warning.
   ASSERT_EQ(run("view " + path("cornell.plf") + " --renderer cpu --frames 1" + size, nullptr, &errors), 0) << errors;
   EXPECT_EQ(linesWith(errors, "warning"), 0) << errors;
+}
+
+// `view --stats`: the session's frames and timings as JSON, the renderer and its device named as
+// `render --stats` names them; an unwritable stats path is refused before the window opens.
+TEST_F(ViewerCliTest, StatsJsonHasTheSessionsTimings) {
+  for (const std::string renderer : {"cpu", "gpu"}) {
+    SCOPED_TRACE(renderer);
+    std::string errors;
+    ASSERT_EQ(run("view " + path("cornell.plf") + " --renderer " + renderer + " --frames 3 --width 64 --height 48 --stats " +
+                      path("stats.json") + " --quiet",
+                  nullptr, &errors),
+              0)
+        << errors;
+    const nlohmann::json stats = nlohmann::json::parse(std::ifstream(path("stats.json")));
+    EXPECT_EQ(stats["frames"], 3);
+    EXPECT_EQ(stats["width"], 64);
+    EXPECT_EQ(stats["height"], 48);
+    EXPECT_EQ(stats["renderer"], renderer);
+    EXPECT_EQ(stats.contains("device"), renderer == "gpu");
+    if (renderer == "gpu") {
+      EXPECT_NE(stats["device"].get<std::string>().find("OpenGL 4.5"), std::string::npos) << stats;
+    }
+    const double ms = stats["ms_per_frame_median"], renderMs = stats["render_ms_median"], fps = stats["fps"];
+    EXPECT_GT(renderMs, 0.0);
+    EXPECT_GE(ms, renderMs);  // a frame is its render, display and present
+    EXPECT_NEAR(fps * ms, 1000.0, 1e-6 * fps * ms);
+  }
+  std::string errors;
+  EXPECT_NE(run("view " + path("cornell.plf") + " --frames 1 --stats " + path("missing/stats.json"), nullptr, &errors), 0);
+  EXPECT_NE(errors.find("--stats " + path("missing/stats.json") + ": directory"), std::string::npos) << errors;
 }
 
 TEST_F(ViewerCliTest, BadInputsAreClearErrors) {
