@@ -187,8 +187,18 @@ class GpuRenderer {
   /// GPU and 4 bytes per pixel are read back into `pixels` (`pitchBytes` per row, the bytes
   /// between rows left as they are) — instead of 12 of radiance and a tone-mapping pass on the
   /// CPU.
+  /// With `average`, the frame encoded is the average of the accumulated ones (accumulate:
+  /// their sum × 1 / their count, as the viewer averages its refinement batches on the CPU).
   void encodeDisplay(DisplayEncoder& encoder, float exposureScale, const ToneMapSettings& settings, uint32_t* pixels,
-                     int pitchBytes);
+                     int pitchBytes, bool average = false);
+  /// Adds the last draw()'s radiance to the accumulation on the GPU (16 bytes per pixel, made
+  /// on the first call), or starts it again from that frame (`restart`; also after the image
+  /// size changed): the viewer's refinement of a still view in batches of samples. The
+  /// average is shown by encodeDisplay(…, true) and read back by readAverage; accumulatedFrames
+  /// says how many frames it holds.
+  void accumulate(bool restart);
+  int accumulatedFrames() const;
+  void readAverage(Image& image);
   /// Compiles the display pass's programs and uploads its table now rather than at the first
   /// encodeDisplay: the viewer does it while it chooses its renderer, so that a driver that
   /// fails on them is a reason to take the CPU renderer (pl::Error with the driver's log).

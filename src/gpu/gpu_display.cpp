@@ -13,10 +13,10 @@ namespace pl::gpu {
 std::string displayGlslConstants(uint32_t radianceImageUnit) {
   return fmt::format(
       "#define DISPLAY_WORDS_BINDING {}\n#define SRGB_TABLE_BINDING {}\n#define DISPLAY_STATISTICS_BINDING {}\n"
-      "#define DISPLAY_RADIANCE_UNIT {}\n"
+      "#define DISPLAY_RADIANCE_UNIT {}\n#define DISPLAY_ACCUMULATION_UNIT {}\n"
       "const uint kToneReinhard = {}u, kToneLinear = {}u, kToneClamp = {}u;\n"
       "const float kSrgbTableLast = {:.1f};\nconst uint kNonFiniteWord = {}u;\nconst int kStatisticsStride = {};\n",
-      kDisplayWordsBinding, kSrgbTableBinding, kDisplayStatisticsBinding, radianceImageUnit,
+      kDisplayWordsBinding, kSrgbTableBinding, kDisplayStatisticsBinding, radianceImageUnit, kAccumulationImageUnit,
       unsigned(ToneMapOperator::Reinhard), unsigned(ToneMapOperator::Linear), unsigned(ToneMapOperator::Clamp),
       double(DisplayEncoder::kSrgbTableSize - 1), DisplayEncoder::kNonFiniteWord, DisplayEncoder::kStatisticsStride);
 }
@@ -73,27 +73,45 @@ uint displayWord(vec3 exposed) {
 const char* const kDisplayStatisticsCompute = R"glsl(
 layout(local_size_x = 8, local_size_y = 8) in;
 uniform ivec2 size;
+uniform float weight;  // the shown image is the bound one × weight (1 / the frames accumulated)
 layout(binding = DISPLAY_RADIANCE_UNIT, rgba32f) uniform readonly image2D radiance;
 layout(std430, binding = DISPLAY_STATISTICS_BINDING) writeonly buffer Statistics { vec4 statistics[]; };
 void main() {
   ivec2 sub = ivec2(gl_GlobalInvocationID.xy);
   ivec2 subSize = (size + kStatisticsStride - 1) / kStatisticsStride;
   if (sub.x >= subSize.x || sub.y >= subSize.y) return;
-  statistics[sub.y * subSize.x + sub.x] = vec4(imageLoad(radiance, sub * kStatisticsStride).rgb, 0.0);
+  precise vec3 shown = imageLoad(radiance, sub * kStatisticsStride).rgb * weight;
+  statistics[sub.y * subSize.x + sub.x] = vec4(shown, 0.0);
 }
 )glsl";
 
 const char* const kDisplayEncodeCompute = R"glsl(
 layout(local_size_x = 8, local_size_y = 8) in;
 uniform ivec2 size;
-uniform float exposureScale;
+uniform float weight, exposureScale;
 layout(binding = DISPLAY_RADIANCE_UNIT, rgba32f) uniform readonly image2D radiance;
 layout(std430, binding = DISPLAY_WORDS_BINDING) writeonly buffer Words { uint words[]; };
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (pixel.x >= size.x || pixel.y >= size.y) return;
-  precise vec3 exposed = imageLoad(radiance, pixel).rgb * exposureScale;
+  precise vec3 shown = imageLoad(radiance, pixel).rgb * weight;
+  precise vec3 exposed = shown * exposureScale;
   words[pixel.y * size.x + pixel.x] = displayWord(exposed);
+}
+)glsl";
+
+const char* const kAccumulateCompute = R"glsl(
+layout(local_size_x = 8, local_size_y = 8) in;
+uniform ivec2 size;
+uniform bool restart;
+layout(binding = DISPLAY_RADIANCE_UNIT, rgba32f) uniform readonly image2D radiance;
+layout(binding = DISPLAY_ACCUMULATION_UNIT, rgba32f) uniform image2D accumulation;
+void main() {
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (pixel.x >= size.x || pixel.y >= size.y) return;
+  vec4 frame = imageLoad(radiance, pixel);
+  precise vec4 sum = restart ? frame : imageLoad(accumulation, pixel) + frame;
+  imageStore(accumulation, pixel, sum);
 }
 )glsl";
 

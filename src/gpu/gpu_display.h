@@ -21,6 +21,9 @@ namespace pl::gpu {
 /// Shader storage bindings of the display programs: the words written, DisplayEncoder's
 /// table (one uint per entry), the radiance subsample (vec4 per pixel).
 inline constexpr uint32_t kDisplayWordsBinding = 26, kSrgbTableBinding = 27, kDisplayStatisticsBinding = 28;
+/// The image unit of the accumulated frames (the refinement of a still view; the frame's
+/// radiance is at the renderer's radiance unit).
+inline constexpr uint32_t kAccumulationImageUnit = 2;
 
 /// The #defines and constants the display GLSL needs (bindings, the radiance image unit, the
 /// table size and stride, the operators' numbers, the non-finite word).
@@ -30,13 +33,17 @@ std::string displayGlslConstants(uint32_t radianceImageUnit);
 ///   vec3 toneCurve(vec3 exposed) — ToneMapCurve::apply for finite input;
 ///   uint displayWord(vec3 exposed) — DisplayEncoder::word.
 extern const char* const kDisplayGlsl;
-/// Compute programs (8 × 8 groups) over a frame of uniform `size`:
-///   statistics: the radiance at every stride-th pixel into the statistics buffer (row-major,
+/// Compute programs (8 × 8 groups) over a frame of uniform `size`, reading the image at the
+/// radiance unit — a frame's radiance, or the sum of several (accumulate) — as shown = image ·
+/// weight (1, or 1 / the frames summed, as the viewer averages its refinement batches):
+///   statistics: shown at every stride-th pixel into the statistics buffer (row-major,
 ///     statisticsSize(width) per row);
-///   encode: displayWord(radiance · exposureScale) of every pixel into the words buffer, row y
-///     at y · width (the image's rows, top first, as render() reads them back).
+///   encode: displayWord(shown · exposureScale) of every pixel into the words buffer, row y
+///     at y · width (the image's rows, top first, as render() reads them back);
+///   accumulate: the accumulation image = the frame (restart) or itself + the frame.
 extern const char* const kDisplayStatisticsCompute;
 extern const char* const kDisplayEncodeCompute;
+extern const char* const kAccumulateCompute;
 /// A query program's body (after the renderer's query head): displayWord of each query's
 /// exposed colour (vec4 in, one uint out).
 extern const char* const kDisplayWordsCompute;

@@ -1150,6 +1150,10 @@ struct GpuRenderer::State {
   /// sRGB table, and the frame's words and radiance subsample (re-made with the targets).
   GLuint displayStatisticsProgram = 0, displayEncodeProgram = 0, displayWordsProgram = 0, srgbTable = 0;
   GLuint displayWords = 0, displayStatistics = 0;
+  /// The sum of the frames accumulate() added since its last restart (made on its first call,
+  /// re-made with the targets), and how many.
+  GLuint accumulateProgram = 0, accumulationTexture = 0;
+  int accumulated = 0;
   int width = 0, height = 0;
   int idScale = 1;  ///< the visibility targets are idScale·width × idScale·height
   GLsizei indexCount = 0, vertexCount = 0;
@@ -1178,6 +1182,7 @@ struct GpuRenderer::State {
     glDeleteProgram(displayStatisticsProgram);
     glDeleteProgram(displayEncodeProgram);
     glDeleteProgram(displayWordsProgram);
+    glDeleteProgram(accumulateProgram);
     glDeleteBuffers(1, &srgbTable);
     glDeleteQueries(kPassEnds, passEndQueries);
     releaseTargets();
@@ -1192,6 +1197,9 @@ struct GpuRenderer::State {
     glDeleteRenderbuffers(1, &depthBuffer);
     glDeleteBuffers(1, &displayWords);
     glDeleteBuffers(1, &displayStatistics);
+    glDeleteTextures(1, &accumulationTexture);
+    accumulationTexture = 0;
+    accumulated = 0;
     visibilityFramebuffer = readbackFramebuffer = idTexture = hitsTexture = rayQueue = radianceTexture = depthBuffer = 0;
     displayWords = displayStatistics = 0;
     width = height = 0;
@@ -1290,7 +1298,8 @@ struct GpuRenderer::State {
   }
   uint64_t targetBytes() const {
     return kRayQueueHeaderBytes + uint64_t(width) * uint64_t(height) * (16 + 16 + 4 + uint64_t(idScale) * uint64_t(idScale) * (4 + 4)) +
-           (displayWords != 0 ? displayBytes(width, height) : 0) + (srgbTable != 0 ? srgbTableBytes() : 0);
+           (displayWords != 0 ? displayBytes(width, height) : 0) + (srgbTable != 0 ? srgbTableBytes() : 0) +
+           (accumulationTexture != 0 ? 16 * uint64_t(width) * uint64_t(height) : 0);
   }
   /// The display pass's frame buffers: 4 bytes per pixel of words, 16 per subsample pixel.
   static uint64_t displayBytes(int w, int h) {
@@ -1318,6 +1327,8 @@ struct GpuRenderer::State {
     if (displayEncodeProgram == 0)
       displayEncodeProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(gpu::kDisplayGlsl) + gpu::kDisplayEncodeCompute}},
                                          "display", false, constants);
+    if (accumulateProgram == 0)
+      accumulateProgram = linkProgram({{GL_COMPUTE_SHADER, gpu::kAccumulateCompute}}, "accumulate", false, constants);
   }
   /// ensureDisplayPrograms, and the frame's display buffers, made when missing.
   void ensureDisplay() {
@@ -1739,16 +1750,22 @@ void GpuRenderer::readRadiance(Image& image) {
 }
 
 void GpuRenderer::encodeDisplay(DisplayEncoder& encoder, float exposureScale, const ToneMapSettings& settings,
-                                uint32_t* pixels, int pitchBytes) {
+                                uint32_t* pixels, int pitchBytes, bool average) {
   State& s = *state_;
   s.context.makeCurrent();
   s.requireFrame("encoding the display");
+  if (average && s.accumulated == 0) fail("GPU renderer: encoding the average of no accumulated frames");
   s.ensureDisplay();
   const int w = s.width, h = s.height;
   const int sw = DisplayEncoder::statisticsSize(w), sh = DisplayEncoder::statisticsSize(h);
-  // Both programs read the radiance image the shading pass stored.
+  // Both programs read the radiance image the shading pass stored, or the accumulated sum, and
+  // weigh it as the viewer averages its batches (1 / their count, computed here as there).
+  const float weight = average ? 1.0f / float(s.accumulated) : 1.0f;
   glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-  glBindImageTexture(kRadianceImageUnit, s.radianceTexture, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  glBindImageTexture(kRadianceImageUnit, average ? s.accumulationTexture : s.radianceTexture, 0, GL_FALSE, 0, GL_READ_ONLY,
+                     GL_RGBA32F);
+  for (GLuint program : {s.displayStatisticsProgram, s.displayEncodeProgram})
+    glProgramUniform1f(program, glGetUniformLocation(program, "weight"), weight);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gpu::kDisplayStatisticsBinding, s.displayStatistics);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gpu::kDisplayWordsBinding, s.displayWords);
   glProgramUniform2i(s.displayStatisticsProgram, glGetUniformLocation(s.displayStatisticsProgram, "size"), w, h);
@@ -1778,6 +1795,44 @@ void GpuRenderer::encodeDisplay(DisplayEncoder& encoder, float exposureScale, co
   }
   s.collectFrameStats();
   checkGl("the display pass");
+}
+
+void GpuRenderer::accumulate(bool restart) {
+  State& s = *state_;
+  s.context.makeCurrent();
+  s.requireFrame("accumulating");
+  s.ensureDisplayPrograms();
+  if (s.accumulationTexture == 0) {
+    glCreateTextures(GL_TEXTURE_2D, 1, &s.accumulationTexture);
+    glTextureStorage2D(s.accumulationTexture, 1, GL_RGBA32F, s.width, s.height);
+    checkGl("creating the accumulation image (out of GPU memory?)");
+    restart = true;
+  }
+  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  glBindImageTexture(kRadianceImageUnit, s.radianceTexture, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  glBindImageTexture(gpu::kAccumulationImageUnit, s.accumulationTexture, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  const GLuint program = s.accumulateProgram;
+  glProgramUniform2i(program, glGetUniformLocation(program, "size"), s.width, s.height);
+  glProgramUniform1i(program, glGetUniformLocation(program, "restart"), restart || s.accumulated == 0 ? 1 : 0);
+  glUseProgram(program);
+  glDispatchCompute(GLuint((s.width + 7) / 8), GLuint((s.height + 7) / 8), 1);
+  s.accumulated = restart ? 1 : s.accumulated + 1;
+  checkGl("accumulating the frame");
+}
+
+int GpuRenderer::accumulatedFrames() const { return state_->accumulated; }
+
+void GpuRenderer::readAverage(Image& image) {
+  State& s = *state_;
+  s.context.makeCurrent();
+  if (s.accumulated == 0) fail("GPU renderer: reading the average of no accumulated frames");
+  glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+  std::vector<float> sum(4 * size_t(s.width) * size_t(s.height));
+  glGetTextureImage(s.accumulationTexture, 0, GL_RGBA, GL_FLOAT, GLsizei(sum.size() * sizeof(float)), sum.data());
+  if (image.width != s.width || image.height != s.height) image = Image(s.width, s.height);
+  const float weight = 1.0f / float(s.accumulated);  // as encodeDisplay's average
+  for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = Rgb(sum[4 * i], sum[4 * i + 1], sum[4 * i + 2]) * weight;
+  checkGl("reading the average back");
 }
 
 void GpuRenderer::prepareDisplay() {

@@ -694,6 +694,57 @@ TEST_F(GpuRendererTest, EncodeDisplayMatchesTheCpuEncoder) {
   }
 }
 
+// The viewer's refinement on the GPU: frames of several samples accumulated there, their
+// average (sum × 1 / count) read back and shown, against the same average made on the CPU from
+// each frame read back — the same floats, and the same words as DisplayEncoder makes of them.
+TEST_F(GpuRendererTest, AccumulatedFramesAverageAsOnTheCpu) {
+  const LightField lf = randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 5);
+  GpuRenderer gpu(lf);
+  const Camera camera(insideCamera(lf.scene), 40, 30);
+  Image frame, sum, average;
+  RenderSettings settings;
+  settings.samplesPerPixel = 2;
+  EXPECT_THROW(gpu.readAverage(average), Error);  // nothing accumulated yet
+  for (int batch = 0; batch < 3; ++batch) {
+    settings.seed = 17 + uint64_t(batch);
+    gpu.draw(camera, settings);
+    gpu.accumulate(batch == 0);
+    gpu.readRadiance(frame);
+    if (batch == 0) sum = Image(frame.width, frame.height);
+    for (size_t i = 0; i < sum.pixels.size(); ++i) sum.pixels[i] += frame.pixels[i];
+    EXPECT_EQ(gpu.accumulatedFrames(), batch + 1);
+  }
+  const float weight = 1.0f / 3.0f;
+  Image expected(sum.width, sum.height);
+  for (size_t i = 0; i < sum.pixels.size(); ++i) expected.pixels[i] = sum.pixels[i] * weight;
+  gpu.readAverage(average);
+  ASSERT_EQ(average.width, 40);
+  size_t equal = 0;
+  for (size_t i = 0; i < average.pixels.size(); ++i) equal += average.pixels[i] == expected.pixels[i];
+  EXPECT_EQ(equal, average.pixels.size());
+  DisplayEncoder onGpu, onCpu;
+  std::vector<uint32_t> words(40 * 30), expectedWords(40 * 30);
+  gpu.encodeDisplay(onGpu, 0.7f, ToneMapSettings{}, words.data(), 40 * 4, true);
+  onCpu.encode(expected, 0.7f, ToneMapSettings{}, expectedWords.data(), 40 * 4);
+  int worst = 0, differing = 0;
+  for (size_t i = 0; i < words.size(); ++i) {
+    worst = std::max(worst, wordChannelDistance(words[i], expectedWords[i]));
+    differing += words[i] != expectedWords[i];
+  }
+  EXPECT_LE(worst, 1);
+  EXPECT_LE(differing, int(words.size() / 200));
+  // A restart keeps the last frame alone; the accumulation is 16 bytes per pixel of GPU memory.
+  gpu.accumulate(true);
+  EXPECT_EQ(gpu.accumulatedFrames(), 1);
+  gpu.readAverage(average);
+  gpu.readRadiance(frame);
+  EXPECT_EQ(compareImages(average, frame).maxAbsError, 0.0);
+  const uint64_t before = gpu.gpuBytes();
+  gpu.draw(Camera(insideCamera(lf.scene), 20, 10), settings);  // new targets: the accumulation is gone
+  EXPECT_EQ(gpu.accumulatedFrames(), 0);
+  EXPECT_LT(gpu.gpuBytes(), before);
+}
+
 void addLights(Scene& scene);  // below
 
 // Mirror-like lobes (specular charts of a Blinn-Phong or GGX model too narrow for a map):

@@ -249,9 +249,11 @@ class FrameRenderer {
   void drawOnGpu(const Camera& camera, const RenderSettings& settings) { gpu_->draw(camera, settings); }
   void readRadiance(Image& image) { gpu_->readRadiance(image); }
   void encodeDisplay(DisplayEncoder& encoder, float exposureScale, const ToneMapSettings& settings, uint32_t* pixels,
-                     int pitchBytes) {
-    gpu_->encodeDisplay(encoder, exposureScale, settings, pixels, pitchBytes);
+                     int pitchBytes, bool average) {
+    gpu_->encodeDisplay(encoder, exposureScale, settings, pixels, pitchBytes, average);
   }
+  void accumulate(bool restart) { gpu_->accumulate(restart); }
+  void readAverage(Image& image) { gpu_->readAverage(image); }
 
  private:
   /// Sets gpu_ when the GPU renderer can draw; returns why not (Automatic) or throws (Gpu).
@@ -386,7 +388,7 @@ class ViewerSession {
       // The GPU's frame becomes the window's pixels there; its read-back waits for the frame,
       // so the render time ends after it.
       uint32_t* pixels = window_.lockFrame(frame_.width, frame_.height, pitch);
-      renderer_.encodeDisplay(display_, exposureScale(), toneMap_, pixels, pitch);
+      renderer_.encodeDisplay(display_, exposureScale(), toneMap_, pixels, pitch, refiningOnGpu_);
       if (rendered) renderDone();
     } else {
       if (rendered) renderDone();
@@ -492,12 +494,30 @@ class ViewerSession {
     const int done = shown_ == Shown::Refined ? batches_ * batchSpp : baseIsBatch ? spp : 0;
     if (done + batchSpp > std::max(spp, ViewerOptions::kRefinedSamples) || !renderer_.multiSample(cameraAt(1, 1)))
       return 0.0;
+    RenderSettings batch = options_.render;
+    batch.samplesPerPixel = batchSpp;
+    if (shown_ == Shown::Base ? gpuDraws() && baseOnGpu_ : refiningOnGpu_) {
+      // On the GPU: the batches summed there (the base frame, when it is the first batch, is
+      // still its last frame), their average shown from there.
+      if (shown_ == Shown::Base) {
+        batches_ = baseIsBatch ? 1 : 0;
+        if (baseIsBatch) renderer_.accumulate(true);
+      }
+      batch.seed = options_.render.seed + uint64_t(batches_) + 1;
+      drawWithShare(share_, [&] {
+        renderer_.drawOnGpu(cameraAt(width, height), batch);
+        renderer_.accumulate(batches_ == 0);
+      });
+      ++batches_;
+      frameOnGpu_ = refiningOnGpu_ = true;
+      baseOnGpu_ = false;
+      shown_ = Shown::Refined;
+      return 1.0;
+    }
     if (shown_ == Shown::Base) {
       accumulation_ = baseIsBatch ? shownRadiance() : Image(width, height);
       batches_ = baseIsBatch ? 1 : 0;
     }
-    RenderSettings batch = options_.render;
-    batch.samplesPerPixel = batchSpp;
     batch.seed = options_.render.seed + uint64_t(batches_) + 1;
     draw(cameraAt(width, height), batch, batchImage_);
     ++batches_;
@@ -513,19 +533,28 @@ class ViewerSession {
   /// Renders the view the window shows next: with the GPU renderer its frame stays on the GPU
   /// (frameOnGpu_), where renderAndPresent turns it into the window's pixels; else into frame_.
   void drawShown(const Camera& camera, const RenderSettings& settings) {
-    if (renderer_.gpu() && !(live_ && live_->renderer())) {
-      renderer_.drawOnGpu(camera, settings);
+    refiningOnGpu_ = false;
+    if (gpuDraws()) {
+      drawWithShare(share_, [&] { renderer_.drawOnGpu(camera, settings); });
       if (frame_.width != camera.width() || frame_.height != camera.height()) frame_ = Image(camera.width(), camera.height());
-      frameOnGpu_ = true;
+      frameOnGpu_ = baseOnGpu_ = true;
       return;
     }
     draw(camera, settings, frame_);
   }
+  /// Whether the session's frames are the GPU renderer's (not the CPU one's, nor a relit light
+  /// field's).
+  bool gpuDraws() const { return renderer_.gpu() && !(live_ && live_->renderer()); }
 
-  /// frame_, the shown view's radiance: read back first where it is still on the GPU.
+  /// frame_, the shown view's radiance: read back first where it is still on the GPU (its last
+  /// frame, or the refinement's average).
   const Image& shownRadiance() {
     if (frameOnGpu_) {
-      renderer_.readRadiance(frame_);
+      if (refiningOnGpu_) {
+        renderer_.readAverage(frame_);
+      } else {
+        renderer_.readRadiance(frame_);
+      }
       frameOnGpu_ = false;
     }
     return frame_;
@@ -536,7 +565,8 @@ class ViewerSession {
   /// The shown frame, if still on the GPU, is read back first: the GPU renderer holds one.
   void draw(const Camera& camera, const RenderSettings& settings, Image& image) {
     if (&image != &frame_) shownRadiance();
-    if (&image == &frame_) frameOnGpu_ = false;
+    if (&image == &frame_) frameOnGpu_ = refiningOnGpu_ = false;
+    baseOnGpu_ = false;  // the GPU's last frame is no longer the shown base frame
     drawWithShare(share_, [&] {
       if (const FastRenderer* relit = live_ ? live_->renderer() : nullptr) {
         relit->render(camera, settings, image);
@@ -642,7 +672,10 @@ class ViewerSession {
   float exposureEv_ = 0.0f;  ///< the +/− offset on top of options.exposureScale
   ToneMapSettings toneMap_;
   Image frame_;         ///< what the window shows (radiance; scaled, base or refined), its size
-  bool frameOnGpu_ = false;  ///< frame_'s pixels are the GPU renderer's last frame, not read back
+  /// frame_'s pixels are on the GPU, not read back: the GPU renderer's last frame, or with
+  /// refiningOnGpu_ the average of the refinement batches it accumulated; baseOnGpu_: its last
+  /// frame is the shown base frame (the first refinement batch when that has several samples).
+  bool frameOnGpu_ = false, refiningOnGpu_ = false, baseOnGpu_ = false;
   Image accumulation_;  ///< the sum of the refinement batches
   Image batchImage_, screenshot_;
   Shown shown_ = Shown::Nothing;

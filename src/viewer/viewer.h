@@ -23,7 +23,8 @@
 // resolution). While the live relighting works, the cores are shared by core_share.h (Split):
 // the CPU renderer on the pool's threads − 1 at kRelightTargetFps, the relighter on one core. When the camera stops, the frame is rendered at full resolution, then (both
 // renderers) refined with batches of jittered samples averaged up to kRefinedSamples per
-// pixel; then the loop waits for input. Screenshots are always the full-resolution frame at the --spp samples (what
+// pixel (the GPU renderer's summed and shown on the GPU: GpuRenderer::accumulate); then the
+// loop waits for input. Screenshots are always the full-resolution frame at the --spp samples (what
 // `render` writes), rendered for the purpose when the window shows a scaled or refined one.
 //
 // Controls:
