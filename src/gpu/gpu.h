@@ -56,7 +56,8 @@
 // the frame's targets (radiance and the resolve pass's hits 16 bytes per pixel each, its queue
 // of rays to cast 4 and 16 in all; id and depth 8 bytes per pixel, or per texel of the finer
 // multi-sample visibility pass; once the viewer's display pass has run, 4 more per pixel and
-// 16 per 16 pixels, and its 64 KiB sRGB table). A light field whose buffers exceed the GPU
+// 16 per 16 pixels, and its 64 KiB sRGB table; once it refines a still view, 16 more per pixel
+// for the sum of its batches). A light field whose buffers exceed the GPU
 // memory available (gpu_memory.h: the driver's query, GL_NVX_gpu_memory_info or
 // GL_ATI_meminfo; the PLENOPTIC_GPU_MEMORY variable; 4 GiB where neither says) is refused
 // before anything is uploaded, with the sizes, and so is one with a buffer larger than the
