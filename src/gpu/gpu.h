@@ -88,6 +88,10 @@
 // (at most two ids, unmarked, one of them hit by the ray), else it is cast through the BVH —
 // in the shading pass itself, which then has no resolve pass before it.
 //
+// With PLENOPTIC_GPU_VISIBILITY=rays no ids are drawn and every camera ray is cast through the
+// BVH (in the resolve pass, or the multi-sample shading pass): the same hits without the
+// rasteriser, for measuring a GPU with few rasterising units (docs/benchmarks.md).
+//
 // A thin lens (depth of field): each sample's lens point is the CPU renderers' (pixelSample's
 // second ZSobol dimension, mapped to the aperture by sampleConcentricDisk; the lens centre at
 // one sample per pixel) and its ray starts there, off the eye the id buffer is rasterised
