@@ -231,8 +231,9 @@ class GpuRenderer {
   GpuPassMilliseconds lastGpuPasses() const;
   /// The share of that frame's pixels whose camera ray the resolve pass cast through
   /// the BVH: those the id texels could not answer (edges, silhouettes, triangles smaller than a
-  /// pixel; every pixel of a thin lens) — `render --stats` gpu_bvh_ray_share_median. Empty
-  /// after a frame of several samples per pixel, whose rays are cast in the shading pass.
+  /// pixel; every pixel of a thin lens, or with PLENOPTIC_GPU_VISIBILITY=rays) — `render --stats`
+  /// gpu_bvh_ray_share_median. Empty after a frame of several samples per pixel, whose rays are
+  /// cast in the shading pass.
   std::optional<double> lastBvhRayShare() const;
   /// The most pixels (width × height) render() draws on this driver: the resolve pass's queue
   /// of rays to cast, 4 bytes per pixel, within its largest storage block
