@@ -40,6 +40,7 @@ std::string viewStatsJson(const ViewerResult& result, const ViewerOptions& viewe
   json["ms_per_frame_median"] = result.msPerFrameMedian;
   json["fps"] = result.msPerFrameMedian > 0.0 ? 1e3 / result.msPerFrameMedian : 0.0;
   json["render_ms_median"] = result.renderMsMedian;
+  if (result.gpuMsMedian > 0.0) json["gpu_ms_median"] = result.gpuMsMedian;
   json["renderer"] = result.device.empty() ? "cpu" : "gpu";
   if (!result.device.empty()) json["device"] = result.device;
   if (!result.fallback.empty()) json["fallback"] = result.fallback;
@@ -111,7 +112,7 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
                       "Write the last frame to this image (.png tone-mapped, .exr/.hdr/.pfm radiance) on exit");
   command->add_option("--path", options->pathFile, "Fly a camera path (JSON keyframes) instead of the keys");
   command->add_option("--stats", options->statsPath,
-                      "Write JSON on exit: frames, ms_per_frame_median, fps, render_ms_median, renderer, device");
+                      "Write JSON on exit: frames, ms_per_frame_median, fps, render_ms_median, gpu_ms_median, renderer, device");
   command->add_option("--record", viewer.recordPath, "Where P (or R) saves the recorded camera path")
       ->capture_default_str();
   command->add_option("--speed", viewer.speed, "Movement speed in scene units per second (0 = automatic)")

@@ -253,6 +253,8 @@ class FrameRenderer {
     gpu_->encodeDisplay(encoder, exposureScale, settings, pixels, pitchBytes, average);
   }
   void accumulate(bool restart) { gpu_->accumulate(restart); }
+  /// The GPU's own time for its last frame read back, pass by pass (GpuRenderer::lastGpuPasses).
+  GpuPassMilliseconds gpuPasses() const { return gpu_->lastGpuPasses(); }
   void readAverage(Image& image) { gpu_->readAverage(image); }
 
  private:
@@ -389,7 +391,11 @@ class ViewerSession {
       // so the render time ends after it.
       uint32_t* pixels = window_.lockFrame(frame_.width, frame_.height, pitch);
       renderer_.encodeDisplay(display_, exposureScale(), toneMap_, pixels, pitch, refiningOnGpu_);
-      if (rendered) renderDone();
+      if (rendered) {
+        renderDone();
+        gpuPasses_ = renderer_.gpuPasses();
+        gpuMs_.push_back(gpuPasses_.total());
+      }
     } else {
       if (rendered) renderDone();
       uint32_t* pixels = window_.lockFrame(frame_.width, frame_.height, pitch);
@@ -428,6 +434,7 @@ class ViewerSession {
     result.frames = int(frameMs_.size());
     result.msPerFrameMedian = median(frameMs_);
     result.renderMsMedian = median(renderMs_);
+    result.gpuMsMedian = gpuMs_.empty() ? 0.0 : median(gpuMs_);
     result.renderer = renderer_.name();
     result.device = renderer_.device();
     result.fallback = renderer_.fallback();
@@ -639,10 +646,15 @@ class ViewerSession {
                     share_.renderThreads > 0 ? fmt::format("  {} THREAD{} (RELIGHT 1)", share_.renderThreads,
                                                            share_.renderThreads > 1 ? "S" : "")
                                              : ""),
+        frameOnGpu_ && gpuPasses_.total() > 0.0
+            ? fmt::format("GPU {:.2f} MS: VISIBILITY {:.2f}  RESOLVE {:.2f}  SHADING {:.2f}", gpuPasses_.total(),
+                          gpuPasses_.visibility, gpuPasses_.resolve, gpuPasses_.shading)
+            : std::string(),
         fmt::format("EYE {:.3g} {:.3g} {:.3g}", eye.x, eye.y, eye.z),
         fmt::format("EXPOSURE {:+.1f} EV  TONEMAP {}{}", exposureEv_, toneMapOperatorName(toneMap_.op),
                     recorder_.recording() ? "  [REC]" : ""),
     };
+    std::erase(lines, std::string());
     if (live_ && relightHud_)
       for (std::string& line : live_->hudLines()) lines.push_back(std::move(line));
     if (!message_.empty() && frameStart < messageUntil_) lines.push_back(message_);
@@ -683,6 +695,8 @@ class ViewerSession {
   int shownWidth_ = 0, shownHeight_ = 0;
   int batches_ = 0;  ///< refinement batches in accumulation_
   std::vector<double> frameMs_, renderMs_, recentMs_, relightMs_;
+  std::vector<double> gpuMs_;       ///< the GPU's own time of each frame it drew and showed
+  GpuPassMilliseconds gpuPasses_;   ///< the last such frame's, pass by pass (the HUD's GPU line)
   std::unique_ptr<LiveRelight> live_;  ///< the relighting keys' (null without a visibility field)
   bool relightHud_ = true;
   int screenshots_ = 0;

@@ -41,8 +41,9 @@
 // field re-propagates in the background and the view shows each iteration.
 //   H               show or hide the relighting lines of the HUD
 // The window is resizable; the image is rendered at the window's size. The HUD shows fps,
-// frame time (render + display), the renderer, the render scale and samples per pixel, camera
-// position, exposure and tone mapping.
+// frame time (render + display), the renderer, the render scale and samples per pixel, with
+// the GPU renderer the GPU's own time for the frame pass by pass, camera position, exposure and
+// tone mapping.
 //
 // Headless use (tests, CI): `frames` > 0 runs that many frames of the loop and quits;
 // `screenshotPath` is then written from the last frame's view; `path` drives the camera (frame k at the path's time
@@ -103,6 +104,9 @@ struct ViewerResult {
   /// The renderer alone (frames that rendered); with the GPU renderer until its frame's pixels
   /// are read back (its display pass included), the GPU working apart from the CPU until then.
   double renderMsMedian = 0.0;
+  /// With the GPU renderer, the GPU's own time for a frame (its passes by timestamp queries,
+  /// GpuRenderer::lastGpuPasses; the read-back and display pass excluded); 0 otherwise.
+  double gpuMsMedian = 0.0;
   std::string renderer;           ///< "gpu (DEVICE)" or "cpu"
   std::string device;             ///< with the GPU renderer, DEVICE: GpuRenderer::deviceName
   std::string fallback;           ///< why the CPU renderer was taken in Automatic mode; empty otherwise

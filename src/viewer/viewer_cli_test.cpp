@@ -266,6 +266,12 @@ TEST_F(ViewerCliTest, StatsJsonHasTheSessionsTimings) {
     EXPECT_GT(renderMs, 0.0);
     EXPECT_GE(ms, renderMs);  // a frame is its render, display and present
     EXPECT_NEAR(fps * ms, 1000.0, 1e-6 * fps * ms);
+    // The GPU's own time: within the frame's render (which waits for it), and only with it.
+    EXPECT_EQ(stats.contains("gpu_ms_median"), renderer == "gpu");
+    if (renderer == "gpu") {
+      EXPECT_GT(stats["gpu_ms_median"].get<double>(), 0.0);
+      EXPECT_LE(stats["gpu_ms_median"].get<double>(), renderMs + 0.5);
+    }
   }
   std::string errors;
   EXPECT_NE(run("view " + path("cornell.plf") + " --frames 1 --stats " + path("missing/stats.json"), nullptr, &errors), 0);
