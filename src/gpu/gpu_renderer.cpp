@@ -602,10 +602,6 @@ void main() {
   float t;
   uint triangle;
   vec2 b;
-  if (castAllRays) {  // every ray through the BVH, here, in 8×8 tiles of neighbouring rays
-    storeHit(pixel, bvhIntersect(origin, direction, 0.0, 1.0 / 0.0, t, triangle, b), t, triangle, b);
-    return;
-  }
   int answer = cameraIdsHit(film, direction, t, triangle, b);
   if (answer != kIdsUnsure) {
     storeHit(pixel, answer == kIdsHit, t, triangle, b);
@@ -1355,7 +1351,7 @@ struct GpuRenderer::State {
     if (oneSample) {
       GLuint queued = 0;  // the queue's count (kResolveCompute), after its header's three group counts
       glGetNamedBufferSubData(rayQueue, 3 * sizeof(GLuint), sizeof(queued), &queued);
-      lastBvhRayShare = castAllRays ? 1.0 : double(queued) / (double(width) * double(height));
+      lastBvhRayShare = double(queued) / (double(width) * double(height));
     }
   }
   void requireFrame(const char* what) const {
@@ -1802,18 +1798,18 @@ void GpuRenderer::accumulate(bool restart) {
   s.context.makeCurrent();
   s.requireFrame("accumulating");
   s.ensureDisplayPrograms();
-  if (s.accumulationTexture == 0) {
+  if (s.accumulationTexture == 0) {  // (made with the targets' size: accumulated is 0 then)
     glCreateTextures(GL_TEXTURE_2D, 1, &s.accumulationTexture);
     glTextureStorage2D(s.accumulationTexture, 1, GL_RGBA32F, s.width, s.height);
     checkGl("creating the accumulation image (out of GPU memory?)");
-    restart = true;
   }
+  restart = restart || s.accumulated == 0;
   glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   glBindImageTexture(kRadianceImageUnit, s.radianceTexture, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
   glBindImageTexture(gpu::kAccumulationImageUnit, s.accumulationTexture, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   const GLuint program = s.accumulateProgram;
   glProgramUniform2i(program, glGetUniformLocation(program, "size"), s.width, s.height);
-  glProgramUniform1i(program, glGetUniformLocation(program, "restart"), restart || s.accumulated == 0 ? 1 : 0);
+  glProgramUniform1i(program, glGetUniformLocation(program, "restart"), restart ? 1 : 0);
   glUseProgram(program);
   glDispatchCompute(GLuint((s.width + 7) / 8), GLuint((s.height + 7) / 8), 1);
   s.accumulated = restart ? 1 : s.accumulated + 1;
