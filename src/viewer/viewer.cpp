@@ -503,9 +503,10 @@ class ViewerSession {
       return 0.0;
     RenderSettings batch = options_.render;
     batch.samplesPerPixel = batchSpp;
-    if (shown_ == Shown::Base ? gpuDraws() && baseOnGpu_ : refiningOnGpu_) {
-      // On the GPU: the batches summed there (the base frame, when it is the first batch, is
-      // still its last frame), their average shown from there.
+    if (shown_ == Shown::Base ? gpuDraws() : refiningOnGpu_) {
+      // On the GPU: the batches summed there, their average shown from there. A base frame the
+      // GPU drew (drawShown) is still its last frame, for it is the first batch: nothing else
+      // draws on the GPU while the base is shown, and a relit light field, once drawn, stays.
       if (shown_ == Shown::Base) {
         batches_ = baseIsBatch ? 1 : 0;
         if (baseIsBatch) renderer_.accumulate(true);
@@ -517,7 +518,6 @@ class ViewerSession {
       });
       ++batches_;
       frameOnGpu_ = refiningOnGpu_ = true;
-      baseOnGpu_ = false;
       shown_ = Shown::Refined;
       return 1.0;
     }
@@ -544,7 +544,7 @@ class ViewerSession {
     if (gpuDraws()) {
       drawWithShare(share_, [&] { renderer_.drawOnGpu(camera, settings); });
       if (frame_.width != camera.width() || frame_.height != camera.height()) frame_ = Image(camera.width(), camera.height());
-      frameOnGpu_ = baseOnGpu_ = true;
+      frameOnGpu_ = true;
       return;
     }
     draw(camera, settings, frame_);
@@ -573,7 +573,6 @@ class ViewerSession {
   void draw(const Camera& camera, const RenderSettings& settings, Image& image) {
     if (&image != &frame_) shownRadiance();
     if (&image == &frame_) frameOnGpu_ = refiningOnGpu_ = false;
-    baseOnGpu_ = false;  // the GPU's last frame is no longer the shown base frame
     drawWithShare(share_, [&] {
       if (const FastRenderer* relit = live_ ? live_->renderer() : nullptr) {
         relit->render(camera, settings, image);
@@ -685,9 +684,8 @@ class ViewerSession {
   ToneMapSettings toneMap_;
   Image frame_;         ///< what the window shows (radiance; scaled, base or refined), its size
   /// frame_'s pixels are on the GPU, not read back: the GPU renderer's last frame, or with
-  /// refiningOnGpu_ the average of the refinement batches it accumulated; baseOnGpu_: its last
-  /// frame is the shown base frame (the first refinement batch when that has several samples).
-  bool frameOnGpu_ = false, refiningOnGpu_ = false, baseOnGpu_ = false;
+  /// refiningOnGpu_ the average of the refinement batches it accumulated.
+  bool frameOnGpu_ = false, refiningOnGpu_ = false;
   Image accumulation_;  ///< the sum of the refinement batches
   Image batchImage_, screenshot_;
   Shown shown_ = Shown::Nothing;
