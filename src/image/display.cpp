@@ -29,10 +29,11 @@ void DisplayEncoder::encode(const Image& radiance, float exposureScale, const To
                             uint32_t* pixels, int pitchBytes) {
   const int width = radiance.width, height = radiance.height;
   const int stride = kStatisticsStride;
-  Image subsample(statisticsSize(width), statisticsSize(height));
-  for (int y = 0; y < subsample.height; ++y)
-    for (int x = 0; x < subsample.width; ++x) subsample.at(x, y) = radiance.at(x * stride, y * stride);
-  const ToneMapCurve& curve = resolveCurve(subsample, exposureScale, settings);
+  const int sw = statisticsSize(width), sh = statisticsSize(height);
+  if (subsample_.width != sw || subsample_.height != sh) subsample_ = Image(sw, sh);
+  for (int y = 0; y < sh; ++y)
+    for (int x = 0; x < sw; ++x) subsample_.at(x, y) = radiance.at(x * stride, y * stride);
+  const ToneMapCurve& curve = resolveCurve(subsample_, exposureScale, settings);
   parallelForRange(uint64_t(height), 16, [&](uint64_t begin, uint64_t end) {
     for (int y = int(begin); y < int(end); ++y) {
       uint32_t* row = reinterpret_cast<uint32_t*>(reinterpret_cast<uint8_t*>(pixels) + size_t(y) * size_t(pitchBytes));

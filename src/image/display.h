@@ -69,6 +69,7 @@ class DisplayEncoder {
   uint32_t channel(float v) const { return srgbTable_[tableIndex(v)]; }
 
   std::vector<uint8_t> srgbTable_;
+  Image subsample_;    ///< encode()'s radiance subsample (kept: one allocation per frame size)
   Image statistics_;  ///< the exposed subsample the curve is resolved from
   ToneMapCurve curve_;
 };
