@@ -585,10 +585,17 @@ int wordChannelDistance(uint32_t a, uint32_t b) {
   return worst;
 }
 
+/// How many of `count` display words the GPU may make differently from DisplayEncoder, by one
+/// level: a word changes only where a display value lies within float rounding of a step of the
+/// sRGB table (every 1/16383 of [0, 1]) and the GPU rounds otherwise — GLSL's division may be 2.5
+/// ulp off — which a few ulp hit about once in 10⁶ channels (llvmpipe: none). One word in 1000,
+/// at least one, leaves room for that and still fails a wrong formula: a constant changed by
+/// 1e-4 in the GLSL changes 160 to 1426 words of 20 000.
+int allowedRoundingWords(size_t count) { return int(count / 1000) + 1; }
+
 // The display pass's GLSL (gpu_display.h) against DisplayEncoder::word on random exposed
 // colours, for each operator: dark and bright (10⁻⁸ … 10⁸), saturated, negative, zero and
-// non-finite ones. The words may differ only where a display value sits within float rounding
-// of a table step (the GPU's division is not IEEE-exact), and then by one level.
+// non-finite ones (magenta, exactly), the rest within allowedRoundingWords.
 TEST_F(GpuRendererTest, DisplayWordsMatchTheCpuEncoder) {
   const LightField lf = randomLightField(makeCornellBox(), 1);
   GpuRenderer gpu(lf);
@@ -629,7 +636,7 @@ TEST_F(GpuRendererTest, DisplayWordsMatchTheCpuEncoder) {
       worst = std::max(worst, wordChannelDistance(words[i], expected));
     }
     EXPECT_LE(worst, 1) << toneMapOperatorName(curve.op);
-    EXPECT_LE(differing, int(exposed.size() / 1000)) << toneMapOperatorName(curve.op);
+    EXPECT_LE(differing, allowedRoundingWords(exposed.size())) << toneMapOperatorName(curve.op);
     std::printf("%s: %d of %zu words differ (by one level)\n", toneMapOperatorName(curve.op), differing, exposed.size());
   }
 }
@@ -685,7 +692,7 @@ TEST_F(GpuRendererTest, EncodeDisplayMatchesTheCpuEncoder) {
             worst = std::max(worst, wordChannelDistance(pixels[i], expected[i]));
           }
         EXPECT_LE(worst, 1) << toneMapOperatorName(settings.op);
-        EXPECT_LE(differing, width * height / 200) << toneMapOperatorName(settings.op);
+        EXPECT_LE(differing, allowedRoundingWords(size_t(width * height))) << toneMapOperatorName(settings.op);
       }
     }
     EXPECT_GT(gpu.lastGpuPasses().total(), 0.0);
@@ -732,8 +739,8 @@ TEST_F(GpuRendererTest, AccumulatedFramesAverageAsOnTheCpu) {
     differing += words[i] != expectedWords[i];
   }
   EXPECT_LE(worst, 1);
-  EXPECT_LE(differing, int(words.size() / 200));
-  // A restart keeps the last frame alone; the accumulation is 16 bytes per pixel of GPU memory.
+  EXPECT_LE(differing, allowedRoundingWords(words.size()));
+  // A restart keeps the last frame alone; new targets (another size) drop the sum.
   gpu.accumulate(true);
   EXPECT_EQ(gpu.accumulatedFrames(), 1);
   gpu.readAverage(average);
@@ -1302,6 +1309,25 @@ TEST_F(GpuRendererTest, MatchesFastRendererOnSponza) {
     EXPECT_LE(differing, image.pixels.size() / 200);
     EXPECT_LE(rest.relMseAverage, 1e-4);
     EXPECT_NEAR(all.meanLuminanceRatio, 1.0, 1e-3);
+    // The viewer's display pass on this frame (textures, the sky map's range, automatic key):
+    // the words DisplayEncoder makes of the radiance render() read back.
+    ToneMapSettings autoKey;
+    autoKey.autoKey = true;
+    for (const ToneMapSettings& settings : {ToneMapSettings{}, autoKey}) {
+      DisplayEncoder onGpu, onCpu;
+      std::vector<uint32_t> words(image.pixels.size()), expectedWords(image.pixels.size());
+      gpu.encodeDisplay(onGpu, 0.5f, settings, words.data(), image.width * 4);
+      onCpu.encode(image, 0.5f, settings, expectedWords.data(), image.width * 4);
+      int differingWords = 0, worst = 0;
+      for (size_t i = 0; i < words.size(); ++i) {
+        differingWords += words[i] != expectedWords[i];
+        worst = std::max(worst, wordChannelDistance(words[i], expectedWords[i]));
+      }
+      EXPECT_LE(worst, 1);
+      EXPECT_LE(differingWords, allowedRoundingWords(words.size()));
+      std::printf("Sponza %s display words (%s key): %d of %zu differ\n", desc.name.c_str(),
+                  settings.autoKey ? "automatic" : "fixed", differingWords, words.size());
+    }
   }
 }
 
