@@ -44,6 +44,7 @@ std::string viewStatsJson(const ViewerResult& result, const ViewerOptions& viewe
   json["renderer"] = result.device.empty() ? "cpu" : "gpu";
   if (!result.device.empty()) json["device"] = result.device;
   if (!result.fallback.empty()) json["fallback"] = result.fallback;
+  json["presentation"] = result.presentation;
   if (!viewer.relightKeys.empty()) {
     json["relight_iterations"] = result.relightIterations;
     json["relight_converged"] = result.relightConverged;
@@ -60,6 +61,7 @@ void runView(const ViewCommandOptions& options, const GlobalOptions& global) {
   const ViewSettings& view = options.view;
   if (!options.viewer.screenshotPath.empty()) ViewSettings::checkImageOutput(options.viewer.screenshotPath, "--screenshot");
   if (!options.statsPath.empty()) checkOutputPath(options.statsPath, {}, "--stats");
+  if (!options.viewer.windowShotPath.empty()) checkOutputPath(options.viewer.windowShotPath, {".png"}, "--window-shot");
   const LightField lightField = readLightField(options.input);
   const Accel accel(lightField.scene);
 
@@ -110,6 +112,8 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   command->add_option("--screenshot", viewer.screenshotPath,
                       "Write the last frame to this image (.png tone-mapped, .exr/.hdr/.pfm radiance) on exit");
+  command->add_option("--window-shot", viewer.windowShotPath,
+                      "Write the last frame's window as shown, HUD included, to this PNG on exit");
   command->add_option("--path", options->pathFile, "Fly a camera path (JSON keyframes) instead of the keys");
   command->add_option("--stats", options->statsPath,
                       "Write JSON on exit: frames, ms_per_frame_median, fps, render_ms_median, gpu_ms_median, renderer, device");

@@ -1,7 +1,7 @@
 #pragma once
-// The GPU light-field renderer (OpenGL 4.5 core, through a headless EGL context): the fast
-// renderer's picture (realtime/realtime.h) drawn by the graphics processor — or, on a machine
-// without one, by Mesa's llvmpipe software rasteriser, which is how the tests run it.
+// The GPU light-field renderer (OpenGL 4.5 core, through a headless EGL context or a window's):
+// the fast renderer's picture (realtime/realtime.h) drawn by the graphics processor — or, on a
+// machine without one, by Mesa's llvmpipe software rasteriser, which is how the tests run it.
 //
 // A frame is three passes:
 //   1. visibility: every triangle of the scene rasterised once with a reversed-Z float depth
@@ -57,7 +57,9 @@
 // of rays to cast 4 and 16 in all; id and depth 8 bytes per pixel, or per texel of the finer
 // multi-sample visibility pass; once the viewer's display pass has run, 4 more per pixel and
 // 16 per 16 pixels, and its 64 KiB sRGB table; once it refines a still view, 16 more per pixel
-// for the sum of its batches). A light field whose buffers exceed the GPU
+// for the sum of its batches; once it presents, 4 per pixel of the HUD, and of the frame where
+// it is not the display pass's at the window's size).
+// A light field whose buffers exceed the GPU
 // memory available (gpu_memory.h: the driver's query, GL_NVX_gpu_memory_info or
 // GL_ATI_meminfo; the PLENOPTIC_GPU_MEMORY variable; 4 GiB where neither says) is refused
 // before anything is uploaded, with the sizes, and so is one with a buffer larger than the
@@ -160,15 +162,33 @@ struct GpuPassMilliseconds {
   double total() const { return visibility + resolve + shading; }
 };
 
+/// Where a GpuRenderer's OpenGL context comes from.
+enum class GpuContext {
+  /// Its own, without a window: EGL on Mesa's surfaceless platform, else on the default
+  /// display with a 1×1 pbuffer. It renders into framebuffer objects only.
+  Headless,
+  /// The OpenGL 4.5 core context current on the calling thread — a window's (the viewer's,
+  /// made by SDL) — which the caller keeps current whenever it calls the renderer; present()
+  /// draws into its window.
+  Current,
+};
+
+/// 0xAARRGGBB words in memory (as SDL_PIXELFORMAT_ARGB8888 and DisplayEncoder write them),
+/// `pitchBytes` per row, top row first.
+struct DisplayPixels {
+  const uint32_t* words = nullptr;
+  int width = 0, height = 0, pitchBytes = 0;
+};
+
 class GpuRenderer {
  public:
-  /// Creates the headless context (EGL: Mesa's surfaceless platform, else the default display
-  /// with a 1×1 pbuffer), compiles the shaders and uploads the light field. Throws pl::Error
-  /// naming the EGL or GL error when no OpenGL 4.5 core context can be had, naming the
-  /// feature (gpuUnsupportedFeature) for a light field it cannot draw, and giving the sizes
-  /// for one that does not fit the GPU memory. `lightField` must
-  /// outlive the renderer. The context belongs to the renderer: use it from one thread.
-  explicit GpuRenderer(const LightField& lightField);
+  /// Creates the headless context (GpuContext::Headless) or takes the current one, compiles
+  /// the shaders and uploads the light field. Throws pl::Error naming the EGL or GL error when
+  /// no OpenGL 4.5 core context can be had (or the current one is older or not a core one),
+  /// naming the feature (gpuUnsupportedFeature) for a light field it cannot draw, and giving
+  /// the sizes for one that does not fit the GPU memory. `lightField` must outlive the
+  /// renderer. Use it from one thread: the context's.
+  explicit GpuRenderer(const LightField& lightField, GpuContext context = GpuContext::Headless);
   ~GpuRenderer();
   GpuRenderer(const GpuRenderer&) = delete;
   GpuRenderer& operator=(const GpuRenderer&) = delete;
@@ -194,8 +214,24 @@ class GpuRenderer {
   /// CPU.
   /// With `average`, the frame encoded is the average of the accumulated ones (accumulate:
   /// their sum × 1 / their count, as the viewer averages its refinement batches on the CPU).
+  /// With `pixels` null nothing is read back: the words stay on the GPU for present().
   void encodeDisplay(DisplayEncoder& encoder, float exposureScale, const ToneMapSettings& settings, uint32_t* pixels,
                      int pitchBytes, bool average = false);
+  /// The viewer's picture drawn into the current context's window (framebuffer 0: its back
+  /// buffer; the caller swaps it in) at windowWidth × windowHeight: the frame — `frame`, or
+  /// where frame.words is null the last encodeDisplay's words, still on the GPU — stretched
+  /// over the window (texel for pixel where the sizes agree, else bilinear), and `overlay`
+  /// (the HUD; none where its words are null) blended over the window's top-left corner by its
+  /// alpha (gpu_display.h kPresentFragment). So with GpuContext::Current a frame the GPU drew
+  /// never leaves it: no read-back, no copy through the CPU.
+  void present(const DisplayPixels& frame, const DisplayPixels& overlay, int windowWidth, int windowHeight);
+  /// present()'s picture drawn into an offscreen target instead and read back, top row first:
+  /// what the window shows (gpu_test checks it).
+  std::vector<uint32_t> presentOffscreen(const DisplayPixels& frame, const DisplayPixels& overlay, int windowWidth,
+                                         int windowHeight);
+  /// The window's back buffer as present() left it (call it before the swap), top row first:
+  /// what the window shows (`view --window-shot`).
+  std::vector<uint32_t> readPresented(int windowWidth, int windowHeight);
   /// Adds the last draw()'s radiance to the accumulation on the GPU (16 bytes per pixel, made
   /// on the first call), or starts it again from that frame (`restart`; also after the image
   /// size changed): the viewer's refinement of a still view in batches of samples. The
@@ -312,6 +348,10 @@ class GpuRenderer {
   uint64_t lightFieldGpuBytes() const;
 
  private:
+  /// present() into `framebuffer` (0: the window's back buffer).
+  void presentInto(uint32_t framebuffer, const DisplayPixels& frame, const DisplayPixels& overlay, int windowWidth,
+                   int windowHeight);
+
   struct State;
   const LightField& lightField_;
   std::unique_ptr<State> state_;

@@ -14,9 +14,11 @@ std::string displayGlslConstants(uint32_t radianceImageUnit) {
   return fmt::format(
       "#define DISPLAY_WORDS_BINDING {}\n#define SRGB_TABLE_BINDING {}\n#define DISPLAY_STATISTICS_BINDING {}\n"
       "#define DISPLAY_RADIANCE_UNIT {}\n#define DISPLAY_ACCUMULATION_UNIT {}\n"
+      "#define PRESENT_FRAME_UNIT {}\n#define PRESENT_OVERLAY_UNIT {}\n"
       "const uint kToneReinhard = {}u, kToneLinear = {}u, kToneClamp = {}u;\n"
       "const float kSrgbTableLast = {:.1f};\nconst uint kNonFiniteWord = {}u;\nconst int kStatisticsStride = {};\n",
       kDisplayWordsBinding, kSrgbTableBinding, kDisplayStatisticsBinding, radianceImageUnit, kAccumulationImageUnit,
+      kPresentFrameUnit, kPresentOverlayUnit,
       unsigned(ToneMapOperator::Reinhard), unsigned(ToneMapOperator::Linear), unsigned(ToneMapOperator::Clamp),
       double(DisplayEncoder::kSrgbTableSize - 1), DisplayEncoder::kNonFiniteWord, DisplayEncoder::kStatisticsStride);
 }
@@ -122,6 +124,40 @@ void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= count) return;
   results[i] = displayWord(queries[i].rgb);
+}
+)glsl";
+
+const char* const kPresentVertex = R"glsl(
+void main() {
+  // (−1, −1), (3, −1), (−1, 3): one triangle covering the viewport.
+  vec2 corner = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+  gl_Position = vec4(corner, 0.0, 1.0);
+}
+)glsl";
+
+const char* const kPresentFragment = R"glsl(
+uniform ivec2 windowSize, frameSize, overlaySize;
+uniform bool wordsInBuffer;  // the display pass's words at the window's size: read as they are
+layout(std430, binding = DISPLAY_WORDS_BINDING) readonly buffer Words { uint words[]; };
+layout(binding = PRESENT_FRAME_UNIT) uniform sampler2D frame;
+layout(binding = PRESENT_OVERLAY_UNIT) uniform sampler2D overlay;
+out vec4 colour;
+void main() {
+  // gl_FragCoord counts rows from the bottom; the frame's and overlay's row 0 is the top.
+  ivec2 pixel = ivec2(int(gl_FragCoord.x), windowSize.y - 1 - int(gl_FragCoord.y));
+  vec3 c;
+  if (wordsInBuffer) {
+    uint w = words[pixel.y * windowSize.x + pixel.x];
+    c = vec3(float((w >> 16) & 255u), float((w >> 8) & 255u), float(w & 255u)) / 255.0;
+  } else {
+    c = frameSize == windowSize ? texelFetch(frame, pixel, 0).rgb
+                                : texture(frame, (vec2(pixel) + 0.5) / vec2(windowSize)).rgb;
+  }
+  if (pixel.x < overlaySize.x && pixel.y < overlaySize.y) {
+    vec4 o = texelFetch(overlay, pixel, 0);
+    c = o.rgb * o.a + c * (1.0 - o.a);
+  }
+  colour = vec4(c, 1.0);
 }
 )glsl";
 

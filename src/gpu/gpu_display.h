@@ -25,6 +25,9 @@ inline constexpr uint32_t kDisplayWordsBinding = 26, kSrgbTableBinding = 27, kDi
 /// radiance is at the renderer's radiance unit).
 inline constexpr uint32_t kAccumulationImageUnit = 2;
 
+/// Texture units of the present pass: the frame's words (as RGBA8), the overlay (the HUD).
+inline constexpr uint32_t kPresentFrameUnit = 2, kPresentOverlayUnit = 3;
+
 /// The #defines and constants the display GLSL needs (bindings, the radiance image unit, the
 /// table size and stride, the operators' numbers, the non-finite word).
 std::string displayGlslConstants(uint32_t radianceImageUnit);
@@ -47,6 +50,20 @@ extern const char* const kAccumulateCompute;
 /// A query program's body (after the renderer's query head): displayWord of each query's
 /// exposed colour (vec4 in, one uint out).
 extern const char* const kDisplayWordsCompute;
+
+/// The present pass (GpuRenderer::present), a full-screen triangle drawn into the window:
+///   vertex: the triangle from gl_VertexID alone (no vertex buffer);
+///   fragment: window pixel p (row 0 at the top, as the frame's and the overlay's rows) shows
+///     the frame's word p where the frame is the window's size — read from the display pass's
+///     words buffer where it is that frame (wordsInBuffer: no copy), else the frame texture's
+///     texel (texelFetch) — and else the frame texture stretched over the window, bilinear (as
+///     SDL's renderer with SDL_HINT_RENDER_SCALE_QUALITY "linear" shows a frame rendered below
+///     the window's size);
+///     and over it, where p is inside the overlay (its top-left corner at the window's), the
+///     overlay's texel blended by its alpha, c = o·a + c·(1 − a) (SDL_BLENDMODE_BLEND).
+/// Uniforms: windowSize, frameSize, overlaySize (0 × 0: none), wordsInBuffer.
+extern const char* const kPresentVertex;
+extern const char* const kPresentFragment;
 
 /// Sets `program`'s curve uniforms from `curve`.
 void setToneCurveUniforms(uint32_t program, const ToneMapCurve& curve);

@@ -987,6 +987,22 @@ GLuint compileShader(GLenum type, const std::string& source, const char* name) {
   return shader;
 }
 
+/// Links `shaders` (compiled, deleted here) into `program`; throws pl::Error with the driver's
+/// log when it does not link.
+GLuint linkShaders(GLuint program, const std::vector<GLuint>& shaders, const char* name) {
+  for (GLuint shader : shaders) glAttachShader(program, shader);
+  glLinkProgram(program);
+  for (GLuint shader : shaders) glDeleteShader(shader);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    const std::string log = infoLog(program, glGetProgramiv, glGetProgramInfoLog);
+    glDeleteProgram(program);
+    fail("GPU renderer: the {} program does not link: {}", name, log);
+  }
+  return program;
+}
+
 /// A program of the given stages, each source prefixed by the version line, `header`
 /// (extensions, defines), the generated constants and, where `lookup`, the lookup functions.
 /// Fragment stages (and compute stages where `computeFrame`) read the geometry and the camera.
@@ -1004,18 +1020,8 @@ GLuint linkProgram(std::initializer_list<std::pair<GLenum, std::string>> stages,
                                                       : prefix + (frame ? std::string(kGeometryGlsl) + kFrameGlsl : "") + detail +
                                                             (lookup ? kLookupGlsl : "") + source;
     shaders.push_back(compileShader(type, text, name));
-    glAttachShader(program, shaders.back());
   }
-  glLinkProgram(program);
-  for (GLuint shader : shaders) glDeleteShader(shader);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    const std::string log = infoLog(program, glGetProgramiv, glGetProgramInfoLog);
-    glDeleteProgram(program);
-    fail("GPU renderer: the {} program does not link: {}", name, log);
-  }
-  return program;
+  return linkShaders(program, shaders, name);
 }
 
 /// GL_RENDERER and GL_VERSION of the current context (GpuRenderer::deviceName).
@@ -1092,11 +1098,34 @@ bool castAllCameraRays() {
 
 }  // namespace
 
+/// The renderer's OpenGL context: its own headless one (GpuContext::Headless), or the caller's
+/// (GpuContext::Current), which the caller keeps current: then there is nothing to make current.
+struct RendererContext {
+  std::optional<gpu::EglContext> own;
+  explicit RendererContext(GpuContext context) {
+    if (context == GpuContext::Headless) {
+      own.emplace();
+      return;
+    }
+    // The caller's: at least OpenGL 4.5, a core profile (every shader says #version 450 core).
+    const char* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+    if (version == nullptr) fail("GPU renderer: no OpenGL context is current");
+    GLint profile = 0;
+    glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &profile);
+    if (epoxy_gl_version() < 45 || (profile & GL_CONTEXT_CORE_PROFILE_BIT) == 0)
+      fail("GPU renderer: the window's OpenGL context is {} ({} profile), not 4.5 core", version,
+           (profile & GL_CONTEXT_CORE_PROFILE_BIT) != 0 ? "core" : "compatibility");
+  }
+  void makeCurrent() const {
+    if (own) own->makeCurrent();
+  }
+};
+
 /// The ray queue's header (kResolveCompute): groups x, y, z to dispatch, and the count.
 constexpr uint64_t kRayQueueHeaderBytes = 16;
 
 struct GpuRenderer::State {
-  gpu::EglContext context;
+  RendererContext context;
   // values, charts, positions, triangles, indices, normals, sun masks, environment map, surface detail
   static constexpr GLsizei kBufferCount = 9;
   GLuint buffers[kBufferCount] = {};
@@ -1146,6 +1175,12 @@ struct GpuRenderer::State {
   /// sRGB table, and the frame's words and radiance subsample (re-made with the targets).
   GLuint displayStatisticsProgram = 0, displayEncodeProgram = 0, displayWordsProgram = 0, srgbTable = 0;
   GLuint displayWords = 0, displayStatistics = 0;
+  bool displayEncoded = false;  ///< displayWords holds an encodeDisplay's words (present)
+  /// The present pass (present; made on its first call): its program, the textures it shows —
+  /// the frame's words and the overlay's, made at their sizes — and an offscreen target
+  /// (presentOffscreen).
+  GLuint presentProgram = 0, presentFrame = 0, presentOverlay = 0;
+  int presentFrameSize[2] = {0, 0}, presentOverlaySize[2] = {0, 0};
   /// The sum of the frames accumulate() added since its last restart (made on its first call,
   /// re-made with the targets), and how many.
   GLuint accumulateProgram = 0, accumulationTexture = 0;
@@ -1157,6 +1192,7 @@ struct GpuRenderer::State {
   uint64_t bufferBytes = 0;
   Rgb background{0.0f};
 
+  explicit State(GpuContext c) : context(c) {}
   ~State() {
     context.makeCurrent();
     glDeleteBuffers(kBufferCount, buffers);
@@ -1179,6 +1215,9 @@ struct GpuRenderer::State {
     glDeleteProgram(displayEncodeProgram);
     glDeleteProgram(displayWordsProgram);
     glDeleteProgram(accumulateProgram);
+    glDeleteProgram(presentProgram);
+    glDeleteTextures(1, &presentFrame);
+    glDeleteTextures(1, &presentOverlay);
     glDeleteBuffers(1, &srgbTable);
     glDeleteQueries(kPassEnds, passEndQueries);
     releaseTargets();
@@ -1198,6 +1237,7 @@ struct GpuRenderer::State {
     accumulated = 0;
     visibilityFramebuffer = readbackFramebuffer = idTexture = hitsTexture = rayQueue = radianceTexture = depthBuffer = 0;
     displayWords = displayStatistics = 0;
+    displayEncoded = false;
     width = height = 0;
     frameDrawn = false;
   }
@@ -1295,7 +1335,9 @@ struct GpuRenderer::State {
   uint64_t targetBytes() const {
     return kRayQueueHeaderBytes + uint64_t(width) * uint64_t(height) * (16 + 16 + 4 + uint64_t(idScale) * uint64_t(idScale) * (4 + 4)) +
            (displayWords != 0 ? displayBytes(width, height) : 0) + (srgbTable != 0 ? srgbTableBytes() : 0) +
-           (accumulationTexture != 0 ? 16 * uint64_t(width) * uint64_t(height) : 0);
+           (accumulationTexture != 0 ? 16 * uint64_t(width) * uint64_t(height) : 0) +
+           4 * (uint64_t(presentFrameSize[0]) * uint64_t(presentFrameSize[1]) +
+                uint64_t(presentOverlaySize[0]) * uint64_t(presentOverlaySize[1]));
   }
   /// The display pass's frame buffers: 4 bytes per pixel of words, 16 per subsample pixel.
   static uint64_t displayBytes(int w, int h) {
@@ -1359,11 +1401,11 @@ struct GpuRenderer::State {
   }
 };
 
-GpuRenderer::GpuRenderer(const LightField& lightField) : lightField_(lightField) {
+GpuRenderer::GpuRenderer(const LightField& lightField, GpuContext context) : lightField_(lightField) {
   if (const std::string missing = gpuUnsupportedFeature(lightField); !missing.empty())
     fail("GPU renderer: this light field has {}, which the GPU renderer does not draw yet (render it with --renderer cpu)",
          missing);
-  state_ = std::make_unique<State>();
+  state_ = std::make_unique<State>(context);
   State& s = *state_;
   s.castAllRays = castAllCameraRays();
   const Scene& scene = lightField.scene;
@@ -1780,17 +1822,171 @@ void GpuRenderer::encodeDisplay(DisplayEncoder& encoder, float exposureScale, co
   glProgramUniform1f(program, glGetUniformLocation(program, "exposureScale"), exposureScale);
   glUseProgram(program);
   glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  s.displayEncoded = true;
   const size_t rowBytes = 4 * size_t(w);
-  if (size_t(pitchBytes) == rowBytes) {
+  if (pixels == nullptr) {
+    // (Left on the GPU for present().)
+  } else if (size_t(pitchBytes) == rowBytes) {
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     glGetNamedBufferSubData(s.displayWords, 0, GLsizeiptr(rowBytes * size_t(h)), pixels);
   } else {
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     for (int y = 0; y < h; ++y)
       glGetNamedBufferSubData(s.displayWords, GLintptr(rowBytes * size_t(y)), GLsizeiptr(rowBytes),
                               reinterpret_cast<uint8_t*>(pixels) + size_t(y) * size_t(pitchBytes));
   }
   s.collectFrameStats();
   checkGl("the display pass");
+}
+
+namespace {
+
+/// `texture` made (again) as an RGBA8 texture of `width` × `height` where it has another size,
+/// with `filter` for both minification and magnification, clamped at its edges.
+void ensurePresentTexture(GLuint& texture, int (&size)[2], int width, int height, GLenum filter) {
+  if (texture != 0 && size[0] == width && size[1] == height) return;
+  glDeleteTextures(1, &texture);
+  glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+  glTextureStorage2D(texture, 1, GL_RGBA8, width, height);
+  glTextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GLint(filter));
+  glTextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GLint(filter));
+  glTextureParameteri(texture, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(texture, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  size[0] = width;
+  size[1] = height;
+}
+
+/// Uploads `pixels` into `texture` (its size): the 0xAARRGGBB words are the bytes B, G, R, A
+/// in memory (a little-endian machine, as SDL's ARGB8888), which GL_BGRA reads as they are.
+void uploadDisplayPixels(GLuint texture, const DisplayPixels& pixels) {
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, pixels.pitchBytes / 4);
+  glTextureSubImage2D(texture, 0, 0, 0, pixels.width, pixels.height, GL_BGRA, GL_UNSIGNED_BYTE, pixels.words);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+}
+
+/// The 8-bit pixels of `framebuffer`'s colour buffer `buffer` as 0xAARRGGBB words, top row
+/// first (GL's rows count from the bottom).
+std::vector<uint32_t> readWords(GLuint framebuffer, GLenum buffer, int width, int height) {
+  std::vector<uint32_t> words(size_t(width) * size_t(height));
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+  glReadBuffer(buffer);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadnPixels(0, 0, width, height, GL_BGRA, GL_UNSIGNED_BYTE, GLsizei(words.size() * 4), words.data());
+  for (int y = 0; y < height / 2; ++y)
+    std::swap_ranges(words.begin() + ptrdiff_t(y) * width, words.begin() + ptrdiff_t(y + 1) * width,
+                     words.begin() + ptrdiff_t(height - 1 - y) * width);
+  return words;
+}
+
+void checkDisplayPixels(const DisplayPixels& pixels, const char* what) {
+  if (pixels.width < 1 || pixels.height < 1 || pixels.pitchBytes < 4 * pixels.width || pixels.pitchBytes % 4 != 0)
+    fail("GPU renderer: presenting a {} of {}x{} pixels with {} bytes per row", what, pixels.width, pixels.height,
+         pixels.pitchBytes);
+}
+
+}  // namespace
+
+void GpuRenderer::present(const DisplayPixels& frame, const DisplayPixels& overlay, int windowWidth, int windowHeight) {
+  state_->context.makeCurrent();
+  presentInto(0, frame, overlay, windowWidth, windowHeight);
+}
+
+void GpuRenderer::presentInto(uint32_t framebuffer, const DisplayPixels& frame, const DisplayPixels& overlay,
+                              int windowWidth, int windowHeight) {
+  State& s = *state_;
+  if (windowWidth < 1 || windowHeight < 1) fail("GPU renderer: presenting into a {}x{} window", windowWidth, windowHeight);
+  if (s.presentProgram == 0) {
+    const std::string prefix = "#version 450 core\n" + gpu::displayGlslConstants(kRadianceImageUnit);
+    const GLuint vertex = compileShader(GL_VERTEX_SHADER, prefix + gpu::kPresentVertex, "present");
+    GLuint fragment = 0;
+    try {
+      fragment = compileShader(GL_FRAGMENT_SHADER, prefix + gpu::kPresentFragment, "present");
+    } catch (...) {
+      glDeleteShader(vertex);
+      throw;
+    }
+    s.presentProgram = linkShaders(glCreateProgram(), {vertex, fragment}, "present");
+  }
+  // The frame: the display pass's words, read where they are when the frame is the window's
+  // size, else copied on the GPU (buffer → texture) to be stretched; or the caller's, uploaded.
+  const bool wordsInBuffer = frame.words == nullptr && s.width == windowWidth && s.height == windowHeight;
+  if (frame.words == nullptr) {
+    if (!s.displayEncoded) fail("GPU renderer: presenting the frame before encodeDisplay encoded it");
+    if (wordsInBuffer) {
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gpu::kDisplayWordsBinding, s.displayWords);
+    } else {
+      ensurePresentTexture(s.presentFrame, s.presentFrameSize, s.width, s.height, GL_LINEAR);
+      glMemoryBarrier(GL_PIXEL_BUFFER_BARRIER_BIT);
+      glBindBuffer(GL_PIXEL_UNPACK_BUFFER, s.displayWords);
+      uploadDisplayPixels(s.presentFrame, {nullptr, s.width, s.height, 4 * s.width});
+      glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    }
+  } else {
+    checkDisplayPixels(frame, "frame");
+    ensurePresentTexture(s.presentFrame, s.presentFrameSize, frame.width, frame.height, GL_LINEAR);
+    uploadDisplayPixels(s.presentFrame, frame);
+  }
+  const bool hasOverlay = overlay.words != nullptr;
+  if (hasOverlay) {
+    checkDisplayPixels(overlay, "overlay");
+    ensurePresentTexture(s.presentOverlay, s.presentOverlaySize, overlay.width, overlay.height, GL_NEAREST);
+    uploadDisplayPixels(s.presentOverlay, overlay);
+  }
+  const GLuint program = s.presentProgram;
+  glProgramUniform2i(program, glGetUniformLocation(program, "windowSize"), windowWidth, windowHeight);
+  glProgramUniform1i(program, glGetUniformLocation(program, "wordsInBuffer"), wordsInBuffer ? 1 : 0);
+  glProgramUniform2i(program, glGetUniformLocation(program, "frameSize"), s.presentFrameSize[0], s.presentFrameSize[1]);
+  glProgramUniform2i(program, glGetUniformLocation(program, "overlaySize"), hasOverlay ? overlay.width : 0,
+                     hasOverlay ? overlay.height : 0);
+  glBindTextureUnit(gpu::kPresentFrameUnit, s.presentFrame);
+  glBindTextureUnit(gpu::kPresentOverlayUnit, s.presentOverlay);
+  // Into `framebuffer` (0: the window's back buffer): the words are sRGB already, written as
+  // they are.
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
+  glViewport(0, 0, windowWidth, windowHeight);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glDisable(GL_SCISSOR_TEST);
+  glDisable(GL_FRAMEBUFFER_SRGB);
+  glUseProgram(program);
+  glBindVertexArray(s.vertexArray);  // (the triangle reads no attributes; core GL wants a vertex array bound)
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  checkGl("presenting the frame");
+}
+
+std::vector<uint32_t> GpuRenderer::presentOffscreen(const DisplayPixels& frame, const DisplayPixels& overlay,
+                                                    int windowWidth, int windowHeight) {
+  State& s = *state_;
+  s.context.makeCurrent();
+  if (windowWidth < 1 || windowHeight < 1) fail("GPU renderer: presenting into a {}x{} window", windowWidth, windowHeight);
+  GLuint texture = 0, framebuffer = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+  glTextureStorage2D(texture, 1, GL_RGBA8, windowWidth, windowHeight);
+  glCreateFramebuffers(1, &framebuffer);
+  glNamedFramebufferTexture(framebuffer, GL_COLOR_ATTACHMENT0, texture, 0);
+  std::vector<uint32_t> words;
+  try {
+    presentInto(framebuffer, frame, overlay, windowWidth, windowHeight);
+    words = readWords(framebuffer, GL_COLOR_ATTACHMENT0, windowWidth, windowHeight);
+  } catch (...) {
+    glDeleteFramebuffers(1, &framebuffer);
+    glDeleteTextures(1, &texture);
+    throw;
+  }
+  glDeleteFramebuffers(1, &framebuffer);  // (a bound framebuffer deleted binds 0)
+  glDeleteTextures(1, &texture);
+  checkGl("reading the presented picture back");
+  return words;
+}
+
+std::vector<uint32_t> GpuRenderer::readPresented(int windowWidth, int windowHeight) {
+  state_->context.makeCurrent();
+  if (windowWidth < 1 || windowHeight < 1) fail("GPU renderer: reading a {}x{} window", windowWidth, windowHeight);
+  std::vector<uint32_t> words = readWords(0, GL_BACK, windowWidth, windowHeight);
+  checkGl("reading the window back");
+  return words;
 }
 
 void GpuRenderer::accumulate(bool restart) {

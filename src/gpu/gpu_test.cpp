@@ -701,6 +701,123 @@ TEST_F(GpuRendererTest, EncodeDisplayMatchesTheCpuEncoder) {
   }
 }
 
+/// Channel `shift` (0: blue … 24: alpha) of an 0xAARRGGBB word, in [0, 255].
+int wordChannel(uint32_t word, int shift) { return int((word >> shift) & 255u); }
+
+/// What a window shows of `frame` (fw × fh words) stretched over w × h pixels by GL's bilinear
+/// filter (texel centres at half-integers, clamped at the edges), each channel rounded.
+std::vector<uint32_t> bilinearStretch(const std::vector<uint32_t>& frame, int fw, int fh, int w, int h) {
+  std::vector<uint32_t> out(size_t(w) * size_t(h));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double u = (x + 0.5) / w * fw - 0.5, v = (y + 0.5) / h * fh - 0.5;
+      const int x0 = int(std::floor(u)), y0 = int(std::floor(v));
+      const double ax = u - x0, ay = v - y0;
+      auto texel = [&](int tx, int ty) {
+        return frame[size_t(std::clamp(ty, 0, fh - 1)) * size_t(fw) + size_t(std::clamp(tx, 0, fw - 1))];
+      };
+      uint32_t word = 0xFF000000u;
+      for (int shift : {0, 8, 16}) {
+        const double c = (1 - ay) * ((1 - ax) * wordChannel(texel(x0, y0), shift) + ax * wordChannel(texel(x0 + 1, y0), shift)) +
+                         ay * ((1 - ax) * wordChannel(texel(x0, y0 + 1), shift) + ax * wordChannel(texel(x0 + 1, y0 + 1), shift));
+        word |= uint32_t(std::lround(c)) << shift;
+      }
+      out[size_t(y) * size_t(w) + size_t(x)] = word;
+    }
+  return out;
+}
+
+// The viewer's present pass (what a window with the renderer's context shows): the frame's
+// words as the display pass made them, texel for pixel; the HUD blended over the top-left
+// corner by its alpha as SDL_BLENDMODE_BLEND blends; a frame smaller than the window
+// stretched bilinearly; a frame from the CPU (its pitch honoured) shown as it is.
+TEST_F(GpuRendererTest, PresentShowsTheFrameWordsAndTheHud) {
+  const LightField lf = randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 3);
+  GpuRenderer gpu(lf);
+  constexpr int kWidth = 40, kHeight = 30;
+  const Camera camera(insideCamera(lf.scene), kWidth, kHeight);
+  gpu.draw(camera, RenderSettings{});
+  EXPECT_THROW(gpu.presentOffscreen({}, {}, kWidth, kHeight), Error);  // drawn, not encoded yet
+  DisplayEncoder encoder;
+  std::vector<uint32_t> words(size_t(kWidth) * size_t(kHeight));
+  gpu.encodeDisplay(encoder, 1.0f, ToneMapSettings{}, words.data(), 4 * kWidth);
+  const uint64_t before = gpu.gpuBytes();
+  EXPECT_EQ(gpu.presentOffscreen({}, {}, kWidth, kHeight), words);
+  EXPECT_EQ(gpu.gpuBytes(), before);  // (the words read where the display pass wrote them)
+  gpu.encodeDisplay(encoder, 0.25f, ToneMapSettings{}, nullptr, 0);  // left on the GPU
+  std::vector<uint32_t> darker(words.size());
+  gpu.encodeDisplay(encoder, 0.25f, ToneMapSettings{}, darker.data(), 4 * kWidth);
+  EXPECT_EQ(gpu.presentOffscreen({}, {}, kWidth, kHeight), darker);
+  EXPECT_NE(darker, words);
+
+  // The HUD: 13 × 7 words of every alpha, blended over the frame's corner.
+  Pcg32 rng(7, 1);
+  constexpr int kHudWidth = 13, kHudHeight = 7;
+  std::vector<uint32_t> hud(size_t(kHudWidth) * size_t(kHudHeight));
+  for (uint32_t& word : hud) word = rng.next();
+  hud[0] = 0x00FFFFFFu;  // transparent
+  hud[1] = 0xFF102030u;  // opaque
+  hud[2] = 0x80000000u;  // the HUD's backdrop: black at half opacity
+  const std::vector<uint32_t> shown = gpu.presentOffscreen({}, {hud.data(), kHudWidth, kHudHeight, 4 * kHudWidth}, kWidth, kHeight);
+  ASSERT_EQ(shown.size(), darker.size());
+  int worst = 0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const size_t i = size_t(y) * kWidth + size_t(x);
+      if (x >= kHudWidth || y >= kHudHeight) {
+        ASSERT_EQ(shown[i], darker[i]) << x << ", " << y;
+        continue;
+      }
+      const uint32_t o = hud[size_t(y) * kHudWidth + size_t(x)];
+      const double a = wordChannel(o, 24) / 255.0;
+      EXPECT_EQ(wordChannel(shown[i], 24), 255);
+      for (int shift : {0, 8, 16}) {
+        const long expected = std::lround(wordChannel(o, shift) * a + wordChannel(darker[i], shift) * (1.0 - a));
+        worst = std::max(worst, int(std::abs(wordChannel(shown[i], shift) - expected)));
+      }
+    }
+  EXPECT_LE(worst, 1);  // (8-bit blending: one level of rounding)
+  EXPECT_EQ(shown[0], darker[0]);
+  EXPECT_EQ(shown[1], 0xFF102030u);
+
+  // A CPU frame with a padded pitch, at the window's size: as it is; smaller: stretched.
+  constexpr int kPitchWords = kWidth + 5;
+  std::vector<uint32_t> padded(size_t(kPitchWords) * kHeight, 0xFFFF00FFu);
+  for (int y = 0; y < kHeight; ++y) std::copy_n(&words[size_t(y) * kWidth], kWidth, &padded[size_t(y) * kPitchWords]);
+  EXPECT_EQ(gpu.presentOffscreen({padded.data(), kWidth, kHeight, 4 * kPitchWords}, {}, kWidth, kHeight), words);
+  // Stretched: the CPU's frame, and the display pass's (copied into the frame texture on the GPU).
+  for (bool cpuFrame : {true, false})
+    for (auto [w, h] : {std::pair{80, 60}, std::pair{67, 45}}) {
+      const std::vector<uint32_t>& source = cpuFrame ? words : darker;
+      const std::vector<uint32_t> stretched =
+          gpu.presentOffscreen(cpuFrame ? DisplayPixels{words.data(), kWidth, kHeight, 4 * kWidth} : DisplayPixels{}, {}, w, h);
+      const std::vector<uint32_t> expected = bilinearStretch(source, kWidth, kHeight, w, h);
+      int far = 0;
+      for (size_t i = 0; i < expected.size(); ++i) far = std::max(far, wordChannelDistance(stretched[i], expected[i]));
+      // (GPUs weigh the four texels in fixed point, 8 bits on most: a level or two off the exact
+      // weights where neighbours differ by most of the range.)
+      EXPECT_LE(far, 2) << w << "x" << h << (cpuFrame ? " from the CPU" : " from the GPU");
+    }
+  EXPECT_EQ(gpu.gpuBytes() - before, 4u * kWidth * kHeight + 4u * kHudWidth * kHudHeight);  // frame and HUD textures
+  EXPECT_THROW(gpu.presentOffscreen({words.data(), kWidth, kHeight, 4 * kWidth - 4}, {}, kWidth, kHeight), Error);
+  EXPECT_THROW(gpu.presentOffscreen({}, {}, 0, kHeight), Error);
+  // A new size re-makes the frame's targets: nothing encoded at that size yet.
+  gpu.draw(Camera(insideCamera(lf.scene), 20, 15), RenderSettings{});
+  EXPECT_THROW(gpu.presentOffscreen({}, {}, 20, 15), Error);
+}
+
+// A renderer in the caller's context (the viewer's window's) needs one to be current: without
+// one it is a clear error, not a crash in the GL dispatch.
+TEST_F(GpuRendererTest, CurrentContextIsRequired) {
+  const LightField lf = randomLightField(makeCornellBox(), 3);
+  try {
+    GpuRenderer gpu(lf, GpuContext::Current);
+    FAIL() << "made a renderer without a current context";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no OpenGL context is current"), std::string::npos) << e.what();
+  }
+}
+
 // The viewer's refinement on the GPU: frames of several samples accumulated there, their
 // average (sum × 1 / count) read back and shown, against the same average made on the CPU from
 // each frame read back — the same floats, and the same words as DisplayEncoder makes of them.

@@ -43,84 +43,183 @@ constexpr float kRadiansPerPixel = 0.004f;  ///< mouse look sensitivity
 constexpr int kHudScale = 2;
 constexpr size_t kTimingWindow = 60;  ///< frames averaged for the HUD's fps
 
-/// Owns SDL's window, renderer and streaming textures (the frame, and the HUD over it);
-/// releases them in reverse order.
+/// Owns SDL's window and what draws into it — an SDL renderer with streaming textures (the
+/// frame, and the HUD over it), or an OpenGL 4.5 core context in which the GPU renderer draws
+/// and presents (GpuRenderer::present) — and releases them in reverse order.
 class Window {
  public:
-  /// softwareRenderer: SDL's software renderer even where an accelerated one exists (the GPU
-  /// light-field renderer keeps its own OpenGL context current on this thread).
-  Window(const std::string& title, int width, int height, bool softwareRenderer) {
+  /// How the window shows its frames.
+  enum class Mode {
+    OpenGl,       ///< its own OpenGL context, the GPU renderer's (else Software: no OpenGL in SDL's driver)
+    Software,     ///< SDL's software renderer (the GPU renderer keeps its headless context current)
+    Accelerated,  ///< SDL's accelerated renderer where there is one (the CPU renderer's frames)
+  };
+
+  Window(const std::string& title, int width, int height, Mode mode) : title_(title) {
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
       const char* driver = std::getenv("SDL_VIDEODRIVER");
       fail("view: cannot initialise SDL video{}: {} (no display? run under xvfb-run, or set SDL_VIDEODRIVER=dummy "
            "for a headless run)",
            driver ? fmt::format(" (SDL_VIDEODRIVER={})", driver) : std::string(), SDL_GetError());
     }
-    window_ = SDL_CreateWindow(title.c_str(), SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, width, height,
-                               SDL_WINDOW_RESIZABLE);
-    if (!window_) fail("view: cannot open a {}x{} window: {}", width, height, SDL_GetError());
-    // (SDL's software renderer draws into the window surface, which SDL itself would back
-    // with an OpenGL texture on X11 unless told not to.)
-    if (softwareRenderer) SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
-    if (!softwareRenderer) renderer_ = SDL_CreateRenderer(window_, -1, SDL_RENDERER_ACCELERATED);
-    if (!renderer_) renderer_ = SDL_CreateRenderer(window_, -1, SDL_RENDERER_SOFTWARE);
-    if (!renderer_) fail("view: cannot create an SDL renderer: {}", SDL_GetError());
-    // A frame rendered below the window's size is upscaled bilinearly.
-    SDL_SetHint(SDL_HINT_RENDER_SCALE_QUALITY, "linear");
+    open(width, height, mode);
   }
   ~Window() {
-    if (hud_) SDL_DestroyTexture(hud_);
-    if (frame_) SDL_DestroyTexture(frame_);
-    if (renderer_) SDL_DestroyRenderer(renderer_);
-    if (window_) SDL_DestroyWindow(window_);
+    close();
     SDL_Quit();
   }
   Window(const Window&) = delete;
   Window& operator=(const Window&) = delete;
 
+  /// Re-opens the window (same size) to show its frames another way: the GPU renderer could
+  /// not draw in its OpenGL context, or not at all.
+  void reopen(Mode mode) {
+    int width = 0, height = 0;
+    SDL_GetWindowSize(window_, &width, &height);
+    close();
+    open(width, height, mode);
+  }
+  /// Whether the window has its OpenGL context (current on this thread).
+  bool openGl() const { return glContext_ != nullptr; }
+
   /// The size to render at: the window's drawable size.
   void outputSize(int& width, int& height) const {
-    if (SDL_GetRendererOutputSize(renderer_, &width, &height) != 0 || width < 1 || height < 1)
-      SDL_GetWindowSize(window_, &width, &height);
-  }
-  /// Locks the frame texture at width × height (re-created when the size differs); the pixels
-  /// are 0xAARRGGBB words, `pitch` bytes per row, until present().
-  uint32_t* lockFrame(int width, int height, int& pitch) { return lock(frame_, frameSize_, width, height, pitch, false); }
-  /// Locks the HUD texture (blended over the frame's top-left corner at the window's scale).
-  uint32_t* lockHud(int width, int height, int& pitch) { return lock(hud_, hudSize_, width, height, pitch, true); }
-  /// Shows the frame stretched over the window and the HUD over it.
-  void present() {
-    SDL_UnlockTexture(frame_);
-    SDL_RenderClear(renderer_);
-    SDL_RenderCopy(renderer_, frame_, nullptr, nullptr);
-    if (hud_) {
-      SDL_UnlockTexture(hud_);
-      const SDL_Rect rect{0, 0, hudSize_[0], hudSize_[1]};
-      SDL_RenderCopy(renderer_, hud_, nullptr, &rect);
+    if (glContext_) {
+      SDL_GL_GetDrawableSize(window_, &width, &height);
+    } else if (SDL_GetRendererOutputSize(renderer_, &width, &height) != 0) {
+      width = height = 0;
     }
-    SDL_RenderPresent(renderer_);
+    if (width < 1 || height < 1) SDL_GetWindowSize(window_, &width, &height);
+  }
+  /// Locks the frame's pixels at width × height (re-made when the size differs): 0xAARRGGBB
+  /// words, `pitch` bytes per row, until present().
+  uint32_t* lockFrame(int width, int height, int& pitch) { return lock(frame_, width, height, pitch, false); }
+  /// Locks the HUD's pixels (blended over the frame's top-left corner at the window's scale).
+  uint32_t* lockHud(int width, int height, int& pitch) { return lock(hud_, width, height, pitch, true); }
+  /// Shows the frame stretched over the window (width × height, its outputSize when the frame
+  /// was rendered) and the HUD over it. With the OpenGL context, `gpu` draws them there — the
+  /// frame it encoded and kept (frameOnGpu), else the locked one — and the window swaps its
+  /// buffers. `capture`, when given, gets what the window shows (read back before the swap).
+  void present(GpuRenderer* gpu, bool frameOnGpu, int width, int height, Image8* capture = nullptr) {
+    std::vector<uint32_t> shown;
+    if (glContext_) {
+      gpu->present(frameOnGpu ? DisplayPixels{} : pixelsOf(frame_), pixelsOf(hud_), width, height);
+      if (capture) shown = gpu->readPresented(width, height);
+      SDL_GL_SwapWindow(window_);
+    } else {
+      SDL_UnlockTexture(frame_.texture);
+      SDL_RenderClear(renderer_);
+      SDL_RenderCopy(renderer_, frame_.texture, nullptr, nullptr);
+      if (hud_.texture) {
+        SDL_UnlockTexture(hud_.texture);
+        const SDL_Rect rect{0, 0, hud_.width, hud_.height};
+        SDL_RenderCopy(renderer_, hud_.texture, nullptr, &rect);
+      }
+      if (capture) {
+        shown.resize(size_t(width) * size_t(height));
+        const SDL_Rect rect{0, 0, width, height};
+        if (SDL_RenderReadPixels(renderer_, &rect, SDL_PIXELFORMAT_ARGB8888, shown.data(), 4 * width) != 0)
+          fail("view: cannot read the window's pixels: {}", SDL_GetError());
+      }
+      SDL_RenderPresent(renderer_);
+    }
+    if (!capture) return;
+    capture->width = width;
+    capture->height = height;
+    capture->rgb.resize(3 * shown.size());
+    for (size_t i = 0; i < shown.size(); ++i) {
+      capture->rgb[3 * i] = uint8_t(shown[i] >> 16);
+      capture->rgb[3 * i + 1] = uint8_t(shown[i] >> 8);
+      capture->rgb[3 * i + 2] = uint8_t(shown[i]);
+    }
   }
 
  private:
-  uint32_t* lock(SDL_Texture*& texture, int (&size)[2], int width, int height, int& pitch, bool blend) {
-    if (!texture || width != size[0] || height != size[1]) {
-      if (texture) SDL_DestroyTexture(texture);
-      texture = SDL_CreateTexture(renderer_, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, width, height);
-      if (!texture) fail("view: cannot create a {}x{} texture: {}", width, height, SDL_GetError());
-      SDL_SetTextureBlendMode(texture, blend ? SDL_BLENDMODE_BLEND : SDL_BLENDMODE_NONE);
-      size[0] = width;
-      size[1] = height;
+  /// A frame or the HUD: an SDL streaming texture, or (with the OpenGL context) words in memory.
+  struct Layer {
+    SDL_Texture* texture = nullptr;
+    std::vector<uint32_t> words;
+    int width = 0, height = 0;
+  };
+
+  void open(int width, int height, Mode mode) {
+    if (mode == Mode::OpenGl) {
+      if (openGlWindow(width, height)) return;
+      mode = Mode::Software;
+    }
+    window_ = SDL_CreateWindow(title_.c_str(), SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, width, height,
+                               SDL_WINDOW_RESIZABLE);
+    if (!window_) fail("view: cannot open a {}x{} window: {}", width, height, SDL_GetError());
+    // (SDL's software renderer draws into the window surface, which SDL itself would back
+    // with an OpenGL texture on X11 unless told not to.)
+    if (mode == Mode::Software) SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
+    if (mode == Mode::Accelerated) renderer_ = SDL_CreateRenderer(window_, -1, SDL_RENDERER_ACCELERATED);
+    if (!renderer_) renderer_ = SDL_CreateRenderer(window_, -1, SDL_RENDERER_SOFTWARE);
+    if (!renderer_) fail("view: cannot create an SDL renderer: {}", SDL_GetError());
+    // A frame rendered below the window's size is upscaled bilinearly.
+    SDL_SetHint(SDL_HINT_RENDER_SCALE_QUALITY, "linear");
+  }
+  /// A window with an OpenGL 4.5 core context made current, without vertical sync (the frame
+  /// rate is the renderer's); false, with nothing left open, where SDL's video driver has no
+  /// OpenGL (dummy, offscreen) or no such context.
+  bool openGlWindow(int width, int height) {
+    SDL_GL_ResetAttributes();
+    SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 4);
+    SDL_GL_SetAttribute(SDL_GL_CONTEXT_MINOR_VERSION, 5);
+    SDL_GL_SetAttribute(SDL_GL_CONTEXT_PROFILE_MASK, SDL_GL_CONTEXT_PROFILE_CORE);
+    SDL_GL_SetAttribute(SDL_GL_DOUBLEBUFFER, 1);
+    SDL_GL_SetAttribute(SDL_GL_DEPTH_SIZE, 0);
+    window_ = SDL_CreateWindow(title_.c_str(), SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, width, height,
+                               SDL_WINDOW_RESIZABLE | SDL_WINDOW_OPENGL);
+    if (window_) glContext_ = SDL_GL_CreateContext(window_);
+    if (glContext_ && SDL_GL_MakeCurrent(window_, glContext_) == 0) {
+      SDL_GL_SetSwapInterval(0);
+      return true;
+    }
+    close();
+    return false;
+  }
+  void close() {
+    for (Layer* layer : {&hud_, &frame_}) {
+      if (layer->texture) SDL_DestroyTexture(layer->texture);
+      *layer = Layer{};
+    }
+    if (renderer_) SDL_DestroyRenderer(renderer_);
+    if (glContext_) SDL_GL_DeleteContext(glContext_);
+    if (window_) SDL_DestroyWindow(window_);
+    renderer_ = nullptr;
+    glContext_ = nullptr;
+    window_ = nullptr;
+  }
+  uint32_t* lock(Layer& layer, int width, int height, int& pitch, bool blend) {
+    const bool resized = width != layer.width || height != layer.height;
+    layer.width = width;
+    layer.height = height;
+    if (glContext_) {
+      layer.words.resize(size_t(width) * size_t(height));
+      pitch = 4 * width;
+      return layer.words.data();
+    }
+    if (!layer.texture || resized) {
+      if (layer.texture) SDL_DestroyTexture(layer.texture);
+      layer.texture = SDL_CreateTexture(renderer_, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, width, height);
+      if (!layer.texture) fail("view: cannot create a {}x{} texture: {}", width, height, SDL_GetError());
+      SDL_SetTextureBlendMode(layer.texture, blend ? SDL_BLENDMODE_BLEND : SDL_BLENDMODE_NONE);
     }
     void* pixels = nullptr;
-    if (SDL_LockTexture(texture, nullptr, &pixels, &pitch) != 0) fail("view: cannot lock a texture: {}", SDL_GetError());
+    if (SDL_LockTexture(layer.texture, nullptr, &pixels, &pitch) != 0) fail("view: cannot lock a texture: {}", SDL_GetError());
     return static_cast<uint32_t*>(pixels);
   }
+  static DisplayPixels pixelsOf(const Layer& layer) {
+    if (layer.words.empty()) return {};
+    return {layer.words.data(), layer.width, layer.height, 4 * layer.width};
+  }
 
+  std::string title_;
   SDL_Window* window_ = nullptr;
+  SDL_GLContext glContext_ = nullptr;
   SDL_Renderer* renderer_ = nullptr;
-  SDL_Texture* frame_ = nullptr;
-  SDL_Texture* hud_ = nullptr;
-  int frameSize_[2] = {0, 0}, hudSize_[2] = {0, 0};
+  Layer frame_, hud_;
 };
 
 /// The relighting key of an SDL key (viewer.h), if it is one.
@@ -188,6 +287,8 @@ void checkViewerOptions(const ViewerOptions& options) {
     fail("view: --target-fps must be within 0..1000, got {}", options.targetFps);
   if (!options.screenshotPath.empty() && options.frames == 0 && !options.path && options.relightKeys.empty())
     fail("view: --screenshot needs --frames N or --path (it is written after the last frame)");
+  if (!options.windowShotPath.empty() && options.frames == 0 && !options.path)
+    fail("view: --window-shot needs --frames N or --path (it is the last frame's window)");
   isFramePattern(options.screenshotPattern, "screenshot pattern");  // validates it
   for (char c : options.relightKeys)
     if (!relightKeyOfChar(c))
@@ -211,23 +312,57 @@ std::string oneLine(std::string text) {
   return text;
 }
 
+/// Why the viewer does not try the GPU renderer (Automatic: a feature it does not draw, no
+/// OpenGL 4.5 core context, a software rasteriser), or empty; throws where the GPU renderer was
+/// asked for and cannot draw this light field.
+std::string gpuRefusal(const LightField& lightField, const ViewerOptions& options) {
+  if (options.renderer == ViewerRendererChoice::Cpu) return {};
+  const bool asked = options.renderer == ViewerRendererChoice::Gpu;
+  if (const std::string feature = gpuUnsupportedFeature(lightField); !feature.empty()) {
+    const std::string refused = fmt::format("the GPU renderer does not draw {} yet", feature);
+    if (asked) fail("view: {} (use --renderer cpu)", refused);
+    return refused;
+  }
+  if (asked) return {};
+  const GpuProbe probe = probeGpu();
+  if (!probe.available) return oneLine(probe.error);
+  if (probe.software)
+    return fmt::format("OpenGL here is a software rasteriser ({}), slower than the CPU renderer "
+                       "(--renderer gpu takes it anyway)",
+                       probe.device);
+  return {};
+}
+
+/// How the session's window is opened: with an OpenGL context for the GPU renderer to draw
+/// in, unless it will not be tried.
+Window::Mode windowModeFor(const ViewerOptions& options, const std::string& gpuRefused) {
+  return options.renderer != ViewerRendererChoice::Cpu && gpuRefused.empty() ? Window::Mode::OpenGl
+                                                                             : Window::Mode::Accelerated;
+}
+
 /// The light-field renderer of a session: the GPU one or the CPU fast one, chosen as viewer.h
-/// says.
+/// says. The GPU one draws in the window's OpenGL context where the window has one and it can;
+/// else in its own headless context (the window re-opened to show its frames through SDL).
 class FrameRenderer {
  public:
-  FrameRenderer(const LightField& lightField, const Accel& accel, const ViewerOptions& options) {
-    if (options.renderer != ViewerRendererChoice::Cpu) fallback_ = tryGpu(lightField, options);
+  FrameRenderer(const LightField& lightField, const Accel& accel, const ViewerOptions& options,
+                const std::string& gpuRefused, Window& window) {
+    fallback_ = gpuRefused;
+    if (options.renderer != ViewerRendererChoice::Cpu && gpuRefused.empty()) fallback_ = tryGpu(lightField, options, window);
     if (gpu_) {
       device_ = gpu_->deviceName();
       name_ = fmt::format("gpu ({})", device_);
       return;
     }
+    if (window.openGl()) window.reopen(Window::Mode::Accelerated);
     if (!fallback_.empty()) fmt::print(stderr, "plenoptic: warning: view uses the CPU renderer: {}\n", fallback_);
     cpu_ = std::make_unique<FastRenderer>(lightField, accel);
     name_ = "cpu";
   }
 
   bool gpu() const { return gpu_ != nullptr; }
+  /// The GPU renderer, where the session has it (Window::present draws with it).
+  GpuRenderer* gpuRenderer() const { return gpu_.get(); }
   /// Whether it renders several jittered samples per pixel (the refinement of a still view).
   bool multiSample(const Camera& camera) const {
     RenderSettings two;
@@ -248,6 +383,7 @@ class FrameRenderer {
   /// read back by readRadiance. Only with the GPU renderer.
   void drawOnGpu(const Camera& camera, const RenderSettings& settings) { gpu_->draw(camera, settings); }
   void readRadiance(Image& image) { gpu_->readRadiance(image); }
+  /// GpuRenderer::encodeDisplay (`pixels` null: the words stay on the GPU for present).
   void encodeDisplay(DisplayEncoder& encoder, float exposureScale, const ToneMapSettings& settings, uint32_t* pixels,
                      int pitchBytes, bool average) {
     gpu_->encodeDisplay(encoder, exposureScale, settings, pixels, pitchBytes, average);
@@ -258,27 +394,29 @@ class FrameRenderer {
   void readAverage(Image& image) { gpu_->readAverage(image); }
 
  private:
-  /// Sets gpu_ when the GPU renderer can draw; returns why not (Automatic) or throws (Gpu).
-  std::string tryGpu(const LightField& lightField, const ViewerOptions& options) {
+  /// Sets gpu_ when the GPU renderer can draw — in the window's OpenGL context, else in its
+  /// own; returns why not (Automatic) or throws (Gpu).
+  std::string tryGpu(const LightField& lightField, const ViewerOptions& options, Window& window) {
     const bool asked = options.renderer == ViewerRendererChoice::Gpu;
     const Camera camera(options.camera, options.width, options.height, options.vignetting, options.metresPerUnit);
-    if (const std::string feature = gpuUnsupportedFeature(lightField); !feature.empty()) {
-      const std::string refused = fmt::format("the GPU renderer does not draw {} yet", feature);
-      if (asked) fail("view: {} (use --renderer cpu)", refused);
-      return refused;
-    }
-    if (!asked) {
-      const GpuProbe probe = probeGpu();
-      if (!probe.available) return oneLine(probe.error);
-      if (probe.software)
-        return fmt::format("OpenGL here is a software rasteriser ({}), slower than the CPU renderer "
-                           "(--renderer gpu takes it anyway)",
-                           probe.device);
-    }
-    try {
-      gpu_ = std::make_unique<GpuRenderer>(lightField);
+    auto make = [&](GpuContext context) {
+      gpu_ = std::make_unique<GpuRenderer>(lightField, context);
       gpu_->checkSettings(options.render, camera);  // what this driver lacks
       gpu_->prepareDisplay();                       // the display pass's shaders compile here
+    };
+    if (window.openGl()) {
+      try {
+        make(GpuContext::Current);
+        return {};
+      } catch (const Error& e) {
+        gpu_.reset();
+        fmt::print(stderr, "plenoptic: warning: view draws on the GPU in a context of its own, its frames read back: {}\n",
+                   oneLine(e.what()));
+        window.reopen(Window::Mode::Software);
+      }
+    }
+    try {
+      make(GpuContext::Headless);
     } catch (const Error& e) {
       gpu_.reset();
       if (asked) throw;
@@ -308,8 +446,9 @@ class ViewerSession {
       : options_(options),
         speed_(flySpeed(lightField.scene, options)),
         fly_(options.camera, speed_),
-        renderer_(lightField, accel, options),
-        window_(options.title, options.width, options.height, renderer_.gpu()),
+        gpuRefused_(gpuRefusal(lightField, options)),
+        window_(options.title, options.width, options.height, windowModeFor(options, gpuRefused_)),
+        renderer_(lightField, accel, options, gpuRefused_, window_),
         toneMap_(options.toneMap),
         recorder_(options.recordInterval),
         start_(Clock::now()) {
@@ -372,8 +511,9 @@ class ViewerSession {
   }
 
   /// Renders what the frame needs (renderFrame) at the window's size, encodes it into the
-  /// window's texture, draws the HUD, and presents them. Returns whether anything was rendered.
-  bool renderAndPresent(Clock::time_point frameStart) {
+  /// window's texture, draws the HUD, and presents them; with `capture` (the last frame, for
+  /// --window-shot) keeps what the window shows. Returns whether anything was rendered.
+  bool renderAndPresent(Clock::time_point frameStart, bool capture) {
     int width = 0, height = 0;
     window_.outputSize(width, height);
     const Clock::time_point renderStart = Clock::now();
@@ -387,9 +527,10 @@ class ViewerSession {
     auto renderDone = [&] { renderMs_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count()); };
     int pitch = 0;
     if (frameOnGpu_) {
-      // The GPU's frame becomes the window's pixels there; its read-back waits for the frame,
-      // so the render time ends after it.
-      uint32_t* pixels = window_.lockFrame(frame_.width, frame_.height, pitch);
+      // The GPU's frame becomes the window's pixels there: kept there where the window has the
+      // renderer's context, else read back. The read-back of the curve's subsample, or of the
+      // pixels, waits for the frame, so the render time ends after it.
+      uint32_t* pixels = window_.openGl() ? nullptr : window_.lockFrame(frame_.width, frame_.height, pitch);
       renderer_.encodeDisplay(display_, exposureScale(), toneMap_, pixels, pitch, refiningOnGpu_);
       if (rendered) {
         renderDone();
@@ -402,7 +543,7 @@ class ViewerSession {
       display_.encode(frame_, exposureScale(), toneMap_, pixels, pitch);
     }
     drawHud(width, height, frameStart);
-    window_.present();
+    window_.present(renderer_.gpuRenderer(), frameOnGpu_, width, height, capture ? &windowShot_ : nullptr);
     // The frame-rate controller learns from frames at the settings' own samples per pixel.
     if (rendered && shown_ != Shown::Refined)
       scales_(share_).record(scale, std::chrono::duration<double, std::milli>(Clock::now() - renderStart).count());
@@ -430,6 +571,7 @@ class ViewerSession {
     if (recorder_.recording()) stopRecording(Clock::now());
     if (!options_.screenshotPath.empty() && shown_ != Shown::Nothing)
       writeFrame(options_.screenshotPath, baseFrame(), exposureScale(), toneMap_);
+    if (!options_.windowShotPath.empty() && windowShot_.width > 0) writePng(options_.windowShotPath, windowShot_);
     ViewerResult result;
     result.frames = int(frameMs_.size());
     result.msPerFrameMedian = median(frameMs_);
@@ -438,6 +580,7 @@ class ViewerSession {
     result.renderer = renderer_.name();
     result.device = renderer_.device();
     result.fallback = renderer_.fallback();
+    result.presentation = window_.openGl() ? "opengl" : "sdl";
     if (live_) {
       const RelightStatus status = live_->status();
       result.relightFrames = int(relightMs_.size());
@@ -675,9 +818,10 @@ class ViewerSession {
   const ViewerOptions& options_;
   const float speed_;
   FlyCamera fly_;
+  const std::string gpuRefused_;  ///< why the GPU renderer is not tried (gpuRefusal)
+  Window window_;                 ///< (before renderer_: its OpenGL context outlives the GPU renderer)
   FrameRenderer renderer_;
   DisplayEncoder display_;
-  Window window_;
   ShareScale scales_;
   CoreShare share_;  ///< the frame's (renderAndPresent)
   float exposureEv_ = 0.0f;  ///< the +/− offset on top of options.exposureScale
@@ -688,6 +832,7 @@ class ViewerSession {
   bool frameOnGpu_ = false, refiningOnGpu_ = false;
   Image accumulation_;  ///< the sum of the refinement batches
   Image batchImage_, screenshot_;
+  Image8 windowShot_;  ///< the last frame's window as shown (--window-shot)
   Shown shown_ = Shown::Nothing;
   CameraDesc shownDesc_;
   int shownWidth_ = 0, shownHeight_ = 0;
@@ -721,7 +866,7 @@ ViewerResult runViewer(const LightField& lightField, const Accel& accel, const V
     previous = frameStart;
     session.handleEvents(frameStart);
     session.moveCamera(frame, dt, frameStart);
-    const bool rendered = session.renderAndPresent(frameStart);
+    const bool rendered = session.renderAndPresent(frameStart, frame + 1 == totalFrames && !options.windowShotPath.empty());
     session.endFrame(frameStart, rendered);
   }
   return session.finish();

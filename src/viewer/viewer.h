@@ -10,12 +10,16 @@
 // a feature the GPU renderer does not draw yet). Asked for explicitly, the GPU renderer
 // refuses with that error instead. Either way a frame is radiance encoded (exposure, tone
 // mapping, sRGB) into the window's 8-bit pixels by one rule, DisplayEncoder's (image/display.h):
-// the CPU renderer's frame by the CPU; the GPU renderer's on the GPU, in its headless EGL
-// context (GpuRenderer::encodeDisplay: the curve resolved on the CPU from the frame's
-// subsample, each pixel's word computed there, 4 bytes per pixel read back instead of 12 of
-// radiance), then blitted (the window uses SDL's software renderer, so that no second OpenGL
-// context competes for the thread). Screenshots are the radiance read back and written as
-// `plenoptic render` writes it.
+// the CPU renderer's frame by the CPU; the GPU renderer's on the GPU (GpuRenderer::encodeDisplay:
+// the curve resolved on the CPU from the frame's subsample, each pixel's word computed there).
+// The GPU renderer draws in the window's own OpenGL 4.5 core context where SDL's video driver
+// gives one (GpuContext::Current), and presents the frame and the HUD there
+// (GpuRenderer::present): nothing of the frame comes back to the CPU. Elsewhere (SDL's dummy
+// and offscreen drivers have no OpenGL) it draws in its headless EGL context, its 4 bytes per
+// pixel are read back and SDL's software renderer blits them (not SDL's accelerated one: no
+// second OpenGL context may compete for the thread). The CPU renderer's frames are blitted by
+// SDL's renderer. Screenshots are the radiance read back and written as `plenoptic render`
+// writes it; --window-shot writes what the window shows, read back from it.
 //
 // Frame rate: with the CPU renderer, while the camera moves each frame is rendered at the
 // reduced internal resolution RenderScaleController (render_scale.h) picks for the frame-rate
@@ -84,6 +88,9 @@ struct ViewerOptions {
   static constexpr int kRefinedSamples = 16;  ///< samples per pixel a still view is refined to
   int frames = 0;                    ///< > 0: quit after this many frames
   std::string screenshotPath;        ///< written after the last frame (.png or .exr/.hdr/.pfm)
+  /// The last frame's window as it shows it, HUD included, written as PNG on exit (frames or
+  /// path needed): the pixels read back from the window (its OpenGL back buffer, or SDL's).
+  std::string windowShotPath;
   std::optional<CameraPath> path;    ///< scripted camera (overrides keys and mouse)
   std::string recordPath = "walk-path.json";     ///< where P/R saves the flown path
   std::string screenshotPattern = "screenshot-%04d.png";  ///< F12 (frame pattern, numbered from 0)
@@ -110,6 +117,10 @@ struct ViewerResult {
   std::string renderer;           ///< "gpu (DEVICE)" or "cpu"
   std::string device;             ///< with the GPU renderer, DEVICE: GpuRenderer::deviceName
   std::string fallback;           ///< why the CPU renderer was taken in Automatic mode; empty otherwise
+  /// How frames reached the window: "opengl" (the GPU renderer drew them in the window's own
+  /// OpenGL context) or "sdl" (blitted by SDL's renderer: the CPU renderer's, or the GPU
+  /// renderer's read back from its headless context).
+  std::string presentation;
   /// With relighting: frames drawn while the propagation ran, their median time, and the
   /// last relight's times and state (seconds; live_relight.h RelightStatus).
   int relightFrames = 0;

@@ -169,6 +169,55 @@ TEST_F(ViewerCliTest, GpuScreenshotUnderXvfbEqualsGpuRender) {
   EXPECT_EQ(differingPixels(path("render.png"), path("view.png")), 0);
 }
 
+// What the window shows, read back from it (--window-shot): in an X window under Xvfb the GPU
+// renderer draws and presents in the window's own OpenGL context; headless (SDL's dummy driver)
+// its frame is read back and SDL blits it. Below the HUD, whose figures differ from run to run,
+// the two windows show the same pixels.
+TEST_F(ViewerCliTest, WindowShowsTheSamePixelsThroughOpenGlAndSdl) {
+  if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/bootstrap.sh installs it)";
+  {
+    std::ofstream json(path("walk.json"));
+    json << R"({"fps": 4, "keyframes": [
+      {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0], "fov": 39},
+      {"time": 0.5, "eye": [350, 250, -300], "target": [250, 150, 300], "fov": 55}]})";
+  }
+  constexpr int kWidth = 128, kHeight = 224;
+  // The HUD: at most 5 lines here (no relighting), kLineAdvance·2 pixels each and 6 more.
+  constexpr int kBelowHud = 5 * 9 * 2 + 6;
+  const std::string view = "view " + path("cornell.plf") + " --path " + path("walk.json") + " --width " +
+                           std::to_string(kWidth) + " --height " + std::to_string(kHeight) + " --quiet --window-shot ";
+  std::string out, errors;
+  ASSERT_EQ(cli_test::runPlenoptic(view + path("gl.png") + " --renderer gpu --stats " + path("gl.json"), dir_, &out, &errors,
+                                   "SDL_VIDEODRIVER=x11 xvfb-run -a -s '-screen 0 320x240x24'"),
+            0)
+      << out << errors;
+  ASSERT_EQ(run(view + path("sdl.png") + " --renderer gpu --stats " + path("sdl.json"), nullptr, &errors), 0) << errors;
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(path("gl.json")))["presentation"], "opengl");
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(path("sdl.json")))["presentation"], "sdl");
+  const Image gl = readImage(path("gl.png")), sdl = readImage(path("sdl.png"));
+  for (const Image* image : {&gl, &sdl}) {
+    ASSERT_EQ(image->width, kWidth);
+    ASSERT_EQ(image->height, kHeight);
+  }
+  int differ = 0, variedFromFirst = 0;
+  for (int y = kBelowHud; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const size_t i = size_t(y) * kWidth + size_t(x);
+      differ += gl.pixels[i] != sdl.pixels[i];
+      variedFromFirst += gl.pixels[i] != gl.pixels[size_t(kBelowHud) * kWidth];
+    }
+  EXPECT_EQ(differ, 0);
+  EXPECT_GT(variedFromFirst, kWidth * (kHeight - kBelowHud) / 2);  // a picture, not a cleared window
+  // The HUD is there: its half-transparent backdrop darkens the window's top-left corner.
+  const Image screenshot = [&] {
+    EXPECT_EQ(run("render " + path("cornell.plf") + " --renderer gpu -o " + path("render.png") +
+                  " --eye 350,250,-300 --target 250,150,300 --fov 55 --width 128 --height 224"),
+              0);
+    return readImage(path("render.png"));
+  }();
+  EXPECT_LT(gl.pixels[size_t(kWidth) * 2 + 2].g, screenshot.pixels[size_t(kWidth) * 2 + 2].g);
+}
+
 /// A light field with mirror-like lobes (a chart the GPU renderer does not draw yet).
 /// The mirror-like Cornell box lit by a sky map too: environment maps lighting mirror-like
 /// lobes are what the GPU renderer does not draw yet.
@@ -286,6 +335,11 @@ TEST_F(ViewerCliTest, BadInputsAreClearErrors) {
   EXPECT_NE(run("view " + path("cornell.plf") + " --target-fps -1 --frames 1", nullptr, &errors), 0);
   EXPECT_NE(run("view " + path("cornell.plf") + " --screenshot " + path("x.png"), nullptr, &errors), 0);
   EXPECT_NE(errors.find("--screenshot needs --frames"), std::string::npos) << errors;
+  EXPECT_NE(run("view " + path("cornell.plf") + " --window-shot " + path("w.png"), nullptr, &errors), 0);
+  EXPECT_NE(errors.find("--window-shot needs --frames"), std::string::npos) << errors;
+  EXPECT_NE(run("view " + path("cornell.plf") + " --frames 1 --window-shot " + path("w.exr"), nullptr, &errors), 0);
+  EXPECT_NE(errors.find("--window-shot " + path("w.exr")), std::string::npos) << errors;
+  EXPECT_FALSE(fs::exists(path("w.exr")));
   {
     std::ofstream json(path("bad.json"));
     json << R"({"keyframes": [{"time": 0, "eye": [0, 0, 1]}]})";
