@@ -10,7 +10,7 @@ packages=(
   libembree-dev libtbb-dev libglm-dev libtinyobjloader-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev
   libopenexr-dev libstb-dev libzstd-dev libsquish-dev libsdl2-dev libxxhash-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
-  libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
+  libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libgl1 libglx-mesa0
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
   xvfb xauth bash-completion
