@@ -102,7 +102,8 @@ SDL_VIDEODRIVER=dummy "$BIN" view "$D/cornell.plf" --renderer gpu --width "$WIDT
 python3 - "$D/view.json" <<'PY' | tee -a "$SUMMARY" || say "view: failed"
 import json, sys
 s = json.load(open(sys.argv[1]))
-print(f"view cornell {s['width']}x{s['height']} (GPU renderer, display pass on the GPU): {s['fps']:.1f} fps "
+print(f"view cornell {s['width']}x{s['height']} (GPU renderer, display pass on the GPU, shown by "
+      f"{s.get('presentation', 'sdl')}): {s['fps']:.1f} fps "
       f"({s['ms_per_frame_median']:.3f} ms/frame median, render and read-back {s['render_ms_median']:.3f} ms, "
       f"GPU time alone {s.get('gpu_ms_median', 0):.3f} ms), "
       f"{s['frames']} frames, on {s.get('device', s['renderer'])}")
