@@ -45,6 +45,7 @@ std::string viewStatsJson(const ViewerResult& result, const ViewerOptions& viewe
   if (!result.device.empty()) json["device"] = result.device;
   if (!result.fallback.empty()) json["fallback"] = result.fallback;
   json["presentation"] = result.presentation;
+  json["vsync"] = result.vsync;
   if (!viewer.relightKeys.empty()) {
     json["relight_iterations"] = result.relightIterations;
     json["relight_converged"] = result.relightConverged;
@@ -130,6 +131,12 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
           "gpu (OpenGL 4.5 through EGL) or cpu (the fast renderer); default: the GPU one on a graphics card when it "
           "draws this light field, else the CPU one with a warning saying why")
       ->check(CLI::IsMember({"cpu", "gpu"}));
+  command
+      ->add_option_function<std::string>(
+          "--vsync", [options](const std::string& s) { options->viewer.vsync = s == "on"; },
+          "GPU renderer in the window: swap at the display's vertical sync (on) or as soon as a frame is drawn (off)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->default_str("on");
   command->add_option("--target-fps", viewer.targetFps,
                       "CPU renderer: frame rate held while moving, by rendering at a lower resolution (0 = always full)")
       ->check(CLI::Range(0.0, 1000.0))

@@ -55,7 +55,8 @@ class Window {
     Accelerated,  ///< SDL's accelerated renderer where there is one (the CPU renderer's frames)
   };
 
-  Window(const std::string& title, int width, int height, Mode mode) : title_(title) {
+  /// vsync: where the window has its OpenGL context, swap at the display's vertical sync.
+  Window(const std::string& title, int width, int height, Mode mode, bool vsync) : title_(title), vsync_(vsync) {
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
       const char* driver = std::getenv("SDL_VIDEODRIVER");
       fail("view: cannot initialise SDL video{}: {} (no display? run under xvfb-run, or set SDL_VIDEODRIVER=dummy "
@@ -79,8 +80,10 @@ class Window {
     close();
     open(width, height, mode);
   }
-  /// Whether the window has its OpenGL context (current on this thread).
+  /// Whether the window has its OpenGL context (current on this thread), and whether its swaps
+  /// wait for the vertical sync (SDL_GL_GetSwapInterval: what the driver took).
   bool openGl() const { return glContext_ != nullptr; }
+  bool vsync() const { return glContext_ != nullptr && SDL_GL_GetSwapInterval() != 0; }
 
   /// The size to render at: the window's drawable size.
   void outputSize(int& width, int& height) const {
@@ -159,9 +162,9 @@ class Window {
     // A frame rendered below the window's size is upscaled bilinearly.
     SDL_SetHint(SDL_HINT_RENDER_SCALE_QUALITY, "linear");
   }
-  /// A window with an OpenGL 4.5 core context made current, without vertical sync (the frame
-  /// rate is the renderer's); false, with nothing left open, where SDL's video driver has no
-  /// OpenGL (dummy, offscreen) or no such context.
+  /// A window with an OpenGL 4.5 core context made current, swapping at the vertical sync
+  /// (adaptive, else plain) or not (vsync_); false, with nothing left open, where SDL's video
+  /// driver has no OpenGL (dummy, offscreen) or no such context.
   bool openGlWindow(int width, int height) {
     SDL_GL_ResetAttributes();
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 4);
@@ -173,7 +176,7 @@ class Window {
                                SDL_WINDOW_RESIZABLE | SDL_WINDOW_OPENGL);
     if (window_) glContext_ = SDL_GL_CreateContext(window_);
     if (glContext_ && SDL_GL_MakeCurrent(window_, glContext_) == 0) {
-      SDL_GL_SetSwapInterval(0);
+      if (!vsync_ || SDL_GL_SetSwapInterval(-1) != 0) SDL_GL_SetSwapInterval(vsync_ ? 1 : 0);
       return true;
     }
     close();
@@ -216,6 +219,7 @@ class Window {
   }
 
   std::string title_;
+  bool vsync_ = false;
   SDL_Window* window_ = nullptr;
   SDL_GLContext glContext_ = nullptr;
   SDL_Renderer* renderer_ = nullptr;
@@ -447,7 +451,7 @@ class ViewerSession {
         speed_(flySpeed(lightField.scene, options)),
         fly_(options.camera, speed_),
         gpuRefused_(gpuRefusal(lightField, options)),
-        window_(options.title, options.width, options.height, windowModeFor(options, gpuRefused_)),
+        window_(options.title, options.width, options.height, windowModeFor(options, gpuRefused_), options.vsync),
         renderer_(lightField, accel, options, gpuRefused_, window_),
         toneMap_(options.toneMap),
         recorder_(options.recordInterval),
@@ -581,6 +585,7 @@ class ViewerSession {
     result.device = renderer_.device();
     result.fallback = renderer_.fallback();
     result.presentation = window_.openGl() ? "opengl" : "sdl";
+    result.vsync = window_.vsync();
     if (live_) {
       const RelightStatus status = live_->status();
       result.relightFrames = int(relightMs_.size());
@@ -784,7 +789,9 @@ class ViewerSession {
                     renderMs_.empty() ? 0.0 : renderMs_.back(), width, height),
         fmt::format("{} RENDERER  SCALE {:.0f}% ({}X{})  {} SPP{}{}", renderer_.gpu() && !(live_ && live_->renderer()) ? "GPU" : "CPU",
                     100.0 * double(frame_.width) / double(width), frame_.width, frame_.height, spp,
-                    share_.targetFps > 0 ? fmt::format("  TARGET {:g} FPS", share_.targetFps) : "",
+                    share_.targetFps > 0 ? fmt::format("  TARGET {:g} FPS", share_.targetFps)
+                    : window_.vsync()    ? "  VSYNC"
+                                         : "",
                     share_.renderThreads > 0 ? fmt::format("  {} THREAD{} (RELIGHT 1)", share_.renderThreads,
                                                            share_.renderThreads > 1 ? "S" : "")
                                              : ""),

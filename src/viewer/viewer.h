@@ -85,6 +85,10 @@ struct ViewerOptions {
   RenderSettings render;             ///< samples, mirror depth, seed
   ViewerRendererChoice renderer = ViewerRendererChoice::Automatic;
   double targetFps = 30.0;           ///< CPU renderer: frame rate held while moving; 0 = always full resolution
+  /// With the GPU renderer in the window's OpenGL context: swap at the display's vertical sync
+  /// (adaptive where the driver offers it: a late frame is shown at once), or as soon as a
+  /// frame is drawn (the frame rate is then the renderer's, as benchmarks want).
+  bool vsync = true;
   static constexpr int kRefinedSamples = 16;  ///< samples per pixel a still view is refined to
   int frames = 0;                    ///< > 0: quit after this many frames
   std::string screenshotPath;        ///< written after the last frame (.png or .exr/.hdr/.pfm)
@@ -121,6 +125,7 @@ struct ViewerResult {
   /// OpenGL context) or "sdl" (blitted by SDL's renderer: the CPU renderer's, or the GPU
   /// renderer's read back from its headless context).
   std::string presentation;
+  bool vsync = false;  ///< the window's swaps waited for the vertical sync (presentation "opengl" only)
   /// With relighting: frames drawn while the propagation ran, their median time, and the
   /// last relight's times and state (seconds; live_relight.h RelightStatus).
   int relightFrames = 0;

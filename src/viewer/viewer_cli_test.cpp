@@ -187,12 +187,14 @@ TEST_F(ViewerCliTest, WindowShowsTheSamePixelsThroughOpenGlAndSdl) {
   const std::string view = "view " + path("cornell.plf") + " --path " + path("walk.json") + " --width " +
                            std::to_string(kWidth) + " --height " + std::to_string(kHeight) + " --quiet --window-shot ";
   std::string out, errors;
-  ASSERT_EQ(cli_test::runPlenoptic(view + path("gl.png") + " --renderer gpu --stats " + path("gl.json"), dir_, &out, &errors,
+  ASSERT_EQ(cli_test::runPlenoptic(view + path("gl.png") + " --renderer gpu --vsync off --stats " + path("gl.json"), dir_, &out, &errors,
                                    "SDL_VIDEODRIVER=x11 xvfb-run -a -s '-screen 0 320x240x24'"),
             0)
       << out << errors;
   ASSERT_EQ(run(view + path("sdl.png") + " --renderer gpu --stats " + path("sdl.json"), nullptr, &errors), 0) << errors;
-  EXPECT_EQ(nlohmann::json::parse(std::ifstream(path("gl.json")))["presentation"], "opengl");
+  const nlohmann::json glStats = nlohmann::json::parse(std::ifstream(path("gl.json")));
+  EXPECT_EQ(glStats["presentation"], "opengl");
+  EXPECT_EQ(glStats["vsync"], false);  // (--vsync off: swapped as soon as drawn)
   EXPECT_EQ(nlohmann::json::parse(std::ifstream(path("sdl.json")))["presentation"], "sdl");
   const Image gl = readImage(path("gl.png")), sdl = readImage(path("sdl.png"));
   for (const Image* image : {&gl, &sdl}) {
@@ -307,6 +309,8 @@ TEST_F(ViewerCliTest, StatsJsonHasTheSessionsTimings) {
     EXPECT_EQ(stats["width"], 64);
     EXPECT_EQ(stats["height"], 48);
     EXPECT_EQ(stats["renderer"], renderer);
+    EXPECT_EQ(stats["presentation"], "sdl");  // (SDL's dummy driver: no OpenGL in the window)
+    EXPECT_EQ(stats["vsync"], false);
     EXPECT_EQ(stats.contains("device"), renderer == "gpu");
     if (renderer == "gpu") {
       EXPECT_NE(stats["device"].get<std::string>().find("OpenGL 4.5"), std::string::npos) << stats;
@@ -333,6 +337,8 @@ TEST_F(ViewerCliTest, BadInputsAreClearErrors) {
   std::string errors;
   EXPECT_NE(run("view " + path("cornell.plf") + " --renderer vulkan --frames 1", nullptr, &errors), 0);
   EXPECT_NE(run("view " + path("cornell.plf") + " --target-fps -1 --frames 1", nullptr, &errors), 0);
+  EXPECT_NE(run("view " + path("cornell.plf") + " --vsync maybe --frames 1", nullptr, &errors), 0);
+  EXPECT_NE(errors.find("--vsync"), std::string::npos) << errors;
   EXPECT_NE(run("view " + path("cornell.plf") + " --screenshot " + path("x.png"), nullptr, &errors), 0);
   EXPECT_NE(errors.find("--screenshot needs --frames"), std::string::npos) << errors;
   EXPECT_NE(run("view " + path("cornell.plf") + " --window-shot " + path("w.png"), nullptr, &errors), 0);
