@@ -1113,7 +1113,7 @@ struct RendererContext {
     GLint profile = 0;
     glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &profile);
     if (epoxy_gl_version() < 45 || (profile & GL_CONTEXT_CORE_PROFILE_BIT) == 0)
-      fail("GPU renderer: the window's OpenGL context is {} ({} profile), not 4.5 core", version,
+      fail("GPU renderer: the current OpenGL context is {} ({} profile), not 4.5 core", version,
            (profile & GL_CONTEXT_CORE_PROFILE_BIT) != 0 ? "core" : "compatibility");
   }
   void makeCurrent() const {

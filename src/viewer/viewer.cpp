@@ -351,14 +351,15 @@ class FrameRenderer {
  public:
   FrameRenderer(const LightField& lightField, const Accel& accel, const ViewerOptions& options,
                 const std::string& gpuRefused, Window& window) {
-    fallback_ = gpuRefused;
-    if (options.renderer != ViewerRendererChoice::Cpu && gpuRefused.empty()) fallback_ = tryGpu(lightField, options, window);
+    const bool triedGpu = windowModeFor(options, gpuRefused) == Window::Mode::OpenGl;
+    fallback_ = triedGpu ? tryGpu(lightField, options, window) : gpuRefused;
     if (gpu_) {
       device_ = gpu_->deviceName();
       name_ = fmt::format("gpu ({})", device_);
       return;
     }
-    if (window.openGl()) window.reopen(Window::Mode::Accelerated);
+    // (The window was opened for the GPU renderer: in OpenGL, or for SDL's software renderer.)
+    if (triedGpu) window.reopen(Window::Mode::Accelerated);
     if (!fallback_.empty()) fmt::print(stderr, "plenoptic: warning: view uses the CPU renderer: {}\n", fallback_);
     cpu_ = std::make_unique<FastRenderer>(lightField, accel);
     name_ = "cpu";

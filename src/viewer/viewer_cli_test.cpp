@@ -57,6 +57,19 @@ class ViewerCliTest : public cli_test::CliTest {
     writeLightField(path("cornell.plf"), cornellLightField());
   }
 
+  /// walk.json: from the box's default view to the eye (350, 250, −300) looking at (250, 150,
+  /// 300), the field of view 39° → 55°, in 0.5 s at 4 fps (3 frames).
+  void writeWalkToTheSide() const {
+    std::ofstream json(path("walk.json"));
+    json << R"({"fps": 4, "keyframes": [
+      {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0], "fov": 39},
+      {"time": 0.5, "eye": [350, 250, -300], "target": [250, 150, 300], "fov": 55}]})";
+  }
+  static bool xvfbInstalled() { return std::system("command -v xvfb-run > /dev/null 2>&1") == 0; }
+  /// The environment of a run in an X11 window: xvfb-run starts a virtual X server (-a: on a
+  /// free display number) and runs the viewer on it.
+  static constexpr const char* kInXvfb = "SDL_VIDEODRIVER=x11 xvfb-run -a -s '-screen 0 320x240x24'";
+
   /// Number of pixels whose 8-bit values differ between two PNGs (read back as linear).
   static int differingPixels(const std::string& a, const std::string& b) {
     const Image ia = readImage(a), ib = readImage(b);
@@ -145,13 +158,8 @@ TEST_F(ViewerCliTest, GpuScreenshotEqualsGpuRender) {
 }
 
 TEST_F(ViewerCliTest, GpuScreenshotUnderXvfbEqualsGpuRender) {
-  if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/bootstrap.sh installs it)";
-  {
-    std::ofstream json(path("walk.json"));
-    json << R"({"fps": 4, "keyframes": [
-      {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0], "fov": 39},
-      {"time": 0.5, "eye": [350, 250, -300], "target": [250, 150, 300], "fov": 55}]})";
-  }
+  if (!xvfbInstalled()) GTEST_SKIP() << "xvfb-run is not installed (scripts/bootstrap.sh installs it)";
+  writeWalkToTheSide();
   const std::string size = " --width 128 --height 96";
   std::string out, errors;
   ASSERT_EQ(run("render " + path("cornell.plf") + " --renderer gpu -o " + path("render.png") + size +
@@ -159,11 +167,9 @@ TEST_F(ViewerCliTest, GpuScreenshotUnderXvfbEqualsGpuRender) {
                 nullptr, &errors),
             0)
       << errors;
-  // xvfb-run starts a virtual X server (-a: on a free display number) and runs the viewer in an
-  // X11 window on it.
   const int code = cli_test::runPlenoptic("view " + path("cornell.plf") + " --renderer gpu --path " + path("walk.json") +
                                               " --screenshot " + path("view.png") + size + " --quiet",
-                                          dir_, &out, &errors, "SDL_VIDEODRIVER=x11 xvfb-run -a -s '-screen 0 320x240x24'");
+                                          dir_, &out, &errors, kInXvfb);
   ASSERT_EQ(code, 0) << out << errors;
   EXPECT_NE(out.find("renderer gpu ("), std::string::npos) << out;
   EXPECT_EQ(differingPixels(path("render.png"), path("view.png")), 0);
@@ -174,21 +180,15 @@ TEST_F(ViewerCliTest, GpuScreenshotUnderXvfbEqualsGpuRender) {
 // its frame is read back and SDL blits it. Below the HUD, whose figures differ from run to run,
 // the two windows show the same pixels.
 TEST_F(ViewerCliTest, WindowShowsTheSamePixelsThroughOpenGlAndSdl) {
-  if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/bootstrap.sh installs it)";
-  {
-    std::ofstream json(path("walk.json"));
-    json << R"({"fps": 4, "keyframes": [
-      {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0], "fov": 39},
-      {"time": 0.5, "eye": [350, 250, -300], "target": [250, 150, 300], "fov": 55}]})";
-  }
+  if (!xvfbInstalled()) GTEST_SKIP() << "xvfb-run is not installed (scripts/bootstrap.sh installs it)";
+  writeWalkToTheSide();
   constexpr int kWidth = 128, kHeight = 224;
   // The HUD: at most 5 lines here (no relighting), kLineAdvance·2 pixels each and 6 more.
   constexpr int kBelowHud = 5 * 9 * 2 + 6;
   const std::string view = "view " + path("cornell.plf") + " --path " + path("walk.json") + " --width " +
                            std::to_string(kWidth) + " --height " + std::to_string(kHeight) + " --quiet --window-shot ";
   std::string out, errors;
-  ASSERT_EQ(cli_test::runPlenoptic(view + path("gl.png") + " --renderer gpu --vsync off --stats " + path("gl.json"), dir_, &out, &errors,
-                                   "SDL_VIDEODRIVER=x11 xvfb-run -a -s '-screen 0 320x240x24'"),
+  ASSERT_EQ(cli_test::runPlenoptic(view + path("gl.png") + " --renderer gpu --vsync off --stats " + path("gl.json"), dir_, &out, &errors, kInXvfb),
             0)
       << out << errors;
   ASSERT_EQ(run(view + path("sdl.png") + " --renderer gpu --stats " + path("sdl.json"), nullptr, &errors), 0) << errors;
