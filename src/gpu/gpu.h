@@ -207,8 +207,10 @@ class GpuRenderer {
   void readRadiance(Image& image);
   /// The last draw()'s frame as display words, the same as `encoder.encode(radiance,
   /// exposureScale, settings, pixels, pitchBytes)` on readRadiance()'s image (image/display.h):
-  /// the radiance subsample is read back and encoder.resolveCurve resolves the curve from it on
-  /// the CPU; the display pass (gpu_display.h) computes each pixel's word, 0xFFRRGGBB, on the
+  /// the statistics the curve needs are read back — the partial sums of the subsample's
+  /// log-average for Reinhard's key, the subsample itself for the automatic key, nothing
+  /// otherwise (gpu_display.h) — and encoder.resolveCurve resolves the curve from them on the
+  /// CPU; the display pass (gpu_display.h) computes each pixel's word, 0xFFRRGGBB, on the
   /// GPU and 4 bytes per pixel are read back into `pixels` (`pitchBytes` per row, the bytes
   /// between rows left as they are) — instead of 12 of radiance and a tone-mapping pass on the
   /// CPU.
@@ -247,6 +249,10 @@ class GpuRenderer {
   /// The display pass's GLSL (displayWord) on given exposed colours with `curve`: what
   /// DisplayEncoder::word(curve, exposed) gives, one word each (gpu_test checks the two agree).
   std::vector<uint32_t> displayWords(const ToneMapCurve& curve, const std::vector<Rgb>& exposed);
+  /// The display pass's log sum term (logLuminanceTerm, in float) of given exposed colours,
+  /// NaN for a non-finite one (left out of the sum): what tonemap.h's logLuminanceTerm gives,
+  /// to float rounding (gpu_test checks the two agree).
+  std::vector<float> logLuminanceTerms(const std::vector<Rgb>& exposed);
 
   /// What this driver lacks for `settings` (several samples per pixel, a thin lens's default
   /// among them, need GL_ARB_gpu_shader_int64); empty when render() can draw them.
@@ -351,6 +357,8 @@ class GpuRenderer {
   /// present() into `framebuffer` (0: the window's back buffer).
   void presentInto(uint32_t framebuffer, const DisplayPixels& frame, const DisplayPixels& overlay, int windowWidth,
                    int windowHeight);
+  /// displayWords's and logLuminanceTerms's queries: per colour its word, then its term's bits.
+  std::vector<uint32_t> displayQueries(const ToneMapCurve& curve, const std::vector<Rgb>& exposed);
 
   struct State;
   const LightField& lightField_;

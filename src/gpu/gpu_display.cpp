@@ -16,11 +16,18 @@ std::string displayGlslConstants(uint32_t radianceImageUnit) {
       "#define DISPLAY_RADIANCE_UNIT {}\n#define DISPLAY_ACCUMULATION_UNIT {}\n"
       "#define PRESENT_FRAME_UNIT {}\n#define PRESENT_OVERLAY_UNIT {}\n"
       "const uint kToneReinhard = {}u, kToneLinear = {}u, kToneClamp = {}u;\n"
-      "const float kSrgbTableLast = {:.1f};\nconst uint kNonFiniteWord = {}u;\nconst int kStatisticsStride = {};\n",
+      "const float kSrgbTableLast = {:.1f};\nconst uint kNonFiniteWord = {}u;\nconst int kStatisticsStride = {};\n"
+      "const float kLogAverageDelta = {:.9e};\n#define LOG_SUM_RUN {}\n",
       kDisplayWordsBinding, kSrgbTableBinding, kDisplayStatisticsBinding, radianceImageUnit, kAccumulationImageUnit,
       kPresentFrameUnit, kPresentOverlayUnit,
       unsigned(ToneMapOperator::Reinhard), unsigned(ToneMapOperator::Linear), unsigned(ToneMapOperator::Clamp),
-      double(DisplayEncoder::kSrgbTableSize - 1), DisplayEncoder::kNonFiniteWord, DisplayEncoder::kStatisticsStride);
+      double(DisplayEncoder::kSrgbTableSize - 1), DisplayEncoder::kNonFiniteWord, DisplayEncoder::kStatisticsStride,
+      double(kLogAverageDelta), kLogSumRun);
+}
+
+int logSumRuns(int width, int height) {
+  const int runsPerRow = (DisplayEncoder::statisticsSize(width) + kLogSumRun - 1) / kLogSumRun;
+  return runsPerRow * DisplayEncoder::statisticsSize(height);
 }
 
 // ToneMapCurve::apply and DisplayEncoder::word (tonemap.cpp, display.h), statement for
@@ -60,6 +67,8 @@ vec3 toneCurve(vec3 exposed) {
   return m > 1.0 ? c / m : c;
 }
 bool nonFinite(vec3 c) { return any(isnan(c)) || any(isinf(c)); }
+// logLuminanceTerm (tonemap.h) of a finite pixel, in float: ln(δ + max(0, Y)).
+float logLuminanceTerm(vec3 exposed) { return log(kLogAverageDelta + max(0.0, luminance709(exposed))); }
 uint tableLevel(float v) {
   precise float index = clamp(v, 0.0, 1.0) * kSrgbTableLast + 0.5;
   return srgbTable[uint(index)];
@@ -84,6 +93,39 @@ void main() {
   if (sub.x >= subSize.x || sub.y >= subSize.y) return;
   precise vec3 shown = imageLoad(radiance, sub * kStatisticsStride).rgb * weight;
   statistics[sub.y * subSize.x + sub.x] = vec4(shown, 0.0);
+}
+)glsl";
+
+const char* const kDisplayLogSumCompute = R"glsl(
+// One invocation per run of LOG_SUM_RUN subsample pixels along a row: a loop, no shared
+// memory or barriers (which a software rasteriser runs slowly), compensated (Kahan) so that
+// a run's float sum is off by a rounding or two of the sum, not one per term.
+layout(local_size_x = 64) in;
+uniform ivec2 size;
+uniform float weight, exposureScale;
+layout(binding = DISPLAY_RADIANCE_UNIT, rgba32f) uniform readonly image2D radiance;
+struct LogSum { float sum; uint count; };
+layout(std430, binding = DISPLAY_STATISTICS_BINDING) writeonly buffer LogSums { LogSum logSums[]; };
+void main() {
+  ivec2 subSize = (size + kStatisticsStride - 1) / kStatisticsStride;
+  int runsPerRow = (subSize.x + LOG_SUM_RUN - 1) / LOG_SUM_RUN;
+  int run = int(gl_GlobalInvocationID.x);
+  if (run >= runsPerRow * subSize.y) return;
+  int y = run / runsPerRow, first = (run % runsPerRow) * LOG_SUM_RUN;
+  int last = min(first + LOG_SUM_RUN, subSize.x);
+  precise float sum = 0.0, compensation = 0.0;
+  uint count = 0u;
+  for (int x = first; x < last; ++x) {
+    precise vec3 shown = imageLoad(radiance, ivec2(x, y) * kStatisticsStride).rgb * weight;
+    precise vec3 exposed = shown * exposureScale;
+    if (nonFinite(exposed)) continue;
+    precise float term = logLuminanceTerm(exposed) - compensation;
+    precise float next = sum + term;
+    compensation = (next - sum) - term;
+    sum = next;
+    ++count;
+  }
+  logSums[run] = LogSum(sum, count);
 }
 )glsl";
 
@@ -117,13 +159,15 @@ void main() {
 }
 )glsl";
 
-const char* const kDisplayWordsCompute = R"glsl(
+const char* const kDisplayQueriesCompute = R"glsl(
 layout(std430, binding = QUERIES_BINDING) readonly buffer Queries { vec4 queries[]; };
 layout(std430, binding = RESULTS_BINDING) writeonly buffer Results { uint results[]; };
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= count) return;
-  results[i] = displayWord(queries[i].rgb);
+  vec3 exposed = queries[i].rgb;
+  results[2u * i] = displayWord(exposed);
+  results[2u * i + 1u] = nonFinite(exposed) ? 0x7FC00000u : floatBitsToUint(logLuminanceTerm(exposed));
 }
 )glsl";
 

@@ -1172,8 +1172,11 @@ struct GpuRenderer::State {
   GLuint idTexture = 0, depthBuffer = 0, hitsTexture = 0, rayQueue = 0, radianceTexture = 0, visibilityFramebuffer = 0,
          readbackFramebuffer = 0;
   /// The display pass (encodeDisplay; made on its first call): its programs and DisplayEncoder's
-  /// sRGB table, and the frame's words and radiance subsample (re-made with the targets).
-  GLuint displayStatisticsProgram = 0, displayEncodeProgram = 0, displayWordsProgram = 0, srgbTable = 0;
+  /// sRGB table, and the frame's words and statistics — its radiance subsample, or the log
+  /// sum's partial sums, in the same buffer (re-made with the targets). displayQueriesProgram is
+  /// displayWords's and logLuminanceTerms's.
+  GLuint displayStatisticsProgram = 0, displayLogSumProgram = 0, displayEncodeProgram = 0, displayQueriesProgram = 0,
+         srgbTable = 0;
   GLuint displayWords = 0, displayStatistics = 0;
   bool displayEncoded = false;  ///< displayWords holds an encodeDisplay's words (present)
   /// The present pass (present; made on its first call): its program, the textures it shows —
@@ -1212,8 +1215,9 @@ struct GpuRenderer::State {
     glDeleteProgram(lookupProgram);
     glDeleteProgram(multisampleProgram);
     glDeleteProgram(displayStatisticsProgram);
+    glDeleteProgram(displayLogSumProgram);
     glDeleteProgram(displayEncodeProgram);
-    glDeleteProgram(displayWordsProgram);
+    glDeleteProgram(displayQueriesProgram);
     glDeleteProgram(accumulateProgram);
     glDeleteProgram(presentProgram);
     glDeleteTextures(1, &presentFrame);
@@ -1339,7 +1343,8 @@ struct GpuRenderer::State {
            4 * (uint64_t(presentFrameSize[0]) * uint64_t(presentFrameSize[1]) +
                 uint64_t(presentOverlaySize[0]) * uint64_t(presentOverlaySize[1]));
   }
-  /// The display pass's frame buffers: 4 bytes per pixel of words, 16 per subsample pixel.
+  /// The display pass's frame buffers: 4 bytes per pixel of words, 16 per subsample pixel (the
+  /// log sum's partial sums, 8 bytes per run of subsample pixels, fit in the same buffer).
   static uint64_t displayBytes(int w, int h) {
     return 4 * uint64_t(w) * uint64_t(h) +
            16 * uint64_t(DisplayEncoder::statisticsSize(w)) * uint64_t(DisplayEncoder::statisticsSize(h));
@@ -1362,6 +1367,10 @@ struct GpuRenderer::State {
     if (displayStatisticsProgram == 0)
       displayStatisticsProgram =
           linkProgram({{GL_COMPUTE_SHADER, gpu::kDisplayStatisticsCompute}}, "display statistics", false, constants);
+    if (displayLogSumProgram == 0)
+      displayLogSumProgram =
+          linkProgram({{GL_COMPUTE_SHADER, std::string(gpu::kDisplayGlsl) + gpu::kDisplayLogSumCompute}}, "display log sum",
+                      false, constants);
     if (displayEncodeProgram == 0)
       displayEncodeProgram = linkProgram({{GL_COMPUTE_SHADER, std::string(gpu::kDisplayGlsl) + gpu::kDisplayEncodeCompute}},
                                          "display", false, constants);
@@ -1802,23 +1811,52 @@ void GpuRenderer::encodeDisplay(DisplayEncoder& encoder, float exposureScale, co
   glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   glBindImageTexture(kRadianceImageUnit, average ? s.accumulationTexture : s.radianceTexture, 0, GL_FALSE, 0, GL_READ_ONLY,
                      GL_RGBA32F);
-  for (GLuint program : {s.displayStatisticsProgram, s.displayEncodeProgram})
+  for (GLuint program : {s.displayStatisticsProgram, s.displayLogSumProgram, s.displayEncodeProgram}) {
     glProgramUniform1f(program, glGetUniformLocation(program, "weight"), weight);
+    glProgramUniform2i(program, glGetUniformLocation(program, "size"), w, h);
+  }
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gpu::kDisplayStatisticsBinding, s.displayStatistics);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gpu::kDisplayWordsBinding, s.displayWords);
-  glProgramUniform2i(s.displayStatisticsProgram, glGetUniformLocation(s.displayStatisticsProgram, "size"), w, h);
-  glUseProgram(s.displayStatisticsProgram);
-  glDispatchCompute(GLuint((sw + 7) / 8), GLuint((sh + 7) / 8), 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  std::vector<float> statistics(4 * size_t(sw) * size_t(sh));
-  glGetNamedBufferSubData(s.displayStatistics, 0, GLsizeiptr(statistics.size() * sizeof(float)), statistics.data());
-  Image subsample(sw, sh);
-  for (size_t i = 0; i < subsample.pixels.size(); ++i)
-    subsample.pixels[i] = Rgb(statistics[4 * i], statistics[4 * i + 1], statistics[4 * i + 2]);
-  const ToneMapCurve& curve = encoder.resolveCurve(subsample, exposureScale, settings);
+  // The curve's statistics (gpu_display.h): what the settings need, and no more, read back.
+  const ToneMapCurve* curve = nullptr;
+  switch (toneMapStatistics(settings)) {
+    case ToneMapStatistics::None:
+      curve = &encoder.resolveCurve(0.0f, settings);
+      break;
+    case ToneMapStatistics::LogAverage: {
+      glProgramUniform1f(s.displayLogSumProgram, glGetUniformLocation(s.displayLogSumProgram, "exposureScale"),
+                         exposureScale);
+      glUseProgram(s.displayLogSumProgram);
+      const int runs = gpu::logSumRuns(w, h);
+      glDispatchCompute(GLuint((runs + 63) / 64), 1, 1);
+      glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+      std::vector<gpu::LogSum> sums(static_cast<size_t>(runs));
+      glGetNamedBufferSubData(s.displayStatistics, 0, GLsizeiptr(sums.size() * sizeof(gpu::LogSum)), sums.data());
+      // Eq. 1 as logAverageLuminance sums it: the runs' sums added in double.
+      double sum = 0.0;
+      uint64_t count = 0;
+      for (const gpu::LogSum& group : sums) {
+        sum += double(group.sum);
+        count += group.count;
+      }
+      curve = &encoder.resolveCurve(count ? float(std::exp(sum / double(count))) : 0.0f, settings);
+      break;
+    }
+    case ToneMapStatistics::Percentiles: {
+      glUseProgram(s.displayStatisticsProgram);
+      glDispatchCompute(GLuint((sw + 7) / 8), GLuint((sh + 7) / 8), 1);
+      glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+      std::vector<float> statistics(4 * size_t(sw) * size_t(sh));
+      glGetNamedBufferSubData(s.displayStatistics, 0, GLsizeiptr(statistics.size() * sizeof(float)), statistics.data());
+      Image subsample(sw, sh);
+      for (size_t i = 0; i < subsample.pixels.size(); ++i)
+        subsample.pixels[i] = Rgb(statistics[4 * i], statistics[4 * i + 1], statistics[4 * i + 2]);
+      curve = &encoder.resolveCurve(subsample, exposureScale, settings);
+      break;
+    }
+  }
   const GLuint program = s.displayEncodeProgram;
-  gpu::setToneCurveUniforms(program, curve);
-  glProgramUniform2i(program, glGetUniformLocation(program, "size"), w, h);
+  gpu::setToneCurveUniforms(program, *curve);
   glProgramUniform1f(program, glGetUniformLocation(program, "exposureScale"), exposureScale);
   glUseProgram(program);
   glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
@@ -2033,22 +2071,36 @@ void GpuRenderer::prepareDisplay() {
   checkGl("preparing the display pass");
 }
 
-std::vector<uint32_t> GpuRenderer::displayWords(const ToneMapCurve& curve, const std::vector<Rgb>& exposed) {
+std::vector<uint32_t> GpuRenderer::displayQueries(const ToneMapCurve& curve, const std::vector<Rgb>& exposed) {
   State& s = *state_;
   s.context.makeCurrent();
   s.ensureSrgbTable();
-  if (s.displayWordsProgram == 0)
-    s.displayWordsProgram =
-        linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + gpu::kDisplayGlsl + gpu::kDisplayWordsCompute}},
-                    "display words", false, gpu::displayGlslConstants(kRadianceImageUnit));
-  gpu::setToneCurveUniforms(s.displayWordsProgram, curve);
+  if (s.displayQueriesProgram == 0)
+    s.displayQueriesProgram =
+        linkProgram({{GL_COMPUTE_SHADER, std::string(kQueryComputeHead) + gpu::kDisplayGlsl + gpu::kDisplayQueriesCompute}},
+                    "display queries", false, gpu::displayGlslConstants(kRadianceImageUnit));
+  gpu::setToneCurveUniforms(s.displayQueriesProgram, curve);
   std::vector<float> input;
   input.reserve(exposed.size() * 4);
   for (const Rgb& c : exposed) input.insert(input.end(), {c.r, c.g, c.b, 0.0f});
-  const std::vector<float> output = runQueries(s.displayWordsProgram, input, exposed.size(), 1, "the display queries");
+  const std::vector<float> output = runQueries(s.displayQueriesProgram, input, exposed.size(), 2, "the display queries");
+  std::vector<uint32_t> results(output.size());
+  std::memcpy(results.data(), output.data(), results.size() * sizeof(uint32_t));
+  return results;
+}
+
+std::vector<uint32_t> GpuRenderer::displayWords(const ToneMapCurve& curve, const std::vector<Rgb>& exposed) {
+  const std::vector<uint32_t> results = displayQueries(curve, exposed);
   std::vector<uint32_t> words(exposed.size());
-  std::memcpy(words.data(), output.data(), words.size() * sizeof(uint32_t));
+  for (size_t i = 0; i < words.size(); ++i) words[i] = results[2 * i];
   return words;
+}
+
+std::vector<float> GpuRenderer::logLuminanceTerms(const std::vector<Rgb>& exposed) {
+  const std::vector<uint32_t> results = displayQueries(ToneMapCurve{}, exposed);
+  std::vector<float> terms(exposed.size());
+  for (size_t i = 0; i < terms.size(); ++i) std::memcpy(&terms[i], &results[2 * i + 1], sizeof(float));
+  return terms;
 }
 
 uint64_t GpuRenderer::maxImagePixels() const {

@@ -593,13 +593,9 @@ int wordChannelDistance(uint32_t a, uint32_t b) {
 /// 1e-4 in the GLSL changes 160 to 1426 words of 20 000.
 int allowedRoundingWords(size_t count) { return int(count / 1000) + 1; }
 
-// The display pass's GLSL (gpu_display.h) against DisplayEncoder::word on random exposed
-// colours, for each operator: dark and bright (10⁻⁸ … 10⁸), saturated, negative, zero and
-// non-finite ones (magenta, exactly), the rest within allowedRoundingWords.
-TEST_F(GpuRendererTest, DisplayWordsMatchTheCpuEncoder) {
-  const LightField lf = randomLightField(makeCornellBox(), 1);
-  GpuRenderer gpu(lf);
-  const DisplayEncoder encoder;
+/// 20 004 exposed colours to hold the display pass's GLSL to the C++ with: dark and bright
+/// (10⁻⁸ … 10⁸), saturated, negative, zero, and four non-finite ones at the end.
+std::vector<Rgb> randomExposedColours() {
   Pcg32 rng(5, 9);
   std::vector<Rgb> exposed;
   for (int i = 0; i < 20000; ++i) {
@@ -614,6 +610,17 @@ TEST_F(GpuRendererTest, DisplayWordsMatchTheCpuEncoder) {
   }
   const float inf = std::numeric_limits<float>::infinity(), nan = std::nanf("");
   for (const Rgb& c : {Rgb(nan, 0.5f, 0.5f), Rgb(0.5f, inf, 0.5f), Rgb(0.5f, 0.5f, -inf), Rgb(nan)}) exposed.push_back(c);
+  return exposed;
+}
+
+// The display pass's GLSL (gpu_display.h) against DisplayEncoder::word on random exposed
+// colours (randomExposedColours), for each operator: the non-finite ones magenta, exactly, the
+// rest within allowedRoundingWords.
+TEST_F(GpuRendererTest, DisplayWordsMatchTheCpuEncoder) {
+  const LightField lf = randomLightField(makeCornellBox(), 1);
+  GpuRenderer gpu(lf);
+  const DisplayEncoder encoder;
+  const std::vector<Rgb> exposed = randomExposedColours();
   std::vector<ToneMapCurve> curves(5);
   curves[0].luminanceScale = 0.37f;  // Reinhard with a key, no white point (eq. 3)
   curves[1].luminanceScale = 1.9f;   // with a white point (eq. 4)
@@ -641,10 +648,38 @@ TEST_F(GpuRendererTest, DisplayWordsMatchTheCpuEncoder) {
   }
 }
 
+// The log sum's GLSL term (gpu_display.h) against tonemap.h's logLuminanceTerm on random exposed
+// colours (randomExposedColours; the non-finite ones NaN: left out of the sum), within GLSL's
+// precision of log (2⁻²¹ absolute near 1, 3 ulp elsewhere) and the float rounding of δ + Y.
+TEST_F(GpuRendererTest, LogLuminanceTermsMatchTheCpu) {
+  const LightField lf = randomLightField(makeCornellBox(), 1);
+  GpuRenderer gpu(lf);
+  const std::vector<Rgb> exposed = randomExposedColours();
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<float> terms = gpu.logLuminanceTerms(exposed);
+  ASSERT_EQ(terms.size(), exposed.size());
+  double worst = 0.0;
+  for (size_t i = 0; i < exposed.size(); ++i) {
+    if (!isFinite(exposed[i])) {
+      EXPECT_TRUE(std::isnan(terms[i])) << i;
+      continue;
+    }
+    const double expected = logLuminanceTerm(exposed[i]);
+    const float magnitude = float(std::abs(expected));
+    const double ulp = double(std::nextafter(magnitude, inf) - magnitude);
+    const double allowed = std::exp2(-21.0) + 3.0 * ulp + 2.0 * std::exp2(-24.0);
+    EXPECT_LE(std::abs(double(terms[i]) - expected), allowed) << i << ": " << exposed[i].r << ", " << exposed[i].g << ", "
+                                                             << exposed[i].b;
+    worst = std::max(worst, std::abs(double(terms[i]) - expected));
+  }
+  std::printf("log luminance terms: worst difference %.3g\n", worst);
+}
+
 // The viewer's path: draw(), then encodeDisplay() — the frame's words made on the GPU — against
-// readRadiance() and DisplayEncoder::encode on the CPU, at an odd size (a subsample row and
-// column at the edge) and a padded pitch, for each operator and its statistics (the key from
-// the log-average, the automatic key from the percentiles, white points).
+// readRadiance() and DisplayEncoder::encode on the CPU, at odd sizes (a subsample row and column
+// at the edge; one or two runs of the log sum per row) and a padded pitch, for each operator and
+// its statistics (the key from the log-average summed on the GPU, to float rounding; the
+// automatic key from the percentiles of the subsample read back, exactly; white points).
 TEST_F(GpuRendererTest, EncodeDisplayMatchesTheCpuEncoder) {
   const LightField lf = randomLightField(loadScene(kMcGuire + "CornellBox-Glossy.obj"), 3);
   GpuRenderer gpu(lf);
@@ -659,7 +694,7 @@ TEST_F(GpuRendererTest, EncodeDisplayMatchesTheCpuEncoder) {
   linear.white = 0.5f;
   ToneMapSettings clamp;
   clamp.op = ToneMapOperator::Clamp;
-  for (auto [width, height] : {std::pair{67, 45}, std::pair{40, 30}}) {
+  for (auto [width, height] : {std::pair{67, 45}, std::pair{40, 30}, std::pair{301, 170}}) {
     const Camera camera(insideCamera(lf.scene), width, height);
     gpu.draw(camera, RenderSettings{});
     Image radiance;
@@ -678,8 +713,16 @@ TEST_F(GpuRendererTest, EncodeDisplayMatchesTheCpuEncoder) {
         std::vector<uint32_t> expected = pixels;
         gpu.encodeDisplay(onGpu, exposure, settings, pixels.data(), pitchWords * 4);
         onCpu.encode(radiance, exposure, settings, expected.data(), pitchWords * 4);
-        EXPECT_EQ(onGpu.curve().luminanceScale, onCpu.curve().luminanceScale);
-        EXPECT_EQ(onGpu.curve().whiteScaled, onCpu.curve().whiteScaled);
+        if (toneMapStatistics(settings) == ToneMapStatistics::LogAverage) {
+          // Eq. 1's terms in float, summed in float per run: a relative 2e-5 covers both.
+          const float scale = onCpu.curve().luminanceScale;
+          EXPECT_NEAR(onGpu.curve().luminanceScale, scale, 2e-5f * scale) << width;
+          std::printf("%dx%d: log-average key's scale relative difference %.3g\n", width, height,
+                      double(onGpu.curve().luminanceScale / scale - 1.0f));
+        } else {
+          EXPECT_EQ(onGpu.curve().luminanceScale, onCpu.curve().luminanceScale);
+          EXPECT_EQ(onGpu.curve().whiteScaled, onCpu.curve().whiteScaled);
+        }
         int differing = 0, worst = 0;
         for (int y = 0; y < height; ++y)
           for (int x = 0; x < pitchWords; ++x) {

@@ -18,8 +18,9 @@
 // toneMap() on the full image.
 //
 // The GPU renderer's display pass (gpu/gpu_display.h) does the per-pixel part on the GPU: the
-// subsample read back, the curve resolved here (resolveCurve), then word() for every pixel in
-// GLSL with this table, so that the viewer reads back 4 bytes per pixel and tone-maps nothing.
+// subsample's log-average summed there (or, for the automatic key, the subsample read back),
+// the curve resolved here (resolveCurve), then word() for every pixel in GLSL with this table,
+// so that the viewer reads back at most 4 bytes per pixel and tone-maps nothing.
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -51,6 +52,13 @@ class DisplayEncoder {
   /// frame, unexposed) and the exposure: what encode() applies, and what the GPU renderer's
   /// display pass takes (GpuRenderer::encodeDisplay).
   const ToneMapCurve& resolveCurve(const Image& radianceSubsample, float exposureScale, const ToneMapSettings& settings);
+  /// The same from the exposed subsample's log-average luminance, for settings that need no
+  /// more (toneMapStatistics; unused where they need none): the GPU's display pass sums it
+  /// where the frame is and reads back only its partial sums.
+  const ToneMapCurve& resolveCurve(float exposedLogAverage, const ToneMapSettings& settings) {
+    curve_ = resolveToneMap(exposedLogAverage, settings);
+    return curve_;
+  }
 
   /// One exposed pixel's word through `curve`, the table and the rounding above.
   uint32_t word(const ToneMapCurve& curve, const Rgb& exposed) const {

@@ -27,8 +27,6 @@ const char* toneMapOperatorName(ToneMapOperator op) {
 
 namespace {
 
-constexpr float kLogDelta = 1e-4f;  ///< Reinhard's δ in eq. 1
-
 // Rec.709 YUV (analog form, ITU-R BT.709 luma weights): Y is relative luminance,
 // U = (B − Y)/1.8556 and V = (R − Y)/1.5748 are the scaled colour differences.
 struct Yuv {
@@ -86,7 +84,7 @@ float logAverageLuminance(const Image& image) {
   size_t count = 0;
   for (const Rgb& p : image.pixels) {
     if (!isFinite(p)) continue;
-    sum += std::log(double(kLogDelta) + std::max(0.0, double(luminance(p))));
+    sum += logLuminanceTerm(p);
     ++count;
   }
   return count ? float(std::exp(sum / double(count))) : 0.0f;
@@ -108,22 +106,29 @@ float automaticKey(const Image& image) {
   return float(0.18 * std::pow(4.0, (2.0 * lavg - lmin - lmax) / (lmax - lmin)));
 }
 
-ToneMapCurve resolveToneMap(const Image& exposed, const ToneMapSettings& settings) {
+ToneMapStatistics toneMapStatistics(const ToneMapSettings& settings) {
+  if (settings.op != ToneMapOperator::Reinhard) return ToneMapStatistics::None;
+  if (settings.autoKey) return ToneMapStatistics::Percentiles;
+  return settings.key ? ToneMapStatistics::LogAverage : ToneMapStatistics::None;
+}
+
+namespace {
+
+/// The curve of `settings` with Reinhard's key `key` (unset: none) for an image of
+/// log-average luminance `logAverage` (read only with a key).
+ToneMapCurve resolveWithKey(std::optional<float> key, float logAverage, const ToneMapSettings& settings) {
   ToneMapCurve curve;
   curve.op = settings.op;
   if (settings.white && !(*settings.white > 0.0f && std::isfinite(*settings.white)))
     fail("tone mapping: white point {} must be a positive number", *settings.white);
   switch (settings.op) {
-    case ToneMapOperator::Reinhard: {
-      std::optional<float> key = settings.autoKey ? std::optional<float>(automaticKey(exposed)) : settings.key;
+    case ToneMapOperator::Reinhard:
       if (key) {
         if (!(*key > 0.0f && std::isfinite(*key))) fail("tone mapping: key {} must be a positive number", *key);
-        const float average = logAverageLuminance(exposed);
-        curve.luminanceScale = average > 0.0f ? *key / average : 1.0f;
+        curve.luminanceScale = logAverage > 0.0f ? *key / logAverage : 1.0f;
       }
       if (settings.white) curve.whiteScaled = *settings.white * curve.luminanceScale;
       break;
-    }
     case ToneMapOperator::Linear:
       curve.luminanceScale = settings.white ? 1.0f / *settings.white : 1.0f;
       break;
@@ -131,6 +136,21 @@ ToneMapCurve resolveToneMap(const Image& exposed, const ToneMapSettings& setting
       break;
   }
   return curve;
+}
+
+}  // namespace
+
+ToneMapCurve resolveToneMap(const Image& exposed, const ToneMapSettings& settings) {
+  const ToneMapStatistics statistics = toneMapStatistics(settings);
+  const std::optional<float> key =
+      statistics == ToneMapStatistics::Percentiles ? std::optional<float>(automaticKey(exposed)) : settings.key;
+  return resolveWithKey(key, statistics == ToneMapStatistics::None ? 0.0f : logAverageLuminance(exposed), settings);
+}
+
+ToneMapCurve resolveToneMap(float logAverage, const ToneMapSettings& settings) {
+  if (toneMapStatistics(settings) == ToneMapStatistics::Percentiles)
+    fail("tone mapping: the automatic key needs the image's luminances, not only their log-average");
+  return resolveWithKey(settings.key, logAverage, settings);
 }
 
 Image8 encodeSrgb8(const Image& display) {

@@ -27,6 +27,8 @@
 //
 // Non-finite pixels (NaN, ±Inf) are never silently hidden: they are excluded from the image
 // statistics and drawn magenta (255, 0, 255) in 8-bit output.
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <string>
 
@@ -64,12 +66,28 @@ struct ToneMapCurve {
   Rgb apply(const Rgb& exposed) const;
 };
 
-/// Reinhard eq. 1: exp(mean log(δ + Y)) over finite pixels, δ = 1e-4 (absorbs black pixels).
+/// Reinhard's δ in eq. 1 (absorbs black pixels).
+inline constexpr float kLogAverageDelta = 1e-4f;
+/// One finite pixel's term of eq. 1, ln(δ + max(0, Y)) (Y: luminance(), Rec.709 weights).
+inline double logLuminanceTerm(const Rgb& exposed) {
+  return std::log(double(kLogAverageDelta) + std::max(0.0, double(luminance(exposed))));
+}
+/// Reinhard eq. 1: exp(mean logLuminanceTerm) over finite pixels; 0 for an image without one.
 float logAverageLuminance(const Image& image);
 /// The automatic key estimate described above.
 float automaticKey(const Image& image);
+
+/// What resolveToneMap reads of the image for `settings`: nothing (linear, clamp, Reinhard
+/// without a key), its log-average luminance (Reinhard with a key), or also its luminances'
+/// percentiles (the automatic key).
+enum class ToneMapStatistics { None, LogAverage, Percentiles };
+ToneMapStatistics toneMapStatistics(const ToneMapSettings& settings);
 /// Computes the statistics `settings` needs from `exposed` and returns the curve.
 ToneMapCurve resolveToneMap(const Image& exposed, const ToneMapSettings& settings);
+/// The same curve from the statistics already computed, for settings that need at most the
+/// log-average (toneMapStatistics): `logAverage` is the exposed image's logAverageLuminance,
+/// unused where none is needed. (The GPU's display pass sums eq. 1 where the frame is.)
+ToneMapCurve resolveToneMap(float logAverage, const ToneMapSettings& settings);
 
 /// Display values in [0, 1] → 8-bit sRGB (rounded to nearest). NaN components → magenta.
 Image8 encodeSrgb8(const Image& display);

@@ -107,6 +107,40 @@ TEST(Reinhard, AutomaticKeyFollowsReinhard2002) {
   EXPECT_NEAR(resolveToneMap(image, s).luminanceScale, automaticKey(image) / logAverageLuminance(image), 1e-6f);
 }
 
+// The curve from a log-average computed elsewhere (the GPU's display pass sums eq. 1 where the
+// frame is) is the image's own for every setting that needs no more; the statistics each
+// setting reads; the automatic key refused without its percentiles.
+TEST(ToneMap, ResolvesFromTheLogAverageAlone) {
+  Pcg32 rng(3, 8);
+  Image image(50, 20);
+  for (Rgb& p : image.pixels) p = Rgb(rng.uniform(), rng.uniform(), rng.uniform()) * std::pow(10.0f, 3.0f * rng.uniform() - 1.0f);
+  image.at(3, 4) = Rgb(std::nanf(""));  // left out of eq. 1 both ways
+  ToneMapSettings withWhite;
+  withWhite.white = 6.0f;
+  ToneMapSettings noKey;
+  noKey.key.reset();
+  ToneMapSettings linear{ToneMapOperator::Linear, {}, false, 4.0f};
+  ToneMapSettings clamp{ToneMapOperator::Clamp, {}, false, {}};
+  const float logAverage = logAverageLuminance(image);
+  for (const ToneMapSettings& s : {ToneMapSettings{}, withWhite, noKey, linear, clamp}) {
+    const ToneMapCurve fromImage = resolveToneMap(image, s), fromAverage = resolveToneMap(logAverage, s);
+    EXPECT_EQ(fromAverage.op, fromImage.op);
+    EXPECT_EQ(fromAverage.luminanceScale, fromImage.luminanceScale);
+    EXPECT_EQ(fromAverage.whiteScaled, fromImage.whiteScaled);
+  }
+  EXPECT_EQ(toneMapStatistics(ToneMapSettings{}), ToneMapStatistics::LogAverage);
+  EXPECT_EQ(toneMapStatistics(withWhite), ToneMapStatistics::LogAverage);
+  EXPECT_EQ(toneMapStatistics(noKey), ToneMapStatistics::None);
+  EXPECT_EQ(toneMapStatistics(linear), ToneMapStatistics::None);
+  EXPECT_EQ(toneMapStatistics(clamp), ToneMapStatistics::None);
+  ToneMapSettings autoKey;
+  autoKey.autoKey = true;
+  EXPECT_EQ(toneMapStatistics(autoKey), ToneMapStatistics::Percentiles);
+  EXPECT_THROW(resolveToneMap(logAverage, autoKey), Error);
+  // An image without a finite pixel: log-average 0, the scale left at 1.
+  EXPECT_EQ(resolveToneMap(0.0f, ToneMapSettings{}).luminanceScale, 1.0f);
+}
+
 TEST(ToneMap, LinearAndClamp) {
   ToneMapSettings linear{ToneMapOperator::Linear, {}, false, 4.0f};
   const ToneMapCurve l = resolveToneMap(Image(1, 1), linear);
