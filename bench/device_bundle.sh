@@ -23,9 +23,18 @@ STAGE=$(mktemp -d)
 trap 'rm -rf "$STAGE"' EXIT
 mkdir -p "$STAGE/plenoptic/bin" "$STAGE/plenoptic/lib"
 cp "$BIN" "$STAGE/plenoptic/bin/plenoptic.bin"
-# The libraries the binary loads, by ldd, but the OpenGL and EGL dispatch (glvnd, which must
+# The display pass's benchmark (gpu_device.sh runs it from bin/bench/), where it is built.
+DISPLAY_BENCH=$(dirname "$BIN")/bench/gpu_display_bench
+BINARIES=("$BIN")
+if [ -x "$DISPLAY_BENCH" ]; then
+  mkdir -p "$STAGE/plenoptic/bin/bench"
+  cp "$DISPLAY_BENCH" "$STAGE/plenoptic/bin/bench/gpu_display_bench.bin"
+  BINARIES+=("$DISPLAY_BENCH")
+fi
+# The libraries the binaries load, by ldd, but the OpenGL and EGL dispatch (glvnd, which must
 # find the card's driver: from the packages below) and the kernel's vDSO.
-ldd "$BIN" | awk '$3 ~ /^\// {print $3} $1 ~ /^\/.*ld-linux/ {print $1}' | sort -u | while read -r lib; do
+for binary in "${BINARIES[@]}"; do ldd "$binary"; done |
+  awk '$3 ~ /^\// {print $3} $1 ~ /^\/.*ld-linux/ {print $1}' | sort -u | while read -r lib; do
   case "$(basename "$lib")" in
     libEGL.so*|libGL.so*|libGLX.so*|libGLdispatch.so*|libOpenGL.so*|libGLESv2.so*) continue ;;
   esac
@@ -41,6 +50,15 @@ exec "$here/../lib/ld-linux-x86-64.so.2" --library-path "$here/../lib:/usr/lib/x
   "$here/plenoptic.bin" "$@"
 SH
 chmod +x "$STAGE/plenoptic/bin/plenoptic"
+if [ -f "$STAGE/plenoptic/bin/bench/gpu_display_bench.bin" ]; then
+  cat > "$STAGE/plenoptic/bin/bench/gpu_display_bench" <<'SH'
+#!/bin/sh
+here=$(dirname "$(readlink -f "$0")")
+exec "$here/../../lib/ld-linux-x86-64.so.2" --library-path "$here/../../lib:/usr/lib/x86_64-linux-gnu:/usr/local/nvidia/lib64:/usr/lib64" \
+  "$here/gpu_display_bench.bin" "$@"
+SH
+  chmod +x "$STAGE/plenoptic/bin/bench/gpu_display_bench"
+fi
 rm -rf "$OUTDIR"
 mkdir -p "$OUTDIR/gl"
 tar -C "$STAGE" -cJf "$OUTDIR/plenoptic.tar.xz" plenoptic

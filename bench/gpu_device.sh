@@ -2,7 +2,9 @@
 # The GPU renderer on a graphics card, in one run: the frame rate of `render --renderer gpu`
 # on the built-in Cornell box and on Sponza at 1920×1080 (each camera; rasterised ids, then
 # every camera ray through the BVH: PLENOPTIC_GPU_VISIBILITY=rays), the viewer's on the
-# box (`view --renderer gpu` flying a path, headless), and the GPU-vs-CPU
+# box and on Sponza's `main` (`view --renderer gpu` flying a path, headless), the display pass
+# alone per tone curve (bench/gpu_display_bench, where it is built beside the binary, as
+# build/bench/), and the GPU-vs-CPU
 # comparison of bench/gpu_vs_cpu.sh on both light fields — so that minutes on a lent machine
 # go to measuring. It bakes what it is not given (draft preset: the box in seconds, Sponza in
 # a minute or two on 16 cores) and refuses to measure a software rasteriser (llvmpipe) unless
@@ -89,7 +91,7 @@ for camera in $(cameras "$SPONZA_PLF"); do
 done
 # The viewer's frames with the GPU renderer, on SDL's dummy video driver (no window): the box
 # flown along a path, so that every frame is drawn — the render, the display pass (tone mapping
-# on the GPU) and the read-back of its 8-bit pixels, the HUD and SDL's blit.
+# on the GPU) and the read-back of its 8-bit pixels, the HUD and SDL's blit; then Sponza.
 python3 - "$D/box-walk.json" "$FRAMES" <<'PY'
 import json, sys
 frames = int(sys.argv[2])
@@ -97,15 +99,49 @@ json.dump({"fps": 30, "keyframes": [
     {"time": 0, "eye": [278, 273, -800], "target": [278, 273, 0]},
     {"time": frames / 30, "eye": [200, 300, -500], "target": [300, 250, 300]}]}, open(sys.argv[1], "w"))
 PY
-SDL_VIDEODRIVER=dummy "$BIN" view "$D/cornell.plf" --renderer gpu --width "$WIDTH" --height "$HEIGHT" \
-  --path "$D/box-walk.json" --stats "$D/view.json" --quiet >/dev/null 2>&1 || true
-python3 - "$D/view.json" <<'PY' | tee -a "$SUMMARY" || say "view: failed"
+# Sponza's `main` flown the same way: from its camera a tenth of the way towards its target
+# (the scene's JSON gives them; skipped when Sponza came as a .plf).
+case "$SPONZA" in
+  *.json) python3 - "$SPONZA" "$D/sponza-walk.json" "$FRAMES" <<'PY' ;;
 import json, sys
-s = json.load(open(sys.argv[1]))
-print(f"view cornell {s['width']}x{s['height']} (GPU renderer, display pass on the GPU, shown by "
+cameras = {c["name"]: c for c in json.load(open(sys.argv[1])).get("cameras", [])}
+frames = int(sys.argv[3])
+if "main" in cameras:
+    c = cameras["main"]
+    eye, target = c["eye"], c["target"]
+    ahead = [e + 0.1 * (t - e) for e, t in zip(eye, target)]
+    json.dump({"fps": 30, "keyframes": [
+        {"time": 0, "eye": eye, "target": target, "fov": c.get("fov", 60)},
+        {"time": frames / 30, "eye": ahead, "target": target}]}, open(sys.argv[2], "w"))
+PY
+esac
+# One viewer measurement: `view --renderer gpu` along a path, headless; prints its frame rate.
+view_measure() {  # name plf path
+  SDL_VIDEODRIVER=dummy "$BIN" view "$2" --renderer gpu --width "$WIDTH" --height "$HEIGHT" \
+    --path "$3" --stats "$D/view-$1.json" --quiet >/dev/null 2>&1 || true
+  python3 - "$1" "$D/view-$1.json" <<'PY' | tee -a "$SUMMARY" || say "view $1: failed"
+import json, sys
+s = json.load(open(sys.argv[2]))
+print(f"view {sys.argv[1]} {s['width']}x{s['height']} (GPU renderer, display pass on the GPU, shown by "
       f"{s.get('presentation', 'sdl')}): {s['fps']:.1f} fps "
       f"({s['ms_per_frame_median']:.3f} ms/frame median, render and read-back {s['render_ms_median']:.3f} ms, "
       f"GPU time alone {s.get('gpu_ms_median', 0):.3f} ms), "
       f"{s['frames']} frames, on {s.get('device', s['renderer'])}")
 PY
+}
+view_measure cornell "$D/cornell.plf" "$D/box-walk.json"
+[ -f "$D/sponza-walk.json" ] && view_measure sponza-main "$SPONZA_PLF" "$D/sponza-walk.json"
+# The display pass alone per tone curve (bench/gpu_display_bench), where it is built beside.
+DISPLAY_BENCH=${GPU_DISPLAY_BENCH:-$(dirname "$BIN")/bench/gpu_display_bench}
+if [ -x "$DISPLAY_BENCH" ]; then
+  "$DISPLAY_BENCH" --benchmark_min_time=1 --benchmark_format=json --benchmark_out="$D/gpu_display_bench.json" \
+    >/dev/null 2>&1 || say "gpu_display_bench: failed"
+  python3 - "$D/gpu_display_bench.json" <<'PY' | tee -a "$SUMMARY" || true
+import json, sys
+for b in json.load(open(sys.argv[1]))["benchmarks"]:
+    extra = (f", statistics {b['statistics_ms_median']:.3f} ms (CPU {b['statistics_cpu_ms_median']:.3f} ms)"
+             if "statistics_ms_median" in b else "")
+    print(f"{b['name']}: {b['ms_median']:.3f} ms median, calling thread's CPU {b['cpu_ms_median']:.3f} ms{extra}")
+PY
+fi
 echo "summary: $SUMMARY"
