@@ -1835,9 +1835,9 @@ void GpuRenderer::encodeDisplay(DisplayEncoder& encoder, float exposureScale, co
       // Eq. 1 as logAverageLuminance sums it: the runs' sums added in double.
       double sum = 0.0;
       uint64_t count = 0;
-      for (const gpu::LogSum& group : sums) {
-        sum += double(group.sum);
-        count += group.count;
+      for (const gpu::LogSum& run : sums) {
+        sum += double(run.sum);
+        count += run.count;
       }
       curve = &encoder.resolveCurve(count ? float(std::exp(sum / double(count))) : 0.0f, settings);
       break;
