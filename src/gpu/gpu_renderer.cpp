@@ -948,15 +948,18 @@ void checkGl(const char* what) {
   if (error != GL_NO_ERROR) fail("GPU renderer: {}: {}", what, glErrorName(error));
 }
 
-/// The info log of a shader or program (getLength/getLog: glGetShaderiv/glGetShaderInfoLog or
-/// the program pair).
-template <typename GetLength, typename GetLog>
-std::string infoLog(GLuint object, GetLength getLength, GetLog getLog) {
+/// Where a shader's or program's `status` (GL_COMPILE_STATUS, GL_LINK_STATUS) is false, its
+/// info log (getIv/getLog: glGetShaderiv/glGetShaderInfoLog or the program pair); else nothing.
+template <typename GetIv, typename GetLog>
+std::optional<std::string> failureLog(GLuint object, GLenum status, GetIv getIv, GetLog getLog) {
+  GLint ok = 0;
+  getIv(object, status, &ok);
+  if (ok) return std::nullopt;
   GLint length = 0;
-  getLength(object, GL_INFO_LOG_LENGTH, &length);
+  getIv(object, GL_INFO_LOG_LENGTH, &length);
   std::string log(size_t(std::max(length, 1)), '\0');
   getLog(object, length, nullptr, log.data());
-  return log.c_str();
+  return std::string(log.c_str());
 }
 
 /// With PLENOPTIC_GPU_SHADER_DUMP=DIR, each shader's full text is written to DIR/NAME.STAGE
@@ -977,12 +980,9 @@ GLuint compileShader(GLenum type, const std::string& source, const char* name) {
   const char* text = source.c_str();
   glShaderSource(shader, 1, &text, nullptr);
   glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    const std::string log = infoLog(shader, glGetShaderiv, glGetShaderInfoLog);
+  if (const auto log = failureLog(shader, GL_COMPILE_STATUS, glGetShaderiv, glGetShaderInfoLog)) {
     glDeleteShader(shader);
-    fail("GPU renderer: the {} shader does not compile: {}", name, log);
+    fail("GPU renderer: the {} shader does not compile: {}", name, *log);
   }
   return shader;
 }
@@ -993,12 +993,9 @@ GLuint linkShaders(GLuint program, const std::vector<GLuint>& shaders, const cha
   for (GLuint shader : shaders) glAttachShader(program, shader);
   glLinkProgram(program);
   for (GLuint shader : shaders) glDeleteShader(shader);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    const std::string log = infoLog(program, glGetProgramiv, glGetProgramInfoLog);
+  if (const auto log = failureLog(program, GL_LINK_STATUS, glGetProgramiv, glGetProgramInfoLog)) {
     glDeleteProgram(program);
-    fail("GPU renderer: the {} program does not link: {}", name, log);
+    fail("GPU renderer: the {} program does not link: {}", name, *log);
   }
   return program;
 }

@@ -533,7 +533,7 @@ class ViewerSession {
     int pitch = 0;
     if (frameOnGpu_) {
       // The GPU's frame becomes the window's pixels there: kept there where the window has the
-      // renderer's context, else read back. The read-back of the curve's subsample, or of the
+      // renderer's context, else read back. The read-back of the curve's statistics, or of the
       // pixels, waits for the frame, so the render time ends after it.
       uint32_t* pixels = window_.openGl() ? nullptr : window_.lockFrame(frame_.width, frame_.height, pitch);
       renderer_.encodeDisplay(display_, exposureScale(), toneMap_, pixels, pitch, refiningOnGpu_);
